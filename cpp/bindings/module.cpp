@@ -1,0 +1,13 @@
+// animlod._core: thin pybind11 bindings over the C++ core, one bind_<concept>.cpp per header.
+#include <pybind11/pybind11.h>
+
+namespace py = pybind11;
+
+namespace animlod::bindings {
+void bind_skinning(py::module_& m);
+}
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "animlod C++ core (level of detail for animated content). Users import animlod.";
+  animlod::bindings::bind_skinning(m);
+}

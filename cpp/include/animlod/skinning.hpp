@@ -1,0 +1,28 @@
+// Linear blend skinning (LBS): bake a skinned mesh and a motion into per-frame positions.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "animlod/status.hpp"
+
+namespace animlod {
+
+// Non-owning views of the inputs of bake_lbs.
+struct SkinningInput {
+  const float* rest_positions = nullptr;  // (V, 3) bind-pose positions
+  const int32_t* joints = nullptr;        // (V, K) joint index per influence
+  const float* weights = nullptr;         // (V, K) influence weights (sum 1 per vertex)
+  const float* skin_matrices = nullptr;   // (T, J, 16) world * inverse bind, column-major 4x4
+  size_t vertex_count = 0;                // V
+  size_t influence_count = 0;             // K
+  size_t joint_count = 0;                 // J
+  size_t frame_count = 0;                 // T
+};
+
+// Writes out_positions (T, V, 3): sum_k w_k * M[t, j_k] * rest. The caller owns
+// out_positions, which must hold T * V * 3 floats.
+// Errors: a joint index outside [0, J) or a non-finite weight (naming the vertex).
+Status bake_lbs(const SkinningInput& input, float* out_positions);
+
+}  // namespace animlod

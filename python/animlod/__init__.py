@@ -1,0 +1,11 @@
+"""animlod: level of detail for animated content.
+
+The data model lives in :mod:`animlod.model`; file formats in :mod:`animlod.io`; procedural
+assets in :mod:`animlod.synth`. Heavy lifting is done by the C++ core, ``animlod._core``.
+"""
+
+from .model import AnimatedMesh, LodChain, LodLevel, Motion, Skeleton, SkinnedMesh
+
+__version__ = "0.1.0"
+
+__all__ = ["AnimatedMesh", "LodChain", "LodLevel", "Motion", "Skeleton", "SkinnedMesh", "__version__"]

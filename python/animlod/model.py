@@ -1,0 +1,331 @@
+"""The data model every part of animlod shares (DESIGN.md, "Data model").
+
+Shapes: ``F`` frames, ``V`` vertices, ``M`` faces, ``J`` joints, ``T`` motion frames, ``K`` skin
+influences per vertex. Positions are float32, indices int32, quaternions (x, y, z, w), matrices
+(4, 4) acting on column vectors. Units are the asset's own; nothing is rescaled.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import rotations
+
+
+def _require(condition: bool, what: str) -> None:
+    if not condition:
+        raise ValueError(what)
+
+
+def _check_finite(name: str, array: np.ndarray) -> None:
+    if not np.all(np.isfinite(array)):
+        bad = np.argwhere(~np.isfinite(array))[0]
+        raise ValueError(f"{name}: non-finite value at index {tuple(int(i) for i in bad)}")
+
+
+def _check_faces(faces: np.ndarray, vertex_count: int) -> np.ndarray:
+    faces = np.ascontiguousarray(faces, dtype=np.int32)
+    _require(faces.ndim == 2 and faces.shape[1] == 3, f"faces: expected shape (M, 3), got {faces.shape}")
+    if faces.size and (faces.min() < 0 or faces.max() >= vertex_count):
+        row = int(np.argmax(np.any((faces < 0) | (faces >= vertex_count), axis=1)))
+        raise ValueError(f"faces: face {row} {faces[row].tolist()} has an index outside [0, {vertex_count})")
+    return faces
+
+
+@dataclass
+class AnimatedMesh:
+    """A deforming mesh with fixed connectivity.
+
+    Attributes
+    ----------
+    faces : (M, 3) int32, counter-clockwise front faces.
+    frames : (F, V, 3) float32 positions per frame.
+    fps : frames per second, or None when the frames are not a time sequence (e.g. poses).
+    """
+
+    faces: np.ndarray
+    frames: np.ndarray
+    fps: float | None = None
+
+    def __post_init__(self) -> None:
+        self.frames = np.ascontiguousarray(self.frames, dtype=np.float32)
+        _require(
+            self.frames.ndim == 3 and self.frames.shape[2] == 3 and self.frames.shape[0] >= 1,
+            f"frames: expected shape (F, V, 3) with F >= 1, got {self.frames.shape}",
+        )
+        _check_finite("frames", self.frames)
+        self.faces = _check_faces(self.faces, self.frames.shape[1])
+
+    @property
+    def frame_count(self) -> int:
+        return int(self.frames.shape[0])
+
+    @property
+    def vertex_count(self) -> int:
+        return int(self.frames.shape[1])
+
+    @property
+    def face_count(self) -> int:
+        return int(self.faces.shape[0])
+
+
+@dataclass
+class Skeleton:
+    """A joint hierarchy in topological order (``parents[j] < j``, ``parents[root] == -1``).
+
+    Attributes
+    ----------
+    names : J joint names, unique.
+    parents : (J,) int32 parent index per joint, -1 for the root (joint 0).
+    offsets : (J, 3) float64 translation of each joint in its parent's frame (the root's
+        offset is its rest position).
+    rest_rotations : (J, 4) float64 local rotation of each joint in the rest pose.
+    """
+
+    names: list[str]
+    parents: np.ndarray
+    offsets: np.ndarray
+    rest_rotations: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        self.names = [str(n) for n in self.names]
+        self.parents = np.asarray(self.parents, dtype=np.int32)
+        self.offsets = np.asarray(self.offsets, dtype=np.float64)
+        joint_count = len(self.names)
+        _require(joint_count >= 1, "skeleton: needs at least one joint")
+        _require(len(set(self.names)) == joint_count, "skeleton: joint names must be unique")
+        _require(self.parents.shape == (joint_count,), f"parents: expected shape ({joint_count},), got {self.parents.shape}")
+        _require(self.offsets.shape == (joint_count, 3), f"offsets: expected shape ({joint_count}, 3), got {self.offsets.shape}")
+        _require(self.parents[0] == -1, "parents: joint 0 must be the root (parent -1)")
+        later = np.nonzero(self.parents[1:] >= np.arange(1, joint_count))[0]
+        _require(later.size == 0, f"parents: joint {later[0] + 1 if later.size else 0} has a parent that does not come before it")
+        _require(bool(np.all(self.parents[1:] >= 0)), "parents: only joint 0 may have no parent")
+        _check_finite("offsets", self.offsets)
+        if self.rest_rotations is None:
+            self.rest_rotations = rotations.identity((joint_count,))
+        self.rest_rotations = rotations.normalize(self.rest_rotations)
+        _require(self.rest_rotations.shape == (joint_count, 4), "rest_rotations: expected shape (J, 4)")
+
+    @property
+    def joint_count(self) -> int:
+        return len(self.names)
+
+    def index(self, name: str) -> int:
+        """Index of the joint called ``name``; ValueError naming the joint if there is none."""
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise ValueError(f"skeleton has no joint named {name!r}") from None
+
+    def children(self) -> list[list[int]]:
+        """Child joint indices of every joint."""
+        result: list[list[int]] = [[] for _ in self.names]
+        for joint, parent in enumerate(self.parents[1:], start=1):
+            result[parent].append(joint)
+        return result
+
+    def rest_world_transforms(self) -> np.ndarray:
+        """World transforms ``(J, 4, 4)`` of the rest pose (root at its offset)."""
+        motion = Motion(self, self.offsets[None, 0], self.rest_rotations[None], fps=1.0)
+        return motion.world_transforms()[0]
+
+
+@dataclass
+class Motion:
+    """Skeletal motion: root translation and every joint's local rotation per frame.
+
+    The local transform of joint j at frame t is ``T(offsets[j]) @ R(local_rotations[t, j])``,
+    except the root, whose translation is ``root_positions[t]``.
+
+    Attributes
+    ----------
+    skeleton : the joint hierarchy.
+    root_positions : (T, 3) float64 world position of the root per frame.
+    local_rotations : (T, J, 4) float64 local joint rotations (x, y, z, w) per frame.
+    fps : frames per second.
+    name : clip name ("" when the source has none).
+    """
+
+    skeleton: Skeleton
+    root_positions: np.ndarray
+    local_rotations: np.ndarray
+    fps: float
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        self.root_positions = np.asarray(self.root_positions, dtype=np.float64)
+        local = np.asarray(self.local_rotations, dtype=np.float64)
+        frame_count = self.root_positions.shape[0] if self.root_positions.ndim == 2 else -1
+        _require(
+            self.root_positions.ndim == 2 and self.root_positions.shape[1] == 3 and frame_count >= 1,
+            f"root_positions: expected shape (T, 3) with T >= 1, got {self.root_positions.shape}",
+        )
+        expected = (frame_count, self.skeleton.joint_count, 4)
+        _require(local.shape == expected, f"local_rotations: expected shape {expected}, got {local.shape}")
+        _check_finite("root_positions", self.root_positions)
+        _check_finite("local_rotations", local)
+        self.local_rotations = rotations.normalize(local)
+        _require(self.fps > 0 and np.isfinite(self.fps), f"fps: must be positive, got {self.fps}")
+
+    @property
+    def frame_count(self) -> int:
+        return int(self.root_positions.shape[0])
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the first to the last frame."""
+        return (self.frame_count - 1) / self.fps
+
+    def world_transforms(self) -> np.ndarray:
+        """Forward kinematics: world transforms ``(T, J, 4, 4)`` of every joint.
+
+        One numpy step per joint (O(J) Python work, vectorised over frames).
+        """
+        skeleton = self.skeleton
+        translations = np.broadcast_to(skeleton.offsets, self.local_rotations.shape[:2] + (3,)).copy()
+        translations[:, 0] = self.root_positions
+        local = rotations.compose_transform(translations, self.local_rotations)
+        world = np.empty_like(local)
+        world[:, 0] = local[:, 0]
+        for joint in range(1, skeleton.joint_count):
+            world[:, joint] = world[:, skeleton.parents[joint]] @ local[:, joint]
+        return world
+
+    def world_positions(self) -> np.ndarray:
+        """World positions ``(T, J, 3)`` of every joint."""
+        return self.world_transforms()[..., :3, 3]
+
+    def skin_matrices(self, inverse_bind: np.ndarray) -> np.ndarray:
+        """Skinning matrices ``world @ inverse_bind``, ``(T, J, 4, 4)``."""
+        return self.world_transforms() @ np.asarray(inverse_bind, dtype=np.float64)
+
+
+@dataclass
+class SkinnedMesh:
+    """A mesh bound to a skeleton with linear blend skinning.
+
+    Attributes
+    ----------
+    rest_positions : (V, 3) float32 bind-pose positions.
+    faces : (M, 3) int32.
+    joints : (V, K) int32 joint index per influence, K = 4 by default (8 allowed).
+    weights : (V, K) float32, normalised to sum 1 per vertex and sorted by decreasing weight.
+    inverse_bind : (J, 4, 4) float64 inverse bind matrices.
+    skeleton : the joint hierarchy the indices in ``joints`` refer to.
+    uvs : (V, 2) float32 or None.
+    normals : (V, 3) float32 or None.
+    morph_targets : (N, V, 3) float32 position deltas or None.
+    morph_target_names : N names, or None.
+    """
+
+    rest_positions: np.ndarray
+    faces: np.ndarray
+    joints: np.ndarray
+    weights: np.ndarray
+    inverse_bind: np.ndarray
+    skeleton: Skeleton
+    uvs: np.ndarray | None = None
+    normals: np.ndarray | None = None
+    morph_targets: np.ndarray | None = None
+    morph_target_names: list[str] | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        self.rest_positions = np.ascontiguousarray(self.rest_positions, dtype=np.float32)
+        vertex_count = self.rest_positions.shape[0]
+        _require(self.rest_positions.shape == (vertex_count, 3), f"rest_positions: expected (V, 3), got {self.rest_positions.shape}")
+        _check_finite("rest_positions", self.rest_positions)
+        self.faces = _check_faces(self.faces, vertex_count)
+        self.joints = np.ascontiguousarray(self.joints, dtype=np.int32)
+        weights = np.asarray(self.weights, dtype=np.float64)
+        _require(self.joints.ndim == 2 and self.joints.shape[0] == vertex_count, f"joints: expected (V, K), got {self.joints.shape}")
+        _require(weights.shape == self.joints.shape, f"weights: expected {self.joints.shape}, got {weights.shape}")
+        _require(self.joints.shape[1] in (1, 2, 3, 4, 8), f"joints: K must be 1-4 or 8 influences, got {self.joints.shape[1]}")
+        _check_finite("weights", weights)
+        joint_count = self.skeleton.joint_count
+        if self.joints.size and (self.joints.min() < 0 or self.joints.max() >= joint_count):
+            vertex = int(np.argmax(np.any((self.joints < 0) | (self.joints >= joint_count), axis=1)))
+            raise ValueError(f"joints: vertex {vertex} references a joint outside [0, {joint_count})")
+        _require(bool(np.all(weights >= 0.0)), "weights: negative skin weight")
+        self.joints, self.weights = normalize_skin_weights(self.joints, weights)
+        self.inverse_bind = np.asarray(self.inverse_bind, dtype=np.float64)
+        _require(self.inverse_bind.shape == (joint_count, 4, 4), f"inverse_bind: expected ({joint_count}, 4, 4), got {self.inverse_bind.shape}")
+        _check_finite("inverse_bind", self.inverse_bind)
+        if self.uvs is not None:
+            self.uvs = np.ascontiguousarray(self.uvs, dtype=np.float32)
+            _require(self.uvs.shape == (vertex_count, 2), f"uvs: expected ({vertex_count}, 2), got {self.uvs.shape}")
+        if self.normals is not None:
+            self.normals = np.ascontiguousarray(self.normals, dtype=np.float32)
+            _require(self.normals.shape == (vertex_count, 3), f"normals: expected ({vertex_count}, 3), got {self.normals.shape}")
+        if self.morph_targets is not None:
+            self.morph_targets = np.ascontiguousarray(self.morph_targets, dtype=np.float32)
+            _require(
+                self.morph_targets.ndim == 3 and self.morph_targets.shape[1:] == (vertex_count, 3),
+                f"morph_targets: expected (N, {vertex_count}, 3), got {self.morph_targets.shape}",
+            )
+
+    @property
+    def vertex_count(self) -> int:
+        return int(self.rest_positions.shape[0])
+
+    @property
+    def face_count(self) -> int:
+        return int(self.faces.shape[0])
+
+    def bake(self, motion: Motion) -> AnimatedMesh:
+        """Linear blend skinning of every frame of ``motion`` in the C++ core."""
+        from ._core import bake_lbs
+
+        if motion.skeleton.joint_count != self.skeleton.joint_count:
+            raise ValueError(
+                f"motion has {motion.skeleton.joint_count} joints, the skin's skeleton {self.skeleton.joint_count}"
+            )
+        matrices = motion.skin_matrices(self.inverse_bind).astype(np.float32)
+        frames = bake_lbs(self.rest_positions, self.joints, self.weights, matrices)
+        return AnimatedMesh(self.faces, frames, fps=motion.fps)
+
+
+def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sort influences by decreasing weight and normalise them to sum 1 per vertex.
+
+    A vertex with all-zero weights is an error (it would not move with any joint).
+    Returns ``joints (V, K) int32`` and ``weights (V, K) float32``.
+    """
+    weights = np.asarray(weights, dtype=np.float64)
+    totals = weights.sum(axis=1)
+    if np.any(totals <= 0.0):
+        vertex = int(np.argmax(totals <= 0.0))
+        raise ValueError(f"weights: vertex {vertex} has no positive skin weight")
+    order = np.argsort(-weights, axis=1, kind="stable")
+    weights = np.take_along_axis(weights, order, axis=1) / totals[:, None]
+    joints = np.take_along_axis(np.asarray(joints), order, axis=1)
+    # Unused influences point at joint 0 with weight 0, as glTF allows.
+    joints = np.where(weights > 0.0, joints, 0)
+    return np.ascontiguousarray(joints, dtype=np.int32), np.ascontiguousarray(weights, dtype=np.float32)
+
+
+@dataclass
+class LodLevel:
+    """One level of a chain: what is drawn, its error in asset units and when it is used."""
+
+    mesh: AnimatedMesh | SkinnedMesh | None
+    skeleton: Skeleton | None
+    motions: list[Motion]
+    error: float
+    screen_coverage: float
+
+
+@dataclass
+class LodChain:
+    """Levels from finest (index 0) to coarsest."""
+
+    levels: list[LodLevel] = field(default_factory=list)
+
+    def level_for(self, screen_error_budget: float, distance: float, focal_length_px: float) -> int:
+        """Coarsest level whose error, projected to pixels, stays within the budget."""
+        chosen = 0
+        for index, level in enumerate(self.levels):
+            if level.error / max(distance, 1e-12) * focal_length_px <= screen_error_budget:
+                chosen = index
+        return chosen

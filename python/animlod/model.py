@@ -82,12 +82,15 @@ class Skeleton:
     offsets : (J, 3) float64 translation of each joint in its parent's frame (the root's
         offset is its rest position).
     rest_rotations : (J, 4) float64 local rotation of each joint in the rest pose.
+    end_sites : (J,) bool, True for leaf markers that carry no rotation of their own (BVH
+        "End Site"); they give leaf bones a length and direction.
     """
 
     names: list[str]
     parents: np.ndarray
     offsets: np.ndarray
     rest_rotations: np.ndarray | None = None
+    end_sites: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.names = [str(n) for n in self.names]
@@ -107,6 +110,11 @@ class Skeleton:
             self.rest_rotations = rotations.identity((joint_count,))
         self.rest_rotations = rotations.normalize(self.rest_rotations)
         _require(self.rest_rotations.shape == (joint_count, 4), "rest_rotations: expected shape (J, 4)")
+        self.end_sites = np.zeros(joint_count, bool) if self.end_sites is None else np.asarray(self.end_sites, bool)
+        _require(self.end_sites.shape == (joint_count,), f"end_sites: expected shape ({joint_count},)")
+        has_children = np.zeros(joint_count, bool)
+        has_children[self.parents[1:]] = True
+        _require(not np.any(self.end_sites & has_children), "end_sites: an end site must be a leaf")
 
     @property
     def joint_count(self) -> int:

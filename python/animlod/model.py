@@ -154,6 +154,9 @@ class Motion:
     local_rotations : (T, J, 4) float64 local joint rotations (x, y, z, w) per frame.
     fps : frames per second.
     name : clip name ("" when the source has none).
+    joint_translations : (T, J, 3) float64 or None. Per-frame local translations that replace
+        ``offsets`` for non-root joints (BVH position channels on non-root joints); column 0
+        is ignored, the root uses ``root_positions``. None when the offsets hold in every frame.
     """
 
     skeleton: Skeleton
@@ -161,6 +164,7 @@ class Motion:
     local_rotations: np.ndarray
     fps: float
     name: str = ""
+    joint_translations: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.root_positions = np.asarray(self.root_positions, dtype=np.float64)
@@ -176,6 +180,13 @@ class Motion:
         _check_finite("local_rotations", local)
         self.local_rotations = rotations.normalize(local)
         _require(self.fps > 0 and np.isfinite(self.fps), f"fps: must be positive, got {self.fps}")
+        if self.joint_translations is not None:
+            self.joint_translations = np.asarray(self.joint_translations, dtype=np.float64)
+            _require(
+                self.joint_translations.shape == expected[:2] + (3,),
+                f"joint_translations: expected shape {expected[:2] + (3,)}, got {self.joint_translations.shape}",
+            )
+            _check_finite("joint_translations", self.joint_translations)
 
     @property
     def frame_count(self) -> int:
@@ -192,7 +203,10 @@ class Motion:
         One numpy step per joint (O(J) Python work, vectorised over frames).
         """
         skeleton = self.skeleton
-        translations = np.broadcast_to(skeleton.offsets, self.local_rotations.shape[:2] + (3,)).copy()
+        if self.joint_translations is None:
+            translations = np.broadcast_to(skeleton.offsets, self.local_rotations.shape[:2] + (3,)).copy()
+        else:
+            translations = self.joint_translations.copy()
         translations[:, 0] = self.root_positions
         local = rotations.compose_transform(translations, self.local_rotations)
         world = np.empty_like(local)

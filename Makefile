@@ -1,0 +1,73 @@
+# animlod: the commands README shows. Each target installs what is missing first, so that on a
+# fresh Debian 12 machine `make test` and `make demo` are one command each; a second run skips
+# what is already there.
+#
+#   make setup     system packages, release OpenMesh, .venv with animlod installed
+#   make test      C++ unit tests (ctest), the find_package(animlod) consumer, pytest
+#   make demo      the main job on the embedded procedural character, into out/demo
+#   make bench     benchmark tables (peers in the same run); heavy, not part of test
+#   make sanitize  C++ tests and pytest under ASan + UBSan
+
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+OPENMESH := .deps/openmesh
+OPENMESH_CONFIG := $(OPENMESH)/share/OpenMesh/cmake/OpenMeshConfig.cmake
+CPP_BUILD := build/cpp
+CMAKE_GENERATOR := Ninja
+JOBS ?= 2
+
+.PHONY: setup system-packages python-package cpp-test consumer-test test demo bench sanitize clean
+
+setup: python-package
+
+system-packages:
+	@scripts/install_system_packages.sh
+
+$(OPENMESH_CONFIG): | system-packages
+	scripts/build_release_openmesh.sh $(OPENMESH)
+
+$(VENV)/bin/pip: | system-packages
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/pip install -q --upgrade pip
+
+# An editable install: Python sources are used from the checkout, and the extension is
+# rebuilt incrementally (build/python-*) whenever this target runs.
+python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
+	$(VENV)/bin/pip install -q scikit-build-core pybind11
+	$(VENV)/bin/pip install -q --no-build-isolation -e ".[test]"
+
+$(CPP_BUILD)/build.ninja: $(OPENMESH_CONFIG)
+	cmake -S . -B $(CPP_BUILD) -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_INSTALL_PREFIX=$(CURDIR)/build/install > $(CPP_BUILD).configure.log
+
+cpp-test: $(CPP_BUILD)/build.ninja
+	cmake --build $(CPP_BUILD) --parallel $(JOBS)
+	ctest --test-dir $(CPP_BUILD) --output-on-failure
+
+# find_package(animlod) from a separate project after `cmake --install`.
+consumer-test: cpp-test
+	cmake --install $(CPP_BUILD) > /dev/null
+	cmake -S tests/consumer -B build/consumer -G $(CMAKE_GENERATOR) \
+	  -DCMAKE_PREFIX_PATH=$(CURDIR)/build/install > build/consumer.configure.log
+	cmake --build build/consumer
+	build/consumer/animlod_consumer
+
+test: python-package consumer-test
+	ANIMLOD_GLTF_PROBE=$(CURDIR)/$(CPP_BUILD)/tests/cpp/animlod_gltf_probe $(PY) -m pytest -q tests/python
+
+demo: python-package
+	$(VENV)/bin/animlod demo -o out/demo
+
+bench: python-package
+	$(VENV)/bin/pip install -q -e ".[test,bench]" --no-build-isolation
+	@for script in bench/bench_*.py; do echo "== $$script"; $(PY) $$script || exit 1; done
+
+sanitize: $(OPENMESH_CONFIG) $(VENV)/bin/pip
+	cmake -S . -B build/sanitize -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer" > build/sanitize.configure.log
+	cmake --build build/sanitize --parallel $(JOBS)
+	ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1 ctest --test-dir build/sanitize --output-on-failure
+
+clean:
+	rm -rf build out

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian packages animlod needs (DESIGN.md's list, plus the Python headers and
+# venv for building the extension, doctest for the C++ tests and dpkg-dev for unpacking the
+# OpenMesh source package). Installs only what is missing, so a second run is quick.
+set -euo pipefail
+
+packages=(g++ cmake ninja-build pkg-config libopenmesh-dev libeigen3-dev libglm-dev libglfw3-dev
+          libgl-dev libegl-dev libopengl-dev libtinygltf-dev xvfb xauth libgl1-mesa-dri libegl-mesa0
+          doctest-dev dpkg-dev python3-dev python3-venv)
+
+missing=()
+for package in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$package" 2>/dev/null || true)
+  [ "$status" = "install ok installed" ] || missing+=("$package")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "system packages: all present"
+  exit 0
+fi
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+echo "system packages: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null

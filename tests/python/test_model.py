@@ -1,0 +1,131 @@
+import numpy as np
+import pytest
+
+from animlod import AnimatedMesh, Motion, Skeleton, SkinnedMesh, rotations
+from animlod._core import bake_lbs
+
+Z = np.array([0.0, 0.0, 1.0])
+
+
+def _chain() -> Skeleton:
+    """Three joints along +X, one unit apart."""
+    return Skeleton(["root", "mid", "tip"], [-1, 0, 1], [[0, 0, 0], [1, 0, 0], [1, 0, 0]])
+
+
+def _bend(angles_mid: np.ndarray) -> Motion:
+    frames = len(angles_mid)
+    local = rotations.identity((frames, 3))
+    local[:, 1] = rotations.from_axis_angle(Z, angles_mid)
+    return Motion(_chain(), np.zeros((frames, 3)), local, fps=30.0)
+
+
+def test_forward_kinematics_of_a_bent_chain():
+    positions = _bend(np.array([0.0, np.pi / 2])).world_positions()
+    np.testing.assert_allclose(positions[0], [[0, 0, 0], [1, 0, 0], [2, 0, 0]], atol=1e-12)
+    # Rotating the middle joint by 90 degrees about Z swings the tip to +Y.
+    np.testing.assert_allclose(positions[1], [[0, 0, 0], [1, 0, 0], [1, 1, 0]], atol=1e-12)
+
+
+def test_root_translation_moves_everything():
+    motion = _bend(np.zeros(2))
+    motion.root_positions[1] = [0, 5, 0]
+    positions = motion.world_positions()
+    np.testing.assert_allclose(positions[1] - positions[0], np.tile([0, 5, 0], (3, 1)), atol=1e-12)
+
+
+def test_world_transforms_are_rigid():
+    motion = _bend(np.linspace(0, 1, 5))
+    rot = motion.world_transforms()[..., :3, :3]
+    np.testing.assert_allclose(rot @ np.swapaxes(rot, -1, -2), np.broadcast_to(np.eye(3), rot.shape), atol=1e-12)
+
+
+def _numpy_lbs(rest, joints, weights, matrices):
+    homogeneous = np.concatenate([rest, np.ones((len(rest), 1))], axis=1)
+    per_influence = np.einsum("tvkij,vj->tvki", matrices[:, joints], homogeneous)
+    return np.einsum("tvki,vk->tvi", per_influence, weights)[..., :3]
+
+
+def test_bake_lbs_matches_numpy_reference():
+    rng = np.random.default_rng(7)
+    rest = rng.normal(size=(50, 3)).astype(np.float32)
+    joints = rng.integers(0, 6, size=(50, 4)).astype(np.int32)
+    weights = rng.random((50, 4)).astype(np.float32)
+    weights /= weights.sum(axis=1, keepdims=True)
+    q = rotations.normalize(rng.normal(size=(3, 6, 4)))
+    matrices = rotations.compose_transform(rng.normal(size=(3, 6, 3)), q).astype(np.float32)
+    got = bake_lbs(rest, joints, weights, matrices)
+    assert got.shape == (3, 50, 3) and got.dtype == np.float32
+    np.testing.assert_allclose(got, _numpy_lbs(rest, joints, weights, matrices), atol=1e-5)
+
+
+def _skinned_bar() -> SkinnedMesh:
+    """Two vertices at x = 0.5 and 1.5, the first on the root, the second on 'mid'."""
+    skeleton = _chain()
+    inverse_bind = np.linalg.inv(skeleton.rest_world_transforms())
+    return SkinnedMesh(
+        rest_positions=[[0.5, 0, 0], [1.5, 0, 0], [2.0, 0, 0]],
+        faces=[[0, 1, 2]],
+        joints=[[0, 1], [1, 0], [1, 2]],
+        weights=[[1, 0], [3, 1], [1, 1]],
+        inverse_bind=inverse_bind,
+        skeleton=skeleton,
+    )
+
+
+def test_skinned_mesh_normalises_and_sorts_weights():
+    skinned = _skinned_bar()
+    np.testing.assert_allclose(skinned.weights, [[1, 0], [0.75, 0.25], [0.5, 0.5]])
+    assert skinned.joints[0].tolist() == [0, 0]  # unused influence points at joint 0
+
+
+def test_bake_follows_the_skeleton():
+    skinned = _skinned_bar()
+    mesh = skinned.bake(_bend(np.array([0.0, np.pi / 2])))
+    assert isinstance(mesh, AnimatedMesh) and mesh.frames.shape == (2, 3, 3)
+    np.testing.assert_allclose(mesh.frames[0], skinned.rest_positions, atol=1e-6)
+    # The vertex fully on 'mid' (half a unit beyond it along the bone) swings to +Y.
+    expected_mid = 0.75 * np.array([1.0, 0.5, 0.0]) + 0.25 * np.array([1.5, 0.0, 0.0])
+    np.testing.assert_allclose(mesh.frames[1, 1], expected_mid, atol=1e-6)
+
+
+def test_bake_rejects_a_motion_for_another_skeleton():
+    other = Skeleton(["a", "b"], [-1, 0], np.zeros((2, 3)))
+    motion = Motion(other, np.zeros((1, 3)), rotations.identity((1, 2)), fps=30.0)
+    with pytest.raises(ValueError, match="2 joints"):
+        _skinned_bar().bake(motion)
+
+
+@pytest.mark.parametrize(
+    "parents, message",
+    [([0, 0, 1], "joint 0 must be the root"), ([-1, 2, 0], "does not come before"), ([-1, 0, -1], "only joint 0")],
+)
+def test_skeleton_rejects_bad_hierarchies(parents, message):
+    with pytest.raises(ValueError, match=message):
+        Skeleton(["a", "b", "c"], parents, np.zeros((3, 3)))
+
+
+def test_end_site_must_be_a_leaf():
+    with pytest.raises(ValueError, match="leaf"):
+        Skeleton(["a", "b", "c"], [-1, 0, 1], np.zeros((3, 3)), end_sites=[False, True, False])
+
+
+def test_animated_mesh_validation_names_the_problem():
+    frames = np.zeros((2, 3, 3), np.float32)
+    with pytest.raises(ValueError, match=r"face 0 \[0, 1, 3\]"):
+        AnimatedMesh([[0, 1, 3]], frames)
+    frames[1, 2, 0] = np.nan
+    with pytest.raises(ValueError, match=r"non-finite value at index \(1, 2, 0\)"):
+        AnimatedMesh([[0, 1, 2]], frames)
+
+
+def test_motion_rejects_nan_rotation():
+    local = rotations.identity((2, 3))
+    local[1, 2, 0] = np.nan
+    with pytest.raises(ValueError, match="local_rotations"):
+        Motion(_chain(), np.zeros((2, 3)), local, fps=30.0)
+
+
+def test_skinned_mesh_rejects_vertex_without_weight():
+    with pytest.raises(ValueError, match="vertex 1 has no positive skin weight"):
+        SkinnedMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]], [[0], [0], [0]], [[1], [0], [1]],
+                    np.tile(np.eye(4), (3, 1, 1)), _chain())

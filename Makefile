@@ -12,7 +12,7 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 OPENMESH := .deps/openmesh
-OPENMESH_CONFIG := $(OPENMESH)/share/OpenMesh/cmake/OpenMeshConfig.cmake
+OPENMESH_CONFIG := $(OPENMESH)/lib/cmake/OpenMesh/OpenMeshConfig.cmake
 CPP_BUILD := build/cpp
 CMAKE_GENERATOR := Ninja
 JOBS ?= 2
@@ -61,6 +61,7 @@ demo: python-package
 
 bench: python-package
 	$(VENV)/bin/pip install -q -e ".[test,bench]" --no-build-isolation
+	bench/openmesh_build/run.sh
 	@for script in bench/bench_*.py; do echo "== $$script"; $(PY) $$script || exit 1; done
 
 sanitize: $(OPENMESH_CONFIG) $(VENV)/bin/pip

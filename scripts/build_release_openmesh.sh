@@ -11,7 +11,7 @@
 set -euo pipefail
 
 prefix=$(realpath -m "${1:?usage: $0 PREFIX}")
-if [ -f "$prefix/share/OpenMesh/cmake/OpenMeshConfig.cmake" ]; then
+if [ -f "$prefix/lib/cmake/OpenMesh/OpenMeshConfig.cmake" ]; then
   echo "release OpenMesh already in $prefix"
   exit 0
 fi

@@ -1,0 +1,38 @@
+"""Which reader a path needs, decided once for every CLI command."""
+
+from __future__ import annotations
+
+import glob
+import os
+from pathlib import Path
+
+from .errors import FormatError
+
+SEQUENCE_SUFFIXES = (".obj", ".ply")
+
+
+def input_kind(path: str | os.PathLike) -> str:
+    """``"bvh"``, ``"gltf"``, ``"npz"`` or ``"sequence"`` (a folder, glob or single OBJ/PLY).
+
+    Raises FormatError when the path does not exist or its type is not one animlod reads.
+    """
+    text = os.fspath(path)
+    candidate = Path(text)
+    if glob.has_magic(text):
+        if not glob.glob(text):
+            raise FormatError(text, "pattern", "matches no file")
+        return "sequence"
+    if candidate.is_dir():
+        return "sequence"
+    if not candidate.exists():
+        raise FormatError(text, "file", "does not exist")
+    suffix = candidate.suffix.lower()
+    if suffix == ".bvh":
+        return "bvh"
+    if suffix in (".glb", ".gltf"):
+        return "gltf"
+    if suffix == ".npz":
+        return "npz"
+    if suffix in SEQUENCE_SUFFIXES:
+        return "sequence"
+    raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected .bvh, .glb, .gltf, .npz, .obj, .ply or a folder")

@@ -1,0 +1,107 @@
+// AQEM: simplification of a deforming mesh over all its frames by edge collapse, with the
+// animated quadric error metric and motion-feature weights of Yang et al. 2019 (Eqs. 1-7).
+//
+// Every collapse is shared by all frames (one connectivity), and the new vertex gets its own
+// optimal position in every frame. One run yields several levels of detail from the same
+// collapse sequence, plus the ordered collapse record.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "animlod/animated_mesh_view.hpp"
+#include "animlod/motion_features.hpp"
+#include "animlod/status.hpp"
+
+namespace animlod {
+
+struct AqemOptions {
+  // Levels as fractions of the input face count, each in (0, 1]. Ignored when
+  // target_face_counts is not empty.
+  std::vector<double> target_ratios = {0.5};
+  // Levels as face counts, each in [4, M].
+  std::vector<size_t> target_face_counts;
+  // Asset units. The run stops before a collapse whose error (see AqemLevel::error) exceeds it;
+  // levels not reached then hold the last mesh and reached = false.
+  double max_error = std::numeric_limits<double>::infinity();
+  // Weights of Eq. 6 from the motion features; off gives every vertex weight 1.
+  bool use_motion_features = true;
+  MotionFeatureOptions motion_features;
+  // Adds, per frame, a plane through every boundary edge perpendicular to its face, so that
+  // open borders keep their shape (Garland and Heckbert 1997, section 6.1).
+  bool boundary_quadrics = true;
+  // Rejects collapses that invert a face according to Eq. 7 (summed over the frames).
+  bool check_inversion = true;
+  // Stricter than Eq. 7: rejects a collapse that inverts a face in any single frame.
+  bool strict_inversion = false;
+  // Quadrics over K frames only (memory O(V K) instead of O(V F)): 0 uses every frame,
+  // otherwise K frames chosen by farthest-point sampling of the poses (see frames_used).
+  size_t max_frames = 0;
+  // Explicit frames for the quadrics; overrides max_frames when not empty.
+  std::vector<int32_t> frame_subset;
+  // Called now and then with (collapses done, collapses needed for the last level).
+  std::function<void(size_t, size_t)> progress;
+};
+
+// Optional per-vertex inputs; a null pointer means "not given".
+struct AqemVertexData {
+  const uint8_t* locked = nullptr;        // (V,) nonzero: the vertex keeps its positions and is
+                                          //      never removed (edges may collapse into it)
+  const float* importance = nullptr;      // (V,) > 0, multiplies the vertex weight of Eq. 6
+  const float* attributes = nullptr;      // (V, A) interpolated along collapsed edges (e.g. UVs)
+  size_t attribute_count = 0;             // A
+  const int32_t* skin_joints = nullptr;   // (V, K) joint per influence
+  const float* skin_weights = nullptr;    // (V, K) influence weights; merged, top K kept
+  size_t influence_count = 0;             // K
+};
+
+struct AqemLevel {
+  size_t target_face_count = 0;
+  bool reached = false;              // false when max_error or legality stopped the run first
+  size_t collapse_count = 0;         // the level is the first collapse_count records applied
+  double error = 0.0;                // asset units: the largest sqrt(quadric cost / frames)
+                                     // over the collapses so far (an RMS plane distance)
+  std::vector<int32_t> faces;        // (M', 3) indices into the kept vertices
+  std::vector<int32_t> kept_vertices;  // (V',) original index of each kept vertex, ascending
+  std::vector<int32_t> vertex_map;   // (V,) original vertex -> index of the kept vertex it merged into
+  std::vector<float> positions;      // (F, V', 3) positions of the kept vertices in every frame
+  std::vector<float> attributes;     // (V', A)
+  std::vector<int32_t> skin_joints;  // (V', K)
+  std::vector<float> skin_weights;   // (V', K) sorted by decreasing weight, summing to 1
+};
+
+// The ordered collapses (structure of arrays, C collapses): vertex removed[i] merged into
+// vertex kept[i], which moved to positions[i]. Vertex indices are the input's.
+struct CollapseRecord {
+  std::vector<int32_t> removed;   // (C,)
+  std::vector<int32_t> kept;      // (C,)
+  std::vector<float> positions;   // (C, F, 3) new positions of the kept vertex in every frame
+  std::vector<double> cost;       // (C,) weighted cost of Eq. 6
+  std::vector<double> error;      // (C,) sqrt(unweighted cost / frames used), asset units
+};
+
+struct AqemResult {
+  std::vector<AqemLevel> levels;     // one per target, finest first
+  CollapseRecord collapses;
+  std::vector<int32_t> frames_used;  // frames whose quadrics drove the simplification
+  std::vector<float> vertex_weights; // (V,) weights of Eq. 6 (motion features x importance)
+};
+
+// Simplifies `mesh` to every target of `options`.
+//
+// Placement (Eq. 5): per frame, v = X^-1 Y of the merged quadric; where a frame's X is
+// singular, the best of the two endpoints and the midpoint. In frames outside frames_used the
+// new vertex sits on the collapsed edge at the parameter that best matches the optimal
+// positions of the used frames. Attributes and skin weights are interpolated with that same
+// parameter. Ties in cost are broken by edge index, so the output is deterministic.
+//
+// Errors (the message names the element): the checks of validate_animated_mesh; a target
+// ratio outside (0, 1] or face count outside [4, M]; a frame index outside [0, F); a
+// non-positive or non-finite importance; a skin joint index below 0; a non-finite attribute.
+Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& vertex_data,
+                         const AqemOptions& options, AqemResult& out);
+
+}  // namespace animlod

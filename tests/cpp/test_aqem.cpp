@@ -1,0 +1,298 @@
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "animlod/aqem.hpp"
+#include "test_aqem_meshes.hpp"
+
+using animlod::AqemLevel;
+using animlod::AqemOptions;
+using animlod::AqemResult;
+using animlod::AqemVertexData;
+using animlod::simplify_animated;
+using animlod::testing::OwnedAnimatedMesh;
+
+namespace {
+
+AqemResult simplify(const OwnedAnimatedMesh& mesh, const AqemOptions& options, const AqemVertexData& data = {}) {
+  AqemResult result;
+  const animlod::Status status = simplify_animated(mesh.view(), data, options, result);
+  REQUIRE_MESSAGE(status.ok, status.message);
+  return result;
+}
+
+std::string failure(const OwnedAnimatedMesh& mesh, const AqemOptions& options = {}) {
+  AqemResult result;
+  const animlod::Status status = simplify_animated(mesh.view(), {}, options, result);
+  CHECK_FALSE(status.ok);
+  return status.message;
+}
+
+// Every undirected edge of the level has one or two faces, each direction used once.
+bool is_manifold(const AqemLevel& level) {
+  std::set<std::pair<int32_t, int32_t>> directed;
+  for (size_t f = 0; f < level.faces.size(); f += 3)
+    for (int k = 0; k < 3; ++k)
+      if (!directed.insert({level.faces[f + k], level.faces[f + (k + 1) % 3]}).second) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("aqem keeps a flat grid flat and inside its square, at or below the target") {
+  const OwnedAnimatedMesh mesh = animlod::testing::grid(8);  // 128 faces
+  AqemOptions options;
+  options.target_ratios = {0.5, 0.25, 0.1};
+  const AqemResult result = simplify(mesh, options);
+  REQUIRE(result.levels.size() == 3);
+  const size_t targets[] = {64, 32, 13};
+  for (size_t i = 0; i < 3; ++i) {
+    const AqemLevel& level = result.levels[i];
+    CHECK(level.reached);
+    CHECK(level.target_face_count == targets[i]);
+    CHECK(level.faces.size() / 3 <= targets[i]);
+    CHECK(is_manifold(level));
+    CHECK(level.error == doctest::Approx(0.0));
+    for (size_t v = 0; v < level.positions.size(); v += 3) {
+      CHECK(level.positions[v + 2] == doctest::Approx(0.0));
+      CHECK(level.positions[v] >= -1e-6f);
+      CHECK(level.positions[v] <= 1.0f + 1e-6f);
+    }
+    for (int32_t index : level.faces) CHECK((index >= 0 && size_t(index) < level.kept_vertices.size()));
+  }
+  // The four corners are fixed by the boundary planes of two sides.
+  const AqemLevel& coarsest = result.levels[2];
+  for (int32_t corner : {0, 8, 72, 80})
+    CHECK(std::count(coarsest.kept_vertices.begin(), coarsest.kept_vertices.end(), corner) == 1);
+}
+
+TEST_CASE("aqem levels come from one collapse sequence, with growing error") {
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(12, 16, 3);
+  AqemOptions options;
+  options.target_ratios = {0.1, 0.5, 0.25};  // any order; levels come finest first
+  const AqemResult result = simplify(mesh, options);
+  REQUIRE(result.levels.size() == 3);
+  const size_t collapses = result.collapses.removed.size();
+  CHECK(result.collapses.positions.size() == collapses * 3 * mesh.frame_count);
+  for (size_t i = 0; i + 1 < 3; ++i) {
+    CHECK(result.levels[i].target_face_count > result.levels[i + 1].target_face_count);
+    CHECK(result.levels[i].collapse_count < result.levels[i + 1].collapse_count);
+    CHECK(result.levels[i].error <= result.levels[i + 1].error);
+  }
+  CHECK(result.levels[2].collapse_count == collapses);
+  // A closed mesh loses two faces and one vertex per collapse.
+  for (const AqemLevel& level : result.levels) {
+    CHECK(level.faces.size() / 3 == mesh.faces.size() / 3 - 2 * level.collapse_count);
+    CHECK(level.kept_vertices.size() == mesh.vertex_count - level.collapse_count);
+    CHECK(is_manifold(level));
+  }
+}
+
+TEST_CASE("aqem is deterministic") {
+  const OwnedAnimatedMesh mesh = animlod::testing::bending_tube(12, 10, 4, 1.2);
+  AqemOptions options;
+  options.target_ratios = {0.3};
+  const AqemResult first = simplify(mesh, options);
+  const AqemResult second = simplify(mesh, options);
+  CHECK(first.levels[0].faces == second.levels[0].faces);
+  CHECK(first.levels[0].positions == second.levels[0].positions);
+  CHECK(first.collapses.removed == second.collapses.removed);
+}
+
+TEST_CASE("aqem over F identical frames equals aqem over one frame") {
+  OwnedAnimatedMesh single = animlod::testing::bending_tube(12, 10, 4, 1.2);
+  single.frames.resize(single.vertex_count * 3);
+  single.frame_count = 1;
+  OwnedAnimatedMesh repeated = single;
+  for (int f = 1; f < 5; ++f) repeated.frames.insert(repeated.frames.end(), single.frames.begin(), single.frames.end());
+  repeated.frame_count = 5;
+  AqemOptions options;
+  options.target_ratios = {0.5, 0.2};
+  const AqemResult one = simplify(single, options);
+  const AqemResult five = simplify(repeated, options);
+  CHECK(one.collapses.removed == five.collapses.removed);
+  CHECK(one.collapses.kept == five.collapses.kept);
+  for (size_t i = 0; i < 2; ++i) {
+    CHECK(one.levels[i].faces == five.levels[i].faces);
+    const std::vector<float>& p = one.levels[i].positions;
+    for (size_t f = 0; f < 5; ++f)
+      for (size_t j = 0; j < p.size(); ++j) CHECK(five.levels[i].positions[f * p.size() + j] == doctest::Approx(p[j]));
+    CHECK(five.levels[i].error == doctest::Approx(one.levels[i].error));
+  }
+}
+
+TEST_CASE("aqem never flips a face of a deforming sphere in any frame") {
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(16, 24, 4);
+  AqemOptions options;
+  options.target_ratios = {0.05};
+  const AqemResult result = simplify(mesh, options);
+  const AqemLevel& level = result.levels[0];
+  const size_t kept = level.kept_vertices.size();
+  for (size_t f = 0; f < mesh.frame_count; ++f) {
+    const float* p = &level.positions[f * kept * 3];
+    for (size_t t = 0; t < level.faces.size(); t += 3) {
+      double a[3], b[3], c[3];
+      for (int k = 0; k < 3; ++k) {
+        a[k] = p[3 * level.faces[t] + k];
+        b[k] = p[3 * level.faces[t + 1] + k];
+        c[k] = p[3 * level.faces[t + 2] + k];
+      }
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      // The centroid direction of a convex shape centred at the origin points outward.
+      CHECK(n[0] * (a[0] + b[0] + c[0]) + n[1] * (a[1] + b[1] + c[1]) + n[2] * (a[2] + b[2] + c[2]) > 0.0);
+    }
+  }
+}
+
+TEST_CASE("aqem keeps locked vertices where they are") {
+  const OwnedAnimatedMesh mesh = animlod::testing::bending_tube(12, 10, 3, 1.0);
+  std::vector<uint8_t> locked(mesh.vertex_count, 0);
+  for (size_t v = 50; v < 60; ++v) locked[v] = 1;  // one ring in the middle
+  AqemVertexData data;
+  data.locked = locked.data();
+  AqemOptions options;
+  options.target_ratios = {0.2};
+  const AqemResult result = simplify(mesh, options, data);
+  const AqemLevel& level = result.levels[0];
+  const size_t kept = level.kept_vertices.size();
+  for (int32_t v = 50; v < 60; ++v) {
+    const int32_t index = level.vertex_map[v];
+    REQUIRE(index >= 0);
+    CHECK(level.kept_vertices[index] == v);
+    for (size_t f = 0; f < mesh.frame_count; ++f)
+      for (int k = 0; k < 3; ++k)
+        CHECK(level.positions[(f * kept + index) * 3 + k] == mesh.frames[(f * mesh.vertex_count + v) * 3 + k]);
+  }
+}
+
+TEST_CASE("aqem stops at max_error and marks the levels it did not reach") {
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(12, 16, 2);
+  AqemOptions options;
+  options.target_ratios = {0.9, 0.05};
+  const AqemResult unbounded = simplify(mesh, options);
+  const double bound = unbounded.levels[0].error;
+  REQUIRE(bound < unbounded.levels[1].error);
+  options.max_error = bound;
+  const AqemResult result = simplify(mesh, options);
+  CHECK(result.levels[0].reached);
+  CHECK(result.levels[0].faces == unbounded.levels[0].faces);
+  CHECK_FALSE(result.levels[1].reached);
+  CHECK(result.levels[1].error <= bound);
+  CHECK(result.levels[1].faces.size() / 3 > result.levels[1].target_face_count);
+}
+
+TEST_CASE("aqem samples frames that cover the motion") {
+  const OwnedAnimatedMesh mesh = animlod::testing::bending_tube(8, 8, 9, 1.5);
+  AqemOptions options;
+  options.max_frames = 3;
+  const AqemResult result = simplify(mesh, options);
+  // Frame 0, then the farthest pose (the last), then the one farthest from both (the middle).
+  CHECK(result.frames_used == std::vector<int32_t>{0, 4, 8});
+  CHECK(result.levels[0].positions.size() == mesh.frame_count * result.levels[0].kept_vertices.size() * 3);
+}
+
+TEST_CASE("aqem merges skin weights and interpolates attributes") {
+  const OwnedAnimatedMesh mesh = animlod::testing::grid(4);
+  std::vector<int32_t> joints(mesh.vertex_count * 2);
+  std::vector<float> weights(mesh.vertex_count * 2);
+  std::vector<float> uvs(mesh.vertex_count * 2);
+  for (size_t v = 0; v < mesh.vertex_count; ++v) {
+    joints[2 * v] = int32_t(v % 3);
+    joints[2 * v + 1] = 3;
+    weights[2 * v] = 0.75f;
+    weights[2 * v + 1] = 0.25f;
+    uvs[2 * v] = mesh.frames[3 * v];
+    uvs[2 * v + 1] = mesh.frames[3 * v + 1];
+  }
+  AqemVertexData data;
+  data.skin_joints = joints.data();
+  data.skin_weights = weights.data();
+  data.influence_count = 2;
+  data.attributes = uvs.data();
+  data.attribute_count = 2;
+  AqemOptions options;
+  options.target_ratios = {0.25};
+  const AqemResult result = simplify(mesh, options, data);
+  const AqemLevel& level = result.levels[0];
+  for (size_t i = 0; i < level.kept_vertices.size(); ++i) {
+    CHECK(level.skin_weights[2 * i] + level.skin_weights[2 * i + 1] == doctest::Approx(1.0));
+    CHECK(level.skin_weights[2 * i] >= level.skin_weights[2 * i + 1]);
+    // UVs equal the flat grid's x, y, and vertices stay on the grid plane, so they agree.
+    CHECK(level.attributes[2 * i] == doctest::Approx(level.positions[3 * i]).epsilon(1e-5));
+    CHECK(level.attributes[2 * i + 1] == doctest::Approx(level.positions[3 * i + 1]).epsilon(1e-5));
+  }
+}
+
+TEST_CASE("aqem names the element of bad input") {
+  OwnedAnimatedMesh mesh = animlod::testing::grid(2);
+  SUBCASE("non-finite position") {
+    mesh.frames[3 * 4 + 1] = NAN;
+    CHECK(failure(mesh) == "frame 0, vertex 4: non-finite position");
+  }
+  SUBCASE("index out of range") {
+    mesh.faces[5] = 99;
+    CHECK(failure(mesh).find("face 1 (0, 4, 99): vertex index 99 outside [0, 9)") == 0);
+  }
+  SUBCASE("degenerate face") {
+    mesh.faces[4] = 0;
+    CHECK(failure(mesh).find("face 1 (0, 0, 3): degenerate") == 0);
+  }
+  SUBCASE("duplicate face") {
+    mesh.faces.insert(mesh.faces.end(), {4, 0, 1});
+    CHECK(failure(mesh).find("faces 0 and 8: duplicate") == 0);
+  }
+  SUBCASE("non-manifold edge") {
+    mesh.frames.insert(mesh.frames.end(), {0.5f, 0.5f, 1.0f});
+    mesh.vertex_count += 1;
+    mesh.faces.insert(mesh.faces.end(), {0, 4, 9});
+    CHECK(failure(mesh).find("edge (0, 4): non-manifold") == 0);
+  }
+  SUBCASE("non-manifold vertex") {
+    // A second grid cell glued at vertex 8 only (a bow tie).
+    mesh.frames.insert(mesh.frames.end(), {2, 2, 0, 3, 2, 0});
+    mesh.vertex_count += 2;
+    mesh.faces.insert(mesh.faces.end(), {8, 9, 10});
+    CHECK(failure(mesh) == "vertex 8: non-manifold, its faces form separate fans joined only at the vertex");
+  }
+  SUBCASE("unreferenced vertex") {
+    mesh.frames.insert(mesh.frames.end(), {5, 5, 5});
+    mesh.vertex_count += 1;
+    CHECK(failure(mesh) == "vertex 9: not referenced by any face");
+  }
+  SUBCASE("targets out of range") {
+    AqemOptions options;
+    options.target_face_counts = {9};
+    CHECK(failure(mesh, options).find("target_face_counts: 9 outside [4, 8]") == 0);
+    options.target_face_counts = {3};
+    CHECK(failure(mesh, options).find("target_face_counts: 3 outside [4, 8]") == 0);
+    options.target_face_counts = {};
+    options.target_ratios = {0.25};
+    CHECK(failure(mesh, options).find("below 4 faces") != std::string::npos);
+    options.target_ratios = {1.5};
+    CHECK(failure(mesh, options).find("target_ratios: 1.5") == 0);
+  }
+}
+
+TEST_CASE("aqem reduces a subdivided cube to its eight exact corners") {
+  const OwnedAnimatedMesh mesh = animlod::testing::subdivided_cube(4);  // 192 faces
+  AqemOptions options;
+  options.target_face_counts = {12};
+  const AqemResult result = simplify(mesh, options);
+  const AqemLevel& level = result.levels[0];
+  CHECK(level.reached);
+  CHECK(level.faces.size() / 3 == 12);
+  CHECK(level.error == doctest::Approx(0.0));
+  REQUIRE(level.kept_vertices.size() == 8);
+  std::set<std::array<float, 3>> corners;
+  for (size_t i = 0; i < 8; ++i)
+    corners.insert({std::round(level.positions[3 * i] * 1e5f) / 1e5f, std::round(level.positions[3 * i + 1] * 1e5f) / 1e5f,
+                    std::round(level.positions[3 * i + 2] * 1e5f) / 1e5f});
+  CHECK(corners.size() == 8);
+  for (const auto& corner : corners)
+    for (float value : corner) CHECK((value == 0.0f || value == 1.0f));
+}

@@ -1,0 +1,137 @@
+// Small procedural animated meshes for the AQEM and motion-feature tests.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <array>
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "animlod/animated_mesh_view.hpp"
+
+namespace animlod::testing {
+
+struct OwnedAnimatedMesh {
+  std::vector<float> frames;    // (F, V, 3)
+  std::vector<int32_t> faces;   // (M, 3)
+  size_t frame_count = 0, vertex_count = 0;
+
+  AnimatedMeshView view() const {
+    return {frames.data(), faces.data(), frame_count, vertex_count, faces.size() / 3};
+  }
+};
+
+// A flat (n+1) x (n+1) grid in z = 0 over [0, 1]^2, faces facing +z, one frame.
+inline OwnedAnimatedMesh grid(int n) {
+  OwnedAnimatedMesh mesh;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) mesh.frames.insert(mesh.frames.end(), {float(i) / n, float(j) / n, 0.0f});
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      mesh.faces.insert(mesh.faces.end(), {a, b, d, a, d, c});
+    }
+  mesh.frame_count = 1;
+  mesh.vertex_count = size_t(n + 1) * (n + 1);
+  return mesh;
+}
+
+// An open tube of radius 0.2 along x in [-1, 1] (rings x segments vertices), faces facing out.
+// Frame f bends the half x > 0 about the z axis by angle f * bend / (F - 1), with a short
+// blend zone around x = 0, like an elbow.
+inline OwnedAnimatedMesh bending_tube(int rings, int segments, int frame_count, double bend) {
+  OwnedAnimatedMesh mesh;
+  mesh.frame_count = size_t(frame_count);
+  mesh.vertex_count = size_t(rings) * segments;
+  const double pi = 3.14159265358979323846;
+  for (int f = 0; f < frame_count; ++f) {
+    const double angle = frame_count > 1 ? bend * f / (frame_count - 1) : 0.0;
+    for (int r = 0; r < rings; ++r) {
+      const double x = -1.0 + 2.0 * r / (rings - 1);
+      const double blend = std::clamp(x / 0.2 + 0.5, 0.0, 1.0);  // 0 left of the elbow, 1 right of it
+      const double a = angle * blend;
+      for (int s = 0; s < segments; ++s) {
+        const double phi = 2.0 * pi * s / segments;
+        const double px = x, py = 0.2 * std::cos(phi), pz = 0.2 * std::sin(phi);
+        mesh.frames.insert(mesh.frames.end(), {float(std::cos(a) * px - std::sin(a) * py),
+                                               float(std::sin(a) * px + std::cos(a) * py), float(pz)});
+      }
+    }
+  }
+  for (int r = 0; r + 1 < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const int32_t a = r * segments + s, b = r * segments + (s + 1) % segments;
+      const int32_t c = a + segments, d = b + segments;
+      mesh.faces.insert(mesh.faces.end(), {a, d, c, a, b, d});
+    }
+  return mesh;
+}
+
+// A closed latitude-longitude sphere of radius 1 (two poles), faces facing out; frame f
+// scales it by (1 + 0.5 f, 1, 1 - 0.3 f / F) so that it deforms smoothly.
+inline OwnedAnimatedMesh sphere(int rings, int segments, int frame_count) {
+  OwnedAnimatedMesh mesh;
+  mesh.frame_count = size_t(frame_count);
+  mesh.vertex_count = size_t(rings - 1) * segments + 2;
+  const double pi = 3.14159265358979323846;
+  for (int f = 0; f < frame_count; ++f) {
+    const double sx = 1.0 + 0.5 * f, sz = 1.0 - 0.3 * f / frame_count;
+    mesh.frames.insert(mesh.frames.end(), {0.0f, 0.0f, float(sz)});
+    for (int r = 1; r < rings; ++r) {
+      const double theta = pi * r / rings;
+      for (int s = 0; s < segments; ++s) {
+        const double phi = 2.0 * pi * s / segments;
+        mesh.frames.insert(mesh.frames.end(), {float(sx * std::sin(theta) * std::cos(phi)),
+                                               float(std::sin(theta) * std::sin(phi)), float(sz * std::cos(theta))});
+      }
+    }
+    mesh.frames.insert(mesh.frames.end(), {0.0f, 0.0f, float(-sz)});
+  }
+  const int32_t south = int32_t(mesh.vertex_count) - 1;
+  auto ring_vertex = [segments](int r, int s) { return int32_t(1 + (r - 1) * segments + (s % segments)); };
+  for (int s = 0; s < segments; ++s) mesh.faces.insert(mesh.faces.end(), {0, ring_vertex(1, s), ring_vertex(1, s + 1)});
+  for (int r = 1; r + 1 < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const int32_t a = ring_vertex(r, s), b = ring_vertex(r, s + 1), c = ring_vertex(r + 1, s), d = ring_vertex(r + 1, s + 1);
+      mesh.faces.insert(mesh.faces.end(), {a, c, d, a, d, b});
+    }
+  for (int s = 0; s < segments; ++s)
+    mesh.faces.insert(mesh.faces.end(), {south, ring_vertex(rings - 1, s + 1), ring_vertex(rings - 1, s)});
+  return mesh;
+}
+
+// The surface of the cube [0, 1]^3 with every side split into n x n cells (two triangles
+// each), vertices shared, faces facing out, one frame.
+inline OwnedAnimatedMesh subdivided_cube(int n) {
+  OwnedAnimatedMesh mesh;
+  std::map<std::array<int, 3>, int32_t> index;
+  auto vertex = [&](std::array<int, 3> lattice) {
+    auto [it, added] = index.emplace(lattice, int32_t(index.size()));
+    if (added)
+      for (int k = 0; k < 3; ++k) mesh.frames.push_back(float(lattice[k]) / n);
+    return it->second;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      // (u, v, axis) is right-handed for side 1; side 0 swaps u and v to face -axis.
+      const int u_axis = (axis + 1 + (1 - side)) % 3, v_axis = (axis + 2 - (1 - side)) % 3;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          auto corner = [&](int di, int dj) {
+            std::array<int, 3> lattice{};
+            lattice[axis] = side * n;
+            lattice[u_axis] = i + di;
+            lattice[v_axis] = j + dj;
+            return vertex(lattice);
+          };
+          const int32_t a = corner(0, 0), b = corner(1, 0), c = corner(1, 1), d = corner(0, 1);
+          mesh.faces.insert(mesh.faces.end(), {a, b, c, a, c, d});
+        }
+    }
+  mesh.frame_count = 1;
+  mesh.vertex_count = index.size();
+  return mesh;
+}
+
+}  // namespace animlod::testing

@@ -1,0 +1,85 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "animlod/motion_features.hpp"
+#include "test_aqem_meshes.hpp"
+
+using animlod::MotionFeatureOptions;
+using animlod::MotionFeatures;
+using animlod::testing::OwnedAnimatedMesh;
+
+namespace {
+MotionFeatures features_of(const OwnedAnimatedMesh& mesh, const MotionFeatureOptions& options) {
+  MotionFeatures features;
+  const animlod::Status status = animlod::compute_motion_features(mesh.view(), options, features);
+  REQUIRE_MESSAGE(status.ok, status.message);
+  return features;
+}
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
+TEST_CASE("motion features measure the change of a hinge's dihedral angle exactly") {
+  // Two triangles on the edge (0, 1); frame 1 folds triangle (1, 0, 3) up by 30 degrees.
+  OwnedAnimatedMesh mesh;
+  const float c = float(std::cos(kPi / 6)), s = float(std::sin(kPi / 6));
+  mesh.frames = {0, 0, 0, 1, 0, 0, 0.5f, 1, 0, 0.5f, -1, 0,
+                 0, 0, 0, 1, 0, 0, 0.5f, 1, 0, 0.5f, -c, s};
+  mesh.faces = {0, 1, 2, 1, 0, 3};
+  mesh.frame_count = 2;
+  mesh.vertex_count = 4;
+  MotionFeatureOptions options;
+  options.boundary_is_feature = false;
+  options.feature_threshold = 0.1;
+  const MotionFeatures features = features_of(mesh, options);
+  REQUIRE(features.edges.size() == 10);
+  CHECK(features.edges[0] == 0);  // edges sorted: (0, 1) first
+  CHECK(features.edges[1] == 1);
+  CHECK(features.angle_change[0] == doctest::Approx(kPi / 6));
+  for (size_t e = 1; e < 5; ++e) CHECK(features.angle_change[e] == 0.0f);
+  CHECK(features.connected == std::vector<uint8_t>{1, 0, 0, 0, 0});
+  CHECK(features.feature_sizes == std::vector<int32_t>{2});
+  CHECK(features.vertex_weights == std::vector<float>{2, 2, 1, 1});
+  CHECK(features.vertex_feature == std::vector<int32_t>{0, 0, -1, -1});
+}
+
+TEST_CASE("a rigidly translating mesh has no motion features") {
+  OwnedAnimatedMesh mesh = animlod::testing::bending_tube(10, 12, 1, 0.0);
+  const std::vector<float> first = mesh.frames;
+  for (int f = 1; f < 6; ++f)
+    for (size_t i = 0; i < first.size(); ++i) mesh.frames.push_back(first[i] + (i % 3 == 0 ? 0.37f * f : 0.0f));
+  mesh.frame_count = 6;
+  MotionFeatureOptions options;
+  options.boundary_is_feature = false;
+  const MotionFeatures features = features_of(mesh, options);
+  CHECK(features.feature_sizes.empty());
+  for (float w : features.vertex_weights) CHECK(w == 1.0f);
+
+  // With the paper's boundary rule the two open ends are features of 12 vertices each.
+  options.boundary_is_feature = true;
+  const MotionFeatures with_boundary = features_of(mesh, options);
+  CHECK(with_boundary.feature_sizes == std::vector<int32_t>{12, 12});
+  CHECK(with_boundary.vertex_weights[0] == 12.0f);
+  CHECK(with_boundary.vertex_weights[12] == 1.0f);
+}
+
+TEST_CASE("a bending tube has its motion feature at the elbow") {
+  const int rings = 21, segments = 12;
+  const OwnedAnimatedMesh mesh = animlod::testing::bending_tube(rings, segments, 5, 1.2);
+  MotionFeatureOptions options;
+  options.boundary_is_feature = false;
+  const MotionFeatures features = features_of(mesh, options);
+  // The elbow's two kinks (rings 9 and 11, where the blend zone starts and ends) bend most.
+  REQUIRE_FALSE(features.feature_sizes.empty());
+  for (size_t v = 0; v < mesh.vertex_count; ++v) {
+    const double x = -1.0 + 2.0 * double(v / segments) / (rings - 1);  // rest position along the tube
+    if (std::fabs(x) > 0.35) CHECK(features.vertex_feature[v] == -1);
+  }
+  for (int ring : {9, 11}) {
+    const int32_t feature = features.vertex_feature[ring * segments];
+    REQUIRE(feature >= 0);
+    CHECK(features.vertex_weights[ring * segments] == float(features.feature_sizes[feature]));
+  }
+  CHECK(features.threshold > 0.0);
+}

@@ -1,5 +1,22 @@
 """File formats: BVH, glTF 2.0 / GLB, OBJ and PLY frame sequences, NPZ."""
 
+from .bvh import read_bvh, write_bvh
 from .errors import FormatError
+from .meshseq import read_mesh, read_obj, read_ply, read_sequence, write_mesh, write_obj, write_ply, write_sequence
+from .npz import read_npz, write_npz
 
-__all__ = ["FormatError"]
+__all__ = [
+    "FormatError",
+    "read_bvh",
+    "read_mesh",
+    "read_npz",
+    "read_obj",
+    "read_ply",
+    "read_sequence",
+    "write_bvh",
+    "write_mesh",
+    "write_npz",
+    "write_obj",
+    "write_ply",
+    "write_sequence",
+]

@@ -1,0 +1,423 @@
+"""BVH (Biovision Hierarchy) motion files: read and write.
+
+A BVH file has a HIERARCHY (joints with an OFFSET, CHANNELS and children, leaves marked by
+``End Site``) and a MOTION table with one row of channel values per frame.
+
+Conventions of this reader, in terms of :class:`animlod.model.Motion`:
+
+- Joints are kept in file order (depth first), so parents come before children. An
+  ``End Site`` becomes a joint with ``skeleton.end_sites[j] = True``, named after the name
+  written beside it or else ``f"{parent}_End"``.
+- ``skeleton.offsets`` are the OFFSET values; the root's offset is its rest position.
+- Position channels *replace* the offset of their joint. The root's become
+  ``root_positions`` (the root's OFFSET when it has none). Position channels on other joints
+  (Bandai Namco files put six channels on every joint, and animate the hips' translation under
+  a static root) become ``Motion.joint_translations`` when they differ from the OFFSET in any
+  frame, so forward kinematics matches the file exactly; otherwise it stays None.
+- Rotation channels are intrinsic Euler angles in degrees, in the order the channels are
+  written (``Zrotation Xrotation Yrotation`` means ``R = Rz @ Rx @ Ry``), per joint.
+- ``Frame Time`` gives fps; when the written frame time is an integer rate rounded to the digits
+  written (``.0083333`` for 120 fps), fps is that integer.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import rotations
+from ..model import Motion, Skeleton
+from .atomic import atomic_write
+from .errors import FormatError
+from .tokens import tokens_per_line
+
+# Lower-case channel name -> (kind, axis index).
+_CHANNELS = {
+    f"{axis.lower()}{kind}": (kind, index)
+    for index, axis in enumerate("XYZ")
+    for kind in ("position", "rotation")
+}
+_MOTION_LINE = re.compile(r"^[ \t]*MOTION\b", re.MULTILINE)
+
+
+@dataclass
+class _JointSpec:
+    """One joint as written in the HIERARCHY section."""
+
+    name: str
+    parent: int
+    line: int
+    end_site: bool
+    offset: tuple[float, float, float] | None = None
+    channels: list[str] = field(default_factory=list)
+
+
+class _TokenCursor:
+    """Whitespace-separated tokens of the HIERARCHY section, each with its 1-based line number."""
+
+    def __init__(self, path: Path, lines: list[str]) -> None:
+        self.path = path
+        self.tokens = [(token, number) for number, line in enumerate(lines, start=1) for token in line.split()]
+        self.position = 0
+        self.last_line = len(lines)
+
+    def error(self, line: int, reason: str) -> FormatError:
+        return FormatError(self.path, f"line {line}", reason)
+
+    def peek(self) -> tuple[str, int] | None:
+        return self.tokens[self.position] if self.position < len(self.tokens) else None
+
+    def next(self, expected: str) -> tuple[str, int]:
+        token = self.peek()
+        if token is None:
+            raise self.error(self.last_line, f"file ends where {expected} was expected")
+        self.position += 1
+        return token
+
+    def expect(self, literal: str) -> int:
+        token, line = self.next(repr(literal))
+        if token != literal:
+            raise self.error(line, f"expected {literal!r}, found {token!r}")
+        return line
+
+    def number(self, what: str) -> float:
+        token, line = self.next(what)
+        try:
+            value = float(token)
+        except ValueError:
+            raise self.error(line, f"{what}: {token!r} is not a number") from None
+        if not np.isfinite(value):
+            raise self.error(line, f"{what}: value {token} is not finite")
+        return value
+
+    def rest_of_line(self, line: int) -> str:
+        """Join the tokens left on ``line`` up to an opening brace (joint names may hold spaces)."""
+        words = []
+        while (token := self.peek()) is not None and token[1] == line and token[0] != "{":
+            words.append(self.next("name")[0])
+        return " ".join(words)
+
+
+def read_bvh(path: str | os.PathLike) -> Motion:
+    """Read a BVH file into a :class:`~animlod.model.Motion` (conventions in the module docstring).
+
+    Parameters
+    ----------
+    path : the .bvh file; LF, CRLF and mixed line endings are accepted.
+
+    Returns
+    -------
+    Motion with ``local_rotations (T, J, 4)``, ``root_positions (T, 3)``, fps from Frame Time,
+    the file's stem as name, and ``joint_translations (T, J, 3)`` when non-root position
+    channels move their joints away from their offsets.
+
+    Raises
+    ------
+    FormatError
+        Naming the file, the line, joint or frame, and the reason: a malformed hierarchy, a
+        MOTION table with fewer or more rows than ``Frames:``, a row with the wrong number of
+        values, a value that is not a finite number.
+    """
+    path = Path(path)
+    text = path.read_bytes().decode("utf-8", errors="replace").replace("\r\n", "\n").replace("\r", "\n")
+    motion_match = _MOTION_LINE.search(text)
+    hierarchy_lines = text[: motion_match.start() if motion_match else len(text)].split("\n")
+    cursor = _TokenCursor(path, hierarchy_lines)
+    joints = _parse_hierarchy(cursor)
+    if motion_match is None:
+        raise FormatError(path, f"line {len(hierarchy_lines)}", "no MOTION section after the hierarchy")
+    motion_line = len(hierarchy_lines)
+    frame_count, frame_time, data_line, data_text = _parse_motion_header(path, text[motion_match.end() :], motion_line)
+    channel_count = sum(len(joint.channels) for joint in joints)
+    values = _parse_motion_table(path, data_text, data_line, frame_count, channel_count, joints)
+    return _build_motion(path, joints, values, frame_time)
+
+
+def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
+    cursor.expect("HIERARCHY")
+    token, line = cursor.next("ROOT")
+    if token != "ROOT":
+        raise cursor.error(line, f"expected ROOT, found {token!r}")
+    joints: list[_JointSpec] = []
+    _parse_joint(cursor, joints, parent=-1, line=line, end_site=False)
+    extra = cursor.peek()
+    if extra is not None:
+        reason = "a second ROOT is not supported" if extra[0] == "ROOT" else f"unexpected {extra[0]!r} after the root"
+        raise cursor.error(extra[1], reason)
+    return joints
+
+
+def _parse_joint(cursor: _TokenCursor, joints: list[_JointSpec], parent: int, line: int, end_site: bool) -> None:
+    """Parse one ROOT / JOINT / End Site block (its keyword already consumed) and its children."""
+    name = cursor.rest_of_line(line)
+    if end_site:
+        name = _unique_name(name or f"{joints[parent].name}_End", joints)
+    elif not name:
+        raise cursor.error(line, "joint without a name")
+    elif any(joint.name == name for joint in joints):
+        raise cursor.error(line, f"joint name {name!r} is used twice")
+    cursor.expect("{")
+    index = len(joints)
+    joint = _JointSpec(name, parent, line, end_site)
+    joints.append(joint)
+    while True:
+        token, token_line = cursor.next(f"'}}' closing joint {name!r} (opened on line {line})")
+        if token == "}":
+            break
+        if token == "OFFSET":
+            joint.offset = tuple(cursor.number(f"OFFSET of joint {name!r}") for _ in range(3))
+        elif token == "CHANNELS" and not end_site:
+            joint.channels = _parse_channels(cursor, name, token_line)
+        elif token == "JOINT" and not end_site:
+            _parse_joint(cursor, joints, index, token_line, end_site=False)
+        elif token == "End" and not end_site:
+            cursor.expect("Site")
+            _parse_joint(cursor, joints, index, token_line, end_site=True)
+        else:
+            where = f"End Site of {joints[parent].name!r}" if end_site else f"joint {name!r}"
+            raise cursor.error(token_line, f"unexpected {token!r} in {where}")
+    if joint.offset is None:
+        raise cursor.error(line, f"joint {name!r} has no OFFSET")
+
+
+def _parse_channels(cursor: _TokenCursor, joint_name: str, line: int) -> list[str]:
+    count_token, _ = cursor.next("channel count")
+    if not count_token.isdigit():
+        raise cursor.error(line, f"joint {joint_name!r}: channel count {count_token!r} is not a whole number")
+    channels = [cursor.next(f"channel name of joint {joint_name!r}")[0] for _ in range(int(count_token))]
+    unknown = [channel for channel in channels if channel.lower() not in _CHANNELS]
+    if unknown:
+        raise cursor.error(line, f"joint {joint_name!r}: unknown channel {unknown[0]!r}")
+    lowered = [channel.lower() for channel in channels]
+    rotation_count = sum(_CHANNELS[channel][0] == "rotation" for channel in lowered)
+    if len(set(lowered)) != len(lowered) or rotation_count not in (0, 3):
+        reason = f"channels {channels} must name each axis once, with all three rotations or none"
+        raise cursor.error(line, f"joint {joint_name!r}: {reason}")
+    return lowered
+
+
+def _unique_name(name: str, joints: list[_JointSpec]) -> str:
+    taken = {joint.name for joint in joints}
+    candidate, suffix = name, 1
+    while candidate in taken:
+        candidate, suffix = f"{name}{suffix}", suffix + 1
+    return candidate
+
+
+def _parse_motion_header(path: Path, text: str, motion_line: int) -> tuple[int, float, int, str]:
+    """Read ``Frames:`` and ``Frame Time:`` after MOTION; return them, the first data line and the data text."""
+    header = text.split("\n", 3)
+    if len(header) < 3:
+        raise FormatError(path, f"line {motion_line}", "MOTION is not followed by Frames: and Frame Time: lines")
+    frames_match = re.fullmatch(r"\s*Frames:\s*(\d+)\s*", header[1])
+    if frames_match is None:
+        raise FormatError(path, f"line {motion_line + 1}", f"expected 'Frames: N', found {header[1].strip()!r}")
+    time_match = re.fullmatch(r"\s*Frame\s+Time:\s*(\S+)\s*", header[2])
+    frame_time = _finite_float(time_match.group(1)) if time_match else None
+    if frame_time is None or frame_time <= 0.0:
+        found = header[2].strip()
+        raise FormatError(path, f"line {motion_line + 2}", f"expected 'Frame Time: SECONDS' > 0, found {found!r}")
+    frame_count = int(frames_match.group(1))
+    if frame_count < 1:
+        raise FormatError(path, f"line {motion_line + 1}", "Frames: must be at least 1")
+    return frame_count, _frame_rate(time_match.group(1)), motion_line + 3, header[3] if len(header) > 3 else ""
+
+
+def _finite_float(token: str) -> float | None:
+    try:
+        value = float(token)
+    except ValueError:
+        return None
+    return value if np.isfinite(value) else None
+
+
+def _frame_rate(frame_time: str) -> float:
+    """Frames per second for a written frame time, snapped to the integer rate it was rounded from."""
+    seconds = float(frame_time)
+    decimals = len(frame_time.split(".")[1]) if "." in frame_time and "e" not in frame_time.lower() else None
+    rate = 1.0 / seconds
+    whole = round(rate)
+    if decimals is not None and whole >= 1 and abs(seconds - 1.0 / whole) <= 0.5 * 10.0**-decimals:
+        return float(whole)
+    return rate
+
+
+def _parse_motion_table(
+    path: Path, text: str, first_line: int, frame_count: int, channel_count: int, joints: list[_JointSpec]
+) -> np.ndarray:
+    """Channel values ``(T, C)`` of the MOTION rows, checked row by row against the hierarchy."""
+    counts = tokens_per_line(text.encode("utf-8"))
+    rows = np.nonzero(counts)[0]  # blank lines are skipped
+    wrong = rows[counts[rows] != channel_count]
+    if wrong.size:
+        row = int(np.searchsorted(rows, wrong[0]))
+        raise FormatError(
+            path,
+            f"line {first_line + wrong[0]} (frame {row})",
+            f"expected {channel_count} channel values, found {counts[wrong[0]]}",
+        )
+    if rows.size != frame_count:
+        reason = f"Frames: says {frame_count} but the MOTION table has {rows.size} rows"
+        reason += " (truncated file?)" if rows.size < frame_count else ""
+        raise FormatError(path, f"line {first_line + (rows[-1] + 1 if rows.size else 0)} (frame {rows.size})", reason)
+    owners = [(joint.name, channel) for joint in joints for channel in joint.channels]
+
+    def value_error(flat_index: int, reason: str) -> FormatError:
+        frame, column = divmod(flat_index, channel_count)
+        joint_name, channel = owners[column]
+        element = f"line {first_line + rows[frame]} (frame {frame}), joint {joint_name!r} {channel}"
+        return FormatError(path, element, reason)
+
+    tokens = text.split()
+    try:
+        values = np.array(tokens, dtype=np.float64).reshape(frame_count, channel_count)
+    except ValueError:
+        bad = next(index for index, token in enumerate(tokens) if not _is_number(token))
+        raise value_error(bad, f"{tokens[bad]!r} is not a number") from None
+    finite = np.isfinite(values)
+    if not finite.all():
+        bad = int(np.argmin(finite.ravel()))
+        raise value_error(bad, f"value {values.flat[bad]} is not finite")
+    return values
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
+def _build_motion(path: Path, joints: list[_JointSpec], values: np.ndarray, fps: float) -> Motion:
+    """Turn channel values ``(T, C)`` into root positions, local rotations and joint translations."""
+    joint_count = len(joints)
+    offsets = np.array([joint.offset for joint in joints], dtype=np.float64)
+    translations = np.repeat(offsets[None], values.shape[0], axis=0)
+    local_rotations = rotations.identity((values.shape[0], joint_count))
+    position_columns: list[tuple[int, int, int]] = []  # (joint, axis, column)
+    rotation_columns: dict[str, list[tuple[int, list[int]]]] = {}  # Euler order -> [(joint, columns)]
+    column = 0
+    for index, joint in enumerate(joints):
+        order, columns = "", []
+        for channel in joint.channels:
+            kind, axis = _CHANNELS[channel]
+            if kind == "position":
+                position_columns.append((index, axis, column))
+            else:
+                order, columns = order + "XYZ"[axis], columns + [column]
+            column += 1
+        if order:
+            rotation_columns.setdefault(order, []).append((index, columns))
+    if position_columns:
+        joint_index, axis, source = np.array(position_columns).T
+        translations[:, joint_index, axis] = values[:, source]
+    # One vectorised conversion per Euler order present in the file (at most six).
+    for order, entries in rotation_columns.items():
+        joint_index = np.array([entry[0] for entry in entries])
+        angles = np.radians(values[:, np.array([entry[1] for entry in entries])])
+        local_rotations[:, joint_index] = rotations.from_euler(angles, order)
+    moved = np.any(translations[:, 1:] != offsets[None, 1:])
+    skeleton = Skeleton(
+        [joint.name for joint in joints],
+        np.array([joint.parent for joint in joints]),
+        offsets,
+        end_sites=np.array([joint.end_site for joint in joints]),
+    )
+    return Motion(
+        skeleton,
+        translations[:, 0],
+        local_rotations,
+        fps,
+        name=path.stem,
+        joint_translations=translations if moved else None,
+    )
+
+
+def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZXY", precision: int = 6) -> None:
+    """Write ``motion`` as a BVH file, atomically.
+
+    The root gets six channels (position, then rotation in ``rotation_order``), other joints
+    three rotation channels, plus three position channels where ``motion.joint_translations``
+    moves them away from their offsets. End-site joints are written as ``End Site`` blocks
+    (their names are not stored; :func:`read_bvh` names them ``f"{parent}_End"``). A leaf that
+    is not an end site is written as a JOINT without children. ``skeleton.rest_rotations`` are
+    not written: Motion's forward kinematics does not use them.
+
+    Parameters
+    ----------
+    path : destination file.
+    motion : the motion to write.
+    rotation_order : Euler order of the rotation channels, three different axes, e.g. "ZXY".
+    precision : digits after the decimal point for offsets and channel values.
+
+    Raises
+    ------
+    ValueError
+        For an unsupported ``rotation_order`` or an end site whose translation is animated.
+    """
+    order = rotation_order.upper()
+    if len(order) != 3 or set(order) != set("XYZ"):
+        raise ValueError(f"rotation_order must be a permutation of XYZ, got {rotation_order!r}")
+    skeleton = motion.skeleton
+    translations = motion.joint_translations
+    has_position = np.zeros(skeleton.joint_count, dtype=bool)
+    has_position[0] = True
+    if translations is not None:
+        has_position[1:] = np.any(translations[:, 1:] != skeleton.offsets[None, 1:], axis=(0, 2))
+        translations = translations.copy()
+    else:
+        translations = np.repeat(skeleton.offsets[None], motion.frame_count, axis=0)
+    translations[:, 0] = motion.root_positions
+    animated_end_sites = np.nonzero(has_position & skeleton.end_sites)[0]
+    if animated_end_sites.size:
+        name = skeleton.names[animated_end_sites[0]]
+        raise ValueError(f"joint {name!r} is an end site with animated translation; BVH cannot store it")
+    rotated = ~skeleton.end_sites
+    angles = np.degrees(rotations.to_euler(motion.local_rotations[:, rotated], order))
+    angle_of_joint = np.cumsum(rotated) - 1
+    blocks = []
+    for joint in range(skeleton.joint_count):
+        if has_position[joint]:
+            blocks.append(translations[:, joint])
+        if rotated[joint]:
+            blocks.append(angles[:, angle_of_joint[joint]])
+    table = np.concatenate(blocks, axis=1)
+    hierarchy = _hierarchy_text(skeleton, has_position, order, precision)
+    with atomic_write(path, "w", encoding="utf-8", newline="\n") as handle:
+        handle.write(hierarchy)
+        handle.write(f"MOTION\nFrames: {motion.frame_count}\nFrame Time: {1.0 / motion.fps:.10g}\n")
+        np.savetxt(handle, table, fmt=f"%.{precision}f", delimiter=" ")
+
+
+def _hierarchy_text(skeleton: Skeleton, has_position: np.ndarray, order: str, precision: int) -> str:
+    children = skeleton.children()
+    lines = ["HIERARCHY"]
+
+    def emit(joint: int, depth: int) -> None:
+        indent = "\t" * depth
+        offset = " ".join(f"{value:.{precision}f}" for value in skeleton.offsets[joint])
+        if skeleton.end_sites[joint]:
+            lines.extend([f"{indent}End Site", f"{indent}{{", f"{indent}\tOFFSET {offset}", f"{indent}}}"])
+            return
+        channels = [f"{axis}position" for axis in "XYZ"] if has_position[joint] else []
+        channels += [f"{axis}rotation" for axis in order]
+        keyword = "ROOT" if joint == 0 else "JOINT"
+        lines.extend(
+            [
+                f"{indent}{keyword} {skeleton.names[joint]}",
+                f"{indent}{{",
+                f"{indent}\tOFFSET {offset}",
+                f"{indent}\tCHANNELS {len(channels)} {' '.join(channels)}",
+            ]
+        )
+        for child in children[joint]:
+            emit(child, depth + 1)
+        lines.append(f"{indent}}}")
+
+    emit(0, 0)
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,517 @@
+"""OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
+
+Only geometry is read: OBJ ``v`` and ``f`` lines (1-based or negative indices, ``a/b/c``
+corners, polygons fan-triangulated; other statements such as ``vt``, ``vn``, ``g``, ``usemtl``
+are ignored) and PLY ``vertex`` x, y, z with the ``face`` list ``vertex_indices`` (ascii,
+binary_little_endian, binary_big_endian; other elements and properties are skipped).
+Statements must start at the beginning of their line. Parsing works on the whole file's
+bytes with numpy: there is no Python loop over lines, vertices or faces.
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..model import AnimatedMesh
+from .atomic import atomic_write
+from .errors import FormatError
+from .tokens import tokens_per_line
+
+MESH_SUFFIXES = (".obj", ".ply")
+_PLY_TYPES = {
+    name: code
+    for names, code in [
+        (("char", "int8"), "i1"),
+        (("uchar", "uint8"), "u1"),
+        (("short", "int16"), "i2"),
+        (("ushort", "uint16"), "u2"),
+        (("int", "int32"), "i4"),
+        (("uint", "uint32"), "u4"),
+        (("float", "float32"), "f4"),
+        (("double", "float64"), "f8"),
+    ]
+    for name in names
+}
+_PLY_FORMATS = {"ascii": None, "binary_little_endian": "<", "binary_big_endian": ">"}
+_FACE_LIST_NAMES = ("vertex_indices", "vertex_index")
+
+
+# ---------------------------------------------------------------------------------------------
+# Sequences
+
+
+def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: float | None = None) -> AnimatedMesh:
+    """Read OBJ/PLY frames that share one connectivity into an :class:`~animlod.model.AnimatedMesh`.
+
+    Parameters
+    ----------
+    source : a folder (every .obj and .ply file in it, in natural order: frame2 before
+        frame10), a glob pattern (its matches in natural order), a single file, or a list of
+        files (in the order given).
+    fps : frames per second of the sequence, or None for a set of poses.
+
+    Returns
+    -------
+    AnimatedMesh with ``frames (F, V, 3) float32`` and the first file's ``faces (M, 3) int32``.
+
+    Raises
+    ------
+    FormatError
+        When no frame is found, a file cannot be read, or a frame's vertex count or faces
+        differ from the first frame's (naming the file and the first differing face).
+    """
+    paths = _sequence_paths(source)
+    first_vertices, faces = read_mesh(paths[0])
+    frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
+    frames[0] = first_vertices
+    for index, path in enumerate(paths[1:], start=1):
+        vertices, frame_faces = read_mesh(path)
+        _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
+        frames[index] = vertices
+    return AnimatedMesh(faces, frames, fps=fps)
+
+
+def write_sequence(folder: str | os.PathLike, mesh: AnimatedMesh, fmt: str = "obj", stem: str = "frame") -> list[Path]:
+    """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, each file atomically.
+
+    Existing files with other names are left alone, so write into an empty folder if it is to be
+    read back with :func:`read_sequence`. ``fmt`` is "obj" or "ply" (binary little-endian).
+    Returns the written paths in frame order.
+    """
+    if fmt not in ("obj", "ply"):
+        raise ValueError(f"fmt must be 'obj' or 'ply', got {fmt!r}")
+    width = max(4, len(str(mesh.frame_count - 1)))
+    paths = [Path(folder) / f"{stem}_{index:0{width}d}.{fmt}" for index in range(mesh.frame_count)]
+    for path, vertices in zip(paths, mesh.frames):
+        write_mesh(path, vertices, mesh.faces)
+    return paths
+
+
+def _sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> list[Path]:
+    if not isinstance(source, (str, os.PathLike)):
+        paths = [Path(path) for path in source]
+        if not paths:
+            raise FormatError("<list>", "source", "the list of frames is empty")
+        return paths
+    location = Path(source)
+    if location.is_dir():
+        paths = [path for path in location.iterdir() if path.suffix.lower() in MESH_SUFFIXES and path.is_file()]
+    elif glob.has_magic(os.fspath(source)):
+        paths = [Path(match) for match in glob.glob(os.fspath(source))]
+    elif location.is_file():
+        return [location]
+    else:
+        raise FormatError(source, "source", "is not a folder, a glob pattern or an existing file")
+    if not paths:
+        raise FormatError(source, "source", "no .obj or .ply frame found")
+    return sorted(paths, key=_natural_key)
+
+
+def _natural_key(path: Path) -> tuple[list[object], str]:
+    """Sort key that orders embedded numbers by value (frame2 < frame10), then by full path."""
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", path.name)], str(path)
+
+
+def _check_same_connectivity(
+    path: Path, vertices: np.ndarray, faces: np.ndarray, first_path: Path, first_faces: np.ndarray, vertex_count: int
+) -> None:
+    first = f"the first frame {first_path.name}"
+    if len(vertices) != vertex_count:
+        raise FormatError(path, "vertices", f"{len(vertices)} vertices, but {first} has {vertex_count}")
+    if faces.shape != first_faces.shape:
+        raise FormatError(path, "faces", f"{len(faces)} triangles, but {first} has {len(first_faces)}")
+    differs = np.any(faces != first_faces, axis=1)
+    if differs.any():
+        face = int(np.argmax(differs))
+        reason = f"{faces[face].tolist()} differs from {first_faces[face].tolist()} in {first}"
+        raise FormatError(path, f"face {face}", reason)
+
+
+# ---------------------------------------------------------------------------------------------
+# Single meshes
+
+
+def read_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
+    """Read one .obj or .ply file: ``vertices (V, 3) float32`` and triangle ``faces (M, 3) int32``."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".obj":
+        return read_obj(path)
+    if suffix == ".ply":
+        return read_ply(path)
+    raise FormatError(path, "file name", f"expected one of {', '.join(MESH_SUFFIXES)}")
+
+
+def write_mesh(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) -> None:
+    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".obj":
+        write_obj(path, vertices, faces)
+    elif suffix == ".ply":
+        write_ply(path, vertices, faces)
+    else:
+        raise ValueError(f"{os.fspath(path)}: expected one of {', '.join(MESH_SUFFIXES)}")
+
+
+def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
+    """Read the ``v`` and ``f`` lines of a Wavefront OBJ file.
+
+    Returns ``vertices (V, 3) float32`` (extra values such as w or colours are dropped) and
+    ``faces (M, 3) int32``, 0-based, polygons fan-triangulated in file order.
+
+    Raises
+    ------
+    FormatError
+        Naming the line and vertex or face for a malformed or non-finite coordinate, a face
+        with fewer than three corners, or a face index outside the vertices defined so far.
+    """
+    path = Path(path)
+    data = path.read_bytes().replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    (vertex_block, vertex_lines), (face_block, face_lines) = _obj_statements(data, (b"v", b"f"))
+
+    def name_vertex(vertex: int) -> str:
+        return f"vertex {vertex} (line {vertex_lines[vertex]})"
+
+    tokens, starts, sizes = _tagged_rows(vertex_block, b"v")
+    _require_sizes(path, sizes, 3, name_vertex, "coordinates")
+    columns = tokens[starts[:, None] + np.arange(1, 4)]
+    vertices = _parse_numbers(path, columns, np.float64, lambda token: name_vertex(token // 3)).astype(np.float32)
+    _check_finite_vertices(path, vertices, name_vertex)
+
+    def name_face(face: int) -> str:
+        return f"face {face} (line {face_lines[face]})"
+
+    tokens, starts, sizes = _tagged_rows(re.sub(rb"/\S*", b"", face_block), b"f")  # the vertex of v/vt/vn
+    _require_sizes(path, sizes, 3, name_face, "vertices")
+    owner = np.repeat(np.arange(sizes.size), sizes)
+    written = _parse_numbers(path, np.delete(tokens, starts), np.int64, lambda corner: name_face(owner[corner]))
+    # Negative indices count back from the last vertex defined above the face's line.
+    defined = np.searchsorted(vertex_lines, face_lines)[owner]
+    resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
+    _check_face_indices(path, resolved, written, owner, len(vertices), name_face)
+    return vertices, _fan_triangulate(resolved, sizes)
+
+
+def write_obj(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) -> None:
+    """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically.
+
+    Coordinates are written with 9 significant digits, which round-trips float32 exactly.
+    """
+    vertices = np.asarray(vertices, dtype=np.float32).astype(np.float64)
+    faces = np.asarray(faces, dtype=np.int64) + 1
+    with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
+        handle.write("# written by animlod\n")
+        handle.write(("v %.9g %.9g %.9g\n" * len(vertices)) % tuple(vertices.ravel()))
+        handle.write(("f %d %d %d\n" * len(faces)) % tuple(faces.ravel()))
+
+
+def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:
+    """For each one-letter tag: the bytes of all lines starting with it, and their 1-based line numbers."""
+    codes = np.frombuffer(data + b"\n\n", dtype=np.uint8)  # padding: every line start has two bytes
+    newline = codes[: len(data)] == ord("\n")
+    line_starts = np.concatenate(([0], np.flatnonzero(newline) + 1))
+    separated = np.isin(codes[line_starts + 1], np.frombuffer(b" \t", dtype=np.uint8))
+    line_of_byte = np.cumsum(newline) - newline
+    result = []
+    for tag in tags:
+        selected = (codes[line_starts] == tag[0]) & separated
+        result.append((codes[: len(data)][selected[line_of_byte]].tobytes(), np.flatnonzero(selected) + 1))
+    return result
+
+
+def _tagged_rows(block: bytes, tag: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Tokens of ``tag``-led lines, the index of each line's tag and the values after each tag."""
+    tokens = np.array(block.split(), dtype=np.bytes_)
+    starts = np.flatnonzero(tokens == tag)
+    sizes = np.diff(np.append(starts, tokens.size)) - 1
+    return tokens, starts, sizes
+
+
+def _require_sizes(path: Path, sizes: np.ndarray, minimum: int, element: Callable[[int], str], what: str) -> None:
+    short = np.flatnonzero(sizes < minimum)
+    if short.size:
+        raise FormatError(path, element(short[0]), f"needs at least {minimum} {what}, has {sizes[short[0]]}")
+
+
+def _parse_numbers(path: Path, tokens: np.ndarray, dtype: type, element: Callable[[int], str]) -> np.ndarray:
+    """Convert byte-string tokens to ``dtype``; on failure name the element holding the first bad token."""
+    try:
+        return tokens.astype(dtype)
+    except ValueError:
+        flat = tokens.ravel()
+        bad = next(index for index, token in enumerate(flat) if not _parses(token, dtype))
+        raise FormatError(path, element(bad), f"{flat[bad].decode(errors='replace')!r} is not a number") from None
+
+
+def _parses(token: bytes, dtype: type) -> bool:
+    try:
+        np.array([token]).astype(dtype)
+    except ValueError:
+        return False
+    return True
+
+
+def _check_finite_vertices(path: Path, vertices: np.ndarray, element: Callable[[int], str]) -> None:
+    finite = np.isfinite(vertices).all(axis=1)
+    if not finite.all():
+        vertex = int(np.argmin(finite))
+        raise FormatError(path, element(vertex), f"coordinates {vertices[vertex].tolist()} are not finite")
+
+
+def _check_face_indices(
+    path: Path,
+    indices: np.ndarray,
+    written: np.ndarray,
+    owner: np.ndarray,
+    vertex_count: int,
+    element: Callable[[int], str],
+) -> None:
+    """``indices`` are 0-based corners, ``written`` as in the file, ``owner`` the face of each corner."""
+    outside = np.flatnonzero((indices < 0) | (indices >= vertex_count))
+    if outside.size:
+        corner = outside[0]
+        reason = f"vertex index {written[corner]} is outside the {vertex_count} vertices"
+        raise FormatError(path, element(int(owner[corner])), reason)
+
+
+def _fan_triangulate(corners: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """Triangles ``(sum(sizes - 2), 3) int32`` fanning each polygon from its first corner.
+
+    ``corners`` holds the vertex indices of all polygons back to back, ``sizes`` their lengths.
+    """
+    first = np.cumsum(sizes) - sizes
+    triangle_counts = sizes - 2
+    polygon = np.repeat(np.arange(sizes.size), triangle_counts)
+    step = np.arange(triangle_counts.sum()) - np.repeat(np.cumsum(triangle_counts) - triangle_counts, triangle_counts)
+    base = first[polygon]
+    return np.stack([corners[base], corners[base + step + 1], corners[base + step + 2]], axis=1).astype(np.int32)
+
+
+# ---------------------------------------------------------------------------------------------
+# PLY
+
+
+@dataclass
+class _PlyProperty:
+    name: str
+    type_code: str  # numpy type code without byte order, e.g. "f4"
+    count_code: str | None = None  # set for list properties: the type of the length prefix
+
+
+@dataclass
+class _PlyElement:
+    name: str
+    count: int
+    properties: list[_PlyProperty] = field(default_factory=list)
+
+
+def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
+    """Read the vertex positions and faces of a PLY file (ascii or binary).
+
+    Returns ``vertices (V, 3) float32`` from vertex x, y, z and ``faces (M, 3) int32`` from the
+    face list ``vertex_indices`` (or ``vertex_index``), fan-triangulated; no face element gives
+    ``(0, 3)``. A binary file must use one polygon size per list element (all triangles, say);
+    ascii files may mix sizes.
+
+    Raises
+    ------
+    FormatError
+        For an unreadable header, a body shorter than the header announces, a missing x/y/z,
+        a non-finite coordinate or a face index out of range.
+    """
+    path = Path(path)
+    data = path.read_bytes()
+    byte_order, elements, body = _read_ply_header(path, data)
+    if byte_order is None:
+        values = _read_ply_ascii(path, data[body:], elements)
+    else:
+        values = _read_ply_binary(path, data, body, elements, byte_order)
+    vertex = values.get("vertex", {})
+    missing = [axis for axis in "xyz" if axis not in vertex or isinstance(vertex[axis], tuple)]
+    if missing:
+        raise FormatError(path, "element vertex", f"has no scalar property {missing[0]}")
+    vertices = np.stack([vertex[axis] for axis in "xyz"], axis=1).astype(np.float32)
+    _check_finite_vertices(path, vertices, lambda index: f"vertex {index}")
+    face = values.get("face", {})
+    face_list = next((face[name] for name in _FACE_LIST_NAMES if isinstance(face.get(name), tuple)), None)
+    if face_list is None:
+        if any(element.name == "face" and element.count for element in elements):
+            raise FormatError(path, "element face", "has no list property vertex_indices")
+        return vertices, np.zeros((0, 3), dtype=np.int32)
+    sizes, corners = face_list
+
+    def name_face(face_index: int) -> str:
+        return f"face {face_index}"
+
+    _require_sizes(path, sizes, 3, name_face, "vertices")
+    corners = corners.astype(np.int64)
+    _check_face_indices(path, corners, corners, np.repeat(np.arange(sizes.size), sizes), len(vertices), name_face)
+    return vertices, _fan_triangulate(corners, sizes)
+
+
+def write_ply(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, binary: bool = True) -> None:
+    """Write ``vertices (V, 3)`` as float x, y, z and ``faces (M, 3)`` as uchar/int lists, atomically.
+
+    ``binary=True`` writes binary_little_endian (exact); ``binary=False`` ascii with 9
+    significant digits (exact for float32).
+    """
+    vertices = np.ascontiguousarray(vertices, dtype="<f4")
+    faces = np.asarray(faces, dtype=np.int64)
+    header = (
+        f"ply\nformat {'binary_little_endian' if binary else 'ascii'} 1.0\ncomment written by animlod\n"
+        f"element vertex {len(vertices)}\nproperty float x\nproperty float y\nproperty float z\n"
+        f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    if binary:
+        face_rows = np.empty(len(faces), dtype=[("size", "u1"), ("indices", "<i4", (3,))])
+        face_rows["size"] = 3
+        face_rows["indices"] = faces
+        body = vertices.tobytes() + face_rows.tobytes()
+    else:
+        text = ("%.9g %.9g %.9g\n" * len(vertices)) % tuple(vertices.astype(np.float64).ravel())
+        text += ("3 %d %d %d\n" * len(faces)) % tuple(faces.ravel())
+        body = text.encode("ascii")
+    with atomic_write(path, "wb") as handle:
+        handle.write(header.encode("ascii") + body)
+
+
+def _read_ply_header(path: Path, data: bytes) -> tuple[str | None, list[_PlyElement], int]:
+    """Parse the header: byte order ("<", ">", None for ascii), the elements, and where the body starts."""
+    end = data.find(b"end_header")
+    if not data.startswith(b"ply") or end < 0:
+        raise FormatError(path, "header", "not a PLY header (must start with 'ply' and close with 'end_header')")
+    body = data.find(b"\n", end)
+    body = len(data) if body < 0 else body + 1
+    byte_order: str | None = None
+    format_seen = False
+    elements: list[_PlyElement] = []
+    lines = data[:end].decode("ascii", errors="replace").replace("\r", "").split("\n")
+    for number, line in enumerate(lines[1:], start=2):
+        words = line.split()
+        if not words or words[0] in ("comment", "obj_info"):
+            continue
+        element = f"header line {number}"
+        if words[0] == "format" and len(words) == 3 and words[1] in _PLY_FORMATS:
+            byte_order, format_seen = _PLY_FORMATS[words[1]], True
+        elif words[0] == "element" and len(words) == 3 and words[2].isdigit():
+            elements.append(_PlyElement(words[1], int(words[2])))
+        elif words[0] == "property" and elements:
+            elements[-1].properties.append(_ply_property(path, element, words))
+        else:
+            raise FormatError(path, element, f"cannot read {line.strip()!r}")
+    if not format_seen:
+        raise FormatError(path, "header", "no 'format ascii|binary_little_endian|binary_big_endian 1.0' line")
+    return byte_order, elements, body
+
+
+def _ply_property(path: Path, element: str, words: list[str]) -> _PlyProperty:
+    if len(words) == 3 and words[1] in _PLY_TYPES:
+        return _PlyProperty(words[2], _PLY_TYPES[words[1]])
+    if len(words) == 5 and words[1] == "list" and words[2] in _PLY_TYPES and words[3] in _PLY_TYPES:
+        return _PlyProperty(words[4], _PLY_TYPES[words[3]], count_code=_PLY_TYPES[words[2]])
+    raise FormatError(path, element, f"cannot read property {' '.join(words)!r}")
+
+
+# Parsed element values: property name -> (N,) array, or (sizes (N,), items) for a list property.
+_ElementValues = dict[str, "np.ndarray | tuple[np.ndarray, np.ndarray]"]
+
+
+def _single_list(path: Path, element: _PlyElement) -> int | None:
+    """Position of the element's list property (None if it has none); more than one is not supported."""
+    lists = [index for index, prop in enumerate(element.properties) if prop.count_code is not None]
+    if len(lists) > 1:
+        raise FormatError(path, f"element {element.name}", "more than one list property is not supported")
+    return lists[0] if lists else None
+
+
+def _read_ply_binary(
+    path: Path, data: bytes, offset: int, elements: list[_PlyElement], byte_order: str
+) -> dict[str, _ElementValues]:
+    """Read each element as one structured numpy array; a list property must have one length throughout."""
+    values: dict[str, _ElementValues] = {}
+    for element in elements:
+        list_at = _single_list(path, element)
+        fields = [(prop.name, byte_order + prop.type_code) for prop in element.properties]
+        length = 0
+        if list_at is not None and element.count:
+            prefix = np.dtype(fields[:list_at]).itemsize if list_at else 0
+            count_type = np.dtype(byte_order + element.properties[list_at].count_code)
+            if offset + prefix + count_type.itemsize > len(data):
+                raise FormatError(path, f"element {element.name}", "file ends inside the element")
+            length = int(np.frombuffer(data, count_type, 1, offset + prefix)[0])
+        if list_at is not None:
+            list_prop = element.properties[list_at]
+            fields[list_at : list_at + 1] = [
+                ("_size", byte_order + list_prop.count_code),
+                (list_prop.name, byte_order + list_prop.type_code, (length,)),
+            ]
+        row = np.dtype(fields)
+        if offset + row.itemsize * element.count > len(data):
+            raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
+        table = np.frombuffer(data, row, element.count, offset)
+        offset += row.itemsize * element.count
+        values[element.name] = {prop.name: table[prop.name] for prop in element.properties if prop.count_code is None}
+        if list_at is not None:
+            other = np.flatnonzero(table["_size"] != length)
+            if other.size:
+                size = table["_size"][other[0]]
+                reason = f"list of {size} items after rows of {length} (mixed lengths need ascii PLY)"
+                raise FormatError(path, f"element {element.name} row {other[0]}", reason)
+            name = element.properties[list_at].name
+            values[element.name][name] = (np.full(element.count, length, dtype=np.int64), table[name].ravel())
+    return values
+
+
+def _read_ply_ascii(path: Path, body: bytes, elements: list[_PlyElement]) -> dict[str, _ElementValues]:
+    """Read an ascii body: one line per row, elements one after the other."""
+    body = body.replace(b"\r", b"")
+    counts = tokens_per_line(body)
+    rows = np.flatnonzero(counts)  # blank lines are skipped
+    tokens = np.array(body.split(), dtype=np.bytes_)
+    row_start = np.cumsum(counts[rows]) - counts[rows]
+    values: dict[str, _ElementValues] = {}
+    first_row = 0
+    for element in elements:
+        if first_row + element.count > rows.size:
+            reason = f"file ends after {rows.size - first_row} of its {element.count} rows"
+            raise FormatError(path, f"element {element.name}", reason)
+        chosen = slice(first_row, first_row + element.count)
+        starts, lengths = row_start[chosen], counts[rows[chosen]]
+        list_at = _single_list(path, element)
+        scalar_count = len(element.properties) - (list_at is not None)
+        element_values: _ElementValues = {}
+
+        def name_row(row: int, element: _PlyElement = element) -> str:
+            return f"element {element.name} row {row}"
+
+        if list_at is None:
+            sizes = np.zeros(element.count, dtype=np.int64)
+        else:
+            sizes = _parse_numbers(path, tokens[starts + list_at], np.int64, name_row)
+        expected = scalar_count + sizes + (list_at is not None)
+        wrong = np.flatnonzero((lengths != expected) | (sizes < 0))
+        if wrong.size:
+            row = wrong[0]
+            raise FormatError(path, name_row(row), f"has {lengths[row]} values, expected {expected[row]}")
+        for index, prop in enumerate(element.properties):
+            dtype = np.float64 if prop.type_code.startswith("f") else np.int64
+            if prop.count_code is None:
+                # Scalars after the list are pushed right by the list's items.
+                column = starts + index + (sizes if list_at is not None and index > list_at else 0)
+                element_values[prop.name] = _parse_numbers(path, tokens[column], dtype, name_row)
+            else:
+                owner = np.repeat(np.arange(element.count), sizes)
+                item_start = np.repeat(starts + index + 1 - (np.cumsum(sizes) - sizes), sizes)
+                items = tokens[item_start + np.arange(sizes.sum())]
+                parsed = _parse_numbers(path, items, dtype, lambda item: name_row(owner[item]))
+                element_values[prop.name] = (sizes, parsed)
+        values[element.name] = element_values
+        first_row += element.count
+    return values

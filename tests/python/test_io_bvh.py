@@ -1,0 +1,242 @@
+"""BVH reading and writing: conventions on hand-written files, round trips, real clips, bad input."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from animlod import rotations
+from animlod.io import FormatError, read_bvh, write_bvh
+from animlod.model import Motion, Skeleton
+
+# Root with 6 channels, a 3-channel joint A (Z-X-Y intrinsic), an End Site, and a 6-channel
+# non-root joint B whose position channels replace its OFFSET. Line endings are mixed on purpose.
+SMALL_BVH = (
+    "HIERARCHY\r\n"
+    "ROOT Hips\r\n"
+    "{\n"
+    "\tOFFSET 0 0 0\r\n"
+    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+    "\tJOINT A\r\n"
+    "\t{\n"
+    "\t\tOFFSET 0 1 0\n"
+    "\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n"
+    "\t\tEnd Site\n"
+    "\t\t{\n"
+    "\t\t\tOFFSET 0 2 0\n"
+    "\t\t}\n"
+    "\t}\n"
+    "\tJOINT B\n"
+    "\t{\n"
+    "\t\tOFFSET 5 0 0\n"
+    "\t\tCHANNELS 6 Xposition Yposition Zposition Xrotation Yrotation Zrotation\n"
+    "\t}\n"
+    "}\n"
+    "MOTION\r\n"
+    "Frames: 2\r\n"
+    "Frame Time: .0333333\r\n"
+    "1 2 3 0 0 0 0 0 0 5 0 0 0 0 0\r\n"
+    "1 2 3 90 0 0 90 90 0 7 0 0 0 0 0\n"
+)
+
+
+def _write(tmp_path: Path, text: str, name: str = "clip.bvh") -> Path:
+    path = tmp_path / name
+    path.write_bytes(text.encode())
+    return path
+
+
+def test_reads_hierarchy_channels_and_end_sites(tmp_path: Path) -> None:
+    motion = read_bvh(_write(tmp_path, SMALL_BVH))
+    skeleton = motion.skeleton
+    assert skeleton.names == ["Hips", "A", "A_End", "B"]
+    assert skeleton.parents.tolist() == [-1, 0, 1, 0]
+    assert skeleton.end_sites.tolist() == [False, False, True, False]
+    np.testing.assert_array_equal(skeleton.offsets, [[0, 0, 0], [0, 1, 0], [0, 2, 0], [5, 0, 0]])
+    np.testing.assert_array_equal(motion.root_positions, [[1, 2, 3], [1, 2, 3]])
+    assert motion.fps == 30.0
+    assert motion.name == "clip"
+    # B's position channel moves it to x=7 in frame 1, so per-frame translations are kept.
+    assert motion.joint_translations is not None
+    np.testing.assert_array_equal(motion.joint_translations[:, 3], [[5, 0, 0], [7, 0, 0]])
+
+
+def test_euler_angles_follow_the_written_channel_order(tmp_path: Path) -> None:
+    world = read_bvh(_write(tmp_path, SMALL_BVH)).world_positions()
+    # Frame 0: no rotation.
+    np.testing.assert_allclose(world[0], [[1, 2, 3], [1, 3, 3], [1, 5, 3], [6, 2, 3]], atol=1e-12)
+    # Frame 1: the root turns 90 degrees about Z, so A's offset (0, 1, 0) points along -X and
+    # B (translated by its channels to (7, 0, 0)) lands at +Y. A rotates Rz(90) @ Rx(90) (the
+    # written order): its end site offset (0, 2, 0) -> Rx -> (0, 0, 2) -> Rz -> (0, 0, 2).
+    np.testing.assert_allclose(world[1], [[1, 2, 3], [0, 2, 3], [0, 2, 5], [1, 9, 3]], atol=1e-12)
+
+
+def test_no_joint_translations_when_channels_equal_offsets(tmp_path: Path) -> None:
+    text = SMALL_BVH.replace("1 2 3 90 0 0 90 90 0 7 0 0", "1 2 3 90 0 0 90 90 0 5 0 0")
+    assert read_bvh(_write(tmp_path, text)).joint_translations is None
+
+
+@pytest.mark.parametrize(("frame_time", "fps"), [("0.008333", 120.0), (".04", 25.0), ("0.0123456", 1 / 0.0123456)])
+def test_frame_time_gives_fps(tmp_path: Path, frame_time: str, fps: float) -> None:
+    motion = read_bvh(_write(tmp_path, SMALL_BVH.replace(".0333333", frame_time)))
+    assert motion.fps == pytest.approx(fps, rel=1e-12)
+
+
+def _hand_made_motion(seed: int, animated_translation: bool) -> Motion:
+    """A 6-joint tree (two branches, one end site) with random rotations and root motion."""
+    rng = np.random.default_rng(seed)
+    frame_count = 7
+    skeleton = Skeleton(
+        ["root", "spine", "head", "head_End", "arm", "hand"],
+        [-1, 0, 1, 2, 1, 4],
+        [[0.5, 1.0, -0.2], [0, 1, 0], [0, 0.6, 0.1], [0, 0.3, 0], [0.4, 0.5, 0], [0.7, 0, 0]],
+        end_sites=[False, False, False, True, False, False],
+    )
+    local = rotations.normalize(rng.normal(size=(frame_count, 6, 4)))
+    translations = None
+    if animated_translation:
+        translations = np.repeat(skeleton.offsets[None], frame_count, axis=0)
+        translations[:, 4] += rng.normal(scale=0.1, size=(frame_count, 3))
+    return Motion(skeleton, rng.normal(size=(frame_count, 3)), local, fps=24.0, joint_translations=translations)
+
+
+@pytest.mark.parametrize("order", ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"])
+@pytest.mark.parametrize("animated_translation", [False, True])
+def test_round_trip_preserves_world_positions(tmp_path: Path, order: str, animated_translation: bool) -> None:
+    motion = _hand_made_motion(seed=len(order) + ord(order[0]), animated_translation=animated_translation)
+    path = tmp_path / "round.bvh"
+    write_bvh(path, motion, rotation_order=order)
+    back = read_bvh(path)
+    assert back.skeleton.names == motion.skeleton.names
+    assert back.skeleton.parents.tolist() == motion.skeleton.parents.tolist()
+    assert back.skeleton.end_sites.tolist() == motion.skeleton.end_sites.tolist()
+    assert back.fps == motion.fps
+    np.testing.assert_allclose(back.skeleton.offsets, motion.skeleton.offsets, atol=5e-7)
+    # 6 decimals of degrees and of length units: FK agrees to about 1e-6.
+    np.testing.assert_allclose(back.world_positions(), motion.world_positions(), atol=1e-5)
+    assert (back.joint_translations is not None) == animated_translation
+    channel_lines = [line.split()[1] for line in path.read_text().splitlines() if "CHANNELS" in line]
+    expected = ["6", "3", "3", "6" if animated_translation else "3", "3"]  # the end site has none
+    assert channel_lines == expected
+
+
+def test_write_rejects_bad_rotation_order(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="rotation_order"):
+        write_bvh(tmp_path / "x.bvh", _hand_made_motion(0, False), rotation_order="XXY")
+
+
+def test_write_replaces_the_file_atomically(tmp_path: Path) -> None:
+    path = tmp_path / "x.bvh"
+    write_bvh(path, _hand_made_motion(0, False))
+    assert [p.name for p in tmp_path.iterdir()] == ["x.bvh"]
+
+
+# --- real clips (SOURCES.md) ---------------------------------------------------------------
+
+REAL_CLIPS = [
+    # file, joints (without end sites), end sites, frames, fps, has animated non-root translation
+    ("131_01.bvh", 31, 7, 994, 120.0, False),
+    ("dataset-1_run_proud_001.bvh", 22, 5, 141, 30.0, True),
+]
+
+
+@pytest.mark.parametrize(("name", "joints", "end_sites", "frames", "fps", "translated"), REAL_CLIPS)
+def test_real_clip_loads_with_documented_stats(
+    data_dir: Path, name: str, joints: int, end_sites: int, frames: int, fps: float, translated: bool
+) -> None:
+    motion = read_bvh(data_dir / "bvh" / name)
+    assert motion.skeleton.joint_count - int(motion.skeleton.end_sites.sum()) == joints
+    assert int(motion.skeleton.end_sites.sum()) == end_sites
+    assert motion.frame_count == frames
+    assert motion.fps == fps
+    assert (motion.joint_translations is not None) == translated
+
+
+def test_cmu_clip_first_frame_values(data_dir: Path) -> None:
+    motion = read_bvh(data_dir / "bvh" / "131_01.bvh")
+    np.testing.assert_array_equal(motion.root_positions[0], [5.23, 16.9002, -33.8986])
+    np.testing.assert_array_equal(motion.skeleton.offsets[2], [1.24777, -1.64261, 0.71711])
+    # Root channels "Zrotation Yrotation Xrotation" = -5.4029 9.8098 10.4956 degrees.
+    expected = rotations.from_euler(np.radians([-5.4029, 9.8098, 10.4956]), "ZYX")
+    np.testing.assert_allclose(motion.local_rotations[0, 0], expected, atol=1e-15)
+
+
+@pytest.mark.parametrize("name", [clip[0] for clip in REAL_CLIPS])
+def test_real_clip_round_trip(data_dir: Path, tmp_path: Path, name: str) -> None:
+    motion = read_bvh(data_dir / "bvh" / name)
+    write_bvh(tmp_path / name, motion)
+    back = read_bvh(tmp_path / name)
+    assert back.skeleton.names == motion.skeleton.names
+    extent = np.ptp(motion.world_positions().reshape(-1, 3), axis=0).max()
+    np.testing.assert_allclose(back.world_positions(), motion.world_positions(), atol=1e-6 * extent)
+
+
+# --- bad input --------------------------------------------------------------------------------
+
+
+def _read_error(tmp_path: Path, text: str) -> str:
+    with pytest.raises(FormatError) as caught:
+        read_bvh(_write(tmp_path, text))
+    message = str(caught.value)
+    assert message.startswith(str(tmp_path / "clip.bvh") + ": ")
+    return message
+
+
+def test_truncated_motion_table(tmp_path: Path) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace("Frames: 2", "Frames: 3"))
+    assert "line 26 (frame 2): Frames: says 3 but the MOTION table has 2 rows" in message
+
+
+def test_more_rows_than_frames(tmp_path: Path) -> None:
+    assert "Frames: says 1 but the MOTION table has 2 rows" in _read_error(tmp_path, SMALL_BVH.replace("Frames: 2", "Frames: 1"))
+
+
+def test_row_with_wrong_channel_count(tmp_path: Path) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace("7 0 0 0 0 0", "7 0 0 0 0"))
+    assert "line 25 (frame 1): expected 15 channel values, found 14" in message
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf", "-Infinity"])
+def test_non_finite_value_names_joint_and_channel(tmp_path: Path, bad: str) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace("90 90 0 7", f"90 {bad} 0 7"))
+    assert "line 25 (frame 1), joint 'A' xrotation: value" in message and "is not finite" in message
+
+
+def test_value_that_is_not_a_number(tmp_path: Path) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace("90 90 0 7", "90 9O 0 7"))
+    assert "line 25 (frame 1), joint 'A' xrotation: '9O' is not a number" in message
+
+
+def test_missing_closing_brace(tmp_path: Path) -> None:
+    text = SMALL_BVH.replace("\t\t}\n\t}\n", "\t\t}\n", 1)
+    message = _read_error(tmp_path, text)
+    assert "'}' closing joint 'Hips' (opened on line 2)" in message
+
+
+def test_unknown_keyword_in_joint(tmp_path: Path) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace("\t\tOFFSET 5 0 0", "\t\tOFFSET 5 0 0\n\t\tSCALE 1 1 1"))
+    assert "line 18: unexpected 'SCALE' in joint 'B'" in message
+
+
+def test_unknown_channel_name(tmp_path: Path) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace("CHANNELS 3 Zrotation Xrotation Yrotation", "CHANNELS 3 Zrotation Xrotation Wrotation"))
+    assert "line 9: joint 'A': unknown channel 'Wrotation'" in message
+
+
+def test_channel_count_larger_than_names(tmp_path: Path) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace("CHANNELS 3 Zrotation", "CHANNELS 4 Zrotation"))
+    assert "joint 'A'" in message
+
+
+def test_duplicate_joint_name(tmp_path: Path) -> None:
+    assert "joint name 'A' is used twice" in _read_error(tmp_path, SMALL_BVH.replace("JOINT B", "JOINT A"))
+
+
+def test_missing_motion_section(tmp_path: Path) -> None:
+    assert "no MOTION section" in _read_error(tmp_path, SMALL_BVH.split("MOTION")[0])
+
+
+def test_not_a_bvh_file(tmp_path: Path) -> None:
+    assert "line 1: expected 'HIERARCHY', found 'ply'" in _read_error(tmp_path, "ply\nformat ascii 1.0\n")

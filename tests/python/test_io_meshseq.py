@@ -1,0 +1,217 @@
+"""OBJ and PLY frame sequences: parsing details, round trips, real sequences, bad input."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from animlod.io import FormatError, read_mesh, read_obj, read_ply, read_sequence, write_ply, write_sequence
+from animlod.model import AnimatedMesh
+
+# A unit square (quad) and a triangle on top, written with CRLF, comments, texture/normal
+# statements, a/b/c corners and a negative (relative) index.
+OBJ_TEXT = (
+    "# square and roof\r\n"
+    "o house\r\n"
+    "v 0 0 0\r\n"
+    "v 1 0 0\r\n"
+    "v 1 1 0\r\n"
+    "v 0 1 0\r\n"
+    "vt 0 0\r\n"
+    "vn 0 0 1\r\n"
+    "f 1/1/1 2/1/1 3/1/1 4/1/1\r\n"
+    "v 0.5 1.5 0 1.0\r\n"
+    "f 4//1 3//1 -1//1\r\n"
+)
+EXPECTED_VERTICES = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 1.5, 0]], dtype=np.float32)
+EXPECTED_FACES = np.array([[0, 1, 2], [0, 2, 3], [3, 2, 4]], dtype=np.int32)
+
+
+def _write(path: Path, content: str | bytes) -> Path:
+    path.write_bytes(content.encode() if isinstance(content, str) else content)
+    return path
+
+
+def _moving_mesh(frame_count: int = 3, seed: int = 0) -> AnimatedMesh:
+    rng = np.random.default_rng(seed)
+    frames = rng.normal(size=(frame_count, 5, 3)).astype(np.float32)
+    return AnimatedMesh(EXPECTED_FACES, frames, fps=24.0)
+
+
+def test_obj_statements_corners_quads_and_negative_indices(tmp_path: Path) -> None:
+    vertices, faces = read_obj(_write(tmp_path / "house.obj", OBJ_TEXT))
+    np.testing.assert_array_equal(vertices, EXPECTED_VERTICES)
+    np.testing.assert_array_equal(faces, EXPECTED_FACES)
+    assert vertices.dtype == np.float32 and faces.dtype == np.int32
+
+
+def test_ascii_ply_with_mixed_polygons_and_extra_properties(tmp_path: Path) -> None:
+    text = (
+        "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\n"
+        "element vertex 5\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nproperty uchar red\r\n"
+        "element face 2\r\nproperty uchar flags\r\nproperty list uchar int vertex_indices\r\nproperty float quality\r\n"
+        "end_header\r\n"
+        "0 0 0 255\r\n1 0 0 0\r\n1 1 0 0\r\n0 1 0 0\r\n0.5 1.5 0 9\r\n"
+        "7 4 0 1 2 3 0.5\r\n"
+        "7 3 3 2 4 0.25\r\n"
+    )
+    vertices, faces = read_ply(_write(tmp_path / "house.ply", text))
+    np.testing.assert_array_equal(vertices, EXPECTED_VERTICES)
+    np.testing.assert_array_equal(faces, EXPECTED_FACES)
+
+
+def test_binary_big_endian_ply(tmp_path: Path) -> None:
+    header = (
+        "ply\nformat binary_big_endian 1.0\nelement vertex 5\nproperty double x\nproperty double y\n"
+        "property double z\nelement face 3\nproperty list uchar uint vertex_index\nend_header\n"
+    )
+    faces = np.zeros(3, dtype=[("size", "u1"), ("indices", ">u4", (3,))])
+    faces["size"], faces["indices"] = 3, EXPECTED_FACES
+    body = EXPECTED_VERTICES.astype(">f8").tobytes() + faces.tobytes()
+    vertices, read_faces = read_ply(_write(tmp_path / "house.ply", header.encode() + body))
+    np.testing.assert_array_equal(vertices, EXPECTED_VERTICES)
+    np.testing.assert_array_equal(read_faces, EXPECTED_FACES)
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_ply_write_read_is_exact(tmp_path: Path, binary: bool) -> None:
+    mesh = _moving_mesh()
+    write_ply(tmp_path / "f.ply", mesh.frames[1], mesh.faces, binary=binary)
+    vertices, faces = read_ply(tmp_path / "f.ply")
+    np.testing.assert_array_equal(vertices, mesh.frames[1])
+    np.testing.assert_array_equal(faces, mesh.faces)
+
+
+@pytest.mark.parametrize("fmt", ["obj", "ply"])
+def test_sequence_round_trip_is_exact(tmp_path: Path, fmt: str) -> None:
+    mesh = _moving_mesh(frame_count=4)
+    paths = write_sequence(tmp_path / "seq", mesh, fmt=fmt, stem="pose")
+    assert [path.name for path in paths] == [f"pose_{index:04d}.{fmt}" for index in range(4)]
+    assert sorted(path.name for path in (tmp_path / "seq").iterdir()) == [path.name for path in paths]  # no temp files
+    back = read_sequence(tmp_path / "seq", fps=24.0)
+    np.testing.assert_array_equal(back.frames, mesh.frames)
+    np.testing.assert_array_equal(back.faces, mesh.faces)
+    assert back.fps == 24.0
+
+
+def test_folder_and_glob_use_natural_order_and_lists_keep_theirs(tmp_path: Path) -> None:
+    mesh = _moving_mesh(frame_count=3)
+    for name, vertices in zip(["f10.obj", "f2.obj", "f1.obj"], mesh.frames[::-1]):
+        write_sequence(tmp_path, AnimatedMesh(mesh.faces, vertices[None]), stem=name[:-4])
+    # write_sequence appended _0000; frames are f1 = frame 0, f2 = frame 1, f10 = frame 2.
+    np.testing.assert_array_equal(read_sequence(tmp_path).frames, mesh.frames)
+    np.testing.assert_array_equal(read_sequence(str(tmp_path / "f*_0000.obj")).frames, mesh.frames)
+    listed = [tmp_path / "f10_0000.obj", tmp_path / "f1_0000.obj"]
+    np.testing.assert_array_equal(read_sequence(listed).frames, mesh.frames[[2, 0]])
+    np.testing.assert_array_equal(read_sequence(tmp_path / "f2_0000.obj").frames, mesh.frames[[1]])
+
+
+# --- real sequences (SOURCES.md) ------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("folder", "frames", "vertices", "faces"),
+    [("crane", 12, 10002, 20000), ("face-poses", 4, 29299, 57836)],
+)
+def test_real_sequence_loads_with_documented_stats(data_dir: Path, folder: str, frames: int, vertices: int, faces: int) -> None:
+    mesh = read_sequence(data_dir / "meshseq" / folder)
+    assert mesh.frames.shape == (frames, vertices, 3)
+    assert mesh.faces.shape == (faces, 3)
+    assert mesh.faces.min() == 0 and mesh.faces.max() == vertices - 1
+
+
+def test_crane_first_vertex_matches_the_file(data_dir: Path) -> None:
+    mesh = read_sequence(data_dir / "meshseq" / "crane")
+    # mesh_0048.obj: the first "v" line is "v 0.498967 0.482328 -0.258473", the first "f" "f 15 57 9818".
+    np.testing.assert_array_equal(mesh.frames[0, 0], np.float32([0.498967, 0.482328, -0.258473]))
+    np.testing.assert_array_equal(mesh.faces[0], [14, 56, 9817])
+
+
+# --- bad input --------------------------------------------------------------------------------
+
+
+def _error(path: Path) -> str:
+    with pytest.raises(FormatError) as caught:
+        read_sequence(path) if path.is_dir() else read_mesh(path)
+    return str(caught.value)
+
+
+def test_obj_face_index_out_of_range(tmp_path: Path) -> None:
+    path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 3 6"))
+    assert _error(path) == f"{path}: face 1 (line 11): vertex index 6 is outside the 5 vertices"
+
+
+@pytest.mark.parametrize("index", ["0", "-6"])
+def test_obj_zero_or_too_negative_index(tmp_path: Path, index: str) -> None:
+    path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("-1//1", f"{index}//1"))
+    assert _error(path) == f"{path}: face 1 (line 11): vertex index {index} is outside the 5 vertices"
+
+
+def test_obj_face_with_two_corners(tmp_path: Path) -> None:
+    path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 3"))
+    assert _error(path) == f"{path}: face 1 (line 11): needs at least 3 vertices, has 2"
+
+
+@pytest.mark.parametrize(("value", "reason"), [("nan", "are not finite"), ("1e999", "are not finite"), ("x1", "'x1' is not a number")])
+def test_obj_bad_coordinate(tmp_path: Path, value: str, reason: str) -> None:
+    path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("v 1 1 0", f"v 1 {value} 0"))
+    message = _error(path)
+    assert message.startswith(f"{path}: vertex 2 (line 5): ") and reason in message
+
+
+def test_frames_with_different_vertex_counts(tmp_path: Path) -> None:
+    _write(tmp_path / "a_1.obj", OBJ_TEXT)
+    _write(tmp_path / "a_2.obj", OBJ_TEXT.replace("v 0.5 1.5 0 1.0\r\n", "v 0.5 1.5 0\r\nv 9 9 9\r\n"))
+    assert _error(tmp_path) == f"{tmp_path / 'a_2.obj'}: vertices: 6 vertices, but the first frame a_1.obj has 5"
+
+
+def test_frames_with_different_faces(tmp_path: Path) -> None:
+    _write(tmp_path / "a_1.obj", OBJ_TEXT)
+    _write(tmp_path / "a_2.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 2 5"))
+    message = _error(tmp_path)
+    assert message == f"{tmp_path / 'a_2.obj'}: face 2: [3, 1, 4] differs from [3, 2, 4] in the first frame a_1.obj"
+
+
+@pytest.mark.parametrize(
+    ("content", "element"),
+    [
+        (b"\x00\x01garbage", "header: not a PLY header"),
+        (b"ply\nformat ascii 1.0\nelement vertex three\nend_header\n", "header line 3: cannot read 'element vertex three'"),
+        (b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float3 x\nend_header\n", "header line 4: cannot read property"),
+        (b"ply\nelement vertex 0\nend_header\n", "header: no 'format"),
+    ],
+)
+def test_unreadable_ply_header(tmp_path: Path, content: bytes, element: str) -> None:
+    path = _write(tmp_path / "bad.ply", content)
+    assert _error(path).startswith(f"{path}: {element}")
+
+
+def test_truncated_binary_ply(tmp_path: Path) -> None:
+    mesh = _moving_mesh()
+    write_ply(tmp_path / "whole.ply", mesh.frames[0], mesh.faces)
+    path = _write(tmp_path / "cut.ply", (tmp_path / "whole.ply").read_bytes()[:-5])
+    assert _error(path) == f"{path}: element face: file ends before its 3 rows"
+
+
+def test_ply_face_index_out_of_range(tmp_path: Path) -> None:
+    mesh = _moving_mesh()
+    faces = mesh.faces.copy()
+    faces[2, 2] = 7
+    write_ply(tmp_path / "bad.ply", mesh.frames[0], faces)
+    assert _error(tmp_path / "bad.ply") == f"{tmp_path / 'bad.ply'}: face 2: vertex index 7 is outside the 5 vertices"
+
+
+def test_ascii_ply_row_with_wrong_length(tmp_path: Path) -> None:
+    mesh = _moving_mesh()
+    write_ply(tmp_path / "ok.ply", mesh.frames[0], mesh.faces, binary=False)
+    text = (tmp_path / "ok.ply").read_text().replace("3 3 2 4", "3 3 2")
+    path = _write(tmp_path / "bad.ply", text)
+    assert _error(path) == f"{path}: element face row 2: has 3 values, expected 4"
+
+
+def test_empty_or_missing_source(tmp_path: Path) -> None:
+    assert _error(tmp_path) == f"{tmp_path}: source: no .obj or .ply frame found"
+    with pytest.raises(FormatError, match="is not a folder, a glob pattern or an existing file"):
+        read_sequence(tmp_path / "nothing")

@@ -1,0 +1,74 @@
+"""NPZ archives of AnimatedMesh: exact round trips, the stored keys, bad archives."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from animlod.io import FormatError, read_npz, write_npz
+from animlod.io.npz import FORMAT_VERSION
+from animlod.model import AnimatedMesh
+
+FACES = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.int32)
+
+
+def _mesh(fps: float | None) -> AnimatedMesh:
+    frames = np.random.default_rng(3).normal(size=(5, 4, 3)).astype(np.float32)
+    return AnimatedMesh(FACES, frames, fps=fps)
+
+
+@pytest.mark.parametrize("fps", [30.0, None])
+def test_round_trip_is_exact(tmp_path: Path, fps: float | None) -> None:
+    mesh = _mesh(fps)
+    write_npz(tmp_path / "mesh.npz", mesh)
+    back = read_npz(tmp_path / "mesh.npz")
+    np.testing.assert_array_equal(back.frames, mesh.frames)
+    np.testing.assert_array_equal(back.faces, mesh.faces)
+    assert back.fps == fps
+    assert back.frames.dtype == np.float32 and back.faces.dtype == np.int32
+
+
+def test_archive_keys_and_no_leftover_files(tmp_path: Path) -> None:
+    write_npz(tmp_path / "mesh.npz", _mesh(24.0))
+    assert [path.name for path in tmp_path.iterdir()] == ["mesh.npz"]
+    with np.load(tmp_path / "mesh.npz") as archive:
+        assert sorted(archive.files) == ["faces", "format_version", "fps", "frames"]
+        assert int(archive["format_version"]) == FORMAT_VERSION
+
+
+def _save(tmp_path: Path, **arrays: np.ndarray) -> Path:
+    keys = {"format_version": np.int32(1), "faces": FACES, "frames": _mesh(None).frames, "fps": np.float64(30.0)}
+    keys.update(arrays)
+    path = tmp_path / "bad.npz"
+    np.savez(path, **{key: value for key, value in keys.items() if value is not None})
+    return path
+
+
+@pytest.mark.parametrize(
+    ("arrays", "message"),
+    [
+        ({"frames": None}, "key 'frames': missing"),
+        ({"format_version": None}, "key 'format_version': missing"),
+        ({"format_version": np.int32(2)}, "key 'format_version': unsupported version 2"),
+        ({"frames": np.zeros((4, 3), np.float32)}, "key 'frames': expected float (F, V, 3), got float32 (4, 3)"),
+        ({"faces": np.zeros((2, 4), np.int32)}, "key 'faces': expected integer (M, 3), got int32 (2, 4)"),
+        ({"faces": FACES.astype(np.float32)}, "key 'faces': expected integer (M, 3), got float32 (2, 3)"),
+        ({"fps": np.float64(-1.0)}, "key 'fps': must be positive or NaN, got -1.0"),
+        ({"faces": FACES + 2}, "mesh: faces: face 0 [2, 3, 4] has an index outside [0, 4)"),
+        ({"frames": np.full((1, 4, 3), np.nan, np.float32)}, "mesh: frames: non-finite value"),
+    ],
+)
+def test_bad_archive(tmp_path: Path, arrays: dict, message: str) -> None:
+    path = _save(tmp_path, **arrays)
+    with pytest.raises(FormatError) as caught:
+        read_npz(path)
+    assert str(caught.value).startswith(f"{path}: {message}")
+
+
+def test_not_an_archive(tmp_path: Path) -> None:
+    path = tmp_path / "text.npz"
+    path.write_text("hello")
+    with pytest.raises(FormatError, match="archive: not a readable npz archive"):
+        read_npz(path)

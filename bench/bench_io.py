@@ -1,0 +1,65 @@
+"""Reading speed of the file formats on the real development data (../shared/data).
+
+Run: ``.venv/bin/python bench/bench_io.py``. Each row is the best of a few runs; inputs that
+are absent are skipped. The crane sequence is also converted to binary PLY and NPZ in a
+temporary folder, to show what the faster containers buy over OBJ text.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from table import print_table, stopwatch  # noqa: E402
+
+from animlod.io import read_bvh, read_npz, read_sequence, write_npz, write_sequence  # noqa: E402
+
+DATA_DIR = Path(os.environ.get("ANIMLOD_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
+REPEATS = 3
+
+
+def best_time(action: Callable[[], object]) -> tuple[float, object]:
+    """Shortest wall time of ``REPEATS`` runs of ``action`` and its last result."""
+    times = []
+    for _ in range(REPEATS):
+        with stopwatch() as elapsed:
+            result = action()
+        times.append(elapsed[0])
+    return min(times), result
+
+
+def main() -> None:
+    rows = []
+    for name in ("131_01.bvh", "dataset-1_run_proud_001.bvh"):
+        path = DATA_DIR / "bvh" / name
+        if not path.is_file():
+            print(f"skipped {path}: not found")
+            continue
+        seconds, motion = best_time(lambda path=path: read_bvh(path))
+        end_sites = int(motion.skeleton.end_sites.sum())
+        size = f"{motion.skeleton.joint_count - end_sites} joints + {end_sites} end sites, {motion.frame_count} frames"
+        rows.append((f"read BVH {name}", size, seconds * 1e3, motion.frame_count / seconds))
+    crane = DATA_DIR / "meshseq" / "crane"
+    if crane.is_dir():
+        seconds, mesh = best_time(lambda: read_sequence(crane))
+        size = f"{mesh.vertex_count} vertices, {mesh.face_count} faces, {mesh.frame_count} frames"
+        rows.append(("read OBJ sequence crane/", size, seconds * 1e3, mesh.frame_count / seconds))
+        with tempfile.TemporaryDirectory() as folder:
+            write_sequence(Path(folder) / "ply", mesh, fmt="ply")
+            write_npz(Path(folder) / "crane.npz", mesh)
+            seconds, _ = best_time(lambda: read_sequence(Path(folder) / "ply"))
+            rows.append(("read binary PLY sequence (crane)", size, seconds * 1e3, mesh.frame_count / seconds))
+            seconds, _ = best_time(lambda: read_npz(Path(folder) / "crane.npz"))
+            rows.append(("read NPZ (crane)", size, seconds * 1e3, mesh.frame_count / seconds))
+    else:
+        print(f"skipped {crane}: not found")
+    print_table("File reading (best of 3)", ["case", "size", "time (ms)", "frames/s"], rows)
+
+
+if __name__ == "__main__":
+    main()

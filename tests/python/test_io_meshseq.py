@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from animlod.io import FormatError, read_mesh, read_obj, read_ply, read_sequence, write_ply, write_sequence
+from animlod.io import FormatError, read_mesh, read_obj, read_ply, read_sequence, write_obj, write_ply, write_sequence
 from animlod.model import AnimatedMesh
 
 # A unit square (quad) and a triangle on top, written with CRLF, comments, texture/normal
@@ -115,7 +115,9 @@ def test_folder_and_glob_use_natural_order_and_lists_keep_theirs(tmp_path: Path)
     ("folder", "frames", "vertices", "faces"),
     [("crane", 12, 10002, 20000), ("face-poses", 4, 29299, 57836)],
 )
-def test_real_sequence_loads_with_documented_stats(data_dir: Path, folder: str, frames: int, vertices: int, faces: int) -> None:
+def test_real_sequence_loads_with_documented_stats(
+    data_dir: Path, folder: str, frames: int, vertices: int, faces: int
+) -> None:
     mesh = read_sequence(data_dir / "meshseq" / folder)
     assert mesh.frames.shape == (frames, vertices, 3)
     assert mesh.faces.shape == (faces, 3)
@@ -154,7 +156,9 @@ def test_obj_face_with_two_corners(tmp_path: Path) -> None:
     assert _error(path) == f"{path}: face 1 (line 11): needs at least 3 vertices, has 2"
 
 
-@pytest.mark.parametrize(("value", "reason"), [("nan", "are not finite"), ("1e999", "are not finite"), ("x1", "'x1' is not a number")])
+@pytest.mark.parametrize(
+    ("value", "reason"), [("nan", "are not finite"), ("1e999", "are not finite"), ("x1", "'x1' is not a number")]
+)
 def test_obj_bad_coordinate(tmp_path: Path, value: str, reason: str) -> None:
     path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("v 1 1 0", f"v 1 {value} 0"))
     message = _error(path)
@@ -178,8 +182,8 @@ def test_frames_with_different_faces(tmp_path: Path) -> None:
     ("content", "element"),
     [
         (b"\x00\x01garbage", "header: not a PLY header"),
-        (b"ply\nformat ascii 1.0\nelement vertex three\nend_header\n", "header line 3: cannot read 'element vertex three'"),
-        (b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float3 x\nend_header\n", "header line 4: cannot read property"),
+        (b"ply\nformat ascii 1.0\nelement vertex three\nend_header\n", "header line 3: cannot read 'element"),
+        (b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float3 x\nend_header\n", "header line 4: cannot read"),
         (b"ply\nelement vertex 0\nend_header\n", "header: no 'format"),
     ],
 )
@@ -197,10 +201,18 @@ def test_truncated_binary_ply(tmp_path: Path) -> None:
 
 def test_ply_face_index_out_of_range(tmp_path: Path) -> None:
     mesh = _moving_mesh()
-    faces = mesh.faces.copy()
-    faces[2, 2] = 7
-    write_ply(tmp_path / "bad.ply", mesh.frames[0], faces)
-    assert _error(tmp_path / "bad.ply") == f"{tmp_path / 'bad.ply'}: face 2: vertex index 7 is outside the 5 vertices"
+    write_ply(tmp_path / "ok.ply", mesh.frames[0], mesh.faces)
+    # The file ends with the last corner of the last face as a little-endian int32.
+    path = _write(tmp_path / "bad.ply", (tmp_path / "ok.ply").read_bytes()[:-4] + np.int32(7).tobytes())
+    assert _error(path) == f"{path}: face 2: vertex index 7 is outside the 5 vertices"
+
+
+def test_writers_reject_bad_meshes(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match=r"face 0 \[0, 1, 5\] has an index outside \[0, 5\)"):
+        write_ply(tmp_path / "bad.ply", EXPECTED_VERTICES, [[0, 1, 5]])
+    with pytest.raises(ValueError, match="non-finite"):
+        write_obj(tmp_path / "bad.obj", np.full((3, 3), np.nan), [[0, 1, 2]])
+    assert not list(tmp_path.iterdir())
 
 
 def test_ascii_ply_row_with_wrong_length(tmp_path: Path) -> None:

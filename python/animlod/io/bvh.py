@@ -50,7 +50,6 @@ class _JointSpec:
 
     name: str
     parent: int
-    line: int
     end_site: bool
     offset: tuple[float, float, float] | None = None
     channels: list[str] = field(default_factory=list)
@@ -78,11 +77,10 @@ class _TokenCursor:
         self.position += 1
         return token
 
-    def expect(self, literal: str) -> int:
+    def expect(self, literal: str) -> None:
         token, line = self.next(repr(literal))
         if token != literal:
             raise self.error(line, f"expected {literal!r}, found {token!r}")
-        return line
 
     def number(self, what: str) -> float:
         token, line = self.next(what)
@@ -131,10 +129,10 @@ def read_bvh(path: str | os.PathLike) -> Motion:
     if motion_match is None:
         raise FormatError(path, f"line {len(hierarchy_lines)}", "no MOTION section after the hierarchy")
     motion_line = len(hierarchy_lines)
-    frame_count, frame_time, data_line, data_text = _parse_motion_header(path, text[motion_match.end() :], motion_line)
+    frame_count, fps, data_line, data_text = _parse_motion_header(path, text[motion_match.end() :], motion_line)
     channel_count = sum(len(joint.channels) for joint in joints)
     values = _parse_motion_table(path, data_text, data_line, frame_count, channel_count, joints)
-    return _build_motion(path, joints, values, frame_time)
+    return _build_motion(path, joints, values, fps)
 
 
 def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
@@ -162,7 +160,7 @@ def _parse_joint(cursor: _TokenCursor, joints: list[_JointSpec], parent: int, li
         raise cursor.error(line, f"joint name {name!r} is used twice")
     cursor.expect("{")
     index = len(joints)
-    joint = _JointSpec(name, parent, line, end_site)
+    joint = _JointSpec(name, parent, end_site)
     joints.append(joint)
     while True:
         token, token_line = cursor.next(f"'}}' closing joint {name!r} (opened on line {line})")
@@ -197,7 +195,7 @@ def _parse_channels(cursor: _TokenCursor, joint_name: str, line: int) -> list[st
     if len(set(lowered)) != len(lowered) or rotation_count not in (0, 3):
         reason = f"channels {channels} must name each axis once, with all three rotations or none"
         raise cursor.error(line, f"joint {joint_name!r}: {reason}")
-    return lowered
+    return channels
 
 
 def _unique_name(name: str, joints: list[_JointSpec]) -> str:
@@ -209,7 +207,10 @@ def _unique_name(name: str, joints: list[_JointSpec]) -> str:
 
 
 def _parse_motion_header(path: Path, text: str, motion_line: int) -> tuple[int, float, int, str]:
-    """Read ``Frames:`` and ``Frame Time:`` after MOTION; return them, the first data line and the data text."""
+    """Read ``Frames:`` and ``Frame Time:`` after MOTION.
+
+    Returns the frame count, the frame rate, the line number of the first row and the rows' text.
+    """
     header = text.split("\n", 3)
     if len(header) < 3:
         raise FormatError(path, f"line {motion_line}", "MOTION is not followed by Frames: and Frame Time: lines")
@@ -305,7 +306,7 @@ def _build_motion(path: Path, joints: list[_JointSpec], values: np.ndarray, fps:
     for index, joint in enumerate(joints):
         order, columns = "", []
         for channel in joint.channels:
-            kind, axis = _CHANNELS[channel]
+            kind, axis = _CHANNELS[channel.lower()]
             if kind == "position":
                 position_columns.append((index, axis, column))
             else:

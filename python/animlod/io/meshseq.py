@@ -204,12 +204,19 @@ def write_obj(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) 
 
     Coordinates are written with 9 significant digits, which round-trips float32 exactly.
     """
-    vertices = np.asarray(vertices, dtype=np.float32).astype(np.float64)
-    faces = np.asarray(faces, dtype=np.int64) + 1
+    vertices, faces = _checked(vertices, faces)
+    vertices, faces = vertices.astype(np.float64), faces.astype(np.int64) + 1
     with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
         handle.write("# written by animlod\n")
         handle.write(("v %.9g %.9g %.9g\n" * len(vertices)) % tuple(vertices.ravel()))
         handle.write(("f %d %d %d\n" * len(faces)) % tuple(faces.ravel()))
+
+
+def _checked(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``vertices (V, 3) float32`` and ``faces (M, 3) int32`` checked as AnimatedMesh checks them
+    (shapes, finite values, indices in range); ValueError otherwise."""
+    mesh = AnimatedMesh(faces, np.asarray(vertices)[None])
+    return mesh.frames[0], mesh.faces
 
 
 def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:
@@ -362,8 +369,8 @@ def write_ply(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, 
     ``binary=True`` writes binary_little_endian (exact); ``binary=False`` ascii with 9
     significant digits (exact for float32).
     """
-    vertices = np.ascontiguousarray(vertices, dtype="<f4")
-    faces = np.asarray(faces, dtype=np.int64)
+    vertices, faces = _checked(vertices, faces)
+    vertices, faces = vertices.astype("<f4"), faces.astype(np.int64)
     header = (
         f"ply\nformat {'binary_little_endian' if binary else 'ascii'} 1.0\ncomment written by animlod\n"
         f"element vertex {len(vertices)}\nproperty float x\nproperty float y\nproperty float z\n"

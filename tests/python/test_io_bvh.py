@@ -163,6 +163,33 @@ def test_cmu_clip_first_frame_values(data_dir: Path) -> None:
     np.testing.assert_allclose(motion.local_rotations[0, 0], expected, atol=1e-15)
 
 
+def _axis_matrix(axis: str, degrees: float) -> np.ndarray:
+    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
+    i, j = {"X": (1, 2), "Y": (2, 0), "Z": (0, 1)}[axis]
+    m = np.eye(4)
+    m[i, i], m[i, j], m[j, i], m[j, j] = c, -s, s, c
+    return m
+
+
+def test_bandai_forward_kinematics_matches_a_matrix_reference(data_dir: Path) -> None:
+    """Every Bandai joint has "Xposition Yposition Zposition Zrotation Xrotation Yrotation":
+    world = parent @ T(position channels) @ Rz @ Rx @ Ry, built here from elementary matrices."""
+    path = data_dir / "bvh" / "dataset-1_run_proud_001.bvh"
+    motion = read_bvh(path)
+    frame = 57
+    row = np.array(path.read_text().split("Frame Time:")[1].splitlines()[1 + frame].split(), dtype=float).reshape(-1, 6)
+    joints = np.flatnonzero(~motion.skeleton.end_sites)
+    world = {}
+    for values, joint in zip(row, joints):
+        local = np.eye(4)
+        local[:3, 3] = values[:3]
+        local = local @ _axis_matrix("Z", values[3]) @ _axis_matrix("X", values[4]) @ _axis_matrix("Y", values[5])
+        parent = motion.skeleton.parents[joint]
+        world[joint] = local if parent < 0 else world[parent] @ local
+    expected = np.array([world[joint][:3, 3] for joint in joints])
+    np.testing.assert_allclose(motion.world_positions()[frame, joints], expected, atol=1e-9)
+
+
 @pytest.mark.parametrize("name", [clip[0] for clip in REAL_CLIPS])
 def test_real_clip_round_trip(data_dir: Path, tmp_path: Path, name: str) -> None:
     motion = read_bvh(data_dir / "bvh" / name)

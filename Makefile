@@ -64,11 +64,22 @@ bench: python-package
 	bench/openmesh_build/run.sh
 	@for script in bench/bench_*.py; do echo "== $$script"; $(PY) $$script || exit 1; done
 
+# The C++ tests, then pytest against an extension built with the same sanitizers (in its own
+# venv, so that the normal one stays fast). Debian's libasan is preloaded into python.
+SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer
+SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+
 sanitize: $(OPENMESH_CONFIG) $(VENV)/bin/pip
 	cmake -S . -B build/sanitize -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer" > build/sanitize.configure.log
+	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" > build/sanitize.configure.log
 	cmake --build build/sanitize --parallel $(JOBS)
-	ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1 ctest --test-dir build/sanitize --output-on-failure
+	$(SANITIZE_ENV) ctest --test-dir build/sanitize --output-on-failure
+	test -x .venv-sanitize/bin/pip || $(PYTHON) -m venv .venv-sanitize
+	.venv-sanitize/bin/pip install -q scikit-build-core pybind11
+	.venv-sanitize/bin/pip install -q --no-build-isolation -e ".[test]" -Cbuild-dir=build/python-sanitize \
+	  -Ccmake.build-type=RelWithDebInfo -Ccmake.define.CMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)"
+	$(SANITIZE_ENV) LD_PRELOAD="$$(g++ -print-file-name=libasan.so) $$(g++ -print-file-name=libubsan.so)" \
+	  .venv-sanitize/bin/python -m pytest -q -p no:cacheprovider tests/python
 
 clean:
 	rm -rf build out

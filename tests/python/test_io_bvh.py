@@ -78,6 +78,18 @@ def test_no_joint_translations_when_channels_equal_offsets(tmp_path: Path) -> No
     assert read_bvh(_write(tmp_path, text)).joint_translations is None
 
 
+def test_root_without_position_channels_stays_at_its_offset(tmp_path: Path) -> None:
+    text = (
+        "HIERARCHY\nROOT Hips\n{\n  OFFSET 1 2 3\n  CHANNELS 3 Yrotation Xrotation Zrotation\n"
+        "  End Site Nose\n  {\n    OFFSET 0 0 1\n  }\n}\nMOTION\nFrames: 2\nFrame Time: 0.5\n\n0 0 0\n90 0 0  \n\n"
+    )
+    motion = read_bvh(_write(tmp_path, text))
+    assert motion.skeleton.names == ["Hips", "Nose"]
+    assert motion.fps == 2.0
+    np.testing.assert_array_equal(motion.root_positions, [[1, 2, 3], [1, 2, 3]])
+    np.testing.assert_allclose(motion.world_positions()[:, 1], [[1, 2, 4], [2, 2, 3]], atol=1e-12)
+
+
 @pytest.mark.parametrize(("frame_time", "fps"), [("0.008333", 120.0), (".04", 25.0), ("0.0123456", 1 / 0.0123456)])
 def test_frame_time_gives_fps(tmp_path: Path, frame_time: str, fps: float) -> None:
     motion = read_bvh(_write(tmp_path, SMALL_BVH.replace(".0333333", frame_time)))

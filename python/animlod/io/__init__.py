@@ -2,18 +2,23 @@
 
 from .bvh import read_bvh, write_bvh
 from .errors import FormatError
+from .gltf import GltfScene, read_gltf, read_skinned, write_glb
 from .meshseq import read_mesh, read_obj, read_ply, read_sequence, write_mesh, write_obj, write_ply, write_sequence
 from .npz import read_npz, write_npz
 
 __all__ = [
     "FormatError",
+    "GltfScene",
     "read_bvh",
+    "read_gltf",
     "read_mesh",
     "read_npz",
     "read_obj",
     "read_ply",
     "read_sequence",
+    "read_skinned",
     "write_bvh",
+    "write_glb",
     "write_mesh",
     "write_npz",
     "write_obj",

@@ -1,0 +1,376 @@
+"""Checked access to a loaded glTF 2.0 document: buffers, accessors and the node tree.
+
+pygltflib parses the JSON and splits a GLB into its chunks; this module turns what it gives
+into numpy arrays and checks every reference on the way, so that a broken file fails with
+:class:`FormatError` naming the file, the element and the reason instead of an IndexError or
+a silently wrong array.
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import json
+import os
+import struct
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pygltflib
+
+from .. import rotations
+from .errors import FormatError
+from .gltf_keyframes import INTERPOLATIONS
+
+_GLB_MAGIC = b"glTF"
+_GLB_HEADER_BYTES = 12
+_DATA_URI_BASE64 = ";base64,"
+
+_COMPONENT_DTYPES = {
+    5120: np.dtype("<i1"),
+    5121: np.dtype("<u1"),
+    5122: np.dtype("<i2"),
+    5123: np.dtype("<u2"),
+    5125: np.dtype("<u4"),
+    5126: np.dtype("<f4"),
+}
+# Normalised integers map to [0, 1] (unsigned) or [-1, 1] (signed), glTF 2.0 section 3.11.
+_NORMALIZED_DIVISORS = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}
+_TYPE_WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+
+# Relative tolerance under which a node's scale counts as uniform (exporters leave float noise
+# such as 1.0000009 on scales that are meant to be 1).
+UNIFORM_SCALE_TOLERANCE = 1e-4
+
+
+class GltfDocument:
+    """A parsed glTF file with its buffers loaded, and checked accessors into it.
+
+    Attributes
+    ----------
+    path : the file, for error messages.
+    gltf : the pygltflib document.
+    parents : (N,) int, parent node of every node, -1 for nodes at the top of the tree.
+    """
+
+    def __init__(self, path: str | os.PathLike) -> None:
+        self.path = os.fspath(path)
+        self.gltf = _parse(self.path)
+        self._buffers: dict[int, bytes] = {}
+        self._accessors: dict[int, np.ndarray] = {}
+        self.parents = self._node_parents()
+
+    def fail(self, element: str, reason: str) -> FormatError:
+        """The error to raise for ``element`` of this file."""
+        return FormatError(self.path, element, reason)
+
+    def item(self, kind: str, index: Any, referrer: str) -> Any:
+        """``gltf.<kind>[index]``, or FormatError naming ``referrer`` when the index is invalid."""
+        items = getattr(self.gltf, kind) or []
+        if not isinstance(index, int) or isinstance(index, bool) or not 0 <= index < len(items):
+            raise self.fail(referrer, f"refers to {kind[:-1]} {index!r}, but the file has {len(items)} {kind}")
+        return items[index]
+
+    # ---- accessors -------------------------------------------------------------------------
+
+    def accessor(self, index: Any, referrer: str) -> np.ndarray:
+        """The elements of accessor ``index`` as a read-only ``(count, width)`` array (cached).
+
+        Float and normalised-integer accessors come back as float32 (checked finite), other
+        integer accessors in their own dtype. Sparse substitutions are applied.
+        """
+        accessor = self.item("accessors", index, referrer)
+        if index not in self._accessors:
+            self._accessors[index] = self._decode_accessor(index, accessor, f"accessor {index} ({referrer})")
+        return self._accessors[index]
+
+    def _decode_accessor(self, index: int, accessor: pygltflib.Accessor, element: str) -> np.ndarray:
+        component = accessor.componentType
+        if component not in _COMPONENT_DTYPES:
+            raise self.fail(element, f"unknown componentType {component!r}")
+        if accessor.type not in _TYPE_WIDTHS:
+            raise self.fail(element, f"type {accessor.type!r} is not supported here")
+        count = accessor.count
+        if not isinstance(count, int) or count < 0:
+            raise self.fail(element, f"invalid count {count!r}")
+        width = _TYPE_WIDTHS[accessor.type]
+        dtype = _COMPONENT_DTYPES[component]
+        if accessor.bufferView is None:
+            values = np.zeros((count, width), dtype)  # all zeros unless sparse says otherwise
+        else:
+            values = self._strided_elements(accessor, count, width, dtype, element)
+        if accessor.sparse is not None:
+            self._apply_sparse(accessor.sparse, values, width, dtype, element)
+        if accessor.normalized and component in _NORMALIZED_DIVISORS:
+            values = np.maximum(values / np.float32(_NORMALIZED_DIVISORS[component]), np.float32(-1.0))
+        if values.dtype.kind == "f":
+            values = values.astype(np.float32)
+            finite = np.isfinite(values)
+            if not finite.all():
+                bad = int(np.argmax(~finite.all(axis=1)))
+                raise self.fail(element, f"non-finite value at element {bad}")
+        values.flags.writeable = False
+        return values
+
+    def _strided_elements(
+        self, accessor: pygltflib.Accessor, count: int, width: int, dtype: np.dtype, element: str
+    ) -> np.ndarray:
+        view_index = accessor.bufferView
+        view = self.item("bufferViews", view_index, element)
+        data = self._buffer(view.buffer, f"bufferView {view_index}")
+        view_offset = view.byteOffset or 0
+        view_length = view.byteLength or 0
+        if view_offset + view_length > len(data):
+            raise self.fail(
+                f"bufferView {view_index}",
+                f"bytes [{view_offset}, {view_offset + view_length}) lie outside buffer {view.buffer} "
+                f"of {len(data)} bytes (truncated file?)",
+            )
+        element_bytes = dtype.itemsize * width
+        stride = view.byteStride or element_bytes
+        start = accessor.byteOffset or 0
+        needed = start + stride * (count - 1) + element_bytes if count else 0
+        if needed > view_length:
+            raise self.fail(element, f"needs {needed} bytes but bufferView {view_index} has {view_length}")
+        if count == 0:
+            return np.zeros((0, width), dtype)
+        window = np.frombuffer(data, np.uint8, needed - start, view_offset + start)
+        rows = np.lib.stride_tricks.as_strided(window, (count, element_bytes), (stride, 1))
+        return rows.copy().view(dtype).reshape(count, width)
+
+    def _apply_sparse(
+        self, sparse: pygltflib.Sparse, values: np.ndarray, width: int, dtype: np.dtype, element: str
+    ) -> None:
+        substitutes = sparse.count or 0
+        index_dtype = _COMPONENT_DTYPES.get(sparse.indices.componentType)
+        indices = self._sparse_part(sparse.indices, substitutes, 1, index_dtype, f"{element} sparse indices")
+        new_values = self._sparse_part(sparse.values, substitutes, width, dtype, f"{element} sparse values")
+        rows = indices[:, 0].astype(np.int64)
+        if rows.size and rows.max() >= values.shape[0]:
+            raise self.fail(f"{element} sparse indices", f"index {int(rows.max())} outside [0, {values.shape[0]})")
+        values[rows] = new_values
+
+    def _sparse_part(self, part: Any, count: int, width: int, dtype: np.dtype | None, element: str) -> np.ndarray:
+        if dtype is None:
+            raise self.fail(element, "unknown componentType")
+        view = self.item("bufferViews", part.bufferView, element)
+        data = self._buffer(view.buffer, f"bufferView {part.bufferView}")
+        start = (view.byteOffset or 0) + (part.byteOffset or 0)
+        length = count * width * dtype.itemsize
+        if start + length > len(data):
+            raise self.fail(element, f"needs bytes up to {start + length}, buffer has {len(data)}")
+        return np.frombuffer(data, dtype, count * width, start).reshape(count, width)
+
+    def _buffer(self, index: Any, referrer: str) -> bytes:
+        buffer = self.item("buffers", index, referrer)
+        if index not in self._buffers:
+            self._buffers[index] = self._buffer_bytes(index, buffer)
+        return self._buffers[index]
+
+    def _buffer_bytes(self, index: int, buffer: pygltflib.Buffer) -> bytes:
+        element = f"buffer {index}"
+        if buffer.uri is None:
+            blob = self.gltf.binary_blob()
+            if blob is None:
+                raise self.fail(element, "has no uri and the file has no GLB binary chunk")
+            data = bytes(blob)
+        elif buffer.uri.startswith("data:"):
+            try:
+                data = base64.b64decode(buffer.uri.split(_DATA_URI_BASE64, 1)[1], validate=True)
+            except (IndexError, binascii.Error) as error:
+                raise self.fail(element, f"malformed base64 data URI ({error})") from None
+        else:
+            external = Path(self.path).parent / buffer.uri
+            try:
+                data = external.read_bytes()
+            except OSError as error:
+                raise self.fail(element, f"cannot read {external} ({error.strerror})") from None
+        if buffer.byteLength is not None and len(data) < buffer.byteLength:
+            raise self.fail(element, f"holds {len(data)} bytes, byteLength says {buffer.byteLength} (truncated file?)")
+        return data
+
+    # ---- nodes ------------------------------------------------------------------------------
+
+    def _node_parents(self) -> np.ndarray:
+        nodes = self.gltf.nodes or []
+        parents = np.full(len(nodes), -1, dtype=np.int64)
+        for index, node in enumerate(nodes):
+            for child in node.children or []:
+                self.item("nodes", child, f"node {index} children")
+                if parents[child] != -1 or child == index:
+                    raise self.fail(f"node {child}", "has more than one parent (the node graph must be a tree)")
+                parents[child] = index
+        for index in range(len(nodes)):  # a cycle never reaches a top node
+            seen, node = 0, index
+            while node != -1:
+                node, seen = parents[node], seen + 1
+                if seen > len(nodes):
+                    raise self.fail(f"node {index}", "lies on a cycle of children")
+        return parents
+
+    def node_label(self, index: int) -> str:
+        """``node 5 'Hips'`` for messages."""
+        name = self.gltf.nodes[index].name
+        return f"node {index} {name!r}" if name else f"node {index}"
+
+    def ancestors(self, index: int) -> list[int]:
+        """Ancestors of node ``index``, nearest first."""
+        chain = []
+        node = self.parents[index]
+        while node != -1:
+            chain.append(int(node))
+            node = self.parents[node]
+        return chain
+
+    def rest_trs(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Rest ``translation (3,)``, ``rotation (4,)`` and ``scale (3,)`` of node ``index``.
+
+        A ``matrix`` is decomposed; shear and mirroring cannot be expressed as TRS and raise.
+        """
+        node = self.gltf.nodes[index]
+        if node.matrix is not None:
+            return self._decompose(index, node.matrix)
+        translation = np.asarray(node.translation if node.translation is not None else (0.0, 0.0, 0.0), np.float64)
+        rotation = np.asarray(node.rotation if node.rotation is not None else (0.0, 0.0, 0.0, 1.0), np.float64)
+        scale = np.asarray(node.scale if node.scale is not None else (1.0, 1.0, 1.0), np.float64)
+        if translation.shape != (3,) or rotation.shape != (4,) or scale.shape != (3,):
+            raise self.fail(self.node_label(index), "translation, rotation or scale has the wrong length")
+        if not (np.all(np.isfinite(translation)) and np.all(np.isfinite(rotation)) and np.all(np.isfinite(scale))):
+            raise self.fail(self.node_label(index), "non-finite translation, rotation or scale")
+        if np.linalg.norm(rotation) == 0.0:
+            raise self.fail(self.node_label(index), "zero rotation quaternion")
+        return translation, rotations.normalize(rotation), scale
+
+    def _decompose(self, index: int, values: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        matrix = np.asarray(values, np.float64)
+        if matrix.shape != (16,) or not np.all(np.isfinite(matrix)):
+            raise self.fail(self.node_label(index), "matrix must be 16 finite numbers")
+        matrix = matrix.reshape(4, 4).T  # glTF stores column-major
+        linear = matrix[:3, :3]
+        scale = np.linalg.norm(linear, axis=0)
+        if np.any(scale == 0.0):
+            raise self.fail(self.node_label(index), "matrix is singular")
+        rotation = linear / scale
+        if np.linalg.det(rotation) < 0.0 or not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-4):
+            raise self.fail(self.node_label(index), "matrix has shear or mirroring, not translation-rotation-scale")
+        return matrix[:3, 3].copy(), rotations.from_matrix(rotation), scale
+
+    def rest_matrix(self, index: int) -> np.ndarray:
+        """Local rest transform ``(4, 4)`` of node ``index``."""
+        translation, rotation, scale = self.rest_trs(index)
+        return rotations.compose_transform(translation, rotation, scale)
+
+    def rest_world_matrix(self, index: int) -> np.ndarray:
+        """World rest transform ``(4, 4)`` of node ``index`` (its ancestors included)."""
+        world = self.rest_matrix(index)
+        for ancestor in self.ancestors(index):
+            world = self.rest_matrix(ancestor) @ world
+        return world
+
+    def uniform_scale(self, index: int, scale: np.ndarray, element: str) -> float:
+        """The common value of a uniform positive ``scale (3,)``; FormatError otherwise."""
+        value = float(np.mean(scale))
+        if value <= 0.0 or np.max(np.abs(scale - value)) > UNIFORM_SCALE_TOLERANCE * value:
+            raise self.fail(
+                element,
+                f"scale {np.round(scale, 6).tolist()} of {self.node_label(index)} is not uniform and positive; "
+                "animlod skeletons fold only uniform scale into bone offsets",
+            )
+        return value
+
+    # ---- animations -------------------------------------------------------------------------
+
+    def animation_label(self, index: int) -> str:
+        """``animation 'Run'`` (or ``animation 3`` when unnamed) for messages."""
+        name = self.gltf.animations[index].name
+        return f"animation {name!r}" if name else f"animation {index}"
+
+    def animation_duration(self, index: int) -> float:
+        """Last key time over all samplers of an animation: the clip length a viewer plays."""
+        label = self.animation_label(index)
+        samplers = self.gltf.animations[index].samplers or []
+        ends = [self.accessor(s.input, f"{label} sampler {k} input").max(initial=0.0) for k, s in enumerate(samplers)]
+        return float(max(ends, default=0.0))
+
+    def sampler_keys(
+        self, animation_index: int, sampler_index: Any, width: int, element: str
+    ) -> tuple[np.ndarray, np.ndarray, str]:
+        """Key ``times (N,)``, values and interpolation of one animation sampler.
+
+        Values are ``(N, width)``, or ``(N, 3, width)`` (in-tangent, value, out-tangent) for
+        CUBICSPLINE; ``width`` is 3 or 4 for node paths and the morph target count for weights.
+        """
+        samplers = self.gltf.animations[animation_index].samplers or []
+        if not isinstance(sampler_index, int) or not 0 <= sampler_index < len(samplers):
+            raise self.fail(element, f"refers to sampler {sampler_index!r}, the animation has {len(samplers)}")
+        sampler = samplers[sampler_index]
+        interpolation = sampler.interpolation or "LINEAR"
+        if interpolation not in INTERPOLATIONS:
+            raise self.fail(element, f"unknown interpolation {interpolation!r}")
+        times = self.accessor(sampler.input, f"{element} input")
+        if times.shape[1] != 1 or times.dtype.kind != "f" or times.shape[0] == 0:
+            raise self.fail(element, "input must be a non-empty float SCALAR accessor")
+        times = times[:, 0]
+        steps = np.diff(times)
+        if np.any(steps <= 0.0):
+            key = int(np.argmax(steps <= 0.0)) + 1
+            raise self.fail(element, f"key times are not strictly increasing (at key {key})")
+        output = self.accessor(sampler.output, f"{element} output")
+        count = times.shape[0]
+        per_key = 3 if interpolation == "CUBICSPLINE" else 1
+        if output.size != count * per_key * width:
+            raise self.fail(element, f"output holds {output.size} numbers, {count} keys x {per_key} x {width} expected")
+        return times, output.reshape((count, 3, width) if per_key == 3 else (count, width)), interpolation
+
+
+def _parse(path: str) -> pygltflib.GLTF2:
+    """pygltflib's document for a .glb or .gltf file; FormatError for anything else."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError as error:
+        raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
+    if data[:4] == _GLB_MAGIC:
+        _check_glb_header(path, data)
+        parse = pygltflib.GLTF2.load_from_bytes
+        source: bytes | str = data
+    else:
+        try:
+            source = data.decode("utf-8-sig")
+            json.loads(source)
+        except (UnicodeDecodeError, json.JSONDecodeError):
+            raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor JSON") from None
+        parse = pygltflib.GLTF2.gltf_from_json
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # pygltflib warns about unknown chunks; we check what we use
+            gltf = parse(source)
+    except (ValueError, KeyError, TypeError, AttributeError, struct.error, UnicodeDecodeError) as error:
+        raise FormatError(path, "JSON", f"not a valid glTF document ({type(error).__name__}: {error})") from None
+    if gltf is None:
+        raise FormatError(path, "GLB", "no JSON chunk")
+    version = str(getattr(gltf.asset, "version", "") or "")
+    if not version.startswith("2."):
+        raise FormatError(path, "asset", f"glTF version {version!r} is not 2.x")
+    return gltf
+
+
+def _check_glb_header(path: str, data: bytes) -> None:
+    if len(data) < _GLB_HEADER_BYTES + 8:
+        raise FormatError(path, "GLB header", f"file is truncated ({len(data)} bytes)")
+    version, length = struct.unpack_from("<II", data, 4)
+    if version != 2:
+        raise FormatError(path, "GLB header", f"container version {version} is not 2")
+    if length > len(data):
+        raise FormatError(path, "GLB header", f"file is truncated: header says {length} bytes, file has {len(data)}")
+    offset = _GLB_HEADER_BYTES
+    while offset < length:
+        if offset + 8 > length:
+            raise FormatError(path, f"GLB chunk at byte {offset}", "chunk header is truncated")
+        chunk_length = struct.unpack_from("<I", data, offset)[0]
+        if offset + 8 + chunk_length > length:
+            raise FormatError(
+                path, f"GLB chunk at byte {offset}", f"declares {chunk_length} bytes, only {length - offset - 8} remain"
+            )
+        offset += 8 + chunk_length

@@ -1,0 +1,65 @@
+"""Evaluate glTF animation samplers at fixed frame times (glTF 2.0 specification, Appendix C).
+
+Vectorised over the sample times: one ``searchsorted`` finds every frame's key interval.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import rotations
+
+INTERPOLATIONS = ("LINEAR", "STEP", "CUBICSPLINE")
+
+# A key time may sit a float32 rounding below k / fps; this slack (in frames) keeps that frame.
+_FRAME_SLACK = 1e-3
+
+
+def frame_times(duration: float, fps: float) -> np.ndarray:
+    """Sample times ``(T,)`` in seconds: ``k / fps`` from 0 up to ``duration`` (T >= 1)."""
+    count = int(np.floor(max(duration, 0.0) * fps + _FRAME_SLACK)) + 1
+    return np.arange(count) / fps
+
+
+def sample_keyframes(
+    times: np.ndarray, values: np.ndarray, interpolation: str, at: np.ndarray, rotation: bool = False
+) -> np.ndarray:
+    """Interpolate one sampler's keys at the times ``at``.
+
+    Parameters
+    ----------
+    times : (N,) strictly increasing key times, N >= 1.
+    values : (N, C) key values, or (N, 3, C) for CUBICSPLINE (in-tangent, value, out-tangent).
+    interpolation : "LINEAR", "STEP" or "CUBICSPLINE".
+    at : (T,) sample times; before the first key or after the last the end values hold.
+    rotation : True for (x, y, z, w) quaternions: LINEAR becomes slerp, and cubic results are
+        normalised, as the specification asks.
+
+    Returns
+    -------
+    (T, C) float64 values.
+    """
+    times = np.asarray(times, np.float64)
+    values = np.asarray(values, np.float64)
+    at = np.asarray(at, np.float64)
+    keys = values[:, 1] if interpolation == "CUBICSPLINE" else values
+    if times.shape[0] == 1:
+        return np.repeat(keys[:1], at.shape[0], axis=0)
+    if interpolation == "STEP":
+        return keys[np.clip(np.searchsorted(times, at, side="right") - 1, 0, times.shape[0] - 1)]
+    start = np.clip(np.searchsorted(times, at, side="right") - 1, 0, times.shape[0] - 2)
+    span = times[start + 1] - times[start]
+    s = np.clip((at - times[start]) / span, 0.0, 1.0)
+    if interpolation == "LINEAR":
+        if rotation:
+            return rotations.slerp(keys[start], keys[start + 1], s)
+        return keys[start] + s[:, None] * (keys[start + 1] - keys[start])
+    # Cubic Hermite spline, Appendix C: tangents are scaled by the key interval length.
+    s2, s3 = s * s, s * s * s
+    result = (
+        (2 * s3 - 3 * s2 + 1)[:, None] * keys[start]
+        + ((s3 - 2 * s2 + s) * span)[:, None] * values[start, 2]
+        + (-2 * s3 + 3 * s2)[:, None] * keys[start + 1]
+        + ((s3 - s2) * span)[:, None] * values[start + 1, 0]
+    )
+    return rotations.normalize(result) if rotation else result

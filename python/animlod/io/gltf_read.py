@@ -1,0 +1,203 @@
+"""Read glTF 2.0 / GLB files into animlod's data model.
+
+What a file becomes:
+
+- every (mesh, skin) pair used by a node -> a :class:`SkinnedMesh` on the skin's skeleton
+  (:mod:`.gltf_skin`), with one :class:`Motion` per animation that moves it;
+- every mesh without a skin whose morph weights are animated -> one :class:`AnimatedMesh` per
+  animation, the targets baked at ``fps`` (rest + sum_i w_i * delta_i);
+- every other mesh without a skin -> a one-frame :class:`AnimatedMesh`.
+
+Placement follows what a glTF viewer shows. A skinned mesh's node transform does not affect
+the skinned result (glTF 2.0, section 3.7.3.3); animlod still applies it to ``rest_positions``
+so that the rest mesh lies where the skinned mesh does in its bind pose, and compensates the
+inverse bind matrices (``IBM' = S(c) @ IBM @ M^-1``) so that baking stays exactly what a
+viewer shows. Meshes without a skin are placed by their node's world transform.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model import AnimatedMesh, Motion, SkinnedMesh
+from .gltf_document import GltfDocument
+from .gltf_keyframes import frame_times, sample_keyframes
+from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_normals, transform_points
+from .gltf_skin import SkinRig
+
+
+@dataclass
+class GltfScene:
+    """Everything animlod reads from one glTF file.
+
+    Attributes
+    ----------
+    skinned_meshes : one per (mesh, skin) pair used by a node, in node order.
+    motions : the animations on the skeleton of ``skinned_meshes[0]`` (empty without skins).
+    morph_animations : meshes without a skin whose morph weights an animation drives, baked
+        at ``fps``, one per (node, animation).
+    static_meshes : the other meshes without a skin, one frame each, in world space.
+    skinned_motions : the animations of every skinned mesh, parallel to ``skinned_meshes``.
+    """
+
+    skinned_meshes: list[SkinnedMesh]
+    motions: list[Motion]
+    morph_animations: list[AnimatedMesh]
+    static_meshes: list[AnimatedMesh]
+    skinned_motions: list[list[Motion]] = field(default_factory=list)
+
+
+def read_gltf(path: str | os.PathLike, fps: float = 30.0) -> GltfScene:
+    """Read every skinned mesh, motion, morph animation and static mesh of a .glb / .gltf file.
+
+    Animations are sampled at ``fps`` from time 0 to their last key. Raises
+    :class:`~animlod.io.FormatError` naming the file, the element and the reason for input it
+    cannot read.
+    """
+    doc = GltfDocument(path)
+    rigs: dict[int, SkinRig] = {}
+    skinned, skinned_motions = [], []
+    for node in _skinned_mesh_nodes(doc):
+        skin = doc.gltf.nodes[node].skin
+        if skin not in rigs:
+            rigs[skin] = SkinRig(doc, skin)
+        mesh, motions = _read_skinned_node(doc, node, rigs[skin], fps)
+        skinned.append(mesh)
+        skinned_motions.append(motions)
+    morph_animations, static_meshes = _read_unskinned_meshes(doc, fps)
+    return GltfScene(
+        skinned_meshes=skinned,
+        motions=skinned_motions[0] if skinned_motions else [],
+        morph_animations=morph_animations,
+        static_meshes=static_meshes,
+        skinned_motions=skinned_motions,
+    )
+
+
+def read_skinned(
+    path: str | os.PathLike, skin: int | str | None = None, fps: float = 30.0
+) -> tuple[SkinnedMesh, list[Motion]]:
+    """One skinned mesh of a glTF file and its motions sampled at ``fps``.
+
+    ``skin`` picks the skin by index, or by skin or mesh name; None takes the first skinned
+    mesh. A file without that skin raises FormatError naming the file and the skin asked for.
+    """
+    doc = GltfDocument(path)
+    nodes = _skinned_mesh_nodes(doc)
+    chosen = [node for node in nodes if skin is None or _uses_skin(doc, node, skin)]
+    if not chosen:
+        available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes})) or "none"
+        asked = "a skinned mesh" if skin is None else repr(skin)
+        raise doc.fail(f"skin {asked}", f"not in the file (skinned meshes use skins: {available})")
+    return _read_skinned_node(doc, chosen[0], SkinRig(doc, doc.gltf.nodes[chosen[0]].skin), fps)
+
+
+def _skinned_mesh_nodes(doc: GltfDocument) -> list[int]:
+    """The first node of every distinct (mesh, skin) pair, in node order."""
+    seen, nodes = set(), []
+    for index, node in enumerate(doc.gltf.nodes or []):
+        if node.mesh is not None and node.skin is not None and (node.mesh, node.skin) not in seen:
+            doc.item("meshes", node.mesh, doc.node_label(index))
+            doc.item("skins", node.skin, doc.node_label(index))
+            seen.add((node.mesh, node.skin))
+            nodes.append(index)
+    return nodes
+
+
+def _skin_label(doc: GltfDocument, skin: int) -> str:
+    name = doc.gltf.skins[skin].name
+    return f"{skin} {name!r}" if name else str(skin)
+
+
+def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:
+    skin = doc.gltf.nodes[node].skin
+    if isinstance(wanted, int):
+        return skin == wanted
+    return wanted in (doc.gltf.skins[skin].name, doc.gltf.meshes[doc.gltf.nodes[node].mesh].name)
+
+
+def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -> tuple[SkinnedMesh, list[Motion]]:
+    mesh_index = doc.gltf.nodes[node].mesh
+    geometry = read_mesh_geometry(doc, mesh_index, skinned=True)
+    slots = len(rig.remap)
+    # Unused influences may carry any index (some exporters leave garbage there).
+    joints = np.where(geometry.weights > 0.0, geometry.joints, 0)
+    if joints.size and joints.max() >= slots:
+        vertex = int(np.argmax((joints >= slots).any(axis=1)))
+        reason = f"vertex {vertex} uses joint slot {int(joints[vertex].max())}, skin {rig.skin} has {slots}"
+        raise doc.fail(f"mesh {mesh_index} JOINTS", reason)
+    mesh_world = doc.rest_world_matrix(node)
+    row_scale = np.ones((slots, 4, 1))
+    row_scale[:, :3] = rig.scales[:, None, None]
+    inverse_bind = (row_scale * rig.inverse_bind) @ np.linalg.inv(mesh_world)
+    try:
+        mesh = SkinnedMesh(
+            rest_positions=transform_points(mesh_world, geometry.positions),
+            faces=geometry.faces,
+            joints=rig.remap[joints],
+            weights=geometry.weights,
+            inverse_bind=inverse_bind,
+            skeleton=rig.skeleton,
+            uvs=geometry.uvs,
+            normals=None if geometry.normals is None else transform_normals(mesh_world, geometry.normals),
+            morph_targets=None if geometry.targets is None else geometry.targets @ mesh_world[:3, :3].T,
+            morph_target_names=geometry.target_names,
+        )
+    except ValueError as error:
+        raise doc.fail(f"mesh {mesh_index} with skin {rig.skin}", str(error)) from None
+    motions = [rig.motion(doc, animation, fps) for animation in range(len(doc.gltf.animations or []))]
+    return mesh, [motion for motion in motions if motion is not None]
+
+
+def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[AnimatedMesh], list[AnimatedMesh]]:
+    """Morph-animated meshes (one per node and animation) and static meshes, in world space."""
+    morphs, statics = [], []
+    geometries: dict[int, MeshGeometry] = {}
+    for node_index, node in enumerate(doc.gltf.nodes or []):
+        if node.mesh is None or node.skin is not None:
+            continue
+        if node.mesh not in geometries:
+            geometries[node.mesh] = read_mesh_geometry(doc, node.mesh, skinned=False)
+        geometry = geometries[node.mesh]
+        world = doc.rest_world_matrix(node_index)
+        # A mirroring transform turns counter-clockwise triangles clockwise (glTF 2.0, 3.7.4).
+        faces = geometry.faces[:, ::-1] if np.linalg.det(world[:3, :3]) < 0.0 else geometry.faces
+        tracks = [] if geometry.targets is None else _morph_weight_tracks(doc, node_index, len(geometry.targets), fps)
+        for label, weights in tracks:
+            frames = transform_points(world, geometry.positions + np.einsum("tn,nvc->tvc", weights, geometry.targets))
+            morphs.append(_animated_mesh(doc, f"{doc.node_label(node_index)} {label}", faces, frames, fps))
+        if not tracks:
+            positions = geometry.positions.astype(np.float64)
+            if geometry.targets is not None:
+                weights = np.asarray(node.weights, np.float64) if node.weights else geometry.default_weights
+                positions = positions + np.einsum("n,nvc->vc", weights, geometry.targets)
+            frames = transform_points(world, positions)[None]
+            statics.append(_animated_mesh(doc, doc.node_label(node_index), faces, frames, None))
+    return morphs, statics
+
+
+def _morph_weight_tracks(doc: GltfDocument, node: int, target_count: int, fps: float) -> list[tuple[str, np.ndarray]]:
+    """``(animation label, weights (T, N))`` for every animation that drives the node's morph weights."""
+    tracks = []
+    for a, animation in enumerate(doc.gltf.animations or []):
+        label = doc.animation_label(a)
+        for index, channel in enumerate(animation.channels or []):
+            if channel.target is None or channel.target.node != node or channel.target.path != "weights":
+                continue
+            element = f"{label} channel {index}"
+            times, values, interpolation = doc.sampler_keys(a, channel.sampler, target_count, element)
+            at = frame_times(doc.animation_duration(a), fps)
+            tracks.append((label, sample_keyframes(times, values, interpolation, at)))
+    return tracks
+
+
+def _animated_mesh(
+    doc: GltfDocument, element: str, faces: np.ndarray, frames: np.ndarray, fps: float | None
+) -> AnimatedMesh:
+    try:
+        return AnimatedMesh(faces, frames, fps=fps)
+    except ValueError as error:
+        raise doc.fail(element, str(error)) from None

@@ -1,0 +1,225 @@
+"""A glTF skin as an animlod skeleton, and its animations as motions.
+
+The skin's joints are put in topological order (parents first; an order that already is
+topological is kept, so JOINTS_0 of such files need no remapping). Every joint and every
+ancestor of one takes part in posing: the armature above the root joint (glTF viewers apply
+it, so baking must too) and any non-joint node between two joints. A pose composes world
+rotations and positions through that node tree; a joint's motion rotation is then its world
+rotation relative to its parent joint's, and the root's position is its world position.
+
+Scale: glTF nodes may scale, animlod motions are rigid. A uniform scale ``c`` accumulated down
+the tree scales the bone offsets below it, and ``diag(c, c, c, 1)`` moves into the joint's
+inverse bind matrix (``W = W_rigid @ S(c)``, so ``W @ IBM = W_rigid @ (S(c) @ IBM)``).
+Non-uniform scale and animated scale have no rigid equivalent and raise FormatError.
+"""
+
+from __future__ import annotations
+
+import heapq
+
+import numpy as np
+
+from .. import rotations
+from ..model import Motion, Skeleton
+from .gltf_document import UNIFORM_SCALE_TOLERANCE, GltfDocument
+from .gltf_keyframes import frame_times, sample_keyframes
+
+# Animated bone offsets within this fraction of the skeleton's largest rest offset of their
+# rest value count as held, so the motion needs no per-frame joint translations.
+_HELD_TRANSLATION_TOLERANCE = 1e-4
+_NODE_PATHS = ("translation", "rotation", "scale")
+
+
+class SkinRig:
+    """Skin ``skin`` of a document as a skeleton, with what is needed to pose it.
+
+    Attributes
+    ----------
+    skeleton : the joints in topological order, rest offsets and rotations from the nodes.
+    remap : (S,) skeleton joint of each skin slot (the index JOINTS_0 stores).
+    scales : (J,) accumulated uniform scale of each joint's node at rest.
+    inverse_bind : (J, 4, 4) the skin's inverse bind matrices in skeleton order, as stored.
+    """
+
+    def __init__(self, doc: GltfDocument, skin: int) -> None:
+        self.skin = skin
+        self.element = f"skin {skin}"
+        joint_nodes = self._joint_nodes(doc)
+        parent_slots = self._parent_slots(doc, joint_nodes)
+        order = _topological_order(parent_slots)
+        self.joint_nodes = [joint_nodes[slot] for slot in order]
+        self.remap = np.empty(len(order), np.int64)
+        self.remap[order] = np.arange(len(order))
+        parents = np.array([-1 if parent_slots[slot] < 0 else self.remap[parent_slots[slot]] for slot in order])
+        self._parents = parents
+        # Every joint and ancestor, parents first (depth order).
+        tree = {n for joint in joint_nodes for n in [joint, *doc.ancestors(joint)]}
+        self._nodes = sorted(tree, key=lambda n: len(doc.ancestors(n)))
+        self._node_parents = {n: int(doc.parents[n]) for n in self._nodes}
+        self.rest_translation, self.rest_rotation, self._local_scale, self._world_scale = {}, {}, {}, {}
+        for node in self._nodes:
+            translation, rotation, scale = doc.rest_trs(node)
+            self.rest_translation[node], self.rest_rotation[node] = translation[None], rotation[None]
+            self._local_scale[node] = doc.uniform_scale(node, scale, self.element)
+            self._world_scale[node] = self._local_scale[node] * self._world_scale.get(self._node_parents[node], 1.0)
+        self.scales = np.array([self._world_scale[n] for n in self.joint_nodes])
+        self.inverse_bind = self._inverse_bind(doc)[order]
+        positions, world_rotations = self._pose(self.rest_translation, self.rest_rotation, frames=1)
+        offsets = self._offsets(positions, world_rotations)[0]
+        self._translation_tolerance = _HELD_TRANSLATION_TOLERANCE * max(np.abs(offsets[1:]).max(initial=0.0), 1e-12)
+        names = _unique_names(doc, self.joint_nodes)
+        try:
+            self.skeleton = Skeleton(names, parents, offsets, self._local_rotations(world_rotations)[0])
+        except ValueError as error:
+            raise doc.fail(self.element, str(error)) from None
+
+    def motion(self, doc: GltfDocument, animation_index: int, fps: float) -> Motion | None:
+        """Animation ``animation_index`` sampled at ``fps`` on this skeleton; None if it moves none of its nodes.
+
+        Channels missing for a node keep its rest TRS. Animated translations of non-root bones
+        become per-frame ``joint_translations`` (None when every bone keeps its rest offset).
+        """
+        animation = doc.gltf.animations[animation_index]
+        label = doc.animation_label(animation_index)
+        channels = [
+            (index, channel)
+            for index, channel in enumerate(animation.channels or [])
+            if channel.target is not None
+            and channel.target.node in self.rest_translation
+            and channel.target.path in _NODE_PATHS
+        ]
+        if not channels:
+            return None
+        at = frame_times(doc.animation_duration(animation_index), fps)
+        translations, local_rotations = dict(self.rest_translation), dict(self.rest_rotation)
+        for index, channel in channels:
+            element = f"{label} channel {index}"
+            node, path = channel.target.node, channel.target.path
+            times, values, interpolation = doc.sampler_keys(
+                animation_index, channel.sampler, 4 if path == "rotation" else 3, element
+            )
+            if path == "scale":
+                self._check_scale_held(doc, node, values, element)
+            elif path == "translation":
+                translations[node] = sample_keyframes(times, values, interpolation, at)
+            else:
+                local_rotations[node] = sample_keyframes(times, values, interpolation, at, rotation=True)
+        positions, world_rotations = self._pose(translations, local_rotations, frames=len(at))
+        offsets = self._offsets(positions, world_rotations)
+        bones_move = np.abs(offsets[:, 1:] - self.skeleton.offsets[1:]).max(initial=0.0) > self._translation_tolerance
+        try:
+            return Motion(
+                self.skeleton,
+                offsets[:, 0],
+                self._local_rotations(world_rotations),
+                fps=fps,
+                name=animation.name or "",
+                joint_translations=offsets if bones_move else None,
+            )
+        except ValueError as error:
+            raise doc.fail(label, str(error)) from None
+
+    def _joint_nodes(self, doc: GltfDocument) -> list[int]:
+        joints = list(doc.gltf.skins[self.skin].joints or [])
+        if not joints:
+            raise doc.fail(self.element, "has no joints")
+        for slot, node in enumerate(joints):
+            doc.item("nodes", node, f"{self.element} joint {slot}")
+        if len(set(joints)) != len(joints):
+            raise doc.fail(self.element, "lists a node twice among its joints")
+        return joints
+
+    def _parent_slots(self, doc: GltfDocument, joint_nodes: list[int]) -> list[int]:
+        """Skin slot of each joint's nearest joint ancestor, -1 for the root."""
+        slot_of = {node: slot for slot, node in enumerate(joint_nodes)}
+        parents = [next((slot_of[a] for a in doc.ancestors(node) if a in slot_of), -1) for node in joint_nodes]
+        roots = [doc.node_label(joint_nodes[slot]) for slot, parent in enumerate(parents) if parent < 0]
+        if len(roots) != 1:
+            reason = f"joints form {len(roots)} separate trees ({', '.join(roots)}); one root joint is needed"
+            raise doc.fail(self.element, reason)
+        return parents
+
+    def _inverse_bind(self, doc: GltfDocument) -> np.ndarray:
+        """The skin's inverse bind matrices ``(S, 4, 4)`` in skin order (identity when absent)."""
+        skin = doc.gltf.skins[self.skin]
+        count = len(skin.joints)
+        if skin.inverseBindMatrices is None:
+            return np.broadcast_to(np.eye(4), (count, 4, 4)).copy()
+        matrices = doc.accessor(skin.inverseBindMatrices, f"{self.element} inverseBindMatrices")
+        if matrices.shape != (count, 16) or matrices.dtype.kind != "f":
+            got = f"{matrices.shape[0]} of width {matrices.shape[1]}"
+            raise doc.fail(self.element, f"inverseBindMatrices must be {count} float MAT4, got {got}")
+        return matrices.reshape(count, 4, 4).transpose(0, 2, 1).astype(np.float64)  # glTF is column-major
+
+    def _pose(self, translations: dict, local_rotations: dict, frames: int) -> tuple[np.ndarray, np.ndarray]:
+        """World positions ``(T, J, 3)`` and rotations ``(T, J, 4)`` of the joints, T = ``frames``.
+
+        ``translations[node] (T or 1, 3)`` and ``local_rotations[node] (T or 1, 4)`` give the
+        local transform of every node of the tree. A node's position is its parent's plus the
+        parent's accumulated scale times its translation turned by the parent's rotation.
+        """
+        position, rotation = {}, {}
+        for node in self._nodes:
+            parent = self._node_parents[node]
+            if parent < 0:
+                position[node], rotation[node] = translations[node], local_rotations[node]
+                continue
+            turned = rotations.rotate(rotation[parent], translations[node])
+            position[node] = position[parent] + self._world_scale[parent] * turned
+            rotation[node] = rotations.multiply(rotation[parent], local_rotations[node])
+        return self._per_joint(position, frames), self._per_joint(rotation, frames)
+
+    def _per_joint(self, values: dict, frames: int) -> np.ndarray:
+        """``(T, J, C)`` from per-node ``(T or 1, C)`` arrays."""
+        return np.stack([np.broadcast_to(values[n], (frames, values[n].shape[1])) for n in self.joint_nodes], axis=1)
+
+    def _offsets(self, positions: np.ndarray, world_rotations: np.ndarray) -> np.ndarray:
+        """Joint translations ``(T, J, 3)`` in the parent joint's rigid frame (the root's in the world)."""
+        offsets = positions.copy()
+        parents = self._parents[1:]
+        offsets[:, 1:] = rotations.rotate(
+            rotations.conjugate(world_rotations[:, parents]), positions[:, 1:] - positions[:, parents]
+        )
+        return offsets
+
+    def _local_rotations(self, world_rotations: np.ndarray) -> np.ndarray:
+        """Joint rotations ``(T, J, 4)`` relative to the parent joint's world rotation."""
+        local = world_rotations.copy()
+        parents = self._parents[1:]
+        local[:, 1:] = rotations.multiply(rotations.conjugate(world_rotations[:, parents]), world_rotations[:, 1:])
+        return local
+
+    def _check_scale_held(self, doc: GltfDocument, node: int, values: np.ndarray, element: str) -> None:
+        """A scale channel must keep its node's rest scale: rigid motions cannot scale."""
+        keys = values[:, 1] if values.ndim == 3 else values  # CUBICSPLINE: the values between tangents
+        rest = self._local_scale[node]
+        deviation = float(np.abs(keys - rest).max())
+        if deviation > UNIFORM_SCALE_TOLERANCE * rest:
+            reason = f"animated scale is not supported (motions are rigid); it leaves the rest scale by {deviation:.6g}"
+            raise doc.fail(element, reason)
+
+
+def _topological_order(parent_slots: list[int]) -> list[int]:
+    """Skin slots ordered parents first; an order that already is topological stays as it is.
+
+    Kahn's algorithm, taking the smallest ready slot each time.
+    """
+    children: list[list[int]] = [[] for _ in parent_slots]
+    for slot, parent in enumerate(parent_slots):
+        if parent >= 0:
+            children[parent].append(slot)
+    ready = [slot for slot, parent in enumerate(parent_slots) if parent < 0]
+    order = []
+    while ready:
+        slot = heapq.heappop(ready)
+        order.append(slot)
+        for child in children[slot]:
+            heapq.heappush(ready, child)
+    return order
+
+
+def _unique_names(doc: GltfDocument, nodes: list[int]) -> list[str]:
+    """Node names (``node<i>`` when unnamed), with ``#<node>`` appended where names repeat."""
+    names = [doc.gltf.nodes[n].name or f"node{n}" for n in nodes]
+    repeated = {name for name in names if names.count(name) > 1}
+    return [f"{name}#{node}" if name in repeated else name for name, node in zip(names, nodes)]

@@ -1,0 +1,560 @@
+"""glTF 2.0 / GLB reading and writing (animlod.io.gltf)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pygltflib
+import pytest
+
+from animlod import rotations
+from animlod.io import FormatError
+from animlod.io.gltf import read_gltf, read_skinned, write_glb
+from animlod.io.gltf_keyframes import frame_times, sample_keyframes
+from animlod.model import Motion, Skeleton, SkinnedMesh
+
+# ---- a 3-joint chain skinning a box, built by hand --------------------------------------
+
+
+def _chain_skeleton() -> Skeleton:
+    return Skeleton(
+        names=["root", "mid", "tip"],
+        parents=[-1, 0, 1],
+        offsets=[[0.5, 0.0, -0.25], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+        rest_rotations=rotations.from_axis_angle(np.eye(3)[[2, 0, 1]], np.array([0.1, -0.2, 0.3])),
+    )
+
+
+def _box_along_y(rings: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    """A square tube of ``rings`` rings of 4 vertices from y = 0 to y = 2, capped; (V, 3), (M, 3)."""
+    square = np.array([[-0.2, -0.2], [0.2, -0.2], [0.2, 0.2], [-0.2, 0.2]])
+    heights = np.linspace(0.0, 2.0, rings)
+    x, z = np.tile(square[:, 0], rings), np.tile(square[:, 1], rings)
+    positions = np.stack([x, np.repeat(heights, 4), z], axis=-1)
+    faces = []
+    for ring in range(rings - 1):
+        for side in range(4):
+            a, b = ring * 4 + side, ring * 4 + (side + 1) % 4
+            faces += [[a, b, b + 4], [a, b + 4, a + 4]]
+    last = (rings - 1) * 4
+    faces += [[0, 2, 1], [0, 3, 2], [last, last + 1, last + 2], [last, last + 2, last + 3]]
+    return positions.astype(np.float32), np.array(faces, np.int32)
+
+
+def _chain_mesh(influences: int = 4, extras: bool = True) -> SkinnedMesh:
+    skeleton = _chain_skeleton()
+    positions, faces = _box_along_y()
+    vertex_count = len(positions)
+    # Weights fall off with the distance along the chain from each joint (rest heights 0, 1, 2).
+    height = positions[:, 1:2]
+    raw = np.maximum(1.0 - np.abs(height - np.array([[0.0, 1.0, 2.0]])), 0.0) + 0.05
+    joints = np.zeros((vertex_count, influences), np.int32)
+    weights = np.zeros((vertex_count, influences))
+    joints[:, :3] = [0, 1, 2]
+    weights[:, :3] = raw
+    if influences == 8:  # spread some weight to further slots so the second set is used
+        joints[:, 4:7] = [2, 1, 0]
+        weights[:, 4:7] = raw[:, ::-1] * 0.25
+    rest = Skeleton(skeleton.names, skeleton.parents, [[0, 0, 0], [0, 1, 0], [0, 1, 0]])
+    inverse_bind = np.linalg.inv(rest.rest_world_transforms())
+    rng = np.random.default_rng(7)
+    return SkinnedMesh(
+        rest_positions=positions,
+        faces=faces,
+        joints=joints,
+        weights=weights,
+        inverse_bind=inverse_bind,
+        skeleton=skeleton,
+        uvs=rng.random((vertex_count, 2)).astype(np.float32) if extras else None,
+        normals=_unit(rng.normal(size=(vertex_count, 3))) if extras else None,
+        morph_targets=rng.normal(scale=0.01, size=(2, vertex_count, 3)).astype(np.float32) if extras else None,
+        morph_target_names=["bulge", "twist"] if extras else None,
+    )
+
+
+def _unit(vectors: np.ndarray) -> np.ndarray:
+    return (vectors / np.linalg.norm(vectors, axis=1, keepdims=True)).astype(np.float32)
+
+
+def _chain_motion(skeleton: Skeleton, frames: int = 6, fps: float = 24.0, name: str = "bend") -> Motion:
+    t = np.arange(frames) / fps
+    angles = np.stack([0.4 * np.sin(3 * t), 0.8 * t, -0.5 * t], axis=1)
+    axes = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 0.6, 0.8]])
+    local = rotations.multiply(skeleton.rest_rotations, rotations.from_axis_angle(axes, angles))
+    root = skeleton.offsets[0] + np.stack([t, 0.1 * t**2, -t], axis=1)
+    return Motion(skeleton, root, local, fps=fps, name=name)
+
+
+@pytest.fixture
+def chain_glb(tmp_path: Path) -> tuple[Path, SkinnedMesh, Motion]:
+    mesh = _chain_mesh()
+    motion = _chain_motion(mesh.skeleton)
+    path = tmp_path / "chain.glb"
+    write_glb(path, mesh, [motion])
+    return path, mesh, motion
+
+
+def _edit_glb(source: Path, target: Path, edit: Callable[[pygltflib.GLTF2, bytearray], None]) -> Path:
+    """Copy a GLB through pygltflib, letting ``edit`` change its JSON and binary chunk."""
+    gltf = pygltflib.GLTF2.load_from_bytes(source.read_bytes())
+    blob = bytearray(gltf.binary_blob())
+    edit(gltf, blob)
+    gltf.set_binary_blob(bytes(blob))
+    gltf.buffers[0].byteLength = len(blob)
+    target.write_bytes(b"".join(gltf.save_to_bytes()))
+    return target
+
+
+def _accessor_view(gltf: pygltflib.GLTF2, blob: bytearray, index: int, dtype: str) -> np.ndarray:
+    """A writable ``(count, width)`` view of a non-sparse accessor inside ``blob``."""
+    accessor = gltf.accessors[index]
+    view = gltf.bufferViews[accessor.bufferView]
+    width = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}[accessor.type]
+    itemsize = np.dtype(dtype).itemsize
+    stride = view.byteStride or width * itemsize
+    start = (view.byteOffset or 0) + (accessor.byteOffset or 0)
+    flat = np.frombuffer(blob, dtype, ((accessor.count - 1) * stride) // itemsize + width, start)
+    return np.lib.stride_tricks.as_strided(flat, (accessor.count, width), (stride, itemsize))
+
+
+def _transform(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
+    return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+# ---- keyframe interpolation ---------------------------------------------------------------
+
+
+def test_frame_times_cover_the_clip_and_tolerate_float32_key_times():
+    assert len(frame_times(1.4, 30.0)) == 43
+    assert len(frame_times(float(np.float32(21 / 30)), 30.0)) == 22  # 0.7 s stored a hair below
+    assert len(frame_times(0.0, 30.0)) == 1
+    np.testing.assert_allclose(frame_times(0.1, 30.0), [0.0, 1 / 30, 2 / 30, 3 / 30])
+
+
+def test_step_and_linear_interpolation():
+    times = np.array([0.0, 1.0, 3.0])
+    values = np.array([[0.0], [10.0], [30.0]])
+    at = np.array([-1.0, 0.0, 0.5, 1.0, 2.0, 3.0, 4.0])
+    np.testing.assert_allclose(sample_keyframes(times, values, "STEP", at)[:, 0], [0, 0, 0, 10, 10, 30, 30])
+    np.testing.assert_allclose(sample_keyframes(times, values, "LINEAR", at)[:, 0], [0, 0, 5, 10, 20, 30, 30])
+
+
+def test_linear_rotation_is_slerp():
+    z = np.array([0.0, 0.0, 1.0])
+    keys = rotations.from_axis_angle(np.stack([z, z]), np.array([0.0, np.pi / 2]))
+    half = sample_keyframes(np.array([0.0, 1.0]), keys, "LINEAR", np.array([0.5]), rotation=True)
+    np.testing.assert_allclose(half[0], rotations.from_axis_angle(z, np.pi / 4), atol=1e-12)
+
+
+def test_cubic_spline_reproduces_a_line_with_matching_tangents():
+    times = np.array([0.0, 0.5, 2.0])
+    slope = 3.0
+    keys = slope * times[:, None] + 1.0
+    tangents = np.full_like(keys, slope)  # glTF tangents are per second, scaled by the interval
+    values = np.stack([tangents, keys, tangents], axis=1)
+    at = np.linspace(0.0, 2.0, 9)
+    np.testing.assert_allclose(sample_keyframes(times, values, "CUBICSPLINE", at)[:, 0], slope * at + 1.0)
+    # Zero tangents give smoothstep: the midpoint of an interval lies halfway.
+    flat = np.stack([np.zeros_like(keys), keys, np.zeros_like(keys)], axis=1)
+    midpoint = sample_keyframes(times, flat, "CUBICSPLINE", np.array([1.25]))[0, 0]
+    assert midpoint == pytest.approx((keys[1, 0] + keys[2, 0]) / 2)
+
+
+def test_cubic_spline_rotations_come_out_normalised():
+    keys = rotations.from_axis_angle(np.array([[1.0, 0, 0], [0, 1.0, 0]]), np.array([0.3, 1.2]))
+    tangents = np.full_like(keys, 0.7)
+    values = np.stack([tangents, keys, tangents], axis=1)
+    result = sample_keyframes(np.array([0.0, 1.0]), values, "CUBICSPLINE", np.linspace(0, 1, 5), rotation=True)
+    np.testing.assert_allclose(np.linalg.norm(result, axis=1), 1.0)
+    np.testing.assert_allclose(result[[0, -1]], keys, atol=1e-12)
+
+
+# ---- round trips --------------------------------------------------------------------------
+
+
+def _assert_same_skinned(read: SkinnedMesh, written: SkinnedMesh) -> None:
+    np.testing.assert_array_equal(read.rest_positions, written.rest_positions)
+    np.testing.assert_array_equal(read.faces, written.faces)
+    np.testing.assert_array_equal(read.joints, written.joints)
+    np.testing.assert_allclose(read.weights, written.weights, atol=1e-7)
+    np.testing.assert_allclose(read.inverse_bind, written.inverse_bind.astype(np.float32), rtol=0, atol=1e-7)
+    assert read.skeleton.names == written.skeleton.names
+    np.testing.assert_array_equal(read.skeleton.parents, written.skeleton.parents)
+    np.testing.assert_allclose(read.skeleton.offsets, written.skeleton.offsets, atol=1e-7)
+    np.testing.assert_allclose(read.skeleton.rest_rotations, written.skeleton.rest_rotations, atol=1e-7)
+    for name in ("uvs", "normals", "morph_targets"):
+        expected = getattr(written, name)
+        if expected is None:
+            assert getattr(read, name) is None
+        else:
+            np.testing.assert_allclose(getattr(read, name), expected, atol=1e-6)
+    assert read.morph_target_names == written.morph_target_names
+
+
+def test_round_trip_keeps_mesh_skin_and_motion(chain_glb):
+    path, mesh, motion = chain_glb
+    read, motions = read_skinned(path, fps=motion.fps)
+    _assert_same_skinned(read, mesh)
+    assert [m.name for m in motions] == ["bend"]
+    assert motions[0].frame_count == motion.frame_count and motions[0].fps == motion.fps
+    assert motions[0].joint_translations is None
+    np.testing.assert_allclose(motions[0].world_transforms(), motion.world_transforms(), atol=1e-6)
+    np.testing.assert_allclose(read.bake(motions[0]).frames, mesh.bake(motion).frames, atol=1e-5)
+
+
+def test_round_trip_eight_influences_and_no_optional_attributes(tmp_path):
+    mesh = _chain_mesh(influences=8, extras=False)
+    assert np.count_nonzero(mesh.weights[:, 4:]) > 0
+    path = tmp_path / "k8.glb"
+    write_glb(path, mesh, [])
+    read, motions = read_skinned(path)
+    assert read.joints.shape == (mesh.vertex_count, 8)
+    _assert_same_skinned(read, mesh)
+    assert motions == []
+
+
+def test_round_trip_of_stretching_bones_keeps_joint_translations(tmp_path):
+    mesh = _chain_mesh()
+    base = _chain_motion(mesh.skeleton)
+    stretch = np.broadcast_to(mesh.skeleton.offsets, (base.frame_count, 3, 3)).copy()
+    stretch[:, 2, 1] *= 1.0 + 0.5 * np.arange(base.frame_count) / base.frame_count
+    motion = Motion(base.skeleton, base.root_positions, base.local_rotations, base.fps, "stretch", stretch)
+    path = tmp_path / "stretch.glb"
+    write_glb(path, mesh, [motion])
+    _, (read,) = read_skinned(path, fps=motion.fps)
+    assert read.joint_translations is not None
+    np.testing.assert_allclose(read.joint_translations[:, 1:], stretch[:, 1:], atol=1e-6)
+    np.testing.assert_allclose(read.world_positions(), motion.world_positions(), atol=1e-6)
+
+
+def test_round_trip_of_procedural_humanoid(tmp_path):
+    synth = pytest.importorskip("animlod.synth")
+    if not hasattr(synth, "humanoid"):
+        pytest.skip("animlod.synth.humanoid is not there yet")
+    character = synth.humanoid()
+    mesh = character if isinstance(character, SkinnedMesh) else character.mesh
+    motions = [synth.walk(mesh.skeleton)] if hasattr(synth, "walk") else []
+    path = tmp_path / "humanoid.glb"
+    write_glb(path, mesh, motions)
+    read, read_motions = read_skinned(path, fps=motions[0].fps if motions else 30.0)
+    _assert_same_skinned(read, mesh)
+    for written, loaded in zip(motions, read_motions):
+        np.testing.assert_allclose(loaded.world_positions(), written.world_positions(), atol=1e-5)
+
+
+def test_animation_names_override_and_mismatched_skeleton_is_refused(tmp_path):
+    mesh = _chain_mesh()
+    motion = _chain_motion(mesh.skeleton)
+    path = tmp_path / "named.glb"
+    write_glb(path, mesh, [motion, motion], names=["first", "second"])
+    assert [m.name for m in read_skinned(path)[1]] == ["first", "second"]
+    with pytest.raises(ValueError, match="names"):
+        write_glb(path, mesh, [motion], names=["a", "b"])
+    other = Skeleton(["a", "b", "c"], [-1, 0, 1], mesh.skeleton.offsets)
+    with pytest.raises(ValueError, match="motion 0"):
+        write_glb(tmp_path / "bad.glb", mesh, [Motion(other, motion.root_positions, motion.local_rotations, 24.0)])
+    assert not (tmp_path / "bad.glb").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["named.glb"]  # no temporary left behind
+
+
+def test_read_gltf_on_a_written_file_lists_the_skin_and_motion(chain_glb):
+    path, mesh, _ = chain_glb
+    scene = read_gltf(path)
+    assert len(scene.skinned_meshes) == 1 and scene.skinned_meshes[0].vertex_count == mesh.vertex_count
+    assert [m.name for m in scene.motions] == ["bend"]
+    assert scene.skinned_motions == [scene.motions]
+    assert scene.morph_animations == [] and scene.static_meshes == []
+
+
+# ---- skeleton building --------------------------------------------------------------------
+
+
+def test_joints_out_of_topological_order_are_reordered_and_remapped(chain_glb, tmp_path):
+    path, mesh, motion = chain_glb
+
+    def reverse_joints(gltf, blob):
+        gltf.skins[0].joints = gltf.skins[0].joints[::-1]  # tip, mid, root
+        matrices = _accessor_view(gltf, blob, gltf.skins[0].inverseBindMatrices, "<f4")
+        matrices[:] = matrices[::-1].copy()
+        attributes = gltf.meshes[0].primitives[0].attributes
+        joints = _accessor_view(gltf, blob, attributes.JOINTS_0, "u1")
+        joints[:] = 2 - joints
+
+    read, motions = read_skinned(_edit_glb(path, tmp_path / "reversed.glb", reverse_joints), fps=motion.fps)
+    assert read.skeleton.names == ["root", "mid", "tip"]
+    np.testing.assert_array_equal(read.skeleton.parents, [-1, 0, 1])
+    np.testing.assert_allclose(read.bake(motions[0]).frames, mesh.bake(motion).frames, atol=1e-5)
+
+
+def test_armature_above_the_root_is_folded_into_the_pose(chain_glb, tmp_path):
+    path, mesh, motion = chain_glb
+    rotation = rotations.from_axis_angle(np.array([1.0, 0.0, 0.0]), -np.pi / 2)
+    armature = rotations.compose_transform(np.array([1.0, 2.0, 3.0]), rotation, np.full(3, 0.01))
+
+    def add_armature(gltf, blob):
+        armature_node = pygltflib.Node(name="Armature", children=[0], translation=[1.0, 2.0, 3.0])
+        armature_node.rotation, armature_node.scale = rotation.tolist(), [0.01] * 3
+        gltf.nodes.append(armature_node)
+        gltf.scenes[0].nodes = [len(gltf.nodes) - 1, 3]
+
+    read, motions = read_skinned(_edit_glb(path, tmp_path / "armature.glb", add_armature), fps=motion.fps)
+    expected = _transform(armature, mesh.bake(motion).frames.astype(np.float64))
+    np.testing.assert_allclose(read.bake(motions[0]).frames, expected, atol=1e-6)
+    # The rigid skeleton carries the 0.01 in its offsets, the inverse bind matrices the rest.
+    np.testing.assert_allclose(np.linalg.norm(read.skeleton.offsets[1:], axis=1), 0.01, rtol=1e-6)
+
+
+def test_mesh_node_transform_moves_the_rest_mesh_but_not_the_skinned_result(chain_glb, tmp_path):
+    path, mesh, motion = chain_glb
+
+    def move_mesh_node(gltf, blob):
+        gltf.nodes[3].translation = [5.0, 0.0, 0.0]
+
+    read, motions = read_skinned(_edit_glb(path, tmp_path / "moved.glb", move_mesh_node), fps=motion.fps)
+    np.testing.assert_allclose(read.rest_positions, mesh.rest_positions + [5.0, 0.0, 0.0], atol=1e-6)
+    np.testing.assert_allclose(read.bake(motions[0]).frames, mesh.bake(motion).frames, atol=1e-5)
+
+
+def test_primitives_of_one_mesh_are_merged(chain_glb, tmp_path):
+    path, mesh, _ = chain_glb
+
+    def duplicate_primitive(gltf, blob):
+        primitive = gltf.meshes[0].primitives[0]
+        gltf.meshes[0].primitives.append(
+            pygltflib.Primitive(attributes=primitive.attributes, indices=primitive.indices, targets=primitive.targets)
+        )
+
+    read, _ = read_skinned(_edit_glb(path, tmp_path / "two.glb", duplicate_primitive))
+    vertex_count = mesh.vertex_count
+    assert read.vertex_count == 2 * vertex_count
+    np.testing.assert_array_equal(read.faces[mesh.face_count :], mesh.faces + vertex_count)
+    np.testing.assert_array_equal(read.rest_positions[vertex_count:], mesh.rest_positions)
+
+
+# ---- bad input ----------------------------------------------------------------------------
+
+
+def test_garbage_bytes_are_not_a_gltf(tmp_path):
+    path = tmp_path / "garbage.glb"
+    path.write_bytes(np.random.default_rng(1).integers(0, 256, 500, dtype=np.uint8).tobytes())
+    with pytest.raises(FormatError, match="not a glTF file") as caught:
+        read_gltf(path)
+    assert str(path) in str(caught.value)
+
+
+def test_truncated_glb_is_reported(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+    data = path.read_bytes()
+    for cut in (len(data) // 2, 16):
+        truncated = tmp_path / f"cut{cut}.glb"
+        truncated.write_bytes(data[:cut])
+        with pytest.raises(FormatError, match="truncated") as caught:
+            read_skinned(truncated)
+        assert str(truncated) in str(caught.value)
+
+
+def test_missing_skin_names_the_file_and_the_skin(chain_glb):
+    path, _, _ = chain_glb
+    with pytest.raises(FormatError, match=r"skin 5: not in the file") as caught:
+        read_skinned(path, skin=5)
+    assert str(path) in str(caught.value)
+    with pytest.raises(FormatError, match=r"skin 'Hero'"):
+        read_skinned(path, skin="Hero")
+    assert read_skinned(path, skin=0)[0].vertex_count == read_skinned(path, skin="skinned mesh")[0].vertex_count
+
+
+def test_accessor_index_out_of_range(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def break_position(gltf, blob):
+        gltf.meshes[0].primitives[0].attributes.POSITION = 999
+
+    with pytest.raises(FormatError, match=r"mesh 0 primitive 0 POSITION: refers to accessor 999"):
+        read_skinned(_edit_glb(path, tmp_path / "oob.glb", break_position))
+
+
+def test_nan_in_positions(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def poison(gltf, blob):
+        _accessor_view(gltf, blob, gltf.meshes[0].primitives[0].attributes.POSITION, "<f4")[3, 1] = np.nan
+
+    with pytest.raises(FormatError, match=r"accessor 1 \(mesh 0 primitive 0 POSITION\): non-finite value at element 3"):
+        read_skinned(_edit_glb(path, tmp_path / "nan.glb", poison))
+
+
+def test_non_uniform_joint_scale_is_rejected(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def stretch(gltf, blob):
+        gltf.nodes[1].scale = [1.0, 2.0, 1.0]
+
+    with pytest.raises(FormatError, match=r"skin 0: scale \[1.0, 2.0, 1.0\] of node 1 'mid' is not uniform"):
+        read_skinned(_edit_glb(path, tmp_path / "scaled.glb", stretch))
+
+
+def test_animated_scale_is_rejected(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def animate_scale(gltf, blob):
+        animation = gltf.animations[0]
+        rotation_channel = animation.channels[1]
+        sampler = animation.samplers[rotation_channel.sampler]
+        # Reuse a VEC3 output (the root translation keys) as scale keys of joint 1.
+        scale_output = animation.samplers[animation.channels[0].sampler].output
+        animation.samplers.append(pygltflib.AnimationSampler(input=sampler.input, output=scale_output))
+        target = pygltflib.AnimationChannelTarget(node=1, path="scale")
+        animation.channels.append(pygltflib.AnimationChannel(sampler=len(animation.samplers) - 1, target=target))
+
+    with pytest.raises(FormatError, match=r"animation 'bend' channel 4: animated scale is not supported"):
+        read_skinned(_edit_glb(path, tmp_path / "animated_scale.glb", animate_scale))
+
+
+# ---- the tinygltf probe -------------------------------------------------------------------
+
+
+def test_tinygltf_loads_what_animlod_writes(tmp_path):
+    probe = os.environ.get("ANIMLOD_GLTF_PROBE")
+    if not probe:
+        pytest.skip("ANIMLOD_GLTF_PROBE is not set (make test sets it to the built animlod_gltf_probe)")
+    mesh = _chain_mesh(influences=8)
+    motions = [_chain_motion(mesh.skeleton), _chain_motion(mesh.skeleton, frames=11, fps=30.0, name="long")]
+    path = tmp_path / "probe.glb"
+    write_glb(path, mesh, motions)
+    result = subprocess.run([probe, str(path)], capture_output=True, text=True, check=True, timeout=60)
+    summary = json.loads(result.stdout)
+    assert summary["vertices"] == mesh.vertex_count
+    assert summary["triangles"] == mesh.face_count
+    assert summary["joints"] == mesh.skeleton.joint_count
+    assert summary["morph_targets"] == 2
+    assert summary["position_sum"] == pytest.approx(float(mesh.rest_positions.astype(np.float64).sum()), rel=1e-6)
+    inverse_bind_sum = float(mesh.inverse_bind.astype(np.float32).astype(np.float64).sum())
+    assert summary["inverse_bind_sum"] == pytest.approx(inverse_bind_sum, rel=1e-6)
+    assert summary["weight_sum"] == pytest.approx(float(mesh.weights.astype(np.float64).sum()), rel=1e-6)
+    assert summary["animations"] == [{"channels": 1 + 3, "keys": 6}, {"channels": 1 + 3, "keys": 11}]
+
+
+# ---- the real development files -----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def soldier(data_dir):
+    path = data_dir / "gltf" / "Soldier.glb"
+    return path, read_gltf(path)
+
+
+def test_rigged_figure(data_dir):
+    mesh, motions = read_skinned(data_dir / "gltf" / "RiggedFigure.glb")
+    assert (mesh.vertex_count, mesh.face_count, mesh.skeleton.joint_count, len(motions)) == (370, 256, 19, 1)
+    assert np.all(mesh.skeleton.parents[1:] < np.arange(1, 19))
+    np.testing.assert_allclose(mesh.weights.sum(axis=1), 1.0, atol=1e-6)  # the file's own sums reach 0.2
+    assert motions[0].frame_count == 38 and motions[0].fps == 30.0  # 1.25 s at 30 fps
+    _assert_rest_bake_matches(mesh)
+    frames = mesh.bake(motions[0]).frames
+    assert np.all(np.isfinite(frames))
+    assert np.abs(frames - mesh.rest_positions).max() > 0.01  # it does move
+
+
+def _assert_rest_bake_matches(mesh: SkinnedMesh) -> None:
+    """Baking the rest pose reproduces the bind mesh (these files are consistent)."""
+    skeleton = mesh.skeleton
+    rest = Motion(skeleton, skeleton.offsets[None, 0], skeleton.rest_rotations[None], fps=30.0)
+    baked = mesh.bake(rest).frames[0]
+    extent = np.ptp(mesh.rest_positions, axis=0).max()
+    np.testing.assert_allclose(baked.min(axis=0), mesh.rest_positions.min(axis=0), atol=1e-3 * extent)
+    np.testing.assert_allclose(baked.max(axis=0), mesh.rest_positions.max(axis=0), atol=1e-3 * extent)
+    assert np.abs(baked - mesh.rest_positions).max() < 1e-3 * extent
+
+
+def test_soldier_counts_and_placement(soldier):
+    _, scene = soldier
+    body, visor = scene.skinned_meshes
+    assert [m.skeleton.joint_count for m in scene.skinned_meshes] == [49, 2]
+    assert body.vertex_count + visor.vertex_count == 7434
+    assert body.face_count + visor.face_count == 11376
+    for motions in scene.skinned_motions:
+        assert [m.name for m in motions] == ["Idle", "Run", "TPose", "Walk"]
+        assert [m.frame_count for m in motions] == [60, 22, 2, 32]  # 1.97, 0.70, 0.03, 1.03 s
+    # The armature's 0.01 scale and Z-up rotation are folded in: a 1.8 m figure standing on y = 0.
+    height = body.rest_positions[:, 1]
+    assert height.min() == pytest.approx(0.0, abs=0.01) and height.max() == pytest.approx(1.83, abs=0.02)
+    for mesh in scene.skinned_meshes:
+        _assert_rest_bake_matches(mesh)
+    assert scene.morph_animations == [] and scene.static_meshes == []
+
+
+def test_soldier_run_matches_a_direct_glTF_skinning(soldier):
+    """Bake against an independent evaluation of the glTF node tree with 4x4 matrices."""
+    path, scene = soldier
+    gltf = pygltflib.GLTF2.load_from_bytes(path.read_bytes())
+    blob = bytearray(gltf.binary_blob())
+    run = next(a for a in gltf.animations if a.name == "Run")
+    frames = [0, 7, 21]  # Run's keys sit at 30 fps, so frame k is key k
+    keys = {}
+    for channel in run.channels:
+        sampler = run.samplers[channel.sampler]
+        keys[(channel.target.node, channel.target.path)] = _accessor_view(gltf, blob, sampler.output, "<f4")
+
+    def world(node: int, frame: int) -> np.ndarray:
+        n = gltf.nodes[node]
+        trs = {"translation": n.translation, "rotation": n.rotation, "scale": n.scale}  # Soldier sets all three
+        for path_ in trs:
+            if (node, path_) in keys:
+                trs[path_] = keys[(node, path_)][frame]
+        local = rotations.compose_transform(*(np.array(trs[p]) for p in ("translation", "rotation", "scale")))
+        parent = next((i for i, p in enumerate(gltf.nodes) if node in (p.children or [])), None)
+        return local if parent is None else world(parent, frame) @ local
+
+    for mesh, motions, node in zip(scene.skinned_meshes, scene.skinned_motions, (1, 2)):
+        skin = gltf.skins[gltf.nodes[node].skin]
+        attributes = gltf.meshes[gltf.nodes[node].mesh].primitives[0].attributes
+        positions = _accessor_view(gltf, blob, attributes.POSITION, "<f4").astype(np.float64)
+        joint_dtype = "<u2" if gltf.accessors[attributes.JOINTS_0].componentType == pygltflib.UNSIGNED_SHORT else "u1"
+        joints = _accessor_view(gltf, blob, attributes.JOINTS_0, joint_dtype)
+        weights = _accessor_view(gltf, blob, attributes.WEIGHTS_0, "<f4").astype(np.float64)
+        weights = weights / weights.sum(axis=1, keepdims=True)
+        inverse_bind = _accessor_view(gltf, blob, skin.inverseBindMatrices, "<f4").reshape(-1, 4, 4).transpose(0, 2, 1)
+        baked = mesh.bake(next(m for m in motions if m.name == "Run")).frames
+        for frame in frames:
+            skinning = np.stack([world(j, frame) @ inverse_bind[k] for k, j in enumerate(skin.joints)])
+            homogeneous = np.c_[positions, np.ones(len(positions))]
+            per_influence = np.einsum("vkij,vj->vki", skinning[joints][..., :3, :], homogeneous)
+            expected = np.einsum("vk,vki->vi", weights, per_influence)
+            np.testing.assert_allclose(baked[frame], expected, atol=2e-5)
+
+
+def test_read_skinned_picks_a_skin_by_name(soldier):
+    path, scene = soldier
+    visor, motions = read_skinned(path, skin="vanguard_visor")
+    assert visor.skeleton.names == ["mixamorig:Neck", "mixamorig:Head"]
+    np.testing.assert_array_equal(visor.rest_positions, scene.skinned_meshes[1].rest_positions)
+    assert [m.name for m in motions] == ["Idle", "Run", "TPose", "Walk"]
+
+
+def test_flamingo_morph_animation(data_dir):
+    path = data_dir / "meshseq" / "Flamingo-morph-glTF" / "Flamingo.glb"
+    scene = read_gltf(path)
+    assert scene.skinned_meshes == [] and scene.motions == [] and scene.static_meshes == []
+    (flight,) = scene.morph_animations
+    assert flight.frames.shape == (43, 337, 3) and flight.face_count == 542 and flight.fps == 30.0  # 1.4 s
+    gltf = pygltflib.GLTF2.load_from_bytes(path.read_bytes())
+    blob = bytearray(gltf.binary_blob())
+    primitive = gltf.meshes[0].primitives[0]
+    assert len(primitive.targets) == 14
+    rest = _accessor_view(gltf, blob, primitive.attributes.POSITION, "<f4")
+    deltas = np.stack([_accessor_view(gltf, blob, t["POSITION"], "<f4") for t in primitive.targets])
+    sampler = gltf.animations[0].samplers[0]
+    weights = _accessor_view(gltf, blob, sampler.output, "<f4").reshape(-1, 14)
+    times = _accessor_view(gltf, blob, sampler.input, "<f4")[:, 0]
+    np.testing.assert_allclose(times, np.arange(15) / 10, atol=1e-6)  # keys every 0.1 s up to 1.4 s
+    # Frame 9 (0.3 s) sits on key 3; frame 10 (1/3 s) a third of the way from key 3 to key 4.
+    np.testing.assert_allclose(flight.frames[9], rest + np.einsum("n,nvc->vc", weights[3], deltas), atol=1e-4)
+    between = weights[3] + (weights[4] - weights[3]) / 3
+    np.testing.assert_allclose(flight.frames[10], rest + np.einsum("n,nvc->vc", between, deltas), atol=1e-4)
+    with pytest.raises(FormatError, match="Flamingo.glb: skin a skinned mesh: not in the file"):
+        read_skinned(path)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import base64
 import json
 import os
 import subprocess
@@ -27,6 +28,7 @@ def _chain_skeleton() -> Skeleton:
         parents=[-1, 0, 1],
         offsets=[[0.5, 0.0, -0.25], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
         rest_rotations=rotations.from_axis_angle(np.eye(3)[[2, 0, 1]], np.array([0.1, -0.2, 0.3])),
+        end_sites=[False, False, True],
     )
 
 
@@ -187,6 +189,7 @@ def _assert_same_skinned(read: SkinnedMesh, written: SkinnedMesh) -> None:
     np.testing.assert_array_equal(read.skeleton.parents, written.skeleton.parents)
     np.testing.assert_allclose(read.skeleton.offsets, written.skeleton.offsets, atol=1e-7)
     np.testing.assert_allclose(read.skeleton.rest_rotations, written.skeleton.rest_rotations, atol=1e-7)
+    np.testing.assert_array_equal(read.skeleton.end_sites, written.skeleton.end_sites)
     for name in ("uvs", "normals", "morph_targets"):
         expected = getattr(written, name)
         if expected is None:
@@ -233,18 +236,17 @@ def test_round_trip_of_stretching_bones_keeps_joint_translations(tmp_path):
 
 
 def test_round_trip_of_procedural_humanoid(tmp_path):
-    synth = pytest.importorskip("animlod.synth")
-    if not hasattr(synth, "humanoid"):
-        pytest.skip("animlod.synth.humanoid is not there yet")
-    character = synth.humanoid()
-    mesh = character if isinstance(character, SkinnedMesh) else character.mesh
-    motions = [synth.walk(mesh.skeleton)] if hasattr(synth, "walk") else []
+    humanoid = pytest.importorskip("animlod.synth.humanoid").humanoid
+    humanoid_motion = pytest.importorskip("animlod.synth.gait").humanoid_motion
+    mesh = humanoid()
+    walk = humanoid_motion(mesh.skeleton, "walk")
     path = tmp_path / "humanoid.glb"
-    write_glb(path, mesh, motions)
-    read, read_motions = read_skinned(path, fps=motions[0].fps if motions else 30.0)
+    write_glb(path, mesh, [walk])
+    read, (read_walk,) = read_skinned(path, fps=walk.fps)
     _assert_same_skinned(read, mesh)
-    for written, loaded in zip(motions, read_motions):
-        np.testing.assert_allclose(loaded.world_positions(), written.world_positions(), atol=1e-5)
+    assert read_walk.frame_count == walk.frame_count and read_walk.name == "walk"
+    np.testing.assert_allclose(read_walk.world_positions(), walk.world_positions(), atol=1e-5)
+    np.testing.assert_allclose(read.bake(read_walk).frames, mesh.bake(walk).frames, atol=1e-5)
 
 
 def test_animation_names_override_and_mismatched_skeleton_is_refused(tmp_path):
@@ -334,6 +336,91 @@ def test_primitives_of_one_mesh_are_merged(chain_glb, tmp_path):
     assert read.vertex_count == 2 * vertex_count
     np.testing.assert_array_equal(read.faces[mesh.face_count :], mesh.faces + vertex_count)
     np.testing.assert_array_equal(read.rest_positions[vertex_count:], mesh.rest_positions)
+
+
+# ---- meshes without a skin, from a hand-written .gltf -------------------------------------
+
+
+def _write_quad_gltf(folder: Path, buffer_uri: str | None) -> Path:
+    """A .gltf whose one mesh has a TRIANGLE_STRIP and a TRIANGLE_FAN primitive over the same
+    quad and one sparse morph target (vertex 3 lifted by 0.5 in z, weight 1); node 0 places it
+    with TRS, node 1 with a mirroring matrix. ``buffer_uri`` None embeds the buffer as a data URI.
+    """
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], "<f4")
+    strip, fan = np.array([0, 1, 2, 3], "<u2"), np.array([0, 1, 3, 2], "<u2")
+    sparse_index, sparse_value = np.array([3, 0], "<u2"), np.array([[0, 0, 0.5]], "<f4")  # index padded to 4 bytes
+    chunks = [positions, strip, fan, sparse_index, sparse_value]
+    data = b"".join(c.tobytes() for c in chunks)
+    starts = np.cumsum([0] + [c.nbytes for c in chunks])
+    views = [{"buffer": 0, "byteOffset": int(start), "byteLength": c.nbytes} for c, start in zip(chunks, starts)]
+    views[3]["byteLength"] = 2
+    if buffer_uri is None:
+        uri = "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+    else:
+        (folder / buffer_uri).write_bytes(data)
+        uri = buffer_uri
+    targets = [{"POSITION": 3}]
+    document = {
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": len(data), "uri": uri}],
+        "bufferViews": views,
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5123, "count": 4, "type": "SCALAR"},
+            {"bufferView": 2, "componentType": 5123, "count": 4, "type": "SCALAR"},
+            {
+                "componentType": 5126,
+                "count": 4,
+                "type": "VEC3",
+                "sparse": {
+                    "count": 1,
+                    "indices": {"bufferView": 3, "componentType": 5123},
+                    "values": {"bufferView": 4},
+                },
+            },
+        ],
+        "meshes": [
+            {
+                "primitives": [
+                    {"attributes": {"POSITION": 0}, "indices": 1, "mode": 5, "targets": targets},
+                    {"attributes": {"POSITION": 0}, "indices": 2, "mode": 6, "targets": targets},
+                ],
+                "weights": [1.0],
+            }
+        ],
+        "nodes": [
+            {"mesh": 0, "translation": [0, 0, 5]},
+            {"mesh": 0, "matrix": [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 10, 0, 0, 1]},
+        ],
+        "scenes": [{"nodes": [0, 1]}],
+        "scene": 0,
+    }
+    path = folder / "quad.gltf"
+    path.write_text(json.dumps(document))
+    return path
+
+
+@pytest.mark.parametrize("buffer_uri", [None, "quad.bin"])
+def test_static_meshes_strips_fans_sparse_targets_and_mirroring(tmp_path, buffer_uri):
+    scene = read_gltf(_write_quad_gltf(tmp_path, buffer_uri))
+    assert scene.skinned_meshes == [] and scene.morph_animations == []
+    placed, mirrored = scene.static_meshes
+    quad = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.5]])
+    # Strip triangles (0 1 2) (1 3 2); fan triangles (1 3 0) (3 2 0), offset by the strip's 4 vertices.
+    faces = np.array([[0, 1, 2], [1, 3, 2], [5, 7, 4], [7, 6, 4]])
+    np.testing.assert_array_equal(placed.faces, faces)
+    np.testing.assert_allclose(placed.frames[0], np.vstack([quad, quad]) + [0, 0, 5])
+    assert placed.fps is None
+    # A mirroring node keeps the triangles front-facing by reversing their corners.
+    np.testing.assert_array_equal(mirrored.faces, faces[:, ::-1])
+    np.testing.assert_allclose(mirrored.frames[0], np.vstack([quad, quad]) * [-1, 1, 1] + [10, 0, 0])
+
+
+def test_missing_external_buffer_is_reported(tmp_path):
+    path = _write_quad_gltf(tmp_path, "quad.bin")
+    (tmp_path / "quad.bin").unlink()
+    with pytest.raises(FormatError, match=r"quad.gltf: buffer 0: cannot read .*quad.bin"):
+        read_gltf(path)
 
 
 # ---- bad input ----------------------------------------------------------------------------

@@ -231,7 +231,7 @@ class GltfDocument:
         """
         node = self.gltf.nodes[index]
         if node.matrix is not None:
-            return self._decompose(index, node.matrix)
+            return self._decompose(index)
         translation = np.asarray(node.translation if node.translation is not None else (0.0, 0.0, 0.0), np.float64)
         rotation = np.asarray(node.rotation if node.rotation is not None else (0.0, 0.0, 0.0, 1.0), np.float64)
         scale = np.asarray(node.scale if node.scale is not None else (1.0, 1.0, 1.0), np.float64)
@@ -243,11 +243,8 @@ class GltfDocument:
             raise self.fail(self.node_label(index), "zero rotation quaternion")
         return translation, rotations.normalize(rotation), scale
 
-    def _decompose(self, index: int, values: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        matrix = np.asarray(values, np.float64)
-        if matrix.shape != (16,) or not np.all(np.isfinite(matrix)):
-            raise self.fail(self.node_label(index), "matrix must be 16 finite numbers")
-        matrix = matrix.reshape(4, 4).T  # glTF stores column-major
+    def _decompose(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        matrix = self.rest_matrix(index)
         linear = matrix[:3, :3]
         scale = np.linalg.norm(linear, axis=0)
         if np.any(scale == 0.0):
@@ -258,7 +255,13 @@ class GltfDocument:
         return matrix[:3, 3].copy(), rotations.from_matrix(rotation), scale
 
     def rest_matrix(self, index: int) -> np.ndarray:
-        """Local rest transform ``(4, 4)`` of node ``index``."""
+        """Local rest transform ``(4, 4)`` of node ``index`` (a ``matrix`` is taken as it is)."""
+        matrix = self.gltf.nodes[index].matrix
+        if matrix is not None:
+            matrix = np.asarray(matrix, np.float64)
+            if matrix.shape != (16,) or not np.all(np.isfinite(matrix)):
+                raise self.fail(self.node_label(index), "matrix must be 16 finite numbers")
+            return matrix.reshape(4, 4).T  # glTF stores column-major
         translation, rotation, scale = self.rest_trs(index)
         return rotations.compose_transform(translation, rotation, scale)
 

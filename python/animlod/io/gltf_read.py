@@ -172,7 +172,8 @@ def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[Animated
         if not tracks:
             positions = geometry.positions.astype(np.float64)
             if geometry.targets is not None:
-                weights = np.asarray(node.weights, np.float64) if node.weights else geometry.default_weights
+                # pygltflib's Node has no ``weights`` field, so the mesh's default weights apply.
+                weights = geometry.default_weights
                 positions = positions + np.einsum("n,nvc->vc", weights, geometry.targets)
             frames = transform_points(world, positions)[None]
             statics.append(_animated_mesh(doc, doc.node_label(node_index), faces, frames, None))

@@ -28,6 +28,9 @@ from .gltf_keyframes import frame_times, sample_keyframes
 # rest value count as held, so the motion needs no per-frame joint translations.
 _HELD_TRANSLATION_TOLERANCE = 1e-4
 _NODE_PATHS = ("translation", "rotation", "scale")
+# Node extras key marking a joint as an end site (a BVH "End Site": a leaf without rotation);
+# animlod writes it and reads it back, other tools ignore it.
+END_SITE_EXTRA = "animlod_end_site"
 
 
 class SkinRig:
@@ -69,7 +72,9 @@ class SkinRig:
         self._translation_tolerance = _HELD_TRANSLATION_TOLERANCE * max(np.abs(offsets[1:]).max(initial=0.0), 1e-12)
         names = _unique_names(doc, self.joint_nodes)
         try:
-            self.skeleton = Skeleton(names, parents, offsets, self._local_rotations(world_rotations)[0])
+            self.skeleton = Skeleton(
+                names, parents, offsets, self._local_rotations(world_rotations)[0], end_sites=self._end_sites(doc)
+            )
         except ValueError as error:
             raise doc.fail(self.element, str(error)) from None
 
@@ -118,6 +123,10 @@ class SkinRig:
             )
         except ValueError as error:
             raise doc.fail(label, str(error)) from None
+
+    def _end_sites(self, doc: GltfDocument) -> np.ndarray:
+        extras = [doc.gltf.nodes[n].extras for n in self.joint_nodes]
+        return np.array([isinstance(e, dict) and e.get(END_SITE_EXTRA) is True for e in extras])
 
     def _joint_nodes(self, doc: GltfDocument) -> list[int]:
         joints = list(doc.gltf.skins[self.skin].joints or [])

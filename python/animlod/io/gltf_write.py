@@ -1,12 +1,13 @@
 """Write a skinned mesh and its motions to one binary glTF 2.0 file (GLB).
 
-The file holds one node per joint (rest translation and rotation, parents before children),
-a mesh node with the skin, one mesh primitive (POSITION, NORMAL and TEXCOORD_0 when present,
-JOINTS_0/WEIGHTS_0 and, for 8 influences, JOINTS_1/WEIGHTS_1, uint16/uint32 indices, morph
-targets with their names in ``extras.targetNames``), and one LINEAR animation per motion: the
-root's translation and every joint's rotation at every frame (and every joint's translation
-when the motion has per-frame ``joint_translations``). pygltflib builds the JSON and
-the GLB container; the binary chunk is packed here with 4-byte aligned buffer views.
+The file holds one node per joint (rest translation and rotation, parents before children,
+end sites marked with ``extras.animlod_end_site``), a mesh node with the skin, one mesh
+primitive (POSITION, NORMAL and TEXCOORD_0 when present, JOINTS_0/WEIGHTS_0 and, for 8
+influences, JOINTS_1/WEIGHTS_1, uint16/uint32 indices, morph targets with their names in
+``extras.targetNames``), and one LINEAR animation per motion: the root's translation and every
+joint's rotation at every frame (and every joint's translation when the motion has per-frame
+``joint_translations``). pygltflib builds the JSON and the GLB container; the binary chunk is
+packed here with 4-byte aligned buffer views.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import pygltflib
 
 from ..model import Motion, SkinnedMesh
 from .atomic import atomic_write
+from .gltf_skin import END_SITE_EXTRA
 
 _COMPONENT_TYPES = {
     np.dtype("float32"): pygltflib.FLOAT,
@@ -62,6 +64,7 @@ def write_glb(
             translation=skeleton.offsets[j].tolist(),
             rotation=skeleton.rest_rotations[j].tolist(),
             children=children[j] or None,
+            extras={END_SITE_EXTRA: True} if skeleton.end_sites[j] else {},
         )
         for j in range(joint_count)
     ]

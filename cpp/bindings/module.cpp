@@ -5,9 +5,13 @@ namespace py = pybind11;
 
 namespace animlod::bindings {
 void bind_skinning(py::module_& m);
+void bind_aqem(py::module_& m);
+void bind_motion_features(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "animlod C++ core (level of detail for animated content). Users import animlod.";
   animlod::bindings::bind_skinning(m);
+  animlod::bindings::bind_aqem(m);
+  animlod::bindings::bind_motion_features(m);
 }

@@ -123,7 +123,8 @@ class Simplifier {
         used_count_(frames_.size()),
         vertex_weights_(weights.begin(), weights.end()),
         merged_into_(mesh.vertex_count),
-        new_positions_(used_count_) {}
+        new_positions_(used_count_),
+        singular_(used_count_) {}
 
   Status run(const std::vector<size_t>& targets, AqemResult& out);
 
@@ -131,6 +132,7 @@ class Simplifier {
   Status build_connectivity();
   void accumulate_quadrics();
   Candidate evaluate(int32_t edge);
+  Candidate evaluate_on_edge(Candidate candidate, bool pinned);
   bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
   bool keeps_orientation(const Candidate& candidate);
   void collapse(const Candidate& candidate, TriMesh::HalfedgeHandle halfedge, CollapseRecord& record);
@@ -159,6 +161,7 @@ class Simplifier {
   std::vector<int32_t> merged_into_;   // (V,) the vertex each removed vertex merged into
   std::vector<uint8_t> parked_;        // (E,) popped while illegal; re-tried when the area changes
   std::vector<Eigen::Vector3d> new_positions_;  // (K,) placement of the candidate being evaluated
+  std::vector<uint8_t> singular_;               // (K,) frames of that candidate using the fallback
   TriMesh connectivity_;
   detail::IndexedMinHeap heap_{0};
   size_t face_count_ = 0;
@@ -216,9 +219,11 @@ void Simplifier::accumulate_quadrics() {
   }
 }
 
-// Steps 5-6: merged quadric, weight and optimal placement per used frame (Eq. 5) with the
-// fallback to the best of the endpoints and the midpoint where X is singular; cost of Eq. 6.
-// Leaves the placement in new_positions_.
+// Steps 5-6: merged quadric, weight and optimal placement per used frame (Eq. 5); cost of
+// Eq. 6. Frames whose X is singular share one fallback, the best in sum over those frames of
+// the kept endpoint, the removed endpoint and the midpoint (ties in that order), so that the
+// vertex does not slide to a different point of a flat region in every frame. Leaves the
+// placement in new_positions_.
 Candidate Simplifier::evaluate(int32_t edge) {
   const auto halfedge = connectivity_.halfedge_handle(connectivity_.edge_handle(edge), 0);
   const int32_t a = connectivity_.from_vertex_handle(halfedge).idx();
@@ -233,35 +238,64 @@ Candidate Simplifier::evaluate(int32_t edge) {
 
   const Quadric* kept_quadrics = quadrics_of(candidate.kept);
   const Quadric* removed_quadrics = quadrics_of(candidate.removed);
-  double total = 0.0, along = 0.0, length2 = 0.0;
+  if (pinned || options_.placement == Placement::on_edge) return evaluate_on_edge(candidate, pinned);
+  constexpr double kFallbacks[3] = {0.0, 1.0, 0.5};  // kept, removed, midpoint along the edge
+  double fallback_cost[3] = {0.0, 0.0, 0.0};
+  double total = 0.0;
   for (size_t k = 0; k < used_count_; ++k) {
     const size_t frame = static_cast<size_t>(frames_[k]);
     const Quadric merged = kept_quadrics[k] + removed_quadrics[k];
-    const Eigen::Vector3d p_kept = position(candidate.kept, frame), p_removed = position(candidate.removed, frame);
     Eigen::Vector3d& v = new_positions_[k];
-    double cost = 0.0;
-    if (pinned) {
-      v = p_kept;
-      cost = merged.evaluate(v);
-    } else if (merged.minimizer(v)) {
-      cost = merged.evaluate(v);
-    } else {
-      const Eigen::Vector3d midpoint = 0.5 * (p_kept + p_removed);
-      v = p_kept;
-      cost = merged.evaluate(v);
-      for (const Eigen::Vector3d& option : {p_removed, midpoint}) {
-        const double option_cost = merged.evaluate(option);
-        if (option_cost < cost) {
-          cost = option_cost;
-          v = option;
-        }
-      }
+    singular_[k] = !merged.minimizer(v);
+    if (!singular_[k]) {
+      total += merged.evaluate(v);
+      continue;
     }
-    total += cost;
-    along += (v - p_kept).dot(p_removed - p_kept);
+    const Eigen::Vector3d p_kept = position(candidate.kept, frame), p_removed = position(candidate.removed, frame);
+    for (int option = 0; option < 3; ++option)
+      fallback_cost[option] += merged.evaluate(p_kept + kFallbacks[option] * (p_removed - p_kept));
+  }
+  int fallback = 0;
+  for (int option = 1; option < 3; ++option)
+    if (fallback_cost[option] < fallback_cost[fallback]) fallback = option;
+  total += fallback_cost[fallback];
+
+  double along = 0.0, length2 = 0.0;
+  for (size_t k = 0; k < used_count_; ++k) {
+    const size_t frame = static_cast<size_t>(frames_[k]);
+    const Eigen::Vector3d p_kept = position(candidate.kept, frame), p_removed = position(candidate.removed, frame);
+    if (singular_[k]) new_positions_[k] = p_kept + kFallbacks[fallback] * (p_removed - p_kept);
+    along += (new_positions_[k] - p_kept).dot(p_removed - p_kept);
     length2 += (p_removed - p_kept).squaredNorm();
   }
   candidate.t = length2 > 0.0 ? std::clamp(along / length2, 0.0, 1.0) : 0.0;
+  candidate.cost = candidate.weight * total;
+  candidate.error = std::sqrt(total / static_cast<double>(used_count_));
+  return candidate;
+}
+
+// Placement::on_edge (and a locked kept vertex, t = 0): the t in [0, 1] minimising
+// sum_f Q_f(kept_f + t (removed_f - kept_f)), a quadratic in t.
+Candidate Simplifier::evaluate_on_edge(Candidate candidate, bool pinned) {
+  const Quadric* kept_quadrics = quadrics_of(candidate.kept);
+  const Quadric* removed_quadrics = quadrics_of(candidate.removed);
+  double curvature = 0.0, slope = 0.0;
+  if (!pinned) {
+    for (size_t k = 0; k < used_count_; ++k) {
+      const size_t frame = static_cast<size_t>(frames_[k]);
+      const Eigen::Vector3d p_kept = position(candidate.kept, frame);
+      (kept_quadrics[k] + removed_quadrics[k])
+          .accumulate_line(p_kept, position(candidate.removed, frame) - p_kept, curvature, slope);
+    }
+  }
+  candidate.t = curvature > 0.0 ? std::clamp(-slope / curvature, 0.0, 1.0) : (slope < 0.0 ? 1.0 : 0.0);
+  double total = 0.0;
+  for (size_t k = 0; k < used_count_; ++k) {
+    const size_t frame = static_cast<size_t>(frames_[k]);
+    const Eigen::Vector3d p_kept = position(candidate.kept, frame);
+    new_positions_[k] = p_kept + candidate.t * (position(candidate.removed, frame) - p_kept);
+    total += (kept_quadrics[k] + removed_quadrics[k]).evaluate(new_positions_[k]);
+  }
   candidate.cost = candidate.weight * total;
   candidate.error = std::sqrt(total / static_cast<double>(used_count_));
   return candidate;

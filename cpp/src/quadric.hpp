@@ -40,6 +40,15 @@ struct Quadric {
     return value > 0.0 ? value : 0.0;
   }
 
+  // Along the line p + t d: Q = Q(p) + 2 t slope + t^2 curvature. Adds curvature = d^T A d and
+  // slope = (A p - b) . d to the running sums (for one t shared by all frames).
+  void accumulate_line(const Eigen::Vector3d& p, const Eigen::Vector3d& d, double& curvature, double& slope) const {
+    const Eigen::Vector3d ad(a00 * d.x() + a01 * d.y() + a02 * d.z(), a01 * d.x() + a11 * d.y() + a12 * d.z(),
+                             a02 * d.x() + a12 * d.y() + a22 * d.z());
+    curvature += ad.dot(d);
+    slope += ad.dot(p) - (b0 * d.x() + b1 * d.y() + b2 * d.z());
+  }
+
   // Eq. 5: the minimiser v = A^-1 b. Returns false when A is (nearly) singular, i.e. its
   // determinant is tiny against the cube of its scale (flat or ridge-like neighbourhoods).
   bool minimizer(Eigen::Vector3d& v) const {

@@ -18,6 +18,17 @@
 
 namespace animlod {
 
+// Where the vertex of a collapse goes.
+enum class Placement {
+  // Eq. 5 in every frame: v_f = X_f^-1 Y_f (the paper). Smallest error; the new vertex may
+  // stand for a different point of the surface in different frames.
+  optimal,
+  // One point of the collapsed edge for all frames, kept + t (removed - kept) with the t that
+  // minimises the summed quadric: the vertex keeps one identity, so interpolated UVs and
+  // merged skin weights stay consistent with its positions (used for skinned meshes).
+  on_edge,
+};
+
 struct AqemOptions {
   // Levels as fractions of the input face count, each in (0, 1]. Ignored when
   // target_face_counts is not empty.
@@ -44,6 +55,7 @@ struct AqemOptions {
   std::vector<int32_t> frame_subset;
   // Called now and then with (collapses done, collapses needed for the last level).
   std::function<void(size_t, size_t)> progress;
+  Placement placement = Placement::optimal;
 };
 
 // Optional per-vertex inputs; a null pointer means "not given".
@@ -92,8 +104,9 @@ struct AqemResult {
 
 // Simplifies `mesh` to every target of `options`.
 //
-// Placement (Eq. 5): per frame, v = X^-1 Y of the merged quadric; where a frame's X is
-// singular, the best of the two endpoints and the midpoint. In frames outside frames_used the
+// Placement (Eq. 5, Placement::optimal): per frame, v = X^-1 Y of the merged quadric; where a
+// frame's X is singular, the best of the two endpoints and the midpoint (one choice shared by
+// those frames). Placement::on_edge puts the vertex at one point of the edge. In frames outside frames_used the
 // new vertex sits on the collapsed edge at the parameter that best matches the optimal
 // positions of the used frames. Attributes and skin weights are interpolated with that same
 // parameter. Ties in cost are broken by edge index, so the output is deterministic.

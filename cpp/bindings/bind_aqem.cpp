@@ -1,0 +1,180 @@
+#include <optional>
+#include <string>
+
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "animlod/aqem.hpp"
+#include "array_checks.hpp"
+#include "numpy_from_vector.hpp"
+
+namespace animlod::bindings {
+
+namespace {
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+using IndexArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
+using MaskArray = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>;
+
+py::dict level_to_dict(AqemLevel&& level, py::ssize_t frame_count, py::ssize_t attribute_count,
+                       py::ssize_t influence_count) {
+  const auto kept = static_cast<py::ssize_t>(level.kept_vertices.size());
+  const auto face_count = static_cast<py::ssize_t>(level.faces.size() / 3);
+  const auto vertex_count = static_cast<py::ssize_t>(level.vertex_map.size());
+  py::dict out;
+  out["target_face_count"] = level.target_face_count;
+  out["reached"] = level.reached;
+  out["collapse_count"] = level.collapse_count;
+  out["error"] = level.error;
+  out["faces"] = numpy_from_vector(std::move(level.faces), {face_count, 3});
+  out["kept_vertices"] = numpy_from_vector(std::move(level.kept_vertices), {kept});
+  out["vertex_map"] = numpy_from_vector(std::move(level.vertex_map), {vertex_count});
+  out["positions"] = numpy_from_vector(std::move(level.positions), {frame_count, kept, 3});
+  out["attributes"] = numpy_from_vector(std::move(level.attributes), {kept, attribute_count});
+  out["skin_joints"] = numpy_from_vector(std::move(level.skin_joints), {level.skin_joints.empty() ? 0 : kept, influence_count});
+  out["skin_weights"] = numpy_from_vector(std::move(level.skin_weights), {level.skin_weights.empty() ? 0 : kept, influence_count});
+  return out;
+}
+
+py::dict simplify_animated_py(const FloatArray& frames, const IndexArray& faces, std::vector<double> target_ratios,
+                              std::vector<size_t> target_face_counts, double max_error, bool use_motion_features,
+                              double feature_threshold, double min_angle_change, bool boundary_is_feature,
+                              bool boundary_quadrics, bool check_inversion, bool strict_inversion, size_t max_frames,
+                              std::vector<int32_t> frame_subset, const std::optional<MaskArray>& locked,
+                              const std::optional<FloatArray>& importance, const std::optional<FloatArray>& attributes,
+                              const std::optional<IndexArray>& skin_joints,
+                              const std::optional<FloatArray>& skin_weights,
+                              const std::optional<py::function>& progress, const std::string& placement) {
+  require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
+  require_shape(faces, "faces", {-1, 3}, "(M, 3)");
+  const py::ssize_t vertex_count = frames.shape(1);
+  const AnimatedMeshView mesh{frames.data(), faces.data(), static_cast<size_t>(frames.shape(0)),
+                              static_cast<size_t>(vertex_count), static_cast<size_t>(faces.shape(0))};
+
+  AqemVertexData data;
+  if (locked) {
+    require_shape(*locked, "locked", {vertex_count}, "(V,)");
+    data.locked = locked->data();
+  }
+  if (importance) {
+    require_shape(*importance, "importance", {vertex_count}, "(V,)");
+    data.importance = importance->data();
+  }
+  if (attributes) {
+    require_shape(*attributes, "attributes", {vertex_count, -1}, "(V, A)");
+    data.attributes = attributes->data();
+    data.attribute_count = static_cast<size_t>(attributes->shape(1));
+  }
+  if (skin_joints.has_value() != skin_weights.has_value())
+    throw py::value_error("skin_joints and skin_weights: give both or neither");
+  if (skin_joints) {
+    require_shape(*skin_joints, "skin_joints", {vertex_count, -1}, "(V, K)");
+    require_shape(*skin_weights, "skin_weights", {vertex_count, skin_joints->shape(1)}, "(V, K) like skin_joints");
+    data.skin_joints = skin_joints->data();
+    data.skin_weights = skin_weights->data();
+    data.influence_count = static_cast<size_t>(skin_joints->shape(1));
+  }
+
+  AqemOptions options;
+  options.target_ratios = std::move(target_ratios);
+  options.target_face_counts = std::move(target_face_counts);
+  options.max_error = max_error;
+  options.use_motion_features = use_motion_features;
+  options.motion_features.feature_threshold = feature_threshold;
+  options.motion_features.min_angle_change = min_angle_change;
+  options.motion_features.boundary_is_feature = boundary_is_feature;
+  options.boundary_quadrics = boundary_quadrics;
+  options.check_inversion = check_inversion;
+  options.strict_inversion = strict_inversion;
+  options.max_frames = max_frames;
+  options.frame_subset = std::move(frame_subset);
+  if (placement == "optimal") options.placement = Placement::optimal;
+  else if (placement == "on_edge") options.placement = Placement::on_edge;
+  else throw py::value_error("placement: expected 'optimal' or 'on_edge', got '" + placement + "'");
+  if (progress) {
+    const py::function callback = *progress;
+    options.progress = [callback](size_t done, size_t total) {
+      py::gil_scoped_acquire acquire;
+      callback(done, total);
+    };
+  }
+
+  AqemResult result;
+  Status status;
+  {
+    py::gil_scoped_release release;
+    status = simplify_animated(mesh, data, options, result);
+  }
+  raise_if_error(status);
+
+  const py::ssize_t frame_count = frames.shape(0);
+  py::list levels;
+  for (AqemLevel& level : result.levels)
+    levels.append(level_to_dict(std::move(level), frame_count, static_cast<py::ssize_t>(data.attribute_count),
+                                static_cast<py::ssize_t>(data.influence_count)));
+  CollapseRecord& record = result.collapses;
+  const auto collapse_count = static_cast<py::ssize_t>(record.removed.size());
+  py::dict collapses;
+  collapses["removed"] = numpy_from_vector(std::move(record.removed), {collapse_count});
+  collapses["kept"] = numpy_from_vector(std::move(record.kept), {collapse_count});
+  collapses["positions"] = numpy_from_vector(std::move(record.positions), {collapse_count, frame_count, 3});
+  collapses["cost"] = numpy_from_vector(std::move(record.cost), {collapse_count});
+  collapses["error"] = numpy_from_vector(std::move(record.error), {collapse_count});
+  py::dict out;
+  out["levels"] = levels;
+  out["collapses"] = collapses;
+  const auto used = static_cast<py::ssize_t>(result.frames_used.size());
+  out["frames_used"] = numpy_from_vector(std::move(result.frames_used), {used});
+  out["vertex_weights"] = numpy_from_vector(std::move(result.vertex_weights), {vertex_count});
+  return out;
+}
+}  // namespace
+
+void bind_aqem(py::module_& m) {
+  const AqemOptions defaults;
+  m.def("simplify_animated", &simplify_animated_py, py::arg("frames"), py::arg("faces"), py::kw_only(),
+        py::arg("target_ratios") = defaults.target_ratios, py::arg("target_face_counts") = defaults.target_face_counts,
+        py::arg("max_error") = defaults.max_error, py::arg("use_motion_features") = defaults.use_motion_features,
+        py::arg("feature_threshold") = defaults.motion_features.feature_threshold,
+        py::arg("min_angle_change") = defaults.motion_features.min_angle_change,
+        py::arg("boundary_is_feature") = defaults.motion_features.boundary_is_feature,
+        py::arg("boundary_quadrics") = defaults.boundary_quadrics, py::arg("check_inversion") = defaults.check_inversion,
+        py::arg("strict_inversion") = defaults.strict_inversion, py::arg("max_frames") = defaults.max_frames,
+        py::arg("frame_subset") = defaults.frame_subset, py::arg("locked") = py::none(),
+        py::arg("importance") = py::none(), py::arg("attributes") = py::none(), py::arg("skin_joints") = py::none(),
+        py::arg("skin_weights") = py::none(), py::arg("progress") = py::none(),
+        py::arg("placement") = "optimal",
+        R"doc(AQEM simplification of a deforming mesh over all its frames (Yang et al. 2019, Eqs. 1-7).
+
+Parameters
+----------
+frames : (F, V, 3) float32 positions per frame (float64 is converted).
+faces : (M, 3) int32 triangles.
+target_ratios : level sizes as fractions of M in (0, 1]; ignored when target_face_counts is given.
+target_face_counts : level sizes as face counts in [4, M].
+max_error : asset units; stop before a collapse whose error sqrt(quadric cost / frames) exceeds it.
+use_motion_features, feature_threshold, min_angle_change, boundary_is_feature : Eq. 6 weights
+    (see motion_features).
+boundary_quadrics : perpendicular planes on open borders (Garland and Heckbert).
+check_inversion : Eq. 7 inversion test across frames; strict_inversion: in every frame.
+max_frames : 0 for all frames, else K frames by farthest-point sampling; frame_subset: explicit.
+locked : (V,) bool, vertices never removed or moved.  importance : (V,) float32 > 0 weights.
+attributes : (V, A) float32 interpolated along collapses (UVs).
+skin_joints, skin_weights : (V, K) int32 / float32, merged keeping the top K.
+progress : callable(done, total) called with the GIL held now and then.
+placement : "optimal" (Eq. 5 in every frame) or "on_edge" (one point of the edge for all
+    frames, so UVs and skin weights stay consistent with the positions).
+
+Returns
+-------
+dict with "levels" (list, finest first, of dicts: faces (M', 3), kept_vertices (V',),
+vertex_map (V,), positions (F, V', 3), attributes, skin_joints, skin_weights, error, reached,
+target_face_count, collapse_count), "collapses" (removed, kept (C,), positions (C, F, 3),
+cost, error (C,)), "frames_used" and "vertex_weights" (V,). Arrays own their memory (moved
+from the core, no copy). The GIL is released while simplifying.
+
+Raises ValueError naming the element for bad meshes, targets or per-vertex inputs.)doc");
+}
+
+}  // namespace animlod::bindings

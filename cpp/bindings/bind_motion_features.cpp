@@ -1,0 +1,74 @@
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include "animlod/motion_features.hpp"
+#include "array_checks.hpp"
+#include "numpy_from_vector.hpp"
+
+namespace animlod::bindings {
+
+namespace {
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+using IndexArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
+
+py::dict motion_features_py(const FloatArray& frames, const IndexArray& faces, double feature_threshold,
+                            double min_angle_change, bool boundary_is_feature) {
+  require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
+  require_shape(faces, "faces", {-1, 3}, "(M, 3)");
+  const AnimatedMeshView mesh{frames.data(), faces.data(), static_cast<size_t>(frames.shape(0)),
+                              static_cast<size_t>(frames.shape(1)), static_cast<size_t>(faces.shape(0))};
+  MotionFeatureOptions options;
+  options.feature_threshold = feature_threshold;
+  options.min_angle_change = min_angle_change;
+  options.boundary_is_feature = boundary_is_feature;
+  MotionFeatures features;
+  Status status;
+  {
+    py::gil_scoped_release release;
+    status = compute_motion_features(mesh, options, features);
+  }
+  raise_if_error(status);
+  const auto edge_count = static_cast<py::ssize_t>(features.angle_change.size());
+  const auto vertex_count = static_cast<py::ssize_t>(features.vertex_weights.size());
+  const auto feature_count = static_cast<py::ssize_t>(features.feature_sizes.size());
+  py::dict out;
+  out["edges"] = numpy_from_vector(std::move(features.edges), {edge_count, 2});
+  out["angle_change"] = numpy_from_vector(std::move(features.angle_change), {edge_count});
+  out["connected"] = numpy_from_vector(std::move(features.connected), {edge_count}).attr("view")("bool");
+  out["threshold"] = features.threshold;
+  out["vertex_feature"] = numpy_from_vector(std::move(features.vertex_feature), {vertex_count});
+  out["feature_sizes"] = numpy_from_vector(std::move(features.feature_sizes), {feature_count});
+  out["vertex_weights"] = numpy_from_vector(std::move(features.vertex_weights), {vertex_count});
+  return out;
+}
+}  // namespace
+
+void bind_motion_features(py::module_& m) {
+  const MotionFeatureOptions defaults;
+  m.def("motion_features", &motion_features_py, py::arg("frames"), py::arg("faces"), py::kw_only(),
+        py::arg("feature_threshold") = defaults.feature_threshold,
+        py::arg("min_angle_change") = defaults.min_angle_change,
+        py::arg("boundary_is_feature") = defaults.boundary_is_feature,
+        R"doc(Motion features of a deforming mesh (Yang et al. 2019): regions whose dihedral angles change.
+
+Parameters
+----------
+frames : (F, V, 3) float32 positions per frame (float64 is converted).
+faces : (M, 3) int32 triangles.
+feature_threshold : radians; an edge is connected when its largest change of dihedral angle
+    between consecutive frames exceeds it. 0 selects the paper's THR, the mean over interior edges.
+min_angle_change : radians; connected edges must also change by more than this (1 degree).
+boundary_is_feature : boundary edges count as connected, as in the paper.
+
+Returns
+-------
+dict of arrays that own their memory (moved from the core, no copy):
+edges (E, 2) int32, angle_change (E,) float32 radians, connected (E,) bool, threshold float,
+vertex_feature (V,) int32 (-1 outside features), feature_sizes (C,) int32,
+vertex_weights (V,) float32 (the feature's vertex count, 1 outside).
+
+Raises ValueError naming the element on a non-finite position, an index out of range, a
+degenerate, duplicate or non-manifold face, or an unreferenced vertex. The GIL is released.)doc");
+}
+
+}  // namespace animlod::bindings

@@ -10,6 +10,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -43,16 +44,23 @@ double read_component(const unsigned char* at, int component_type, bool normaliz
   }
 }
 
-// Sum of every component of every element of accessor `index` (byte stride honoured).
+// Sum of every component of every element of accessor `index` (byte stride honoured); NaN when
+// the accessor reaches past its buffer, so that a comparison with the expected sum fails.
 double accessor_sum(const tinygltf::Model& model, int index) {
   if (index < 0) return 0.0;
   const tinygltf::Accessor& accessor = model.accessors[index];
   if (accessor.bufferView < 0) return 0.0;
   const tinygltf::BufferView& view = model.bufferViews[accessor.bufferView];
-  const unsigned char* base = model.buffers[view.buffer].data.data() + view.byteOffset + accessor.byteOffset;
+  const std::vector<unsigned char>& buffer = model.buffers[view.buffer].data;
   const int components = tinygltf::GetNumComponentsInType(accessor.type);
   const int component_bytes = tinygltf::GetComponentSizeInBytes(accessor.componentType);
   const int stride = accessor.ByteStride(view);
+  const size_t start = view.byteOffset + accessor.byteOffset;
+  if (accessor.count == 0) return 0.0;
+  if (stride <= 0 || start + (accessor.count - 1) * stride + components * component_bytes > buffer.size()) {
+    return std::nan("");
+  }
+  const unsigned char* base = buffer.data() + start;
   double sum = 0.0;
   for (size_t element = 0; element < accessor.count; ++element) {
     for (int c = 0; c < components; ++c) {

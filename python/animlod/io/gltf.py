@@ -1,7 +1,9 @@
 """glTF 2.0 / GLB in and out: the public entry points.
 
-Reading lives in :mod:`.gltf_read` (with :mod:`.gltf_document` for checked buffer access and
-:mod:`.gltf_keyframes` for sampler interpolation), writing in :mod:`.gltf_write`.
+Reading lives in :mod:`.gltf_read`, which builds on :mod:`.gltf_document` (checked buffers,
+accessors, nodes and samplers), :mod:`.gltf_mesh` (primitives merged into one vertex set),
+:mod:`.gltf_skin` (skins as skeletons, animations as motions) and :mod:`.gltf_keyframes`
+(sampler interpolation). Writing lives in :mod:`.gltf_write`.
 """
 
 from .gltf_read import GltfScene, read_gltf, read_skinned

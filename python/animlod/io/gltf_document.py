@@ -16,6 +16,7 @@ import struct
 import warnings
 from pathlib import Path
 from typing import Any
+from urllib.parse import unquote
 
 import numpy as np
 import pygltflib
@@ -182,7 +183,7 @@ class GltfDocument:
             except (IndexError, binascii.Error) as error:
                 raise self.fail(element, f"malformed base64 data URI ({error})") from None
         else:
-            external = Path(self.path).parent / buffer.uri
+            external = Path(self.path).parent / unquote(buffer.uri)  # a relative URI, percent-encoded
             try:
                 data = external.read_bytes()
             except OSError as error:

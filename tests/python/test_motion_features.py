@@ -1,0 +1,64 @@
+"""Motion features (paper section "Rotation connected graph") through animlod.simplify."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from simplify_inputs import bending_tube
+
+from animlod.model import AnimatedMesh
+from animlod.simplify import motion_features
+
+
+def test_a_hinge_reports_its_exact_angle_change():
+    fold = math.radians(30)
+    frames = np.array(
+        [
+            [[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -1, 0]],
+            [[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -math.cos(fold), math.sin(fold)]],
+        ],
+        np.float32,
+    )
+    features = motion_features(AnimatedMesh([[0, 1, 2], [1, 0, 3]], frames), feature_threshold=0.1, boundary_is_feature=False)
+    np.testing.assert_array_equal(features.edges[0], [0, 1])
+    assert features.angle_change[0] == pytest.approx(fold, rel=1e-6)
+    np.testing.assert_array_equal(features.connected, [True, False, False, False, False])
+    np.testing.assert_array_equal(features.vertex_weights, [2, 2, 1, 1])
+
+
+def test_a_rigidly_translating_mesh_has_no_motion_features():
+    rest = bending_tube(frames=1).frames[0]
+    frames = rest[None] + np.array([0.3, -0.1, 0.2], np.float32) * np.arange(6, dtype=np.float32)[:, None, None]
+    features = motion_features(AnimatedMesh(bending_tube().faces, frames), boundary_is_feature=False)
+    assert features.feature_sizes.size == 0
+    assert np.all(features.vertex_weights == 1)
+    assert features.angle_change.max() < math.radians(1)
+
+
+def test_a_bending_tube_has_its_features_at_the_bend():
+    mesh = bending_tube(frames=6, rings=21)
+    features = motion_features(mesh, boundary_is_feature=False)
+    in_feature = features.vertex_feature >= 0
+    x = mesh.frames[0, :, 0]
+    assert in_feature.any()
+    assert np.all(np.abs(x[in_feature]) < 0.35)
+    assert features.threshold == pytest.approx(features.angle_change[features.angle_change > 0].mean(), rel=0.6)
+    sizes = features.feature_sizes[features.vertex_feature[in_feature]]
+    np.testing.assert_array_equal(features.vertex_weights[in_feature], sizes)
+
+
+def test_boundaries_are_features_by_default():
+    features = motion_features(bending_tube(frames=2, bend=0.0))
+    np.testing.assert_array_equal(features.feature_sizes, [12, 12])  # the two open ends
+
+
+def test_crane_features_are_found(data_dir):
+    from animlod.io.meshseq import read_sequence
+
+    mesh = read_sequence(data_dir / "meshseq" / "crane")
+    features = motion_features(mesh)
+    assert features.edges.shape == (30000, 2)  # closed genus-0 mesh: E = 3M / 2
+    assert 0 < features.threshold < math.pi
+    assert features.feature_sizes.sum() == np.count_nonzero(features.vertex_feature >= 0)

@@ -1,0 +1,188 @@
+"""AQEM through animlod.simplify: invariants on procedural and real sequences."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
+
+from animlod.model import AnimatedMesh
+from animlod.simplify import simplify_animated
+
+
+def test_levels_respect_targets_and_stay_valid_manifolds():
+    mesh = bending_tube()
+    result = simplify_animated(mesh, (0.5, 0.25, 0.1))
+    assert [level.target_face_count for level in result.levels] == [180, 90, 36]
+    for level in result.levels:
+        assert level.reached
+        assert level.mesh.face_count <= level.target_face_count
+        assert level.mesh.frames.shape == (mesh.frame_count, level.kept_vertices.size, 3)
+        assert level.mesh.faces.min() >= 0 and level.mesh.faces.max() < level.kept_vertices.size
+        assert directed_edges_unique(level.mesh.faces)
+        # Every input vertex maps to a kept vertex, and kept vertices map to themselves.
+        assert level.vertex_map.min() >= 0
+        np.testing.assert_array_equal(level.vertex_map[level.kept_vertices], np.arange(level.kept_vertices.size))
+    errors = [level.error for level in result.levels]
+    assert errors == sorted(errors) and errors[-1] > errors[0]
+    collapses = [level.collapse_count for level in result.levels]
+    assert collapses == sorted(collapses) and collapses[-1] == result.collapses.removed.size
+
+
+def test_collapse_record_replays_to_the_last_level():
+    mesh = bending_tube(frames=3)
+    result = simplify_animated(mesh, (0.3,))
+    record, level = result.collapses, result.levels[0]
+    assert record.positions.shape == (record.removed.size, 3, 3)
+    # The last collapse that touched each kept vertex gave it its final positions.
+    last = {int(kept): i for i, kept in enumerate(record.kept)}
+    for kept_index, vertex in enumerate(level.kept_vertices):
+        expected = record.positions[last[vertex]] if vertex in last else mesh.frames[:, vertex]
+        np.testing.assert_array_equal(level.mesh.frames[:, kept_index], expected)
+    assert np.all(record.cost >= 0) and np.all(record.error >= 0)
+
+
+def test_output_is_deterministic():
+    mesh = bending_tube()
+    first = simplify_animated(mesh, (0.2,))
+    second = simplify_animated(mesh, (0.2,))
+    assert first.levels[0].mesh.faces.tobytes() == second.levels[0].mesh.faces.tobytes()
+    assert first.levels[0].mesh.frames.tobytes() == second.levels[0].mesh.frames.tobytes()
+    assert first.collapses.removed.tobytes() == second.collapses.removed.tobytes()
+
+
+def test_identical_frames_give_the_single_frame_result():
+    single = AnimatedMesh(bending_tube().faces, bending_tube().frames[-1:])
+    repeated = AnimatedMesh(single.faces, np.repeat(single.frames, 4, axis=0))
+    one = simplify_animated(single, (0.5, 0.2))
+    four = simplify_animated(repeated, (0.5, 0.2))
+    for a, b in zip(one.levels, four.levels):
+        np.testing.assert_array_equal(a.mesh.faces, b.mesh.faces)
+        np.testing.assert_allclose(b.mesh.frames, np.repeat(a.mesh.frames, 4, axis=0), atol=1e-6)
+        assert b.error == pytest.approx(a.error, rel=1e-6, abs=1e-12)
+
+
+def test_no_face_flips_in_any_frame():
+    mesh = ellipsoid()
+    level = simplify_animated(mesh, (0.08,)).levels[0]
+    corners = level.mesh.frames[:, level.mesh.faces]  # (F, M', 3, 3)
+    normals = np.cross(corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0])
+    # The ellipsoid is convex and centred at the origin: outward normals agree with the centroid.
+    assert np.all(np.sum(normals * corners.mean(axis=2), axis=-1) > 0)
+
+
+def test_locked_vertices_keep_their_positions():
+    mesh = bending_tube()
+    locked = np.arange(84, 96)  # the ring at the elbow
+    level = simplify_animated(mesh, (0.15,), locked_vertices=locked).levels[0]
+    np.testing.assert_array_equal(level.kept_vertices[level.vertex_map[locked]], locked)
+    np.testing.assert_array_equal(level.mesh.frames[:, level.vertex_map[locked]], mesh.frames[:, locked])
+
+
+def test_importance_protects_a_region():
+    mesh = ellipsoid(frames=1)
+    right = mesh.frames[0, :, 0] > 0.3
+    importance = np.where(right, 1000.0, 1.0).astype(np.float32)
+    plain = simplify_animated(mesh, (0.25,), use_motion_features=False).levels[0]
+    weighted = simplify_animated(mesh, (0.25,), use_motion_features=False, importance=importance).levels[0]
+    assert right[weighted.kept_vertices].sum() > right[plain.kept_vertices].sum()
+
+
+def test_max_error_stops_early_and_says_so():
+    mesh = ellipsoid(frames=2)
+    unbounded = simplify_animated(mesh, (0.9, 0.1))
+    bound = unbounded.levels[0].error
+    bounded = simplify_animated(mesh, (0.9, 0.1), max_error=bound)
+    assert bounded.levels[0].reached and not bounded.levels[1].reached
+    assert bounded.levels[1].error <= bound
+    assert bounded.levels[1].mesh.face_count > 0.1 * mesh.face_count
+
+
+def test_frame_sampling_covers_the_motion_and_positions_every_frame():
+    mesh = bending_tube(frames=9)
+    result = simplify_animated(mesh, (0.3,), max_frames=3)
+    np.testing.assert_array_equal(result.frames_used, [0, 4, 8])
+    assert result.levels[0].mesh.frame_count == 9
+    explicit = simplify_animated(mesh, (0.3,), frame_subset=[8, 0, 4])
+    np.testing.assert_array_equal(explicit.levels[0].mesh.faces, result.levels[0].mesh.faces)
+
+
+def test_uvs_are_carried_as_attributes():
+    mesh = bending_tube(frames=2)
+    rest = mesh.frames[0]
+    uvs = np.stack([rest[:, 0], np.arctan2(rest[:, 2], rest[:, 1])], axis=1).astype(np.float32)
+    level = simplify_animated(mesh, (0.5,), attributes=uvs, placement="on_edge").levels[0]
+    assert level.attributes.shape == (level.kept_vertices.size, 2)
+    # On-edge placement interpolates u with the same parameter as x in the rest pose.
+    np.testing.assert_allclose(level.attributes[:, 0], level.mesh.frames[0, :, 0], atol=1e-5)
+
+
+def test_progress_reports_the_collapses():
+    calls = []
+    result = simplify_animated(bending_tube(), (0.1,), progress=lambda done, total: calls.append((done, total)))
+    assert calls[-1] == (result.collapses.removed.size, (360 - 36 + 1) // 2)
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda f: np.concatenate([f, f[:1]]), "faces 0 and 360: duplicate, same three vertices"),
+        (lambda f: np.concatenate([f, [[0, 0, 1]]]), "face 360 (0, 0, 1): degenerate, repeats a vertex"),
+        (lambda f: np.concatenate([f, [[0, 13, 191]]]), "edge (0, 13): non-manifold"),
+    ],
+)
+def test_bad_connectivity_names_the_element(edit, message):
+    mesh = bending_tube(frames=2)
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        simplify_animated(AnimatedMesh(edit(mesh.faces), mesh.frames), (0.5,))
+
+
+def test_unreferenced_vertex_and_targets_out_of_range_are_named():
+    mesh = bending_tube(frames=2)
+    extra = AnimatedMesh(mesh.faces, np.concatenate([mesh.frames, mesh.frames[:, :1]], axis=1))
+    with pytest.raises(ValueError, match="vertex 192: not referenced by any face"):
+        simplify_animated(extra, (0.5,))
+    with pytest.raises(ValueError, match=r"target_face_counts: 400 outside \[4, 360\]"):
+        simplify_animated(mesh, target_face_counts=[400])
+    with pytest.raises(ValueError, match="below 4 faces"):
+        simplify_animated(mesh, (0.005,))
+    with pytest.raises(ValueError, match="placement"):
+        simplify_animated(mesh, placement="middle")
+
+
+def test_repair_drops_what_it_documents_and_maps_back():
+    mesh = bending_tube(frames=2)
+    faces = np.concatenate([mesh.faces, mesh.faces[:2], [[5, 5, 6]]])
+    frames = np.concatenate([mesh.frames[:, :7], mesh.frames[:, :1], mesh.frames[:, 7:]], axis=1)
+    faces = np.where(faces >= 7, faces + 1, faces)  # vertex 7 is now unreferenced
+    result = simplify_animated(AnimatedMesh(faces, frames), (0.5,), repair=True)
+    clean = simplify_animated(mesh, (0.5,))
+    level, reference = result.levels[0], clean.levels[0]
+    np.testing.assert_array_equal(level.mesh.faces, reference.mesh.faces)
+    assert level.vertex_map[7] == -1
+    np.testing.assert_array_equal(level.kept_vertices, np.where(reference.kept_vertices >= 7, reference.kept_vertices + 1, reference.kept_vertices))
+
+
+def test_open_borders_keep_their_outline():
+    positions, faces = tube(rings=10, segments=16)
+    mesh = AnimatedMesh(faces, positions[None])
+    level = simplify_animated(mesh, (0.3,)).levels[0]
+    ends = level.mesh.frames[0, :, 0]
+    assert ends.min() == pytest.approx(-1.0) and ends.max() == pytest.approx(1.0)
+
+
+def test_crane_sequence_at_ten_percent(data_dir):
+    from animlod.io.meshseq import read_sequence
+
+    mesh = read_sequence(data_dir / "meshseq" / "crane")
+    diagonal = float(np.linalg.norm(np.ptp(mesh.frames[0], axis=0)))
+    for use_motion_features in (True, False):
+        result = simplify_animated(mesh, (0.5, 0.25, 0.1), use_motion_features=use_motion_features)
+        for level in result.levels:
+            assert level.reached and level.mesh.face_count <= level.target_face_count
+            assert directed_edges_unique(level.mesh.faces)
+            assert math.isfinite(level.error)
+    # Without feature weights the collapse order is the plain animated quadric's: small error.
+    assert result.levels[-1].error < 0.02 * diagonal

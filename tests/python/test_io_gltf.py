@@ -128,6 +128,44 @@ def _transform(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
 
+def _viewer_skinning(gltf: pygltflib.GLTF2, blob: bytearray, mesh_node: int, animation: str, key: int) -> np.ndarray:
+    """Skinned positions ``(V, 3)`` of the first primitive of ``mesh_node`` at key ``key`` of an
+    animation, evaluated the way a glTF viewer does: 4x4 node matrices multiplied down the tree
+    (scale included), ``world @ inverse bind`` per joint, weights normalised. Independent of
+    animlod's skeleton building, so that baking can be checked against it.
+    """
+    clip = next(a for a in gltf.animations if a.name == animation)
+    keys = {
+        (c.target.node, c.target.path): _accessor_view(gltf, blob, clip.samplers[c.sampler].output, "<f4")
+        for c in clip.channels
+    }
+    parents = {child: index for index, node in enumerate(gltf.nodes) for child in node.children or []}
+
+    def world(node: int) -> np.ndarray:
+        n = gltf.nodes[node]
+        trs = {
+            "translation": n.translation or [0, 0, 0],
+            "rotation": n.rotation or [0, 0, 0, 1],
+            "scale": n.scale or [1, 1, 1],
+        }
+        trs.update({path: keys[(node, path)][key] for path in trs if (node, path) in keys})
+        local = rotations.compose_transform(*(np.array(trs[p]) for p in ("translation", "rotation", "scale")))
+        return local if node not in parents else world(parents[node]) @ local
+
+    skin = gltf.skins[gltf.nodes[mesh_node].skin]
+    attributes = gltf.meshes[gltf.nodes[mesh_node].mesh].primitives[0].attributes
+    positions = _accessor_view(gltf, blob, attributes.POSITION, "<f4").astype(np.float64)
+    joint_dtype = "<u2" if gltf.accessors[attributes.JOINTS_0].componentType == pygltflib.UNSIGNED_SHORT else "u1"
+    joints = _accessor_view(gltf, blob, attributes.JOINTS_0, joint_dtype)
+    weights = _accessor_view(gltf, blob, attributes.WEIGHTS_0, "<f4").astype(np.float64)
+    weights = weights / weights.sum(axis=1, keepdims=True)
+    inverse_bind = _accessor_view(gltf, blob, skin.inverseBindMatrices, "<f4").reshape(-1, 4, 4).transpose(0, 2, 1)
+    skinning = np.stack([world(j) @ inverse_bind[k] for k, j in enumerate(skin.joints)])
+    homogeneous = np.c_[positions, np.ones(len(positions))]
+    per_influence = np.einsum("vkij,vj->vki", skinning[joints][..., :3, :], homogeneous)
+    return np.einsum("vk,vki->vi", weights, per_influence)
+
+
 # ---- keyframe interpolation ---------------------------------------------------------------
 
 
@@ -309,6 +347,38 @@ def test_armature_above_the_root_is_folded_into_the_pose(chain_glb, tmp_path):
     np.testing.assert_allclose(read.bake(motions[0]).frames, expected, atol=1e-6)
     # The rigid skeleton carries the 0.01 in its offsets, the inverse bind matrices the rest.
     np.testing.assert_allclose(np.linalg.norm(read.skeleton.offsets[1:], axis=1), 0.01, rtol=1e-6)
+
+
+def _split_chain_under_an_armature(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+    """Armature -> [root, mid -> tip]: the skin's joints now form two trees."""
+    gltf.nodes[0].children = []
+    gltf.nodes.append(pygltflib.Node(name="Armature", children=[0, 1], translation=[0.0, 0.0, 2.0]))
+    gltf.scenes[0].nodes = [len(gltf.nodes) - 1, 3]
+
+
+def test_joints_in_several_trees_get_their_common_ancestor_as_root(chain_glb, tmp_path):
+    path, _, motion = chain_glb
+    split = _edit_glb(path, tmp_path / "split.glb", _split_chain_under_an_armature)
+    read, (read_motion,) = read_skinned(split, fps=motion.fps)
+    assert read.skeleton.names == ["Armature", "root", "mid", "tip"]
+    np.testing.assert_array_equal(read.skeleton.parents, [-1, 0, 0, 2])
+    assert read.joints.max() <= 3 and not np.any(read.weights[read.joints == 0] > 0)  # nothing bound to it
+    gltf = pygltflib.GLTF2.load_from_bytes(split.read_bytes())
+    baked = read.bake(read_motion).frames
+    for frame in (0, 3, motion.frame_count - 1):
+        expected = _viewer_skinning(gltf, bytearray(gltf.binary_blob()), 3, "bend", frame)
+        np.testing.assert_allclose(baked[frame], expected, atol=1e-5)
+
+
+def test_joints_in_trees_without_a_common_node_are_refused(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def two_scene_roots(gltf, blob):
+        gltf.nodes[0].children = []
+        gltf.scenes[0].nodes = [0, 1, 3]
+
+    with pytest.raises(FormatError, match=r"skin 0: joints form 2 separate trees \(node 0 'root', node 1 'mid'\)"):
+        read_skinned(_edit_glb(path, tmp_path / "forest.glb", two_scene_roots))
 
 
 def test_mesh_node_transform_moves_the_rest_mesh_but_not_the_skinned_result(chain_glb, tmp_path):
@@ -576,42 +646,13 @@ def test_soldier_counts_and_placement(soldier):
 
 
 def test_soldier_run_matches_a_direct_glTF_skinning(soldier):
-    """Bake against an independent evaluation of the glTF node tree with 4x4 matrices."""
     path, scene = soldier
     gltf = pygltflib.GLTF2.load_from_bytes(path.read_bytes())
     blob = bytearray(gltf.binary_blob())
-    run = next(a for a in gltf.animations if a.name == "Run")
-    frames = [0, 7, 21]  # Run's keys sit at 30 fps, so frame k is key k
-    keys = {}
-    for channel in run.channels:
-        sampler = run.samplers[channel.sampler]
-        keys[(channel.target.node, channel.target.path)] = _accessor_view(gltf, blob, sampler.output, "<f4")
-
-    def world(node: int, frame: int) -> np.ndarray:
-        n = gltf.nodes[node]
-        trs = {"translation": n.translation, "rotation": n.rotation, "scale": n.scale}  # Soldier sets all three
-        for path_ in trs:
-            if (node, path_) in keys:
-                trs[path_] = keys[(node, path_)][frame]
-        local = rotations.compose_transform(*(np.array(trs[p]) for p in ("translation", "rotation", "scale")))
-        parent = next((i for i, p in enumerate(gltf.nodes) if node in (p.children or [])), None)
-        return local if parent is None else world(parent, frame) @ local
-
-    for mesh, motions, node in zip(scene.skinned_meshes, scene.skinned_motions, (1, 2)):
-        skin = gltf.skins[gltf.nodes[node].skin]
-        attributes = gltf.meshes[gltf.nodes[node].mesh].primitives[0].attributes
-        positions = _accessor_view(gltf, blob, attributes.POSITION, "<f4").astype(np.float64)
-        joint_dtype = "<u2" if gltf.accessors[attributes.JOINTS_0].componentType == pygltflib.UNSIGNED_SHORT else "u1"
-        joints = _accessor_view(gltf, blob, attributes.JOINTS_0, joint_dtype)
-        weights = _accessor_view(gltf, blob, attributes.WEIGHTS_0, "<f4").astype(np.float64)
-        weights = weights / weights.sum(axis=1, keepdims=True)
-        inverse_bind = _accessor_view(gltf, blob, skin.inverseBindMatrices, "<f4").reshape(-1, 4, 4).transpose(0, 2, 1)
+    for mesh, motions, mesh_node in zip(scene.skinned_meshes, scene.skinned_motions, (1, 2)):
         baked = mesh.bake(next(m for m in motions if m.name == "Run")).frames
-        for frame in frames:
-            skinning = np.stack([world(j, frame) @ inverse_bind[k] for k, j in enumerate(skin.joints)])
-            homogeneous = np.c_[positions, np.ones(len(positions))]
-            per_influence = np.einsum("vkij,vj->vki", skinning[joints][..., :3, :], homogeneous)
-            expected = np.einsum("vk,vki->vi", weights, per_influence)
+        for frame in (0, 7, 21):  # Run's keys sit at 30 fps, so frame k is key k
+            expected = _viewer_skinning(gltf, blob, mesh_node, "Run", frame)
             np.testing.assert_allclose(baked[frame], expected, atol=2e-5)
 
 

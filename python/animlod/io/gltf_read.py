@@ -122,7 +122,7 @@ def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:
 def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -> tuple[SkinnedMesh, list[Motion]]:
     mesh_index = doc.gltf.nodes[node].mesh
     geometry = read_mesh_geometry(doc, mesh_index, skinned=True)
-    slots = len(rig.remap)
+    slots = rig.skin_slots
     # Unused influences may carry any index (some exporters leave garbage there).
     joints = np.where(geometry.weights > 0.0, geometry.joints, 0)
     if joints.size and joints.max() >= slots:
@@ -130,7 +130,7 @@ def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -
         reason = f"vertex {vertex} uses joint slot {int(joints[vertex].max())}, skin {rig.skin} has {slots}"
         raise doc.fail(f"mesh {mesh_index} JOINTS", reason)
     mesh_world = doc.rest_world_matrix(node)
-    row_scale = np.ones((slots, 4, 1))
+    row_scale = np.ones((len(rig.scales), 4, 1))
     row_scale[:, :3] = rig.scales[:, None, None]
     inverse_bind = (row_scale * rig.inverse_bind) @ np.linalg.inv(mesh_world)
     try:

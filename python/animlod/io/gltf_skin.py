@@ -39,7 +39,10 @@ class SkinRig:
     Attributes
     ----------
     skeleton : the joints in topological order, rest offsets and rotations from the nodes.
-    remap : (S,) skeleton joint of each skin slot (the index JOINTS_0 stores).
+        When the skin's joints form several trees, their lowest common ancestor node joins
+        the skeleton as its root (no vertex is bound to it, its inverse bind is identity).
+    skin_slots : S, the number of joints the skin lists (JOINTS_0 indexes them).
+    remap : (J,) skeleton joint of each skin slot, then of the added common root if any.
     scales : (J,) accumulated uniform scale of each joint's node at rest.
     inverse_bind : (J, 4, 4) the skin's inverse bind matrices in skeleton order, as stored.
     """
@@ -48,6 +51,8 @@ class SkinRig:
         self.skin = skin
         self.element = f"skin {skin}"
         joint_nodes = self._joint_nodes(doc)
+        self.skin_slots = len(joint_nodes)
+        joint_nodes += self._common_root(doc, joint_nodes)
         parent_slots = self._parent_slots(doc, joint_nodes)
         order = _topological_order(parent_slots)
         self.joint_nodes = [joint_nodes[slot] for slot in order]
@@ -66,7 +71,7 @@ class SkinRig:
             self._local_scale[node] = doc.uniform_scale(node, scale, self.element)
             self._world_scale[node] = self._local_scale[node] * self._world_scale.get(self._node_parents[node], 1.0)
         self.scales = np.array([self._world_scale[n] for n in self.joint_nodes])
-        self.inverse_bind = self._inverse_bind(doc)[order]
+        self.inverse_bind = self._inverse_bind(doc, len(order))[order]
         positions, world_rotations = self._pose(self.rest_translation, self.rest_rotation, frames=1)
         offsets = self._offsets(positions, world_rotations)[0]
         self._translation_tolerance = _HELD_TRANSLATION_TOLERANCE * max(np.abs(offsets[1:]).max(initial=0.0), 1e-12)
@@ -138,27 +143,38 @@ class SkinRig:
             raise doc.fail(self.element, "lists a node twice among its joints")
         return joints
 
-    def _parent_slots(self, doc: GltfDocument, joint_nodes: list[int]) -> list[int]:
-        """Skin slot of each joint's nearest joint ancestor, -1 for the root."""
-        slot_of = {node: slot for slot, node in enumerate(joint_nodes)}
-        parents = [next((slot_of[a] for a in doc.ancestors(node) if a in slot_of), -1) for node in joint_nodes]
-        roots = [doc.node_label(joint_nodes[slot]) for slot, parent in enumerate(parents) if parent < 0]
-        if len(roots) != 1:
-            reason = f"joints form {len(roots)} separate trees ({', '.join(roots)}); one root joint is needed"
+    def _common_root(self, doc: GltfDocument, joint_nodes: list[int]) -> list[int]:
+        """``[lowest common ancestor]`` of the joints' top nodes when there are several, else ``[]``."""
+        joints = set(joint_nodes)
+        roots = [node for node in joint_nodes if joints.isdisjoint(doc.ancestors(node))]
+        if len(roots) == 1:
+            return []
+        shared = set.intersection(*({root, *doc.ancestors(root)} for root in roots))
+        if not shared:
+            labels = ", ".join(doc.node_label(root) for root in roots)
+            reason = f"joints form {len(roots)} separate trees ({labels}) under no common node; one root is needed"
             raise doc.fail(self.element, reason)
-        return parents
+        return [max(shared, key=lambda node: len(doc.ancestors(node)))]  # the deepest shared node
 
-    def _inverse_bind(self, doc: GltfDocument) -> np.ndarray:
-        """The skin's inverse bind matrices ``(S, 4, 4)`` in skin order (identity when absent)."""
+    def _parent_slots(self, doc: GltfDocument, joint_nodes: list[int]) -> list[int]:
+        """Slot of each joint's nearest joint ancestor, -1 for the root."""
+        slot_of = {node: slot for slot, node in enumerate(joint_nodes)}
+        return [next((slot_of[a] for a in doc.ancestors(node) if a in slot_of), -1) for node in joint_nodes]
+
+    def _inverse_bind(self, doc: GltfDocument, joint_count: int) -> np.ndarray:
+        """Inverse bind matrices ``(J, 4, 4)`` in slot order: the skin's (identity when absent),
+        then identity for an added common root."""
         skin = doc.gltf.skins[self.skin]
-        count = len(skin.joints)
+        matrices = np.broadcast_to(np.eye(4), (joint_count, 4, 4)).copy()
         if skin.inverseBindMatrices is None:
-            return np.broadcast_to(np.eye(4), (count, 4, 4)).copy()
-        matrices = doc.accessor(skin.inverseBindMatrices, f"{self.element} inverseBindMatrices")
-        if matrices.shape != (count, 16) or matrices.dtype.kind != "f":
-            got = f"{matrices.shape[0]} of width {matrices.shape[1]}"
+            return matrices
+        stored = doc.accessor(skin.inverseBindMatrices, f"{self.element} inverseBindMatrices")
+        count = self.skin_slots
+        if stored.shape != (count, 16) or stored.dtype.kind != "f":
+            got = f"{stored.shape[0]} of width {stored.shape[1]}"
             raise doc.fail(self.element, f"inverseBindMatrices must be {count} float MAT4, got {got}")
-        return matrices.reshape(count, 4, 4).transpose(0, 2, 1).astype(np.float64)  # glTF is column-major
+        matrices[:count] = stored.reshape(count, 4, 4).transpose(0, 2, 1)  # glTF is column-major
+        return matrices
 
     def _pose(self, translations: dict, local_rotations: dict, frames: int) -> tuple[np.ndarray, np.ndarray]:
         """World positions ``(T, J, 3)`` and rotations ``(T, J, 4)`` of the joints, T = ``frames``.

@@ -248,6 +248,23 @@ def test_round_trip_keeps_mesh_skin_and_motion(chain_glb):
     np.testing.assert_allclose(read.bake(motions[0]).frames, mesh.bake(motion).frames, atol=1e-5)
 
 
+def test_written_rotation_keys_have_no_sign_flips(tmp_path):
+    mesh = _chain_mesh()
+    motion = _chain_motion(mesh.skeleton)
+    flipped = motion.local_rotations * np.where(np.arange(motion.frame_count) % 2, -1.0, 1.0)[:, None, None]
+    path = tmp_path / "flips.glb"
+    write_glb(path, mesh, [Motion(mesh.skeleton, motion.root_positions, flipped, motion.fps, "flips")])
+    gltf = pygltflib.GLTF2.load_from_bytes(path.read_bytes())
+    blob = bytearray(gltf.binary_blob())
+    animation = gltf.animations[0]
+    for channel in animation.channels:
+        if channel.target.path == "rotation":
+            keys = _accessor_view(gltf, blob, animation.samplers[channel.sampler].output, "<f4")
+            assert np.all(np.sum(keys[1:] * keys[:-1], axis=1) > 0.0)
+    _, (read,) = read_skinned(path, fps=motion.fps)
+    np.testing.assert_allclose(read.world_transforms(), motion.world_transforms(), atol=1e-6)
+
+
 def test_round_trip_eight_influences_and_no_optional_attributes(tmp_path):
     mesh = _chain_mesh(influences=8, extras=False)
     assert np.count_nonzero(mesh.weights[:, 4:]) > 0

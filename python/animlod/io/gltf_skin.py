@@ -6,6 +6,8 @@ ancestor of one takes part in posing: the armature above the root joint (glTF vi
 it, so baking must too) and any non-joint node between two joints. A pose composes world
 rotations and positions through that node tree; a joint's motion rotation is then its world
 rotation relative to its parent joint's, and the root's position is its world position.
+Joints that form several trees (several root bones under one armature) get the lowest node
+above all of them as an extra root joint.
 
 Scale: glTF nodes may scale, animlod motions are rigid. A uniform scale ``c`` accumulated down
 the tree scales the bone offsets below it, and ``diag(c, c, c, 1)`` moves into the joint's

@@ -146,7 +146,8 @@ def _animation(builder: _GlbBuilder, motion: Motion, name: str) -> pygltflib.Ani
     tracks = [(0, "translation", motion.root_positions)]
     if motion.joint_translations is not None:  # bones that stretch or slide get their own tracks
         tracks += [(j, "translation", motion.joint_translations[:, j]) for j in range(1, joint_count)]
-    tracks += [(j, "rotation", motion.local_rotations[:, j]) for j in range(joint_count)]
+    local_rotations = _sign_continuous(motion.local_rotations)
+    tracks += [(j, "rotation", local_rotations[:, j]) for j in range(joint_count)]
     samplers, channels = [], []
     for node, path, values in tracks:
         channels.append(
@@ -158,6 +159,17 @@ def _animation(builder: _GlbBuilder, motion: Motion, name: str) -> pygltflib.Ani
         sampler = pygltflib.AnimationSampler(input=time_accessor, output=output, interpolation=pygltflib.ANIM_LINEAR)
         samplers.append(sampler)
     return pygltflib.Animation(name=name, samplers=samplers, channels=channels)
+
+
+def _sign_continuous(quaternions: np.ndarray) -> np.ndarray:
+    """``(T, J, 4)`` with signs flipped so consecutive keys have a non-negative dot product.
+
+    q and -q are the same rotation, but a viewer interpolating from q to -q' may take the long
+    way round; each flip is carried forward to every later frame.
+    """
+    dots = np.sum(quaternions[1:] * quaternions[:-1], axis=-1)
+    signs = np.cumprod(np.where(dots < 0.0, -1.0, 1.0), axis=0)
+    return quaternions * np.concatenate([np.ones((1,) + signs.shape[1:]), signs])[..., None]
 
 
 class _GlbBuilder:

@@ -1,0 +1,52 @@
+"""Type stubs of the C++ extension animlod._core (see cpp/bindings/)."""
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+def bake_lbs(
+    rest_positions: npt.ArrayLike,
+    joints: npt.ArrayLike,
+    weights: npt.ArrayLike,
+    skin_matrices: npt.ArrayLike,
+) -> npt.NDArray[np.float32]:
+    """Linear blend skinning: (V, 3), (V, K), (V, K), (T, J, 4, 4) -> (T, V, 3) float32."""
+
+def motion_features(
+    frames: npt.ArrayLike,
+    faces: npt.ArrayLike,
+    *,
+    feature_threshold: float = 0.0,
+    min_angle_change: float = 0.017453292519943295,
+    boundary_is_feature: bool = True,
+) -> dict[str, Any]:
+    """Motion features of (F, V, 3) frames and (M, 3) faces: edges, angle_change, connected,
+    threshold, vertex_feature, feature_sizes, vertex_weights."""
+
+def simplify_animated(
+    frames: npt.ArrayLike,
+    faces: npt.ArrayLike,
+    *,
+    target_ratios: Sequence[float] = [0.5],
+    target_face_counts: Sequence[int] = [],
+    max_error: float = ...,
+    use_motion_features: bool = True,
+    feature_threshold: float = 0.0,
+    min_angle_change: float = 0.017453292519943295,
+    boundary_is_feature: bool = True,
+    boundary_quadrics: bool = True,
+    check_inversion: bool = True,
+    strict_inversion: bool = False,
+    max_frames: int = 0,
+    frame_subset: Sequence[int] = [],
+    locked: npt.ArrayLike | None = None,
+    importance: npt.ArrayLike | None = None,
+    attributes: npt.ArrayLike | None = None,
+    skin_joints: npt.ArrayLike | None = None,
+    skin_weights: npt.ArrayLike | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    placement: str = "optimal",
+) -> dict[str, Any]:
+    """AQEM over all frames: {"levels": [...], "collapses": {...}, "frames_used", "vertex_weights"}."""

@@ -62,8 +62,9 @@ def _chain_mesh(influences: int = 4, extras: bool = True) -> SkinnedMesh:
     if influences == 8:  # spread some weight to further slots so the second set is used
         joints[:, 4:7] = [2, 1, 0]
         weights[:, 4:7] = raw[:, ::-1] * 0.25
-    rest = Skeleton(skeleton.names, skeleton.parents, [[0, 0, 0], [0, 1, 0], [0, 1, 0]])
-    inverse_bind = np.linalg.inv(rest.rest_world_transforms())
+    # Bound in a straight pose that differs from the skeleton's rest pose, as in real files.
+    bind_pose = Skeleton(skeleton.names, skeleton.parents, [[0, 0, 0], [0, 1, 0], [0, 1, 0]])
+    inverse_bind = np.linalg.inv(bind_pose.rest_world_transforms())
     rng = np.random.default_rng(7)
     return SkinnedMesh(
         rest_positions=positions,

@@ -543,6 +543,16 @@ def test_missing_skin_names_the_file_and_the_skin(chain_glb):
     assert read_skinned(path, skin=0)[0].vertex_count == read_skinned(path, skin="skinned mesh")[0].vertex_count
 
 
+def test_required_extension_animlod_cannot_read(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def require_draco(gltf, blob):
+        gltf.extensionsUsed = gltf.extensionsRequired = ["KHR_draco_mesh_compression"]
+
+    with pytest.raises(FormatError, match=r"extensionsRequired: needs KHR_draco_mesh_compression"):
+        read_gltf(_edit_glb(path, tmp_path / "draco.glb", require_draco))
+
+
 def test_accessor_index_out_of_range(chain_glb, tmp_path):
     path, _, _ = chain_glb
 

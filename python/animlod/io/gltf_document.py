@@ -28,6 +28,10 @@ from .gltf_keyframes import INTERPOLATIONS
 _GLB_MAGIC = b"glTF"
 _GLB_HEADER_BYTES = 12
 _DATA_URI_BASE64 = ";base64,"
+# Required extensions that leave geometry, skins and animation readable as plain glTF
+# (quantized attributes are ordinary normalised or integer accessors); any other required
+# extension (Draco, meshopt, ...) changes what the buffers mean and is refused.
+_HARMLESS_EXTENSIONS = ("KHR_mesh_quantization", "KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_")
 
 _COMPONENT_DTYPES = {
     5120: np.dtype("<i1"),
@@ -357,6 +361,9 @@ def _parse(path: str) -> pygltflib.GLTF2:
     version = str(getattr(gltf.asset, "version", "") or "")
     if not version.startswith("2."):
         raise FormatError(path, "asset", f"glTF version {version!r} is not 2.x")
+    unsupported = [name for name in gltf.extensionsRequired or [] if not name.startswith(_HARMLESS_EXTENSIONS)]
+    if unsupported:
+        raise FormatError(path, "extensionsRequired", f"needs {', '.join(unsupported)}, which animlod cannot read")
     return gltf
 
 

@@ -12,7 +12,7 @@ import importlib
 import sys
 
 # Subcommand modules in the order --help lists them.
-COMMAND_MODULES = ("info", "demo")
+COMMAND_MODULES = ("info", "demo", "simplify")
 
 
 class UserError(Exception):

@@ -1,0 +1,43 @@
+"""``animlod simplify`` on small sequences written to a temporary folder."""
+
+from __future__ import annotations
+
+import numpy as np
+from simplify_inputs import bending_tube
+
+from animlod.cli import main
+from animlod.io.meshseq import read_sequence, write_sequence
+from animlod.io.npz import read_npz, write_npz
+
+
+def test_simplify_an_obj_sequence_writes_each_level_as_a_sequence(tmp_path, capsys):
+    source = tmp_path / "tube"
+    source.mkdir()
+    write_sequence(source, bending_tube(frames=3))
+    code = main(["simplify", str(source), "-o", str(tmp_path / "out"), "--ratio", "0.5", "0.2", "--no-metrics"])
+    assert code == 0
+    for level, faces in ((1, 180), (2, 72)):
+        mesh = read_sequence(tmp_path / "out" / f"tube_lod{level}")
+        assert mesh.frame_count == 3 and mesh.face_count <= faces
+    table = capsys.readouterr().out
+    assert "AQEM error" in table and "180" in table
+
+
+def test_simplify_npz_with_metrics_and_plot(tmp_path, capsys):
+    write_npz(tmp_path / "tube.npz", bending_tube(frames=2))
+    code = main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), "--ratio", "0.3", "--plot"])
+    assert code == 0
+    level = read_npz(tmp_path / "out" / "tube_lod1.npz")
+    assert level.face_count <= 108
+    assert (tmp_path / "out" / "tube_levels.png").stat().st_size > 1000
+    assert "e-0" in capsys.readouterr().out  # a measured Hausdorff/RMS value
+
+
+def test_bad_ratio_and_bad_mesh_exit_with_code_2(tmp_path, capsys):
+    write_npz(tmp_path / "tube.npz", bending_tube(frames=2))
+    assert main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), "--ratio", "1.5"]) == 2
+    assert "--ratio" in capsys.readouterr().err
+    mesh = bending_tube(frames=2)
+    write_npz(tmp_path / "bad.npz", type(mesh)(np.concatenate([mesh.faces, mesh.faces[:1]]), mesh.frames))
+    assert main(["simplify", str(tmp_path / "bad.npz"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 2
+    assert "duplicate" in capsys.readouterr().err

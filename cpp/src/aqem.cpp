@@ -137,6 +137,7 @@ class Simplifier {
   bool keeps_orientation(const Candidate& candidate);
   void collapse(const Candidate& candidate, TriMesh::HalfedgeHandle halfedge, CollapseRecord& record);
   void rekey_around(TriMesh::VertexHandle vertex, bool all_edges);
+  void park(int32_t edge);
   AqemLevel snapshot(size_t target, bool reached);
 
   Eigen::Vector3d position(int32_t vertex, size_t frame) const {
@@ -160,6 +161,7 @@ class Simplifier {
   std::vector<float> skin_weights_;    // (V, K)
   std::vector<int32_t> merged_into_;   // (V,) the vertex each removed vertex merged into
   std::vector<uint8_t> parked_;        // (E,) popped while illegal; re-tried when the area changes
+  std::vector<uint8_t> may_have_parked_;  // (V,) set when an edge of the vertex is parked
   std::vector<Eigen::Vector3d> new_positions_;  // (K,) placement of the candidate being evaluated
   std::vector<uint8_t> singular_;               // (K,) frames of that candidate using the fallback
   TriMesh connectivity_;
@@ -415,6 +417,8 @@ void Simplifier::collapse(const Candidate& candidate, TriMesh::HalfedgeHandle ha
 // Re-evaluates the edges at `vertex`: all of them when its quadric changed, otherwise only
 // the parked ones (their cost is unchanged, but their legality may have changed).
 void Simplifier::rekey_around(TriMesh::VertexHandle vertex, bool all_edges) {
+  if (!all_edges && !may_have_parked_[vertex.idx()]) return;
+  may_have_parked_[vertex.idx()] = 0;
   for (const auto edge : connectivity_.ve_range(vertex)) {
     const int32_t e = edge.idx();
     if (!all_edges && !parked_[e]) continue;
@@ -422,6 +426,14 @@ void Simplifier::rekey_around(TriMesh::VertexHandle vertex, bool all_edges) {
     if (locked(edge.v0().idx()) && locked(edge.v1().idx())) continue;  // can never collapse
     heap_.set(e, evaluate(e).cost);
   }
+}
+
+void Simplifier::park(int32_t edge) {
+  heap_.remove(edge);
+  parked_[edge] = 1;
+  const auto handle = connectivity_.edge_handle(edge);
+  may_have_parked_[connectivity_.to_vertex_handle(connectivity_.halfedge_handle(handle, 0)).idx()] = 1;
+  may_have_parked_[connectivity_.to_vertex_handle(connectivity_.halfedge_handle(handle, 1)).idx()] = 1;
 }
 
 AqemLevel Simplifier::snapshot(size_t target, bool reached) {
@@ -488,8 +500,17 @@ Status Simplifier::run(const std::vector<size_t>& targets, AqemResult& out) {
   const size_t edge_count = connectivity_.n_edges();
   heap_ = detail::IndexedMinHeap(edge_count);
   parked_.assign(edge_count, 0);
-  for (const auto edge : connectivity_.edges())
-    if (!locked(edge.v0().idx()) || !locked(edge.v1().idx())) heap_.set(edge.idx(), evaluate(edge.idx()).cost);
+  may_have_parked_.assign(vertex_count, 0);
+  std::vector<int32_t> ids;
+  std::vector<double> keys;
+  ids.reserve(edge_count);
+  keys.reserve(edge_count);
+  for (const auto edge : connectivity_.edges()) {
+    if (locked(edge.v0().idx()) && locked(edge.v1().idx())) continue;  // can never collapse
+    ids.push_back(edge.idx());
+    keys.push_back(evaluate(edge.idx()).cost);
+  }
+  heap_.assign(ids, keys);
 
   // Steps 8-12, taking a level each time the face count reaches a target.
   const size_t planned = (mesh_.face_count - targets.back() + 1) / 2;
@@ -502,11 +523,12 @@ Status Simplifier::run(const std::vector<size_t>& targets, AqemResult& out) {
   while (next_level < targets.size() && !heap_.empty()) {
     const int32_t edge = heap_.top();
     const Candidate candidate = evaluate(edge);
-    const auto halfedge = connectivity_.find_halfedge(connectivity_.vertex_handle(candidate.removed),
-                                                      connectivity_.vertex_handle(candidate.kept));
+    // The halfedge from the removed vertex to the kept one (OpenMesh keeps the "to" vertex).
+    auto halfedge = connectivity_.halfedge_handle(connectivity_.edge_handle(edge), 0);
+    if (connectivity_.from_vertex_handle(halfedge).idx() != candidate.removed)
+      halfedge = connectivity_.opposite_halfedge_handle(halfedge);
     if (!is_legal(candidate, halfedge)) {
-      heap_.remove(edge);
-      parked_[edge] = 1;
+      park(edge);
       continue;
     }
     if (candidate.error > options_.max_error) break;

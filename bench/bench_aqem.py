@@ -1,0 +1,259 @@
+"""AQEM against static and per-frame baselines: surface error over frames and time.
+
+Run: ``.venv/bin/python bench/bench_aqem.py [--quick]`` (needs libigl, meshoptimizer and
+fast-simplification from the ``bench`` extra). Tables:
+
+1. Quality on the dev sequences (../shared/data/meshseq) and a procedural bending tube at 50%,
+   25% and 10% of the faces: AQEM with and without motion features; static QEM on frame 0
+   applied to every frame (meshoptimizer, keeping its vertex subset); fast-simplification on
+   frame 0 with its collapses replayed on every frame; meshoptimizer's simplifyWithAttributes
+   given other frames' positions as attributes. Errors are symmetric Hausdorff and RMS surface
+   distances per frame relative to the bounding-box diagonal, mean / max over frames.
+2. Speed with one frame on a procedural mesh of about 1M triangles to 10%.
+3. Time against the frame count F = 1, 4, 16, 64 on one animated procedural mesh.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from table import print_table, stopwatch  # noqa: E402
+
+from animlod.metrics import surface_error  # noqa: E402
+from animlod.model import AnimatedMesh  # noqa: E402
+from animlod.simplify import simplify_animated  # noqa: E402
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshseq"
+RATIOS = (0.5, 0.25, 0.1)
+# meshoptimizer accepts at most 32 attribute floats per vertex: 10 other frames of xyz.
+MESHOPT_MAX_ATTRIBUTE_FRAMES = 10
+
+
+def bumpy_sphere(rings: int, segments: int, frames: int) -> AnimatedMesh:
+    """A closed bumpy latitude-longitude sphere twisting about z and swelling over the frames."""
+    theta = np.pi * np.arange(1, rings) / rings
+    phi = 2 * np.pi * np.arange(segments) / segments
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    radius = 1.0 + 0.05 * np.sin(8 * t) * np.cos(6 * p)
+    unit = np.stack([radius * np.sin(t) * np.cos(p), radius * np.sin(t) * np.sin(p), radius * np.cos(t)], -1)
+    rest = np.concatenate([[[0, 0, 1]], unit.reshape(-1, 3), [[0, 0, -1]]])
+    ring, seg = np.meshgrid(np.arange(rings - 2), np.arange(segments), indexing="ij")
+    a = 1 + ring * segments + seg
+    b = 1 + ring * segments + (seg + 1) % segments
+    top = 1 + np.arange(segments)
+    south = len(rest) - 1
+    faces = np.concatenate(
+        [
+            np.stack([np.zeros(segments, int), top, np.roll(top, -1)], -1),
+            np.stack([a, a + segments, b + segments], -1).reshape(-1, 3),
+            np.stack([a, b + segments, b], -1).reshape(-1, 3),
+            np.stack([np.full(segments, south), np.roll(top, -1) + (rings - 2) * segments, top + (rings - 2) * segments], -1),
+        ]
+    )
+    amount = np.linspace(0.0, 1.0, frames)[:, None]
+    angle = amount * rest[None, :, 2] * 1.2  # twist grows with height
+    x, y, z = rest.T
+    swell = 1.0 + 0.2 * amount * np.exp(-(z * 3) ** 2)
+    frames_array = np.stack(
+        [swell * (np.cos(angle) * x - np.sin(angle) * y), swell * (np.sin(angle) * x + np.cos(angle) * y), np.broadcast_to(z, angle.shape)],
+        axis=-1,
+    )
+    return AnimatedMesh(faces, frames_array.astype(np.float32))
+
+
+def bending_tube(frames: int = 24) -> AnimatedMesh:
+    """A finely tessellated tube bending 90 degrees at its middle, the classic elbow."""
+    rings, segments = 80, 48
+    x = np.linspace(-1.0, 1.0, rings)
+    phi = 2 * np.pi * np.arange(segments) / segments
+    rest = np.stack(np.broadcast_arrays(x[:, None], 0.2 * np.cos(phi)[None], 0.2 * np.sin(phi)[None]), -1).reshape(-1, 3)
+    ring, seg = np.meshgrid(np.arange(rings - 1), np.arange(segments), indexing="ij")
+    a, b = ring * segments + seg, ring * segments + (seg + 1) % segments
+    faces = np.concatenate([np.stack([a, b + segments, a + segments], -1).reshape(-1, 3), np.stack([a, b, b + segments], -1).reshape(-1, 3)])
+    blend = np.clip(rest[:, 0] / 0.3 + 0.5, 0.0, 1.0)
+    angle = np.linspace(0.0, np.pi / 2, frames)[:, None] * blend[None]
+    xs, ys, zs = rest.T
+    stacked = np.stack([np.cos(angle) * xs - np.sin(angle) * ys, np.sin(angle) * xs + np.cos(angle) * ys, np.broadcast_to(zs, angle.shape)], -1)
+    return AnimatedMesh(faces, stacked.astype(np.float32))
+
+
+def dev_sequences(quick: bool) -> list[tuple[str, AnimatedMesh]]:
+    from animlod.io.meshseq import read_sequence
+
+    inputs = [("bending tube (procedural)", bending_tube())]
+    if DATA.is_dir():
+        inputs.append(("crane (12 frames)", read_sequence(DATA / "crane")))
+        if not quick:
+            inputs.append(("face-poses (4 poses)", read_sequence(DATA / "face-poses")))
+    return inputs
+
+
+# --- the methods: each maps (mesh, face ratio) to a simplified AnimatedMesh -----------------
+
+
+def aqem(features: bool) -> Callable[[AnimatedMesh, float], AnimatedMesh]:
+    def run(mesh: AnimatedMesh, ratio: float) -> AnimatedMesh:
+        return simplify_animated(mesh, (ratio,), use_motion_features=features).levels[0].mesh
+
+    return run
+
+
+def _meshopt_subset(mesh: AnimatedMesh, indices: np.ndarray) -> AnimatedMesh:
+    """Keep meshoptimizer's vertex subset: the same vertices, in every frame."""
+    used, faces = np.unique(indices, return_inverse=True)
+    return AnimatedMesh(faces.reshape(-1, 3).astype(np.int32), mesh.frames[:, used])
+
+
+def meshopt_frame0(mesh: AnimatedMesh, ratio: float) -> AnimatedMesh:
+    import meshoptimizer
+
+    indices = mesh.faces.ravel().astype(np.uint32)
+    destination = np.zeros_like(indices)
+    count = meshoptimizer.simplify(
+        destination, indices, mesh.frames[0], target_index_count=3 * round(ratio * mesh.face_count), target_error=1.0
+    )
+    return _meshopt_subset(mesh, destination[:count])
+
+
+def _declare_simplify_with_attributes() -> None:
+    """The meshoptimizer wheel (0.2.30a0) calls meshopt_simplifyWithAttributes without ctypes
+    argument types, so size_t arguments are truncated and the call crashes; declare them."""
+    from meshoptimizer._loader import lib
+
+    c = ctypes
+    lib.meshopt_simplifyWithAttributes.argtypes = [
+        c.POINTER(c.c_uint), c.POINTER(c.c_uint), c.c_size_t, c.POINTER(c.c_float), c.c_size_t, c.c_size_t,
+        c.POINTER(c.c_float), c.c_size_t, c.POINTER(c.c_float), c.c_size_t, c.POINTER(c.c_ubyte), c.c_size_t,
+        c.c_float, c.c_uint, c.POINTER(c.c_float),
+    ]  # fmt: skip
+    lib.meshopt_simplifyWithAttributes.restype = c.c_size_t
+
+
+def meshopt_attributes(mesh: AnimatedMesh, ratio: float) -> AnimatedMesh:
+    """simplifyWithAttributes with the positions of up to 10 other frames as attributes."""
+    import meshoptimizer
+
+    _declare_simplify_with_attributes()
+
+    others = np.unique(np.linspace(1, mesh.frame_count - 1, min(mesh.frame_count - 1, MESHOPT_MAX_ATTRIBUTE_FRAMES)).astype(int))
+    if others.size == 0:
+        return meshopt_frame0(mesh, ratio)
+    attributes = np.ascontiguousarray(mesh.frames[others].transpose(1, 0, 2).reshape(mesh.vertex_count, -1))
+    indices = mesh.faces.ravel().astype(np.uint32)
+    destination = np.zeros_like(indices)
+    count = meshoptimizer.simplify_with_attributes(
+        destination,
+        indices,
+        mesh.frames[0],
+        attributes,
+        np.ones(attributes.shape[1], np.float32),
+        target_index_count=3 * round(ratio * mesh.face_count),
+        target_error=1.0,
+    )
+    return _meshopt_subset(mesh, destination[:count])
+
+
+def fast_simplification_replayed(mesh: AnimatedMesh, ratio: float) -> AnimatedMesh:
+    """fast-simplification on frame 0, its collapses replayed on every frame."""
+    import fast_simplification
+
+    _, faces, collapses = fast_simplification.simplify(
+        mesh.frames[0], mesh.faces, target_count=round(ratio * mesh.face_count), return_collapses=True
+    )
+    frames = [fast_simplification.replay_simplification(frame, mesh.faces, collapses)[0] for frame in mesh.frames]
+    replayed_faces = fast_simplification.replay_simplification(mesh.frames[0], mesh.faces, collapses)[1]
+    return AnimatedMesh(replayed_faces.astype(np.int32), np.stack(frames).astype(np.float32))
+
+
+METHODS = {
+    "AQEM + motion features": aqem(True),
+    "AQEM, no features": aqem(False),
+    "meshoptimizer on frame 0": meshopt_frame0,
+    "fast-simplification frame 0, replayed": fast_simplification_replayed,
+    "meshoptimizer + other frames as attributes": meshopt_attributes,
+}
+
+
+def quality_table(quick: bool) -> None:
+    rows = []
+    for name, mesh in dev_sequences(quick):
+        for ratio in RATIOS:
+            for method, simplify in METHODS.items():
+                with stopwatch() as elapsed:
+                    simplified = simplify(mesh, ratio)
+                summary = surface_error(mesh, simplified, samples=10000).summary()
+                rows.append(
+                    (
+                        name,
+                        f"{ratio:.0%}",
+                        method,
+                        simplified.face_count,
+                        f"{summary['hausdorff_mean']:.2e} / {summary['hausdorff_max']:.2e}",
+                        f"{summary['rms_mean']:.2e} / {summary['rms_max']:.2e}",
+                        elapsed[0],
+                    )
+                )
+    print_table(
+        "Quality: error relative to the bounding-box diagonal, mean / max over frames",
+        ("input", "faces kept", "method", "faces", "Hausdorff", "RMS", "time s"),
+        rows,
+    )
+
+
+def speed_table(quick: bool) -> None:
+    import fast_simplification
+    import meshoptimizer
+
+    mesh = bumpy_sphere(*((240, 240) if quick else (710, 705)), frames=1)
+    target = round(0.1 * mesh.face_count)
+    rows = []
+    with stopwatch() as elapsed:
+        level = simplify_animated(mesh, target_face_counts=[target], use_motion_features=False).levels[0]
+    rows.append(("AQEM (animlod, OpenMesh)", mesh.face_count, level.mesh.face_count, elapsed[0]))
+    indices = mesh.faces.ravel().astype(np.uint32)
+    destination = np.zeros_like(indices)
+    with stopwatch() as elapsed:
+        count = meshoptimizer.simplify(destination, indices, mesh.frames[0], target_index_count=3 * target, target_error=1.0)
+    rows.append(("meshoptimizer simplify", mesh.face_count, count // 3, elapsed[0]))
+    with stopwatch() as elapsed:
+        _, faces = fast_simplification.simplify(mesh.frames[0], mesh.faces, target_count=target)
+    rows.append(("fast-simplification", mesh.face_count, len(faces), elapsed[0]))
+    rows = [(*row, f"{(row[1] - row[2]) / row[3] / 1e6:.2f}") for row in rows]
+    print_table("Speed, one frame, to 10% of the faces", ("method", "input faces", "output faces", "time s", "M faces removed / s"), rows)
+
+
+def frame_count_table(quick: bool) -> None:
+    rings, segments = (60, 60) if quick else (160, 160)
+    rows = []
+    for frames in (1, 4, 16, 64):
+        mesh = bumpy_sphere(rings, segments, frames)
+        with stopwatch() as elapsed:
+            simplify_animated(mesh, (0.1,), use_motion_features=False)
+        with stopwatch() as with_features:
+            simplify_animated(mesh, (0.1,))
+        rows.append((frames, mesh.face_count, elapsed[0], with_features[0], elapsed[0] / frames))
+    print_table(
+        "Time against the number of frames (bumpy twisting sphere, to 10%)",
+        ("F", "faces", "AQEM s", "AQEM + features s", "AQEM s per frame"),
+        rows,
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="smaller inputs, for a smoke test")
+    args = parser.parse_args()
+    quality_table(args.quick)
+    speed_table(args.quick)
+    frame_count_table(args.quick)
+
+
+if __name__ == "__main__":
+    main()

@@ -196,8 +196,10 @@ def simplify_animated(
     attributes : (V, A) float32 per-vertex data interpolated along collapses (e.g. UVs).
     skin_joints, skin_weights : (V, K) int32 / float32 skin influences, merged along collapses
         (union, blended, the K largest kept, renormalised); the levels carry them.
-    repair : drop faces that repeat a vertex, duplicate faces and unreferenced vertices first,
-        instead of raising; non-manifold input still raises.
+    repair : first drop faces that repeat a vertex, duplicate faces and unreferenced vertices,
+        and split non-manifold vertices (see :func:`repair_mesh`), instead of raising; edges
+        shared by three or more faces still raise. ``kept_vertices``, ``vertex_map`` and the
+        collapse record then refer to the input's vertices.
     progress : ``progress(done, total)`` called now and then from the simplifier.
     placement : ``"optimal"``, the paper's Eq. 5 in every frame, or ``"on_edge"``, one point of
         the collapsed edge for all frames (the vertex keeps one identity, so UVs and skin
@@ -213,21 +215,18 @@ def simplify_animated(
     duplicate face, non-manifold edge or vertex, unreferenced vertex, target out of range.
     """
     original_vertex_count = mesh.vertex_count
-    kept_input = np.arange(original_vertex_count, dtype=np.int32)
+    kept_input = None
     if repair:
         mesh, kept_input = repair_mesh(mesh)
     locked = None
     if locked_vertices is not None:
         locked = np.zeros(original_vertex_count, dtype=bool)
         locked[np.asarray(locked_vertices, dtype=np.int64)] = True
-        locked = locked[kept_input]
-    if importance is not None:
-        importance = np.asarray(importance, dtype=np.float32)[kept_input]
-    if attributes is not None:
-        attributes = np.asarray(attributes, dtype=np.float32)[kept_input]
-    if skin_joints is not None and skin_weights is not None:
-        skin_joints = np.asarray(skin_joints, dtype=np.int32)[kept_input]
-        skin_weights = np.asarray(skin_weights, dtype=np.float32)[kept_input]
+    locked = _per_vertex(locked, bool, kept_input)
+    importance = _per_vertex(importance, np.float32, kept_input)
+    attributes = _per_vertex(attributes, np.float32, kept_input)
+    skin_joints = _per_vertex(skin_joints, np.int32, kept_input)
+    skin_weights = _per_vertex(skin_weights, np.float32, kept_input)
     raw = _core.simplify_animated(
         mesh.frames,
         mesh.faces,
@@ -336,23 +335,68 @@ def simplify_skinned(
 
 
 def repair_mesh(mesh: AnimatedMesh) -> tuple[AnimatedMesh, np.ndarray]:
-    """Drop faces that repeat a vertex, duplicate faces (the first copy stays) and vertices no
-    face references.
+    """Make a mesh acceptable to the simplifier where that is unambiguous.
 
-    Returns the repaired mesh and ``(V',) int32`` the input index of each remaining vertex.
-    Non-manifold configurations are left for the simplifier to report.
+    Drops faces that repeat a vertex and duplicate faces (the first copy stays), drops vertices
+    no face references, and splits every non-manifold vertex (faces forming separate fans
+    joined only at the vertex, a "bow tie") into one vertex per fan. Edges shared by three or
+    more faces are left for the simplifier to report.
+
+    Returns the repaired mesh and ``(V',) int32`` the input index of each of its vertices
+    (split vertices appear once per fan).
     """
     faces = mesh.faces
     distinct = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
     faces = faces[distinct]
     _, first = np.unique(np.sort(faces, axis=1), axis=0, return_index=True)
     faces = faces[np.sort(first)]
-    used = np.zeros(mesh.vertex_count, dtype=bool)
-    used[faces.ravel()] = True
-    kept_input = np.flatnonzero(used).astype(np.int32)
-    new_index = np.cumsum(used, dtype=np.int32) - 1
-    repaired = AnimatedMesh(new_index[faces], mesh.frames[:, kept_input], fps=mesh.fps)
+    fan = _corner_fans(faces)
+    # One output vertex per (input vertex, fan), numbered in input-vertex order.
+    keys, corner_vertex = np.unique(np.stack([faces.ravel(), fan], axis=1), axis=0, return_inverse=True)
+    kept_input = keys[:, 0].astype(np.int32)
+    repaired = AnimatedMesh(corner_vertex.reshape(-1, 3).astype(np.int32), mesh.frames[:, kept_input], fps=mesh.fps)
     return repaired, kept_input
+
+
+def _corner_fans(faces: np.ndarray) -> np.ndarray:
+    """(3M,) label of each face corner: corners of one vertex share a label when their faces
+    are joined through edges around that vertex (label propagation, vectorised)."""
+    corner_count = faces.size
+    corners = np.arange(corner_count).reshape(-1, 3)
+    # Each face side a -> b, with the corners of a and b in that face.
+    starts, ends = faces.ravel(), faces[:, [1, 2, 0]].ravel()
+    start_corner, end_corner = corners.ravel(), corners[:, [1, 2, 0]].ravel()
+    low, high = np.minimum(starts, ends), np.maximum(starts, ends)
+    order = np.lexsort((high, low))
+    same = (low[order][1:] == low[order][:-1]) & (high[order][1:] == high[order][:-1])
+    first, second = order[:-1][same], order[1:][same]
+    # Across a shared edge the side runs a -> b in one face and b -> a in the other (or the same
+    # way when orientation is inconsistent); join corners of equal vertices either way.
+    straight = starts[first] == starts[second]
+    pairs = np.concatenate(
+        [
+            np.stack([start_corner[first], np.where(straight, start_corner[second], end_corner[second])], axis=1),
+            np.stack([end_corner[first], np.where(straight, end_corner[second], start_corner[second])], axis=1),
+        ]
+    )
+    label = np.arange(corner_count)
+    while True:
+        smaller = np.minimum(label[pairs[:, 0]], label[pairs[:, 1]])
+        updated = label.copy()
+        np.minimum.at(updated, pairs[:, 0], smaller)
+        np.minimum.at(updated, pairs[:, 1], smaller)
+        updated = updated[updated]  # pointer jumping: follow labels to their own labels
+        if np.array_equal(updated, label):
+            return label
+        label = updated
+
+
+def _per_vertex(values: np.ndarray | None, dtype: type, kept_input: np.ndarray | None) -> np.ndarray | None:
+    """Per-vertex input as ``dtype``, following a repair's vertex selection when there was one."""
+    if values is None:
+        return None
+    values = np.asarray(values, dtype=dtype)
+    return values if kept_input is None else values[kept_input]
 
 
 def _largest_distance(a: np.ndarray, b: np.ndarray) -> float:
@@ -360,19 +404,23 @@ def _largest_distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(np.max(np.sum((a.astype(np.float64) - b) ** 2, axis=-1)))) if a.size else 0.0
 
 
-def _result_in_input_indices(raw: dict, fps: float | None, kept_input: np.ndarray, vertex_count: int) -> SimplifyResult:
-    """Wrap the core's dictionaries, mapping vertex indices back through a repair."""
-    repaired = kept_input.shape[0] != vertex_count
+def _result_in_input_indices(
+    raw: dict, fps: float | None, kept_input: np.ndarray | None, vertex_count: int
+) -> SimplifyResult:
+    """Wrap the core's dictionaries; after a repair, map vertex indices back to the input
+    (``kept_input[i]`` is the input vertex of repaired vertex i; a split vertex maps to one of
+    its copies)."""
     levels = []
     for level in raw["levels"]:
-        vertex_map = level["vertex_map"]
-        if repaired:
+        vertex_map, kept_vertices = level["vertex_map"], level["kept_vertices"]
+        if kept_input is not None:
             vertex_map = np.full(vertex_count, -1, dtype=np.int32)
             vertex_map[kept_input] = level["vertex_map"]
+            kept_vertices = kept_input[kept_vertices]
         levels.append(
             SimplifiedLevel(
                 mesh=AnimatedMesh(level["faces"], level["positions"], fps=fps),
-                kept_vertices=kept_input[level["kept_vertices"]] if repaired else level["kept_vertices"],
+                kept_vertices=kept_vertices,
                 vertex_map=vertex_map,
                 error=float(level["error"]),
                 target_face_count=int(level["target_face_count"]),
@@ -384,7 +432,7 @@ def _result_in_input_indices(raw: dict, fps: float | None, kept_input: np.ndarra
             )
         )
     collapses = raw["collapses"]
-    if repaired:
+    if kept_input is not None:
         collapses = {**collapses, "removed": kept_input[collapses["removed"]], "kept": kept_input[collapses["kept"]]}
     return SimplifyResult(
         levels=levels,

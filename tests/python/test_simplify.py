@@ -186,3 +186,18 @@ def test_crane_sequence_at_ten_percent(data_dir):
             assert math.isfinite(level.error)
     # Without feature weights the collapse order is the plain animated quadric's: small error.
     assert result.levels[-1].error < 0.02 * diagonal
+
+
+def test_repair_splits_a_bow_tie_vertex():
+    mesh = bending_tube(frames=2)
+    # A closed tetrahedron that touches the tube at vertex 0 only.
+    apex = mesh.frames[:, :1] + np.array([-0.5, 0.0, 0.0], np.float32)
+    frames = np.concatenate([mesh.frames, apex, apex + [[[0, 0.3, 0]]], apex + [[[0, 0, 0.3]]]], axis=1)
+    a, b, c = 192, 193, 194
+    faces = np.concatenate([mesh.faces, [[0, b, a], [0, c, b], [0, a, c], [a, b, c]]])
+    with pytest.raises(ValueError, match="vertex 0: non-manifold"):
+        simplify_animated(AnimatedMesh(faces, frames), (0.5,))
+    level = simplify_animated(AnimatedMesh(faces, frames), (0.5,), repair=True).levels[0]
+    assert level.mesh.face_count <= 182
+    assert directed_edges_unique(level.mesh.faces)
+    assert level.vertex_map.min() >= 0

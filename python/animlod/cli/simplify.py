@@ -35,6 +35,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--placement", choices=("optimal", "on_edge"), default=None,
         help="optimal: Eq. 5 per frame (default for sequences); on_edge: one point of the edge (default for skins)",
     )
+    parser.add_argument(
+        "--repair", action="store_true",
+        help="drop degenerate/duplicate faces and unreferenced vertices, split bow-tie vertices (not for skins)",
+    )
     parser.add_argument("--no-metrics", action="store_true", help="skip the Hausdorff/RMS measurement (needs libigl)")
     parser.add_argument("--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side")
     parser.set_defaults(run=run)
@@ -75,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
 
     start = time.perf_counter()
     with _ProgressBar("AQEM") as progress:
-        result = simplify_animated(original, args.ratio, progress=progress, **options)
+        result = simplify_animated(original, args.ratio, progress=progress, repair=args.repair, **options)
     elapsed = time.perf_counter() - start
     rows = []
     for index, level in enumerate(result.levels):
@@ -92,6 +96,8 @@ def _simplify_skinned(args: argparse.Namespace, scene, output: Path, stem: str, 
     from ..io.gltf import write_glb
     from ..simplify import simplify_skinned
 
+    if args.repair:
+        raise UserError("--repair: not available for skinned glTF meshes; repair the mesh in a DCC tool")
     skinned, motions = scene.skinned_meshes[0], scene.motions
     start = time.perf_counter()
     levels = simplify_skinned(skinned, motions, args.ratio, **options)

@@ -9,7 +9,9 @@ fast-simplification from the ``bench`` extra). Tables:
    frame 0 with its collapses replayed on every frame; meshoptimizer's simplifyWithAttributes
    given other frames' positions as attributes. Errors are symmetric Hausdorff and RMS surface
    distances per frame relative to the bounding-box diagonal, mean / max over frames.
-2. Speed with one frame on a procedural mesh of about 1M triangles to 10%.
+2. Speed with one frame to 10%: a procedural mesh of about 1M triangles (AQEM, meshoptimizer,
+   fast-simplification) and the 200k-triangle sphere of bench/openmesh_build, on which
+   OpenMesh's own Decimater with ModQuadric also runs.
 3. Time against the frame count F = 1, 4, 16, 64 on one animated procedural mesh.
 """
 
@@ -66,6 +68,51 @@ def bumpy_sphere(rings: int, segments: int, frames: int) -> AnimatedMesh:
         axis=-1,
     )
     return AnimatedMesh(faces, frames_array.astype(np.float32))
+
+
+def openmesh_bench_sphere() -> AnimatedMesh:
+    """The 200,344-triangle wobbly sphere of bench/openmesh_build/decimate_sphere.cpp, same formula."""
+    rings = segments = 317
+    theta = np.pi * np.arange(1, rings) / rings
+    phi = 2 * np.pi * np.arange(segments) / segments
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    radius = 1.0 + 0.05 * np.sin(5 * t) * np.cos(7 * p)
+    grid = np.stack([radius * np.sin(t) * np.cos(p), radius * np.cos(t), radius * np.sin(t) * np.sin(p)], -1)
+    positions = np.concatenate([[[0, 1, 0]], grid.reshape(-1, 3), [[0, -1, 0]]]).astype(np.float32)
+    at = 1 + np.arange(rings - 1)[:, None] * segments + np.arange(segments + 1)[None] % segments  # (ring-1, s)
+    south = len(positions) - 1
+    faces = np.concatenate(
+        [
+            np.stack([np.zeros(segments, int), at[0, 1:], at[0, :-1]], -1),
+            np.stack([np.full(segments, south), at[-1, :-1], at[-1, 1:]], -1),
+            np.stack([at[:-1, :-1], at[:-1, 1:], at[1:, 1:]], -1).reshape(-1, 3),
+            np.stack([at[:-1, :-1], at[1:, 1:], at[1:, :-1]], -1).reshape(-1, 3),
+        ]
+    )
+    return AnimatedMesh(faces, positions[None])
+
+
+def openmesh_decimater_row() -> tuple | None:
+    """Runs OpenMesh's own Decimater + ModQuadric (bench/openmesh_build, release OpenMesh) on its
+    200k-triangle sphere; None when it cannot be built."""
+    import subprocess
+
+    root = Path(__file__).resolve().parents[1]
+    build = root / "build" / "openmesh_bench_release"
+    binary = build / "openmesh_decimater_bench"
+    if not binary.exists():
+        config = root / ".deps" / "openmesh" / "lib" / "cmake" / "OpenMesh"
+        steps = [
+            ["cmake", "-S", str(root / "bench" / "openmesh_build"), "-B", str(build), "-G", "Ninja",
+             "-DCMAKE_BUILD_TYPE=Release", f"-DOpenMesh_DIR={config}"],
+            ["cmake", "--build", str(build)],
+        ]  # fmt: skip
+        for step in steps:
+            if subprocess.run(step, capture_output=True).returncode != 0:
+                return None
+    cells = subprocess.run([str(binary), "OpenMesh"], capture_output=True, text=True, check=True).stdout.split("|")
+    before, after, seconds = int(cells[2]), int(cells[3]), float(cells[4])
+    return ("OpenMesh Decimater + ModQuadric", "wobbly sphere", before, after, seconds)
 
 
 def bending_tube(frames: int = 24) -> AnimatedMesh:
@@ -211,22 +258,32 @@ def speed_table(quick: bool) -> None:
     import fast_simplification
     import meshoptimizer
 
-    mesh = bumpy_sphere(*((240, 240) if quick else (710, 705)), frames=1)
-    target = round(0.1 * mesh.face_count)
     rows = []
-    with stopwatch() as elapsed:
-        level = simplify_animated(mesh, target_face_counts=[target], use_motion_features=False).levels[0]
-    rows.append(("AQEM (animlod, OpenMesh)", mesh.face_count, level.mesh.face_count, elapsed[0]))
-    indices = mesh.faces.ravel().astype(np.uint32)
-    destination = np.zeros_like(indices)
-    with stopwatch() as elapsed:
-        count = meshoptimizer.simplify(destination, indices, mesh.frames[0], target_index_count=3 * target, target_error=1.0)
-    rows.append(("meshoptimizer simplify", mesh.face_count, count // 3, elapsed[0]))
-    with stopwatch() as elapsed:
-        _, faces = fast_simplification.simplify(mesh.frames[0], mesh.faces, target_count=target)
-    rows.append(("fast-simplification", mesh.face_count, len(faces), elapsed[0]))
-    rows = [(*row, f"{(row[1] - row[2]) / row[3] / 1e6:.2f}") for row in rows]
-    print_table("Speed, one frame, to 10% of the faces", ("method", "input faces", "output faces", "time s", "M faces removed / s"), rows)
+    inputs = [("bumpy sphere", bumpy_sphere(*((240, 240) if quick else (710, 705)), frames=1))]
+    if not quick:
+        inputs.append(("wobbly sphere", openmesh_bench_sphere()))
+        decimater = openmesh_decimater_row()
+        if decimater:
+            rows.append(decimater)
+    for name, mesh in inputs:
+        target = mesh.face_count // 10
+        with stopwatch() as elapsed:
+            level = simplify_animated(mesh, target_face_counts=[target], use_motion_features=False).levels[0]
+        rows.append(("AQEM (animlod, OpenMesh connectivity)", name, mesh.face_count, level.mesh.face_count, elapsed[0]))
+        indices = mesh.faces.ravel().astype(np.uint32)
+        destination = np.zeros_like(indices)
+        with stopwatch() as elapsed:
+            count = meshoptimizer.simplify(destination, indices, mesh.frames[0], target_index_count=3 * target, target_error=1.0)
+        rows.append(("meshoptimizer simplify", name, mesh.face_count, count // 3, elapsed[0]))
+        with stopwatch() as elapsed:
+            _, faces = fast_simplification.simplify(mesh.frames[0], mesh.faces, target_count=target)
+        rows.append(("fast-simplification", name, mesh.face_count, len(faces), elapsed[0]))
+    rows = [(*row, f"{(row[2] - row[3]) / row[4] / 1e6:.2f}") for row in rows]
+    print_table(
+        "Speed, one frame, to 10% of the faces",
+        ("method", "input", "input faces", "output faces", "time s", "M faces removed / s"),
+        rows,
+    )
 
 
 def frame_count_table(quick: bool) -> None:

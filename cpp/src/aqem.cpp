@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -159,7 +160,7 @@ class Simplifier {
   std::vector<float> attributes_;      // (V, A)
   std::vector<int32_t> skin_joints_;   // (V, K)
   std::vector<float> skin_weights_;    // (V, K)
-  std::vector<int32_t> merged_into_;   // (V,) the vertex each removed vertex merged into
+  std::vector<int32_t> merged_into_;   // (V,) a vertex each removed vertex merged into (directly or not)
   std::vector<uint8_t> parked_;        // (E,) popped while illegal; re-tried when the area changes
   std::vector<uint8_t> may_have_parked_;  // (V,) set when an edge of the vertex is parked
   std::vector<Eigen::Vector3d> new_positions_;  // (K,) placement of the candidate being evaluated
@@ -453,6 +454,8 @@ AqemLevel Simplifier::snapshot(size_t target, bool reached) {
   for (size_t v = 0; v < vertex_count; ++v) {
     int32_t root = static_cast<int32_t>(v);
     while (merged_into_[root] != root) root = merged_into_[root];
+    // Path compression: later snapshots follow one link.
+    for (int32_t x = static_cast<int32_t>(v); merged_into_[x] != root;) x = std::exchange(merged_into_[x], root);
     level.vertex_map[v] = new_index[root];
   }
   for (const auto face : connectivity_.faces()) {

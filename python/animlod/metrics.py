@@ -85,7 +85,9 @@ def sample_surface(mesh: AnimatedMesh, count: int, seed: int = 0) -> SurfaceSamp
     return SurfaceSamples(faces, np.stack([1 - u - v, u, v], axis=1))
 
 
-def surface_error(original: AnimatedMesh, simplified: AnimatedMesh, samples: int = 20000, seed: int = 0) -> SurfaceError:
+def surface_error(
+    original: AnimatedMesh, simplified: AnimatedMesh, samples: int = 20000, seed: int = 0
+) -> SurfaceError:
     """Symmetric Hausdorff and RMS distance between two animations with the same frame count.
 
     Parameters

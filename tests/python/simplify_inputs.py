@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
-
 from animlod.model import AnimatedMesh, Motion, Skeleton, SkinnedMesh
 
 
-def tube(rings: int = 16, segments: int = 12, length: float = 2.0, radius: float = 0.2) -> tuple[np.ndarray, np.ndarray]:
+def tube(
+    rings: int = 16, segments: int = 12, length: float = 2.0, radius: float = 0.2
+) -> tuple[np.ndarray, np.ndarray]:
     """Open tube along x in [-length/2, length/2]: positions (rings*segments, 3), faces facing out."""
     x = np.linspace(-length / 2, length / 2, rings)
     phi = 2 * np.pi * np.arange(segments) / segments
@@ -38,7 +39,11 @@ def ellipsoid(frames: int = 4, rings: int = 14, segments: int = 20) -> AnimatedM
     theta = np.pi * np.arange(1, rings) / rings
     phi = 2 * np.pi * np.arange(segments) / segments
     body = np.stack(
-        [np.outer(np.sin(theta), np.cos(phi)), np.outer(np.sin(theta), np.sin(phi)), np.outer(np.cos(theta), np.ones_like(phi))],
+        [
+            np.outer(np.sin(theta), np.cos(phi)),
+            np.outer(np.sin(theta), np.sin(phi)),
+            np.outer(np.cos(theta), np.ones_like(phi)),
+        ],
         axis=-1,
     ).reshape(-1, 3)
     unit = np.concatenate([[[0, 0, 1]], body, [[0, 0, -1]]])

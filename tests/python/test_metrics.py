@@ -7,10 +7,9 @@ import pytest
 
 pytest.importorskip("igl")
 
-from simplify_inputs import ellipsoid  # noqa: E402
-
-from animlod.metrics import sample_surface, surface_error  # noqa: E402
-from animlod.model import AnimatedMesh  # noqa: E402
+from animlod.metrics import sample_surface, surface_error
+from animlod.model import AnimatedMesh
+from simplify_inputs import ellipsoid
 
 
 def flat_square(offsets: np.ndarray) -> AnimatedMesh:

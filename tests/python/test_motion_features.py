@@ -6,10 +6,9 @@ import math
 
 import numpy as np
 import pytest
-from simplify_inputs import bending_tube
-
 from animlod.model import AnimatedMesh
 from animlod.simplify import motion_features
+from simplify_inputs import bending_tube
 
 
 def test_a_hinge_reports_its_exact_angle_change():
@@ -21,7 +20,9 @@ def test_a_hinge_reports_its_exact_angle_change():
         ],
         np.float32,
     )
-    features = motion_features(AnimatedMesh([[0, 1, 2], [1, 0, 3]], frames), feature_threshold=0.1, boundary_is_feature=False)
+    features = motion_features(
+        AnimatedMesh([[0, 1, 2], [1, 0, 3]], frames), feature_threshold=0.1, boundary_is_feature=False
+    )
     np.testing.assert_array_equal(features.edges[0], [0, 1])
     assert features.angle_change[0] == pytest.approx(fold, rel=1e-6)
     np.testing.assert_array_equal(features.connected, [True, False, False, False, False])

@@ -6,10 +6,9 @@ import math
 
 import numpy as np
 import pytest
-from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
-
 from animlod.model import AnimatedMesh
 from animlod.simplify import simplify_animated
+from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
 
 
 def test_levels_respect_targets_and_stay_valid_manifolds():
@@ -162,7 +161,10 @@ def test_repair_drops_what_it_documents_and_maps_back():
     level, reference = result.levels[0], clean.levels[0]
     np.testing.assert_array_equal(level.mesh.faces, reference.mesh.faces)
     assert level.vertex_map[7] == -1
-    np.testing.assert_array_equal(level.kept_vertices, np.where(reference.kept_vertices >= 7, reference.kept_vertices + 1, reference.kept_vertices))
+    np.testing.assert_array_equal(
+        level.kept_vertices,
+        np.where(reference.kept_vertices >= 7, reference.kept_vertices + 1, reference.kept_vertices),
+    )
 
 
 def test_open_borders_keep_their_outline():

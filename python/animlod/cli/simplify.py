@@ -28,19 +28,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("input", help="a folder, glob or file of OBJ/PLY frames, an .npz, or a .glb/.gltf")
     parser.add_argument("-o", "--output", required=True, help="folder to write the levels into (created if missing)")
     parser.add_argument("--ratio", type=float, nargs="+", default=[0.5, 0.25, 0.1], help="face ratios of the levels")
-    parser.add_argument("--max-error", type=float, default=math.inf, help="stop when the error exceeds this (asset units)")
+    parser.add_argument(
+        "--max-error", type=float, default=math.inf, help="stop when the error exceeds this (asset units)"
+    )
     parser.add_argument("--no-features", action="store_true", help="ignore motion features (all vertex weights 1)")
     parser.add_argument("--max-frames", type=int, default=0, help="quadrics over K frames chosen to cover the motion")
     parser.add_argument(
-        "--placement", choices=("optimal", "on_edge"), default=None,
+        "--placement",
+        choices=("optimal", "on_edge"),
+        default=None,
         help="optimal: Eq. 5 per frame (default for sequences); on_edge: one point of the edge (default for skins)",
     )
     parser.add_argument(
-        "--repair", action="store_true",
+        "--repair",
+        action="store_true",
         help="drop degenerate/duplicate faces and unreferenced vertices, split bow-tie vertices (not for skins)",
     )
     parser.add_argument("--no-metrics", action="store_true", help="skip the Hausdorff/RMS measurement (needs libigl)")
-    parser.add_argument("--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side")
+    parser.add_argument(
+        "--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side"
+    )
     parser.set_defaults(run=run)
 
 
@@ -78,8 +85,11 @@ def run(args: argparse.Namespace) -> int:
     from ..simplify import simplify_animated
 
     start = time.perf_counter()
-    with _ProgressBar("AQEM") as progress:
+    progress = _ProgressBar("AQEM")
+    try:
         result = simplify_animated(original, args.ratio, progress=progress, repair=args.repair, **options)
+    finally:
+        progress.close()
     elapsed = time.perf_counter() - start
     rows = []
     for index, level in enumerate(result.levels):
@@ -107,7 +117,9 @@ def _simplify_skinned(args: argparse.Namespace, scene, output: Path, stem: str, 
     rows, reskinned = [], []
     for index, level in enumerate(levels):
         write_glb(output / f"{stem}_lod{index + 1}.glb", level.mesh, motions)
-        posed = level.mesh.bake(motions[0]) if motions else AnimatedMesh(level.mesh.faces, level.mesh.rest_positions[None])
+        posed = (
+            level.mesh.bake(motions[0]) if motions else AnimatedMesh(level.mesh.faces, level.mesh.rest_positions[None])
+        )
         reskinned.append(posed)
         rows.append(_row(index + 1, posed, level.error, original, args.no_metrics, elapsed))
     _print_summary(original, rows)
@@ -131,7 +143,9 @@ def _write_animated(kind: str, source: str, target: Path, mesh: AnimatedMesh) ->
         write_npz(target.with_suffix(".npz"), mesh)
 
 
-def _row(level: int, mesh: AnimatedMesh, error: float, original: AnimatedMesh, skip_metrics: bool, elapsed: float) -> tuple:
+def _row(
+    level: int, mesh: AnimatedMesh, error: float, original: AnimatedMesh, skip_metrics: bool, elapsed: float
+) -> tuple:
     """One summary row; the surface error compares ``mesh`` with ``original`` frame by frame."""
     hausdorff = rms = "-"
     if not skip_metrics:
@@ -153,14 +167,11 @@ def _print_summary(original: AnimatedMesh, rows: list[tuple]) -> None:
 
 
 class _ProgressBar:
-    """A tqdm bar fed by the simplifier's progress(done, total) callback."""
+    """A tqdm bar fed by the simplifier's progress(done, total) callback; close() when done."""
 
     def __init__(self, description: str) -> None:
         self.description = description
         self.bar = None
-
-    def __enter__(self) -> _ProgressBar:
-        return self
 
     def __call__(self, done: int, total: int) -> None:
         from tqdm import tqdm
@@ -169,7 +180,7 @@ class _ProgressBar:
             self.bar = tqdm(total=total, desc=self.description, unit="collapse", leave=False)
         self.bar.update(min(done, total) - self.bar.n)
 
-    def __exit__(self, *exc_info: object) -> None:
+    def close(self) -> None:
         if self.bar is not None:
             self.bar.close()
 
@@ -199,7 +210,9 @@ def _plot(path: Path, original: AnimatedMesh, levels: list[AnimatedMesh], show_f
         axes = figure.add_subplot(1, len(meshes), index + 1, projection="3d")
         triangles = mesh.frames[frame][mesh.faces]
         colors = np.where(highlight[:, None], [0.85, 0.1, 0.1, 1.0], [0.75, 0.75, 0.8, 1.0])
-        axes.add_collection3d(Poly3DCollection(triangles, facecolors=colors, edgecolors=(0, 0, 0, 0.15), linewidths=0.2))
+        axes.add_collection3d(
+            Poly3DCollection(triangles, facecolors=colors, edgecolors=(0, 0, 0, 0.15), linewidths=0.2)
+        )
         axes.set_xlim(low[0], high[0])
         axes.set_ylim(low[1], high[1])
         axes.set_zlim(low[2], high[2])

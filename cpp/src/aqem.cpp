@@ -551,19 +551,18 @@ Status Simplifier::run(const std::vector<size_t>& targets, AqemResult& out) {
 Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& vertex_data, const AqemOptions& options,
                          AqemResult& out) {
   out = AqemResult{};
-  if (Status status = validate_animated_mesh(mesh); !status) return status;
+  // Steps 3-4: motion features give the vertex weights of Eq. 6 (their extraction validates
+  // the mesh too); importance multiplies them.
+  MotionFeatures features;
+  const Status valid = options.use_motion_features ? compute_motion_features(mesh, options.motion_features, features)
+                                                   : validate_animated_mesh(mesh);
+  if (!valid) return valid;
   std::vector<size_t> targets;
   if (Status status = resolve_targets(mesh, options, targets); !status) return status;
   if (Status status = resolve_frames(mesh, options, out.frames_used); !status) return status;
   if (Status status = validate_vertex_data(mesh, vertex_data); !status) return status;
-
-  // Steps 3-4: motion features give the vertex weights of Eq. 6; importance multiplies them.
-  std::vector<float> weights(mesh.vertex_count, 1.0f);
-  if (options.use_motion_features) {
-    MotionFeatures features;
-    if (Status status = compute_motion_features(mesh, options.motion_features, features); !status) return status;
-    weights = std::move(features.vertex_weights);
-  }
+  std::vector<float> weights = options.use_motion_features ? std::move(features.vertex_weights)
+                                                           : std::vector<float>(mesh.vertex_count, 1.0f);
   if (vertex_data.importance)
     for (size_t v = 0; v < mesh.vertex_count; ++v) weights[v] *= vertex_data.importance[v];
 

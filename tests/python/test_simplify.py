@@ -203,3 +203,33 @@ def test_repair_splits_a_bow_tie_vertex():
     assert level.mesh.face_count <= 182
     assert directed_edges_unique(level.mesh.faces)
     assert level.vertex_map.min() >= 0
+
+
+def test_inversion_check_rejects_a_collapse_that_folds_a_star():
+    # A flat star: centre 0, ring vertices alternating radius 1 and 0.25. Only the centre may
+    # move (the ring is locked); every collapse costs 0, so ties pick the lowest edge, (0, 1),
+    # which folds two triangles over; Eq. 7 must pick a collapse that folds nothing.
+    k = np.arange(8)
+    radius = np.where(k % 2 == 0, 1.0, 0.25)
+    ring = np.stack([radius * np.cos(np.pi * k / 4), radius * np.sin(np.pi * k / 4), 0 * k], axis=1)
+    mesh = AnimatedMesh(
+        np.stack([np.zeros(8, int), 1 + k, 1 + (k + 1) % 8], axis=1), np.concatenate([[[0, 0, 0]], ring])[None]
+    )
+
+    def normal_z(check_inversion: bool) -> tuple[np.ndarray, int]:
+        result = simplify_animated(
+            mesh,
+            target_face_counts=[6],
+            locked_vertices=1 + k,
+            use_motion_features=False,
+            check_inversion=check_inversion,
+        )
+        corners = result.levels[0].mesh.frames[0][result.levels[0].mesh.faces]
+        return np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])[:, 2], int(
+            result.collapses.kept[0]
+        )
+
+    unchecked, kept_unchecked = normal_z(False)
+    checked, kept_checked = normal_z(True)
+    assert kept_unchecked == 1 and np.count_nonzero(unchecked < 0) == 2
+    assert kept_checked == 2 and np.all(checked > 0)

@@ -1,0 +1,195 @@
+"""Motion analysis: posture error, key frames, joint importance and the elimination order.
+
+Implements Section 4 of the motion LoD paper (seeds/000): the posture error E_j(t_ref, t) of
+Eq. 1, the key frame of each joint (Eq. 2), the key posture assembled from them and the joint
+importance eps_j (Eq. 3), which orders the joints for elimination (lowest first).
+
+Conventions this implementation fixes where the paper is silent:
+
+- ``c`` runs over the *direct* children of ``j`` (end sites included), as in the paper's
+  Fig. 3. The bone ``j -> c`` is measured in the frame of ``j``'s parent, i.e. as
+  ``R_j(t) @ offset_c``: only ``j``'s own rotation changes it, so a joint whose local rotation
+  never changes has importance exactly zero, however its ancestors move. (Freezing ``j`` fixes
+  exactly that local rotation, so this is the error the freeze introduces.)
+- Eq. 1 is used as printed: ``(r(t_ref) + r(t)) * theta / (2 pi r_max)``; ``r_max`` is the summed
+  length of the root's child bones (mean over frames), or the longest bone when those are all
+  zero. Constant factors do not change key frames or the order.
+- Joints whose local translation is animated (BVH position channels below the root) are never
+  frozen: freezing would pin their translation to one frame.
+- End sites carry no rotation: they give leaf joints a direction, have importance 0 and are never
+  in the priority list (they are not joints of a level). A leaf joint *without* an end site has
+  no bone to measure, so its importance is 0 and it is eliminated first.
+- Long clips: the n x n table is never stored; its row sums are accumulated in blocks of rows.
+  Above ``max_frames`` frames, Eqs. 1-3 run on ``max_frames`` evenly spaced frames: key frames
+  are then chosen among those frames and eps_j becomes the same mean over a uniform subsample
+  (a Riemann sum of the full-rate mean), which changes it by at most the motion between two
+  sampled frames. ``MotionAnalysis.frames`` records which frames were used.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import rotations
+from ..model import Motion
+
+# Rows of the posture-error table evaluated at once: bounds memory to rows x frames x 3 floats.
+_BLOCK_ROWS = 16
+
+
+@dataclass(frozen=True)
+class MotionAnalysis:
+    """Result of :func:`analyze_motion` for a motion with ``J`` joints (end sites included).
+
+    Attributes
+    ----------
+    key_frames : (J,) int64 key frame t_key_j of every joint (Eq. 2), an index into the motion.
+    importance : (J,) float64 joint importance eps_j (Eq. 3); 0 for end sites.
+    priority : joint indices in elimination order (lowest importance first, ties by index);
+        never the root, end sites, locked joints or joints with animated translation.
+    locked : joint indices the caller locked (never frozen).
+    frames : (n,) int64 frames the analysis used (all frames unless subsampled).
+    r_max : the normaliser of Eq. 1, in the asset's units.
+    """
+
+    key_frames: np.ndarray
+    importance: np.ndarray
+    priority: list[int]
+    locked: list[int]
+    frames: np.ndarray
+    r_max: float
+
+    def key_rotations(self, motion: Motion) -> np.ndarray:
+        """Key posture (Section 4.2): every joint's local rotation at its key frame, ``(J, 4)``."""
+        joints = np.arange(motion.skeleton.joint_count)
+        return motion.local_rotations[self.key_frames, joints]
+
+    def key_translations(self, motion: Motion) -> np.ndarray:
+        """Every joint's local translation at its key frame, ``(J, 3)`` (offsets unless animated)."""
+        translations = local_translations(motion)
+        return translations[self.key_frames, np.arange(motion.skeleton.joint_count)]
+
+
+def local_translations(motion: Motion) -> np.ndarray:
+    """Local translation of every joint per frame ``(T, J, 3)``; column 0 is the root position."""
+    if motion.joint_translations is None:
+        translations = np.broadcast_to(motion.skeleton.offsets, (motion.frame_count,) + motion.skeleton.offsets.shape).copy()
+    else:
+        translations = motion.joint_translations.copy()
+    translations[:, 0] = motion.root_positions
+    return translations
+
+
+def animated_translation_joints(motion: Motion) -> np.ndarray:
+    """Non-root joints whose local translation changes over the clip, ``(J,) bool``."""
+    animated = np.zeros(motion.skeleton.joint_count, bool)
+    if motion.joint_translations is not None:
+        animated[1:] = np.ptp(motion.joint_translations[:, 1:], axis=0).max(axis=-1) > 0.0
+    return animated
+
+
+def child_bones(motion: Motion, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every non-root joint's bone as seen from its parent's parent frame.
+
+    Returns ``owners (B,)`` (the joint ``j`` each bone hangs from, B = J - 1) and
+    ``vectors (n, B, 3)``: ``R_j(t) @ offset_c(t)`` for child ``c`` of ``j`` at the given frames.
+    """
+    parents = motion.skeleton.parents[1:]
+    children = np.arange(1, motion.skeleton.joint_count)
+    offsets = local_translations(motion)[frames][:, children]
+    vectors = rotations.rotate(motion.local_rotations[frames][:, parents], offsets)
+    return parents.astype(np.int64), vectors
+
+
+def _angles_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Angles between vectors ``a (..., 3)`` and ``b (..., 3)`` (0 where either has zero length).
+
+    Kahan's form 2 atan2(|a'-b'|, |a'+b'|) on unit vectors: exact 0 for identical directions,
+    accurate near 0 and pi, where arccos of a dot product is not.
+    """
+    return 2.0 * np.arctan2(np.linalg.norm(a - b, axis=-1), np.linalg.norm(a + b, axis=-1))
+
+
+def posture_error_row_sums(motion: Motion, frames: np.ndarray, r_max: float) -> np.ndarray:
+    """Row sums ``S[j, a] = sum_b E_j(frames[a], frames[b])`` of Eq. 1's table, ``(J, n)``.
+
+    The table itself is never held: rows are evaluated ``_BLOCK_ROWS`` at a time.
+    """
+    owners, vectors = child_bones(motion, frames)
+    lengths = np.linalg.norm(vectors, axis=-1)  # r_jc(t), (n, B)
+    units = np.divide(vectors, lengths[..., None], out=np.zeros_like(vectors), where=lengths[..., None] > 0.0)
+    n, bone_count = lengths.shape
+    per_bone = np.zeros((bone_count, n))
+    for start in range(0, n, _BLOCK_ROWS):
+        rows = slice(start, min(start + _BLOCK_ROWS, n))
+        # theta_jc(t_ref, t) for the block's t_ref against every t: (rows, n, B).
+        theta = _angles_between(units[rows, None], units[None])
+        radii = lengths[rows, None] + lengths[None]  # r_jc(t_ref) + r_jc(t)
+        per_bone[:, rows] = np.einsum("abk,abk->ka", radii, theta)
+    sums = np.zeros((motion.skeleton.joint_count, n))
+    np.add.at(sums, owners, per_bone)  # sum over the children c of j (Eq. 1)
+    return sums / (2.0 * np.pi * r_max)
+
+
+def _r_max(motion: Motion) -> float:
+    """Summed mean length of the root's child bones (Eq. 1's normaliser), longest bone if zero."""
+    lengths = np.linalg.norm(local_translations(motion)[:, 1:], axis=-1).mean(axis=0)
+    root_children = motion.skeleton.parents[1:] == 0
+    total = float(lengths[root_children].sum())
+    if total > 0.0:
+        return total
+    longest = float(lengths.max()) if lengths.size else 0.0
+    if longest <= 0.0:
+        raise ValueError("skeleton: every bone has zero length, so posture error (Eq. 1) is undefined")
+    return longest
+
+
+def analyze_motion(
+    motion: Motion,
+    locked: Iterable[str] = (),
+    max_frames: int = 600,
+) -> MotionAnalysis:
+    """Key frames, joint importance and elimination priority of a motion (Eqs. 1-3).
+
+    Parameters
+    ----------
+    motion : the clip, at least two frames.
+    locked : names of joints never to freeze (the root never is).
+    max_frames : above this many frames, analyse an evenly spaced subsample of this size
+        (see the module notes for how that changes the result).
+
+    Returns
+    -------
+    MotionAnalysis
+    """
+    skeleton = motion.skeleton
+    if motion.frame_count < 2:
+        raise ValueError(f"motion: needs at least 2 frames for motion analysis, got {motion.frame_count}")
+    if max_frames < 2:
+        raise ValueError(f"max_frames: must be at least 2, got {max_frames}")
+    locked_indices = sorted({skeleton.index(name) for name in locked})
+    end_site_locks = [skeleton.names[j] for j in locked_indices if skeleton.end_sites[j]]
+    if end_site_locks:
+        raise ValueError(f"locked: {end_site_locks[0]!r} is an end site, not a joint")
+
+    if motion.frame_count > max_frames:
+        frames = np.unique(np.round(np.linspace(0, motion.frame_count - 1, max_frames)).astype(np.int64))
+    else:
+        frames = np.arange(motion.frame_count, dtype=np.int64)
+    r_max = _r_max(motion)
+    sums = posture_error_row_sums(motion, frames, r_max)
+    best = np.argmin(sums, axis=1)  # Eq. 2 (first minimum on ties)
+    key_frames = frames[best]
+    importance = sums[np.arange(skeleton.joint_count), best] / frames.size  # Eq. 3
+
+    candidates = np.ones(skeleton.joint_count, bool)
+    candidates[0] = False
+    candidates[skeleton.end_sites] = False
+    candidates[locked_indices] = False
+    candidates[animated_translation_joints(motion)] = False
+    order = np.lexsort((np.arange(skeleton.joint_count), importance))
+    priority = [int(j) for j in order if candidates[j]]
+    return MotionAnalysis(key_frames, importance, priority, locked_indices, frames, r_max)

@@ -1,0 +1,127 @@
+"""Frozen joints (Section 5.1): what one level keeps, and the key-posture geometry it holds.
+
+A frozen joint keeps the local transform of its key frame (Eq. 2) for the whole clip. Every
+kept point then hangs from its *nearest kept ancestor* through the frozen joints between them,
+whose key transforms fold into one constant transform: the kept point's new offset is
+``fold_translation + fold_rotation @ offset`` and its rotation is preceded by ``fold_rotation``.
+
+End sites (see analysis.py) are never counted as joints of a level; an end site is kept when its
+joint is kept and dropped with it when that joint is frozen.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import rotations
+from ..model import Motion, Skeleton
+from .analysis import MotionAnalysis, animated_translation_joints
+
+
+@dataclass(frozen=True)
+class FrozenLevel:
+    """One level's split of the original skeleton into kept and frozen points (``J`` points).
+
+    Attributes
+    ----------
+    skeleton : the original skeleton.
+    frozen : (J,) bool joints frozen at this level.
+    kept : (J,) bool points in the level's skeleton (not frozen, not an end site of a frozen joint).
+    kept_parent : (J,) int64 nearest kept ancestor of each kept point, -1 for the root and for
+        points that are not kept.
+    key_rotations : (J, 4) local rotations of the key posture (Section 4.2).
+    key_translations : (J, 3) local translations of the key posture (root at the origin).
+    key_positions : (J, 3) world positions of the key posture.
+    fold_rotations : (J, 4) product of the key rotations of the frozen joints between a kept
+        point and its kept parent (identity when there are none).
+    fold_translations : (J, 3) their combined translation, in the kept parent's frame.
+    animated : (J,) bool joints whose local translation is animated (their bone is not rigid).
+    """
+
+    skeleton: Skeleton
+    frozen: np.ndarray
+    kept: np.ndarray
+    kept_parent: np.ndarray
+    key_rotations: np.ndarray
+    key_translations: np.ndarray
+    key_positions: np.ndarray
+    fold_rotations: np.ndarray
+    fold_translations: np.ndarray
+    animated: np.ndarray
+
+    @property
+    def kept_indices(self) -> np.ndarray:
+        """Original indices of the kept points, in order (the level skeleton's joint order)."""
+        return np.flatnonzero(self.kept)
+
+    @property
+    def joint_count(self) -> int:
+        """Joints of the level, end sites not counted."""
+        return int(np.count_nonzero(self.kept & ~self.skeleton.end_sites))
+
+    def length_scale(self) -> float:
+        """Diagonal of the key posture's bounding box, the objective's length unit."""
+        extent = float(np.linalg.norm(np.ptp(self.key_positions, axis=0)))
+        if extent <= 0.0:
+            raise ValueError("skeleton: all points coincide in the key posture, there is nothing to re-fit")
+        return extent
+
+
+def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | np.ndarray) -> FrozenLevel:
+    """Freeze ``frozen_joints`` (original indices) of ``motion`` at their key frames.
+
+    Raises ValueError for the root, an end site, a locked joint or one with animated translation.
+    """
+    skeleton = motion.skeleton
+    count = skeleton.joint_count
+    frozen = np.zeros(count, bool)
+    frozen[np.asarray(frozen_joints, dtype=np.int64)] = True
+    animated = animated_translation_joints(motion)
+    forbidden = frozen & (skeleton.end_sites | animated)
+    forbidden[0] |= frozen[0]
+    forbidden[analysis.locked] |= frozen[analysis.locked]
+    if forbidden.any():
+        name = skeleton.names[int(np.argmax(forbidden))]
+        raise ValueError(f"frozen joints: {name!r} cannot be frozen (root, end site, locked or translating)")
+
+    kept = ~frozen
+    end_site_parents = skeleton.parents[skeleton.end_sites]
+    kept[np.flatnonzero(skeleton.end_sites)[frozen[end_site_parents]]] = False
+
+    key_rotations = analysis.key_rotations(motion)
+    key_translations = analysis.key_translations(motion)
+    key_translations[0] = 0.0
+    key_motion = Motion(skeleton, key_translations[None, 0], key_rotations[None], fps=1.0, joint_translations=key_translations[None])
+    key_positions = key_motion.world_positions()[0]
+
+    kept_parent = np.full(count, -1, dtype=np.int64)
+    fold_rotations = rotations.identity((count,))
+    fold_translations = np.zeros((count, 3))
+    for joint in np.flatnonzero(kept)[1:]:
+        chain = []
+        ancestor = int(skeleton.parents[joint])
+        while frozen[ancestor]:
+            chain.append(ancestor)
+            ancestor = int(skeleton.parents[ancestor])
+        kept_parent[joint] = ancestor
+        for frozen_joint in reversed(chain):  # top-down: T(t_r1) R_r1 T(t_r2) R_r2 ...
+            fold_translations[joint] += rotations.rotate(fold_rotations[joint], key_translations[frozen_joint])
+            fold_rotations[joint] = rotations.multiply(fold_rotations[joint], key_rotations[frozen_joint])
+    return FrozenLevel(
+        skeleton, frozen, kept, kept_parent, key_rotations, key_translations, key_positions,
+        fold_rotations, fold_translations, animated,
+    )
+
+
+def frozen_motion(level: FrozenLevel, motion: Motion) -> Motion:
+    """``motion`` with every frozen joint held at its key rotation (no re-fit).
+
+    Its positions satisfy every bone length and frozen angle of the level exactly, so they are
+    the re-fit's safe fallback and a good starting point.
+    """
+    local = motion.local_rotations.copy()
+    frozen = np.flatnonzero(level.frozen)
+    local[:, frozen] = level.key_rotations[frozen]
+    return Motion(motion.skeleton, motion.root_positions, local, motion.fps, motion.name, motion.joint_translations)

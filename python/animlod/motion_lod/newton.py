@@ -1,0 +1,120 @@
+"""A faster solver of the same objective: damped Newton, vectorised over frames.
+
+E (Eqs. 5-8) has cheap exact second derivatives (objective.half_hessian), so each step solves
+``(H + mu I) delta = -grad / 2`` for all active frames at once with batched dense solves
+(3(P - 1) unknowns per frame). mu follows Nielsen's rule for Levenberg-Marquardt: shrink it by
+the ratio of actual to promised decrease when a step succeeds, double its growth factor when
+one fails. It has no hard constraints (use SLSQP for those). Frames converge independently and
+leave the active set. SLSQP (refit.py) stays the reference; bench/bench_motion.py compares their
+optima.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from .objective import RefitProblem, half_hessian, objective
+from .refit import FrameFailure, RefitResult
+
+
+def refit_newton(
+    problem: RefitProblem,
+    original: np.ndarray,
+    start: np.ndarray | None = None,
+    ftol_rel: float = 1e-8,
+    xtol: float = 1e-6,
+    max_iterations: int = 100,
+    chunk_frames: int = 256,
+    progress: Callable[[int], None] | None = None,
+) -> RefitResult:
+    """Minimise E per frame, starting from the original positions.
+
+    Parameters
+    ----------
+    problem : the level's problem.
+    original : (T, P, 3) original positions (Ed's targets).
+    start : (T, P, 3) starting positions, ``original`` when None.
+    ftol_rel : a frame is done when the next step promises less than this fraction of E,
+    xtol : or when an accepted step moves no point by more than ``xtol * L`` (E is quartic, so
+        flat, where a frozen chain is straight in the key posture: cos theta_r(0) = -1).
+    max_iterations : steps per frame; a frame still moving then is reported as a failure
+        (its best point is kept).
+    chunk_frames : frames solved together (bounds the (chunk, N, N) matrices in memory).
+    progress : called with the number of frames finished after each chunk.
+
+    Returns
+    -------
+    RefitResult; ``evaluations`` counts objective evaluations per frame.
+    """
+    results = []
+    for first in range(0, original.shape[0], chunk_frames):
+        rows = slice(first, first + chunk_frames)
+        begin = original[rows] if start is None else start[rows]
+        results.append(_solve_chunk(problem, first, original[rows], begin, ftol_rel, xtol, max_iterations))
+        if progress:
+            progress(results[-1].positions.shape[0])
+    return RefitResult(
+        np.concatenate([r.positions for r in results]),
+        np.concatenate([r.objective for r in results]),
+        np.concatenate([r.evaluations for r in results]),
+        [f for r in results for f in r.failures],
+    )
+
+
+def _solve_chunk(
+    problem: RefitProblem,
+    first_frame: int,
+    original: np.ndarray,
+    start: np.ndarray,
+    ftol_rel: float,
+    xtol: float,
+    max_iterations: int,
+) -> RefitResult:
+    frames, n = original.shape[0], problem.variable_count
+    x = start.copy()
+    value, gradient = objective(problem, x, original)
+    evaluations = np.ones(frames, dtype=np.int64)
+    stiffness = problem.weights.distance / problem.length_scale**2  # Ed's curvature, H's floor
+    growth = np.full(frames, 2.0)
+    active = np.flatnonzero(value > 0.0)
+    diagonal = np.arange(n)
+    damping = np.full(frames, 1e-3 * stiffness)
+    for iteration in range(max_iterations):
+        if active.size == 0:
+            break
+        xa = x[active]
+        g = -0.5 * gradient[active, 1:].reshape(active.size, n)
+        matrix = half_hessian(problem, xa)
+        if iteration == 0:
+            # Far from the optimum H can be strongly indefinite (a frozen joint bends a chain
+            # hard); start mu just past its most negative eigenvalue instead of growing into it.
+            lowest = np.linalg.eigvalsh(matrix)[:, 0]
+            damping[active] += np.maximum(-1.5 * lowest, 0.0)
+        matrix[:, diagonal, diagonal] += damping[active, None]
+        step = np.linalg.solve(matrix, g[..., None])[..., 0]
+        # E(x + d) ~ E - 2 g.d + d^T H d with (H + mu) d = g: the model promises g.d + mu |d|^2.
+        promised = np.sum(g * step, axis=1) + damping[active] * np.sum(step**2, axis=1)
+        trial = xa.copy()
+        trial[:, 1:] += step.reshape(active.size, -1, 3)
+        trial_value, trial_gradient = objective(problem, trial, original[active])
+        evaluations[active] += 1
+        gain = value[active] - trial_value
+        # An indefinite H + mu I can promise a rise: reject that step and damp harder.
+        better = np.isfinite(trial_value) & (gain > 0.0) & (promised > 0.0)
+        accepted = active[better]
+        x[accepted] = trial[better]
+        gradient[accepted] = trial_gradient[better]
+        value[accepted] = trial_value[better]
+        ratio = np.where(promised > 0.0, gain / np.maximum(promised, 1e-300), 0.0)
+        damping[active] = np.where(
+            better, damping[active] * np.maximum(1.0 / 3.0, 1.0 - (2.0 * ratio - 1.0) ** 3), damping[active] * growth[active]
+        )
+        growth[active] = np.where(better, 2.0, growth[active] * 2.0)
+        small_step = better & (np.abs(step).max(axis=1) <= xtol * problem.length_scale)
+        flat = (promised >= 0.0) & (promised <= ftol_rel * value[active])
+        done = flat | small_step | (damping[active] > 1e12 * stiffness)
+        active = active[~done]
+    failures = [FrameFailure(first_frame + int(i), f"not converged in {max_iterations} steps", "kept best point") for i in active]
+    return RefitResult(x, value, evaluations, failures)

@@ -1,0 +1,314 @@
+"""The re-fit objective of one level: E = alpha Ed + beta Es + gamma Ea (Eqs. 5-8), with
+analytic first derivatives and the Gauss-Newton normal matrix.
+
+Unknowns are the world positions ``x (P, 3)`` of every point of the original skeleton (joints,
+frozen ones included, and end sites) per frame; the root stays at its original position. The
+terms do not couple frames, so everything here is vectorised over a leading frame axis ``F``.
+
+- Ed (Eq. 6): squared distance of every non-root point to its original position.
+- Es (Eq. 7): squared change of the length between each kept point and its nearest kept
+  ancestor, against the key posture ("frame 0"). Extension: also between kept children of one
+  kept joint (siblings), because the output skeleton moves them as one rigid body; without it
+  a parent's rotation could not reproduce its children's optimised positions. Pairs at zero key
+  length (a BVH joint at its parent's position) use the vector difference instead of the
+  length, which is smooth there.
+- Ea (Eq. 8): squared change of cos theta_r (Eq. 4), the angle at each frozen joint r between
+  its parent bone and each child bone, against the key posture.
+
+Lengths are divided by a length scale ``L`` (the key posture's extent) so that the weights mean
+the same for an asset in metres or centimetres: Ed and Es are unit-free like Ea.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .frozen import FrozenLevel
+
+# Key lengths below this fraction of the length scale count as zero-length ("coincident") pairs.
+_COINCIDENT = 1e-9
+
+
+@dataclass(frozen=True)
+class Weights:
+    """alpha, beta, gamma of Eq. 5 (the paper uses 0.2, 0.4, 0.4)."""
+
+    distance: float = 0.2
+    string: float = 0.4
+    angle: float = 0.4
+
+    def __post_init__(self) -> None:
+        for name, value in (("distance", self.distance), ("string", self.string), ("angle", self.angle)):
+            if not (np.isfinite(value) and value >= 0.0):
+                raise ValueError(f"weights: {name} must be a finite non-negative number, got {value}")
+        if self.distance <= 0.0:
+            raise ValueError("weights: distance must be positive, or the re-fit has no unique optimum")
+
+
+@dataclass(frozen=True)
+class RefitProblem:
+    """Static structure of one level's per-frame problem.
+
+    Attributes
+    ----------
+    point_count : P, points of the original skeleton (joints and end sites).
+    length_pairs : (Np, 2) int64 point pairs whose length is held (Es), child side first.
+    key_lengths : (Np,) float64 their lengths in the key posture, b(0).
+    bone_pair : (Np,) bool True for Eq. 7's kept-joint-to-kept-ancestor pairs (the ones the
+        hard constraints hold), False for the sibling extension.
+    coincident_pairs : (Nc, 2) int64 pairs at zero key length, held together as vectors.
+    coincident_bone : (Nc,) bool as ``bone_pair``.
+    angle_triples : (Na, 3) int64 (parent, frozen joint, child) for Ea.
+    key_cosines : (Na,) float64 cos theta_r in the key posture.
+    weights : alpha, beta, gamma.
+    length_scale : L in the asset's units.
+    """
+
+    point_count: int
+    length_pairs: np.ndarray
+    key_lengths: np.ndarray
+    bone_pair: np.ndarray
+    coincident_pairs: np.ndarray
+    coincident_bone: np.ndarray
+    angle_triples: np.ndarray
+    key_cosines: np.ndarray
+    weights: Weights
+    length_scale: float
+
+    @property
+    def variable_count(self) -> int:
+        """3 (P - 1): every point but the root."""
+        return 3 * (self.point_count - 1)
+
+    @property
+    def constraint_count(self) -> int:
+        """Equalities of the hard bone-length option: one per bone, three per zero-length bone."""
+        return int(self.bone_pair.sum()) + 3 * int(self.coincident_bone.sum())
+
+
+def _cosines(x: np.ndarray, triples: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """cos theta at the middle point of each triple (Eq. 4) and its gradients.
+
+    Returns ``cos (F, Na)`` and the gradients with respect to the parent, joint and child
+    points, each ``(F, Na, 3)``.
+    """
+    u = x[:, triples[:, 0]] - x[:, triples[:, 1]]
+    v = x[:, triples[:, 2]] - x[:, triples[:, 1]]
+    nu = np.linalg.norm(u, axis=-1, keepdims=True)
+    nv = np.linalg.norm(v, axis=-1, keepdims=True)
+    cos = np.sum(u * v, axis=-1, keepdims=True) / (nu * nv)
+    d_u = v / (nu * nv) - cos * u / nu**2
+    d_v = u / (nu * nv) - cos * v / nv**2
+    return cos[..., 0], (d_u, -(d_u + d_v), d_v)
+
+
+def _lengths(x: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lengths ``(F, Np)`` of the pairs and their unit directions ``(F, Np, 3)`` (0 at length 0)."""
+    d = x[:, pairs[:, 0]] - x[:, pairs[:, 1]]
+    length = np.linalg.norm(d, axis=-1)
+    unit = np.divide(d, length[..., None], out=np.zeros_like(d), where=length[..., None] > 0.0)
+    return length, unit
+
+
+def _scatter(point_count: int, indices: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Sum ``values (F, N, 3)`` into points ``indices (N,)``, giving ``(F, P, 3)``."""
+    incidence = np.zeros((point_count, indices.size))
+    incidence[indices, np.arange(indices.size)] = 1.0
+    return incidence @ values
+
+
+def objective(problem: RefitProblem, x: np.ndarray, original: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """E (Eq. 5) per frame and its gradient.
+
+    Parameters
+    ----------
+    x : (F, P, 3) candidate positions; row 0 (the root) is ignored and held at ``original``.
+    original : (F, P, 3) original positions x^o.
+
+    Returns
+    -------
+    value : (F,) E per frame.
+    gradient : (F, P, 3) dE/dx, zero for the root.
+    """
+    w = problem.weights
+    scale2 = problem.length_scale**2
+    p = problem.point_count
+    delta = x - original
+    delta[:, 0] = 0.0
+    value = w.distance / scale2 * np.sum(delta**2, axis=(1, 2))  # Ed, Eq. 6
+    gradient = 2.0 * w.distance / scale2 * delta
+
+    pairs = problem.length_pairs
+    if pairs.size:  # Es, Eq. 7
+        length, unit = _lengths(x, pairs)
+        excess = length - problem.key_lengths
+        value = value + w.string / scale2 * np.sum(excess**2, axis=1)
+        pull = 2.0 * w.string / scale2 * excess[..., None] * unit
+        gradient += _scatter(p, pairs[:, 0], pull) - _scatter(p, pairs[:, 1], pull)
+    together = problem.coincident_pairs
+    if together.size:  # Es at zero key length
+        d = x[:, together[:, 0]] - x[:, together[:, 1]]
+        value = value + w.string / scale2 * np.sum(d**2, axis=(1, 2))
+        pull = 2.0 * w.string / scale2 * d
+        gradient += _scatter(p, together[:, 0], pull) - _scatter(p, together[:, 1], pull)
+    triples = problem.angle_triples
+    if triples.size:  # Ea, Eq. 8
+        cos, grads = _cosines(x, triples)
+        excess = cos - problem.key_cosines
+        value = value + w.angle * np.sum(excess**2, axis=1)
+        for column, grad in enumerate(grads):
+            gradient += _scatter(p, triples[:, column], 2.0 * w.angle * excess[..., None] * grad)
+    gradient[:, 0] = 0.0
+    return value, gradient
+
+
+def _cosine_hessians(x: np.ndarray, triples: np.ndarray) -> np.ndarray:
+    """Second derivatives of cos theta (Eq. 4) in (parent, joint, child) coordinates, ``(F, Na, 9, 9)``."""
+    u = x[:, triples[:, 0]] - x[:, triples[:, 1]]
+    v = x[:, triples[:, 2]] - x[:, triples[:, 1]]
+    nu = np.linalg.norm(u, axis=-1)[..., None, None]
+    nv = np.linalg.norm(v, axis=-1)[..., None, None]
+    cos = (np.sum(u * v, axis=-1)[..., None, None]) / (nu * nv)
+    g_u = v[..., :, None] / (nu * nv) - cos * u[..., :, None] / nu**2  # column vectors
+    g_v = u[..., :, None] / (nu * nv) - cos * v[..., :, None] / nv**2
+    eye = np.eye(3)
+
+    def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return a @ np.swapaxes(b, -1, -2)
+
+    uc, vc = u[..., :, None], v[..., :, None]
+    h_uu = -outer(vc, uc) / (nu**3 * nv) - (outer(uc, g_u) + cos * eye) / nu**2 + 2.0 * cos * outer(uc, uc) / nu**4
+    h_vv = -outer(uc, vc) / (nv**3 * nu) - (outer(vc, g_v) + cos * eye) / nv**2 + 2.0 * cos * outer(vc, vc) / nv**4
+    h_uv = eye / (nu * nv) - outer(vc, vc) / (nu * nv**3) - outer(uc, g_v) / nu**2
+    h_uu = 0.5 * (h_uu + np.swapaxes(h_uu, -1, -2))
+    h_vv = 0.5 * (h_vv + np.swapaxes(h_vv, -1, -2))
+    # u = x_parent - x_joint, v = x_child - x_joint: map (u, v) to the three points.
+    du = np.array([1.0, -1.0, 0.0])
+    dv = np.array([0.0, -1.0, 1.0])
+    blocks = (
+        np.einsum("i,j->ij", du, du)[..., None, None] * h_uu[..., None, None, :, :]
+        + np.einsum("i,j->ij", dv, dv)[..., None, None] * h_vv[..., None, None, :, :]
+        + np.einsum("i,j->ij", du, dv)[..., None, None] * h_uv[..., None, None, :, :]
+        + np.einsum("i,j->ij", dv, du)[..., None, None] * np.swapaxes(h_uv, -1, -2)[..., None, None, :, :]
+    )  # (F, Na, 3 points, 3 points, 3, 3)
+    return blocks.transpose(0, 1, 2, 4, 3, 5).reshape(x.shape[0], triples.shape[0], 9, 9)
+
+
+def half_hessian(problem: RefitProblem, x: np.ndarray) -> np.ndarray:
+    """Half the exact Hessian of E over the non-root points, ``(F, 3(P-1), 3(P-1))``.
+
+    For each squared residual w r^2 the block is w (grad r grad r^T + r Hess r): the first part
+    is the Gauss-Newton matrix, the second the curvature of the lengths and cosines, which plain
+    Gauss-Newton drops and which makes it crawl when a frozen joint bends a chain hard. Can be
+    indefinite; the solver damps it. O(pairs + triples) Python steps, vectorised over frames.
+    """
+    w = problem.weights
+    scale2 = problem.length_scale**2
+    frames, p = x.shape[0], problem.point_count
+    h = np.zeros((frames, p, 3, p, 3))
+    eye = np.eye(3)
+    diagonal = np.arange(p)
+    h[:, diagonal, :, diagonal, :] += w.distance / scale2 * eye
+
+    def add_pair(a: int, b: int, block: np.ndarray) -> None:
+        h[:, a, :, a, :] += block
+        h[:, b, :, b, :] += block
+        h[:, a, :, b, :] -= block
+        h[:, b, :, a, :] -= block
+
+    if problem.length_pairs.size:
+        length, unit = _lengths(x, problem.length_pairs)
+        along = unit[..., :, None] * unit[..., None, :]
+        stretch = (length - problem.key_lengths) / np.maximum(length, 1e-300)
+        blocks = w.string / scale2 * (along + stretch[..., None, None] * (eye - along))
+        for k, (a, b) in enumerate(problem.length_pairs):
+            add_pair(a, b, blocks[:, k])
+    for a, b in problem.coincident_pairs:
+        add_pair(a, b, w.string / scale2 * eye)
+    if problem.angle_triples.size:
+        cos, grads = _cosines(x, problem.angle_triples)
+        g = np.concatenate(grads, axis=-1)  # (F, Na, 9)
+        curvature = (cos - problem.key_cosines)[..., None, None] * _cosine_hessians(x, problem.angle_triples)
+        blocks = w.angle * (g[..., :, None] * g[..., None, :] + curvature)
+        for k, triple in enumerate(problem.angle_triples):
+            for i, pi in enumerate(triple):
+                for j, pj in enumerate(triple):
+                    h[:, pi, :, pj, :] += blocks[:, k, 3 * i : 3 * i + 3, 3 * j : 3 * j + 3]
+    n = 3 * (p - 1)
+    return np.ascontiguousarray(h[:, 1:, :, 1:, :].reshape(frames, n, n))
+
+
+def bone_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Hard bone-length equalities, scaled by 1/L, and their Jacobian.
+
+    Returns ``values (F, m)`` (zero when every kept bone has its key length; zero-length bones
+    give three rows, x_a - x_b) and ``jacobian (F, m, P, 3)``.
+    """
+    frames, p = x.shape[0], problem.point_count
+    pairs = problem.length_pairs[problem.bone_pair]
+    together = problem.coincident_pairs[problem.coincident_bone]
+    length, unit = _lengths(x, pairs)
+    values = [(length - problem.key_lengths[problem.bone_pair]) / problem.length_scale]
+    rows = np.zeros((frames, pairs.shape[0], p, 3))
+    index = np.arange(pairs.shape[0])
+    rows[:, index, pairs[:, 0]] = unit / problem.length_scale
+    rows[:, index, pairs[:, 1]] = -unit / problem.length_scale
+    jacobians = [rows]
+    if together.size:
+        values.append(((x[:, together[:, 0]] - x[:, together[:, 1]]) / problem.length_scale).reshape(frames, -1))
+        rows = np.zeros((frames, together.shape[0], 3, p, 3))
+        for k, (a, b) in enumerate(together):
+            rows[:, k, :, a, :] = np.eye(3) / problem.length_scale
+            rows[:, k, :, b, :] = -np.eye(3) / problem.length_scale
+        jacobians.append(rows.reshape(frames, -1, p, 3))
+    jacobian = np.concatenate(jacobians, axis=1)
+    jacobian[:, :, 0] = 0.0
+    return np.concatenate(values, axis=1), jacobian
+
+
+def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitProblem:
+    """The per-frame problem of a level: its Es pairs and Ea triples with key-posture targets."""
+    weights = weights or Weights()
+    skeleton = level.skeleton
+    scale = level.length_scale()
+    key = level.key_positions
+    kept = level.kept_indices[1:]
+    rigid = ~level.animated  # an animated translation has no fixed length to hold
+
+    bones = [(int(c), int(level.kept_parent[c])) for c in kept if rigid[c]]
+    siblings = []
+    for parent in np.unique(level.kept_parent[kept]):
+        group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c]]
+        siblings += [(a, b) for i, b in enumerate(group) for a in group[i + 1 :]]
+    pairs = np.array(bones + siblings, dtype=np.int64).reshape(-1, 2)
+    is_bone = np.arange(pairs.shape[0]) < len(bones)
+    lengths = np.linalg.norm(key[pairs[:, 0]] - key[pairs[:, 1]], axis=-1)
+    coincident = lengths <= _COINCIDENT * scale
+
+    triples = []
+    children = skeleton.children()
+    offset_length = np.linalg.norm(level.key_translations, axis=-1)
+    for joint in np.flatnonzero(level.frozen):
+        if offset_length[joint] <= _COINCIDENT * scale:
+            continue  # no parent bone, no angle
+        triples += [
+            (int(skeleton.parents[joint]), int(joint), child)
+            for child in children[joint]
+            if rigid[child] and offset_length[child] > _COINCIDENT * scale
+        ]
+    triples_array = np.array(triples, dtype=np.int64).reshape(-1, 3)
+    cosines, _ = _cosines(key[None], triples_array)
+    return RefitProblem(
+        point_count=skeleton.joint_count,
+        length_pairs=pairs[~coincident],
+        key_lengths=lengths[~coincident],
+        bone_pair=is_bone[~coincident],
+        coincident_pairs=pairs[coincident],
+        coincident_bone=is_bone[coincident],
+        angle_triples=triples_array,
+        key_cosines=cosines[0],
+        weights=weights,
+        length_scale=scale,
+    )

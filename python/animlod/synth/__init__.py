@@ -1,0 +1,35 @@
+"""Procedural assets, deterministic from a seed: the embedded default and most tests' input.
+
+- :func:`humanoid` and :func:`humanoid_motion`: a 41-joint skinned character and its cyclic
+  walk, run and jump;
+- :func:`face` and :func:`face_animation`: a head with named animation regions;
+- :func:`bending_cylinder`, :func:`twisting_bar`, :func:`translating_mesh`: small deforming
+  meshes with known motion for unit tests;
+- :func:`icosphere`: a geodesic sphere.
+"""
+
+from .deforming import bending_cylinder, bending_cylinder_skinned, translating_mesh, twisting_bar
+from .face import REGION_NAMES, STILL_REGIONS, FaceModel, face
+from .face_animation import face_animation
+from .gait import KINDS, STILL_FINGER_CHAIN, humanoid_motion
+from .geometry import icosphere
+from .humanoid import END_SITES, humanoid, humanoid_skeleton
+
+__all__ = [
+    "END_SITES",
+    "KINDS",
+    "REGION_NAMES",
+    "STILL_FINGER_CHAIN",
+    "STILL_REGIONS",
+    "FaceModel",
+    "bending_cylinder",
+    "bending_cylinder_skinned",
+    "face",
+    "face_animation",
+    "humanoid",
+    "humanoid_motion",
+    "humanoid_skeleton",
+    "icosphere",
+    "translating_mesh",
+    "twisting_bar",
+]

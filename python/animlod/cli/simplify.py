@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import math
 import time
 from pathlib import Path
@@ -54,6 +55,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if any(not 0.0 < ratio <= 1.0 for ratio in args.ratio):
         raise UserError(f"--ratio: every ratio must be in (0, 1], got {args.ratio}")
+    if not args.no_metrics and importlib.util.find_spec("igl") is None:
+        print("note: libigl is not installed (pip install libigl); skipping the Hausdorff/RMS measurement")
+        args.no_metrics = True
     kind = input_kind(args.input)
     if kind == "bvh":
         raise UserError(f"{args.input}: a BVH file holds motion only; simplify needs a mesh")

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from animlod import synth
 from animlod.simplify import simplify_skinned
 from simplify_inputs import directed_edges_unique, two_bone_tube
 
 
 def test_skinned_levels_skin_with_valid_merged_weights():
-    skinned, motion = two_bone_tube()
+    skinned, motion = two_bone_tube()  # an open tube with UVs
     levels = simplify_skinned(skinned, [motion], (0.5, 0.2))
     assert [level.target_face_count for level in levels] == [180, 72]
     for level in levels:
@@ -36,4 +37,30 @@ def test_reskinned_level_stays_close_to_the_original_animation():
     level = simplify_skinned(skinned, [motion], (0.25,))[0]
     error = surface_error(skinned.bake(motion), level.mesh.bake(motion), samples=2000)
     # Within 2% of the bounding-box diagonal in every frame of the bend.
+    assert error.summary()["hausdorff_max"] < 0.02
+
+
+def test_procedural_humanoid_walk_still_skins():
+    skinned = synth.humanoid()
+    walk = synth.humanoid_motion(skinned.skeleton, "walk")
+    levels = simplify_skinned(skinned, [walk], (0.5, 0.2))
+    height = float(np.ptp(skinned.rest_positions[:, 1]))
+    for level in levels:
+        mesh = level.mesh
+        assert mesh.face_count <= level.target_face_count
+        assert directed_edges_unique(mesh.faces)
+        assert mesh.joints.max() < skinned.skeleton.joint_count
+        np.testing.assert_allclose(mesh.weights.sum(axis=1), 1.0, rtol=1e-5)
+        assert level.skinning_error < 0.02 * height
+    errors = [level.error for level in levels]
+    assert errors == sorted(errors)
+
+
+def test_bending_cylinder_level_follows_the_bend_after_reskinning():
+    pytest.importorskip("igl")
+    from animlod.metrics import surface_error
+
+    skinned, motion = synth.bending_cylinder_skinned(frames=8)
+    level = simplify_skinned(skinned, [motion], (0.2,))[0]
+    error = surface_error(skinned.bake(motion), level.mesh.bake(motion), samples=2000)
     assert error.summary()["hausdorff_max"] < 0.02

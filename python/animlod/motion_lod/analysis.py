@@ -76,7 +76,9 @@ class MotionAnalysis:
 def local_translations(motion: Motion) -> np.ndarray:
     """Local translation of every joint per frame ``(T, J, 3)``; column 0 is the root position."""
     if motion.joint_translations is None:
-        translations = np.broadcast_to(motion.skeleton.offsets, (motion.frame_count,) + motion.skeleton.offsets.shape).copy()
+        translations = np.broadcast_to(
+            motion.skeleton.offsets, (motion.frame_count,) + motion.skeleton.offsets.shape
+        ).copy()
     else:
         translations = motion.joint_translations.copy()
     translations[:, 0] = motion.root_positions

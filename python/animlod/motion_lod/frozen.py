@@ -93,7 +93,9 @@ def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | 
     key_rotations = analysis.key_rotations(motion)
     key_translations = analysis.key_translations(motion)
     key_translations[0] = 0.0
-    key_motion = Motion(skeleton, key_translations[None, 0], key_rotations[None], fps=1.0, joint_translations=key_translations[None])
+    key_motion = Motion(
+        skeleton, key_translations[None, 0], key_rotations[None], fps=1.0, joint_translations=key_translations[None]
+    )
     key_positions = key_motion.world_positions()[0]
 
     kept_parent = np.full(count, -1, dtype=np.int64)
@@ -110,8 +112,16 @@ def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | 
             fold_translations[joint] += rotations.rotate(fold_rotations[joint], key_translations[frozen_joint])
             fold_rotations[joint] = rotations.multiply(fold_rotations[joint], key_rotations[frozen_joint])
     return FrozenLevel(
-        skeleton, frozen, kept, kept_parent, key_rotations, key_translations, key_positions,
-        fold_rotations, fold_translations, animated,
+        skeleton,
+        frozen,
+        kept,
+        kept_parent,
+        key_rotations,
+        key_translations,
+        key_positions,
+        fold_rotations,
+        fold_translations,
+        animated,
     )
 
 

@@ -109,12 +109,17 @@ def _solve_chunk(
         value[accepted] = trial_value[better]
         ratio = np.where(promised > 0.0, gain / np.maximum(promised, 1e-300), 0.0)
         damping[active] = np.where(
-            better, damping[active] * np.maximum(1.0 / 3.0, 1.0 - (2.0 * ratio - 1.0) ** 3), damping[active] * growth[active]
+            better,
+            damping[active] * np.maximum(1.0 / 3.0, 1.0 - (2.0 * ratio - 1.0) ** 3),
+            damping[active] * growth[active],
         )
         growth[active] = np.where(better, 2.0, growth[active] * 2.0)
         small_step = better & (np.abs(step).max(axis=1) <= xtol * problem.length_scale)
         flat = (promised >= 0.0) & (promised <= ftol_rel * value[active])
         done = flat | small_step | (damping[active] > 1e12 * stiffness)
         active = active[~done]
-    failures = [FrameFailure(first_frame + int(i), f"not converged in {max_iterations} steps", "kept best point") for i in active]
+    failures = [
+        FrameFailure(first_frame + int(i), f"not converged in {max_iterations} steps", "kept best point")
+        for i in active
+    ]
     return RefitResult(x, value, evaluations, failures)

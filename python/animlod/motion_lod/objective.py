@@ -56,10 +56,13 @@ class RefitProblem:
     point_count : P, points of the original skeleton (joints and end sites).
     length_pairs : (Np, 2) int64 point pairs whose length is held (Es), child side first.
     key_lengths : (Np,) float64 their lengths in the key posture, b(0).
-    bone_pair : (Np,) bool True for Eq. 7's kept-joint-to-kept-ancestor pairs (the ones the
-        hard constraints hold), False for the sibling extension.
+    bone_pair : (Np,) bool True for Eq. 7's kept-joint-to-kept-ancestor pairs (the bones whose
+        lengths Fig. 7 measures), False for the sibling extension.
     coincident_pairs : (Nc, 2) int64 pairs at zero key length, held together as vectors.
-    coincident_bone : (Nc,) bool as ``bone_pair``.
+    handed_quads : (Nh, 4) int64 (parent, three kept children) whose key posture is not flat:
+        lengths fix such a group only up to a mirror image, which no rotation reproduces, so
+        the hard option also keeps the sign of their volume.
+    key_volumes : (Nh,) float64 the signed volumes det[a - p, b - p, c - p] in the key posture.
     angle_triples : (Na, 3) int64 (parent, frozen joint, child) for Ea.
     key_cosines : (Na,) float64 cos theta_r in the key posture.
     weights : alpha, beta, gamma.
@@ -71,7 +74,8 @@ class RefitProblem:
     key_lengths: np.ndarray
     bone_pair: np.ndarray
     coincident_pairs: np.ndarray
-    coincident_bone: np.ndarray
+    handed_quads: np.ndarray
+    key_volumes: np.ndarray
     angle_triples: np.ndarray
     key_cosines: np.ndarray
     weights: Weights
@@ -84,8 +88,8 @@ class RefitProblem:
 
     @property
     def constraint_count(self) -> int:
-        """Equalities of the hard bone-length option: one per bone, three per zero-length bone."""
-        return int(self.bone_pair.sum()) + 3 * int(self.coincident_bone.sum())
+        """Equalities of the hard option: one per held length, three per zero-length pair."""
+        return self.length_pairs.shape[0] + 3 * self.coincident_pairs.shape[0]
 
 
 def _cosines(x: np.ndarray, triples: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -110,6 +114,16 @@ def _lengths(x: np.ndarray, pairs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     length = np.linalg.norm(d, axis=-1)
     unit = np.divide(d, length[..., None], out=np.zeros_like(d), where=length[..., None] > 0.0)
     return length, unit
+
+
+def _volumes(x: np.ndarray, quads: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+    """Signed volumes ``det[a - p, b - p, c - p]`` ``(F, Nh)`` of (p, a, b, c) quads and their
+    gradients with respect to p, a, b, c, each ``(F, Nh, 3)``."""
+    u = x[:, quads[:, 1]] - x[:, quads[:, 0]]
+    v = x[:, quads[:, 2]] - x[:, quads[:, 0]]
+    w = x[:, quads[:, 3]] - x[:, quads[:, 0]]
+    d_u, d_v, d_w = np.cross(v, w), np.cross(w, u), np.cross(u, v)
+    return np.sum(u * d_u, axis=-1), (-(d_u + d_v + d_w), d_u, d_v, d_w)
 
 
 def _scatter(point_count: int, indices: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -240,17 +254,18 @@ def half_hessian(problem: RefitProblem, x: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(h[:, 1:, :, 1:, :].reshape(frames, n, n))
 
 
-def bone_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Hard bone-length equalities, scaled by 1/L, and their Jacobian.
+def rigidity_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Hard equalities, scaled by 1/L, and their Jacobian: every length Es holds (bones and
+    siblings), so the kept points move exactly as the level's rigid skeleton can.
 
-    Returns ``values (F, m)`` (zero when every kept bone has its key length; zero-length bones
-    give three rows, x_a - x_b) and ``jacobian (F, m, P, 3)``.
+    Returns ``values (F, m)`` (zero when every pair has its key length; zero-length pairs give
+    three rows, x_a - x_b) and ``jacobian (F, m, P, 3)``.
     """
     frames, p = x.shape[0], problem.point_count
-    pairs = problem.length_pairs[problem.bone_pair]
-    together = problem.coincident_pairs[problem.coincident_bone]
+    pairs = problem.length_pairs
+    together = problem.coincident_pairs
     length, unit = _lengths(x, pairs)
-    values = [(length - problem.key_lengths[problem.bone_pair]) / problem.length_scale]
+    values = [(length - problem.key_lengths) / problem.length_scale]
     rows = np.zeros((frames, pairs.shape[0], p, 3))
     index = np.arange(pairs.shape[0])
     rows[:, index, pairs[:, 0]] = unit / problem.length_scale
@@ -268,6 +283,22 @@ def bone_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.ndarray, 
     return np.concatenate(values, axis=1), jacobian
 
 
+def handedness_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Inequalities ``<= 0`` keeping each handed quad on its key posture's side of flat.
+
+    Returns ``values (F, Nh)`` (``-sign(V0) V / L^3``) and ``jacobian (F, Nh, P, 3)``.
+    """
+    frames, p = x.shape[0], problem.point_count
+    volumes, grads = _volumes(x, problem.handed_quads)
+    sign = -np.sign(problem.key_volumes) / problem.length_scale**3
+    jacobian = np.zeros((frames, problem.handed_quads.shape[0], p, 3))
+    index = np.arange(problem.handed_quads.shape[0])
+    for column, grad in enumerate(grads):
+        jacobian[:, index, problem.handed_quads[:, column]] += sign[:, None] * grad
+    jacobian[:, :, 0] = 0.0
+    return sign * volumes, jacobian
+
+
 def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitProblem:
     """The per-frame problem of a level: its Es pairs and Ea triples with key-posture targets."""
     weights = weights or Weights()
@@ -278,14 +309,32 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
     rigid = ~level.animated  # an animated translation has no fixed length to hold
 
     bones = [(int(c), int(level.kept_parent[c])) for c in kept if rigid[c]]
+    # Siblings at their parent's position are already held by their bone: a pair with them
+    # would repeat that bone's constraint (and make SLSQP's constraint Jacobian singular).
+    apart = np.linalg.norm(key - key[np.maximum(level.kept_parent, 0)], axis=-1) > _COINCIDENT * scale
     siblings = []
     for parent in np.unique(level.kept_parent[kept]):
-        group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c]]
+        group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c] and apart[c]]
         siblings += [(a, b) for i, b in enumerate(group) for a in group[i + 1 :]]
     pairs = np.array(bones + siblings, dtype=np.int64).reshape(-1, 2)
     is_bone = np.arange(pairs.shape[0]) < len(bones)
     lengths = np.linalg.norm(key[pairs[:, 0]] - key[pairs[:, 1]], axis=-1)
     coincident = lengths <= _COINCIDENT * scale
+
+    quads = []
+    for parent in np.unique(level.kept_parent[kept]):
+        group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c] and apart[c]]
+        candidates = [
+            (int(parent), a, b, c)
+            for i, a in enumerate(group)
+            for j, b in enumerate(group[i + 1 :], i + 1)
+            for c in group[j + 1 :]
+        ]
+        if candidates:
+            volumes = np.abs(_volumes(key[None], np.array(candidates))[0][0])
+            if volumes.max() > 1e-6 * scale**3:
+                quads.append(candidates[int(np.argmax(volumes))])
+    quads_array = np.array(quads, dtype=np.int64).reshape(-1, 4)
 
     triples = []
     children = skeleton.children()
@@ -306,7 +355,8 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
         key_lengths=lengths[~coincident],
         bone_pair=is_bone[~coincident],
         coincident_pairs=pairs[coincident],
-        coincident_bone=is_bone[coincident],
+        handed_quads=quads_array,
+        key_volumes=_volumes(key[None], quads_array)[0][0],
         angle_triples=triples_array,
         key_cosines=cosines[0],
         weights=weights,

@@ -10,9 +10,13 @@ chunks can run in worker processes (threads would not help: the callbacks are Py
 
 Every solve is checked: the result must be finite, not worse than its start, and, with hard
 bone-length constraints, feasible within ``feasibility_tolerance`` (SLSQP can report success
-with violated constraints). A frame that fails is solved again from z = 0, and if that fails too
+with violated constraints). Hard constraints hold every length Es holds, bones and siblings,
+and keep rigid groups of three children from flipping into their mirror image, so that
+forward kinematics of the recovered skeleton reproduces the result. A frame that fails is solved again from z = 0, and if that fails too
 it takes the fallback positions (the original motion with frozen joints at their key rotations,
 which satisfies every constraint); every such frame is reported in ``RefitResult.failures``.
+With hard constraints, cold starts begin at the fallback rather than the original positions:
+it is feasible, and on the key posture's side of every mirror image.
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ from dataclasses import dataclass, field
 import nlopt
 import numpy as np
 
-from .objective import RefitProblem, bone_constraints, objective
+from .objective import RefitProblem, handedness_constraints, objective, rigidity_constraints
 
 
 @dataclass(frozen=True)
@@ -77,7 +81,13 @@ def _solve_frame(
         return float(value[0])
 
     def constraints(result: np.ndarray, z: np.ndarray, grad: np.ndarray) -> None:
-        values, jacobian = bone_constraints(problem, _positions(problem, original, z)[None])
+        values, jacobian = rigidity_constraints(problem, _positions(problem, original, z)[None])
+        result[:] = values[0]
+        if grad.size:
+            grad[:] = scale * jacobian[0, :, 1:].reshape(values.shape[1], n)
+
+    def handedness(result: np.ndarray, z: np.ndarray, grad: np.ndarray) -> None:
+        values, jacobian = handedness_constraints(problem, _positions(problem, original, z)[None])
         result[:] = values[0]
         if grad.size:
             grad[:] = scale * jacobian[0, :, 1:].reshape(values.shape[1], n)
@@ -86,7 +96,11 @@ def _solve_frame(
     opt.set_exceptions_enabled(False)  # keep the last point and read the code instead
     opt.set_min_objective(energy)
     if options.hard_constraints and problem.constraint_count:
-        opt.add_equality_mconstraint(constraints, np.full(problem.constraint_count, 0.1 * options.feasibility_tolerance))
+        opt.add_equality_mconstraint(
+            constraints, np.full(problem.constraint_count, 0.1 * options.feasibility_tolerance)
+        )
+        if problem.handed_quads.size:
+            opt.add_inequality_mconstraint(handedness, np.zeros(problem.handed_quads.shape[0]))
     opt.set_ftol_rel(options.ftol_rel)
     opt.set_maxeval(options.max_evaluations)
     start_value = energy(z0, np.empty(0))
@@ -94,16 +108,21 @@ def _solve_frame(
     code = opt.last_optimize_result()
     evaluations = opt.get_numevals()
     value = energy(z, np.empty(0)) if np.all(np.isfinite(z)) else np.inf
-    if code < 0:
-        return z, value, evaluations, f"nlopt result {code}"
     if not np.isfinite(value):
         return z, value, evaluations, "non-finite result"
+    if code < 0:
+        return z, value, evaluations, f"nlopt result {code}"
     if options.hard_constraints and problem.constraint_count:
         result = np.empty(problem.constraint_count)
         constraints(result, z, np.empty(0))
         violation = float(np.abs(result).max())
         if violation > options.feasibility_tolerance:
-            return z, value, evaluations, f"bone length violated by {violation:.3g} L"
+            return z, value, evaluations, f"a held length is off by {violation:.3g} L"
+        if problem.handed_quads.size:
+            result = np.empty(problem.handed_quads.shape[0])
+            handedness(result, z, np.empty(0))
+            if result.max() > 0.0:
+                return z, value, evaluations, "a rigid group turned into its mirror image"
     elif value > start_value:
         return z, value, evaluations, "objective rose above its start"
     return z, value, evaluations, ""
@@ -118,18 +137,25 @@ def _solve_chunk(
     values = np.empty(frames)
     evaluations = np.zeros(frames, dtype=np.int64)
     failures = []
-    z = np.zeros(problem.variable_count)
+    # Cold starts: the original positions (the paper), or with hard constraints the fallback,
+    # which is feasible and on the right side of every mirror image.
+    cold = (fallback - original)[:, 1:].reshape(frames, -1) / problem.length_scale
+    if not options.hard_constraints:
+        cold[:] = 0.0
+    z = cold[0]
     for i in range(frames):  # sequential by nature: each frame starts from the previous optimum
-        start = z if options.warm_start else np.zeros_like(z)
+        start = z if options.warm_start else cold[i]
         z, value, count, reason = _solve_frame(problem, original[i], start, options)
         evaluations[i] = count
         if reason:
-            z, value, count, second = _solve_frame(problem, original[i], np.zeros_like(z), options)
+            z, value, count, second = _solve_frame(problem, original[i], cold[i], options)
             evaluations[i] += count
-            if second:
-                z = (fallback[i, 1:] - original[i, 1:]).ravel() / problem.length_scale
-                value = float(objective(problem, fallback[i : i + 1], original[i : i + 1])[0][0])
             failures.append(FrameFailure(first_frame + i, reason, "fallback" if second else "cold restart"))
+            if second:
+                positions[i] = fallback[i]
+                values[i] = float(objective(problem, fallback[i : i + 1], original[i : i + 1])[0][0])
+                z = (fallback[i, 1:] - original[i, 1:]).ravel() / problem.length_scale
+                continue
         positions[i] = _positions(problem, original[i], z)
         values[i] = value
     return RefitResult(positions, values, evaluations, failures)

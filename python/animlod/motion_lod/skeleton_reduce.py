@@ -59,7 +59,9 @@ def _swing(from_vectors: np.ndarray, to_vectors: np.ndarray) -> np.ndarray:
     if opposite.any():
         helper = np.where(np.abs(a[opposite, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
         axis = np.cross(a[opposite], helper)
-        q[opposite] = np.concatenate([axis / np.linalg.norm(axis, axis=-1, keepdims=True), np.zeros((axis.shape[0], 1))], -1)
+        q[opposite] = np.concatenate(
+            [axis / np.linalg.norm(axis, axis=-1, keepdims=True), np.zeros((axis.shape[0], 1))], -1
+        )
     zero = (np.linalg.norm(from_vectors, axis=-1) == 0.0) | (np.linalg.norm(to_vectors, axis=-1) == 0.0)
     q[zero] = rotations.identity()
     return rotations.normalize(q)

@@ -1,0 +1,82 @@
+"""Motion analysis (Eqs. 1-3): hand-computed values, still joints, priority, subsampling."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from animlod.motion_lod import analyze_motion
+from animlod.motion_lod.analysis import posture_error_row_sums
+from test_motion_figures import chain_motion, figure_motion
+
+
+def test_eq1_to_eq3_on_a_three_joint_chain() -> None:
+    # A turns by 0, 0.5, 1.0 rad; its child bone has r = 2 in every frame; r_max = |root->A| = 1.
+    # E_A(a, b) = (2 + 2) |phi_a - phi_b| / (2 pi) (Eq. 1), so the row sums are 3/pi, 2/pi, 3/pi.
+    motion = chain_motion([0.0, 0.5, 1.0])
+    sums = posture_error_row_sums(motion, np.arange(3), r_max=1.0)
+    np.testing.assert_allclose(sums[1], [3 / np.pi, 2 / np.pi, 3 / np.pi], rtol=1e-14)
+    analysis = analyze_motion(motion)
+    assert analysis.r_max == pytest.approx(1.0)
+    assert analysis.key_frames[1] == 1  # Eq. 2: the middle frame has the smallest row sum
+    assert analysis.importance[1] == pytest.approx(2 / (3 * np.pi), rel=1e-14)  # Eq. 3
+    assert analysis.importance[2] == 0.0  # B never rotates
+    assert analysis.importance[3] == 0.0  # an end site
+    assert analysis.priority == [2, 1]  # lowest first; never the root or an end site
+
+
+def test_a_still_joint_has_zero_importance_however_its_ancestors_move() -> None:
+    still = analyze_motion(chain_motion([0.0, 0.5, 1.0], root_angles=[0.0, 0.7, -0.4]))
+    assert still.importance[2] == 0.0
+    assert still.importance[0] > 0.0  # the root's own turn is measured
+    # A's error is measured in the root's frame, so the root's turn does not change it.
+    assert still.importance[1] == pytest.approx(2 / (3 * np.pi), rel=1e-12)
+
+
+def test_figure_priority_puts_the_still_wrist_first_and_respects_locks() -> None:
+    motion = figure_motion()
+    analysis = analyze_motion(motion)
+    names = motion.skeleton.names
+    assert names[analysis.priority[0]] == "LeftWrist"
+    assert analysis.importance[names.index("LeftWrist")] == 0.0
+    assert len(analysis.priority) == 11  # 12 joints, not the root
+    locked = analyze_motion(motion, locked=["LeftWrist", "Chest"])
+    assert names.index("LeftWrist") not in locked.priority
+    assert names.index("Chest") not in locked.priority
+    assert len(locked.priority) == 9
+    key = analysis.key_rotations(motion)
+    joints = np.arange(motion.skeleton.joint_count)
+    np.testing.assert_array_equal(key, motion.local_rotations[analysis.key_frames, joints])
+
+
+def test_subsampling_analyses_evenly_spaced_frames() -> None:
+    motion = figure_motion(frames=40)
+    analysis = analyze_motion(motion, max_frames=10)
+    assert analysis.frames.size == 10
+    assert analysis.frames[0] == 0 and analysis.frames[-1] == 39
+    assert np.all(np.isin(analysis.key_frames, analysis.frames))
+    full = analyze_motion(motion)
+    # A uniform subsample estimates the same mean: close, not equal.
+    moving = full.importance > 0
+    np.testing.assert_allclose(analysis.importance[moving], full.importance[moving], rtol=0.25)
+
+
+def test_bad_input_is_refused_with_a_reason() -> None:
+    with pytest.raises(ValueError, match="at least 2 frames"):
+        analyze_motion(chain_motion([0.3]))
+    with pytest.raises(ValueError, match="no joint named 'Elbow'"):
+        analyze_motion(chain_motion([0.0, 1.0]), locked=["Elbow"])
+    with pytest.raises(ValueError, match="end site"):
+        analyze_motion(chain_motion([0.0, 1.0]), locked=["B_End"])
+
+
+def test_real_clip_analysis(data_dir) -> None:
+    from animlod.io.bvh import read_bvh
+
+    motion = read_bvh(data_dir / "bvh" / "131_01.bvh")
+    analysis = analyze_motion(motion, max_frames=200)
+    skeleton = motion.skeleton
+    assert len(analysis.priority) == int((~skeleton.end_sites).sum()) - 1
+    assert np.all(analysis.importance >= 0.0)
+    assert np.all(analysis.importance[skeleton.end_sites] == 0.0)
+    ordered = analysis.importance[analysis.priority]
+    assert np.all(np.diff(ordered) >= 0.0)

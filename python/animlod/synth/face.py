@@ -12,7 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import AnimatedMesh
 from .geometry import cross_section, icosphere, merge, orthonormal_frame, tube
 
 _HEAD_RADII = np.array([0.075, 0.11, 0.095])  # half width, height, depth
@@ -27,7 +26,7 @@ _FEATURES = [
     ((-0.33, 0.18, 0.93), (0.13, 0.09, 0.3), -0.012),
     ((0.30, 0.33, 0.89), (0.2, 0.06, 0.3), 0.006),  # brow ridges
     ((-0.30, 0.33, 0.89), (0.2, 0.06, 0.3), 0.006),
-    ((0.0, -0.05, 1.0), (0.07, 0.16, 0.3), 0.026),  # nose bridge and tip
+    ((0.0, -0.05, 1.0), (0.07, 0.16, 0.3), 0.016),  # nose bridge and tip
     ((0.0, -0.17, 0.98), (0.07, 0.06, 0.3), 0.01),
     ((0.5, -0.2, 0.84), (0.15, 0.15, 0.3), 0.008),  # cheeks
     ((-0.5, -0.2, 0.84), (0.15, 0.15, 0.3), 0.008),
@@ -45,12 +44,12 @@ _FEATURES = [
 _HEAD_REGIONS = {
     "ear_left": ((1.0, 0.0, -0.1), (0.45, 0.3, 0.25)),
     "ear_right": ((-1.0, 0.0, -0.1), (0.45, 0.3, 0.25)),
-    "eyelid_upper_left": ((0.33, 0.24, 0.91), (0.15, 0.08, 0.3)),
-    "eyelid_upper_right": ((-0.33, 0.24, 0.91), (0.15, 0.08, 0.3)),
-    "eyelid_lower_left": ((0.33, 0.1, 0.94), (0.15, 0.08, 0.3)),
-    "eyelid_lower_right": ((-0.33, 0.1, 0.94), (0.15, 0.08, 0.3)),
-    "eyebrow_left": ((0.3, 0.38, 0.87), (0.18, 0.08, 0.3)),
-    "eyebrow_right": ((-0.3, 0.38, 0.87), (0.18, 0.08, 0.3)),
+    "eyelid_upper_left": ((0.33, 0.25, 0.91), (0.18, 0.09, 0.3)),
+    "eyelid_upper_right": ((-0.33, 0.25, 0.91), (0.18, 0.09, 0.3)),
+    "eyelid_lower_left": ((0.33, 0.1, 0.94), (0.18, 0.08, 0.3)),
+    "eyelid_lower_right": ((-0.33, 0.1, 0.94), (0.18, 0.08, 0.3)),
+    "eyebrow_left": ((0.3, 0.39, 0.87), (0.22, 0.08, 0.3)),
+    "eyebrow_right": ((-0.3, 0.39, 0.87), (0.22, 0.08, 0.3)),
     "nose": ((0.0, -0.04, 1.0), (0.13, 0.24, 0.3)),
     "lip_upper": ((0.0, -0.39, 0.92), (0.2, 0.07, 0.3)),
     "lip_lower": ((0.0, -0.53, 0.85), (0.2, 0.07, 0.3)),
@@ -127,10 +126,10 @@ def _head(rings: int, segments: int, scale: np.ndarray) -> tuple[np.ndarray, np.
     meridians crowd around the face, where the regions are small, and thin out at the back.
     """
     uniform = np.pi * np.arange(1, rings + 1) / (rings + 1)
-    polar = uniform - 0.35 * np.sin(2.0 * uniform - np.pi)  # from the bottom pole up, dense mid-height
+    polar = uniform - 0.3 * np.sin(2.0 * uniform - np.pi)  # from the bottom pole up, dense mid-height
     frame = orthonormal_frame([0.0, 1.0, 0.0], [1.0, 0.0, 0.0])  # outline angle -pi/2 faces +Z
     around = 2.0 * np.pi * np.arange(segments) / segments
-    around = around - 0.7 * np.sin(around + 0.5 * np.pi)
+    around = around - 0.85 * np.sin(around + 0.5 * np.pi)
     sphere = tube(
         -np.cos(polar)[:, None] * frame[2], np.sin(polar), np.sin(polar), frame,
         np.array([[0.0, -1.0, 0.0], [0.0, 1.0, 0.0]]), np.stack([np.cos(around), np.sin(around)], -1),
@@ -153,14 +152,14 @@ def _teeth_arc(height: float, front: float, arc_radius: float, span: float) -> t
 
 
 def face(seed: int = 0) -> FaceModel:
-    """A head of about 2,330 triangles with the regions in ``REGION_NAMES``.
+    """A head of 2,304 triangles with the regions in ``REGION_NAMES``.
 
-    Head ellipsoid 1,944 triangles, eyeballs 2 x 80 (icospheres), teeth 2 x 112. ``seed``
+    Head ellipsoid 1,920 triangles, eyeballs 2 x 80 (icospheres), teeth 2 x 112. ``seed``
     scales the head by up to +-4 % per axis; same seed, same bytes.
     """
     rng = np.random.default_rng(seed)
     scale = 1.0 + 0.04 * rng.uniform(-1.0, 1.0, size=3)
-    head_positions, head_faces, directions = _head(27, 36, scale)
+    head_positions, head_faces, directions = _head(24, 40, scale)
     head_region = np.full(len(head_positions), REGION_NAMES.index("scalp"), dtype=np.int32)
     for index, (centre, extent) in reversed(list(enumerate(_HEAD_REGIONS.values()))):
         head_region[_inside(directions, centre, extent)] = index  # earlier regions overwrite later ones

@@ -66,7 +66,7 @@ def face_animation(face: FaceModel, seconds: float = 2.0, fps: float = 30.0, see
     if not (seconds > 0 and fps > 0):
         raise ValueError(f"seconds and fps must be positive, got {seconds} and {fps}")
     rng = np.random.default_rng(seed)
-    frame_count = max(1, int(round(seconds * fps)))
+    frame_count = max(1, round(seconds * fps))
     t = np.arange(frame_count) / fps
     rest = face.positions.astype(np.float64)
 
@@ -87,8 +87,12 @@ def face_animation(face: FaceModel, seconds: float = 2.0, fps: float = 30.0, see
     fields_and_curves = [
         (_region_field(face, {"lip_upper": 1.0, "mouth": 0.3})[:, None] * np.array([0.0, 0.003, 0.002]), speech),
         (
-            _region_field(face, dict.fromkeys(["mouth", "lip_upper", "lip_lower"], 1.0)
-                          | dict.fromkeys(_both("cheek"), 0.6) | dict.fromkeys(_both("zygomatic"), 0.3))[:, None]
+            _region_field(
+                face,
+                dict.fromkeys(["mouth", "lip_upper", "lip_lower"], 1.0)
+                | dict.fromkeys(_both("cheek"), 0.6)
+                | dict.fromkeys(_both("zygomatic"), 0.3),
+            )[:, None]
             * (0.004 * sideways + 0.003 * up),
             smile,
         ),

@@ -104,8 +104,9 @@ def _gait(phase: np.ndarray, style: GaitStyle) -> tuple[np.ndarray, dict[str, np
         "Spine": _xyz(0.4 * style.lean, 0.4 * twist),
         "Spine1": _xyz(0.3 * style.lean, 0.6 * twist),
         "Spine2": _xyz(0.3 * style.lean, 0.6 * twist),
-        # The chest ends up twisted by 0.6 * twist; neck and head undo it and the lean.
-        "Neck": _xyz(-0.5 * style.lean, -0.3 * twist, -0.15 * style.pelvis_yaw * np.cos(phase)),
+        # The chest ends up twisted by 0.6 * twist; neck and head undo that, the lean and the
+        # pelvis roll, so the head stays level and looks ahead.
+        "Neck": _xyz(-0.5 * style.lean, -0.3 * twist, -0.3 * style.pelvis_yaw * np.cos(phase)),
         "Head": _xyz(-0.5 * style.lean + 0.02 * np.sin(2.0 * phase), -0.3 * twist),
     }
     for side, side_phase in (("Left", phase), ("Right", phase + np.pi)):
@@ -189,7 +190,7 @@ def humanoid_motion(
         raise ValueError(f"fps: must be positive, got {fps}")
     rng = np.random.default_rng(seed)
     period = _STYLES[kind].period if kind in _STYLES else _JUMP_PERIOD
-    frames_per_cycle = max(2, int(round(period * fps)))
+    frames_per_cycle = max(2, round(period * fps))
     phase = 2.0 * np.pi * np.arange(cycles * frames_per_cycle) / frames_per_cycle
     if kind == "jump":
         displacement, angles = _jump((phase / (2.0 * np.pi)) % 1.0, skeleton, 1.0 + 0.08 * rng.uniform(-1, 1))

@@ -140,7 +140,7 @@ def capsule(
     length = stations[-1, 0]
     # A rounded end is as long as the mean radius there, at most a third of the tube.
     cap_lengths = np.minimum(0.5 * (stations[[0, -1], 1] + stations[[0, -1], 2]), length / 3.0)
-    body_count = max(2, int(round((length - cap_lengths.sum()) / spacing)) + 1)
+    body_count = max(2, round((length - cap_lengths.sum()) / spacing) + 1)
     body = np.linspace(cap_lengths[0], length - cap_lengths[1], body_count)
     theta = 0.5 * np.pi * np.arange(1, cap_rings + 1) / (cap_rings + 1)  # pole -> body
     start_cap = cap_lengths[0] * (1.0 - np.sin(theta))

@@ -59,7 +59,7 @@ def _mirrored(rows: list[_JointRow]) -> list[_JointRow]:
     """The right-side twin of left-side rows: names renamed, x negated."""
 
     def right(name: str) -> str:
-        return "Right" + name[len("Left"):] if name.startswith("Left") else name
+        return "Right" + name[len("Left") :] if name.startswith("Left") else name
 
     return [(right(name), parent and right(parent), (-x, y, z)) for name, parent, (x, y, z) in rows]
 
@@ -122,7 +122,7 @@ def _body_parts(joints: dict[str, np.ndarray], girth: float) -> list[tuple[Tube,
 def _limb_parts(joints: dict[str, np.ndarray], side: str, sign: float, girth: float) -> list[tuple[Tube, list[str]]]:
     """Arm with palm, four fingers, leg and foot of one side (``sign`` +1 left, -1 right)."""
     outward, up, forward = np.array([sign, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
-    named = {key[len(side):]: value for key, value in joints.items() if key.startswith(side)}
+    named = {key[len(side) :]: value for key, value in joints.items() if key.startswith(side)}
     shoulder, arm, fore, hand = (named[k] for k in ("Shoulder", "Arm", "ForeArm", "Hand"))
     arm_start = shoulder + 0.05 * outward
     knuckle_row = np.mean([named["Hand" + finger + "1"] for finger in FINGERS[1:]], axis=0)
@@ -142,7 +142,7 @@ def _limb_parts(joints: dict[str, np.ndarray], side: str, sign: float, girth: fl
     arm_stations[:, 1:3] *= girth
     parts = [
         (
-            capsule(arm_start, outward, up, arm_stations, 12, 0.05, cap_rings=2),
+            capsule(arm_start, outward, up, arm_stations, 12, 0.055, cap_rings=2),
             ["Spine2", side + "Shoulder", side + "Arm", side + "ForeArm", side + "Hand"],
         )
     ]
@@ -155,7 +155,7 @@ def _limb_parts(joints: dict[str, np.ndarray], side: str, sign: float, girth: fl
         stations = np.array([[0.0, radius, radius, 0.0], [length, 0.85 * radius, 0.8 * radius, 0.0]])
         parts.append(
             (
-                capsule(start, tip - start, up, stations, 6, 0.018, cap_rings=2),
+                capsule(start, tip - start, up, stations, 6, 0.03, cap_rings=2),
                 [side + "Hand", side + "Hand" + finger + "1", side + "Hand" + finger + "2"],
             )
         )
@@ -189,7 +189,7 @@ def _limb_parts(joints: dict[str, np.ndarray], side: str, sign: float, girth: fl
     foot_stations[:, 1:3] *= girth
     parts += [
         (
-            capsule(leg_start, -up, [1.0, 0.0, 0.0], leg_stations, 12, 0.05, shift_direction=forward),
+            capsule(leg_start, -up, [1.0, 0.0, 0.0], leg_stations, 12, 0.06, shift_direction=forward),
             ["Hips", side + "UpLeg", side + "Leg", side + "Foot"],
         ),
         (
@@ -236,7 +236,7 @@ def _skin_weights(
 
 
 def humanoid(seed: int = 0, influences: int = 4) -> SkinnedMesh:
-    """A skinned humanoid in T-pose: 41 joints, about 3,000 triangles, 15 closed tubes.
+    """A skinned humanoid in T-pose: 41 joints, about 3,700 triangles, 15 closed tubes.
 
     Parameters
     ----------

@@ -3,7 +3,8 @@
 Run: ``.venv/bin/python bench/bench_aqem.py [--quick]`` (needs libigl, meshoptimizer and
 fast-simplification from the ``bench`` extra). Tables:
 
-1. Quality on the dev sequences (../shared/data/meshseq) and a procedural bending tube at 50%,
+1. Quality on the dev sequences (../shared/data/meshseq), a procedural bending tube and the
+   synth humanoid's walk (baked) at 50%,
    25% and 10% of the faces: AQEM with and without motion features; static QEM on frame 0
    applied to every frame (meshoptimizer, keeping its vertex subset); fast-simplification on
    frame 0 with its collapses replayed on every frame; meshoptimizer's simplifyWithAttributes
@@ -151,9 +152,12 @@ def bending_tube(frames: int = 24) -> AnimatedMesh:
 
 
 def dev_sequences(quick: bool) -> list[tuple[str, AnimatedMesh]]:
+    from animlod import synth
     from animlod.io.meshseq import read_sequence
 
-    inputs = [("bending tube (procedural)", bending_tube())]
+    humanoid = synth.humanoid()
+    walk = synth.humanoid_motion(humanoid.skeleton, "walk")
+    inputs = [("bending tube (procedural)", bending_tube()), ("humanoid walk (synth)", humanoid.bake(walk))]
     if DATA.is_dir():
         inputs.append(("crane (12 frames)", read_sequence(DATA / "crane")))
         if not quick:

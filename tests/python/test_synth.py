@@ -77,13 +77,15 @@ def test_humanoid_skeleton(body):
     np.testing.assert_allclose(world[skeleton.index("RightHand")], hand * [-1, 1, 1])
 
 
-def test_humanoid_body_size_and_surface(body):
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_humanoid_body_size_and_surface(seed):
+    body = synth.humanoid(seed=seed)
     assert 1300 <= body.face_count <= 5000
     height = body.rest_positions[:, 1].max() - body.rest_positions[:, 1].min()
-    assert 1.65 < height < 1.85
+    assert 1.68 < height < 1.82
     assert abs(body.rest_positions[:, 1].min()) < 0.01  # standing on y = 0
     assert_closed_manifold(body.faces)
-    assert signed_volume(body.rest_positions, body.faces) > 0.03  # a person is about 0.07 m^3
+    assert 0.04 < signed_volume(body.rest_positions, body.faces) < 0.1  # a person is about 0.07 m^3
 
 
 def test_humanoid_skin(body):
@@ -285,3 +287,13 @@ def test_face_animation_moves_the_jaw_not_the_ears(head):
     assert animation.frames[:, jaw, 1].mean(axis=1).min() < head.positions[jaw, 1].mean() - 0.003
     again = synth.face_animation(head, seconds=2.0, fps=30.0)
     assert again.frames.tobytes() == animation.frames.tobytes()
+    assert synth.face_animation(head, seconds=2.0, fps=30.0, seed=1).frames.tobytes() != animation.frames.tobytes()
+
+
+def test_face_animation_blinks_and_rejects_bad_input(head):
+    animation = synth.face_animation(head, seconds=2.0, fps=30.0)
+    eyelid = head.region_mask("eyelid_upper_left")
+    height = animation.frames[:, eyelid, 1].mean(axis=1)
+    assert height.min() < height[0] - 0.001  # the upper lid comes down at least once
+    with pytest.raises(ValueError, match="seconds"):
+        synth.face_animation(head, seconds=0.0)

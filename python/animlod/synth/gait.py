@@ -42,7 +42,7 @@ class GaitStyle:
     pelvis_yaw: float  # pelvis twist; the chest counter-twists
     bob: float  # vertical travel of the hips
     sway: float  # sideways travel of the hips
-    running: bool  # lowest at mid-stance (a run) instead of highest (a walk)
+    running: bool  # a flight phase: highest with the legs apart (a walk is lowest there)
 
 
 _STYLES = {
@@ -95,9 +95,11 @@ def _finger_angles(curl: np.ndarray) -> dict[str, np.ndarray]:
 
 def _gait(phase: np.ndarray, style: GaitStyle) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Root displacement ``(T, 3)`` from the rest pose and Euler angles per joint of a walk or run."""
-    double = 0.5 - 0.5 * np.cos(2.0 * phase)  # 0 at mid-stance, 1 with the legs apart
-    drop = style.bob * ((1.0 - double) if style.running else double)
-    root = _xyz(-style.sway * np.cos(phase), -drop, 0.0)
+    apart = 0.5 - 0.5 * np.cos(2.0 * phase)  # 0 at mid-stance, 1 with the legs furthest apart
+    # A walker vaults over the stance leg (lowest with both feet down); a runner flies
+    # between steps (highest with the legs apart). Mid-stance keeps the rest height.
+    bob = style.bob * apart * (1.0 if style.running else -1.0)
+    root = _xyz(-style.sway * np.cos(phase), bob, 0.0)
     twist = style.pelvis_yaw * np.sin(phase)  # left hip forward while the left thigh swings forward
     angles = {
         "Hips": _xyz(0.0, -twist, 0.3 * style.pelvis_yaw * np.cos(phase)),

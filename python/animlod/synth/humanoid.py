@@ -68,14 +68,18 @@ def _joint_table() -> list[_JointRow]:
     return _SPINE + _LEFT_ARM + _mirrored(_LEFT_ARM) + _LEFT_LEG + _mirrored(_LEFT_LEG)
 
 
+def _proportions(seed: int) -> tuple[float, float]:
+    """Height and girth scale factors of ``seed``: within +-3 % and +-6 %."""
+    height, girth = np.clip(np.random.default_rng(seed).standard_normal(2), -1.0, 1.0)
+    return 1.0 + 0.03 * height, 1.0 + 0.06 * girth
+
+
 def humanoid_skeleton(seed: int = 0) -> Skeleton:
     """The 41-joint skeleton, its proportions varied by ``seed`` (height within about +-3 %)."""
     table = _joint_table()
     names = [name for name, _, _ in table]
     parents = np.array([-1 if parent is None else names.index(parent) for _, parent, _ in table], dtype=np.int32)
-    offsets = np.array([offset for _, _, offset in table], dtype=np.float64)
-    rng = np.random.default_rng(seed)
-    offsets *= 1.0 + 0.03 * np.clip(rng.standard_normal(), -1.0, 1.0)
+    offsets = np.array([offset for _, _, offset in table], dtype=np.float64) * _proportions(seed)[0]
     end_sites = np.isin(names, END_SITES)
     return Skeleton(names, parents, offsets, end_sites=end_sites)
 
@@ -253,7 +257,7 @@ def humanoid(seed: int = 0, influences: int = 4) -> SkinnedMesh:
     if influences not in (1, 2, 3, 4, 8):
         raise ValueError(f"influences: K must be 1-4 or 8, got {influences}")
     skeleton = humanoid_skeleton(seed)
-    girth = 1.0 + 0.06 * np.clip(np.random.default_rng(seed + 1).standard_normal(), -1.0, 1.0)
+    girth = _proportions(seed)[1]
     rest = skeleton.rest_world_transforms()
     world = rest[:, :3, 3]
     parts = _body_parts(dict(zip(skeleton.names, world)), girth)

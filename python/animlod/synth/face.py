@@ -17,7 +17,7 @@ from .geometry import cross_section, icosphere, merge, orthonormal_frame, tube
 _HEAD_RADII = np.array([0.075, 0.11, 0.095])  # half width, height, depth
 _EYE_DIRECTIONS = np.array([[0.33, 0.18, 0.926], [-0.33, 0.18, 0.926]])  # left (+X), right
 _EYE_RADIUS = 0.012
-_MOUTH_HEIGHT = -0.046  # y of the mouth slit
+_MOUTH_DIRECTION = np.array([0.0, -0.46, 0.88])  # between the lips
 
 # (centre direction, extent, amplitude in metres): Gaussian bumps on the unit sphere that push
 # the ellipsoid along its direction into a face.
@@ -122,8 +122,8 @@ def _head_surface(directions: np.ndarray, scale: np.ndarray) -> np.ndarray:
 def _head(rings: int, segments: int, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Latitude-longitude head with poles on the Y axis; returns positions, faces, directions.
 
-    Both angles are warped (``s - k sin(s - s0)``, monotone for k < 1) so that rings and
-    meridians crowd around the face, where the regions are small, and thin out at the back.
+    Both angles are warped as ``a - k sin(n a + c)`` (monotone while ``n k < 1``) so that rings
+    and meridians crowd around the face, where the regions are small, and thin out at the back.
     """
     uniform = np.pi * np.arange(1, rings + 1) / (rings + 1)
     polar = uniform - 0.3 * np.sin(2.0 * uniform - np.pi)  # from the bottom pole up, dense mid-height
@@ -165,15 +165,15 @@ def face(seed: int = 0) -> FaceModel:
         head_region[_inside(directions, centre, extent)] = index  # earlier regions overwrite later ones
 
     eye_positions, eye_faces = icosphere(1, _EYE_RADIUS)
-    eye_centres = _head_surface(_unit(_EYE_DIRECTIONS), scale) - 0.5 * _EYE_RADIUS * _unit(_EYE_DIRECTIONS)
-    mouth_front = float(_head_surface(_unit([[0.0, -0.46, 0.88]]), scale)[0, 2])
+    eye_centres = _head_surface(_unit(_EYE_DIRECTIONS), scale) - 0.2 * _EYE_RADIUS * _unit(_EYE_DIRECTIONS)
+    _, mouth_height, mouth_front = _head_surface(_unit(_MOUTH_DIRECTION[None]), scale)[0]
     arc_radius = 0.032 * scale[0]
     parts = [
         (head_positions, head_faces),
         (eye_positions + eye_centres[0], eye_faces),
         (eye_positions + eye_centres[1], eye_faces),
-        _teeth_arc(_MOUTH_HEIGHT * scale[1] + 0.006, mouth_front - 0.008, arc_radius, 1.8),
-        _teeth_arc(_MOUTH_HEIGHT * scale[1] - 0.006, mouth_front - 0.010, arc_radius, 1.8),
+        _teeth_arc(mouth_height + 0.006, mouth_front - 0.011, arc_radius, 1.8),
+        _teeth_arc(mouth_height - 0.006, mouth_front - 0.013, arc_radius, 1.8),
     ]
     positions, faces, part = merge(parts)
     # The head is part 0 (its vertices come first); the other parts are one region each.

@@ -22,7 +22,8 @@ class Tube:
     faces : (2 * S * R, 3) int32, counter-clockwise seen from outside.
     around : (R * S + 2,) float64 in [0, 1): angle of each vertex about the axis / 2 pi
         (0.5 for the poles); a cylindrical texture coordinate.
-    along : (R * S + 2,) float64 in [0, 1]: position along the axis (0 and 1 at the poles).
+    along : (R * S + 2,) float64 in [0, 1]: ring position along the axis, from the start pole (0)
+        to the end pole (1).
     """
 
     positions: np.ndarray
@@ -79,15 +80,16 @@ def tube(
     poles : (2, 3) the vertex closing the first ring and the one closing the last ring.
     outline : (S, 2) unit cross-section from :func:`cross_section`.
     """
-    u, v, _ = frame
+    u, v, w = frame
     centres = np.asarray(centres, dtype=np.float64)
+    poles = np.asarray(poles, dtype=np.float64)
     ring_count, segment_count = centres.shape[0], outline.shape[0]
     if ring_count < 2:
         raise ValueError(f"centres: a tube needs at least 2 rings, got {ring_count}")
     radii_u = np.asarray(half_widths, dtype=np.float64)[:, None, None] * outline[None, :, 0:1]
     radii_v = np.asarray(half_depths, dtype=np.float64)[:, None, None] * outline[None, :, 1:2]
     rings = centres[:, None, :] + radii_u * u + radii_v * v  # (R, S, 3)
-    positions = np.concatenate([rings.reshape(-1, 3), np.asarray(poles, dtype=np.float64)])
+    positions = np.concatenate([rings.reshape(-1, 3), poles])
 
     ring = np.arange(ring_count)[:, None]
     segment = np.arange(segment_count)[None, :]
@@ -106,7 +108,7 @@ def tube(
     faces = np.concatenate([sides, start_cap, end_cap]).astype(np.int32)
 
     around = np.concatenate([np.tile(np.arange(segment_count) / segment_count, ring_count), [0.5, 0.5]])
-    ring_along = np.linspace(0.0, 1.0, ring_count + 2)[1:-1]
+    ring_along = (centres - poles[0]) @ w / ((poles[1] - poles[0]) @ w)
     along = np.concatenate([np.repeat(ring_along, segment_count), [0.0, 1.0]])
     return Tube(positions, faces, around, along)
 

@@ -15,10 +15,12 @@ import numpy as np
 from ..model import Skeleton, SkinnedMesh
 from .geometry import Tube, capsule, merge, vertex_normals
 
+_JointRow = tuple[str, Optional[str], tuple[float, float, float]]
+
 # Mocap-style joint table for the left side and the centre line: (name, parent, offset in
 # metres). Right-side joints mirror the left ones in x. Fingers: thumb, index, middle and ring
 # with two joints each.
-_SPINE = [
+_SPINE: list[_JointRow] = [
     ("Hips", None, (0.0, 0.95, 0.0)),
     ("Spine", "Hips", (0.0, 0.10, 0.0)),
     ("Spine1", "Spine", (0.0, 0.12, 0.0)),
@@ -27,7 +29,7 @@ _SPINE = [
     ("Head", "Neck", (0.0, 0.10, 0.0)),
     ("HeadTop_End", "Head", (0.0, 0.18, 0.0)),
 ]
-_LEFT_ARM = [
+_LEFT_ARM: list[_JointRow] = [
     ("LeftShoulder", "Spine2", (0.05, 0.12, 0.0)),
     ("LeftArm", "LeftShoulder", (0.13, 0.0, 0.0)),
     ("LeftForeArm", "LeftArm", (0.28, 0.0, 0.0)),
@@ -41,7 +43,7 @@ _LEFT_ARM = [
     ("LeftHandRing1", "LeftHand", (0.085, 0.0, -0.025)),
     ("LeftHandRing2", "LeftHandRing1", (0.04, 0.0, 0.0)),
 ]
-_LEFT_LEG = [
+_LEFT_LEG: list[_JointRow] = [
     ("LeftUpLeg", "Hips", (0.09, -0.05, 0.0)),
     ("LeftLeg", "LeftUpLeg", (0.0, -0.42, 0.0)),
     ("LeftFoot", "LeftLeg", (0.0, -0.40, 0.0)),
@@ -50,9 +52,6 @@ _LEFT_LEG = [
 ]
 END_SITES = ("HeadTop_End", "LeftToe_End", "RightToe_End")
 FINGERS = ("Thumb", "Index", "Middle", "Ring")
-
-
-_JointRow = tuple[str, Optional[str], tuple[float, float, float]]
 
 
 def _mirrored(rows: list[_JointRow]) -> list[_JointRow]:

@@ -12,7 +12,7 @@ import importlib
 import sys
 
 # Subcommand modules in the order --help lists them.
-COMMAND_MODULES = ("info", "demo", "simplify")
+COMMAND_MODULES = ("info", "demo", "simplify", "motion")
 
 
 class UserError(Exception):

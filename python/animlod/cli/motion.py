@@ -1,0 +1,154 @@
+"""``animlod motion INPUT -o OUT --levels 8``: motion levels of detail (joint elimination)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..io.detect import input_kind
+from . import UserError
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "motion",
+        help="remove joints from a motion level by level and re-fit the rest (motion LoD)",
+        description=(
+            "Motion LoD (Sections 4-6 of the motion LoD paper): joint importance from posture error picks the "
+            "joints to freeze at their key frames; every frame is re-fitted (E = 0.2 Ed + 0.4 Es + 0.4 Ea) so "
+            "that the kept joints stay close to the original with rigid bones. Writes one BVH per level and, "
+            "for a skinned glTF, one GLB per level with the skin moved onto the kept joints."
+        ),
+    )
+    parser.add_argument("input", help="a .bvh motion, or a .glb/.gltf with a skinned mesh and an animation")
+    parser.add_argument("-o", "--output", required=True, help="folder to write the levels into (created if missing)")
+    parser.add_argument("--levels", type=int, default=8, help="number of levels, the paper's 100..8%% of the joints")
+    parser.add_argument("--joints", type=int, nargs="+", help="joint counts of the levels instead of --levels")
+    parser.add_argument("--lock", nargs="+", default=[], metavar="JOINT", help="joints never to freeze")
+    parser.add_argument(
+        "--solver",
+        choices=("newton", "slsqp"),
+        default="newton",
+        help="newton: damped Newton over all frames at once (fast); slsqp: nlopt SLSQP per frame (the reference)",
+    )
+    parser.add_argument("--hard", action="store_true", help="hold bone lengths as equality constraints (slsqp)")
+    parser.add_argument("--workers", type=int, default=1, help="processes for --solver slsqp")
+    parser.add_argument(
+        "--weights", type=float, nargs=3, default=(0.2, 0.4, 0.4), metavar=("ALPHA", "BETA", "GAMMA"),
+        help="weights of the distance, string and angle errors (Eq. 5)",
+    )  # fmt: skip
+    parser.add_argument("--max-frames", type=int, default=600, help="frames motion analysis looks at, at most")
+    parser.add_argument("--clip", type=int, default=0, help="which animation of a glTF file (index)")
+    parser.add_argument("--plot", action="store_true", help="write importance, key posture and error charts (PNG)")
+    parser.set_defaults(run=run)
+
+
+class _Progress:
+    """tqdm over levels, and over frames inside each level."""
+
+    def __init__(self, level_count: int) -> None:
+        from tqdm import tqdm
+
+        self._tqdm = tqdm
+        self.levels = tqdm(total=level_count, desc="levels", unit="level", position=0)
+        self.frames = None
+
+    def start_level(self, index: int, joints: int, frame_count: int):
+        if self.frames is not None:
+            self.frames.close()
+            self.levels.update(1)
+        self.frames = self._tqdm(total=frame_count, desc=f"level {index} ({joints} joints)", unit="frame",
+                                 position=1, leave=False)  # fmt: skip
+        return self.frames.update
+
+    def close(self) -> None:
+        if self.frames is not None:
+            self.frames.close()
+            self.levels.update(1)
+        self.levels.close()
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..motion_lod.analysis import analyze_motion
+    from ..motion_lod.chain import build_motion_chain, level_joint_counts
+    from ..motion_lod.objective import Weights
+    from ..motion_lod.refit import SlsqpOptions
+
+    if args.hard and args.solver != "slsqp":
+        raise UserError("--hard: bone-length equality constraints need --solver slsqp")
+    if args.workers < 1:
+        raise UserError(f"--workers: must be at least 1, got {args.workers}")
+    kind = input_kind(args.input)
+    skin = None
+    if kind == "bvh":
+        from ..io.bvh import read_bvh
+
+        motion = read_bvh(args.input)
+    elif kind == "gltf":
+        from ..io.gltf import read_skinned
+
+        skin, motions = read_skinned(args.input)
+        if not motions:
+            raise UserError(f"{args.input}: the skinned mesh has no animation to simplify")
+        if not 0 <= args.clip < len(motions):
+            raise UserError(f"--clip: {args.input} has {len(motions)} animations, got index {args.clip}")
+        motion = motions[args.clip]
+    else:
+        raise UserError(f"{args.input}: motion LoD needs a .bvh or a skinned .glb/.gltf")
+
+    analysis = analyze_motion(motion, locked=args.lock, max_frames=args.max_frames)
+    levels = args.joints if args.joints else args.levels
+    counts = level_joint_counts(motion, analysis, levels)
+    progress = _Progress(len(counts))
+    try:
+        chain = build_motion_chain(
+            motion,
+            counts,
+            weights=Weights(*args.weights),
+            solver=args.solver,
+            slsqp_options=SlsqpOptions(hard_constraints=args.hard),
+            workers=args.workers,
+            skin=skin,
+            on_level=lambda index, joints: progress.start_level(index, joints, motion.frame_count),
+            analysis=analysis,
+        )
+    finally:
+        progress.close()
+
+    output = Path(args.output)
+    output.mkdir(parents=True, exist_ok=True)
+    stem = Path(args.input).stem
+    from ..io.bvh import write_bvh
+
+    for index, level in enumerate(chain.levels):
+        write_bvh(output / f"{stem}_lod{index}.bvh", level.motion)
+        if level.skin is not None:
+            from ..io.gltf import write_glb
+
+            write_glb(output / f"{stem}_lod{index}.glb", level.skin, [level.motion])
+    _print_summary(chain)
+    if args.plot:
+        from ..motion_lod.plots import plot_chain
+
+        plot_chain(output / f"{stem}_motion_lod.png", chain, motion.skeleton.names)
+    return 0
+
+
+def _print_summary(chain) -> None:
+    size = chain.figure_size
+    print(f"\nfigure size {size:.4g} (asset units); errors over every original joint and frame")
+    header = ("level", "joints", "mean err", "max err", "max/size", "bone err", "bone var", "FK resid", "failed", "s")
+    print(" | ".join(f"{h:>9}" for h in header))
+    for index, level in enumerate(chain.levels):
+        r = level.report
+        cells = (
+            index, r.joint_count, f"{r.mean_error:.4g}", f"{r.max_error:.4g}", f"{100 * r.max_error / size:.2f}%",
+            f"{r.bone_error:.3g}", f"{100 * r.bone_variation:.3f}%", f"{r.fk_residual:.2g}", len(r.failures),
+            f"{r.seconds:.1f}",
+        )  # fmt: skip
+        print(" | ".join(f"{c!s:>9}" for c in cells))
+    failures = [f for level in chain.levels for f in level.report.failures]
+    for failure in failures[:10]:
+        print(f"frame {failure.frame}: {failure.reason} -> {failure.outcome}")
+    if len(failures) > 10:
+        print(f"... and {len(failures) - 10} more frames with a failed first solve")

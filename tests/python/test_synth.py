@@ -136,6 +136,11 @@ def test_motion_is_cyclic(body, kind, period):
     assert 0.0 < wrap <= 1.05 * steps.max()
 
 
+def test_motion_frame_count_follows_fps(body):
+    motion = synth.humanoid_motion(body.skeleton, "walk", cycles=3, fps=24.0)
+    assert motion.frame_count == 3 * round(1.1 * 24.0) and motion.fps == 24.0
+
+
 def test_motion_is_deterministic(body):
     a = synth.humanoid_motion(body.skeleton, "walk", seed=7)
     b = synth.humanoid_motion(body.skeleton, "walk", seed=7)
@@ -158,8 +163,18 @@ def test_walk_looks_like_a_walk(body):
     # Hips bob and sway a little; the head stays level.
     root = motion.root_positions
     assert 0.01 < np.ptp(root[:, 1]) < 0.08 and 0.01 < np.ptp(root[:, 0]) < 0.1
-    head_up = motion.world_transforms()[:, skeleton.index("Head"), :3, 1]
+    world = motion.world_transforms()
+    head_up = world[:, skeleton.index("Head"), :3, 1]
     assert np.degrees(np.arccos(head_up[:, 1].min())) < 8.0
+    # The chest twists against the pelvis (yaw of each joint's +Z axis about +Y).
+    forward = world[:, :, :3, 2]
+    yaw = np.arctan2(forward[..., 0], forward[..., 2])
+    pelvis, chest = yaw[:, skeleton.index("Hips")], yaw[:, skeleton.index("Spine2")]
+    assert np.corrcoef(pelvis, chest)[0, 1] < -0.9 and np.ptp(pelvis) > 0.05
+    # Knees bend forward only, by up to about 60 degrees in the swing.
+    knee = motion.local_rotations[:, skeleton.index("LeftLeg")]
+    angle = 2.0 * np.arctan2(knee[:, 0], knee[:, 3])  # rotation about +X
+    assert angle.min() >= 0.0 and 0.7 < angle.max() < 1.4
 
 
 def test_jump_leaves_the_ground(body):

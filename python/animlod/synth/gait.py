@@ -121,7 +121,8 @@ def _jump(u: np.ndarray, skeleton: Skeleton, scale: float) -> tuple[np.ndarray, 
 
     Crouch (0-0.42), take-off at 0.42, flight (0.42-0.78, the root on a parabola), landing
     crouch (0.78-1). While the feet are down the legs follow the hip drop by two-bone inverse
-    kinematics, so the ankles stay under the hips and the feet stay flat.
+    kinematics, so the ankles stay under the hips and the feet stay flat. ``scale`` scales the
+    crouch depth and the jump height.
     """
     crouch = bump(u, 0.0, 0.42) + 0.8 * bump(u, 0.78, 1.0)
     flight = np.clip((u - 0.42) / 0.36, 0.0, 1.0)

@@ -13,7 +13,7 @@ import numpy as np
 import pygltflib
 import pytest
 
-from animlod import rotations
+from animlod import rotations, synth
 from animlod.io import FormatError
 from animlod.io.gltf import read_gltf, read_skinned, write_glb
 from animlod.io.gltf_keyframes import frame_times, sample_keyframes
@@ -292,10 +292,8 @@ def test_round_trip_of_stretching_bones_keeps_joint_translations(tmp_path):
 
 
 def test_round_trip_of_procedural_humanoid(tmp_path):
-    humanoid = pytest.importorskip("animlod.synth.humanoid").humanoid
-    humanoid_motion = pytest.importorskip("animlod.synth.gait").humanoid_motion
-    mesh = humanoid()
-    walk = humanoid_motion(mesh.skeleton, "walk")
+    mesh = synth.humanoid()
+    walk = synth.humanoid_motion(mesh.skeleton, "walk")
     path = tmp_path / "humanoid.glb"
     write_glb(path, mesh, [walk])
     read, (read_walk,) = read_skinned(path, fps=walk.fps)

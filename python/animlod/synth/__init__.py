@@ -9,11 +9,11 @@
 """
 
 from .deforming import bending_cylinder, bending_cylinder_skinned, translating_mesh, twisting_bar
-from .face import REGION_NAMES, STILL_REGIONS, FaceModel, face
+from .face_model import REGION_NAMES, STILL_REGIONS, FaceModel, face
 from .face_animation import face_animation
 from .gait import KINDS, STILL_FINGER_CHAIN, humanoid_motion
 from .geometry import icosphere
-from .humanoid import END_SITES, humanoid, humanoid_skeleton
+from .humanoid_body import END_SITES, humanoid, humanoid_skeleton
 
 __all__ = [
     "END_SITES",

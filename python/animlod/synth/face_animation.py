@@ -12,7 +12,7 @@ import numpy as np
 from .. import rotations
 from ..model import AnimatedMesh
 from .curves import bump
-from .face import STILL_REGIONS, FaceModel
+from .face_model import STILL_REGIONS, FaceModel
 
 _JAW_OPENING = 0.28  # radians at the widest
 

@@ -21,7 +21,7 @@ import numpy as np
 from .. import rotations
 from ..model import Motion, Skeleton
 from .curves import bump, raised
-from .humanoid import FINGERS
+from .humanoid_body import FINGERS
 
 STILL_FINGER_CHAIN = ("LeftHandRing1", "LeftHandRing2")
 KINDS = ("walk", "run", "jump")

@@ -1,0 +1,73 @@
+"""The animlod command line: info on every format, demo end to end, exit code 2 on user mistakes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from animlod import AnimatedMesh, Motion, Skeleton, rotations
+from animlod.cli import main
+from animlod.io.bvh import write_bvh
+from animlod.io.npz import write_npz
+
+
+def _small_motion() -> Motion:
+    skeleton = Skeleton(["hips", "leg", "leg_End"], [-1, 0, 1], [[0, 1, 0], [0, -0.5, 0], [0, -0.5, 0]],
+                        end_sites=[False, False, True])
+    local = rotations.identity((4, 3))
+    local[:, 1] = rotations.from_axis_angle(np.array([1.0, 0, 0]), np.linspace(0, 0.5, 4))
+    return Motion(skeleton, np.tile([0.0, 1.0, 0.0], (4, 1)), local, fps=24.0)
+
+
+def test_info_bvh(tmp_path, capsys):
+    path = tmp_path / "clip.bvh"
+    write_bvh(path, _small_motion())
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "joints: 2 (+1 end sites), root 'hips'" in out
+    assert "frames: 4 at 24 fps" in out
+
+
+def test_info_npz(tmp_path, capsys):
+    path = tmp_path / "mesh.npz"
+    frames = np.random.default_rng(0).normal(size=(3, 4, 3))
+    write_npz(path, AnimatedMesh([[0, 1, 2], [0, 2, 3]], frames, fps=10.0))
+    assert main(["info", str(path)]) == 0
+    assert "vertices: 4, triangles: 2" in capsys.readouterr().out
+
+
+def test_info_real_files(data_dir, capsys):
+    assert main(["info", str(data_dir / "bvh" / "131_01.bvh")]) == 0
+    assert "joints: 31 (+7 end sites)" in capsys.readouterr().out
+    assert main(["info", str(data_dir / "gltf" / "Soldier.glb")]) == 0
+    out = capsys.readouterr().out
+    assert out.count("skinned mesh") == 2 and "'Walk'" in out
+    assert main(["info", str(data_dir / "meshseq" / "crane")]) == 0
+    assert "vertices: 10002, triangles: 20000" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "name, content, message",
+    [
+        ("missing.bvh", None, "does not exist"),
+        ("notes.txt", b"hello", "unknown type .txt"),
+        ("broken.bvh", b"HIERARCHY\nROOT hips\n{\n", "broken.bvh"),
+    ],
+)
+def test_user_mistakes_exit_2_with_one_line(tmp_path, capsys, name, content, message):
+    path = tmp_path / name
+    if content is not None:
+        path.write_bytes(content)
+    assert main(["info", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_demo_writes_a_glb_that_loads_back(tmp_path, capsys):
+    from animlod.io.gltf import read_skinned
+
+    assert main(["demo", "-o", str(tmp_path)]) == 0
+    skinned, motions = read_skinned(tmp_path / "character.glb")
+    assert skinned.skeleton.joint_count >= 30
+    assert [m.name for m in motions] == ["walk", "run", "jump"]
+    assert (tmp_path / "summary.txt").read_text().startswith("character:")

@@ -31,7 +31,7 @@ def test_the_still_finger_chain_has_zero_importance_and_goes_first(walk_chain) -
 
 
 def test_levels_have_the_asked_joint_counts_and_growing_error(walk_chain) -> None:
-    _, motion, chain = walk_chain
+    _, _, chain = walk_chain
     assert [level.report.joint_count for level in chain.levels] == [38, 28, 18, 10]
     frozen = [level.report.frozen for level in chain.levels]
     for finer, coarser in zip(frozen, frozen[1:]):

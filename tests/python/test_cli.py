@@ -71,3 +71,4 @@ def test_demo_writes_a_glb_that_loads_back(tmp_path, capsys):
     assert skinned.skeleton.joint_count >= 30
     assert [m.name for m in motions] == ["walk", "run", "jump"]
     assert (tmp_path / "summary.txt").read_text().startswith("character:")
+

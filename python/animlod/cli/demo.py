@@ -44,7 +44,8 @@ def run(args: argparse.Namespace) -> int:
     baked = character.bake(motions[0])
     extent = baked.frames.max(axis=(0, 1)) - baked.frames.min(axis=(0, 1))
     lines.append(
-        f"baked walk: {baked.frame_count} frames at {baked.fps:g} fps, extent {np.round(extent, 3).tolist()} "
+        f"baked walk: {baked.frame_count} frames at {baked.fps:g} fps, extent "
+        f"{' x '.join(f'{value:.2f}' for value in extent)} m "
         f"({time.perf_counter() - start:.3f} s)"
     )
 

@@ -20,8 +20,16 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> It
     try:
         with os.fdopen(fd, mode, **open_kwargs) as handle:
             yield handle
+        # mkstemp creates the file 0600; give it the permissions a plain open() would.
+        os.chmod(temporary, 0o666 & ~_current_umask())
         os.replace(temporary, target)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(temporary)
         raise
+
+
+def _current_umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask

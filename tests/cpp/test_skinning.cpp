@@ -9,25 +9,32 @@ namespace {
 std::vector<float> translation(float x, float y, float z) {
   return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, x, y, z, 1};
 }
-}  // namespace
 
-TEST_CASE("bake_lbs blends two translated joints by weight") {
-  const std::vector<float> rest = {1, 2, 3};
-  const std::vector<int32_t> joints = {0, 1};
-  const std::vector<float> weights = {0.25f, 0.75f};
-  std::vector<float> matrices = translation(4, 0, 0);
-  const std::vector<float> second = translation(0, 8, 0);
-  matrices.insert(matrices.end(), second.begin(), second.end());
-
+// One frame; the vectors must outlive the returned view.
+animlod::SkinningInput one_frame(const std::vector<float>& rest, const std::vector<int32_t>& joints,
+                                 const std::vector<float>& weights, const std::vector<float>& matrices) {
   animlod::SkinningInput input;
   input.rest_positions = rest.data();
   input.joints = joints.data();
   input.weights = weights.data();
   input.skin_matrices = matrices.data();
-  input.vertex_count = 1;
-  input.influence_count = 2;
-  input.joint_count = 2;
+  input.vertex_count = rest.size() / 3;
+  input.influence_count = joints.size() / input.vertex_count;
+  input.joint_count = matrices.size() / 16;
   input.frame_count = 1;
+  return input;
+}
+}  // namespace
+
+TEST_CASE("bake_lbs blends two translated joints by weight") {
+  const std::vector<float> rest = {1, 2, 3};
+  std::vector<float> matrices = translation(4, 0, 0);
+  const std::vector<float> second = translation(0, 8, 0);
+  matrices.insert(matrices.end(), second.begin(), second.end());
+  const std::vector<int32_t> joints = {0, 1};
+  const std::vector<float> weights = {0.25f, 0.75f};
+  const animlod::SkinningInput input = one_frame(rest, joints, weights, matrices);
+
   std::vector<float> out(3);
   REQUIRE(animlod::bake_lbs(input, out.data()).ok);
   CHECK(out[0] == doctest::Approx(1 + 0.25 * 4));
@@ -40,17 +47,8 @@ TEST_CASE("bake_lbs names the vertex with a joint index out of range") {
   const std::vector<int32_t> joints = {0, 5};
   const std::vector<float> weights = {1, 1};
   const std::vector<float> matrices = translation(0, 0, 0);
-  animlod::SkinningInput input;
-  input.rest_positions = rest.data();
-  input.joints = joints.data();
-  input.weights = weights.data();
-  input.skin_matrices = matrices.data();
-  input.vertex_count = 2;
-  input.influence_count = 1;
-  input.joint_count = 1;
-  input.frame_count = 1;
   std::vector<float> out(6);
-  const animlod::Status status = animlod::bake_lbs(input, out.data());
+  const animlod::Status status = animlod::bake_lbs(one_frame(rest, joints, weights, matrices), out.data());
   CHECK_FALSE(status.ok);
   CHECK(status.message.find("vertex 1") != std::string::npos);
 }

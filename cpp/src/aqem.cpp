@@ -523,6 +523,7 @@ Status Simplifier::run(const std::vector<size_t>& targets, AqemResult& out) {
       out.levels.push_back(snapshot(targets[next_level], true));
   };
   take_reached_levels();
+  if (options_.progress) options_.progress(0, planned);
   while (next_level < targets.size() && !heap_.empty()) {
     const int32_t edge = heap_.top();
     const Candidate candidate = evaluate(edge);

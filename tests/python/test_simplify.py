@@ -121,7 +121,8 @@ def test_uvs_are_carried_as_attributes():
 def test_progress_reports_the_collapses():
     calls = []
     result = simplify_animated(bending_tube(), (0.1,), progress=lambda done, total: calls.append((done, total)))
-    assert calls[-1] == (result.collapses.removed.size, (360 - 36 + 1) // 2)
+    planned = (360 - 36 + 1) // 2
+    assert calls[0] == (0, planned) and calls[-1] == (result.collapses.removed.size, planned)
 
 
 @pytest.mark.parametrize(
@@ -233,3 +234,16 @@ def test_inversion_check_rejects_a_collapse_that_folds_a_star():
     checked, kept_checked = normal_z(True)
     assert kept_unchecked == 1 and np.count_nonzero(unchecked < 0) == 2
     assert kept_checked == 2 and np.all(checked > 0)
+
+
+def test_an_exception_in_progress_stops_the_run_cleanly():
+    calls = []
+
+    def interrupt(done: int, total: int) -> None:
+        calls.append(done)
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        simplify_animated(bending_tube(), (0.1,), progress=interrupt)
+    assert calls == [0]  # raised at the first report, before any collapse
+    assert simplify_animated(bending_tube(), (0.1,)).levels[0].reached  # still usable afterwards

@@ -2,7 +2,7 @@
 
 E (Eqs. 5-8) has cheap exact second derivatives (objective.half_hessian), so each step solves
 ``(H + mu I) delta = -grad / 2`` for all active frames at once with batched dense solves
-(3(P - 1) unknowns per frame). mu follows Nielsen's rule for Levenberg-Marquardt: shrink it by
+(3 unknowns per point of each independent group, objective.split_problem). mu follows Nielsen's rule for Levenberg-Marquardt: shrink it by
 the ratio of actual to promised decrease when a step succeeds, double its growth factor when
 one fails. It has no hard constraints (use SLSQP for those). Frames converge independently and
 leave the active set. SLSQP (refit.py) stays the reference; bench/bench_motion.py compares their
@@ -15,8 +15,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .objective import RefitProblem, half_hessian, objective
-from .refit import FrameFailure, RefitResult
+from .objective import RefitProblem, half_hessian, objective, split_problem
+from .refit import FrameFailure, RefitResult, combine_groups, concatenate
 
 
 def refit_newton(
@@ -27,7 +27,7 @@ def refit_newton(
     xtol: float = 1e-6,
     max_iterations: int = 100,
     chunk_frames: int = 256,
-    progress: Callable[[int], None] | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> RefitResult:
     """Minimise E per frame, starting from the original positions.
 
@@ -42,25 +42,24 @@ def refit_newton(
     max_iterations : steps per frame; a frame still moving then is reported as a failure
         (its best point is kept).
     chunk_frames : frames solved together (bounds the (chunk, N, N) matrices in memory).
-    progress : called with the number of frames finished after each chunk.
+    progress : called with the (fractional) number of frames finished after each chunk.
 
     Returns
     -------
-    RefitResult; ``evaluations`` counts objective evaluations per frame.
+    RefitResult; ``evaluations`` counts objective evaluations per frame, summed over groups.
     """
-    results = []
-    for first in range(0, original.shape[0], chunk_frames):
-        rows = slice(first, first + chunk_frames)
-        begin = original[rows] if start is None else start[rows]
-        results.append(_solve_chunk(problem, first, original[rows], begin, ftol_rel, xtol, max_iterations))
-        if progress:
-            progress(results[-1].positions.shape[0])
-    return RefitResult(
-        np.concatenate([r.positions for r in results]),
-        np.concatenate([r.objective for r in results]),
-        np.concatenate([r.evaluations for r in results]),
-        [f for r in results for f in r.failures],
-    )
+    groups, _ = split_problem(problem)
+    solved = []
+    for points, sub in groups:
+        chunks = []
+        for first in range(0, original.shape[0], chunk_frames):
+            rows = slice(first, first + chunk_frames)
+            begin = original[rows, points] if start is None else start[rows, points]
+            chunks.append(_solve_chunk(sub, first, original[rows, points], begin, ftol_rel, xtol, max_iterations))
+            if progress:
+                progress(chunks[-1].positions.shape[0] / len(groups))
+        solved.append((points, concatenate(chunks)))
+    return combine_groups(problem, original, solved)
 
 
 def _solve_chunk(

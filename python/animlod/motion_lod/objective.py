@@ -362,3 +362,73 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
         weights=weights,
         length_scale=scale,
     )
+
+
+def split_problem(problem: RefitProblem) -> tuple[list[tuple[np.ndarray, RefitProblem]], np.ndarray]:
+    """Split E into the independent problems of groups of points its terms tie together.
+
+    The root is fixed, so terms only couple non-root points: E is the sum of one problem per
+    connected group (e.g. the legs and the upper body when the hips' children sit at the hips)
+    and a point with no Es or Ea term has its original position as exact optimum. Solving the
+    groups apart finds the same optimum at a fraction of the cost (a dense solve costs n^3).
+
+    Returns ``[(points, sub_problem)]``, where ``points`` are original point indices with the
+    root first and the sub-problem numbers its points by position in ``points``, and the
+    isolated points (root excluded).
+    """
+    label = np.arange(problem.point_count)
+
+    def find(point: int) -> int:
+        while label[point] != point:
+            label[point] = label[label[point]]
+            point = label[point]
+        return point
+
+    triples, quads = problem.angle_triples, problem.handed_quads
+    edges = [
+        problem.length_pairs,
+        problem.coincident_pairs,
+        triples[:, :2],
+        triples[:, 1:],
+        quads[:, :2],
+        quads[:, 1:3],
+        quads[:, 2:],
+    ]
+    coupled = np.zeros(problem.point_count, bool)
+    for a, b in np.concatenate([e.reshape(-1, 2) for e in edges]):
+        coupled[[a, b]] = True
+        if a != 0 and b != 0:
+            label[find(int(a))] = find(int(b))
+    coupled[0] = False
+    group_of = np.array([find(p) for p in range(problem.point_count)])
+    result = []
+    for group in np.unique(group_of[coupled]):
+        points = np.concatenate([[0], np.flatnonzero(coupled & (group_of == group))])
+        renumber = np.full(problem.point_count, -1, dtype=np.int64)
+        renumber[points] = np.arange(points.size)
+
+        # A term belongs to the group holding all its points.
+        pairs, together, angles, handed = (
+            np.all(renumber[terms] >= 0, axis=1)
+            for terms in (problem.length_pairs, problem.coincident_pairs, triples, quads)
+        )
+        result.append(
+            (
+                points,
+                RefitProblem(
+                    point_count=points.size,
+                    length_pairs=renumber[problem.length_pairs[pairs]].reshape(-1, 2),
+                    key_lengths=problem.key_lengths[pairs],
+                    bone_pair=problem.bone_pair[pairs],
+                    coincident_pairs=renumber[problem.coincident_pairs[together]].reshape(-1, 2),
+                    handed_quads=renumber[quads[handed]].reshape(-1, 4),
+                    key_volumes=problem.key_volumes[handed],
+                    angle_triples=renumber[triples[angles]].reshape(-1, 3),
+                    key_cosines=problem.key_cosines[angles],
+                    weights=problem.weights,
+                    length_scale=problem.length_scale,
+                ),
+            )
+        )
+    isolated = np.flatnonzero(~coupled)
+    return result, isolated[isolated != 0]

@@ -1,7 +1,8 @@
 """Per-frame re-fit with nlopt's SLSQP (Section 5.2: "SQP is applied to solve this problem").
 
 E (Eq. 5) does not couple frames, so every frame is one small problem in 3(P - 1) unknowns,
-never one big one (SLSQP's cost grows with the cube of the size). The unknowns are the points'
+never one big one (SLSQP's cost grows with the cube of the size); within a frame it splits
+further into independent groups of points (objective.split_problem), each solved on its own. The unknowns are the points'
 displacements from the original positions in units of the length scale L, so a frame starts
 at z = 0 (the paper's "initial values: the original positions") and the next frame is
 warm-started from the previous frame's correction z*(t-1), since neighbouring frames need
@@ -21,14 +22,14 @@ it is feasible, and on the key posture's side of every mirror image.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import nlopt
 import numpy as np
 
-from .objective import RefitProblem, handedness_constraints, objective, rigidity_constraints
+from .objective import RefitProblem, handedness_constraints, objective, rigidity_constraints, split_problem
 
 
 @dataclass(frozen=True)
@@ -168,9 +169,9 @@ def refit_slsqp(
     options: SlsqpOptions | None = None,
     chunk_frames: int = 64,
     workers: int = 1,
-    progress: Callable[[int], None] | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> RefitResult:
-    """Re-fit every frame with SLSQP.
+    """Re-fit every frame with SLSQP, one solve per frame and independent group of points.
 
     Parameters
     ----------
@@ -180,24 +181,41 @@ def refit_slsqp(
     options : stopping rules, hard constraints, checks.
     chunk_frames : frames per warm-started chunk (and per task with ``workers > 1``).
     workers : processes; 1 solves in this process.
-    progress : called with the number of frames finished after each chunk.
+    progress : called with the (fractional) number of frames finished after each chunk.
     """
     options = options or SlsqpOptions()
-    starts = list(range(0, original.shape[0], chunk_frames))
-    tasks = [(problem, s, original[s : s + chunk_frames], fallback[s : s + chunk_frames], options) for s in starts]
+    groups, _ = split_problem(problem)
+    tasks = [
+        (sub, s, original[s : s + chunk_frames, points], fallback[s : s + chunk_frames, points], options)
+        for points, sub in groups
+        for s in range(0, original.shape[0], chunk_frames)
+    ]
     if workers > 1:
         with ProcessPoolExecutor(max_workers=workers) as pool:
-            results = []
-            for result in pool.map(_solve_chunk_task, tasks):
-                results.append(result)
-                if progress:
-                    progress(result.positions.shape[0])
+            results = list(_reported(pool.map(_solve_chunk_task, tasks), len(groups), progress))
     else:
-        results = []
-        for task in tasks:
-            results.append(_solve_chunk(*task))
-            if progress:
-                progress(results[-1].positions.shape[0])
+        results = list(_reported(map(_solve_chunk_task, tasks), len(groups), progress))
+    per_group = len(tasks) // max(len(groups), 1)
+    return combine_groups(
+        problem,
+        original,
+        [(points, concatenate(results[k * per_group : (k + 1) * per_group])) for k, (points, _) in enumerate(groups)],
+    )
+
+
+def _reported(results: Iterable[RefitResult], group_count: int, progress: Callable[[float], None] | None):
+    for result in results:
+        if progress:
+            progress(result.positions.shape[0] / group_count)
+        yield result
+
+
+def _solve_chunk_task(task: tuple) -> RefitResult:
+    return _solve_chunk(*task)
+
+
+def concatenate(results: list[RefitResult]) -> RefitResult:
+    """Consecutive chunks of frames as one result."""
     return RefitResult(
         np.concatenate([r.positions for r in results]),
         np.concatenate([r.objective for r in results]),
@@ -206,5 +224,20 @@ def refit_slsqp(
     )
 
 
-def _solve_chunk_task(task: tuple) -> RefitResult:
-    return _solve_chunk(*task)
+def combine_groups(
+    problem: RefitProblem, original: np.ndarray, solved: list[tuple[np.ndarray, RefitResult]]
+) -> RefitResult:
+    """The whole problem's result from its groups' (objective.split_problem): points in no group
+    keep their original positions, their exact optimum; E and evaluations add up; a frame is
+    reported once, with its first group failure."""
+    positions = original.copy()
+    value = np.zeros(original.shape[0])
+    evaluations = np.zeros(original.shape[0], dtype=np.int64)
+    failures: dict[int, FrameFailure] = {}
+    for points, result in solved:
+        positions[:, points[1:]] = result.positions[:, 1:]
+        value += result.objective
+        evaluations += result.evaluations
+        for failure in result.failures:
+            failures.setdefault(failure.frame, failure)
+    return RefitResult(positions, value, evaluations, [failures[f] for f in sorted(failures)])

@@ -50,6 +50,7 @@ struct AqemOptions {
   bool strict_inversion = false;
   // Quadrics over K frames only (memory O(V K) instead of O(V F)): 0 uses every frame,
   // otherwise K frames chosen by farthest-point sampling of the poses (see frames_used).
+  // Motion features always look at every frame (they cost O(E F) time and O(E) memory).
   size_t max_frames = 0;
   // Explicit frames for the quadrics; overrides max_frames when not empty.
   std::vector<int32_t> frame_subset;

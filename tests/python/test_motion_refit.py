@@ -162,3 +162,25 @@ def test_freezing_the_root_or_an_end_site_is_refused(figure) -> None:
         freeze(motion, analysis, [0])
     with pytest.raises(ValueError, match="'LeftKnee_End' cannot be frozen"):
         freeze(motion, analysis, [motion.skeleton.index("LeftKnee_End")])
+
+
+def test_a_zero_length_bone_is_held_together_and_survives_hard_constraints() -> None:
+    from animlod.model import Motion, Skeleton
+
+    motion = figure_motion()
+    skeleton = motion.skeleton
+    offsets = skeleton.offsets.copy()
+    offsets[skeleton.index("LeftHip")] = 0.0  # LeftHip sits on Hips, as CMU's LHipJoint does
+    zero = Skeleton(skeleton.names, skeleton.parents, offsets, end_sites=skeleton.end_sites)
+    motion = Motion(zero, motion.root_positions, motion.local_rotations, motion.fps)
+    analysis = analyze_motion(motion)
+    level = freeze(motion, analysis, [skeleton.index("LeftKnee")])
+    problem = build_problem(level)
+    assert problem.coincident_pairs.tolist() == [[skeleton.index("LeftHip"), 0]]
+    original = motion.world_positions()
+    fallback = frozen_motion(level, motion).world_positions()
+    result = refit_slsqp(problem, original, fallback, SlsqpOptions(hard_constraints=True))
+    assert result.failures == []
+    np.testing.assert_allclose(result.positions[:, skeleton.index("LeftHip")], original[:, 0], atol=1e-9)
+    reduced = recover_motion(level, result.positions, motion)
+    np.testing.assert_allclose(reduced.world_positions(), result.positions[:, level.kept_indices], atol=1e-6)

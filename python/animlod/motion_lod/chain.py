@@ -117,14 +117,15 @@ def _refit(
     solver: str,
     slsqp_options: SlsqpOptions,
     workers: int,
-    progress: Callable[[int], None] | None,
+    progress: Callable[[float], None] | None,
 ) -> RefitResult:
     if solver == "slsqp":
         return refit_slsqp(problem, original, fallback, slsqp_options, workers=workers, progress=progress)
     # E has several minima at coarse levels; Newton is cheap enough to try the paper's start
     # (the original positions) and the frozen motion, and keep the lower E per frame.
-    from_original = refit_newton(problem, original)
-    from_frozen = refit_newton(problem, original, start=fallback, progress=progress)
+    half = (lambda frames: progress(frames / 2)) if progress else None
+    from_original = refit_newton(problem, original, progress=half)
+    from_frozen = refit_newton(problem, original, start=fallback, progress=half)
     better = from_frozen.objective < from_original.objective
     keep = [f for f in from_original.failures if not better[f.frame]] + [
         f for f in from_frozen.failures if better[f.frame]
@@ -158,7 +159,7 @@ def build_level(
     slsqp_options: SlsqpOptions | None = None,
     workers: int = 1,
     skin: SkinnedMesh | None = None,
-    progress: Callable[[int], None] | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> MotionLevel:
     """One level with ``joint_count`` joints (see :func:`build_motion_chain` for the options)."""
     if solver not in SOLVERS:
@@ -211,7 +212,7 @@ def build_motion_chain(
     workers: int = 1,
     skin: SkinnedMesh | None = None,
     max_frames: int = 600,
-    on_level: Callable[[int, int], Callable[[int], None] | None] | None = None,
+    on_level: Callable[[int, int], Callable[[float], None] | None] | None = None,
     analysis: MotionAnalysis | None = None,
 ) -> MotionLodChain:
     """Analyse ``motion`` and build its levels.

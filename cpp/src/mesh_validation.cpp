@@ -44,18 +44,37 @@ Status check_sizes_and_values(const AnimatedMeshView& mesh) {
   return Status::success();
 }
 
-Status check_duplicate_faces(const AnimatedMeshView& mesh) {
-  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> sorted(mesh.face_count);
-  for (size_t f = 0; f < mesh.face_count; ++f) {
-    std::array<int32_t, 3> key{mesh.faces[3 * f], mesh.faces[3 * f + 1], mesh.faces[3 * f + 2]};
-    std::sort(key.begin(), key.end());
-    sorted[f] = {key, static_cast<int32_t>(f)};
+bool same_vertices(const AnimatedMeshView& mesh, int32_t f, int32_t g) {
+  std::array<int32_t, 3> a{mesh.faces[3 * f], mesh.faces[3 * f + 1], mesh.faces[3 * f + 2]};
+  std::array<int32_t, 3> b{mesh.faces[3 * g], mesh.faces[3 * g + 1], mesh.faces[3 * g + 2]};
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  return a == b;
+}
+
+Status duplicate_error(int32_t f, int32_t g) {
+  return Status::error("faces " + std::to_string(std::min(f, g)) + " and " + std::to_string(std::max(f, g)) +
+                       ": duplicate, same three vertices");
+}
+
+// Two faces on the same three vertices share every edge: either in the same direction (the
+// edge table flags that edge) or in opposite directions with the same opposite vertex.
+Status check_duplicate_faces(const AnimatedMeshView& mesh, const detail::EdgeTable& edges) {
+  if (!edges.manifold) {
+    const auto& bad = edges.bad_faces;
+    for (int i = 0; i < 3; ++i)
+      for (int j = i + 1; j < 3; ++j)
+        if (bad[i] >= 0 && bad[j] >= 0 && same_vertices(mesh, bad[i], bad[j])) return duplicate_error(bad[i], bad[j]);
   }
-  std::sort(sorted.begin(), sorted.end());
-  for (size_t i = 1; i < sorted.size(); ++i)
-    if (sorted[i].first == sorted[i - 1].first)
-      return Status::error("faces " + std::to_string(sorted[i - 1].second) + " and " +
-                           std::to_string(sorted[i].second) + ": duplicate, same three vertices");
+  auto opposite = [&](int32_t face, const std::array<int32_t, 2>& edge) {
+    const int32_t* v = mesh.faces + 3 * face;
+    return v[0] != edge[0] && v[0] != edge[1] ? v[0] : v[1] != edge[0] && v[1] != edge[1] ? v[1] : v[2];
+  };
+  for (size_t e = 0; e < edges.size(); ++e) {
+    if (edges.is_boundary(e)) continue;
+    const auto [f, g] = edges.faces[e];
+    if (opposite(f, edges.vertices[e]) == opposite(g, edges.vertices[e])) return duplicate_error(f, g);
+  }
   return Status::success();
 }
 
@@ -102,9 +121,14 @@ Status check_manifold_vertices(const AnimatedMeshView& mesh, const detail::EdgeT
 }  // namespace
 
 Status validate_animated_mesh(const AnimatedMeshView& mesh) {
+  detail::EdgeTable edges;
+  return detail::validate_and_build_edges(mesh, edges);
+}
+
+Status detail::validate_and_build_edges(const AnimatedMeshView& mesh, EdgeTable& edges) {
   if (Status status = check_sizes_and_values(mesh); !status) return status;
-  if (Status status = check_duplicate_faces(mesh); !status) return status;
-  const detail::EdgeTable edges = detail::build_edge_table(mesh.faces, mesh.face_count);
+  edges = build_edge_table(mesh.faces, mesh.face_count);
+  if (Status status = check_duplicate_faces(mesh, edges); !status) return status;
   if (Status status = check_manifold_edges(edges); !status) return status;
   return check_manifold_vertices(mesh, edges);
 }

@@ -13,7 +13,6 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "animlod/mesh_validation.hpp"
 #include "edge_table.hpp"
 #include "union_find.hpp"
 
@@ -74,10 +73,10 @@ std::vector<float> angle_changes(const AnimatedMeshView& mesh, const detail::Edg
 
 Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeatureOptions& options,
                                MotionFeatures& out) {
-  if (Status status = validate_animated_mesh(mesh); !status) return status;
+  detail::EdgeTable edges;
+  if (Status status = detail::validate_and_build_edges(mesh, edges); !status) return status;
   if (!(options.feature_threshold >= 0.0) || !(options.min_angle_change >= 0.0))
     return Status::error("motion features: feature_threshold and min_angle_change must be >= 0 radians");
-  const detail::EdgeTable edges = detail::build_edge_table(mesh.faces, mesh.face_count);
   const size_t edge_count = edges.size();
 
   // g_i and THR.

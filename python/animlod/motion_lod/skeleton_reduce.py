@@ -8,9 +8,9 @@ optimisation result x_j(t) and the hierarchical information of each joint". Here
   frozen.py).
 - Each kept joint's world rotation starts from its original world rotation (so a bone keeps its
   original twist) and is corrected by the smallest rotation that carries its children's offsets
-  onto the re-fitted child positions: the swing onto the longest child when it has one child (or
-  only collinear ones), the best-fit rotation (Kabsch) when it has several, none when it has no
-  child. Forward kinematics then reproduces the re-fitted positions exactly wherever they are
+  onto the re-fitted child positions, aimed from where forward kinematics has put the joint:
+  the swing onto the longest child when it has one child (or only collinear ones), the best-fit
+  rotation (Kabsch) when it has several, none when it has no child. Forward kinematics then reproduces the re-fitted positions exactly wherever they are
   rigid with respect to the level's skeleton, which the string term Es asks for.
 """
 
@@ -100,12 +100,18 @@ def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) ->
 
     world = np.empty_like(original_world)
     local = np.empty_like(original_world)
+    placed = np.empty_like(targets)  # where forward kinematics has put each joint so far
+    placed[:, 0] = targets[:, 0]
     for joint in range(skeleton.joint_count):
+        parent = skeleton.parents[joint]
+        if parent >= 0:
+            placed[:, joint] = placed[:, parent] + rotations.rotate(world[:, parent], translations[:, joint])
         useful = [c for c in children[joint] if static_offsets[c] > _SHORT * scale]
         base = original_world[:, joint]
         if useful:
             offsets = rotations.rotate(base[:, None], translations[:, useful])
-            wanted = targets[:, useful] - targets[:, joint, None]
+            # Aim from where the joint really is, so that misfits do not pile up down a chain.
+            wanted = targets[:, useful] - placed[:, joint, None]
             if _spans_a_plane(skeleton.offsets[useful]):
                 correction = _best_fit_rotation(offsets, wanted)
             else:
@@ -113,7 +119,6 @@ def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) ->
                 correction = _swing(offsets[:, longest], wanted[:, longest])
             base = rotations.multiply(correction, base)
         world[:, joint] = base
-        parent = skeleton.parents[joint]
         local[:, joint] = base if parent < 0 else rotations.multiply(rotations.conjugate(world[:, parent]), base)
     joint_translations = translations if motion.joint_translations is not None else None
     return Motion(skeleton, positions[:, 0], local, motion.fps, motion.name, joint_translations)

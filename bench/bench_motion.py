@@ -13,7 +13,8 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]``. Tables:
    error and the worst bone's length standard deviation relative to its key length (goal:
    under 0.5 %), FK residual and frames whose solve did not converge.
 3. SLSQP (the paper's SQP) against damped Newton on the same objective, per level of 131_01,
-   on a frame sample: mean E, worst per-frame relative difference of E, seconds per frame.
+   on a frame sample: mean E, worst and best per-frame relative difference of E, time per frame;
+   and SLSQP with hard length constraints: E, time, Fig. 7's bone length variation.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from animlod.motion_lod.chain import build_motion_chain, level_joint_counts
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.newton import refit_newton
 from animlod.motion_lod.objective import build_problem
-from animlod.motion_lod.refit import refit_slsqp
+from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
 from animlod.synth import humanoid, humanoid_motion
 from table import print_table, stopwatch
 
@@ -112,16 +113,22 @@ def solver_table(motion, quick: bool) -> None:
             slsqp = refit_slsqp(problem, original, fallback)
         with stopwatch() as newton_time:
             newton = refit_newton(problem, original)
+        with stopwatch() as hard_time:
+            hard = refit_slsqp(problem, original, fallback, SlsqpOptions(hard_constraints=True))
+        bones = problem.length_pairs[problem.bone_pair]
+        lengths = np.linalg.norm(hard.positions[:, bones[:, 0]] - hard.positions[:, bones[:, 1]], axis=-1)
+        hard_variation = (lengths.std(axis=0) / problem.key_lengths[problem.bone_pair]).max() if bones.size else 0.0
         difference = (newton.objective - slsqp.objective) / np.maximum(slsqp.objective, 1e-300)
         rows.append(
             (count, f"{slsqp.objective.mean():.4g}", f"{newton.objective.mean():.4g}", f"{difference.max():+.2e}",
              f"{difference.min():+.2e}", 1e3 * slsqp_time[0] / frames.size, 1e3 * newton_time[0] / frames.size,
-             f"{slsqp.evaluations.mean():.0f}", f"{newton.evaluations.mean():.0f}")
+             f"{slsqp.evaluations.mean():.0f}", f"{newton.evaluations.mean():.0f}", f"{hard.objective.mean():.4g}",
+             1e3 * hard_time[0] / frames.size, f"{100 * hard_variation:.2e}%", len(hard.failures))
         )  # fmt: skip
     print_table(
         f"SLSQP vs damped Newton (same objective, same start: the original positions), {frames.size} frames",
         ("joints", "E SLSQP", "E Newton", "worst (N-S)/S", "best (N-S)/S", "ms/frame SLSQP", "ms/frame Newton",
-         "evals SLSQP", "evals Newton"),
+         "evals SLSQP", "evals Newton", "E SLSQP hard", "ms/frame hard", "bone std/len hard", "hard failed"),
         rows,
     )  # fmt: skip
 

@@ -15,6 +15,7 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]``. Tables:
 3. SLSQP (the paper's SQP) against damped Newton on the same objective, per level of 131_01,
    on a frame sample: mean E, worst and best per-frame relative difference of E, time per frame;
    and SLSQP with hard length constraints: E, time, Fig. 7's bone length variation.
+4. SLSQP with 1 and 2 worker processes on the same frames (does the pool pay?).
 """
 
 from __future__ import annotations
@@ -133,6 +134,27 @@ def solver_table(motion, quick: bool) -> None:
     )  # fmt: skip
 
 
+def workers_table(motion, quick: bool) -> None:
+    """Does a process pool pay for SLSQP? Same level and frames with 1 and 2 workers."""
+    analysis = analyze_motion(motion)
+    count = level_joint_counts(motion, analysis, 8)[2]
+    level = freeze(motion, analysis, analysis.priority[: int((~motion.skeleton.end_sites).sum()) - count])
+    problem = build_problem(level)
+    frames = sample(motion.frame_count, 32 if quick else 128)
+    original = motion.world_positions()[frames]
+    fallback = frozen_motion(level, motion).world_positions()[frames]
+    rows = []
+    for workers in (1, 2):
+        with stopwatch() as elapsed:
+            refit_slsqp(problem, original, fallback, chunk_frames=16, workers=workers)
+        rows.append((count, frames.size, workers, elapsed[0], 1e3 * elapsed[0] / frames.size))
+    print_table(
+        "SLSQP over worker processes (chunks of 16 frames, warm starts inside a chunk)",
+        ("joints", "frames", "workers", "seconds", "ms/frame"),
+        rows,
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer clips, frames and levels")
@@ -142,6 +164,7 @@ def main() -> None:
     motion = read_bvh(path) if path.exists() else humanoid_motion(humanoid().skeleton, "walk", cycles=8)
     level_table(motion, args.quick)
     solver_table(motion, args.quick)
+    workers_table(motion, args.quick)
 
 
 if __name__ == "__main__":

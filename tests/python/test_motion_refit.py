@@ -184,3 +184,14 @@ def test_a_zero_length_bone_is_held_together_and_survives_hard_constraints() -> 
     np.testing.assert_allclose(result.positions[:, skeleton.index("LeftHip")], original[:, 0], atol=1e-9)
     reduced = recover_motion(level, result.positions, motion)
     np.testing.assert_allclose(reduced.world_positions(), result.positions[:, level.kept_indices], atol=1e-6)
+
+
+def test_worker_processes_give_the_same_result(figure) -> None:
+    motion, analysis, original = figure
+    level = freeze(motion, analysis, analysis.priority[:6])
+    problem = build_problem(level)
+    fallback = frozen_motion(level, motion).world_positions()
+    alone = refit_slsqp(problem, original[:8], fallback[:8], chunk_frames=4)
+    pooled = refit_slsqp(problem, original[:8], fallback[:8], chunk_frames=4, workers=2)
+    np.testing.assert_array_equal(pooled.positions, alone.positions)
+    np.testing.assert_array_equal(pooled.evaluations, alone.evaluations)

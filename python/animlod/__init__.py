@@ -5,7 +5,19 @@ assets in :mod:`animlod.synth`. Heavy lifting is done by the C++ core, ``animlod
 """
 
 from .model import AnimatedMesh, LodChain, LodLevel, Motion, Skeleton, SkinnedMesh
+from .simplify import motion_features, simplify_animated, simplify_skinned
 
 __version__ = "0.1.0"
 
-__all__ = ["AnimatedMesh", "LodChain", "LodLevel", "Motion", "Skeleton", "SkinnedMesh", "__version__"]
+__all__ = [
+    "AnimatedMesh",
+    "LodChain",
+    "LodLevel",
+    "Motion",
+    "Skeleton",
+    "SkinnedMesh",
+    "__version__",
+    "motion_features",
+    "simplify_animated",
+    "simplify_skinned",
+]

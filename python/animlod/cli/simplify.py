@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import math
 import time
 from pathlib import Path
@@ -45,7 +44,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         action="store_true",
         help="drop degenerate/duplicate faces and unreferenced vertices, split bow-tie vertices (not for skins)",
     )
-    parser.add_argument("--no-metrics", action="store_true", help="skip the Hausdorff/RMS measurement (needs libigl)")
+    parser.add_argument("--no-metrics", action="store_true", help="skip the Hausdorff/RMS measurement")
     parser.add_argument(
         "--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side"
     )
@@ -55,9 +54,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if any(not 0.0 < ratio <= 1.0 for ratio in args.ratio):
         raise UserError(f"--ratio: every ratio must be in (0, 1], got {args.ratio}")
-    if not args.no_metrics and importlib.util.find_spec("igl") is None:
-        print("note: libigl is not installed (pip install libigl); skipping the Hausdorff/RMS measurement")
-        args.no_metrics = True
     kind = input_kind(args.input)
     if kind == "bvh":
         raise UserError(f"{args.input}: a BVH file holds motion only; simplify needs a mesh")

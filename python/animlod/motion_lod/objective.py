@@ -8,10 +8,10 @@ terms do not couple frames, so everything here is vectorised over a leading fram
 - Ed (Eq. 6): squared distance of every non-root point to its original position.
 - Es (Eq. 7): squared change of the length between each kept point and its nearest kept
   ancestor, against the key posture ("frame 0"). Extension: also between kept children of one
-  kept joint (siblings), because the output skeleton moves them as one rigid body; without it
-  a parent's rotation could not reproduce its children's optimised positions. Pairs at zero key
-  length (a BVH joint at its parent's position) use the vector difference instead of the
-  length, which is smooth there.
+  kept joint (siblings, a minimal set, see _rigid_set), because the output skeleton moves them
+  as one rigid body; without it a parent's rotation could not reproduce its children's
+  optimised positions. Pairs at zero key length (a BVH joint at its parent's position) use the
+  vector difference instead of the length, which is smooth there.
 - Ea (Eq. 8): squared change of cos theta_r (Eq. 4), the angle at each frozen joint r between
   its parent bone and each child bone, against the key posture.
 
@@ -299,6 +299,43 @@ def handedness_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.nda
     return sign * volumes, jacobian
 
 
+def _rigid_set(
+    parent: int, children: list[int], key: np.ndarray, tolerance: float
+) -> tuple[list[tuple[int, int]], list[tuple[int, int]], list[tuple[int, int, int, int]]]:
+    """The lengths that make a kept joint and its kept children one rigid body, none redundant.
+
+    A child at the parent's position is tied to the parent, one at an earlier child's position
+    to that child; the others (distinct points) get their bone to the parent (Eq. 7) and, when
+    they span a plane with it, the distances that pin them to the two children spanning the
+    largest triangle with the parent (3k - 3 lengths for k distinct children, the count of a
+    rigid body's shape). Each child off that plane also gets a handedness quad.
+
+    Returns bone pairs, sibling pairs and quads (parent, base a, base b, child).
+    """
+    bones, siblings, distinct = [], [], []
+    for child in children:
+        if np.linalg.norm(key[child] - key[parent]) <= tolerance:
+            bones.append((child, parent))
+            continue
+        same = [d for d in distinct if np.linalg.norm(key[child] - key[d]) <= tolerance]
+        if same:
+            siblings.append((child, same[0]))
+        else:
+            distinct.append(child)
+            bones.append((child, parent))
+    if len(distinct) < 2:
+        return bones, siblings, []
+    arms = key[distinct] - key[parent]
+    areas = np.linalg.norm(np.cross(arms[:, None], arms[None]), axis=-1)
+    i, j = np.unravel_index(int(np.argmax(areas)), areas.shape)
+    if areas[i, j] <= tolerance * float(np.linalg.norm(arms, axis=-1).max()):
+        return bones, siblings, []  # all on one line through the parent: the bones hold it
+    a, b = distinct[min(i, j)], distinct[max(i, j)]
+    others = [c for c in distinct if c not in (a, b)]
+    siblings += [(b, a)] + [(c, base) for c in others for base in (a, b)]
+    return bones, siblings, [(parent, a, b, c) for c in others]
+
+
 def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitProblem:
     """The per-frame problem of a level: its Es pairs and Ea triples with key-posture targets."""
     weights = weights or Weights()
@@ -308,32 +345,17 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
     kept = level.kept_indices[1:]
     rigid = ~level.animated  # an animated translation has no fixed length to hold
 
-    bones = [(int(c), int(level.kept_parent[c])) for c in kept if rigid[c]]
-    # Siblings at their parent's position are already held by their bone: a pair with them
-    # would repeat that bone's constraint (and make SLSQP's constraint Jacobian singular).
-    apart = np.linalg.norm(key - key[np.maximum(level.kept_parent, 0)], axis=-1) > _COINCIDENT * scale
-    siblings = []
+    bones, siblings, quads = [], [], []
     for parent in np.unique(level.kept_parent[kept]):
-        group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c] and apart[c]]
-        siblings += [(a, b) for i, b in enumerate(group) for a in group[i + 1 :]]
+        group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c]]
+        rigid_set = _rigid_set(int(parent), group, key, _COINCIDENT * scale)
+        bones += rigid_set[0]
+        siblings += rigid_set[1]
+        quads += [q for q in rigid_set[2] if abs(_volumes(key[None], np.array([q]))[0][0, 0]) > 1e-6 * scale**3]
     pairs = np.array(bones + siblings, dtype=np.int64).reshape(-1, 2)
     is_bone = np.arange(pairs.shape[0]) < len(bones)
     lengths = np.linalg.norm(key[pairs[:, 0]] - key[pairs[:, 1]], axis=-1)
     coincident = lengths <= _COINCIDENT * scale
-
-    quads = []
-    for parent in np.unique(level.kept_parent[kept]):
-        group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c] and apart[c]]
-        candidates = [
-            (int(parent), a, b, c)
-            for i, a in enumerate(group)
-            for j, b in enumerate(group[i + 1 :], i + 1)
-            for c in group[j + 1 :]
-        ]
-        if candidates:
-            volumes = np.abs(_volumes(key[None], np.array(candidates))[0][0])
-            if volumes.max() > 1e-6 * scale**3:
-                quads.append(candidates[int(np.argmax(volumes))])
     quads_array = np.array(quads, dtype=np.int64).reshape(-1, 4)
 
     triples = []

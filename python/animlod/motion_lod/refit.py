@@ -111,7 +111,9 @@ def _solve_frame(
     value = energy(z, np.empty(0)) if np.all(np.isfinite(z)) else np.inf
     if not np.isfinite(value):
         return z, value, evaluations, "non-finite result"
-    if code < 0:
+    # NLopt documents ROUNDOFF_LIMITED as usually still returning a useful result: it is kept
+    # when it passes the same checks as a success.
+    if code < 0 and code != nlopt.ROUNDOFF_LIMITED:
         return z, value, evaluations, f"nlopt result {code}"
     if options.hard_constraints and problem.constraint_count:
         result = np.empty(problem.constraint_count)

@@ -195,3 +195,11 @@ def test_worker_processes_give_the_same_result(figure) -> None:
     pooled = refit_slsqp(problem, original[:8], fallback[:8], chunk_frames=4, workers=2)
     np.testing.assert_array_equal(pooled.positions, alone.positions)
     np.testing.assert_array_equal(pooled.evaluations, alone.evaluations)
+
+
+def test_newton_worker_processes_give_the_same_result(figure) -> None:
+    motion, analysis, original = figure
+    problem = build_problem(freeze(motion, analysis, analysis.priority[:6]))
+    alone = refit_newton(problem, original, chunk_frames=8)
+    pooled = refit_newton(problem, original, chunk_frames=8, workers=2)
+    np.testing.assert_array_equal(pooled.positions, alone.positions)

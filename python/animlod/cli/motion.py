@@ -32,7 +32,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="newton: damped Newton over all frames at once (fast); slsqp: nlopt SLSQP per frame (the reference)",
     )
     parser.add_argument("--hard", action="store_true", help="hold bone lengths as equality constraints (slsqp)")
-    parser.add_argument("--workers", type=int, default=1, help="processes for --solver slsqp")
+    parser.add_argument("--workers", type=int, default=1, help="processes solving chunks of frames side by side")
     parser.add_argument(
         "--weights", type=float, nargs=3, default=(0.2, 0.4, 0.4), metavar=("ALPHA", "BETA", "GAMMA"),
         help="weights of the distance, string and angle errors (Eq. 5)",

@@ -124,8 +124,8 @@ def _refit(
     # E has several minima at coarse levels; Newton is cheap enough to try the paper's start
     # (the original positions) and the frozen motion, and keep the lower E per frame.
     half = (lambda frames: progress(frames / 2)) if progress else None
-    from_original = refit_newton(problem, original, progress=half)
-    from_frozen = refit_newton(problem, original, start=fallback, progress=half)
+    from_original = refit_newton(problem, original, workers=workers, progress=half)
+    from_frozen = refit_newton(problem, original, start=fallback, workers=workers, progress=half)
     better = from_frozen.objective < from_original.objective
     keep = [f for f in from_original.failures if not better[f.frame]] + [
         f for f in from_frozen.failures if better[f.frame]
@@ -226,7 +226,7 @@ def build_motion_chain(
     solver : ``"newton"`` (damped Newton, vectorised over frames; default) or ``"slsqp"``
         (nlopt's SLSQP per frame, the paper's SQP; needed for hard constraints).
     slsqp_options : SLSQP stopping rules and the hard-constraint option.
-    workers : processes for SLSQP.
+    workers : processes solving chunks of frames side by side (both solvers).
     skin : the character's skin on ``motion.skeleton`` (same joint names), or None.
     max_frames : frames motion analysis uses at most (analysis.py).
     on_level : called with (level index, joint count) before each level; may return a progress

@@ -12,6 +12,8 @@ optima.
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import nullcontext
 
 import numpy as np
 
@@ -27,6 +29,7 @@ def refit_newton(
     xtol: float = 1e-6,
     max_iterations: int = 100,
     chunk_frames: int = 256,
+    workers: int = 1,
     progress: Callable[[float], None] | None = None,
 ) -> RefitResult:
     """Minimise E per frame, starting from the original positions.
@@ -42,6 +45,7 @@ def refit_newton(
     max_iterations : steps per frame; a frame still moving then is reported as a failure
         (its best point is kept).
     chunk_frames : frames solved together (bounds the (chunk, N, N) matrices in memory).
+    workers : processes solving chunks side by side; 1 solves in this process.
     progress : called with the (fractional) number of frames finished after each chunk.
 
     Returns
@@ -49,17 +53,29 @@ def refit_newton(
     RefitResult; ``evaluations`` counts objective evaluations per frame, summed over groups.
     """
     groups, _ = split_problem(problem)
-    solved = []
-    for points, sub in groups:
-        chunks = []
-        for first in range(0, original.shape[0], chunk_frames):
-            rows = slice(first, first + chunk_frames)
-            begin = original[rows, points] if start is None else start[rows, points]
-            chunks.append(_solve_chunk(sub, first, original[rows, points], begin, ftol_rel, xtol, max_iterations))
+    begin = original if start is None else start
+    tasks = [
+        (sub, first, original[first : first + chunk_frames, points], begin[first : first + chunk_frames, points],
+         ftol_rel, xtol, max_iterations)
+        for points, sub in groups
+        for first in range(0, original.shape[0], chunk_frames)
+    ]  # fmt: skip
+    results = []
+    with ProcessPoolExecutor(max_workers=workers) if workers > 1 else nullcontext() as pool:
+        for result in pool.map(_solve_task, tasks) if pool else map(_solve_task, tasks):
+            results.append(result)
             if progress:
-                progress(chunks[-1].positions.shape[0] / len(groups))
-        solved.append((points, concatenate(chunks)))
-    return combine_groups(problem, original, solved)
+                progress(result.positions.shape[0] / len(groups))
+    per_group = len(tasks) // max(len(groups), 1)
+    return combine_groups(
+        problem,
+        original,
+        [(points, concatenate(results[k * per_group : (k + 1) * per_group])) for k, (points, _) in enumerate(groups)],
+    )
+
+
+def _solve_task(task: tuple) -> RefitResult:
+    return _solve_chunk(*task)
 
 
 def _solve_chunk(

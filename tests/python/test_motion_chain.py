@@ -120,3 +120,13 @@ def test_cli_on_a_skinned_glb_writes_a_glb_per_level(tmp_path) -> None:
     assert full.skeleton.joint_count == skin.skeleton.joint_count
     assert coarse.skeleton.joint_count < full.skeleton.joint_count
     assert len(motions) == 1 and motions[0].skeleton.joint_count == coarse.skeleton.joint_count
+
+
+def test_frozen_joints_keep_their_key_angle_on_the_walk(walk_chain) -> None:
+    _, motion, chain = walk_chain
+    for level in chain.levels[1:]:
+        frozen = np.flatnonzero(level.frozen.frozen)
+        placed = expand_motion(level.frozen, level.motion, motion).local_rotations[:, frozen]
+        key = level.frozen.key_rotations[frozen]
+        np.testing.assert_allclose(np.abs(np.sum(placed * key, axis=-1)), 1.0, atol=1e-12)
+        assert set(frozen.tolist()) == {motion.skeleton.index(name) for name in level.report.frozen}

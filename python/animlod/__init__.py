@@ -4,6 +4,7 @@ The data model lives in :mod:`animlod.model`; file formats in :mod:`animlod.io`;
 assets in :mod:`animlod.synth`. Heavy lifting is done by the C++ core, ``animlod._core``.
 """
 
+from .motion_lod import analyze_motion, build_motion_chain
 from .model import AnimatedMesh, LodChain, LodLevel, Motion, Skeleton, SkinnedMesh
 from .simplify import motion_features, simplify_animated, simplify_skinned
 
@@ -17,6 +18,8 @@ __all__ = [
     "Skeleton",
     "SkinnedMesh",
     "__version__",
+    "analyze_motion",
+    "build_motion_chain",
     "motion_features",
     "simplify_animated",
     "simplify_skinned",

@@ -329,13 +329,17 @@ def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.
 
 @dataclass
 class LodLevel:
-    """One level of a chain: what is drawn, its error in asset units and when it is used."""
+    """One level of a chain: what is drawn and its error in asset units.
+
+    ``screen_coverage`` is the MSFT_screencoverage hint of a glTF chain, or None where the
+    level is chosen from its error alone (:meth:`LodChain.level_for`).
+    """
 
     mesh: AnimatedMesh | SkinnedMesh | None
     skeleton: Skeleton | None
     motions: list[Motion]
     error: float
-    screen_coverage: float
+    screen_coverage: float | None = None
 
 
 @dataclass
@@ -345,9 +349,15 @@ class LodChain:
     levels: list[LodLevel] = field(default_factory=list)
 
     def level_for(self, screen_error_budget: float, distance: float, focal_length_px: float) -> int:
-        """Coarsest level whose error, projected to pixels, stays within the budget."""
+        """Coarsest level whose error, projected to pixels at ``distance``, is within the budget.
+
+        ``error / distance * focal_length_px`` is the level's error on screen in pixels; level 0
+        is used when no level fits.
+        """
+        if distance <= 0.0:
+            raise ValueError(f"distance: must be positive, got {distance}")
         chosen = 0
         for index, level in enumerate(self.levels):
-            if level.error / max(distance, 1e-12) * focal_length_px <= screen_error_budget:
+            if level.error / distance * focal_length_px <= screen_error_budget:
                 chosen = index
         return chosen

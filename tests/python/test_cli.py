@@ -63,12 +63,29 @@ def test_user_mistakes_exit_2_with_one_line(tmp_path, capsys, name, content, mes
     assert message in err and err.count("\n") == 1 and "Traceback" not in err
 
 
-def test_demo_writes_a_glb_that_loads_back(tmp_path, capsys):
+def test_demo_writes_every_level_with_manifests(tmp_path, capsys):
+    import json
+
+    from animlod.io.bvh import read_bvh
     from animlod.io.gltf import read_skinned
 
     assert main(["demo", "-o", str(tmp_path)]) == 0
     skinned, motions = read_skinned(tmp_path / "character.glb")
     assert skinned.skeleton.joint_count >= 30
     assert [m.name for m in motions] == ["walk", "run", "jump"]
-    assert (tmp_path / "summary.txt").read_text().startswith("character:")
 
+    mesh_manifest = json.loads((tmp_path / "character_mesh_lod.json").read_text())
+    faces = [level["faces"] for level in mesh_manifest["levels"]]
+    assert faces[0] == skinned.face_count and faces == sorted(faces, reverse=True) and len(faces) == 4
+    errors = [level["error"] for level in mesh_manifest["levels"]]
+    assert errors[0] == 0.0 and errors == sorted(errors)
+    for level in mesh_manifest["levels"][1:]:
+        coarse, _ = read_skinned(tmp_path / level["file"])
+        assert coarse.face_count == level["faces"]
+
+    motion_manifest = json.loads((tmp_path / "walk_motion_lod.json").read_text())
+    joints = [level["joints"] for level in motion_manifest["levels"]]
+    assert joints == sorted(joints, reverse=True) and len(joints) == 4
+    coarsest = read_bvh(tmp_path / motion_manifest["levels"][-1]["files"][0])
+    assert coarsest.skeleton.joint_count - int(coarsest.skeleton.end_sites.sum()) == joints[-1]
+    assert (tmp_path / "summary.txt").read_text().startswith("character:")

@@ -129,3 +129,16 @@ def test_skinned_mesh_rejects_vertex_without_weight():
     with pytest.raises(ValueError, match="vertex 1 has no positive skin weight"):
         SkinnedMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]], [[0], [0], [0]], [[1], [0], [1]],
                     np.tile(np.eye(4), (3, 1, 1)), _chain())
+
+
+def test_lod_chain_picks_the_coarsest_level_within_the_pixel_budget():
+    from animlod import LodChain, LodLevel
+
+    chain = LodChain([LodLevel(None, None, [], error) for error in (0.0, 0.01, 0.05, 0.2)])
+    # At 10 units with a 1000 px focal length, errors project to 0, 1, 5 and 20 pixels.
+    assert chain.level_for(1.0, 10.0, 1000.0) == 1
+    assert chain.level_for(5.0, 10.0, 1000.0) == 2
+    assert chain.level_for(0.5, 10.0, 1000.0) == 0
+    assert chain.level_for(1.0, 1000.0, 1000.0) == 3
+    with pytest.raises(ValueError, match="distance"):
+        chain.level_for(1.0, 0.0, 1000.0)

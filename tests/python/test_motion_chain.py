@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from animlod.cli import main
@@ -101,6 +103,10 @@ def test_cli_writes_bvh_levels_a_plot_and_refuses_bad_requests(tmp_path, capsys)
     counts = [int((~read_bvh(out / f"figure_lod{k}.bvh").skeleton.end_sites).sum()) for k in range(3)]
     assert counts[0] == 12 and counts[1] < 12 and counts[2] < counts[1]
     assert (out / "figure_motion_lod.png").stat().st_size > 0
+    manifest = json.loads((out / "figure_motion_lod.json").read_text())
+    assert [level["joints"] for level in manifest["levels"]] == counts
+    assert [level["files"] for level in manifest["levels"]] == [[f"figure_lod{k}.bvh"] for k in range(3)]
+    assert manifest["levels"][0]["error"] < 1e-9 < manifest["levels"][2]["error"]
     assert "mean err" in capsys.readouterr().out
     assert main(["motion", str(source), "-o", str(out), "--levels", "99"]) == 2
     assert main(["motion", str(source), "-o", str(out), "--hard"]) == 2

@@ -120,12 +120,20 @@ def run(args: argparse.Namespace) -> int:
     stem = Path(args.input).stem
     from ..io.bvh import write_bvh
 
+    from ..io.manifest import write_lod_manifest
+
+    rows = []
     for index, level in enumerate(chain.levels):
-        write_bvh(output / f"{stem}_lod{index}.bvh", level.motion)
+        files = [f"{stem}_lod{index}.bvh"]
+        write_bvh(output / files[0], level.motion)
         if level.skin is not None:
             from ..io.gltf import write_glb
 
-            write_glb(output / f"{stem}_lod{index}.glb", level.skin, [level.motion])
+            files.append(f"{stem}_lod{index}.glb")
+            write_glb(output / files[1], level.skin, [level.motion])
+        rows.append({"files": files, "joints": level.report.joint_count, "error": level.report.max_error})
+    # The runtime's level chooser: each level's largest joint position error in asset units.
+    write_lod_manifest(output / f"{stem}_motion_lod.json", "motion", rows)
     _print_summary(chain)
     if args.plot:
         from ..motion_lod.plots import plot_chain

@@ -3,7 +3,7 @@
 # what is already there.
 #
 #   make setup     system packages, release OpenMesh, .venv with animlod installed
-#   make test      C++ unit tests (ctest), the find_package(animlod) consumer, pytest
+#   make test      ruff, C++ unit tests (ctest), the find_package(animlod) consumer, pytest
 #   make demo      the main job on the embedded procedural character, into out/demo
 #   make bench     benchmark tables (peers in the same run); heavy, not part of test
 #   make sanitize  C++ tests and pytest under ASan + UBSan
@@ -17,7 +17,7 @@ CPP_BUILD := build/cpp
 CMAKE_GENERATOR := Ninja
 JOBS ?= 2
 
-.PHONY: setup system-packages python-package cpp-test consumer-test test demo bench sanitize clean
+.PHONY: setup system-packages python-package lint cpp-test consumer-test test demo bench sanitize clean
 
 setup: python-package
 
@@ -53,7 +53,10 @@ consumer-test: cpp-test
 	cmake --build build/consumer
 	build/consumer/animlod_consumer
 
-test: python-package consumer-test
+lint: python-package
+	$(VENV)/bin/ruff check python tests bench
+
+test: python-package lint consumer-test
 	ANIMLOD_GLTF_PROBE=$(CURDIR)/$(CPP_BUILD)/tests/cpp/animlod_gltf_probe $(PY) -m pytest -q tests/python
 
 demo: python-package

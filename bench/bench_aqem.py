@@ -27,10 +27,11 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from table import print_table, stopwatch
+
 from animlod.metrics import surface_error
 from animlod.model import AnimatedMesh
 from animlod.simplify import simplify_animated
-from table import print_table, stopwatch
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshseq"
 RATIOS = (0.5, 0.25, 0.1)

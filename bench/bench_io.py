@@ -15,9 +15,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from table import print_table, stopwatch  # noqa: E402
+from table import print_table, stopwatch
 
-from animlod.io import read_bvh, read_npz, read_sequence, write_npz, write_sequence  # noqa: E402
+from animlod.io import read_bvh, read_npz, read_sequence, write_npz, write_sequence
 
 DATA_DIR = Path(os.environ.get("ANIMLOD_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 REPEATS = 3

@@ -9,7 +9,8 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]``. Tables:
    frame sample and scaled to the whole clip, on the dev clips and the procedural ones.
 2. All 8 levels of 131_01.bvh (31 joints, 994 frames, 120 fps) with the default solver: time
    per level and in total (goal: under 30 s on this 2-core machine), joint position error mean
-   and max (asset units and relative to the figure size), total time also with 2 workers, Fig. 7's mean summed bone length
+   and max (asset units and relative to the figure size), total time also with 2 workers, Fig. 7's mean summed bone
+   length
    error and the worst bone's length standard deviation relative to its key length (goal:
    under 0.5 %), FK residual and frames whose solve did not converge.
 3. SLSQP (the paper's SQP) against damped Newton on the same objective, per level of 131_01,
@@ -29,6 +30,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from table import print_table, stopwatch
+
 from animlod.io.bvh import read_bvh
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, level_joint_counts
@@ -37,7 +40,6 @@ from animlod.motion_lod.newton import refit_newton
 from animlod.motion_lod.objective import build_problem
 from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
 from animlod.synth import humanoid, humanoid_motion
-from table import print_table, stopwatch
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "bvh"
 
@@ -132,8 +134,9 @@ def solver_table(motion, quick: bool) -> None:
         )  # fmt: skip
     print_table(
         f"SLSQP vs damped Newton (same objective, same start: the original positions), {frames.size} frames",
-        ("joints", "E SLSQP", "E Newton", "worst (N-S)/mean S", "best (N-S)/mean S", "ms/frame SLSQP", "ms/frame Newton",
-         "evals SLSQP", "evals Newton", "E SLSQP hard", "ms/frame hard", "bone std/len hard", "hard failed"),
+        ("joints", "E SLSQP", "E Newton", "worst (N-S)/mean S", "best (N-S)/mean S", "ms/frame SLSQP",
+         "ms/frame Newton", "evals SLSQP", "evals Newton", "E SLSQP hard", "ms/frame hard", "bone std/len hard",
+         "hard failed"),
         rows,
     )  # fmt: skip
 

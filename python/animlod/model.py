@@ -99,11 +99,19 @@ class Skeleton:
         joint_count = len(self.names)
         _require(joint_count >= 1, "skeleton: needs at least one joint")
         _require(len(set(self.names)) == joint_count, "skeleton: joint names must be unique")
-        _require(self.parents.shape == (joint_count,), f"parents: expected shape ({joint_count},), got {self.parents.shape}")
-        _require(self.offsets.shape == (joint_count, 3), f"offsets: expected shape ({joint_count}, 3), got {self.offsets.shape}")
+        _require(
+            self.parents.shape == (joint_count,), f"parents: expected shape ({joint_count},), got {self.parents.shape}"
+        )
+        _require(
+            self.offsets.shape == (joint_count, 3),
+            f"offsets: expected shape ({joint_count}, 3), got {self.offsets.shape}",
+        )
         _require(self.parents[0] == -1, "parents: joint 0 must be the root (parent -1)")
         later = np.nonzero(self.parents[1:] >= np.arange(1, joint_count))[0]
-        _require(later.size == 0, f"parents: joint {later[0] + 1 if later.size else 0} has a parent that does not come before it")
+        _require(
+            later.size == 0,
+            f"parents: joint {later[0] + 1 if later.size else 0} has a parent that does not come before it",
+        )
         _require(bool(np.all(self.parents[1:] >= 0)), "parents: only joint 0 may have no parent")
         _check_finite("offsets", self.offsets)
         if self.rest_rotations is None:
@@ -256,14 +264,23 @@ class SkinnedMesh:
     def __post_init__(self) -> None:
         self.rest_positions = np.ascontiguousarray(self.rest_positions, dtype=np.float32)
         vertex_count = self.rest_positions.shape[0]
-        _require(self.rest_positions.shape == (vertex_count, 3), f"rest_positions: expected (V, 3), got {self.rest_positions.shape}")
+        _require(
+            self.rest_positions.shape == (vertex_count, 3),
+            f"rest_positions: expected (V, 3), got {self.rest_positions.shape}",
+        )
         _check_finite("rest_positions", self.rest_positions)
         self.faces = _check_faces(self.faces, vertex_count)
         self.joints = np.ascontiguousarray(self.joints, dtype=np.int32)
         weights = np.asarray(self.weights, dtype=np.float64)
-        _require(self.joints.ndim == 2 and self.joints.shape[0] == vertex_count, f"joints: expected (V, K), got {self.joints.shape}")
+        _require(
+            self.joints.ndim == 2 and self.joints.shape[0] == vertex_count,
+            f"joints: expected (V, K), got {self.joints.shape}",
+        )
         _require(weights.shape == self.joints.shape, f"weights: expected {self.joints.shape}, got {weights.shape}")
-        _require(self.joints.shape[1] in (1, 2, 3, 4, 8), f"joints: K must be 1-4 or 8 influences, got {self.joints.shape[1]}")
+        _require(
+            self.joints.shape[1] in (1, 2, 3, 4, 8),
+            f"joints: K must be 1-4 or 8 influences, got {self.joints.shape[1]}",
+        )
         _check_finite("weights", weights)
         joint_count = self.skeleton.joint_count
         if self.joints.size and (self.joints.min() < 0 or self.joints.max() >= joint_count):
@@ -272,14 +289,20 @@ class SkinnedMesh:
         _require(bool(np.all(weights >= 0.0)), "weights: negative skin weight")
         self.joints, self.weights = normalize_skin_weights(self.joints, weights)
         self.inverse_bind = np.asarray(self.inverse_bind, dtype=np.float64)
-        _require(self.inverse_bind.shape == (joint_count, 4, 4), f"inverse_bind: expected ({joint_count}, 4, 4), got {self.inverse_bind.shape}")
+        _require(
+            self.inverse_bind.shape == (joint_count, 4, 4),
+            f"inverse_bind: expected ({joint_count}, 4, 4), got {self.inverse_bind.shape}",
+        )
         _check_finite("inverse_bind", self.inverse_bind)
         if self.uvs is not None:
             self.uvs = np.ascontiguousarray(self.uvs, dtype=np.float32)
             _require(self.uvs.shape == (vertex_count, 2), f"uvs: expected ({vertex_count}, 2), got {self.uvs.shape}")
         if self.normals is not None:
             self.normals = np.ascontiguousarray(self.normals, dtype=np.float32)
-            _require(self.normals.shape == (vertex_count, 3), f"normals: expected ({vertex_count}, 3), got {self.normals.shape}")
+            _require(
+                self.normals.shape == (vertex_count, 3),
+                f"normals: expected ({vertex_count}, 3), got {self.normals.shape}",
+            )
         if self.morph_targets is not None:
             self.morph_targets = np.ascontiguousarray(self.morph_targets, dtype=np.float32)
             _require(

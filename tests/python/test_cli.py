@@ -12,8 +12,9 @@ from animlod.io.npz import write_npz
 
 
 def _small_motion() -> Motion:
-    skeleton = Skeleton(["hips", "leg", "leg_End"], [-1, 0, 1], [[0, 1, 0], [0, -0.5, 0], [0, -0.5, 0]],
-                        end_sites=[False, False, True])
+    skeleton = Skeleton(
+        ["hips", "leg", "leg_End"], [-1, 0, 1], [[0, 1, 0], [0, -0.5, 0], [0, -0.5, 0]], end_sites=[False, False, True]
+    )
     local = rotations.identity((4, 3))
     local[:, 1] = rotations.from_axis_angle(np.array([1.0, 0, 0]), np.linspace(0, 0.5, 4))
     return Motion(skeleton, np.tile([0.0, 1.0, 0.0], (4, 1)), local, fps=24.0)

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+from simplify_inputs import bending_tube
+
 from animlod.cli import main
 from animlod.io.meshseq import read_sequence, write_sequence
 from animlod.io.npz import read_npz, write_npz
-from simplify_inputs import bending_tube
 
 
 def test_simplify_an_obj_sequence_writes_each_level_as_a_sequence(tmp_path, capsys):

@@ -7,9 +7,10 @@ import pytest
 
 pytest.importorskip("igl")
 
+from simplify_inputs import ellipsoid
+
 from animlod.metrics import sample_surface, surface_error
 from animlod.model import AnimatedMesh
-from simplify_inputs import ellipsoid
 
 
 def flat_square(offsets: np.ndarray) -> AnimatedMesh:

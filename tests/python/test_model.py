@@ -127,8 +127,14 @@ def test_motion_rejects_nan_rotation():
 
 def test_skinned_mesh_rejects_vertex_without_weight():
     with pytest.raises(ValueError, match="vertex 1 has no positive skin weight"):
-        SkinnedMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]], [[0], [0], [0]], [[1], [0], [1]],
-                    np.tile(np.eye(4), (3, 1, 1)), _chain())
+        SkinnedMesh(
+            [[0, 0, 0], [1, 0, 0], [0, 1, 0]],
+            [[0, 1, 2]],
+            [[0], [0], [0]],
+            [[1], [0], [1]],
+            np.tile(np.eye(4), (3, 1, 1)),
+            _chain(),
+        )
 
 
 def test_lod_chain_picks_the_coarsest_level_within_the_pixel_budget():

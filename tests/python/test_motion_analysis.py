@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_motion_figures import chain_motion, figure_motion
+
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.analysis import posture_error_row_sums
-from test_motion_figures import chain_motion, figure_motion
 
 
 def test_eq1_to_eq3_on_a_three_joint_chain() -> None:

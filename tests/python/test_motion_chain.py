@@ -6,13 +6,14 @@ import json
 
 import numpy as np
 import pytest
+from test_motion_figures import figure_motion
+
 from animlod.cli import main
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, level_joint_counts
 from animlod.motion_lod.skeleton_reduce import expand_motion
 from animlod.synth import humanoid, humanoid_motion
 from animlod.synth.gait import STILL_FINGER_CHAIN
-from test_motion_figures import figure_motion
 
 
 @pytest.fixture(scope="module")

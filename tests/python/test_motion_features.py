@@ -6,10 +6,11 @@ import math
 
 import numpy as np
 import pytest
+from simplify_inputs import bending_tube
+
 from animlod import synth
 from animlod.model import AnimatedMesh
 from animlod.simplify import motion_features
-from simplify_inputs import bending_tube
 
 
 def test_a_hinge_reports_its_exact_angle_change():

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+
 from animlod import rotations
 from animlod.model import Motion, Skeleton
 

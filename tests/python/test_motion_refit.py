@@ -5,13 +5,14 @@ from __future__ import annotations
 import nlopt
 import numpy as np
 import pytest
+from test_motion_figures import figure_motion
+
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.newton import refit_newton
 from animlod.motion_lod.objective import Weights, build_problem, half_hessian, objective, rigidity_constraints
 from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
 from animlod.motion_lod.skeleton_reduce import expand_motion, recover_motion, reduce_skeleton
-from test_motion_figures import figure_motion
 
 
 @pytest.fixture(scope="module")

@@ -6,9 +6,10 @@ import math
 
 import numpy as np
 import pytest
+from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
+
 from animlod.model import AnimatedMesh
 from animlod.simplify import simplify_animated
-from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
 
 
 def test_levels_respect_targets_and_stay_valid_manifolds():

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from simplify_inputs import directed_edges_unique, two_bone_tube
+
 from animlod import synth
 from animlod.simplify import simplify_skinned
-from simplify_inputs import directed_edges_unique, two_bone_tube
 
 
 def test_skinned_levels_skin_with_valid_merged_weights():

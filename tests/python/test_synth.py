@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from animlod import rotations, synth
 from animlod.model import AnimatedMesh
 

@@ -68,12 +68,14 @@ def run(args: argparse.Namespace) -> int:
     )
     start = time.perf_counter()
     baked = [character.bake(motion) for motion in motions]
-    report(f"baked {sum(b.frame_count for b in baked)} frames with LBS in the core ({time.perf_counter() - start:.3f} s)")
+    seconds = time.perf_counter() - start
+    report(f"baked {sum(b.frame_count for b in baked)} frames with LBS in the core ({seconds:.3f} s)")
     write_glb(output / "character.glb", character, motions)
 
     start = time.perf_counter()
     mesh_levels = simplify_skinned(character, motions, MESH_RATIOS)
     report(f"mesh LoD (AQEM over {1 + sum(b.frame_count for b in baked)} poses): {time.perf_counter() - start:.2f} s")
+
     # A level's error for the runtime is measured, not bounded: the largest Hausdorff distance
     # between the original and the level re-skinned with its merged weights (AQEM's own
     # quadric error is an upper bound, several times larger).
@@ -85,8 +87,11 @@ def run(args: argparse.Namespace) -> int:
         name = f"character_mesh_lod{index}.glb"
         write_glb(output / name, level.mesh, motions)
         hausdorff = max(
-            float(surface_error(measured_frames(original), measured_frames(level.mesh.bake(motion)), samples=2000)
-                  .hausdorff.max())
+            float(
+                surface_error(
+                    measured_frames(original), measured_frames(level.mesh.bake(motion)), samples=2000
+                ).hausdorff.max()
+            )
             for original, motion in zip(baked, motions)
         )
         mesh_rows.append({"file": name, "faces": level.mesh.face_count, "error": hausdorff, "aqem_error": level.error})

@@ -119,7 +119,6 @@ def run(args: argparse.Namespace) -> int:
     output.mkdir(parents=True, exist_ok=True)
     stem = Path(args.input).stem
     from ..io.bvh import write_bvh
-
     from ..io.manifest import write_lod_manifest
 
     rows = []

@@ -35,4 +35,5 @@ def input_kind(path: str | os.PathLike) -> str:
         return "npz"
     if suffix in SEQUENCE_SUFFIXES:
         return "sequence"
-    raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected .bvh, .glb, .gltf, .npz, .obj, .ply or a folder")
+    expected = ".bvh, .glb, .gltf, .npz, .obj, .ply or a folder"
+    raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}")

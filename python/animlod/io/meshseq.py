@@ -517,7 +517,7 @@ def _read_ply_ascii(path: Path, body: bytes, elements: list[_PlyElement]) -> dic
                 owner = np.repeat(np.arange(element.count), sizes)
                 item_start = np.repeat(starts + index + 1 - (np.cumsum(sizes) - sizes), sizes)
                 items = tokens[item_start + np.arange(sizes.sum())]
-                parsed = _parse_numbers(path, items, dtype, lambda item: name_row(owner[item]))
+                parsed = _parse_numbers(path, items, dtype, lambda item, owner=owner: name_row(owner[item]))
                 element_values[prop.name] = (sizes, parsed)
         values[element.name] = element_values
         first_row += element.count

@@ -2,7 +2,8 @@
 
 E (Eqs. 5-8) has cheap exact second derivatives (objective.half_hessian), so each step solves
 ``(H + mu I) delta = -grad / 2`` for all active frames at once with batched dense solves
-(3 unknowns per point of each independent group, objective.split_problem). mu follows Nielsen's rule for Levenberg-Marquardt: shrink it by
+(3 unknowns per point of each independent group, objective.split_problem). mu follows Nielsen's rule for
+Levenberg-Marquardt: shrink it by
 the ratio of actual to promised decrease when a step succeeds, double its growth factor when
 one fails. It has no hard constraints (use SLSQP for those). Frames converge independently and
 leave the active set. SLSQP (refit.py) stays the reference; bench/bench_motion.py compares their

@@ -2,7 +2,8 @@
 
 E (Eq. 5) does not couple frames, so every frame is one small problem in 3(P - 1) unknowns,
 never one big one (SLSQP's cost grows with the cube of the size); within a frame it splits
-further into independent groups of points (objective.split_problem), each solved on its own. The unknowns are the points'
+further into independent groups of points (objective.split_problem), each solved on its own. The unknowns are the
+points'
 displacements from the original positions in units of the length scale L, so a frame starts
 at z = 0 (the paper's "initial values: the original positions") and the next frame is
 warm-started from the previous frame's correction z*(t-1), since neighbouring frames need
@@ -13,7 +14,8 @@ Every solve is checked: the result must be finite, not worse than its start, and
 bone-length constraints, feasible within ``feasibility_tolerance`` (SLSQP can report success
 with violated constraints). Hard constraints hold every length Es holds, bones and siblings,
 and keep rigid groups of three children from flipping into their mirror image, so that
-forward kinematics of the recovered skeleton reproduces the result. A frame that fails is solved again from z = 0, and if that fails too
+forward kinematics of the recovered skeleton reproduces the result. A frame that fails is solved again from z = 0,
+and if that fails too
 it takes the fallback positions (the original motion with frozen joints at their key rotations,
 which satisfies every constraint); every such frame is reported in ``RefitResult.failures``.
 With hard constraints, cold starts begin at the fallback rather than the original positions:

@@ -10,7 +10,8 @@ optimisation result x_j(t) and the hierarchical information of each joint". Here
   original twist) and is corrected by the smallest rotation that carries its children's offsets
   onto the re-fitted child positions, aimed from where forward kinematics has put the joint:
   the swing onto the longest child when it has one child (or only collinear ones), the best-fit
-  rotation (Kabsch) when it has several, none when it has no child. Forward kinematics then reproduces the re-fitted positions exactly wherever they are
+  rotation (Kabsch) when it has several, none when it has no child. Forward kinematics then reproduces the re-fitted
+  positions exactly wherever they are
   rigid with respect to the level's skeleton, which the string term Es asks for.
 """
 

@@ -9,8 +9,8 @@
 """
 
 from .deforming import bending_cylinder, bending_cylinder_skinned, translating_mesh, twisting_bar
-from .face_model import REGION_NAMES, STILL_REGIONS, FaceModel, face
 from .face_animation import face_animation
+from .face_model import REGION_NAMES, STILL_REGIONS, FaceModel, face
 from .gait import KINDS, STILL_FINGER_CHAIN, humanoid_motion
 from .geometry import icosphere
 from .humanoid_body import END_SITES, humanoid, humanoid_skeleton

@@ -40,7 +40,10 @@ def test_levels_have_the_asked_joint_counts_and_growing_error(walk_chain) -> Non
     for finer, coarser in zip(frozen, frozen[1:]):
         assert coarser[: len(finer)] == finer  # frozen once, frozen at every coarser level
     errors = [level.report.mean_error for level in chain.levels]
-    assert errors[0] < 1e-9 and all(b >= a for a, b in zip(errors, errors[1:]))
+    # Levels that freeze only still joints have zero error up to round-off (1e-16 here).
+    round_off = 1e-12 * chain.figure_size
+    assert errors[0] < round_off and all(b >= a - round_off for a, b in zip(errors, errors[1:]))
+    assert errors[-1] > errors[0] + 1e-4 * chain.figure_size
     assert all(level.report.failures == [] for level in chain.levels)
 
 
@@ -110,7 +113,7 @@ def test_cli_writes_bvh_levels_a_plot_and_refuses_bad_requests(tmp_path, capsys)
     assert manifest["levels"][0]["error"] < 1e-9 < manifest["levels"][2]["error"]
     assert "mean err" in capsys.readouterr().out
     assert main(["motion", str(source), "-o", str(out), "--levels", "99"]) == 2
-    assert main(["motion", str(source), "-o", str(out), "--hard"]) == 2
+    assert main(["motion", str(source), "-o", str(out), "--hard", "--solver", "newton"]) == 2
     assert main(["motion", str(source), "-o", str(out), "--lock", "Tail"]) == 2
     assert "no joint named 'Tail'" in capsys.readouterr().err
 

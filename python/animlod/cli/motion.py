@@ -27,9 +27,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--lock", nargs="+", default=[], metavar="JOINT", help="joints never to freeze")
     parser.add_argument(
         "--solver",
-        choices=("newton", "slsqp"),
-        default="newton",
-        help="newton: damped Newton over all frames at once (fast); slsqp: nlopt SLSQP per frame (the reference)",
+        choices=("slsqp", "newton"),
+        default="slsqp",
+        help="slsqp: nlopt SLSQP per frame (the reference, default); newton: damped Newton on the same objective "
+        "over all frames at once (20-40x faster)",
     )
     parser.add_argument("--hard", action="store_true", help="hold bone lengths as equality constraints (slsqp)")
     parser.add_argument("--workers", type=int, default=1, help="processes solving chunks of frames side by side")

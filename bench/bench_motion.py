@@ -7,12 +7,12 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]``. Tables:
    24 of 33) with the key posture from motion analysis (ASQP) against the first frame as key
    posture (SQP): mean objective evaluations per frame and seconds, measured on an evenly spaced
    frame sample and scaled to the whole clip, on the dev clips and the procedural ones.
-2. All 8 levels of 131_01.bvh (31 joints, 994 frames, 120 fps) with the default solver: time
-   per level and in total (goal: under 30 s on this 2-core machine), joint position error mean
-   and max (asset units and relative to the figure size), total time also with 2 workers, Fig. 7's mean summed bone
-   length
-   error and the worst bone's length standard deviation relative to its key length (goal:
-   under 0.5 %), FK residual and frames whose solve did not converge.
+2. All 8 levels of 131_01.bvh (31 joints, 994 frames, 120 fps), once with SLSQP (the default)
+   and once with damped Newton: time per level and in total (goal: under 30 s on this 2-core
+   machine), also with 2 worker processes; joint position error mean and max (asset units and
+   relative to the figure size); Fig. 7's mean summed bone length error and the worst bone's
+   length standard deviation relative to its key length (goal: under 0.5 %); FK residual and
+   frames whose solve did not converge.
 3. SLSQP (the paper's SQP) against damped Newton on the same objective, per level of 131_01,
    on a frame sample: mean E, worst and best per-frame difference of E relative to the mean,
    time per frame;
@@ -34,7 +34,7 @@ from table import print_table, stopwatch
 
 from animlod.io.bvh import read_bvh
 from animlod.motion_lod import analyze_motion
-from animlod.motion_lod.chain import build_motion_chain, level_joint_counts
+from animlod.motion_lod.chain import SOLVERS, build_motion_chain, level_joint_counts
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.newton import refit_newton
 from animlod.motion_lod.objective import build_problem
@@ -84,12 +84,12 @@ def table1(quick: bool) -> None:
     )
 
 
-def level_table(motion, quick: bool) -> None:
+def level_table(motion, quick: bool, solver: str) -> None:
     levels = 4 if quick else 8
     with stopwatch() as pooled:
-        build_motion_chain(motion, levels, workers=2)
+        build_motion_chain(motion, levels, solver=solver, workers=2)
     with stopwatch() as elapsed:
-        chain = build_motion_chain(motion, levels)
+        chain = build_motion_chain(motion, levels, solver=solver)
     size = chain.figure_size
     rows = [
         (k, level.report.joint_count, level.report.seconds, level.report.mean_error, level.report.max_error,
@@ -98,7 +98,7 @@ def level_table(motion, quick: bool) -> None:
         for k, level in enumerate(chain.levels)
     ]  # fmt: skip
     print_table(
-        f"{levels} levels of {motion.name or '131_01'} ({motion.frame_count} frames), default solver: total "
+        f"{levels} levels of {motion.name or '131_01'} ({motion.frame_count} frames), solver {solver}: total "
         f"{elapsed[0]:.1f} s including analysis ({pooled[0]:.1f} s with 2 worker processes); figure size {size:.4g}",
         ("level", "joints", "seconds", "mean error", "max error", "max/size", "Fig.7 bone error", "bone std/len",
          "FK residual", "not converged"),
@@ -169,7 +169,8 @@ def main() -> None:
     table1(args.quick)
     path = DATA / "131_01.bvh"
     motion = read_bvh(path) if path.exists() else humanoid_motion(humanoid().skeleton, "walk", cycles=8)
-    level_table(motion, args.quick)
+    for solver in SOLVERS:
+        level_table(motion, args.quick, solver)
     solver_table(motion, args.quick)
     workers_table(motion, args.quick)
 

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io.detect import input_kind
+from ..motion_lod.chain import SOLVERS
 from . import UserError
 
 
@@ -27,8 +28,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--lock", nargs="+", default=[], metavar="JOINT", help="joints never to freeze")
     parser.add_argument(
         "--solver",
-        choices=("slsqp", "newton"),
-        default="slsqp",
+        choices=SOLVERS,
+        default=SOLVERS[0],
         help="slsqp: nlopt SLSQP per frame (the reference, default); newton: damped Newton on the same objective "
         "over all frames at once (20-40x faster)",
     )

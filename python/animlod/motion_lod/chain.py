@@ -23,7 +23,7 @@ from .refit import FrameFailure, RefitResult, SlsqpOptions, refit_slsqp
 from .skeleton_reduce import expand_motion, recover_motion
 from .skin_transfer import transfer_skin
 
-SOLVERS = ("newton", "slsqp")
+SOLVERS = ("slsqp", "newton")  # the first is the default
 # Joint counts of the paper's 8 levels as fractions of the full skeleton (Fig. 1).
 _PAPER_FRACTIONS = np.array([1.0, 0.82, 0.70, 0.58, 0.45, 0.33, 0.20, 0.08])
 
@@ -155,7 +155,7 @@ def build_level(
     analysis: MotionAnalysis,
     joint_count: int,
     weights: Weights | None = None,
-    solver: str = "slsqp",
+    solver: str = SOLVERS[0],
     slsqp_options: SlsqpOptions | None = None,
     workers: int = 1,
     skin: SkinnedMesh | None = None,
@@ -207,7 +207,7 @@ def build_motion_chain(
     levels: int | Sequence[int] = 8,
     locked: Sequence[str] = (),
     weights: Weights | None = None,
-    solver: str = "slsqp",
+    solver: str = SOLVERS[0],
     slsqp_options: SlsqpOptions | None = None,
     workers: int = 1,
     skin: SkinnedMesh | None = None,

@@ -205,18 +205,23 @@ class Motion:
         """Seconds from the first to the last frame."""
         return (self.frame_count - 1) / self.fps
 
+    def local_translations(self) -> np.ndarray:
+        """Local translation of every joint per frame ``(T, J, 3)``, a new array: the offsets (or
+        ``joint_translations`` where given), with column 0 the root position."""
+        if self.joint_translations is None:
+            translations = np.broadcast_to(self.skeleton.offsets, self.local_rotations.shape[:2] + (3,)).copy()
+        else:
+            translations = self.joint_translations.copy()
+        translations[:, 0] = self.root_positions
+        return translations
+
     def world_transforms(self) -> np.ndarray:
         """Forward kinematics: world transforms ``(T, J, 4, 4)`` of every joint.
 
         One numpy step per joint (O(J) Python work, vectorised over frames).
         """
         skeleton = self.skeleton
-        if self.joint_translations is None:
-            translations = np.broadcast_to(skeleton.offsets, self.local_rotations.shape[:2] + (3,)).copy()
-        else:
-            translations = self.joint_translations.copy()
-        translations[:, 0] = self.root_positions
-        local = rotations.compose_transform(translations, self.local_rotations)
+        local = rotations.compose_transform(self.local_translations(), self.local_rotations)
         world = np.empty_like(local)
         world[:, 0] = local[:, 0]
         for joint in range(1, skeleton.joint_count):

@@ -365,15 +365,10 @@ def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZX
     if len(order) != 3 or set(order) != set("XYZ"):
         raise ValueError(f"rotation_order must be a permutation of XYZ, got {rotation_order!r}")
     skeleton = motion.skeleton
-    translations = motion.joint_translations
+    translations = motion.local_translations()
     has_position = np.zeros(skeleton.joint_count, dtype=bool)
     has_position[0] = True
-    if translations is not None:
-        has_position[1:] = np.any(translations[:, 1:] != skeleton.offsets[None, 1:], axis=(0, 2))
-        translations = translations.copy()
-    else:
-        translations = np.repeat(skeleton.offsets[None], motion.frame_count, axis=0)
-    translations[:, 0] = motion.root_positions
+    has_position[1:] = np.any(translations[:, 1:] != skeleton.offsets[None, 1:], axis=(0, 2))
     animated_end_sites = np.nonzero(has_position & skeleton.end_sites)[0]
     if animated_end_sites.size:
         name = skeleton.names[animated_end_sites[0]]

@@ -38,6 +38,7 @@ python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
 	$(VENV)/bin/pip install -q --no-build-isolation -e ".[test]"
 
 $(CPP_BUILD)/build.ninja: $(OPENMESH_CONFIG)
+	@mkdir -p build
 	cmake -S . -B $(CPP_BUILD) -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=Release \
 	  -DCMAKE_INSTALL_PREFIX=$(CURDIR)/build/install > $(CPP_BUILD).configure.log
 
@@ -73,6 +74,7 @@ SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer
 SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 
 sanitize: $(OPENMESH_CONFIG) $(VENV)/bin/pip
+	@mkdir -p build
 	cmake -S . -B build/sanitize -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" > build/sanitize.configure.log
 	cmake --build build/sanitize --parallel $(JOBS)

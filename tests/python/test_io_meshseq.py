@@ -227,3 +227,53 @@ def test_empty_or_missing_source(tmp_path: Path) -> None:
     assert _error(tmp_path) == f"{tmp_path}: source: no .obj or .ply frame found"
     with pytest.raises(FormatError, match="is not a folder, a glob pattern or an existing file"):
         read_sequence(tmp_path / "nothing")
+
+
+def test_indented_obj_reads_like_the_unindented_one(tmp_path: Path) -> None:
+    indented = "".join(("  " if index % 2 else "\t ") + line for index, line in enumerate(OBJ_TEXT.splitlines(True)))
+    vertices, faces = read_obj(_write(tmp_path / "indented.obj", indented))
+    np.testing.assert_array_equal(vertices, EXPECTED_VERTICES)
+    np.testing.assert_array_equal(faces, EXPECTED_FACES)
+    # Line numbers in errors still count the file's lines.
+    path = _write(tmp_path / "bad.obj", indented.replace("-1//1", "6"))
+    assert _error(path) == f"{path}: face 1 (line 11): vertex index 6 is outside the 5 vertices"
+
+
+def test_obj_face_index_too_large_for_int64(tmp_path: Path) -> None:
+    path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 1 2 99999999999999999999"))
+    message = _error(path)
+    assert message == f"{path}: face 1 (line 11): '99999999999999999999' is not a number or out of range"
+
+
+def _ascii_ply(face_property: str, face_rows: str) -> str:
+    return (
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        f"element face 2\n{face_property}\nend_header\n0 0 0\n1 0 0\n0 1 0\n{face_rows}"
+    )
+
+
+def test_ascii_ply_list_count_too_large_for_int64(tmp_path: Path) -> None:
+    text = _ascii_ply("property list uchar int vertex_indices", "3 0 1 2\n99999999999999999999 0 1 2\n")
+    path = _write(tmp_path / "bad.ply", text)
+    assert _error(path) == f"{path}: element face row 1: '99999999999999999999' is not a number or out of range"
+
+
+def test_ascii_ply_short_last_row_before_its_list(tmp_path: Path) -> None:
+    properties = "property uchar flags\nproperty uchar group\nproperty list uchar int vertex_indices"
+    path = _write(tmp_path / "bad.ply", _ascii_ply(properties, "0 0 3 0 1 2\n7\n"))
+    assert _error(path) == f"{path}: element face row 1: has 1 values, expected at least 3"
+
+
+@pytest.mark.parametrize("binary", [False, True])
+def test_ply_float_vertex_indices_are_refused(tmp_path: Path, binary: bool) -> None:
+    header = _ascii_ply("property list uchar float vertex_indices", "").replace(
+        "format ascii", "format binary_little_endian" if binary else "format ascii"
+    )
+    if binary:
+        header = header.replace("0 0 0\n1 0 0\n0 1 0\n", "")
+        face = np.array([3], "u1").tobytes() + np.array([0.7, 1.2, 2.9], "<f4").tobytes()
+        content = header.encode() + np.eye(3, dtype="<f4")[[2, 0, 1]].tobytes() + face * 2
+    else:
+        content = (header + "3 0.7 1.2 2.9\n3 0 1 2\n").encode()
+    path = _write(tmp_path / "bad.ply", content)
+    assert _error(path) == f"{path}: element face: vertex index list has float items; indices must be integers"

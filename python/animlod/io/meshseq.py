@@ -4,8 +4,8 @@ Only geometry is read: OBJ ``v`` and ``f`` lines (1-based or negative indices, `
 corners, polygons fan-triangulated; other statements such as ``vt``, ``vn``, ``g``, ``usemtl``
 are ignored) and PLY ``vertex`` x, y, z with the ``face`` list ``vertex_indices`` (ascii,
 binary_little_endian, binary_big_endian; other elements and properties are skipped).
-Statements must start at the beginning of their line. Parsing works on the whole file's
-bytes with numpy: there is no Python loop over lines, vertices or faces.
+Statements may be indented. Parsing works on the whole file's bytes with numpy: there is no
+Python loop over lines, vertices or faces.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import numpy as np
 from ..model import AnimatedMesh
 from .atomic import atomic_write
 from .errors import FormatError
-from .tokens import tokens_per_line
+from .tokens import parses, tokens_per_line
 
 MESH_SUFFIXES = (".obj", ".ply")
 _PLY_TYPES = {
@@ -174,6 +174,7 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     """
     path = Path(path)
     data = path.read_bytes().replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
     (vertex_block, vertex_lines), (face_block, face_lines) = _obj_statements(data, (b"v", b"f"))
 
     def name_vertex(vertex: int) -> str:
@@ -251,18 +252,11 @@ def _parse_numbers(path: Path, tokens: np.ndarray, dtype: type, element: Callabl
     """Convert byte-string tokens to ``dtype``; on failure name the element holding the first bad token."""
     try:
         return tokens.astype(dtype)
-    except ValueError:
+    except (ValueError, OverflowError):
         flat = tokens.ravel()
-        bad = next(index for index, token in enumerate(flat) if not _parses(token, dtype))
-        raise FormatError(path, element(bad), f"{flat[bad].decode(errors='replace')!r} is not a number") from None
-
-
-def _parses(token: bytes, dtype: type) -> bool:
-    try:
-        np.array([token]).astype(dtype)
-    except ValueError:
-        return False
-    return True
+        bad = next(index for index, token in enumerate(flat) if not parses(token, dtype))
+        text = flat[bad].decode(errors="replace")
+        raise FormatError(path, element(bad), f"{text!r} is not a number or out of range") from None
 
 
 def _check_finite_vertices(path: Path, vertices: np.ndarray, element: Callable[[int], str]) -> None:
@@ -353,6 +347,8 @@ def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
             raise FormatError(path, "element face", "has no list property vertex_indices")
         return vertices, np.zeros((0, 3), dtype=np.int32)
     sizes, corners = face_list
+    if corners.dtype.kind == "f":
+        raise FormatError(path, "element face", "vertex index list has float items; indices must be integers")
 
     def name_face(face_index: int) -> str:
         return f"face {face_index}"
@@ -501,6 +497,12 @@ def _read_ply_ascii(path: Path, body: bytes, elements: list[_PlyElement]) -> dic
         if list_at is None:
             sizes = np.zeros(element.count, dtype=np.int64)
         else:
+            # The list's length is read from the row, so the row must reach it first.
+            short = np.flatnonzero(lengths < scalar_count + 1)
+            if short.size:
+                row = short[0]
+                reason = f"has {lengths[row]} values, expected at least {scalar_count + 1}"
+                raise FormatError(path, name_row(row), reason)
             sizes = _parse_numbers(path, tokens[starts + list_at], np.int64, name_row)
         expected = scalar_count + sizes + (list_at is not None)
         wrong = np.flatnonzero((lengths != expected) | (sizes < 0))

@@ -1,4 +1,4 @@
-"""Vectorised helpers for whitespace-separated text tables (BVH MOTION rows, ASCII PLY bodies).
+"""Vectorised helpers for whitespace-separated text tables (BVH MOTION rows, OBJ and ASCII PLY bodies).
 
 Counting tokens line by line in Python is a loop over frames or vertices; these work on the
 bytes of the whole table at once.
@@ -22,3 +22,16 @@ def tokens_per_line(data: bytes) -> np.ndarray:
     newline = codes == ord("\n")
     line_of_byte = np.cumsum(newline) - newline
     return np.bincount(line_of_byte[token_start], minlength=int(newline.sum()) + 1)
+
+
+def parses(token: str | bytes, dtype: type) -> bool:
+    """Whether numpy converts ``token`` to ``dtype``, as it does a whole table of such tokens.
+
+    False for malformed text and for integers too large for ``dtype``; used after a bulk
+    ``astype`` failed, to find the token to name in the error.
+    """
+    try:
+        np.array([token]).astype(dtype)
+    except (ValueError, OverflowError):
+        return False
+    return True

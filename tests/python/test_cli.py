@@ -90,3 +90,21 @@ def test_demo_writes_every_level_with_manifests(tmp_path, capsys):
     coarsest = read_bvh(tmp_path / motion_manifest["levels"][-1]["files"][0])
     assert coarsest.skeleton.joint_count - int(coarsest.skeleton.end_sites.sum()) == joints[-1]
     assert (tmp_path / "summary.txt").read_text().startswith("character:")
+
+
+@pytest.mark.parametrize(
+    "relative, expected",
+    [("frames/*.obj", "frames"), ("frames", "frames"), ("frames/", "frames"), ("clip.bvh", "clip")],
+)
+def test_input_stem_names_outputs_after_the_input(tmp_path, monkeypatch, relative, expected):
+    from animlod.io.detect import input_stem
+
+    (tmp_path / "frames").mkdir()
+    monkeypatch.chdir(tmp_path)
+    assert input_stem(relative) == expected
+
+
+def test_animlod_debug_shows_the_traceback(tmp_path, monkeypatch):
+    monkeypatch.setenv("ANIMLOD_DEBUG", "1")
+    with pytest.raises(ValueError, match="does not exist"):
+        main(["info", str(tmp_path / "missing.bvh")])

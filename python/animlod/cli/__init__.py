@@ -2,13 +2,14 @@
 
 Every subcommand module has ``register(subparsers)`` which adds its parser and sets
 ``run=function(args) -> int``. A user mistake (bad file, bad value) exits with code 2 and
-one line on stderr, never a traceback.
+one line on stderr, never a traceback (set ANIMLOD_DEBUG=1 to see it).
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 # Subcommand modules in the order --help lists them.
@@ -36,6 +37,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args.run(args) or 0)
     except (UserError, ValueError, OSError) as error:
+        # Readers, validators and the core report bad input as ValueError; ANIMLOD_DEBUG=1 shows
+        # the traceback behind the one line, for telling a bug from a user mistake.
+        if os.environ.get("ANIMLOD_DEBUG"):
+            raise
         print(f"animlod {args.command}: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.detect import input_kind
+from ..io.detect import input_kind, input_stem
 from ..model import AnimatedMesh
 from . import UserError
 
@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     options = {"max_error": args.max_error, "use_motion_features": not args.no_features, "max_frames": args.max_frames}
     if args.placement:
         options["placement"] = args.placement
-    stem = Path(args.input.rstrip("/*")).stem or "mesh"
+    stem = input_stem(args.input)
 
     if kind == "gltf":
         from ..io.gltf import read_gltf

@@ -37,3 +37,16 @@ def input_kind(path: str | os.PathLike) -> str:
         return "sequence"
     expected = ".bvh, .glb, .gltf, .npz, .obj, .ply or a folder"
     raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}")
+
+
+def input_stem(path: str | os.PathLike) -> str:
+    """A name for outputs derived from ``path``: a file's stem, a folder's name, or for a glob
+    the name of the folder its pattern starts in (``frames/*.obj`` -> ``frames``)."""
+    text = os.fspath(path)
+    if glob.has_magic(text):
+        fixed = Path(text)
+        while glob.has_magic(str(fixed)):
+            fixed = fixed.parent
+        return fixed.resolve().name or "mesh"
+    candidate = Path(text)
+    return (candidate.resolve().name if candidate.is_dir() else candidate.stem) or "mesh"

@@ -204,3 +204,28 @@ def test_newton_worker_processes_give_the_same_result(figure) -> None:
     alone = refit_newton(problem, original, chunk_frames=8)
     pooled = refit_newton(problem, original, chunk_frames=8, workers=2)
     np.testing.assert_array_equal(pooled.positions, alone.positions)
+
+
+def test_newton_reports_frames_stopped_by_the_damping_limit(figure, monkeypatch) -> None:
+    import animlod.motion_lod.newton as newton
+
+    motion, analysis, original = figure
+    level = freeze(motion, analysis, analysis.priority[:6])
+    problem = build_problem(level)
+    frames = original[:3]
+    exact = newton.objective
+
+    def no_step_succeeds(problem, x, target):
+        value, gradient = exact(problem, x, target)
+        moved = np.any(x != target, axis=(1, 2))  # every trial point: the start is the original
+        return np.where(moved, np.nan, value), gradient
+
+    # Every trial is rejected, so the damping grows until the frame gives up, well before 100
+    # steps (ftol_rel=0: a promise shrunk by the damping does not count as converged).
+    monkeypatch.setattr(newton, "objective", no_step_succeeds)
+    result = refit_newton(problem, frames, ftol_rel=0.0)
+    assert [(f.frame, f.reason, f.outcome) for f in result.failures] == [
+        (t, "damping limit", "kept best point") for t in range(3)
+    ]
+    np.testing.assert_array_equal(result.positions, frames)
+    assert np.all(result.evaluations < 100 * len(newton.split_problem(problem)[0]))

@@ -44,7 +44,8 @@ def refit_newton(
     xtol : or when an accepted step moves no point by more than ``xtol * L`` (E is quartic, so
         flat, where a frozen chain is straight in the key posture: cos theta_r(0) = -1).
     max_iterations : steps per frame; a frame still moving then is reported as a failure
-        (its best point is kept).
+        (its best point is kept), as is a frame whose damping passes 1e12 times Ed's curvature
+        before it converges (reason "damping limit").
     chunk_frames : frames solved together (bounds the (chunk, N, N) matrices in memory).
     workers : processes solving chunks side by side; 1 solves in this process.
     progress : called with the (fractional) number of frames finished after each chunk.
@@ -97,6 +98,7 @@ def _solve_chunk(
     active = np.flatnonzero(value > 0.0)
     diagonal = np.arange(n)
     damping = np.full(frames, 1e-3 * stiffness)
+    failed_frames: list[int] = []  # frames stopped by the damping limit
     for iteration in range(max_iterations):
         if active.size == 0:
             break
@@ -132,10 +134,13 @@ def _solve_chunk(
         growth[active] = np.where(better, 2.0, growth[active] * 2.0)
         small_step = better & (np.abs(step).max(axis=1) <= xtol * problem.length_scale)
         flat = (promised >= 0.0) & (promised <= ftol_rel * value[active])
-        done = flat | small_step | (damping[active] > 1e12 * stiffness)
-        active = active[~done]
-    failures = [
+        converged = flat | small_step
+        # Damping this large means no step is found at all: the frame stops unconverged.
+        stalled = ~converged & (damping[active] > 1e12 * stiffness)
+        failed_frames.extend(int(i) for i in active[stalled])
+        active = active[~(converged | stalled)]
+    failures = [FrameFailure(first_frame + i, "damping limit", "kept best point") for i in failed_frames] + [
         FrameFailure(first_frame + int(i), f"not converged in {max_iterations} steps", "kept best point")
         for i in active
     ]
-    return RefitResult(x, value, evaluations, failures)
+    return RefitResult(x, value, evaluations, sorted(failures, key=lambda f: f.frame))

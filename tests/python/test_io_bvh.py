@@ -139,10 +139,44 @@ def test_write_rejects_bad_rotation_order(tmp_path: Path) -> None:
         write_bvh(tmp_path / "x.bvh", _hand_made_motion(0, False), rotation_order="XXY")
 
 
-def test_write_replaces_the_file_atomically(tmp_path: Path) -> None:
+def test_a_write_failing_part_way_keeps_the_old_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     path = tmp_path / "x.bvh"
-    write_bvh(path, _hand_made_motion(0, False))
+    path.write_text("old content")
+
+    def write_some_rows_then_fail(handle, table, **kwargs) -> None:
+        handle.write("0.0 1.0 2.0\n")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savetxt", write_some_rows_then_fail)
+    with pytest.raises(OSError, match="disk full"):
+        write_bvh(path, _hand_made_motion(0, False))
+    assert path.read_text() == "old content"
     assert [p.name for p in tmp_path.iterdir()] == ["x.bvh"]
+
+
+def _chain_bvh(depth: int) -> str:
+    """A root and ``depth - 1`` nested joints, each one unit above its parent, then an End Site."""
+    opening = "".join(
+        f"JOINT j{index}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n" for index in range(1, depth)
+    )
+    root = (
+        "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+    )
+    end_site = "End Site\n{\nOFFSET 0 1 0\n}\n"
+    motion = f"MOTION\nFrames: 1\nFrame Time: 0.04\n{' '.join(['0'] * (3 + 3 * depth))}\n"
+    return root + opening + end_site + "}\n" * depth + motion
+
+
+def test_deeply_nested_chain_reads_and_writes(tmp_path: Path) -> None:
+    depth = 3000  # far past Python's default recursion limit of 1000
+    motion = read_bvh(_write(tmp_path, _chain_bvh(depth)))
+    assert motion.skeleton.joint_count == depth + 1
+    assert motion.skeleton.parents.tolist() == list(range(-1, depth))
+    assert motion.skeleton.names[-1] == f"j{depth - 1}_End"
+    write_bvh(tmp_path / "back.bvh", motion)
+    back = read_bvh(tmp_path / "back.bvh")
+    assert back.skeleton.parents.tolist() == motion.skeleton.parents.tolist()
+    np.testing.assert_array_equal(back.skeleton.offsets, motion.skeleton.offsets)
 
 
 # --- real clips (SOURCES.md) ---------------------------------------------------------------
@@ -280,3 +314,17 @@ def test_missing_motion_section(tmp_path: Path) -> None:
 
 def test_not_a_bvh_file(tmp_path: Path) -> None:
     assert "line 1: expected 'HIERARCHY', found 'ply'" in _read_error(tmp_path, "ply\nformat ascii 1.0\n")
+
+
+@pytest.mark.parametrize("frame_time", ["1e-320", "0", "-0.1", "inf", "nan", "x"])
+def test_frame_time_without_a_finite_rate(tmp_path: Path, frame_time: str) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace(".0333333", frame_time))
+    assert (
+        f"line 23: expected 'Frame Time: SECONDS' > 0 with a finite frame rate, found 'Frame Time: {frame_time}'"
+        in message
+    )
+
+
+def test_channel_count_that_is_a_non_ascii_digit(tmp_path: Path) -> None:
+    message = _read_error(tmp_path, SMALL_BVH.replace("CHANNELS 3 Zrotation", "CHANNELS ³ Zrotation"))
+    assert "line 9: joint 'A': channel count '³' is not a whole number" in message

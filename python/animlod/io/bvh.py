@@ -33,13 +33,11 @@ from .. import rotations
 from ..model import Motion, Skeleton
 from .atomic import atomic_write
 from .errors import FormatError
-from .tokens import tokens_per_line
+from .tokens import parses, tokens_per_line
 
 # Lower-case channel name -> (kind, axis index).
 _CHANNELS = {
-    f"{axis.lower()}{kind}": (kind, index)
-    for index, axis in enumerate("XYZ")
-    for kind in ("position", "rotation")
+    f"{axis.lower()}{kind}": (kind, index) for index, axis in enumerate("XYZ") for kind in ("position", "rotation")
 }
 _MOTION_LINE = re.compile(r"^[ \t]*MOTION\b", re.MULTILINE)
 
@@ -136,12 +134,33 @@ def read_bvh(path: str | os.PathLike) -> Motion:
 
 
 def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
+    """Joints in file order. Iterative, with a stack of open blocks: chains of any depth parse."""
     cursor.expect("HIERARCHY")
     token, line = cursor.next("ROOT")
     if token != "ROOT":
         raise cursor.error(line, f"expected ROOT, found {token!r}")
     joints: list[_JointSpec] = []
-    _parse_joint(cursor, joints, parent=-1, line=line, end_site=False)
+    open_blocks = [_open_joint(cursor, joints, parent=-1, line=line, end_site=False)]  # (joint, line)
+    while open_blocks:
+        index, opened = open_blocks[-1]
+        joint = joints[index]
+        token, token_line = cursor.next(f"'}}' closing joint {joint.name!r} (opened on line {opened})")
+        if token == "}":
+            if joint.offset is None:
+                raise cursor.error(opened, f"joint {joint.name!r} has no OFFSET")
+            open_blocks.pop()
+        elif token == "OFFSET":
+            joint.offset = tuple(cursor.number(f"OFFSET of joint {joint.name!r}") for _ in range(3))
+        elif token == "CHANNELS" and not joint.end_site:
+            joint.channels = _parse_channels(cursor, joint.name, token_line)
+        elif token == "JOINT" and not joint.end_site:
+            open_blocks.append(_open_joint(cursor, joints, index, token_line, end_site=False))
+        elif token == "End" and not joint.end_site:
+            cursor.expect("Site")
+            open_blocks.append(_open_joint(cursor, joints, index, token_line, end_site=True))
+        else:
+            where = f"End Site of {joints[joint.parent].name!r}" if joint.end_site else f"joint {joint.name!r}"
+            raise cursor.error(token_line, f"unexpected {token!r} in {where}")
     extra = cursor.peek()
     if extra is not None:
         reason = "a second ROOT is not supported" if extra[0] == "ROOT" else f"unexpected {extra[0]!r} after the root"
@@ -149,8 +168,13 @@ def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
     return joints
 
 
-def _parse_joint(cursor: _TokenCursor, joints: list[_JointSpec], parent: int, line: int, end_site: bool) -> None:
-    """Parse one ROOT / JOINT / End Site block (its keyword already consumed) and its children."""
+def _open_joint(
+    cursor: _TokenCursor, joints: list[_JointSpec], parent: int, line: int, end_site: bool
+) -> tuple[int, int]:
+    """Read the name and ``{`` of a ROOT / JOINT / End Site (keyword consumed); append the joint.
+
+    Returns the new joint's index and the line that opened it.
+    """
     name = cursor.rest_of_line(line)
     if end_site:
         name = _unique_name(name or f"{joints[parent].name}_End", joints)
@@ -159,32 +183,13 @@ def _parse_joint(cursor: _TokenCursor, joints: list[_JointSpec], parent: int, li
     elif any(joint.name == name for joint in joints):
         raise cursor.error(line, f"joint name {name!r} is used twice")
     cursor.expect("{")
-    index = len(joints)
-    joint = _JointSpec(name, parent, end_site)
-    joints.append(joint)
-    while True:
-        token, token_line = cursor.next(f"'}}' closing joint {name!r} (opened on line {line})")
-        if token == "}":
-            break
-        if token == "OFFSET":
-            joint.offset = tuple(cursor.number(f"OFFSET of joint {name!r}") for _ in range(3))
-        elif token == "CHANNELS" and not end_site:
-            joint.channels = _parse_channels(cursor, name, token_line)
-        elif token == "JOINT" and not end_site:
-            _parse_joint(cursor, joints, index, token_line, end_site=False)
-        elif token == "End" and not end_site:
-            cursor.expect("Site")
-            _parse_joint(cursor, joints, index, token_line, end_site=True)
-        else:
-            where = f"End Site of {joints[parent].name!r}" if end_site else f"joint {name!r}"
-            raise cursor.error(token_line, f"unexpected {token!r} in {where}")
-    if joint.offset is None:
-        raise cursor.error(line, f"joint {name!r} has no OFFSET")
+    joints.append(_JointSpec(name, parent, end_site))
+    return len(joints) - 1, line
 
 
 def _parse_channels(cursor: _TokenCursor, joint_name: str, line: int) -> list[str]:
     count_token, _ = cursor.next("channel count")
-    if not count_token.isdigit():
+    if not (count_token.isascii() and count_token.isdigit()):  # "²".isdigit() is True, int("²") fails
         raise cursor.error(line, f"joint {joint_name!r}: channel count {count_token!r} is not a whole number")
     channels = [cursor.next(f"channel name of joint {joint_name!r}")[0] for _ in range(int(count_token))]
     unknown = [channel for channel in channels if channel.lower() not in _CHANNELS]
@@ -218,22 +223,16 @@ def _parse_motion_header(path: Path, text: str, motion_line: int) -> tuple[int, 
     if frames_match is None:
         raise FormatError(path, f"line {motion_line + 1}", f"expected 'Frames: N', found {header[1].strip()!r}")
     time_match = re.fullmatch(r"\s*Frame\s+Time:\s*(\S+)\s*", header[2])
-    frame_time = _finite_float(time_match.group(1)) if time_match else None
-    if frame_time is None or frame_time <= 0.0:
+    frame_time = float(time_match.group(1)) if time_match and parses(time_match.group(1), np.float64) else None
+    # The rate 1 / Frame Time must be finite too: Frame Time: 1e-320 is positive but its inverse is not.
+    if frame_time is None or not (frame_time > 0.0 and np.isfinite(frame_time) and np.isfinite(1.0 / frame_time)):
         found = header[2].strip()
-        raise FormatError(path, f"line {motion_line + 2}", f"expected 'Frame Time: SECONDS' > 0, found {found!r}")
+        reason = f"expected 'Frame Time: SECONDS' > 0 with a finite frame rate, found {found!r}"
+        raise FormatError(path, f"line {motion_line + 2}", reason)
     frame_count = int(frames_match.group(1))
     if frame_count < 1:
         raise FormatError(path, f"line {motion_line + 1}", "Frames: must be at least 1")
     return frame_count, _frame_rate(time_match.group(1)), motion_line + 3, header[3] if len(header) > 3 else ""
-
-
-def _finite_float(token: str) -> float | None:
-    try:
-        value = float(token)
-    except ValueError:
-        return None
-    return value if np.isfinite(value) else None
 
 
 def _frame_rate(frame_time: str) -> float:
@@ -277,21 +276,13 @@ def _parse_motion_table(
     try:
         values = np.array(tokens, dtype=np.float64).reshape(frame_count, channel_count)
     except ValueError:
-        bad = next(index for index, token in enumerate(tokens) if not _is_number(token))
+        bad = next(index for index, token in enumerate(tokens) if not parses(token, np.float64))
         raise value_error(bad, f"{tokens[bad]!r} is not a number") from None
     finite = np.isfinite(values)
     if not finite.all():
         bad = int(np.argmin(finite.ravel()))
         raise value_error(bad, f"value {values.flat[bad]} is not finite")
     return values
-
-
-def _is_number(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
 
 
 def _build_motion(path: Path, joints: list[_JointSpec], values: np.ndarray, fps: float) -> Motion:
@@ -391,15 +382,20 @@ def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZX
 
 
 def _hierarchy_text(skeleton: Skeleton, has_position: np.ndarray, order: str, precision: int) -> str:
+    """The HIERARCHY section, depth first. Iterative, so chains of any depth are written."""
     children = skeleton.children()
     lines = ["HIERARCHY"]
-
-    def emit(joint: int, depth: int) -> None:
+    pending = [(0, 0, False)]  # (joint, depth, whether to close its block)
+    while pending:
+        joint, depth, close = pending.pop()
         indent = "\t" * depth
+        if close:
+            lines.append(f"{indent}}}")
+            continue
         offset = " ".join(f"{value:.{precision}f}" for value in skeleton.offsets[joint])
         if skeleton.end_sites[joint]:
             lines.extend([f"{indent}End Site", f"{indent}{{", f"{indent}\tOFFSET {offset}", f"{indent}}}"])
-            return
+            continue
         channels = [f"{axis}position" for axis in "XYZ"] if has_position[joint] else []
         channels += [f"{axis}rotation" for axis in order]
         keyword = "ROOT" if joint == 0 else "JOINT"
@@ -411,9 +407,6 @@ def _hierarchy_text(skeleton: Skeleton, has_position: np.ndarray, order: str, pr
                 f"{indent}\tCHANNELS {len(channels)} {' '.join(channels)}",
             ]
         )
-        for child in children[joint]:
-            emit(child, depth + 1)
-        lines.append(f"{indent}}}")
-
-    emit(0, 0)
+        pending.append((joint, depth, True))
+        pending.extend((child, depth + 1, False) for child in reversed(children[joint]))
     return "\n".join(lines) + "\n"

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import struct
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -30,12 +32,27 @@ def test_round_trip_is_exact(tmp_path: Path, fps: float | None) -> None:
     assert back.frames.dtype == np.float32 and back.faces.dtype == np.int32
 
 
-def test_archive_keys_and_no_leftover_files(tmp_path: Path) -> None:
+def test_archive_keys(tmp_path: Path) -> None:
     write_npz(tmp_path / "mesh.npz", _mesh(24.0))
-    assert [path.name for path in tmp_path.iterdir()] == ["mesh.npz"]
     with np.load(tmp_path / "mesh.npz") as archive:
         assert sorted(archive.files) == ["faces", "format_version", "fps", "frames"]
         assert int(archive["format_version"]) == FORMAT_VERSION
+
+
+def test_a_write_failing_part_way_keeps_the_old_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = tmp_path / "mesh.npz"
+    write_npz(path, _mesh(24.0))
+    old = path.read_bytes()
+
+    def write_a_header_then_fail(handle, **arrays) -> None:
+        handle.write(b"PK\x03\x04 half an archive")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savez_compressed", write_a_header_then_fail)
+    with pytest.raises(OSError, match="disk full"):
+        write_npz(path, _mesh(30.0))
+    assert path.read_bytes() == old
+    assert [entry.name for entry in tmp_path.iterdir()] == ["mesh.npz"]
 
 
 def _save(tmp_path: Path, **arrays: np.ndarray) -> Path:
@@ -71,4 +88,19 @@ def test_not_an_archive(tmp_path: Path) -> None:
     path = tmp_path / "text.npz"
     path.write_text("hello")
     with pytest.raises(FormatError, match="archive: not a readable npz archive"):
+        read_npz(path)
+
+
+@pytest.mark.parametrize("damage", [b"\xff" * 8, b"\x00" * 8])
+def test_damaged_compressed_member(tmp_path: Path, damage: bytes) -> None:
+    path = tmp_path / "mesh.npz"
+    write_npz(path, _mesh(24.0))
+    data = bytearray(path.read_bytes())
+    with zipfile.ZipFile(path) as archive:
+        local_header = archive.getinfo("frames.npy").header_offset
+    name_length, extra_length = struct.unpack("<HH", data[local_header + 26 : local_header + 30])
+    start = local_header + 30 + name_length + extra_length  # the member's deflate stream
+    data[start : start + len(damage)] = damage
+    path.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="archive: not a readable npz archive .*decompressing"):
         read_npz(path)

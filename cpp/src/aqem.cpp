@@ -125,7 +125,8 @@ class Simplifier {
         vertex_weights_(weights.begin(), weights.end()),
         merged_into_(mesh.vertex_count),
         new_positions_(used_count_),
-        singular_(used_count_) {}
+        singular_(used_count_),
+        placed_(frame_count_) {}
 
   Status run(const std::vector<size_t>& targets, AqemResult& out);
 
@@ -135,6 +136,7 @@ class Simplifier {
   Candidate evaluate(int32_t edge);
   Candidate evaluate_on_edge(Candidate candidate, bool pinned);
   bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
+  void place_in_every_frame(const Candidate& candidate);
   bool keeps_orientation(const Candidate& candidate);
   void collapse(const Candidate& candidate, TriMesh::HalfedgeHandle halfedge, CollapseRecord& record);
   void rekey_around(TriMesh::VertexHandle vertex, bool all_edges);
@@ -165,6 +167,7 @@ class Simplifier {
   std::vector<uint8_t> may_have_parked_;  // (V,) set when an edge of the vertex is parked
   std::vector<Eigen::Vector3d> new_positions_;  // (K,) placement of the candidate being evaluated
   std::vector<uint8_t> singular_;               // (K,) frames of that candidate using the fallback
+  std::vector<Eigen::Vector3d> placed_;         // (F,) its position in every frame (place_in_every_frame)
   TriMesh connectivity_;
   detail::IndexedMinHeap heap_{0};
   size_t face_count_ = 0;
@@ -308,6 +311,7 @@ Candidate Simplifier::evaluate_on_edge(Candidate candidate, bool pinned) {
 // sqrt(A(t^f) A(t'^f) w_t w_t') < 0 means inverted. The weights w_t, w_t' do not depend on the
 // frame, so they cannot change the sign of one face's sum and are left out. A face whose area
 // vanishes in every frame is rejected too; strict_inversion rejects a flip in any one frame.
+// Every frame is tested, not only the quadrics' frames: the others get placed_ positions too.
 bool Simplifier::keeps_orientation(const Candidate& candidate) {
   for (const int32_t moved : {candidate.kept, candidate.removed}) {
     const int32_t other = moved == candidate.kept ? candidate.removed : candidate.kept;
@@ -322,12 +326,11 @@ bool Simplifier::keeps_orientation(const Candidate& candidate) {
       if (collapses) continue;  // the two faces on the edge disappear
       double agreement = 0.0;
       bool has_area = false;
-      for (size_t k = 0; k < used_count_; ++k) {
-        const size_t frame = static_cast<size_t>(frames_[k]);
+      for (size_t frame = 0; frame < frame_count_; ++frame) {
         Eigen::Vector3d before[3], after[3];
         for (int c = 0; c < 3; ++c) {
           before[c] = position(corners[c], frame);
-          after[c] = corners[c] == moved ? new_positions_[k] : before[c];
+          after[c] = corners[c] == moved ? placed_[frame] : before[c];
         }
         const Eigen::Vector3d n_before = (before[1] - before[0]).cross(before[2] - before[0]);
         const Eigen::Vector3d n_after = (after[1] - after[0]).cross(after[2] - after[0]);
@@ -358,7 +361,21 @@ bool Simplifier::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle co
   return !options_.check_inversion || keeps_orientation(candidate);
 }
 
-// Steps 9-10: move the kept vertex to its new positions in every frame, merge quadrics (the
+// The candidate's vertex in every frame F: its Eq. 5 placement (new_positions_) in the
+// quadrics' frames, kept + t (removed - kept) in the others.
+void Simplifier::place_in_every_frame(const Candidate& candidate) {
+  size_t used = 0;
+  for (size_t frame = 0; frame < frame_count_; ++frame) {
+    if (used < used_count_ && static_cast<size_t>(frames_[used]) == frame) {
+      placed_[frame] = new_positions_[used++];
+      continue;
+    }
+    const Eigen::Vector3d p_kept = position(candidate.kept, frame);
+    placed_[frame] = p_kept + candidate.t * (position(candidate.removed, frame) - p_kept);
+  }
+}
+
+// Steps 9-10: move the kept vertex to its placed_ positions in every frame, merge quadrics (the
 // text after Eq. 4), weights (Eq. 6) and attributes, collapse, and re-key the affected edges.
 void Simplifier::collapse(const Candidate& candidate, TriMesh::HalfedgeHandle halfedge, CollapseRecord& record) {
   record.removed.push_back(candidate.removed);
@@ -366,18 +383,10 @@ void Simplifier::collapse(const Candidate& candidate, TriMesh::HalfedgeHandle ha
   record.cost.push_back(candidate.cost);
   record.error.push_back(candidate.error);
 
-  size_t used = 0;
   for (size_t frame = 0; frame < frame_count_; ++frame) {
-    const Eigen::Vector3d p_kept = position(candidate.kept, frame);
-    Eigen::Vector3d p;
-    if (used < used_count_ && static_cast<size_t>(frames_[used]) == frame) {
-      p = new_positions_[used++];
-    } else {
-      p = p_kept + candidate.t * (position(candidate.removed, frame) - p_kept);
-    }
     float* out = &positions_[(static_cast<size_t>(candidate.kept) * frame_count_ + frame) * 3];
     for (int axis = 0; axis < 3; ++axis) {
-      out[axis] = static_cast<float>(p[axis]);
+      out[axis] = static_cast<float>(placed_[frame][axis]);
       record.positions.push_back(out[axis]);
     }
   }
@@ -527,6 +536,7 @@ Status Simplifier::run(const std::vector<size_t>& targets, AqemResult& out) {
   while (next_level < targets.size() && !heap_.empty()) {
     const int32_t edge = heap_.top();
     const Candidate candidate = evaluate(edge);
+    place_in_every_frame(candidate);
     // The halfedge from the removed vertex to the kept one (OpenMesh keeps the "to" vertex).
     auto halfedge = connectivity_.halfedge_handle(connectivity_.edge_handle(edge), 0);
     if (connectivity_.from_vertex_handle(halfedge).idx() != candidate.removed)

@@ -41,6 +41,28 @@ bool is_manifold(const AqemLevel& level) {
   return true;
 }
 
+// Faces of a level whose normal points towards the origin, over every frame. The test
+// shapes are convex and centred at the origin, so an outward face has n . centroid > 0.
+size_t inward_faces(const AqemLevel& level, size_t frame_count) {
+  const size_t kept = level.kept_vertices.size();
+  size_t inward = 0;
+  for (size_t f = 0; f < frame_count; ++f) {
+    const float* p = &level.positions[f * kept * 3];
+    for (size_t t = 0; t < level.faces.size(); t += 3) {
+      double a[3], b[3], c[3];
+      for (int k = 0; k < 3; ++k) {
+        a[k] = p[3 * level.faces[t] + k];
+        b[k] = p[3 * level.faces[t + 1] + k];
+        c[k] = p[3 * level.faces[t + 2] + k];
+      }
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      if (n[0] * (a[0] + b[0] + c[0]) + n[1] * (a[1] + b[1] + c[1]) + n[2] * (a[2] + b[2] + c[2]) <= 0.0) ++inward;
+    }
+  }
+  return inward;
+}
+
 }  // namespace
 
 TEST_CASE("aqem keeps a flat grid flat and inside its square, at or below the target") {
@@ -130,23 +152,46 @@ TEST_CASE("aqem never flips a face of a deforming sphere in any frame") {
   AqemOptions options;
   options.target_ratios = {0.05};
   const AqemResult result = simplify(mesh, options);
-  const AqemLevel& level = result.levels[0];
-  const size_t kept = level.kept_vertices.size();
-  for (size_t f = 0; f < mesh.frame_count; ++f) {
-    const float* p = &level.positions[f * kept * 3];
-    for (size_t t = 0; t < level.faces.size(); t += 3) {
-      double a[3], b[3], c[3];
-      for (int k = 0; k < 3; ++k) {
-        a[k] = p[3 * level.faces[t] + k];
-        b[k] = p[3 * level.faces[t + 1] + k];
-        c[k] = p[3 * level.faces[t + 2] + k];
-      }
-      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-      const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-      // The centroid direction of a convex shape centred at the origin points outward.
-      CHECK(n[0] * (a[0] + b[0] + c[0]) + n[1] * (a[1] + b[1] + c[1]) + n[2] * (a[2] + b[2] + c[2]) > 0.0);
-    }
+  CHECK(inward_faces(result.levels[0], mesh.frame_count) == 0);
+}
+
+TEST_CASE("aqem checks orientation in the frames outside the quadrics' frames too") {
+  // Regression: with max_frames (or frame_subset) the frames left out of the quadrics get
+  // kept + t (removed - kept) and went unchecked, so faces flipped there. Frame 1 jitters the
+  // flat grid in its plane by under half a cell: no input face turns down, but collapses
+  // placed from frame 0 alone flipped one. In-plane, every normal is +z or -z, so
+  // strict_inversion (no flip in any single frame) must leave every face up.
+  OwnedAnimatedMesh mesh = animlod::testing::grid(8);
+  const size_t vertex_count = mesh.vertex_count;
+  for (size_t v = 0; v < vertex_count; ++v) {
+    const double i = double(v);
+    const double offset[3] = {0.45 / 8 * std::sin(i * 6.8 + 0.3), 0.45 / 8 * std::sin(i * 9.2 + 1.1), 0.0};
+    for (int k = 0; k < 3; ++k) mesh.frames.push_back(float(mesh.frames[3 * v + k] + offset[k]));
   }
+  mesh.frame_count = 2;
+  auto downward_faces = [](const std::vector<float>& positions, const std::vector<int32_t>& faces, size_t frame,
+                           size_t vertex_count_) {
+    size_t down = 0;
+    const float* p = &positions[frame * vertex_count_ * 3];
+    for (size_t t = 0; t < faces.size(); t += 3) {
+      const float* a = p + 3 * faces[t];
+      const float* b = p + 3 * faces[t + 1];
+      const float* c = p + 3 * faces[t + 2];
+      const double normal_z = double(b[0] - a[0]) * (c[1] - a[1]) - double(b[1] - a[1]) * (c[0] - a[0]);
+      down += normal_z <= 0.0;
+    }
+    return down;
+  };
+  REQUIRE(downward_faces(mesh.frames, mesh.faces, 1, vertex_count) == 0);
+  AqemOptions options;
+  options.target_ratios = {0.5, 0.25, 0.1};
+  options.max_frames = 1;
+  options.strict_inversion = true;
+  const AqemResult result = simplify(mesh, options);
+  CHECK(result.frames_used == std::vector<int32_t>{0});
+  for (const AqemLevel& level : result.levels)
+    for (size_t frame = 0; frame < 2; ++frame)
+      CHECK(downward_faces(level.positions, level.faces, frame, level.kept_vertices.size()) == 0);
 }
 
 TEST_CASE("aqem keeps locked vertices where they are") {

@@ -44,9 +44,12 @@ struct AqemOptions {
   // Adds, per frame, a plane through every boundary edge perpendicular to its face, so that
   // open borders keep their shape (Garland and Heckbert 1997, section 6.1).
   bool boundary_quadrics = true;
-  // Rejects collapses that invert a face according to Eq. 7 (summed over the frames).
+  // Rejects collapses that invert a face according to Eq. 7, summed over every frame F (also
+  // the frames outside frames_used, at their on-edge positions). The sum lets a face flip in a
+  // few frames when it gains area in the others.
   bool check_inversion = true;
-  // Stricter than Eq. 7: rejects a collapse that inverts a face in any single frame.
+  // Stricter than Eq. 7: rejects a collapse that inverts a face in any single frame. Ignored
+  // when check_inversion is false.
   bool strict_inversion = false;
   // Quadrics over K frames only (memory O(V K) instead of O(V F)): 0 uses every frame,
   // otherwise K frames chosen by farthest-point sampling of the poses (see frames_used).

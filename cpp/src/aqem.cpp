@@ -94,11 +94,22 @@ Status resolve_frames(const AnimatedMeshView& mesh, const AqemOptions& options, 
   return Status::success();
 }
 
+// The pointers and counts must agree before any value is read.
+Status validate_vertex_data_layout(const AqemVertexData& data) {
+  if (data.attribute_count > 0 && !data.attributes)
+    return Status::error("attributes: attribute_count is " + std::to_string(data.attribute_count) +
+                         " but attributes is null");
+  if ((data.skin_joints == nullptr) != (data.skin_weights == nullptr))
+    return Status::error("skin_joints and skin_weights: give both or neither");
+  return Status::success();
+}
+
 Status validate_vertex_data(const AnimatedMeshView& mesh, const AqemVertexData& data) {
+  if (Status status = validate_vertex_data_layout(data); !status) return status;
   for (size_t v = 0; v < mesh.vertex_count; ++v) {
     if (data.importance && !(std::isfinite(data.importance[v]) && data.importance[v] > 0.0f))
       return Status::error("importance: vertex " + std::to_string(v) + " has a non-positive or non-finite weight");
-    for (size_t a = 0; a < data.attribute_count && data.attributes; ++a)
+    for (size_t a = 0; a < data.attribute_count; ++a)
       if (!std::isfinite(data.attributes[v * data.attribute_count + a]))
         return Status::error("attributes: vertex " + std::to_string(v) + " has a non-finite value");
     for (size_t k = 0; k < data.influence_count && data.skin_joints; ++k) {
@@ -561,7 +572,12 @@ Status Simplifier::run(const std::vector<size_t>& targets, AqemResult& out) {
 
 Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& vertex_data, const AqemOptions& options,
                          AqemResult& out) {
+  // Everything is built in `result` and moved into `out` only on success, so that an error
+  // (or an exception from the progress callback) leaves `out` empty, never half filled.
   out = AqemResult{};
+  AqemResult result;
+  // The cheap O(V) check first; the mesh checks inside compute_motion_features cost O(M log M + F V).
+  if (Status status = validate_vertex_data(mesh, vertex_data); !status) return status;
   // Steps 3-4: motion features give the vertex weights of Eq. 6 (their extraction validates
   // the mesh too); importance multiplies them.
   MotionFeatures features;
@@ -570,15 +586,16 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   if (!valid) return valid;
   std::vector<size_t> targets;
   if (Status status = resolve_targets(mesh, options, targets); !status) return status;
-  if (Status status = resolve_frames(mesh, options, out.frames_used); !status) return status;
-  if (Status status = validate_vertex_data(mesh, vertex_data); !status) return status;
+  if (Status status = resolve_frames(mesh, options, result.frames_used); !status) return status;
   std::vector<float> weights = options.use_motion_features ? std::move(features.vertex_weights)
                                                            : std::vector<float>(mesh.vertex_count, 1.0f);
   if (vertex_data.importance)
     for (size_t v = 0; v < mesh.vertex_count; ++v) weights[v] *= vertex_data.importance[v];
 
-  Simplifier simplifier(mesh, vertex_data, options, out.frames_used, std::move(weights));
-  return simplifier.run(targets, out);
+  Simplifier simplifier(mesh, vertex_data, options, result.frames_used, std::move(weights));
+  if (Status status = simplifier.run(targets, result); !status) return status;
+  out = std::move(result);
+  return Status::success();
 }
 
 }  // namespace animlod

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -321,6 +322,57 @@ TEST_CASE("aqem names the element of bad input") {
     options.target_ratios = {1.5};
     CHECK(failure(mesh, options).find("target_ratios: 1.5") == 0);
   }
+}
+
+TEST_CASE("aqem rejects per-vertex data whose pointers and counts disagree") {
+  const OwnedAnimatedMesh mesh = animlod::testing::grid(2);
+  std::vector<int32_t> joints(mesh.vertex_count, 0);
+  std::vector<float> weights(mesh.vertex_count, 1.0f);
+  AqemVertexData data;
+  std::string expected;
+  SUBCASE("attribute_count without attributes") {
+    data.attribute_count = 2;
+    expected = "attributes: attribute_count is 2 but attributes is null";
+  }
+  SUBCASE("skin_joints without skin_weights") {
+    data.skin_joints = joints.data();
+    data.influence_count = 1;
+    expected = "skin_joints and skin_weights: give both or neither";
+  }
+  SUBCASE("skin_weights without skin_joints") {
+    data.skin_weights = weights.data();
+    data.influence_count = 1;
+    expected = "skin_joints and skin_weights: give both or neither";
+  }
+  AqemResult result;
+  const animlod::Status status = simplify_animated(mesh.view(), data, AqemOptions{}, result);
+  CHECK_FALSE(status.ok);
+  CHECK(status.message == expected);
+}
+
+TEST_CASE("aqem leaves the result empty when it fails") {
+  // Regression: frames_used was written before later checks failed, and a throwing progress
+  // callback left the levels taken so far.
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(8, 10, 2);
+  AqemResult result;
+  result.frames_used = {7};  // stale content must go too
+  AqemOptions options;
+  options.target_ratios = {0.9, 0.5};
+  SUBCASE("bad vertex data") {
+    const std::vector<float> importance(mesh.vertex_count, -1.0f);
+    AqemVertexData data;
+    data.importance = importance.data();
+    CHECK_FALSE(simplify_animated(mesh.view(), data, options, result).ok);
+  }
+  SUBCASE("progress callback throws") {
+    options.target_ratios = {1.0, 0.5};  // the first level is taken before the first call
+    options.progress = [](size_t, size_t) { throw std::runtime_error("cancelled"); };
+    CHECK_THROWS_AS(simplify_animated(mesh.view(), {}, options, result), std::runtime_error);
+  }
+  CHECK(result.levels.empty());
+  CHECK(result.frames_used.empty());
+  CHECK(result.collapses.removed.empty());
+  CHECK(result.vertex_weights.empty());
 }
 
 TEST_CASE("aqem reduces a subdivided cube to its eight exact corners") {

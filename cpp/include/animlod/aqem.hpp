@@ -62,7 +62,8 @@ struct AqemOptions {
   Placement placement = Placement::optimal;
 };
 
-// Optional per-vertex inputs; a null pointer means "not given".
+// Optional per-vertex inputs; a null pointer means "not given". attributes must be given when
+// attribute_count > 0, and skin_joints and skin_weights together (simplify_animated checks).
 struct AqemVertexData {
   const uint8_t* locked = nullptr;        // (V,) nonzero: the vertex keeps its positions and is
                                           //      never removed (edges may collapse into it)
@@ -117,7 +118,10 @@ struct AqemResult {
 //
 // Errors (the message names the element): the checks of validate_animated_mesh; a target
 // ratio outside (0, 1] or face count outside [4, M]; a frame index outside [0, F); a
-// non-positive or non-finite importance; a skin joint index below 0; a non-finite attribute.
+// non-positive or non-finite importance; a skin joint index below 0; a negative or non-finite
+// skin weight; a non-finite attribute; attribute_count > 0 with null attributes; only one of
+// skin_joints and skin_weights. On error (or an exception thrown by options.progress) `out`
+// is left empty.
 Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& vertex_data,
                          const AqemOptions& options, AqemResult& out);
 

@@ -712,3 +712,59 @@ def test_flamingo_morph_animation(data_dir):
     np.testing.assert_allclose(flight.frames[10], rest + np.einsum("n,nvc->vc", between, deltas), atol=1e-4)
     with pytest.raises(FormatError, match="Flamingo.glb: skin a skinned mesh: not in the file"):
         read_skinned(path)
+
+
+def _edit_quad_gltf(folder: Path, edit: Callable[[dict], None]) -> Path:
+    """The quad .gltf of :func:`_write_quad_gltf` (external buffer) with ``edit`` applied to its JSON."""
+    path = _write_quad_gltf(folder, "quad.bin")
+    document = json.loads(path.read_text())
+    edit(document)
+    path.write_text(json.dumps(document))
+    return path
+
+
+@pytest.mark.parametrize("stride", [8, 14, 256])
+def test_byte_stride_outside_the_spec_is_refused(tmp_path, stride):
+    def set_stride(document):
+        document["bufferViews"][0]["byteStride"] = stride
+
+    path = _edit_quad_gltf(tmp_path, set_stride)
+    with pytest.raises(FormatError) as caught:
+        read_gltf(path)
+    reason = f"byteStride {stride} must be a multiple of 4 from 12 (the element size of accessor 0"
+    assert str(caught.value).startswith(f"{path}: bufferView 0: {reason}")
+
+
+@pytest.mark.parametrize(
+    ("element", "owner"),
+    [
+        ("bufferView 1", lambda document: document["bufferViews"][1]),
+        ("accessor 1 (mesh 0 primitive 0 indices)", lambda document: document["accessors"][1]),
+        (
+            "accessor 3 (mesh 0 primitive 0 target 0 POSITION) sparse indices",
+            lambda document: document["accessors"][3]["sparse"]["indices"],
+        ),
+    ],
+)
+def test_negative_byte_offset_is_refused(tmp_path, element, owner):
+    path = _edit_quad_gltf(tmp_path, lambda document: owner(document).update(byteOffset=-4))
+    with pytest.raises(FormatError) as caught:
+        read_gltf(path)
+    assert str(caught.value) == f"{path}: {element}: byteOffset -4 is not a whole number >= 0"
+
+
+def test_signed_sparse_indices_are_refused(tmp_path):
+    def signed_indices(document):
+        document["accessors"][3]["sparse"]["indices"]["componentType"] = 5122
+
+    path = _edit_quad_gltf(tmp_path, signed_indices)
+    with pytest.raises(FormatError, match=r"sparse indices: componentType 5122 is not one of \(5121, 5123, 5125\)"):
+        read_gltf(path)
+
+
+def test_node_with_a_missing_mesh_names_it_in_the_singular(tmp_path):
+    def break_mesh(document):
+        document["nodes"][1]["mesh"] = 7
+
+    with pytest.raises(FormatError, match=r"refers to mesh 7, but the file has 1 meshes"):
+        read_gltf(_edit_quad_gltf(tmp_path, break_mesh))

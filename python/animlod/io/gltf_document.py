@@ -44,6 +44,12 @@ _COMPONENT_DTYPES = {
 # Normalised integers map to [0, 1] (unsigned) or [-1, 1] (signed), glTF 2.0 section 3.11.
 _NORMALIZED_DIVISORS = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}
 _TYPE_WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+# Sparse indices are unsigned: UNSIGNED_BYTE, UNSIGNED_SHORT, UNSIGNED_INT (glTF 2.0 section 3.6.2.3).
+_SPARSE_INDEX_COMPONENTS = (5121, 5123, 5125)
+# bufferView.byteStride is a multiple of 4 no larger than 252 (glTF 2.0 section 3.6.2.4).
+_MAX_BYTE_STRIDE = 252
+# Top-level arrays whose singular is not the name without its last letter.
+_IRREGULAR_SINGULARS = {"meshes": "mesh"}
 
 # Relative tolerance under which a node's scale counts as uniform (exporters leave float noise
 # such as 1.0000009 on scales that are meant to be 1).
@@ -75,7 +81,8 @@ class GltfDocument:
         """``gltf.<kind>[index]``, or FormatError naming ``referrer`` when the index is invalid."""
         items = getattr(self.gltf, kind) or []
         if not isinstance(index, int) or isinstance(index, bool) or not 0 <= index < len(items):
-            raise self.fail(referrer, f"refers to {kind[:-1]} {index!r}, but the file has {len(items)} {kind}")
+            singular = _IRREGULAR_SINGULARS.get(kind, kind[:-1])
+            raise self.fail(referrer, f"refers to {singular} {index!r}, but the file has {len(items)} {kind}")
         return items[index]
 
     # ---- accessors -------------------------------------------------------------------------
@@ -125,8 +132,8 @@ class GltfDocument:
         view_index = accessor.bufferView
         view = self.item("bufferViews", view_index, element)
         data = self._buffer(view.buffer, f"bufferView {view_index}")
-        view_offset = view.byteOffset or 0
-        view_length = view.byteLength or 0
+        view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {view_index}")
+        view_length = self._whole_number(view.byteLength, "byteLength", f"bufferView {view_index}")
         if view_offset + view_length > len(data):
             raise self.fail(
                 f"bufferView {view_index}",
@@ -134,8 +141,17 @@ class GltfDocument:
                 f"of {len(data)} bytes (truncated file?)",
             )
         element_bytes = dtype.itemsize * width
-        stride = view.byteStride or element_bytes
-        start = accessor.byteOffset or 0
+        stride = view.byteStride
+        if stride is None:
+            stride = element_bytes
+        # A stride below the element size would read elements that overlap.
+        elif not (isinstance(stride, int) and element_bytes <= stride <= _MAX_BYTE_STRIDE and stride % 4 == 0):
+            reason = (
+                f"byteStride {stride!r} must be a multiple of 4 from {element_bytes} (the element size of "
+                f"{element}) to {_MAX_BYTE_STRIDE}"
+            )
+            raise self.fail(f"bufferView {view_index}", reason)
+        start = self._whole_number(accessor.byteOffset, "byteOffset", element)
         needed = start + stride * (count - 1) + element_bytes if count else 0
         if needed > view_length:
             raise self.fail(element, f"needs {needed} bytes but bufferView {view_index} has {view_length}")
@@ -148,25 +164,36 @@ class GltfDocument:
     def _apply_sparse(
         self, sparse: pygltflib.Sparse, values: np.ndarray, width: int, dtype: np.dtype, element: str
     ) -> None:
-        substitutes = sparse.count or 0
-        index_dtype = _COMPONENT_DTYPES.get(sparse.indices.componentType)
-        indices = self._sparse_part(sparse.indices, substitutes, 1, index_dtype, f"{element} sparse indices")
+        substitutes = self._whole_number(sparse.count, "sparse count", element)
+        index_element = f"{element} sparse indices"
+        if sparse.indices.componentType not in _SPARSE_INDEX_COMPONENTS:
+            reason = f"componentType {sparse.indices.componentType!r} is not one of {_SPARSE_INDEX_COMPONENTS}"
+            raise self.fail(index_element, reason)
+        index_dtype = _COMPONENT_DTYPES[sparse.indices.componentType]
+        indices = self._sparse_part(sparse.indices, substitutes, 1, index_dtype, index_element)
         new_values = self._sparse_part(sparse.values, substitutes, width, dtype, f"{element} sparse values")
-        rows = indices[:, 0].astype(np.int64)
+        rows = indices[:, 0].astype(np.int64)  # unsigned, so only the upper bound can be crossed
         if rows.size and rows.max() >= values.shape[0]:
-            raise self.fail(f"{element} sparse indices", f"index {int(rows.max())} outside [0, {values.shape[0]})")
+            raise self.fail(index_element, f"index {int(rows.max())} outside [0, {values.shape[0]})")
         values[rows] = new_values
 
-    def _sparse_part(self, part: Any, count: int, width: int, dtype: np.dtype | None, element: str) -> np.ndarray:
-        if dtype is None:
-            raise self.fail(element, "unknown componentType")
+    def _sparse_part(self, part: Any, count: int, width: int, dtype: np.dtype, element: str) -> np.ndarray:
         view = self.item("bufferViews", part.bufferView, element)
         data = self._buffer(view.buffer, f"bufferView {part.bufferView}")
-        start = (view.byteOffset or 0) + (part.byteOffset or 0)
+        view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {part.bufferView}")
+        start = view_offset + self._whole_number(part.byteOffset, "byteOffset", element)
         length = count * width * dtype.itemsize
         if start + length > len(data):
             raise self.fail(element, f"needs bytes up to {start + length}, buffer has {len(data)}")
         return np.frombuffer(data, dtype, count * width, start).reshape(count, width)
+
+    def _whole_number(self, value: Any, name: str, element: str) -> int:
+        """A byteOffset, byteLength or count of ``element``: 0 when absent, else a whole number >= 0."""
+        if value is None:
+            return 0
+        if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+            raise self.fail(element, f"{name} {value!r} is not a whole number >= 0")
+        return value
 
     def _buffer(self, index: Any, referrer: str) -> bytes:
         buffer = self.item("buffers", index, referrer)

@@ -10,7 +10,14 @@ from test_motion_figures import figure_motion
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.newton import refit_newton
-from animlod.motion_lod.objective import Weights, build_problem, half_hessian, objective, rigidity_constraints
+from animlod.motion_lod.objective import (
+    Weights,
+    build_problem,
+    half_hessian,
+    objective,
+    rigidity_constraints,
+    split_problem,
+)
 from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
 from animlod.motion_lod.skeleton_reduce import expand_motion, recover_motion, reduce_skeleton
 
@@ -196,6 +203,12 @@ def test_worker_processes_give_the_same_result(figure) -> None:
     pooled = refit_slsqp(problem, original[:8], fallback[:8], chunk_frames=4, workers=2)
     np.testing.assert_array_equal(pooled.positions, alone.positions)
     np.testing.assert_array_equal(pooled.evaluations, alone.evaluations)
+    finished = []
+    alone = refit_newton(problem, original[:8], chunk_frames=4)
+    pooled = refit_newton(problem, original[:8], chunk_frames=4, workers=2, progress=finished.append)
+    np.testing.assert_array_equal(pooled.positions, alone.positions)
+    np.testing.assert_array_equal(pooled.evaluations, alone.evaluations)
+    assert sum(finished) == pytest.approx(8.0)  # every group's chunks add up to the 8 frames
 
 
 def test_newton_worker_processes_give_the_same_result(figure) -> None:
@@ -228,4 +241,4 @@ def test_newton_reports_frames_stopped_by_the_damping_limit(figure, monkeypatch)
         (t, "damping limit", "kept best point") for t in range(3)
     ]
     np.testing.assert_array_equal(result.positions, frames)
-    assert np.all(result.evaluations < 100 * len(newton.split_problem(problem)[0]))
+    assert np.all(result.evaluations < 100 * len(split_problem(problem)[0]))

@@ -17,9 +17,10 @@ import numpy as np
 from ..model import Motion, SkinnedMesh
 from .analysis import MotionAnalysis, analyze_motion
 from .frozen import FrozenLevel, freeze, frozen_motion
+from .grouped_solve import FrameFailure, RefitResult
 from .newton import refit_newton
 from .objective import RefitProblem, Weights, build_problem
-from .refit import FrameFailure, RefitResult, SlsqpOptions, refit_slsqp
+from .refit import SlsqpOptions, refit_slsqp
 from .skeleton_reduce import expand_motion, recover_motion
 from .skin_transfer import transfer_skin
 

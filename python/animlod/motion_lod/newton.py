@@ -13,13 +13,11 @@ optima.
 from __future__ import annotations
 
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
-from contextlib import nullcontext
 
 import numpy as np
 
-from .objective import RefitProblem, half_hessian, objective, split_problem
-from .refit import FrameFailure, RefitResult, combine_groups, concatenate
+from .grouped_solve import FrameFailure, RefitResult, solve_grouped
+from .objective import RefitProblem, half_hessian, objective
 
 
 def refit_newton(
@@ -54,30 +52,10 @@ def refit_newton(
     -------
     RefitResult; ``evaluations`` counts objective evaluations per frame, summed over groups.
     """
-    groups, _ = split_problem(problem)
     begin = original if start is None else start
-    tasks = [
-        (sub, first, original[first : first + chunk_frames, points], begin[first : first + chunk_frames, points],
-         ftol_rel, xtol, max_iterations)
-        for points, sub in groups
-        for first in range(0, original.shape[0], chunk_frames)
-    ]  # fmt: skip
-    results = []
-    with ProcessPoolExecutor(max_workers=workers) if workers > 1 else nullcontext() as pool:
-        for result in pool.map(_solve_task, tasks) if pool else map(_solve_task, tasks):
-            results.append(result)
-            if progress:
-                progress(result.positions.shape[0] / len(groups))
-    per_group = len(tasks) // max(len(groups), 1)
-    return combine_groups(
-        problem,
-        original,
-        [(points, concatenate(results[k * per_group : (k + 1) * per_group])) for k, (points, _) in enumerate(groups)],
+    return solve_grouped(
+        problem, _solve_chunk, (original, begin), (ftol_rel, xtol, max_iterations), chunk_frames, workers, progress
     )
-
-
-def _solve_task(task: tuple) -> RefitResult:
-    return _solve_chunk(*task)
 
 
 def _solve_chunk(

@@ -24,33 +24,14 @@ it is feasible, and on the key posture's side of every mirror image.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
-from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import nlopt
 import numpy as np
 
-from .objective import RefitProblem, handedness_constraints, objective, rigidity_constraints, split_problem
-
-
-@dataclass(frozen=True)
-class FrameFailure:
-    """A frame whose first solve was not kept, and what was kept instead."""
-
-    frame: int
-    reason: str
-    outcome: str  # "cold restart" or "fallback"
-
-
-@dataclass
-class RefitResult:
-    """Positions ``(T, P, 3)`` after the re-fit, with per-frame statistics ``(T,)``."""
-
-    positions: np.ndarray
-    objective: np.ndarray
-    evaluations: np.ndarray
-    failures: list[FrameFailure] = field(default_factory=list)
+from .grouped_solve import FrameFailure, RefitResult, solve_grouped
+from .objective import RefitProblem, handedness_constraints, objective, rigidity_constraints
 
 
 @dataclass(frozen=True)
@@ -188,60 +169,4 @@ def refit_slsqp(
     progress : called with the (fractional) number of frames finished after each chunk.
     """
     options = options or SlsqpOptions()
-    groups, _ = split_problem(problem)
-    tasks = [
-        (sub, s, original[s : s + chunk_frames, points], fallback[s : s + chunk_frames, points], options)
-        for points, sub in groups
-        for s in range(0, original.shape[0], chunk_frames)
-    ]
-    if workers > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            results = list(_reported(pool.map(_solve_chunk_task, tasks), len(groups), progress))
-    else:
-        results = list(_reported(map(_solve_chunk_task, tasks), len(groups), progress))
-    per_group = len(tasks) // max(len(groups), 1)
-    return combine_groups(
-        problem,
-        original,
-        [(points, concatenate(results[k * per_group : (k + 1) * per_group])) for k, (points, _) in enumerate(groups)],
-    )
-
-
-def _reported(results: Iterable[RefitResult], group_count: int, progress: Callable[[float], None] | None):
-    for result in results:
-        if progress:
-            progress(result.positions.shape[0] / group_count)
-        yield result
-
-
-def _solve_chunk_task(task: tuple) -> RefitResult:
-    return _solve_chunk(*task)
-
-
-def concatenate(results: list[RefitResult]) -> RefitResult:
-    """Consecutive chunks of frames as one result."""
-    return RefitResult(
-        np.concatenate([r.positions for r in results]),
-        np.concatenate([r.objective for r in results]),
-        np.concatenate([r.evaluations for r in results]),
-        [f for r in results for f in r.failures],
-    )
-
-
-def combine_groups(
-    problem: RefitProblem, original: np.ndarray, solved: list[tuple[np.ndarray, RefitResult]]
-) -> RefitResult:
-    """The whole problem's result from its groups' (objective.split_problem): points in no group
-    keep their original positions, their exact optimum; E and evaluations add up; a frame is
-    reported once, with its first group failure."""
-    positions = original.copy()
-    value = np.zeros(original.shape[0])
-    evaluations = np.zeros(original.shape[0], dtype=np.int64)
-    failures: dict[int, FrameFailure] = {}
-    for points, result in solved:
-        positions[:, points[1:]] = result.positions[:, 1:]
-        value += result.objective
-        evaluations += result.evaluations
-        for failure in result.failures:
-            failures.setdefault(failure.frame, failure)
-    return RefitResult(positions, value, evaluations, [failures[f] for f in sorted(failures)])
+    return solve_grouped(problem, _solve_chunk, (original, fallback), (options,), chunk_frames, workers, progress)

@@ -7,8 +7,7 @@ import os
 from pathlib import Path
 
 from .errors import FormatError
-
-SEQUENCE_SUFFIXES = (".obj", ".ply")
+from .meshseq import MESH_SUFFIXES
 
 
 def input_kind(path: str | os.PathLike) -> str:
@@ -33,7 +32,7 @@ def input_kind(path: str | os.PathLike) -> str:
         return "gltf"
     if suffix == ".npz":
         return "npz"
-    if suffix in SEQUENCE_SUFFIXES:
+    if suffix in MESH_SUFFIXES:
         return "sequence"
     expected = ".bvh, .glb, .gltf, .npz, .obj, .ply or a folder"
     raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}")

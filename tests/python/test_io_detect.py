@@ -1,0 +1,42 @@
+"""input_kind: which reader a CLI path needs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from animlod.io import FormatError
+from animlod.io.detect import input_kind
+
+
+@pytest.mark.parametrize(
+    ("name", "kind"),
+    [
+        ("a.bvh", "bvh"),
+        ("a.glb", "gltf"),
+        ("a.GLTF", "gltf"),
+        ("a.npz", "npz"),
+        ("a.obj", "sequence"),
+        ("a.PLY", "sequence"),
+    ],
+)
+def test_kind_follows_the_suffix(tmp_path: Path, name: str, kind: str) -> None:
+    (tmp_path / name).write_bytes(b"")
+    assert input_kind(tmp_path / name) == kind
+
+
+def test_folders_and_globs_are_sequences(tmp_path: Path) -> None:
+    (tmp_path / "frame_1.obj").write_bytes(b"")
+    assert input_kind(tmp_path) == "sequence"
+    assert input_kind(str(tmp_path / "frame_*.obj")) == "sequence"
+
+
+def test_unknown_missing_or_unmatched_paths(tmp_path: Path) -> None:
+    (tmp_path / "notes.txt").write_bytes(b"")
+    with pytest.raises(FormatError, match=r"notes.txt: file: unknown type .txt; expected .bvh, .glb"):
+        input_kind(tmp_path / "notes.txt")
+    with pytest.raises(FormatError, match="file: does not exist"):
+        input_kind(tmp_path / "gone.bvh")
+    with pytest.raises(FormatError, match="pattern: matches no file"):
+        input_kind(str(tmp_path / "*.ply"))

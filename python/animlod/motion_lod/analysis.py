@@ -69,20 +69,7 @@ class MotionAnalysis:
 
     def key_translations(self, motion: Motion) -> np.ndarray:
         """Every joint's local translation at its key frame, ``(J, 3)`` (offsets unless animated)."""
-        translations = local_translations(motion)
-        return translations[self.key_frames, np.arange(motion.skeleton.joint_count)]
-
-
-def local_translations(motion: Motion) -> np.ndarray:
-    """Local translation of every joint per frame ``(T, J, 3)``; column 0 is the root position."""
-    if motion.joint_translations is None:
-        translations = np.broadcast_to(
-            motion.skeleton.offsets, (motion.frame_count,) + motion.skeleton.offsets.shape
-        ).copy()
-    else:
-        translations = motion.joint_translations.copy()
-    translations[:, 0] = motion.root_positions
-    return translations
+        return motion.local_translations()[self.key_frames, np.arange(motion.skeleton.joint_count)]
 
 
 def animated_translation_joints(motion: Motion) -> np.ndarray:
@@ -101,7 +88,7 @@ def child_bones(motion: Motion, frames: np.ndarray) -> tuple[np.ndarray, np.ndar
     """
     parents = motion.skeleton.parents[1:]
     children = np.arange(1, motion.skeleton.joint_count)
-    offsets = local_translations(motion)[frames][:, children]
+    offsets = motion.local_translations()[frames][:, children]
     vectors = rotations.rotate(motion.local_rotations[frames][:, parents], offsets)
     return parents.astype(np.int64), vectors
 
@@ -138,7 +125,7 @@ def posture_error_row_sums(motion: Motion, frames: np.ndarray, r_max: float) -> 
 
 def _r_max(motion: Motion) -> float:
     """Summed mean length of the root's child bones (Eq. 1's normaliser), longest bone if zero."""
-    lengths = np.linalg.norm(local_translations(motion)[:, 1:], axis=-1).mean(axis=0)
+    lengths = np.linalg.norm(motion.local_translations()[:, 1:], axis=-1).mean(axis=0)
     root_children = motion.skeleton.parents[1:] == 0
     total = float(lengths[root_children].sum())
     if total > 0.0:

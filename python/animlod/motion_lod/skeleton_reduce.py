@@ -21,7 +21,6 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton
-from .analysis import local_translations
 from .frozen import FrozenLevel
 
 # Child offsets shorter than this fraction of the level's extent give no direction.
@@ -92,7 +91,7 @@ def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) ->
     """
     skeleton = reduce_skeleton(level)
     kept = level.kept_indices
-    translations = _folded_offsets(level, local_translations(motion))  # (T, K, 3)
+    translations = _folded_offsets(level, motion.local_translations())  # (T, K, 3)
     original_world = rotations.from_matrix(motion.world_transforms()[:, kept, :3, :3])
     targets = positions[:, kept]
     scale = level.length_scale()

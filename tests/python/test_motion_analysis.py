@@ -12,14 +12,15 @@ from animlod.motion_lod.analysis import posture_error_row_sums
 
 def test_eq1_to_eq3_on_a_three_joint_chain() -> None:
     # A turns by 0, 0.5, 1.0 rad; its child bone has r = 2 in every frame; r_max = |root->A| = 1.
-    # E_A(a, b) = (2 + 2) |phi_a - phi_b| / (2 pi) (Eq. 1), so the row sums are 3/pi, 2/pi, 3/pi.
+    # E_A(a, b) = (2 + 2) / 2 |phi_a - phi_b| / (2 pi) = |phi_a - phi_b| / pi (Eq. 1: an arc of
+    # the mean radius), so the row sums are 1.5/pi, 1/pi, 1.5/pi.
     motion = chain_motion([0.0, 0.5, 1.0])
     sums = posture_error_row_sums(motion, np.arange(3), r_max=1.0)
-    np.testing.assert_allclose(sums[1], [3 / np.pi, 2 / np.pi, 3 / np.pi], rtol=1e-14)
+    np.testing.assert_allclose(sums[1], [1.5 / np.pi, 1 / np.pi, 1.5 / np.pi], rtol=1e-14)
     analysis = analyze_motion(motion)
     assert analysis.r_max == pytest.approx(1.0)
     assert analysis.key_frames[1] == 1  # Eq. 2: the middle frame has the smallest row sum
-    assert analysis.importance[1] == pytest.approx(2 / (3 * np.pi), rel=1e-14)  # Eq. 3
+    assert analysis.importance[1] == pytest.approx(1 / (3 * np.pi), rel=1e-14)  # Eq. 3
     assert analysis.importance[2] == 0.0  # B never rotates
     assert analysis.importance[3] == 0.0  # an end site
     assert analysis.priority == [2, 1]  # lowest first; never the root or an end site
@@ -30,7 +31,7 @@ def test_a_still_joint_has_zero_importance_however_its_ancestors_move() -> None:
     assert still.importance[2] == 0.0
     assert still.importance[0] > 0.0  # the root's own turn is measured
     # A's error is measured in the root's frame, so the root's turn does not change it.
-    assert still.importance[1] == pytest.approx(2 / (3 * np.pi), rel=1e-12)
+    assert still.importance[1] == pytest.approx(1 / (3 * np.pi), rel=1e-12)
 
 
 def test_figure_priority_puts_the_still_wrist_first_and_respects_locks() -> None:

@@ -11,9 +11,10 @@ Conventions this implementation fixes where the paper is silent:
   ``R_j(t) @ offset_c``: only ``j``'s own rotation changes it, so a joint whose local rotation
   never changes has importance exactly zero, however its ancestors move. (Freezing ``j`` fixes
   exactly that local rotation, so this is the error the freeze introduces.)
-- Eq. 1 is used as printed: ``(r(t_ref) + r(t)) * theta / (2 pi r_max)``; ``r_max`` is the summed
+- Eq. 1 takes, as the paper's text says, the average of the two radii: the arc length
+  ``(r(t_ref) + r(t)) / 2 * theta`` over the circumference ``2 pi r_max``; ``r_max`` is the summed
   length of the root's child bones (mean over frames), or the longest bone when those are all
-  zero. Constant factors do not change key frames or the order.
+  zero. (The printed bracket omits the 1/2; constant factors change neither key frames nor order.)
 - Joints whose local translation is animated (BVH position channels below the root) are never
   frozen: freezing would pin their translation to one frame.
 - End sites carry no rotation: they give leaf joints a direction, have importance 0 and are never
@@ -116,8 +117,8 @@ def posture_error_row_sums(motion: Motion, frames: np.ndarray, r_max: float) -> 
         rows = slice(start, min(start + _BLOCK_ROWS, n))
         # theta_jc(t_ref, t) for the block's t_ref against every t: (rows, n, B).
         theta = _angles_between(units[rows, None], units[None])
-        radii = lengths[rows, None] + lengths[None]  # r_jc(t_ref) + r_jc(t)
-        per_bone[:, rows] = np.einsum("abk,abk->ka", radii, theta)
+        radius = 0.5 * (lengths[rows, None] + lengths[None])  # mean of r_jc(t_ref) and r_jc(t)
+        per_bone[:, rows] = np.einsum("abk,abk->ka", radius, theta)  # arc lengths
     sums = np.zeros((motion.skeleton.joint_count, n))
     np.add.at(sums, owners, per_bone)  # sum over the children c of j (Eq. 1)
     return sums / (2.0 * np.pi * r_max)

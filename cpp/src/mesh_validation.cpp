@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,14 @@ std::string face_text(const AnimatedMeshView& mesh, size_t f) {
 Status check_sizes_and_values(const AnimatedMeshView& mesh) {
   if (mesh.frame_count == 0) return Status::error("frames: the mesh has no frames");
   if (mesh.face_count == 0) return Status::error("faces: the mesh has no faces");
+  // Vertices, faces and face corners (3 M) are numbered with int32 everywhere downstream.
+  constexpr size_t kMaxIndex = std::numeric_limits<int32_t>::max();
+  if (mesh.vertex_count > kMaxIndex)
+    return Status::error("frames: " + std::to_string(mesh.vertex_count) + " vertices, more than int32 indices reach (" +
+                         std::to_string(kMaxIndex) + ")");
+  if (mesh.face_count > kMaxIndex / 3)
+    return Status::error("faces: " + std::to_string(mesh.face_count) +
+                         " faces, more than int32 corner indices reach (3 M <= " + std::to_string(kMaxIndex) + ")");
   const size_t value_count = mesh.frame_count * mesh.vertex_count * 3;
   for (size_t i = 0; i < value_count; ++i) {
     if (!std::isfinite(mesh.frames[i])) {
@@ -45,8 +55,10 @@ Status check_sizes_and_values(const AnimatedMeshView& mesh) {
 }
 
 bool same_vertices(const AnimatedMeshView& mesh, int32_t f, int32_t g) {
-  std::array<int32_t, 3> a{mesh.faces[3 * f], mesh.faces[3 * f + 1], mesh.faces[3 * f + 2]};
-  std::array<int32_t, 3> b{mesh.faces[3 * g], mesh.faces[3 * g + 1], mesh.faces[3 * g + 2]};
+  const int32_t* pf = mesh.faces + 3 * static_cast<size_t>(f);
+  const int32_t* pg = mesh.faces + 3 * static_cast<size_t>(g);
+  std::array<int32_t, 3> a{pf[0], pf[1], pf[2]};
+  std::array<int32_t, 3> b{pg[0], pg[1], pg[2]};
   std::sort(a.begin(), a.end());
   std::sort(b.begin(), b.end());
   return a == b;
@@ -67,7 +79,7 @@ Status check_duplicate_faces(const AnimatedMeshView& mesh, const detail::EdgeTab
         if (bad[i] >= 0 && bad[j] >= 0 && same_vertices(mesh, bad[i], bad[j])) return duplicate_error(bad[i], bad[j]);
   }
   auto opposite = [&](int32_t face, const std::array<int32_t, 2>& edge) {
-    const int32_t* v = mesh.faces + 3 * face;
+    const int32_t* v = mesh.faces + 3 * static_cast<size_t>(face);
     return v[0] != edge[0] && v[0] != edge[1] ? v[0] : v[1] != edge[0] && v[1] != edge[1] ? v[1] : v[2];
   };
   for (size_t e = 0; e < edges.size(); ++e) {
@@ -94,9 +106,11 @@ Status check_manifold_edges(const detail::EdgeTable& edges) {
 // Corners around a vertex are joined across every interior edge; a vertex whose corners end in
 // more than one set has several separate fans (a "bow tie").
 Status check_manifold_vertices(const AnimatedMeshView& mesh, const detail::EdgeTable& edges) {
+  // 3 M fits int32 (check_sizes_and_values), so the corner index does too.
   auto corner_of = [&](int32_t face, int32_t vertex) {
-    const int32_t* v = mesh.faces + 3 * face;
-    return 3 * face + (v[0] == vertex ? 0 : v[1] == vertex ? 1 : 2);
+    const size_t first = 3 * static_cast<size_t>(face);
+    const int32_t* v = mesh.faces + first;
+    return static_cast<int32_t>(first + (v[0] == vertex ? 0 : v[1] == vertex ? 1 : 2));
   };
   detail::UnionFind corners(3 * mesh.face_count);
   for (size_t e = 0; e < edges.size(); ++e) {

@@ -23,7 +23,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 Eigen::Vector3d position(const float* frame, int32_t vertex) {
-  return Eigen::Vector3f(frame[3 * vertex], frame[3 * vertex + 1], frame[3 * vertex + 2]).cast<double>();
+  const float* p = frame + 3 * static_cast<size_t>(vertex);  // 3 V may exceed int32
+  return Eigen::Vector3f(p[0], p[1], p[2]).cast<double>();
 }
 
 // Unnormalised face normals (twice the area) of one frame: (M, 3).

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "animlod/mesh_validation.hpp"
 #include "animlod/motion_features.hpp"
 #include "test_aqem_meshes.hpp"
 
@@ -82,4 +83,24 @@ TEST_CASE("a bending tube has its motion feature at the elbow") {
     CHECK(features.vertex_weights[ring * segments] == float(features.feature_sizes[feature]));
   }
   CHECK(features.threshold > 0.0);
+}
+
+TEST_CASE("mesh validation rejects sizes beyond int32 indices before reading any data") {
+  // Regression: 3 * face and 3 * vertex were int32 products and wrapped for huge meshes. The
+  // counts are checked first, so the one-vertex buffers are never read past.
+  const float frames[3] = {0, 0, 0};
+  const int32_t faces[3] = {0, 0, 0};
+  animlod::AnimatedMeshView mesh{frames, faces, 1, 1, 1};
+  SUBCASE("vertices") {
+    mesh.vertex_count = size_t{1} << 31;
+    CHECK(animlod::validate_animated_mesh(mesh).message ==
+          "frames: 2147483648 vertices, more than int32 indices reach (2147483647)");
+  }
+  SUBCASE("faces") {
+    mesh.face_count = 715827883;  // 3 M = 2^31 + 1
+    CHECK(animlod::validate_animated_mesh(mesh).message ==
+          "faces: 715827883 faces, more than int32 corner indices reach (3 M <= 2147483647)");
+    MotionFeatures features;
+    CHECK_FALSE(animlod::compute_motion_features(mesh, {}, features).ok);
+  }
 }

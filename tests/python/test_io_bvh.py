@@ -328,3 +328,9 @@ def test_frame_time_without_a_finite_rate(tmp_path: Path, frame_time: str) -> No
 def test_channel_count_that_is_a_non_ascii_digit(tmp_path: Path) -> None:
     message = _read_error(tmp_path, SMALL_BVH.replace("CHANNELS 3 Zrotation", "CHANNELS ³ Zrotation"))
     assert "line 9: joint 'A': channel count '³' is not a whole number" in message
+
+
+def test_unicode_space_inside_a_value_is_not_a_separator(tmp_path: Path) -> None:
+    value = "9\u00a00"  # a no-break space, which str.split() would split on
+    message = _read_error(tmp_path, SMALL_BVH.replace("90 90 0 7", f"90 {value} 0 7"))
+    assert f"line 25 (frame 1), joint 'A' Xrotation: {value!r} is not a number" in message

@@ -272,12 +272,14 @@ def _parse_motion_table(
         element = f"line {first_line + rows[frame]} (frame {frame}), joint {joint_name!r} {channel}"
         return FormatError(path, element, reason)
 
-    tokens = text.split()
+    # Split on the ASCII whitespace tokens_per_line counted: str.split() also splits on Unicode
+    # separators such as U+00A0, which would shift the values against the checked row lengths.
+    tokens = np.array(text.encode("utf-8").split(), dtype=np.bytes_)
     try:
-        values = np.array(tokens, dtype=np.float64).reshape(frame_count, channel_count)
+        values = tokens.astype(np.float64).reshape(frame_count, channel_count)
     except ValueError:
         bad = next(index for index, token in enumerate(tokens) if not parses(token, np.float64))
-        raise value_error(bad, f"{tokens[bad]!r} is not a number") from None
+        raise value_error(bad, f"{tokens[bad].decode(errors='replace')!r} is not a number") from None
     finite = np.isfinite(values)
     if not finite.all():
         bad = int(np.argmin(finite.ravel()))

@@ -104,3 +104,16 @@ def test_damaged_compressed_member(tmp_path: Path, damage: bytes) -> None:
     path.write_bytes(bytes(data))
     with pytest.raises(FormatError, match="archive: not a readable npz archive .*decompressing"):
         read_npz(path)
+
+
+def test_member_with_an_unknown_compression_method(tmp_path: Path) -> None:
+    path = tmp_path / "mesh.npz"
+    write_npz(path, _mesh(24.0))
+    data = bytearray(path.read_bytes())
+    # zipfile takes the method from the central directory entry, whose 46-byte header precedes the name.
+    central_header = data.rfind(b"frames.npy") - 46
+    assert data[central_header : central_header + 4] == b"PK\x01\x02"
+    data[central_header + 10 : central_header + 12] = struct.pack("<H", 99)  # method 99: AE-x encryption
+    path.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="archive: not a readable npz archive .*compression method"):
+        read_npz(path)

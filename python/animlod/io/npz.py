@@ -45,10 +45,11 @@ def read_npz(path: str | os.PathLike) -> AnimatedMesh:
     path = Path(path)
     try:
         # A plain .npy file gives an ndarray, which is no context manager: TypeError. A damaged
-        # member fails while it is decompressed: zlib.error, EOFError, or BadZipFile for its CRC.
+        # member fails while it is decompressed: zlib.error, EOFError, or BadZipFile for its CRC;
+        # zipfile raises RuntimeError (NotImplementedError) for encrypted or unknown compression.
         with np.load(path, allow_pickle=False) as archive:
             arrays = {key: archive[key] for key in _KEYS if key in archive.files}
-    except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError, TypeError) as error:
+    except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError, TypeError, RuntimeError) as error:
         raise FormatError(path, "archive", f"not a readable npz archive ({error})") from None
     missing = [key for key in _KEYS if key not in arrays]
     if missing:

@@ -768,3 +768,46 @@ def test_node_with_a_missing_mesh_names_it_in_the_singular(tmp_path):
 
     with pytest.raises(FormatError, match=r"refers to mesh 7, but the file has 1 meshes"):
         read_gltf(_edit_quad_gltf(tmp_path, break_mesh))
+
+
+def test_sparse_accessor_without_indices(tmp_path):
+    def drop_indices(document):
+        del document["accessors"][3]["sparse"]["indices"]
+
+    path = _edit_quad_gltf(tmp_path, drop_indices)
+    with pytest.raises(FormatError) as caught:
+        read_gltf(path)
+    assert (
+        str(caught.value)
+        == f"{path}: accessor 3 (mesh 0 primitive 0 target 0 POSITION) sparse: needs both indices and values"
+    )
+
+
+def test_data_uri_with_non_ascii_text(tmp_path):
+    path = _write_quad_gltf(tmp_path, None)
+    path.write_text(path.read_text().replace(";base64,", ";base64,\u00e9"))
+    with pytest.raises(FormatError, match=r"quad.gltf: buffer 0: malformed base64 data URI"):
+        read_gltf(path)
+
+
+def test_key_time_far_beyond_any_clip_is_refused(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def stretch_last_key(gltf, blob):
+        times = _accessor_view(gltf, blob, gltf.animations[0].samplers[0].input, "<f4")
+        times[-1, 0] = 1e7
+
+    with pytest.raises(FormatError, match=r"animation 'bend': lasts 1e\+07 s, more than 1000000 frames at 30 fps"):
+        read_skinned(_edit_glb(path, tmp_path / "long.glb", stretch_last_key))
+
+
+def test_zero_rotation_key_is_refused(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def zero_rotation(gltf, blob):
+        animation = gltf.animations[0]
+        channel = next(c for c in animation.channels if c.target.path == "rotation")
+        _accessor_view(gltf, blob, animation.samplers[channel.sampler].output, "<f4")[:] = 0.0
+
+    with pytest.raises(FormatError, match=r"animation 'bend' channel \d+: quaternion with zero or non-finite norm"):
+        read_skinned(_edit_glb(path, tmp_path / "zero.glb", zero_rotation))

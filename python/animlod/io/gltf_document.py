@@ -9,7 +9,6 @@ a silently wrong array.
 from __future__ import annotations
 
 import base64
-import binascii
 import json
 import os
 import struct
@@ -23,7 +22,7 @@ import pygltflib
 
 from .. import rotations
 from .errors import FormatError
-from .gltf_keyframes import INTERPOLATIONS
+from .gltf_keyframes import INTERPOLATIONS, frame_times
 
 _GLB_MAGIC = b"glTF"
 _GLB_HEADER_BYTES = 12
@@ -48,6 +47,9 @@ _TYPE_WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 _SPARSE_INDEX_COMPONENTS = (5121, 5123, 5125)
 # bufferView.byteStride is a multiple of 4 no larger than 252 (glTF 2.0 section 3.6.2.4).
 _MAX_BYTE_STRIDE = 252
+# Most frames an animation is sampled to: 10^6 is 4.6 hours at 60 fps. Later key times are taken
+# as corrupt rather than allocated.
+MAX_ANIMATION_FRAMES = 1_000_000
 # Top-level arrays whose singular is not the name without its last letter.
 _IRREGULAR_SINGULARS = {"meshes": "mesh"}
 
@@ -164,6 +166,8 @@ class GltfDocument:
     def _apply_sparse(
         self, sparse: pygltflib.Sparse, values: np.ndarray, width: int, dtype: np.dtype, element: str
     ) -> None:
+        if sparse.indices is None or sparse.values is None:
+            raise self.fail(f"{element} sparse", "needs both indices and values")
         substitutes = self._whole_number(sparse.count, "sparse count", element)
         index_element = f"{element} sparse indices"
         if sparse.indices.componentType not in _SPARSE_INDEX_COMPONENTS:
@@ -211,7 +215,7 @@ class GltfDocument:
         elif buffer.uri.startswith("data:"):
             try:
                 data = base64.b64decode(buffer.uri.split(_DATA_URI_BASE64, 1)[1], validate=True)
-            except (IndexError, binascii.Error) as error:
+            except (IndexError, ValueError) as error:  # binascii.Error, or non-ASCII text
                 raise self.fail(element, f"malformed base64 data URI ({error})") from None
         else:
             external = Path(self.path).parent / unquote(buffer.uri)  # a relative URI, percent-encoded
@@ -322,12 +326,17 @@ class GltfDocument:
         name = self.gltf.animations[index].name
         return f"animation {name!r}" if name else f"animation {index}"
 
-    def animation_duration(self, index: int) -> float:
-        """Last key time over all samplers of an animation: the clip length a viewer plays."""
+    def animation_frame_times(self, index: int, fps: float) -> np.ndarray:
+        """Sample times ``(T,)`` at ``fps`` from 0 to the last key time over all samplers of
+        animation ``index``: the clip length a viewer plays."""
         label = self.animation_label(index)
         samplers = self.gltf.animations[index].samplers or []
         ends = [self.accessor(s.input, f"{label} sampler {k} input").max(initial=0.0) for k, s in enumerate(samplers)]
-        return float(max(ends, default=0.0))
+        duration = float(max(ends, default=0.0))
+        if duration * fps >= MAX_ANIMATION_FRAMES:
+            reason = f"lasts {duration:g} s, more than {MAX_ANIMATION_FRAMES} frames at {fps:g} fps"
+            raise self.fail(label, reason)
+        return frame_times(duration, fps)
 
     def sampler_keys(
         self, animation_index: int, sampler_index: Any, width: int, element: str

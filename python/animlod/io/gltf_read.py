@@ -24,7 +24,7 @@ import numpy as np
 
 from ..model import AnimatedMesh, Motion, SkinnedMesh
 from .gltf_document import GltfDocument
-from .gltf_keyframes import frame_times, sample_keyframes
+from .gltf_keyframes import sample_keyframes
 from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_normals, transform_points
 from .gltf_skin import SkinRig
 
@@ -190,7 +190,7 @@ def _morph_weight_tracks(doc: GltfDocument, node: int, target_count: int, fps: f
                 continue
             element = f"{label} channel {index}"
             times, values, interpolation = doc.sampler_keys(a, channel.sampler, target_count, element)
-            at = frame_times(doc.animation_duration(a), fps)
+            at = doc.animation_frame_times(a, fps)
             tracks.append((label, sample_keyframes(times, values, interpolation, at)))
     return tracks
 

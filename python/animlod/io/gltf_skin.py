@@ -24,7 +24,7 @@ import numpy as np
 from .. import rotations
 from ..model import Motion, Skeleton
 from .gltf_document import UNIFORM_SCALE_TOLERANCE, GltfDocument
-from .gltf_keyframes import frame_times, sample_keyframes
+from .gltf_keyframes import sample_keyframes
 
 # Animated bone offsets within this fraction of the skeleton's largest rest offset of their
 # rest value count as held, so the motion needs no per-frame joint translations.
@@ -102,7 +102,7 @@ class SkinRig:
         ]
         if not channels:
             return None
-        at = frame_times(doc.animation_duration(animation_index), fps)
+        at = doc.animation_frame_times(animation_index, fps)
         translations, local_rotations = dict(self.rest_translation), dict(self.rest_rotation)
         for index, channel in channels:
             element = f"{label} channel {index}"
@@ -115,7 +115,10 @@ class SkinRig:
             elif path == "translation":
                 translations[node] = sample_keyframes(times, values, interpolation, at)
             else:
-                local_rotations[node] = sample_keyframes(times, values, interpolation, at, rotation=True)
+                try:
+                    local_rotations[node] = sample_keyframes(times, values, interpolation, at, rotation=True)
+                except ValueError as error:  # a zero or non-finite quaternion among the keys
+                    raise doc.fail(element, str(error)) from None
         positions, world_rotations = self._pose(translations, local_rotations, frames=len(at))
         offsets = self._offsets(positions, world_rotations)
         bones_move = np.abs(offsets[:, 1:] - self.skeleton.offsets[1:]).max(initial=0.0) > self._translation_tolerance

@@ -19,6 +19,11 @@ import numpy as np
 from .grouped_solve import FrameFailure, RefitResult, solve_grouped
 from .objective import RefitProblem, half_hessian, objective
 
+# E is unit-free and E >= alpha |x - x^o|^2 / L^2 (Eq. 6), so below this no point can move by
+# more than ~1e-12 L: a frame there is solved (a group with no Es or Ea error starts at ~1e-32,
+# rounding error, where no step can gain and the damping would only climb to its limit).
+_NEGLIGIBLE_OBJECTIVE = 1e-24
+
 
 def refit_newton(
     problem: RefitProblem,
@@ -73,7 +78,7 @@ def _solve_chunk(
     evaluations = np.ones(frames, dtype=np.int64)
     stiffness = problem.weights.distance / problem.length_scale**2  # Ed's curvature, H's floor
     growth = np.full(frames, 2.0)
-    active = np.flatnonzero(value > 0.0)
+    active = np.flatnonzero(value > _NEGLIGIBLE_OBJECTIVE)
     diagonal = np.arange(n)
     damping = np.full(frames, 1e-3 * stiffness)
     failed_frames: list[int] = []  # frames stopped by the damping limit

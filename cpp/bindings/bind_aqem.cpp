@@ -13,8 +13,6 @@
 namespace animlod::bindings {
 
 namespace {
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-using IndexArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
 using MaskArray = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>;
 
 py::dict level_to_dict(AqemLevel&& level, py::ssize_t frame_count, py::ssize_t attribute_count,
@@ -37,16 +35,18 @@ py::dict level_to_dict(AqemLevel&& level, py::ssize_t frame_count, py::ssize_t a
   return out;
 }
 
-py::dict simplify_animated_py(const FloatArray& frames, const IndexArray& faces, std::vector<double> target_ratios,
-                              std::vector<size_t> target_face_counts, double max_error, bool use_motion_features,
+py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_indices,
+                              std::vector<double> target_ratios, std::vector<size_t> target_face_counts,
+                              double max_error, bool use_motion_features,
                               double feature_threshold, double min_angle_change, bool boundary_is_feature,
                               bool boundary_quadrics, bool check_inversion, bool strict_inversion, size_t max_frames,
                               std::vector<int32_t> frame_subset, const std::optional<MaskArray>& locked,
                               const std::optional<FloatArray>& importance, const std::optional<FloatArray>& attributes,
-                              const std::optional<IndexArray>& skin_joints,
+                              const std::optional<py::array>& skin_joint_indices,
                               const std::optional<FloatArray>& skin_weights,
                               const std::optional<py::function>& progress, const std::string& placement) {
   require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
+  const IndexArray faces = index_array(face_indices, "faces");
   require_shape(faces, "faces", {-1, 3}, "(M, 3)");
   const py::ssize_t vertex_count = frames.shape(1);
   const AnimatedMeshView mesh{frames.data(), faces.data(), static_cast<size_t>(frames.shape(0)),
@@ -66,6 +66,8 @@ py::dict simplify_animated_py(const FloatArray& frames, const IndexArray& faces,
     data.attributes = attributes->data();
     data.attribute_count = static_cast<size_t>(attributes->shape(1));
   }
+  std::optional<IndexArray> skin_joints;
+  if (skin_joint_indices) skin_joints = index_array(*skin_joint_indices, "skin_joints");
   if (skin_joints.has_value() != skin_weights.has_value())
     throw py::value_error("skin_joints and skin_weights: give both or neither");
   if (skin_joints) {
@@ -150,7 +152,7 @@ void bind_aqem(py::module_& m) {
 Parameters
 ----------
 frames : (F, V, 3) float32 positions per frame (float64 is converted).
-faces : (M, 3) int32 triangles.
+faces : (M, 3) int32 or int64 triangles (values must fit int32).
 target_ratios : level sizes as fractions of M in (0, 1]; ignored when target_face_counts is given.
 target_face_counts : level sizes as face counts in [4, M].
 max_error : asset units; stop before a collapse whose error sqrt(quadric cost / frames) exceeds it.
@@ -161,7 +163,7 @@ check_inversion : Eq. 7 inversion test across frames; strict_inversion: in every
 max_frames : 0 for all frames, else K frames by farthest-point sampling; frame_subset: explicit.
 locked : (V,) bool, vertices never removed or moved.  importance : (V,) float32 > 0 weights.
 attributes : (V, A) float32 interpolated along collapses (UVs).
-skin_joints, skin_weights : (V, K) int32 / float32, merged keeping the top K.
+skin_joints, skin_weights : (V, K) int32 or int64 / float32, merged keeping the top K.
 progress : callable(done, total) called with the GIL held now and then.
 placement : "optimal" (Eq. 5 in every frame) or "on_edge" (one point of the edge for all
     frames, so UVs and skin weights stay consistent with the positions).

@@ -8,12 +8,11 @@
 namespace animlod::bindings {
 
 namespace {
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-using IndexArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
 
-py::dict motion_features_py(const FloatArray& frames, const IndexArray& faces, double feature_threshold,
+py::dict motion_features_py(const FloatArray& frames, const py::array& face_indices, double feature_threshold,
                             double min_angle_change, bool boundary_is_feature) {
   require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
+  const IndexArray faces = index_array(face_indices, "faces");
   require_shape(faces, "faces", {-1, 3}, "(M, 3)");
   const AnimatedMeshView mesh{frames.data(), faces.data(), static_cast<size_t>(frames.shape(0)),
                               static_cast<size_t>(frames.shape(1)), static_cast<size_t>(faces.shape(0))};
@@ -54,7 +53,7 @@ void bind_motion_features(py::module_& m) {
 Parameters
 ----------
 frames : (F, V, 3) float32 positions per frame (float64 is converted).
-faces : (M, 3) int32 triangles.
+faces : (M, 3) int32 or int64 triangles (values must fit int32).
 feature_threshold : radians; an edge is connected when its largest change of dihedral angle
     between consecutive frames exceeds it. 0 selects the paper's THR, the mean over interior edges.
 min_angle_change : radians; connected edges must also change by more than this (1 degree).

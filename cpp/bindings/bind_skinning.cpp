@@ -7,12 +7,11 @@
 namespace animlod::bindings {
 
 namespace {
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-using IndexArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
 
-py::array_t<float> bake_lbs_py(const FloatArray& rest_positions, const IndexArray& joints, const FloatArray& weights,
-                               const FloatArray& skin_matrices) {
+py::array_t<float> bake_lbs_py(const FloatArray& rest_positions, const py::array& joint_indices,
+                               const FloatArray& weights, const FloatArray& skin_matrices) {
   require_shape(rest_positions, "rest_positions", {-1, 3}, "(V, 3)");
+  const IndexArray joints = index_array(joint_indices, "joints");
   require_shape(joints, "joints", {rest_positions.shape(0), -1}, "(V, K)");
   require_shape(weights, "weights", {joints.shape(0), joints.shape(1)}, "(V, K) like joints");
   require_shape(skin_matrices, "skin_matrices", {-1, -1, 4, 4}, "(T, J, 4, 4)");
@@ -50,7 +49,7 @@ void bind_skinning(py::module_& m) {
 Parameters
 ----------
 rest_positions : (V, 3) float32 bind-pose positions (float64 is converted).
-joints : (V, K) int32 joint index per influence.
+joints : (V, K) int32 or int64 joint index per influence.
 weights : (V, K) float32 influence weights, summing to 1 per vertex.
 skin_matrices : (T, J, 4, 4) float32 world @ inverse_bind, numpy layout (acting on columns).
 

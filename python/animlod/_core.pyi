@@ -12,7 +12,10 @@ def bake_lbs(
     weights: npt.ArrayLike,
     skin_matrices: npt.ArrayLike,
 ) -> npt.NDArray[np.float32]:
-    """Linear blend skinning: (V, 3), (V, K), (V, K), (T, J, 4, 4) -> (T, V, 3) float32."""
+    """Linear blend skinning: (V, 3), (V, K), (V, K), (T, J, 4, 4) -> (T, V, 3) float32.
+
+    Index arrays may be int32 or int64; a value outside int32 raises ValueError.
+    """
 
 def motion_features(
     frames: npt.ArrayLike,

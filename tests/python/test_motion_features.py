@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from simplify_inputs import bending_tube
 
-from animlod import synth
+from animlod import _core, synth
 from animlod.model import AnimatedMesh
 from animlod.simplify import motion_features
 
@@ -70,3 +70,14 @@ def test_crane_features_are_found(data_dir):
     assert features.edges.shape == (30000, 2)  # closed genus-0 mesh: E = 3M / 2
     assert 0 < features.threshold < math.pi
     assert features.feature_sizes.sum() == np.count_nonzero(features.vertex_feature >= 0)
+
+
+def test_int64_faces_are_range_checked_not_wrapped():
+    # Regression: forcecast turned index 2**32 + 1 into 1.
+    mesh = bending_tube(frames=3)
+    wide = _core.motion_features(mesh.frames, mesh.faces.astype(np.int64))
+    np.testing.assert_array_equal(wide["edges"], _core.motion_features(mesh.frames, mesh.faces)["edges"])
+    faces = mesh.faces.astype(np.int64)
+    faces[0, 2] = -(2**31) - 1
+    with pytest.raises(ValueError, match=r"^faces: element \(0, 2\) = -2147483649 does not fit int32$"):
+        _core.motion_features(mesh.frames, faces)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
 
+from animlod import _core
 from animlod.model import AnimatedMesh
 from animlod.simplify import simplify_animated
 
@@ -248,3 +249,23 @@ def test_an_exception_in_progress_stops_the_run_cleanly():
         simplify_animated(bending_tube(), (0.1,), progress=interrupt)
     assert calls == [0]  # raised at the first report, before any collapse
     assert simplify_animated(bending_tube(), (0.1,)).levels[0].reached  # still usable afterwards
+
+
+def test_int64_indices_are_range_checked_not_wrapped():
+    # Regression: forcecast turned index 2**32 + 5 into 5, silently simplifying another mesh.
+    mesh = bending_tube(frames=3)
+    narrow = _core.simplify_animated(mesh.frames, mesh.faces, target_ratios=[0.5])
+    wide = _core.simplify_animated(mesh.frames, mesh.faces.astype(np.int64), target_ratios=[0.5])
+    np.testing.assert_array_equal(wide["levels"][0]["faces"], narrow["levels"][0]["faces"])
+    faces = mesh.faces.astype(np.int64)
+    faces[3, 1] += 2**32
+    with pytest.raises(ValueError, match=r"^faces: element \(3, 1\) = 4294967\d+ does not fit int32$"):
+        _core.simplify_animated(mesh.frames, faces)
+    joints = np.zeros((mesh.vertex_count, 1), np.uint64)
+    joints[7, 0] = 2**63
+    with pytest.raises(ValueError, match=r"^skin_joints: element \(7, 0\) = 9223372036854775808 does not fit int32$"):
+        _core.simplify_animated(
+            mesh.frames, mesh.faces, skin_joints=joints, skin_weights=np.ones((mesh.vertex_count, 1), np.float32)
+        )
+    with pytest.raises(ValueError, match=r"^faces: expected an integer array \(int32 or int64\), got dtype float64$"):
+        _core.simplify_animated(mesh.frames, mesh.faces.astype(np.float64))

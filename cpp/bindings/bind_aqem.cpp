@@ -155,7 +155,9 @@ frames : (F, V, 3) float32 positions per frame (float64 is converted).
 faces : (M, 3) int32 or int64 triangles (values must fit int32).
 target_ratios : level sizes as fractions of M in (0, 1]; ignored when target_face_counts is given.
 target_face_counts : level sizes as face counts in [4, M].
-max_error : asset units; stop before a collapse whose error sqrt(quadric cost / frames) exceeds it.
+max_error : asset units; stop before a collapse whose error exceeds it. A collapse's error is the
+    RMS distance of the new vertex to the planes of its merged quadric, over those planes and the
+    frames used.
 use_motion_features, feature_threshold, min_angle_change, boundary_is_feature : Eq. 6 weights
     (see motion_features).
 boundary_quadrics : perpendicular planes on open borders (Garland and Heckbert).

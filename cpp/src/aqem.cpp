@@ -41,7 +41,7 @@ struct Candidate {
   int32_t kept = -1;
   int32_t removed = -1;
   double cost = 0.0;   // weighted cost of Eq. 6
-  double error = 0.0;  // sqrt(unweighted cost / frames used), asset units
+  double error = 0.0;  // RMS distance to the merged quadric's planes over the used frames, asset units
   double t = 0.0;      // the new vertex is kept + t (removed - kept) in frames outside the quadrics
   double weight = 1.0; // (w_kept + w_removed) / 2, Eq. 6
 };
@@ -145,6 +145,7 @@ class Simplifier {
   Status build_connectivity();
   void accumulate_quadrics();
   Candidate evaluate(int32_t edge);
+  double rms_plane_distance(const Candidate& candidate, double total) const;
   Candidate evaluate_on_edge(Candidate candidate, bool pinned);
   bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
   void place_in_every_frame(const Candidate& candidate);
@@ -170,6 +171,7 @@ class Simplifier {
   std::vector<double> vertex_weights_; // (V,) Eq. 6 weights, passed on by collapses (step 9)
   std::vector<float> positions_;       // (V, F, 3) current positions, contiguous per vertex
   std::vector<Quadric> quadrics_;      // (V, K) per-frame quadrics, contiguous per vertex
+  std::vector<double> plane_counts_;   // (V,) planes summed into each of the vertex's K quadrics
   std::vector<float> attributes_;      // (V, A)
   std::vector<int32_t> skin_joints_;   // (V, K)
   std::vector<float> skin_weights_;    // (V, K)
@@ -203,10 +205,14 @@ Status Simplifier::build_connectivity() {
 
 // Steps 1-2 (Eqs. 1-4): every face's plane in every used frame goes into its three vertices'
 // quadrics of that frame; boundary edges add a perpendicular plane (option boundary_quadrics).
+// plane_counts_ counts the planes of each vertex, so that the error can be a mean; a face with
+// no area in a frame counts there as a plane at distance 0.
 void Simplifier::accumulate_quadrics() {
   quadrics_.assign(mesh_.vertex_count * used_count_, Quadric{});
+  plane_counts_.assign(mesh_.vertex_count, 0.0);
   for (size_t f = 0; f < mesh_.face_count; ++f) {
     const int32_t* v = mesh_.faces + 3 * f;
+    for (int corner = 0; corner < 3; ++corner) plane_counts_[v[corner]] += 1.0;
     for (size_t k = 0; k < used_count_; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d p0 = position(v[0], frame), p1 = position(v[1], frame), p2 = position(v[2], frame);
@@ -222,6 +228,8 @@ void Simplifier::accumulate_quadrics() {
     if (!halfedge.is_boundary()) continue;
     const int32_t a = halfedge.from().idx(), b = halfedge.to().idx();
     const int32_t c = halfedge.opp().next().to().idx();  // third vertex of the face on the other side
+    plane_counts_[a] += 1.0;
+    plane_counts_[b] += 1.0;
     for (size_t k = 0; k < used_count_; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d pa = position(a, frame), pb = position(b, frame), pc = position(c, frame);
@@ -287,8 +295,16 @@ Candidate Simplifier::evaluate(int32_t edge) {
   }
   candidate.t = length2 > 0.0 ? std::clamp(along / length2, 0.0, 1.0) : 0.0;
   candidate.cost = candidate.weight * total;
-  candidate.error = std::sqrt(total / static_cast<double>(used_count_));
+  candidate.error = rms_plane_distance(candidate, total);
   return candidate;
+}
+
+// The merged quadric's `total` (Eq. 6 unweighted: sum over the K frames of the squared
+// distances to its planes) over K times its plane count: an RMS plane distance that does not
+// grow with the number of planes merged.
+double Simplifier::rms_plane_distance(const Candidate& candidate, double total) const {
+  const double planes = plane_counts_[candidate.kept] + plane_counts_[candidate.removed];
+  return std::sqrt(total / (static_cast<double>(used_count_) * planes));
 }
 
 // Placement::on_edge (and a locked kept vertex, t = 0): the t in [0, 1] minimising
@@ -314,7 +330,7 @@ Candidate Simplifier::evaluate_on_edge(Candidate candidate, bool pinned) {
     total += (kept_quadrics[k] + removed_quadrics[k]).evaluate(new_positions_[k]);
   }
   candidate.cost = candidate.weight * total;
-  candidate.error = std::sqrt(total / static_cast<double>(used_count_));
+  candidate.error = rms_plane_distance(candidate, total);
   return candidate;
 }
 
@@ -404,6 +420,7 @@ void Simplifier::collapse(const Candidate& candidate, TriMesh::HalfedgeHandle ha
   Quadric* kept_quadrics = quadrics_of(candidate.kept);
   const Quadric* removed_quadrics = quadrics_of(candidate.removed);
   for (size_t k = 0; k < used_count_; ++k) kept_quadrics[k] += removed_quadrics[k];
+  plane_counts_[candidate.kept] += plane_counts_[candidate.removed];
   vertex_weights_[candidate.kept] = candidate.weight;
   const size_t attribute_count = data_.attribute_count;
   for (size_t a = 0; a < attribute_count; ++a) {

@@ -59,7 +59,7 @@ class SimplifiedLevel:
     kept_vertices : (V',) int32 index in the input of every kept vertex, ascending.
     vertex_map : (V,) int32 input vertex -> kept vertex it merged into (-1 for vertices that
         ``repair=True`` dropped).
-    error : asset units, the largest sqrt(quadric cost / frames) of the collapses so far.
+    error : asset units, the largest collapse error so far (see ``CollapseRecord.error``).
     target_face_count : the face count asked for; ``mesh`` has at most that many if ``reached``.
     reached : False when ``max_error`` (or no legal collapse left) stopped the run first.
     collapse_count : this level is the first ``collapse_count`` entries of the collapse record.
@@ -88,7 +88,8 @@ class CollapseRecord:
     removed, kept : (C,) int32.
     positions : (C, F, 3) float32 new positions of the kept vertex in every frame.
     cost : (C,) float64 weighted cost of Eq. 6.
-    error : (C,) float64 sqrt(unweighted cost / frames used), asset units.
+    error : (C,) float64 asset units: RMS distance of the new vertex to the planes of its merged
+        quadric, over those planes and the frames used.
     """
 
     removed: np.ndarray

@@ -195,6 +195,38 @@ TEST_CASE("aqem checks orientation in the frames outside the quadrics' frames to
       CHECK(downward_faces(level.positions, level.faces, frame, level.kept_vertices.size()) == 0);
 }
 
+TEST_CASE("aqem's collapse error is the RMS distance to the merged quadric's planes") {
+  // Recomputes the first collapse's error from its definition: the planes of the faces around
+  // the kept and the removed vertex (a face around both counts twice, as in Q_i + Q_j), the new
+  // vertex's recorded positions, every frame (all are used). Closed mesh: no boundary planes.
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(8, 10, 3);
+  AqemOptions options;
+  options.target_ratios = {0.9};
+  const AqemResult result = simplify(mesh, options);
+  REQUIRE_FALSE(result.collapses.removed.empty());
+  const int32_t ends[2] = {result.collapses.kept[0], result.collapses.removed[0]};
+  double squared = 0.0;
+  size_t planes = 0;
+  for (size_t f = 0; f < mesh.frame_count; ++f) {
+    const float* frame = &mesh.frames[f * mesh.vertex_count * 3];
+    const float* placed = &result.collapses.positions[f * 3];
+    for (int32_t end : ends)
+      for (size_t t = 0; t < mesh.faces.size(); t += 3) {
+        const int32_t* face = &mesh.faces[t];
+        if (face[0] != end && face[1] != end && face[2] != end) continue;
+        const float *a = frame + 3 * face[0], *b = frame + 3 * face[1], *c = frame + 3 * face[2];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+        const double distance = (n[0] * (placed[0] - a[0]) + n[1] * (placed[1] - a[1]) + n[2] * (placed[2] - a[2])) /
+                                std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        squared += distance * distance;
+        ++planes;
+      }
+  }
+  CHECK(result.collapses.error[0] == doctest::Approx(std::sqrt(squared / double(planes))).epsilon(1e-4));
+  CHECK(result.collapses.error[0] > 0.0);
+}
+
 TEST_CASE("aqem keeps locked vertices where they are") {
   const OwnedAnimatedMesh mesh = animlod::testing::bending_tube(12, 10, 3, 1.0);
   std::vector<uint8_t> locked(mesh.vertex_count, 0);

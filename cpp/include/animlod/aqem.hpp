@@ -35,8 +35,9 @@ struct AqemOptions {
   std::vector<double> target_ratios = {0.5};
   // Levels as face counts, each in [4, M].
   std::vector<size_t> target_face_counts;
-  // Asset units. The run stops before a collapse whose error (see AqemLevel::error) exceeds it;
-  // levels not reached then hold the last mesh and reached = false.
+  // Asset units. The run stops before a collapse whose error (an RMS plane distance, see
+  // CollapseRecord::error) exceeds it; levels not reached then hold the last mesh and
+  // reached = false.
   double max_error = std::numeric_limits<double>::infinity();
   // Weights of Eq. 6 from the motion features; off gives every vertex weight 1.
   bool use_motion_features = true;
@@ -79,8 +80,8 @@ struct AqemLevel {
   size_t target_face_count = 0;
   bool reached = false;              // false when max_error or legality stopped the run first
   size_t collapse_count = 0;         // the level is the first collapse_count records applied
-  double error = 0.0;                // asset units: the largest sqrt(quadric cost / frames)
-                                     // over the collapses so far (an RMS plane distance)
+  double error = 0.0;                // asset units: the largest collapse error so far (see
+                                     // CollapseRecord::error)
   std::vector<int32_t> faces;        // (M', 3) indices into the kept vertices
   std::vector<int32_t> kept_vertices;  // (V',) original index of each kept vertex, ascending
   std::vector<int32_t> vertex_map;   // (V,) original vertex -> index of the kept vertex it merged into
@@ -97,7 +98,9 @@ struct CollapseRecord {
   std::vector<int32_t> kept;      // (C,)
   std::vector<float> positions;   // (C, F, 3) new positions of the kept vertex in every frame
   std::vector<double> cost;       // (C,) weighted cost of Eq. 6
-  std::vector<double> error;      // (C,) sqrt(unweighted cost / frames used), asset units
+  std::vector<double> error;      // (C,) asset units: RMS distance of the new vertex to the planes
+                                  //      of its merged quadric, over those planes and the frames
+                                  //      used: sqrt(sum_k Q_k(v_k) / (K planes)), Eqs. 3-6 unweighted
 };
 
 struct AqemResult {

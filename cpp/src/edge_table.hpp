@@ -7,9 +7,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "animlod/animated_mesh_view.hpp"
-#include "animlod/status.hpp"
-
 namespace animlod::detail {
 
 struct EdgeTable {
@@ -30,9 +27,5 @@ struct EdgeTable {
 
 // faces (M, 3) with indices already known to be in range and distinct within each face.
 EdgeTable build_edge_table(const int32_t* faces, size_t face_count);
-
-// validate_animated_mesh (animlod/mesh_validation.hpp), keeping the edge table it builds for
-// callers that need it next (motion features).
-Status validate_and_build_edges(const AnimatedMeshView& mesh, EdgeTable& edges);
 
 }  // namespace animlod::detail

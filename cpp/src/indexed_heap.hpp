@@ -18,7 +18,6 @@ class IndexedMinHeap {
   size_t size() const { return heap_.size(); }
   bool contains(int32_t id) const { return position_[id] >= 0; }
   int32_t top() const { return heap_.front().id; }
-  double key(int32_t id) const { return heap_[position_[id]].key; }
 
   // Replaces the contents with `ids` and their `keys` in O(N) (Floyd's heap construction).
   void assign(const std::vector<int32_t>& ids, const std::vector<double>& keys) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "edge_table.hpp"
+#include "mesh_validation_detail.hpp"
 #include "union_find.hpp"
 
 namespace animlod {

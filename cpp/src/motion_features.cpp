@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "edge_table.hpp"
+#include "mesh_validation_detail.hpp"
 #include "union_find.hpp"
 
 namespace animlod {

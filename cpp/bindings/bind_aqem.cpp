@@ -161,7 +161,8 @@ max_error : asset units; stop before a collapse whose error exceeds it. A collap
 use_motion_features, feature_threshold, min_angle_change, boundary_is_feature : Eq. 6 weights
     (see motion_features).
 boundary_quadrics : perpendicular planes on open borders (Garland and Heckbert).
-check_inversion : Eq. 7 inversion test across frames; strict_inversion: in every frame.
+check_inversion : Eq. 7 inversion test summed over every frame; strict_inversion: no flip in any
+    single frame (ignored when check_inversion is False).
 max_frames : 0 for all frames, else K frames by farthest-point sampling; frame_subset: explicit.
 locked : (V,) bool, vertices never removed or moved.  importance : (V,) float32 > 0 weights.
 attributes : (V, A) float32 interpolated along collapses (UVs).

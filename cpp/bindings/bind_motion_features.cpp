@@ -55,7 +55,8 @@ Parameters
 frames : (F, V, 3) float32 positions per frame (float64 is converted).
 faces : (M, 3) int32 or int64 triangles (values must fit int32).
 feature_threshold : radians; an edge is connected when its largest change of dihedral angle
-    between consecutive frames exceeds it. 0 selects the paper's THR, the mean over interior edges.
+    between consecutive frames exceeds it. 0 selects an adaptive THR, the mean over the interior
+    edges (the paper averages over all edges; boundary edges are features anyway).
 min_angle_change : radians; connected edges must also change by more than this (1 degree).
 boundary_is_feature : boundary edges count as connected, as in the paper.
 

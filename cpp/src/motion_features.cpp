@@ -2,7 +2,8 @@
 // allocation"):
 //   g_i = max_f CVDA_i^{(f-1)-f}, the largest change of edge i's dihedral angle between
 //         consecutive frames;
-//   THR = (sum_i g_i) / n over the n interior edges;
+//   THR = (sum_i g_i) / n over the n interior edges (the paper: over all edges; boundary
+//         edges have no dihedral angle and are features anyway, so they are left out);
 //   edge i is connected when g_i > THR and g_i > 1 degree; boundary edges are connected;
 //   the connected components of connected edges are the features, and every vertex of a
 //   feature with w vertices gets weight w (others 1), the vertex weights of Eq. 6.

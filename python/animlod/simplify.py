@@ -64,7 +64,8 @@ class SimplifiedLevel:
     reached : False when ``max_error`` (or no legal collapse left) stopped the run first.
     collapse_count : this level is the first ``collapse_count`` entries of the collapse record.
     attributes : (V', A) float32 carried per-vertex attributes, or None.
-    skin_joints, skin_weights : (V', K) merged skin influences (sorted, summing to 1), or None.
+    skin_joints, skin_weights : (V', K) skin influences, or None. Rows of vertices made by a
+        collapse are merged: sorted by decreasing weight, summing to 1; other rows are the input's.
     """
 
     mesh: AnimatedMesh
@@ -137,7 +138,8 @@ def motion_features(
     Parameters
     ----------
     mesh : the deforming mesh.
-    feature_threshold : radians; 0 selects the paper's THR, the mean of g_i over interior edges.
+    feature_threshold : radians; 0 selects an adaptive THR, the mean of g_i over the interior
+        edges (the paper averages over all edges; boundary edges are features anyway).
     min_angle_change : radians; g_i must also exceed this floor (paper: 1 degree).
     boundary_is_feature : count boundary edges as connected, as the paper does.
 
@@ -184,12 +186,14 @@ def simplify_animated(
     mesh : (F, V, 3) frames and (M, 3) faces; manifold, no degenerate or duplicate faces.
     target_ratios : level sizes as fractions of M in (0, 1].
     target_face_counts : level sizes as face counts in [4, M]; replaces ``target_ratios``.
-    max_error : asset units; the run stops before a collapse whose error exceeds it.
+    max_error : asset units; the run stops before a collapse whose error (an RMS plane distance,
+        see ``CollapseRecord.error``) exceeds it.
     use_motion_features, feature_threshold, min_angle_change, boundary_is_feature : the
         weights of Eq. 6 (see :func:`motion_features`); off gives every vertex weight 1.
     boundary_quadrics : planes perpendicular to open borders keep their shape.
-    check_inversion : reject collapses that invert a face by Eq. 7, summed over frames;
-        ``strict_inversion`` rejects an inversion in any single frame.
+    check_inversion : reject collapses that invert a face by Eq. 7, summed over every frame
+        (also those outside the quadrics' frames); ``strict_inversion`` rejects an inversion in
+        any single frame and is ignored when ``check_inversion`` is False.
     max_frames : quadrics over K frames chosen by farthest-point sampling of the poses (0: all).
     frame_subset : explicit frames for the quadrics; replaces ``max_frames``.
     locked_vertices : indices of vertices that are never removed nor moved.

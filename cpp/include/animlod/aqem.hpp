@@ -52,8 +52,10 @@ struct AqemOptions {
   // Stricter than Eq. 7: rejects a collapse that inverts a face in any single frame. Ignored
   // when check_inversion is false.
   bool strict_inversion = false;
-  // Quadrics over K frames only (memory O(V K) instead of O(V F)): 0 uses every frame,
-  // otherwise K frames chosen by farthest-point sampling of the poses (see frames_used).
+  // Quadrics over K frames only: 0 uses every frame, otherwise K frames chosen by
+  // farthest-point sampling of the poses (see frames_used). Only the quadrics shrink to
+  // O(V K) memory and placement time; positions, the inversion test and the outputs stay
+  // O(V F), every frame being kept (frames outside the K placed on the collapsed edge).
   // Motion features always look at every frame (they cost O(E F) time and O(E) memory).
   size_t max_frames = 0;
   // Explicit frames for the quadrics; overrides max_frames when not empty.
@@ -88,7 +90,9 @@ struct AqemLevel {
   std::vector<float> positions;      // (F, V', 3) positions of the kept vertices in every frame
   std::vector<float> attributes;     // (V', A)
   std::vector<int32_t> skin_joints;  // (V', K)
-  std::vector<float> skin_weights;   // (V', K) sorted by decreasing weight, summing to 1
+  std::vector<float> skin_weights;   // (V', K) rows of vertices made by a collapse: sorted by
+                                     // decreasing weight, summing to 1, zero-padded; the
+                                     // others: the input's rows unchanged
 };
 
 // The ordered collapses (structure of arrays, C collapses): vertex removed[i] merged into

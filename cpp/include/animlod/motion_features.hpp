@@ -13,8 +13,10 @@
 namespace animlod {
 
 struct MotionFeatureOptions {
-  // Radians. An edge is "connected" when its factor g_i exceeds this threshold; 0 selects the
-  // paper's adaptive THR = mean of g_i over the interior edges.
+  // Radians. An edge is "connected" when its factor g_i exceeds this threshold; 0 selects an
+  // adaptive THR = mean of g_i over the interior edges. (The paper averages over all edges;
+  // boundary edges have no dihedral angle, g_i = 0, and are features anyway, so counting them
+  // would only lower THR on open meshes.)
   double feature_threshold = 0.0;
   // Radians. g_i must also exceed this floor (the paper's 1 degree), so that rounding noise on a
   // rigidly moving mesh finds no feature (paper, Fig. 4).

@@ -811,3 +811,24 @@ def test_zero_rotation_key_is_refused(chain_glb, tmp_path):
 
     with pytest.raises(FormatError, match=r"animation 'bend' channel \d+: quaternion with zero or non-finite norm"):
         read_skinned(_edit_glb(path, tmp_path / "zero.glb", zero_rotation))
+
+
+def test_null_inside_an_array_is_refused(tmp_path):
+    def null_accessor(document):
+        document["accessors"][2] = None
+
+    path = _edit_quad_gltf(tmp_path, null_accessor)
+    with pytest.raises(FormatError) as caught:
+        read_gltf(path)
+    assert str(caught.value) == f"{path}: JSON: accessors[2] is null (glTF arrays hold no nulls)"
+
+
+@pytest.mark.parametrize("count", [True, 2**32, -1])
+def test_accessor_count_that_is_no_uint32(tmp_path, count):
+    def set_count(document):
+        document["accessors"][3]["count"] = count
+
+    with pytest.raises(
+        FormatError, match=rf"accessor 3 \(mesh 0 primitive 0 target 0 POSITION\): invalid count {count}"
+    ):
+        read_gltf(_edit_quad_gltf(tmp_path, set_count))

@@ -9,6 +9,7 @@ a silently wrong array.
 from __future__ import annotations
 
 import base64
+import dataclasses
 import json
 import os
 import struct
@@ -47,6 +48,7 @@ _TYPE_WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 _SPARSE_INDEX_COMPONENTS = (5121, 5123, 5125)
 # bufferView.byteStride is a multiple of 4 no larger than 252 (glTF 2.0 section 3.6.2.4).
 _MAX_BYTE_STRIDE = 252
+_MAX_ACCESSOR_COUNT = 2**32 - 1
 # Most frames an animation is sampled to: 10^6 is 4.6 hours at 60 fps. Later key times are taken
 # as corrupt rather than allocated.
 MAX_ANIMATION_FRAMES = 1_000_000
@@ -107,7 +109,8 @@ class GltfDocument:
         if accessor.type not in _TYPE_WIDTHS:
             raise self.fail(element, f"type {accessor.type!r} is not supported here")
         count = accessor.count
-        if not isinstance(count, int) or count < 0:
+        # Elements are addressed by unsigned 32-bit indices, which bounds what a file can mean.
+        if not isinstance(count, int) or isinstance(count, bool) or not 0 <= count <= _MAX_ACCESSOR_COUNT:
             raise self.fail(element, f"invalid count {count!r}")
         width = _TYPE_WIDTHS[accessor.type]
         dtype = _COMPONENT_DTYPES[component]
@@ -394,6 +397,9 @@ def _parse(path: str) -> pygltflib.GLTF2:
         raise FormatError(path, "JSON", f"not a valid glTF document ({type(error).__name__}: {error})") from None
     if gltf is None:
         raise FormatError(path, "GLB", "no JSON chunk")
+    null = _first_null_entry(gltf, "")
+    if null is not None:
+        raise FormatError(path, "JSON", f"{null} is null (glTF arrays hold no nulls)")
     version = str(getattr(gltf.asset, "version", "") or "")
     if not version.startswith("2."):
         raise FormatError(path, "asset", f"glTF version {version!r} is not 2.x")
@@ -401,6 +407,26 @@ def _parse(path: str) -> pygltflib.GLTF2:
     if unsupported:
         raise FormatError(path, "extensionsRequired", f"needs {', '.join(unsupported)}, which animlod cannot read")
     return gltf
+
+
+def _first_null_entry(node: Any, where: str) -> str | None:
+    """Path such as ``accessors[2]`` of the first null inside an array of the document, or None.
+
+    pygltflib keeps a null where an object belongs, which would otherwise surface later as an
+    AttributeError. ``extras`` and ``extensions`` are free JSON and are not looked into.
+    """
+    if isinstance(node, list):
+        for index, item in enumerate(node):
+            found = f"{where}[{index}]" if item is None else _first_null_entry(item, f"{where}[{index}]")
+            if found is not None:
+                return found
+    elif dataclasses.is_dataclass(node):
+        for field in dataclasses.fields(node):
+            if field.name not in ("extras", "extensions"):
+                found = _first_null_entry(getattr(node, field.name), f"{where}.{field.name}".lstrip("."))
+                if found is not None:
+                    return found
+    return None
 
 
 def _check_glb_header(path: str, data: bytes) -> None:

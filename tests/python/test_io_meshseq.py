@@ -277,3 +277,23 @@ def test_ply_float_vertex_indices_are_refused(tmp_path: Path, binary: bool) -> N
         content = (header + "3 0.7 1.2 2.9\n3 0 1 2\n").encode()
     path = _write(tmp_path / "bad.ply", content)
     assert _error(path) == f"{path}: element face: vertex index list has float items; indices must be integers"
+
+
+def _binary_ply_with_list_length(count_type: str, length: int) -> bytes:
+    header = _ascii_ply(f"property list {count_type} int vertex_indices", "").replace("0 0 0\n1 0 0\n0 1 0\n", "")
+    header = header.replace("format ascii", "format binary_little_endian").replace("element face 2", "element face 1")
+    face = np.array([length], {"char": "i1", "uint": "<u4"}[count_type]).tobytes() + np.arange(3, dtype="<i4").tobytes()
+    return header.encode() + np.eye(3, dtype="<f4").tobytes() + face
+
+
+@pytest.mark.parametrize(("count_type", "length"), [("char", -1), ("uint", 4_000_000_000)])
+def test_binary_ply_list_length_negative_or_past_the_end(tmp_path: Path, count_type: str, length: int) -> None:
+    path = _write(tmp_path / "bad.ply", _binary_ply_with_list_length(count_type, length))
+    reason = f"list length {length} is negative or longer than the rest of the file"
+    assert _error(path) == f"{path}: element face row 0: {reason}"
+
+
+def test_ascii_ply_negative_list_length(tmp_path: Path) -> None:
+    text = _ascii_ply("property list char int vertex_indices", "3 0 1 2\n-1\n")
+    path = _write(tmp_path / "bad.ply", text)
+    assert _error(path) == f"{path}: element face row 1: list length -1 is negative"

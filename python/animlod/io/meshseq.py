@@ -449,6 +449,10 @@ def _read_ply_binary(
             if offset + prefix + count_type.itemsize > len(data):
                 raise FormatError(path, f"element {element.name}", "file ends inside the element")
             length = int(np.frombuffer(data, count_type, 1, offset + prefix)[0])
+            # Each item takes at least a byte, so a longer list cannot fit in the rest of the file.
+            if not 0 <= length <= len(data) - offset:
+                reason = f"list length {length} is negative or longer than the rest of the file"
+                raise FormatError(path, f"element {element.name} row 0", reason)
         if list_at is not None:
             list_prop = element.properties[list_at]
             fields[list_at : list_at + 1] = [
@@ -504,8 +508,11 @@ def _read_ply_ascii(path: Path, body: bytes, elements: list[_PlyElement]) -> dic
                 reason = f"has {lengths[row]} values, expected at least {scalar_count + 1}"
                 raise FormatError(path, name_row(row), reason)
             sizes = _parse_numbers(path, tokens[starts + list_at], np.int64, name_row)
+        negative = np.flatnonzero(sizes < 0)
+        if negative.size:
+            raise FormatError(path, name_row(negative[0]), f"list length {sizes[negative[0]]} is negative")
         expected = scalar_count + sizes + (list_at is not None)
-        wrong = np.flatnonzero((lengths != expected) | (sizes < 0))
+        wrong = np.flatnonzero(lengths != expected)
         if wrong.size:
             row = wrong[0]
             raise FormatError(path, name_row(row), f"has {lengths[row]} values, expected {expected[row]}")

@@ -297,3 +297,23 @@ def test_ascii_ply_negative_list_length(tmp_path: Path) -> None:
     text = _ascii_ply("property list char int vertex_indices", "3 0 1 2\n-1\n")
     path = _write(tmp_path / "bad.ply", text)
     assert _error(path) == f"{path}: element face row 1: list length -1 is negative"
+
+
+def test_ply_property_declared_twice(tmp_path: Path) -> None:
+    text = _ascii_ply("property list uchar int vertex_indices", "3 0 1 2\n3 0 1 2\n").replace(
+        "property float z\n", "property float z\nproperty float x\n"
+    )
+    path = _write(tmp_path / "bad.ply", text)
+    assert _error(path) == f"{path}: header line 7: property 'x' is declared twice in 'vertex'"
+
+
+def test_binary_ply_scalar_named_like_an_internal_field(tmp_path: Path) -> None:
+    header = _ascii_ply("property uchar _size\nproperty list uchar int vertex_indices", "").replace(
+        "0 0 0\n1 0 0\n0 1 0\n", ""
+    )
+    header = header.replace("format ascii", "format binary_little_endian").replace("element face 2", "element face 1")
+    face = np.array([9, 3], "u1").tobytes() + np.array([2, 0, 1], "<i4").tobytes()
+    path = _write(tmp_path / "named.ply", header.encode() + np.eye(3, dtype="<f4").tobytes() + face)
+    vertices, faces = read_ply(path)
+    np.testing.assert_array_equal(vertices, np.eye(3))
+    np.testing.assert_array_equal(faces, [[2, 0, 1]])

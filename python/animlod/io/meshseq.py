@@ -41,6 +41,8 @@ _PLY_TYPES = {
 }
 _PLY_FORMATS = {"ascii": None, "binary_little_endian": "<", "binary_big_endian": ">"}
 _FACE_LIST_NAMES = ("vertex_indices", "vertex_index")
+# Field of a binary row holding a list's length; the space keeps it apart from any PLY property name.
+_LIST_SIZE_FIELD = "list size"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -406,7 +408,10 @@ def _read_ply_header(path: Path, data: bytes) -> tuple[str | None, list[_PlyElem
         elif words[0] == "element" and len(words) == 3 and words[2].isdigit():
             elements.append(_PlyElement(words[1], int(words[2])))
         elif words[0] == "property" and elements:
-            elements[-1].properties.append(_ply_property(path, element, words))
+            prop = _ply_property(path, element, words)
+            if any(other.name == prop.name for other in elements[-1].properties):
+                raise FormatError(path, element, f"property {prop.name!r} is declared twice in {elements[-1].name!r}")
+            elements[-1].properties.append(prop)
         else:
             raise FormatError(path, element, f"cannot read {line.strip()!r}")
     if not format_seen:
@@ -456,7 +461,7 @@ def _read_ply_binary(
         if list_at is not None:
             list_prop = element.properties[list_at]
             fields[list_at : list_at + 1] = [
-                ("_size", byte_order + list_prop.count_code),
+                (_LIST_SIZE_FIELD, byte_order + list_prop.count_code),
                 (list_prop.name, byte_order + list_prop.type_code, (length,)),
             ]
         row = np.dtype(fields)
@@ -466,9 +471,9 @@ def _read_ply_binary(
         offset += row.itemsize * element.count
         values[element.name] = {prop.name: table[prop.name] for prop in element.properties if prop.count_code is None}
         if list_at is not None:
-            other = np.flatnonzero(table["_size"] != length)
+            other = np.flatnonzero(table[_LIST_SIZE_FIELD] != length)
             if other.size:
-                size = table["_size"][other[0]]
+                size = table[_LIST_SIZE_FIELD][other[0]]
                 reason = f"list of {size} items after rows of {length} (mixed lengths need ascii PLY)"
                 raise FormatError(path, f"element {element.name} row {other[0]}", reason)
             name = element.properties[list_at].name

@@ -508,8 +508,10 @@ AqemLevel Simplifier::snapshot(size_t target, bool reached) {
   }
   auto gather = [&](const auto& source, size_t width, auto& destination) {
     destination.resize(kept_count * width);
+    // data() rather than &v[0]: an absent attribute set is an empty vector, and indexing it is UB.
     for (size_t i = 0; i < kept_count; ++i)
-      std::copy_n(&source[static_cast<size_t>(level.kept_vertices[i]) * width], width, &destination[i * width]);
+      std::copy_n(source.data() + static_cast<size_t>(level.kept_vertices[i]) * width, width,
+                  destination.data() + i * width);
   };
   gather(attributes_, data_.attribute_count, level.attributes);
   if (!skin_joints_.empty()) {

@@ -17,7 +17,7 @@ from ..io.atomic import atomic_write
 
 MESH_RATIOS = (0.5, 0.25, 0.1)
 MOTION_LEVELS = 4
-# The damped Newton solver reaches SLSQP's optimum on this objective 16-50x faster
+# The damped Newton solver reaches SLSQP's optimum on this objective over ten times faster
 # (bench/bench_motion.py compares them); SLSQP stays the library's and the CLI's default.
 MOTION_SOLVER = "newton"
 # Where the summary shows which levels a runtime would pick: a 1080p camera with a 60 degree

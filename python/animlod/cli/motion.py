@@ -31,7 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         choices=SOLVERS,
         default=SOLVERS[0],
         help="slsqp: nlopt SLSQP per frame (the reference, default); newton: damped Newton on the same objective "
-        "over all frames at once (16-50x faster per frame in bench/bench_motion.py)",
+        "over all frames at once (over ten times faster per frame in bench/bench_motion.py)",
     )
     parser.add_argument("--hard", action="store_true", help="hold bone lengths as equality constraints (slsqp)")
     parser.add_argument("--workers", type=int, default=1, help="processes solving chunks of frames side by side")

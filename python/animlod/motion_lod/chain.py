@@ -226,7 +226,7 @@ def build_motion_chain(
     weights : alpha, beta, gamma of Eq. 5.
     solver : ``"slsqp"`` (nlopt's SLSQP per frame, the paper's SQP and the reference; needed
         for hard constraints; default) or ``"newton"`` (damped Newton on the same objective,
-        vectorised over frames, 16-50x faster per frame where both converge; see bench/bench_motion.py).
+        vectorised over frames, over ten times faster per frame where both converge; see bench/bench_motion.py).
     slsqp_options : SLSQP stopping rules and the hard-constraint option.
     workers : processes solving chunks of frames side by side (both solvers).
     skin : the character's skin on ``motion.skeleton`` (same joint names), or None.

@@ -27,13 +27,14 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from devdata import DATA_DIR
 from table import print_table, stopwatch
 
 from animlod.metrics import surface_error
 from animlod.model import AnimatedMesh
 from animlod.simplify import simplify_animated
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshseq"
+DATA = DATA_DIR / "meshseq"
 RATIOS = (0.5, 0.25, 0.1)
 # meshoptimizer accepts at most 32 attribute floats per vertex: 10 other frames of xyz.
 MESHOPT_MAX_ATTRIBUTE_FRAMES = 10

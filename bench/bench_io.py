@@ -7,7 +7,6 @@ temporary folder, to show what the faster containers buy over OBJ text.
 
 from __future__ import annotations
 
-import os
 import sys
 import tempfile
 from collections.abc import Callable
@@ -15,11 +14,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from devdata import DATA_DIR
 from table import print_table, stopwatch
 
 from animlod.io import read_bvh, read_npz, read_sequence, write_npz, write_sequence
 
-DATA_DIR = Path(os.environ.get("ANIMLOD_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 REPEATS = 3
 
 

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from devdata import DATA_DIR
 from table import print_table, stopwatch
 
 from animlod.io.bvh import read_bvh
@@ -41,7 +42,7 @@ from animlod.motion_lod.objective import build_problem
 from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
 from animlod.synth import humanoid, humanoid_motion
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "bvh"
+DATA = DATA_DIR / "bvh"
 
 
 def clips(quick: bool) -> list[tuple[str, object]]:

@@ -33,9 +33,11 @@ $(VENV)/bin/pip: | system-packages
 
 # An editable install: Python sources are used from the checkout, and the extension is
 # rebuilt incrementally (build/python-*) whenever this target runs.
+# Optional dependency groups of pyproject.toml; `make bench` adds the benchmark peers.
+EXTRAS := test
 python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
 	$(VENV)/bin/pip install -q scikit-build-core pybind11
-	$(VENV)/bin/pip install -q --no-build-isolation -e ".[test]"
+	$(VENV)/bin/pip install -q --no-build-isolation -e ".[$(EXTRAS)]"
 
 $(CPP_BUILD)/build.ninja: $(OPENMESH_CONFIG)
 	@mkdir -p build
@@ -63,8 +65,8 @@ test: python-package lint consumer-test
 demo: python-package
 	$(VENV)/bin/animlod demo -o out/demo
 
+bench: EXTRAS := test,bench
 bench: python-package
-	$(VENV)/bin/pip install -q -e ".[test,bench]" --no-build-isolation
 	bench/openmesh_build/run.sh
 	@for script in bench/bench_*.py; do echo "== $$script"; $(PY) $$script || exit 1; done
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..io.detect import input_kind
+from ..io.detect import input_kind, input_stem
 from ..motion_lod.chain import SOLVERS
 from . import UserError
 
@@ -119,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
 
     output = Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
-    stem = Path(args.input).stem
+    stem = input_stem(args.input)
     from ..io.bvh import write_bvh
     from ..io.manifest import write_lod_manifest
 

@@ -97,6 +97,13 @@ Status derive_links(TdagData& data) {
     }
   }
   data.static_structure = static_structure;
+  data.codes_by_frame.assign(static_cast<size_t>(frame_count) * collapse_count, 65535);
+  for (size_t c = 0; c < collapse_count; ++c)
+    for (int32_t r = data.error_offsets[c]; r < data.error_offsets[c + 1]; ++r) {
+      const ErrorRun& run = data.error_runs[static_cast<size_t>(r)];
+      for (int32_t t = run.range.birth; t < run.range.death; ++t)
+        data.codes_by_frame[static_cast<size_t>(t) * collapse_count + c] = run.code;
+    }
 
   // Parents: every collapse that has the node as a child; at most one alive per frame.
   data.parent_offsets.assign(static_cast<size_t>(node_count) + 1, 0);

@@ -445,13 +445,20 @@ struct CutState {
       std::copy_n(residual_of(vertex_nodes[slot], at), 3, &vertex_residuals[slot * 3]);
   }
 
-  void emit(int32_t at, TdagMesh& out) const {
+  // The mesh with the affine map of `at` and the residuals of `residuals_at` (the cached ones
+  // when that is residual_frame).
+  void emit(int32_t at, int32_t residuals_at, TdagMesh& out) const {
     out.frame = at;
     out.cut_frame = frame;
-    out.residual_frame = residual_frame;
+    out.residual_frame = residuals_at;
     out.positions.resize(vertex_residuals.size());
-    apply_affine(&d->maps[static_cast<size_t>(at) * 12], vertex_residuals.data(), vertex_nodes.size(),
-                 out.positions.data());
+    const double* map = &d->maps[static_cast<size_t>(at) * 12];
+    if (residuals_at == residual_frame) {
+      apply_affine(map, vertex_residuals.data(), vertex_nodes.size(), out.positions.data());
+    } else {
+      for (size_t slot = 0; slot < vertex_nodes.size(); ++slot)
+        apply_affine(map, residual_of(vertex_nodes[slot], residuals_at), 1, &out.positions[3 * slot]);
+    }
     out.faces.resize(face_ids.size() * 3);
     for (size_t i = 0; i < face_ids.size(); ++i)
       for (size_t k = 0; k < 3; ++k)
@@ -587,20 +594,11 @@ Status TdagCut::approximate(int32_t frame, ApproximationLevel level, TdagMesh& o
     default:
       return Status::error("level: " + std::to_string(static_cast<int>(level)) + " is not 1, 2 or 3");
   }
-  s.emit(frame, out);
+  s.emit(frame, s.residual_frame, out);
   return Status::success();
 }
 
-void TdagCut::mesh(TdagMesh& out) const {
-  const detail::CutState& s = *state_;
-  if (s.residual_frame == s.frame) {
-    s.emit(s.frame, out);
-    return;
-  }
-  detail::CutState copy = s;
-  copy.refresh_residuals(s.frame);
-  copy.emit(s.frame, out);
-}
+void TdagCut::mesh(TdagMesh& out) const { state_->emit(state_->frame, state_->frame, out); }
 
 void TdagCut::input_vertex_map(std::vector<int32_t>& out) const {
   const detail::CutState& s = *state_;

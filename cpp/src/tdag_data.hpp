@@ -88,6 +88,9 @@ struct TdagData {
   std::vector<int32_t> event_offsets;      // (F + 1,) collapses whose structure (alive, links) changes at t
   std::vector<int32_t> event_nodes;
   bool static_structure = true;            // every collapse and link alive on every frame
+  // (F, C) the error code of every collapse in every frame (65535 where not alive): the runs
+  // expanded for O(1) lookups in queries; memory only, never stored.
+  std::vector<uint16_t> codes_by_frame;
 
   size_t collapse_count() const { return kept_child.size(); }
   size_t node_count() const { return static_cast<size_t>(vertex_count) + collapse_count(); }
@@ -98,6 +101,10 @@ struct TdagData {
 
   // The error code of collapse c at `frame`; 65535 (never collapsed) where it is not alive.
   uint16_t error_code(size_t c, int32_t frame) const {
+    return codes_by_frame[static_cast<size_t>(frame) * collapse_count() + c];
+  }
+  // The same from the stored runs (derive_links expands them into codes_by_frame).
+  uint16_t error_code_from_runs(size_t c, int32_t frame) const {
     const ErrorRun* begin = error_runs.data() + error_offsets[c];
     const ErrorRun* end = error_runs.data() + error_offsets[c + 1];
     const ErrorRun* run = std::upper_bound(begin, end, frame, [](int32_t f, const ErrorRun& r) { return f < r.range.birth; });

@@ -16,7 +16,8 @@
 //   per collapse: v (node - kept), v (node - removed), v killed[0] + 1, v killed[1] + 1,
 //                tag (alive), v dependency count, per dependency z (node - dependency) and a tag
 //                (v 0: the collapse's alive tag; else v range count + 1, then ranges), v error
-//                run count, per run v (birth - previous death), v length, z code change
+//                run count, per run v ((length - 1) * 2 + gap?), [v gap from the previous
+//                death], z code change
 //   tag          v range count, per range v (birth - previous death), v length
 #include <algorithm>
 #include <array>
@@ -154,8 +155,8 @@ class Reader {
     const uint64_t ranges = count(what, static_cast<uint64_t>(frame_count));
     int64_t previous = 0;
     for (uint64_t i = 0; i < ranges && ok(); ++i) {
-      const int64_t birth = previous + static_cast<int64_t>(varint(what));
-      const int64_t death = birth + static_cast<int64_t>(varint(what));
+      const int64_t birth = previous + static_cast<int64_t>(count(what, static_cast<uint64_t>(frame_count)));
+      const int64_t death = birth + static_cast<int64_t>(count(what, static_cast<uint64_t>(frame_count)));
       if (birth < previous || death <= birth || death > frame_count) {
         fail(std::string(what) + ": range outside the frames");
         break;
@@ -238,8 +239,9 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
     int32_t code = 0;
     for (int32_t r = d.error_offsets[c]; r < d.error_offsets[c + 1]; ++r) {
       const detail::ErrorRun& run = d.error_runs[static_cast<size_t>(r)];
-      w.varint(static_cast<uint64_t>(run.range.birth - death));
-      w.varint(static_cast<uint64_t>(run.range.death - run.range.birth));
+      const auto gap = static_cast<uint64_t>(run.range.birth - death);
+      w.varint((static_cast<uint64_t>(run.range.death - run.range.birth - 1) << 1) | (gap > 0 ? 1u : 0u));
+      if (gap > 0) w.varint(gap);
       w.zigzag(int32_t(run.code) - code);
       death = run.range.death;
       code = run.code;
@@ -354,8 +356,8 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
       TimeTag tag;
       int64_t last = 0;
       for (uint64_t k = 0; k + 1 < ranges && r.ok(); ++k) {
-        const int64_t birth = last + static_cast<int64_t>(r.varint("dependency tag"));
-        const int64_t death = birth + static_cast<int64_t>(r.varint("dependency tag"));
+        const int64_t birth = last + static_cast<int64_t>(r.count("dependency tag", frame_count));
+        const int64_t death = birth + static_cast<int64_t>(r.count("dependency tag", frame_count));
         if (death <= birth || death > frames) r.fail("dependency tag: range outside the frames");
         else tag.add({static_cast<int32_t>(birth), static_cast<int32_t>(death)});
         last = death;
@@ -366,8 +368,13 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
     const uint64_t runs = r.count("error run count", frame_count);
     int64_t death = 0, code = 0;
     for (uint64_t i = 0; i < runs && r.ok(); ++i) {
-      const int64_t birth = death + static_cast<int64_t>(r.varint("error runs"));
-      death = birth + static_cast<int64_t>(r.varint("error runs"));
+      const uint64_t head = r.varint("error runs");
+      if ((head >> 1) >= frame_count) {
+        r.fail("error runs: a run longer than the frames");
+        break;
+      }
+      const int64_t birth = death + ((head & 1u) ? static_cast<int64_t>(r.count("error runs", frame_count)) : 0);
+      death = birth + static_cast<int64_t>(head >> 1) + 1;
       code += r.zigzag("error runs");
       if (death <= birth || death > frames || code < 0 || code > 65535) {
         r.fail("error runs: a run outside the frames or an invalid code");

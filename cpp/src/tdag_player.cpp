@@ -5,6 +5,7 @@
 #include "animlod/tdag_player.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -29,13 +30,17 @@ struct TdagPlayer::Impl {
   std::mutex mutex;
   std::condition_variable changed;
   bool busy = false;        // the update thread is bringing `back` to `target`
+  std::atomic<bool> pending{false};  // busy, readable without the lock (for spinning)
   bool stop = false;
   int32_t target = -1;
   int32_t back_frame = -1;  // the frame `back` is at (valid while not busy)
 
+  // The update thread: waits for a target (spinning briefly first, as a frame's handoff is
+  // usually a fraction of a millisecond away and a sleeping thread can take far longer to wake).
   void run() {
-    std::unique_lock<std::mutex> lock(mutex);
     while (true) {
+      spin_until([&] { return pending.load(std::memory_order_acquire); });
+      std::unique_lock<std::mutex> lock(mutex);
       changed.wait(lock, [&] { return stop || busy; });
       if (stop) return;
       const int32_t goal = target;
@@ -44,8 +49,15 @@ struct TdagPlayer::Impl {
       lock.lock();
       back_frame = goal;
       busy = false;
+      pending.store(false, std::memory_order_release);
       changed.notify_all();
     }
+  }
+
+  template <typename Ready>
+  static void spin_until(Ready&& ready) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
+    while (!ready() && std::chrono::steady_clock::now() < until) std::this_thread::yield();
   }
 
   // Starts the update of `back` to `frame` when the update thread is idle and `back` is not there.
@@ -54,10 +66,12 @@ struct TdagPlayer::Impl {
     if (busy || frame >= static_cast<int32_t>(dag.frame_count()) || back_frame == frame) return;
     target = frame;
     busy = true;
+    pending.store(true, std::memory_order_release);
     changed.notify_all();
   }
 
   void wait_idle() {
+    spin_until([&] { return !pending.load(std::memory_order_acquire); });
     std::unique_lock<std::mutex> lock(mutex);
     changed.wait(lock, [&] { return !busy; });
   }
@@ -72,6 +86,7 @@ struct TdagPlayer::Impl {
     {
       std::lock_guard<std::mutex> lock(mutex);
       stop = true;
+      pending.store(true, std::memory_order_release);
       changed.notify_all();
     }
     worker.join();
@@ -146,7 +161,8 @@ double vertex_error(const TdagCut& cut, const TdagMesh& mesh, const std::vector<
   return std::sqrt(largest);
 }
 
-void add(PlayerLevelStats& stats, double seconds, double error, const TdagMesh& mesh) {
+void add(PlayerLevelStats& stats, std::vector<double>& times, double seconds, double error, const TdagMesh& mesh) {
+  times.push_back(seconds);
   stats.mean_seconds += seconds;
   stats.max_seconds = std::max(stats.max_seconds, seconds);
   stats.mean_error += error;
@@ -155,7 +171,11 @@ void add(PlayerLevelStats& stats, double seconds, double error, const TdagMesh& 
   stats.mean_faces += static_cast<double>(mesh.faces.size() / 3);
 }
 
-void finish(PlayerLevelStats& stats, int32_t frames) {
+void finish(PlayerLevelStats& stats, std::vector<double>& times, int32_t frames) {
+  if (!times.empty()) {
+    std::nth_element(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(times.size() / 2), times.end());
+    stats.median_seconds = times[times.size() / 2];
+  }
   const double n = std::max(1, frames);
   stats.mean_seconds /= n;
   stats.mean_error /= n;
@@ -177,6 +197,7 @@ Status play_temporal_dag(const TemporalDag& dag, const PlayerOptions& options, P
   TdagMesh mesh;
   const ApproximationLevel levels[3] = {ApproximationLevel::affine, ApproximationLevel::residual,
                                         ApproximationLevel::full};
+  std::vector<double> times[4];
   for (int32_t t = options.first_frame + 1; t <= last; ++t) {
     if (options.measure_error) dag.frame_positions(t, original.data());
     for (int i = 0; i < 3; ++i) {
@@ -187,17 +208,17 @@ Status play_temporal_dag(const TemporalDag& dag, const PlayerOptions& options, P
         out.mean_splits += static_cast<double>(walker.last_split_count());
         out.mean_collapses += static_cast<double>(walker.last_collapse_count());
       }
-      add(out.levels[i], seconds, options.measure_error ? vertex_error(walker, mesh, original, map) : 0.0, mesh);
+      add(out.levels[i], times[i], seconds, options.measure_error ? vertex_error(walker, mesh, original, map) : 0.0, mesh);
     }
     const auto start = Clock::now();
     if (Status status = fresh.query(t, options.tolerance); !status) return status;
     fresh.mesh(mesh);
     const double seconds = seconds_since(start);
-    add(out.full_query, seconds, options.measure_error ? vertex_error(fresh, mesh, original, map) : 0.0, mesh);
+    add(out.full_query, times[3], seconds, options.measure_error ? vertex_error(fresh, mesh, original, map) : 0.0, mesh);
     ++out.frames;
   }
-  for (auto& stats : out.levels) finish(stats, out.frames);
-  finish(out.full_query, out.frames);
+  for (int i = 0; i < 3; ++i) finish(out.levels[i], times[i], out.frames);
+  finish(out.full_query, times[3], out.frames);
   out.mean_splits /= std::max(1, out.frames);
   out.mean_collapses /= std::max(1, out.frames);
 

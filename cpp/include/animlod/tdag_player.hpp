@@ -49,6 +49,7 @@ struct PlayerLevelStats {
   double max_error = 0.0;   // largest over frames
   double mean_vertices = 0.0;
   double mean_faces = 0.0;
+  double median_seconds = 0.0;  // robust to the odd preempted frame
 };
 
 struct PlayerOptions {

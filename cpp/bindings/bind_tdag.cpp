@@ -176,7 +176,9 @@ void bind_tdag(py::module_& m) {
       .def_readwrite("boundary_quadrics", &TdagOptions::boundary_quadrics, "planes along open borders")
       .def_readwrite("check_inversion", &TdagOptions::check_inversion,
                      "reject collapses that flip a face of the decimated frame")
-      .def_readwrite("use_motion_features", &TdagOptions::use_motion_features, "governing='aqem': Eq. 6 weights");
+      .def_readwrite("use_motion_features", &TdagOptions::use_motion_features, "governing='aqem': Eq. 6 weights")
+      .def_readwrite("weld", &TdagOptions::weld,
+                     "weld vertices equal in every frame (seam copies) into one TDAG vertex, as AQEM does");
 
   py::class_<TemporalDag>(m, "TemporalDag", "A TDAG (animlod/tdag.hpp): immutable; copies share the data.")
       .def_property_readonly("frame_count", &TemporalDag::frame_count)
@@ -192,7 +194,14 @@ void bind_tdag(py::module_& m) {
             std::vector<int32_t> faces(d.faces(), d.faces() + d.face_count() * 3);
             return numpy_from_vector(std::move(faces), {static_cast<py::ssize_t>(d.face_count()), 3});
           },
-          "(M, 3) int32 input faces (a copy)")
+          "(M, 3) int32 faces over the TDAG's vertices (a copy)")
+      .def_property_readonly(
+          "input_points",
+          [](const TemporalDag& d) {
+            std::vector<int32_t> p(d.input_points(), d.input_points() + d.input_vertex_count());
+            return numpy_from_vector(std::move(p), {static_cast<py::ssize_t>(d.input_vertex_count())});
+          },
+          "(input V,) int32 TDAG vertex standing for each input vertex (-1: used by no face)")
       .def_property_readonly(
           "affine_maps",
           [](const TemporalDag& d) {

@@ -48,6 +48,10 @@ Status derive_links(TdagData& data) {
       data.error_offsets.size() != collapse_count + 1 || data.dep_tags.size() != data.dep_nodes.size())
     return Status::error("collapse fields of different lengths");
   const auto face_count = static_cast<int32_t>(data.face_count());
+  for (size_t v = 0; v < data.input_points.size(); ++v)
+    if (data.input_points[v] < -1 || data.input_points[v] >= vertex_count)
+      return Status::error("input vertex " + std::to_string(v) + ": vertex " + std::to_string(data.input_points[v]) +
+                           " outside [0, " + std::to_string(vertex_count) + ")");
   for (size_t i = 0; i < data.faces.size(); ++i)
     if (data.faces[i] < 0 || data.faces[i] >= vertex_count)
       return Status::error("face " + std::to_string(i / 3) + ": vertex index " + std::to_string(data.faces[i]) +
@@ -199,6 +203,8 @@ size_t TemporalDag::face_count() const { return data_ ? data_->face_count() : 0;
 size_t TemporalDag::collapse_count() const { return data_ ? data_->collapse_count() : 0; }
 size_t TemporalDag::node_count() const { return data_ ? data_->node_count() : 0; }
 const int32_t* TemporalDag::faces() const { return data_ ? data_->faces.data() : nullptr; }
+size_t TemporalDag::input_vertex_count() const { return data_ ? data_->input_points.size() : 0; }
+const int32_t* TemporalDag::input_points() const { return data_ ? data_->input_points.data() : nullptr; }
 Governing TemporalDag::governing() const { return data_ ? data_->governing : Governing::first; }
 AffineBase TemporalDag::affine_base() const { return data_ ? data_->affine_base : AffineBase::first; }
 

@@ -19,10 +19,13 @@
 #include <Eigen/Core>
 
 #include "animlod/aqem.hpp"
-#include "animlod/mesh_validation.hpp"
 #include "animlod/tdag.hpp"
+#include "collapse_engine.hpp"
+#include "mesh_preparation.hpp"
+#include "mesh_validation_detail.hpp"
 #include "tdag_data.hpp"
-#include "tdag_decimate.hpp"
+#include "tdag_hierarchy.hpp"
+#include "tdag_policy.hpp"
 
 namespace animlod {
 
@@ -46,35 +49,38 @@ Status check_options(const AnimatedMeshView& mesh, const TdagOptions& options) {
   return Status::success();
 }
 
-// The online history term: collapses of the previous frame's hierarchy come first in its order
-// when lambda is large.
-class HistoryPriority final : public detail::CollapsePriority {
- public:
-  HistoryPriority(const CollapseTable& table, const FrameHierarchy& previous, double lambda) : table_(table) {
-    rank_.assign(table.representative.size(), -1);
-    double total = 0.0;
-    for (size_t i = 0; i < previous.nodes.size(); ++i) {
-      rank_[static_cast<size_t>(previous.nodes[i])] = static_cast<int32_t>(i);
-      total += previous.costs[i];
+// The TDAG's vertices: the prepared points, with their frames (F, P, 3).
+struct PointMesh {
+  detail::PreparedMesh prepared;
+  std::vector<float> frames;
+  AnimatedMeshView view;  // over `frames` and prepared.faces
+  std::vector<std::vector<int32_t>> twins;  // (P,) other points cut from the same input vertex
+
+  PointMesh(const AnimatedMeshView& mesh, bool weld) {
+    detail::WeldInput input;
+    input.weld = weld;
+    prepared = detail::prepare_mesh(mesh, input);
+    const size_t point_count = prepared.point_source.size();
+    frames.resize(mesh.frame_count * point_count * 3);
+    for (size_t f = 0; f < mesh.frame_count; ++f)
+      for (size_t p = 0; p < point_count; ++p)
+        std::copy_n(mesh.frames + (f * mesh.vertex_count + static_cast<size_t>(prepared.point_source[p])) * 3, 3,
+                    &frames[(f * point_count + p) * 3]);
+    view = {frames.data(), prepared.faces.data(), mesh.frame_count, point_count, prepared.faces.size() / 3};
+    twins.resize(point_count);
+    if (prepared.split_points == 0) return;
+    std::vector<std::pair<int32_t, int32_t>> by_source;
+    for (size_t p = 0; p < point_count; ++p) by_source.emplace_back(prepared.point_source[p], static_cast<int32_t>(p));
+    std::sort(by_source.begin(), by_source.end());
+    for (size_t i = 0; i < by_source.size();) {
+      size_t j = i;
+      while (j < by_source.size() && by_source[j].first == by_source[i].first) ++j;
+      for (size_t a = i; a < j; ++a)
+        for (size_t b = i; b < j; ++b)
+          if (a != b) twins[static_cast<size_t>(by_source[a].second)].push_back(by_source[b].second);
+      i = j;
     }
-    count_ = std::max<double>(1.0, static_cast<double>(previous.nodes.size()));
-    const double mean = previous.nodes.empty() ? 0.0 : total / static_cast<double>(previous.nodes.size());
-    weight_ = lambda * (mean > 0.0 ? mean : 1.0);
   }
-
-  double priority(int32_t kept_node, int32_t removed_node, double cost) const override {
-    if (weight_ == 0.0) return cost;
-    const int32_t node = table_.find(kept_node, removed_node);
-    const int32_t rank = node >= 0 && static_cast<size_t>(node) < rank_.size() ? rank_[static_cast<size_t>(node)] : -1;
-    const double history = rank >= 0 ? static_cast<double>(rank) / count_ : 2.0;
-    return cost + weight_ * history;
-  }
-
- private:
-  const CollapseTable& table_;
-  std::vector<int32_t> rank_;  // node -> index in the previous frame's order, -1: not there
-  double count_ = 1.0;
-  double weight_ = 0.0;        // lambda * s
 };
 
 // Per-frame fields of the collapses, accumulated frame after frame.
@@ -197,7 +203,7 @@ double bounding_box_diagonal(const AnimatedMeshView& mesh) {
   return diagonal > 0.0 && std::isfinite(diagonal) ? diagonal : 1.0;
 }
 
-// The governing geometry (V, 3): frame 0, the average or frame k.
+// The governing geometry of the input vertices (V, 3): frame 0, the average or frame k.
 std::vector<float> governing_positions(const AnimatedMeshView& mesh, const TdagOptions& options) {
   const size_t per_frame = mesh.vertex_count * 3;
   if (options.governing == Governing::average) {
@@ -212,37 +218,53 @@ std::vector<float> governing_positions(const AnimatedMeshView& mesh, const TdagO
   return {mesh.frames + frame * per_frame, mesh.frames + (frame + 1) * per_frame};
 }
 
-detail::DecimationInput decimation_input(const AnimatedMeshView& mesh, const TdagOptions& options, const float* positions) {
-  detail::DecimationInput input;
-  input.positions = positions;
-  input.faces = mesh.faces;
-  input.vertex_count = mesh.vertex_count;
-  input.face_count = mesh.face_count;
-  input.boundary_quadrics = options.boundary_quadrics;
-  input.check_inversion = options.check_inversion;
-  return input;
+// One frame's order from the collapse engine with the TDAG policy: `positions` (V, 3) are the
+// input vertices in the decimated geometry; returns the order and its quadric costs.
+Status decimate(const AnimatedMeshView& mesh, const PointMesh& points, const float* positions,
+                const TdagOptions& options, const std::vector<detail::BoundarySide>* boundary,
+                const detail::HistoryTerm* history, CollapseTable& table, FrameHierarchy& out,
+                std::vector<double>& costs) {
+  const AnimatedMeshView one_frame{positions, mesh.faces, 1, mesh.vertex_count, mesh.face_count};
+  detail::EngineOptions engine_options;
+  engine_options.check_inversion = options.check_inversion;
+  const detail::CarriedData carried;
+  detail::CollapseEngine engine(one_frame, points.prepared, carried, engine_options);
+  std::vector<float> point_positions(points.view.vertex_count * 3);
+  for (size_t p = 0; p < points.view.vertex_count; ++p)
+    std::copy_n(positions + static_cast<size_t>(points.prepared.point_source[p]) * 3, 3, &point_positions[p * 3]);
+  std::vector<Quadric> quadrics;
+  detail::vertex_quadrics(point_positions.data(), points.view.faces, points.view.vertex_count,
+                          points.view.face_count, boundary, quadrics);
+  detail::TdagCollapsePolicy policy(engine, std::move(quadrics), table, history);
+  std::vector<detail::EngineLevel> levels;
+  detail::EngineRecord record;
+  engine.run(policy, {1}, levels, record);
+  costs = policy.costs();
+  return detail::record_hierarchy(points.view.faces, points.view.face_count, points.view.vertex_count,
+                                  policy.collapses(), nullptr, table, out);
 }
 
-// The AQEM order over all frames, replayed on the connectivity to get the hierarchy.
-Status aqem_hierarchy(const AnimatedMeshView& mesh, const TdagOptions& options, CollapseTable& table,
-                      FrameHierarchy& out) {
+// The AQEM order over all frames (simplify_animated's collapse record, welded as the TDAG is),
+// turned into the points' hierarchy. AQEM places the merged vertex optimally; the TDAG keeps
+// the position of its kept vertex.
+Status aqem_hierarchy(const AnimatedMeshView& mesh, const PointMesh& points, const TdagOptions& options,
+                      CollapseTable& table, FrameHierarchy& out) {
   AqemOptions aqem;
-  aqem.target_face_counts = {std::min<size_t>(4, mesh.face_count)};
+  aqem.target_face_counts = {1};
   aqem.use_motion_features = options.use_motion_features;
   aqem.boundary_quadrics = options.boundary_quadrics;
   aqem.check_inversion = options.check_inversion;
+  aqem.weld = options.weld;
   AqemResult result;
-  if (mesh.face_count < 4) {
-    out = FrameHierarchy{};
-    out.dep_offsets.push_back(0);
-    return Status::success();
-  }
   if (Status status = simplify_animated(mesh, {}, aqem, result); !status) return Status::error("AQEM: " + status.message);
-  detail::DecimationInput input = decimation_input(mesh, options, mesh.frames);
-  input.replay_removed = result.collapses.removed.data();
-  input.replay_kept = result.collapses.kept.data();
-  input.replay_count = result.collapses.removed.size();
-  if (Status status = detail::decimate_frame(input, table, out); !status)
+  std::vector<detail::VertexCollapse> collapses(result.collapses.removed.size());
+  for (size_t i = 0; i < collapses.size(); ++i) {
+    collapses[i].removed = points.prepared.wedge_point[static_cast<size_t>(result.collapses.removed[i])];
+    collapses[i].kept = points.prepared.wedge_point[static_cast<size_t>(result.collapses.kept[i])];
+  }
+  if (Status status = detail::record_hierarchy(points.view.faces, points.view.face_count, points.view.vertex_count,
+                                               collapses, &points.twins, table, out);
+      !status)
     return Status::error("AQEM order: " + status.message);
   return Status::success();
 }
@@ -252,10 +274,17 @@ Status aqem_hierarchy(const AnimatedMeshView& mesh, const TdagOptions& options, 
 Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& options, TemporalDag& out,
                           TdagBuildReport* report) {
   out = TemporalDag{};
-  if (Status status = validate_animated_mesh(mesh); !status) return status;
+  if (Status status = detail::check_sizes_values_and_indices(mesh); !status) return status;
   if (Status status = check_options(mesh, options); !status) return status;
   if (mesh.frame_count > static_cast<size_t>(INT32_MAX - 1))
     return Status::error("frames: " + std::to_string(mesh.frame_count) + " frames, more than int32 frame numbers reach");
+
+  // The TDAG's vertices: welded points, degenerate and repeated faces dropped, non-manifold
+  // spots cut apart (as the collapse engine needs them).
+  const PointMesh points(mesh, options.weld);
+  if (points.view.face_count == 0)
+    return Status::error("faces: every face is degenerate (no face has three distinct positions)");
+  const AnimatedMeshView& view = points.view;
 
   auto data = std::make_shared<detail::TdagData>();
   TdagBuildReport local_report;
@@ -263,38 +292,44 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
   rep = TdagBuildReport{};
   const auto frame_count = static_cast<int32_t>(mesh.frame_count);
   data->frame_count = frame_count;
-  data->vertex_count = static_cast<int32_t>(mesh.vertex_count);
-  data->faces.assign(mesh.faces, mesh.faces + mesh.face_count * 3);
+  data->vertex_count = static_cast<int32_t>(view.vertex_count);
+  data->faces = points.prepared.faces;
+  data->input_points = points.prepared.wedge_point;
   data->affine_base = options.affine_base;
   data->governing = options.governing;
   data->governing_frame = options.governing == Governing::frame ? options.governing_frame : 0;
   data->history_weight = options.governing == Governing::online ? options.history_weight : 0.0;
-  data->scale = bounding_box_diagonal(mesh);
+  data->scale = bounding_box_diagonal(view);
 
   // Section 3: the affine split.
   auto start = std::chrono::steady_clock::now();
   AffineSplit split;
-  if (Status status = affine_split(mesh, options.affine_base, split); !status) return status;
+  if (Status status = affine_split(view, options.affine_base, split); !status) return status;
   data->maps = std::move(split.maps);
   data->residuals = std::move(split.residuals);
   rep.seconds_affine = seconds_since(start);
 
   // Section 4: the hierarchy (one order, or one per frame online) and the per-frame fields.
   CollapseTable table(data->vertex_count);
-  FieldBuilder fields(mesh, options, data->scale);
+  FieldBuilder fields(view, options, data->scale);
+  const std::vector<detail::BoundarySide> boundary =
+      options.boundary_quadrics ? detail::boundary_sides(view.faces, view.face_count) : std::vector<detail::BoundarySide>{};
+  const std::vector<detail::BoundarySide>* boundary_or_null = options.boundary_quadrics ? &boundary : nullptr;
   auto progress = [&](size_t done) {
     if (options.progress) options.progress(done, mesh.frame_count);
   };
+  std::vector<double> costs;
   if (options.governing != Governing::online) {
     start = std::chrono::steady_clock::now();
     FrameHierarchy hierarchy;
     if (options.governing == Governing::aqem) {
-      if (Status status = aqem_hierarchy(mesh, options, table, hierarchy); !status) return status;
+      if (Status status = aqem_hierarchy(mesh, points, options, table, hierarchy); !status) return status;
     } else {
       const std::vector<float> positions = governing_positions(mesh, options);
-      if (Status status = detail::decimate_frame(decimation_input(mesh, options, positions.data()), table, hierarchy);
+      if (Status status = decimate(mesh, points, positions.data(), options, boundary_or_null, nullptr, table,
+                                   hierarchy, costs);
           !status)
-        return status;
+        return Status::error("internal: " + status.message);
     }
     rep.seconds_hierarchy = seconds_since(start);
     progress(0);
@@ -306,23 +341,24 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
     rep.seconds_fields = seconds_since(start);
   } else {
     FrameHierarchy previous, current;
+    std::vector<double> previous_costs;
     progress(0);
     for (int32_t t = 0; t < frame_count; ++t) {
       start = std::chrono::steady_clock::now();
       const float* positions = mesh.frames + static_cast<size_t>(t) * mesh.vertex_count * 3;
-      detail::DecimationInput input = decimation_input(mesh, options, positions);
-      std::unique_ptr<HistoryPriority> history;
-      if (t > 0 && options.history_weight > 0.0) {
-        history = std::make_unique<HistoryPriority>(table, previous, options.history_weight);
-        input.priority = history.get();
-      }
-      if (Status status = detail::decimate_frame(input, table, current); !status)
-        return Status::error("frame " + std::to_string(t) + ": " + status.message);
+      std::unique_ptr<detail::HistoryTerm> history;
+      if (t > 0 && options.history_weight > 0.0)
+        history = std::make_unique<detail::HistoryTerm>(table, previous, previous_costs, options.history_weight);
+      if (Status status = decimate(mesh, points, positions, options, boundary_or_null, history.get(), table, current,
+                                   costs);
+          !status)
+        return Status::error("internal: frame " + std::to_string(t) + ": " + status.message);
       rep.seconds_hierarchy += seconds_since(start);
       start = std::chrono::steady_clock::now();
       fields.add_frame(t, table, current, rep);
       rep.seconds_fields += seconds_since(start);
       std::swap(previous, current);
+      previous_costs = costs;
       progress(static_cast<size_t>(t) + 1);
     }
   }

@@ -54,7 +54,8 @@ struct TdagData {
   // ---- stored ----
   int32_t frame_count = 0;   // F
   int32_t vertex_count = 0;  // V: nodes 0..V-1 are the input vertices (leaves)
-  std::vector<int32_t> faces;  // (M, 3) the input's faces
+  std::vector<int32_t> faces;  // (M, 3) over the TDAG's vertices
+  std::vector<int32_t> input_points;  // (input V,) TDAG vertex of each input vertex, -1: unused
   AffineBase affine_base = AffineBase::first;
   Governing governing = Governing::first;
   int32_t governing_frame = 0;

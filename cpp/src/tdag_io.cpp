@@ -10,6 +10,8 @@
 // Body: unsigned LEB128 varints ("v"), zigzag varints for signed deltas ("z"), raw IEEE values:
 //   v F, V, M, C; u8 affine base, u8 governing; z governing frame; f64 history weight, f64 scale
 //   faces        z delta of each index from the one before (3 M values)
+//   inputs       v input vertex count, u8 1 when input vertex v is TDAG vertex v, else each
+//                input vertex's TDAG vertex as z delta from the one before (from -1)
 //   maps         F * 12 f64
 //   residuals    frame 0: V * 3 f32; frame t > 0: a bit per vertex (changed since t - 1), then
 //                the changed vertices' 3 f32 (a vertex that does not move is stored once)
@@ -197,6 +199,18 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
     w.zigzag(static_cast<int64_t>(index) - previous);
     previous = index;
   }
+  // The input vertices' points: a flag for the identity, else each as a delta + 1.
+  bool identity = d.input_points.size() == vertex_count;
+  for (size_t v = 0; identity && v < vertex_count; ++v) identity = d.input_points[v] == static_cast<int32_t>(v);
+  w.varint(d.input_points.size());
+  w.u8(identity ? 1 : 0);
+  if (!identity) {
+    int64_t last = -1;
+    for (int32_t point : d.input_points) {
+      w.zigzag(static_cast<int64_t>(point) - last);
+      last = point;
+    }
+  }
   w.raw_array(d.maps.data(), d.maps.size());
   const size_t per_frame = vertex_count * 3;
   w.raw_array(d.residuals.data(), per_frame);
@@ -315,6 +329,19 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
       break;
     }
     index = static_cast<int32_t>(previous);
+  }
+  const uint64_t input_count = r.count("input vertex count", kMaxIndex);
+  const uint8_t identity = r.u8("input vertices");
+  if (identity > 1 || (identity && input_count != vertex_count)) r.fail("input vertices: bad identity flag");
+  if (!identity && input_count > r.remaining()) r.fail("input vertices: count does not fit the file");
+  if (r.ok()) {
+    d->input_points.resize(input_count);
+    int64_t last = -1;
+    for (size_t v = 0; v < input_count && r.ok(); ++v) {
+      last = identity ? static_cast<int64_t>(v) : last + r.zigzag("input vertices");
+      if (last < -1 || last >= static_cast<int64_t>(vertex_count)) r.fail("input vertices: a point outside [0, V)");
+      d->input_points[v] = static_cast<int32_t>(last);
+    }
   }
   d->maps.resize(frame_count * 12);
   r.raw_array(d->maps.data(), d->maps.size(), "affine maps");

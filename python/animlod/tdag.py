@@ -295,13 +295,14 @@ class TemporalDag:
         check_inversion: bool = True,
         boundary_quadrics: bool = True,
         use_motion_features: bool = True,
+        weld: bool = True,
         progress: Callable[[int, int], None] | None = None,
     ) -> TemporalDag:
         """Build the TDAG of ``mesh`` (Sections 3-4).
 
         Parameters
         ----------
-        mesh : (F, V, 3) frames and (M, 3) faces; manifold, no degenerate or duplicate faces.
+        mesh : (F, V, 3) frames and (M, 3) faces, any indexed triangle mesh.
         governing : the collapse order: ``"first"`` (decimate frame 0), ``"average"`` (the average
             mesh), a frame number (that frame), ``"aqem"`` (AQEM over all frames) or ``"online"``
             (every frame decimated in turn with a history term).
@@ -313,12 +314,15 @@ class TemporalDag:
         check_inversion : reject collapses that flip a face of the decimated frame.
         boundary_quadrics : planes along open borders keep their shape.
         use_motion_features : ``governing="aqem"`` only: the weights of Eq. 6.
+        weld : weld vertices equal in every frame (UV-seam copies) into one TDAG vertex, as AQEM
+            does. Either way degenerate and repeated faces are dropped and non-manifold spots cut
+            apart, so any indexed triangle mesh is taken (see :attr:`input_points`).
         progress : ``progress(frames_done, F)`` called as the build goes.
 
         Raises
         ------
-        ValueError naming the element: non-finite position, index out of range, degenerate or
-        duplicate face, non-manifold edge or vertex, unreferenced vertex, bad option.
+        ValueError naming the element: non-finite position, index out of range, every face
+        degenerate, bad option.
         """
         options = _core.TdagOptions()
         if isinstance(governing, bool) or not isinstance(governing, (str, int, np.integer)):
@@ -335,6 +339,7 @@ class TemporalDag:
         options.check_inversion = bool(check_inversion)
         options.boundary_quadrics = bool(boundary_quadrics)
         options.use_motion_features = bool(use_motion_features)
+        options.weld = bool(weld)
         core, raw = _core.build_temporal_dag(mesh.frames, mesh.faces, options, progress)
         return cls(core, TdagBuildReport(**raw))
 
@@ -394,8 +399,17 @@ class TemporalDag:
 
     @property
     def faces(self) -> np.ndarray:
-        """(M, 3) int32 input faces."""
+        """(M, 3) int32 faces over the TDAG's vertices."""
         return self._core.faces
+
+    @property
+    def input_points(self) -> np.ndarray:
+        """(input V,) int32 TDAG vertex standing for each input vertex (-1: used by no face).
+
+        The TDAG's vertices are the input's welded points (copies along UV seams are one vertex;
+        copies cut from non-manifold spots are several), so ``frame_positions(t)[input_points]``
+        are the input frame's positions."""
+        return self._core.input_points
 
     @property
     def affine_maps(self) -> np.ndarray:

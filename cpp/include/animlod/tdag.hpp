@@ -66,6 +66,11 @@ struct TdagOptions {
   bool use_motion_features = true;
   // Called with (frames done, F) as the build goes. Exceptions propagate (nothing is built).
   std::function<void(size_t, size_t)> progress;
+  // Welds vertices equal in every frame (UV-seam and flat-shading copies) into one vertex of
+  // the TDAG, as AQEM does; off, every input vertex is its own. Either way degenerate and
+  // repeated faces are dropped and non-manifold spots are cut apart (their copies are locked),
+  // so the TDAG's vertices are "points" (TemporalDag::input_points maps the input onto them).
+  bool weld = true;
 };
 
 // What the build measured. Costs are quadric costs (squared asset units) of the half-edge
@@ -89,12 +94,16 @@ class TemporalDag {
 
   bool empty() const;
   size_t frame_count() const;     // F
-  size_t vertex_count() const;    // V
+  size_t vertex_count() const;    // V: the TDAG's vertices (the welded points of the input)
   size_t face_count() const;      // M
   size_t collapse_count() const;  // C
   size_t node_count() const;      // V + C
-  // (M, 3) the input's faces.
+  // (M, 3) faces over the TDAG's vertices (the input's, less degenerate and repeated ones).
   const int32_t* faces() const;
+  // Number of input vertices, and (input_vertex_count,) the TDAG vertex standing for each
+  // (-1 for a vertex no face used).
+  size_t input_vertex_count() const;
+  const int32_t* input_points() const;
   Governing governing() const;
   AffineBase affine_base() const;
   // (3, 4) row-major affine map of `frame` (Section 3).
@@ -129,13 +138,16 @@ class TemporalDag {
   friend Status serialize_temporal_dag(const TemporalDag&, std::vector<uint8_t>&);
 };
 
-// Builds the TDAG of `mesh` (Sections 3-4). Cost: governed, one decimation plus O(F (V log V +
-// M)) for the per-frame fields; online, one decimation per frame.
+// Builds the TDAG of `mesh` (Sections 3-4). The collapse orders come from the collapse engine
+// (cpp/src/collapse_engine.hpp) with the TDAG's half-edge quadric policy, or from AQEM. Cost:
+// governed, one decimation plus O(F (V depth + M)) for the per-frame fields; online, one
+// decimation per frame.
 //
-// Errors (naming the element): the checks of validate_animated_mesh (manifold, no duplicate
-// or degenerate faces, finite positions, every vertex used); governing_frame outside [0, F);
-// history_weight negative or not finite; for Governing::aqem, any error of simplify_animated.
-// `out` is left empty on error; `report` (may be null) is filled on success.
+// Any indexed triangle mesh is taken (see TdagOptions::weld). Errors (naming the element): no
+// frames or faces, a non-finite position, a face index outside [0, V), every face degenerate;
+// governing_frame outside [0, F); history_weight negative or not finite; for Governing::aqem,
+// any error of simplify_animated. `out` is left empty on error; `report` (may be null) is
+// filled on success.
 Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& options, TemporalDag& out,
                           TdagBuildReport* report = nullptr);
 

@@ -39,9 +39,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     build.add_argument("--base", choices=("first", "average"), default="first", help="base mesh of the affine split")
     build.add_argument("--no-inversion-check", action="store_true", help="allow collapses that flip a face")
     build.add_argument(
-        "--repair",
-        action="store_true",
-        help="drop degenerate/duplicate faces and unreferenced vertices, split bow-tie vertices first",
+        "--no-weld", action="store_true", help="keep seam copies of a position apart (they become borders)"
     )
     build.set_defaults(run=run_build)
 
@@ -122,10 +120,6 @@ def run_build(args: argparse.Namespace) -> int:
 
     governing = _governing(args.governing)
     mesh = read_animation(args.input)
-    if args.repair:
-        from ..simplify import repair_mesh
-
-        mesh, _ = repair_mesh(mesh)
     bar = tqdm(total=mesh.frame_count, desc="TDAG", unit="frame", leave=False)
 
     def progress(done: int, total: int) -> None:
@@ -138,6 +132,7 @@ def run_build(args: argparse.Namespace) -> int:
             history_weight=args.history_weight,
             base=args.base,
             check_inversion=not args.no_inversion_check,
+            weld=not args.no_weld,
             progress=progress,
         )
     finally:
@@ -150,7 +145,11 @@ def run_build(args: argparse.Namespace) -> int:
     average, median = report.quality_measure()
     print(f"wrote {args.output}")
     rows = [
-        ("frames, vertices, faces", f"{mesh.frame_count}, {mesh.vertex_count}, {mesh.face_count}"),
+        (
+            "frames, vertices, faces",
+            f"{mesh.frame_count}, {mesh.vertex_count}, {mesh.face_count} (TDAG: {dag.vertex_count} welded "
+            f"vertices, {dag.face_count} faces)",
+        ),
         ("governing", f"{dag.governing}" + (f" (lambda {args.history_weight:g})" if dag.governing == "online" else "")),
         ("collapses (nodes), per frame", f"{dag.collapse_count}, {report.collapse_counts.mean():.0f}"),
         (

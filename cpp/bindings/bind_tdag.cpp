@@ -448,6 +448,8 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
         out["mean_collapses"] = report.mean_collapses;
         out["sequential_seconds_per_frame"] = report.sequential_seconds_per_frame;
         out["double_buffered_seconds_per_frame"] = report.double_buffered_seconds_per_frame;
+        out["median_update_seconds"] = report.median_update_seconds;
+        out["median_fresh_cut_seconds"] = report.median_fresh_cut_seconds;
         return out;
       },
       py::arg("dag"), py::arg("tolerance"), py::arg("first_frame") = 0, py::arg("frame_count") = -1,

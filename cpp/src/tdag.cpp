@@ -137,6 +137,40 @@ Status derive_links(TdagData& data) {
     }
   }
 
+  // Leaf ranges of a static forest: children are visited kept first, leaves numbered in order.
+  data.leaf_position.clear();
+  data.leaf_range.clear();
+  if (static_structure) {
+    data.leaf_position.assign(static_cast<size_t>(vertex_count), -1);
+    data.leaf_range.assign(static_cast<size_t>(node_count), {0, 0});
+    int32_t next = 0;
+    std::vector<std::pair<int32_t, bool>> stack;  // (node, children done)
+    for (size_t root = static_cast<size_t>(node_count); root-- > 0;) {
+      if (data.parent_offsets[root + 1] > data.parent_offsets[root]) continue;  // not a root
+      stack.assign(1, {static_cast<int32_t>(root), false});
+      while (!stack.empty()) {
+        auto [node, done] = stack.back();
+        stack.pop_back();
+        auto& range = data.leaf_range[static_cast<size_t>(node)];
+        if (node < vertex_count) {
+          data.leaf_position[static_cast<size_t>(node)] = next;
+          range = {next, next + 1};
+          ++next;
+          continue;
+        }
+        const size_t c = static_cast<size_t>(node - vertex_count);
+        if (done) {
+          range = {data.leaf_range[static_cast<size_t>(data.kept_child[c])][0],
+                   data.leaf_range[static_cast<size_t>(data.removed_child[c])][1]};
+          continue;
+        }
+        stack.push_back({node, true});
+        stack.push_back({data.removed_child[c], false});
+        stack.push_back({data.kept_child[c], false});
+      }
+    }
+  }
+
   // Dependents: the reverse links, with the index of the link for its tag.
   data.dependent_offsets.assign(collapse_count + 1, 0);
   for (int32_t d : data.dep_nodes) data.dependent_offsets[static_cast<size_t>(d - vertex_count) + 1] += 1;

@@ -170,6 +170,15 @@ struct CutState {
     return x;
   }
 
+  // The child of a split node (kept or removed, both active) that stands for input vertex
+  // `vertex`: O(1) with the leaf ranges of a static structure, else a walk up the hierarchy.
+  int32_t child_holding(int32_t vertex, int32_t kept, int32_t removed) const {
+    if (d->leaf_range.empty()) return active_ancestor(vertex);
+    const int32_t position = d->leaf_position[static_cast<size_t>(vertex)];
+    const auto& range = d->leaf_range[static_cast<size_t>(kept)];
+    return range[0] <= position && position < range[1] ? kept : removed;
+  }
+
   // ---- collapse and split of one node; counters and fronts ----
   void collapse(size_t c) {
     const int32_t node = node_of(c), kept = d->kept_child[c], removed = d->removed_child[c];
@@ -210,7 +219,7 @@ struct CutState {
       for (size_t k = 0; k < 3; ++k) {
         const size_t corner = 3 * static_cast<size_t>(face) + k;
         if (corner_nodes[corner] != node) continue;
-        const int32_t child = active_ancestor(d->faces[corner]);
+        const int32_t child = child_holding(d->faces[corner], kept, removed);
         corner_nodes[corner] = child;
         faces_of[static_cast<size_t>(child)].push_back(face);
       }

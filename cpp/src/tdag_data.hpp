@@ -89,6 +89,11 @@ struct TdagData {
   std::vector<int32_t> event_offsets;      // (F + 1,) collapses whose structure (alive, links) changes at t
   std::vector<int32_t> event_nodes;
   bool static_structure = true;            // every collapse and link alive on every frame
+  // With a static structure: the position of every leaf in a depth-first order of the forest
+  // (V,) and every node's range of positions [begin, end) (V + C, 2), so that "is vertex v
+  // under node n" is O(1). Empty otherwise.
+  std::vector<int32_t> leaf_position;
+  std::vector<std::array<int32_t, 2>> leaf_range;
   // (F, C) the error code of every collapse in every frame (65535 where not alive): the runs
   // expanded for O(1) lookups in queries; memory only, never stored.
   std::vector<uint16_t> codes_by_frame;

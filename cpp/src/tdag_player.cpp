@@ -197,11 +197,15 @@ Status play_temporal_dag(const TemporalDag& dag, const PlayerOptions& options, P
   TdagMesh mesh;
   const ApproximationLevel levels[3] = {ApproximationLevel::affine, ApproximationLevel::residual,
                                         ApproximationLevel::full};
-  std::vector<double> times[4];
+  std::vector<double> times[4], update_times, fresh_cut_times;
   for (int32_t t = options.first_frame + 1; t <= last; ++t) {
     if (options.measure_error) dag.frame_positions(t, original.data());
     for (int i = 0; i < 3; ++i) {
       const auto start = Clock::now();
+      if (i == 2) {
+        if (Status status = walker.advance(t); !status) return status;
+        update_times.push_back(seconds_since(start));
+      }
       if (Status status = walker.approximate(t, levels[i], mesh); !status) return status;
       const double seconds = seconds_since(start);
       if (i == 2) {
@@ -212,6 +216,7 @@ Status play_temporal_dag(const TemporalDag& dag, const PlayerOptions& options, P
     }
     const auto start = Clock::now();
     if (Status status = fresh.query(t, options.tolerance); !status) return status;
+    fresh_cut_times.push_back(seconds_since(start));
     fresh.mesh(mesh);
     const double seconds = seconds_since(start);
     add(out.full_query, times[3], seconds, options.measure_error ? vertex_error(fresh, mesh, original, map) : 0.0, mesh);
@@ -219,6 +224,13 @@ Status play_temporal_dag(const TemporalDag& dag, const PlayerOptions& options, P
   }
   for (int i = 0; i < 3; ++i) finish(out.levels[i], times[i], out.frames);
   finish(out.full_query, times[3], out.frames);
+  auto median = [](std::vector<double>& values) {
+    if (values.empty()) return 0.0;
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+    return values[values.size() / 2];
+  };
+  out.median_update_seconds = median(update_times);
+  out.median_fresh_cut_seconds = median(fresh_cut_times);
   out.mean_splits /= std::max(1, out.frames);
   out.mean_collapses /= std::max(1, out.frames);
 

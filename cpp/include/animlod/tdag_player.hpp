@@ -67,6 +67,8 @@ struct PlayerReport {
   double mean_collapses = 0.0;
   double sequential_seconds_per_frame = 0.0;      // level-3 walk on one thread
   double double_buffered_seconds_per_frame = 0.0; // level-3 walk with TdagPlayer (two threads)
+  double median_update_seconds = 0.0;     // the cut update of level 3 alone (TdagCut::advance)
+  double median_fresh_cut_seconds = 0.0;  // the fresh query's cut alone (TdagCut::query)
 };
 
 // Walks the frames from options.first_frame and measures every level on every frame, a fresh

@@ -2,7 +2,7 @@
 // "Temporal and spatial level of details for dynamic meshes", Sections 2-5).
 //
 // One multi-resolution structure for all frames: a vertex hierarchy whose nodes are half-edge
-// collapses (the collapsed vertex keeps the position of the vertex it merges into), whose
+// collapses (the merged vertex takes the position of one of its two children), whose
 // fields carry time tags (tdag_time_tag.hpp): a collapse is alive on the frames whose
 // hierarchy uses it, its dependencies (the collapses that must be applied before it, so that
 // every cut is a valid mesh) and its error bound are tagged per frame. Positions are stored as

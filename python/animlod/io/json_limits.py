@@ -57,6 +57,7 @@ def load_json(path: str | os.PathLike, data: bytes, element: str = "JSON") -> An
     except UnicodeDecodeError as error:
         raise FormatError(path, element, f"not UTF-8 text (byte {error.start})") from None
     except json.JSONDecodeError as error:
-        raise FormatError(path, element, f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}") from None
+        reason = f"invalid JSON at line {error.lineno} column {error.colno}: {error.msg}"
+        raise FormatError(path, element, reason) from None
     except RecursionError:  # a deep stack of callers; the depth check above makes this rare
         raise FormatError(path, element, "nests too deeply to parse") from None

@@ -1,6 +1,6 @@
 """Fuzz harness: read_bvh on any bytes."""
 
-from fuzz_common import read_as
+from reader_check import read_as
 
 from animlod.io.bvh import read_bvh
 

@@ -1,6 +1,6 @@
 """Fuzz harness: read_gltf on any bytes named .glb (binary container, skins, animations)."""
 
-from fuzz_common import read_as
+from reader_check import read_as
 
 from animlod.io.gltf import read_gltf
 

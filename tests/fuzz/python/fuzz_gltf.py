@@ -1,6 +1,6 @@
 """Fuzz harness: read_gltf on any bytes named .gltf (JSON with data-URI buffers)."""
 
-from fuzz_common import read_as
+from reader_check import read_as
 
 from animlod.io.gltf import read_gltf
 

@@ -1,6 +1,6 @@
 """Fuzz harness: read_lod_manifest on any bytes."""
 
-from fuzz_common import read_as
+from reader_check import read_as
 
 from animlod.io.manifest import read_lod_manifest
 

@@ -1,6 +1,6 @@
 """Fuzz harness: read_npz on any bytes."""
 
-from fuzz_common import read_as
+from reader_check import read_as
 
 from animlod.io.npz import read_npz
 

@@ -1,6 +1,6 @@
 """Fuzz harness: an OBJ frame through read_sequence (what the CLI reads for a .obj)."""
 
-from fuzz_common import read_as
+from reader_check import read_as
 
 from animlod.io.meshseq import read_sequence
 

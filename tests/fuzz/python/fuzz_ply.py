@@ -1,6 +1,6 @@
 """Fuzz harness: a PLY frame through read_sequence (ascii and binary bodies)."""
 
-from fuzz_common import read_as
+from reader_check import read_as
 
 from animlod.io.meshseq import read_sequence
 

@@ -17,7 +17,9 @@ import contextlib
 import importlib
 import io
 import os
+import signal
 import sys
+import threading
 import warnings
 from collections.abc import Iterator
 
@@ -133,14 +135,37 @@ def _guarded_stderr(command: str) -> Iterator[_HeldStderr]:
                 print(f"animlod {command}: warning: {' '.join(str(warning.message).split())}", file=original)
 
 
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that every write in progress removes its temporary."""
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise _Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_unwinds() -> Iterator[None]:
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as stop:  # --help (0), or the one-line usage error of _Parser (2)
+        return int(stop.code or 0)
     source = getattr(args, "input", None) or getattr(args, "path", None)
     if os.environ.get("ANIMLOD_DEBUG"):
         return int(args.run(args) or 0)  # tracebacks and live output, for telling a bug from a mistake
     try:
-        with _guarded_stderr(args.command):
+        with _sigterm_unwinds(), _guarded_stderr(args.command):
             return int(args.run(args) or 0)
     except UserError as error:
         print(f"animlod {args.command}: error: {' '.join(str(error).split())}", file=sys.stderr)
@@ -155,6 +180,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"animlod {args.command}: interrupted", file=sys.stderr)
         return 130
+    except _Terminated:
+        print(f"animlod {args.command}: terminated", file=sys.stderr)
+        return 143
 
 
 if __name__ == "__main__":

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import AnimatedMesh
-from .atomic import atomic_write
+from .atomic import atomic_folder, atomic_write
 from .errors import FormatError
 from .tokens import parses, tokens_per_line
 
@@ -85,19 +85,22 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
 
 
 def write_sequence(folder: str | os.PathLike, mesh: AnimatedMesh, fmt: str = "obj", stem: str = "frame") -> list[Path]:
-    """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, each file atomically.
+    """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, the folder atomically.
 
-    Existing files with other names are left alone, so write into an empty folder if it is to be
-    read back with :func:`read_sequence`. ``fmt`` is "obj" or "ply" (binary little-endian).
+    The frames are written into a temporary folder beside ``folder``, which is renamed to
+    ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
+    interrupted run never leaves a folder short of frames under the final name. An existing
+    ``folder`` is replaced as a whole. ``fmt`` is "obj" or "ply" (binary little-endian).
     Returns the written paths in frame order.
     """
     if fmt not in ("obj", "ply"):
         raise ValueError(f"{os.fspath(folder)}: fmt: must be 'obj' or 'ply', got {fmt!r}")
     width = max(4, len(str(mesh.frame_count - 1)))
-    paths = [Path(folder) / f"{stem}_{index:0{width}d}.{fmt}" for index in range(mesh.frame_count)]
-    for path, vertices in zip(paths, mesh.frames):
-        write_mesh(path, vertices, mesh.faces)
-    return paths
+    names = [f"{stem}_{index:0{width}d}.{fmt}" for index in range(mesh.frame_count)]
+    with atomic_folder(folder) as temporary:
+        for name, vertices in zip(names, mesh.frames):
+            write_mesh(temporary / name, vertices, mesh.faces)
+    return [Path(folder) / name for name in names]
 
 
 def _sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> list[Path]:

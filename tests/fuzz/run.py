@@ -126,6 +126,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seconds", type=int, default=int(os.environ.get("FUZZ_SECONDS", "60")))
     parser.add_argument("--only", nargs="+", help="harness names (default: all)")
     parser.add_argument("--jobs", type=int, default=1, help="harnesses run side by side (at most 2 here)")
+    parser.add_argument(
+        "--fail-on", default=",".join(ARTIFACT_KINDS),
+        help="artifact kinds that fail the run (CI's smoke leaves out timeouts, which a loaded machine can cause)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     harnesses = [h for h in load_registry() if not args.only or h.name in args.only]
     unknown = set(args.only or ()) - {h.name for h in harnesses}
@@ -141,12 +145,16 @@ def main(argv: list[str] | None = None) -> int:
         found = ", ".join(p.name for p in r["found"]) or "none"
         print(f"| {r['harness']} | {r['language']} | {r['seconds']} | {r['seeds']} | {r['executions']} | {rate} | "
               f"{r['coverage']} | {r['features']} | {r['corpus']} | {found} |")  # fmt: skip
-    failed = [r for r in rows if r["found"] or (r["exit"] != 0 and not r["found"])]
+    fatal = tuple(kind for kind in args.fail_on.split(",") if kind)
+    # A harness fails on a fatal artifact, or on a non-zero exit that left no artifact at all.
+    failed = [r for r in rows if any(p.name.startswith(fatal) for p in r["found"]) or (r["exit"] and not r["found"])]
     for r in failed:
         print(f"\n{r['harness']}: exit {r['exit']}, log {r['log']}", file=sys.stderr)
         for path in r["found"]:
-            print(f"  saved {path.relative_to(ROOT)} ({path.stat().st_size} bytes): replayed by make test",
-                  file=sys.stderr)
+            data = path.read_bytes()
+            print(f"  saved {path.relative_to(ROOT)} ({len(data)} bytes): replayed by make test", file=sys.stderr)
+            if len(data) <= 4096:  # a CI log keeps a small input even when the clone is gone
+                print(f"  hex: {data.hex()}", file=sys.stderr)
         print("  " + "\n  ".join(r["log"].read_text(errors="replace").splitlines()[-25:]), file=sys.stderr)
     return 1 if failed else 0
 

@@ -286,3 +286,17 @@ def test_npz_round_trip_passes_the_member_checks(tmp_path) -> None:
     mesh = synth.twisting_bar(frames=3)
     write_npz(tmp_path / "bar.npz", mesh)
     assert main(["info", str(tmp_path / "bar.npz")]) == 0
+
+
+def test_accessor_of_zeros_is_bounded_by_the_file(tmp_path) -> None:
+    """An accessor without a bufferView is zeros; 2**32 - 1 MAT4 of them (275 GB) is refused."""
+    path = _write(tmp_path / "zeros.gltf", (
+        b'{"asset": {"version": "2.0"}, "accessors": [{"componentType": 5126, "count": 4294967295, "type": "MAT4"}],'
+        b' "nodes": [{"name": "a"}, {"name": "b"}], "skins": [{"joints": [0, 1], "inverseBindMatrices": 0}],'
+        b' "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}]}'
+    ))  # fmt: skip
+    from animlod.io.gltf_document import GltfDocument
+
+    doc = GltfDocument(path)
+    with pytest.raises(FormatError, match=r"accessor 0 \(probe\): count 4294967295 without a bufferView needs"):
+        doc.accessor(0, "probe")

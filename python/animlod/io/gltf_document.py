@@ -49,6 +49,9 @@ _SPARSE_INDEX_COMPONENTS = (5121, 5123, 5125)
 # bufferView.byteStride is a multiple of 4 no larger than 252 (glTF 2.0 section 3.6.2.4).
 _MAX_BYTE_STRIDE = 252
 _MAX_ACCESSOR_COUNT = 2**32 - 1
+# An accessor without a bufferView is zeros (plus sparse values); it may take at most this many
+# times the bytes of the file and its buffers (+1 MiB).
+_ZERO_FILL_FACTOR = 16
 # Most frames an animation is sampled to by default: 100,000 is 55 minutes at 30 fps. A file whose
 # keys run longer is refused (naming the animation and its duration) rather than sampled: a
 # few kilobytes with a key at 30,000 s would otherwise become 900,001 frames. Raise it per
@@ -125,7 +128,14 @@ class GltfDocument:
         width = _TYPE_WIDTHS[accessor.type]
         dtype = _COMPONENT_DTYPES[component]
         if accessor.bufferView is None:
-            values = np.zeros((count, width), dtype)  # all zeros unless sparse says otherwise
+            # All zeros unless sparse says otherwise: nothing in the file backs the elements, so
+            # their number is bounded by what the file holds elsewhere (a sparse morph target is
+            # as long as its POSITION accessor, whose bytes are in a buffer).
+            limit = _ZERO_FILL_FACTOR * (self._file_bytes() + 2**20)
+            if count * width * dtype.itemsize > limit:
+                reason = f"count {count} without a bufferView needs {count * width * dtype.itemsize} bytes of zeros"
+                raise self.fail(element, f"{reason}, more than the file can justify ({limit})")
+            values = np.zeros((count, width), dtype)
         else:
             values = self._strided_elements(accessor, count, width, dtype, element)
         if accessor.sparse is not None:
@@ -203,6 +213,16 @@ class GltfDocument:
         if start + length > len(data):
             raise self.fail(element, f"needs bytes up to {start + length}, buffer has {len(data)}")
         return np.frombuffer(data, dtype, count * width, start).reshape(count, width)
+
+    def _file_bytes(self) -> int:
+        """Size of the file and of the external buffer files it names: what bounds its accessors
+        (declared byteLengths are not trusted)."""
+        total = os.path.getsize(self.path)
+        for buffer in self.gltf.buffers or []:
+            if isinstance(buffer.uri, str) and not buffer.uri.startswith("data:"):
+                external = Path(self.path).parent / unquote(buffer.uri)
+                total += external.stat().st_size if external.is_file() else 0
+        return total
 
     def _whole_number(self, value: Any, name: str, element: str) -> int:
         """A byteOffset, byteLength or count of ``element``: 0 when absent, else a whole number >= 0."""

@@ -99,13 +99,16 @@ def seeds_features(data_dir: Path | None) -> dict[str, bytes]:
 def seeds_aqem(data_dir: Path | None) -> dict[str, bytes]:
     seeds = {}
     variants = {
-        # flags, flags2, levels - 1, 4 level bytes, max_frames, max_error, threshold, attributes, influences - 1
+        # flags, flags2, levels - 1, 4 level bytes, max_frames, max_error, threshold, counts (A | weld off << 2
+        # | B << 3), influences - 1
         "default": (0b00010111, 0, 2, [128, 64, 26, 0], 0, 0, 0, 0, 0),
         "on_edge_skin": (0b00110111, 0b00000011, 1, [128, 51, 0, 0], 2, 0, 0, 2, 3),
         "locked_counts": (0b11010011, 0b00010100, 1, [200, 100, 0, 0], 1, 8, 16, 0, 0),
+        "groups_morph": (0b00010111, 0b11000001, 0, [128, 0, 0, 0], 0, 0, 0, 0b1001, 0),
+        "no_weld": (0b00010111, 0, 0, [100, 0, 0, 0], 0, 0, 0, 0b100, 0),
     }
     for name, mesh in _all_meshes(data_dir).items():
-        vertex_count = mesh[0].shape[1]
+        vertex_count, face_count = mesh[0].shape[1], len(mesh[1])
         for variant, (flags, flags2, levels, sizes, max_frames, max_error, threshold, attrs, k) in variants.items():
             header = bytes([flags, flags2, levels, *sizes, max_frames, max_error, threshold, attrs, k])
             tail = b""
@@ -113,10 +116,14 @@ def seeds_aqem(data_dir: Path | None) -> dict[str, bytes]:
                 tail += bytes(int(v % 7 == 0) for v in range(vertex_count))
             if flags & 0x80:
                 tail += bytes([16] * vertex_count)
-            if flags2 & 1 and attrs:
-                tail += np.arange(vertex_count * attrs, dtype="<i2").tobytes()
+            if flags2 & 1 and attrs & 3:
+                tail += np.arange(vertex_count * (attrs & 3), dtype="<i2").tobytes()
             if flags2 & 2:
                 tail += bytes([1, 128, 0, 127] * vertex_count * (k + 1))[: 2 * vertex_count * (k + 1)]
+            if flags2 & 0x40 and attrs >> 3:
+                tail += (np.arange(vertex_count * (attrs >> 3), dtype="<i2") % 7).tobytes()
+            if flags2 & 0x80:
+                tail += bytes(f * 4 // max(face_count, 1) for f in range(face_count))
             seeds[f"{name}_{variant}"] = header + encode_mesh(*mesh) + tail
     return seeds
 

@@ -27,6 +27,7 @@ from .json_limits import load_json
 
 _GLB_MAGIC = b"glTF"
 _GLB_HEADER_BYTES = 12
+_GLB_JSON_CHUNK = 0x4E4F534A  # "JSON"
 _DATA_URI_BASE64 = ";base64,"
 # Required extensions that leave geometry, skins and animation readable as plain glTF
 # (quantized attributes are ordinary normalised or integer accessors); any other required
@@ -78,13 +79,15 @@ class GltfDocument:
     ----------
     path : the file, for error messages.
     gltf : the pygltflib document.
+    json : the document's JSON as parsed, every property kept (pygltflib drops some, such as a
+        node's morph ``weights``); what whole-document writers start from.
     parents : (N,) int, parent node of every node, -1 for nodes at the top of the tree.
     """
 
     def __init__(self, path: str | os.PathLike, max_animation_frames: int | None = None) -> None:
         self.path = os.fspath(path)
         self.max_animation_frames = _frame_limit(max_animation_frames)
-        self.gltf = _parse(self.path)
+        self.gltf, self.json = _parse(self.path)
         self._buffers: dict[int, bytes] = {}
         self._accessors: dict[int, np.ndarray] = {}
         self.parents = self._node_parents()
@@ -156,7 +159,7 @@ class GltfDocument:
     ) -> np.ndarray:
         view_index = accessor.bufferView
         view = self.item("bufferViews", view_index, element)
-        data = self._buffer(view.buffer, f"bufferView {view_index}")
+        data = self.buffer_bytes(view.buffer, f"bufferView {view_index}")
         view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {view_index}")
         view_length = self._whole_number(view.byteLength, "byteLength", f"bufferView {view_index}")
         if view_offset + view_length > len(data):
@@ -206,7 +209,7 @@ class GltfDocument:
 
     def _sparse_part(self, part: Any, count: int, width: int, dtype: np.dtype, element: str) -> np.ndarray:
         view = self.item("bufferViews", part.bufferView, element)
-        data = self._buffer(view.buffer, f"bufferView {part.bufferView}")
+        data = self.buffer_bytes(view.buffer, f"bufferView {part.bufferView}")
         view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {part.bufferView}")
         start = view_offset + self._whole_number(part.byteOffset, "byteOffset", element)
         length = count * width * dtype.itemsize
@@ -232,7 +235,8 @@ class GltfDocument:
             raise self.fail(element, f"{name} {value!r} is not a whole number >= 0")
         return value
 
-    def _buffer(self, index: Any, referrer: str) -> bytes:
+    def buffer_bytes(self, index: Any, referrer: str) -> bytes:
+        """The bytes of buffer ``index`` (cached); FormatError naming ``referrer`` if it cannot be read."""
         buffer = self.item("buffers", index, referrer)
         if index not in self._buffers:
             self._buffers[index] = self._buffer_bytes(index, buffer)
@@ -425,8 +429,8 @@ class GltfDocument:
         return times, output.reshape((count, 3, width) if per_key == 3 else (count, width)), interpolation
 
 
-def _parse(path: str) -> pygltflib.GLTF2:
-    """pygltflib's document for a .glb or .gltf file; FormatError for anything else."""
+def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
+    """pygltflib's document for a .glb or .gltf file and its raw JSON; FormatError for anything else."""
     try:
         data = Path(path).read_bytes()
     except OSError as error:
@@ -443,7 +447,8 @@ def _parse(path: str) -> pygltflib.GLTF2:
         json_chunk = data
     # Parsed here first with bounded nesting (json.loads recurses per level) and checked for the
     # shape pygltflib silently bends ("nodes": {} would become an empty list).
-    _check_top_level(path, load_json(path, json_chunk))
+    raw = load_json(path, json_chunk, "GLB JSON chunk" if data[:4] == _GLB_MAGIC else "JSON")
+    _check_top_level(path, raw)
     if data[:4] != _GLB_MAGIC:
         parse = pygltflib.GLTF2.gltf_from_json
     try:
@@ -463,7 +468,7 @@ def _parse(path: str) -> pygltflib.GLTF2:
     unsupported = [name for name in gltf.extensionsRequired or [] if not name.startswith(_HARMLESS_EXTENSIONS)]
     if unsupported:
         raise FormatError(path, "extensionsRequired", f"needs {', '.join(unsupported)}, which animlod cannot read")
-    return gltf
+    return gltf, raw
 
 
 def _first_null_entry(node: Any, where: str) -> str | None:
@@ -532,7 +537,7 @@ def _check_glb_header(path: str, data: bytes) -> bytes:
                 path, f"GLB chunk at byte {offset}", f"declares {chunk_length} bytes, only {length - offset - 8} remain"
             )
         if json_chunk is None:
-            if data[offset + 4 : offset + 8] != b"JSON":
+            if struct.unpack_from("<I", data, offset + 4)[0] != _GLB_JSON_CHUNK:
                 raise FormatError(path, f"GLB chunk at byte {offset}", "the first chunk must be the JSON chunk")
             json_chunk = data[offset + 8 : offset + 8 + chunk_length]
         offset += 8 + chunk_length

@@ -8,6 +8,7 @@ patch, so the functions are patched after import, one by one.
 from __future__ import annotations
 
 import gc
+import hashlib
 import importlib
 import sys
 import types
@@ -26,8 +27,17 @@ for function in [obj for obj in gc.get_objects() if isinstance(obj, types.Functi
         atheris.instrument_func(function)
 
 
+# The input is saved before the exception goes to atheris: its own crash report was seen to die
+# (SIGALRM of the -timeout watchdog, under load) before libFuzzer wrote the artifact.
+ARTIFACTS = next((arg.split("=", 1)[1] for arg in sys.argv if arg.startswith("-artifact_prefix=")), "./")
+
+
 def test_one_input(data: bytes) -> None:
-    harness.check(data)
+    try:
+        harness.check(data)
+    except BaseException:
+        Path(f"{ARTIFACTS}crash-{hashlib.sha1(data).hexdigest()}").write_bytes(data)
+        raise
 
 
 atheris.Setup(sys.argv, test_one_input)

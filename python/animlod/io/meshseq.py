@@ -419,7 +419,12 @@ def _read_ply_header(path: Path, data: bytes) -> tuple[str | None, list[_PlyElem
         element = f"header line {number}"
         if words[0] == "format" and len(words) == 3 and words[1] in _PLY_FORMATS:
             byte_order, format_seen = _PLY_FORMATS[words[1]], True
-        elif words[0] == "element" and len(words) == 3 and words[2].isdigit():
+        elif words[0] == "element" and len(words) == 3 and words[2].isascii() and words[2].isdigit():
+            # Every row takes at least a byte (binary) or a line (ascii): more rows than the file
+            # has bytes cannot be there, and would overflow numpy's counts for empty rows.
+            if int(words[2]) > len(data):
+                reason = f"element {words[1]!r} declares {words[2]} rows, more than the file's {len(data)} bytes"
+                raise FormatError(path, element, reason)
             elements.append(_PlyElement(words[1], int(words[2])))
         elif words[0] == "property" and elements:
             prop = _ply_property(path, element, words)

@@ -62,7 +62,7 @@ class SimplifiedLevel:
     face_sources : (M',) int32 input face of every face (its primitive or material).
     kept_vertices : (V',) int32 index in the input of every kept vertex, ascending.
     vertex_map : (V,) int32 input vertex -> kept vertex it merged into (-1 for vertices no face
-        references).
+        references, vertices of dropped faces only, and vertices of a piece that collapsed away).
     error : asset units, the largest collapse error so far (see ``CollapseRecord.error``).
     target_face_count : the face count asked for; ``mesh`` has at most that many if ``reached``.
     reached : False when ``max_error`` (or no legal collapse left) stopped the run first.

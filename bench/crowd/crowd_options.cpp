@@ -17,7 +17,9 @@ a path and reports frame times per LoD mode as a Markdown table (stdout) and JSO
 
   --count N              characters (default 1000)
   --frames K             measured frames per mode (default 300)
-  --warmup W             unmeasured frames before each mode (default 10)
+  --warmup W             unmeasured frames before each mode in each round (default 10)
+  --rounds R             split the path into R rounds and let the modes take turns on each,
+                         so that a change in machine load hits every mode alike (default 1)
   --modes LIST           all, or comma-separated of Original, GLoD, MLoD, G+MLoD, each
                          optionally with +skip (frame skipping); all = the four with and
                          without +skip (default all)
@@ -145,6 +147,8 @@ bool parse_options(int argc, char** argv, CrowdOptions& out, std::string& error)
       ok = int_option(out.frames, 1);
     } else if (arg == "--warmup") {
       ok = int_option(out.warmup, 0);
+    } else if (arg == "--rounds") {
+      ok = int_option(out.rounds, 1);
     } else if (arg == "--width") {
       ok = int_option(out.width, 16);
     } else if (arg == "--height") {
@@ -197,6 +201,10 @@ bool parse_options(int argc, char** argv, CrowdOptions& out, std::string& error)
   }
   if (out.chains.empty()) {
     error = "no chain given: pass one or more LoD GLB files (see --help)";
+    return false;
+  }
+  if (out.rounds > out.frames) {
+    error = "--rounds: " + std::to_string(out.rounds) + " rounds for " + std::to_string(out.frames) + " measured frames";
     return false;
   }
   for (const auto& shot : out.screenshots) {

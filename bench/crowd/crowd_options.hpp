@@ -28,7 +28,8 @@ struct CrowdOptions {
   std::vector<std::string> chains;  // LoD GLB files; characters take them in turn
   int count = 1000;                 // characters
   int frames = 300;                 // measured frames per mode
-  int warmup = 10;                  // frames before measuring, per mode (camera at its start)
+  int warmup = 10;                  // frames before measuring, per mode and round (camera at the round's start)
+  int rounds = 1;                   // the measured frames split into rounds; the modes take turns per round
   std::vector<Mode> modes;
   CameraPath path = CameraPath::nav1;
   int width = 1280, height = 720;   // window, pixels

@@ -55,6 +55,14 @@ const ModeResult* original_of(const std::vector<ModeResult>& results) {
 
 double fps(const ModeResult& r) { return 1000.0 / std::max(mean(r.frame_ms), 1e-9); }
 
+// Speed-up over `base` in each round (the modes took turns on the same path segment).
+std::vector<double> round_speedups(const ModeResult& r, const ModeResult& base) {
+  std::vector<double> out;
+  for (size_t k = 0; k < r.round_fps.size() && k < base.round_fps.size(); ++k)
+    out.push_back(base.round_fps[k] > 0.0 ? r.round_fps[k] / base.round_fps[k] : 0.0);
+  return out;
+}
+
 }  // namespace
 
 void ModeResult::add(const FrameCounts& counts, size_t buckets, size_t palette_joints_uploaded) {
@@ -94,9 +102,9 @@ std::string markdown_report(const RunInfo& info, const std::vector<ModeResult>& 
     out << "| mesh level | motion level | triangles / frame | joints / frame | FPS | frame ms p50 |\n";
     out << "|---:|---:|---:|---:|---:|---:|\n";
   } else {
-    out << "| mode | FPS | speed-up | frame ms p50 | p95 | drawn | triangles | joints animated | palette joints | "
-           "CPU anim ms | upload ms | submit ms | swap ms | GPU ms |\n";
-    out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    out << "| mode | FPS | speed-up | per round | frame ms p50 | p95 | drawn | triangles | joints animated | "
+           "palette joints | CPU anim ms | upload ms | submit ms | swap ms | GPU ms |\n";
+    out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   }
   char line[512];
   for (const ModeResult& r : results) {
@@ -106,11 +114,18 @@ std::string markdown_report(const RunInfo& info, const std::vector<ModeResult>& 
                     r.triangles / frames, r.joints / frames, fps(r), percentile(r.frame_ms, 50));
     } else {
       const ModeResult* base = original_of(results);
-      const std::string speedup = base ? number(fps(r) / fps(*base)) + "x" : "-";
+      char speedup[32] = "-", range[64] = "-";
+      if (base) {
+        std::snprintf(speedup, sizeof speedup, "%.2fx", fps(r) / fps(*base));
+        const std::vector<double> rounds = round_speedups(r, *base);
+        if (rounds.size() > 1)
+          std::snprintf(range, sizeof range, "%.2f-%.2fx", *std::min_element(rounds.begin(), rounds.end()),
+                        *std::max_element(rounds.begin(), rounds.end()));
+      }
       const std::string gpu = r.gpu_ms.empty() ? "-" : number(mean(r.gpu_ms));
       std::snprintf(line, sizeof line,
-                    "| %s | %.2f | %s | %.1f | %.1f | %.0f | %.0f | %.0f | %.0f | %.2f | %.2f | %.2f | %.1f | %s |\n",
-                    r.name.c_str(), fps(r), speedup.c_str(), percentile(r.frame_ms, 50), percentile(r.frame_ms, 95),
+                    "| %s | %.2f | %s | %s | %.1f | %.1f | %.0f | %.0f | %.0f | %.0f | %.2f | %.2f | %.2f | %.1f | %s |\n",
+                    r.name.c_str(), fps(r), speedup, range, percentile(r.frame_ms, 50), percentile(r.frame_ms, 95),
                     r.drawn / frames, r.triangles / frames, r.joints / frames, r.palette_joints / frames,
                     mean(r.animation_ms), mean(r.upload_ms), mean(r.submit_ms), mean(r.swap_ms), gpu.c_str());
     }
@@ -125,7 +140,7 @@ std::string json_report(const RunInfo& info, const std::vector<ModeResult>& resu
   out << "{\n  \"renderer\": " << quoted(info.renderer) << ",\n  \"gl_version\": " << quoted(info.gl_version)
       << ",\n  \"palette_upload\": " << quoted(info.persistent_mapping ? "persistent" : "orphaned")
       << ",\n  \"timer_queries\": " << (info.timer_queries ? "true" : "false") << ",\n  \"count\": " << options.count
-      << ",\n  \"frames\": " << options.frames << ",\n  \"warmup\": " << options.warmup << ",\n  \"width\": " << info.width
+      << ",\n  \"frames\": " << options.frames << ",\n  \"warmup\": " << options.warmup << ",\n  \"rounds\": " << options.rounds << ",\n  \"width\": " << info.width
       << ",\n  \"height\": " << info.height << ",\n  \"path\": " << quoted(path_name(options.path))
       << ",\n  \"pixel_error\": " << number(options.pixel_error) << ",\n  \"hysteresis\": " << number(options.hysteresis)
       << ",\n  \"skip_full_coverage\": " << number(options.skip_full_coverage)
@@ -170,7 +185,14 @@ std::string json_report(const RunInfo& info, const std::vector<ModeResult>& resu
         << ", \"upload_ms\": " << number(mean(r.upload_ms)) << ", \"submit_ms\": " << number(mean(r.submit_ms))
         << ", \"swap_ms\": " << number(mean(r.swap_ms))
         << ", \"gpu_ms\": " << (r.gpu_ms.empty() ? "null" : number(mean(r.gpu_ms))) << ", \"measured_frames\": " << r.frame_ms.size()
-        << ", \"levels\": [";
+        << ", \"round_fps\": [";
+    for (size_t k = 0; k < r.round_fps.size(); ++k) out << (k ? ", " : "") << number(r.round_fps[k]);
+    out << "], \"round_speedups\": [";
+    if (base) {
+      const std::vector<double> rounds = round_speedups(r, *base);
+      for (size_t k = 0; k < rounds.size(); ++k) out << (k ? ", " : "") << number(rounds[k]);
+    }
+    out << "], \"levels\": [";
     size_t last = 0;
     for (size_t l = 0; l < r.levels.size(); ++l)
       if (r.levels[l] > 0) last = l + 1;

@@ -22,6 +22,7 @@ struct ModeResult {
   std::vector<double> submit_ms;      // CPU: issuing the draws
   std::vector<double> swap_ms;        // CPU: waiting in the swap (the GPU finishing the frame)
   std::vector<double> gpu_ms;         // timer-query time of the draws (frames whose query returned)
+  std::vector<double> round_fps;      // FPS of each round (--rounds)
   double drawn = 0, triangles = 0, joints = 0, palette_joints = 0, updates = 0, draw_calls = 0;  // sums
   std::vector<double> levels = std::vector<double>(16, 0.0);  // sums per level index
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -39,6 +40,9 @@ CrowdScene::CrowdScene(const std::vector<Asset>& assets, const CrowdOptions& opt
   }
 }
 
+CrowdScene::CrowdScene(std::vector<Placement> placements, float half_extent, float character_height)
+    : placements_(std::move(placements)), half_extent_(half_extent), height_(character_height) {}
+
 float CrowdScene::ground_height(float x, float z) const {
   const float k1 = 2.0f * kPi / (12.0f * height_), k2 = 2.0f * kPi / (17.0f * height_), k3 = 2.0f * kPi / (29.0f * height_);
   return relief_ * (std::sin(k1 * x) * std::cos(k2 * z) + 0.5f * std::sin(k3 * (x + z)));
@@ -71,8 +75,16 @@ Camera CrowdScene::camera(CameraPath path, float u, float aspect, float fov_radi
       break;
     }
   }
-  c.view = glm::lookAt(c.eye, c.target, glm::vec3(0.0f, 1.0f, 0.0f));
-  c.projection = glm::perspective(fov_radians, aspect, 0.05f * h, 12.0f * e + 100.0f * h);
+  return make_camera(c.eye, c.target, fov_radians, aspect, 0.05f * h, 12.0f * e + 100.0f * h);
+}
+
+Camera make_camera(const glm::vec3& eye, const glm::vec3& target, float fov_radians, float aspect, float near_plane,
+                   float far_plane) {
+  Camera c;
+  c.eye = eye;
+  c.target = target;
+  c.view = glm::lookAt(eye, target, glm::vec3(0.0f, 1.0f, 0.0f));
+  c.projection = glm::perspective(fov_radians, aspect, near_plane, far_plane);
   // Frustum planes from the rows of projection * view (Gribb and Hartmann).
   const glm::mat4 m = glm::transpose(c.projection * c.view);
   c.planes = {m[3] + m[0], m[3] - m[0], m[3] + m[1], m[3] - m[1], m[3] + m[2], m[3] - m[2]};

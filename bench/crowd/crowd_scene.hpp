@@ -33,6 +33,8 @@ class CrowdScene {
   // Places options.count characters on a square field sized by the largest character and
   // options.spacing; deterministic in options.seed.
   CrowdScene(const std::vector<Asset>& assets, const CrowdOptions& options);
+  // A hand-built scene (tests): these placements on a flat field of the given size.
+  CrowdScene(std::vector<Placement> placements, float half_extent, float character_height);
 
   float ground_height(float x, float z) const;
   const std::vector<Placement>& placements() const { return placements_; }
@@ -51,6 +53,10 @@ class CrowdScene {
   float height_ = 1.0f;
   float relief_ = 0.0f;  // amplitude of the height map
 };
+
+// A perspective camera at `eye` looking at `target` (+y up) with its frustum planes.
+Camera make_camera(const glm::vec3& eye, const glm::vec3& target, float fov_radians, float aspect, float near_plane,
+                   float far_plane);
 
 // Whether a sphere touches the frustum.
 bool sphere_visible(const Camera& camera, const glm::vec3& center, float radius);

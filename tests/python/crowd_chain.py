@@ -37,7 +37,9 @@ class _Blob:
     def add(self, values: np.ndarray, bounds: bool = False) -> int:
         values = np.ascontiguousarray(values)
         self.data.extend(b"\0" * (-len(self.data) % 4))
-        self.gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=len(self.data), byteLength=values.nbytes))
+        self.gltf.bufferViews.append(
+            pygltflib.BufferView(buffer=0, byteOffset=len(self.data), byteLength=values.nbytes)
+        )
         self.data.extend(values.tobytes())
         accessor = pygltflib.Accessor(bufferView=len(self.gltf.bufferViews) - 1, componentType=_COMPONENT[values.dtype],
                                       count=values.shape[0], type=_TYPE[values.shape[1]])  # fmt: skip
@@ -109,14 +111,19 @@ def write_hand_built_chain(path: Path, seed: int = 0) -> Path:
                 node=first_new + new_index[c.target.node], path=c.target.path))
             for c in original.channels if c.target.node in new_index
         ]  # fmt: skip
-        gltf.animations.append(pygltflib.Animation(name=f"{original.name} (motion level 1)", samplers=original.samplers,
-                                                   channels=channels, extras={"animlod": {"clip": index, "motion_level": 1}}))  # fmt: skip
+        extras = {"animlod": {"clip": index, "motion_level": 1}}
+        name = f"{original.name} (motion level 1)"
+        gltf.animations.append(
+            pygltflib.Animation(name=name, samplers=original.samplers, channels=channels, extras=extras)
+        )
 
     levels = [(mesh_node, 0, 0, joint_count), (None, 1, 0, joint_count), (None, 1, 1, len(kept))]
     ids = []
     for level, (node, mesh_level, motion_level, joints_animated) in enumerate(levels):
-        extras = {"animlod": {"level": level, "error": ERRORS[level], "triangles": len(half) if level else len(skinned.faces),
-                              "mesh_level": mesh_level, "motion_level": motion_level, "joints": joints_animated}}  # fmt: skip
+        triangles = len(half) if level else len(skinned.faces)
+        record = {"level": level, "error": ERRORS[level], "triangles": triangles, "mesh_level": mesh_level,
+                  "motion_level": motion_level, "joints": joints_animated}  # fmt: skip
+        extras = {"animlod": record}
         if node is None:
             gltf.nodes.append(pygltflib.Node(name=f"skinned mesh LOD{level}", mesh=(level1, level2)[level - 1],
                                              skin=level - 1, extras=extras))  # fmt: skip

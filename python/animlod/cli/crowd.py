@@ -51,11 +51,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..crowd import CrowdError, procedural_chain, run_crowd, write_heat_map
+    from ..crowd import CrowdError, mode_list, procedural_chain, run_crowd, write_heat_map
     from ..io.atomic import atomic_write
 
     if args.heat_map and not args.grid:
         raise UserError("--heat-map: needs --grid")
+    mode_list(args.modes)  # an unknown mode is refused before any chain is built
     try:
         screenshots = [(int(frame), png) for frame, png in args.screenshot]
     except ValueError:

@@ -130,13 +130,6 @@ def run_crowd(
     CrowdError with the binary's one-line message: bad input (``bad_input``), no GL context, or
     the binary missing.
     """
-    executable = Path(binary) if binary else find_crowd_binary()
-    if executable is None or not executable.is_file():
-        raise CrowdError(
-            "animlod_crowd is not built: run `make bench-crowd` (or cmake --build build/cpp), "
-            "or point ANIMLOD_CROWD_BIN at it",
-            bad_input=False,
-        )
     if not chains:
         raise CrowdError("no chain given", bad_input=True)
     if path not in PATHS:
@@ -145,6 +138,13 @@ def run_crowd(
         names = mode_list(modes)
     except ValueError as error:
         raise CrowdError(str(error), bad_input=True) from None
+    executable = Path(binary) if binary else find_crowd_binary()
+    if executable is None or not executable.is_file():
+        raise CrowdError(
+            "animlod_crowd is not built: run `make bench-crowd` (or cmake --build build/cpp), "
+            "or point ANIMLOD_CROWD_BIN at it",
+            bad_input=False,
+        )
     with tempfile.TemporaryDirectory(prefix="animlod_crowd_") as scratch:
         report_path = Path(json_path) if json_path else Path(scratch) / "crowd.json"
         command = [str(executable), *(str(Path(c)) for c in chains)]

@@ -10,9 +10,19 @@ CrowdAnimator::CrowdAnimator(const std::vector<Asset>& assets, const CrowdScene&
     : assets_(assets), scene_(scene), options_(options) {
   size_t most_joints = 0, most_chains = 0;
   bucket_base_.resize(assets.size());
+  rig_clips_.resize(assets.size());
   for (size_t a = 0; a < assets.size(); ++a) {
-    size_t joints = 0;
-    for (const Rig& rig : assets[a].rigs) joints += rig.joint_count();
+    // Any level using a rig maps the original clips to that rig's clips the same way.
+    rig_clips_[a].assign(assets[a].rigs.size(), nullptr);
+    for (const Chain& chain : assets[a].chains)
+      for (const Level& level : chain.levels)
+        if (!rig_clips_[a][static_cast<size_t>(level.rig)]) rig_clips_[a][static_cast<size_t>(level.rig)] = &level.clips;
+    size_t joints = 0;  // a character draws one level per chain: at most one skeleton each
+    for (const Chain& chain : assets[a].chains) {
+      size_t most = 0;
+      for (const Level& level : chain.levels) most = std::max(most, assets[a].rigs[static_cast<size_t>(level.rig)].joint_count());
+      joints += most;
+    }
     most_joints = std::max(most_joints, joints);
     most_chains = std::max(most_chains, assets[a].chains.size());
     for (size_t c = 0; c < assets[a].chains.size(); ++c) {
@@ -84,12 +94,8 @@ void CrowdAnimator::update_pose(const Asset& asset, const Placement& placement, 
   scales_.assign(rig.rest_scales.begin(), rig.rest_scales.end());
   world_.resize(16 * poses);
   palette_.resize(16 * joints);
-  // The clip of this skeleton for the character's original clip (any level of the asset using
-  // this rig maps clips the same way).
-  const Clip* clip = nullptr;
-  for (const Chain& chain : asset.chains)
-    for (const Level& level : chain.levels)
-      if (level.rig == rig_index && !clip) clip = &asset.clips[static_cast<size_t>(level.clips[static_cast<size_t>(placement.clip)])];
+  const std::vector<int>* clips = rig_clips_[static_cast<size_t>(placement.asset)][static_cast<size_t>(rig_index)];
+  const Clip* clip = clips ? &asset.clips[static_cast<size_t>((*clips)[static_cast<size_t>(placement.clip)])] : nullptr;
   const animlod::LocalPose pose{translations_.data(), rotations_.data(), scales_.data(), poses};
   if (clip && clip->duration > 0.0f) {
     // A skipped frame keeps the last pose; an update samples the current time, so the clip keeps

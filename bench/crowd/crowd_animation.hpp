@@ -89,6 +89,7 @@ class CrowdAnimator {
   std::vector<Character> characters_;
   std::vector<std::vector<ChainSubset>> subsets_;  // [asset][chain]
   std::vector<std::vector<int>> bucket_base_;      // [asset][chain] first bucket id
+  std::vector<std::vector<const std::vector<int>*>> rig_clips_;  // [asset][rig] clip per original clip
   std::vector<Bucket> all_buckets_, buckets_;
   size_t max_palette_floats_ = 0, max_instances_ = 0;
   uint64_t frame_ = 0;

@@ -36,6 +36,8 @@ a path and reports frame times per LoD mode as a Markdown table (stdout) and JSO
   --level-colors         tint every character by the index of the level it shows
   --grid                 Fig. 1: every (mesh level, motion level) of the first chain forced
                          on all characters, one row per level (instead of --modes)
+  --upload orphan        upload palettes through orphaned buffers (the OpenGL 3.3 path) even
+                         where persistent mapping (4.4) is available
   --json FILE            write the report as JSON
   --screenshot F FILE    save measured frame F of the first mode as PNG (repeatable)
 )";
@@ -185,6 +187,13 @@ bool parse_options(int argc, char** argv, CrowdOptions& out, std::string& error)
       out.level_colors = true;
     } else if (arg == "--grid") {
       out.grid = true;
+    } else if (arg == "--upload") {
+      ok = value(text);
+      if (ok && text == "orphan") out.orphan_uploads = true;
+      else if (ok && text != "auto") {
+        error = "--upload: expected orphan or auto, got '" + text + "'";
+        ok = false;
+      }
     } else if (arg == "--json") {
       ok = value(out.json_path);
     } else if (arg == "--screenshot") {

@@ -42,6 +42,8 @@ struct CrowdOptions {
   unsigned seed = 1;
   bool level_colors = false;        // tint each character by its level index
   bool grid = false;                // Fig. 1: every (mesh level, motion level) for all characters
+  bool orphan_uploads = false;      // use the GL 3.3 upload path (orphaned buffers) even where
+                                    // persistent mapping is available
   std::string json_path;            // write the JSON report here ("" = none)
   std::vector<std::pair<int, std::string>> screenshots;  // (measured frame of the first mode, PNG path)
 };

@@ -208,7 +208,7 @@ GlRenderer::~GlRenderer() {
   glfwTerminate();
 }
 
-bool GlRenderer::open(int width, int height, std::string& error) {
+bool GlRenderer::open(int width, int height, bool orphan_uploads, std::string& error) {
   glfwSetErrorCallback(on_glfw_error);
   if (!glfwInit()) {
     error = "cannot initialise GLFW (no display? run under xvfb-run -a -s \"-screen 0 1280x720x24\"): " + glfw_error;
@@ -236,7 +236,11 @@ bool GlRenderer::open(int width, int height, std::string& error) {
   const int version = 10 * major + minor;
   persistent_ = version >= 44 || has_extension("GL_ARB_buffer_storage");
   buffer_range_ = version >= 43 || has_extension("GL_ARB_texture_buffer_range");
-  persistent_ = persistent_ && buffer_range_;  // a ring section must be bound as a texture buffer range
+  persistent_ = persistent_ && buffer_range_ && !orphan_uploads;  // a ring section is bound as a buffer range
+  if (version < 33) {
+    error = "OpenGL " + version_ + " is older than 3.3 core, which animlod_crowd needs";
+    return false;
+  }
   GLint bits = 0;
   glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
   timers_ = bits > 0;

@@ -51,8 +51,8 @@ class GlRenderer {
   ~GlRenderer();
 
   // Opens the window and context. False with `error` (one line) when there is no display or the
-  // context is older than OpenGL 3.3 core.
-  bool open(int width, int height, std::string& error);
+  // context is older than OpenGL 3.3 core. `orphan_uploads` keeps to the GL 3.3 upload path.
+  bool open(int width, int height, bool orphan_uploads, std::string& error);
 
   std::string renderer() const { return renderer_; }
   std::string version() const { return version_; }

@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   const double load_seconds = milliseconds(load_start, Clock::now()) / 1000.0;
 
   crowd::GlRenderer renderer;
-  if (!renderer.open(options.width, options.height, error)) return fail(3, error);
+  if (!renderer.open(options.width, options.height, options.orphan_uploads, error)) return fail(3, error);
   const crowd::CrowdScene scene(assets, options);
   crowd::CrowdAnimator animator(assets, scene, options);
 

@@ -48,12 +48,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--count", type=int, default=1000, help="characters for Table 2 (default 1000)")
     parser.add_argument("--frames", type=int, default=60, help="measured frames per mode (default 60)")
+    parser.add_argument("--rounds", type=int, default=3, help="path segments the modes take turns on (default 3)")
     parser.add_argument("--big-count", type=int, default=10000, help="the 'rendered at all' run (default 10000)")
     parser.add_argument("--out", type=Path, default=Path("out/bench-crowd"))
     parser.add_argument("--quick", action="store_true", help="100 characters, 10 frames, no 10,000 run")
     args = parser.parse_args()
     if args.quick:
-        args.count, args.frames, args.big_count = 100, 10, 0
+        args.count, args.frames, args.big_count, args.rounds = 100, 10, 0, 1
     args.out.mkdir(parents=True, exist_ok=True)
     for label, chain in chains(args.out):
         stem = chain.stem
@@ -61,7 +62,7 @@ def main() -> None:
         for path in ("nav1", "nav2"):
             shot = [(args.frames // 2, args.out / f"{stem}_{path}.png")]
             reports[path] = run_crowd(
-                [chain], count=args.count, frames=args.frames, modes="all", path=path,
+                [chain], count=args.count, frames=args.frames, rounds=args.rounds, modes="all", path=path,
                 json_path=args.out / f"{stem}_{path}.json", screenshots=shot,
             )  # fmt: skip
         data = reports["nav1"].data

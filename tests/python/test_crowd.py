@@ -81,6 +81,16 @@ def test_smoke_run_reports_every_mode_and_shows_a_level_switch(binary, chain, tm
     assert pixels_far["orange"] > 0
 
 
+def test_opengl_3_3_with_orphaned_uploads(binary, chain, monkeypatch) -> None:
+    """The GL 3.3 core path (no persistent mapping): Mesa asked for a 3.3 context."""
+    monkeypatch.setenv("MESA_GL_VERSION_OVERRIDE", "3.3")
+    report = run_crowd([chain], frames=3, modes="G+MLoD", extra_args=["--upload", "orphan"], **SMALL)
+    assert report.data["palette_upload"] == "orphaned"
+    if "Mesa" in report.data["gl_version"]:
+        assert report.data["gl_version"].startswith("3.3")
+    assert report.modes["G+MLoD"]["fps"] > 0 and report.modes["G+MLoD"]["drawn"] > 0
+
+
 def test_grid_gives_one_cell_per_level_and_a_heat_map(binary, chain, tmp_path) -> None:
     report = run_crowd([chain], frames=3, grid=True, **SMALL)
     cells = report.data["grid"]

@@ -95,6 +95,7 @@ def run_crowd(
     count: int = 1000,
     frames: int = 300,
     warmup: int = 10,
+    rounds: int = 1,
     modes: str | Sequence[str] = "all",
     path: str = "nav1",
     width: int = 1280,
@@ -114,6 +115,8 @@ def run_crowd(
     ----------
     chains : LoD GLB files (MSFT_lod chains; a GLB without MSFT_lod is one level).
     count, frames, warmup : characters, measured frames per mode and unmeasured frames before.
+    rounds : the path split into this many segments, the modes taking turns on each (so that a
+        change in machine load hits every mode alike); each round repeats the warm-up.
     modes : "all" or names from MODES, each optionally with "+skip" (frame skipping).
     path : camera path, one of PATHS.
     width, height : window in pixels (under xvfb-run the screen is made this large).
@@ -148,7 +151,7 @@ def run_crowd(
     with tempfile.TemporaryDirectory(prefix="animlod_crowd_") as scratch:
         report_path = Path(json_path) if json_path else Path(scratch) / "crowd.json"
         command = [str(executable), *(str(Path(c)) for c in chains)]
-        command += ["--count", str(count), "--frames", str(frames), "--warmup", str(warmup)]
+        command += ["--count", str(count), "--frames", str(frames), "--warmup", str(warmup), "--rounds", str(rounds)]
         command += ["--modes", ",".join(names), "--path", path, "--width", str(width), "--height", str(height)]
         command += ["--pixel-error", repr(float(pixel_error)), "--json", str(report_path)]
         if level_colors:

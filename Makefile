@@ -68,8 +68,8 @@ test: python-package lint consumer-test
 
 demo: python-package crowd-binary
 	$(VENV)/bin/animlod demo -o out/demo
-	ANIMLOD_CROWD_BIN=$(CROWD_BIN) $(VENV)/bin/animlod crowd out/demo/character.glb --count 200 --frames 60 \
-	  --modes all --level-colors --json out/demo/crowd.json --screenshot 30 out/demo/crowd.png
+	ANIMLOD_CROWD_BIN=$(CROWD_BIN) $(VENV)/bin/animlod crowd out/demo/character.glb --count 100 --frames 30 \
+	  --modes all --level-colors --json out/demo/crowd.json --screenshot 15 out/demo/crowd.png
 
 crowd-binary: $(CPP_BUILD)/build.ninja
 	cmake --build $(CPP_BUILD) --target animlod_crowd --parallel $(JOBS)

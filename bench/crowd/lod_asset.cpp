@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <limits>
 #include <map>
@@ -636,6 +637,11 @@ class Loader {
 }  // namespace
 
 bool load_asset(const std::string& path, Asset& out, std::string& error) {
+  std::error_code status;
+  if (!std::filesystem::is_regular_file(path, status)) {
+    error = path + ": " + (std::filesystem::exists(path, status) ? "not a regular file" : "no such file");
+    return false;
+  }
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
   std::string warnings;

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -44,7 +46,19 @@ std::vector<std::pair<int, int>> grid_cells(const crowd::Asset& asset) {
 
 }  // namespace
 
+int run(int argc, char** argv);
+
 int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    return fail(1, "out of memory (fewer characters, or a smaller chain?)");
+  } catch (const std::exception& error) {
+    return fail(1, std::string("unexpected failure: ") + error.what());
+  }
+}
+
+int run(int argc, char** argv) {
   crowd::CrowdOptions options;
   std::string error;
   if (!crowd::parse_options(argc, argv, options, error)) return error.empty() ? 0 : fail(2, error);

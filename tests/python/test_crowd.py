@@ -149,6 +149,12 @@ def test_bad_arguments_exit_2_with_one_line(binary, chain, arguments, message) -
     assert completed.stderr.count("\n") == 1 and message in completed.stderr
 
 
+def test_a_folder_or_a_missing_file_is_one_line(binary, tmp_path) -> None:
+    for path, message in ((tmp_path, "not a regular file"), (tmp_path / "missing.glb", "no such file")):
+        completed = subprocess.run([str(binary), str(path)], capture_output=True, text=True, check=False)
+        assert completed.returncode == 2 and message in completed.stderr and completed.stderr.count("\n") == 1
+
+
 def test_no_display_is_one_line_and_exit_3(binary, chain) -> None:
     environment = {key: value for key, value in os.environ.items() if key not in ("DISPLAY", "WAYLAND_DISPLAY")}
     completed = subprocess.run([str(binary), str(chain), "--count", "2"], capture_output=True, text=True,

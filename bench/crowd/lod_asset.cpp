@@ -475,6 +475,10 @@ class Loader {
                             " keys");
         out.track.key_count = keys;
         out.track.component_count = static_cast<size_t>(width);
+        out.track.times = clip.times.back().data();  // re-pointed below once every channel is read
+        out.track.values = clip.values.back().data();
+        const animlod::Status status = animlod::validate_track(out.track, out.path == animlod::ChannelPath::rotation);
+        if (!status) fail(element, status.message);
         out.joint = target->second;
         channels.push_back(out);
         if (keys > 0) clip.duration = std::max(clip.duration, clip.times.back().back());

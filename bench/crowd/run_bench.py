@@ -40,7 +40,7 @@ def chains(out: Path) -> list[tuple[str, Path]]:
     soldier = DATA_DIR / "gltf" / "Soldier.glb"
     if soldier.exists():
         built = character_chain(soldier, out / "Soldier_lod.glb")
-        result.append(("Soldier.glb", built or soldier))
+        result.append(("Soldier.glb", built))
     return result
 
 

@@ -41,6 +41,27 @@ CrowdAnimator::CrowdAnimator(const std::vector<Asset>& assets, const CrowdScene&
   max_instances_ = count * most_chains;
 }
 
+namespace {
+
+// The level of `chain` drawing (mesh level g, motion level m), or where the chain has no such
+// node the one with the most reduction that stays within both (level 0 at worst).
+int nearest_level(const Chain& chain, int g, int m) {
+  const int exact = chain.find(g, m);
+  if (exact >= 0) return exact;
+  int best = 0, best_reduction = -1;
+  for (size_t l = 0; l < chain.levels.size(); ++l) {
+    const Level& level = chain.levels[l];
+    const int reduction = level.mesh_level + level.motion_level;
+    if (level.mesh_level <= g && level.motion_level <= m && reduction > best_reduction) {
+      best = static_cast<int>(l);
+      best_reduction = reduction;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 void CrowdAnimator::start(const Mode& mode, const int* forced) {
   mode_ = mode;
   frame_ = 0;
@@ -48,21 +69,14 @@ void CrowdAnimator::start(const Mode& mode, const int* forced) {
   for (size_t a = 0; a < assets_.size(); ++a) {
     for (const Chain& chain : assets_[a].chains) {
       ChainSubset subset;
-      for (size_t l = 0; l < chain.levels.size(); ++l) {
+      for (size_t l = 0; l < chain.selection_count; ++l) {
         const Level& level = chain.levels[l];
-        const bool geometry_ok = level.mesh_level == 0 || mode.geometry_levels;
-        const bool motion_ok = level.motion_level == 0 || mode.motion_levels;
-        if (geometry_ok && motion_ok) subset.levels.push_back(static_cast<int>(l));
-        if (forced && level.mesh_level == forced[0] && level.motion_level == forced[1]) subset.forced = static_cast<int>(l);
+        subset.errors.push_back(level.error);
+        subset.coverages.push_back(level.coverage);
+        subset.drawn.push_back(nearest_level(chain, mode.geometry_levels ? level.mesh_level : 0,
+                                             mode.motion_levels ? level.motion_level : 0));
       }
-      if (forced && subset.forced < 0) subset.forced = 0;
-      if (chain.has_errors)  // errors need not be monotone in a geometry x motion chain: sort them
-        std::stable_sort(subset.levels.begin(), subset.levels.end(),
-                         [&](int x, int y) { return chain.levels[static_cast<size_t>(x)].error < chain.levels[static_cast<size_t>(y)].error; });
-      for (int l : subset.levels) {
-        subset.errors.push_back(chain.levels[static_cast<size_t>(l)].error);
-        subset.coverages.push_back(chain.levels[static_cast<size_t>(l)].coverage);
-      }
+      if (forced) subset.forced = nearest_level(chain, forced[0], forced[1]);
       subsets_[a].push_back(std::move(subset));
     }
   }
@@ -74,6 +88,7 @@ void CrowdAnimator::start(const Mode& mode, const int* forced) {
     const Asset& asset = assets_[static_cast<size_t>(scene_.placements()[i].asset)];
     characters_[i].selectors.assign(asset.chains.size(), animlod::LodSelector(selector_options));
     characters_[i].levels.assign(asset.chains.size(), 0);
+    characters_[i].tints.assign(asset.chains.size(), 0);
   }
 }
 
@@ -143,22 +158,18 @@ void CrowdAnimator::animate(const Camera& camera, const animlod::LodCamera& lod_
     for (size_t c = 0; c < asset.chains.size(); ++c) {
       const ChainSubset& subset = subsets_[static_cast<size_t>(placement.asset)][c];
       const Chain& chain = asset.chains[c];
-      int level = 0;
-      if (subset.forced >= 0) {
-        level = subset.forced;
-      } else if (subset.levels.size() > 1 && chain.has_errors) {
-        level = subset.levels[static_cast<size_t>(character.selectors[c].select_by_error(
-            subset.errors.data(), subset.errors.size(), sphere.distance, focal))];
-      } else if (subset.levels.size() > 1 && chain.has_coverages) {
-        level = subset.levels[static_cast<size_t>(character.selectors[c].select_by_coverage(
-            subset.coverages.data(), subset.coverages.size(), sphere.coverage))];
-      } else {
-        level = subset.levels.front();
-      }
+      int selected = 0;  // index into the MSFT_lod chain
+      if (subset.forced < 0 && chain.selection_count > 1 && chain.has_errors)
+        selected = character.selectors[c].select_by_error(subset.errors.data(), subset.errors.size(), sphere.distance, focal);
+      else if (subset.forced < 0 && chain.selection_count > 1 && chain.has_coverages)
+        selected = character.selectors[c].select_by_coverage(subset.coverages.data(), subset.coverages.size(),
+                                                             sphere.coverage);
+      const int level = subset.forced >= 0 ? subset.forced : subset.drawn[static_cast<size_t>(selected)];
       character.levels[c] = level;
+      character.tints[c] = subset.forced >= 0 ? level : selected;
       const Level& chosen = chain.levels[static_cast<size_t>(level)];
       counts.triangles += static_cast<int64_t>(asset.meshes[static_cast<size_t>(chosen.mesh)].triangle_count());
-      ++counts.levels[static_cast<size_t>(std::min(level, 15))];
+      ++counts.levels[static_cast<size_t>(std::min(character.tints[c], 15))];
     }
     // Poses due this frame, once per skeleton the chosen levels use.
     const int interval = mode_.frame_skipping ? animlod::animation_update_interval(sphere.coverage, rate) : 1;
@@ -219,7 +230,7 @@ void CrowdAnimator::gather(float* palettes, InstanceGpu* instances, size_t& pale
       }
       InstanceGpu& out = instances[next[static_cast<size_t>(base[c] + level)]++];
       out = {placement.position.x, placement.position.y, placement.position.z, placement.yaw, cache.gathered_base,
-             static_cast<uint32_t>(level)};
+             static_cast<uint32_t>(character.tints[c])};
     }
   }
   instance_count = total;

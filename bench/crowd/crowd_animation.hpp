@@ -20,7 +20,7 @@ namespace crowd {
 struct InstanceGpu {
   float x, y, z, yaw;     // placement
   uint32_t palette_base;  // first palette matrix of the instance
-  uint32_t tint;          // level index, for --level-colors
+  uint32_t tint;          // selected level index, for --level-colors
 };
 
 // One instanced draw: the instances [first, first + count) of the gathered instance array.
@@ -35,15 +35,18 @@ struct FrameCounts {
   int64_t joints = 0;         // pose nodes evaluated by FK (characters whose pose was due)
   int64_t palette_joints = 0; // matrices uploaded
   int updates = 0;            // (character, skeleton) poses updated
-  std::vector<int> levels;    // drawn chain instances per level index
+  std::vector<int> levels;    // drawn chain instances per selected MSFT_lod level index
 };
 
 class CrowdAnimator {
  public:
   CrowdAnimator(const std::vector<Asset>& assets, const CrowdScene& scene, const CrowdOptions& options);
 
-  // Starts a mode: selectors, pose caches and the mode's level subsets reset. With `forced`
-  // (mesh level, motion level) every chain shows that level (or its level 0 if it has none).
+  // Starts a mode: selectors and pose caches reset. The selector picks a level of each chain's
+  // MSFT_lod chain by its error; the mode then draws that level's (mesh level, motion level)
+  // with the motion level (GLoD) or the mesh level (MLoD) set to 0, or both (Original), as the
+  // paper compares them at the same simplification rate. With `forced` (mesh level, motion
+  // level) every chain draws that combination (or the nearest coarser-or-equal one it has).
   void start(const Mode& mode, const int* forced = nullptr);
 
   // Selects levels and updates due poses for `frame` at animation time `time` (seconds).
@@ -68,15 +71,16 @@ class CrowdAnimator {
   };
   struct Character {
     std::vector<animlod::LodSelector> selectors;  // per chain
-    std::vector<int> levels;                      // per chain, this frame
+    std::vector<int> levels;                      // per chain, this frame: the level node drawn
+    std::vector<int> tints;                       // per chain, this frame: the level selected
     std::vector<PoseCache> caches;                // per rig used so far
     bool visible = false;
     bool was_visible = false;
   };
   struct ChainSubset {
-    std::vector<int> levels;  // allowed level indices in selection order
-    std::vector<float> errors, coverages;
-    int forced = -1;
+    std::vector<float> errors, coverages;  // of the MSFT_lod levels
+    std::vector<int> drawn;                // level drawn for each MSFT_lod level in this mode
+    int forced = -1;                       // the level every character draws (--grid)
   };
 
   PoseCache& cache_for(Character& character, int rig);

@@ -87,10 +87,13 @@ std::string markdown_report(const RunInfo& info, const std::vector<ModeResult>& 
     out << asset.path << ":";
     for (const Chain& chain : asset.chains) {
       out << " [" << chain.name << ":";
-      for (const Level& level : chain.levels)
+      for (size_t l = 0; l < chain.levels.size(); ++l) {
+        const Level& level = chain.levels[l];
+        if (l == chain.selection_count) out << " | grid:";
         out << " g" << level.mesh_level << "m" << level.motion_level << " "
             << asset.meshes[static_cast<size_t>(level.mesh)].triangle_count() << "t/"
             << asset.rigs[static_cast<size_t>(level.rig)].joint_count() << "j";
+      }
       out << "]";
     }
     out << " clips:";
@@ -157,7 +160,8 @@ std::string json_report(const RunInfo& info, const std::vector<ModeResult>& resu
       out << (c ? ", " : "") << "{\"name\": " << quoted(chain.name) << ", \"levels\": [";
       for (size_t l = 0; l < chain.levels.size(); ++l) {
         const Level& level = chain.levels[l];
-        out << (l ? ", " : "") << "{\"mesh_level\": " << level.mesh_level << ", \"motion_level\": " << level.motion_level
+        out << (l ? ", " : "") << "{\"chain_level\": " << (l < chain.selection_count ? static_cast<long>(l) : -1L)
+            << ", \"mesh_level\": " << level.mesh_level << ", \"motion_level\": " << level.motion_level
             << ", \"triangles\": " << asset.meshes[static_cast<size_t>(level.mesh)].triangle_count()
             << ", \"joints\": " << asset.rigs[static_cast<size_t>(level.rig)].joint_count()
             << ", \"error\": " << number(level.error) << ", \"coverage\": " << number(level.coverage) << "}";

@@ -298,39 +298,61 @@ class Loader {
     }
     chain.has_errors = true;
     for (size_t i = 0; i < level_nodes.size(); ++i) {
-      chain.levels.push_back(read_level(level_nodes[i], static_cast<int>(i)));
+      chain.levels.push_back(read_level(level_nodes[i], "level " + std::to_string(i), static_cast<int>(i), 0));
       Level& level = chain.levels.back();
       if (chain.has_coverages) level.coverage = coverages[i];
       const Value* extras = animlod_extras(model_.nodes[static_cast<size_t>(level.node)].extras);
       if (i > 0 && !(extras && object_member(*extras, "error"))) chain.has_errors = false;
     }
+    chain.selection_count = chain.levels.size();
+    // The rest of a character chain's grid: extras.animlod_grid[g][m] = node of (g, m).
+    if (const Value* grid = object_member(base.extras, "animlod_grid")) {
+      for (size_t g = 0; grid->IsArray() && g < grid->ArrayLen(); ++g) {
+        const Value& row = grid->Get(static_cast<int>(g));
+        for (size_t m = 0; row.IsArray() && m < row.ArrayLen(); ++m) {
+          const Value& id = row.Get(static_cast<int>(m));
+          const int cell = id.IsNumber() ? id.GetNumberAsInt() : -1;
+          const std::string label = "animlod_grid[" + std::to_string(g) + "][" + std::to_string(m) + "]";
+          if (cell < 0 || static_cast<size_t>(cell) >= model_.nodes.size())
+            fail(node_label(model_, node), label + " is not a node");
+          bool listed = false;
+          for (const Level& level : chain.levels) listed = listed || level.node == cell;
+          if (listed) continue;
+          chain.levels.push_back(read_level(cell, label, static_cast<int>(g), static_cast<int>(m)));
+          chain.levels.back().mesh_level = static_cast<int>(g);  // the grid's place wins over extras
+          chain.levels.back().motion_level = static_cast<int>(m);
+        }
+      }
+    }
     const std::string& root = asset_.rigs[static_cast<size_t>(chain.levels[0].rig)].root_name;
     for (size_t i = 1; i < chain.levels.size(); ++i) {
       const std::string& other = asset_.rigs[static_cast<size_t>(chain.levels[i].rig)].root_name;
       if (other != root)
-        fail(node_label(model_, node), "level " + std::to_string(i) + " (" + node_label(model_, chain.levels[i].node) +
+        fail(node_label(model_, node), "level node " + std::to_string(i) + " (" + node_label(model_, chain.levels[i].node) +
                                            ") has skeleton root '" + other + "', level 0 has '" + root +
                                            "': the levels of a chain must share a skeleton root");
     }
     return chain;
   }
 
-  Level read_level(int node, int index) {
+  // A level node; (mesh_level, motion_level) hold where its extras.animlod does not say.
+  Level read_level(int node, const std::string& name, int mesh_level, int motion_level) {
     const tinygltf::Node& n = model_.nodes[static_cast<size_t>(node)];
-    const std::string label = "level " + std::to_string(index) + " (" + node_label(model_, node) + ")";
+    const std::string label = name + " (" + node_label(model_, node) + ")";
     if (n.mesh < 0 || static_cast<size_t>(n.mesh) >= model_.meshes.size()) fail(label, "has no mesh");
     if (n.skin < 0 || static_cast<size_t>(n.skin) >= model_.skins.size()) fail(label, "has no skin");
     Level level;
     level.node = node;
-    level.mesh_level = index;
+    level.mesh_level = mesh_level;
+    level.motion_level = motion_level;
     if (const Value* extras = animlod_extras(n.extras)) {
       auto number = [&](const char* key, double fallback) {
         const Value* v = object_member(*extras, key);
         return v && v->IsNumber() ? v->GetNumberAsDouble() : fallback;
       };
       level.error = static_cast<float>(number("error", 0.0));
-      level.mesh_level = static_cast<int>(number("mesh_level", index));
-      level.motion_level = static_cast<int>(number("motion_level", 0));
+      level.mesh_level = static_cast<int>(number("mesh_level", level.mesh_level));
+      level.motion_level = static_cast<int>(number("motion_level", level.motion_level));
       if (!std::isfinite(level.error) || level.error < 0.0f) fail(label, "extras.animlod.error must be a number >= 0");
     }
     level.rig = rig_for_skin(n.skin);

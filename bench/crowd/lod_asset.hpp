@@ -70,12 +70,26 @@ struct Level {
   std::vector<int> clips;    // per original clip k: index into Asset::clips
 };
 
+// A chain of one skinned mesh node. levels[0, selection_count) are the MSFT_lod chain, finest
+// first: the selector picks one of them by its error (or coverage). A character chain from
+// `animlod character` has geometry level i with motion level i along it, and every other
+// (mesh level, motion level) combination as further level nodes listed by the base node's
+// extras.animlod_grid[g][m]; those follow in levels[selection_count, ...) so that the GLoD and
+// MLoD modes (and the Fig. 1 grid) can draw them.
 struct Chain {
   int node = -1;  // the level-0 mesh node
   std::string name;
-  std::vector<Level> levels;  // finest first
-  bool has_errors = false;     // every level records extras.animlod.error
+  std::vector<Level> levels;
+  size_t selection_count = 0;
+  bool has_errors = false;     // every chain level records extras.animlod.error
   bool has_coverages = false;  // the node has MSFT_screencoverage
+
+  // The level drawing (mesh level g, motion level m), or -1.
+  int find(int mesh_level, int motion_level) const {
+    for (size_t l = 0; l < levels.size(); ++l)
+      if (levels[l].mesh_level == mesh_level && levels[l].motion_level == motion_level) return static_cast<int>(l);
+    return -1;
+  }
 };
 
 struct Asset {

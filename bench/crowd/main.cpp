@@ -4,6 +4,7 @@
 //
 // Exit codes: 0 done, 1 an output could not be written, 2 bad input (arguments, files),
 // 3 no usable OpenGL context (no display, GL older than 3.3 core).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -32,15 +33,14 @@ int fail(int code, const std::string& message) {
   return code;
 }
 
-// The (mesh level, motion level) pairs of the first chain, in chain order, for --grid.
+// The (mesh level, motion level) pairs of the first chain, by mesh level then motion level, for --grid.
 std::vector<std::pair<int, int>> grid_cells(const crowd::Asset& asset) {
   std::vector<std::pair<int, int>> cells;
   for (const crowd::Level& level : asset.chains.front().levels) {
     const std::pair<int, int> cell(level.mesh_level, level.motion_level);
-    bool seen = false;
-    for (const auto& c : cells) seen = seen || c == cell;
-    if (!seen) cells.push_back(cell);
+    if (std::find(cells.begin(), cells.end(), cell) == cells.end()) cells.push_back(cell);
   }
+  std::sort(cells.begin(), cells.end());
   return cells;
 }
 

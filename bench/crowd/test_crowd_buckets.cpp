@@ -14,16 +14,17 @@ namespace {
 
 using namespace crowd;
 
-// One chain of four levels: (mesh level, motion level, error) = (0, 0, 0), (1, 0, 0.01),
-// (0, 1, 0.02), (1, 1, 0.04); meshes of 4 and 2 triangles; rigs of 3 and 2 joints.
+// A character chain as `animlod character` writes it: the MSFT_lod chain (g, m) = (0, 0), (1, 1),
+// (2, 2) with errors 0, 0.01, 0.04, then the other cells of the 3 x 3 grid. Mesh level g has
+// 4, 2, 1 triangles; motion level m a skeleton of 3, 2, 1 joints.
 Asset hand_built_asset() {
   Asset asset;
-  for (int triangles : {4, 2}) {
+  for (int triangles : {4, 2, 1}) {
     MeshData mesh;
     for (int t = 0; t < triangles; ++t) mesh.indices.insert(mesh.indices.end(), {0u, 1u, 2u});
     asset.meshes.push_back(mesh);
   }
-  for (int joints : {3, 2}) {
+  for (int joints : {3, 2, 1}) {
     Rig rig;
     rig.skin = static_cast<int>(asset.rigs.size());
     for (int j = 0; j < joints; ++j) {
@@ -41,17 +42,23 @@ Asset hand_built_asset() {
   }
   Chain chain;
   chain.has_errors = true;
-  const float errors[4] = {0.0f, 0.01f, 0.02f, 0.04f};
-  for (int l = 0; l < 4; ++l) {
+  auto add = [&](int g, int m, float error) {
     Level level;
-    level.mesh_level = l % 2;
-    level.motion_level = l / 2;
-    level.error = errors[l];
-    level.mesh = l % 2;
-    level.rig = l / 2;
-    level.clips = {l / 2};
+    level.mesh_level = g;
+    level.motion_level = m;
+    level.error = error;
+    level.mesh = g;
+    level.rig = m;
+    level.clips = {m};
     chain.levels.push_back(level);
-  }
+  };
+  add(0, 0, 0.0f);
+  add(1, 1, 0.01f);
+  add(2, 2, 0.04f);
+  chain.selection_count = 3;
+  for (int g = 0; g < 3; ++g)
+    for (int m = 0; m < 3; ++m)
+      if (g != m) add(g, m, 0.0f);  // grid cells record no error of their own
   asset.chains.push_back(chain);
   asset.clip_names = {"rest"};
   asset.bounds_min = glm::vec3(-0.5f, 0.0f, -0.5f);
@@ -96,9 +103,9 @@ struct HandBuiltScene {
     return out;
   }
 
-  // Level index -> instances drawn, after one frame of `mode`.
-  std::map<int, uint32_t> run(const char* name, bool geometry, bool motion, FrameCounts& counts,
-                              std::vector<InstanceGpu>& instances) {
+  // (mesh level, motion level) -> instances drawn, after one frame of `mode`.
+  std::map<std::pair<int, int>, uint32_t> run(const char* name, bool geometry, bool motion, FrameCounts& counts,
+                                              std::vector<InstanceGpu>& instances) {
     CrowdAnimator animator(assets, scene, options);
     Mode mode;
     mode.name = name;
@@ -111,45 +118,68 @@ struct HandBuiltScene {
     size_t floats = 0, count = 0;
     animator.gather(palettes.data(), instances.data(), floats, count);
     instances.resize(count);
-    std::map<int, uint32_t> levels;
+    std::map<std::pair<int, int>, uint32_t> cells;
     uint32_t next = 0;
+    const Chain& chain = assets[0].chains[0];
     for (const Bucket& bucket : animator.buckets()) {
       CHECK(bucket.first == next);  // buckets tile the instance array in order
       next += bucket.count;
-      levels[bucket.level] = bucket.count;
-      for (uint32_t i = bucket.first; i < bucket.first + bucket.count; ++i) CHECK(instances[i].tint == static_cast<uint32_t>(bucket.level));
+      const Level& level = chain.levels[static_cast<size_t>(bucket.level)];
+      cells[{level.mesh_level, level.motion_level}] = bucket.count;
     }
     CHECK(floats == 12 * static_cast<size_t>(counts.joints));  // every drawn skeleton uploaded once
-    return levels;
+    return cells;
   }
 };
 
 }  // namespace
 
-TEST_CASE("crowd buckets: each mode picks the levels its projected errors allow") {
+TEST_CASE("crowd buckets: the selected chain level, reduced in geometry, motion or both by the mode") {
   HandBuiltScene s;
   FrameCounts counts;
   std::vector<InstanceGpu> instances;
-
-  auto levels = s.run("G+MLoD", true, true, counts, instances);
+  using Cells = std::map<std::pair<int, int>, uint32_t>;
+  // Selected chain levels: 0 at distance 5, 1 at 15 and 30 (0.04 would show 2.7 and 1.3 px), 2 at 100.
+  Cells cells = s.run("G+MLoD", true, true, counts, instances);
   CHECK(counts.drawn == 4);  // the character behind the camera is culled
-  CHECK(levels == std::map<int, uint32_t>{{0, 1}, {1, 1}, {2, 1}, {3, 1}});
-  CHECK(counts.triangles == 4 + 2 + 4 + 2);
-  CHECK(counts.joints == 3 + 3 + 2 + 2);
+  CHECK(cells == Cells{{{0, 0}, 1}, {{1, 1}, 2}, {{2, 2}, 1}});
+  CHECK(counts.triangles == 4 + 2 + 2 + 1);
+  CHECK(counts.joints == 3 + 2 + 2 + 1);
+  CHECK(counts.levels[0] == 1);
+  CHECK(counts.levels[1] == 2);
+  CHECK(counts.levels[2] == 1);
+  // The tint is the selected chain level, whatever the mode draws.
+  std::vector<uint32_t> tints;
+  for (const InstanceGpu& instance : instances) tints.push_back(instance.tint);
+  CHECK(tints == std::vector<uint32_t>{0, 1, 1, 2});
 
-  levels = s.run("GLoD", true, false, counts, instances);
-  CHECK(levels == std::map<int, uint32_t>{{0, 1}, {1, 3}});
-  CHECK(counts.triangles == 4 + 3 * 2);
+  cells = s.run("GLoD", true, false, counts, instances);
+  CHECK(cells == Cells{{{0, 0}, 1}, {{1, 0}, 2}, {{2, 0}, 1}});
+  CHECK(counts.triangles == 4 + 2 + 2 + 1);
+  CHECK(counts.joints == 4 * 3);
 
-  levels = s.run("MLoD", false, true, counts, instances);
-  CHECK(levels == std::map<int, uint32_t>{{0, 2}, {2, 2}});
-  CHECK(counts.joints == 3 + 3 + 2 + 2);
+  cells = s.run("MLoD", false, true, counts, instances);
+  CHECK(cells == Cells{{{0, 0}, 1}, {{0, 1}, 2}, {{0, 2}, 1}});
+  CHECK(counts.triangles == 4 * 4);
+  CHECK(counts.joints == 3 + 2 + 2 + 1);
 
-  levels = s.run("Original", false, false, counts, instances);
-  CHECK(levels == std::map<int, uint32_t>{{0, 4}});
+  cells = s.run("Original", false, false, counts, instances);
+  CHECK(cells == Cells{{{0, 0}, 4}});
   CHECK(counts.joints == 4 * 3);
   // Each instance points at its own palette.
   for (size_t i = 0; i < instances.size(); ++i) CHECK(instances[i].palette_base == 3 * i);
+}
+
+TEST_CASE("crowd grid: a forced cell is drawn by every character, the nearest coarser-or-equal one if missing") {
+  HandBuiltScene s;
+  s.assets[0].chains[0].levels.pop_back();  // drop the (2, 1) cell
+  CrowdAnimator animator(s.assets, s.scene, s.options);
+  const int forced[2] = {2, 1};
+  animator.start(Mode(), forced);
+  FrameCounts counts;
+  animator.animate(s.camera, s.lod_camera, 0, 0.0f, counts);
+  CHECK(counts.triangles == 4 * 2);  // (2, 1) missing: (1, 1) is the most reduced within it
+  CHECK(counts.joints == 4 * 2);
 }
 
 TEST_CASE("crowd frame skipping: far characters keep their pose for several frames") {

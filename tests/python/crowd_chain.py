@@ -1,14 +1,16 @@
-"""A hand-built LoD GLB (the format of HELPER_PREAMBLE "The LoD GLB format") for the crowd tests.
+"""A hand-built LoD GLB in the layout ``animlod character`` writes (README, "The LoD GLB"), for the
+crowd tests.
 
 Not a chain builder: levels are made crudely and their errors are set by hand, so that the
-crowd binary's reader, level buckets and level switches can be tested without the character
-pipeline. Levels of the procedural humanoid (walk and run clips):
+crowd binary's reader, level buckets and level switches can be tested in seconds. The
+procedural humanoid (walk and run clips) as a 2 x 2 grid of (mesh level g, motion level m):
 
-- level 0: the original (``write_glb``), error 0;
-- level 1 (mesh level 1, motion level 0): every other triangle of the mesh, error 0.01;
-- level 2 (mesh level 1, motion level 1): level 1's triangles on a skeleton without the finger
-  joints (weights moved to the nearest kept ancestor), the clips retargeted onto its own joint
-  nodes, error 0.03.
+- g = 1 draws every other triangle of the mesh; m = 1 is a skeleton without the finger joints
+  (their weights moved to the nearest kept ancestor) with the clips retargeted onto its own
+  joint nodes (``extras.animlod = {"clip", "motion_level": 1}``);
+- the MSFT_lod chain is (0, 0) then (1, 1), errors 0 and 0.03, screen coverages 0.3 and 0;
+- (1, 0) and (0, 1) are grid-only nodes (error 0, as the character pipeline writes them),
+  listed with the chain's in ``base.extras.animlod_grid[g][m]``.
 """
 
 from __future__ import annotations
@@ -21,8 +23,8 @@ import pygltflib
 from animlod import synth
 from animlod.io.gltf import write_glb
 
-ERRORS = (0.0, 0.01, 0.03)
-COVERAGES = (0.5, 0.2, 0.0)
+ERROR = 0.03  # of the chain's level 1
+COVERAGES = (0.3, 0.0)
 FINGERS = ("Thumb", "Index", "Middle", "Ring")
 _COMPONENT = {np.dtype(np.float32): pygltflib.FLOAT, np.dtype(np.uint16): pygltflib.UNSIGNED_SHORT,
               np.dtype(np.uint32): pygltflib.UNSIGNED_INT}  # fmt: skip
@@ -79,9 +81,8 @@ def write_hand_built_chain(path: Path, seed: int = 0) -> Path:
     weights = np.pad(skinned.weights, ((0, 0), (0, 4 - skinned.weights.shape[1])))
     half = skinned.faces[::2]
 
-    # Level 1: half the triangles on the original skin.
-    level1 = _mesh(blob, skinned.rest_positions, half, joints, weights)
-    # Level 2: a skeleton without finger joints; each removed joint's weight goes to its nearest kept ancestor.
+    # Mesh level 1: half the triangles. Motion level 1: a skeleton without finger joints, each
+    # removed joint's weight on its nearest kept ancestor.
     kept = [j for j, name in enumerate(skeleton.names) if not any(f in name for f in FINGERS)]
     target = np.arange(joint_count)
     for j in range(joint_count):
@@ -103,7 +104,11 @@ def write_hand_built_chain(path: Path, seed: int = 0) -> Path:
     inverse_bind = skinned.inverse_bind[kept].transpose(0, 2, 1).reshape(len(kept), 16).astype(np.float32)
     gltf.skins.append(pygltflib.Skin(joints=[first_new + i for i in range(len(kept))], skeleton=first_new,
                                      inverseBindMatrices=blob.add(inverse_bind)))  # fmt: skip
-    level2 = _mesh(blob, skinned.rest_positions, half, reduced_joints, reduced_weights)
+    meshes = {
+        (1, 0): _mesh(blob, skinned.rest_positions, half, joints, weights),
+        (0, 1): _mesh(blob, skinned.rest_positions, skinned.faces, reduced_joints, reduced_weights),
+        (1, 1): _mesh(blob, skinned.rest_positions, half, reduced_joints, reduced_weights),
+    }
     for index in range(len(gltf.animations)):
         original = gltf.animations[index]
         channels = [
@@ -117,20 +122,19 @@ def write_hand_built_chain(path: Path, seed: int = 0) -> Path:
             pygltflib.Animation(name=name, samplers=original.samplers, channels=channels, extras=extras)
         )
 
-    levels = [(mesh_node, 0, 0, joint_count), (None, 1, 0, joint_count), (None, 1, 1, len(kept))]
-    ids = []
-    for level, (node, mesh_level, motion_level, joints_animated) in enumerate(levels):
-        triangles = len(half) if level else len(skinned.faces)
-        record = {"level": level, "error": ERRORS[level], "triangles": triangles, "mesh_level": mesh_level,
-                  "motion_level": motion_level, "joints": joints_animated}  # fmt: skip
-        extras = {"animlod": record}
-        if node is None:
-            gltf.nodes.append(pygltflib.Node(name=f"skinned mesh LOD{level}", mesh=(level1, level2)[level - 1],
-                                             skin=level - 1, extras=extras))  # fmt: skip
-            ids.append(len(gltf.nodes) - 1)
-        else:
-            gltf.nodes[node].extras = {**extras, "MSFT_screencoverage": list(COVERAGES)}
-    gltf.nodes[mesh_node].extensions = {"MSFT_lod": {"ids": ids}}
+    def record(level: int, error: float, g: int, m: int) -> dict:
+        return {"animlod": {"level": level, "error": error, "triangles": len(half) if g else len(skinned.faces),
+                            "mesh_level": g, "motion_level": m, "joints": len(kept) if m else joint_count}}  # fmt: skip
+
+    grid = [[mesh_node, -1], [-1, -1]]
+    for (g, m), mesh in meshes.items():
+        on_chain = (g, m) == (1, 1)
+        extras = record(1 if on_chain else -1, ERROR if on_chain else 0.0, g, m)
+        gltf.nodes.append(pygltflib.Node(name=f"skinned mesh G{g}M{m}", mesh=mesh, skin=m, extras=extras))
+        grid[g][m] = len(gltf.nodes) - 1
+    gltf.nodes[mesh_node].extras = {**record(0, 0.0, 0, 0), "MSFT_screencoverage": list(COVERAGES),
+                                    "animlod_grid": grid}  # fmt: skip
+    gltf.nodes[mesh_node].extensions = {"MSFT_lod": {"ids": [grid[1][1]]}}
     gltf.extensionsUsed = sorted({*(gltf.extensionsUsed or []), "MSFT_lod"})
     blob.finish()
     gltf.save_binary(str(path))

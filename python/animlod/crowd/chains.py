@@ -1,39 +1,35 @@
 """LoD GLB chains for the crowd: the procedural humanoid's (the default when none is given), or any
-character's: geometry levels x motion levels from ``animlod character`` where this installation
-has it, else geometry levels only from the whole-document simplifier."""
+character's, built by the character pipeline (geometry levels x motion levels in one GLB)."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
-GEOMETRY_RATIOS = (0.5, 0.25, 0.1)
+# The motion re-fit the chains use: damped Newton reaches SLSQP's optimum on the same objective
+# over ten times faster (bench/bench_motion.py), which keeps `animlod crowd` and the demo quick.
+SOLVER = "newton"
 
 
-def character_chain(source: str | os.PathLike, output: str | os.PathLike) -> Path:
-    """Build the LoD GLB of the skinned character ``source`` at ``output``; its path.
+def character_chain(
+    source: str | os.PathLike, output: str | os.PathLike, progress: Callable[[str], None] | None = None
+) -> Path:
+    """Build the LoD GLB of the skinned, animated character ``source`` at ``output``; its path.
 
-    With the character pipeline (``animlod character``) the chain holds geometry levels times
-    motion levels; without it, the geometry levels of
-    :func:`animlod.pipelines.lod_document.simplify_document` (50 %, 25 % and 10 % of the
-    triangles), on which the MLoD modes draw level 0.
+    :func:`animlod.pipelines.character.build_character` with its default geometry ratios:
+    geometry level i with motion level i along the MSFT_lod chain, and every other combination
+    in ``extras.animlod_grid`` (what the GLoD and MLoD modes of the crowd draw).
 
-    Raises ValueError (or FormatError) when the pipeline refuses ``source``.
+    Raises FormatError (a ValueError) when ``source`` has no skinned mesh with an animation.
     """
-    from ..cli import COMMAND_MODULES, main
+    from ..pipelines.character import build_character
 
-    if "character" in COMMAND_MODULES:
-        code = main(["character", str(source), "-o", str(output)])
-        if code != 0:
-            raise ValueError(f"animlod character {source}: failed with exit code {code}")
-        return Path(output)
-    from ..pipelines.lod_document import simplify_document
-
-    simplify_document(source, output, GEOMETRY_RATIOS)
+    build_character(source, output, solver=SOLVER, progress=progress)
     return Path(output)
 
 
-def procedural_chain(path: str | os.PathLike, seed: int = 0) -> Path:
+def procedural_chain(path: str | os.PathLike, seed: int = 0, progress: Callable[[str], None] | None = None) -> Path:
     """The procedural humanoid (walk, run and jump clips) as a LoD GLB at ``path``; its path.
 
     The humanoid is written to ``<stem>_source.glb`` beside ``path`` and made a chain by
@@ -47,4 +43,4 @@ def procedural_chain(path: str | os.PathLike, seed: int = 0) -> Path:
     character = synth.humanoid(seed=seed)
     motions = [synth.humanoid_motion(character.skeleton, kind, seed=seed) for kind in synth.KINDS]
     write_glb(source, character, motions)
-    return character_chain(source, path)
+    return character_chain(source, path, progress)

@@ -68,7 +68,7 @@ test: python-package lint consumer-test
 
 demo: python-package crowd-binary
 	$(VENV)/bin/animlod demo -o out/demo
-	ANIMLOD_CROWD_BIN=$(CROWD_BIN) $(VENV)/bin/animlod crowd --count 100 --frames 30 \
+	ANIMLOD_CROWD_BIN=$(CROWD_BIN) $(VENV)/bin/animlod crowd out/demo/character_lod.glb --count 100 --frames 30 \
 	  --modes all --level-colors --json out/demo/crowd.json --screenshot 15 out/demo/crowd.png
 
 crowd-binary: $(CPP_BUILD)/build.ninja

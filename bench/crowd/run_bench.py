@@ -35,13 +35,19 @@ PAPER = {"nav1": {"GLoD": 1.8, "MLoD": 2.6, "G+MLoD": 3.2}, "nav2": {"G+MLoD": 2
 MODES = ("Original", "GLoD", "MLoD", "G+MLoD")
 
 
-def chains(out: Path, count: int, real_count: int) -> list[tuple[str, Path, int]]:
+def chains(out: Path, count: int, real_count: int, reuse: bool) -> list[tuple[str, Path, int]]:
     """(label, LoD GLB, characters): the procedural humanoid (3,664 triangles) and Soldier.glb
-    (11,376 triangles, so fewer of them for a measurable Original)."""
-    result = [("procedural humanoid", procedural_chain(out / "humanoid_lod.glb"), count)]
+    (11,376 triangles, so fewer of them for a measurable Original). ``reuse`` keeps chains
+    already in ``out`` (building them takes minutes)."""
+    humanoid, soldier_chain = out / "humanoid_lod.glb", out / "Soldier_lod.glb"
+    if not (reuse and humanoid.exists()):
+        procedural_chain(humanoid, progress=print)
+    result = [("procedural humanoid", humanoid, count)]
     soldier = DATA_DIR / "gltf" / "Soldier.glb"
     if soldier.exists():
-        result.append(("Soldier.glb", character_chain(soldier, out / "Soldier_lod.glb"), real_count))
+        if not (reuse and soldier_chain.exists()):
+            character_chain(soldier, soldier_chain, progress=print)
+        result.append(("Soldier.glb", soldier_chain, real_count))
     return result
 
 
@@ -53,12 +59,13 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3, help="path segments the modes take turns on (default 3)")
     parser.add_argument("--big-count", type=int, default=10000, help="the 'rendered at all' run (default 10000)")
     parser.add_argument("--out", type=Path, default=Path("out/bench-crowd"))
+    parser.add_argument("--reuse-chains", action="store_true", help="keep the LoD GLBs already in --out")
     parser.add_argument("--quick", action="store_true", help="100 characters, 10 frames, no 10,000 run")
     args = parser.parse_args()
     if args.quick:
         args.count, args.real_count, args.frames, args.big_count, args.rounds = 100, 50, 10, 0, 1
     args.out.mkdir(parents=True, exist_ok=True)
-    for label, chain, count in chains(args.out, args.count, args.real_count):
+    for label, chain, count in chains(args.out, args.count, args.real_count, args.reuse_chains):
         stem = chain.stem
         reports = {}
         for path in ("nav1", "nav2"):

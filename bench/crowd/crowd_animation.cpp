@@ -1,3 +1,5 @@
+// Per-frame culling, level selection, frame skipping and posing of the crowd, and the gather of
+// palettes and instances (crowd_animation.hpp; seeds/000 Section 3, seeds/004 Section 4.2.3).
 #include "crowd_animation.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// Command-line parsing of animlod_crowd (crowd_options.hpp): every mistake is one line.
 #include "crowd_options.hpp"
 
 #include <cmath>

@@ -1,3 +1,5 @@
+// Placement on the height map and the camera paths (crowd_scene.hpp; the motion LoD paper,
+// seeds/000 Section 3: a height map of the movable region; Section 6.4: two navigation paths).
 #include "crowd_scene.hpp"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+// GLFW window, OpenGL 3.3+ buffers and shaders, instanced GPU skinning draws, timer queries and
+// screenshots (gl_renderer.hpp).
 #include "gl_renderer.hpp"
 
 #include <GLFW/glfw3.h>

@@ -35,16 +35,20 @@ PAPER = {"nav1": {"GLoD": 1.8, "MLoD": 2.6, "G+MLoD": 3.2}, "nav2": {"G+MLoD": 2
 MODES = ("Original", "GLoD", "MLoD", "G+MLoD")
 
 
-def chains(out: Path, count: int, real_count: int, reuse: bool) -> list[tuple[str, Path, int]]:
+def chains(out: Path, count: int, real_count: int, reuse: bool, which: list[str]) -> list[tuple[str, Path, int]]:
     """(label, LoD GLB, characters): the procedural humanoid (3,664 triangles) and Soldier.glb
     (11,376 triangles, so fewer of them for a measurable Original). ``reuse`` keeps chains
     already in ``out`` (building them takes minutes)."""
     humanoid, soldier_chain = out / "humanoid_lod.glb", out / "Soldier_lod.glb"
-    if not (reuse and humanoid.exists()):
-        procedural_chain(humanoid, progress=print)
-    result = [("procedural humanoid", humanoid, count)]
+    result = []
+    if "humanoid" in which:
+        if not (reuse and humanoid.exists()):
+            procedural_chain(humanoid, progress=print)
+        result.append(("procedural humanoid", humanoid, count))
     soldier = DATA_DIR / "gltf" / "Soldier.glb"
-    if soldier.exists():
+    if "soldier" in which and not soldier.exists():
+        print(f"{soldier}: not found (set ANIMLOD_DATA), skipped")
+    if "soldier" in which and soldier.exists():
         if not (reuse and soldier_chain.exists()):
             character_chain(soldier, soldier_chain, progress=print)
         result.append(("Soldier.glb", soldier_chain, real_count))
@@ -60,23 +64,26 @@ def main() -> None:
     parser.add_argument("--big-count", type=int, default=10000, help="the 'rendered at all' run (default 10000)")
     parser.add_argument("--out", type=Path, default=Path("out/bench-crowd"))
     parser.add_argument("--reuse-chains", action="store_true", help="keep the LoD GLBs already in --out")
+    parser.add_argument("--chains", nargs="+", choices=("humanoid", "soldier"), default=["humanoid", "soldier"])
     parser.add_argument("--quick", action="store_true", help="100 characters, 10 frames, no 10,000 run")
     args = parser.parse_args()
     if args.quick:
         args.count, args.real_count, args.frames, args.big_count, args.rounds = 100, 50, 10, 0, 1
     args.out.mkdir(parents=True, exist_ok=True)
-    for label, chain, count in chains(args.out, args.count, args.real_count, args.reuse_chains):
+    for label, chain, count in chains(args.out, args.count, args.real_count, args.reuse_chains, args.chains):
         stem = chain.stem
         reports = {}
         for path in ("nav1", "nav2"):
             shot = [(args.frames // 2, args.out / f"{stem}_{path}.png")]
             reports[path] = run_crowd(
-                [chain], count=count, frames=args.frames, rounds=args.rounds, modes="all", path=path,
+                [chain], count=count, frames=args.frames, rounds=args.rounds, warmup=3, modes="all", path=path,
                 json_path=args.out / f"{stem}_{path}.json", screenshots=shot,
             )  # fmt: skip
         data = reports["nav1"].data
         levels = data["chains"][0]["nodes"][0]["levels"]
-        print(f"\n## {label}: {chain.name}, {len(levels)} levels, {count} characters, {data['renderer']}")
+        chain_levels = sum(level["chain_level"] >= 0 for level in levels)
+        heading = f"{label}: {chain.name}, {chain_levels} chain levels ({len(levels)} grid cells), {count} characters"
+        print(f"\n## {heading}, {data['renderer']}")
         rows = []
         for path, report in reports.items():
             modes = report.modes

@@ -1,0 +1,319 @@
+"""Levels of detail of blendshape faces (glTF morph targets, or a neutral face and expressions).
+
+A blendshape face is ``neutral + sum_i w_i(t) delta_i``. Each target plays the part a region
+plays in seeds/004: a unit of animation that can be skipped when it matters little. Per level:
+
+- **ranking**: a target's contribution is the largest displacement it ever causes, the largest
+  weight the animation gives it times its largest vertex delta (asset units); targets are ranked
+  by it, ties by index;
+- **pruning**: each level keeps its most important targets (a fraction of them), so fewer
+  targets are blended per frame further away; the coarsest level may keep none;
+- **geometry**: AQEM over the neutral face and the kept targets at their largest weights, with
+  region importance from regions grown from the targets' motion (moving 1, static lower), and
+  the kept targets' deltas carried through the collapses as attributes; vertices are placed on
+  the collapsed edge (``placement="on_edge"``) so that a vertex and its deltas describe one point.
+
+Shapes: ``V`` vertices, ``M`` faces, ``N`` targets, ``T`` animation frames.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import AnimatedMesh
+from ..simplify import simplify_animated
+from .grow import GrowOptions, grow_regions, motion_of_targets
+from .regions import FaceRegions
+
+
+@dataclass
+class BlendshapeFace:
+    """A neutral mesh, its morph targets and an animation of their weights.
+
+    Attributes
+    ----------
+    neutral : (V, 3) float32 positions.
+    faces : (M, 3) int32.
+    targets : (N, V, 3) float32 position deltas.
+    names : N target names.
+    weights : (T, N) float64 target weights per animation frame.
+    fps : frames per second of ``weights``.
+    uvs : (V, 2) float32 or None.
+    """
+
+    neutral: np.ndarray
+    faces: np.ndarray
+    targets: np.ndarray
+    names: list[str]
+    weights: np.ndarray
+    fps: float = 30.0
+    uvs: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        self.neutral = np.ascontiguousarray(self.neutral, dtype=np.float32)
+        vertex_count = len(self.neutral)
+        if self.neutral.shape != (vertex_count, 3):
+            raise ValueError(f"blendshape face: neutral of shape {self.neutral.shape}, expected (V, 3)")
+        self.faces = AnimatedMesh(self.faces, self.neutral[None]).faces
+        names = [str(name) for name in self.names]
+        targets = []
+        for index, target in enumerate(self.targets):  # O(N), each checked whole
+            target = np.asarray(target, dtype=np.float32)
+            if target.shape != (vertex_count, 3):
+                name = names[index] if index < len(names) else ""
+                raise ValueError(
+                    f"morph target {index} {name!r} has shape {target.shape}: expected ({vertex_count}, 3), "
+                    f"one delta per vertex of its mesh"
+                )
+            targets.append(target)
+        self.targets = np.stack(targets) if targets else np.zeros((0, vertex_count, 3), np.float32)
+        self.names = names
+        if len(self.names) != len(self.targets):
+            raise ValueError(f"blendshape face: {len(self.names)} names for {len(self.targets)} targets")
+        if not np.all(np.isfinite(self.targets)):
+            index = int(np.argwhere(~np.isfinite(self.targets))[0, 0])
+            raise ValueError(f"morph target {index} {self.names[index]!r} has a non-finite delta")
+        self.weights = np.asarray(self.weights, dtype=np.float64)
+        if self.weights.ndim != 2 or self.weights.shape[1] != len(self.targets) or len(self.weights) == 0:
+            raise ValueError(
+                f"blendshape face: weights of shape {self.weights.shape}, expected (T, {len(self.targets)}) with T >= 1"
+            )
+        if not np.all(np.isfinite(self.weights)):
+            frame = int(np.argwhere(~np.isfinite(self.weights))[0, 0])
+            raise ValueError(f"blendshape face: animation frame {frame} has a non-finite weight")
+        if self.uvs is not None:
+            self.uvs = np.ascontiguousarray(self.uvs, dtype=np.float32)
+            if self.uvs.shape != (vertex_count, 2):
+                raise ValueError(f"blendshape face: uvs of shape {self.uvs.shape}, expected ({vertex_count}, 2)")
+
+    @property
+    def target_count(self) -> int:
+        return int(len(self.targets))
+
+    @property
+    def vertex_count(self) -> int:
+        return int(len(self.neutral))
+
+    def largest_weights(self) -> np.ndarray:
+        """(N,) the largest absolute weight the animation gives each target."""
+        return np.abs(self.weights).max(axis=0)
+
+    def frames(self, weights: np.ndarray | None = None) -> AnimatedMesh:
+        """The face blended with ``weights (T, N)`` (the animation when None)."""
+        weights = self.weights if weights is None else np.asarray(weights, dtype=np.float64)
+        blended = self.neutral[None] + np.tensordot(weights, self.targets, axes=(1, 0))
+        return AnimatedMesh(self.faces, blended, fps=self.fps)
+
+
+@dataclass
+class BlendshapeLevel:
+    """One level of a blendshape face.
+
+    Attributes
+    ----------
+    faces : (M', 3) int32.
+    neutral : (V', 3) float32.
+    targets : (N', V', 3) float32 deltas of the kept targets.
+    kept_targets : (N',) int64 index of each kept target in the input.
+    kept_vertices : (V',) int32 input vertex of each vertex.
+    uvs : (V', 2) float32 or None.
+    aqem_error : AQEM's error, asset units (0 at level 0).
+    """
+
+    faces: np.ndarray
+    neutral: np.ndarray
+    targets: np.ndarray
+    kept_targets: np.ndarray
+    kept_vertices: np.ndarray
+    uvs: np.ndarray | None
+    aqem_error: float
+
+    @property
+    def triangle_count(self) -> int:
+        return int(len(self.faces))
+
+    def frame(self, weights: np.ndarray) -> np.ndarray:
+        """(V', 3) float32 positions for the input's ``weights (N,)`` (pruned targets ignored)."""
+        kept = np.asarray(weights, dtype=np.float32)[self.kept_targets]
+        if kept.size == 0:
+            return self.neutral
+        return self.neutral + (kept @ self.targets.reshape(len(kept), -1)).reshape(-1, 3)
+
+    def frames(self, weights: np.ndarray) -> AnimatedMesh:
+        """The level over ``weights (T, N)`` of the input's targets."""
+        kept = np.asarray(weights, dtype=np.float64)[:, self.kept_targets]
+        return AnimatedMesh(self.faces, self.neutral[None] + np.tensordot(kept, self.targets, axes=(1, 0)))
+
+
+@dataclass
+class BlendshapeLodOptions:
+    """How :func:`build_blendshape_lod` builds the levels.
+
+    Attributes
+    ----------
+    ratios : triangle fractions of the levels after the input (level 0).
+    face_counts : the same as counts; replaces ``ratios``.
+    target_fractions : per level (the input included) the fraction of targets kept, rounded up;
+        default: 1 at level 0, then 3/4, 1/2, 1/4, ... of the targets.
+    grow : how regions are grown from the targets' motion for the importance weights (None:
+        every vertex has importance 1).
+    """
+
+    ratios: Sequence[float] = (0.5, 0.25, 0.1)
+    face_counts: Sequence[int] | None = None
+    target_fractions: Sequence[float] | None = None
+    grow: GrowOptions | None = None
+
+
+def target_contributions(face: BlendshapeFace) -> np.ndarray:
+    """(N,) the largest displacement (asset units) each target causes over the animation: its
+    largest absolute weight times its largest vertex delta."""
+    largest_delta = np.linalg.norm(face.targets, axis=2).max(axis=1, initial=0.0)
+    return face.largest_weights() * largest_delta
+
+
+def rank_targets(face: BlendshapeFace) -> np.ndarray:
+    """(N,) target indices, most important first (ties: lower index first)."""
+    return np.lexsort((np.arange(face.target_count), -target_contributions(face)))
+
+
+def default_target_fractions(level_count: int) -> list[float]:
+    return [1.0] + [max(0.0, 1.0 - 0.25 * level) for level in range(1, level_count)]
+
+
+def target_regions(face: BlendshapeFace, options: GrowOptions | None = None) -> FaceRegions:
+    """Regions grown from the targets' motion (each region a set of vertices that the same
+    targets move alike), groups "moving" and "static"."""
+    return grow_regions(motion_of_targets(face.targets, face.largest_weights()), face.faces, options)
+
+
+def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | None = None) -> list[BlendshapeLevel]:
+    """Levels of ``face``, the input first: each with fewer triangles and fewer targets.
+
+    Raises ValueError for fractions of the wrong length or outside [0, 1] and whatever AQEM
+    rejects (naming the element).
+    """
+    options = options or BlendshapeLodOptions()
+    counts = (
+        [int(c) for c in options.face_counts]
+        if options.face_counts is not None
+        else [max(4, round(r * len(face.faces))) for r in options.ratios]
+    )
+    fractions = list(options.target_fractions or default_target_fractions(len(counts) + 1))
+    if len(fractions) != len(counts) + 1:
+        raise ValueError(f"target fractions: {len(fractions)} given for {len(counts) + 1} levels")
+    for index, fraction in enumerate(fractions):
+        if not 0.0 <= fraction <= 1.0:
+            raise ValueError(f"target fraction of level {index}: {fraction} is outside [0, 1]")
+    order = rank_targets(face)
+    kept_per_level = [np.sort(order[: int(np.ceil(f * face.target_count - 1e-9))]) for f in fractions]
+    importance = None
+    if options.grow is not None and face.target_count and np.any(face.targets):
+        importance = target_regions(face, options.grow).vertex_importance()
+    levels = [
+        BlendshapeLevel(face.faces, face.neutral, face.targets[kept_per_level[0]], kept_per_level[0],
+                        np.arange(face.vertex_count, dtype=np.int32), face.uvs, 0.0)
+    ]  # fmt: skip
+    for count, kept in zip(counts, kept_per_level[1:]):
+        levels.append(_simplified_level(face, count, kept, importance))
+    return levels
+
+
+def _simplified_level(
+    face: BlendshapeFace, face_count: int, kept: np.ndarray, importance: np.ndarray | None
+) -> BlendshapeLevel:
+    """AQEM over the neutral face and the kept targets at their largest weights, carrying UVs
+    and the kept deltas."""
+    largest = face.largest_weights()[kept]
+    frames = np.concatenate([face.neutral[None], face.neutral[None] + largest[:, None, None] * face.targets[kept]])
+    columns = [np.zeros((face.vertex_count, 0), np.float32)]
+    uv_width = 0 if face.uvs is None else 2
+    if uv_width:
+        columns.append(face.uvs)
+    columns.append(face.targets[kept].transpose(1, 0, 2).reshape(face.vertex_count, -1))
+    result = simplify_animated(
+        AnimatedMesh(face.faces, frames),
+        target_face_counts=[face_count],
+        importance=importance,
+        attributes=np.concatenate(columns, axis=1),
+        placement="on_edge",
+    )
+    level = result.levels[0]
+    carried = level.attributes if level.attributes is not None else np.zeros((len(level.kept_vertices), 0), np.float32)
+    deltas = carried[:, uv_width:].reshape(len(level.kept_vertices), len(kept), 3).transpose(1, 0, 2)
+    return BlendshapeLevel(
+        faces=level.mesh.faces,
+        neutral=level.mesh.frames[0],
+        targets=np.ascontiguousarray(deltas),
+        kept_targets=kept,
+        kept_vertices=level.kept_vertices,
+        uvs=carried[:, :uv_width] if uv_width else None,
+        aqem_error=level.error,
+    )
+
+
+@dataclass
+class BlendshapeMeasurement:
+    """One row of the blendshape table: size, targets, time per frame to blend, error."""
+
+    level: int
+    triangles: int
+    vertices: int
+    targets: int
+    max_frame_seconds: float
+    median_frame_seconds: float
+    hausdorff: float
+    hausdorff_units: float
+
+
+def measure_blendshape_lod(
+    face: BlendshapeFace, levels: Sequence[BlendshapeLevel], repeats: int = 5, max_frames: int = 60,
+    samples: int = 20000,
+) -> list[BlendshapeMeasurement]:  # fmt: skip
+    """Per level: the largest (and median) time to blend one frame over the whole animation
+    (numpy, the fastest of ``repeats`` runs per frame) and the largest symmetric Hausdorff
+    distance to the full face over up to ``max_frames`` evenly spaced frames, relative to its
+    bounding-box diagonal."""
+    from ..metrics import surface_error
+
+    picked = np.unique(np.linspace(0, len(face.weights) - 1, min(max_frames, len(face.weights))).round().astype(int))
+    weights = face.weights[picked]
+    reference = face.frames(weights)
+    rows = []
+    for index, level in enumerate(levels):
+        best = np.full(len(face.weights), np.inf)
+        for _ in range(repeats):  # O(repeats x T) blends, each vectorised
+            for frame, row in enumerate(face.weights):
+                start = time.perf_counter()
+                level.frame(row)
+                best[frame] = min(best[frame], time.perf_counter() - start)
+        error = surface_error(reference, level.frames(weights), samples=samples)
+        worst = int(np.argmax(error.hausdorff))
+        rows.append(
+            BlendshapeMeasurement(
+                level=index,
+                triangles=level.triangle_count,
+                vertices=len(level.neutral),
+                targets=len(level.kept_targets),
+                max_frame_seconds=float(best.max()),
+                median_frame_seconds=float(np.median(best)),
+                hausdorff=float(error.relative_hausdorff[worst]),
+                hausdorff_units=float(error.hausdorff[worst]),
+            )
+        )
+    return rows
+
+
+def one_at_a_time(target_count: int, frames_each: int = 15) -> np.ndarray:
+    """(T, N) weights that raise every target from 0 to 1 and back in turn (for faces given as
+    poses, which have no animation of their own)."""
+    per = max(3, frames_each)
+    envelope = np.sin(np.pi * np.arange(per) / (per - 1)) ** 2
+    weights = np.zeros((per * max(target_count, 1), target_count))
+    for index in range(target_count):  # O(N) rows
+        weights[index * per : (index + 1) * per, index] = envelope
+    return weights

@@ -1,0 +1,240 @@
+"""The face LoD pipeline: a face in, its levels, a measured table and pictures out.
+
+Inputs: nothing (the procedural head, animated by MPAs and lattices), a glTF with morph targets,
+or a folder of OBJ/PLY poses (neutral + expressions). Both kinds are written level by level as
+GLB files with morph targets (the procedural face's MPAs become one target each: the FFD is
+linear in the MPA intensities, so a level's MPA displacements are exact blendshapes), with a
+JSON manifest holding each level's size, measured error (asset units), screen-coverage
+threshold and, for the procedural face, its active regions and lattice sizes.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .blendshape import BlendshapeLodOptions, build_blendshape_lod, measure_blendshape_lod
+from .chain import FaceLodOptions, build_face_lod
+from .grow import GrowOptions
+from .measure import animation_errors, every_nth, measure_chain
+from .mpa import expression_intensities, expression_sequence
+from .procedural import procedural_face
+from .selection import Camera, coverage_thresholds
+
+# The head of the procedural face is about 0.24 m tall; a face of that size fills the viewport
+# height at about 0.2 m with the default camera.
+PIXEL_TOLERANCE = 1.0
+
+
+@dataclass
+class FaceRun:
+    """What :func:`run_face_lod` did.
+
+    Attributes
+    ----------
+    kind : "procedural" or "blendshape".
+    columns, rows : the measured table (one row per level).
+    files : every file written.
+    notes : lines worth printing (what was read, what was pruned).
+    """
+
+    kind: str
+    columns: list[str]
+    rows: list[list[object]]
+    files: list[Path] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+def run_face_lod(
+    source: str | os.PathLike | None,
+    output: str | os.PathLike,
+    *,
+    ratios: Sequence[float] | None = None,
+    face_counts: Sequence[int] | None = None,
+    target_fractions: Sequence[float] | None = None,
+    neutral: str | None = None,
+    plot: bool = False,
+    expression: str | None = None,
+    repeats: int = 3,
+    error_frames: int = 24,
+) -> FaceRun:
+    """Build, measure and write the levels of a face.
+
+    Parameters
+    ----------
+    source : None for the procedural face, a .glb/.gltf with morph targets, or a pose folder.
+    output : folder for the files (created).
+    ratios, face_counts : triangle fractions or counts of the levels after the full face.
+    target_fractions : blendshape faces: fraction of targets kept per level (the full face included).
+    neutral : pose folders: the file name of the neutral face.
+    plot : also write a PNG with every level showing one expression.
+    expression : the expression (procedural face) or target (blendshape face) to plot.
+    repeats : timing runs per frame (the fastest is kept).
+    error_frames : animation frames the surface error is measured on, at most.
+    """
+    output = Path(output)
+    output.mkdir(parents=True, exist_ok=True)
+    if source is None:
+        return _run_procedural(output, ratios, face_counts, plot, expression, repeats, error_frames)
+    return _run_blendshape(
+        Path(source), output, ratios, face_counts, target_fractions, neutral, plot, expression, repeats, error_frames
+    )
+
+
+def _run_procedural(output, ratios, face_counts, plot, expression, repeats, error_frames) -> FaceRun:
+    from ..io.manifest import write_lod_manifest
+
+    face = procedural_face()
+    rig = face.rig
+    animation = expression_sequence(face.expressions, rig.mpa_names)
+    options = FaceLodOptions(face_counts=face_counts, **({"ratios": tuple(ratios)} if ratios else {}))
+    chain = build_face_lod(rig, face.tree, animation, options)
+    measured = measure_chain(chain, animation, repeats=repeats, samples=10000, error_frames=error_frames)
+    timed = [row.max_frame_seconds for row in measured]
+    radius = _radius(rig.positions)
+    thresholds = coverage_thresholds([row.hausdorff_units for row in measured], radius, Camera(), PIXEL_TOLERANCE)
+    run = FaceRun(
+        "procedural",
+        ["level", "triangles", "vertices", "animated regions", "lattices", "MPAs", "MAT (us)", "MAT / level 0",
+         "Hausdorff (% of diagonal)", "coverage >="],
+        [],
+    )  # fmt: skip
+    manifest = []
+    for row, threshold in zip(measured, thresholds):
+        g = row.geometry_level
+        level = chain.geometry[g]
+        animator = chain.animator(g)
+        path = output / f"face_lod{g}.glb"
+        _write_blendshape_glb(path, level.rest, level.faces, animator.targets(), rig.mpa_names)
+        run.files.append(path)
+        run.rows.append([g, row.triangles, row.vertices, row.animated_regions, row.lattices, row.active_mpas,
+                         1e6 * row.max_frame_seconds, row.max_frame_seconds / timed[0] if timed[0] else 0.0,
+                         100 * row.hausdorff, threshold])  # fmt: skip
+        manifest.append({
+            "files": [path.name], "triangles": row.triangles, "vertices": row.vertices, "error": row.hausdorff_units,
+            "screen_coverage": threshold, "animation_level": row.animation_level,
+            "active_regions": sorted(chain.tree.active(row.animation_level)),
+            "lattices": {name: "2x2x2" if name in level.reduced else "3x3x3" for name in animator.regions},
+        })  # fmt: skip
+    manifest_path = output / "face_lod.json"
+    write_lod_manifest(manifest_path, "face", manifest)
+    run.files.append(manifest_path)
+    errors = animation_errors(chain, every_nth(animation, error_frames))
+    run.notes.append(
+        "active tree levels (regions animated, largest vertex error in asset units): "
+        + "; ".join(f"{k}: {len(chain.tree.active(k))}, {e:.3g}" for k, e in enumerate(errors))
+    )
+    if plot:
+        name = expression or "smile"
+        chosen = next((e for e in face.expressions if e.name == name), None)
+        if chosen is None:
+            raise ValueError(f"--expression: no expression {name!r}; the face has "
+                             f"{', '.join(e.name for e in face.expressions)}")  # fmt: skip
+        weights = expression_intensities(chosen, rig.mpa_names)
+        panels = [
+            (chain.animator(g).frame(weights), chain.geometry[g].faces, chain.geometry[g].face_regions,
+             f"level {g}: {chain.geometry[g].triangle_count} triangles, {run.rows[g][3]} regions")
+            for g in range(len(chain.geometry))
+        ]  # fmt: skip
+        run.files.append(_plot(output / "face_lod.png", panels, f"procedural face, {name}"))
+    return run
+
+
+def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutral, plot, expression, repeats,
+                    error_frames) -> FaceRun:  # fmt: skip
+    from ..io.detect import input_kind, input_stem
+    from ..io.manifest import write_lod_manifest
+    from .sources import read_gltf_face, read_pose_face
+
+    kind = input_kind(source)
+    if kind == "gltf":
+        face = read_gltf_face(source)
+    elif kind == "sequence" and source.is_dir():
+        face = read_pose_face(source, neutral)
+    else:
+        raise ValueError(f"{source}: face LoD reads a .glb/.gltf with morph targets or a folder of OBJ/PLY poses")
+    options = BlendshapeLodOptions(face_counts=face_counts, target_fractions=target_fractions, grow=GrowOptions(),
+                                   **({"ratios": tuple(ratios)} if ratios else {}))  # fmt: skip
+    levels = build_blendshape_lod(face, options)
+    measured = measure_blendshape_lod(face, levels, repeats=repeats, max_frames=error_frames, samples=10000)
+    thresholds = coverage_thresholds([row.hausdorff_units for row in measured], _radius(face.neutral), Camera(),
+                                     PIXEL_TOLERANCE)  # fmt: skip
+    stem = input_stem(source)
+    run = FaceRun(
+        "blendshape",
+        ["level", "triangles", "vertices", "targets", "blend max (us)", "blend / level 0",
+         "Hausdorff (% of diagonal)", "coverage >="],
+        [],
+        notes=[f"{source}: {face.vertex_count} vertices, {len(face.faces)} triangles, {face.target_count} targets, "
+               f"{len(face.weights)} animation frames"],
+    )  # fmt: skip
+    manifest = []
+    base = measured[0].max_frame_seconds
+    for level, row, threshold in zip(levels, measured, thresholds):
+        path = output / f"{stem}_lod{row.level}.glb"
+        names = [face.names[i] for i in level.kept_targets]
+        _write_blendshape_glb(path, level.neutral, level.faces, level.targets, names, level.uvs)
+        run.files.append(path)
+        run.rows.append([row.level, row.triangles, row.vertices, row.targets, 1e6 * row.max_frame_seconds,
+                         row.max_frame_seconds / base if base else 0.0, 100 * row.hausdorff, threshold])  # fmt: skip
+        manifest.append({"files": [path.name], "triangles": row.triangles, "vertices": row.vertices,
+                         "targets": names, "error": row.hausdorff_units, "screen_coverage": threshold})  # fmt: skip
+    manifest_path = output / f"{stem}_face_lod.json"
+    write_lod_manifest(manifest_path, "blendshape_face", manifest)
+    run.files.append(manifest_path)
+    if plot:
+        weights = _plot_weights(face, expression)
+        panels = [
+            (level.frame(weights), level.faces, None, f"level {i}: {level.triangle_count} triangles, "
+             f"{len(level.kept_targets)} targets")
+            for i, level in enumerate(levels)
+        ]  # fmt: skip
+        run.files.append(_plot(output / f"{stem}_face_lod.png", panels, f"{stem}"))
+    return run
+
+
+def _plot_weights(face, expression: str | None) -> np.ndarray:
+    """The target named ``expression`` at weight 1, or the animation frame that moves the face most."""
+    if expression is not None:
+        if expression not in face.names:
+            raise ValueError(f"--expression: no target {expression!r}; the face has {', '.join(face.names)}")
+        weights = np.zeros(face.target_count)
+        weights[face.names.index(expression)] = 1.0
+        return weights
+    motion = np.abs(face.weights) @ np.linalg.norm(face.targets, axis=2).max(axis=1, initial=0.0)
+    return face.weights[int(np.argmax(motion))]
+
+
+def _plot(path: Path, panels, title: str) -> Path:
+    from .plots import Panel, plot_panels
+
+    plot_panels(path, [[Panel(positions, faces, text, colours) for positions, faces, colours, text in panels]],
+                title=title)  # fmt: skip
+    return path
+
+
+def _radius(positions: np.ndarray) -> float:
+    """Radius of the bounding sphere around the bounding-box centre."""
+    points = np.asarray(positions, dtype=np.float64)
+    centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+    return float(np.linalg.norm(points - centre, axis=1).max(initial=0.0)) or 1.0
+
+
+def _write_blendshape_glb(path: Path, positions, faces, targets, names, uvs=None) -> None:
+    """One level as a GLB: the mesh with its morph targets, bound to a one-joint identity skin
+    (the GLB writer of this version writes skinned meshes only)."""
+    from ..io.gltf import write_glb
+    from ..model import Skeleton, SkinnedMesh
+
+    count = len(positions)
+    skinned = SkinnedMesh(
+        rest_positions=positions, faces=faces, joints=np.zeros((count, 1), np.int32),
+        weights=np.ones((count, 1), np.float32), inverse_bind=np.eye(4)[None],
+        skeleton=Skeleton(["root"], [-1], np.zeros((1, 3))), uvs=uvs,
+        morph_targets=targets if len(names) else None, morph_target_names=list(names) if len(names) else None,
+    )  # fmt: skip
+    write_glb(path, skinned)

@@ -220,30 +220,68 @@ Status ffd_displace(const LatticeSetView& lattices, const float* rest, const flo
 }
 
 Status ffd_fit(const size_t size[3], const double* weights, const float* local, const float* targets,
-               size_t point_count, double* out_control_points) {
+               size_t point_count, const double* prior, double* out_control_points, const FfdFitOptions& options) {
   if (Status status = check_size(size, "lattice"); !status) return status;
   if (point_count == 0) return Status::error("fit: no points to fit the lattice to");
+  if (!(std::isfinite(options.smoothness) && options.smoothness >= 0.0 && std::isfinite(options.ridge) &&
+        options.ridge >= 0.0))
+    return Status::error("fit: smoothness and ridge must be finite and >= 0");
   const size_t controls = size[0] * size[1] * size[2];
   if (Status status = check_weights(weights, controls, 0, "lattice"); !status) return status;
   if (Status status = check_local(local, point_count); !status) return status;
-  // Rows of the design matrix are the rational basis of each point; X_P = A P is linear in P.
-  Eigen::MatrixXd design(point_count, controls);
-  Eigen::MatrixXd right(point_count, 3);
+  if (prior != nullptr)
+    for (size_t q = 0; q < 3 * controls; ++q)
+      if (!std::isfinite(prior[q])) return Status::error("prior: control point " + std::to_string(q / 3) + " is not finite");
+
+  // Phase 1: rows of the data term, the rational basis of each point (X_P = A P is linear in P).
+  const double scale = static_cast<double>(point_count) / static_cast<double>(controls);
+  const double smooth = std::sqrt(options.smoothness * scale), ridge = std::sqrt(options.ridge * scale);
+  size_t second_differences = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    if (size[axis] >= 3) second_differences += (size[axis] - 2) * (controls / size[axis]);
+  const size_t rows = point_count + (smooth > 0.0 ? second_differences : 0) + (ridge > 0.0 ? controls : 0);
+  Eigen::MatrixXd design = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(controls));
+  Eigen::MatrixXd right = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows), 3);
   std::vector<double> basis(controls);
   for (size_t p = 0; p < point_count; ++p) {
+    const auto row = static_cast<Eigen::Index>(p);
+    if (!rational_basis(size, weights, local + 3 * p, basis.data()))
+      return Status::error("lattice: rational basis vanishes at point " + std::to_string(p));
     for (int d = 0; d < 3; ++d) {
       if (!std::isfinite(targets[3 * p + d]))
         return Status::error("targets: point " + std::to_string(p) + " is not finite");
-      right(static_cast<Eigen::Index>(p), d) = targets[3 * p + d];
+      right(row, d) = targets[3 * p + d];
     }
-    if (!rational_basis(size, weights, local + 3 * p, basis.data()))
-      return Status::error("lattice: rational basis vanishes at point " + std::to_string(p));
-    for (size_t c = 0; c < controls; ++c) design(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(c)) = basis[c];
+    for (size_t c = 0; c < controls; ++c) {
+      design(row, static_cast<Eigen::Index>(c)) = basis[c];
+      if (prior != nullptr)  // the correction fits what the prior leaves
+        for (int d = 0; d < 3; ++d) right(row, d) -= basis[c] * prior[3 * c + d];
+    }
   }
-  // Least norm where the points leave control points free.
+  // Phase 2: regularisation rows on the correction Q: Q_{i-1} - 2 Q_i + Q_{i+1} along every
+  // line, then Q itself.
+  auto row = static_cast<Eigen::Index>(point_count);
+  if (smooth > 0.0) {
+    const size_t stride[3] = {size[1] * size[2], size[2], 1};
+    for (int axis = 0; axis < 3; ++axis) {
+      if (size[axis] < 3) continue;
+      for (size_t c = 0; c < controls; ++c) {
+        const size_t index = (c / stride[axis]) % size[axis];
+        if (index == 0 || index + 1 == size[axis]) continue;
+        design(row, static_cast<Eigen::Index>(c - stride[axis])) = smooth;
+        design(row, static_cast<Eigen::Index>(c)) = -2.0 * smooth;
+        design(row, static_cast<Eigen::Index>(c + stride[axis])) = smooth;
+        ++row;
+      }
+    }
+  }
+  if (ridge > 0.0)
+    for (size_t c = 0; c < controls; ++c, ++row) design(row, static_cast<Eigen::Index>(c)) = ridge;
+  // Phase 3: least squares, least norm where the system leaves freedom; P = prior + Q.
   const Eigen::MatrixXd solution = design.completeOrthogonalDecomposition().solve(right);
   for (size_t c = 0; c < controls; ++c)
-    for (int d = 0; d < 3; ++d) out_control_points[3 * c + d] = solution(static_cast<Eigen::Index>(c), d);
+    for (int d = 0; d < 3; ++d)
+      out_control_points[3 * c + d] = (prior ? prior[3 * c + d] : 0.0) + solution(static_cast<Eigen::Index>(c), d);
   return Status::success();
 }
 

@@ -232,28 +232,68 @@ TEST_CASE("a 2x2x2 lattice fitted to a trilinear field reproduces it; a 3x3x3 fi
   }
   const size_t two[3] = {2, 2, 2};
   std::vector<double> fitted(8 * 3);
-  REQUIRE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), count, fitted.data()).ok);
+  animlod::FfdFitOptions exact;
+  exact.smoothness = exact.ridge = 0.0;
+  REQUIRE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), count, nullptr, fitted.data(), exact).ok);
   LatticeView lattice;
   lattice.size[0] = lattice.size[1] = lattice.size[2] = 2;
   lattice.control_points = fitted.data();
   std::vector<float> back(local.size());
   REQUIRE(animlod::ffd_evaluate(lattice, local.data(), count, back.data()).ok);
   for (size_t q = 0; q < back.size(); ++q) CHECK(back[q] == doctest::Approx(targets[q]).epsilon(1e-5));
+  // With the default regularisation and the exact lattice as the prior, the fit stays exact.
+  const std::vector<double> prior = fitted;
+  REQUIRE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), count, prior.data(), fitted.data()).ok);
+  for (size_t q = 0; q < fitted.size(); ++q) CHECK(fitted[q] == doctest::Approx(prior[q]).epsilon(1e-6));
 
   // A quadratic field is not trilinear: the 2x2x2 fit leaves a residual, the 3x3x3 fit none.
   for (size_t p = 0; p < count; ++p) targets[3 * p] = float(local[3 * p] * local[3 * p]);
-  REQUIRE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), count, fitted.data()).ok);
+  REQUIRE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), count, nullptr, fitted.data()).ok);
   REQUIRE(animlod::ffd_evaluate(lattice, local.data(), count, back.data()).ok);
   double residual = 0.0;
   for (size_t p = 0; p < count; ++p) residual = std::max(residual, std::abs(double(back[3 * p]) - targets[3 * p]));
   CHECK(residual > 1e-2);
   const size_t three[3] = {3, 3, 3};
   std::vector<double> fitted3(27 * 3);
-  REQUIRE(animlod::ffd_fit(three, nullptr, local.data(), targets.data(), count, fitted3.data()).ok);
+  REQUIRE(animlod::ffd_fit(three, nullptr, local.data(), targets.data(), count, nullptr, fitted3.data(), exact).ok);
   LatticeView lattice3;
   lattice3.control_points = fitted3.data();
   REQUIRE(animlod::ffd_evaluate(lattice3, local.data(), count, back.data()).ok);
   for (size_t q = 0; q < back.size(); ++q) CHECK(back[q] == doctest::Approx(targets[q]).epsilon(1e-4));
+}
+
+TEST_CASE("ffd_fit regularisation keeps a thin region's lattice tame and still fits it") {
+  // 30 points in a slab 1e-4 thick: plain least squares is free to use huge control points
+  // that cancel at the points; the regularised fit is small and fits almost as well.
+  std::vector<float> local, targets;
+  for (int p = 0; p < 30; ++p) {
+    const float s = float(std::fmod(0.37 * p + 0.05, 1.0)), t = float(std::fmod(0.61 * p + 0.11, 1.0));
+    local.insert(local.end(), {s, t, 0.5f + 1e-4f * float(p % 3)});
+    // A smooth field plus 1e-3 of noise: plain least squares explains the noise with the slab's
+    // 1e-4 thickness, which takes control points of order 1e-3 / 1e-4 times the basis.
+    targets.insert(targets.end(), {0.0f, float(s * s + 0.3 * t * s), float(1e-3 * ((7 * p) % 5 - 2))});
+  }
+  const size_t three[3] = {3, 3, 3};
+  std::vector<double> tame(81), wild(81);
+  animlod::FfdFitOptions plain;
+  plain.smoothness = plain.ridge = 0.0;
+  REQUIRE(animlod::ffd_fit(three, nullptr, local.data(), targets.data(), 30, nullptr, wild.data(), plain).ok);
+  REQUIRE(animlod::ffd_fit(three, nullptr, local.data(), targets.data(), 30, nullptr, tame.data()).ok);
+  double largest_tame = 0.0, largest_wild = 0.0;
+  for (size_t q = 0; q < 81; ++q) {
+    largest_tame = std::max(largest_tame, std::abs(tame[q]));
+    largest_wild = std::max(largest_wild, std::abs(wild[q]));
+  }
+  CHECK(largest_tame < 2.0);
+  CHECK(largest_wild > 10.0 * largest_tame);
+  LatticeView lattice;
+  lattice.control_points = tame.data();
+  std::vector<float> back(local.size());
+  REQUIRE(animlod::ffd_evaluate(lattice, local.data(), 30, back.data()).ok);
+  for (size_t q = 0; q < back.size(); ++q) CHECK(back[q] == doctest::Approx(targets[q]).epsilon(0.02).scale(1.0));
+  animlod::FfdFitOptions negative;
+  negative.ridge = -1.0;
+  CHECK_FALSE(animlod::ffd_fit(three, nullptr, local.data(), targets.data(), 30, nullptr, tame.data(), negative).ok);
 }
 
 TEST_CASE("ffd_fit with points in a plane returns the least-norm solution, and rejects no points") {
@@ -264,7 +304,15 @@ TEST_CASE("ffd_fit with points in a plane returns the least-norm solution, and r
   }
   const size_t two[3] = {2, 2, 2};
   std::vector<double> fitted(24);
-  REQUIRE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), 12, fitted.data()).ok);
+  animlod::FfdFitOptions exact;
+  exact.smoothness = exact.ridge = 0.0;
+  REQUIRE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), 12, nullptr, fitted.data(), exact).ok);
   for (size_t c = 0; c < 8; ++c) CHECK(fitted[3 * c + 1] == doctest::Approx(1.0));  // least norm: equal halves
-  CHECK_FALSE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), 0, fitted.data()).ok);
+  CHECK_FALSE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), 0, nullptr, fitted.data()).ok);
+  // With the default ridge the free direction (P at u = 0 minus P at u = 1) keeps the prior's 3,
+  // and the determined one (their mean, 1) is fitted: 2.5 and -0.5.
+  std::vector<double> prior(24, 0.0);
+  for (size_t c = 0; c < 8; c += 2) prior[3 * c + 1] = 3.0;
+  REQUIRE(animlod::ffd_fit(two, nullptr, local.data(), targets.data(), 12, prior.data(), fitted.data()).ok);
+  for (size_t c = 0; c < 8; ++c) CHECK(fitted[3 * c + 1] == doctest::Approx(c % 2 == 0 ? 2.5 : -0.5).epsilon(1e-3));
 }

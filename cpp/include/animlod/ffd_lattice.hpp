@@ -82,18 +82,34 @@ Status ffd_evaluate(const LatticeView& lattice, const float* local, size_t point
 Status ffd_displace(const LatticeSetView& lattices, const float* rest, const float* local,
                     const int32_t* vertex_lattice, size_t vertex_count, float* out);
 
+// How ffd_fit regularises the correction Q = P - prior of the control points. Both weights are
+// relative to the data: a weight w stands for w * V / (l m n) (V points), the average weight a
+// control point gets from the data, so that well-determined control points barely feel them.
+struct FfdFitOptions {
+  // Squared second differences of Q along every lattice line (size >= 3): the correction is
+  // smooth. Trilinear corrections cost nothing, so a 2x2x2 fit is unaffected.
+  double smoothness = 1e-3;
+  // Squared Q: control points the points hardly determine (a thin region, an empty corner of
+  // the box) stay at the prior instead of taking huge values that cancel at the points.
+  double ridge = 1e-3;
+};
+
 // Least-squares fit of a lattice to target positions: the control points P (l m n, 3) that
-// minimise sum_v |X_P(local[v]) - target[v]|^2 for fixed weights (the FFD is linear in P). Used to
-// replace a region's 3x3x3 lattice by a 2x2x2 one at coarse levels (seeds/004, Section 4.2.2):
-// fit the 2x2x2 displacements to the 3x3x3 displacements at the region's vertices.
+// minimise sum_v |X_P(local[v]) - target[v]|^2 for fixed weights (the FFD is linear in P), plus
+// the regularisation of `options` on P - prior. Used to turn a displacement field into the
+// control displacements of an MPA (prior: the field at the control points), and to replace a
+// region's 3x3x3 lattice by a 2x2x2 one at coarse levels (seeds/004, Section 4.2.2; prior: the
+// 3x3x3 corners, which the volume interpolates).
 //
 // size: l, m, n in [2, 16]; weights (l m n,) > 0 or null; local (V, 3) float32, clamped to
-// [0, 1]; targets (V, 3) float32; out_control_points (l m n, 3) float64, caller-owned. When the
-// points do not determine every control point (fewer points than controls, or points in a
-// plane), the solution of least norm is returned (complete orthogonal decomposition).
-// Errors: a size outside [2, 16], no points, a bad weight, a non-finite local coordinate or
-// target (naming the point).
+// [0, 1]; targets (V, 3) float32; prior (l m n, 3) float64 or null for zeros;
+// out_control_points (l m n, 3) float64, caller-owned. Without regularisation (both weights 0),
+// where the points do not determine every control point the correction of least norm is
+// returned (complete orthogonal decomposition).
+// Errors: a size outside [2, 16], no points, a bad weight, a negative or non-finite
+// regularisation weight, a non-finite local coordinate, target or prior (naming the point).
 Status ffd_fit(const size_t size[3], const double* weights, const float* local, const float* targets,
-               size_t point_count, double* out_control_points);
+               size_t point_count, const double* prior, double* out_control_points,
+               const FfdFitOptions& options = {});
 
 }  // namespace animlod

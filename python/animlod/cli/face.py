@@ -30,7 +30,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--faces", type=int, nargs="+", help="triangle counts of the levels instead of --ratio")
     parser.add_argument("--targets", type=float, nargs="+", metavar="FRACTION",
                         help="blendshape faces: fraction of morph targets kept at each level, the full face included "
-                        "(default 1, 0.75, 0.5, 0.25, ...)")  # fmt: skip
+                        "(default: a level drops the targets that move the face less than its geometric error, and "
+                        "the coarsest level keeps none)")  # fmt: skip
     parser.add_argument("--neutral", help="pose folders: file name of the neutral face")
     parser.add_argument("--expression", help="expression (procedural face) or morph target to show with --plot")
     parser.add_argument("--plot", action="store_true", help="write a PNG of every level showing one expression")

@@ -6,12 +6,15 @@ plays in seeds/004: a unit of animation that can be skipped when it matters litt
 - **ranking**: a target's contribution is the largest displacement it ever causes, the largest
   weight the animation gives it times its largest vertex delta (asset units); targets are ranked
   by it, ties by index;
-- **pruning**: each level keeps its most important targets (a fraction of them), so fewer
-  targets are blended per frame further away; the coarsest level may keep none;
-- **geometry**: AQEM over the neutral face and the kept targets at their largest weights, with
-  region importance from regions grown from the targets' motion (moving 1, static lower), and
-  the kept targets' deltas carried through the collapses as attributes; vertices are placed on
-  the collapsed edge (``placement="on_edge"``) so that a vertex and its deltas describe one point.
+- **geometry**: one AQEM run over the neutral face and every target at its largest weight, with
+  region importance from regions grown from the targets' motion (moving 1, static lower), every
+  target's deltas carried through the collapses as attributes; vertices are placed on the
+  collapsed edge (``placement="on_edge"``) so that a vertex and its deltas describe one point;
+- **pruning**: a level drops the targets whose contribution is no more than its geometric error
+  (the Hausdorff distance between its neutral mesh and the full one): what they add is below
+  what the simplification already lost, as the lattice reduction of the region-animated face
+  (Figure 6). The coarsest level keeps no target ("when the model is far enough, no animation is
+  needed", Section 4.2.1). Explicit fractions of kept targets per level replace the rule.
 
 Shapes: ``V`` vertices, ``M`` faces, ``N`` targets, ``T`` animation frames.
 """
@@ -20,7 +23,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -122,6 +125,8 @@ class BlendshapeLevel:
     kept_vertices : (V',) int32 input vertex of each vertex.
     uvs : (V', 2) float32 or None.
     aqem_error : AQEM's error, asset units (0 at level 0).
+    geometric_error : Hausdorff distance between the level's neutral mesh and the input's,
+        asset units; targets contributing no more than this are pruned.
     """
 
     faces: np.ndarray
@@ -131,6 +136,7 @@ class BlendshapeLevel:
     kept_vertices: np.ndarray
     uvs: np.ndarray | None
     aqem_error: float
+    geometric_error: float = 0.0
 
     @property
     def triangle_count(self) -> int:
@@ -157,8 +163,9 @@ class BlendshapeLodOptions:
     ----------
     ratios : triangle fractions of the levels after the input (level 0).
     face_counts : the same as counts; replaces ``ratios``.
-    target_fractions : per level (the input included) the fraction of targets kept, rounded up;
-        default: 1 at level 0, then 3/4, 1/2, 1/4, ... of the targets.
+    target_fractions : per level (the input included) the fraction of targets kept, most
+        important first, rounded up; replaces the error rule.
+    animate_coarsest : keep the error rule at the coarsest level too, instead of no target.
     grow : how regions are grown from the targets' motion for the importance weights (None:
         every vertex has importance 1).
     """
@@ -166,7 +173,8 @@ class BlendshapeLodOptions:
     ratios: Sequence[float] = (0.5, 0.25, 0.1)
     face_counts: Sequence[int] | None = None
     target_fractions: Sequence[float] | None = None
-    grow: GrowOptions | None = None
+    animate_coarsest: bool = False
+    grow: GrowOptions | None = field(default_factory=GrowOptions)
 
 
 def target_contributions(face: BlendshapeFace) -> np.ndarray:
@@ -181,10 +189,6 @@ def rank_targets(face: BlendshapeFace) -> np.ndarray:
     return np.lexsort((np.arange(face.target_count), -target_contributions(face)))
 
 
-def default_target_fractions(level_count: int) -> list[float]:
-    return [1.0] + [max(0.0, 1.0 - 0.25 * level) for level in range(1, level_count)]
-
-
 def target_regions(face: BlendshapeFace, options: GrowOptions | None = None) -> FaceRegions:
     """Regions grown from the targets' motion (each region a set of vertices that the same
     targets move alike), groups "moving" and "static"."""
@@ -192,68 +196,86 @@ def target_regions(face: BlendshapeFace, options: GrowOptions | None = None) -> 
 
 
 def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | None = None) -> list[BlendshapeLevel]:
-    """Levels of ``face``, the input first: each with fewer triangles and fewer targets.
+    """Levels of ``face``, the input first: each with fewer triangles and no more targets.
 
     Raises ValueError for fractions of the wrong length or outside [0, 1] and whatever AQEM
     rejects (naming the element).
     """
+    from ..metrics import surface_error
+
     options = options or BlendshapeLodOptions()
     counts = (
         [int(c) for c in options.face_counts]
         if options.face_counts is not None
         else [max(4, round(r * len(face.faces))) for r in options.ratios]
     )
-    fractions = list(options.target_fractions or default_target_fractions(len(counts) + 1))
-    if len(fractions) != len(counts) + 1:
-        raise ValueError(f"target fractions: {len(fractions)} given for {len(counts) + 1} levels")
-    for index, fraction in enumerate(fractions):
-        if not 0.0 <= fraction <= 1.0:
-            raise ValueError(f"target fraction of level {index}: {fraction} is outside [0, 1]")
-    order = rank_targets(face)
-    kept_per_level = [np.sort(order[: int(np.ceil(f * face.target_count - 1e-9))]) for f in fractions]
+    fractions = None if options.target_fractions is None else list(options.target_fractions)
+    if fractions is not None:
+        if len(fractions) != len(counts) + 1:
+            raise ValueError(f"target fractions: {len(fractions)} given for {len(counts) + 1} levels")
+        for index, fraction in enumerate(fractions):
+            if not 0.0 <= fraction <= 1.0:
+                raise ValueError(f"target fraction of level {index}: {fraction} is outside [0, 1]")
+    everything = np.arange(face.target_count)
+    identity = np.arange(face.vertex_count, dtype=np.int32)
+    levels = [BlendshapeLevel(face.faces, face.neutral, face.targets, everything, identity, face.uvs, 0.0, 0.0)]
+    if not counts:
+        return levels
     importance = None
     if options.grow is not None and face.target_count and np.any(face.targets):
         importance = target_regions(face, options.grow).vertex_importance()
-    levels = [
-        BlendshapeLevel(face.faces, face.neutral, face.targets[kept_per_level[0]], kept_per_level[0],
-                        np.arange(face.vertex_count, dtype=np.int32), face.uvs, 0.0)
-    ]  # fmt: skip
-    for count, kept in zip(counts, kept_per_level[1:]):
-        levels.append(_simplified_level(face, count, kept, importance))
+    order, contributions = rank_targets(face), target_contributions(face)
+    full = AnimatedMesh(face.faces, face.neutral[None])
+    for index, level in enumerate(_simplified_levels(face, counts, importance), start=1):
+        rest = AnimatedMesh(level.faces, level.neutral[None])
+        level.geometric_error = float(surface_error(full, rest, samples=5000).hausdorff[0])
+        if fractions is not None:
+            kept = np.sort(order[: int(np.ceil(fractions[index] * face.target_count - 1e-9))])
+        elif index == len(counts) and not options.animate_coarsest:
+            kept = everything[:0]
+        else:
+            kept = everything[contributions > level.geometric_error]
+        level.kept_targets = kept
+        level.targets = np.ascontiguousarray(level.targets[kept])
+        levels.append(level)
     return levels
 
 
-def _simplified_level(
-    face: BlendshapeFace, face_count: int, kept: np.ndarray, importance: np.ndarray | None
-) -> BlendshapeLevel:
-    """AQEM over the neutral face and the kept targets at their largest weights, carrying UVs
-    and the kept deltas."""
-    largest = face.largest_weights()[kept]
-    frames = np.concatenate([face.neutral[None], face.neutral[None] + largest[:, None, None] * face.targets[kept]])
+def _simplified_levels(face: BlendshapeFace, counts: list[int], importance: np.ndarray | None) -> list[BlendshapeLevel]:
+    """One AQEM run over the neutral face and every target at its largest weight, carrying UVs
+    and every target's deltas; one level per count, every target still attached."""
+    largest = face.largest_weights()
+    frames = np.concatenate([face.neutral[None], face.neutral[None] + largest[:, None, None] * face.targets])
     columns = [np.zeros((face.vertex_count, 0), np.float32)]
     uv_width = 0 if face.uvs is None else 2
     if uv_width:
         columns.append(face.uvs)
-    columns.append(face.targets[kept].transpose(1, 0, 2).reshape(face.vertex_count, -1))
+    columns.append(face.targets.transpose(1, 0, 2).reshape(face.vertex_count, -1))
     result = simplify_animated(
         AnimatedMesh(face.faces, frames),
-        target_face_counts=[face_count],
+        target_face_counts=counts,
         importance=importance,
         attributes=np.concatenate(columns, axis=1),
         placement="on_edge",
     )
-    level = result.levels[0]
-    carried = level.attributes if level.attributes is not None else np.zeros((len(level.kept_vertices), 0), np.float32)
-    deltas = carried[:, uv_width:].reshape(len(level.kept_vertices), len(kept), 3).transpose(1, 0, 2)
-    return BlendshapeLevel(
-        faces=level.mesh.faces,
-        neutral=level.mesh.frames[0],
-        targets=np.ascontiguousarray(deltas),
-        kept_targets=kept,
-        kept_vertices=level.kept_vertices,
-        uvs=carried[:, :uv_width] if uv_width else None,
-        aqem_error=level.error,
-    )
+    levels = []
+    for level in result.levels:
+        kept = len(level.kept_vertices)
+        carried = level.attributes if level.attributes is not None else np.zeros((kept, 0), np.float32)
+        deltas = carried[:, uv_width:].reshape(kept, face.target_count, 3).transpose(1, 0, 2)
+        levels.append(
+            BlendshapeLevel(
+                faces=level.mesh.faces,
+                neutral=level.mesh.frames[0],
+                targets=np.ascontiguousarray(deltas),
+                kept_targets=np.arange(face.target_count),
+                kept_vertices=level.kept_vertices,
+                uvs=carried[:, :uv_width] if uv_width else None,
+                aqem_error=level.error,
+                geometric_error=0.0,
+            )
+        )
+    return levels
 
 
 @dataclass
@@ -312,7 +334,7 @@ def one_at_a_time(target_count: int, frames_each: int = 15) -> np.ndarray:
     """(T, N) weights that raise every target from 0 to 1 and back in turn (for faces given as
     poses, which have no animation of their own)."""
     per = max(3, frames_each)
-    envelope = np.sin(np.pi * np.arange(per) / (per - 1)) ** 2
+    envelope = 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(per) / (per - 1))  # sin^2, exact 0 at the ends
     weights = np.zeros((per * max(target_count, 1), target_count))
     for index in range(target_count):  # O(N) rows
         weights[index * per : (index + 1) * per, index] = envelope

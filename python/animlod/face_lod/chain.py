@@ -8,8 +8,9 @@
 - **animation levels** from the active tree (Section 4.2.1);
 - **deformation levels**: at geometry level g >= 1 a region's 3x3x3 lattice is replaced by the
   2x2x2 lattice fitted to it (Section 4.2.2) when what that loses is no more than the geometry
-  already lost there (the largest 2x2x2 fit error over the region's MPAs at intensity 1 is at
-  most the level's geometric error), or as listed explicitly;
+  already lost (the largest 2x2x2 fit error over the region's MPAs at intensity 1 is at most the
+  level's geometric error, the Hausdorff distance of its rest mesh to the full one), or as
+  listed explicitly;
 - the **dependency** of Figure 6: each geometry level has a finest animation level it allows;
 - and the error of every level in asset units, from which :mod:`.selection` derives screen
   coverage thresholds.
@@ -24,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..metrics import surface_error
 from ..model import AnimatedMesh
 from ..simplify import simplify_animated
 from .active_tree import ActiveTree
@@ -74,6 +76,8 @@ class GeometryLevel:
     regions : labels of the level (the input labels of the kept vertices).
     face_regions : (M',) int32 region of each face.
     aqem_error : AQEM's error of the level, asset units (0 for the full face).
+    geometric_error : Hausdorff distance between the level's rest mesh and the full face's,
+        asset units (0 for the full face).
     animation_floor : the finest active tree level this geometry allows.
     reduced : regions that use a 2x2x2 lattice at this level.
     """
@@ -84,6 +88,7 @@ class GeometryLevel:
     regions: FaceRegions
     face_regions: np.ndarray
     aqem_error: float
+    geometric_error: float
     animation_floor: int
     reduced: frozenset[str]
 
@@ -170,10 +175,15 @@ def build_face_lod(
     level_count = 1 + len(counts)
     floors = _floors(options.animation_floor, level_count, tree)
     reduction_error = _reduction_errors(rig)
-    reduced_sets = _reduced(options.reduced_lattices, level_count, rig, reduction_error, result)
+    rest = AnimatedMesh(rig.faces, rig.positions[None])
+    geometric = [0.0] + [
+        float(surface_error(rest, AnimatedMesh(level.mesh.faces, level.mesh.frames[:1]), samples=5000).hausdorff[0])
+        for level in result.levels
+    ]
+    reduced_sets = _reduced(options.reduced_lattices, rig, reduction_error, geometric)
     geometry = [
         GeometryLevel(rig.faces, rig.positions, np.arange(len(rig.positions), dtype=np.int32), rig.regions,
-                      rig.regions.face_regions(rig.faces), 0.0, floors[0], reduced_sets[0])
+                      rig.regions.face_regions(rig.faces), 0.0, 0.0, floors[0], reduced_sets[0])
     ]  # fmt: skip
     for index, level in enumerate(result.levels, start=1):
         labels = rig.regions.subset(level.kept_vertices)
@@ -185,6 +195,7 @@ def build_face_lod(
                 regions=labels,
                 face_regions=labels.face_regions(level.mesh.faces),
                 aqem_error=level.error,
+                geometric_error=geometric[index],
                 animation_floor=floors[index],
                 reduced=reduced_sets[index],
             )
@@ -223,16 +234,15 @@ def _reduction_errors(rig: FaceRig) -> dict[str, float]:
 
 
 def _reduced(
-    given: Sequence[Sequence[str]] | None, level_count: int, rig: FaceRig, errors: dict[str, float], result
+    given: Sequence[Sequence[str]] | None, rig: FaceRig, errors: dict[str, float], geometric: list[float]
 ) -> list[frozenset[str]]:
     if given is not None:
-        if len(given) != level_count:
-            raise ValueError(f"reduced lattices: {len(given)} region lists given for {level_count} geometry levels")
+        if len(given) != len(geometric):
+            raise ValueError(f"reduced lattices: {len(given)} region lists given for {len(geometric)} geometry levels")
         for index, names in enumerate(given):
             for name in names:
                 rig.regions.index(name, f"reduced lattices of geometry level {index}")
         return [frozenset(names) for names in given]
-    sets = [frozenset()]
-    for level in result.levels:
-        sets.append(frozenset(region for region, error in errors.items() if error <= level.error))
-    return sets
+    return [frozenset()] + [
+        frozenset(region for region, error in errors.items() if error <= tolerance) for tolerance in geometric[1:]
+    ]

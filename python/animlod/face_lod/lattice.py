@@ -84,13 +84,23 @@ def region_lattice(
 
 
 def fit_displacements(
-    local: np.ndarray, targets: np.ndarray, size: tuple[int, int, int], weights: np.ndarray | None = None
+    local: np.ndarray,
+    targets: np.ndarray,
+    size: tuple[int, int, int],
+    weights: np.ndarray | None = None,
+    prior: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Least-squares control displacements ``(l, m, n, 3)`` whose rational FFD best reproduces
-    the displacements ``targets (V, 3)`` at local coordinates ``local (V, 3)`` (core ``ffd_fit``)."""
+    """Control displacements ``(l, m, n, 3)`` whose rational FFD best reproduces the
+    displacements ``targets (V, 3)`` at local coordinates ``local (V, 3)``; control points the
+    vertices hardly determine stay near ``prior (l, m, n, 3)`` (core ``ffd_fit``, regularised)."""
     return _core.ffd_fit(
-        np.asarray(local, dtype=np.float32), np.asarray(targets, dtype=np.float32), list(size), weights
+        np.asarray(local, dtype=np.float32), np.asarray(targets, dtype=np.float32), list(size), weights, prior=prior
     )
+
+
+def corners(control_points: np.ndarray) -> np.ndarray:
+    """(2, 2, 2, 3) corner control points of a lattice: where its volume passes exactly."""
+    return np.ascontiguousarray(control_points[[0, -1]][:, [0, -1]][:, :, [0, -1]])
 
 
 def evaluate(local: np.ndarray, control_points: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:

@@ -10,7 +10,7 @@ Shapes: ``N`` MPAs, ``T`` animation frames, ``(l, m, n)`` control points per axi
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -101,36 +101,6 @@ def expression_sequence(
         raise ValueError("expression sequence: no expressions")
     per = max(3, round(seconds_each * fps))
     phase = np.arange(per) / (per - 1)
-    envelope = np.sin(np.pi * phase) ** 2  # 0 -> 1 -> 0, smooth at both ends
+    envelope = 0.5 - 0.5 * np.cos(2.0 * np.pi * phase)  # sin^2(pi x): 0 -> 1 -> 0, smooth, exact 0 at the ends
     rows = [envelope[:, None] * expression_intensities(expression, mpa_names)[None] for expression in expressions]
     return MpaAnimation(list(mpa_names), np.concatenate(rows), fps)
-
-
-def mpa_from_field(
-    name: str,
-    regions: Sequence[str],
-    field: Callable[[np.ndarray], np.ndarray],
-    region_points: Callable[[str], tuple[np.ndarray, np.ndarray]],
-    fit: Callable[[np.ndarray, np.ndarray, str], np.ndarray],
-    min_displacement: float = 0.0,
-) -> Mpa:
-    """An MPA whose control displacements reproduce a displacement ``field`` as well as each
-    region's lattice can (least squares over the region's vertices).
-
-    Parameters
-    ----------
-    name : MPA name.
-    regions : the regions it acts on.
-    field : ``field(points (V, 3)) -> (V, 3)`` displacement at intensity 1, asset units.
-    region_points : ``region_points(region) -> (positions (V, 3), local (V, 3))`` of a region.
-    fit : ``fit(local, targets, region) -> (l, m, n, 3)`` control displacements.
-    min_displacement : regions where the field never exceeds this (asset units) are left out.
-    """
-    displacements = {}
-    for region in regions:
-        points, local = region_points(region)
-        targets = np.asarray(field(points), dtype=np.float64)
-        if np.max(np.linalg.norm(targets, axis=1), initial=0.0) <= min_displacement:
-            continue
-        displacements[region] = fit(local, targets, region)
-    return Mpa(name, displacements)

@@ -19,7 +19,6 @@ import numpy as np
 
 from .blendshape import BlendshapeLodOptions, build_blendshape_lod, measure_blendshape_lod
 from .chain import FaceLodOptions, build_face_lod
-from .grow import GrowOptions
 from .measure import animation_errors, every_nth, measure_chain
 from .mpa import expression_intensities, expression_sequence
 from .procedural import procedural_face
@@ -116,14 +115,23 @@ def _run_procedural(output, ratios, face_counts, plot, expression, repeats, erro
                          100 * row.hausdorff, threshold])  # fmt: skip
         manifest.append({
             "files": [path.name], "triangles": row.triangles, "vertices": row.vertices, "error": row.hausdorff_units,
-            "screen_coverage": threshold, "animation_level": row.animation_level,
+            "screen_coverage": threshold, "animation_floor": level.animation_floor,
             "active_regions": sorted(chain.tree.active(row.animation_level)),
             "lattices": {name: "2x2x2" if name in level.reduced else "3x3x3" for name in animator.regions},
         })  # fmt: skip
     manifest_path = output / "face_lod.json"
     write_lod_manifest(manifest_path, "face", manifest)
     run.files.append(manifest_path)
+    # The active tree's levels with their own errors and thresholds: a runtime picks the animation
+    # level from the coverage too, then lowers it to the geometry level's floor (Figure 6).
     errors = animation_errors(chain, every_nth(animation, error_frames))
+    animation_thresholds = coverage_thresholds(errors, radius, Camera(), PIXEL_TOLERANCE)
+    tree_path = output / "face_lod_animation.json"
+    write_lod_manifest(tree_path, "face_animation", [
+        {"regions": sorted(chain.tree.active(k)), "error": error, "screen_coverage": threshold}
+        for k, (error, threshold) in enumerate(zip(errors, animation_thresholds))
+    ])  # fmt: skip
+    run.files.append(tree_path)
     run.notes.append(
         "active tree levels (regions animated, largest vertex error in asset units): "
         + "; ".join(f"{k}: {len(chain.tree.active(k))}, {e:.3g}" for k, e in enumerate(errors))
@@ -157,9 +165,12 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
         face = read_pose_face(source, neutral)
     else:
         raise ValueError(f"{source}: face LoD reads a .glb/.gltf with morph targets or a folder of OBJ/PLY poses")
-    options = BlendshapeLodOptions(face_counts=face_counts, target_fractions=target_fractions, grow=GrowOptions(),
+    options = BlendshapeLodOptions(face_counts=face_counts, target_fractions=target_fractions,
                                    **({"ratios": tuple(ratios)} if ratios else {}))  # fmt: skip
-    levels = build_blendshape_lod(face, options)
+    try:
+        levels = build_blendshape_lod(face, options)
+    except ValueError as error:
+        raise ValueError(f"{source}: {error}") from None
     measured = measure_blendshape_lod(face, levels, repeats=repeats, max_frames=error_frames, samples=10000)
     thresholds = coverage_thresholds([row.hausdorff_units for row in measured], _radius(face.neutral), Camera(),
                                      PIXEL_TOLERANCE)  # fmt: skip

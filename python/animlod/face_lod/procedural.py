@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from .. import synth
 from ..synth import face_mpa
 from .active_tree import ActiveTree
-from .mpa import Expression, mpa_from_field
+from .mpa import Expression
 from .regions import FaceRegions, region_groups
 from .rig import FaceRig
 
@@ -36,6 +36,6 @@ def procedural_face(seed: int = 0) -> ProceduralFace:
     regions = FaceRegions(model.region_names, labels, region_groups(model.region_names, face_mpa.REGION_GROUPS))
     rig = FaceRig(model.positions, model.faces, regions, lattice_weights=face_mpa.LATTICE_WEIGHTS)
     for name, (names, field) in face_mpa.mpa_fields(model).items():
-        rig.add_mpa(mpa_from_field(name, names, field, rig.region_points, rig.fit, min_displacement=1e-5))
+        rig.add_mpa(rig.mpa_from_field(name, names, field, min_displacement=1e-5))
     expressions = [Expression(name, dict(values)) for name, values in face_mpa.EXPRESSIONS.items()]
     return ProceduralFace(rig, expressions, ActiveTree(face_mpa.ACTIVE_TREE, regions))

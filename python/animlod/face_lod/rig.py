@@ -12,12 +12,12 @@ Shapes: ``V`` vertices of the full face, ``V'`` of a level, ``N`` MPAs, ``C`` co
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
 from .. import _core
-from .lattice import DEFAULT_SIZE, REDUCED_SIZE, RegionLattice, evaluate, fit_displacements, region_lattice
+from .lattice import DEFAULT_SIZE, REDUCED_SIZE, RegionLattice, corners, evaluate, fit_displacements, region_lattice
 from .mpa import Mpa
 from .regions import FaceRegions
 
@@ -99,11 +99,35 @@ class FaceRig:
         members = self.regions.vertex_regions == self.regions.index(region)
         return self.positions[members], self.local[members]
 
-    def fit(self, local: np.ndarray, targets: np.ndarray, region: str) -> np.ndarray:
-        """3x3x3 control displacements of ``region`` that best reproduce ``targets`` (for
-        :func:`~animlod.face_lod.mpa.mpa_from_field`)."""
-        lattice = self.lattices[region]
-        return fit_displacements(local, targets, lattice.size, lattice.weights)
+    def mpa_from_field(
+        self, name: str, regions: Sequence[str], field: Callable[[np.ndarray], np.ndarray],
+        min_displacement: float = 0.0,
+    ) -> Mpa:  # fmt: skip
+        """An MPA whose control displacements reproduce a displacement ``field`` as well as each
+        region's lattice can: least squares over the region's vertices, starting from the field
+        at the control points (where the vertices say little, the control points keep it).
+
+        Parameters
+        ----------
+        name : MPA name.
+        regions : the regions it acts on (ValueError naming the MPA for an unknown one).
+        field : ``field(points (V, 3)) -> (V, 3)`` displacement at intensity 1, asset units.
+        min_displacement : regions where the field never exceeds this (asset units) are left out.
+        """
+        displacements = {}
+        for region in regions:
+            self.regions.index(region, f"MPA {name!r}")
+            if region not in self.lattices:
+                raise ValueError(f"MPA {name!r}: region {region!r} has no vertex to move")
+            points, local = self.region_points(region)
+            targets = np.asarray(field(points.astype(np.float64)), dtype=np.float64)
+            if np.max(np.linalg.norm(targets, axis=1), initial=0.0) <= min_displacement:
+                continue
+            lattice = self.lattices[region]
+            controls = lattice.control_points()
+            prior = np.asarray(field(controls.reshape(-1, 3)), dtype=np.float64).reshape(controls.shape)
+            displacements[region] = fit_displacements(local, targets, lattice.size, lattice.weights, prior)
+        return Mpa(name, displacements)
 
     def reduced_displacements(self, mpa: int, region: str) -> np.ndarray:
         """(2, 2, 2, 3) displacements of a 2x2x2 lattice on ``region`` fitted by least squares to
@@ -112,8 +136,9 @@ class FaceRig:
         if key not in self._reduced:
             _, local = self.region_points(region)
             lattice = self.lattices[region]
-            moved = evaluate(local, self.mpas[mpa].displacements[region], lattice.weights)
-            self._reduced[key] = fit_displacements(local, moved, REDUCED_SIZE)
+            delta = self.mpas[mpa].displacements[region]
+            moved = evaluate(local, delta, lattice.weights)
+            self._reduced[key] = fit_displacements(local, moved, REDUCED_SIZE, prior=corners(delta))
         return self._reduced[key]
 
     def animator(

@@ -103,3 +103,21 @@ def skipped_frames(frame_count: int, step: int) -> np.ndarray:
     if step < 1:
         raise ValueError(f"frame step: must be at least 1, got {step}")
     return (np.arange(frame_count) // step) * step
+
+
+def select_face_levels(
+    coverage: float,
+    geometry_thresholds: Sequence[float],
+    animation_thresholds: Sequence[float],
+    animation_floors: Sequence[int],
+    full_rate_coverage: float = 0.25,
+    max_step: int = 4,
+) -> FaceSelection:
+    """Figure 6 at run time: the geometry level and the animation level from the face's
+    projected ``coverage``, the animation level lowered to the finest one the geometry level
+    allows (``animation_floors[g]``), and the frame step of frame skipping."""
+    if len(animation_floors) != len(geometry_thresholds):
+        raise ValueError(f"animation floors: {len(animation_floors)} for {len(geometry_thresholds)} geometry levels")
+    geometry = level_for_coverage(geometry_thresholds, coverage)
+    animation = max(level_for_coverage(animation_thresholds, coverage), int(animation_floors[geometry]))
+    return FaceSelection(geometry, animation, frame_step(coverage, full_rate_coverage, max_step), coverage)

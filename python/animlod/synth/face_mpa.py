@@ -76,11 +76,12 @@ EXPRESSIONS: dict[str, dict[str, float]] = {
 
 def animation_labels(face: FaceModel, max_rings: int = 3) -> np.ndarray:
     """(V,) int32 region labels of ``face`` for animation: ``face.vertex_regions`` with every scalp
-    vertex within ``max_rings`` mesh rings of a face-mask region given that region (the nearest
-    in rings; ties to the region listed first in ``REGION_NAMES``). The back of the head stays scalp."""
+    vertex of the front half (z > 0) within ``max_rings`` mesh rings of a face-mask region given
+    that region (the nearest in rings; ties to the region listed first in ``REGION_NAMES``). The
+    back of the head stays scalp."""
     names = face.region_names
     labels = face.vertex_regions.astype(np.int64)
-    scalp = labels == names.index("scalp")
+    scalp = (labels == names.index("scalp")) & (face.positions[:, 2] > 0.0)
     filled = np.isin(labels, [names.index(name) for name in _FILLED])
     edges = np.sort(face.faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
     edges = np.unique(edges, axis=0)

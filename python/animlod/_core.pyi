@@ -51,5 +51,9 @@ def simplify_animated(
     skin_weights: npt.ArrayLike | None = None,
     progress: Callable[[int, int], None] | None = None,
     placement: str = "optimal",
+    position_attributes: npt.ArrayLike | None = None,
+    face_groups: npt.ArrayLike | None = None,
+    weld: bool = True,
 ) -> dict[str, Any]:
-    """AQEM over all frames: {"levels": [...], "collapses": {...}, "frames_used", "vertex_weights"}."""
+    """AQEM over all frames, any topology: {"levels": [...], "collapses": {...}, "frames_used",
+    "vertex_weights", "preparation"}."""

@@ -323,8 +323,12 @@ class SkinnedMesh:
     def face_count(self) -> int:
         return int(self.faces.shape[0])
 
-    def bake(self, motion: Motion) -> AnimatedMesh:
-        """Linear blend skinning of every frame of ``motion`` in the C++ core."""
+    def bake(self, motion: Motion, morph_weights: np.ndarray | None = None) -> AnimatedMesh:
+        """Linear blend skinning of every frame of ``motion`` in the C++ core.
+
+        ``morph_weights (T, N)`` blends the morph targets into the rest pose of each frame first,
+        as glTF does (morphing before skinning).
+        """
         from ._core import bake_lbs
 
         if motion.skeleton.joint_count != self.skeleton.joint_count:
@@ -332,7 +336,18 @@ class SkinnedMesh:
                 f"motion has {motion.skeleton.joint_count} joints, the skin's skeleton {self.skeleton.joint_count}"
             )
         matrices = motion.skin_matrices(self.inverse_bind).astype(np.float32)
-        frames = bake_lbs(self.rest_positions, self.joints, self.weights, matrices)
+        if morph_weights is None or self.morph_targets is None:
+            frames = bake_lbs(self.rest_positions, self.joints, self.weights, matrices)
+            return AnimatedMesh(self.faces, frames, fps=motion.fps)
+        morph_weights = np.asarray(morph_weights, np.float64)
+        expected = (motion.frame_count, len(self.morph_targets))
+        _require(
+            morph_weights.shape == expected, f"morph_weights: expected shape {expected}, got {morph_weights.shape}"
+        )
+        frames = np.empty((motion.frame_count, self.vertex_count, 3), np.float32)
+        for t in range(motion.frame_count):  # O(T) calls, each a whole frame in C++
+            rest = self.rest_positions + np.einsum("n,nvc->vc", morph_weights[t], self.morph_targets)
+            frames[t] = bake_lbs(rest.astype(np.float32), self.joints, self.weights, matrices[t : t + 1])[0]
         return AnimatedMesh(self.faces, frames, fps=motion.fps)
 
 

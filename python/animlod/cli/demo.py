@@ -45,13 +45,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from .. import synth
+    from ..aqem import simplify_skinned
     from ..io.bvh import write_bvh
     from ..io.gltf import write_glb
     from ..io.manifest import write_lod_manifest
     from ..metrics import surface_error
     from ..model import AnimatedMesh, LodChain, LodLevel
     from ..motion_lod import build_motion_chain
-    from ..simplify import simplify_skinned
 
     output = Path(args.output)
     lines: list[str] = []

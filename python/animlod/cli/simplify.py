@@ -39,11 +39,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=None,
         help="optimal: Eq. 5 per frame (default for sequences); on_edge: one point of the edge (default for skins)",
     )
-    parser.add_argument(
-        "--repair",
-        action="store_true",
-        help="drop degenerate/duplicate faces and unreferenced vertices, split bow-tie vertices (not for skins)",
-    )
     parser.add_argument("--no-metrics", action="store_true", help="skip the Hausdorff/RMS measurement")
     parser.add_argument(
         "--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side"
@@ -82,12 +77,12 @@ def run(args: argparse.Namespace) -> int:
 
         original = read_sequence(args.input)
 
-    from ..simplify import simplify_animated
+    from ..aqem import simplify_animated
 
     start = time.perf_counter()
     progress = _ProgressBar("AQEM")
     try:
-        result = simplify_animated(original, args.ratio, progress=progress, repair=args.repair, **options)
+        result = simplify_animated(original, args.ratio, progress=progress, **options)
     finally:
         progress.close()
     elapsed = time.perf_counter() - start
@@ -103,11 +98,9 @@ def run(args: argparse.Namespace) -> int:
 
 def _simplify_skinned(args: argparse.Namespace, scene, output: Path, stem: str, options: dict) -> int:
     """Levels of the first skinned mesh over all the scene's animations, written as GLB."""
+    from ..aqem import simplify_skinned
     from ..io.gltf import write_glb
-    from ..simplify import simplify_skinned
 
-    if args.repair:
-        raise UserError("--repair: not available for skinned glTF meshes; repair the mesh in a DCC tool")
     skinned, motions = scene.skinned_meshes[0], scene.motions
     start = time.perf_counter()
     levels = simplify_skinned(skinned, motions, args.ratio, **options)
@@ -193,8 +186,8 @@ def _plot(path: Path, original: AnimatedMesh, levels: list[AnimatedMesh], show_f
     import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+    from ..aqem import motion_features
     from ..io.atomic import atomic_write
-    from ..simplify import motion_features
 
     frame = original.frame_count // 2
     red = np.zeros(original.face_count, dtype=bool)

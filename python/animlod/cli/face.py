@@ -36,6 +36,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--expression", help="expression (procedural face) or morph target to show with --plot")
     parser.add_argument("--plot", action="store_true", help="write a PNG of every level showing one expression")
     parser.add_argument("--repeats", type=int, default=3, help="timing runs per frame; the fastest is kept")
+    parser.add_argument("--error-frames", type=int, default=24,
+                        help="animation frames the surface error is measured on, evenly spaced (default 24)")
     parser.set_defaults(run=run)
 
 
@@ -46,6 +48,8 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("give --ratio or --faces, not both")
     if args.repeats < 1:
         raise UserError(f"--repeats: must be at least 1, got {args.repeats}")
+    if args.error_frames < 1:
+        raise UserError(f"--error-frames: must be at least 1, got {args.error_frames}")
     if args.input is None and (args.targets or args.neutral):
         raise UserError("--targets and --neutral apply to blendshape faces (give an INPUT)")
     result = run_face_lod(
@@ -58,6 +62,7 @@ def run(args: argparse.Namespace) -> int:
         plot=args.plot,
         expression=args.expression,
         repeats=args.repeats,
+        error_frames=args.error_frames,
     )
     for note in result.notes:
         print(note)

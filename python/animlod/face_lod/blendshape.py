@@ -27,8 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..aqem import simplify_animated
 from ..model import AnimatedMesh
-from ..simplify import simplify_animated
 from .grow import GrowOptions, grow_regions, motion_of_targets
 from .regions import FaceRegions
 
@@ -243,26 +243,24 @@ def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | N
 
 def _simplified_levels(face: BlendshapeFace, counts: list[int], importance: np.ndarray | None) -> list[BlendshapeLevel]:
     """One AQEM run over the neutral face and every target at its largest weight, carrying UVs
-    and every target's deltas; one level per count, every target still attached."""
+    (attributes: copies with other UVs form seams) and every target's deltas (position
+    attributes); one level per count, every target still attached."""
     largest = face.largest_weights()
     frames = np.concatenate([face.neutral[None], face.neutral[None] + largest[:, None, None] * face.targets])
-    columns = [np.zeros((face.vertex_count, 0), np.float32)]
-    uv_width = 0 if face.uvs is None else 2
-    if uv_width:
-        columns.append(face.uvs)
-    columns.append(face.targets.transpose(1, 0, 2).reshape(face.vertex_count, -1))
     result = simplify_animated(
         AnimatedMesh(face.faces, frames),
         target_face_counts=counts,
         importance=importance,
-        attributes=np.concatenate(columns, axis=1),
+        attributes=face.uvs,
+        position_attributes=face.targets.transpose(1, 0, 2).reshape(face.vertex_count, -1),
         placement="on_edge",
     )
     levels = []
     for level in result.levels:
         kept = len(level.kept_vertices)
-        carried = level.attributes if level.attributes is not None else np.zeros((kept, 0), np.float32)
-        deltas = carried[:, uv_width:].reshape(kept, face.target_count, 3).transpose(1, 0, 2)
+        carried = level.position_attributes
+        carried = np.zeros((kept, 0), np.float32) if carried is None else carried
+        deltas = carried.reshape(kept, face.target_count, 3).transpose(1, 0, 2)
         levels.append(
             BlendshapeLevel(
                 faces=level.mesh.faces,
@@ -270,7 +268,7 @@ def _simplified_levels(face: BlendshapeFace, counts: list[int], importance: np.n
                 targets=np.ascontiguousarray(deltas),
                 kept_targets=np.arange(face.target_count),
                 kept_vertices=level.kept_vertices,
-                uvs=carried[:, :uv_width] if uv_width else None,
+                uvs=level.attributes if face.uvs is not None else None,
                 aqem_error=level.error,
                 geometric_error=0.0,
             )

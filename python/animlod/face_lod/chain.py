@@ -25,9 +25,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..aqem import simplify_animated
 from ..metrics import surface_error
 from ..model import AnimatedMesh
-from ..simplify import simplify_animated
 from .active_tree import ActiveTree
 from .mpa import MpaAnimation
 from .regions import FaceRegions

@@ -39,7 +39,7 @@ class GrowOptions:
     region_count: int = 8
     static_fraction: float = 0.05
     min_vertices: int = 8
-    static_importance: float = 0.25
+    static_importance: float = 0.5
     iterations: int = 30
 
 

@@ -89,6 +89,13 @@ def _run_procedural(output, ratios, face_counts, plot, expression, repeats, erro
 
     face = procedural_face()
     rig = face.rig
+    chosen = None
+    if plot:  # a mistake in the name stops the run before the work
+        name = expression or "smile"
+        chosen = next((e for e in face.expressions if e.name == name), None)
+        if chosen is None:
+            raise ValueError(f"--expression: no expression {name!r}; the face has "
+                             f"{', '.join(e.name for e in face.expressions)}")  # fmt: skip
     animation = expression_sequence(face.expressions, rig.mpa_names)
     options = FaceLodOptions(face_counts=face_counts, **({"ratios": tuple(ratios)} if ratios else {}))
     chain = build_face_lod(rig, face.tree, animation, options)
@@ -136,19 +143,14 @@ def _run_procedural(output, ratios, face_counts, plot, expression, repeats, erro
         "active tree levels (regions animated, largest vertex error in asset units): "
         + "; ".join(f"{k}: {len(chain.tree.active(k))}, {e:.3g}" for k, e in enumerate(errors))
     )
-    if plot:
-        name = expression or "smile"
-        chosen = next((e for e in face.expressions if e.name == name), None)
-        if chosen is None:
-            raise ValueError(f"--expression: no expression {name!r}; the face has "
-                             f"{', '.join(e.name for e in face.expressions)}")  # fmt: skip
+    if chosen is not None:
         weights = expression_intensities(chosen, rig.mpa_names)
         panels = [
             (chain.animator(g).frame(weights), chain.geometry[g].faces, chain.geometry[g].face_regions,
              f"level {g}: {chain.geometry[g].triangle_count} triangles, {run.rows[g][3]} regions")
             for g in range(len(chain.geometry))
         ]  # fmt: skip
-        run.files.append(_plot(output / "face_lod.png", panels, f"procedural face, {name}"))
+        run.files.append(_plot(output / "face_lod.png", panels, f"procedural face, {chosen.name}"))
     return run
 
 
@@ -165,6 +167,7 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
         face = read_pose_face(source, neutral)
     else:
         raise ValueError(f"{source}: face LoD reads a .glb/.gltf with morph targets or a folder of OBJ/PLY poses")
+    plot_weights = _plot_weights(face, expression) if plot else None
     options = BlendshapeLodOptions(face_counts=face_counts, target_fractions=target_fractions,
                                    **({"ratios": tuple(ratios)} if ratios else {}))  # fmt: skip
     try:
@@ -197,10 +200,9 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
     manifest_path = output / f"{stem}_face_lod.json"
     write_lod_manifest(manifest_path, "blendshape_face", manifest)
     run.files.append(manifest_path)
-    if plot:
-        weights = _plot_weights(face, expression)
+    if plot_weights is not None:
         panels = [
-            (level.frame(weights), level.faces, None, f"level {i}: {level.triangle_count} triangles, "
+            (level.frame(plot_weights), level.faces, None, f"level {i}: {level.triangle_count} triangles, "
              f"{len(level.kept_targets)} targets")
             for i, level in enumerate(levels)
         ]  # fmt: skip

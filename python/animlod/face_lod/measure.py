@@ -38,6 +38,9 @@ class LevelMeasurement:
     max_frame_seconds, median_frame_seconds : time to animate one frame (MAT and typical).
     hausdorff : largest symmetric Hausdorff distance over the frames, fraction of the diagonal.
     hausdorff_units : the same in asset units.
+    focus_error : largest distance over the frames from the full face's vertices in the focus
+        regions (the mobile face mask, say) to the level's surface, fraction of the diagonal;
+        NaN when no focus was given.
     """
 
     geometry_level: int
@@ -51,6 +54,7 @@ class LevelMeasurement:
     median_frame_seconds: float
     hausdorff: float
     hausdorff_units: float
+    focus_error: float = float("nan")
 
 
 def time_frames(animator: LevelAnimator, intensities: np.ndarray, repeats: int = 5) -> np.ndarray:
@@ -87,10 +91,12 @@ def measure_level(
     repeats: int = 5,
     samples: int = 20000,
     error_frames: int = 0,
+    focus: np.ndarray | None = None,
 ) -> LevelMeasurement:
     """Measure one (geometry, animation) level pair: time over every frame of ``animation``,
     error over ``error_frames`` evenly spaced ones (0: all); ``reference`` is the full face
-    animated at full detail over those frames (computed when None)."""
+    animated at full detail over those frames (computed when None); ``focus (V,) bool`` marks the
+    full face's vertices whose distance to the level is reported as ``focus_error``."""
     sampled = every_nth(animation, error_frames)
     if reference is None:
         reference = animate(chain.animator(0, 0), chain.rig.faces, sampled)
@@ -98,8 +104,12 @@ def measure_level(
     animator = chain.animator(geometry_level, animation_level)
     level = chain.geometry[geometry_level]
     times = time_frames(animator, animation.intensities, repeats)
-    error = surface_error(reference, animate(animator, level.faces, sampled), samples=samples)
+    simplified = animate(animator, level.faces, sampled)
+    error = surface_error(reference, simplified, samples=samples)
     worst = int(np.argmax(error.hausdorff))
+    focus_error = float("nan")
+    if focus is not None:
+        focus_error = float(np.max(focus_distances(reference, simplified, focus) / error.diagonal))
     return LevelMeasurement(
         geometry_level=geometry_level,
         animation_level=animation_level,
@@ -112,7 +122,23 @@ def measure_level(
         median_frame_seconds=float(np.median(times)),
         hausdorff=float(error.relative_hausdorff[worst]),
         hausdorff_units=float(error.hausdorff[worst]),
+        focus_error=focus_error,
     )
+
+
+def focus_distances(reference: AnimatedMesh, simplified: AnimatedMesh, focus: np.ndarray) -> np.ndarray:
+    """(F,) per frame, the largest distance from ``reference``'s vertices where ``focus`` is True
+    to ``simplified``'s surface (libigl's AABB tree)."""
+    import igl
+
+    distances = np.empty(reference.frame_count)
+    for frame in range(reference.frame_count):  # O(F), vectorised inside
+        points = reference.frames[frame][focus].astype(np.float64)
+        squared = igl.point_mesh_squared_distance(
+            points, simplified.frames[frame].astype(np.float64), simplified.faces.astype(np.int64)
+        )[0]
+        distances[frame] = np.sqrt(squared.max(initial=0.0))
+    return distances
 
 
 def measure_chain(

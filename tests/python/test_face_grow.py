@@ -63,3 +63,14 @@ def test_regions_from_targets_and_a_face_that_does_not_move(head):
     assert len(regions.names) >= 2
     with pytest.raises(ValueError, match="no vertex moves"):
         grow_regions(np.zeros((len(model.positions), 6)), model.faces)
+
+
+def test_a_face_without_labels_is_offered_grown_ones(head):
+    from animlod.face_lod import FaceRig
+
+    model, animation = head
+    with pytest.raises(ValueError, match="no region labels.*grow_regions"):
+        FaceRig(model.positions, model.faces, None)
+    regions = grow_regions(motion_of_frames(animation.frames), model.faces)
+    rig = FaceRig(model.positions, model.faces, regions)  # the grown labels make a rig
+    assert set(rig.lattices) == set(regions.names)

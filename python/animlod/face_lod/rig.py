@@ -29,7 +29,8 @@ class FaceRig:
     ----------
     positions : (V, 3) rest positions, asset units.
     faces : (M, 3) int32 triangles.
-    regions : labels covering the V vertices.
+    regions : labels covering the V vertices (None is refused with a message offering labels
+        grown from the face's motion, :func:`animlod.face_lod.grow_regions`).
     mpas : the MPAs; each displacement array must match its region's lattice size.
     lattice_weights : region -> (3, 3, 3) rational weights (ones where not given).
     margin : lattice boxes are the regions' bounding boxes grown by this fraction.
@@ -42,13 +43,19 @@ class FaceRig:
         self,
         positions: np.ndarray,
         faces: np.ndarray,
-        regions: FaceRegions,
+        regions: FaceRegions | None,
         mpas: Sequence[Mpa] = (),
         lattice_weights: dict[str, np.ndarray] | None = None,
         margin: float = 0.05,
     ) -> None:
         self.positions = np.ascontiguousarray(positions, dtype=np.float32)
         self.faces = np.ascontiguousarray(faces, dtype=np.int32)
+        if regions is None:
+            raise ValueError(
+                "face has no region labels, and region-based animation needs them; grow labels from its motion "
+                "with animlod.face_lod.grow_regions(motion_of_frames(frames) or motion_of_targets(targets, "
+                "weights), faces)"
+            )
         regions.check_vertex_count(len(self.positions))
         self.regions = regions
         lattice_weights = lattice_weights or {}

@@ -298,6 +298,10 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   }
   out.seam_points = static_cast<size_t>(std::count_if(wedges_at_point.begin(), wedges_at_point.end(),
                                                       [](int32_t count) { return count > 1; }));
+  // Where three or more attribute charts meet, no collapse keeps every chart's corner: the
+  // point stays where it is (meshoptimizer's "complex" vertices), like a cut point.
+  for (size_t p = 0; p < wedges_at_point.size(); ++p)
+    if (wedges_at_point[p] > 2) out.point_split[p] = 1;
   out.corner_wedges.resize(corner_inputs.size());
   for (size_t c = 0; c < corner_inputs.size(); ++c) out.corner_wedges[c] = out.wedge_representative[corner_inputs[c]];
   return out;

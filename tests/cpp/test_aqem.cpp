@@ -426,6 +426,61 @@ TEST_CASE("aqem welds seam copies and keeps the seam") {
   CHECK(left == right);
 }
 
+TEST_CASE("aqem keeps a point where three or more attribute charts meet in place") {
+  // An open cone whose sides form three UV charts meeting at the apex. A rim vertex on a seam
+  // may collapse along its seam into the apex, but the apex must not move, as meshoptimizer's
+  // "complex" vertices do not: moved, it would drag every chart's corner (here down towards the
+  // rim, shortening the cone: the merged quadric's optimum).
+  const int sides = 9;
+  const double pi = 3.14159265358979323846;
+  OwnedAnimatedMesh mesh;
+  mesh.frame_count = 1;
+  std::vector<float> uvs;
+  // Apex copies first, one per chart, so that the apex is the kept end of its edges.
+  for (int chart = 0; chart < 3; ++chart) {
+    mesh.frames.insert(mesh.frames.end(), {0.0f, 0.0f, 2.0f});
+    uvs.insert(uvs.end(), {10.0f * chart, 1.0f});
+  }
+  // Rim vertices, one copy per chart that uses them.
+  std::vector<std::array<int32_t, 3>> rim(sides, {-1, -1, -1});
+  auto rim_vertex = [&](int i, int chart) {
+    int32_t& v = rim[i % sides][chart];
+    if (v < 0) {
+      v = static_cast<int32_t>(mesh.frames.size() / 3);
+      const double angle = 2 * pi * (i % sides) / sides;
+      mesh.frames.insert(mesh.frames.end(), {float(std::cos(angle)), float(std::sin(angle)), 0.0f});
+      uvs.insert(uvs.end(), {10.0f * chart + float(i % sides), 0.0f});
+    }
+    return v;
+  };
+  for (int i = 0; i < sides; ++i) {
+    const int chart = i / 3;
+    mesh.faces.insert(mesh.faces.end(), {rim_vertex(i, chart), rim_vertex(i + 1, chart), chart});
+  }
+  mesh.vertex_count = mesh.frames.size() / 3;
+  // Only the apex and the rim seam point between charts 0 and 1 may move; that rim point can
+  // only collapse along its seam, into the apex.
+  std::vector<uint8_t> locked(mesh.vertex_count, 1);
+  for (int32_t v : {0, 1, 2, rim[3][0], rim[3][1]}) locked[v] = 0;
+  AqemVertexData data;
+  data.attributes = uvs.data();
+  data.attribute_count = 2;
+  data.locked = locked.data();
+  AqemOptions options;
+  options.target_face_counts = {7};
+  const AqemResult result = simplify(mesh, options, data);
+  CHECK(result.preparation.seam_vertices == 4);  // the apex and the three rim seam points
+  const AqemLevel& level = result.levels[0];
+  CHECK(level.reached);
+  for (int32_t copy = 0; copy < 3; ++copy) {
+    const int32_t out = level.vertex_map[copy];
+    REQUIRE(out >= 0);
+    CHECK(level.positions[3 * out] == 0.0f);
+    CHECK(level.positions[3 * out + 1] == 0.0f);
+    CHECK(level.positions[3 * out + 2] == 2.0f);
+  }
+}
+
 TEST_CASE("aqem simplifies an unwelded (flat-shaded) mesh like the welded one") {
   const OwnedAnimatedMesh welded = animlod::testing::sphere(8, 10, 2);
   OwnedAnimatedMesh unwelded;

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .blendshape import BlendshapeLodOptions, build_blendshape_lod, measure_blendshape_lod
+from .blendshape import BlendshapeLodOptions, build_blendshape_lod, measure_blendshape_lod, target_regions
 from .chain import FaceLodOptions, build_face_lod
 from .measure import animation_errors, every_nth, measure_chain
 from .mpa import expression_intensities, expression_sequence
@@ -180,30 +180,34 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
     stem = input_stem(source)
     run = FaceRun(
         "blendshape",
-        ["level", "triangles", "vertices", "targets", "blend max (us)", "blend / level 0",
+        ["level", "triangles", "vertices", "targets", "blend max (us)", "blend median (us)", "median / level 0",
          "Hausdorff (% of diagonal)", "coverage >="],
         [],
         notes=[f"{source}: {face.vertex_count} vertices, {len(face.faces)} triangles, {face.target_count} targets, "
                f"{len(face.weights)} animation frames"],
     )  # fmt: skip
     manifest = []
-    base = measured[0].max_frame_seconds
+    base = measured[0].median_frame_seconds
     for level, row, threshold in zip(levels, measured, thresholds):
         path = output / f"{stem}_lod{row.level}.glb"
         names = [face.names[i] for i in level.kept_targets]
         _write_blendshape_glb(path, level.neutral, level.faces, level.targets, names, level.uvs)
         run.files.append(path)
         run.rows.append([row.level, row.triangles, row.vertices, row.targets, 1e6 * row.max_frame_seconds,
-                         row.max_frame_seconds / base if base else 0.0, 100 * row.hausdorff, threshold])  # fmt: skip
+                         1e6 * row.median_frame_seconds, row.median_frame_seconds / base if base else 0.0,
+                         100 * row.hausdorff, threshold])  # fmt: skip
         manifest.append({"files": [path.name], "triangles": row.triangles, "vertices": row.vertices,
                          "targets": names, "error": row.hausdorff_units, "screen_coverage": threshold})  # fmt: skip
     manifest_path = output / f"{stem}_face_lod.json"
     write_lod_manifest(manifest_path, "blendshape_face", manifest)
     run.files.append(manifest_path)
     if plot_weights is not None:
+        # Coloured by the regions grown from the targets' motion (the importance AQEM used).
+        regions = target_regions(face, options.grow) if options.grow and np.any(face.targets) else None
         panels = [
-            (level.frame(plot_weights), level.faces, None, f"level {i}: {level.triangle_count} triangles, "
-             f"{len(level.kept_targets)} targets")
+            (level.frame(plot_weights), level.faces,
+             None if regions is None else regions.subset(level.kept_vertices).face_regions(level.faces),
+             f"level {i}: {level.triangle_count} triangles, {len(level.kept_targets)} targets")
             for i, level in enumerate(levels)
         ]  # fmt: skip
         run.files.append(_plot(output / f"{stem}_face_lod.png", panels, f"{stem}"))
@@ -225,8 +229,9 @@ def _plot_weights(face, expression: str | None) -> np.ndarray:
 def _plot(path: Path, panels, title: str) -> Path:
     from .plots import Panel, plot_panels
 
+    dense = max(len(faces) for _, faces, _, _ in panels) > 20000  # a wireframe would hide the surface
     plot_panels(path, [[Panel(positions, faces, text, colours) for positions, faces, colours, text in panels]],
-                title=title)  # fmt: skip
+                title=title, wireframe=not dense)  # fmt: skip
     return path
 
 

@@ -49,7 +49,8 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
                               const std::optional<FloatArray>& skin_weights,
                               const std::optional<py::function>& progress, const std::string& placement,
                               const std::optional<FloatArray>& position_attributes,
-                              const std::optional<py::array>& face_group_indices, bool weld) {
+                              const std::optional<py::array>& face_group_indices, bool weld,
+                              const std::optional<MaskArray>& guarded) {
   require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
   const IndexArray faces = index_array(face_indices, "faces");
   require_shape(faces, "faces", {-1, 3}, "(M, 3)");
@@ -61,6 +62,10 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   if (locked) {
     require_shape(*locked, "locked", {vertex_count}, "(V,)");
     data.locked = locked->data();
+  }
+  if (guarded) {
+    require_shape(*guarded, "guarded", {vertex_count}, "(V,)");
+    data.guarded = guarded->data();
   }
   if (importance) {
     require_shape(*importance, "importance", {vertex_count}, "(V,)");
@@ -175,7 +180,7 @@ void bind_aqem(py::module_& m) {
         py::arg("importance") = py::none(), py::arg("attributes") = py::none(), py::arg("skin_joints") = py::none(),
         py::arg("skin_weights") = py::none(), py::arg("progress") = py::none(),
         py::arg("placement") = "optimal", py::arg("position_attributes") = py::none(),
-        py::arg("face_groups") = py::none(), py::arg("weld") = defaults.weld,
+        py::arg("face_groups") = py::none(), py::arg("weld") = defaults.weld, py::arg("guarded") = py::none(),
         R"doc(AQEM simplification of a deforming mesh over all its frames (Yang et al. 2019, Eqs. 1-7).
 
 Parameters
@@ -206,6 +211,7 @@ position_attributes : (V, B) float32 that follow the position (morph target delt
     only when they agree; blended once per collapse.
 face_groups : (M,) int32 material or primitive per face; group borders are seams.
 weld : weld copies of a position (equal in every frame, position_attributes and skin).
+guarded : (V,) bool, vertices kept in place until no other collapse is legal.
 
 Returns
 -------

@@ -408,6 +408,7 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
 
   detail::CarriedData carried;
   carried.locked = vertex_data.locked;
+  carried.guarded = vertex_data.guarded;
   carried.attributes = vertex_data.attributes;
   carried.attribute_count = vertex_data.attribute_count;
   carried.position_attributes = vertex_data.position_attributes;

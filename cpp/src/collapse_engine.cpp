@@ -26,10 +26,14 @@ CollapseEngine::CollapseEngine(const AnimatedMeshView& mesh, const PreparedMesh&
     for (size_t p = 0; p < point_count_; ++p)
       std::copy_n(mesh_.frames + (frame * mesh_.vertex_count + static_cast<size_t>(prepared_.point_source[p])) * 3, 3,
                   &positions_[(p * frame_count_ + frame) * 3]);
-  locked_.assign(prepared_.point_split.begin(), prepared_.point_split.end());
-  if (data_.locked)
-    for (size_t v = 0; v < mesh_.vertex_count; ++v)
-      if (data_.locked[v] && prepared_.wedge_point[v] >= 0) locked_[prepared_.wedge_point[v]] = 1;
+  locked_.resize(point_count_);
+  for (size_t p = 0; p < point_count_; ++p) locked_[p] = prepared_.point_split[p] ? kLocked : 0;
+  for (size_t v = 0; v < mesh_.vertex_count; ++v) {
+    const int32_t point = prepared_.wedge_point[v];
+    if (point < 0) continue;
+    if (data_.locked && data_.locked[v]) locked_[point] = kLocked;
+    else if (data_.guarded && data_.guarded[v] && locked_[point] == 0) locked_[point] = kGuarded;
+  }
   if (data_.attributes)
     attributes_.assign(data_.attributes, data_.attributes + mesh_.vertex_count * data_.attribute_count);
   auto gather_by_point = [&](const auto* source, size_t width, auto& destination) {
@@ -323,6 +327,20 @@ EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
   return level;
 }
 
+// Guarded points stay in place until nothing else can collapse; then they are released, and
+// their edges (including those between two guarded points) enter the heap. Returns whether
+// that put anything in the heap.
+bool CollapseEngine::release_guards(CollapsePolicy& policy) {
+  if (released_) return false;
+  released_ = true;
+  for (size_t p = 0; p < point_count_; ++p) {
+    if (locked_[p] != kGuarded) continue;
+    const auto vertex = connectivity_.vertex_handle(static_cast<int>(p));
+    if (!connectivity_.status(vertex).deleted()) rekey_around(policy, vertex, true);
+  }
+  return !heap_.empty();
+}
+
 void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
                          EngineRecord& record) {
   // Step 7: every collapsible edge into the heap.
@@ -350,7 +368,7 @@ void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targ
   };
   take_reached_levels();
   if (options_.progress) options_.progress(0, planned);
-  while (next_level < targets.size() && !heap_.empty()) {
+  while (next_level < targets.size() && (!heap_.empty() || release_guards(policy))) {
     const int32_t edge = heap_.top();
     const Candidate candidate = evaluate(policy, edge);
     policy.place(candidate, placed_);

@@ -50,6 +50,8 @@ class CollapsePolicy {
 // Per-vertex data the engine carries through collapses (all optional).
 struct CarriedData {
   const uint8_t* locked = nullptr;              // (V,) input vertices that never move
+  const uint8_t* guarded = nullptr;             // (V,) input vertices that stay in place while any
+                                                //      other collapse is legal
   const float* attributes = nullptr;            // (V, A) per wedge, interpolated with t
   size_t attribute_count = 0;
   const float* position_attributes = nullptr;   // (V, B) per point, interpolated with t
@@ -102,7 +104,7 @@ class CollapseEngine {
     const float* p = &positions_[(static_cast<size_t>(point) * frame_count_ + frame) * 3];
     return {p[0], p[1], p[2]};
   }
-  bool locked(int32_t point) const { return locked_[point] != 0; }
+  bool locked(int32_t point) const { return locked_[point] == kLocked || (locked_[point] == kGuarded && !released_); }
   // Sides (a, b, c) whose edge a-b must keep its shape, with c the third point of the face on
   // the other side: every boundary halfedge (in OpenMesh's halfedge order), then both sides of
   // every attribute-seam edge.
@@ -136,7 +138,10 @@ class CollapseEngine {
   const size_t frame_count_;
   const size_t point_count_;
   std::vector<float> positions_;            // (P, F, 3) current positions, contiguous per point
-  std::vector<uint8_t> locked_;             // (P,)
+  static constexpr uint8_t kLocked = 1, kGuarded = 2;
+  bool release_guards(CollapsePolicy& policy);
+  std::vector<uint8_t> locked_;             // (P,) 0, kLocked, or kGuarded (locked until released_)
+  bool released_ = false;                   // set once nothing but guarded points could collapse
   std::vector<float> attributes_;           // (V, A) by wedge (input vertex)
   std::vector<float> position_attributes_;  // (P, B)
   std::vector<int32_t> skin_joints_;        // (P, K)

@@ -54,6 +54,7 @@ def simplify_animated(
     position_attributes: npt.ArrayLike | None = None,
     face_groups: npt.ArrayLike | None = None,
     weld: bool = True,
+    guarded: npt.ArrayLike | None = None,
 ) -> dict[str, Any]:
     """AQEM over all frames, any topology: {"levels": [...], "collapses": {...}, "frames_used",
     "vertex_weights", "preparation"}."""

@@ -202,6 +202,7 @@ def simplify_animated(
     max_frames: int = 0,
     frame_subset: Sequence[int] | None = None,
     locked_vertices: Sequence[int] | np.ndarray | None = None,
+    guarded_vertices: Sequence[int] | np.ndarray | None = None,
     importance: np.ndarray | None = None,
     attributes: np.ndarray | None = None,
     position_attributes: np.ndarray | None = None,
@@ -232,6 +233,8 @@ def simplify_animated(
     max_frames : quadrics over K frames chosen by farthest-point sampling of the poses (0: all).
     frame_subset : explicit frames for the quadrics; replaces ``max_frames``.
     locked_vertices : indices of vertices that are never removed nor moved.
+    guarded_vertices : indices of vertices kept like locked ones until no other collapse is
+        legal, then free (sharp corners kept while the targets allow).
     importance : (V,) float32 > 0, multiplies each vertex's weight (e.g. face regions).
     attributes : (V, A) float32 per-vertex data interpolated along collapses (UVs, normals,
         colours). Copies of a position whose attributes differ form a seam that collapses only
@@ -257,15 +260,8 @@ def simplify_animated(
     ValueError naming the element: non-finite position, index out of range, a locked vertex
     index outside [0, V), target out of range, bad per-vertex data.
     """
-    locked = None
-    if locked_vertices is not None:
-        indices = np.asarray(locked_vertices, dtype=np.int64).ravel()
-        outside = (indices < 0) | (indices >= mesh.vertex_count)
-        if np.any(outside):
-            bad = int(indices[np.argmax(outside)])
-            raise ValueError(f"locked_vertices: vertex {bad} outside [0, {mesh.vertex_count})")
-        locked = np.zeros(mesh.vertex_count, dtype=bool)
-        locked[indices] = True
+    locked = _vertex_mask("locked_vertices", locked_vertices, mesh.vertex_count)
+    guarded = _vertex_mask("guarded_vertices", guarded_vertices, mesh.vertex_count)
     raw = _core.simplify_animated(
         mesh.frames,
         mesh.faces,
@@ -291,6 +287,7 @@ def simplify_animated(
         position_attributes=position_attributes,
         face_groups=face_groups,
         weld=weld,
+        guarded=guarded,
     )
     return _result(raw, mesh.fps)
 
@@ -374,6 +371,19 @@ def simplify_skinned(
             )
         )
     return levels
+
+
+def _vertex_mask(name: str, indices: Sequence[int] | np.ndarray | None, vertex_count: int) -> np.ndarray | None:
+    """(V,) bool with the listed vertices set; ValueError naming an index outside [0, V)."""
+    if indices is None:
+        return None
+    indices = np.asarray(indices, dtype=np.int64).ravel()
+    outside = (indices < 0) | (indices >= vertex_count)
+    if np.any(outside):
+        raise ValueError(f"{name}: vertex {int(indices[np.argmax(outside)])} outside [0, {vertex_count})")
+    mask = np.zeros(vertex_count, dtype=bool)
+    mask[indices] = True
+    return mask
 
 
 def _largest_distance(a: np.ndarray, b: np.ndarray) -> float:

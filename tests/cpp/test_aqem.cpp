@@ -481,6 +481,37 @@ TEST_CASE("aqem keeps a point where three or more attribute charts meet in place
   }
 }
 
+TEST_CASE("aqem keeps guarded vertices while other collapses remain, then frees them") {
+  // A sphere with every fifth vertex guarded: at half the faces the others can give way, so the
+  // guarded ones stay where they were; far below what the others can give, they must go too.
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(8, 10, 2);  // 72 vertices, 140 faces
+  std::vector<uint8_t> guarded(mesh.vertex_count, 0);
+  for (size_t v = 0; v < mesh.vertex_count; v += 5) guarded[v] = 1;
+  auto guarded_kept = [&](const AqemResult& result, size_t level_index) {
+    const AqemLevel& level = result.levels[level_index];
+    size_t kept = 0;
+    for (size_t v = 0; v < mesh.vertex_count; ++v) {
+      if (!guarded[v]) continue;
+      const int32_t out = level.vertex_map[v];
+      bool same = level.kept_vertices[out] == static_cast<int32_t>(v);
+      for (int axis = 0; axis < 3; ++axis) same &= level.positions[3 * out + axis] == mesh.frames[3 * v + axis];
+      kept += same;
+    }
+    return kept;
+  };
+  const size_t guarded_count = static_cast<size_t>(std::count(guarded.begin(), guarded.end(), 1));
+  AqemOptions options;
+  options.target_face_counts = {70, 8};
+  AqemVertexData data;
+  data.guarded = guarded.data();
+  const AqemResult with_guards = simplify(mesh, options, data);
+  CHECK(guarded_kept(with_guards, 0) == guarded_count);
+  CHECK(with_guards.levels[1].reached);
+  CHECK(guarded_kept(with_guards, 1) < guarded_count);
+  const AqemResult control = simplify(mesh, options);  // the same run without guards moves some
+  CHECK(guarded_kept(control, 0) < guarded_count);
+}
+
 TEST_CASE("aqem simplifies an unwelded (flat-shaded) mesh like the welded one") {
   const OwnedAnimatedMesh welded = animlod::testing::sphere(8, 10, 2);
   OwnedAnimatedMesh unwelded;

@@ -98,6 +98,9 @@ struct AqemVertexData {
   const int32_t* face_groups = nullptr;   // (M,) material or primitive of each face: copies of a
                                           //      position in different groups never merge, so
                                           //      group borders are seams
+  const uint8_t* guarded = nullptr;       // (V,) nonzero: the vertex stays in place (like locked)
+                                          //      until no other collapse is legal, then it is free
+                                          //      (sharp corners kept while the targets allow)
 };
 
 struct AqemLevel {

@@ -35,6 +35,8 @@ _COMPONENT_TYPES = {
 _ACCESSOR_TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
 _IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".webp": "image/webp"}
 _GLB_MAGIC, _GLB_VERSION = b"glTF", 2
+# Extensions known not to refer to accessors or buffer views from places prune() does not scan.
+_PRUNE_SAFE_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_mesh_quantization", "MSFT_lod")
 _JSON_CHUNK, _BIN_CHUNK = 0x4E4F534A, 0x004E4942
 
 
@@ -101,6 +103,45 @@ class GlbBuilder:
             accessor["max"] = values.max(axis=0).tolist()
         return self.append("accessors", accessor)
 
+    def prune(self) -> None:
+        """Drops meshes no node draws; then, when no extension could refer to them unseen, the
+        accessors and buffer views nothing refers to, and repacks the binary chunk."""
+        js = self.json
+        nodes = js.get("nodes", [])
+        kept_meshes = sorted({node["mesh"] for node in nodes if "mesh" in node})
+        new_mesh = {old: new for new, old in enumerate(kept_meshes)}
+        for node in nodes:
+            if "mesh" in node:
+                node["mesh"] = new_mesh[node["mesh"]]
+        if "meshes" in js:
+            js["meshes"] = [js["meshes"][old] for old in kept_meshes]
+        if any(not name.startswith(_PRUNE_SAFE_EXTENSIONS) for name in js.get("extensionsUsed", [])):
+            return
+        accessor_refs = list(_accessor_references(js))
+        kept_accessors = sorted({holder[key] for holder, key in accessor_refs})
+        new_accessor = {old: new for new, old in enumerate(kept_accessors)}
+        for holder, key in accessor_refs:
+            holder[key] = new_accessor[holder[key]]
+        js["accessors"] = [js["accessors"][old] for old in kept_accessors]
+        view_refs = [(a, "bufferView") for a in js["accessors"] if "bufferView" in a]
+        for accessor in js["accessors"]:
+            sparse = accessor.get("sparse", {})
+            view_refs += [(sparse[part], "bufferView") for part in ("indices", "values") if part in sparse]
+        view_refs += [(image, "bufferView") for image in js.get("images", []) if "bufferView" in image]
+        kept_views = sorted({holder[key] for holder, key in view_refs})
+        old_views, old_blob = js.get("bufferViews", []), bytes(self.blob)
+        self.blob = bytearray()
+        new_views = []
+        for old in kept_views:
+            view = dict(old_views[old])
+            start = view.get("byteOffset", 0)
+            view["byteOffset"] = self._append(old_blob[start : start + view["byteLength"]])
+            new_views.append(view)
+        new_view = {old: new for new, old in enumerate(kept_views)}
+        for holder, key in view_refs:
+            holder[key] = new_view[holder[key]]
+        js["bufferViews"] = new_views
+
     def add_extension_used(self, name: str) -> None:
         used = self.json.setdefault("extensionsUsed", [])
         if name not in used:
@@ -125,6 +166,25 @@ class GlbBuilder:
         data = self.to_bytes()
         with atomic_write(path, "wb") as handle:
             handle.write(data)
+
+
+def _accessor_references(js: dict):
+    """(holder, key) of every accessor index the core glTF 2.0 schema places."""
+    for mesh in js.get("meshes", []):
+        for primitive in mesh.get("primitives", []):
+            attributes = primitive.get("attributes", {})
+            yield from ((attributes, name) for name in attributes)
+            if "indices" in primitive:
+                yield primitive, "indices"
+            for target in primitive.get("targets", []):
+                yield from ((target, name) for name in target)
+    for skin in js.get("skins", []):
+        if "inverseBindMatrices" in skin:
+            yield skin, "inverseBindMatrices"
+    for animation in js.get("animations", []):
+        for sampler in animation.get("samplers", []):
+            yield sampler, "input"
+            yield sampler, "output"
 
 
 def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | None]:

@@ -86,11 +86,11 @@ class Drawable:
         return transform_points(self.world, self.geometry.positions).astype(np.float32)
 
     def clip_frames(self, clip: Clip, frames: np.ndarray | None = None) -> np.ndarray:
-        """(T', 3) world positions of the drawable in the given frames of ``clip`` (all when None)."""
+        """(T', V, 3) world positions of the drawable in the given frames of ``clip`` (all when None)."""
         frames = np.arange(clip.frame_count) if frames is None else np.asarray(frames)
         weights = None if clip.morph_weights is None else clip.morph_weights[frames]
         if self.skinned is not None:
-            motion = _motion_frames(clip.motion, frames)
+            motion = motion_frames(clip.motion, frames)
             return self.skinned.bake(motion, weights).frames
         rest = self.rest_positions().astype(np.float64)
         if weights is None:
@@ -163,7 +163,7 @@ def _rest_motion(rig: SkinRig, frame_count: int, fps: float) -> Motion:
     )
 
 
-def _motion_frames(motion: Motion, frames: np.ndarray) -> Motion:
+def motion_frames(motion: Motion, frames: np.ndarray) -> Motion:
     """``motion`` restricted to the given frame indices."""
     translations = None if motion.joint_translations is None else motion.joint_translations[frames]
     return Motion(

@@ -22,7 +22,9 @@ Run: ``.venv/bin/python bench/bench_face.py [--quick]``. Tables:
 4. Blendshape faces: the face-pose scans (neutral + 3 expressions, 57,836 triangles) and every
    morph-target glTF of ../shared/data: per level, triangles, targets kept, the largest and the
    median time to blend a frame (numpy), the median's ratio to level 0, and the Hausdorff error
-   over the animation.
+   over the animation. glTF faces twice: levels from the whole-document pipeline (every
+   primitive, attribute and normal kept; what ``animlod face`` writes) and from face_lod's own
+   AQEM run over the neutral face and targets with UVs only, as a peer.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from table import print_table, stopwatch
 
 from animlod.face_lod import FaceLodOptions, build_blendshape_lod, build_face_lod, expression_sequence, procedural_face
 from animlod.face_lod.blendshape import measure_blendshape_lod
+from animlod.face_lod.lod_glb import gltf_face_levels, read_gltf_face
 from animlod.face_lod.measure import animate, animation_errors, every_nth, measure_level, time_frames
 from animlod.face_lod.selection import (
     Camera,
@@ -47,7 +50,7 @@ from animlod.face_lod.selection import (
     select_face_levels,
     skipped_frames,
 )
-from animlod.face_lod.sources import read_gltf_face, read_pose_face
+from animlod.face_lod.sources import read_pose_face
 from animlod.metrics import surface_error
 
 MORPH_FILES = ["morph/Parrot.glb", "morph/Stork.glb", "morph/MorphStressTest.gltf",
@@ -146,31 +149,39 @@ def selection(chain, animation, repeats: int, error_frames: int):
 
 
 def blendshape_faces(repeats: int, error_frames: int, quick: bool):
-    faces = []
+    """Pose scans through face_lod's own AQEM run; glTF faces through the whole-document pipeline
+    (what the CLI writes) and, as a peer, through face_lod's own run (neutral + targets + UVs)."""
+    cases = []
     poses = DATA_DIR / "meshseq" / "face-poses"
     if poses.is_dir():
-        faces.append(("face-poses (neutral face-poses.obj)", lambda: read_pose_face(poses, neutral="face-poses.obj")))
+        label = "face-poses (neutral face-poses.obj)"
+        cases.append((label, "own AQEM", lambda: read_pose_face(poses, "face-poses.obj")))
     for name in MORPH_FILES[: 1 if quick else None]:
         if (DATA_DIR / name).exists():
-            faces.append((Path(name).name, lambda name=name: read_gltf_face(DATA_DIR / name)))
-    if not faces:
+            cases.append((Path(name).name, "document", lambda name=name: read_gltf_face(DATA_DIR / name)))
+            cases.append((Path(name).name, "own AQEM", lambda name=name: read_gltf_face(DATA_DIR / name).face))
+    if not cases:
         print(f"\n(blendshape faces skipped: no development data at {DATA_DIR})")
         return
     rows = []
-    for label, read in faces:
-        face = read()
+    for label, path, read in cases:
+        source = read()
         with stopwatch() as built:
-            levels = build_blendshape_lod(face)
+            if path == "document":
+                face, levels = source.face, gltf_face_levels(source).levels
+            else:
+                face, levels = source, build_blendshape_lod(source)
         measured = measure_blendshape_lod(face, levels, repeats=repeats, max_frames=error_frames)
         base = measured[0].median_frame_seconds
         for row in measured:
-            rows.append([label if row.level == 0 else "", row.level, row.triangles, row.vertices,
+            first = row.level == 0
+            rows.append([label if first else "", path if first else "", row.level, row.triangles, row.vertices,
                          f"{row.targets}/{face.target_count}", 1e6 * row.max_frame_seconds,
                          1e6 * row.median_frame_seconds, row.median_frame_seconds / base, 100 * row.hausdorff,
-                         f"{built[0]:.2f}" if row.level == 0 else ""])  # fmt: skip
+                         f"{built[0]:.2f}" if first else ""])  # fmt: skip
     print_table(
         "Blendshape faces: levels with targets pruned by geometric error (none at the coarsest), blended with numpy",
-        ["face", "level", "triangles", "vertices", "targets", "blend max (us)", "blend median (us)",
+        ["face", "levels by", "level", "triangles", "vertices", "targets", "blend max (us)", "blend median (us)",
          "median / level 0", "Hausdorff (% diag)", "build (s)"],
         rows,
     )  # fmt: skip

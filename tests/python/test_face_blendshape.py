@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+import pygltflib
 import pytest
 
 from animlod.face_lod import BlendshapeFace, BlendshapeLodOptions, build_blendshape_lod, procedural_face, rank_targets
 from animlod.face_lod.blendshape import measure_blendshape_lod, target_contributions
+from animlod.face_lod.lod_glb import gltf_face_levels, read_gltf_face, write_gltf_face_lod
 from animlod.face_lod.mpa import expression_sequence
-from animlod.face_lod.sources import pose_files, read_gltf_face, read_pose_face
+from animlod.face_lod.sources import pose_files, read_pose_face
 from animlod.io import write_obj
 from animlod.io.errors import FormatError
 
@@ -102,7 +104,7 @@ MORPH_FILES = ["morph/Parrot.glb", "morph/Stork.glb", "morph/MorphStressTest.glt
 
 @pytest.mark.parametrize("name", MORPH_FILES)
 def test_every_morph_target_file_gets_levels(data_dir, name):
-    face = read_gltf_face(data_dir / name)
+    face = read_gltf_face(data_dir / name).face
     assert face.target_count > 0 and len(face.weights) > 1
     levels = build_blendshape_lod(face)
     counts = [level.triangle_count for level in levels]
@@ -115,6 +117,35 @@ def test_every_morph_target_file_gets_levels(data_dir, name):
     # A level keeping every target blends to the same silhouette as the input, within its error.
     rows = measure_blendshape_lod(face, levels[:2], repeats=1, max_frames=6, samples=2000)
     assert rows[1].hausdorff < 0.2
+
+
+@pytest.mark.parametrize("name", MORPH_FILES)
+def test_every_morph_target_file_as_one_lod_glb(data_dir, tmp_path, name):
+    source = read_gltf_face(data_dir / name)
+    levels = gltf_face_levels(source)
+    face = source.face
+    contributions = target_contributions(face)
+    for level in levels.levels[1:-1]:
+        assert level.kept_targets.tolist() == np.flatnonzero(contributions > level.geometric_error).tolist()
+    assert levels.levels[-1].kept_targets.size == 0  # the coarsest level animates nothing
+    errors = [0.0] + [1.0 + level.geometric_error for level in levels.levels[1:]]
+    coverages = [0.5 / (1 + index) for index in range(len(levels.levels) - 1)] + [0.0]
+    path = tmp_path / "face_lod.glb"
+    write_gltf_face_lod(path, source, levels, errors, coverages)
+    glb = pygltflib.GLTF2().load(str(path))
+    assert "MSFT_lod" in glb.extensionsUsed
+    base = source.drawable.nodes[0]
+    ids = glb.nodes[base].extensions["MSFT_lod"]["ids"]
+    assert len(ids) == len(levels.levels) - 1
+    assert glb.nodes[base].extras["MSFT_screencoverage"] == coverages
+    base_mesh = glb.meshes[glb.nodes[base].mesh]
+    for node, level in zip(ids, levels.levels[1:]):
+        mesh = glb.meshes[glb.nodes[node].mesh]
+        # Every level keeps every target slot, so the base node's morph-weight clip drives it.
+        assert [len(p.targets) for p in mesh.primitives] == [len(p.targets) for p in base_mesh.primitives]
+        assert glb.nodes[node].extras["animlod"]["targets"] == level.kept_targets.tolist()
+        assert glb.nodes[node].extras["animlod"]["triangles"] == level.triangle_count
+    assert len(glb.animations) == len(source.doc.gltf.animations)  # the input's clips are kept
 
 
 def test_the_face_pose_scans_as_a_blendshape_face(data_dir):

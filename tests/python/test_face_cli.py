@@ -25,9 +25,16 @@ def test_face_procedural_writes_levels_manifest_and_plot(tmp_path, capsys):
     assert "2x2x2" in levels[1]["lattices"].values()
     tree = json.loads((out / "face_lod_animation.json").read_text())["levels"]
     assert tree[-1]["regions"] == [] and len(tree[0]["regions"]) > len(tree[1]["regions"])
-    # Each level is a GLB with one morph target per MPA (zero where the level skips the MPA).
-    glb = pygltflib.GLTF2().load(str(out / "face_lod1.glb"))
+    # One LoD GLB: the face with one morph target per MPA and the expressions as a weights clip,
+    # its levels attached by MSFT_lod (MPAs a level skips are zero targets there).
+    glb = pygltflib.GLTF2().load(str(out / "face_lod.glb"))
+    base = glb.nodes[glb.scenes[0].nodes[0]]
+    assert len(base.extensions["MSFT_lod"]["ids"]) == len(levels) - 1
+    assert base.extras["MSFT_screencoverage"] == [level["screen_coverage"] for level in levels]
     assert len(glb.meshes[0].primitives[0].targets) == len(glb.meshes[0].extras["targetNames"]) >= 12
+    assert glb.animations[0].channels[0].target.path == "weights"
+    coarsest = glb.nodes[base.extensions["MSFT_lod"]["ids"][-1]]
+    assert coarsest.extras["animlod"]["targets"] == []
     png = (out / "face_lod.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10000
     assert not list(out.glob(".*.part"))
@@ -46,7 +53,7 @@ def test_face_pose_folder(tmp_path, capsys):
     arguments = ["face", str(poses), "-o", out, "--ratio", "0.5", "--repeats", "1", "--error-frames", "4"]
     assert main(arguments) == 0
     printed = capsys.readouterr().out
-    assert "1 targets" in printed and "poses_lod1.glb" in printed
+    assert "1 targets" in printed and "poses_lod.glb" in printed
     manifest = json.loads((tmp_path / "out" / "poses_face_lod.json").read_text())
     assert [level["targets"] for level in manifest["levels"]] == [["bulge"], []]
 

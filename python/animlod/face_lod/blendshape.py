@@ -201,21 +201,13 @@ def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | N
     Raises ValueError for fractions of the wrong length or outside [0, 1] and whatever AQEM
     rejects (naming the element).
     """
-    from ..metrics import surface_error
-
     options = options or BlendshapeLodOptions()
     counts = (
         [int(c) for c in options.face_counts]
         if options.face_counts is not None
         else [max(4, round(r * len(face.faces))) for r in options.ratios]
     )
-    fractions = None if options.target_fractions is None else list(options.target_fractions)
-    if fractions is not None:
-        if len(fractions) != len(counts) + 1:
-            raise ValueError(f"target fractions: {len(fractions)} given for {len(counts) + 1} levels")
-        for index, fraction in enumerate(fractions):
-            if not 0.0 <= fraction <= 1.0:
-                raise ValueError(f"target fraction of level {index}: {fraction} is outside [0, 1]")
+    check_fractions(options.target_fractions, len(counts) + 1)
     everything = np.arange(face.target_count)
     identity = np.arange(face.vertex_count, dtype=np.int32)
     levels = [BlendshapeLevel(face.faces, face.neutral, face.targets, everything, identity, face.uvs, 0.0, 0.0)]
@@ -224,21 +216,44 @@ def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | N
     importance = None
     if options.grow is not None and face.target_count and np.any(face.targets):
         importance = target_regions(face, options.grow).vertex_importance()
+    levels += _simplified_levels(face, counts, importance)
+    prune_levels(face, levels, options)
+    return levels
+
+
+def check_fractions(fractions: Sequence[float] | None, level_count: int) -> None:
+    """ValueError unless ``fractions`` is None or one value in [0, 1] per level."""
+    if fractions is None:
+        return
+    if len(fractions) != level_count:
+        raise ValueError(f"target fractions: {len(fractions)} given for {level_count} levels")
+    for index, fraction in enumerate(fractions):
+        if not 0.0 <= fraction <= 1.0:
+            raise ValueError(f"target fraction of level {index}: {fraction} is outside [0, 1]")
+
+
+def prune_levels(face: BlendshapeFace, levels: list[BlendshapeLevel], options: BlendshapeLodOptions) -> None:
+    """Set every simplified level's ``geometric_error`` (Hausdorff distance of its neutral mesh to
+    the input's) and keep, in ``kept_targets`` and ``targets``, the targets the rule of the module
+    notes (or ``options.target_fractions``) keeps. ``levels[0]`` is the input and keeps them all;
+    the others must still hold every target."""
+    from ..metrics import surface_error
+
+    check_fractions(options.target_fractions, len(levels))
+    everything = np.arange(face.target_count)
     order, contributions = rank_targets(face), target_contributions(face)
     full = AnimatedMesh(face.faces, face.neutral[None])
-    for index, level in enumerate(_simplified_levels(face, counts, importance), start=1):
+    for index, level in enumerate(levels[1:], start=1):
         rest = AnimatedMesh(level.faces, level.neutral[None])
         level.geometric_error = float(surface_error(full, rest, samples=5000).hausdorff[0])
-        if fractions is not None:
-            kept = np.sort(order[: int(np.ceil(fractions[index] * face.target_count - 1e-9))])
-        elif index == len(counts) and not options.animate_coarsest:
+        if options.target_fractions is not None:
+            kept = np.sort(order[: int(np.ceil(options.target_fractions[index] * face.target_count - 1e-9))])
+        elif index == len(levels) - 1 and not options.animate_coarsest:
             kept = everything[:0]
         else:
             kept = everything[contributions > level.geometric_error]
         level.kept_targets = kept
         level.targets = np.ascontiguousarray(level.targets[kept])
-        levels.append(level)
-    return levels
 
 
 def _simplified_levels(face: BlendshapeFace, counts: list[int], importance: np.ndarray | None) -> list[BlendshapeLevel]:

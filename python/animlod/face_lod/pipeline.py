@@ -1,11 +1,13 @@
-"""The face LoD pipeline: a face in, its levels, a measured table and pictures out.
+"""The face LoD pipeline: a face in, its levels as one LoD GLB, a measured table and pictures out.
 
 Inputs: nothing (the procedural head, animated by MPAs and lattices), a glTF with morph targets,
-or a folder of OBJ/PLY poses (neutral + expressions). Both kinds are written level by level as
-GLB files with morph targets (the procedural face's MPAs become one target each: the FFD is
-linear in the MPA intensities, so a level's MPA displacements are exact blendshapes), with a
-JSON manifest holding each level's size, measured error (asset units), screen-coverage
-threshold and, for the procedural face, its active regions and lattice sizes.
+or a folder of OBJ/PLY poses (neutral + expressions). The output is one LoD GLB
+(:mod:`animlod.face_lod.lod_glb`): for a glTF, the input document whole with the face's levels
+attached by MSFT_lod; otherwise a new document whose face mesh has one morph target per
+expression or MPA (the procedural face's MPAs become targets exactly: the FFD is linear in the
+MPA intensities) and whose animation plays them. Beside it, a JSON manifest holds each level's
+size, measured error (asset units), screen-coverage threshold and kept targets, and, for the
+procedural face, its active regions, lattice sizes and the active tree's own thresholds.
 """
 
 from __future__ import annotations
@@ -17,8 +19,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .blendshape import BlendshapeLodOptions, build_blendshape_lod, measure_blendshape_lod, target_regions
+from .blendshape import (
+    BlendshapeLevel,
+    BlendshapeLodOptions,
+    build_blendshape_lod,
+    measure_blendshape_lod,
+    target_regions,
+)
 from .chain import FaceLodOptions, build_face_lod
+from .lod_glb import gltf_face_levels, read_gltf_face, write_gltf_face_lod, write_new_face_lod
 from .measure import animation_errors, every_nth, measure_chain
 from .mpa import expression_intensities, expression_sequence
 from .procedural import procedural_face
@@ -109,26 +118,29 @@ def _run_procedural(output, ratios, face_counts, plot, expression, repeats, erro
          "Hausdorff (% of diagonal)", "coverage >="],
         [],
     )  # fmt: skip
-    manifest = []
+    manifest, as_blendshapes = [], []
+    glb = output / "face_lod.glb"
     for row, threshold in zip(measured, thresholds):
         g = row.geometry_level
         level = chain.geometry[g]
         animator = chain.animator(g)
-        path = output / f"face_lod{g}.glb"
-        _write_blendshape_glb(path, level.rest, level.faces, animator.targets(), rig.mpa_names)
-        run.files.append(path)
+        kept = animator.active_mpas
+        as_blendshapes.append(BlendshapeLevel(level.faces, level.rest, animator.targets()[kept], kept,
+                                              level.kept_vertices, None, level.aqem_error))  # fmt: skip
         run.rows.append([g, row.triangles, row.vertices, row.animated_regions, row.lattices, row.active_mpas,
                          1e6 * row.max_frame_seconds, row.max_frame_seconds / timed[0] if timed[0] else 0.0,
                          100 * row.hausdorff, threshold])  # fmt: skip
         manifest.append({
-            "files": [path.name], "triangles": row.triangles, "vertices": row.vertices, "error": row.hausdorff_units,
+            "files": [glb.name], "triangles": row.triangles, "vertices": row.vertices, "error": row.hausdorff_units,
             "screen_coverage": threshold, "animation_floor": level.animation_floor,
             "active_regions": sorted(chain.tree.active(row.animation_level)),
             "lattices": {name: "2x2x2" if name in level.reduced else "3x3x3" for name in animator.regions},
         })  # fmt: skip
+    write_new_face_lod(glb, as_blendshapes, rig.mpa_names, animation.intensities, animation.fps,
+                       [row.hausdorff_units for row in measured], thresholds, "expressions")  # fmt: skip
     manifest_path = output / "face_lod.json"
     write_lod_manifest(manifest_path, "face", manifest)
-    run.files.append(manifest_path)
+    run.files += [glb, manifest_path]
     # The active tree's levels with their own errors and thresholds: a runtime picks the animation
     # level from the coverage too, then lowers it to the geometry level's floor (Figure 6).
     errors = animation_errors(chain, every_nth(animation, error_frames))
@@ -158,11 +170,13 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
                     error_frames) -> FaceRun:  # fmt: skip
     from ..io.detect import input_kind, input_stem
     from ..io.manifest import write_lod_manifest
-    from .sources import read_gltf_face, read_pose_face
+    from .sources import read_pose_face
 
     kind = input_kind(source)
+    gltf = None
     if kind == "gltf":
-        face = read_gltf_face(source)
+        gltf = read_gltf_face(source)
+        face = gltf.face
     elif kind == "sequence" and source.is_dir():
         face = read_pose_face(source, neutral)
     else:
@@ -171,12 +185,16 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
     options = BlendshapeLodOptions(face_counts=face_counts, target_fractions=target_fractions,
                                    **({"ratios": tuple(ratios)} if ratios else {}))  # fmt: skip
     try:
-        levels = build_blendshape_lod(face, options)
+        if gltf is not None:
+            gltf_levels = gltf_face_levels(gltf, options)
+            levels = gltf_levels.levels
+        else:
+            levels = build_blendshape_lod(face, options)
     except ValueError as error:
         raise ValueError(f"{source}: {error}") from None
     measured = measure_blendshape_lod(face, levels, repeats=repeats, max_frames=error_frames, samples=10000)
-    thresholds = coverage_thresholds([row.hausdorff_units for row in measured], _radius(face.neutral), Camera(),
-                                     PIXEL_TOLERANCE)  # fmt: skip
+    errors = [row.hausdorff_units for row in measured]
+    thresholds = coverage_thresholds(errors, _radius(face.neutral), Camera(), PIXEL_TOLERANCE)
     stem = input_stem(source)
     run = FaceRun(
         "blendshape",
@@ -186,21 +204,24 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
         notes=[f"{source}: {face.vertex_count} vertices, {len(face.faces)} triangles, {face.target_count} targets, "
                f"{len(face.weights)} animation frames"],
     )  # fmt: skip
+    glb = output / f"{stem}_lod.glb"
+    if gltf is not None:
+        write_gltf_face_lod(glb, gltf, gltf_levels, errors, thresholds)
+        run.notes += gltf_levels.notes
+    else:
+        write_new_face_lod(glb, levels, face.names, face.weights, face.fps, errors, thresholds, "expressions")
     manifest = []
     base = measured[0].median_frame_seconds
     for level, row, threshold in zip(levels, measured, thresholds):
-        path = output / f"{stem}_lod{row.level}.glb"
         names = [face.names[i] for i in level.kept_targets]
-        _write_blendshape_glb(path, level.neutral, level.faces, level.targets, names, level.uvs)
-        run.files.append(path)
         run.rows.append([row.level, row.triangles, row.vertices, row.targets, 1e6 * row.max_frame_seconds,
                          1e6 * row.median_frame_seconds, row.median_frame_seconds / base if base else 0.0,
                          100 * row.hausdorff, threshold])  # fmt: skip
-        manifest.append({"files": [path.name], "triangles": row.triangles, "vertices": row.vertices,
+        manifest.append({"files": [glb.name], "triangles": row.triangles, "vertices": row.vertices,
                          "targets": names, "error": row.hausdorff_units, "screen_coverage": threshold})  # fmt: skip
     manifest_path = output / f"{stem}_face_lod.json"
     write_lod_manifest(manifest_path, "blendshape_face", manifest)
-    run.files.append(manifest_path)
+    run.files += [glb, manifest_path]
     if plot_weights is not None:
         # Coloured by the regions grown from the targets' motion (the importance AQEM used).
         regions = target_regions(face, options.grow) if options.grow and np.any(face.targets) else None
@@ -240,19 +261,3 @@ def _radius(positions: np.ndarray) -> float:
     points = np.asarray(positions, dtype=np.float64)
     centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
     return float(np.linalg.norm(points - centre, axis=1).max(initial=0.0)) or 1.0
-
-
-def _write_blendshape_glb(path: Path, positions, faces, targets, names, uvs=None) -> None:
-    """One level as a GLB: the mesh with its morph targets, bound to a one-joint identity skin
-    (the GLB writer of this version writes skinned meshes only)."""
-    from ..io.gltf import write_glb
-    from ..model import Skeleton, SkinnedMesh
-
-    count = len(positions)
-    skinned = SkinnedMesh(
-        rest_positions=positions, faces=faces, joints=np.zeros((count, 1), np.int32),
-        weights=np.ones((count, 1), np.float32), inverse_bind=np.eye(4)[None],
-        skeleton=Skeleton(["root"], [-1], np.zeros((1, 3))), uvs=uvs,
-        morph_targets=targets if len(names) else None, morph_target_names=list(names) if len(names) else None,
-    )  # fmt: skip
-    write_glb(path, skinned)

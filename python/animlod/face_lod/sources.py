@@ -1,11 +1,9 @@
-"""Faces from files: a glTF mesh with morph targets, or a folder of poses (neutral + expressions).
+"""Faces from a folder of poses (neutral + expressions) as a blendshape face (glTF faces are
+read with their document, :func:`animlod.face_lod.lod_glb.read_gltf_face`).
 
-Both become a :class:`~animlod.face_lod.blendshape.BlendshapeFace`. A glTF face is the first
-node (in node order) whose mesh has morph targets, placed by its node's world transform; its
-animation is every clip that drives the node's morph weights, sampled at ``fps`` and played one
-after the other (a file without such a clip gets each target raised and lowered in turn). A pose
-folder's neutral face is the file named ``neutral``, else the one named ``*reference*`` or
-``*neutral*``, else the first in natural order; every other file is one expression target.
+A pose folder's neutral face is the file named ``neutral``, else the one named
+``*reference*`` or ``*neutral*``, else the first in natural order; every other file is one
+expression target, and the animation raises and lowers each in turn.
 """
 
 from __future__ import annotations
@@ -14,58 +12,8 @@ import os
 import re
 from pathlib import Path
 
-import numpy as np
-
 from ..io.errors import FormatError
 from .blendshape import BlendshapeFace, one_at_a_time
-
-
-def read_gltf_face(path: str | os.PathLike, fps: float = 30.0, frames_each: int = 15) -> BlendshapeFace:
-    """The first morph-target mesh of a .glb/.gltf file as a blendshape face.
-
-    Raises FormatError naming the file and element when no mesh has morph targets or the file
-    is malformed (a target whose vertex count differs from its primitive's is reported by the
-    glTF reader, naming the primitive and the target).
-    """
-    from ..io.gltf_document import GltfDocument
-    from ..io.gltf_keyframes import sample_keyframes
-    from ..io.gltf_mesh import read_mesh_geometry, transform_points
-
-    doc = GltfDocument(path)
-    for node_index, node in enumerate(doc.gltf.nodes or []):
-        if node.mesh is None:
-            continue
-        mesh = doc.item("meshes", node.mesh, doc.node_label(node_index))
-        if not any(primitive.targets for primitive in mesh.primitives or []):
-            continue
-        geometry = read_mesh_geometry(doc, node.mesh, skinned=False)
-        world = doc.rest_world_matrix(node_index)
-        faces = geometry.faces[:, ::-1] if np.linalg.det(world[:3, :3]) < 0.0 else geometry.faces
-        count = len(geometry.targets)
-        tracks = []
-        for a, animation in enumerate(doc.gltf.animations or []):
-            for c, channel in enumerate(animation.channels or []):
-                target = channel.target
-                if target is None or target.node != node_index or target.path != "weights":
-                    continue
-                element = f"{doc.animation_label(a)} channel {c}"
-                times, values, interpolation = doc.sampler_keys(a, channel.sampler, count, element)
-                tracks.append(sample_keyframes(times, values, interpolation, doc.animation_frame_times(a, fps)))
-        weights = np.concatenate(tracks) if tracks else one_at_a_time(count, frames_each)
-        names = geometry.target_names or [f"target_{index}" for index in range(count)]
-        try:
-            return BlendshapeFace(
-                neutral=transform_points(world, geometry.positions),
-                faces=faces,
-                targets=geometry.targets @ world[:3, :3].T,
-                names=names,
-                weights=weights,
-                fps=fps,
-                uvs=geometry.uvs,
-            )
-        except ValueError as error:
-            raise doc.fail(f"mesh {node.mesh}", str(error)) from None
-    raise doc.fail("meshes", "no mesh has morph targets, so there is no blendshape face to simplify")
 
 
 def _natural_key(path: Path) -> list[object]:

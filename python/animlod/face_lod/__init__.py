@@ -13,9 +13,10 @@ Region-animated faces (the paper's model):
 - :mod:`.procedural`: the procedural head of :mod:`animlod.synth` rigged.
 
 Blendshape faces (glTF morph targets, or a neutral face and expressions):
-:mod:`.blendshape` (ranking, pruning, simplification with targets carried) and :mod:`.sources`
-(readers). Faces without region labels: :mod:`.grow` (regions from motion). Pictures:
-:mod:`.plots`. The whole job for the command line: :mod:`.pipeline`.
+:mod:`.blendshape` (ranking, pruning, simplification with targets carried), :mod:`.sources`
+(pose folders) and :mod:`.lod_glb` (glTF faces through the whole-document pipeline, and every
+face's levels as one LoD GLB). Faces without region labels: :mod:`.grow` (regions from motion).
+Pictures: :mod:`.plots`. The whole job for the command line: :mod:`.pipeline`.
 """
 
 from .active_tree import ActiveTree

@@ -68,6 +68,19 @@ def time_frames(animator: LevelAnimator, intensities: np.ndarray, repeats: int =
     return best
 
 
+def time_animators(animators: list[LevelAnimator], intensities: np.ndarray, repeats: int = 5) -> list[np.ndarray]:
+    """Per animator, (T,) seconds per frame, the fastest of ``repeats`` runs; the animators take
+    turns within every run, so a burst of load from other processes hits them all alike."""
+    best = [np.full(len(intensities), np.inf) for _ in animators]
+    for _ in range(repeats):  # O(repeats x animators x T) calls into the core
+        for times, animator in zip(best, animators):
+            for frame, row in enumerate(intensities):
+                start = time.perf_counter()
+                animator.frame(row)
+                times[frame] = min(times[frame], time.perf_counter() - start)
+    return best
+
+
 def lattice_summary(animator: LevelAnimator) -> str:
     """"9x27 + 8x8" for 9 lattices of 27 control points and 8 of 8; "-" when none."""
     if not animator.animates:
@@ -92,18 +105,21 @@ def measure_level(
     samples: int = 20000,
     error_frames: int = 0,
     focus: np.ndarray | None = None,
+    times: np.ndarray | None = None,
 ) -> LevelMeasurement:
     """Measure one (geometry, animation) level pair: time over every frame of ``animation``,
     error over ``error_frames`` evenly spaced ones (0: all); ``reference`` is the full face
     animated at full detail over those frames (computed when None); ``focus (V,) bool`` marks the
-    full face's vertices whose distance to the level is reported as ``focus_error``."""
+    full face's vertices whose distance to the level is reported as ``focus_error``; ``times``
+    (T,) are the frame times when already measured (:func:`time_animators`)."""
     sampled = every_nth(animation, error_frames)
     if reference is None:
         reference = animate(chain.animator(0, 0), chain.rig.faces, sampled)
     animation_level = chain.animation_level(geometry_level, animation_level)
     animator = chain.animator(geometry_level, animation_level)
     level = chain.geometry[geometry_level]
-    times = time_frames(animator, animation.intensities, repeats)
+    if times is None:
+        times = time_frames(animator, animation.intensities, repeats)
     simplified = animate(animator, level.faces, sampled)
     error = surface_error(reference, simplified, samples=samples)
     worst = int(np.argmax(error.hausdorff))
@@ -146,9 +162,12 @@ def measure_chain(
 ) -> list[LevelMeasurement]:
     """Table 1: every geometry level at the finest animation level it allows."""
     reference = animate(chain.animator(0, 0), chain.rig.faces, every_nth(animation, error_frames))
+    levels = range(len(chain.geometry))
+    times = time_animators([chain.animator(g) for g in levels], animation.intensities, repeats)
     return [
-        measure_level(chain, g, chain.geometry[g].animation_floor, animation, reference, repeats, samples, error_frames)
-        for g in range(len(chain.geometry))
+        measure_level(chain, g, chain.geometry[g].animation_floor, animation, reference, repeats, samples,
+                      error_frames, times=times[g])  # fmt: skip
+        for g in levels
     ]
 
 

@@ -114,19 +114,26 @@ def build_character(
     levels_wanted = len(ratios) + 1
     started = time.perf_counter()
     motion_chains: dict[int, tuple[MotionLodChain, list[tuple[Clip, slice]]]] = {}
-    for drawable in animated:
-        if drawable.skin_index in motion_chains:
+    notes = []
+    joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
+    # Larger skeletons first: a skin whose joints all belong to a larger skin (a helmet bound to
+    # the head) keeps its joints, as freezing them on their own would tear it from the body.
+    for drawable in sorted(animated, key=lambda d: -len(joints_of[d.skin_index])):
+        skin = drawable.skin_index
+        if skin in motion_chains:
             continue
-        say(f"skin {drawable.skin_index}: motion levels over {len(drawable.clips)} clips")
         clips = [clip for clip in drawable.clips if clip.motion is not None]
         joined, spans = _joined_motion([clip.motion for clip in clips])
         analysis = analyze_motion(joined)
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
-        possible = len(analysis.priority) + 1
-        chain = build_motion_chain(
-            joined, levels=min(levels_wanted, possible), solver=solver, workers=workers, analysis=analysis
-        )
-        motion_chains[drawable.skin_index] = (chain, list(zip(clips, spans)))
+        levels = min(levels_wanted, len(analysis.priority) + 1)
+        covering = [other for other in motion_chains if joints_of[skin] < joints_of[other]]
+        if covering:
+            levels = 1
+            notes.append(f"skin {skin}: its joints belong to skin {covering[0]}; it keeps them at every level")
+        say(f"skin {skin}: {levels} motion levels over {len(clips)} clips")
+        chain = build_motion_chain(joined, levels=levels, solver=solver, workers=workers, analysis=analysis)
+        motion_chains[skin] = (chain, list(zip(clips, spans)))
     motion_seconds = time.perf_counter() - started
     started = time.perf_counter()
     geometry = {}
@@ -137,7 +144,7 @@ def build_character(
 
     builder = GlbBuilder.from_document(doc)
     motion_nodes = {skin: _add_motion_levels(builder, chain, clips) for skin, (chain, clips) in motion_chains.items()}
-    chains, notes = {}, []
+    chains = {}
     for drawable in animated:
         chain, clips = motion_chains[drawable.skin_index]
         levels = geometry[drawable.label]

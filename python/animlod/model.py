@@ -26,8 +26,25 @@ def _check_finite(name: str, array: np.ndarray) -> None:
 
 
 def _check_faces(faces: np.ndarray, vertex_count: int) -> np.ndarray:
-    faces = np.ascontiguousarray(faces, dtype=np.int32)
-    _require(faces.ndim == 2 and faces.shape[1] == 3, f"faces: expected shape (M, 3), got {faces.shape}")
+    # Range and integrality are checked before the cast to int32, which would wrap 2**32 + 2 to 2
+    # and truncate 1.9 to 1 silently.
+    given = np.asarray(faces)
+    _require(given.ndim == 2 and given.shape[1] == 3, f"faces: expected shape (M, 3), got {given.shape}")
+    if given.size and given.dtype != np.int32:
+        _require(
+            given.dtype.kind in "iuf" or given.dtype == np.bool_,
+            f"faces: expected integer indices, got dtype {given.dtype}",
+        )
+        wide = given.astype(np.float64) if given.dtype.kind == "f" else given
+        bad = ~np.isfinite(wide) | (wide != np.round(wide)) if given.dtype.kind == "f" else np.zeros(given.shape, bool)
+        if bad.any():
+            row = int(np.argmax(bad.any(axis=1)))
+            raise ValueError(f"faces: face {row} {given[row].tolist()} has an index that is not a whole number")
+        outside = (wide < 0) | (wide >= vertex_count)
+        if outside.any():
+            row = int(np.argmax(outside.any(axis=1)))
+            raise ValueError(f"faces: face {row} {given[row].tolist()} has an index outside [0, {vertex_count})")
+    faces = np.ascontiguousarray(given, dtype=np.int32)
     if faces.size and (faces.min() < 0 or faces.max() >= vertex_count):
         row = int(np.argmax(np.any((faces < 0) | (faces >= vertex_count), axis=1)))
         raise ValueError(f"faces: face {row} {faces[row].tolist()} has an index outside [0, {vertex_count})")

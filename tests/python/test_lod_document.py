@@ -261,3 +261,59 @@ def test_character_refuses_a_file_without_a_skinned_animation(data_dir, tmp_path
     assert main(["character", str(data_dir / "gltf" / "LeePerrySmith.glb"), "-o", str(tmp_path / "x.glb")]) == 2
     assert "no skinned mesh with an animation" in capsys.readouterr().err
     assert not (tmp_path / "x.glb").exists()
+
+
+def test_a_flat_shaded_mesh_simplifies_like_the_welded_one_and_stays_flat(tmp_path):
+    from animlod.model import SkinnedMesh
+
+    character = synth.humanoid()
+    walk = synth.humanoid_motion(character.skeleton, "walk")
+    corners = character.faces.ravel()
+    positions = character.rest_positions[character.faces].astype(np.float64)
+    normals = np.cross(positions[:, 1] - positions[:, 0], positions[:, 2] - positions[:, 0])
+    normals = np.repeat(normals / np.linalg.norm(normals, axis=1, keepdims=True), 3, axis=0)
+    flat = SkinnedMesh(
+        character.rest_positions[corners],
+        np.arange(corners.size).reshape(-1, 3),
+        character.joints[corners],
+        character.weights[corners],
+        character.inverse_bind,
+        character.skeleton,
+        normals=normals,
+    )
+    write_glb(tmp_path / "welded.glb", character, [walk])
+    write_glb(tmp_path / "flat.glb", flat, [walk])
+    welded = simplify_document(tmp_path / "welded.glb", tmp_path / "welded_lod.glb", [0.5, 0.1], **QUICK)
+    report = simplify_document(tmp_path / "flat.glb", tmp_path / "flat_lod.glb", [0.5, 0.1], **QUICK)
+    assert report.drawables[0].preparation.welded_vertices == corners.size - character.vertex_count
+    assert [level.faces for level in report.drawables[0].levels] == [
+        level.faces for level in welded.drawables[0].levels
+    ]
+    assert any("normals rebuilt" in note for note in report.drawables[0].notes)
+    doc = GltfDocument(tmp_path / "flat_lod.glb")
+    base = report.drawables[0].nodes[0]
+    coarse = doc.json["nodes"][doc.json["nodes"][base]["extensions"]["MSFT_lod"]["ids"][-1]]
+    primitive = doc.json["meshes"][coarse["mesh"]]["primitives"][0]
+    faces = doc.accessor(primitive["indices"], "i").reshape(-1, 3)
+    level_normals = doc.accessor(primitive["attributes"]["NORMAL"], "n")[faces]
+    np.testing.assert_allclose(level_normals[:, 0], level_normals[:, 1], atol=1e-6)  # flat again
+    np.testing.assert_allclose(level_normals[:, 0], level_normals[:, 2], atol=1e-6)
+
+
+def test_a_vertex_whose_weights_are_all_zero_is_named(humanoid_glb, tmp_path, capsys):
+    from animlod.io.glb_builder import GlbBuilder
+
+    builder = GlbBuilder.from_document(GltfDocument(humanoid_glb))
+    weights = builder.json["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"]
+    zero = builder.add(np.zeros((1, 4), np.float32))  # a sparse substitution: vertex 7 weighs nothing
+    index = builder.add(np.array([[7]], np.uint32))
+    builder.json["accessors"][weights]["sparse"] = {
+        "count": 1,
+        "indices": {"bufferView": builder.json["accessors"][index]["bufferView"], "componentType": 5125},
+        "values": {"bufferView": builder.json["accessors"][zero]["bufferView"]},
+    }
+    builder.save(tmp_path / "zero.glb")
+    assert main(["simplify", str(tmp_path / "zero.glb"), "-o", str(tmp_path / "out.glb")]) == 2
+    err = capsys.readouterr().err
+    assert "vertex 7 has no positive skin weight" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out.glb").exists()

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io.detect import input_kind, input_stem
-from . import UserError
+from . import UserError, positive_int
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -29,9 +29,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--ratio", type=float, nargs="+", default=[0.5, 0.25, 0.1], help="face ratios of levels 1, 2, ..."
     )
     parser.add_argument("--solver", choices=("slsqp", "newton"), default="slsqp", help="motion re-fit (default slsqp)")
-    parser.add_argument("--workers", type=int, default=1, help="processes for the motion re-fit (default 1)")
+    parser.add_argument("--workers", type=positive_int, default=1, help="processes for the motion re-fit (default 1)")
     parser.add_argument("--no-features", action="store_true", help="ignore motion features in AQEM")
-    parser.add_argument("--max-frames", type=int, default=48, help="frames of all clips that drive AQEM (default 48)")
+    parser.add_argument(
+        "--max-frames", type=positive_int, default=48, help="frames of all clips that drive AQEM (default 48)"
+    )
     parser.set_defaults(run=run)
 
 
@@ -40,8 +42,6 @@ def run(args: argparse.Namespace) -> int:
 
     if any(not 0.0 < ratio <= 1.0 for ratio in args.ratio):
         raise UserError(f"--ratio: every ratio must be in (0, 1], got {args.ratio}")
-    if args.workers < 1 or args.max_frames < 1:
-        raise UserError("--workers and --max-frames must be at least 1")
     if input_kind(args.input) != "gltf":
         raise UserError(f"{args.input}: animlod character needs a .glb or .gltf")
     output = Path(args.output)

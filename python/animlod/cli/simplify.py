@@ -10,7 +10,7 @@ import numpy as np
 
 from ..io.detect import input_kind, input_stem
 from ..model import AnimatedMesh
-from . import UserError
+from . import UserError, non_negative_int
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -41,7 +41,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-features", action="store_true", help="ignore motion features (all vertex weights 1)")
     parser.add_argument(
         "--max-frames",
-        type=int,
+        type=non_negative_int,
         default=0,
         help="sequences: quadrics over K frames chosen to cover the motion; glTF: the most frames of all clips "
         "that drive the simplification (default 48)",
@@ -64,8 +64,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if any(not 0.0 < ratio <= 1.0 for ratio in args.ratio):
         raise UserError(f"--ratio: every ratio must be in (0, 1], got {args.ratio}")
-    if args.max_frames < 0:
-        raise UserError(f"--max-frames: must be >= 0, got {args.max_frames}")
     kind = input_kind(args.input)
     if kind == "bvh":
         raise UserError(f"{args.input}: a BVH file holds motion only; simplify needs a mesh")

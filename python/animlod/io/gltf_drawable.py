@@ -122,7 +122,10 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
         if skin_index is not None:
             label += f" with skin {skin_index}"
         geometry = read_mesh_geometry(doc, mesh_index, skinned=skin_index is not None)
-        drawable = Drawable(mesh_index, skin_index, nodes, label, geometry, doc.rest_world_matrix(nodes[0]))
+        world = doc.rest_world_matrix(nodes[0])
+        if abs(np.linalg.det(world[:3, :3])) < 1e-30:
+            raise doc.fail(doc.node_label(nodes[0]), "its world transform is singular (a zero scale)")
+        drawable = Drawable(mesh_index, skin_index, nodes, label, geometry, world)
         if skin_index is not None:
             if skin_index not in rigs:
                 rigs[skin_index] = SkinRig(doc, skin_index)

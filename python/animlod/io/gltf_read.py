@@ -140,6 +140,8 @@ def skinned_mesh_of_node(
         reason = f"vertex {vertex} uses joint slot {int(joints[vertex].max())}, skin {rig.skin} has {slots}"
         raise doc.fail(f"mesh {mesh_index} JOINTS", reason)
     mesh_world = doc.rest_world_matrix(node) if mesh_world is None else mesh_world
+    if abs(np.linalg.det(mesh_world[:3, :3])) < 1e-30:
+        raise doc.fail(doc.node_label(node), "its world transform is singular (a zero scale): the mesh has no extent")
     row_scale = np.ones((len(rig.scales), 4, 1))
     row_scale[:, :3] = rig.scales[:, None, None]
     inverse_bind = (row_scale * rig.inverse_bind) @ np.linalg.inv(mesh_world)

@@ -65,7 +65,7 @@ def test_face_user_mistakes_exit_2_with_one_line(tmp_path, capsys):
     assert main(["face", str(poses), "-o", str(tmp_path / "out")]) == 2
     assert "holds 1 OBJ/PLY file" in capsys.readouterr().err
     assert main(["face", "-o", str(tmp_path / "out"), "--ratio", "0.5", "--faces", "100"]) == 2
-    assert "not both" in capsys.readouterr().err
+    assert "--ratio and --faces: give one of them, not both" in capsys.readouterr().err
     assert main(["face", "-o", str(tmp_path / "out"), "--targets", "1", "0.5"]) == 2
     assert "apply to blendshape faces" in capsys.readouterr().err
     assert main(["face", str(tmp_path / "absent.glb"), "-o", str(tmp_path / "out")]) == 2

@@ -69,7 +69,7 @@ def test_a_face_without_labels_is_offered_grown_ones(head):
     from animlod.face_lod import FaceRig
 
     model, animation = head
-    with pytest.raises(ValueError, match="no region labels.*grow_regions"):
+    with pytest.raises(ValueError, match="region labels: the face has none.*grow_regions"):
         FaceRig(model.positions, model.faces, None)
     regions = grow_regions(motion_of_frames(animation.frames), model.faces)
     rig = FaceRig(model.positions, model.faces, regions)  # the grown labels make a rig

@@ -105,7 +105,7 @@ def test_labels_that_do_not_cover_the_mesh_are_named(face):
         FaceRegions(rig.regions.names, labels, rig.regions.groups)
     with pytest.raises(ValueError, match="do not cover the mesh: 1161 labels for 1162 vertices"):
         FaceRig(rig.positions, rig.faces, FaceRegions(rig.regions.names, labels[1:] * 0, rig.regions.groups))
-    with pytest.raises(ValueError, match="region 'nose' is in no region group"):
+    with pytest.raises(ValueError, match="region 'nose': in no region group"):
         FaceRegions(["nose", "mouth"], [0, 1], [RegionGroup("g", ["mouth"], 1.0)])
 
 

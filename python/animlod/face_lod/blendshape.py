@@ -79,7 +79,7 @@ class BlendshapeFace:
             raise ValueError(f"blendshape face: {len(self.names)} names for {len(self.targets)} targets")
         if not np.all(np.isfinite(self.targets)):
             index = int(np.argwhere(~np.isfinite(self.targets))[0, 0])
-            raise ValueError(f"morph target {index} {self.names[index]!r} has a non-finite delta")
+            raise ValueError(f"morph target {index} {self.names[index]!r}: non-finite delta")
         self.weights = np.asarray(self.weights, dtype=np.float64)
         if self.weights.ndim != 2 or self.weights.shape[1] != len(self.targets) or len(self.weights) == 0:
             raise ValueError(

@@ -77,11 +77,11 @@ class FaceRegions:
             for region in group.regions:
                 self.index(region, f"region group {group.name!r}")
                 if region in owner:
-                    raise ValueError(f"region {region!r} is in groups {owner[region]!r} and {group.name!r}")
+                    raise ValueError(f"region {region!r}: in groups {owner[region]!r} and {group.name!r}")
                 owner[region] = group.name
         missing = [name for name in self.names if name not in owner]
         if missing:
-            raise ValueError(f"region {missing[0]!r} is in no region group")
+            raise ValueError(f"region {missing[0]!r}: in no region group")
 
     @property
     def region_count(self) -> int:

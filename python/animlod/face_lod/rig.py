@@ -52,7 +52,7 @@ class FaceRig:
         self.faces = np.ascontiguousarray(faces, dtype=np.int32)
         if regions is None:
             raise ValueError(
-                "face has no region labels, and region-based animation needs them; grow labels from its motion "
+                "region labels: the face has none, and region-based animation needs them; grow labels from its motion "
                 "with animlod.face_lod.grow_regions(motion_of_frames(frames) or motion_of_targets(targets, "
                 "weights), faces)"
             )
@@ -82,7 +82,7 @@ class FaceRig:
     def add_mpa(self, mpa: Mpa) -> None:
         """Add an MPA after checking its regions and shapes (ValueError naming MPA and region)."""
         if mpa.name in self.mpa_names:
-            raise ValueError(f"MPA {mpa.name!r} is defined twice")
+            raise ValueError(f"MPA {mpa.name!r}: defined twice")
         for region, delta in mpa.displacements.items():
             self.regions.index(region, f"MPA {mpa.name!r}")
             if region not in self.lattices:

@@ -59,6 +59,37 @@ def simplify_animated(
     """AQEM over all frames, any topology: {"levels": [...], "collapses": {...}, "frames_used",
     "vertex_weights", "preparation"}."""
 
+def ffd_local_coordinates(points: npt.ArrayLike, box: npt.ArrayLike) -> npt.NDArray[np.float32]:
+    """Local coordinates (V, 3) of (V, 3) points in a (4, 3) box (origin, S, T, U axes)."""
+
+def ffd_evaluate(
+    local: npt.ArrayLike, control_points: npt.ArrayLike, weights: npt.ArrayLike | None = None
+) -> npt.NDArray[np.float32]:
+    """Rational Bezier volume of (l, m, n, 3) control points (weights (l, m, n)) at (V, 3) local coordinates."""
+
+def ffd_displace(
+    rest: npt.ArrayLike,
+    local: npt.ArrayLike,
+    vertex_lattice: npt.ArrayLike,
+    sizes: npt.ArrayLike,
+    displacements: npt.ArrayLike,
+    weights: npt.ArrayLike | None = None,
+) -> npt.NDArray[np.float32]:
+    """Rest (V, 3) plus the rational FFD of each vertex's lattice displacements ((C, 3) or (F, C, 3)):
+    (V, 3) or (F, V, 3)."""
+
+def ffd_fit(
+    local: npt.ArrayLike,
+    targets: npt.ArrayLike,
+    size: Sequence[int],
+    weights: npt.ArrayLike | None = None,
+    *,
+    prior: npt.ArrayLike | None = None,
+    smoothness: float = 0.001,
+    ridge: float = 0.001,
+) -> npt.NDArray[np.float64]:
+    """Regularised least-squares control points (l, m, n, 3) reproducing (V, 3) targets at (V, 3) local coordinates."""
+
 # TDAG (cpp/bindings/bind_tdag.cpp)
 
 class TdagOptions:

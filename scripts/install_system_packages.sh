@@ -6,7 +6,7 @@ set -euo pipefail
 
 packages=(g++ cmake ninja-build pkg-config libopenmesh-dev libeigen3-dev libglm-dev libglfw3-dev
           libgl-dev libegl-dev libopengl-dev libtinygltf-dev xvfb xauth libgl1-mesa-dri libegl-mesa0
-          doctest-dev dpkg-dev python3-dev python3-venv)
+          doctest-dev dpkg-dev python3-dev python3-venv libnlopt-dev)
 
 missing=()
 for package in "${packages[@]}"; do

@@ -15,8 +15,13 @@ Conventions this implementation fixes where the paper is silent:
   ``(r(t_ref) + r(t)) / 2 * theta`` over the circumference ``2 pi r_max``; ``r_max`` is the summed
   length of the root's child bones (mean over frames), or the longest bone when those are all
   zero. (The printed bracket omits the 1/2; constant factors change neither key frames nor order.)
-- Joints whose local translation is animated (BVH position channels below the root) are never
-  frozen: freezing would pin their translation to one frame.
+- Joints whose local translation moves (BVH position channels below the root that carry
+  motion) are never frozen: freezing would pin their translation to one frame. A translation
+  counts as moving only when its range over the clip exceeds ``translation_tolerance`` times the
+  joint's bone length (the mean length of its translation, at least 1 % of the longest bone):
+  exporters write a translation key on every joint with float noise, and constant keys are not
+  motion. A joint below the tolerance can freeze; its translation is then held at the key frame
+  like its rotation, and the level's error includes what that costs.
 - End sites carry no rotation: they give leaf joints a direction, have importance 0 and are never
   in the priority list (they are not joints of a level). A leaf joint *without* an end site has
   no bone to measure, so its importance is 0 and it is eliminated first.
@@ -30,12 +35,13 @@ Conventions this implementation fixes where the paper is silent:
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import rotations
 from ..model import Motion
+from .ranking import DEFAULT_RANKING, RANKINGS, rank_scores
 
 # Rows of the posture-error table evaluated at once: bounds memory to rows x frames x 3 floats.
 _BLOCK_ROWS = 16
@@ -49,11 +55,13 @@ class MotionAnalysis:
     ----------
     key_frames : (J,) int64 key frame t_key_j of every joint (Eq. 2), an index into the motion.
     importance : (J,) float64 joint importance eps_j (Eq. 3); 0 for end sites.
-    priority : joint indices in elimination order (lowest importance first, ties by index);
-        never the root, end sites, locked joints or joints with animated translation.
+    priority : joint indices in elimination order (lowest rank first, ties by index, see
+        ranking.py); never the root, end sites, locked joints or translating joints.
     locked : joint indices the caller locked (never frozen).
     frames : (n,) int64 frames the analysis used (all frames unless subsampled).
     r_max : the normaliser of Eq. 1, in the asset's units.
+    translating : joint indices whose translation moves (see translating_joints), never frozen.
+    ranking : the name of the ranking that ordered ``priority`` (ranking.RANKINGS).
     """
 
     key_frames: np.ndarray
@@ -62,6 +70,8 @@ class MotionAnalysis:
     locked: list[int]
     frames: np.ndarray
     r_max: float
+    translating: list[int] = field(default_factory=list)
+    ranking: str = "importance"
 
     def key_rotations(self, motion: Motion) -> np.ndarray:
         """Key posture (Section 4.2): every joint's local rotation at its key frame, ``(J, 4)``."""
@@ -73,12 +83,29 @@ class MotionAnalysis:
         return motion.local_translations()[self.key_frames, np.arange(motion.skeleton.joint_count)]
 
 
-def animated_translation_joints(motion: Motion) -> np.ndarray:
-    """Non-root joints whose local translation changes over the clip, ``(J,) bool``."""
-    animated = np.zeros(motion.skeleton.joint_count, bool)
-    if motion.joint_translations is not None:
-        animated[1:] = np.ptp(motion.joint_translations[:, 1:], axis=0).max(axis=-1) > 0.0
-    return animated
+# Default of translating_joints: a translation whose range stays under 1 % of its bone is held.
+TRANSLATION_TOLERANCE = 1e-2
+
+
+def translating_joints(motion: Motion, tolerance: float = TRANSLATION_TOLERANCE) -> np.ndarray:
+    """Non-root joints whose local translation moves, ``(J,) bool``.
+
+    A joint translates when the range of its local translation over the clip (the length of the
+    per-axis peak-to-peak vector) exceeds ``tolerance`` times its bone length: the mean length of
+    that translation, or 1 % of the longest bone when it is shorter (a joint at its parent's
+    position has no length of its own to compare with). Float noise and constant keys stay below.
+    """
+    if not (np.isfinite(tolerance) and tolerance >= 0.0):
+        raise ValueError(f"translation_tolerance: must be a finite number >= 0, got {tolerance}")
+    moving = np.zeros(motion.skeleton.joint_count, bool)
+    if motion.joint_translations is None or motion.skeleton.joint_count < 2:
+        return moving
+    translations = motion.joint_translations[:, 1:]
+    bones = np.linalg.norm(translations, axis=-1).mean(axis=0)
+    reference = np.maximum(bones, 1e-2 * bones.max())
+    spread = np.linalg.norm(np.ptp(translations, axis=0), axis=-1)
+    moving[1:] = spread > tolerance * reference
+    return moving
 
 
 def child_bones(motion: Motion, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -141,6 +168,8 @@ def analyze_motion(
     motion: Motion,
     locked: Iterable[str] = (),
     max_frames: int = 600,
+    translation_tolerance: float = TRANSLATION_TOLERANCE,
+    ranking: str = DEFAULT_RANKING,
 ) -> MotionAnalysis:
     """Key frames, joint importance and elimination priority of a motion (Eqs. 1-3).
 
@@ -150,12 +179,17 @@ def analyze_motion(
     locked : names of joints never to freeze (the root never is).
     max_frames : above this many frames, analyse an evenly spaced subsample of this size
         (see the module notes for how that changes the result).
+    translation_tolerance : a joint whose translation range exceeds this fraction of its bone
+        length translates and is never frozen (translating_joints).
+    ranking : how joints are ordered for elimination, one of ranking.RANKINGS.
 
     Returns
     -------
     MotionAnalysis
     """
     skeleton = motion.skeleton
+    if ranking not in RANKINGS:
+        raise ValueError(f"ranking: expected one of {', '.join(RANKINGS)}, got {ranking!r}")
     if motion.frame_count < 2:
         raise ValueError(f"motion: needs at least 2 frames for motion analysis, got {motion.frame_count}")
     if max_frames < 2:
@@ -175,11 +209,22 @@ def analyze_motion(
     key_frames = frames[best]
     importance = sums[np.arange(skeleton.joint_count), best] / frames.size  # Eq. 3
 
+    translating = translating_joints(motion, translation_tolerance)
     candidates = np.ones(skeleton.joint_count, bool)
     candidates[0] = False
     candidates[skeleton.end_sites] = False
     candidates[locked_indices] = False
-    candidates[animated_translation_joints(motion)] = False
-    order = np.lexsort((np.arange(skeleton.joint_count), importance))
+    candidates[translating] = False
+    scores = rank_scores(ranking, motion, importance, key_frames, frames)
+    order = np.lexsort((np.arange(skeleton.joint_count), scores))
     priority = [int(j) for j in order if candidates[j]]
-    return MotionAnalysis(key_frames, importance, priority, locked_indices, frames, r_max)
+    return MotionAnalysis(
+        key_frames,
+        importance,
+        priority,
+        locked_indices,
+        frames,
+        r_max,
+        [int(j) for j in np.flatnonzero(translating)],
+        ranking,
+    )

@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton
-from .frozen import FrozenLevel
+from .frozen import FrozenLevel, held_translations
 
 # Child offsets shorter than this fraction of the level's extent give no direction.
 _SHORT = 1e-9
@@ -133,7 +133,8 @@ def _spans_a_plane(vectors: np.ndarray) -> bool:
 
 
 def expand_motion(level: FrozenLevel, reduced: Motion, motion: Motion) -> Motion:
-    """The level's motion put back on the original skeleton, frozen joints at their key rotations.
+    """The level's motion put back on the original skeleton, frozen joints at their key rotations
+    and translations.
 
     Its forward kinematics equals the level's at every kept point, and places the frozen parts
     where the level implicitly carries them, so errors can be measured on every original point.
@@ -143,4 +144,5 @@ def expand_motion(level: FrozenLevel, reduced: Motion, motion: Motion) -> Motion
     frozen = np.flatnonzero(level.frozen)
     local[:, frozen] = level.key_rotations[frozen]
     local[:, kept] = rotations.multiply(rotations.conjugate(level.fold_rotations[kept]), reduced.local_rotations)
-    return Motion(motion.skeleton, reduced.root_positions, local, motion.fps, motion.name, motion.joint_translations)
+    translations = held_translations(level, motion)
+    return Motion(motion.skeleton, reduced.root_positions, local, motion.fps, motion.name, translations)

@@ -34,8 +34,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--joints", type=int, nargs="+", help="joint counts of the levels instead of --levels")
     parser.add_argument("--lock", nargs="+", default=[], metavar="JOINT", help="joints never to freeze")
     parser.add_argument(
-        "--ranking", choices=RANKINGS, default=DEFAULT_RANKING,
-        help="which joints freeze first: importance (the paper's Eq. 3, default), depth (deepest first) or "
+        "--ranking", default=DEFAULT_RANKING, metavar="NAME",
+        help=f"which joints freeze first, one of {', '.join(RANKINGS)}: importance (Eq. 3 with zero-length bones "
+        "measured through the joints below them, default), paper (Eq. 3 as printed), depth (deepest first) or "
         "variance (least rotation first)",
     )  # fmt: skip
     parser.add_argument(
@@ -108,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("--hard: bone-length equality constraints need an SLSQP solver (slsqp or slsqp-python)")
     if args.workers < 0:
         raise UserError(f"--workers: must be at least 0, got {args.workers}")
+    if args.ranking not in RANKINGS:
+        raise UserError(f"--ranking: no ranking named {args.ranking!r} (choose from {', '.join(RANKINGS)})")
     motion, skin = _read_input(args)
     try:
         analysis, counts = _plan_levels(args, motion)

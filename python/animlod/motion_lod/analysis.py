@@ -41,7 +41,7 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion
-from .ranking import DEFAULT_RANKING, RANKINGS, rank_scores
+from .ranking import DEFAULT_RANKING, PAPER_RANKING, RANKINGS, rank_scores
 
 # Rows of the posture-error table evaluated at once: bounds memory to rows x frames x 3 floats.
 _BLOCK_ROWS = 16
@@ -54,7 +54,9 @@ class MotionAnalysis:
     Attributes
     ----------
     key_frames : (J,) int64 key frame t_key_j of every joint (Eq. 2), an index into the motion.
-    importance : (J,) float64 joint importance eps_j (Eq. 3); 0 for end sites.
+    importance : (J,) float64 joint importance eps_j (Eq. 3); 0 for end sites. With every
+        ranking but "paper", Eqs. 1-3 measure a zero-length bone through the points below it
+        (child_bones, look_through); "paper" takes Eq. 1's direct children as printed.
     priority : joint indices in elimination order (lowest rank first, ties by index, see
         ranking.py); never the root, end sites, locked joints or translating joints.
     locked : joint indices the caller locked (never frozen).
@@ -108,17 +110,46 @@ def translating_joints(motion: Motion, tolerance: float = TRANSLATION_TOLERANCE)
     return moving
 
 
-def child_bones(motion: Motion, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Every non-root joint's bone as seen from its parent's parent frame.
+def child_bones(
+    motion: Motion, frames: np.ndarray, look_through: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """Every joint's bones as seen from its parent's frame.
 
-    Returns ``owners (B,)`` (the joint ``j`` each bone hangs from, B = J - 1) and
-    ``vectors (n, B, 3)``: ``R_j(t) @ offset_c(t)`` for child ``c`` of ``j`` at the given frames.
+    Returns ``owners (B,)`` (the joint ``j`` each bone hangs from) and ``vectors (n, B, 3)`` at
+    the given frames: ``R_j(t) @ offset_c(t)`` for every child ``c`` of ``j`` (B = J - 1), the
+    paper's Eq. 1. With ``look_through``, a child at ``j``'s own position (a zero-length bone,
+    which has no direction) is replaced by its own children, recursively: the bones of ``j`` are
+    then the vectors to its nearest points that are not at its position, which ``j``'s rotation
+    (and the zero-length joints' between them) turns. Eq. 1 as printed gives such a joint (CMU's
+    Chest2 or a wrist above a zero-length hand) importance 0, though it turns a whole limb.
     """
-    parents = motion.skeleton.parents[1:]
-    children = np.arange(1, motion.skeleton.joint_count)
+    skeleton = motion.skeleton
+    parents = skeleton.parents[1:]
+    children = np.arange(1, skeleton.joint_count)
     offsets = motion.local_translations()[frames][:, children]
     vectors = rotations.rotate(motion.local_rotations[frames][:, parents], offsets)
-    return parents.astype(np.int64), vectors
+    if not look_through:
+        return parents.astype(np.int64), vectors
+    lengths = np.linalg.norm(offsets, axis=-1).max(axis=0)  # (J - 1,)
+    zero = np.concatenate([[False], lengths <= 1e-9 * max(float(lengths.max(initial=0.0)), 1e-300)])
+    # Nearest non-coincident points below each joint: walk down through zero-length children,
+    # composing their rotations: v = R_j R_c1 ... R_ck offset_d (the zero-length offsets add 0).
+    kids = skeleton.children()
+    local = motion.local_rotations[frames]
+    translations = motion.local_translations()[frames]
+    owners, vectors = [], []
+    for joint in range(skeleton.joint_count):  # O(J) Python steps, vectorised over frames
+        stack = [(child, local[:, joint]) for child in kids[joint]]
+        while stack:
+            point, turn = stack.pop()
+            if zero[point]:
+                stack.extend((child, rotations.multiply(turn, local[:, point])) for child in kids[point])
+            else:
+                owners.append(joint)
+                vectors.append(rotations.rotate(turn, translations[:, point]))
+    if not owners:
+        return np.zeros(0, np.int64), np.zeros((frames.size, 0, 3))
+    return np.array(owners, dtype=np.int64), np.stack(vectors, axis=1)
 
 
 def _angles_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -130,12 +161,15 @@ def _angles_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return 2.0 * np.arctan2(np.linalg.norm(a - b, axis=-1), np.linalg.norm(a + b, axis=-1))
 
 
-def posture_error_row_sums(motion: Motion, frames: np.ndarray, r_max: float) -> np.ndarray:
+def posture_error_row_sums(
+    motion: Motion, frames: np.ndarray, r_max: float, look_through: bool = False
+) -> np.ndarray:
     """Row sums ``S[j, a] = sum_b E_j(frames[a], frames[b])`` of Eq. 1's table, ``(J, n)``.
 
     The table itself is never held: rows are evaluated ``_BLOCK_ROWS`` at a time.
+    ``look_through``: measure zero-length bones through the points below them (child_bones).
     """
-    owners, vectors = child_bones(motion, frames)
+    owners, vectors = child_bones(motion, frames, look_through)
     lengths = np.linalg.norm(vectors, axis=-1)  # r_jc(t), (n, B)
     units = np.divide(vectors, lengths[..., None], out=np.zeros_like(vectors), where=lengths[..., None] > 0.0)
     n, bone_count = lengths.shape
@@ -204,7 +238,7 @@ def analyze_motion(
     else:
         frames = np.arange(motion.frame_count, dtype=np.int64)
     r_max = _r_max(motion)
-    sums = posture_error_row_sums(motion, frames, r_max)
+    sums = posture_error_row_sums(motion, frames, r_max, look_through=ranking != PAPER_RANKING)
     best = np.argmin(sums, axis=1)  # Eq. 2 (first minimum on ties)
     key_frames = frames[best]
     importance = sums[np.arange(skeleton.joint_count), best] / frames.size  # Eq. 3

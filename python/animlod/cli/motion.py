@@ -70,7 +70,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="weights of the distance, string and angle errors (Eq. 5)",
     )  # fmt: skip
     parser.add_argument("--max-frames", type=int, default=600, help="frames motion analysis looks at, at most")
-    parser.add_argument("--clip", type=int, default=0, help="which animation of a glTF file (index)")
+    parser.add_argument(
+        "--clip", type=int, default=None,
+        help="which animation of a glTF file (index); default the first, or all of them as one motion when each "
+        "moves other joints (one animation per joint node)",
+    )  # fmt: skip
     parser.add_argument("--plot", action="store_true", help="write importance, key posture and error charts (PNG)")
     parser.set_defaults(run=run)
 
@@ -178,6 +182,15 @@ def _read_input(args: argparse.Namespace):
         skin, motions = read_skinned(args.input)
         if not motions:
             raise UserError(f"{args.input}: the skinned mesh has no animation to simplify")
+        if args.clip is None:
+            from ..motion_lod.clips import merge_split_clips
+
+            merged = merge_split_clips(motions)
+            if merged is not None:
+                print(f"{args.input}: its {len(motions)} animations each move other joints: simplifying them as one "
+                      "motion (use --clip to take one)", file=sys.stderr)  # fmt: skip
+                return merged, skin
+            return motions[0], skin
         if not 0 <= args.clip < len(motions):
             raise UserError(f"--clip: {args.input} has {len(motions)} animations, got index {args.clip}")
         return motions[args.clip], skin

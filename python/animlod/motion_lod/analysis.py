@@ -25,7 +25,7 @@ Conventions this implementation fixes where the paper is silent:
 - End sites carry no rotation: they give leaf joints a direction, have importance 0 and are never
   in the priority list (they are not joints of a level). A leaf joint *without* an end site has
   no bone to measure, so its importance is 0 and it is eliminated first.
-- Long clips: the n x n table is never stored; its row sums are accumulated in blocks of rows.
+- Long clips: the n x n table is held one bone at a time; only its row sums are kept.
   Above ``max_frames`` frames, Eqs. 1-3 run on ``max_frames`` evenly spaced frames: key frames
   are then chosen among those frames and eps_j becomes the same mean over a uniform subsample
   (a Riemann sum of the full-rate mean), which changes it by at most the motion between two
@@ -42,9 +42,6 @@ import numpy as np
 from .. import rotations
 from ..model import Motion
 from .ranking import DEFAULT_RANKING, PAPER_RANKING, RANKINGS, rank_scores
-
-# Rows of the posture-error table evaluated at once: bounds memory to rows x frames x 3 floats.
-_BLOCK_ROWS = 16
 
 
 @dataclass(frozen=True)
@@ -166,7 +163,7 @@ def posture_error_row_sums(
 ) -> np.ndarray:
     """Row sums ``S[j, a] = sum_b E_j(frames[a], frames[b])`` of Eq. 1's table, ``(J, n)``.
 
-    The table itself is never held: rows are evaluated ``_BLOCK_ROWS`` at a time.
+    One bone's (n, n) table of angles is held at a time.
     ``look_through``: measure zero-length bones through the points below them (child_bones).
     """
     owners, vectors = child_bones(motion, frames, look_through)
@@ -174,15 +171,33 @@ def posture_error_row_sums(
     units = np.divide(vectors, lengths[..., None], out=np.zeros_like(vectors), where=lengths[..., None] > 0.0)
     n, bone_count = lengths.shape
     per_bone = np.zeros((bone_count, n))
-    for start in range(0, n, _BLOCK_ROWS):
-        rows = slice(start, min(start + _BLOCK_ROWS, n))
-        # theta_jc(t_ref, t) for the block's t_ref against every t: (rows, n, B).
-        theta = _angles_between(units[rows, None], units[None])
-        radius = 0.5 * (lengths[rows, None] + lengths[None])  # mean of r_jc(t_ref) and r_jc(t)
-        per_bone[:, rows] = np.einsum("abk,abk->ka", radius, theta)  # arc lengths
+    for bone in range(bone_count):  # O(B) Python steps, each an (n, n) table
+        u = units[:, bone]
+        if not np.any(np.ptp(u, axis=0)):
+            continue  # one direction in every frame: theta = 0 exactly
+        theta = _angle_table(u)  # theta_jc(t_ref, t), rows t_ref
+        r = lengths[:, bone]
+        per_bone[bone] = 0.5 * (r * theta.sum(axis=1) + theta @ r)  # arcs: mean radius times angle
     sums = np.zeros((motion.skeleton.joint_count, n))
     np.add.at(sums, owners, per_bone)  # sum over the children c of j (Eq. 1)
     return sums / (2.0 * np.pi * r_max)
+
+
+def _angle_table(units: np.ndarray) -> np.ndarray:
+    """Angles ``(n, n)`` between every pair of the vectors ``units (n, 3)`` (unit or zero).
+
+    Kahan's form 2 atan2(|a - b|, |a + b|) with |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b from one
+    matrix product; where the angle is tiny that difference cancels, so those entries take
+    |a - b| directly (exact 0 for identical directions).
+    """
+    dots = units @ units.T
+    squares = np.sum(units * units, axis=-1)
+    base = squares[:, None] + squares[None, :]
+    minus = np.maximum(base - 2.0 * dots, 0.0)
+    theta = 2.0 * np.arctan2(np.sqrt(minus), np.sqrt(np.maximum(base + 2.0 * dots, 0.0)))
+    close = np.nonzero(minus < 1e-8)
+    theta[close] = _angles_between(units[close[0]], units[close[1]])
+    return theta
 
 
 def _r_max(motion: Motion) -> float:

@@ -23,6 +23,7 @@
 
 #include "animlod/motion_refit.hpp"
 #include "motion_refit_detail.hpp"
+#include "motion_refit_reduction.hpp"
 
 namespace animlod {
 
@@ -34,44 +35,47 @@ constexpr double kNegligibleObjective = 1e-24;
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 // One thread's state for the frame being solved; nlopt's callbacks read it through their data
-// pointer.
+// pointer. Variables are over the reduced points (motion_refit_reduction.hpp; all non-root points
+// when the solve is not preconditioned).
 struct FrameContext {
   const MotionRefitProblem* problem = nullptr;
+  detail::PointReduction* reduction = nullptr;
   size_t point_count = 0;
-  size_t variable_count = 0;  // n = 3 (P - 1)
+  size_t variable_count = 0;         // n = 3 P_r
   bool precondition = false;
   const double* original = nullptr;  // (P, 3) this frame's x^o
-  std::vector<double> start;         // (P, 3) x_start of the preconditioned variables
+  std::vector<double> start;         // (P_r, 3) reduced x_start of the preconditioned variables
   Eigen::MatrixXd factor;            // lower L with L L^T = E's (clipped) Hessian at x_start
-  RowMajor hessian;
+  std::vector<double> reduced;       // (P_r, 3) reduced positions of the current variables
   std::vector<double> x;             // (P, 3) positions of the current variables
   std::vector<double> gradient;      // (P, 3)
   std::vector<double> jacobian;      // (rows, P, 3)
+  std::vector<double> values;        // (rows,) every equality before the kept ones are picked
+  std::vector<double> rows;          // (rows, P_r, 3)
 };
 
-// Positions from variables: x = x^o + L z (plain), or x = x_start + L^-T y (preconditioned);
-// the root is always the original root.
+// Positions from variables: reduced positions y = y^o + L z (plain), or y = y_start + L^-T v
+// (preconditioned), then the full positions (the root is always the original root).
 void to_positions(FrameContext& c, const double* v) {
   const size_t n = c.variable_count;
-  std::copy(c.original, c.original + 3, c.x.begin());
   if (!c.precondition) {
+    c.reduction->gather(c.original, c.reduced.data());
     const double scale = c.problem->length_scale;
-    for (size_t i = 0; i < n; ++i) c.x[3 + i] = c.original[3 + i] + scale * v[i];
-    return;
+    for (size_t i = 0; i < n; ++i) c.reduced[i] += scale * v[i];
+  } else {
+    Eigen::Map<Eigen::VectorXd> d(c.reduced.data(), static_cast<Eigen::Index>(n));
+    d = Eigen::Map<const Eigen::VectorXd>(v, static_cast<Eigen::Index>(n));
+    c.factor.triangularView<Eigen::Lower>().transpose().solveInPlace(d);
+    for (size_t i = 0; i < n; ++i) c.reduced[i] += c.start[i];
   }
-  Eigen::Map<Eigen::VectorXd> d(c.x.data() + 3, static_cast<Eigen::Index>(n));
-  d = Eigen::Map<const Eigen::VectorXd>(v, static_cast<Eigen::Index>(n));
-  c.factor.triangularView<Eigen::Lower>().transpose().solveInPlace(d);
-  for (size_t i = 0; i < n; ++i) c.x[3 + i] += c.start[3 + i];
+  c.reduction->fill(c.reduced.data(), c.original, c.x.data());
 }
 
-// Derivatives over positions (rows of 3P, root first) to derivatives over the variables:
-// L * g (plain), or L^-1 g (preconditioned). out: (rows, n) row-major, as nlopt wants.
-void to_variables(const FrameContext& c, const double* rows_in, size_t rows, double* out) {
+// Derivative rows over full positions (rows, P, 3) to rows over the variables: over reduced
+// positions, times L (plain) or L^-1 (preconditioned). out: (rows, n) row-major, as nlopt wants.
+void to_variables(FrameContext& c, const double* rows_in, size_t rows, double* out) {
   const size_t n = c.variable_count;
-  const size_t stride = 3 * c.point_count;
-  for (size_t r = 0; r < rows; ++r)
-    std::copy(rows_in + r * stride + 3, rows_in + r * stride + 3 + n, out + r * n);
+  c.reduction->reduce_rows(rows_in, rows, out);
   if (!c.precondition) {
     const double scale = c.problem->length_scale;
     for (size_t i = 0; i < rows * n; ++i) out[i] *= scale;
@@ -94,7 +98,17 @@ double objective_callback(unsigned, const double* v, double* grad, void* data) {
 void equality_callback(unsigned m, double* result, unsigned, const double* v, double* grad, void* data) {
   auto& c = *static_cast<FrameContext*>(data);
   to_positions(c, v);
-  detail::refit_equalities_frame(*c.problem, c.x.data(), result, grad ? c.jacobian.data() : nullptr);
+  const size_t stride = 3 * c.point_count;
+  detail::refit_equalities_frame(*c.problem, c.x.data(), c.values.data(), grad ? c.jacobian.data() : nullptr);
+  const auto& kept = c.reduction->kept_equalities();
+  size_t row = 0;  // the kept rows, packed to the front
+  for (size_t k = 0; k < kept.size(); ++k) {
+    if (!kept[k]) continue;
+    result[row] = c.values[k];
+    if (grad && row != k) std::copy_n(c.jacobian.begin() + static_cast<long>(k * stride), stride,
+                                      c.jacobian.begin() + static_cast<long>(row * stride));
+    ++row;
+  }
   if (grad) to_variables(c, c.jacobian.data(), m, grad);
 }
 
@@ -121,34 +135,45 @@ struct Outcome {
 class FrameSolver {
  public:
   FrameSolver(const MotionRefitProblem& problem, const MotionRefitOptions& options)
-      : problem_(problem), options_(options) {
+      : problem_(problem),
+        options_(options),
+        hard_(options.hard_constraints && motion_refit_equality_count(problem) > 0),
+        reduction_(problem, hard_, options.precondition && options.eliminate_points,
+                   options.precondition && options.eliminate_points) {
     const size_t p = problem.point_count;
+    const size_t m = motion_refit_equality_count(problem);
     c_.problem = &problem_;
+    c_.reduction = &reduction_;
     c_.point_count = p;
-    c_.variable_count = 3 * (p - 1);
+    c_.variable_count = 3 * reduction_.reduced_points();
     c_.precondition = options.precondition;
-    c_.start.assign(3 * p, 0.0);
+    c_.start.assign(c_.variable_count, 0.0);
+    c_.reduced.assign(c_.variable_count, 0.0);
     c_.x.assign(3 * p, 0.0);
     c_.gradient.assign(3 * p, 0.0);
-    const size_t m = motion_refit_equality_count(problem);
-    hard_ = options.hard_constraints && m > 0;
+    c_.values.assign(m, 0.0);
     c_.jacobian.assign(std::max(m, problem.handed_quad_count) * 3 * p, 0.0);
-    if (options.precondition) c_.hessian.resize(c_.variable_count, c_.variable_count);
+    if (options.precondition) {
+      full_hessian_.assign(9 * (p - 1) * (p - 1), 0.0);
+      hessian_.resize(c_.variable_count, c_.variable_count);
+    }
     variables_.assign(c_.variable_count, 0.0);
     equality_values_.assign(m, 0.0);
     handed_values_.assign(problem.handed_quad_count, 0.0);
 
     opt_.reset(nlopt_create(NLOPT_LD_SLSQP, static_cast<unsigned>(c_.variable_count)));
+    if (!opt_) return;
     nlopt_set_min_objective(opt_.get(), objective_callback, &c_);
-    if (hard_) {
-      const std::vector<double> tolerance(m, 0.1 * options.feasibility_tolerance);
-      nlopt_add_equality_mconstraint(opt_.get(), static_cast<unsigned>(m), equality_callback, &c_,
+    const size_t kept = reduction_.kept_equality_count();
+    if (hard_ && kept > 0) {
+      const std::vector<double> tolerance(kept, 0.1 * options.feasibility_tolerance);
+      nlopt_add_equality_mconstraint(opt_.get(), static_cast<unsigned>(kept), equality_callback, &c_,
                                      tolerance.data());
-      if (problem.handed_quad_count > 0) {
-        const std::vector<double> zero(problem.handed_quad_count, 0.0);
-        nlopt_add_inequality_mconstraint(opt_.get(), static_cast<unsigned>(problem.handed_quad_count),
-                                         handedness_callback, &c_, zero.data());
-      }
+    }
+    if (hard_ && problem.handed_quad_count > 0) {
+      const std::vector<double> zero(problem.handed_quad_count, 0.0);
+      nlopt_add_inequality_mconstraint(opt_.get(), static_cast<unsigned>(problem.handed_quad_count),
+                                       handedness_callback, &c_, zero.data());
     }
     nlopt_set_ftol_rel(opt_.get(), options.ftol_rel);
     nlopt_set_maxeval(opt_.get(), options.max_evaluations);
@@ -161,19 +186,20 @@ class FrameSolver {
   }
 
   Outcome solve(const double* original, const double* start, double* result) {
-    const size_t p = problem_.point_count;
     const size_t n = c_.variable_count;
     c_.original = original;
-    std::copy(start, start + 3 * p, c_.start.begin());
-    std::copy(original, original + 3, c_.start.begin());  // the root never moves
+    reduction_.gather(start, c_.start.data());
     if (c_.precondition) {
-      prepare_preconditioner();
       std::fill(variables_.begin(), variables_.end(), 0.0);
+      to_positions(c_, variables_.data());  // the start with its eliminated points placed
+      prepare_preconditioner();
     } else {
-      for (size_t i = 0; i < n; ++i) variables_[i] = (c_.start[3 + i] - original[3 + i]) / problem_.length_scale;
+      reduction_.gather(original, c_.reduced.data());
+      for (size_t i = 0; i < n; ++i) variables_[i] = (c_.start[i] - c_.reduced[i]) / problem_.length_scale;
+      to_positions(c_, variables_.data());
     }
     Outcome outcome;
-    const double start_value = energy(c_.start.data(), original);
+    const double start_value = energy(c_.x.data(), original);
     double minimum = 0.0;
     const nlopt_result code = nlopt_optimize(opt_.get(), variables_.data(), &minimum);
     outcome.evaluations = nlopt_get_numevals(opt_.get());
@@ -204,10 +230,13 @@ class FrameSolver {
   }
 
  private:
+  // E's Hessian (each term's part positive semidefinite) at the placed start c_.x, over the
+  // reduced coordinates (T^T H T), and its Cholesky factor.
   void prepare_preconditioner() {
     const auto n = static_cast<Eigen::Index>(c_.variable_count);
-    detail::refit_hessian_frame(problem_, c_.start.data(), true, c_.hessian.data());
-    Eigen::LLT<Eigen::MatrixXd> llt(c_.hessian);  // symmetric: row-major = column-major
+    detail::refit_hessian_frame(problem_, c_.x.data(), true, full_hessian_.data());
+    reduction_.reduce_matrix(full_hessian_.data(), hessian_.data());
+    Eigen::LLT<Eigen::MatrixXd> llt(hessian_);  // symmetric: row-major = column-major
     if (llt.info() == Eigen::Success) {
       c_.factor = llt.matrixL();
     } else {  // not expected (the matrix is >= 2 alpha / L^2 I); Ed's curvature alone then
@@ -222,8 +251,11 @@ class FrameSolver {
 
   const MotionRefitProblem& problem_;
   const MotionRefitOptions& options_;
-  FrameContext c_;
   bool hard_ = false;
+  detail::PointReduction reduction_;
+  FrameContext c_;
+  std::vector<double> full_hessian_;
+  RowMajor hessian_;
   std::unique_ptr<std::remove_pointer_t<nlopt_opt>, NloptDeleter> opt_;
   std::vector<double> variables_;
   std::vector<double> equality_values_;

@@ -86,6 +86,11 @@ struct MotionRefitOptions {
   // quasi-Newton matrix is then close to the right one and it needs far fewer iterations. Off:
   // the scaled displacements (x - x^o) / L, as the Python reference (motion_lod/refit.py).
   bool precondition = true;
+  // With precondition: leave out points whose optimum follows in closed form from another's (a
+  // leaf held by one length lies on the ray to its original position) or that hard constraints
+  // put onto another point (a zero-length pair); SLSQP's cost grows with the cube of the
+  // variable count. The minima are the same.
+  bool eliminate_points = true;
   int chunk_frames = 64;        // consecutive frames per task (warm starts run inside a chunk)
   int threads = 0;              // worker threads; 0 uses every hardware thread
 };

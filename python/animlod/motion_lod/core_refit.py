@@ -46,6 +46,7 @@ def core_options(options: SlsqpOptions, threads: int = 0, chunk_frames: int = 64
     result.feasibility_tolerance = options.feasibility_tolerance
     result.warm_start = options.warm_start
     result.precondition = options.precondition
+    result.eliminate_points = options.eliminate_points
     result.threads = threads
     result.chunk_frames = chunk_frames
     return result

@@ -51,9 +51,12 @@ class SlsqpOptions:
     ftol_rel, max_evaluations : SLSQP's stopping rules per solve.
     feasibility_tolerance : largest |b - b0| / L accepted with hard constraints.
     warm_start : start each frame from the previous frame's result inside a chunk.
-    precondition : the core solves in variables where E's Gauss-Newton matrix at the start is the
-        identity (far fewer iterations); the Python reference always uses the plain scaled
-        displacements (x - x^o) / L and ignores it.
+    precondition : the core solves in variables where E's Hessian at the start is the identity
+        (far fewer iterations); the Python reference always uses the plain scaled displacements
+        (x - x^o) / L and ignores it.
+    eliminate_points : with precondition, the core places leaves held by one length and points
+        of zero-length pairs in closed form instead of as variables (the same minima); the Python
+        reference ignores it.
     """
 
     hard_constraints: bool = _CORE_DEFAULTS.hard_constraints
@@ -62,6 +65,7 @@ class SlsqpOptions:
     feasibility_tolerance: float = _CORE_DEFAULTS.feasibility_tolerance
     warm_start: bool = _CORE_DEFAULTS.warm_start
     precondition: bool = _CORE_DEFAULTS.precondition
+    eliminate_points: bool = _CORE_DEFAULTS.eliminate_points
 
 
 def _positions(problem: RefitProblem, original: np.ndarray, z: np.ndarray) -> np.ndarray:

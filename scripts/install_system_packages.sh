@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages animlod needs (DESIGN.md's list, plus the Python headers and
-# venv for building the extension, doctest for the C++ tests and dpkg-dev for unpacking the
-# OpenMesh source package). Installs only what is missing, so a second run is quick.
+# venv for building the extension, doctest for the C++ tests, dpkg-dev for unpacking the
+# OpenMesh source package and libnlopt-dev for the core's motion LoD SLSQP). Installs only what is missing, so a second run is quick.
 set -euo pipefail
 
 packages=(g++ cmake ninja-build pkg-config libopenmesh-dev libeigen3-dev libglm-dev libglfw3-dev

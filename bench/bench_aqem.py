@@ -30,9 +30,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from devdata import DATA_DIR
 from table import print_table, stopwatch
 
+from animlod.aqem import simplify_animated
 from animlod.metrics import surface_error
 from animlod.model import AnimatedMesh
-from animlod.simplify import simplify_animated
 
 DATA = DATA_DIR / "meshseq"
 RATIOS = (0.5, 0.25, 0.1)

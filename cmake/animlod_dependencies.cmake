@@ -37,4 +37,3 @@ if(NOT TARGET NLopt::nlopt)
   message(FATAL_ERROR "animlod needs nlopt 2.7+ (C library, SLSQP for the motion LoD re-fit): "
                       "install the Debian package libnlopt-dev")
 endif()
-find_package(Threads REQUIRED)

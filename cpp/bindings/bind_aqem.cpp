@@ -16,7 +16,7 @@ namespace {
 using MaskArray = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>;
 
 py::dict level_to_dict(AqemLevel&& level, py::ssize_t frame_count, py::ssize_t attribute_count,
-                       py::ssize_t influence_count) {
+                       py::ssize_t influence_count, py::ssize_t position_attribute_count) {
   const auto kept = static_cast<py::ssize_t>(level.kept_vertices.size());
   const auto face_count = static_cast<py::ssize_t>(level.faces.size() / 3);
   const auto vertex_count = static_cast<py::ssize_t>(level.vertex_map.size());
@@ -26,12 +26,15 @@ py::dict level_to_dict(AqemLevel&& level, py::ssize_t frame_count, py::ssize_t a
   out["collapse_count"] = level.collapse_count;
   out["error"] = level.error;
   out["faces"] = numpy_from_vector(std::move(level.faces), {face_count, 3});
+  out["face_sources"] = numpy_from_vector(std::move(level.face_sources), {face_count});
   out["kept_vertices"] = numpy_from_vector(std::move(level.kept_vertices), {kept});
   out["vertex_map"] = numpy_from_vector(std::move(level.vertex_map), {vertex_count});
   out["positions"] = numpy_from_vector(std::move(level.positions), {frame_count, kept, 3});
   out["attributes"] = numpy_from_vector(std::move(level.attributes), {kept, attribute_count});
   out["skin_joints"] = numpy_from_vector(std::move(level.skin_joints), {level.skin_joints.empty() ? 0 : kept, influence_count});
   out["skin_weights"] = numpy_from_vector(std::move(level.skin_weights), {level.skin_weights.empty() ? 0 : kept, influence_count});
+  out["position_attributes"] =
+      numpy_from_vector(std::move(level.position_attributes), {kept, position_attribute_count});
   return out;
 }
 
@@ -44,7 +47,10 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
                               const std::optional<FloatArray>& importance, const std::optional<FloatArray>& attributes,
                               const std::optional<py::array>& skin_joint_indices,
                               const std::optional<FloatArray>& skin_weights,
-                              const std::optional<py::function>& progress, const std::string& placement) {
+                              const std::optional<py::function>& progress, const std::string& placement,
+                              const std::optional<FloatArray>& position_attributes,
+                              const std::optional<py::array>& face_group_indices, bool weld,
+                              const std::optional<MaskArray>& guarded) {
   require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
   const IndexArray faces = index_array(face_indices, "faces");
   require_shape(faces, "faces", {-1, 3}, "(M, 3)");
@@ -57,6 +63,10 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
     require_shape(*locked, "locked", {vertex_count}, "(V,)");
     data.locked = locked->data();
   }
+  if (guarded) {
+    require_shape(*guarded, "guarded", {vertex_count}, "(V,)");
+    data.guarded = guarded->data();
+  }
   if (importance) {
     require_shape(*importance, "importance", {vertex_count}, "(V,)");
     data.importance = importance->data();
@@ -65,6 +75,17 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
     require_shape(*attributes, "attributes", {vertex_count, -1}, "(V, A)");
     data.attributes = attributes->data();
     data.attribute_count = static_cast<size_t>(attributes->shape(1));
+  }
+  if (position_attributes) {
+    require_shape(*position_attributes, "position_attributes", {vertex_count, -1}, "(V, B)");
+    data.position_attributes = position_attributes->data();
+    data.position_attribute_count = static_cast<size_t>(position_attributes->shape(1));
+  }
+  std::optional<IndexArray> face_groups;
+  if (face_group_indices) {
+    face_groups = index_array(*face_group_indices, "face_groups");
+    require_shape(*face_groups, "face_groups", {faces.shape(0)}, "(M,)");
+    data.face_groups = face_groups->data();
   }
   std::optional<IndexArray> skin_joints;
   if (skin_joint_indices) skin_joints = index_array(*skin_joint_indices, "skin_joints");
@@ -91,6 +112,7 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   options.strict_inversion = strict_inversion;
   options.max_frames = max_frames;
   options.frame_subset = std::move(frame_subset);
+  options.weld = weld;
   if (placement == "optimal") options.placement = Placement::optimal;
   else if (placement == "on_edge") options.placement = Placement::on_edge;
   else throw py::value_error("placement: expected 'optimal' or 'on_edge', got '" + placement + "'");
@@ -114,7 +136,8 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   py::list levels;
   for (AqemLevel& level : result.levels)
     levels.append(level_to_dict(std::move(level), frame_count, static_cast<py::ssize_t>(data.attribute_count),
-                                static_cast<py::ssize_t>(data.influence_count)));
+                                static_cast<py::ssize_t>(data.influence_count),
+                                static_cast<py::ssize_t>(data.position_attribute_count)));
   CollapseRecord& record = result.collapses;
   const auto collapse_count = static_cast<py::ssize_t>(record.removed.size());
   py::dict collapses;
@@ -129,6 +152,16 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   const auto used = static_cast<py::ssize_t>(result.frames_used.size());
   out["frames_used"] = numpy_from_vector(std::move(result.frames_used), {used});
   out["vertex_weights"] = numpy_from_vector(std::move(result.vertex_weights), {vertex_count});
+  const AqemPreparation& report = result.preparation;
+  py::dict preparation;
+  preparation["degenerate_faces"] = report.degenerate_faces;
+  preparation["duplicate_faces"] = report.duplicate_faces;
+  preparation["welded_vertices"] = report.welded_vertices;
+  preparation["seam_vertices"] = report.seam_vertices;
+  preparation["split_vertices"] = report.split_vertices;
+  preparation["unreferenced_vertices"] = report.unreferenced_vertices;
+  preparation["face_count"] = report.face_count;
+  out["preparation"] = preparation;
   return out;
 }
 }  // namespace
@@ -146,37 +179,48 @@ void bind_aqem(py::module_& m) {
         py::arg("frame_subset") = defaults.frame_subset, py::arg("locked") = py::none(),
         py::arg("importance") = py::none(), py::arg("attributes") = py::none(), py::arg("skin_joints") = py::none(),
         py::arg("skin_weights") = py::none(), py::arg("progress") = py::none(),
-        py::arg("placement") = "optimal",
+        py::arg("placement") = "optimal", py::arg("position_attributes") = py::none(),
+        py::arg("face_groups") = py::none(), py::arg("weld") = defaults.weld, py::arg("guarded") = py::none(),
         R"doc(AQEM simplification of a deforming mesh over all its frames (Yang et al. 2019, Eqs. 1-7).
 
 Parameters
 ----------
 frames : (F, V, 3) float32 positions per frame (float64 is converted).
-faces : (M, 3) int32 or int64 triangles (values must fit int32).
-target_ratios : level sizes as fractions of M in (0, 1]; ignored when target_face_counts is given.
-target_face_counts : level sizes as face counts in [4, M].
+faces : (M, 3) int32 or int64 triangles (values must fit int32). Any topology: seam copies are
+    welded, degenerate and repeated faces dropped, non-manifold spots cut and locked.
+target_ratios : level sizes as fractions of the faces left after preparation, in (0, 1]; ignored
+    when target_face_counts is given.
+target_face_counts : level sizes as face counts in [1, M].
 max_error : asset units; stop before a collapse whose error exceeds it. A collapse's error is the
     RMS distance of the new vertex to the planes of its merged quadric, over those planes and the
     frames used.
 use_motion_features, feature_threshold, min_angle_change, boundary_is_feature : Eq. 6 weights
     (see motion_features).
-boundary_quadrics : perpendicular planes on open borders (Garland and Heckbert).
+boundary_quadrics : perpendicular planes on open borders and attribute seams (Garland and Heckbert).
 check_inversion : Eq. 7 inversion test summed over every frame; strict_inversion: no flip in any
     single frame (ignored when check_inversion is False).
 max_frames : 0 for all frames, else K frames by farthest-point sampling; frame_subset: explicit.
 locked : (V,) bool, vertices never removed or moved.  importance : (V,) float32 > 0 weights.
-attributes : (V, A) float32 interpolated along collapses (UVs).
+attributes : (V, A) float32 interpolated along collapses (UVs, normals, colours); copies of a
+    position with different attributes form a seam that only collapses along itself.
 skin_joints, skin_weights : (V, K) int32 or int64 / float32, merged keeping the top K.
 progress : callable(done, total) called with the GIL held now and then.
 placement : "optimal" (Eq. 5 in every frame) or "on_edge" (one point of the edge for all
     frames, so UVs and skin weights stay consistent with the positions).
+position_attributes : (V, B) float32 that follow the position (morph target deltas): copies weld
+    only when they agree; blended once per collapse.
+face_groups : (M,) int32 material or primitive per face; group borders are seams.
+weld : weld copies of a position (equal in every frame, position_attributes and skin).
+guarded : (V,) bool, vertices kept in place until no other collapse is legal.
 
 Returns
 -------
-dict with "levels" (list, finest first, of dicts: faces (M', 3), kept_vertices (V',),
-vertex_map (V,), positions (F, V', 3), attributes, skin_joints, skin_weights, error, reached,
-target_face_count, collapse_count), "collapses" (removed, kept (C,), positions (C, F, 3),
-cost, error (C,)), "frames_used" and "vertex_weights" (V,). Arrays own their memory (moved
+dict with "levels" (list, finest first, of dicts: faces (M', 3), face_sources (M',),
+kept_vertices (V',), vertex_map (V,), positions (F, V', 3), attributes, position_attributes,
+skin_joints, skin_weights, error, reached, target_face_count, collapse_count), "collapses"
+(removed, kept (C,), positions (C, F, 3), cost, error (C,)), "frames_used", "vertex_weights" (V,)
+and "preparation" (counts of degenerate_faces, duplicate_faces, welded_vertices, seam_vertices,
+split_vertices, unreferenced_vertices, and face_count simplified). Arrays own their memory (moved
 from the core, no copy). The GIL is released while simplifying.
 
 Raises ValueError naming the element for bad meshes, targets or per-vertex inputs.)doc");

@@ -8,6 +8,7 @@ void bind_skinning(py::module_& m);
 void bind_aqem(py::module_& m);
 void bind_motion_features(py::module_& m);
 void bind_motion_refit(py::module_& m);
+void bind_tdag(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -16,4 +17,5 @@ PYBIND11_MODULE(_core, m) {
   animlod::bindings::bind_aqem(m);
   animlod::bindings::bind_motion_features(m);
   animlod::bindings::bind_motion_refit(m);
+  animlod::bindings::bind_tdag(m);
 }

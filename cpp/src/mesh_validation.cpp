@@ -49,6 +49,13 @@ Status check_sizes_and_values(const AnimatedMeshView& mesh) {
       if (v[k] < 0 || v[k] >= vertex_count)
         return Status::error(face_text(mesh, f) + ": vertex index " + std::to_string(v[k]) + " outside [0, " +
                              std::to_string(vertex_count) + ")");
+  }
+  return Status::success();
+}
+
+Status check_no_degenerate_faces(const AnimatedMeshView& mesh) {
+  for (size_t f = 0; f < mesh.face_count; ++f) {
+    const int32_t* v = mesh.faces + 3 * f;
     if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
       return Status::error(face_text(mesh, f) + ": degenerate, repeats a vertex");
   }
@@ -140,8 +147,11 @@ Status validate_animated_mesh(const AnimatedMeshView& mesh) {
   return detail::validate_and_build_edges(mesh, edges);
 }
 
+Status detail::check_sizes_values_and_indices(const AnimatedMeshView& mesh) { return check_sizes_and_values(mesh); }
+
 Status detail::validate_and_build_edges(const AnimatedMeshView& mesh, EdgeTable& edges) {
   if (Status status = check_sizes_and_values(mesh); !status) return status;
+  if (Status status = check_no_degenerate_faces(mesh); !status) return status;
   edges = build_edge_table(mesh.faces, mesh.face_count);
   if (Status status = check_duplicate_faces(mesh, edges); !status) return status;
   if (Status status = check_manifold_edges(edges); !status) return status;

@@ -323,8 +323,12 @@ class SkinnedMesh:
     def face_count(self) -> int:
         return int(self.faces.shape[0])
 
-    def bake(self, motion: Motion) -> AnimatedMesh:
-        """Linear blend skinning of every frame of ``motion`` in the C++ core."""
+    def bake(self, motion: Motion, morph_weights: np.ndarray | None = None) -> AnimatedMesh:
+        """Linear blend skinning of every frame of ``motion`` in the C++ core.
+
+        ``morph_weights (T, N)`` blends the morph targets into the rest pose of each frame first,
+        as glTF does (morphing before skinning).
+        """
         from ._core import bake_lbs
 
         if motion.skeleton.joint_count != self.skeleton.joint_count:
@@ -332,7 +336,18 @@ class SkinnedMesh:
                 f"motion has {motion.skeleton.joint_count} joints, the skin's skeleton {self.skeleton.joint_count}"
             )
         matrices = motion.skin_matrices(self.inverse_bind).astype(np.float32)
-        frames = bake_lbs(self.rest_positions, self.joints, self.weights, matrices)
+        if morph_weights is None or self.morph_targets is None:
+            frames = bake_lbs(self.rest_positions, self.joints, self.weights, matrices)
+            return AnimatedMesh(self.faces, frames, fps=motion.fps)
+        morph_weights = np.asarray(morph_weights, np.float64)
+        expected = (motion.frame_count, len(self.morph_targets))
+        _require(
+            morph_weights.shape == expected, f"morph_weights: expected shape {expected}, got {morph_weights.shape}"
+        )
+        frames = np.empty((motion.frame_count, self.vertex_count, 3), np.float32)
+        for t in range(motion.frame_count):  # O(T) calls, each a whole frame in C++
+            rest = self.rest_positions + np.einsum("n,nvc->vc", morph_weights[t], self.morph_targets)
+            frames[t] = bake_lbs(rest.astype(np.float32), self.joints, self.weights, matrices[t : t + 1])[0]
         return AnimatedMesh(self.faces, frames, fps=motion.fps)
 
 
@@ -357,10 +372,19 @@ def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.
 
 @dataclass
 class LodLevel:
-    """One level of a chain: what is drawn and its error in asset units.
+    """One level of a chain: what is drawn, how it moves, and its error in asset units.
 
-    ``screen_coverage`` is the MSFT_screencoverage hint of a glTF chain, or None where the
-    level is chosen from its error alone (:meth:`LodChain.level_for`).
+    Attributes
+    ----------
+    mesh : the level's geometry (a skinned mesh, a deforming or static mesh), or None for a
+        motion-only level.
+    skeleton : the skeleton the level animates (fewer joints at motion levels), or None.
+    motions : the level's clips on ``skeleton``.
+    error : asset units; what the level gets wrong against level 0 (the max-over-frames
+        surface distance for geometry, the largest joint error for motion).
+    screen_coverage : the MSFT_screencoverage where the level starts to be used (fraction of the
+        viewport height the object covers), or None where the level is chosen from its error.
+    mesh_level, motion_level : the geometry and motion levels this level combines.
     """
 
     mesh: AnimatedMesh | SkinnedMesh | None
@@ -368,13 +392,20 @@ class LodLevel:
     motions: list[Motion]
     error: float
     screen_coverage: float | None = None
+    mesh_level: int = 0
+    motion_level: int = 0
 
 
 @dataclass
 class LodChain:
-    """Levels from finest (index 0) to coarsest."""
+    """Levels from finest (index 0) to coarsest: what every technique returns or converts to,
+    what the LoD GLB holds (:func:`animlod.io.read_lod_chains`), what runtimes consume.
+
+    ``name`` names what the chain draws (the glTF node, or the technique's input).
+    """
 
     levels: list[LodLevel] = field(default_factory=list)
+    name: str = ""
 
     def level_for(self, screen_error_budget: float, distance: float, focal_length_px: float) -> int:
         """Coarsest level whose error, projected to pixels at ``distance``, is within the budget.

@@ -9,8 +9,8 @@ import pytest
 from simplify_inputs import bending_tube
 
 from animlod import _core, synth
+from animlod.aqem import motion_features
 from animlod.model import AnimatedMesh
-from animlod.simplify import motion_features
 
 
 def test_a_hinge_reports_its_exact_angle_change():

@@ -9,8 +9,8 @@ import pytest
 from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
 
 from animlod import _core
+from animlod.aqem import simplify_animated
 from animlod.model import AnimatedMesh
-from animlod.simplify import simplify_animated
 
 
 def test_levels_respect_targets_and_stay_valid_manifolds():
@@ -127,47 +127,36 @@ def test_progress_reports_the_collapses():
     assert calls[0] == (0, planned) and calls[-1] == (result.collapses.removed.size, planned)
 
 
-@pytest.mark.parametrize(
-    "edit, message",
-    [
-        (lambda f: np.concatenate([f, f[:1]]), "faces 0 and 360: duplicate, same three vertices"),
-        (lambda f: np.concatenate([f, [[0, 0, 1]]]), "face 360 (0, 0, 1): degenerate, repeats a vertex"),
-        (lambda f: np.concatenate([f, [[0, 13, 191]]]), "edge (0, 13): non-manifold"),
-    ],
-)
-def test_bad_connectivity_names_the_element(edit, message):
+def test_degenerate_repeated_and_unreferenced_are_dropped_and_counted():
     mesh = bending_tube(frames=2)
-    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
-        simplify_animated(AnimatedMesh(edit(mesh.faces), mesh.frames), (0.5,))
+    extra = mesh.frames[:, :1] + np.float32(5.0)  # vertex 192: no face uses it
+    faces = np.concatenate([mesh.faces, mesh.faces[:1], [[0, 0, 1]]])
+    result = simplify_animated(AnimatedMesh(faces, np.concatenate([mesh.frames, extra], axis=1)), (0.5,))
+    clean = simplify_animated(mesh, (0.5,))
+    assert result.preparation.duplicate_faces == 1
+    assert result.preparation.degenerate_faces == 1
+    assert result.preparation.unreferenced_vertices == 1
+    assert result.levels[0].vertex_map[192] == -1
+    np.testing.assert_array_equal(result.levels[0].mesh.faces, clean.levels[0].mesh.faces)
+    np.testing.assert_array_equal(result.levels[0].kept_vertices, clean.levels[0].kept_vertices)
 
 
-def test_unreferenced_vertex_and_targets_out_of_range_are_named():
+def test_targets_out_of_range_are_named():
     mesh = bending_tube(frames=2)
-    extra = AnimatedMesh(mesh.faces, np.concatenate([mesh.frames, mesh.frames[:, :1]], axis=1))
-    with pytest.raises(ValueError, match="vertex 192: not referenced by any face"):
-        simplify_animated(extra, (0.5,))
-    with pytest.raises(ValueError, match=r"target_face_counts: 400 outside \[4, 360\]"):
+    with pytest.raises(ValueError, match=r"target_face_counts: 400 outside \[1, 360\]"):
         simplify_animated(mesh, target_face_counts=[400])
-    with pytest.raises(ValueError, match="below 4 faces"):
-        simplify_animated(mesh, (0.005,))
     with pytest.raises(ValueError, match="placement"):
         simplify_animated(mesh, placement="middle")
+    with pytest.raises(ValueError, match=r"locked_vertices: vertex 9999 outside \[0, 192\)"):
+        simplify_animated(mesh, locked_vertices=[9999])
 
 
-def test_repair_drops_what_it_documents_and_maps_back():
+def test_a_tiny_ratio_stops_at_the_smallest_reachable_level():
     mesh = bending_tube(frames=2)
-    faces = np.concatenate([mesh.faces, mesh.faces[:2], [[5, 5, 6]]])
-    frames = np.concatenate([mesh.frames[:, :7], mesh.frames[:, :1], mesh.frames[:, 7:]], axis=1)
-    faces = np.where(faces >= 7, faces + 1, faces)  # vertex 7 is now unreferenced
-    result = simplify_animated(AnimatedMesh(faces, frames), (0.5,), repair=True)
-    clean = simplify_animated(mesh, (0.5,))
-    level, reference = result.levels[0], clean.levels[0]
-    np.testing.assert_array_equal(level.mesh.faces, reference.mesh.faces)
-    assert level.vertex_map[7] == -1
-    np.testing.assert_array_equal(
-        level.kept_vertices,
-        np.where(reference.kept_vertices >= 7, reference.kept_vertices + 1, reference.kept_vertices),
-    )
+    level = simplify_animated(mesh, (0.005,)).levels[0]
+    assert not level.reached
+    assert level.target_face_count == 2
+    assert 2 < level.mesh.face_count < 40
 
 
 def test_open_borders_keep_their_outline():
@@ -193,19 +182,74 @@ def test_crane_sequence_at_ten_percent(data_dir):
     assert result.levels[-1].error < 0.02 * diagonal
 
 
-def test_repair_splits_a_bow_tie_vertex():
+def test_a_bow_tie_vertex_and_a_three_face_edge_simplify_without_new_holes():
     mesh = bending_tube(frames=2)
-    # A closed tetrahedron that touches the tube at vertex 0 only.
+    # A closed tetrahedron that touches the tube at vertex 0 only (a bow tie), and a fin: one
+    # more face on the tube's edge (0, 13).
     apex = mesh.frames[:, :1] + np.array([-0.5, 0.0, 0.0], np.float32)
-    frames = np.concatenate([mesh.frames, apex, apex + [[[0, 0.3, 0]]], apex + [[[0, 0, 0.3]]]], axis=1)
-    a, b, c = 192, 193, 194
-    faces = np.concatenate([mesh.faces, [[0, b, a], [0, c, b], [0, a, c], [a, b, c]]])
-    with pytest.raises(ValueError, match="vertex 0: non-manifold"):
-        simplify_animated(AnimatedMesh(faces, frames), (0.5,))
-    level = simplify_animated(AnimatedMesh(faces, frames), (0.5,), repair=True).levels[0]
-    assert level.mesh.face_count <= 182
-    assert directed_edges_unique(level.mesh.faces)
+    fin = mesh.frames[:, :1] + np.array([0.0, 0.0, 0.4], np.float32)
+    frames = np.concatenate([mesh.frames, apex, apex + [[[0, 0.3, 0]]], apex + [[[0, 0, 0.3]]], fin], axis=1)
+    a, b, c, tip = 192, 193, 194, 195
+    faces = np.concatenate([mesh.faces, [[0, b, a], [0, c, b], [0, a, c], [a, b, c], [0, 13, tip]]])
+    result = simplify_animated(AnimatedMesh(faces, frames), (0.5,))
+    assert result.preparation.split_vertices >= 1
+    level = result.levels[0]
+    assert level.reached and level.mesh.face_count <= 183
     assert level.vertex_map.min() >= 0
+    # No new holes: the border edges of the output are the input's (the tube's two rims and
+    # the fin's two free sides), as many as there were.
+    assert _border_edge_count(level.mesh.faces) <= _border_edge_count(faces)
+    # The pieces stay stitched where they touched.
+    for vertex in (0, 13):
+        np.testing.assert_array_equal(level.mesh.frames[:, level.vertex_map[vertex]], frames[:, vertex])
+
+
+def test_an_unwelded_mesh_simplifies_like_the_welded_one():
+    mesh = bending_tube(frames=3)
+    corners = mesh.faces.ravel()
+    unwelded = AnimatedMesh(np.arange(corners.size).reshape(-1, 3), mesh.frames[:, corners])
+    result = simplify_animated(unwelded, (0.5, 0.1))
+    assert result.preparation.welded_vertices == corners.size - mesh.vertex_count
+    reference = simplify_animated(mesh, (0.5, 0.1))
+    for level, expected in zip(result.levels, reference.levels):
+        assert level.reached and expected.reached
+        assert level.mesh.face_count == expected.mesh.face_count
+
+
+def test_uv_seams_stay_seams():
+    mesh = bending_tube(frames=2)
+    # Cut the tube's UV chart along its first column of vertices: faces on one side of the cut
+    # use copies with u = 1 instead of 0.
+    segments = 12  # bending_tube's vertices go round each ring of 12
+    ring = np.arange(mesh.vertex_count) % segments
+    copies = np.flatnonzero(ring == 0)
+    copy_of = np.full(mesh.vertex_count, -1)
+    copy_of[copies] = mesh.vertex_count + np.arange(copies.size)
+    faces = mesh.faces.copy()
+    wraps = np.any(ring[faces] == segments - 1, axis=1)
+    faces[wraps] = np.where(ring[faces[wraps]] == 0, copy_of[faces[wraps]], faces[wraps])
+    frames = np.concatenate([mesh.frames, mesh.frames[:, copies]], axis=1)
+    u = np.concatenate([ring / segments, np.ones(copies.size)]).astype(np.float32)
+    uvs = np.stack([u, np.zeros_like(u)], axis=1)
+    result = simplify_animated(AnimatedMesh(faces, frames), (0.3,), attributes=uvs)
+    assert result.preparation.welded_vertices == copies.size
+    assert result.preparation.seam_vertices == copies.size
+    level = result.levels[0]
+    # Every face keeps UVs from one side of the seam: no face spans u = 0 .. 1.
+    face_u = level.attributes[level.mesh.faces, 0]
+    assert np.all(np.ptp(face_u, axis=1) < 0.5)
+    # The seam is still closed: copies of one position share it in every frame.
+    seam = level.attributes[:, 0] == 1.0
+    assert seam.any()
+    positions = level.mesh.frames[0]
+    on_seam = np.isin(positions.view([("", positions.dtype)] * 3), positions[seam].view([("", positions.dtype)] * 3))
+    assert np.count_nonzero(on_seam) == 2 * np.count_nonzero(seam)
+
+
+def _border_edge_count(faces: np.ndarray) -> int:
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    return int(np.count_nonzero(counts == 1))
 
 
 def test_inversion_check_rejects_a_collapse_that_folds_a_star():

@@ -7,7 +7,7 @@ import pytest
 from simplify_inputs import directed_edges_unique, two_bone_tube
 
 from animlod import synth
-from animlod.simplify import simplify_skinned
+from animlod.aqem import simplify_skinned
 
 
 def test_skinned_levels_skin_with_valid_merged_weights():

@@ -4,6 +4,12 @@
 // Every collapse is shared by all frames (one connectivity), and the new vertex gets its own
 // optimal position in every frame. One run yields several levels of detail from the same
 // collapse sequence, plus the ordered collapse record.
+//
+// Any indexed triangle mesh is accepted, as real assets come: vertices duplicated along UV,
+// normal and material seams are welded into one surface and the seams are kept (a seam vertex
+// only collapses along its seam); degenerate and repeated faces are dropped; non-manifold
+// edges and vertices are cut into manifold pieces whose shared vertices are locked, so the
+// pieces stay stitched. AqemResult::preparation counts what was done.
 #pragma once
 
 #include <cstddef>
@@ -30,10 +36,11 @@ enum class Placement {
 };
 
 struct AqemOptions {
-  // Levels as fractions of the input face count, each in (0, 1]. Ignored when
-  // target_face_counts is not empty.
+  // Levels as fractions of the face count M' left after dropping degenerate and repeated faces,
+  // each in (0, 1]. Ignored when target_face_counts is not empty. A level that no legal collapse
+  // can reach stops at the smallest mesh reachable, with reached = false.
   std::vector<double> target_ratios = {0.5};
-  // Levels as face counts, each in [4, M].
+  // Levels as face counts, each in [1, M].
   std::vector<size_t> target_face_counts;
   // Asset units. The run stops before a collapse whose error (an RMS plane distance, see
   // CollapseRecord::error) exceeds it; levels not reached then hold the last mesh and
@@ -42,8 +49,9 @@ struct AqemOptions {
   // Weights of Eq. 6 from the motion features; off gives every vertex weight 1.
   bool use_motion_features = true;
   MotionFeatureOptions motion_features;
-  // Adds, per frame, a plane through every boundary edge perpendicular to its face, so that
-  // open borders keep their shape (Garland and Heckbert 1997, section 6.1).
+  // Adds, per frame, a plane through every boundary edge and every attribute-seam edge
+  // perpendicular to its face, so that open borders and seams keep their shape (Garland and
+  // Heckbert 1997, section 6.1).
   bool boundary_quadrics = true;
   // Rejects collapses that invert a face according to Eq. 7, summed over every frame F (also
   // the frames outside frames_used, at their on-edge positions). The sum lets a face flip in a
@@ -63,10 +71,19 @@ struct AqemOptions {
   // Called now and then with (collapses done, collapses needed for the last level).
   std::function<void(size_t, size_t)> progress;
   Placement placement = Placement::optimal;
+  // Welds vertices that are equal in every frame, in position_attributes and in skin, so that
+  // seam copies form one surface. Off: every input vertex is its own point (seams are borders).
+  bool weld = true;
 };
 
-// Optional per-vertex inputs; a null pointer means "not given". attributes must be given when
-// attribute_count > 0, and skin_joints and skin_weights together (simplify_animated checks).
+// Optional per-vertex and per-face inputs; a null pointer means "not given". attributes must be
+// given when attribute_count > 0 (likewise position_attributes), and skin_joints and
+// skin_weights together (simplify_animated checks).
+//
+// attributes may differ between copies of a position (UV, normal, colour): where they do, the
+// copies form a seam. position_attributes follow the position (morph target deltas): copies
+// weld only when they agree, and a collapse blends them once per position. Skin weights also
+// follow the position.
 struct AqemVertexData {
   const uint8_t* locked = nullptr;        // (V,) nonzero: the vertex keeps its positions and is
                                           //      never removed (edges may collapse into it)
@@ -76,6 +93,14 @@ struct AqemVertexData {
   const int32_t* skin_joints = nullptr;   // (V, K) joint per influence
   const float* skin_weights = nullptr;    // (V, K) influence weights; merged, top K kept
   size_t influence_count = 0;             // K
+  const float* position_attributes = nullptr;  // (V, B) blended along collapsed edges per position
+  size_t position_attribute_count = 0;         // B
+  const int32_t* face_groups = nullptr;   // (M,) material or primitive of each face: copies of a
+                                          //      position in different groups never merge, so
+                                          //      group borders are seams
+  const uint8_t* guarded = nullptr;       // (V,) nonzero: the vertex stays in place (like locked)
+                                          //      until no other collapse is legal, then it is free
+                                          //      (sharp corners kept while the targets allow)
 };
 
 struct AqemLevel {
@@ -84,22 +109,36 @@ struct AqemLevel {
   size_t collapse_count = 0;         // the level is the first collapse_count records applied
   double error = 0.0;                // asset units: the largest collapse error so far (see
                                      // CollapseRecord::error)
-  std::vector<int32_t> faces;        // (M', 3) indices into the kept vertices
+  std::vector<int32_t> faces;        // (M', 3) indices into the kept vertices, corners in input order
+  std::vector<int32_t> face_sources; // (M',) input face each face comes from (its primitive)
   std::vector<int32_t> kept_vertices;  // (V',) original index of each kept vertex, ascending
-  std::vector<int32_t> vertex_map;   // (V,) original vertex -> index of the kept vertex it merged into
+  std::vector<int32_t> vertex_map;   // (V,) original vertex -> index of the kept vertex it merged
+                                     //      into, -1 for vertices no face references
   std::vector<float> positions;      // (F, V', 3) positions of the kept vertices in every frame
   std::vector<float> attributes;     // (V', A)
   std::vector<int32_t> skin_joints;  // (V', K)
   std::vector<float> skin_weights;   // (V', K) rows of vertices made by a collapse: sorted by
                                      // decreasing weight, summing to 1, zero-padded; the
                                      // others: the input's rows unchanged
+  std::vector<float> position_attributes;  // (V', B)
+};
+
+// What simplify_animated did to the input before simplifying (see the top of this header).
+struct AqemPreparation {
+  size_t degenerate_faces = 0;       // dropped: two corners at one welded position
+  size_t duplicate_faces = 0;        // dropped: the same corners as an earlier face, same turn
+  size_t welded_vertices = 0;        // vertices welded onto a lower-numbered copy
+  size_t seam_vertices = 0;          // welded positions whose copies keep different attributes
+  size_t split_vertices = 0;         // copies made to cut non-manifold edges and vertices (locked)
+  size_t unreferenced_vertices = 0;  // vertices no face uses (not in any level)
+  size_t face_count = 0;             // M', the faces simplified
 };
 
 // The ordered collapses (structure of arrays, C collapses): vertex removed[i] merged into
 // vertex kept[i], which moved to positions[i]. Vertex indices are the input's.
 struct CollapseRecord {
-  std::vector<int32_t> removed;   // (C,)
-  std::vector<int32_t> kept;      // (C,)
+  std::vector<int32_t> removed;   // (C,) the lowest input vertex at the removed position
+  std::vector<int32_t> kept;      // (C,) the lowest input vertex at the kept position
   std::vector<float> positions;   // (C, F, 3) new positions of the kept vertex in every frame
   std::vector<double> cost;       // (C,) weighted cost of Eq. 6
   std::vector<double> error;      // (C,) asset units: RMS distance of the new vertex to the planes
@@ -111,7 +150,9 @@ struct AqemResult {
   std::vector<AqemLevel> levels;     // one per target, finest first
   CollapseRecord collapses;
   std::vector<int32_t> frames_used;  // frames whose quadrics drove the simplification
-  std::vector<float> vertex_weights; // (V,) weights of Eq. 6 (motion features x importance)
+  std::vector<float> vertex_weights; // (V,) weights of Eq. 6 (motion features x importance),
+                                     //      1 for vertices no face uses
+  AqemPreparation preparation;
 };
 
 // Simplifies `mesh` to every target of `options`.
@@ -123,12 +164,12 @@ struct AqemResult {
 // positions of the used frames. Attributes and skin weights are interpolated with that same
 // parameter. Ties in cost are broken by edge index, so the output is deterministic.
 //
-// Errors (the message names the element): the checks of validate_animated_mesh; a target
-// ratio outside (0, 1] or face count outside [4, M]; a frame index outside [0, F); a
-// non-positive or non-finite importance; a skin joint index below 0; a negative or non-finite
-// skin weight; a non-finite attribute; attribute_count > 0 with null attributes; only one of
-// skin_joints and skin_weights. On error (or an exception thrown by options.progress) `out`
-// is left empty.
+// Errors (the message names the element): no frames or faces, sizes beyond int32 indices, a
+// non-finite position, a face index outside [0, V); a target ratio outside (0, 1] or face count
+// outside [1, M]; a frame index outside [0, F); a non-positive or non-finite importance; a skin
+// joint index below 0; a negative or non-finite skin weight; a non-finite attribute; a count > 0
+// with null data; only one of skin_joints and skin_weights. On error (or an exception thrown by
+// options.progress) `out` is left empty.
 Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& vertex_data,
                          const AqemOptions& options, AqemResult& out);
 

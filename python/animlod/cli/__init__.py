@@ -13,7 +13,7 @@ import os
 import sys
 
 # Subcommand modules in the order --help lists them.
-COMMAND_MODULES = ("info", "demo", "simplify", "motion")
+COMMAND_MODULES = ("info", "demo", "simplify", "character", "motion", "tdag")
 
 
 class UserError(Exception):

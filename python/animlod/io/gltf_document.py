@@ -27,6 +27,7 @@ from .gltf_keyframes import INTERPOLATIONS, frame_times
 
 _GLB_MAGIC = b"glTF"
 _GLB_HEADER_BYTES = 12
+_GLB_JSON_CHUNK = 0x4E4F534A  # "JSON"
 _DATA_URI_BASE64 = ";base64,"
 # Required extensions that leave geometry, skins and animation readable as plain glTF
 # (quantized attributes are ordinary normalised or integer accessors); any other required
@@ -67,12 +68,14 @@ class GltfDocument:
     ----------
     path : the file, for error messages.
     gltf : the pygltflib document.
+    json : the document's JSON as parsed, every property kept (pygltflib drops some, such as a
+        node's morph ``weights``); what whole-document writers start from.
     parents : (N,) int, parent node of every node, -1 for nodes at the top of the tree.
     """
 
     def __init__(self, path: str | os.PathLike) -> None:
         self.path = os.fspath(path)
-        self.gltf = _parse(self.path)
+        self.gltf, self.json = _parse(self.path)
         self._buffers: dict[int, bytes] = {}
         self._accessors: dict[int, np.ndarray] = {}
         self.parents = self._node_parents()
@@ -136,7 +139,7 @@ class GltfDocument:
     ) -> np.ndarray:
         view_index = accessor.bufferView
         view = self.item("bufferViews", view_index, element)
-        data = self._buffer(view.buffer, f"bufferView {view_index}")
+        data = self.buffer_bytes(view.buffer, f"bufferView {view_index}")
         view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {view_index}")
         view_length = self._whole_number(view.byteLength, "byteLength", f"bufferView {view_index}")
         if view_offset + view_length > len(data):
@@ -186,7 +189,7 @@ class GltfDocument:
 
     def _sparse_part(self, part: Any, count: int, width: int, dtype: np.dtype, element: str) -> np.ndarray:
         view = self.item("bufferViews", part.bufferView, element)
-        data = self._buffer(view.buffer, f"bufferView {part.bufferView}")
+        data = self.buffer_bytes(view.buffer, f"bufferView {part.bufferView}")
         view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {part.bufferView}")
         start = view_offset + self._whole_number(part.byteOffset, "byteOffset", element)
         length = count * width * dtype.itemsize
@@ -202,7 +205,8 @@ class GltfDocument:
             raise self.fail(element, f"{name} {value!r} is not a whole number >= 0")
         return value
 
-    def _buffer(self, index: Any, referrer: str) -> bytes:
+    def buffer_bytes(self, index: Any, referrer: str) -> bytes:
+        """The bytes of buffer ``index`` (cached); FormatError naming ``referrer`` if it cannot be read."""
         buffer = self.item("buffers", index, referrer)
         if index not in self._buffers:
             self._buffers[index] = self._buffer_bytes(index, buffer)
@@ -372,8 +376,8 @@ class GltfDocument:
         return times, output.reshape((count, 3, width) if per_key == 3 else (count, width)), interpolation
 
 
-def _parse(path: str) -> pygltflib.GLTF2:
-    """pygltflib's document for a .glb or .gltf file; FormatError for anything else."""
+def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
+    """pygltflib's document for a .glb or .gltf file and its raw JSON; FormatError for anything else."""
     try:
         data = Path(path).read_bytes()
     except OSError as error:
@@ -382,10 +386,11 @@ def _parse(path: str) -> pygltflib.GLTF2:
         _check_glb_header(path, data)
         parse = pygltflib.GLTF2.load_from_bytes
         source: bytes | str = data
+        raw = _glb_json(path, data)
     else:
         try:
             source = data.decode("utf-8-sig")
-            json.loads(source)
+            raw = json.loads(source)
         except (UnicodeDecodeError, json.JSONDecodeError):
             raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor JSON") from None
         parse = pygltflib.GLTF2.gltf_from_json
@@ -406,7 +411,7 @@ def _parse(path: str) -> pygltflib.GLTF2:
     unsupported = [name for name in gltf.extensionsRequired or [] if not name.startswith(_HARMLESS_EXTENSIONS)]
     if unsupported:
         raise FormatError(path, "extensionsRequired", f"needs {', '.join(unsupported)}, which animlod cannot read")
-    return gltf
+    return gltf, raw
 
 
 def _first_null_entry(node: Any, where: str) -> str | None:
@@ -427,6 +432,20 @@ def _first_null_entry(node: Any, where: str) -> str | None:
                 if found is not None:
                     return found
     return None
+
+
+def _glb_json(path: str, data: bytes) -> dict:
+    """The JSON chunk of a GLB whose header _check_glb_header accepted."""
+    length, kind = struct.unpack_from("<II", data, _GLB_HEADER_BYTES) if len(data) >= 20 else (0, 0)
+    if kind != _GLB_JSON_CHUNK:
+        raise FormatError(path, "GLB", "the first chunk is not JSON")
+    try:
+        raw = json.loads(data[20 : 20 + length].decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise FormatError(path, "GLB JSON chunk", f"not valid JSON ({error})") from None
+    if not isinstance(raw, dict):
+        raise FormatError(path, "GLB JSON chunk", "is not a JSON object")
+    return raw
 
 
 def _check_glb_header(path: str, data: bytes) -> None:

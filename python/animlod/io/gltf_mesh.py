@@ -1,22 +1,53 @@
-"""Geometry of a glTF mesh: its triangle primitives merged into one vertex set.
+"""Geometry of a glTF mesh: its triangle primitives, each whole, and merged into one vertex set.
 
-Each primitive is read into a :class:`MeshGeometry` (node-local space) and the primitives of a
-mesh are concatenated, their indices offset. Attributes only some primitives have (NORMAL,
-TEXCOORD_0) are dropped rather than invented; skinning sets JOINTS_0/WEIGHTS_0 and, for 8
-influences, JOINTS_1/WEIGHTS_1 are required on every primitive of a skinned mesh.
+Each triangle primitive is read with every vertex attribute and morph target it has
+(:class:`PrimitiveGeometry`, node-local space); the primitives of a mesh are then concatenated,
+their indices offset, with a primitive index per face (:class:`MeshGeometry`). Points and lines
+primitives are listed, not read: animlod leaves them as they are. Merged attributes only some
+primitives have (NORMAL, TEXCOORD_0) are dropped rather than invented; skinning sets
+JOINTS_0/WEIGHTS_0 and, for 8 influences, JOINTS_1/WEIGHTS_1 are required on every primitive of
+a skinned mesh.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pygltflib
 
 from .gltf_document import GltfDocument
 
-_TRIANGLES, _TRIANGLE_STRIP, _TRIANGLE_FAN = 4, 5, 6
+TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN = 4, 5, 6
+_TRIANGLE_MODES = (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN)
 _INFLUENCE_SETS = (0, 1)
+# Widths glTF 2.0 allows for the attributes animlod interprets (section 3.7.2.1); others
+# (custom _ATTRIBUTES) are carried with their accessor's own width.
+_ATTRIBUTE_WIDTHS = {"POSITION": 3, "NORMAL": 3, "TANGENT": 4}
+
+
+@dataclass
+class PrimitiveGeometry:
+    """One triangle primitive as stored, decoded.
+
+    Attributes
+    ----------
+    index : the primitive's index in ``mesh.primitives``.
+    attributes : every vertex attribute by glTF name, ``(n, width)``: float32 (normalised
+        integers decoded to [0, 1] or [-1, 1]), integer arrays for JOINTS_n.
+    faces : (m, 3) int64 counter-clockwise triangles (strips and fans converted), local indices.
+    targets : per morph target, its attributes by name (``POSITION``, ``NORMAL``, ``TANGENT``
+        deltas), ``(n, width)`` float32.
+    """
+
+    index: int
+    attributes: dict[str, np.ndarray]
+    faces: np.ndarray
+    targets: list[dict[str, np.ndarray]] = field(default_factory=list)
+
+    @property
+    def vertex_count(self) -> int:
+        return int(self.attributes["POSITION"].shape[0])
 
 
 @dataclass
@@ -34,6 +65,9 @@ class MeshGeometry:
     targets : (N, V, 3) morph target position deltas, or None.
     target_names : N names from ``mesh.extras.targetNames``, or None.
     default_weights : (N,) morph weights of the mesh, or None.
+    face_groups : (M,) int32 position in ``primitives`` of the primitive of each face.
+    primitives : the triangle primitives, in mesh order; their vertices follow one another.
+    other_primitives : indices of the points and lines primitives, which were not read.
     """
 
     positions: np.ndarray
@@ -45,6 +79,14 @@ class MeshGeometry:
     targets: np.ndarray | None
     target_names: list[str] | None = None
     default_weights: np.ndarray | None = None
+    face_groups: np.ndarray | None = None
+    primitives: list[PrimitiveGeometry] = field(default_factory=list)
+    other_primitives: list[int] = field(default_factory=list)
+
+    @property
+    def vertex_starts(self) -> np.ndarray:
+        """(P + 1,) first vertex of each primitive in the merged arrays, then V."""
+        return np.cumsum([0] + [primitive.vertex_count for primitive in self.primitives])
 
 
 def read_mesh_geometry(doc: GltfDocument, mesh_index: int, skinned: bool) -> MeshGeometry:
@@ -53,27 +95,41 @@ def read_mesh_geometry(doc: GltfDocument, mesh_index: int, skinned: bool) -> Mes
     mesh = doc.item("meshes", mesh_index, element)
     if not mesh.primitives:
         raise doc.fail(element, "has no primitives")
-    parts = [_read_primitive(doc, f"{element} primitive {k}", p, skinned) for k, p in enumerate(mesh.primitives)]
+    parts, others = [], []
+    for k, primitive in enumerate(mesh.primitives):
+        mode = TRIANGLES if primitive.mode is None else primitive.mode
+        if mode in _TRIANGLE_MODES:
+            parts.append(_read_primitive(doc, f"{element} primitive {k}", k, primitive, skinned))
+        elif mode in range(4):
+            others.append(k)
+        else:
+            raise doc.fail(f"{element} primitive {k}", f"unknown mode {mode!r}")
+    if not parts:
+        raise doc.fail(element, "has no triangle primitive (only points or lines)")
     target_counts = sorted({len(part.targets) for part in parts})
     if len(target_counts) > 1:
         raise doc.fail(element, f"primitives have different numbers of morph targets {target_counts}")
     target_count = target_counts[0]
-    starts = np.cumsum([0] + [len(part.positions) for part in parts])
+    starts = np.cumsum([0] + [part.vertex_count for part in parts])
     names = mesh.extras.get("targetNames") if isinstance(mesh.extras, dict) else None
     names_fit = isinstance(names, list) and len(names) == target_count > 0
     defaults = np.asarray(mesh.weights if mesh.weights else np.zeros(target_count), np.float64)
     if defaults.shape != (target_count,):
         raise doc.fail(element, f"has {defaults.size} default weights for {target_count} morph targets")
+    influence_sets = [s for s in _INFLUENCE_SETS if any(f"JOINTS_{s}" in part.attributes for part in parts)]
     return MeshGeometry(
-        positions=np.concatenate([part.positions for part in parts]),
+        positions=np.concatenate([part.attributes["POSITION"] for part in parts]),
         faces=np.concatenate([part.faces + start for part, start in zip(parts, starts)]),
-        normals=_concatenate_if_all([part.normals for part in parts]),
-        uvs=_concatenate_if_all([part.uvs for part in parts]),
-        joints=_concatenate_padded([part.joints for part in parts]) if skinned else None,
-        weights=_concatenate_padded([part.weights for part in parts]) if skinned else None,
-        targets=np.concatenate([part.targets for part in parts], axis=1) if target_count else None,
+        normals=_concatenate_if_all([part.attributes.get("NORMAL") for part in parts]),
+        uvs=_concatenate_if_all([part.attributes.get("TEXCOORD_0") for part in parts]),
+        joints=_influences(parts, "JOINTS", influence_sets) if skinned else None,
+        weights=_influences(parts, "WEIGHTS", influence_sets) if skinned else None,
+        targets=_position_deltas(parts, target_count),
         target_names=[str(n) for n in names] if names_fit else None,
         default_weights=defaults if target_count else None,
+        face_groups=np.concatenate([np.full(len(part.faces), k, np.int32) for k, part in enumerate(parts)]),
+        primitives=parts,
+        other_primitives=others,
     )
 
 
@@ -89,69 +145,68 @@ def transform_normals(matrix: np.ndarray, normals: np.ndarray) -> np.ndarray:
     return turned / np.where(length > 0.0, length, 1.0)  # a zero normal stays zero
 
 
-def _read_primitive(doc: GltfDocument, element: str, primitive: pygltflib.Primitive, skinned: bool) -> MeshGeometry:
-    attributes = primitive.attributes
-    positions = _attribute(doc, attributes, "POSITION", 3, element, required=True)
-    count = len(positions)
-    joints = weights = None
-    if skinned:
-        sets = [s for s in _INFLUENCE_SETS if getattr(attributes, f"JOINTS_{s}", None) is not None]
-        if 0 not in sets:
-            raise doc.fail(element, "a skinned mesh primitive needs JOINTS_0 and WEIGHTS_0")
-        joints = np.concatenate(
-            [_attribute(doc, attributes, f"JOINTS_{s}", 4, element, required=True, integer=True) for s in sets], axis=1
-        )
-        weights = np.concatenate(
-            [_attribute(doc, attributes, f"WEIGHTS_{s}", 4, element, required=True) for s in sets], axis=1
-        )
-    return MeshGeometry(
-        positions=positions,
+def _read_primitive(
+    doc: GltfDocument, element: str, index: int, primitive: pygltflib.Primitive, skinned: bool
+) -> PrimitiveGeometry:
+    attribute_names = [name for name, value in vars(primitive.attributes).items() if value is not None]
+    if "POSITION" not in attribute_names:
+        raise doc.fail(element, "has no POSITION attribute")
+    count = doc.accessor(primitive.attributes.POSITION, f"{element} POSITION").shape[0]
+    attributes = {name: _attribute(doc, primitive.attributes, name, count, element) for name in attribute_names}
+    if skinned and ("JOINTS_0" not in attributes or "WEIGHTS_0" not in attributes):
+        raise doc.fail(element, "a skinned mesh primitive needs JOINTS_0 and WEIGHTS_0")
+    for s in _INFLUENCE_SETS:
+        if (f"JOINTS_{s}" in attributes) != (f"WEIGHTS_{s}" in attributes):
+            raise doc.fail(element, f"has only one of JOINTS_{s} and WEIGHTS_{s}")
+    return PrimitiveGeometry(
+        index=index,
+        attributes=attributes,
         faces=_primitive_faces(doc, primitive, count, element),
-        normals=_attribute(doc, attributes, "NORMAL", 3, element),
-        uvs=_attribute(doc, attributes, "TEXCOORD_0", 2, element),
-        joints=joints,
-        weights=weights,
         targets=_morph_targets(doc, primitive, count, element),
     )
 
 
-def _attribute(
-    doc: GltfDocument, attributes, name: str, width: int, element: str, required: bool = False, integer: bool = False
-) -> np.ndarray | None:
-    """Vertex attribute ``name`` as ``(V, width)``; None when absent and not ``required``."""
-    index = getattr(attributes, name, None)
-    if index is None:
-        if required:
-            raise doc.fail(element, f"has no {name} attribute")
-        return None
-    values = doc.accessor(index, f"{element} {name}")
-    if values.shape[1] != width or (integer and values.dtype.kind == "f"):
-        kind = "integer " if integer else ""
-        raise doc.fail(f"{element} {name}", f"expected {kind}width {width}, got {values.dtype} width {values.shape[1]}")
-    vertex_count = doc.gltf.accessors[attributes.POSITION].count
+def _attribute(doc: GltfDocument, attributes, name: str, vertex_count: int, element: str) -> np.ndarray:
+    """Vertex attribute ``name`` as ``(V, width)``, checked against what glTF allows for it."""
+    values = doc.accessor(getattr(attributes, name), f"{element} {name}")
+    where = f"{element} {name}"
+    width = _ATTRIBUTE_WIDTHS.get(name)
+    if name.startswith("TEXCOORD_"):
+        width = 2
+    elif name.startswith(("JOINTS_", "WEIGHTS_", "COLOR_")):
+        width = values.shape[1] if name.startswith("COLOR_") and values.shape[1] in (3, 4) else 4
+    if width is not None and values.shape[1] != width:
+        raise doc.fail(where, f"expected width {width}, got {values.shape[1]}")
+    if name.startswith("JOINTS_") and values.dtype.kind == "f":
+        raise doc.fail(where, f"expected unsigned integers, got {values.dtype}")
     if len(values) != vertex_count:
-        raise doc.fail(f"{element} {name}", f"has {len(values)} elements, POSITION has {vertex_count}")
+        raise doc.fail(where, f"has {len(values)} elements, POSITION has {vertex_count}")
     return values
 
 
-def _morph_targets(doc: GltfDocument, primitive: pygltflib.Primitive, count: int, element: str) -> np.ndarray:
-    """Position deltas ``(N, V, 3)`` of the primitive's targets (zeros for a target without POSITION)."""
-    targets = np.zeros((len(primitive.targets or []), count, 3), np.float32)
+def _morph_targets(doc: GltfDocument, primitive: pygltflib.Primitive, count: int, element: str) -> list[dict]:
+    """Per target, its deltas by attribute name (``POSITION``, ``NORMAL``, ``TANGENT``)."""
+    targets = []
     for t, target in enumerate(primitive.targets or []):
-        index = target.get("POSITION") if isinstance(target, dict) else getattr(target, "POSITION", None)
-        if index is not None:
-            delta = doc.accessor(index, f"{element} target {t} POSITION")
-            if delta.shape != (count, 3):
-                raise doc.fail(f"{element} target {t} POSITION", f"expected {count} VEC3, got shape {delta.shape}")
-            targets[t] = delta
+        items = target.items() if isinstance(target, dict) else vars(target).items()
+        deltas = {}
+        for name, index in items:
+            if index is None:
+                continue
+            delta = doc.accessor(index, f"{element} target {t} {name}")
+            width = 3 if name in ("POSITION", "NORMAL", "TANGENT") else delta.shape[1]
+            if delta.shape != (count, width) or delta.dtype.kind != "f":
+                raise doc.fail(
+                    f"{element} target {t} {name}", f"expected {count} float VEC{width}, got shape {delta.shape}"
+                )
+            deltas[name] = delta
+        targets.append(deltas)
     return targets
 
 
 def _primitive_faces(doc: GltfDocument, primitive: pygltflib.Primitive, vertex_count: int, element: str) -> np.ndarray:
     """Triangles ``(M, 3)`` of a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive (glTF 2.0, 3.7.2.1)."""
-    mode = _TRIANGLES if primitive.mode is None else primitive.mode
-    if mode not in (_TRIANGLES, _TRIANGLE_STRIP, _TRIANGLE_FAN):
-        raise doc.fail(element, f"mode {mode} (points or lines) is not a triangle mesh")
+    mode = TRIANGLES if primitive.mode is None else primitive.mode
     if primitive.indices is None:
         indices = np.arange(vertex_count, dtype=np.int64)
     else:
@@ -163,12 +218,12 @@ def _primitive_faces(doc: GltfDocument, primitive: pygltflib.Primitive, vertex_c
         at = int(np.argmax(indices >= vertex_count))
         reason = f"index {int(indices[at])} at position {at} is outside [0, {vertex_count})"
         raise doc.fail(f"{element} indices", reason)
-    if mode == _TRIANGLES:
+    if mode == TRIANGLES:
         if indices.size % 3:
             raise doc.fail(f"{element} indices", f"{indices.size} indices do not make whole triangles")
         return indices.reshape(-1, 3)
     i = np.arange(max(indices.size - 2, 0))
-    if mode == _TRIANGLE_STRIP:  # every other triangle swaps two corners to stay counter-clockwise
+    if mode == TRIANGLE_STRIP:  # every other triangle swaps two corners to stay counter-clockwise
         odd = i % 2
         return np.stack([indices[i], indices[i + 1 + odd], indices[i + 2 - odd]], axis=1)
     return np.stack([indices[i + 1], indices[i + 2], np.full_like(i, indices[0] if indices.size else 0)], axis=1)
@@ -178,7 +233,25 @@ def _concatenate_if_all(parts: list[np.ndarray | None]) -> np.ndarray | None:
     return None if any(part is None for part in parts) else np.concatenate(parts)
 
 
-def _concatenate_padded(parts: list[np.ndarray]) -> np.ndarray:
-    """Influence columns of all primitives, padded with zeros to the widest (4 or 8)."""
-    width = max(part.shape[1] for part in parts)
-    return np.concatenate([np.pad(part, ((0, 0), (0, width - part.shape[1]))) for part in parts])
+def _influences(parts: list[PrimitiveGeometry], kind: str, sets: list[int]) -> np.ndarray | None:
+    """JOINTS or WEIGHTS columns of the influence sets any primitive has, merged; a primitive
+    without a set gets zero weights there (4 influences padded to 8)."""
+    if not sets:
+        return None
+
+    def columns(part: PrimitiveGeometry, s: int) -> np.ndarray:
+        values = part.attributes.get(f"{kind}_{s}")
+        return np.zeros((part.vertex_count, 4), np.float32) if values is None else values
+
+    return np.concatenate([np.concatenate([columns(part, s) for s in sets], axis=1) for part in parts])
+
+
+def _position_deltas(parts: list[PrimitiveGeometry], target_count: int) -> np.ndarray | None:
+    """(N, V, 3) POSITION deltas of every target (zeros where a target has none)."""
+    if not target_count:
+        return None
+    deltas = [
+        np.stack([target.get("POSITION", np.zeros((part.vertex_count, 3), np.float32)) for target in part.targets])
+        for part in parts
+    ]
+    return np.concatenate(deltas, axis=1).astype(np.float32)

@@ -120,8 +120,18 @@ def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:
 
 
 def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -> tuple[SkinnedMesh, list[Motion]]:
+    mesh = skinned_mesh_of_node(doc, node, rig, read_mesh_geometry(doc, doc.gltf.nodes[node].mesh, skinned=True))
+    motions = [rig.motion(doc, animation, fps) for animation in range(len(doc.gltf.animations or []))]
+    return mesh, [motion for motion in motions if motion is not None]
+
+
+def skinned_mesh_of_node(
+    doc: GltfDocument, node: int, rig: SkinRig, geometry: MeshGeometry, mesh_world: np.ndarray | None = None
+) -> SkinnedMesh:
+    """The skinned mesh node ``node`` draws with ``rig``, its rest pose in world space (see the
+    module docstring), joints in skeleton order and weights normalised. ``mesh_world`` replaces
+    the node's rest world transform (for a LoD node standing in for another node)."""
     mesh_index = doc.gltf.nodes[node].mesh
-    geometry = read_mesh_geometry(doc, mesh_index, skinned=True)
     slots = rig.skin_slots
     # Unused influences may carry any index (some exporters leave garbage there).
     joints = np.where(geometry.weights > 0.0, geometry.joints, 0)
@@ -129,12 +139,12 @@ def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -
         vertex = int(np.argmax((joints >= slots).any(axis=1)))
         reason = f"vertex {vertex} uses joint slot {int(joints[vertex].max())}, skin {rig.skin} has {slots}"
         raise doc.fail(f"mesh {mesh_index} JOINTS", reason)
-    mesh_world = doc.rest_world_matrix(node)
+    mesh_world = doc.rest_world_matrix(node) if mesh_world is None else mesh_world
     row_scale = np.ones((len(rig.scales), 4, 1))
     row_scale[:, :3] = rig.scales[:, None, None]
     inverse_bind = (row_scale * rig.inverse_bind) @ np.linalg.inv(mesh_world)
     try:
-        mesh = SkinnedMesh(
+        return SkinnedMesh(
             rest_positions=transform_points(mesh_world, geometry.positions),
             faces=geometry.faces,
             joints=rig.remap[joints],
@@ -148,8 +158,6 @@ def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -
         )
     except ValueError as error:
         raise doc.fail(f"mesh {mesh_index} with skin {rig.skin}", str(error)) from None
-    motions = [rig.motion(doc, animation, fps) for animation in range(len(doc.gltf.animations or []))]
-    return mesh, [motion for motion in motions if motion is not None]
 
 
 def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[AnimatedMesh], list[AnimatedMesh]]:
@@ -165,10 +173,11 @@ def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[Animated
         world = doc.rest_world_matrix(node_index)
         # A mirroring transform turns counter-clockwise triangles clockwise (glTF 2.0, 3.7.4).
         faces = geometry.faces[:, ::-1] if np.linalg.det(world[:3, :3]) < 0.0 else geometry.faces
-        tracks = [] if geometry.targets is None else _morph_weight_tracks(doc, node_index, len(geometry.targets), fps)
-        for label, weights in tracks:
+        tracks = [] if geometry.targets is None else morph_weight_tracks(doc, node_index, len(geometry.targets), fps)
+        for animation, weights in tracks:
             frames = transform_points(world, geometry.positions + np.einsum("tn,nvc->tvc", weights, geometry.targets))
-            morphs.append(_animated_mesh(doc, f"{doc.node_label(node_index)} {label}", faces, frames, fps))
+            label = f"{doc.node_label(node_index)} {doc.animation_label(animation)}"
+            morphs.append(_animated_mesh(doc, label, faces, frames, fps))
         if not tracks:
             positions = geometry.positions.astype(np.float64)
             if geometry.targets is not None:
@@ -180,8 +189,9 @@ def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[Animated
     return morphs, statics
 
 
-def _morph_weight_tracks(doc: GltfDocument, node: int, target_count: int, fps: float) -> list[tuple[str, np.ndarray]]:
-    """``(animation label, weights (T, N))`` for every animation that drives the node's morph weights."""
+def morph_weight_tracks(doc: GltfDocument, node: int, target_count: int, fps: float) -> list[tuple[int, np.ndarray]]:
+    """``(animation index, weights (T, N))`` for every animation that drives the node's morph
+    weights, sampled at ``fps``."""
     tracks = []
     for a, animation in enumerate(doc.gltf.animations or []):
         label = doc.animation_label(a)
@@ -191,7 +201,7 @@ def _morph_weight_tracks(doc: GltfDocument, node: int, target_count: int, fps: f
             element = f"{label} channel {index}"
             times, values, interpolation = doc.sampler_keys(a, channel.sampler, target_count, element)
             at = doc.animation_frame_times(a, fps)
-            tracks.append((label, sample_keyframes(times, values, interpolation, at)))
+            tracks.append((a, sample_keyframes(times, values, interpolation, at)))
     return tracks
 
 

@@ -1,11 +1,14 @@
-"""Simplification of deforming and skinned meshes with AQEM (Yang et al. 2019), run in the C++ core.
+"""AQEM (Yang et al. 2019): simplification of deforming and skinned meshes, run in the C++ core.
 
 ``simplify_animated`` collapses edges once for all frames of an :class:`~animlod.model.AnimatedMesh`
 (one connectivity), placing every new vertex optimally in every frame (Eq. 5) and ordering the
 collapses by the animated quadric cost weighted by motion features (Eq. 6). One run returns
-several levels and the ordered collapse record. ``simplify_skinned`` does the same over the
-rest pose and the baked poses of given motions, and returns skinned levels whose merged skin
-weights still drive them. ``motion_features`` exposes the feature extraction on its own.
+several levels and the ordered collapse record. Any indexed triangle mesh is accepted: seam
+copies are welded and the seams kept, degenerate and repeated faces dropped, non-manifold spots
+cut into stitched manifold pieces (``SimplifyResult.preparation`` says what was done).
+``simplify_skinned`` does the same over the rest pose and the baked poses of given motions, and
+returns skinned levels whose merged skin weights still drive them. ``motion_features`` exposes
+the feature extraction on its own.
 
 Shapes: ``F`` frames, ``V`` vertices, ``M`` faces, ``K`` skin influences, ``C`` collapses.
 """
@@ -55,20 +58,23 @@ class SimplifiedLevel:
 
     Attributes
     ----------
-    mesh : the simplified sequence, (F, V', 3) frames and (M', 3) faces.
+    mesh : the simplified sequence, (F, V', 3) frames and (M', 3) faces (corners in input order).
+    face_sources : (M',) int32 input face of every face (its primitive or material).
     kept_vertices : (V',) int32 index in the input of every kept vertex, ascending.
-    vertex_map : (V,) int32 input vertex -> kept vertex it merged into (-1 for vertices that
-        ``repair=True`` dropped).
+    vertex_map : (V,) int32 input vertex -> kept vertex it merged into (-1 for vertices no face
+        references).
     error : asset units, the largest collapse error so far (see ``CollapseRecord.error``).
     target_face_count : the face count asked for; ``mesh`` has at most that many if ``reached``.
     reached : False when ``max_error`` (or no legal collapse left) stopped the run first.
     collapse_count : this level is the first ``collapse_count`` entries of the collapse record.
     attributes : (V', A) float32 carried per-vertex attributes, or None.
+    position_attributes : (V', B) float32 carried position-following attributes, or None.
     skin_joints, skin_weights : (V', K) skin influences, or None. Rows of vertices made by a
         collapse are merged: sorted by decreasing weight, summing to 1; other rows are the input's.
     """
 
     mesh: AnimatedMesh
+    face_sources: np.ndarray
     kept_vertices: np.ndarray
     vertex_map: np.ndarray
     error: float
@@ -76,13 +82,37 @@ class SimplifiedLevel:
     reached: bool
     collapse_count: int
     attributes: np.ndarray | None = None
+    position_attributes: np.ndarray | None = None
     skin_joints: np.ndarray | None = None
     skin_weights: np.ndarray | None = None
 
 
 @dataclass
+class Preparation:
+    """What the simplifier did to the input before simplifying (counts).
+
+    degenerate_faces, duplicate_faces : dropped faces (two corners at one welded position; the
+        same corners as an earlier face).
+    welded_vertices : vertices welded onto a lower-numbered copy (UV-seam or flat-shading copies).
+    seam_vertices : welded positions whose copies keep different attributes (seams kept).
+    split_vertices : copies made to cut non-manifold edges and vertices; they stay in place.
+    unreferenced_vertices : vertices no face uses.
+    face_count : the faces simplified (ratios refer to it).
+    """
+
+    degenerate_faces: int
+    duplicate_faces: int
+    welded_vertices: int
+    seam_vertices: int
+    split_vertices: int
+    unreferenced_vertices: int
+    face_count: int
+
+
+@dataclass
 class CollapseRecord:
-    """Every collapse in order: vertex ``removed[i]`` merged into ``kept[i]`` (input indices).
+    """Every collapse in order: vertex ``removed[i]`` merged into ``kept[i]`` (input indices; for
+    welded copies, the lowest input index at that position).
 
     Attributes
     ----------
@@ -102,13 +132,14 @@ class CollapseRecord:
 
 @dataclass
 class SimplifyResult:
-    """Levels (finest first), the collapse record, the frames whose quadrics were used and the
-    vertex weights (V,) of Eq. 6."""
+    """Levels (finest first), the collapse record, the frames whose quadrics were used, the
+    vertex weights (V,) of Eq. 6 and what preparing the input did."""
 
     levels: list[SimplifiedLevel]
     collapses: CollapseRecord
     frames_used: np.ndarray
     vertex_weights: np.ndarray
+    preparation: Preparation
 
 
 @dataclass
@@ -171,11 +202,14 @@ def simplify_animated(
     max_frames: int = 0,
     frame_subset: Sequence[int] | None = None,
     locked_vertices: Sequence[int] | np.ndarray | None = None,
+    guarded_vertices: Sequence[int] | np.ndarray | None = None,
     importance: np.ndarray | None = None,
     attributes: np.ndarray | None = None,
+    position_attributes: np.ndarray | None = None,
     skin_joints: np.ndarray | None = None,
     skin_weights: np.ndarray | None = None,
-    repair: bool = False,
+    face_groups: np.ndarray | None = None,
+    weld: bool = True,
     progress: Callable[[int, int], None] | None = None,
     placement: str = "optimal",
 ) -> SimplifyResult:
@@ -183,28 +217,35 @@ def simplify_animated(
 
     Parameters
     ----------
-    mesh : (F, V, 3) frames and (M, 3) faces; manifold, no degenerate or duplicate faces.
-    target_ratios : level sizes as fractions of M in (0, 1].
-    target_face_counts : level sizes as face counts in [4, M]; replaces ``target_ratios``.
+    mesh : (F, V, 3) frames and (M, 3) faces, any topology (see the module docstring).
+    target_ratios : level sizes as fractions in (0, 1] of the faces left after dropping
+        degenerate and repeated ones.
+    target_face_counts : level sizes as face counts in [1, M]; replaces ``target_ratios``. A level
+        no legal collapse can reach holds the smallest mesh reached, with ``reached`` False.
     max_error : asset units; the run stops before a collapse whose error (an RMS plane distance,
         see ``CollapseRecord.error``) exceeds it.
     use_motion_features, feature_threshold, min_angle_change, boundary_is_feature : the
         weights of Eq. 6 (see :func:`motion_features`); off gives every vertex weight 1.
-    boundary_quadrics : planes perpendicular to open borders keep their shape.
+    boundary_quadrics : planes perpendicular to open borders and attribute seams keep their shape.
     check_inversion : reject collapses that invert a face by Eq. 7, summed over every frame
         (also those outside the quadrics' frames); ``strict_inversion`` rejects an inversion in
         any single frame and is ignored when ``check_inversion`` is False.
     max_frames : quadrics over K frames chosen by farthest-point sampling of the poses (0: all).
     frame_subset : explicit frames for the quadrics; replaces ``max_frames``.
     locked_vertices : indices of vertices that are never removed nor moved.
+    guarded_vertices : indices of vertices kept like locked ones until no other collapse is
+        legal, then free (sharp corners kept while the targets allow).
     importance : (V,) float32 > 0, multiplies each vertex's weight (e.g. face regions).
-    attributes : (V, A) float32 per-vertex data interpolated along collapses (e.g. UVs).
+    attributes : (V, A) float32 per-vertex data interpolated along collapses (UVs, normals,
+        colours). Copies of a position whose attributes differ form a seam that collapses only
+        along itself.
+    position_attributes : (V, B) float32 data that follows the position (morph target deltas):
+        copies weld only where it agrees, and it is blended once per collapse.
     skin_joints, skin_weights : (V, K) int32 / float32 skin influences, merged along collapses
         (union, blended, the K largest kept, renormalised); the levels carry them.
-    repair : first drop faces that repeat a vertex, duplicate faces and unreferenced vertices,
-        and split non-manifold vertices (see :func:`repair_mesh`), instead of raising; edges
-        shared by three or more faces still raise. ``kept_vertices``, ``vertex_map`` and the
-        collapse record then refer to the input's vertices.
+    face_groups : (M,) int32 primitive or material per face; borders between groups are seams.
+    weld : weld copies of a position (equal in every frame, in ``position_attributes`` and in
+        skin); off, every input vertex is its own point and seams are open borders.
     progress : ``progress(done, total)`` called now and then from the simplifier.
     placement : ``"optimal"``, the paper's Eq. 5 in every frame, or ``"on_edge"``, one point of
         the collapsed edge for all frames (the vertex keeps one identity, so UVs and skin
@@ -216,22 +257,11 @@ def simplify_animated(
 
     Raises
     ------
-    ValueError naming the element: non-finite position, index out of range, degenerate or
-    duplicate face, non-manifold edge or vertex, unreferenced vertex, target out of range.
+    ValueError naming the element: non-finite position, index out of range, a locked vertex
+    index outside [0, V), target out of range, bad per-vertex data.
     """
-    original_vertex_count = mesh.vertex_count
-    kept_input = None
-    if repair:
-        mesh, kept_input = repair_mesh(mesh)
-    locked = None
-    if locked_vertices is not None:
-        locked = np.zeros(original_vertex_count, dtype=bool)
-        locked[np.asarray(locked_vertices, dtype=np.int64)] = True
-    locked = _per_vertex(locked, bool, kept_input)
-    importance = _per_vertex(importance, np.float32, kept_input)
-    attributes = _per_vertex(attributes, np.float32, kept_input)
-    skin_joints = _per_vertex(skin_joints, np.int32, kept_input)
-    skin_weights = _per_vertex(skin_weights, np.float32, kept_input)
+    locked = _vertex_mask("locked_vertices", locked_vertices, mesh.vertex_count)
+    guarded = _vertex_mask("guarded_vertices", guarded_vertices, mesh.vertex_count)
     raw = _core.simplify_animated(
         mesh.frames,
         mesh.faces,
@@ -254,8 +284,12 @@ def simplify_animated(
         skin_weights=skin_weights,
         progress=progress,
         placement=placement,
+        position_attributes=position_attributes,
+        face_groups=face_groups,
+        weld=weld,
+        guarded=guarded,
     )
-    return _result_in_input_indices(raw, mesh.fps, kept_input, original_vertex_count)
+    return _result(raw, mesh.fps)
 
 
 def simplify_skinned(
@@ -278,15 +312,15 @@ def simplify_skinned(
     motions : clips whose poses the levels must fit; their skeleton must match ``skinned``.
     target_ratios : level sizes as fractions of the face count.
     **options : any keyword argument of :func:`simplify_animated` except ``attributes`` and
-        ``repair``; ``placement`` defaults to ``"on_edge"`` here, so that the merged weights
+        ``position_attributes``; ``placement`` defaults to ``"on_edge"`` here, so that the merged weights
         and the positions describe the same point.
 
     Returns
     -------
     One SkinnedLevel per target, finest first.
     """
-    if "attributes" in options or "repair" in options:
-        raise ValueError("simplify_skinned: attributes come from the SkinnedMesh (uvs, morph targets); repair it first")
+    if "attributes" in options or "position_attributes" in options:
+        raise ValueError("simplify_skinned: attributes come from the SkinnedMesh (uvs, normals, morph targets)")
     baked = [skinned.bake(motion).frames for motion in motions]
     poses = AnimatedMesh(skinned.faces, np.concatenate([skinned.rest_positions[None], *baked], axis=0))
     uv_count = 0 if skinned.uvs is None else 2
@@ -339,69 +373,17 @@ def simplify_skinned(
     return levels
 
 
-def repair_mesh(mesh: AnimatedMesh) -> tuple[AnimatedMesh, np.ndarray]:
-    """Make a mesh acceptable to the simplifier where that is unambiguous.
-
-    Drops faces that repeat a vertex and duplicate faces (the first copy stays), drops vertices
-    no face references, and splits every non-manifold vertex (faces forming separate fans
-    joined only at the vertex, a "bow tie") into one vertex per fan. Edges shared by three or
-    more faces are left for the simplifier to report.
-
-    Returns the repaired mesh and ``(V',) int32`` the input index of each of its vertices
-    (split vertices appear once per fan).
-    """
-    faces = mesh.faces
-    distinct = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
-    faces = faces[distinct]
-    _, first = np.unique(np.sort(faces, axis=1), axis=0, return_index=True)
-    faces = faces[np.sort(first)]
-    fan = _corner_fans(faces)
-    # One output vertex per (input vertex, fan), numbered in input-vertex order.
-    keys, corner_vertex = np.unique(np.stack([faces.ravel(), fan], axis=1), axis=0, return_inverse=True)
-    kept_input = keys[:, 0].astype(np.int32)
-    repaired = AnimatedMesh(corner_vertex.reshape(-1, 3).astype(np.int32), mesh.frames[:, kept_input], fps=mesh.fps)
-    return repaired, kept_input
-
-
-def _corner_fans(faces: np.ndarray) -> np.ndarray:
-    """(3M,) label of each face corner: corners of one vertex share a label when their faces
-    are joined through edges around that vertex (label propagation, vectorised)."""
-    corner_count = faces.size
-    corners = np.arange(corner_count).reshape(-1, 3)
-    # Each face side a -> b, with the corners of a and b in that face.
-    starts, ends = faces.ravel(), faces[:, [1, 2, 0]].ravel()
-    start_corner, end_corner = corners.ravel(), corners[:, [1, 2, 0]].ravel()
-    low, high = np.minimum(starts, ends), np.maximum(starts, ends)
-    order = np.lexsort((high, low))
-    same = (low[order][1:] == low[order][:-1]) & (high[order][1:] == high[order][:-1])
-    first, second = order[:-1][same], order[1:][same]
-    # Across a shared edge the side runs a -> b in one face and b -> a in the other (or the same
-    # way when orientation is inconsistent); join corners of equal vertices either way.
-    straight = starts[first] == starts[second]
-    pairs = np.concatenate(
-        [
-            np.stack([start_corner[first], np.where(straight, start_corner[second], end_corner[second])], axis=1),
-            np.stack([end_corner[first], np.where(straight, end_corner[second], start_corner[second])], axis=1),
-        ]
-    )
-    label = np.arange(corner_count)
-    while True:
-        smaller = np.minimum(label[pairs[:, 0]], label[pairs[:, 1]])
-        updated = label.copy()
-        np.minimum.at(updated, pairs[:, 0], smaller)
-        np.minimum.at(updated, pairs[:, 1], smaller)
-        updated = updated[updated]  # pointer jumping: follow labels to their own labels
-        if np.array_equal(updated, label):
-            return label
-        label = updated
-
-
-def _per_vertex(values: np.ndarray | None, dtype: type, kept_input: np.ndarray | None) -> np.ndarray | None:
-    """Per-vertex input as ``dtype``, following a repair's vertex selection when there was one."""
-    if values is None:
+def _vertex_mask(name: str, indices: Sequence[int] | np.ndarray | None, vertex_count: int) -> np.ndarray | None:
+    """(V,) bool with the listed vertices set; ValueError naming an index outside [0, V)."""
+    if indices is None:
         return None
-    values = np.asarray(values, dtype=dtype)
-    return values if kept_input is None else values[kept_input]
+    indices = np.asarray(indices, dtype=np.int64).ravel()
+    outside = (indices < 0) | (indices >= vertex_count)
+    if np.any(outside):
+        raise ValueError(f"{name}: vertex {int(indices[np.argmax(outside)])} outside [0, {vertex_count})")
+    mask = np.zeros(vertex_count, dtype=bool)
+    mask[indices] = True
+    return mask
 
 
 def _largest_distance(a: np.ndarray, b: np.ndarray) -> float:
@@ -409,39 +391,33 @@ def _largest_distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(np.max(np.sum((a.astype(np.float64) - b) ** 2, axis=-1)))) if a.size else 0.0
 
 
-def _result_in_input_indices(
-    raw: dict, fps: float | None, kept_input: np.ndarray | None, vertex_count: int
-) -> SimplifyResult:
-    """Wrap the core's dictionaries; after a repair, map vertex indices back to the input
-    (``kept_input[i]`` is the input vertex of repaired vertex i; a split vertex maps to one of
-    its copies)."""
-    levels = []
-    for level in raw["levels"]:
-        vertex_map, kept_vertices = level["vertex_map"], level["kept_vertices"]
-        if kept_input is not None:
-            vertex_map = np.full(vertex_count, -1, dtype=np.int32)
-            vertex_map[kept_input] = level["vertex_map"]
-            kept_vertices = kept_input[kept_vertices]
-        levels.append(
-            SimplifiedLevel(
-                mesh=AnimatedMesh(level["faces"], level["positions"], fps=fps),
-                kept_vertices=kept_vertices,
-                vertex_map=vertex_map,
-                error=float(level["error"]),
-                target_face_count=int(level["target_face_count"]),
-                reached=bool(level["reached"]),
-                collapse_count=int(level["collapse_count"]),
-                attributes=level["attributes"] if level["attributes"].shape[1] else None,
-                skin_joints=level["skin_joints"] if level["skin_joints"].shape[0] else None,
-                skin_weights=level["skin_weights"] if level["skin_weights"].shape[0] else None,
-            )
+def _result(raw: dict, fps: float | None) -> SimplifyResult:
+    """Wrap the core's dictionaries."""
+
+    def optional(array: np.ndarray) -> np.ndarray | None:
+        return array if array.shape[0] and array.shape[-1] else None
+
+    levels = [
+        SimplifiedLevel(
+            mesh=AnimatedMesh(level["faces"], level["positions"], fps=fps),
+            face_sources=level["face_sources"],
+            kept_vertices=level["kept_vertices"],
+            vertex_map=level["vertex_map"],
+            error=float(level["error"]),
+            target_face_count=int(level["target_face_count"]),
+            reached=bool(level["reached"]),
+            collapse_count=int(level["collapse_count"]),
+            attributes=optional(level["attributes"]),
+            position_attributes=optional(level["position_attributes"]),
+            skin_joints=optional(level["skin_joints"]),
+            skin_weights=optional(level["skin_weights"]),
         )
-    collapses = raw["collapses"]
-    if kept_input is not None:
-        collapses = {**collapses, "removed": kept_input[collapses["removed"]], "kept": kept_input[collapses["kept"]]}
+        for level in raw["levels"]
+    ]
     return SimplifyResult(
         levels=levels,
-        collapses=CollapseRecord(**collapses),
+        collapses=CollapseRecord(**raw["collapses"]),
         frames_used=raw["frames_used"],
         vertex_weights=raw["vertex_weights"],
+        preparation=Preparation(**{name: int(count) for name, count in raw["preparation"].items()}),
     )

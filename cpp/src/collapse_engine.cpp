@@ -1,0 +1,393 @@
+// The collapse loop of Yang et al. 2019's 12-step outline, steps 7-12 (an indexed min-heap of
+// edges; pop, test legality, collapse, re-key), for any cost and placement policy.
+#include "collapse_engine.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <utility>
+
+#include "inversion_test.hpp"
+#include "skin_merge.hpp"
+
+namespace animlod::detail {
+
+CollapseEngine::CollapseEngine(const AnimatedMeshView& mesh, const PreparedMesh& prepared, const CarriedData& data,
+                               const EngineOptions& options)
+    : mesh_(mesh),
+      prepared_(prepared),
+      data_(data),
+      options_(options),
+      frame_count_(mesh.frame_count),
+      point_count_(prepared.point_source.size()),
+      placed_(mesh.frame_count) {
+  // Working copies, laid out per point: (F, V, 3) -> (P, F, 3).
+  positions_.resize(point_count_ * frame_count_ * 3);
+  for (size_t frame = 0; frame < frame_count_; ++frame)
+    for (size_t p = 0; p < point_count_; ++p)
+      std::copy_n(mesh_.frames + (frame * mesh_.vertex_count + static_cast<size_t>(prepared_.point_source[p])) * 3, 3,
+                  &positions_[(p * frame_count_ + frame) * 3]);
+  locked_.resize(point_count_);
+  for (size_t p = 0; p < point_count_; ++p) locked_[p] = prepared_.point_split[p] ? kLocked : 0;
+  for (size_t v = 0; v < mesh_.vertex_count; ++v) {
+    const int32_t point = prepared_.wedge_point[v];
+    if (point < 0) continue;
+    if (data_.locked && data_.locked[v]) locked_[point] = kLocked;
+    else if (data_.guarded && data_.guarded[v] && locked_[point] == 0) locked_[point] = kGuarded;
+  }
+  if (data_.attributes)
+    attributes_.assign(data_.attributes, data_.attributes + mesh_.vertex_count * data_.attribute_count);
+  auto gather_by_point = [&](const auto* source, size_t width, auto& destination) {
+    destination.resize(point_count_ * width);
+    for (size_t p = 0; p < point_count_; ++p)
+      std::copy_n(source + static_cast<size_t>(prepared_.point_source[p]) * width, width,
+                  destination.data() + p * width);
+  };
+  if (data_.position_attributes)
+    gather_by_point(data_.position_attributes, data_.position_attribute_count, position_attributes_);
+  if (data_.skin_joints) {
+    gather_by_point(data_.skin_joints, data_.influence_count, skin_joints_);
+    gather_by_point(data_.skin_weights, data_.influence_count, skin_weights_);
+  }
+  corner_points_ = prepared_.faces;
+  corner_wedges_ = prepared_.corner_wedges;
+  merged_into_.resize(point_count_);
+  for (size_t p = 0; p < point_count_; ++p) merged_into_[p] = static_cast<int32_t>(p);
+  wedge_merged_into_.resize(mesh_.vertex_count);
+  for (size_t v = 0; v < mesh_.vertex_count; ++v) wedge_merged_into_[v] = static_cast<int32_t>(v);
+  build_connectivity();
+  find_border_and_seam_sides();
+}
+
+// prepare_mesh guarantees a manifold, consistently oriented face set, so every face is added.
+void CollapseEngine::build_connectivity() {
+  connectivity_.request_vertex_status();
+  connectivity_.request_edge_status();
+  connectivity_.request_face_status();
+  std::vector<TriMesh::VertexHandle> handles(point_count_);
+  for (size_t p = 0; p < point_count_; ++p) handles[p] = connectivity_.new_vertex();
+  const size_t face_count = corner_points_.size() / 3;
+  for (size_t f = 0; f < face_count; ++f) {
+    const int32_t* v = &corner_points_[3 * f];
+    [[maybe_unused]] const auto face = connectivity_.add_face(handles[v[0]], handles[v[1]], handles[v[2]]);
+    assert(face.is_valid() && face.idx() == static_cast<int>(f));
+  }
+  face_count_ = face_count;
+}
+
+void CollapseEngine::find_border_and_seam_sides() {
+  for (const auto halfedge : connectivity_.halfedges()) {
+    if (!halfedge.is_boundary()) continue;
+    border_sides_.push_back({halfedge.from().idx(), halfedge.to().idx(), halfedge.opp().next().to().idx()});
+  }
+  for (const auto edge : connectivity_.edges()) {
+    if (edge.is_boundary()) continue;
+    const auto h = edge.h0();
+    const auto left = h.face(), right = h.opp().face();
+    const int32_t a = h.from().idx(), b = h.to().idx();
+    if (corner_wedge(left, a) == corner_wedge(right, a) && corner_wedge(left, b) == corner_wedge(right, b)) continue;
+    // A plane through the edge perpendicular to each face keeps the seam line in place.
+    seam_sides_.push_back({a, b, h.next().to().idx()});
+    seam_sides_.push_back({b, a, h.opp().next().to().idx()});
+  }
+}
+
+int32_t CollapseEngine::corner_wedge(TriMesh::FaceHandle face, int32_t point) const {
+  const size_t base = 3 * static_cast<size_t>(face.idx());
+  for (size_t c = 0; c < 3; ++c)
+    if (corner_points_[base + c] == point) return corner_wedges_[base + c];
+  return -1;
+}
+
+// The locked point survives; otherwise the lower index does, for determinism.
+Candidate CollapseEngine::candidate_for(int32_t edge) const {
+  const auto halfedge = connectivity_.halfedge_handle(connectivity_.edge_handle(edge), 0);
+  const int32_t a = connectivity_.from_vertex_handle(halfedge).idx();
+  const int32_t b = connectivity_.to_vertex_handle(halfedge).idx();
+  Candidate candidate;
+  const bool keep_a = locked(a) || (!locked(b) && a < b);
+  candidate.kept = keep_a ? a : b;
+  candidate.removed = keep_a ? b : a;
+  return candidate;
+}
+
+Candidate CollapseEngine::evaluate(CollapsePolicy& policy, int32_t edge) const {
+  Candidate candidate = candidate_for(edge);
+  policy.evaluate(candidate);
+  return candidate;
+}
+
+// Seams: every wedge of the removed point must go to the kept point's wedge on the same side of
+// the collapsed edge. The faces on the edge define the mapping (one pair per side); a wedge of
+// the removed point that no side defines (it lies on another seam), or a side that would send
+// one wedge to two, makes the collapse illegal. Leaves the mapping in wedge_moves_.
+bool CollapseEngine::map_wedges(const Candidate& candidate, TriMesh::HalfedgeHandle collapse) {
+  wedge_moves_.clear();
+  for (const auto side : {collapse, connectivity_.opposite_halfedge_handle(collapse)}) {
+    const auto face = connectivity_.face_handle(side);
+    if (!face.is_valid()) continue;
+    const int32_t from = corner_wedge(face, candidate.removed), to = corner_wedge(face, candidate.kept);
+    const auto known = std::find_if(wedge_moves_.begin(), wedge_moves_.end(),
+                                    [from](const auto& move) { return move.first == from; });
+    if (known == wedge_moves_.end()) wedge_moves_.emplace_back(from, to);
+    else if (known->second != to) return false;
+  }
+  for (const auto face : connectivity_.vf_range(connectivity_.vertex_handle(candidate.removed))) {
+    const int32_t wedge = corner_wedge(face, candidate.removed);
+    const bool mapped = std::any_of(wedge_moves_.begin(), wedge_moves_.end(),
+                                    [wedge](const auto& move) { return move.first == wedge; });
+    if (!mapped) return false;
+  }
+  return true;
+}
+
+bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse) {
+  if (locked(candidate.removed)) return false;  // both endpoints locked
+  if (!connectivity_.is_collapse_ok(collapse)) return false;
+  // A valence-3 interior vertex beside the edge would be left with two faces on the same three
+  // vertices (e.g. a tetrahedron folding flat); is_collapse_ok allows that.
+  for (const auto side : {collapse, connectivity_.opposite_halfedge_handle(collapse)}) {
+    if (connectivity_.is_boundary(side)) continue;
+    const auto opposite = connectivity_.to_vertex_handle(connectivity_.next_halfedge_handle(side));
+    if (!connectivity_.is_boundary(opposite) && connectivity_.valence(opposite) <= 3) return false;
+  }
+  if (!map_wedges(candidate, collapse)) return false;
+  if (!options_.check_inversion) return true;
+  // Eq. 7 for every face that survives around the collapse, in every frame F: the kept and the
+  // removed point both move to placed_.
+  for (const int32_t moved : {candidate.kept, candidate.removed}) {
+    const int32_t other = moved == candidate.kept ? candidate.removed : candidate.kept;
+    for (const auto face : connectivity_.vf_range(connectivity_.vertex_handle(moved))) {
+      std::array<const float*, 3> corners{};
+      int moved_corner = -1, corner = 0;
+      bool collapses = false;
+      for (const auto vertex : face.vertices()) {
+        if (vertex.idx() == moved) moved_corner = corner;
+        collapses |= vertex.idx() == other;
+        corners[corner++] = &positions_[static_cast<size_t>(vertex.idx()) * frame_count_ * 3];
+      }
+      if (collapses) continue;  // the faces on the edge disappear
+      if (!face_keeps_orientation(corners, moved_corner, placed_.data(), frame_count_, options_.strict_inversion))
+        return false;
+    }
+  }
+  return true;
+}
+
+// Steps 9-10: move the kept point to placed_ in every frame, let the policy merge its state,
+// carry wedges, attributes and skin weights over, collapse, and re-key the affected edges.
+void CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
+                              EngineRecord& record) {
+  record.removed.push_back(prepared_.point_source[candidate.removed]);
+  record.kept.push_back(prepared_.point_source[candidate.kept]);
+  record.cost.push_back(candidate.cost);
+  record.error.push_back(candidate.error);
+  for (size_t frame = 0; frame < frame_count_; ++frame) {
+    float* out = &positions_[(static_cast<size_t>(candidate.kept) * frame_count_ + frame) * 3];
+    for (int axis = 0; axis < 3; ++axis) {
+      out[axis] = static_cast<float>(placed_[frame][axis]);
+      record.positions.push_back(out[axis]);
+    }
+  }
+  policy.merge(candidate);
+  const auto t = static_cast<float>(candidate.t);
+  const size_t attribute_count = data_.attribute_count;
+  for (const auto& [from, to] : wedge_moves_)
+    for (size_t a = 0; a < attribute_count; ++a) {
+      float& kept = attributes_[static_cast<size_t>(to) * attribute_count + a];
+      kept += t * (attributes_[static_cast<size_t>(from) * attribute_count + a] - kept);
+    }
+  const size_t width = data_.position_attribute_count;
+  for (size_t b = 0; b < width; ++b) {
+    float& kept = position_attributes_[static_cast<size_t>(candidate.kept) * width + b];
+    kept += t * (position_attributes_[static_cast<size_t>(candidate.removed) * width + b] - kept);
+  }
+  if (!skin_joints_.empty()) {
+    const size_t k = data_.influence_count;
+    const size_t kept = static_cast<size_t>(candidate.kept) * k, removed = static_cast<size_t>(candidate.removed) * k;
+    merge_skin_weights(&skin_joints_[kept], &skin_weights_[kept], &skin_joints_[removed], &skin_weights_[removed], k,
+                       candidate.t);
+  }
+  merged_into_[candidate.removed] = candidate.kept;
+  for (const auto& [from, to] : wedge_moves_) wedge_merged_into_[from] = to;
+  ++collapse_count_;
+
+  // Corners of the removed point now belong to the kept point, with the mapped wedge.
+  const auto removed = connectivity_.vertex_handle(candidate.removed);
+  for (const auto face : connectivity_.vf_range(removed)) {
+    const size_t base = 3 * static_cast<size_t>(face.idx());
+    for (size_t c = 0; c < 3; ++c) {
+      if (corner_points_[base + c] != candidate.removed) continue;
+      corner_points_[base + c] = candidate.kept;
+      for (const auto& [from, to] : wedge_moves_)
+        if (corner_wedges_[base + c] == from) corner_wedges_[base + c] = to;
+    }
+  }
+  // Connectivity: the edges of the removed point either move to the kept one or vanish.
+  std::vector<int32_t> old_edges;
+  for (const auto edge : connectivity_.ve_range(removed)) old_edges.push_back(edge.idx());
+  face_count_ -= connectivity_.is_boundary(connectivity_.edge_handle(halfedge)) ? 1 : 2;
+  connectivity_.collapse(halfedge);
+  for (int32_t edge : old_edges)
+    if (connectivity_.status(connectivity_.edge_handle(edge)).deleted()) heap_.remove(edge);
+
+  // Step 10: the costs of the edges at the kept point changed; the legality of edges one ring
+  // further may have changed, so parked edges there are tried again.
+  const auto kept = connectivity_.vertex_handle(candidate.kept);
+  rekey_around(policy, kept, true);
+  for (const auto neighbour : connectivity_.vv_range(kept)) rekey_around(policy, neighbour, false);
+}
+
+// Re-evaluates the edges at `vertex`: all of them when its state changed, otherwise only the
+// parked ones (their cost is unchanged, but their legality may have changed).
+void CollapseEngine::rekey_around(CollapsePolicy& policy, TriMesh::VertexHandle vertex, bool all_edges) {
+  if (!all_edges && !may_have_parked_[vertex.idx()]) return;
+  may_have_parked_[vertex.idx()] = 0;
+  for (const auto edge : connectivity_.ve_range(vertex)) {
+    const int32_t e = edge.idx();
+    if (!all_edges && !parked_[e]) continue;
+    parked_[e] = 0;
+    if (locked(edge.v0().idx()) && locked(edge.v1().idx())) continue;  // can never collapse
+    heap_.set(e, evaluate(policy, e).cost);
+  }
+}
+
+void CollapseEngine::park(int32_t edge) {
+  heap_.remove(edge);
+  parked_[edge] = 1;
+  const auto handle = connectivity_.edge_handle(edge);
+  may_have_parked_[connectivity_.to_vertex_handle(connectivity_.halfedge_handle(handle, 0)).idx()] = 1;
+  may_have_parked_[connectivity_.to_vertex_handle(connectivity_.halfedge_handle(handle, 1)).idx()] = 1;
+}
+
+EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
+  EngineLevel level;
+  level.target_face_count = target;
+  level.reached = reached;
+  level.error = error_so_far_;
+  level.collapse_count = collapse_count_;
+  const size_t vertex_count = mesh_.vertex_count;
+  // Output vertices: the wedges that surviving corners use, in input order, each at the point
+  // of a corner that uses it.
+  std::vector<int32_t> wedge_point(vertex_count, -1);
+  std::vector<int32_t> live_faces;
+  for (const auto face : connectivity_.faces()) {
+    if (connectivity_.status(face).deleted()) continue;
+    live_faces.push_back(face.idx());
+    const size_t base = 3 * static_cast<size_t>(face.idx());
+    for (size_t c = 0; c < 3; ++c) wedge_point[corner_wedges_[base + c]] = corner_points_[base + c];
+  }
+  std::vector<int32_t> new_index(vertex_count, -1);
+  std::vector<int32_t> point_vertex(point_count_, -1);  // the first output vertex of each point
+  for (size_t v = 0; v < vertex_count; ++v) {
+    if (wedge_point[v] < 0) continue;
+    new_index[v] = static_cast<int32_t>(level.kept_vertices.size());
+    if (point_vertex[wedge_point[v]] < 0) point_vertex[wedge_point[v]] = new_index[v];
+    level.kept_vertices.push_back(static_cast<int32_t>(v));
+  }
+  for (int32_t f : live_faces) {
+    level.face_sources.push_back(prepared_.face_sources[f]);
+    for (size_t c = 0; c < 3; ++c) level.faces.push_back(new_index[corner_wedges_[3 * static_cast<size_t>(f) + c]]);
+  }
+  // An input vertex maps to the output vertex of the wedge it merged into; when no surviving
+  // corner uses that wedge, to an output vertex of the point it merged into.
+  level.vertex_map.assign(vertex_count, -1);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    int32_t wedge = prepared_.wedge_representative[v];
+    if (wedge < 0) continue;
+    while (wedge_merged_into_[wedge] != wedge) wedge = wedge_merged_into_[wedge];
+    if (new_index[wedge] >= 0) {
+      level.vertex_map[v] = new_index[wedge];
+      continue;
+    }
+    int32_t point = prepared_.wedge_point[wedge];
+    while (merged_into_[point] != point) point = merged_into_[point];
+    level.vertex_map[v] = point_vertex[point];
+  }
+  const size_t kept_count = level.kept_vertices.size();
+  level.positions.resize(frame_count_ * kept_count * 3);
+  for (size_t i = 0; i < kept_count; ++i) {
+    const float* source = &positions_[static_cast<size_t>(wedge_point[level.kept_vertices[i]]) * frame_count_ * 3];
+    for (size_t frame = 0; frame < frame_count_; ++frame)
+      std::copy_n(source + frame * 3, 3, &level.positions[(frame * kept_count + i) * 3]);
+  }
+  auto gather = [&](const auto& source, size_t width, auto& destination, bool by_point) {
+    destination.resize(kept_count * width);
+    // data() rather than &v[0]: an absent attribute set is an empty vector, and indexing it is UB.
+    for (size_t i = 0; i < kept_count; ++i) {
+      const int32_t row = by_point ? wedge_point[level.kept_vertices[i]] : level.kept_vertices[i];
+      std::copy_n(source.data() + static_cast<size_t>(row) * width, width, destination.data() + i * width);
+    }
+  };
+  gather(attributes_, data_.attribute_count, level.attributes, false);
+  gather(position_attributes_, data_.position_attribute_count, level.position_attributes, true);
+  if (!skin_joints_.empty()) {
+    gather(skin_joints_, data_.influence_count, level.skin_joints, true);
+    gather(skin_weights_, data_.influence_count, level.skin_weights, true);
+  }
+  return level;
+}
+
+// Guarded points stay in place until nothing else can collapse; then they are released, and
+// their edges (including those between two guarded points) enter the heap. Returns whether
+// that put anything in the heap.
+bool CollapseEngine::release_guards(CollapsePolicy& policy) {
+  if (released_) return false;
+  released_ = true;
+  for (size_t p = 0; p < point_count_; ++p) {
+    if (locked_[p] != kGuarded) continue;
+    const auto vertex = connectivity_.vertex_handle(static_cast<int>(p));
+    if (!connectivity_.status(vertex).deleted()) rekey_around(policy, vertex, true);
+  }
+  return !heap_.empty();
+}
+
+void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
+                         EngineRecord& record) {
+  // Step 7: every collapsible edge into the heap.
+  const size_t edge_count = connectivity_.n_edges();
+  heap_ = IndexedMinHeap(edge_count);
+  parked_.assign(edge_count, 0);
+  may_have_parked_.assign(point_count_, 0);
+  std::vector<int32_t> ids;
+  std::vector<double> keys;
+  ids.reserve(edge_count);
+  keys.reserve(edge_count);
+  for (const auto edge : connectivity_.edges()) {
+    if (locked(edge.v0().idx()) && locked(edge.v1().idx())) continue;  // can never collapse
+    ids.push_back(edge.idx());
+    keys.push_back(evaluate(policy, edge.idx()).cost);
+  }
+  heap_.assign(ids, keys);
+
+  // Steps 8-12, taking a level each time the face count reaches a target.
+  const size_t planned = face_count_ > targets.back() ? (face_count_ - targets.back() + 1) / 2 : 0;
+  size_t next_level = 0;
+  auto take_reached_levels = [&] {
+    for (; next_level < targets.size() && face_count_ <= targets[next_level]; ++next_level)
+      levels.push_back(snapshot(targets[next_level], true));
+  };
+  take_reached_levels();
+  if (options_.progress) options_.progress(0, planned);
+  while (next_level < targets.size() && (!heap_.empty() || release_guards(policy))) {
+    const int32_t edge = heap_.top();
+    const Candidate candidate = evaluate(policy, edge);
+    policy.place(candidate, placed_);
+    // The halfedge from the removed point to the kept one (OpenMesh keeps the "to" vertex).
+    auto halfedge = connectivity_.halfedge_handle(connectivity_.edge_handle(edge), 0);
+    if (connectivity_.from_vertex_handle(halfedge).idx() != candidate.removed)
+      halfedge = connectivity_.opposite_halfedge_handle(halfedge);
+    if (!is_legal(candidate, halfedge)) {
+      park(edge);
+      continue;
+    }
+    if (candidate.error > options_.max_error) break;
+    error_so_far_ = std::max(error_so_far_, candidate.error);
+    collapse(policy, candidate, halfedge, record);
+    take_reached_levels();
+    if (options_.progress && collapse_count_ % 4096 == 0) options_.progress(collapse_count_, planned);
+  }
+  for (; next_level < targets.size(); ++next_level) levels.push_back(snapshot(targets[next_level], false));
+  if (options_.progress) options_.progress(collapse_count_, planned);
+}
+
+}  // namespace animlod::detail

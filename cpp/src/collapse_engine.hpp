@@ -1,0 +1,165 @@
+// The edge-collapse engine shared by every simplifier of the core (AQEM, the TDAG, region
+// weighted faces). In the spirit of libigl's decimate(cost_and_placement, stopping_condition,
+// pre_collapse, post_collapse): the engine owns the connectivity, the heap, legality and the
+// bookkeeping of points, wedges and levels; a CollapsePolicy says what an edge costs, where the
+// merged point goes and what the policy merges on a collapse.
+//
+// Points are welded positions (see mesh_preparation.hpp); wedges are the input vertices that
+// stand for a point in the faces around it. A collapse moves every wedge of the removed point
+// to the wedge of the kept point on the same side of the collapsed edge, so attribute seams
+// only collapse along themselves (meshoptimizer's rule) and never open.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include <Eigen/Core>
+#include <OpenMesh/Core/Mesh/TriConnectivity.hh>
+
+#include "animlod/animated_mesh_view.hpp"
+#include "indexed_heap.hpp"
+#include "mesh_preparation.hpp"
+
+namespace animlod::detail {
+
+// An edge collapse being considered: point `removed` merges into point `kept`.
+struct Candidate {
+  int32_t kept = -1;
+  int32_t removed = -1;
+  double cost = 0.0;   // heap key
+  double error = 0.0;  // asset units; compared with max_error and reported per level
+  double t = 0.0;      // attributes and skin weights blend as kept + t (removed - kept)
+};
+
+class CollapsePolicy {
+ public:
+  virtual ~CollapsePolicy() = default;
+  // Fills cost, error and t of `candidate` (kept and removed are set). Called to key every edge.
+  virtual void evaluate(Candidate& candidate) = 0;
+  // Writes the merged point's position in every frame F into `placed`; called right after
+  // evaluate() of the same candidate, only for the heap's top.
+  virtual void place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) = 0;
+  // The engine is applying `candidate`: merge the policy's per-point state into `kept`.
+  virtual void merge(const Candidate& candidate) = 0;
+};
+
+// Per-vertex data the engine carries through collapses (all optional).
+struct CarriedData {
+  const uint8_t* locked = nullptr;              // (V,) input vertices that never move
+  const uint8_t* guarded = nullptr;             // (V,) input vertices that stay in place while any
+                                                //      other collapse is legal
+  const float* attributes = nullptr;            // (V, A) per wedge, interpolated with t
+  size_t attribute_count = 0;
+  const float* position_attributes = nullptr;   // (V, B) per point, interpolated with t
+  size_t position_attribute_count = 0;
+  const int32_t* skin_joints = nullptr;         // (V, K) per point, merged with t
+  const float* skin_weights = nullptr;
+  size_t influence_count = 0;
+};
+
+struct EngineOptions {
+  bool check_inversion = true;   // Eq. 7 summed over every frame
+  bool strict_inversion = false; // also reject a flip in any one frame
+  double max_error = std::numeric_limits<double>::infinity();
+  std::function<void(size_t, size_t)> progress;
+};
+
+// One level: the surviving faces over the surviving wedges (input vertex indices).
+struct EngineLevel {
+  size_t target_face_count = 0;
+  bool reached = false;
+  size_t collapse_count = 0;
+  double error = 0.0;                   // largest collapse error so far
+  std::vector<int32_t> faces;           // (M', 3) output vertex indices
+  std::vector<int32_t> face_sources;    // (M',) input face of each output face
+  std::vector<int32_t> kept_vertices;   // (V',) input vertex of each output vertex, ascending
+  std::vector<int32_t> vertex_map;      // (V,) input vertex -> output vertex, -1 when dropped
+  std::vector<float> positions;         // (F, V', 3)
+  std::vector<float> attributes;        // (V', A)
+  std::vector<float> position_attributes;  // (V', B)
+  std::vector<int32_t> skin_joints;     // (V', K)
+  std::vector<float> skin_weights;      // (V', K)
+};
+
+struct EngineRecord {
+  std::vector<int32_t> removed, kept;  // (C,) input vertex standing for each point
+  std::vector<float> positions;        // (C, F, 3)
+  std::vector<double> cost, error;     // (C,)
+};
+
+class CollapseEngine {
+ public:
+  // `mesh` gives the frames of the input vertices; `prepared` its points, faces and wedges.
+  CollapseEngine(const AnimatedMeshView& mesh, const PreparedMesh& prepared, const CarriedData& data,
+                 const EngineOptions& options);
+
+  size_t frame_count() const { return frame_count_; }
+  size_t point_count() const { return point_count_; }
+  const PreparedMesh& prepared() const { return prepared_; }
+  Eigen::Vector3d position(int32_t point, size_t frame) const {
+    const float* p = &positions_[(static_cast<size_t>(point) * frame_count_ + frame) * 3];
+    return {p[0], p[1], p[2]};
+  }
+  bool locked(int32_t point) const { return locked_[point] == kLocked || (locked_[point] == kGuarded && !released_); }
+  // Sides (a, b, c) whose edge a-b must keep its shape, with c the third point of the face on
+  // the other side: every boundary halfedge (in OpenMesh's halfedge order), then both sides of
+  // every attribute-seam edge.
+  const std::vector<std::array<int32_t, 3>>& border_sides() const { return border_sides_; }
+  const std::vector<std::array<int32_t, 3>>& seam_sides() const { return seam_sides_; }
+
+  // Collapses until every target face count (descending) is reached or nothing legal remains.
+  void run(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
+           EngineRecord& record);
+
+ private:
+  using TriMesh = OpenMesh::TriConnectivity;
+
+  void build_connectivity();
+  void find_border_and_seam_sides();
+  Candidate candidate_for(int32_t edge) const;
+  Candidate evaluate(CollapsePolicy& policy, int32_t edge) const;
+  int32_t corner_wedge(TriMesh::FaceHandle face, int32_t point) const;
+  bool map_wedges(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
+  bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
+  void collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
+                EngineRecord& record);
+  void rekey_around(CollapsePolicy& policy, TriMesh::VertexHandle vertex, bool all_edges);
+  void park(int32_t edge);
+  EngineLevel snapshot(size_t target, bool reached);
+
+  const AnimatedMeshView& mesh_;
+  const PreparedMesh& prepared_;
+  const CarriedData& data_;
+  const EngineOptions& options_;
+  const size_t frame_count_;
+  const size_t point_count_;
+  std::vector<float> positions_;            // (P, F, 3) current positions, contiguous per point
+  static constexpr uint8_t kLocked = 1, kGuarded = 2;
+  bool release_guards(CollapsePolicy& policy);
+  std::vector<uint8_t> locked_;             // (P,) 0, kLocked, or kGuarded (locked until released_)
+  bool released_ = false;                   // set once nothing but guarded points could collapse
+  std::vector<float> attributes_;           // (V, A) by wedge (input vertex)
+  std::vector<float> position_attributes_;  // (P, B)
+  std::vector<int32_t> skin_joints_;        // (P, K)
+  std::vector<float> skin_weights_;         // (P, K)
+  std::vector<int32_t> corner_points_;      // (M', 3) current point of every face corner
+  std::vector<int32_t> corner_wedges_;      // (M', 3) current wedge of every face corner
+  std::vector<int32_t> merged_into_;        // (P,) a point each removed point merged into
+  std::vector<int32_t> wedge_merged_into_;  // (V,) a wedge each removed wedge merged into
+  std::vector<std::pair<int32_t, int32_t>> wedge_moves_;  // removed wedge -> kept wedge, current collapse
+  std::vector<uint8_t> parked_;             // (E,) popped while illegal; re-tried when the area changes
+  std::vector<uint8_t> may_have_parked_;    // (P,) set when an edge of the point is parked
+  std::vector<Eigen::Vector3d> placed_;     // (F,) the top candidate's position in every frame
+  std::vector<std::array<int32_t, 3>> border_sides_, seam_sides_;
+  TriMesh connectivity_;
+  IndexedMinHeap heap_{0};
+  size_t face_count_ = 0;
+  double error_so_far_ = 0.0;
+  size_t collapse_count_ = 0;
+};
+
+}  // namespace animlod::detail

@@ -1,0 +1,310 @@
+#include "mesh_preparation.hpp"
+
+#include <algorithm>
+#include <array>
+#include <numeric>
+
+#include "union_find.hpp"
+
+namespace animlod::detail {
+
+namespace {
+
+// Lexicographic order of two float rows; equal rows compare equal whatever their bits (-0 == 0).
+int compare_rows(const float* a, const float* b, size_t count, size_t stride_a, size_t stride_b) {
+  for (size_t i = 0; i < count; ++i) {
+    const float x = a[i * stride_a], y = b[i * stride_b];
+    if (x < y) return -1;
+    if (y < x) return 1;
+  }
+  return 0;
+}
+
+// Skin rows compare as (joint, weight) sets: influences with zero weight do not count, and the
+// order of the influences does not matter.
+std::vector<std::pair<int32_t, float>> skin_set(const WeldInput& input, size_t v) {
+  std::vector<std::pair<int32_t, float>> set;
+  for (size_t k = 0; k < input.influence_count; ++k) {
+    const float weight = input.skin_weights[v * input.influence_count + k];
+    if (weight > 0.0f) set.emplace_back(input.skin_joints[v * input.influence_count + k], weight);
+  }
+  std::sort(set.begin(), set.end());
+  return set;
+}
+
+// Step 1: vertices equal in every frame, in position attributes and in skin share a point.
+// Returns (V,) the lowest input vertex each referenced vertex welds with (itself if none), -1
+// for unreferenced vertices.
+std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, const std::vector<uint8_t>& used) {
+  const size_t vertex_count = mesh.vertex_count;
+  const size_t frame_stride = vertex_count * 3;
+  std::vector<int32_t> order;
+  for (size_t v = 0; v < vertex_count; ++v)
+    if (used[v]) order.push_back(static_cast<int32_t>(v));
+  std::vector<int32_t> welded_to(vertex_count, -1);
+  if (!input.weld) {
+    for (int32_t v : order) welded_to[v] = v;
+    return welded_to;
+  }
+  auto compare = [&](int32_t a, int32_t b) {
+    // Frame 0 first: most vertices differ there, so the full rows are rarely read.
+    for (size_t frame = 0; frame < mesh.frame_count; ++frame) {
+      const float* pa = mesh.frames + frame * frame_stride + static_cast<size_t>(a) * 3;
+      const float* pb = mesh.frames + frame * frame_stride + static_cast<size_t>(b) * 3;
+      if (int c = compare_rows(pa, pb, 3, 1, 1)) return c;
+    }
+    const size_t width = input.position_attribute_count;
+    if (width) {
+      const float* pa = input.position_attributes + static_cast<size_t>(a) * width;
+      const float* pb = input.position_attributes + static_cast<size_t>(b) * width;
+      if (int c = compare_rows(pa, pb, width, 1, 1)) return c;
+    }
+    if (input.skin_joints) {
+      const auto sa = skin_set(input, a), sb = skin_set(input, b);
+      if (sa != sb) return sa < sb ? -1 : 1;
+    }
+    return 0;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return compare(a, b) < 0; });
+  for (size_t i = 0; i < order.size();) {
+    size_t j = i + 1;
+    while (j < order.size() && compare(order[i], order[j]) == 0) ++j;
+    // stable_sort keeps equal vertices in input order: the first is the lowest index.
+    for (size_t k = i; k < j; ++k) welded_to[order[k]] = order[i];
+    i = j;
+  }
+  return welded_to;
+}
+
+int32_t next_corner(int32_t corner) { return corner - corner % 3 + (corner % 3 + 1) % 3; }
+
+bool same_triangle(const std::vector<int32_t>& corner_points, int32_t f, int32_t g) {
+  std::array<int32_t, 3> a{corner_points[3 * f], corner_points[3 * f + 1], corner_points[3 * f + 2]};
+  std::array<int32_t, 3> b{corner_points[3 * g], corner_points[3 * g + 1], corner_points[3 * g + 2]};
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  return a == b;
+}
+
+// Corners of one point are joined when their faces are paired across an edge at that point.
+struct Side {
+  uint64_t key;    // (lower point << 32) | higher point
+  int32_t corner;  // corner of the side's start point; (corner / 3) is the face
+  int32_t forward; // 1 when the side runs from the lower to the higher point
+};
+
+uint64_t edge_key(int32_t a, int32_t b) {
+  const auto low = static_cast<uint32_t>(std::min(a, b)), high = static_cast<uint32_t>(std::max(a, b));
+  return (static_cast<uint64_t>(low) << 32) | high;
+}
+
+// Step 3: corner labels such that corners with one label form one fan. Across every undirected
+// edge, sides are paired first-come in face order, one forward with one backward; unpaired sides
+// are borders of their piece.
+std::vector<int32_t> corner_fans(const std::vector<int32_t>& corner_points) {
+  const size_t corner_count = corner_points.size();
+  std::vector<Side> sides(corner_count);
+  for (size_t c = 0; c < corner_count; ++c) {
+    const int32_t a = corner_points[c], b = corner_points[next_corner(static_cast<int32_t>(c))];
+    sides[c] = {edge_key(a, b), static_cast<int32_t>(c), a < b ? 1 : 0};
+  }
+  std::sort(sides.begin(), sides.end(),
+            [](const Side& x, const Side& y) { return x.key != y.key ? x.key < y.key : x.corner < y.corner; });
+  UnionFind fans(corner_count);
+  for (size_t i = 0; i < sides.size();) {
+    size_t j = i;
+    while (j < sides.size() && sides[j].key == sides[i].key) ++j;
+    std::vector<int32_t> forward, backward;
+    for (size_t k = i; k < j; ++k) (sides[k].forward ? forward : backward).push_back(sides[k].corner);
+    std::vector<uint8_t> taken(backward.size(), 0);
+    for (const int32_t ca : forward) {
+      // The first free opposite side, unless its face is the same triangle turned over (a
+      // two-sided sheet): joining those would fold the surface onto itself.
+      size_t match = 0;
+      while (match < backward.size() && (taken[match] || same_triangle(corner_points, ca / 3, backward[match] / 3)))
+        ++match;
+      if (match == backward.size()) continue;
+      taken[match] = 1;
+      // Side a -> b starts at corner ca (point a) and ends at the next corner (point b); the
+      // opposite side b -> a starts at point b. Join the corners of equal points.
+      const int32_t cb = backward[match];
+      fans.unite(ca, next_corner(cb));
+      fans.unite(next_corner(ca), cb);
+    }
+    i = j;
+  }
+  std::vector<int32_t> label(corner_count);
+  for (size_t c = 0; c < corner_count; ++c) label[c] = fans.find(static_cast<int32_t>(c));
+  return label;
+}
+
+}  // namespace
+
+PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) {
+  PreparedMesh out;
+  const size_t vertex_count = mesh.vertex_count;
+  std::vector<uint8_t> used(vertex_count, 0);
+  for (size_t i = 0; i < 3 * mesh.face_count; ++i) used[mesh.faces[i]] = 1;
+  out.unreferenced_vertices = static_cast<size_t>(std::count(used.begin(), used.end(), 0));
+  const std::vector<int32_t> welded_to = weld(mesh, input, used);
+
+  // Points numbered in input order of their lowest vertex, so that a mesh with nothing to
+  // weld keeps its vertex numbering.
+  std::vector<int32_t> point_of(vertex_count, -1);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    if (welded_to[v] < 0) continue;
+    if (welded_to[v] == static_cast<int32_t>(v)) {
+      point_of[v] = static_cast<int32_t>(out.point_source.size());
+      out.point_source.push_back(static_cast<int32_t>(v));
+    } else {
+      point_of[v] = point_of[welded_to[v]];
+      ++out.welded_vertices;
+    }
+  }
+
+  // Step 2: faces in point terms; drop degenerate ones and repeats (same points, same turn).
+  std::vector<std::array<int32_t, 3>> kept_faces;
+  std::vector<int32_t> kept_sources;
+  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> rotated;  // canonical rotation, face
+  for (size_t f = 0; f < mesh.face_count; ++f) {
+    const int32_t* v = mesh.faces + 3 * f;
+    const std::array<int32_t, 3> p{point_of[v[0]], point_of[v[1]], point_of[v[2]]};
+    if (p[0] == p[1] || p[1] == p[2] || p[0] == p[2]) {
+      ++out.degenerate_faces;
+      continue;
+    }
+    const int first = static_cast<int>(std::min_element(p.begin(), p.end()) - p.begin());
+    rotated.push_back({{p[first], p[(first + 1) % 3], p[(first + 2) % 3]}, static_cast<int32_t>(f)});
+  }
+  std::vector<uint8_t> repeated(mesh.face_count, 0);
+  {
+    std::vector<size_t> by_corners(rotated.size());
+    std::iota(by_corners.begin(), by_corners.end(), 0);
+    std::stable_sort(by_corners.begin(), by_corners.end(),
+                     [&](size_t a, size_t b) { return rotated[a].first < rotated[b].first; });
+    for (size_t i = 1; i < by_corners.size(); ++i)
+      if (rotated[by_corners[i]].first == rotated[by_corners[i - 1]].first)
+        repeated[rotated[by_corners[i]].second] = 1;
+  }
+  std::vector<int32_t> corner_points, corner_inputs;
+  for (const auto& entry : rotated) {
+    const int32_t f = entry.second;
+    if (repeated[f]) {
+      ++out.duplicate_faces;
+      continue;
+    }
+    out.face_sources.push_back(f);
+    for (int k = 0; k < 3; ++k) {
+      corner_inputs.push_back(mesh.faces[3 * static_cast<size_t>(f) + k]);
+      corner_points.push_back(point_of[mesh.faces[3 * static_cast<size_t>(f) + k]]);
+    }
+  }
+
+  // Step 3: split points into fans until no directed edge is used twice. A fan that winds
+  // around its point more than once still repeats a directed edge: such a face is cut loose
+  // (three new points), which ends the loop since its points are its own.
+  out.point_split.assign(out.point_source.size(), 0);
+  while (true) {
+    const std::vector<int32_t> label = corner_fans(corner_points);
+    // One point per (point, fan); the fan of the lowest corner keeps the point's index.
+    std::vector<int32_t> fan_point(corner_points.size(), -1);
+    std::vector<int32_t> first_fan(out.point_source.size(), -1);
+    for (size_t c = 0; c < corner_points.size(); ++c) {
+      const int32_t p = corner_points[c], fan = label[c];
+      if (fan_point[fan] >= 0) continue;
+      if (first_fan[p] < 0) {
+        first_fan[p] = fan;
+        fan_point[fan] = p;
+      } else {
+        fan_point[fan] = static_cast<int32_t>(out.point_source.size());
+        out.point_source.push_back(out.point_source[p]);
+        out.point_split.push_back(1);
+        out.point_split[p] = 1;
+        ++out.split_points;
+      }
+    }
+    for (size_t c = 0; c < corner_points.size(); ++c) corner_points[c] = fan_point[label[c]];
+
+    std::vector<std::pair<uint64_t, int32_t>> directed;  // (a << 32 | b, face)
+    for (size_t c = 0; c < corner_points.size(); ++c) {
+      const uint64_t key = (static_cast<uint64_t>(static_cast<uint32_t>(corner_points[c])) << 32) |
+                           static_cast<uint32_t>(corner_points[next_corner(static_cast<int32_t>(c))]);
+      directed.push_back({key, static_cast<int32_t>(c / 3)});
+    }
+    std::sort(directed.begin(), directed.end());
+    std::vector<uint8_t> loose(corner_points.size() / 3, 0);
+    bool any = false;
+    for (size_t i = 1; i < directed.size(); ++i)
+      if (directed[i].first == directed[i - 1].first) loose[directed[i].second] = any = true;
+    if (!any) break;
+    for (size_t f = 0; f < loose.size(); ++f) {
+      if (!loose[f]) continue;
+      for (int k = 0; k < 3; ++k) {
+        int32_t& p = corner_points[3 * f + k];
+        const int32_t old_point = p;
+        out.point_split[old_point] = 1;
+        p = static_cast<int32_t>(out.point_source.size());
+        out.point_source.push_back(out.point_source[old_point]);
+        out.point_split.push_back(1);
+        ++out.split_points;
+      }
+    }
+  }
+  // A point whose only faces were cut loose is left without corners: renumber the points.
+  std::vector<int32_t> renumber(out.point_source.size(), -1);
+  for (int32_t p : corner_points) renumber[p] = 0;
+  if (std::find(renumber.begin(), renumber.end(), -1) != renumber.end()) {
+    std::vector<int32_t> sources;
+    std::vector<uint8_t> split;
+    for (size_t p = 0; p < renumber.size(); ++p) {
+      if (renumber[p] < 0) continue;
+      renumber[p] = static_cast<int32_t>(sources.size());
+      sources.push_back(out.point_source[p]);
+      split.push_back(out.point_split[p]);
+    }
+    out.point_source = std::move(sources);
+    out.point_split = std::move(split);
+    for (int32_t& p : corner_points) p = renumber[p];
+  }
+  out.faces = corner_points;
+
+  // Step 4: wedges of one point with equal attributes and face group merge into the lowest.
+  out.wedge_point.assign(vertex_count, -1);
+  for (size_t c = 0; c < corner_inputs.size(); ++c) out.wedge_point[corner_inputs[c]] = corner_points[c];
+  std::vector<int32_t> wedge_group(vertex_count, 0);
+  if (input.face_groups)
+    for (size_t c = corner_inputs.size(); c-- > 0;)  // the first face using a vertex decides its group
+      wedge_group[corner_inputs[c]] = input.face_groups[out.face_sources[c / 3]];
+  std::vector<int32_t> wedges;
+  for (size_t v = 0; v < vertex_count; ++v)
+    if (out.wedge_point[v] >= 0) wedges.push_back(static_cast<int32_t>(v));
+  const size_t width = input.attribute_count;
+  auto wedge_less = [&](int32_t a, int32_t b) {
+    if (out.wedge_point[a] != out.wedge_point[b]) return out.wedge_point[a] < out.wedge_point[b];
+    if (wedge_group[a] != wedge_group[b]) return wedge_group[a] < wedge_group[b];
+    if (!width) return false;
+    return compare_rows(input.attributes + static_cast<size_t>(a) * width,
+                        input.attributes + static_cast<size_t>(b) * width, width, 1, 1) < 0;
+  };
+  std::stable_sort(wedges.begin(), wedges.end(), wedge_less);
+  out.wedge_representative.assign(vertex_count, -1);
+  std::vector<int32_t> wedges_at_point(out.point_source.size(), 0);
+  for (size_t i = 0; i < wedges.size();) {
+    size_t j = i + 1;
+    while (j < wedges.size() && !wedge_less(wedges[i], wedges[j])) ++j;
+    for (size_t k = i; k < j; ++k) out.wedge_representative[wedges[k]] = wedges[i];
+    ++wedges_at_point[out.wedge_point[wedges[i]]];
+    i = j;
+  }
+  out.seam_points = static_cast<size_t>(std::count_if(wedges_at_point.begin(), wedges_at_point.end(),
+                                                      [](int32_t count) { return count > 1; }));
+  // Where three or more attribute charts meet, no collapse keeps every chart's corner: the
+  // point stays where it is (meshoptimizer's "complex" vertices), like a cut point.
+  for (size_t p = 0; p < wedges_at_point.size(); ++p)
+    if (wedges_at_point[p] > 2) out.point_split[p] = 1;
+  out.corner_wedges.resize(corner_inputs.size());
+  for (size_t c = 0; c < corner_inputs.size(); ++c) out.corner_wedges[c] = out.wedge_representative[corner_inputs[c]];
+  return out;
+}
+
+}  // namespace animlod::detail

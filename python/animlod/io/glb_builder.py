@@ -1,0 +1,203 @@
+"""A glTF document being written as one GLB: its JSON (plain dicts) and its binary chunk.
+
+Either a new document, or a whole input document taken over (:meth:`GlbBuilder.from_document`):
+its JSON exactly as parsed (every property, extension and extra; pygltflib's object model
+drops some, so the writer works on the JSON itself), every buffer (GLB chunk, data URIs,
+external .bin files) gathered into the one binary chunk, and every image with a URI embedded,
+so the output stands alone wherever it is written. New data is appended as tightly packed,
+4-byte aligned buffer views.
+"""
+
+from __future__ import annotations
+
+import base64
+import copy
+import json
+import mimetypes
+import os
+import struct
+from pathlib import Path
+from urllib.parse import unquote
+
+import numpy as np
+
+from .atomic import atomic_write
+from .gltf_document import GltfDocument
+
+FLOAT, UNSIGNED_BYTE, UNSIGNED_SHORT, UNSIGNED_INT = 5126, 5121, 5123, 5125
+ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
+_COMPONENT_TYPES = {
+    np.dtype("float32"): FLOAT,
+    np.dtype("uint8"): UNSIGNED_BYTE,
+    np.dtype("uint16"): UNSIGNED_SHORT,
+    np.dtype("uint32"): UNSIGNED_INT,
+}
+_ACCESSOR_TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
+_IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".webp": "image/webp"}
+_GLB_MAGIC, _GLB_VERSION = b"glTF", 2
+# Extensions known not to refer to accessors or buffer views from places prune() does not scan.
+_PRUNE_SAFE_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_mesh_quantization", "MSFT_lod")
+_JSON_CHUNK, _BIN_CHUNK = 0x4E4F534A, 0x004E4942
+
+
+class GlbBuilder:
+    """A glTF document under construction: ``json`` (dicts and lists) and ``blob`` (binary chunk)."""
+
+    def __init__(self, document: dict | None = None, blob: bytes = b"") -> None:
+        self.json = document if document is not None else {"asset": {"version": "2.0", "generator": "animlod"}}
+        self.blob = bytearray(blob)
+
+    @classmethod
+    def from_document(cls, doc: GltfDocument) -> GlbBuilder:
+        """Everything of ``doc``, its buffers gathered into one binary chunk and its images embedded."""
+        builder = cls(copy.deepcopy(doc.json))
+        views = builder.json.get("bufferViews", [])
+        for index, view in enumerate(views):
+            data = doc.buffer_bytes(view.get("buffer"), f"bufferView {index}")
+            start, length = view.get("byteOffset", 0), view.get("byteLength")
+            if not isinstance(length, int) or start + length > len(data):
+                raise doc.fail(f"bufferView {index}", f"byteLength {length!r} does not fit its buffer")
+            view["buffer"], view["byteOffset"] = 0, builder._append(data[start : start + length])
+        for index, image in enumerate(builder.json.get("images", [])):
+            if "uri" in image:
+                data, mime = _image_bytes(doc, index, image.pop("uri"))
+                image["bufferView"] = len(views)
+                views.append({"buffer": 0, "byteOffset": builder._append(data), "byteLength": len(data)})
+                image.setdefault("mimeType", mime)
+        if views:
+            builder.json["bufferViews"] = views
+        return builder
+
+    def _append(self, data: bytes) -> int:
+        """Appends ``data`` at the next 4-byte boundary; its offset."""
+        self.blob.extend(b"\0" * (-len(self.blob) % 4))
+        offset = len(self.blob)
+        self.blob.extend(data)
+        return offset
+
+    def append(self, kind: str, item: dict) -> int:
+        """Appends ``item`` to the top-level array ``kind`` (e.g. "nodes"); its index."""
+        items = self.json.setdefault(kind, [])
+        items.append(item)
+        return len(items) - 1
+
+    def add(self, values: np.ndarray, target: int | None = None, bounds: bool = False) -> int:
+        """Append ``values (count, width)`` as a tightly packed buffer view and accessor; its index.
+
+        ``bounds`` records min and max, which glTF requires for POSITION and animation inputs.
+        """
+        values = np.ascontiguousarray(values)
+        count, width = values.shape
+        offset = self._append(values.astype(values.dtype.newbyteorder("<")).tobytes())
+        view = {"buffer": 0, "byteOffset": offset, "byteLength": values.nbytes}
+        if target is not None:
+            view["target"] = target
+        accessor = {
+            "bufferView": self.append("bufferViews", view),
+            "componentType": _COMPONENT_TYPES[values.dtype],
+            "count": count,
+            "type": _ACCESSOR_TYPES[width],
+        }
+        if bounds:
+            accessor["min"] = values.min(axis=0).tolist()
+            accessor["max"] = values.max(axis=0).tolist()
+        return self.append("accessors", accessor)
+
+    def prune(self) -> None:
+        """Drops meshes no node draws; then, when no extension could refer to them unseen, the
+        accessors and buffer views nothing refers to, and repacks the binary chunk."""
+        js = self.json
+        nodes = js.get("nodes", [])
+        kept_meshes = sorted({node["mesh"] for node in nodes if "mesh" in node})
+        new_mesh = {old: new for new, old in enumerate(kept_meshes)}
+        for node in nodes:
+            if "mesh" in node:
+                node["mesh"] = new_mesh[node["mesh"]]
+        if "meshes" in js:
+            js["meshes"] = [js["meshes"][old] for old in kept_meshes]
+        if any(not name.startswith(_PRUNE_SAFE_EXTENSIONS) for name in js.get("extensionsUsed", [])):
+            return
+        accessor_refs = list(_accessor_references(js))
+        kept_accessors = sorted({holder[key] for holder, key in accessor_refs})
+        new_accessor = {old: new for new, old in enumerate(kept_accessors)}
+        for holder, key in accessor_refs:
+            holder[key] = new_accessor[holder[key]]
+        js["accessors"] = [js["accessors"][old] for old in kept_accessors]
+        view_refs = [(a, "bufferView") for a in js["accessors"] if "bufferView" in a]
+        for accessor in js["accessors"]:
+            sparse = accessor.get("sparse", {})
+            view_refs += [(sparse[part], "bufferView") for part in ("indices", "values") if part in sparse]
+        view_refs += [(image, "bufferView") for image in js.get("images", []) if "bufferView" in image]
+        kept_views = sorted({holder[key] for holder, key in view_refs})
+        old_views, old_blob = js.get("bufferViews", []), bytes(self.blob)
+        self.blob = bytearray()
+        new_views = []
+        for old in kept_views:
+            view = dict(old_views[old])
+            start = view.get("byteOffset", 0)
+            view["byteOffset"] = self._append(old_blob[start : start + view["byteLength"]])
+            new_views.append(view)
+        new_view = {old: new for new, old in enumerate(kept_views)}
+        for holder, key in view_refs:
+            holder[key] = new_view[holder[key]]
+        js["bufferViews"] = new_views
+
+    def add_extension_used(self, name: str) -> None:
+        used = self.json.setdefault("extensionsUsed", [])
+        if name not in used:
+            used.append(name)
+
+    def to_bytes(self) -> bytes:
+        """The GLB file (glTF 2.0 section 4.4): header, JSON chunk, binary chunk."""
+        self.blob.extend(b"\0" * (-len(self.blob) % 4))
+        if self.blob:
+            self.json["buffers"] = [{"byteLength": len(self.blob)}]
+        else:
+            self.json.pop("buffers", None)
+        text = json.dumps(self.json, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
+        text += b" " * (-len(text) % 4)
+        chunks = struct.pack("<II", len(text), _JSON_CHUNK) + text
+        if self.blob:
+            chunks += struct.pack("<II", len(self.blob), _BIN_CHUNK) + bytes(self.blob)
+        return _GLB_MAGIC + struct.pack("<II", _GLB_VERSION, 12 + len(chunks)) + chunks
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Writes the GLB atomically: ``path`` appears only once complete."""
+        data = self.to_bytes()
+        with atomic_write(path, "wb") as handle:
+            handle.write(data)
+
+
+def _accessor_references(js: dict):
+    """(holder, key) of every accessor index the core glTF 2.0 schema places."""
+    for mesh in js.get("meshes", []):
+        for primitive in mesh.get("primitives", []):
+            attributes = primitive.get("attributes", {})
+            yield from ((attributes, name) for name in attributes)
+            if "indices" in primitive:
+                yield primitive, "indices"
+            for target in primitive.get("targets", []):
+                yield from ((target, name) for name in target)
+    for skin in js.get("skins", []):
+        if "inverseBindMatrices" in skin:
+            yield skin, "inverseBindMatrices"
+    for animation in js.get("animations", []):
+        for sampler in animation.get("samplers", []):
+            yield sampler, "input"
+            yield sampler, "output"
+
+
+def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | None]:
+    """The bytes and MIME type of an image given by a data URI or a file next to the document."""
+    if uri.startswith("data:"):
+        header, _, payload = uri.partition(",")
+        try:
+            return base64.b64decode(payload, validate=True), header[5:].split(";")[0] or None
+        except ValueError as error:
+            raise doc.fail(f"image {index}", f"malformed data URI ({error})") from None
+    path = Path(doc.path).parent / unquote(uri)
+    try:
+        data = path.read_bytes()
+    except OSError as error:
+        raise doc.fail(f"image {index}", f"cannot read {path} ({error.strerror})") from None
+    return data, _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0]

@@ -1,0 +1,199 @@
+"""What a glTF document draws, as animlod simplifies it: one :class:`Drawable` per (mesh, skin)
+pair used by a node, with every animation that moves it.
+
+A drawable holds its mesh's triangle primitives (node-local, :mod:`.gltf_mesh`), the rest
+transform that places them in the world, and, when skinned, the world-space
+:class:`~animlod.model.SkinnedMesh` of :mod:`.gltf_read` with its skin as an animlod skeleton.
+Each animation that moves the skin or the mesh's morph weights becomes a :class:`Clip`, so that
+the drawable's posed frames can be produced for any clip: skinning after morphing, as glTF does.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model import Motion, SkinnedMesh
+from .gltf_document import GltfDocument
+from .gltf_lod import GRID_EXTRA
+from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_points
+from .gltf_read import morph_weight_tracks, skinned_mesh_of_node
+from .gltf_skin import SkinRig
+
+# Weight sums further than this from 1 count as "normalised on load" in the report.
+_WEIGHT_SUM_TOLERANCE = 1e-3
+
+
+@dataclass
+class Clip:
+    """One animation as it moves a drawable.
+
+    Attributes
+    ----------
+    index : the animation's index in the document.
+    name : its name ("" when unnamed).
+    frame_count : T, samples at the drawable's fps.
+    motion : the skeleton's motion (skinned drawables; the rest pose held when the animation
+        moves only morph weights), or None.
+    morph_weights : (T, N) morph weights, or None when the animation does not drive them.
+    """
+
+    index: int
+    name: str
+    frame_count: int
+    motion: Motion | None = None
+    morph_weights: np.ndarray | None = None
+
+
+@dataclass
+class Drawable:
+    """A (mesh, skin) pair of a document and what animates it.
+
+    Attributes
+    ----------
+    mesh_index, skin_index : the glTF mesh and skin (None when unskinned).
+    nodes : the nodes that draw this pair (instances).
+    label : "mesh 0 'Body' with skin 0" for messages.
+    geometry : the triangle primitives, node-local.
+    world : (4, 4) rest world transform of the first node; positions below are in world space.
+    skinned : the world-space skinned mesh (joints in skeleton order), or None.
+    rig : the skin as a skeleton, or None.
+    clips : the animations that move this drawable.
+    renormalised_weights : vertices whose stored skin weights did not sum to 1.
+    """
+
+    mesh_index: int
+    skin_index: int | None
+    nodes: list[int]
+    label: str
+    geometry: MeshGeometry
+    world: np.ndarray
+    skinned: SkinnedMesh | None = None
+    rig: SkinRig | None = None
+    clips: list[Clip] = field(default_factory=list)
+    renormalised_weights: int = 0
+
+    @property
+    def morph_targets(self) -> np.ndarray | None:
+        """(N, V, 3) world-space morph position deltas, or None."""
+        if self.geometry.targets is None:
+            return None
+        return self.geometry.targets @ self.world[:3, :3].T
+
+    def rest_positions(self) -> np.ndarray:
+        """(V, 3) float32 world-space rest positions (morph weights 0)."""
+        return transform_points(self.world, self.geometry.positions).astype(np.float32)
+
+    def clip_frames(self, clip: Clip, frames: np.ndarray | None = None) -> np.ndarray:
+        """(T', V, 3) world positions of the drawable in the given frames of ``clip`` (all when None)."""
+        frames = np.arange(clip.frame_count) if frames is None else np.asarray(frames)
+        weights = None if clip.morph_weights is None else clip.morph_weights[frames]
+        if self.skinned is not None:
+            motion = motion_frames(clip.motion, frames)
+            return self.skinned.bake(motion, weights).frames
+        rest = self.rest_positions().astype(np.float64)
+        if weights is None:
+            return np.broadcast_to(rest, (len(frames),) + rest.shape).astype(np.float32)
+        return (rest + np.einsum("tn,nvc->tvc", weights, self.morph_targets)).astype(np.float32)
+
+
+def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
+    """Every (mesh, skin) pair drawn by a node of ``doc``, in order of first use, with its clips
+    sampled at ``fps``. Nodes that are lower levels of an MSFT_lod chain are alternates of their
+    base node, not drawables of their own. Raises FormatError naming the element for anything
+    it cannot read."""
+    _check_channel_targets(doc)
+    nodes = doc.json.get("nodes", [])
+    alternates = {other for index, node in enumerate(nodes) for other in _alternate_nodes(node) if other != index}
+    pairs: dict[tuple[int, int | None], list[int]] = {}
+    for index, node in enumerate(doc.gltf.nodes or []):
+        if node.mesh is not None and index not in alternates:
+            doc.item("meshes", node.mesh, doc.node_label(index))
+            if node.skin is not None:
+                doc.item("skins", node.skin, doc.node_label(index))
+            pairs.setdefault((node.mesh, node.skin), []).append(index)
+    rigs: dict[int, SkinRig] = {}
+    drawables = []
+    for (mesh_index, skin_index), nodes in pairs.items():
+        name = doc.gltf.meshes[mesh_index].name
+        label = f"mesh {mesh_index}" + (f" {name!r}" if name else "")
+        if skin_index is not None:
+            label += f" with skin {skin_index}"
+        geometry = read_mesh_geometry(doc, mesh_index, skinned=skin_index is not None)
+        drawable = Drawable(mesh_index, skin_index, nodes, label, geometry, doc.rest_world_matrix(nodes[0]))
+        if skin_index is not None:
+            if skin_index not in rigs:
+                rigs[skin_index] = SkinRig(doc, skin_index)
+            drawable.rig = rigs[skin_index]
+            drawable.skinned = skinned_mesh_of_node(doc, nodes[0], drawable.rig, geometry)
+            sums = np.asarray(geometry.weights, np.float64).sum(axis=1)
+            drawable.renormalised_weights = int(np.count_nonzero(np.abs(sums - 1.0) > _WEIGHT_SUM_TOLERANCE))
+        drawable.clips = _clips(doc, drawable, fps)
+        drawables.append(drawable)
+    return drawables
+
+
+def read_document_drawables(path: str | os.PathLike, fps: float = 30.0) -> tuple[GltfDocument, list[Drawable]]:
+    """The parsed document at ``path`` and its drawables."""
+    doc = GltfDocument(path)
+    return doc, read_drawables(doc, fps)
+
+
+def _alternate_nodes(node: dict) -> list[int]:
+    """Nodes standing in for ``node`` at other levels: its MSFT_lod ids and animlod's level grid."""
+    ids = list((node.get("extensions") or {}).get("MSFT_lod", {}).get("ids", []))
+    extras = node.get("extras")
+    grid = extras.get(GRID_EXTRA, []) if isinstance(extras, dict) else []
+    ids += [index for row in grid if isinstance(row, list) for index in row]
+    return [index for index in ids if isinstance(index, int)]
+
+
+def _check_channel_targets(doc: GltfDocument) -> None:
+    """Every animation channel must target a node of the document."""
+    for a, animation in enumerate(doc.gltf.animations or []):
+        for index, channel in enumerate(animation.channels or []):
+            if channel.target is not None and channel.target.node is not None:
+                doc.item("nodes", channel.target.node, f"{doc.animation_label(a)} channel {index} target")
+
+
+def _clips(doc: GltfDocument, drawable: Drawable, fps: float) -> list[Clip]:
+    """Clips of every animation that moves the drawable's skin or its first node's morph weights."""
+    targets = drawable.geometry.targets
+    tracks = {} if targets is None else dict(morph_weight_tracks(doc, drawable.nodes[0], len(targets), fps))
+    clips = []
+    for index, animation in enumerate(doc.gltf.animations or []):
+        motion = drawable.rig.motion(doc, index, fps) if drawable.rig is not None else None
+        weights = tracks.get(index)
+        if motion is None and weights is None:
+            continue
+        frame_count = motion.frame_count if motion is not None else len(weights)
+        if motion is None and drawable.rig is not None:
+            motion = _rest_motion(drawable.rig, frame_count, fps)
+        clips.append(Clip(index, animation.name or "", frame_count, motion, weights))
+    return clips
+
+
+def _rest_motion(rig: SkinRig, frame_count: int, fps: float) -> Motion:
+    """The skeleton held in its rest pose for ``frame_count`` frames."""
+    skeleton = rig.skeleton
+    return Motion(
+        skeleton,
+        np.repeat(skeleton.offsets[None, 0], frame_count, axis=0),
+        np.repeat(skeleton.rest_rotations[None], frame_count, axis=0),
+        fps=fps,
+    )
+
+
+def motion_frames(motion: Motion, frames: np.ndarray) -> Motion:
+    """``motion`` restricted to the given frame indices."""
+    translations = None if motion.joint_translations is None else motion.joint_translations[frames]
+    return Motion(
+        motion.skeleton,
+        motion.root_positions[frames],
+        motion.local_rotations[frames],
+        fps=motion.fps,
+        name=motion.name,
+        joint_translations=translations,
+    )

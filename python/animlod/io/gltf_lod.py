@@ -1,0 +1,234 @@
+"""LoD chains in glTF 2.0: the LoD GLB.
+
+The input document stays whole and level 0 is its own mesh node, untouched. Lower levels are
+nodes listed by the base node's MSFT_lod extension (in no scene and no children list, so that
+any viewer shows level 0), with the base node's transform and skin, and their own meshes whose
+primitives keep the input primitives' materials and attribute sets:
+
+- ``base.extensions.MSFT_lod = {"ids": [n1, ..., nL]}``, finest first;
+- ``base.extras.MSFT_screencoverage = [c0, ..., cL]``: level i is used while the object covers
+  at least ``c_i`` of the viewport height; ``cL = 0``;
+- ``extras.animlod = {"level", "error", "triangles", "mesh_level", "motion_level", "joints"}`` on
+  every node of the chain (``error`` in asset units).
+
+Motion levels (fewer joints, see :mod:`animlod.pipelines.character`) add a reduced skeleton as
+its own joint nodes, a skin over them, and one animation per input clip with
+``extras.animlod = {"clip": <input animation index>, "motion_level": m}``; every combination of
+geometry and motion level is a node, listed by ``base.extras.animlod_grid[g][m]``.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model import AnimatedMesh, LodChain, LodLevel
+from .glb_builder import ARRAY_BUFFER, GlbBuilder
+from .gltf_document import GltfDocument
+from .gltf_mesh import read_mesh_geometry, transform_points
+from .gltf_read import skinned_mesh_of_node
+from .gltf_skin import SkinRig
+from .gltf_write import index_accessor
+
+LOD_EXTENSION = "MSFT_lod"
+COVERAGE_EXTRA = "MSFT_screencoverage"
+ANIMLOD_EXTRA = "animlod"
+# Node extras key of the (mesh level x motion level) grid of level nodes that character chains
+# write beside MSFT_lod: grid[g][m] lists the node drawing geometry level g at motion level m.
+GRID_EXTRA = "animlod_grid"
+_NODE_TRANSFORM = ("matrix", "translation", "rotation", "scale")
+
+
+@dataclass
+class PrimitiveArrays:
+    """One triangle primitive of a level mesh, ready to write.
+
+    Attributes
+    ----------
+    source : index of the input primitive it replaces (material, mode and extras come from it).
+    attributes : glTF attribute name -> (n, width) array: float32, or unsigned integers for
+        JOINTS_n.
+    faces : (m, 3) triangles over the n vertices.
+    targets : per morph target, attribute name -> (n, 3) float32 deltas.
+    vertices : (n,) index of each vertex in the level it was cut from (not written).
+    """
+
+    source: int
+    attributes: dict[str, np.ndarray]
+    faces: np.ndarray
+    targets: list[dict[str, np.ndarray]] = field(default_factory=list)
+    vertices: np.ndarray | None = None
+
+
+@dataclass
+class LevelInfo:
+    """What ``extras.animlod`` records on a node of a chain."""
+
+    level: int
+    error: float
+    triangles: int
+    mesh_level: int
+    motion_level: int = 0
+    joints: int = 0
+
+    def extras(self) -> dict:
+        return {
+            "level": self.level,
+            "error": float(self.error),
+            "triangles": int(self.triangles),
+            "mesh_level": self.mesh_level,
+            "motion_level": self.motion_level,
+            "joints": self.joints,
+        }
+
+
+def add_level_mesh(
+    builder: GlbBuilder, mesh_index: int, primitives: list[PrimitiveArrays], shared: list[int], name: str
+) -> int:
+    """A new mesh like input mesh ``mesh_index`` with the triangle primitives ``primitives`` and
+    the input primitives ``shared`` (points and lines) as they are. Returns its index."""
+    source = builder.json["meshes"][mesh_index]
+    mesh = {key: copy.deepcopy(value) for key, value in source.items() if key != "primitives"}
+    mesh["name"] = name
+    mesh["primitives"] = [copy.deepcopy(source["primitives"][k]) for k in shared]
+    for arrays in primitives:
+        primitive = {
+            key: copy.deepcopy(value)
+            for key, value in source["primitives"][arrays.source].items()
+            if key not in ("attributes", "indices", "targets", "mode")
+        }
+        vertex_count = len(arrays.attributes["POSITION"])
+        primitive["attributes"] = {
+            attribute: builder.add(_storable(values), ARRAY_BUFFER, bounds=attribute == "POSITION")
+            for attribute, values in arrays.attributes.items()
+        }
+        primitive["indices"] = index_accessor(builder, arrays.faces, vertex_count)
+        primitive["mode"] = 4
+        if arrays.targets:
+            primitive["targets"] = [
+                {
+                    name: builder.add(_storable(delta), ARRAY_BUFFER, bounds=name == "POSITION")
+                    for name, delta in t.items()
+                }
+                for t in arrays.targets
+            ]
+        mesh["primitives"].append(primitive)
+    return builder.append("meshes", mesh)
+
+
+def add_level_node(builder: GlbBuilder, base: int, mesh: int, skin: int | None, info: LevelInfo) -> int:
+    """A node drawing ``mesh`` (with ``skin``) where node ``base`` is; in no scene. Its index."""
+    base_node = builder.json["nodes"][base]
+    node = {key: copy.deepcopy(base_node[key]) for key in _NODE_TRANSFORM if key in base_node}
+    node["name"] = f"{base_node.get('name', f'node{base}')}_LOD{info.level}"
+    node["mesh"] = mesh
+    if skin is not None:
+        node["skin"] = skin
+    node["extras"] = {ANIMLOD_EXTRA: info.extras()}
+    return builder.append("nodes", node)
+
+
+def attach_chain(
+    builder: GlbBuilder, base: int, level_nodes: list[int], coverages: list[float], base_info: LevelInfo
+) -> None:
+    """Makes node ``base`` the top of a chain: MSFT_lod ids, screen coverages (one per level,
+    ``len(level_nodes) + 1`` decreasing values ending at 0) and its own animlod extras."""
+    if len(coverages) != len(level_nodes) + 1:
+        raise ValueError(f"coverages: {len(coverages)} values for {len(level_nodes) + 1} levels")
+    node = builder.json["nodes"][base]
+    node.setdefault("extensions", {})[LOD_EXTENSION] = {"ids": list(level_nodes)}
+    extras = node.get("extras")
+    if not isinstance(extras, dict):  # glTF allows any JSON value; keep it beside ours
+        extras = {} if extras is None else {"original_extras": extras}
+    extras[COVERAGE_EXTRA] = [float(c) for c in coverages]
+    extras[ANIMLOD_EXTRA] = base_info.extras()
+    node["extras"] = extras
+    builder.add_extension_used(LOD_EXTENSION)
+
+
+def screen_coverages(
+    errors: list[float], size: float, pixel_error: float = 1.0, viewport_px: float = 1080.0
+) -> list[float]:
+    """MSFT_screencoverage thresholds from each level's error (asset units).
+
+    An object of ``size`` covering a fraction ``c`` of a viewport ``viewport_px`` pixels high
+    shows an error ``e`` as ``e / size * c * viewport_px`` pixels, so level i + 1 is good enough
+    once ``c <= pixel_error * size / (e_(i+1) * viewport_px)``: that is where level i ends.
+    The values are clamped to [0, 1] and made non-increasing; the last is 0.
+    """
+    thresholds = []
+    for error in errors[1:]:
+        limit = 1.0 if error <= 0.0 else pixel_error * size / (error * viewport_px)
+        thresholds.append(min(1.0, limit, thresholds[-1] if thresholds else 1.0))
+    return [*thresholds, 0.0]
+
+
+def read_lod_chains(path: str | os.PathLike, fps: float = 30.0) -> list[LodChain]:
+    """Every chain of a LoD GLB (one per node with MSFT_lod), levels finest first.
+
+    A level's mesh is a world-space :class:`~animlod.model.SkinnedMesh` with the clips that
+    move its skin (a reduced skeleton's own clips at motion levels), or a one-frame
+    :class:`~animlod.model.AnimatedMesh`; its error and coverage come from the extras.
+    A file without MSFT_lod has no chains. Raises FormatError naming the element.
+    """
+    doc = GltfDocument(path)
+    rigs: dict[int, SkinRig] = {}
+    chains = []
+    for base, node in enumerate(doc.json.get("nodes", [])):
+        lod = node.get("extensions", {}).get(LOD_EXTENSION)
+        if lod is None:
+            continue
+        element = f"{doc.node_label(base)} {LOD_EXTENSION}"
+        ids = lod.get("ids") if isinstance(lod, dict) else None
+        if not isinstance(ids, list):
+            raise doc.fail(element, "has no list of level node ids")
+        for index in ids:
+            doc.item("nodes", index, element)
+        extras = node.get("extras") if isinstance(node.get("extras"), dict) else {}
+        coverages = extras.get(COVERAGE_EXTRA, [None] * (len(ids) + 1))
+        if not isinstance(coverages, list) or len(coverages) != len(ids) + 1:
+            raise doc.fail(f"{doc.node_label(base)} extras", f"{COVERAGE_EXTRA} needs {len(ids) + 1} values")
+        parent = doc.parents[base]
+        parent_world = doc.rest_world_matrix(parent) if parent >= 0 else np.eye(4)
+        levels = []
+        for node_index, coverage in zip([base, *ids], coverages):
+            world = parent_world @ doc.rest_matrix(node_index)
+            levels.append(_read_level(doc, node_index, world, rigs, fps, coverage))
+        chains.append(LodChain(levels, name=node.get("name", f"node {base}")))
+    return chains
+
+
+def _read_level(
+    doc: GltfDocument, index: int, world: np.ndarray, rigs: dict, fps: float, coverage: float | None
+) -> LodLevel:
+    node = doc.gltf.nodes[index]
+    label = doc.node_label(index)
+    extras = node.extras.get(ANIMLOD_EXTRA, {}) if isinstance(node.extras, dict) else {}
+    info = extras if isinstance(extras, dict) else {}
+    if node.mesh is None:
+        raise doc.fail(label, "is a level of a LoD chain but draws no mesh")
+    error = float(info.get("error", 0.0))
+    mesh_level, motion_level = int(info.get("mesh_level", 0)), int(info.get("motion_level", 0))
+    if node.skin is None:
+        geometry = read_mesh_geometry(doc, node.mesh, skinned=False)
+        mesh = AnimatedMesh(geometry.faces, transform_points(world, geometry.positions)[None])
+        return LodLevel(mesh, None, [], error, coverage, mesh_level, motion_level)
+    if node.skin not in rigs:
+        rigs[node.skin] = SkinRig(doc, node.skin)
+    rig = rigs[node.skin]
+    geometry = read_mesh_geometry(doc, node.mesh, skinned=True)
+    mesh = skinned_mesh_of_node(doc, index, rig, geometry, world)
+    motions = [rig.motion(doc, animation, fps) for animation in range(len(doc.gltf.animations or []))]
+    motions = [motion for motion in motions if motion is not None]
+    return LodLevel(mesh, rig.skeleton, motions, error, coverage, mesh_level, motion_level)
+
+
+def _storable(values: np.ndarray) -> np.ndarray:
+    """float32, or the smallest unsigned type for integer arrays (JOINTS_n)."""
+    values = np.asarray(values)
+    if values.dtype.kind in "iu":
+        return values.astype(np.uint8 if values.max(initial=0) < 256 else np.uint16)
+    return values.astype(np.float32)

@@ -1,0 +1,388 @@
+"""AQEM levels of one glTF drawable, with every primitive, attribute and morph target carried.
+
+The drawable's primitives are simplified together (faces keep their primitive, borders between
+primitives are seams), over frames that cover its animations: the rest pose, each morph target
+at full weight, and frames spread over every clip. Skinned and morphed drawables use one point
+of each collapsed edge for every frame (``placement="on_edge"``), so that the carried skin
+weights and morph deltas reproduce the simplified poses; static ones use Eq. 5's optimum.
+
+Attributes are carried as the glTF has them: UVs, colours and normals per wedge (copies of a
+position with different values form seams), morph position deltas per position. Hard normal
+edges are the exception: where a primitive's copies of a position differ in their normals (flat
+or faceted shading), those normals would lock nearly every point, so the primitive is welded
+without normals (and tangents) and its normals are rebuilt on each level from the level's own
+faces, split where faces meet at more than a crease angle (every face on its own for a flat
+shaded primitive). Where three or more normals met (the corners of hard edges, such as spike
+tips), the vertices are guarded: they stay in place while the targets can be reached without
+moving them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..aqem import Preparation, SimplifiedLevel, simplify_animated
+from ..io.gltf_drawable import Clip, Drawable, motion_frames
+from ..io.gltf_lod import PrimitiveArrays
+from ..io.gltf_mesh import PrimitiveGeometry, transform_points
+from ..metrics import surface_error
+from ..model import AnimatedMesh, SkinnedMesh
+
+_SKIN_PREFIXES = ("JOINTS_", "WEIGHTS_")
+# A primitive is flat shaded when this share of its faces has equal corner normals along the
+# face's own normal (cosine above _FLAT_COSINE).
+_FLAT_SHARE, _FLAT_COSINE = 0.99, 0.999
+# Rebuilt normals smooth across edges whose faces turn by less than this (radians).
+CREASE_ANGLE = np.radians(60.0)
+_NORMAL_ATTRIBUTES = ("NORMAL", "TANGENT")
+# Points sampled on each surface per measured frame (on top of the vertices).
+_MEASURE_SAMPLES = 4000
+
+
+@dataclass
+class DrawableLevel:
+    """One level of a drawable.
+
+    Attributes
+    ----------
+    simplified : the AQEM level (faces, kept vertices, carried data; positions of the drive frames).
+    primitives : the level's triangle primitives, node-local, ready to write.
+    skinned : the level as a world-space skinned mesh (skinned drawables), else None.
+    rest : (V', 3) world-space rest positions of the level.
+    error : asset units, max over measured frames of the Hausdorff distance to the input.
+    """
+
+    simplified: SimplifiedLevel
+    primitives: list[PrimitiveArrays]
+    skinned: SkinnedMesh | None
+    rest: np.ndarray
+    morph_targets: np.ndarray | None
+    error: float = 0.0
+
+
+@dataclass
+class DrawableLevels:
+    """Levels of a drawable, finest first, with its size (rest bounding-box diagonal)."""
+
+    levels: list[DrawableLevel]
+    size: float
+    preparation: Preparation
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass
+class _Layout:
+    """Where each attribute sits in the matrix handed to AQEM."""
+
+    columns: dict[str, tuple[int, int]]  # name -> (first column, width)
+    target_columns: list[dict[str, tuple[int, int]]]  # per morph target: NORMAL/TANGENT deltas
+    crease: list[float | None]  # per primitive: crease angle of rebuilt normals, None when carried
+    width: int
+
+
+def simplify_drawable(
+    drawable: Drawable,
+    ratios: Sequence[float],
+    frame_budget: int = 48,
+    measured_frames: int = 12,
+    aqem_options: dict | None = None,
+) -> DrawableLevels:
+    """AQEM levels of ``drawable`` at ``ratios``, each measured over every clip."""
+    geometry = drawable.geometry
+    matrix, layout = _attribute_matrix(drawable)
+    deltas = drawable.morph_targets
+    position_attributes = None if deltas is None else deltas.transpose(1, 0, 2).reshape(len(geometry.positions), -1)
+    animated = drawable.skinned is not None or deltas is not None
+    options = {"placement": "on_edge" if animated else "optimal", **(aqem_options or {})}
+    frames = _drive_frames(drawable, frame_budget)
+    result = simplify_animated(
+        AnimatedMesh(geometry.faces, frames),
+        ratios,
+        attributes=matrix if layout.width else None,
+        position_attributes=position_attributes,
+        skin_joints=None if drawable.skinned is None else drawable.skinned.joints,
+        skin_weights=None if drawable.skinned is None else drawable.skinned.weights,
+        face_groups=geometry.face_groups,
+        guarded_vertices=_sharp_corners(drawable, layout),
+        **options,
+    )
+    rest = drawable.rest_positions()
+    size = float(np.linalg.norm(np.ptp(rest, axis=0)))
+    levels = [_level(drawable, level, layout) for level in result.levels]
+    notes = []
+    rebuilt = [geometry.primitives[k].index for k, crease in enumerate(layout.crease) if crease is not None]
+    if rebuilt:
+        notes.append(f"primitives {rebuilt}: hard normal edges; normals rebuilt on each level (crease angle)")
+    if geometry.other_primitives:
+        notes.append(f"primitives {geometry.other_primitives}: points or lines, kept unchanged")
+    _measure(drawable, levels, measured_frames)
+    return DrawableLevels(levels, size, result.preparation, notes)
+
+
+def _drive_frames(drawable: Drawable, budget: int) -> np.ndarray:
+    """(F, V, 3) world positions AQEM works over: the rest pose, each morph target at full weight,
+    then frames spread evenly over every clip (at least two per clip), F <= ``budget`` where the
+    clips allow."""
+    rest = drawable.rest_positions()
+    frames = [rest[None]]
+    if drawable.morph_targets is not None:
+        frames.append((rest[None] + drawable.morph_targets).astype(np.float32))
+    clips = drawable.clips
+    remaining = max(budget - sum(len(f) for f in frames), 2 * len(clips))
+    lengths = np.array([clip.frame_count for clip in clips], np.float64)
+    for clip, share in zip(clips, lengths / max(lengths.sum(), 1.0)):
+        count = int(np.clip(round(share * remaining), 2, clip.frame_count))
+        frames.append(drawable.clip_frames(clip, spread_frames(clip.frame_count, count)))
+    return np.concatenate(frames).astype(np.float32)
+
+
+def spread_frames(frame_count: int, count: int) -> np.ndarray:
+    """(<= count,) int frame indices spread evenly over [0, frame_count), both ends included."""
+    return np.unique(np.linspace(0, frame_count - 1, min(count, frame_count)).round().astype(np.int64))
+
+
+def _attribute_matrix(drawable: Drawable) -> tuple[np.ndarray, _Layout]:
+    """(V, A) float32 of every per-wedge attribute (all but POSITION and skin) and morph
+    NORMAL/TANGENT deltas, primitives one after another; absent values are 0 (faces of one
+    primitive never blend with another's)."""
+    primitives = drawable.geometry.primitives
+    columns: dict[str, tuple[int, int]] = {}
+    width = 0
+
+    def column(name: str, size: int) -> None:
+        nonlocal width
+        if name not in columns:
+            columns[name] = (width, size)
+            width += size
+        elif columns[name][1] < size:
+            raise ValueError(f"{drawable.label}: attribute {name} has different widths across primitives")
+
+    for primitive in primitives:
+        for name, values in primitive.attributes.items():
+            if name != "POSITION" and not name.startswith(_SKIN_PREFIXES):
+                column(name, values.shape[1])
+    target_columns: list[dict[str, tuple[int, int]]] = []
+    for t in range(len(primitives[0].targets) if primitives else 0):
+        per_target = {}
+        for primitive in primitives:
+            for name, values in primitive.targets[t].items():
+                if name != "POSITION":
+                    key = f"target {t} {name}"
+                    column(key, values.shape[1])
+                    per_target[name] = columns[key]
+        target_columns.append(per_target)
+    starts = drawable.geometry.vertex_starts
+    matrix = np.zeros((starts[-1], width), np.float32)
+    crease = []
+    for k, primitive in enumerate(primitives):
+        rows = slice(starts[k], starts[k + 1])
+        crease.append(_crease_angle(primitive))
+        for name, values in primitive.attributes.items():
+            if name in columns and not (crease[k] is not None and name in _NORMAL_ATTRIBUTES):
+                first, size = columns[name]
+                matrix[rows, first : first + values.shape[1]] = values
+        for t, target in enumerate(primitive.targets):
+            for name, values in target.items():
+                if name != "POSITION":
+                    first, size = target_columns[t][name]
+                    matrix[rows, first : first + values.shape[1]] = values
+    return matrix, _Layout(columns, target_columns, crease, width)
+
+
+def _crease_angle(primitive: PrimitiveGeometry) -> float | None:
+    """None when the primitive's normals can be carried (no two copies of a position differ in
+    them); otherwise the crease angle its rebuilt normals use: 0 for flat shading."""
+    normals = primitive.attributes.get("NORMAL")
+    if normals is None:
+        return None
+    positions = primitive.attributes["POSITION"]
+    _, point = np.unique(positions, axis=0, return_inverse=True)
+    keyed = np.unique(np.concatenate([point.reshape(-1, 1), normals], axis=1), axis=0)
+    if len(keyed) == point.max(initial=-1) + 1:
+        return None
+    return 0.0 if _is_flat_shaded(normals, positions, primitive.faces) else float(CREASE_ANGLE)
+
+
+def _sharp_corners(drawable: Drawable, layout: _Layout) -> np.ndarray:
+    """Vertices of primitives with rebuilt normals where three or more normals meet (a corner of
+    hard edges, such as a spike's tip): guarded, so they stay while the targets allow."""
+    starts = drawable.geometry.vertex_starts
+    corners = []
+    for k, primitive in enumerate(drawable.geometry.primitives):
+        if layout.crease[k] is None:
+            continue
+        _, point = np.unique(primitive.attributes["POSITION"], axis=0, return_inverse=True)
+        point = point.ravel()
+        distinct = np.unique(np.concatenate([point[:, None], primitive.attributes["NORMAL"]], axis=1), axis=0)
+        normals_at = np.bincount(distinct[:, 0].astype(np.int64), minlength=point.max() + 1)
+        corners.append(np.flatnonzero(normals_at[point] >= 3) + starts[k])
+    return np.concatenate(corners) if corners else np.zeros(0, np.int64)
+
+
+def _is_flat_shaded(normals: np.ndarray | None, positions: np.ndarray, faces: np.ndarray) -> bool:
+    """Whether (nearly) every face's three corners carry the face's own normal."""
+    if normals is None or len(faces) == 0:
+        return False
+    corners = positions[faces].astype(np.float64)
+    face_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    length = np.linalg.norm(face_normal, axis=1)
+    usable = length > 0.0
+    face_normal = face_normal[usable] / length[usable, None]
+    corner_normals = normals[faces[usable]].astype(np.float64)
+    agree = np.all(np.einsum("fkc,fc->fk", corner_normals, face_normal) > _FLAT_COSINE, axis=1)
+    return bool(agree.mean() >= _FLAT_SHARE) if agree.size else False
+
+
+def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> DrawableLevel:
+    """The level's world-space rest, deltas and skin, and its primitives in node-local space."""
+    geometry = drawable.geometry
+    rest = level.mesh.frames[0]
+    deltas = None
+    if level.position_attributes is not None:
+        deltas = level.position_attributes.reshape(len(rest), -1, 3).transpose(1, 0, 2)
+    skinned = None
+    if drawable.skinned is not None:
+        skinned = SkinnedMesh(
+            rest_positions=rest,
+            faces=level.mesh.faces,
+            joints=level.skin_joints,
+            weights=level.skin_weights,
+            inverse_bind=drawable.skinned.inverse_bind,
+            skeleton=drawable.skinned.skeleton,
+            morph_targets=deltas,
+        )
+    to_local = np.linalg.inv(drawable.world)
+    groups = geometry.face_groups[level.face_sources]
+    primitives = []
+    for k, source in enumerate(geometry.primitives):
+        faces = level.mesh.faces[groups == k]
+        if len(faces) == 0:
+            continue
+        used, local_faces = np.unique(faces, return_inverse=True)
+        local_faces = local_faces.reshape(-1, 3)
+        attributes = {"POSITION": transform_points(to_local, rest[used]).astype(np.float32)}
+        for name, values in source.attributes.items():
+            if name in layout.columns:
+                first, _ = layout.columns[name]
+                attributes[name] = level.attributes[used, first : first + values.shape[1]].copy()
+        _tidy_directions(attributes)
+        if skinned is not None:
+            attributes.update(_skin_columns(drawable, skinned.joints[used], skinned.weights[used]))
+        targets = []
+        for t, target in enumerate(source.targets):
+            arrays = {}
+            for name in target:
+                if name == "POSITION":
+                    arrays[name] = (deltas[t][used] @ to_local[:3, :3].T).astype(np.float32)
+                else:
+                    first, size = layout.target_columns[t][name]
+                    arrays[name] = level.attributes[used, first : first + size].copy()
+            targets.append(arrays)
+        primitive = PrimitiveArrays(source.index, attributes, local_faces, targets, used)
+        if layout.crease[k] is not None:
+            primitive = with_crease_normals(primitive, layout.crease[k])
+        primitives.append(primitive)
+    return DrawableLevel(level, primitives, skinned, rest, deltas)
+
+
+def _tidy_directions(attributes: dict[str, np.ndarray]) -> None:
+    """Interpolated normals back to unit length, tangents too with w = +-1, colours in [0, 1]."""
+    if "NORMAL" in attributes:
+        attributes["NORMAL"] = _unit(attributes["NORMAL"])
+    if "TANGENT" in attributes:
+        tangent = attributes["TANGENT"]
+        tangent[:, :3] = _unit(tangent[:, :3])
+        tangent[:, 3] = np.where(tangent[:, 3] < 0.0, -1.0, 1.0)
+    for name in attributes:
+        if name.startswith("COLOR_"):
+            np.clip(attributes[name], 0.0, 1.0, out=attributes[name])
+
+
+def _unit(vectors: np.ndarray) -> np.ndarray:
+    length = np.linalg.norm(vectors, axis=1, keepdims=True)
+    return (vectors / np.where(length > 0.0, length, 1.0)).astype(np.float32)
+
+
+def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveArrays:
+    """``primitive`` with normals from its own faces: each corner gets the area-weighted normal
+    of the faces around its vertex that turn from its face by at most ``crease`` radians, and
+    a vertex whose corners get different normals is split. Tangents are re-orthogonalised."""
+    positions = primitive.attributes["POSITION"].astype(np.float64)
+    faces = primitive.faces
+    corners = positions[faces]
+    area_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    unit = _unit(area_normal).astype(np.float64)
+    corner_vertex, corner_face = faces.ravel(), np.repeat(np.arange(len(faces)), 3)
+    # Every pair of corners at one vertex: (a, b) with b running over a's vertex group.
+    order = np.argsort(corner_vertex, kind="stable")
+    counts = np.bincount(corner_vertex, minlength=len(positions))
+    group_start = np.concatenate([[0], np.cumsum(counts)])[corner_vertex[order]]
+    group_size = counts[corner_vertex[order]]
+    a = np.repeat(order, group_size)
+    offsets = np.arange(a.size) - np.repeat(np.cumsum(group_size) - group_size, group_size)
+    b = order[np.repeat(group_start, group_size) + offsets]
+    close = np.einsum("pc,pc->p", unit[corner_face[a]], unit[corner_face[b]]) >= np.cos(crease) - 1e-9
+    normal = np.zeros((corner_vertex.size, 3))
+    np.add.at(normal, a[close], area_normal[corner_face[b[close]]])
+    normal = _unit(normal)
+    # One output vertex per (vertex, normal).
+    keys = np.concatenate([corner_vertex[:, None].astype(np.float32), normal], axis=1)
+    _, first, new_index = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    source = corner_vertex[first]
+    attributes = {name: values[source] for name, values in primitive.attributes.items()}
+    attributes["NORMAL"] = normal[first].astype(np.float32)
+    if "TANGENT" in attributes:
+        tangent = attributes["TANGENT"]
+        along = np.einsum("vc,vc->v", tangent[:, :3], attributes["NORMAL"])
+        tangent[:, :3] = _unit(tangent[:, :3] - along[:, None] * attributes["NORMAL"])
+    targets = [{name: values[source] for name, values in target.items()} for target in primitive.targets]
+    return PrimitiveArrays(primitive.source, attributes, new_index.reshape(-1, 3), targets, primitive.vertices[source])
+
+
+def _skin_columns(drawable: Drawable, joints: np.ndarray, weights: np.ndarray) -> dict[str, np.ndarray]:
+    """JOINTS_n / WEIGHTS_n of skeleton-ordered influences, back in the skin's own joint slots."""
+    rig = drawable.rig
+    slot_of_joint = np.empty(len(rig.remap), np.int64)
+    slot_of_joint[rig.remap] = np.arange(len(rig.remap))
+    slots = np.where(weights > 0.0, slot_of_joint[joints], 0)
+    sets = -(-joints.shape[1] // 4)
+    pad = ((0, 0), (0, 4 * sets - joints.shape[1]))
+    slots, weights = np.pad(slots, pad), np.pad(weights, pad).astype(np.float32)
+    out = {}
+    for s in range(sets):
+        out[f"JOINTS_{s}"] = slots[:, 4 * s : 4 * s + 4].astype(np.uint16)
+        out[f"WEIGHTS_{s}"] = weights[:, 4 * s : 4 * s + 4]
+    return out
+
+
+def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: int) -> None:
+    """Each level's error: max over clips and ``measured_frames`` frames per clip (the rest pose
+    when there is no clip) of the Hausdorff distance to the input, in asset units."""
+    faces = drawable.geometry.faces
+    samples: list[tuple[Clip | None, np.ndarray]] = [(None, np.zeros(1, int))]
+    for clip in drawable.clips:
+        count = min(measured_frames, clip.frame_count)
+        samples.append((clip, np.unique(np.linspace(0, clip.frame_count - 1, count).round().astype(int))))
+    for clip, frames in samples:
+        original = AnimatedMesh(
+            faces, drawable.rest_positions()[None] if clip is None else drawable.clip_frames(clip, frames)
+        )
+        for level in levels:
+            posed = AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
+            distance = surface_error(original, posed, samples=_MEASURE_SAMPLES).hausdorff.max()
+            level.error = max(level.error, float(distance))
+
+
+def posed_frames(drawable: Drawable, level: DrawableLevel, clip: Clip | None, frames: np.ndarray) -> np.ndarray:
+    """(T, V', 3) world positions of the level in the given frames of ``clip`` (None: rest)."""
+    if clip is None:
+        return level.rest[None]
+    weights = None if clip.morph_weights is None else clip.morph_weights[frames]
+    if level.skinned is not None:
+        return level.skinned.bake(motion_frames(clip.motion, frames), weights).frames
+    if weights is None:
+        return np.broadcast_to(level.rest, (len(frames),) + level.rest.shape)
+    return (level.rest + np.einsum("tn,nvc->tvc", weights, level.morph_targets)).astype(np.float32)

@@ -1,0 +1,217 @@
+"""A whole glTF document in, one LoD GLB out (or one GLB per level with ``separate``).
+
+Every (mesh, skin) pair a node draws is simplified once with AQEM over frames that cover all
+its animations (skinning and morph weights), its primitives together so that material borders
+do not crack and the triangle budget goes where the error is. Each level is measured after
+re-skinning over every clip (max-over-frames Hausdorff distance, asset units), and the error
+sets the level's MSFT_screencoverage. Everything the simplifier does not touch stays as it was.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..aqem import Preparation, SimplifiedLevel
+from ..io.errors import FormatError
+from ..io.glb_builder import GlbBuilder
+from ..io.gltf_document import GltfDocument
+from ..io.gltf_drawable import Drawable, read_drawables
+from ..io.gltf_lod import LevelInfo, add_level_mesh, add_level_node, attach_chain, screen_coverages
+from ..model import AnimatedMesh
+from .drawable_levels import DrawableLevels, simplify_drawable
+
+DEFAULT_RATIOS = (0.5, 0.25, 0.1)
+
+
+@dataclass
+class LevelReport:
+    """One level of one drawable: faces, whether the target was reached, measured error."""
+
+    level: int
+    faces: int
+    target_faces: int
+    reached: bool
+    error: float  # asset units: max over measured frames of the Hausdorff distance
+    relative_error: float  # error / bounding-box diagonal of the rest pose
+    coverage: float  # MSFT_screencoverage threshold where this level ends
+
+
+@dataclass
+class DrawableReport:
+    """What happened to one (mesh, skin) pair."""
+
+    label: str
+    nodes: list[int]
+    faces: int
+    clips: int
+    preparation: Preparation
+    renormalised_weights: int
+    levels: list[LevelReport] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    rest_meshes: list[AnimatedMesh] = field(default_factory=list)  # level 0, 1, ... in the rest pose, world
+
+
+@dataclass
+class DocumentReport:
+    """The result of :func:`simplify_document`."""
+
+    source: Path
+    outputs: list[Path]
+    drawables: list[DrawableReport]
+    seconds: float
+
+
+def simplify_document(
+    source: str | os.PathLike,
+    output: str | os.PathLike,
+    ratios: Sequence[float] = DEFAULT_RATIOS,
+    *,
+    separate: bool = False,
+    fps: float = 30.0,
+    frame_budget: int = 48,
+    measured_frames: int = 12,
+    pixel_error: float = 1.0,
+    viewport_px: float = 1080.0,
+    progress: Callable[[str], None] | None = None,
+    **aqem_options: object,
+) -> DocumentReport:
+    """Simplify every drawable of the glTF file ``source`` and write the LoD GLB ``output``.
+
+    Parameters
+    ----------
+    source : a .glb or .gltf file.
+    output : the LoD GLB to write (atomically); with ``separate``, a folder that receives one
+        ``<stem>_lod<i>.glb`` per level instead, each the whole document at that level.
+    ratios : face ratios of the levels below level 0, in (0, 1].
+    fps : rate at which animations are sampled.
+    frame_budget : most frames that drive AQEM per drawable (the rest pose, each morph target
+        at full weight and frames spread over every clip).
+    measured_frames : frames per clip at which each level's error is measured.
+    pixel_error, viewport_px : the screen error a level may show where its coverage starts
+        (see :func:`animlod.io.gltf_lod.screen_coverages`).
+    progress : called with a line of text as each drawable starts.
+    **aqem_options : keyword arguments of :func:`animlod.simplify_animated` (``use_motion_features``,
+        ``max_error``, ``placement`` ...).
+
+    Raises
+    ------
+    FormatError naming the file and element for input it cannot read; ValueError for bad options.
+    """
+    started = time.perf_counter()
+    if not ratios or any(not 0.0 < ratio <= 1.0 for ratio in ratios):
+        raise ValueError(f"ratios: each must be in (0, 1], got {list(ratios)}")
+    doc = GltfDocument(source)
+    drawables = read_drawables(doc, fps)
+    if not drawables:
+        raise FormatError(doc.path, "meshes", "no node draws a triangle mesh, nothing to simplify")
+    simplified = []
+    for drawable in drawables:
+        if progress:
+            progress(f"{drawable.label}: {drawable.geometry.faces.shape[0]} triangles, {len(drawable.clips)} clips")
+        simplified.append(simplify_drawable(drawable, ratios, frame_budget, measured_frames, aqem_options=aqem_options))
+    reports = [_report(d, s, pixel_error, viewport_px) for d, s in zip(drawables, simplified)]
+    if separate:
+        outputs = _write_separate(doc, drawables, simplified, reports, Path(output), Path(source).stem)
+    else:
+        outputs = [Path(output)]
+        _write_chain(doc, drawables, simplified, reports).save(output)
+    return DocumentReport(Path(source), outputs, reports, time.perf_counter() - started)
+
+
+def _report(drawable: Drawable, levels: DrawableLevels, pixel_error: float, viewport_px: float) -> DrawableReport:
+    errors = [0.0] + [level.error for level in levels.levels]
+    coverages = screen_coverages(errors, levels.size, pixel_error, viewport_px)
+    report = DrawableReport(
+        label=drawable.label,
+        nodes=drawable.nodes,
+        faces=int(drawable.geometry.faces.shape[0]),
+        clips=len(drawable.clips),
+        preparation=levels.preparation,
+        renormalised_weights=drawable.renormalised_weights,
+        notes=list(levels.notes),
+        rest_meshes=[AnimatedMesh(drawable.geometry.faces, drawable.rest_positions()[None])]
+        + [AnimatedMesh(level.simplified.mesh.faces, level.rest[None]) for level in levels.levels],
+    )
+    for index, (level, coverage) in enumerate(zip(levels.levels, coverages[1:]), start=1):
+        simplified: SimplifiedLevel = level.simplified
+        report.levels.append(
+            LevelReport(
+                level=index,
+                faces=simplified.mesh.face_count,
+                target_faces=simplified.target_face_count,
+                reached=simplified.reached,
+                error=level.error,
+                relative_error=level.error / levels.size if levels.size > 0 else 0.0,
+                coverage=coverage,
+            )
+        )
+        if not simplified.reached:
+            faces, target = simplified.mesh.face_count, simplified.target_face_count
+            report.notes.append(
+                f"level {index}: stopped at {faces} faces (target {target}): no legal collapse left "
+                "(seams, locked spots or the topology's minimum)"
+            )
+    report.levels.insert(0, LevelReport(0, report.faces, report.faces, True, 0.0, 0.0, coverages[0]))
+    return report
+
+
+def _write_chain(
+    doc: GltfDocument, drawables: list[Drawable], simplified: list[DrawableLevels], reports: list[DrawableReport]
+) -> GlbBuilder:
+    """The input document with every drawable's levels attached to its nodes by MSFT_lod."""
+    builder = GlbBuilder.from_document(doc)
+    for drawable, levels, report in zip(drawables, simplified, reports):
+        meshes = [
+            add_level_mesh(builder, drawable.mesh_index, level.primitives, drawable.geometry.other_primitives, name)
+            for level, name in zip(levels.levels, _level_names(doc, drawable, len(levels.levels)))
+        ]
+        coverages = [level.coverage for level in report.levels]
+        joints = len(doc.gltf.skins[drawable.skin_index].joints) if drawable.skin_index is not None else 0
+        infos = [LevelInfo(level.level, level.error, level.faces, level.level, 0, joints) for level in report.levels]
+        for base in drawable.nodes:
+            nodes = [
+                add_level_node(builder, base, mesh, drawable.skin_index, info) for mesh, info in zip(meshes, infos[1:])
+            ]
+            attach_chain(builder, base, nodes, coverages, infos[0])
+    return builder
+
+
+def _write_separate(
+    doc: GltfDocument,
+    drawables: list[Drawable],
+    simplified: list[DrawableLevels],
+    reports: list[DrawableReport],
+    folder: Path,
+    stem: str,
+) -> list[Path]:
+    """One whole document per level, every drawable's nodes drawing that level's mesh."""
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"{folder}: --separate writes a folder of levels, and this is a file")
+    outputs = []
+    for index in range(len(simplified[0].levels)):
+        builder = GlbBuilder.from_document(doc)
+        for drawable, levels, report in zip(drawables, simplified, reports):
+            name = _level_names(doc, drawable, index + 1)[index]
+            mesh = add_level_mesh(
+                builder, drawable.mesh_index, levels.levels[index].primitives, drawable.geometry.other_primitives, name
+            )
+            info = LevelInfo(index + 1, report.levels[index + 1].error, report.levels[index + 1].faces, index + 1)
+            for base in drawable.nodes:
+                node = builder.json["nodes"][base]
+                node["mesh"] = mesh
+                extras = node.get("extras") if isinstance(node.get("extras"), dict) else {}
+                node["extras"] = {**extras, "animlod": info.extras()}
+        builder.prune()
+        path = folder / f"{stem}_lod{index + 1}.glb"
+        builder.save(path)
+        outputs.append(path)
+    return outputs
+
+
+def _level_names(doc: GltfDocument, drawable: Drawable, count: int) -> list[str]:
+    name = doc.gltf.meshes[drawable.mesh_index].name or f"mesh{drawable.mesh_index}"
+    return [f"{name}_LOD{level}" for level in range(1, count + 1)]

@@ -49,6 +49,9 @@ from animlod.motion_lod.objective import build_problem
 from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
 from animlod.synth import humanoid, humanoid_motion
 
+# The core's SLSQP in the Python reference's variables (no preconditioner, every point a variable).
+PLAIN = SlsqpOptions(precondition=False, eliminate_points=False)
+
 
 def subsample(motion: Motion, stride: int) -> Motion:
     """Every ``stride``-th frame."""
@@ -159,7 +162,7 @@ def solver_table(label: str, motion: Motion, frame_count: int) -> None:
         chunk = frames.size
         runs = {
             "python": (refit_slsqp, {"chunk_frames": chunk}),
-            "plain": (refit_core, {"options": SlsqpOptions(precondition=False), "threads": 1, "chunk_frames": chunk}),
+            "plain": (refit_core, {"options": PLAIN, "threads": 1, "chunk_frames": chunk}),
             "core": (refit_core, {"threads": 1, "chunk_frames": chunk}),
         }
         results = {}

@@ -173,7 +173,7 @@ outside [0, P), a repeated point, a non-positive key length, a zero key volume, 
       .def_readwrite("precondition", &MotionRefitOptions::precondition,
                      "Solve in variables where E's Gauss-Newton matrix at the start is the identity.")
       .def_readwrite("eliminate_points", &MotionRefitOptions::eliminate_points,
-                     "With precondition: solve leaves and zero-length pairs in closed form, not as variables.")
+                     "Solve leaves and zero-length pairs in closed form, not as variables (the same minima).")
       .def_readwrite("chunk_frames", &MotionRefitOptions::chunk_frames, "Consecutive frames per task.")
       .def_readwrite("threads", &MotionRefitOptions::threads, "Worker threads; 0 uses every hardware thread.");
 

@@ -138,8 +138,7 @@ class FrameSolver {
       : problem_(problem),
         options_(options),
         hard_(options.hard_constraints && motion_refit_equality_count(problem) > 0),
-        reduction_(problem, hard_, options.precondition && options.eliminate_points,
-                   options.precondition && options.eliminate_points) {
+        reduction_(problem, hard_, options.eliminate_points, options.eliminate_points) {
     const size_t p = problem.point_count;
     const size_t m = motion_refit_equality_count(problem);
     c_.problem = &problem_;

@@ -83,10 +83,11 @@ struct MotionRefitOptions {
   bool warm_start = true;
   // Solve in variables where E's Hessian at the start, each term's part made positive
   // semidefinite, is the identity (y = R (x - x_start), R^T R = that matrix): SLSQP's first
-  // quasi-Newton matrix is then close to the right one and it needs far fewer iterations. Off:
-  // the scaled displacements (x - x^o) / L, as the Python reference (motion_lod/refit.py).
+  // quasi-Newton matrix is then close to the right one and it needs fewer iterations. Off: the
+  // scaled displacements (x - x^o) / L, as the Python reference (motion_lod/refit.py) when
+  // eliminate_points is off too.
   bool precondition = true;
-  // With precondition: leave out points whose optimum follows in closed form from another's (a
+  // Leave out points whose optimum follows in closed form from another's (a
   // leaf held by one length lies on the ray to its original position) or that hard constraints
   // put onto another point (a zero-length pair); SLSQP's cost grows with the cube of the
   // variable count. The minima are the same.

@@ -54,9 +54,8 @@ class SlsqpOptions:
     precondition : the core solves in variables where E's Hessian at the start is the identity
         (far fewer iterations); the Python reference always uses the plain scaled displacements
         (x - x^o) / L and ignores it.
-    eliminate_points : with precondition, the core places leaves held by one length and points
-        of zero-length pairs in closed form instead of as variables (the same minima); the Python
-        reference ignores it.
+    eliminate_points : the core places leaves held by one length and points of zero-length pairs
+        in closed form instead of as variables (the same minima); the Python reference ignores it.
     """
 
     hard_constraints: bool = _CORE_DEFAULTS.hard_constraints

@@ -272,3 +272,66 @@ def skin_palette(
     world: npt.ArrayLike, inverse_bind: npt.ArrayLike, joint_nodes: npt.ArrayLike | None = None
 ) -> npt.NDArray[np.float32]:
     """world[joint_nodes[s]] @ inverse_bind[s]: (T, J, 4, 4), (S, 4, 4) -> (T, S, 4, 4) float32."""
+
+class MotionRefitProblem:
+    """One motion LoD level's per-frame re-fit problem (Eqs. 4-8) over P points, point 0 the root;
+    holds int32/float64 copies of the arrays (cpp/include/animlod/motion_refit.hpp)."""
+
+    def __init__(
+        self,
+        point_count: int,
+        length_pairs: npt.ArrayLike,
+        key_lengths: npt.ArrayLike,
+        coincident_pairs: npt.ArrayLike,
+        handed_quads: npt.ArrayLike,
+        key_volumes: npt.ArrayLike,
+        angle_triples: npt.ArrayLike,
+        key_cosines: npt.ArrayLike,
+        distance_weight: float,
+        string_weight: float,
+        angle_weight: float,
+        length_scale: float,
+    ) -> None: ...
+    @property
+    def point_count(self) -> int: ...
+    @property
+    def equality_count(self) -> int: ...
+
+class MotionRefitOptions:
+    """How the per-frame SLSQP solves run (nlopt's LD_SLSQP); defaults from the C++ struct."""
+
+    hard_constraints: bool
+    ftol_rel: float
+    max_evaluations: int
+    feasibility_tolerance: float
+    warm_start: bool
+    precondition: bool
+    eliminate_points: bool
+    chunk_frames: int
+    threads: int
+    def __init__(self) -> None: ...
+
+def motion_refit_objective(
+    problem: MotionRefitProblem, x: npt.ArrayLike, original: npt.ArrayLike
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """E (Eq. 5) per frame (F,) and its gradient (F, P, 3) at x (F, P, 3) against original (F, P, 3)."""
+
+def motion_refit_equalities(
+    problem: MotionRefitProblem, x: npt.ArrayLike
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Hard equalities scaled by 1/L (F, m) and their Jacobian (F, m, P, 3)."""
+
+def motion_refit_handedness(
+    problem: MotionRefitProblem, x: npt.ArrayLike
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Handedness inequalities (<= 0 when kept) (F, Nh) and their Jacobian (F, Nh, P, 3)."""
+
+def motion_refit_solve(
+    problem: MotionRefitProblem,
+    original: npt.ArrayLike,
+    fallback: npt.ArrayLike,
+    options: MotionRefitOptions = ...,
+    cold_starts: npt.ArrayLike | None = None,
+) -> dict[str, Any]:
+    """SLSQP per frame on several threads: positions (T, P, 3), values (T,), evaluations (T,),
+    failures [(frame, reason, fell_back)]."""

@@ -134,7 +134,7 @@ def run_crowd(
     the binary missing.
     """
     if not chains:
-        raise CrowdError("no chain given", bad_input=True)
+        raise CrowdError("chains: none given", bad_input=True)
     if path not in PATHS:
         raise CrowdError(f"path {path!r}: expected one of {', '.join(PATHS)}", bad_input=True)
     try:

@@ -8,9 +8,9 @@ error in asset units; then the animation level is lowered to the one the geometr
 step of frame skipping grows as the face gets smaller on screen.
 
 The coverage-to-level rule is the one of the LoD GLB (level i is used while the coverage is at
-least c_i, thresholds decreasing, the last 0) and of the core's runtime LoD selector
-(cpp/include/animlod/lod_selector.hpp, being written in parallel); :func:`level_for_coverage`
-is that rule in Python until the selector is bound.
+least c_i, thresholds decreasing, the last 0); it and the frame step are the core's runtime LoD
+selector's (cpp/include/animlod/lod_selector.hpp), so a face picks its levels as the crowd and
+engines do.
 """
 
 from __future__ import annotations
@@ -20,6 +20,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
+from .. import _core
 
 
 @dataclass
@@ -80,19 +82,15 @@ def coverage_thresholds(errors: Sequence[float], radius: float, camera: Camera, 
 
 def level_for_coverage(thresholds: Sequence[float], coverage: float) -> int:
     """The first level i whose threshold ``thresholds[i] <= coverage`` (the LoD GLB rule)."""
-    for index, threshold in enumerate(thresholds):
-        if coverage >= threshold:
-            return index
-    return len(thresholds) - 1
+    return int(_core.level_for_coverage(np.asarray(thresholds, dtype=np.float32), coverage))
 
 
 def frame_step(coverage: float, full_rate_coverage: float, max_step: int) -> int:
     """Frame skipping (Section 4.2.3): a face covering at least ``full_rate_coverage`` of the
     viewport height is animated every frame; smaller ones every ``floor(full / coverage)``
     frames, at most ``max_step`` (the step grows linearly with the view distance)."""
-    if coverage >= full_rate_coverage:
-        return 1
-    return int(min(max_step, max(1, math.floor(full_rate_coverage / max(coverage, 1e-12)))))
+    rate = _core.AnimationRateOptions(full_rate_coverage=full_rate_coverage, max_interval=max_step)
+    return int(_core.animation_update_interval(coverage, rate))
 
 
 def skipped_frames(frame_count: int, step: int) -> np.ndarray:

@@ -245,7 +245,7 @@ def build_level(
         raise ValueError(f"solver: expected one of {SOLVERS}, got {solver!r}")
     slsqp_options = slsqp_options or SlsqpOptions(hard_constraints=solver != "newton")
     if slsqp_options.hard_constraints and solver == "newton":
-        raise ValueError("hard constraints need an SLSQP solver (the Newton solver only minimises E)")
+        raise ValueError("solver: hard constraints need an SLSQP solver (the Newton solver only minimises E)")
     start = time.perf_counter()
     total = int(np.count_nonzero(~motion.skeleton.end_sites))
     frozen_joints = analysis.priority[: total - joint_count]

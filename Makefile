@@ -7,6 +7,7 @@
 #   make demo      the main job on the embedded procedural character, into out/demo
 #   make bench     benchmark tables (peers in the same run); heavy, not part of test
 #   make sanitize  C++ tests and pytest under ASan + UBSan
+#   make fuzz      every fuzz harness of tests/fuzz for FUZZ_SECONDS (default 60) each
 
 PYTHON ?= python3
 VENV := .venv
@@ -17,7 +18,7 @@ CPP_BUILD := build/cpp
 CMAKE_GENERATOR := Ninja
 JOBS ?= 2
 
-.PHONY: setup system-packages python-package lint cpp-test consumer-test test demo bench sanitize clean
+.PHONY: setup system-packages python-package lint cpp-test consumer-test test demo bench sanitize fuzz fuzz-build clean
 
 setup: python-package
 
@@ -87,6 +88,26 @@ sanitize: $(OPENMESH_CONFIG) $(VENV)/bin/pip
 	  -Ccmake.build-type=RelWithDebInfo -Ccmake.define.CMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)"
 	$(SANITIZE_ENV) LD_PRELOAD="$$(g++ -print-file-name=libasan.so) $$(g++ -print-file-name=libubsan.so)" \
 	  .venv-sanitize/bin/python -m pytest -q -p no:cacheprovider tests/python
+
+# Fuzzing (tests/fuzz/README.md): clang's libFuzzer for the C++ harnesses, atheris for the
+# readers. Its packages are installed here, not by `make test`, which replays saved crashes
+# with g++ and pytest alone. New crashes land in tests/fuzz/crashes/<harness>/.
+FUZZ_SECONDS ?= 60
+FUZZ_CXX ?= clang++-14
+FUZZ_PACKAGES := clang-14 libclang-rt-14-dev
+FUZZ_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+
+fuzz-build: $(OPENMESH_CONFIG)
+	@scripts/install_system_packages.sh $(FUZZ_PACKAGES)
+	@mkdir -p build
+	cmake -S . -B build/fuzz -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=$(FUZZ_CXX) \
+	  -DANIMLOD_BUILD_FUZZERS=ON -DANIMLOD_BUILD_TESTS=OFF -DANIMLOD_INSTALL=OFF \
+	  -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" > build/fuzz.configure.log
+	cmake --build build/fuzz --parallel $(JOBS)
+
+fuzz: EXTRAS := test,fuzz
+fuzz: python-package fuzz-build
+	FUZZ_SECONDS=$(FUZZ_SECONDS) $(PY) tests/fuzz/run.py $(FUZZ_ARGS)
 
 clean:
 	rm -rf build out

@@ -7,6 +7,7 @@ namespace animlod::bindings {
 void bind_skinning(py::module_& m);
 void bind_aqem(py::module_& m);
 void bind_motion_features(py::module_& m);
+void bind_tdag(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -14,4 +15,5 @@ PYBIND11_MODULE(_core, m) {
   animlod::bindings::bind_skinning(m);
   animlod::bindings::bind_aqem(m);
   animlod::bindings::bind_motion_features(m);
+  animlod::bindings::bind_tdag(m);
 }

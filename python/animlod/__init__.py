@@ -7,6 +7,7 @@ assets in :mod:`animlod.synth`. Heavy lifting is done by the C++ core, ``animlod
 from .aqem import motion_features, simplify_animated, simplify_skinned
 from .model import AnimatedMesh, LodChain, LodLevel, Motion, Skeleton, SkinnedMesh
 from .motion_lod import analyze_motion, build_motion_chain
+from .tdag import TemporalDag
 
 __version__ = "0.1.0"
 
@@ -17,6 +18,7 @@ __all__ = [
     "Motion",
     "Skeleton",
     "SkinnedMesh",
+    "TemporalDag",
     "__version__",
     "analyze_motion",
     "build_motion_chain",

@@ -58,3 +58,95 @@ def simplify_animated(
 ) -> dict[str, Any]:
     """AQEM over all frames, any topology: {"levels": [...], "collapses": {...}, "frames_used",
     "vertex_weights", "preparation"}."""
+
+# TDAG (cpp/bindings/bind_tdag.cpp)
+
+class TdagOptions:
+    """Options of build_temporal_dag (animlod/tdag.hpp, TdagOptions)."""
+
+    governing: str  # "first", "average", "frame", "aqem" or "online"
+    governing_frame: int
+    history_weight: float
+    affine_base: str  # "first" or "average"
+    boundary_quadrics: bool
+    check_inversion: bool
+    use_motion_features: bool
+    weld: bool
+    def __init__(self) -> None: ...
+
+class TemporalDag:
+    """A TDAG (animlod/tdag.hpp): immutable; copies share the data."""
+
+    frame_count: int
+    vertex_count: int
+    face_count: int
+    collapse_count: int
+    node_count: int
+    governing: str
+    affine_base: str
+    faces: npt.NDArray[np.int32]  # (M, 3)
+    input_points: npt.NDArray[np.int32]  # (input V,)
+    affine_maps: npt.NDArray[np.float64]  # (F, 3, 4)
+    children: npt.NDArray[np.int32]  # (C, 2)
+    representatives: npt.NDArray[np.int32]  # (V + C,)
+    stored_counts: dict[str, int]
+    def residuals(self, frame: int) -> npt.NDArray[np.float32]: ...
+    def frame_positions(self, frame: int) -> npt.NDArray[np.float32]: ...
+    def alive(self, collapse: int) -> list[tuple[int, int]]: ...
+    def alive_mask(self, frame: int) -> npt.NDArray[np.bool_]: ...
+    def dependencies(self, collapse: int, frame: int) -> list[int]: ...
+    def parent(self, node: int, frame: int) -> int: ...
+    def error_bounds(self, frame: int) -> npt.NDArray[np.float64]: ...
+    def to_bytes(self) -> bytes: ...
+    @staticmethod
+    def from_bytes(data: bytes) -> TemporalDag: ...
+
+def build_temporal_dag(
+    frames: npt.ArrayLike,
+    faces: npt.ArrayLike,
+    options: TdagOptions = ...,
+    progress: Callable[[int, int], None] | None = None,
+) -> tuple[TemporalDag, dict[str, Any]]:
+    """(TemporalDag, report: collapse_counts (F,), max_cost (C,), use_counts (C,), seconds_*)."""
+
+def affine_split(frames: npt.ArrayLike, base: str = "first") -> dict[str, Any]:
+    """Section 3: maps (F, 3, 4), residuals (F, V, 3), translation_only (F,)."""
+
+class TdagCut:
+    """A cut of a TDAG (animlod/tdag.hpp, TdagCut)."""
+
+    frame: int
+    tolerance: float
+    has_query: bool
+    active_vertex_count: int
+    active_face_count: int
+    error_bound: float
+    last_split_count: int
+    last_collapse_count: int
+    def __init__(self, dag: TemporalDag) -> None: ...
+    def copy(self) -> TdagCut: ...
+    def query(self, frame: int, tolerance: float) -> None: ...
+    def query_view(
+        self, frame: int, camera: Sequence[float], pixels: float = 1.0, focal_pixels: float = 1000.0
+    ) -> None: ...
+    def advance(self, frame: int) -> None: ...
+    def refine(self, tolerance: float) -> None: ...
+    def refine_view(self, camera: Sequence[float], pixels: float = 1.0, focal_pixels: float = 1000.0) -> None: ...
+    def approximate(self, frame: int, level: int = 3) -> dict[str, Any]: ...
+    def mesh(self) -> dict[str, Any]: ...
+    def input_vertex_map(self) -> npt.NDArray[np.int32]: ...
+
+class TdagPlayer:
+    """Double-buffered player (animlod/tdag_player.hpp)."""
+
+    frame: int
+    done: bool
+    def __init__(self, dag: TemporalDag) -> None: ...
+    def start(self, tolerance: float, first_frame: int = 0) -> None: ...
+    def next(self, level: int = 3) -> dict[str, Any]: ...
+    def next_available(self) -> tuple[dict[str, Any], int]: ...
+
+def play_temporal_dag(
+    dag: TemporalDag, tolerance: float, first_frame: int = 0, frame_count: int = -1, measure_error: bool = True
+) -> dict[str, Any]:
+    """Levels 1-3, a fresh query and the level-3 walk single- and double-buffered (PlayerReport)."""

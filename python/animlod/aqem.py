@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from .model import AnimatedMesh, Motion, SkinnedMesh
+from .model import AnimatedMesh, LodChain, LodLevel, Motion, SkinnedMesh
 
 DEFAULT_MIN_ANGLE_CHANGE = math.radians(1.0)
 DEFAULT_MAX_FEATURE_WEIGHT = 4.0
@@ -68,7 +68,7 @@ class SimplifiedLevel:
     face_sources : (M',) int32 input face of every face (its primitive or material).
     kept_vertices : (V',) int32 index in the input of every kept vertex, ascending.
     vertex_map : (V,) int32 input vertex -> kept vertex it merged into (-1 for vertices no face
-        references).
+        references, vertices of dropped faces only, and vertices of a piece that collapsed away).
     error : asset units, the largest collapse error so far (see ``CollapseRecord.error``).
     target_face_count : the face count asked for; ``mesh`` has at most that many if ``reached``.
     reached : False when ``max_error`` (or no legal collapse left) stopped the run first.
@@ -146,6 +146,13 @@ class SimplifyResult:
     frames_used: np.ndarray
     vertex_weights: np.ndarray
     preparation: Preparation
+
+    def lod_chain(self, original: AnimatedMesh, name: str = "") -> LodChain:
+        """The levels as a :class:`~animlod.model.LodChain`, ``original`` as level 0; each
+        level's error is its AQEM error (asset units, see ``SimplifiedLevel.error``)."""
+        levels = [LodLevel(original, None, [], 0.0)]
+        levels += [LodLevel(level.mesh, None, [], level.error, mesh_level=i) for i, level in enumerate(self.levels, 1)]
+        return LodChain(levels, name)
 
 
 @dataclass
@@ -322,6 +329,19 @@ def simplify_animated(
         guarded=guarded,
     )
     return _result(raw, mesh.fps)
+
+
+def skinned_lod_chain(
+    skinned: SkinnedMesh, motions: Sequence[Motion], levels: Sequence[SkinnedLevel], name: str = ""
+) -> LodChain:
+    """Levels of :func:`simplify_skinned` as a :class:`~animlod.model.LodChain`: ``skinned`` as
+    level 0, every level playing ``motions``; errors are the AQEM errors (asset units)."""
+    chain = [LodLevel(skinned, skinned.skeleton, list(motions), 0.0)]
+    chain += [
+        LodLevel(level.mesh, skinned.skeleton, list(motions), level.error, mesh_level=i)
+        for i, level in enumerate(levels, start=1)
+    ]
+    return LodChain(chain, name)
 
 
 def simplify_skinned(

@@ -32,11 +32,12 @@ class SurfaceError:
 
     @property
     def relative_hausdorff(self) -> np.ndarray:
-        return self.hausdorff / self.diagonal
+        return _relative(self.hausdorff, self.diagonal)
 
     @property
     def relative_rms(self) -> np.ndarray:
-        return self.rms / self.diagonal
+        return _relative(self.rms, self.diagonal)
+
 
     def summary(self) -> dict[str, float]:
         """Mean and max over frames of both errors, relative to the bounding-box diagonal."""
@@ -122,3 +123,10 @@ def surface_error(
         rms[frame] = np.sqrt(squared.mean())
         diagonal[frame] = np.linalg.norm(np.ptp(a, axis=0))
     return SurfaceError(hausdorff, rms, diagonal)
+
+
+def _relative(distance: np.ndarray, diagonal: np.ndarray) -> np.ndarray:
+    """``distance / diagonal`` per frame; where a frame has collapsed to one point (diagonal 0),
+    0 for no distance and inf otherwise, never NaN (with no numpy RuntimeWarning)."""
+    safe = np.where(diagonal > 0.0, diagonal, 1.0)
+    return np.where(diagonal > 0.0, distance / safe, np.where(distance == 0.0, 0.0, np.inf))

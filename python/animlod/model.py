@@ -26,8 +26,25 @@ def _check_finite(name: str, array: np.ndarray) -> None:
 
 
 def _check_faces(faces: np.ndarray, vertex_count: int) -> np.ndarray:
-    faces = np.ascontiguousarray(faces, dtype=np.int32)
-    _require(faces.ndim == 2 and faces.shape[1] == 3, f"faces: expected shape (M, 3), got {faces.shape}")
+    # Range and integrality are checked before the cast to int32, which would wrap 2**32 + 2 to 2
+    # and truncate 1.9 to 1 silently.
+    given = np.asarray(faces)
+    _require(given.ndim == 2 and given.shape[1] == 3, f"faces: expected shape (M, 3), got {given.shape}")
+    if given.size and given.dtype != np.int32:
+        _require(
+            given.dtype.kind in "iuf" or given.dtype == np.bool_,
+            f"faces: expected integer indices, got dtype {given.dtype}",
+        )
+        wide = given.astype(np.float64) if given.dtype.kind == "f" else given
+        bad = ~np.isfinite(wide) | (wide != np.round(wide)) if given.dtype.kind == "f" else np.zeros(given.shape, bool)
+        if bad.any():
+            row = int(np.argmax(bad.any(axis=1)))
+            raise ValueError(f"faces: face {row} {given[row].tolist()} has an index that is not a whole number")
+        outside = (wide < 0) | (wide >= vertex_count)
+        if outside.any():
+            row = int(np.argmax(outside.any(axis=1)))
+            raise ValueError(f"faces: face {row} {given[row].tolist()} has an index outside [0, {vertex_count})")
+    faces = np.ascontiguousarray(given, dtype=np.int32)
     if faces.size and (faces.min() < 0 or faces.max() >= vertex_count):
         row = int(np.argmax(np.any((faces < 0) | (faces >= vertex_count), axis=1)))
         raise ValueError(f"faces: face {row} {faces[row].tolist()} has an index outside [0, {vertex_count})")
@@ -372,10 +389,19 @@ def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.
 
 @dataclass
 class LodLevel:
-    """One level of a chain: what is drawn and its error in asset units.
+    """One level of a chain: what is drawn, how it moves, and its error in asset units.
 
-    ``screen_coverage`` is the MSFT_screencoverage hint of a glTF chain, or None where the
-    level is chosen from its error alone (:meth:`LodChain.level_for`).
+    Attributes
+    ----------
+    mesh : the level's geometry (a skinned mesh, a deforming or static mesh), or None for a
+        motion-only level.
+    skeleton : the skeleton the level animates (fewer joints at motion levels), or None.
+    motions : the level's clips on ``skeleton``.
+    error : asset units; what the level gets wrong against level 0 (the max-over-frames
+        surface distance for geometry, the largest joint error for motion).
+    screen_coverage : the MSFT_screencoverage where the level starts to be used (fraction of the
+        viewport height the object covers), or None where the level is chosen from its error.
+    mesh_level, motion_level : the geometry and motion levels this level combines.
     """
 
     mesh: AnimatedMesh | SkinnedMesh | None
@@ -383,13 +409,20 @@ class LodLevel:
     motions: list[Motion]
     error: float
     screen_coverage: float | None = None
+    mesh_level: int = 0
+    motion_level: int = 0
 
 
 @dataclass
 class LodChain:
-    """Levels from finest (index 0) to coarsest."""
+    """Levels from finest (index 0) to coarsest: what every technique returns or converts to,
+    what the LoD GLB holds (:func:`animlod.io.read_lod_chains`), what runtimes consume.
+
+    ``name`` names what the chain draws (the glTF node, or the technique's input).
+    """
 
     levels: list[LodLevel] = field(default_factory=list)
+    name: str = ""
 
     def level_for(self, screen_error_budget: float, distance: float, focal_length_px: float) -> int:
         """Coarsest level whose error, projected to pixels at ``distance``, is within the budget.

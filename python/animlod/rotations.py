@@ -16,7 +16,7 @@ def normalize(q: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=np.float64)
     norm = np.linalg.norm(q, axis=-1, keepdims=True)
     if np.any(norm == 0.0) or not np.all(np.isfinite(norm)):
-        raise ValueError("quaternion with zero or non-finite norm")
+        raise ValueError("quaternion: zero or non-finite norm")
     return q / norm
 
 
@@ -122,7 +122,7 @@ def from_euler(angles: np.ndarray, order: str) -> np.ndarray:
     angles = np.asarray(angles, dtype=np.float64)
     order = order.upper()
     if len(order) != 3 or set(order) - set(_AXIS_INDEX):
-        raise ValueError(f"Euler order must be three of X, Y, Z, got {order!r}")
+        raise ValueError(f"Euler order: must be three of X, Y, Z, got {order!r}")
     q = identity(angles.shape[:-1])
     for k, axis_name in enumerate(order):
         axis = np.zeros(3)
@@ -139,7 +139,7 @@ def to_euler(q: np.ndarray, order: str) -> np.ndarray:
     order = order.upper()
     i, j, k = (_AXIS_INDEX[a] for a in order)
     if len({i, j, k}) != 3:
-        raise ValueError(f"only Tait-Bryan orders (three different axes) are supported, got {order!r}")
+        raise ValueError(f"Euler order: only Tait-Bryan orders (three different axes) are supported, got {order!r}")
     m = to_matrix(q)
     # For R = R_i(a) R_j(b) R_k(c): m[i, k] = sign * sin(b), with sign +1 for cyclic (i, j, k).
     sign = 1.0 if (j - i) % 3 == 1 else -1.0

@@ -42,7 +42,13 @@ def test_info_real_files(data_dir, capsys):
     assert "joints: 31 (+7 end sites)" in capsys.readouterr().out
     assert main(["info", str(data_dir / "gltf" / "Soldier.glb")]) == 0
     out = capsys.readouterr().out
-    assert out.count("skinned mesh") == 2 and "'Walk'" in out
+    assert out.count(" with skin ") == 2 and "'Walk'" in out and "2 materials, 2 textures" in out
+    assert main(["info", str(data_dir / "gltf" / "Xbot.glb")]) == 0
+    out = capsys.readouterr().out
+    assert "'Mesh' with skin 0" in out and "'Mesh.001' with skin 0" in out and "Beta_Joints_MAT" in out
+    # a folder holding one model file describes that file
+    assert main(["info", str(data_dir / "meshseq" / "Flamingo-morph-glTF")]) == 0
+    assert "14 morph targets" in capsys.readouterr().out
     assert main(["info", str(data_dir / "meshseq" / "crane")]) == 0
     assert "vertices: 10002, triangles: 20000" in capsys.readouterr().out
 
@@ -64,32 +70,23 @@ def test_user_mistakes_exit_2_with_one_line(tmp_path, capsys, name, content, mes
     assert message in err and err.count("\n") == 1 and "Traceback" not in err
 
 
-def test_demo_writes_every_level_with_manifests(tmp_path, capsys):
-    import json
-
-    from animlod.io.bvh import read_bvh
+def test_demo_writes_the_character_and_its_lod_glb(tmp_path, capsys):
+    from animlod.io import read_lod_chains
     from animlod.io.gltf import read_skinned
 
     assert main(["demo", "-o", str(tmp_path)]) == 0
     skinned, motions = read_skinned(tmp_path / "character.glb")
     assert skinned.skeleton.joint_count >= 30
     assert [m.name for m in motions] == ["walk", "run", "jump"]
-
-    mesh_manifest = json.loads((tmp_path / "character_mesh_lod.json").read_text())
-    faces = [level["faces"] for level in mesh_manifest["levels"]]
+    (chain,) = read_lod_chains(tmp_path / "character_lod.glb")
+    faces = [level.mesh.face_count for level in chain.levels]
     assert faces[0] == skinned.face_count and faces == sorted(faces, reverse=True) and len(faces) == 4
-    errors = [level["error"] for level in mesh_manifest["levels"]]
+    joints = [level.skeleton.joint_count for level in chain.levels]
+    assert joints == sorted(joints, reverse=True) and joints[-1] < joints[0]
+    errors = [level.error for level in chain.levels]
     assert errors[0] == 0.0 and errors == sorted(errors)
-    for level in mesh_manifest["levels"][1:]:
-        coarse, _ = read_skinned(tmp_path / level["file"])
-        assert coarse.face_count == level["faces"]
-
-    motion_manifest = json.loads((tmp_path / "walk_motion_lod.json").read_text())
-    joints = [level["joints"] for level in motion_manifest["levels"]]
-    assert joints == sorted(joints, reverse=True) and len(joints) == 4
-    coarsest = read_bvh(tmp_path / motion_manifest["levels"][-1]["files"][0])
-    assert coarsest.skeleton.joint_count - int(coarsest.skeleton.end_sites.sum()) == joints[-1]
-    assert (tmp_path / "summary.txt").read_text().startswith("character:")
+    assert all(len(level.motions) == 3 for level in chain.levels)
+    assert (tmp_path / "summary.txt").read_text().startswith("character.glb:")
 
 
 @pytest.mark.parametrize(

@@ -7,7 +7,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from animlod.io import FormatError, read_mesh, read_obj, read_ply, read_sequence, write_obj, write_ply, write_sequence
+from animlod.io import (
+    FormatError,
+    read_mesh,
+    read_obj,
+    read_ply,
+    read_sequence,
+    write_mesh,
+    write_obj,
+    write_ply,
+    write_sequence,
+)
 from animlod.model import AnimatedMesh
 
 # A unit square (quad) and a triangle on top, written with CRLF, comments, texture/normal
@@ -99,8 +109,8 @@ def test_sequence_round_trip_is_exact(tmp_path: Path, fmt: str) -> None:
 def test_folder_and_glob_use_natural_order_and_lists_keep_theirs(tmp_path: Path) -> None:
     mesh = _moving_mesh(frame_count=3)
     for name, vertices in zip(["f10.obj", "f2.obj", "f1.obj"], mesh.frames[::-1]):
-        write_sequence(tmp_path, AnimatedMesh(mesh.faces, vertices[None]), stem=name[:-4])
-    # write_sequence appended _0000; frames are f1 = frame 0, f2 = frame 1, f10 = frame 2.
+        write_mesh(tmp_path / f"{name[:-4]}_0000.obj", vertices, mesh.faces)
+    # Frames are f1 = frame 0, f2 = frame 1, f10 = frame 2.
     np.testing.assert_array_equal(read_sequence(tmp_path).frames, mesh.frames)
     np.testing.assert_array_equal(read_sequence(str(tmp_path / "f*_0000.obj")).frames, mesh.frames)
     listed = [tmp_path / "f10_0000.obj", tmp_path / "f1_0000.obj"]

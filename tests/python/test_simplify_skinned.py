@@ -65,3 +65,17 @@ def test_bending_cylinder_level_follows_the_bend_after_reskinning():
     level = simplify_skinned(skinned, [motion], (0.2,))[0]
     error = surface_error(skinned.bake(motion), level.mesh.bake(motion), samples=2000)
     assert error.summary()["hausdorff_max"] < 0.02
+
+
+def test_levels_convert_to_the_one_chain_type():
+    from animlod.aqem import simplify_animated, skinned_lod_chain
+
+    character = synth.humanoid()
+    walk = synth.humanoid_motion(character.skeleton, "walk")
+    levels = simplify_skinned(character, [walk], (0.5, 0.25))
+    chain = skinned_lod_chain(character, [walk], levels, "humanoid")
+    assert [level.mesh.face_count for level in chain.levels] == [3664, 1832, 916]
+    assert [level.mesh_level for level in chain.levels] == [0, 1, 2] and chain.levels[0].error == 0.0
+    baked = character.bake(walk)
+    animated = simplify_animated(baked, (0.5,)).lod_chain(baked)
+    assert animated.levels[0].mesh is baked and animated.levels[1].error > 0.0

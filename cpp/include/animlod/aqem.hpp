@@ -113,7 +113,9 @@ struct AqemLevel {
   std::vector<int32_t> face_sources; // (M',) input face each face comes from (its primitive)
   std::vector<int32_t> kept_vertices;  // (V',) original index of each kept vertex, ascending
   std::vector<int32_t> vertex_map;   // (V,) original vertex -> index of the kept vertex it merged
-                                     //      into, -1 for vertices no face references
+                                     //      into; -1 for vertices no face references, vertices of
+                                     //      dropped faces only, and vertices of a piece that
+                                     //      collapsed away entirely (a lone triangle)
   std::vector<float> positions;      // (F, V', 3) positions of the kept vertices in every frame
   std::vector<float> attributes;     // (V', A)
   std::vector<int32_t> skin_joints;  // (V', K)

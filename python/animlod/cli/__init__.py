@@ -1,27 +1,68 @@
 """The ``animlod`` command line: argparse subcommands, one module each in this package.
 
 Every subcommand module has ``register(subparsers)`` which adds its parser and sets
-``run=function(args) -> int``. A user mistake (bad file, bad value) exits with code 2 and
-one line on stderr, never a traceback (set ANIMLOD_DEBUG=1 to see it).
+``run=function(args) -> int``.
+
+The error contract: a user mistake (bad file, bad value, unwritable output) exits with code 2
+and exactly one line on stderr, ``animlod CMD: error: WHERE: WHAT``, where WHERE names the file
+(input or output) and the element; nothing is written to stderr before it (progress bars and
+numpy warnings of the failed run are withheld, see :class:`_HeldStderr`), and there is no
+traceback (set ANIMLOD_DEBUG=1 to see it).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import io
 import os
+import signal
 import sys
+import threading
+import warnings
+from collections.abc import Iterator
+
+from ..io.errors import error_line
 
 # Subcommand modules in the order --help lists them.
-COMMAND_MODULES = ("info", "demo", "simplify", "motion")
+COMMAND_MODULES = ("info", "demo", "simplify", "character", "motion", "tdag")
 
 
 class UserError(Exception):
-    """A mistake in what the user asked for; printed as one line, exit code 2."""
+    """A mistake in what the user asked for; printed as one line, exit code 2.
+
+    The message is ``WHERE: WHAT``, WHERE being an option (``--ratio``) or a file.
+    """
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the one-line error contract: no usage block before the error line."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        if message.startswith("argument "):  # "argument --ratio: invalid float value: 'x'"
+            message = message[len("argument ") :]
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def non_negative_int(text: str) -> int:
+    """argparse type: a whole number >= 0 (``--max-frames -3`` is refused by argparse)."""
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """argparse type: a whole number >= 1."""
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
+    return value
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="animlod",
         description="Level of detail for animated content: meshes, skinned characters, motion and faces.",
     )
@@ -31,21 +72,117 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _HeldStderr(io.TextIOBase):
+    """Stands in for sys.stderr while a command runs, so that a failed run prints its error line
+    and nothing before it.
+
+    On a terminal, writes pass through (progress bars stay live) and a line left unfinished by
+    a progress bar is cleared before the error line. Elsewhere (a pipe, a log, a test), writes
+    are held and replayed only when the command succeeds.
+    """
+
+    def __init__(self, stream) -> None:
+        super().__init__()
+        self.stream = stream
+        self.live = bool(getattr(stream, "isatty", lambda: False)())
+        self.held: list[str] = []
+        self.partial_line = False
+
+    def write(self, text: str) -> int:
+        if self.live:
+            self.stream.write(text)
+            if text:
+                self.partial_line = not text.endswith("\n")
+        else:
+            self.held.append(text)
+        return len(text)
+
+    def flush(self) -> None:
+        if self.live:
+            self.stream.flush()
+
+    def isatty(self) -> bool:
+        return self.live
+
+    def release(self, failed: bool) -> None:
+        """Replay what was held (success), or drop it and clear a live partial line (failure)."""
+        if failed:
+            if self.live and self.partial_line:
+                self.stream.write("\r\x1b[2K")
+        else:
+            self.stream.write("".join(self.held))
+        self.held = []
+
+
+@contextlib.contextmanager
+def _guarded_stderr(command: str) -> Iterator[_HeldStderr]:
+    """Hold stderr and warnings for the run; warnings of a successful run are printed after it,
+    one line each (``animlod CMD: warning: ...``), those of a failed run are dropped."""
+    original = sys.stderr
+    held = _HeldStderr(original)
+    sys.stderr = held
+    failed = True
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("default")
+            yield held
+            failed = False
+    finally:
+        sys.stderr = original
+        held.release(failed)
+        if not failed:
+            for warning in caught:
+                print(f"animlod {command}: warning: {' '.join(str(warning.message).split())}", file=original)
+
+
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that every write in progress removes its temporary."""
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise _Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_unwinds() -> Iterator[None]:
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
     try:
-        return int(args.run(args) or 0)
-    except (UserError, ValueError, OSError) as error:
-        # Readers, validators and the core report bad input as ValueError; ANIMLOD_DEBUG=1 shows
-        # the traceback behind the one line, for telling a bug from a user mistake.
-        if os.environ.get("ANIMLOD_DEBUG"):
-            raise
-        print(f"animlod {args.command}: error: {error}", file=sys.stderr)
+        args = parser.parse_args(argv)
+    except SystemExit as stop:  # --help (0), or the one-line usage error of _Parser (2)
+        return int(stop.code or 0)
+    source = getattr(args, "input", None) or getattr(args, "path", None)
+    if os.environ.get("ANIMLOD_DEBUG"):
+        return int(args.run(args) or 0)  # tracebacks and live output, for telling a bug from a mistake
+    try:
+        with _sigterm_unwinds(), _guarded_stderr(args.command):
+            return int(args.run(args) or 0)
+    except UserError as error:
+        print(f"animlod {args.command}: error: {' '.join(str(error).split())}", file=sys.stderr)
+        return 2
+    except (ValueError, OSError, MemoryError) as error:
+        # Readers, validators and the core report bad input as ValueError (FormatError names the
+        # file); the data model and the core name only the element, so the input is added.
+        if isinstance(error, MemoryError):
+            error = ValueError(f"not enough memory ({error or 'allocation failed'})")
+        print(f"animlod {args.command}: error: {error_line(error, source)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"animlod {args.command}: interrupted", file=sys.stderr)
         return 130
+    except _Terminated:
+        print(f"animlod {args.command}: terminated", file=sys.stderr)
+        return 143
 
 
 if __name__ == "__main__":

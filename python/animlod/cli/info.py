@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 
 from ..io.detect import input_kind
-from ..model import AnimatedMesh, Motion, SkinnedMesh
+from ..model import AnimatedMesh, Motion
+
+_MODEL_SUFFIXES = (".glb", ".gltf", ".bvh", ".npz")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -21,11 +24,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    kind = input_kind(args.path)
-    print(f"{args.path}: {kind}")
-    for line in _describe(kind, args.path):
+    path = _single_model(args.path)
+    kind = input_kind(path)
+    print(f"{path}: {kind}")
+    for line in _describe(kind, path):
         print(f"  {line}")
     return 0
+
+
+def _single_model(path: str) -> str:
+    """A folder holding exactly one model file (glTF, BVH or NPZ) stands for that file."""
+    folder = Path(path)
+    if not folder.is_dir():
+        return path
+    models = [p for p in sorted(folder.iterdir()) if p.suffix.lower() in _MODEL_SUFFIXES]
+    return str(models[0]) if len(models) == 1 else path
 
 
 def _describe(kind: str, path: str) -> list[str]:
@@ -41,22 +54,66 @@ def _describe(kind: str, path: str) -> list[str]:
         from ..io.meshseq import read_sequence
 
         return _animated_lines(read_sequence(path))
-    from ..io.gltf import read_gltf
+    return _document_lines(path)
 
-    scene = read_gltf(path)
-    lines: list[str] = []
-    for index, skinned in enumerate(scene.skinned_meshes):
-        lines.append(f"skinned mesh {index}:")
-        lines += [f"  {line}" for line in _skinned_lines(skinned)]
-    for index, motion in enumerate(scene.motions):
-        lines.append(f"animation {index} {motion.name!r}:")
-        lines += [f"  {line}" for line in _motion_lines(motion)]
-    for index, mesh in enumerate(scene.morph_animations):
-        lines.append(f"morph animation {index}:")
-        lines += [f"  {line}" for line in _animated_lines(mesh)]
-    for index, mesh in enumerate(scene.static_meshes):
-        lines.append(f"static mesh {index}: {mesh.vertex_count} vertices, {mesh.face_count} triangles")
-    return lines or ["no meshes, skins or animations"]
+
+def _document_lines(path: str) -> list[str]:
+    """Every drawn (mesh, skin) pair with its primitives, every animation, and LoD chains."""
+    from ..io.gltf_document import GltfDocument
+    from ..io.gltf_drawable import read_drawables
+
+    doc = GltfDocument(path)
+    drawables = read_drawables(doc)
+    lines = [
+        f"{len(doc.json.get('nodes', []))} nodes, {len(doc.json.get('meshes', []))} meshes, "
+        f"{len(doc.json.get('materials', []))} materials, {len(doc.json.get('textures', []))} textures, "
+        f"{len(doc.json.get('skins', []))} skins, {len(doc.json.get('animations', []))} animations"
+    ]
+    materials = doc.json.get("materials", [])
+    for drawable in drawables:
+        geometry = drawable.geometry
+        lines.append(
+            f"{drawable.label}, drawn by nodes {drawable.nodes}: {len(geometry.positions)} vertices, "
+            f"{len(geometry.faces)} triangles, {len(drawable.clips)} clips"
+        )
+        for primitive in geometry.primitives:
+            source = doc.json["meshes"][drawable.mesh_index]["primitives"][primitive.index]
+            material = source.get("material")
+            name = materials[material].get("name", "") if material is not None and material < len(materials) else ""
+            lines.append(
+                f"  primitive {primitive.index}: {primitive.vertex_count} vertices, {len(primitive.faces)} triangles, "
+                f"{', '.join(primitive.attributes)}"
+                + (f", {len(primitive.targets)} morph targets" if primitive.targets else "")
+                + ("" if material is None else f", material {material} {name!r}")
+            )
+        if geometry.other_primitives:
+            lines.append(f"  primitives {geometry.other_primitives}: points or lines")
+        if drawable.skinned is not None:
+            skeleton = drawable.skinned.skeleton
+            lines.append(
+                f"  skin: {skeleton.joint_count} joints, {drawable.skinned.joints.shape[1]} influences per vertex"
+            )
+            if drawable.renormalised_weights:
+                lines.append(
+                    f"  skin weights of {drawable.renormalised_weights} vertices did not sum to 1 (normalised)"
+                )
+    for index, animation in enumerate(doc.gltf.animations or []):
+        frames = doc.animation_frame_times(index, 30.0)
+        extras = animation.extras.get("animlod") if isinstance(animation.extras, dict) else None
+        level = (
+            f", motion level {extras['motion_level']}" if isinstance(extras, dict) and "motion_level" in extras else ""
+        )
+        lines.append(
+            f"{doc.animation_label(index)}: {len(animation.channels or [])} channels, {frames[-1]:.2f} s{level}"
+        )
+    for index, node in enumerate(doc.json.get("nodes", [])):
+        ids = node.get("extensions", {}).get("MSFT_lod", {}).get("ids")
+        if ids is not None:
+            coverage = (
+                (node.get("extras") or {}).get("MSFT_screencoverage") if isinstance(node.get("extras"), dict) else None
+            )
+            lines.append(f"LoD chain on {doc.node_label(index)}: levels at nodes {[index, *ids]}, coverage {coverage}")
+    return lines
 
 
 def _motion_lines(motion: Motion) -> list[str]:
@@ -71,14 +128,3 @@ def _motion_lines(motion: Motion) -> list[str]:
 def _animated_lines(mesh: AnimatedMesh) -> list[str]:
     fps = f" at {mesh.fps:g} fps" if mesh.fps else ""
     return [f"vertices: {mesh.vertex_count}, triangles: {mesh.face_count}", f"frames: {mesh.frame_count}{fps}"]
-
-
-def _skinned_lines(skinned: SkinnedMesh) -> list[str]:
-    lines = [
-        f"vertices: {skinned.vertex_count}, triangles: {skinned.face_count}",
-        f"skin: {skinned.skeleton.joint_count} joints, {skinned.joints.shape[1]} influences per vertex",
-        f"uvs: {'yes' if skinned.uvs is not None else 'no'}, normals: {'yes' if skinned.normals is not None else 'no'}",
-    ]
-    if skinned.morph_targets is not None:
-        lines.append(f"morph targets: {len(skinned.morph_targets)}")
-    return lines

@@ -4,42 +4,57 @@ from __future__ import annotations
 
 import argparse
 import math
-import time
 from pathlib import Path
 
 import numpy as np
 
 from ..io.detect import input_kind, input_stem
 from ..model import AnimatedMesh
-from . import UserError
+from . import UserError, non_negative_int
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "simplify",
-        help="simplify a deforming or skinned mesh over all its frames (AQEM)",
+        help="simplify a glTF scene or a deforming mesh over all its frames (AQEM)",
         description=(
-            "Build levels of detail of an animated mesh with the animated quadric error metric and motion "
-            "features (Yang et al. 2019): one connectivity per level for all frames, every vertex placed "
-            "optimally in every frame. OBJ/PLY sequences are written as sequences, NPZ as NPZ, skinned glTF as "
-            "GLB with merged skin weights and the input's animations; morph-animated glTF as NPZ (baked frames)."
+            "Build levels of detail with the animated quadric error metric and motion features (Yang et al. 2019): "
+            "one connectivity per level for all frames. A glTF/GLB goes in whole and comes out as one LoD GLB: "
+            "every node, material, texture and animation kept, each drawn mesh's levels attached with MSFT_lod "
+            "and MSFT_screencoverage (--separate: one whole GLB per level instead). Any topology is accepted: "
+            "seams are welded and kept, non-manifold spots cut and kept in place. OBJ/PLY sequences are written "
+            "as sequences and NPZ as NPZ, one per level."
         ),
     )
-    parser.add_argument("input", help="a folder, glob or file of OBJ/PLY frames, an .npz, or a .glb/.gltf")
-    parser.add_argument("-o", "--output", required=True, help="folder to write the levels into (created if missing)")
+    parser.add_argument("input", help="a .glb/.gltf, an .npz, or a folder, glob or file of OBJ/PLY frames")
+    parser.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="glTF input: the LoD .glb to write, or a folder for <name>_lod.glb (with --separate: the folder "
+        "for the level files); sequences and NPZ: the folder for the levels",
+    )
     parser.add_argument("--ratio", type=float, nargs="+", default=[0.5, 0.25, 0.1], help="face ratios of the levels")
     parser.add_argument(
         "--max-error", type=float, default=math.inf, help="stop when the error exceeds this (asset units)"
     )
     parser.add_argument("--no-features", action="store_true", help="ignore motion features (all vertex weights 1)")
-    parser.add_argument("--max-frames", type=int, default=0, help="quadrics over K frames chosen to cover the motion")
+    parser.add_argument(
+        "--max-frames",
+        type=non_negative_int,
+        default=0,
+        help="sequences: quadrics over K frames chosen to cover the motion; glTF: the most frames of all clips "
+        "that drive the simplification (default 48)",
+    )
     parser.add_argument(
         "--placement",
         choices=("optimal", "on_edge"),
         default=None,
-        help="optimal: Eq. 5 per frame (default for sequences); on_edge: one point of the edge (default for skins)",
+        help="optimal: Eq. 5 per frame (default for sequences and static meshes); on_edge: one point of the "
+        "edge (default for skinned and morphed meshes)",
     )
-    parser.add_argument("--no-metrics", action="store_true", help="skip the Hausdorff/RMS measurement")
+    parser.add_argument("--separate", action="store_true", help="glTF: one whole GLB per level instead of one LoD GLB")
+    parser.add_argument("--no-metrics", action="store_true", help="sequences: skip the Hausdorff/RMS measurement")
     parser.add_argument(
         "--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side"
     )
@@ -52,111 +67,103 @@ def run(args: argparse.Namespace) -> int:
     kind = input_kind(args.input)
     if kind == "bvh":
         raise UserError(f"{args.input}: a BVH file holds motion only; simplify needs a mesh")
-    output = Path(args.output)
-    output.mkdir(parents=True, exist_ok=True)
-    options = {"max_error": args.max_error, "use_motion_features": not args.no_features, "max_frames": args.max_frames}
+    options = {"max_error": args.max_error, "use_motion_features": not args.no_features}
     if args.placement:
         options["placement"] = args.placement
-    stem = input_stem(args.input)
-
     if kind == "gltf":
-        from ..io.gltf import read_gltf
+        return _simplify_document(args, options)
+    return _simplify_sequence(args, options)
 
-        scene = read_gltf(args.input)
-        if scene.skinned_meshes:
-            return _simplify_skinned(args, scene, output, stem, options)
-        if not scene.morph_animations:
-            raise UserError(f"{args.input}: no skinned or morph-animated mesh to simplify")
-        original = scene.morph_animations[0]
-    elif kind == "npz":
-        from ..io.npz import read_npz
 
-        original = read_npz(args.input)
-    else:
-        from ..io.meshseq import read_sequence
+def _simplify_document(args: argparse.Namespace, options: dict) -> int:
+    from ..pipelines import simplify_document
 
-        original = read_sequence(args.input)
+    output = Path(args.output)
+    if not args.separate and (output.is_dir() or output.suffix.lower() != ".glb"):
+        output = output / f"{input_stem(args.input)}_lod.glb"
+    frame_budget = {"frame_budget": args.max_frames} if args.max_frames else {}
+    report = simplify_document(
+        args.input, output, args.ratio, separate=args.separate, progress=print, **frame_budget, **options
+    )
+    print("errors: max over the rest pose and frames of every clip of the Hausdorff distance, relative to the")
+    print("bounding-box diagonal; coverage: the MSFT_screencoverage below which the next level takes over")
+    for drawable in report.drawables:
+        prep = drawable.preparation
+        print(
+            f"{drawable.label} (nodes {drawable.nodes}): {drawable.faces} triangles, {drawable.clips} clips; "
+            f"welded {prep.welded_vertices} vertices, {prep.seam_vertices} seam positions kept, "
+            f"{prep.split_vertices} cut at non-manifold spots, {prep.degenerate_faces + prep.duplicate_faces} "
+            f"degenerate or repeated faces dropped"
+            + (
+                f", {drawable.renormalised_weights} skin weight rows renormalised"
+                if drawable.renormalised_weights
+                else ""
+            )
+        )
+        rows = [("level", "faces", "target", "error", "coverage")]
+        rows += [
+            (level.level, level.faces, level.target_faces, f"{level.relative_error:.2e}", f"{level.coverage:.3g}")
+            for level in drawable.levels
+        ]
+        _print_rows(rows, indent="  ")
+        for note in drawable.notes:
+            print(f"  note: {note}")
+    for path in report.outputs:
+        print(f"wrote {path}")
+    print(f"{report.seconds:.2f} s")
+    if args.plot:
+        first = report.drawables[0]
+        folder = output.parent if not args.separate else output
+        _plot(folder / f"{input_stem(args.input)}_levels.png", first.rest_meshes[0], first.rest_meshes[1:], False)
+    return 0
 
-    from ..aqem import simplify_animated
 
-    start = time.perf_counter()
+def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
+    from ..pipelines.lod_sequence import simplify_sequence
+
     progress = _ProgressBar("AQEM")
     try:
-        result = simplify_animated(original, args.ratio, progress=progress, **options)
+        report = simplify_sequence(
+            args.input,
+            args.output,
+            args.ratio,
+            measure=not args.no_metrics,
+            progress=progress,
+            max_frames=args.max_frames,
+            **options,
+        )
     finally:
         progress.close()
-    elapsed = time.perf_counter() - start
-    rows = []
-    for index, level in enumerate(result.levels):
-        _write_animated(kind, args.input, output / f"{stem}_lod{index + 1}", level.mesh)
-        rows.append(_row(index + 1, level.mesh, level.error, original, args.no_metrics, elapsed))
-    _print_summary(original, rows)
-    if args.plot:
-        _plot(output / f"{stem}_levels.png", original, [level.mesh for level in result.levels], not args.no_features)
-    return 0
-
-
-def _simplify_skinned(args: argparse.Namespace, scene, output: Path, stem: str, options: dict) -> int:
-    """Levels of the first skinned mesh over all the scene's animations, written as GLB."""
-    from ..aqem import simplify_skinned
-    from ..io.gltf import write_glb
-
-    skinned, motions = scene.skinned_meshes[0], scene.motions
-    start = time.perf_counter()
-    levels = simplify_skinned(skinned, motions, args.ratio, **options)
-    elapsed = time.perf_counter() - start
-    original = skinned.bake(motions[0]) if motions else AnimatedMesh(skinned.faces, skinned.rest_positions[None])
-    # Measured after re-skinning with the merged weights, on the first animation (or the rest pose).
-    rows, reskinned = [], []
-    for index, level in enumerate(levels):
-        write_glb(output / f"{stem}_lod{index + 1}.glb", level.mesh, motions)
-        posed = (
-            level.mesh.bake(motions[0]) if motions else AnimatedMesh(level.mesh.faces, level.mesh.rest_positions[None])
-        )
-        reskinned.append(posed)
-        rows.append(_row(index + 1, posed, level.error, original, args.no_metrics, elapsed))
-    _print_summary(original, rows)
-    if args.plot:
-        _plot(output / f"{stem}_levels.png", original, reskinned, not args.no_features)
-    return 0
-
-
-def _write_animated(kind: str, source: str, target: Path, mesh: AnimatedMesh) -> None:
-    """Write a level in the input's format (NPZ for NPZ and morph-animated glTF)."""
-    if kind == "sequence":
-        from ..io.meshseq import write_sequence
-
-        files = sorted(Path(source).iterdir()) if Path(source).is_dir() else [Path(source)]
-        fmt = "ply" if any(path.suffix.lower() == ".ply" for path in files) else "obj"
-        target.mkdir(parents=True, exist_ok=True)
-        write_sequence(target, mesh, fmt)
-    else:
-        from ..io.npz import write_npz
-
-        write_npz(target.with_suffix(".npz"), mesh)
-
-
-def _row(
-    level: int, mesh: AnimatedMesh, error: float, original: AnimatedMesh, skip_metrics: bool, elapsed: float
-) -> tuple:
-    """One summary row; the surface error compares ``mesh`` with ``original`` frame by frame."""
-    hausdorff = rms = "-"
-    if not skip_metrics:
-        from ..metrics import surface_error
-
-        summary = surface_error(original, mesh, samples=10000).summary()
-        hausdorff = f"{summary['hausdorff_mean']:.2e} / {summary['hausdorff_max']:.2e}"
-        rms = f"{summary['rms_mean']:.2e} / {summary['rms_max']:.2e}"
-    return (level, mesh.face_count, f"{error:.3g}", hausdorff, rms, f"{elapsed:.2f}")
-
-
-def _print_summary(original: AnimatedMesh, rows: list[tuple]) -> None:
-    header = ("level", "faces", "AQEM error", "Hausdorff mean / max", "RMS mean / max", "time s")
-    table = [header, (0, original.face_count, "0", "-", "-", "-")] + rows
-    widths = [max(len(str(row[column])) for row in table) for column in range(len(header))]
     print("errors relative to the bounding-box diagonal, over frames; time is the whole simplification")
-    for row in table:
-        print("  ".join(str(value).rjust(width) for value, width in zip(row, widths)))
+    rows = [("level", "faces", "AQEM error", "Hausdorff mean / max", "RMS mean / max", "time s")]
+    rows.append((0, report.original.face_count, "0", "-", "-", "-"))
+    for index, level in enumerate(report.levels, start=1):
+        surface = level.surface
+        hausdorff = f"{surface['hausdorff_mean']:.2e} / {surface['hausdorff_max']:.2e}" if surface else "-"
+        rms = f"{surface['rms_mean']:.2e} / {surface['rms_max']:.2e}" if surface else "-"
+        rows.append((index, level.faces, f"{level.aqem_error:.3g}", hausdorff, rms, f"{report.seconds:.2f}"))
+    _print_rows(rows)
+    if args.plot:
+        levels = [_read_level(level.path) for level in report.levels]
+        features = not args.no_features
+        _plot(Path(args.output) / f"{input_stem(args.input)}_levels.png", report.original, levels, features)
+    return 0
+
+
+def _read_level(path: Path) -> AnimatedMesh:
+    if path.suffix == ".npz":
+        from ..io.npz import read_npz
+
+        return read_npz(path)
+    from ..io.meshseq import read_sequence
+
+    return read_sequence(path)
+
+
+def _print_rows(rows: list[tuple], indent: str = "") -> None:
+    widths = [max(len(str(row[column])) for row in rows) for column in range(len(rows[0]))]
+    for row in rows:
+        print(indent + "  ".join(str(value).rjust(width) for value, width in zip(row, widths)))
 
 
 class _ProgressBar:
@@ -194,14 +201,14 @@ def _plot(path: Path, original: AnimatedMesh, levels: list[AnimatedMesh], show_f
     if show_features:
         in_feature = motion_features(original).vertex_feature >= 0
         red = in_feature[original.faces].any(axis=1)
-    meshes = [(original, red, f"original, {original.face_count} faces (features red)")]
+    meshes = [(original, red, f"original, {original.face_count} faces" + (" (features red)" if show_features else ""))]
     meshes += [(mesh, np.zeros(mesh.face_count, bool), f"{mesh.face_count} faces") for mesh in levels]
     figure = plt.figure(figsize=(4 * len(meshes), 4.5))
     corners = original.frames[frame]
     low, high = corners.min(axis=0), corners.max(axis=0)
     for index, (mesh, highlight, title) in enumerate(meshes):
         axes = figure.add_subplot(1, len(meshes), index + 1, projection="3d")
-        triangles = mesh.frames[frame][mesh.faces]
+        triangles = mesh.frames[min(frame, mesh.frame_count - 1)][mesh.faces]
         colors = np.where(highlight[:, None], [0.85, 0.1, 0.1, 1.0], [0.75, 0.75, 0.8, 1.0])
         axes.add_collection3d(
             Poly3DCollection(triangles, facecolors=colors, edgecolors=(0, 0, 0, 0.15), linewidths=0.2)

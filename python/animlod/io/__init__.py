@@ -2,7 +2,7 @@
 
 from .bvh import read_bvh, write_bvh
 from .errors import FormatError
-from .gltf import GltfScene, read_gltf, read_skinned, write_glb
+from .gltf import GltfScene, read_gltf, read_lod_chains, read_skinned, write_glb
 from .meshseq import read_mesh, read_obj, read_ply, read_sequence, write_mesh, write_obj, write_ply, write_sequence
 from .npz import read_npz, write_npz
 
@@ -11,6 +11,7 @@ __all__ = [
     "GltfScene",
     "read_bvh",
     "read_gltf",
+    "read_lod_chains",
     "read_mesh",
     "read_npz",
     "read_obj",

@@ -1,14 +1,32 @@
-"""Write files under a temporary name and rename them into place, so that an interrupted or
-failed write never leaves a half-written file and never clobbers a good one."""
+"""Write files and folders under a temporary name and rename them into place, so that an
+interrupted or failed write never leaves a half-written file or folder under its final name
+and never clobbers a good one.
+
+Temporary names are hidden, beside the target, and carry the writer's process id:
+``.NAME.animlod-PID-TOKEN.part`` for a file, ``...partdir`` for a folder, ``...old`` for the
+folder being replaced. They are removed on every exit path the process controls (errors,
+KeyboardInterrupt, SystemExit; the CLI turns SIGTERM into SystemExit). A process killed outright
+(SIGKILL, power loss) leaves them behind; the next write into the same folder removes those
+whose process is gone (:func:`clean_stale`).
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
+import secrets
+import shutil
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO
+
+_TEMPORARY = re.compile(r"^\..+\.animlod-(\d+)-[a-z0-9_]+\.(part|partdir|old)$")
+
+
+def _prefix(target: Path) -> str:
+    return f".{target.name}.animlod-{os.getpid()}-"
 
 
 @contextlib.contextmanager
@@ -16,7 +34,8 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> It
     """Open a temporary file beside ``path``; on success rename it to ``path``, on error remove it."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
+    clean_stale(target.parent)
+    fd, temporary = tempfile.mkstemp(prefix=_prefix(target), suffix=".part", dir=target.parent)
     try:
         with os.fdopen(fd, mode, **open_kwargs) as handle:
             yield handle
@@ -27,6 +46,74 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> It
         with contextlib.suppress(FileNotFoundError):
             os.unlink(temporary)
         raise
+
+
+@contextlib.contextmanager
+def atomic_folder(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield an empty temporary folder beside ``path``; on success it becomes ``path``.
+
+    A multi-file output (the frames of a level) is written into the yielded folder and appears
+    under its final name only once complete. An existing folder at ``path`` is replaced as a
+    whole (so no stale frame of an earlier, longer run survives): it is renamed aside, the new
+    folder renamed into place, and the old one removed. A crash between the two renames leaves
+    no folder at ``path``, never a partial one. On error the temporary folder is removed.
+    """
+    target = Path(path)
+    if target.exists() and not target.is_dir():
+        raise FileExistsError(17, "File exists (expected a folder)", os.fspath(target))
+    target.parent.mkdir(parents=True, exist_ok=True)
+    clean_stale(target.parent)
+    temporary = Path(tempfile.mkdtemp(prefix=_prefix(target), suffix=".partdir", dir=target.parent))
+    try:
+        yield temporary
+        os.chmod(temporary, 0o777 & ~_current_umask())
+        old = None
+        if target.exists():
+            old = target.parent / f"{_prefix(target)}{secrets.token_hex(4)}.old"
+            os.rename(target, old)
+        os.rename(temporary, target)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(temporary, ignore_errors=True)
+        raise
+
+
+def clean_stale(folder: str | os.PathLike) -> list[Path]:
+    """Remove temporary files and folders left in ``folder`` by writers that no longer run.
+
+    Only names of this module's pattern are touched, and only when the process id in the name
+    is not alive on this machine. Returns what was removed.
+    """
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for entry in entries:
+        match = _TEMPORARY.match(entry.name)
+        if match is None or _alive(int(match.group(1))):
+            continue
+        path = Path(entry.path)
+        if entry.is_dir(follow_symlinks=False):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+        removed.append(path)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's live process
+        return True
+    return True
 
 
 def _current_umask() -> int:

@@ -40,6 +40,10 @@ _CHANNELS = {
     f"{axis.lower()}{kind}": (kind, index) for index, axis in enumerate("XYZ") for kind in ("position", "rotation")
 }
 _MOTION_LINE = re.compile(r"^[ \t]*MOTION\b", re.MULTILINE)
+# Largest magnitude of an OFFSET or channel value. Beyond it, squared distances in forward
+# kinematics and error measures overflow (an OFFSET of 1e300 gave infinite errors and exit 0);
+# 1e12 is a million kilometres in millimetres, or 10^12 degrees.
+MAX_VALUE = 1e12
 
 
 @dataclass
@@ -88,6 +92,8 @@ class _TokenCursor:
             raise self.error(line, f"{what}: {token!r} is not a number") from None
         if not np.isfinite(value):
             raise self.error(line, f"{what}: value {token} is not finite")
+        if abs(value) > MAX_VALUE:
+            raise self.error(line, f"{what}: value {token} is beyond +-{MAX_VALUE:g}")
         return value
 
     def rest_of_line(self, line: int) -> str:
@@ -284,6 +290,10 @@ def _parse_motion_table(
     if not finite.all():
         bad = int(np.argmin(finite.ravel()))
         raise value_error(bad, f"value {values.flat[bad]} is not finite")
+    huge = np.abs(values) > MAX_VALUE
+    if huge.any():
+        bad = int(np.argmax(huge.ravel()))
+        raise value_error(bad, f"value {values.flat[bad]:g} is beyond +-{MAX_VALUE:g}")
     return values
 
 
@@ -356,7 +366,7 @@ def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZX
     """
     order = rotation_order.upper()
     if len(order) != 3 or set(order) != set("XYZ"):
-        raise ValueError(f"rotation_order must be a permutation of XYZ, got {rotation_order!r}")
+        raise ValueError(f"{os.fspath(path)}: rotation_order: must be a permutation of XYZ, got {rotation_order!r}")
     skeleton = motion.skeleton
     translations = motion.local_translations()
     has_position = np.zeros(skeleton.joint_count, dtype=bool)
@@ -365,7 +375,8 @@ def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZX
     animated_end_sites = np.nonzero(has_position & skeleton.end_sites)[0]
     if animated_end_sites.size:
         name = skeleton.names[animated_end_sites[0]]
-        raise ValueError(f"joint {name!r} is an end site with animated translation; BVH cannot store it")
+        reason = "is an end site with animated translation; BVH cannot store it"
+        raise ValueError(f"{os.fspath(path)}: joint {name!r}: {reason}")
     rotated = ~skeleton.end_sites
     angles = np.degrees(rotations.to_euler(motion.local_rotations[:, rotated], order))
     angle_of_joint = np.cumsum(rotated) - 1

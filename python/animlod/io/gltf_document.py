@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import base64
 import dataclasses
-import json
 import os
 import struct
 import warnings
@@ -24,6 +23,7 @@ import pygltflib
 from .. import rotations
 from .errors import FormatError
 from .gltf_keyframes import INTERPOLATIONS, frame_times
+from .json_limits import load_json
 
 _GLB_MAGIC = b"glTF"
 _GLB_HEADER_BYTES = 12
@@ -50,9 +50,20 @@ _SPARSE_INDEX_COMPONENTS = (5121, 5123, 5125)
 # bufferView.byteStride is a multiple of 4 no larger than 252 (glTF 2.0 section 3.6.2.4).
 _MAX_BYTE_STRIDE = 252
 _MAX_ACCESSOR_COUNT = 2**32 - 1
-# Most frames an animation is sampled to: 10^6 is 4.6 hours at 60 fps. Later key times are taken
-# as corrupt rather than allocated.
-MAX_ANIMATION_FRAMES = 1_000_000
+# An accessor without a bufferView is zeros (plus sparse values); it may take at most this many
+# times the bytes of the file and its buffers (+1 MiB).
+_ZERO_FILL_FACTOR = 16
+# Most frames an animation is sampled to by default: 100,000 is 55 minutes at 30 fps. A file whose
+# keys run longer is refused (naming the animation and its duration) rather than sampled: a
+# few kilobytes with a key at 30,000 s would otherwise become 900,001 frames. Raise it per
+# document (GltfDocument(max_animation_frames=...)) or with ANIMLOD_MAX_ANIMATION_FRAMES.
+MAX_ANIMATION_FRAMES = 100_000
+# Top-level glTF properties that are arrays of objects (glTF 2.0 section 5.17).
+_TOP_LEVEL_ARRAYS = (
+    "accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials", "meshes", "nodes",
+    "samplers", "scenes", "skins", "textures", "extensionsUsed", "extensionsRequired",
+)  # fmt: skip
+_CHANNEL_PATHS = ("translation", "rotation", "scale", "weights")
 # Top-level arrays whose singular is not the name without its last letter.
 _IRREGULAR_SINGULARS = {"meshes": "mesh"}
 
@@ -73,12 +84,14 @@ class GltfDocument:
     parents : (N,) int, parent node of every node, -1 for nodes at the top of the tree.
     """
 
-    def __init__(self, path: str | os.PathLike) -> None:
+    def __init__(self, path: str | os.PathLike, max_animation_frames: int | None = None) -> None:
         self.path = os.fspath(path)
+        self.max_animation_frames = _frame_limit(max_animation_frames)
         self.gltf, self.json = _parse(self.path)
         self._buffers: dict[int, bytes] = {}
         self._accessors: dict[int, np.ndarray] = {}
         self.parents = self._node_parents()
+        self._check_scenes_and_channels()
 
     def fail(self, element: str, reason: str) -> FormatError:
         """The error to raise for ``element`` of this file."""
@@ -118,7 +131,14 @@ class GltfDocument:
         width = _TYPE_WIDTHS[accessor.type]
         dtype = _COMPONENT_DTYPES[component]
         if accessor.bufferView is None:
-            values = np.zeros((count, width), dtype)  # all zeros unless sparse says otherwise
+            # All zeros unless sparse says otherwise: nothing in the file backs the elements, so
+            # their number is bounded by what the file holds elsewhere (a sparse morph target is
+            # as long as its POSITION accessor, whose bytes are in a buffer).
+            limit = _ZERO_FILL_FACTOR * (self._file_bytes() + 2**20)
+            if count * width * dtype.itemsize > limit:
+                reason = f"count {count} without a bufferView needs {count * width * dtype.itemsize} bytes of zeros"
+                raise self.fail(element, f"{reason}, more than the file can justify ({limit})")
+            values = np.zeros((count, width), dtype)
         else:
             values = self._strided_elements(accessor, count, width, dtype, element)
         if accessor.sparse is not None:
@@ -197,6 +217,16 @@ class GltfDocument:
             raise self.fail(element, f"needs bytes up to {start + length}, buffer has {len(data)}")
         return np.frombuffer(data, dtype, count * width, start).reshape(count, width)
 
+    def _file_bytes(self) -> int:
+        """Size of the file and of the external buffer files it names: what bounds its accessors
+        (declared byteLengths are not trusted)."""
+        total = os.path.getsize(self.path)
+        for buffer in self.gltf.buffers or []:
+            if isinstance(buffer.uri, str) and not buffer.uri.startswith("data:"):
+                external = Path(self.path).parent / unquote(buffer.uri)
+                total += external.stat().st_size if external.is_file() else 0
+        return total
+
     def _whole_number(self, value: Any, name: str, element: str) -> int:
         """A byteOffset, byteLength or count of ``element``: 0 when absent, else a whole number >= 0."""
         if value is None:
@@ -252,6 +282,26 @@ class GltfDocument:
                 if seen > len(nodes):
                     raise self.fail(f"node {index}", "lies on a cycle of children")
         return parents
+
+    def _check_scenes_and_channels(self) -> None:
+        """The default scene, the scenes' root nodes and every animation channel's target refer to
+        things the file has (a channel on node 9999 or a scene past the list is an error)."""
+        gltf = self.gltf
+        if gltf.scene is not None:
+            self.item("scenes", gltf.scene, "scene")
+        for index, scene in enumerate(gltf.scenes or []):
+            for node in scene.nodes or []:
+                self.item("nodes", node, f"scene {index} nodes")
+        for a, animation in enumerate(gltf.animations or []):
+            for c, channel in enumerate(animation.channels or []):
+                element = f"animation {a} channel {c} target"
+                if channel.target is None:
+                    raise self.fail(f"animation {a} channel {c}", "has no target")
+                if channel.target.node is not None:
+                    self.item("nodes", channel.target.node, element)
+                if channel.target.path not in _CHANNEL_PATHS:
+                    reason = f"path {channel.target.path!r} is not one of {', '.join(_CHANNEL_PATHS)}"
+                    raise self.fail(element, reason)
 
     def node_label(self, index: int) -> str:
         """``node 5 'Hips'`` for messages."""
@@ -340,8 +390,11 @@ class GltfDocument:
         samplers = self.gltf.animations[index].samplers or []
         ends = [self.accessor(s.input, f"{label} sampler {k} input").max(initial=0.0) for k, s in enumerate(samplers)]
         duration = float(max(ends, default=0.0))
-        if duration * fps >= MAX_ANIMATION_FRAMES:
-            reason = f"lasts {duration:g} s, more than {MAX_ANIMATION_FRAMES} frames at {fps:g} fps"
+        if duration * fps >= self.max_animation_frames:
+            reason = (
+                f"lasts {duration:g} s: {int(duration * fps) + 1} frames at {fps:g} fps, more than the limit of "
+                f"{self.max_animation_frames} (ANIMLOD_MAX_ANIMATION_FRAMES raises it)"
+            )
             raise self.fail(label, reason)
         return frame_times(duration, fps)
 
@@ -383,22 +436,26 @@ def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
     except OSError as error:
         raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
     if data[:4] == _GLB_MAGIC:
-        _check_glb_header(path, data)
+        json_chunk = _check_glb_header(path, data)
         parse = pygltflib.GLTF2.load_from_bytes
         source: bytes | str = data
-        raw = _glb_json(path, data)
     else:
         try:
             source = data.decode("utf-8-sig")
-            raw = json.loads(source)
-        except (UnicodeDecodeError, json.JSONDecodeError):
+        except UnicodeDecodeError:
             raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor JSON") from None
+        json_chunk = data
+    # Parsed here first with bounded nesting (json.loads recurses per level) and checked for the
+    # shape pygltflib silently bends ("nodes": {} would become an empty list).
+    raw = load_json(path, json_chunk, "GLB JSON chunk" if data[:4] == _GLB_MAGIC else "JSON")
+    _check_top_level(path, raw)
+    if data[:4] != _GLB_MAGIC:
         parse = pygltflib.GLTF2.gltf_from_json
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # pygltflib warns about unknown chunks; we check what we use
             gltf = parse(source)
-    except (ValueError, KeyError, TypeError, AttributeError, struct.error, UnicodeDecodeError) as error:
+    except (ValueError, KeyError, TypeError, AttributeError, struct.error, UnicodeDecodeError, RecursionError) as error:
         raise FormatError(path, "JSON", f"not a valid glTF document ({type(error).__name__}: {error})") from None
     if gltf is None:
         raise FormatError(path, "GLB", "no JSON chunk")
@@ -434,21 +491,34 @@ def _first_null_entry(node: Any, where: str) -> str | None:
     return None
 
 
-def _glb_json(path: str, data: bytes) -> dict:
-    """The JSON chunk of a GLB whose header _check_glb_header accepted."""
-    length, kind = struct.unpack_from("<II", data, _GLB_HEADER_BYTES) if len(data) >= 20 else (0, 0)
-    if kind != _GLB_JSON_CHUNK:
-        raise FormatError(path, "GLB", "the first chunk is not JSON")
-    try:
-        raw = json.loads(data[20 : 20 + length].decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise FormatError(path, "GLB JSON chunk", f"not valid JSON ({error})") from None
-    if not isinstance(raw, dict):
-        raise FormatError(path, "GLB JSON chunk", "is not a JSON object")
-    return raw
+def _frame_limit(limit: int | None) -> int:
+    """The sampling limit: ``limit``, else ANIMLOD_MAX_ANIMATION_FRAMES, else MAX_ANIMATION_FRAMES."""
+    if limit is None:
+        text = os.environ.get("ANIMLOD_MAX_ANIMATION_FRAMES", "")
+        if not text:
+            return MAX_ANIMATION_FRAMES
+        if not text.isdigit() or int(text) < 1:
+            raise ValueError(f"ANIMLOD_MAX_ANIMATION_FRAMES: expected a whole number >= 1, got {text!r}")
+        return int(text)
+    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+        raise ValueError(f"max_animation_frames: expected a whole number >= 1, got {limit!r}")
+    return limit
 
 
-def _check_glb_header(path: str, data: bytes) -> None:
+def _check_top_level(path: str, document: Any) -> None:
+    """The JSON is an object whose arrays of objects are arrays, and whose scene is an index."""
+    if not isinstance(document, dict):
+        raise FormatError(path, "JSON", f"the document is a {type(document).__name__}, not an object")
+    for key in _TOP_LEVEL_ARRAYS:
+        if key in document and not isinstance(document[key], list):
+            raise FormatError(path, key, f"must be an array, got {type(document[key]).__name__}")
+    scene = document.get("scene")
+    if scene is not None and (isinstance(scene, bool) or not isinstance(scene, int)):
+        raise FormatError(path, "scene", f"must be an index, got {scene!r}")
+
+
+def _check_glb_header(path: str, data: bytes) -> bytes:
+    """Check the GLB header and chunk table; return the bytes of the first (JSON) chunk."""
     if len(data) < _GLB_HEADER_BYTES + 8:
         raise FormatError(path, "GLB header", f"file is truncated ({len(data)} bytes)")
     version, length = struct.unpack_from("<II", data, 4)
@@ -457,6 +527,7 @@ def _check_glb_header(path: str, data: bytes) -> None:
     if length > len(data):
         raise FormatError(path, "GLB header", f"file is truncated: header says {length} bytes, file has {len(data)}")
     offset = _GLB_HEADER_BYTES
+    json_chunk = None
     while offset < length:
         if offset + 8 > length:
             raise FormatError(path, f"GLB chunk at byte {offset}", "chunk header is truncated")
@@ -465,4 +536,11 @@ def _check_glb_header(path: str, data: bytes) -> None:
             raise FormatError(
                 path, f"GLB chunk at byte {offset}", f"declares {chunk_length} bytes, only {length - offset - 8} remain"
             )
+        if json_chunk is None:
+            if struct.unpack_from("<I", data, offset + 4)[0] != _GLB_JSON_CHUNK:
+                raise FormatError(path, f"GLB chunk at byte {offset}", "the first chunk must be the JSON chunk")
+            json_chunk = data[offset + 8 : offset + 8 + chunk_length]
         offset += 8 + chunk_length
+    if json_chunk is None:
+        raise FormatError(path, "GLB", "no JSON chunk")
+    return json_chunk

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..model import Motion, SkinnedMesh
 from .gltf_document import GltfDocument
+from .gltf_lod import GRID_EXTRA
 from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_points
 from .gltf_read import morph_weight_tracks, skinned_mesh_of_node
 from .gltf_skin import SkinRig
@@ -100,10 +101,15 @@ class Drawable:
 
 def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
     """Every (mesh, skin) pair drawn by a node of ``doc``, in order of first use, with its clips
-    sampled at ``fps``. Raises FormatError naming the element for anything it cannot read."""
+    sampled at ``fps``. Nodes that are lower levels of an MSFT_lod chain are alternates of their
+    base node, not drawables of their own. Raises FormatError naming the element for anything
+    it cannot read."""
+    _check_channel_targets(doc)
+    nodes = doc.json.get("nodes", [])
+    alternates = {other for index, node in enumerate(nodes) for other in _alternate_nodes(node) if other != index}
     pairs: dict[tuple[int, int | None], list[int]] = {}
     for index, node in enumerate(doc.gltf.nodes or []):
-        if node.mesh is not None:
+        if node.mesh is not None and index not in alternates:
             doc.item("meshes", node.mesh, doc.node_label(index))
             if node.skin is not None:
                 doc.item("skins", node.skin, doc.node_label(index))
@@ -116,7 +122,10 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
         if skin_index is not None:
             label += f" with skin {skin_index}"
         geometry = read_mesh_geometry(doc, mesh_index, skinned=skin_index is not None)
-        drawable = Drawable(mesh_index, skin_index, nodes, label, geometry, doc.rest_world_matrix(nodes[0]))
+        world = doc.rest_world_matrix(nodes[0])
+        if abs(np.linalg.det(world[:3, :3])) < 1e-30:
+            raise doc.fail(doc.node_label(nodes[0]), "its world transform is singular (a zero scale)")
+        drawable = Drawable(mesh_index, skin_index, nodes, label, geometry, world)
         if skin_index is not None:
             if skin_index not in rigs:
                 rigs[skin_index] = SkinRig(doc, skin_index)
@@ -133,6 +142,23 @@ def read_document_drawables(path: str | os.PathLike, fps: float = 30.0) -> tuple
     """The parsed document at ``path`` and its drawables."""
     doc = GltfDocument(path)
     return doc, read_drawables(doc, fps)
+
+
+def _alternate_nodes(node: dict) -> list[int]:
+    """Nodes standing in for ``node`` at other levels: its MSFT_lod ids and animlod's level grid."""
+    ids = list((node.get("extensions") or {}).get("MSFT_lod", {}).get("ids", []))
+    extras = node.get("extras")
+    grid = extras.get(GRID_EXTRA, []) if isinstance(extras, dict) else []
+    ids += [index for row in grid if isinstance(row, list) for index in row]
+    return [index for index in ids if isinstance(index, int)]
+
+
+def _check_channel_targets(doc: GltfDocument) -> None:
+    """Every animation channel must target a node of the document."""
+    for a, animation in enumerate(doc.gltf.animations or []):
+        for index, channel in enumerate(animation.channels or []):
+            if channel.target is not None and channel.target.node is not None:
+                doc.item("nodes", channel.target.node, f"{doc.animation_label(a)} channel {index} target")
 
 
 def _clips(doc: GltfDocument, drawable: Drawable, fps: float) -> list[Clip]:

@@ -13,22 +13,32 @@ primitives keep the input primitives' materials and attribute sets:
 
 Motion levels (fewer joints, see :mod:`animlod.pipelines.character`) add a reduced skeleton as
 its own joint nodes, a skin over them, and one animation per input clip with
-``extras.animlod = {"clip": <input animation index>, "motion_level": m}``.
+``extras.animlod = {"clip": <input animation index>, "motion_level": m}``; every combination of
+geometry and motion level is a node, listed by ``base.extras.animlod_grid[g][m]``.
 """
 
 from __future__ import annotations
 
 import copy
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model import AnimatedMesh, LodChain, LodLevel
 from .glb_builder import ARRAY_BUFFER, GlbBuilder
+from .gltf_document import GltfDocument
+from .gltf_mesh import read_mesh_geometry, transform_points
+from .gltf_read import skinned_mesh_of_node
+from .gltf_skin import SkinRig
 from .gltf_write import index_accessor
 
 LOD_EXTENSION = "MSFT_lod"
 COVERAGE_EXTRA = "MSFT_screencoverage"
 ANIMLOD_EXTRA = "animlod"
+# Node extras key of the (mesh level x motion level) grid of level nodes that character chains
+# write beside MSFT_lod: grid[g][m] lists the node drawing geometry level g at motion level m.
+GRID_EXTRA = "animlod_grid"
 _NODE_TRANSFORM = ("matrix", "translation", "rotation", "scale")
 
 
@@ -43,12 +53,14 @@ class PrimitiveArrays:
         JOINTS_n.
     faces : (m, 3) triangles over the n vertices.
     targets : per morph target, attribute name -> (n, 3) float32 deltas.
+    vertices : (n,) index of each vertex in the level it was cut from (not written).
     """
 
     source: int
     attributes: dict[str, np.ndarray]
     faces: np.ndarray
     targets: list[dict[str, np.ndarray]] = field(default_factory=list)
+    vertices: np.ndarray | None = None
 
 
 @dataclass
@@ -152,6 +164,66 @@ def screen_coverages(
         limit = 1.0 if error <= 0.0 else pixel_error * size / (error * viewport_px)
         thresholds.append(min(1.0, limit, thresholds[-1] if thresholds else 1.0))
     return [*thresholds, 0.0]
+
+
+def read_lod_chains(path: str | os.PathLike, fps: float = 30.0) -> list[LodChain]:
+    """Every chain of a LoD GLB (one per node with MSFT_lod), levels finest first.
+
+    A level's mesh is a world-space :class:`~animlod.model.SkinnedMesh` with the clips that
+    move its skin (a reduced skeleton's own clips at motion levels), or a one-frame
+    :class:`~animlod.model.AnimatedMesh`; its error and coverage come from the extras.
+    A file without MSFT_lod has no chains. Raises FormatError naming the element.
+    """
+    doc = GltfDocument(path)
+    rigs: dict[int, SkinRig] = {}
+    chains = []
+    for base, node in enumerate(doc.json.get("nodes", [])):
+        lod = node.get("extensions", {}).get(LOD_EXTENSION)
+        if lod is None:
+            continue
+        element = f"{doc.node_label(base)} {LOD_EXTENSION}"
+        ids = lod.get("ids") if isinstance(lod, dict) else None
+        if not isinstance(ids, list):
+            raise doc.fail(element, "has no list of level node ids")
+        for index in ids:
+            doc.item("nodes", index, element)
+        extras = node.get("extras") if isinstance(node.get("extras"), dict) else {}
+        coverages = extras.get(COVERAGE_EXTRA, [None] * (len(ids) + 1))
+        if not isinstance(coverages, list) or len(coverages) != len(ids) + 1:
+            raise doc.fail(f"{doc.node_label(base)} extras", f"{COVERAGE_EXTRA} needs {len(ids) + 1} values")
+        parent = doc.parents[base]
+        parent_world = doc.rest_world_matrix(parent) if parent >= 0 else np.eye(4)
+        levels = []
+        for node_index, coverage in zip([base, *ids], coverages):
+            world = parent_world @ doc.rest_matrix(node_index)
+            levels.append(_read_level(doc, node_index, world, rigs, fps, coverage))
+        chains.append(LodChain(levels, name=node.get("name", f"node {base}")))
+    return chains
+
+
+def _read_level(
+    doc: GltfDocument, index: int, world: np.ndarray, rigs: dict, fps: float, coverage: float | None
+) -> LodLevel:
+    node = doc.gltf.nodes[index]
+    label = doc.node_label(index)
+    extras = node.extras.get(ANIMLOD_EXTRA, {}) if isinstance(node.extras, dict) else {}
+    info = extras if isinstance(extras, dict) else {}
+    if node.mesh is None:
+        raise doc.fail(label, "is a level of a LoD chain but draws no mesh")
+    error = float(info.get("error", 0.0))
+    mesh_level, motion_level = int(info.get("mesh_level", 0)), int(info.get("motion_level", 0))
+    if node.skin is None:
+        geometry = read_mesh_geometry(doc, node.mesh, skinned=False)
+        mesh = AnimatedMesh(geometry.faces, transform_points(world, geometry.positions)[None])
+        return LodLevel(mesh, None, [], error, coverage, mesh_level, motion_level)
+    if node.skin not in rigs:
+        rigs[node.skin] = SkinRig(doc, node.skin)
+    rig = rigs[node.skin]
+    geometry = read_mesh_geometry(doc, node.mesh, skinned=True)
+    mesh = skinned_mesh_of_node(doc, index, rig, geometry, world)
+    motions = [rig.motion(doc, animation, fps) for animation in range(len(doc.gltf.animations or []))]
+    motions = [motion for motion in motions if motion is not None]
+    return LodLevel(mesh, rig.skeleton, motions, error, coverage, mesh_level, motion_level)
 
 
 def _storable(values: np.ndarray) -> np.ndarray:

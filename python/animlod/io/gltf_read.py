@@ -125,9 +125,12 @@ def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -
     return mesh, [motion for motion in motions if motion is not None]
 
 
-def skinned_mesh_of_node(doc: GltfDocument, node: int, rig: SkinRig, geometry: MeshGeometry) -> SkinnedMesh:
+def skinned_mesh_of_node(
+    doc: GltfDocument, node: int, rig: SkinRig, geometry: MeshGeometry, mesh_world: np.ndarray | None = None
+) -> SkinnedMesh:
     """The skinned mesh node ``node`` draws with ``rig``, its rest pose in world space (see the
-    module docstring), joints in skeleton order and weights normalised."""
+    module docstring), joints in skeleton order and weights normalised. ``mesh_world`` replaces
+    the node's rest world transform (for a LoD node standing in for another node)."""
     mesh_index = doc.gltf.nodes[node].mesh
     slots = rig.skin_slots
     # Unused influences may carry any index (some exporters leave garbage there).
@@ -136,7 +139,9 @@ def skinned_mesh_of_node(doc: GltfDocument, node: int, rig: SkinRig, geometry: M
         vertex = int(np.argmax((joints >= slots).any(axis=1)))
         reason = f"vertex {vertex} uses joint slot {int(joints[vertex].max())}, skin {rig.skin} has {slots}"
         raise doc.fail(f"mesh {mesh_index} JOINTS", reason)
-    mesh_world = doc.rest_world_matrix(node)
+    mesh_world = doc.rest_world_matrix(node) if mesh_world is None else mesh_world
+    if abs(np.linalg.det(mesh_world[:3, :3])) < 1e-30:
+        raise doc.fail(doc.node_label(node), "its world transform is singular (a zero scale): the mesh has no extent")
     row_scale = np.ones((len(rig.scales), 4, 1))
     row_scale[:, :3] = rig.scales[:, None, None]
     inverse_bind = (row_scale * rig.inverse_bind) @ np.linalg.inv(mesh_world)

@@ -30,6 +30,9 @@ from .gltf_keyframes import sample_keyframes
 # rest value count as held, so the motion needs no per-frame joint translations.
 _HELD_TRANSLATION_TOLERANCE = 1e-4
 _NODE_PATHS = ("translation", "rotation", "scale")
+# Below this relative volume (|det| over the product of the column lengths) a 3x3 part counts as
+# singular: its inverse would amplify float32 noise by more than a million.
+_SINGULAR_VOLUME = 1e-6
 # Node extras key marking a joint as an end site (a BVH "End Site": a leaf without rotation);
 # animlod writes it and reads it back, other tools ignore it.
 END_SITE_EXTRA = "animlod_end_site"
@@ -179,6 +182,17 @@ class SkinRig:
             got = f"{stored.shape[0]} of width {stored.shape[1]}"
             raise doc.fail(self.element, f"inverseBindMatrices must be {count} float MAT4, got {got}")
         matrices[:count] = stored.reshape(count, 4, 4).transpose(0, 2, 1)  # glTF is column-major
+        # Skinning and re-skinning invert these; a singular one must be named here, not fail
+        # later as a bare "Singular matrix". Volume of the columns relative to their lengths:
+        # 1 for a rotation-scale, 0 for a flattened matrix.
+        linear = matrices[:count, :3, :3]
+        lengths = np.prod(np.linalg.norm(linear, axis=1), axis=1)
+        volume = np.abs(np.linalg.det(linear)) / np.where(lengths > 0.0, lengths, 1.0)
+        singular = np.flatnonzero((lengths == 0.0) | (volume < _SINGULAR_VOLUME))
+        if singular.size:
+            slot = int(singular[0])
+            reason = f"inverse bind matrix of joint {slot} ({doc.node_label(doc.gltf.skins[self.skin].joints[slot])}) "
+            raise doc.fail(f"{self.element} inverseBindMatrices", reason + "is singular (cannot be inverted)")
         return matrices
 
     def _pose(self, translations: dict, local_rotations: dict, frames: int) -> tuple[np.ndarray, np.ndarray]:

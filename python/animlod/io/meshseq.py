@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import AnimatedMesh
-from .atomic import atomic_write
+from .atomic import atomic_folder, atomic_write
 from .errors import FormatError
 from .tokens import parses, tokens_per_line
 
@@ -71,6 +71,10 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
     """
     paths = _sequence_paths(source)
     first_vertices, faces = read_mesh(paths[0])
+    # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
+    if not len(faces):
+        what = "no vertices and no faces" if not len(first_vertices) else f"{len(first_vertices)} vertices but no faces"
+        raise FormatError(paths[0], "mesh", f"{what}; a frame needs triangles")
     frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
     frames[0] = first_vertices
     for index, path in enumerate(paths[1:], start=1):
@@ -81,19 +85,22 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
 
 
 def write_sequence(folder: str | os.PathLike, mesh: AnimatedMesh, fmt: str = "obj", stem: str = "frame") -> list[Path]:
-    """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, each file atomically.
+    """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, the folder atomically.
 
-    Existing files with other names are left alone, so write into an empty folder if it is to be
-    read back with :func:`read_sequence`. ``fmt`` is "obj" or "ply" (binary little-endian).
+    The frames are written into a temporary folder beside ``folder``, which is renamed to
+    ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
+    interrupted run never leaves a folder short of frames under the final name. An existing
+    ``folder`` is replaced as a whole. ``fmt`` is "obj" or "ply" (binary little-endian).
     Returns the written paths in frame order.
     """
     if fmt not in ("obj", "ply"):
-        raise ValueError(f"fmt must be 'obj' or 'ply', got {fmt!r}")
+        raise ValueError(f"{os.fspath(folder)}: fmt: must be 'obj' or 'ply', got {fmt!r}")
     width = max(4, len(str(mesh.frame_count - 1)))
-    paths = [Path(folder) / f"{stem}_{index:0{width}d}.{fmt}" for index in range(mesh.frame_count)]
-    for path, vertices in zip(paths, mesh.frames):
-        write_mesh(path, vertices, mesh.faces)
-    return paths
+    names = [f"{stem}_{index:0{width}d}.{fmt}" for index in range(mesh.frame_count)]
+    with atomic_folder(folder) as temporary:
+        for name, vertices in zip(names, mesh.frames):
+            write_mesh(temporary / name, vertices, mesh.faces)
+    return [Path(folder) / name for name in names]
 
 
 def _sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> list[Path]:
@@ -175,14 +182,18 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         with fewer than three corners, or a face index outside the vertices defined so far.
     """
     path = Path(path)
-    data = path.read_bytes().replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    data = path.read_bytes()
+    nul = data.find(b"\0")
+    if nul >= 0:
+        raise FormatError(path, f"byte {nul}", "NUL byte: an OBJ file is text, this looks like binary data")
+    data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
     data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
     (vertex_block, vertex_lines), (face_block, face_lines) = _obj_statements(data, (b"v", b"f"))
 
     def name_vertex(vertex: int) -> str:
         return f"vertex {vertex} (line {vertex_lines[vertex]})"
 
-    tokens, starts, sizes = _tagged_rows(vertex_block, b"v")
+    tokens, starts, sizes = _tagged_rows(vertex_block, len(vertex_lines))
     _require_sizes(path, sizes, 3, name_vertex, "coordinates")
     columns = tokens[starts[:, None] + np.arange(1, 4)]
     vertices = _parse_numbers(path, columns, np.float64, lambda token: name_vertex(token // 3)).astype(np.float32)
@@ -191,7 +202,7 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     def name_face(face: int) -> str:
         return f"face {face} (line {face_lines[face]})"
 
-    tokens, starts, sizes = _tagged_rows(re.sub(rb"/\S*", b"", face_block), b"f")  # the vertex of v/vt/vn
+    tokens, starts, sizes = _tagged_rows(re.sub(rb"/\S*", b"", face_block), len(face_lines))  # v of v/vt/vn
     _require_sizes(path, sizes, 3, name_face, "vertices")
     owner = np.repeat(np.arange(sizes.size), sizes)
     written = _parse_numbers(path, np.delete(tokens, starts), np.int64, lambda corner: name_face(owner[corner]))
@@ -236,11 +247,14 @@ def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, n
     return result
 
 
-def _tagged_rows(block: bytes, tag: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Tokens of ``tag``-led lines, the index of each line's tag and the values after each tag."""
+def _tagged_rows(block: bytes, line_count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Tokens of the ``line_count`` tag-led lines of ``block``, the index of each line's tag and
+    the number of values after it. Rows are counted by line, not by tag token: ``v v 1 2`` is one
+    row (whose "v" then fails to parse), not two."""
     tokens = np.array(block.split(), dtype=np.bytes_)
-    starts = np.flatnonzero(tokens == tag)
-    sizes = np.diff(np.append(starts, tokens.size)) - 1
+    counts = tokens_per_line(block)[:line_count]
+    starts = np.cumsum(counts) - counts
+    sizes = counts - 1
     return tokens, starts, sizes
 
 
@@ -405,7 +419,12 @@ def _read_ply_header(path: Path, data: bytes) -> tuple[str | None, list[_PlyElem
         element = f"header line {number}"
         if words[0] == "format" and len(words) == 3 and words[1] in _PLY_FORMATS:
             byte_order, format_seen = _PLY_FORMATS[words[1]], True
-        elif words[0] == "element" and len(words) == 3 and words[2].isdigit():
+        elif words[0] == "element" and len(words) == 3 and words[2].isascii() and words[2].isdigit():
+            # Every row takes at least a byte (binary) or a line (ascii): more rows than the file
+            # has bytes cannot be there, and would overflow numpy's counts for empty rows.
+            if int(words[2]) > len(data):
+                reason = f"element {words[1]!r} declares {words[2]} rows, more than the file's {len(data)} bytes"
+                raise FormatError(path, element, reason)
             elements.append(_PlyElement(words[1], int(words[2])))
         elif words[0] == "property" and elements:
             prop = _ply_property(path, element, words)

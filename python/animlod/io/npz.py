@@ -6,7 +6,9 @@ float32`` and ``fps`` (a float, NaN when the mesh has no frame rate).
 
 from __future__ import annotations
 
+import math
 import os
+import struct
 import zipfile
 import zlib
 from pathlib import Path
@@ -19,6 +21,10 @@ from .errors import FormatError
 
 FORMAT_VERSION = 1
 _KEYS = ("format_version", "faces", "frames", "fps")
+# Largest ratio of uncompressed to compressed size that deflate can reach (about 1032:1).
+_MAX_DEFLATE_RATIO = 1032
+_NPY_HEADER_READERS = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
+_MAX_NPY_HEADER = 10_000  # numpy's own default limit of a header's size
 
 
 def write_npz(path: str | os.PathLike, mesh: AnimatedMesh) -> None:
@@ -36,6 +42,10 @@ def write_npz(path: str | os.PathLike, mesh: AnimatedMesh) -> None:
 def read_npz(path: str | os.PathLike) -> AnimatedMesh:
     """Read an AnimatedMesh written by :func:`write_npz`.
 
+    Every member's .npy header is checked before its array is allocated: the shape must need
+    exactly the bytes the member holds, and the member no more bytes than its compressed size
+    can expand to, so a few hostile bytes cannot make the reader allocate gigabytes.
+
     Raises
     ------
     FormatError
@@ -44,13 +54,15 @@ def read_npz(path: str | os.PathLike) -> AnimatedMesh:
     """
     path = Path(path)
     try:
-        # A plain .npy file gives an ndarray, which is no context manager: TypeError. A damaged
-        # member fails while it is decompressed: zlib.error, EOFError, or BadZipFile for its CRC;
-        # zipfile raises RuntimeError (NotImplementedError) for encrypted or unknown compression.
-        with np.load(path, allow_pickle=False) as archive:
-            arrays = {key: archive[key] for key in _KEYS if key in archive.files}
-    except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError, TypeError, RuntimeError) as error:
-        raise FormatError(path, "archive", f"not a readable npz archive ({error})") from None
+        # A damaged member fails while it is decompressed: zlib.error, EOFError, or BadZipFile for
+        # its CRC; zipfile raises RuntimeError (NotImplementedError) for encrypted or unknown
+        # compression, ValueError and struct.error for damaged records.
+        with zipfile.ZipFile(path) as archive:
+            arrays = {key: _member_array(path, archive, key) for key in _KEYS if f"{key}.npy" in archive.namelist()}
+    except (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError, RuntimeError, struct.error) as error:
+        if isinstance(error, FormatError):
+            raise
+        raise FormatError(path, "archive", f"not a readable npz archive ({type(error).__name__}: {error})") from None
     missing = [key for key in _KEYS if key not in arrays]
     if missing:
         raise FormatError(path, f"key {missing[0]!r}", f"missing (an animlod npz has {', '.join(_KEYS)})")
@@ -73,6 +85,42 @@ def read_npz(path: str | os.PathLike) -> AnimatedMesh:
         return AnimatedMesh(faces, frames, fps=None if np.isnan(fps) else float(fps))
     except ValueError as error:
         raise FormatError(path, "mesh", str(error)) from None
+
+
+def _member_array(path: Path, archive: zipfile.ZipFile, key: str) -> np.ndarray:
+    """The array of member ``key.npy``, its header checked against the member's size first."""
+    info = archive.getinfo(f"{key}.npy")
+    element = f"key {key!r}"
+    # Deflate expands at most ~1032:1; a member claiming more is damaged or a bomb.
+    if info.file_size > _MAX_DEFLATE_RATIO * info.compress_size + 1024:
+        reason = f"member claims {info.file_size} bytes from {info.compress_size} compressed bytes"
+        raise FormatError(path, element, reason)
+    with archive.open(info) as member:
+        try:
+            version = np.lib.format.read_magic(member)
+            read_header = _NPY_HEADER_READERS.get(version)
+            if read_header is None:
+                raise FormatError(path, element, f"unknown .npy version {version}")
+            shape, fortran_order, dtype = read_header(member, max_header_size=_MAX_NPY_HEADER)
+        except (ValueError, SyntaxError, TypeError) as error:
+            raise FormatError(path, element, f"not a .npy array ({error})") from None
+        if any(extent < 0 for extent in shape):
+            raise FormatError(path, element, f"header declares a negative extent in shape {shape}")
+        if dtype.hasobject or dtype.itemsize == 0:
+            raise FormatError(path, element, f"dtype {dtype} is not a plain numeric type")
+        header_bytes = member.tell()
+        count = math.prod(shape)
+        if count * dtype.itemsize != info.file_size - header_bytes:
+            reason = (
+                f"header declares shape {shape} of {dtype} ({count * dtype.itemsize} bytes), "
+                f"the member holds {info.file_size - header_bytes}"
+            )
+            raise FormatError(path, element, reason)
+        data = member.read()
+    if len(data) != count * dtype.itemsize:
+        raise FormatError(path, element, f"member ends after {len(data)} of {count * dtype.itemsize} bytes")
+    array = np.frombuffer(data, dtype=dtype)
+    return array.reshape(shape[::-1]).T if fortran_order else array.reshape(shape)
 
 
 def _holds(array: np.ndarray, kind: type) -> bool:

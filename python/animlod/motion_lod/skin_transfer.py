@@ -23,7 +23,7 @@ from .frozen import FrozenLevel
 from .skeleton_reduce import reduce_skeleton
 
 
-def _key_bind_pose(skin: SkinnedMesh, level: FrozenLevel) -> np.ndarray:
+def key_bind_pose(skin: SkinnedMesh, level: FrozenLevel) -> np.ndarray:
     """World transforms ``(J, 4, 4)`` of the bind pose with frozen joints at their key rotations."""
     bind = np.linalg.inv(skin.inverse_bind)
     parents = skin.skeleton.parents
@@ -49,7 +49,7 @@ def transfer_skin(skin: SkinnedMesh, level: FrozenLevel) -> SkinnedMesh:
     skeleton = skin.skeleton
     if skeleton.names != level.skeleton.names:
         raise ValueError("skin: its skeleton's joint names differ from the motion's")
-    posed = _key_bind_pose(skin, level)
+    posed = key_bind_pose(skin, level)
     matrices = posed @ skin.inverse_bind
     rest = bake_lbs(skin.rest_positions, skin.joints, skin.weights, matrices[None].astype(np.float32))[0]
     normals = None

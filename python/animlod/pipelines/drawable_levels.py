@@ -281,7 +281,7 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
                     first, size = layout.target_columns[t][name]
                     arrays[name] = level.attributes[used, first : first + size].copy()
             targets.append(arrays)
-        primitive = PrimitiveArrays(source.index, attributes, local_faces, targets)
+        primitive = PrimitiveArrays(source.index, attributes, local_faces, targets, used)
         if layout.crease[k] is not None:
             primitive = with_crease_normals(primitive, layout.crease[k])
         primitives.append(primitive)
@@ -339,7 +339,7 @@ def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveA
         along = np.einsum("vc,vc->v", tangent[:, :3], attributes["NORMAL"])
         tangent[:, :3] = _unit(tangent[:, :3] - along[:, None] * attributes["NORMAL"])
     targets = [{name: values[source] for name, values in target.items()} for target in primitive.targets]
-    return PrimitiveArrays(primitive.source, attributes, new_index.reshape(-1, 3), targets)
+    return PrimitiveArrays(primitive.source, attributes, new_index.reshape(-1, 3), targets, primitive.vertices[source])
 
 
 def _skin_columns(drawable: Drawable, joints: np.ndarray, weights: np.ndarray) -> dict[str, np.ndarray]:

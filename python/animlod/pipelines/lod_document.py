@@ -21,6 +21,7 @@ from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_drawable import Drawable, read_drawables
 from ..io.gltf_lod import LevelInfo, add_level_mesh, add_level_node, attach_chain, screen_coverages
+from ..model import AnimatedMesh
 from .drawable_levels import DrawableLevels, simplify_drawable
 
 DEFAULT_RATIOS = (0.5, 0.25, 0.1)
@@ -51,6 +52,7 @@ class DrawableReport:
     renormalised_weights: int
     levels: list[LevelReport] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    rest_meshes: list[AnimatedMesh] = field(default_factory=list)  # level 0, 1, ... in the rest pose, world
 
 
 @dataclass
@@ -131,6 +133,8 @@ def _report(drawable: Drawable, levels: DrawableLevels, pixel_error: float, view
         preparation=levels.preparation,
         renormalised_weights=drawable.renormalised_weights,
         notes=list(levels.notes),
+        rest_meshes=[AnimatedMesh(drawable.geometry.faces, drawable.rest_positions()[None])]
+        + [AnimatedMesh(level.simplified.mesh.faces, level.rest[None]) for level in levels.levels],
     )
     for index, (level, coverage) in enumerate(zip(levels.levels, coverages[1:]), start=1):
         simplified: SimplifiedLevel = level.simplified
@@ -166,7 +170,8 @@ def _write_chain(
             for level, name in zip(levels.levels, _level_names(doc, drawable, len(levels.levels)))
         ]
         coverages = [level.coverage for level in report.levels]
-        infos = [LevelInfo(level.level, level.error, level.faces, level.level) for level in report.levels]
+        joints = len(doc.gltf.skins[drawable.skin_index].joints) if drawable.skin_index is not None else 0
+        infos = [LevelInfo(level.level, level.error, level.faces, level.level, 0, joints) for level in report.levels]
         for base in drawable.nodes:
             nodes = [
                 add_level_node(builder, base, mesh, drawable.skin_index, info) for mesh, info in zip(meshes, infos[1:])

@@ -1,0 +1,166 @@
+"""TDAG (Shamir and Pascucci 2001): Figure 6, build time and size, and the cost of each level.
+
+Run: ``.venv/bin/python bench/bench_tdag.py [--quick]``. Tables:
+
+1. Figure 6 on the dev sequences (../shared/data: crane, face-poses, the Flamingo, Parrot,
+   Stork and MorphStressTest morph-target animations baked to frames) and a procedural bending
+   cylinder: for each governing choice (first mesh, average mesh, an arbitrary frame at 2/3 of
+   the sequence, AQEM over all frames, online with lambda = 1) and the per-frame optimal
+   decimation (online, lambda = 0): decimations per frame and in total, and the average and
+   median of the per-edge maximum quadric cost over time (Section 4's measure; costs divided by
+   the squared bounding-box diagonal, times 1e6).
+2. Build time (total and per frame) and .tdag size against the raw float32 frames, governed by
+   the first mesh and online.
+3. Per-frame cost of each temporal approximation level (Section 5) at a tolerance of 2% of the
+   bounding-box diagonal against a fresh query from the roots (median over frames, best of three
+   walks, so that other processes on the machine do not count), the largest vertex error of
+   each, and the level-3 walk on one thread and double-buffered.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from devdata import DATA_DIR
+from table import print_table
+
+from animlod import AnimatedMesh, TemporalDag, synth
+
+TOLERANCE = 0.02  # of the bounding-box diagonal
+
+
+def sequences(quick: bool) -> list[tuple[str, AnimatedMesh]]:
+    """(name, mesh): the dev sequences that exist, then the procedural cylinder."""
+    from animlod.io.gltf import read_gltf
+    from animlod.io.meshseq import read_sequence
+
+    found = []
+    if (DATA_DIR / "meshseq").is_dir():
+        found.append(("crane", read_sequence(DATA_DIR / "meshseq" / "crane")))
+        if not quick:
+            found.append(("face-poses", read_sequence(DATA_DIR / "meshseq" / "face-poses")))
+        gltf = [("Flamingo", DATA_DIR / "meshseq" / "Flamingo-morph-glTF" / "Flamingo.glb")]
+        gltf += [(name, DATA_DIR / "morph" / f"{name}.glb") for name in ("Parrot", "Stork")]
+        gltf += [("MorphStressTest", DATA_DIR / "morph" / "MorphStressTest.gltf")]
+        for name, path in gltf:
+            if path.exists():
+                found.append((name, read_gltf(path).morph_animations[0]))
+    rings, segments = (40, 36) if quick else (96, 90)
+    found.append(("bending cylinder", synth.bending_cylinder(frames=24, rings=rings, segments=segments)))
+    return found
+
+
+def diagonal(mesh: AnimatedMesh) -> float:
+    return float(np.linalg.norm(mesh.frames[0].max(axis=0) - mesh.frames[0].min(axis=0)))
+
+
+def figure6_table(inputs: list[tuple[str, AnimatedMesh]]) -> None:
+    rows = []
+    for name, mesh in inputs:
+        arbitrary = (2 * (mesh.frame_count - 1)) // 3
+        choices = [
+            ("first", "first", 1.0),
+            ("average", "average", 1.0),
+            (f"arbitrary (frame {arbitrary})", arbitrary, 1.0),
+            ("AQEM", "aqem", 1.0),
+            ("online, lambda 1", "online", 1.0),
+            ("optimal (per frame)", "online", 0.0),
+        ]
+        scale = 1e6 / diagonal(mesh) ** 2
+        results = []
+        for label, governing, weight in choices:
+            dag = TemporalDag.build(mesh, governing, history_weight=weight)
+            average, median = dag.report.quality_measure()
+            counts = dag.report.collapse_counts
+            results.append((label, counts.mean(), int(counts.sum()), average * scale, median * scale))
+        optimal = results[-1][3]
+        for label, per_frame, total, average, median in results:
+            ratio = average / optimal if optimal > 0 else float("nan")
+            rows.append((name, mesh.frame_count, label, f"{per_frame:.0f}", total, average, median, f"{ratio:.2f}"))
+    print_table(
+        "Figure 6: governing the decimation (costs / diagonal^2 x 1e6)",
+        ["sequence", "frames", "governing", "decimations per frame", "total", "average", "median", "average / optimal"],
+        rows,
+    )
+
+
+def build_table(inputs: list[tuple[str, AnimatedMesh]]) -> None:
+    rows = []
+    for name, mesh in inputs:
+        for governing in ("first", "online"):
+            start = time.perf_counter()
+            dag = TemporalDag.build(mesh, governing)
+            seconds = time.perf_counter() - start
+            size = len(dag.to_bytes())
+            raw = mesh.frames.size * 4
+            rows.append(
+                (name, governing, mesh.frame_count, mesh.face_count, seconds, seconds / mesh.frame_count * 1e3,
+                 size, raw, f"{size / raw:.2f}")
+            )  # fmt: skip
+    print_table(
+        "Build time and file size (.tdag: TDAG and affine maps; raw: float32 frames)",
+        ["sequence", "governing", "frames", "faces", "build s", "ms per frame", "tdag bytes", "raw bytes", "ratio"],
+        rows,
+    )
+
+
+def query_table(inputs: list[tuple[str, AnimatedMesh]]) -> None:
+    rows = []
+    for name, mesh in inputs:
+        dag = TemporalDag.build(mesh)
+        tolerance = TOLERANCE * diagonal(mesh)
+        walks = [dag.play(tolerance) for _ in range(3)]
+        best = {key: min((walk.levels[i] if i < 3 else walk.full_query).median_seconds for walk in walks)
+                for i, key in enumerate(("1", "2", "3", "fresh"))}  # fmt: skip
+        update = min(walk.median_update_seconds for walk in walks)
+        fresh_cut = min(walk.median_fresh_cut_seconds for walk in walks)
+        report = walks[0]
+        errors = [stats.max_error / tolerance for stats in [*report.levels, report.full_query]]
+        sequential = min(walk.sequential_seconds_per_frame for walk in walks)
+        buffered = min(walk.double_buffered_seconds_per_frame for walk in walks)
+        rows.append(
+            (
+                name,
+                mesh.face_count,
+                f"{report.levels[2].mean_faces:.0f}",
+                best["1"] * 1e3,
+                best["2"] * 1e3,
+                best["3"] * 1e3,
+                best["fresh"] * 1e3,
+                f"{best['3'] / best['fresh']:.3f}",
+                f"{update * 1e3:.3f} / {fresh_cut * 1e3:.3f} = {update / fresh_cut:.3f}",
+                " / ".join(f"{e:.2f}" for e in errors),
+                f"{report.mean_splits:.0f} / {report.mean_collapses:.0f}",
+                f"{sequential * 1e3:.3f} / {buffered * 1e3:.3f}",
+            )
+        )
+    print_table(
+        f"Per-frame cost of the approximation levels at tolerance {TOLERANCE:g} x diagonal (governed by frame 0; "
+        "ms, median over frames, best of 3 walks)",
+        ["sequence", "faces", "cut faces", "level 1", "level 2", "level 3", "fresh query", "level 3 / fresh",
+         "cut update / fresh cut (ms)", "max error / tolerance (1 / 2 / 3 / fresh)", "splits / collapses",
+         "level-3 walk ms: 1 thread / 2"],
+        rows,
+    )  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="smaller inputs, for a smoke test")
+    args = parser.parse_args()
+    inputs = sequences(args.quick)
+    if not (DATA_DIR / "meshseq").is_dir():
+        print(f"development data not found at {DATA_DIR}: procedural input only")
+    figure6_table(inputs)
+    build_table(inputs)
+    query_table(inputs)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,371 @@
+// TDAG construction (Shamir and Pascucci 2001, Sections 3-4).
+//
+//   affine split     Section 3: A_t and the residual meshes (tdag_affine.cpp);
+//   hierarchy        Section 4: one collapse order for all frames, governed by the first mesh,
+//                    the average mesh, an arbitrary frame or AQEM over all frames; or online,
+//                    every frame decimated with a priority that adds a history term favouring
+//                    the order of the frame before (Section 2, [17]), so that where frames
+//                    disagree the nodes and links get different time tags;
+//   fields           per frame and collapse: the quadric cost c_{i,t} on the real frame
+//                    (Section 4 stresses real meshes, not residuals; Figure 6's measure), and
+//                    the error bound, made monotone along dependencies and stored as time-
+//                    tagged runs (Section 2), so that a tolerance query always gives a valid cut.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "animlod/aqem.hpp"
+#include "animlod/tdag.hpp"
+#include "collapse_engine.hpp"
+#include "mesh_preparation.hpp"
+#include "mesh_validation_detail.hpp"
+#include "tdag_data.hpp"
+#include "tdag_hierarchy.hpp"
+#include "tdag_policy.hpp"
+
+namespace animlod {
+
+namespace {
+
+using detail::CollapseTable;
+using detail::FrameHierarchy;
+using detail::Quadric;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Status check_options(const AnimatedMeshView& mesh, const TdagOptions& options) {
+  if (options.governing == Governing::frame &&
+      (options.governing_frame < 0 || static_cast<size_t>(options.governing_frame) >= mesh.frame_count))
+    return Status::error("governing_frame: frame " + std::to_string(options.governing_frame) + " outside [0, " +
+                         std::to_string(mesh.frame_count) + ")");
+  if (!(std::isfinite(options.history_weight) && options.history_weight >= 0.0))
+    return Status::error("history_weight: must be finite and >= 0, got " + std::to_string(options.history_weight));
+  return Status::success();
+}
+
+// The TDAG's vertices: the prepared points, with their frames (F, P, 3).
+struct PointMesh {
+  detail::PreparedMesh prepared;
+  std::vector<float> frames;
+  AnimatedMeshView view;  // over `frames` and prepared.faces
+  std::vector<std::vector<int32_t>> twins;  // (P,) other points cut from the same input vertex
+
+  PointMesh(const AnimatedMeshView& mesh, bool weld) {
+    detail::WeldInput input;
+    input.weld = weld;
+    prepared = detail::prepare_mesh(mesh, input);
+    const size_t point_count = prepared.point_source.size();
+    frames.resize(mesh.frame_count * point_count * 3);
+    for (size_t f = 0; f < mesh.frame_count; ++f)
+      for (size_t p = 0; p < point_count; ++p)
+        std::copy_n(mesh.frames + (f * mesh.vertex_count + static_cast<size_t>(prepared.point_source[p])) * 3, 3,
+                    &frames[(f * point_count + p) * 3]);
+    view = {frames.data(), prepared.faces.data(), mesh.frame_count, point_count, prepared.faces.size() / 3};
+    twins.resize(point_count);
+    if (prepared.split_points == 0) return;
+    std::vector<std::pair<int32_t, int32_t>> by_source;
+    for (size_t p = 0; p < point_count; ++p) by_source.emplace_back(prepared.point_source[p], static_cast<int32_t>(p));
+    std::sort(by_source.begin(), by_source.end());
+    for (size_t i = 0; i < by_source.size();) {
+      size_t j = i;
+      while (j < by_source.size() && by_source[j].first == by_source[i].first) ++j;
+      for (size_t a = i; a < j; ++a)
+        for (size_t b = i; b < j; ++b)
+          if (a != b) twins[static_cast<size_t>(by_source[a].second)].push_back(by_source[b].second);
+      i = j;
+    }
+  }
+};
+
+// Per-frame fields of the collapses, accumulated frame after frame.
+class FieldBuilder {
+ public:
+  FieldBuilder(const AnimatedMeshView& mesh, const TdagOptions& options, double scale)
+      : mesh_(mesh), scale_(scale) {
+    if (options.boundary_quadrics) boundary_ = detail::boundary_sides(mesh.faces, mesh.face_count);
+    use_boundary_ = options.boundary_quadrics;
+  }
+
+  // Adds frame t of hierarchy h (its collapses are already in `table`).
+  void add_frame(int32_t t, const CollapseTable& table, const FrameHierarchy& h, TdagBuildReport& report);
+  void finish(const CollapseTable& table, detail::TdagData& data);
+
+ private:
+  Eigen::Vector3d point(int32_t frame, int32_t vertex) const {
+    const float* p = mesh_.frames + (static_cast<size_t>(frame) * mesh_.vertex_count + static_cast<size_t>(vertex)) * 3;
+    return {p[0], p[1], p[2]};
+  }
+  void grow(size_t collapse_count, TdagBuildReport& report) {
+    if (alive_.size() >= collapse_count) return;
+    alive_.resize(collapse_count);
+    links_.resize(collapse_count);
+    errors_.resize(collapse_count);
+    report.max_cost.resize(collapse_count, 0.0);
+    report.use_counts.resize(collapse_count, 0);
+  }
+
+  const AnimatedMeshView& mesh_;
+  double scale_;
+  bool use_boundary_ = true;
+  std::vector<detail::BoundarySide> boundary_;
+  std::vector<TimeTag> alive_;                   // (C,)
+  std::vector<TaggedSet<int32_t>> links_;        // (C,) dependencies
+  std::vector<TaggedValue<uint16_t>> errors_;    // (C,) error codes
+  std::vector<Quadric> quadrics_;                // (V + C,) scratch
+  std::vector<double> bound_;                    // (V + C,) scratch: monotone bound in this frame
+  std::vector<int32_t> stack_;
+};
+
+void FieldBuilder::add_frame(int32_t t, const CollapseTable& table, const FrameHierarchy& h,
+                             TdagBuildReport& report) {
+  const int32_t vertex_count = table.vertex_count();
+  const size_t node_count = table.representative.size();
+  grow(table.collapse_count(), report);
+  report.collapse_counts.push_back(static_cast<int32_t>(h.nodes.size()));
+
+  // Costs c_{i,t}: the quadric of a node is the sum of its cluster's vertex quadrics in frame t.
+  const float* positions = mesh_.frames + static_cast<size_t>(t) * mesh_.vertex_count * 3;
+  detail::vertex_quadrics(positions, mesh_.faces, mesh_.vertex_count, mesh_.face_count,
+                          use_boundary_ ? &boundary_ : nullptr, quadrics_);
+  quadrics_.resize(node_count);
+  bound_.assign(node_count, 0.0);
+  for (size_t i = 0; i < h.nodes.size(); ++i) {
+    const int32_t node = h.nodes[i];
+    const size_t c = static_cast<size_t>(node - vertex_count);
+    const int32_t kept = table.kept_child[c], removed = table.removed_child[c];
+    const Quadric merged = quadrics_[static_cast<size_t>(kept)] + quadrics_[static_cast<size_t>(removed)];
+    quadrics_[static_cast<size_t>(node)] = merged;
+    const double cost = merged.evaluate(point(t, table.representative[static_cast<size_t>(node)]));
+    report.max_cost[c] = report.use_counts[c] == 0 ? cost : std::max(report.max_cost[c], cost);
+    report.use_counts[c] += 1;
+
+    // Error bound: the farthest input vertex of the cluster from the node's position, then
+    // the largest bound of the children and of the dependencies (all earlier in h).
+    const Eigen::Vector3d centre = point(t, table.representative[static_cast<size_t>(node)]);
+    double farthest = 0.0;
+    stack_.assign({kept, removed});
+    while (!stack_.empty()) {
+      const int32_t x = stack_.back();
+      stack_.pop_back();
+      if (x < vertex_count) {
+        farthest = std::max(farthest, (point(t, x) - centre).squaredNorm());
+        continue;
+      }
+      const size_t cx = static_cast<size_t>(x - vertex_count);
+      stack_.push_back(table.kept_child[cx]);
+      stack_.push_back(table.removed_child[cx]);
+    }
+    double bound = std::sqrt(farthest);
+    bound = std::max({bound, bound_[static_cast<size_t>(kept)], bound_[static_cast<size_t>(removed)]});
+    for (int32_t d = h.dep_offsets[i]; d < h.dep_offsets[i + 1]; ++d)
+      bound = std::max(bound, bound_[static_cast<size_t>(h.dep_nodes[static_cast<size_t>(d)])]);
+    bound_[static_cast<size_t>(node)] = bound;
+
+    alive_[c].add(t);
+    for (int32_t d = h.dep_offsets[i]; d < h.dep_offsets[i + 1]; ++d) links_[c].add(h.dep_nodes[static_cast<size_t>(d)], t);
+    errors_[c].append({t, t + 1}, detail::encode_error(bound, scale_));
+  }
+}
+
+void FieldBuilder::finish(const CollapseTable& table, detail::TdagData& data) {
+  const size_t collapse_count = table.collapse_count();
+  data.kept_child = table.kept_child;
+  data.removed_child = table.removed_child;
+  data.killed = table.killed;
+  data.alive.assign(alive_.begin(), alive_.begin() + static_cast<std::ptrdiff_t>(collapse_count));
+  data.dep_offsets.assign(1, 0);
+  data.error_offsets.assign(1, 0);
+  for (size_t c = 0; c < collapse_count; ++c) {
+    for (const auto& entry : links_[c].entries()) {
+      data.dep_nodes.push_back(entry.value);
+      data.dep_tags.push_back(entry.tag);
+    }
+    data.dep_offsets.push_back(static_cast<int32_t>(data.dep_nodes.size()));
+    for (const auto& run : errors_[c].runs()) data.error_runs.push_back({run.range, run.value});
+    data.error_offsets.push_back(static_cast<int32_t>(data.error_runs.size()));
+  }
+}
+
+double bounding_box_diagonal(const AnimatedMeshView& mesh) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(INFINITY), high = Eigen::Vector3d::Constant(-INFINITY);
+  for (size_t v = 0; v < mesh.vertex_count; ++v) {
+    const Eigen::Vector3d p(mesh.frames[3 * v], mesh.frames[3 * v + 1], mesh.frames[3 * v + 2]);
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  const double diagonal = (high - low).norm();
+  return diagonal > 0.0 && std::isfinite(diagonal) ? diagonal : 1.0;
+}
+
+// The governing geometry of the input vertices (V, 3): frame 0, the average or frame k.
+std::vector<float> governing_positions(const AnimatedMeshView& mesh, const TdagOptions& options) {
+  const size_t per_frame = mesh.vertex_count * 3;
+  if (options.governing == Governing::average) {
+    std::vector<double> sum(per_frame, 0.0);
+    for (size_t f = 0; f < mesh.frame_count; ++f)
+      for (size_t i = 0; i < per_frame; ++i) sum[i] += mesh.frames[f * per_frame + i];
+    std::vector<float> average(per_frame);
+    for (size_t i = 0; i < per_frame; ++i) average[i] = static_cast<float>(sum[i] / double(mesh.frame_count));
+    return average;
+  }
+  const size_t frame = options.governing == Governing::frame ? static_cast<size_t>(options.governing_frame) : 0;
+  return {mesh.frames + frame * per_frame, mesh.frames + (frame + 1) * per_frame};
+}
+
+// One frame's order from the collapse engine with the TDAG policy: `positions` (V, 3) are the
+// input vertices in the decimated geometry; returns the order and its quadric costs.
+Status decimate(const AnimatedMeshView& mesh, const PointMesh& points, const float* positions,
+                const TdagOptions& options, const std::vector<detail::BoundarySide>* boundary,
+                const detail::HistoryTerm* history, CollapseTable& table, FrameHierarchy& out,
+                std::vector<double>& costs) {
+  const AnimatedMeshView one_frame{positions, mesh.faces, 1, mesh.vertex_count, mesh.face_count};
+  detail::EngineOptions engine_options;
+  engine_options.check_inversion = options.check_inversion;
+  const detail::CarriedData carried;
+  detail::CollapseEngine engine(one_frame, points.prepared, carried, engine_options);
+  std::vector<float> point_positions(points.view.vertex_count * 3);
+  for (size_t p = 0; p < points.view.vertex_count; ++p)
+    std::copy_n(positions + static_cast<size_t>(points.prepared.point_source[p]) * 3, 3, &point_positions[p * 3]);
+  std::vector<Quadric> quadrics;
+  detail::vertex_quadrics(point_positions.data(), points.view.faces, points.view.vertex_count,
+                          points.view.face_count, boundary, quadrics);
+  detail::TdagCollapsePolicy policy(engine, std::move(quadrics), table, history);
+  std::vector<detail::EngineLevel> levels;
+  detail::EngineRecord record;
+  engine.run(policy, {1}, levels, record);
+  costs = policy.costs();
+  return detail::record_hierarchy(points.view.faces, points.view.face_count, points.view.vertex_count,
+                                  policy.collapses(), nullptr, table, out);
+}
+
+// The AQEM order over all frames (simplify_animated's collapse record, welded as the TDAG is),
+// turned into the points' hierarchy. AQEM places the merged vertex optimally; the TDAG keeps
+// the position of its kept vertex.
+Status aqem_hierarchy(const AnimatedMeshView& mesh, const PointMesh& points, const TdagOptions& options,
+                      CollapseTable& table, FrameHierarchy& out) {
+  AqemOptions aqem;
+  aqem.target_face_counts = {1};
+  aqem.use_motion_features = options.use_motion_features;
+  aqem.boundary_quadrics = options.boundary_quadrics;
+  aqem.check_inversion = options.check_inversion;
+  aqem.weld = options.weld;
+  AqemResult result;
+  if (Status status = simplify_animated(mesh, {}, aqem, result); !status) return Status::error("AQEM: " + status.message);
+  std::vector<detail::VertexCollapse> collapses(result.collapses.removed.size());
+  for (size_t i = 0; i < collapses.size(); ++i) {
+    collapses[i].removed = points.prepared.wedge_point[static_cast<size_t>(result.collapses.removed[i])];
+    collapses[i].kept = points.prepared.wedge_point[static_cast<size_t>(result.collapses.kept[i])];
+  }
+  if (Status status = detail::record_hierarchy(points.view.faces, points.view.face_count, points.view.vertex_count,
+                                               collapses, &points.twins, table, out);
+      !status)
+    return Status::error("AQEM order: " + status.message);
+  return Status::success();
+}
+
+}  // namespace
+
+Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& options, TemporalDag& out,
+                          TdagBuildReport* report) {
+  out = TemporalDag{};
+  if (Status status = detail::check_sizes_values_and_indices(mesh); !status) return status;
+  if (Status status = check_options(mesh, options); !status) return status;
+  if (mesh.frame_count > static_cast<size_t>(INT32_MAX - 1))
+    return Status::error("frames: " + std::to_string(mesh.frame_count) + " frames, more than int32 frame numbers reach");
+
+  // The TDAG's vertices: welded points, degenerate and repeated faces dropped, non-manifold
+  // spots cut apart (as the collapse engine needs them).
+  const PointMesh points(mesh, options.weld);
+  if (points.view.face_count == 0)
+    return Status::error("faces: every face is degenerate (no face has three distinct positions)");
+  const AnimatedMeshView& view = points.view;
+
+  auto data = std::make_shared<detail::TdagData>();
+  TdagBuildReport local_report;
+  TdagBuildReport& rep = report ? *report : local_report;
+  rep = TdagBuildReport{};
+  const auto frame_count = static_cast<int32_t>(mesh.frame_count);
+  data->frame_count = frame_count;
+  data->vertex_count = static_cast<int32_t>(view.vertex_count);
+  data->faces = points.prepared.faces;
+  data->input_points = points.prepared.wedge_point;
+  data->affine_base = options.affine_base;
+  data->governing = options.governing;
+  data->governing_frame = options.governing == Governing::frame ? options.governing_frame : 0;
+  data->history_weight = options.governing == Governing::online ? options.history_weight : 0.0;
+  data->scale = bounding_box_diagonal(view);
+
+  // Section 3: the affine split.
+  auto start = std::chrono::steady_clock::now();
+  AffineSplit split;
+  if (Status status = affine_split(view, options.affine_base, split); !status) return status;
+  data->maps = std::move(split.maps);
+  data->residuals = std::move(split.residuals);
+  rep.seconds_affine = seconds_since(start);
+
+  // Section 4: the hierarchy (one order, or one per frame online) and the per-frame fields.
+  CollapseTable table(data->vertex_count);
+  FieldBuilder fields(view, options, data->scale);
+  const std::vector<detail::BoundarySide> boundary =
+      options.boundary_quadrics ? detail::boundary_sides(view.faces, view.face_count) : std::vector<detail::BoundarySide>{};
+  const std::vector<detail::BoundarySide>* boundary_or_null = options.boundary_quadrics ? &boundary : nullptr;
+  auto progress = [&](size_t done) {
+    if (options.progress) options.progress(done, mesh.frame_count);
+  };
+  std::vector<double> costs;
+  if (options.governing != Governing::online) {
+    start = std::chrono::steady_clock::now();
+    FrameHierarchy hierarchy;
+    if (options.governing == Governing::aqem) {
+      if (Status status = aqem_hierarchy(mesh, points, options, table, hierarchy); !status) return status;
+    } else {
+      const std::vector<float> positions = governing_positions(mesh, options);
+      if (Status status = decimate(mesh, points, positions.data(), options, boundary_or_null, nullptr, table,
+                                   hierarchy, costs);
+          !status)
+        return Status::error("internal: " + status.message);
+    }
+    rep.seconds_hierarchy = seconds_since(start);
+    progress(0);
+    start = std::chrono::steady_clock::now();
+    for (int32_t t = 0; t < frame_count; ++t) {
+      fields.add_frame(t, table, hierarchy, rep);
+      progress(static_cast<size_t>(t) + 1);
+    }
+    rep.seconds_fields = seconds_since(start);
+  } else {
+    FrameHierarchy previous, current;
+    std::vector<double> previous_costs;
+    progress(0);
+    for (int32_t t = 0; t < frame_count; ++t) {
+      start = std::chrono::steady_clock::now();
+      const float* positions = mesh.frames + static_cast<size_t>(t) * mesh.vertex_count * 3;
+      std::unique_ptr<detail::HistoryTerm> history;
+      if (t > 0 && options.history_weight > 0.0)
+        history = std::make_unique<detail::HistoryTerm>(table, previous, previous_costs, options.history_weight);
+      if (Status status = decimate(mesh, points, positions, options, boundary_or_null, history.get(), table, current,
+                                   costs);
+          !status)
+        return Status::error("internal: frame " + std::to_string(t) + ": " + status.message);
+      rep.seconds_hierarchy += seconds_since(start);
+      start = std::chrono::steady_clock::now();
+      fields.add_frame(t, table, current, rep);
+      rep.seconds_fields += seconds_since(start);
+      std::swap(previous, current);
+      previous_costs = costs;
+      progress(static_cast<size_t>(t) + 1);
+    }
+  }
+  fields.finish(table, *data);
+  if (Status status = detail::derive_links(*data); !status) return Status::error("internal: " + status.message);
+  out.data_ = std::move(data);
+  return Status::success();
+}
+
+}  // namespace animlod

@@ -1,0 +1,453 @@
+// The .tdag file: the TDAG and its affine maps (Shamir and Pascucci 2001, Section 6 stores
+// "the TDAG and affine maps"), versioned and checksummed.
+//
+// Layout (little-endian):
+//   8 bytes   magic "ANLDTDAG"
+//   u32       format version (kTdagFormatVersion)
+//   u64       body length in bytes
+//   body      the fields below
+//   u32       CRC-32 (IEEE) of the body
+// Body: unsigned LEB128 varints ("v"), zigzag varints for signed deltas ("z"), raw IEEE values:
+//   v F, V, M, C; u8 affine base, u8 governing; z governing frame; f64 history weight, f64 scale
+//   faces        z delta of each index from the one before (3 M values)
+//   inputs       v input vertex count, u8 1 when input vertex v is TDAG vertex v, else each
+//                input vertex's TDAG vertex as z delta from the one before (from -1)
+//   maps         F * 12 f64
+//   residuals    frame 0: V * 3 f32; frame t > 0: a bit per vertex (changed since t - 1), then
+//                the changed vertices' 3 f32 (a vertex that does not move is stored once)
+//   per collapse: v (node - kept), v (node - removed), v killed[0] + 1, v killed[1] + 1,
+//                tag (alive), v dependency count, per dependency z (node - dependency) and a tag
+//                (v 0: the collapse's alive tag; else v range count + 1, then ranges), v error
+//                run count, per run v ((length - 1) * 2 + gap?), [v gap from the previous
+//                death], z code change
+//   tag          v range count, per range v (birth - previous death), v length
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "animlod/tdag.hpp"
+#include "tdag_data.hpp"
+
+namespace animlod {
+
+namespace {
+
+constexpr char kMagic[8] = {'A', 'N', 'L', 'D', 'T', 'D', 'A', 'G'};
+constexpr size_t kHeaderSize = 8 + 4 + 8;
+
+uint32_t crc32(const uint8_t* bytes, size_t size) {
+  static const auto table = [] {
+    std::array<uint32_t, 256> t{};
+    for (uint32_t i = 0; i < 256; ++i) {
+      uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      t[i] = c;
+    }
+    return t;
+  }();
+  uint32_t c = 0xFFFFFFFFu;
+  for (size_t i = 0; i < size; ++i) c = table[(c ^ bytes[i]) & 0xFFu] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+class Writer {
+ public:
+  explicit Writer(std::vector<uint8_t>& out) : out_(out) {}
+  void u8(uint8_t v) { out_.push_back(v); }
+  template <typename T>
+  void raw(T v) {
+    uint8_t bytes[sizeof(T)];
+    std::memcpy(bytes, &v, sizeof(T));
+    out_.insert(out_.end(), bytes, bytes + sizeof(T));
+  }
+  template <typename T>
+  void raw_array(const T* values, size_t count) {
+    const auto* bytes = reinterpret_cast<const uint8_t*>(values);
+    out_.insert(out_.end(), bytes, bytes + count * sizeof(T));
+  }
+  void varint(uint64_t v) {
+    while (v >= 0x80) {
+      out_.push_back(static_cast<uint8_t>(v | 0x80));
+      v >>= 7;
+    }
+    out_.push_back(static_cast<uint8_t>(v));
+  }
+  void zigzag(int64_t v) { varint((static_cast<uint64_t>(v) << 1) ^ static_cast<uint64_t>(v >> 63)); }
+  void tag(const TimeTag& tag) {
+    varint(tag.ranges().size());
+    int32_t previous = 0;
+    for (const FrameRange& r : tag.ranges()) {
+      varint(static_cast<uint64_t>(r.birth - previous));
+      varint(static_cast<uint64_t>(r.death - r.birth));
+      previous = r.death;
+    }
+  }
+
+ private:
+  std::vector<uint8_t>& out_;
+};
+
+// Reads the body; every read checks the end, and failures keep the first message.
+class Reader {
+ public:
+  Reader(const uint8_t* bytes, size_t size) : p_(bytes), end_(bytes + size) {}
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+  void fail(const std::string& why) {
+    if (error_.empty()) error_ = why;
+    p_ = end_;
+  }
+  uint8_t u8(const char* what) {
+    if (p_ >= end_) {
+      fail(std::string("truncated in ") + what);
+      return 0;
+    }
+    return *p_++;
+  }
+  template <typename T>
+  T raw(const char* what) {
+    T v{};
+    if (static_cast<size_t>(end_ - p_) < sizeof(T)) {
+      fail(std::string("truncated in ") + what);
+      return v;
+    }
+    std::memcpy(&v, p_, sizeof(T));
+    p_ += sizeof(T);
+    return v;
+  }
+  template <typename T>
+  bool raw_array(T* out, size_t count, const char* what) {
+    if (static_cast<size_t>(end_ - p_) / sizeof(T) < count) {
+      fail(std::string("truncated in ") + what);
+      return false;
+    }
+    std::memcpy(out, p_, count * sizeof(T));
+    p_ += count * sizeof(T);
+    return true;
+  }
+  uint64_t varint(const char* what) {
+    uint64_t v = 0;
+    for (int shift = 0; shift < 64; shift += 7) {
+      const uint8_t byte = u8(what);
+      if (!ok()) return 0;
+      v |= static_cast<uint64_t>(byte & 0x7F) << shift;
+      if (!(byte & 0x80)) return v;
+    }
+    fail(std::string("malformed number in ") + what);
+    return 0;
+  }
+  int64_t zigzag(const char* what) {
+    const uint64_t v = varint(what);
+    return static_cast<int64_t>(v >> 1) ^ -static_cast<int64_t>(v & 1);
+  }
+  // A count that must be at most `limit` (so that a corrupted count cannot allocate wildly).
+  uint64_t count(const char* what, uint64_t limit) {
+    const uint64_t v = varint(what);
+    if (v > limit) fail(std::string(what) + ": " + std::to_string(v) + " exceeds " + std::to_string(limit));
+    return ok() ? v : 0;
+  }
+  TimeTag tag(const char* what, int32_t frame_count) {
+    TimeTag out;
+    const uint64_t ranges = count(what, static_cast<uint64_t>(frame_count));
+    int64_t previous = 0;
+    for (uint64_t i = 0; i < ranges && ok(); ++i) {
+      const int64_t birth = previous + static_cast<int64_t>(count(what, static_cast<uint64_t>(frame_count)));
+      const int64_t death = birth + static_cast<int64_t>(count(what, static_cast<uint64_t>(frame_count)));
+      if (birth < previous || death <= birth || death > frame_count) {
+        fail(std::string(what) + ": range outside the frames");
+        break;
+      }
+      out.add({static_cast<int32_t>(birth), static_cast<int32_t>(death)});
+      previous = death;
+    }
+    return out;
+  }
+  size_t remaining() const { return static_cast<size_t>(end_ - p_); }
+
+ private:
+  const uint8_t* p_;
+  const uint8_t* end_;
+  std::string error_;
+};
+
+}  // namespace
+
+Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out) {
+  out.clear();
+  if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
+  const detail::TdagData& d = *dag.data_;
+  const auto frame_count = static_cast<size_t>(d.frame_count), vertex_count = static_cast<size_t>(d.vertex_count);
+  std::vector<uint8_t> body;
+  Writer w(body);
+  w.varint(frame_count);
+  w.varint(vertex_count);
+  w.varint(d.face_count());
+  w.varint(d.collapse_count());
+  w.u8(static_cast<uint8_t>(d.affine_base));
+  w.u8(static_cast<uint8_t>(d.governing));
+  w.zigzag(d.governing_frame);
+  w.raw(d.history_weight);
+  w.raw(d.scale);
+  int32_t previous = 0;
+  for (int32_t index : d.faces) {
+    w.zigzag(static_cast<int64_t>(index) - previous);
+    previous = index;
+  }
+  // The input vertices' points: a flag for the identity, else each as a delta + 1.
+  bool identity = d.input_points.size() == vertex_count;
+  for (size_t v = 0; identity && v < vertex_count; ++v) identity = d.input_points[v] == static_cast<int32_t>(v);
+  w.varint(d.input_points.size());
+  w.u8(identity ? 1 : 0);
+  if (!identity) {
+    int64_t last = -1;
+    for (int32_t point : d.input_points) {
+      w.zigzag(static_cast<int64_t>(point) - last);
+      last = point;
+    }
+  }
+  w.raw_array(d.maps.data(), d.maps.size());
+  const size_t per_frame = vertex_count * 3;
+  w.raw_array(d.residuals.data(), per_frame);
+  std::vector<uint8_t> changed((vertex_count + 7) / 8);
+  for (size_t f = 1; f < frame_count; ++f) {
+    const float* now = &d.residuals[f * per_frame];
+    const float* before = now - per_frame;
+    std::fill(changed.begin(), changed.end(), 0);
+    for (size_t v = 0; v < vertex_count; ++v)
+      if (std::memcmp(now + 3 * v, before + 3 * v, 3 * sizeof(float)) != 0) changed[v / 8] |= uint8_t(1u << (v % 8));
+    w.raw_array(changed.data(), changed.size());
+    for (size_t v = 0; v < vertex_count; ++v)
+      if (changed[v / 8] & (1u << (v % 8))) w.raw_array(now + 3 * v, 3);
+  }
+  for (size_t c = 0; c < d.collapse_count(); ++c) {
+    const int64_t node = static_cast<int64_t>(vertex_count + c);
+    w.varint(static_cast<uint64_t>(node - d.kept_child[c]));
+    w.varint(static_cast<uint64_t>(node - d.removed_child[c]));
+    w.varint(static_cast<uint64_t>(d.killed[c][0] + 1));
+    w.varint(static_cast<uint64_t>(d.killed[c][1] + 1));
+    w.tag(d.alive[c]);
+    w.varint(static_cast<uint64_t>(d.dep_offsets[c + 1] - d.dep_offsets[c]));
+    for (int32_t link = d.dep_offsets[c]; link < d.dep_offsets[c + 1]; ++link) {
+      w.zigzag(node - d.dep_nodes[static_cast<size_t>(link)]);
+      const TimeTag& tag = d.dep_tags[static_cast<size_t>(link)];
+      if (tag == d.alive[c]) {
+        w.varint(0);
+        continue;
+      }
+      w.varint(tag.ranges().size() + 1);
+      int32_t last = 0;
+      for (const FrameRange& r : tag.ranges()) {
+        w.varint(static_cast<uint64_t>(r.birth - last));
+        w.varint(static_cast<uint64_t>(r.death - r.birth));
+        last = r.death;
+      }
+    }
+    w.varint(static_cast<uint64_t>(d.error_offsets[c + 1] - d.error_offsets[c]));
+    int32_t death = 0;
+    int32_t code = 0;
+    for (int32_t r = d.error_offsets[c]; r < d.error_offsets[c + 1]; ++r) {
+      const detail::ErrorRun& run = d.error_runs[static_cast<size_t>(r)];
+      const auto gap = static_cast<uint64_t>(run.range.birth - death);
+      w.varint((static_cast<uint64_t>(run.range.death - run.range.birth - 1) << 1) | (gap > 0 ? 1u : 0u));
+      if (gap > 0) w.varint(gap);
+      w.zigzag(int32_t(run.code) - code);
+      death = run.range.death;
+      code = run.code;
+    }
+  }
+
+  out.reserve(kHeaderSize + body.size() + 4);
+  Writer header(out);
+  header.raw_array(kMagic, sizeof(kMagic));
+  header.raw(kTdagFormatVersion);
+  header.raw(static_cast<uint64_t>(body.size()));
+  out.insert(out.end(), body.begin(), body.end());
+  header.raw(crc32(body.data(), body.size()));
+  return Status::success();
+}
+
+Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& out) {
+  out = TemporalDag{};
+  if (size < sizeof(kMagic) || std::memcmp(bytes, kMagic, sizeof(kMagic)) != 0)
+    return Status::error("not a TDAG file (no ANLDTDAG signature)");
+  if (size < kHeaderSize) return Status::error("truncated TDAG file (incomplete header)");
+  uint32_t version = 0;
+  uint64_t body_size = 0;
+  std::memcpy(&version, bytes + 8, 4);
+  std::memcpy(&body_size, bytes + 12, 8);
+  if (version != kTdagFormatVersion)
+    return Status::error("TDAG format version " + std::to_string(version) +
+                         (version < kTdagFormatVersion ? " was written by an older animlod" : " was written by a newer animlod") +
+                         "; this build reads version " + std::to_string(kTdagFormatVersion) +
+                         " only (rebuild it with `animlod tdag build`)");
+  if (size - kHeaderSize < 4 || body_size != size - kHeaderSize - 4)
+    return Status::error("truncated or padded TDAG file: the header announces " + std::to_string(body_size) +
+                         " bytes of data, the file holds " + std::to_string(size < kHeaderSize + 4 ? 0 : size - kHeaderSize - 4));
+  const uint8_t* body = bytes + kHeaderSize;
+  uint32_t stored_crc = 0;
+  std::memcpy(&stored_crc, body + body_size, 4);
+  if (crc32(body, static_cast<size_t>(body_size)) != stored_crc)
+    return Status::error("corrupted TDAG file: checksum mismatch");
+
+  Reader r(body, static_cast<size_t>(body_size));
+  auto d = std::make_shared<detail::TdagData>();
+  constexpr uint64_t kMaxIndex = INT32_MAX;
+  const uint64_t frame_count = r.count("frame count", kMaxIndex - 1);
+  const uint64_t vertex_count = r.count("vertex count", kMaxIndex);
+  const uint64_t face_count = r.count("face count", kMaxIndex / 3);
+  const uint64_t collapse_count = r.count("collapse count", kMaxIndex - vertex_count);
+  if (!r.ok()) return Status::error("corrupted TDAG file: " + r.error());
+  // Sizes the remaining bytes must at least hold (so that a bad count cannot allocate wildly).
+  const uint64_t floor = face_count * 3 + frame_count * 12 * 8 + vertex_count * 12 + collapse_count * 6;
+  if (frame_count == 0 || vertex_count == 0 || floor > r.remaining())
+    return Status::error("corrupted TDAG file: sizes (F " + std::to_string(frame_count) + ", V " +
+                         std::to_string(vertex_count) + ", M " + std::to_string(face_count) + ", C " +
+                         std::to_string(collapse_count) + ") do not fit the file");
+  d->frame_count = static_cast<int32_t>(frame_count);
+  d->vertex_count = static_cast<int32_t>(vertex_count);
+  const uint8_t base = r.u8("affine base"), governing = r.u8("governing");
+  if (base > static_cast<uint8_t>(AffineBase::average) || governing > static_cast<uint8_t>(Governing::online))
+    return Status::error("corrupted TDAG file: unknown affine base or governing mesh");
+  d->affine_base = static_cast<AffineBase>(base);
+  d->governing = static_cast<Governing>(governing);
+  d->governing_frame = static_cast<int32_t>(r.zigzag("governing frame"));
+  d->history_weight = r.raw<double>("history weight");
+  d->scale = r.raw<double>("scale");
+  if (!(d->scale > 0.0) || !std::isfinite(d->scale)) r.fail("scale is not a positive number");
+  d->faces.resize(face_count * 3);
+  int64_t previous = 0;
+  for (auto& index : d->faces) {
+    previous += r.zigzag("faces");
+    if (previous < 0 || previous >= static_cast<int64_t>(vertex_count)) {
+      r.fail("faces: a vertex index outside [0, V)");
+      break;
+    }
+    index = static_cast<int32_t>(previous);
+  }
+  const uint64_t input_count = r.count("input vertex count", kMaxIndex);
+  const uint8_t identity = r.u8("input vertices");
+  if (identity > 1 || (identity && input_count != vertex_count)) r.fail("input vertices: bad identity flag");
+  if (!identity && input_count > r.remaining()) r.fail("input vertices: count does not fit the file");
+  if (r.ok()) {
+    d->input_points.resize(input_count);
+    int64_t last = -1;
+    for (size_t v = 0; v < input_count && r.ok(); ++v) {
+      last = identity ? static_cast<int64_t>(v) : last + r.zigzag("input vertices");
+      if (last < -1 || last >= static_cast<int64_t>(vertex_count)) r.fail("input vertices: a point outside [0, V)");
+      d->input_points[v] = static_cast<int32_t>(last);
+    }
+  }
+  d->maps.resize(frame_count * 12);
+  r.raw_array(d->maps.data(), d->maps.size(), "affine maps");
+  const size_t per_frame = static_cast<size_t>(vertex_count) * 3;
+  d->residuals.resize(static_cast<size_t>(frame_count) * per_frame);
+  r.raw_array(d->residuals.data(), per_frame, "residuals");
+  std::vector<uint8_t> changed((static_cast<size_t>(vertex_count) + 7) / 8);
+  for (size_t f = 1; f < frame_count && r.ok(); ++f) {
+    float* now = &d->residuals[f * per_frame];
+    std::copy_n(now - per_frame, per_frame, now);
+    if (!r.raw_array(changed.data(), changed.size(), "residuals")) break;
+    for (size_t v = 0; v < vertex_count; ++v)
+      if (changed[v / 8] & (1u << (v % 8))) r.raw_array(now + 3 * v, 3, "residuals");
+  }
+  for (double value : d->maps)
+    if (!std::isfinite(value)) r.fail("a non-finite affine map");
+  d->kept_child.resize(collapse_count);
+  d->removed_child.resize(collapse_count);
+  d->killed.resize(collapse_count);
+  d->alive.resize(collapse_count);
+  d->dep_offsets.assign(1, 0);
+  d->error_offsets.assign(1, 0);
+  const auto frames = static_cast<int32_t>(frame_count);
+  for (size_t c = 0; c < collapse_count && r.ok(); ++c) {
+    const int64_t node = static_cast<int64_t>(vertex_count + c);
+    d->kept_child[c] = static_cast<int32_t>(node - static_cast<int64_t>(r.count("children", static_cast<uint64_t>(node))));
+    d->removed_child[c] = static_cast<int32_t>(node - static_cast<int64_t>(r.count("children", static_cast<uint64_t>(node))));
+    for (auto& face : d->killed[c]) face = static_cast<int32_t>(r.count("removed faces", face_count)) - 1;
+    d->alive[c] = r.tag("alive tag", frames);
+    const uint64_t links = r.count("dependency count", collapse_count);
+    for (uint64_t i = 0; i < links && r.ok(); ++i) {
+      const int64_t dep = node - r.zigzag("dependencies");
+      d->dep_nodes.push_back(static_cast<int32_t>(std::clamp<int64_t>(dep, -1, INT32_MAX)));
+      const uint64_t ranges = r.count("dependency tag", frame_count + 1);
+      if (ranges == 0) {
+        d->dep_tags.push_back(d->alive[c]);
+        continue;
+      }
+      TimeTag tag;
+      int64_t last = 0;
+      for (uint64_t k = 0; k + 1 < ranges && r.ok(); ++k) {
+        const int64_t birth = last + static_cast<int64_t>(r.count("dependency tag", frame_count));
+        const int64_t death = birth + static_cast<int64_t>(r.count("dependency tag", frame_count));
+        if (death <= birth || death > frames) r.fail("dependency tag: range outside the frames");
+        else tag.add({static_cast<int32_t>(birth), static_cast<int32_t>(death)});
+        last = death;
+      }
+      d->dep_tags.push_back(tag);
+    }
+    d->dep_offsets.push_back(static_cast<int32_t>(d->dep_nodes.size()));
+    const uint64_t runs = r.count("error run count", frame_count);
+    int64_t death = 0, code = 0;
+    for (uint64_t i = 0; i < runs && r.ok(); ++i) {
+      const uint64_t head = r.varint("error runs");
+      if ((head >> 1) >= frame_count) {
+        r.fail("error runs: a run longer than the frames");
+        break;
+      }
+      const int64_t birth = death + ((head & 1u) ? static_cast<int64_t>(r.count("error runs", frame_count)) : 0);
+      death = birth + static_cast<int64_t>(head >> 1) + 1;
+      code += r.zigzag("error runs");
+      if (death <= birth || death > frames || code < 0 || code > 65535) {
+        r.fail("error runs: a run outside the frames or an invalid code");
+        break;
+      }
+      d->error_runs.push_back({{static_cast<int32_t>(birth), static_cast<int32_t>(death)}, static_cast<uint16_t>(code)});
+    }
+    d->error_offsets.push_back(static_cast<int32_t>(d->error_runs.size()));
+  }
+  if (r.ok() && r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " unexpected bytes after the last collapse");
+  if (!r.ok()) return Status::error("corrupted TDAG file: " + r.error());
+  if (Status status = detail::derive_links(*d); !status) return Status::error("corrupted TDAG file: " + status.message);
+  out.data_ = std::move(d);
+  return Status::success();
+}
+
+Status save_temporal_dag(const TemporalDag& dag, const std::string& path) {
+  std::vector<uint8_t> bytes;
+  if (Status status = serialize_temporal_dag(dag, bytes); !status) return Status::error(path + ": " + status.message);
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
+    if (!file) return Status::error(path + ": cannot open for writing");
+    file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!file) {
+      std::remove(temporary.c_str());
+      return Status::error(path + ": write failed");
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::remove(temporary.c_str());
+    return Status::error(path + ": " + error.message());
+  }
+  return Status::success();
+}
+
+Status load_temporal_dag(const std::string& path, TemporalDag& out) {
+  out = TemporalDag{};
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return Status::error(path + ": cannot open");
+  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (Status status = deserialize_temporal_dag(bytes.data(), bytes.size(), out); !status)
+    return Status::error(path + ": " + status.message);
+  return Status::success();
+}
+
+}  // namespace animlod

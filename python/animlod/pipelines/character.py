@@ -1,0 +1,333 @@
+"""A skinned glTF character in, the paper's full chain out: geometry levels times motion levels.
+
+Section 3 of the motion LoD paper pairs a mesh level with a skeleton level per character.
+Here every skinned drawable gets AQEM geometry levels (as :func:`simplify_document` builds
+them) and every skin gets motion levels: the clips of all its animations are analysed as one
+(so one reduced skeleton serves them all), joints are frozen level by level, each clip is
+re-fitted with SLSQP, and the weights of frozen joints move to their kept ancestors (seeds/000,
+Sections 4-5). Level i of the written chain combines geometry level i with motion level i (or
+the coarsest one a small skeleton has);
+every other combination is written too (``extras.animlod_grid`` on the base node lists them by
+geometry level, then motion level) so that a benchmark can walk the whole grid.
+
+Motion level m >= 1 adds, per skin, a reduced skeleton as joint nodes of its own, a skin over
+them and one animation per input clip (``extras.animlod = {"clip", "motion_level"}``); a level
+node at motion level m uses that skin, so any glTF engine can play it.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..io.errors import FormatError
+from ..io.glb_builder import GlbBuilder
+from ..io.gltf_document import GltfDocument
+from ..io.gltf_drawable import Clip, Drawable, motion_frames, read_drawables
+from ..io.gltf_lod import (
+    GRID_EXTRA,
+    LevelInfo,
+    PrimitiveArrays,
+    add_level_mesh,
+    add_level_node,
+    attach_chain,
+    screen_coverages,
+)
+from ..io.gltf_write import add_animation, add_skeleton, add_skin
+from ..metrics import surface_error
+from ..model import AnimatedMesh, Motion, SkinnedMesh
+from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain
+from ..motion_lod.frozen import FrozenLevel
+from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
+from .drawable_levels import DrawableLevel, DrawableLevels, simplify_drawable, spread_frames
+from .lod_document import DEFAULT_RATIOS
+
+
+@dataclass
+class CharacterLevel:
+    """One level of a character's chain: its geometry and motion levels and measured error."""
+
+    level: int
+    mesh_level: int
+    motion_level: int
+    faces: int
+    joints: int
+    error: float  # asset units: max over measured frames of every clip of the Hausdorff distance
+    relative_error: float
+    coverage: float
+
+
+@dataclass
+class CharacterReport:
+    """The result of :func:`build_character`: one chain per skinned drawable."""
+
+    source: Path
+    output: Path
+    chains: dict[str, list[CharacterLevel]]
+    motion_seconds: float
+    geometry_seconds: float
+    notes: list[str] = field(default_factory=list)
+
+
+def build_character(
+    source: str | os.PathLike,
+    output: str | os.PathLike,
+    ratios: Sequence[float] = DEFAULT_RATIOS,
+    *,
+    solver: str = "slsqp",
+    workers: int = 1,
+    fps: float = 30.0,
+    frame_budget: int = 48,
+    measured_frames: int = 12,
+    pixel_error: float = 1.0,
+    viewport_px: float = 1080.0,
+    progress: Callable[[str], None] | None = None,
+    **aqem_options: object,
+) -> CharacterReport:
+    """Build geometry x motion levels of every skinned drawable of ``source`` into one LoD GLB.
+
+    Parameters
+    ----------
+    source, output : the input glTF and the LoD GLB to write (atomically).
+    ratios : face ratios of geometry levels 1, 2, ...; motion levels are as many (joint counts
+        spread down to the fewest the skeleton allows, see :func:`animlod.build_motion_chain`).
+    solver, workers : the motion re-fit (``"slsqp"``, the paper's SQP, or ``"newton"``) and the
+        processes it uses.
+    fps, frame_budget, measured_frames, pixel_error, viewport_px, aqem_options : as for
+        :func:`animlod.pipelines.simplify_document`.
+
+    Raises
+    ------
+    FormatError when the file has no skinned mesh with an animation, or cannot be read.
+    """
+    say = progress or (lambda _line: None)
+    doc = GltfDocument(source)
+    drawables = [d for d in read_drawables(doc, fps) if d.skinned is not None]
+    animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]
+    if not animated:
+        raise FormatError(doc.path, "skins", "no skinned mesh with an animation: a character chain needs both")
+    levels_wanted = len(ratios) + 1
+    started = time.perf_counter()
+    motion_chains: dict[int, tuple[MotionLodChain, list[tuple[Clip, slice]]]] = {}
+    notes = []
+    joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
+    # Larger skeletons first: a skin whose joints all belong to a larger skin (a helmet bound to
+    # the head) keeps its joints, as freezing them on their own would tear it from the body.
+    for drawable in sorted(animated, key=lambda d: -len(joints_of[d.skin_index])):
+        skin = drawable.skin_index
+        if skin in motion_chains:
+            continue
+        clips = [clip for clip in drawable.clips if clip.motion is not None]
+        joined, spans = _joined_motion([clip.motion for clip in clips])
+        analysis = analyze_motion(joined)
+        # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
+        levels = min(levels_wanted, len(analysis.priority) + 1)
+        covering = [other for other in motion_chains if joints_of[skin] < joints_of[other]]
+        if covering:
+            levels = 1
+            notes.append(f"skin {skin}: its joints belong to skin {covering[0]}; it keeps them at every level")
+        say(f"skin {skin}: {levels} motion levels over {len(clips)} clips")
+        chain = build_motion_chain(joined, levels=levels, solver=solver, workers=workers, analysis=analysis)
+        motion_chains[skin] = (chain, list(zip(clips, spans)))
+    motion_seconds = time.perf_counter() - started
+    started = time.perf_counter()
+    geometry = {}
+    for drawable in animated:
+        say(f"{drawable.label}: geometry levels of {len(drawable.geometry.faces)} triangles")
+        geometry[drawable.label] = simplify_drawable(drawable, ratios, frame_budget, measured_frames, aqem_options)
+    geometry_seconds = time.perf_counter() - started
+
+    builder = GlbBuilder.from_document(doc)
+    motion_nodes = {skin: _add_motion_levels(builder, chain, clips) for skin, (chain, clips) in motion_chains.items()}
+    chains = {}
+    for drawable in animated:
+        chain, clips = motion_chains[drawable.skin_index]
+        levels = geometry[drawable.label]
+        say(f"{drawable.label}: writing the grid, measuring the chain")
+        grid = _write_grid(builder, doc, drawable, levels, chain, motion_nodes[drawable.skin_index])
+        report = _measure_chain(drawable, levels, chain, clips, measured_frames)
+        coverages = screen_coverages([level.error for level in report], levels.size, pixel_error, viewport_px)
+        for level, coverage in zip(report, coverages):
+            level.coverage = coverage
+            level.relative_error = level.error / levels.size if levels.size > 0 else 0.0
+        _attach(builder, drawable, report, grid)
+        chains[drawable.label] = report
+        notes += [f"{drawable.label}: {note}" for note in levels.notes]
+    skipped = [d.label for d in read_drawables(doc, fps) if d.label not in chains]
+    if skipped:
+        notes.append(f"left as they are (no skin or no animation): {', '.join(skipped)}")
+    builder.save(output)
+    return CharacterReport(Path(source), Path(output), chains, motion_seconds, geometry_seconds, notes)
+
+
+def _joined_motion(motions: list[Motion]) -> tuple[Motion, list[slice]]:
+    """The clips one after another as one motion (one analysis, one reduced skeleton for all),
+    and each clip's frames in it."""
+    starts = np.cumsum([0] + [motion.frame_count for motion in motions])
+    spans = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
+    translations = None
+    if any(motion.joint_translations is not None for motion in motions):
+        translations = np.concatenate([motion.local_translations() for motion in motions])
+    joined = Motion(
+        motions[0].skeleton,
+        np.concatenate([motion.root_positions for motion in motions]),
+        np.concatenate([motion.local_rotations for motion in motions]),
+        fps=motions[0].fps,
+        name="+".join(motion.name for motion in motions),
+        joint_translations=translations,
+    )
+    return joined, spans
+
+
+@dataclass
+class _MotionLevelNodes:
+    """What one motion level adds to the document for one skin: the joint nodes of its reduced
+    skeleton (None at level 0, which keeps the input's joints) and its joint count."""
+
+    joint_nodes: list[int] | None
+    joints: int
+
+
+def _add_motion_levels(builder: GlbBuilder, chain: MotionLodChain, clips: list) -> list[_MotionLevelNodes]:
+    """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's)."""
+    nodes = [_MotionLevelNodes(None, chain.levels[0].report.joint_count)]
+    for m, level in enumerate(chain.levels[1:], start=1):
+        joint_nodes = add_skeleton(builder, level.motion.skeleton)
+        for clip, span in clips:
+            name = f"{clip.name or f'animation {clip.index}'}@motion{m}"
+            extras = {"animlod": {"clip": clip.index, "motion_level": m}}
+            clip_motion = motion_frames(level.motion, np.arange(span.start, span.stop))
+            add_animation(builder, clip_motion, joint_nodes, name, extras)
+        nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))
+    return nodes
+
+
+def _write_grid(
+    builder: GlbBuilder,
+    doc: GltfDocument,
+    drawable: Drawable,
+    levels: DrawableLevels,
+    chain: MotionLodChain,
+    motion_nodes: list[_MotionLevelNodes],
+) -> list[list[list[int]]]:
+    """Every (geometry g, motion m) combination of ``drawable`` as level nodes, one per base
+    node; returns ``grid[g][m]`` -> those nodes ((0, 0) is the base nodes themselves)."""
+    geometry: list[DrawableLevel | None] = [None, *levels.levels]  # geometry level 0 is the input
+    input_joints = len(doc.gltf.skins[drawable.skin_index].joints)
+    skins = [drawable.skin_index]
+    for m in range(1, len(chain.levels)):  # a reduced skin's inverse binds do not depend on the geometry
+        reduced = transfer_skin(drawable.skinned, chain.levels[m].frozen)
+        skins.append(add_skin(builder, motion_nodes[m].joint_nodes, reduced.inverse_bind))
+    mesh_name = doc.gltf.meshes[drawable.mesh_index].name or f"mesh{drawable.mesh_index}"
+    grid = [[list(drawable.nodes) for _ in chain.levels] for _ in geometry]
+    for g, level in enumerate(geometry):
+        for m, motion_level in enumerate(chain.levels):
+            if g == 0 and m == 0:
+                continue
+            primitives = _input_primitives(drawable) if level is None else level.primitives
+            skinned = drawable.skinned if level is None else level.skinned
+            if m > 0:
+                primitives = _reposed(drawable, skinned, motion_level.frozen, primitives)
+            mesh = add_level_mesh(
+                builder, drawable.mesh_index, primitives, drawable.geometry.other_primitives, f"{mesh_name}_G{g}M{m}"
+            )
+            joints = input_joints if m == 0 else motion_nodes[m].joints
+            info = LevelInfo(-1, 0.0, skinned.face_count, g, m, joints)
+            grid[g][m] = [add_level_node(builder, base, mesh, skins[m], info) for base in drawable.nodes]
+    return grid
+
+
+def _input_primitives(drawable: Drawable) -> list[PrimitiveArrays]:
+    """The input's triangle primitives as level primitives (every vertex, in order)."""
+    starts = drawable.geometry.vertex_starts
+    return [
+        PrimitiveArrays(p.index, dict(p.attributes), p.faces, list(p.targets), np.arange(starts[k], starts[k + 1]))
+        for k, p in enumerate(drawable.geometry.primitives)
+    ]
+
+
+def _reposed(
+    drawable: Drawable, skinned: SkinnedMesh, frozen: FrozenLevel, primitives: list[PrimitiveArrays]
+) -> list[PrimitiveArrays]:
+    """``primitives`` bound to a motion level's reduced skin: positions and directions re-posed
+    into the key posture of the frozen joints (world space, as the reduced skin's inverse binds
+    are), skin weights moved to the kept joints (:func:`transfer_skin`)."""
+    reduced = transfer_skin(skinned, frozen)
+    matrices = key_bind_pose(skinned, frozen) @ skinned.inverse_bind  # (J, 4, 4) rest -> key posture
+    blended = np.einsum("vk,vkij->vij", skinned.weights, matrices[skinned.joints])[:, :3, :3]
+    to_world = np.linalg.inv(drawable.world[:3, :3]).T  # directions: the inverse transpose
+    out = []
+    for primitive in primitives:
+        vertices = primitive.vertices
+        attributes = {k: v for k, v in primitive.attributes.items() if not k.startswith(("JOINTS_", "WEIGHTS_"))}
+        attributes["POSITION"] = reduced.rest_positions[vertices]
+        for name in ("NORMAL", "TANGENT"):
+            if name in attributes:
+                turned = np.einsum("vij,vj->vi", blended[vertices], attributes[name][:, :3] @ to_world.T)
+                length = np.linalg.norm(turned, axis=1, keepdims=True)
+                values = attributes[name].copy()
+                values[:, :3] = turned / np.where(length > 0.0, length, 1.0)
+                attributes[name] = values.astype(np.float32)
+        sets = -(-reduced.joints.shape[1] // 4)
+        pad = ((0, 0), (0, 4 * sets - reduced.joints.shape[1]))
+        joints, weights = np.pad(reduced.joints[vertices], pad), np.pad(reduced.weights[vertices], pad)
+        for s in range(sets):
+            attributes[f"JOINTS_{s}"] = joints[:, 4 * s : 4 * s + 4].astype(np.uint16)
+            attributes[f"WEIGHTS_{s}"] = weights[:, 4 * s : 4 * s + 4].astype(np.float32)
+        targets = [dict(target) for target in primitive.targets]
+        if skinned.morph_targets is not None:  # world-space deltas, like the positions
+            for t, target in enumerate(targets):
+                if "POSITION" in target:
+                    target["POSITION"] = skinned.morph_targets[t][vertices].astype(np.float32)
+        out.append(PrimitiveArrays(primitive.source, attributes, primitive.faces, targets, vertices))
+    return out
+
+
+def _measure_chain(
+    drawable: Drawable,
+    levels: DrawableLevels,
+    chain: MotionLodChain,
+    clips: list[tuple[Clip, slice]],
+    measured_frames: int,
+) -> list[CharacterLevel]:
+    """The chain's levels (geometry level i with motion level i, or the coarsest motion level
+    there is), each measured: the reduced skin played with the re-fitted clips against the
+    input's clips, max Hausdorff distance."""
+    report = [CharacterLevel(0, 0, 0, len(drawable.geometry.faces), chain.levels[0].report.joint_count, 0.0, 0.0, 0.0)]
+    for i in range(1, len(levels.levels) + 1):
+        m = min(i, len(chain.levels) - 1)  # a small skeleton runs out of motion levels first
+        level, motion_level = levels.levels[i - 1], chain.levels[m]
+        reduced = transfer_skin(level.skinned, motion_level.frozen)
+        error = 0.0
+        for clip, span in clips:
+            frames = spread_frames(clip.frame_count, measured_frames)
+            weights = None if clip.morph_weights is None else clip.morph_weights[frames]
+            original = AnimatedMesh(drawable.geometry.faces, drawable.clip_frames(clip, frames))
+            posed = reduced.bake(motion_frames(motion_level.motion, span.start + frames), weights)
+            error = max(error, float(surface_error(original, posed, samples=4000).hausdorff.max()))
+        faces = level.simplified.mesh.face_count
+        report.append(CharacterLevel(i, i, m, faces, motion_level.report.joint_count, error, 0.0, 0.0))
+    return report
+
+
+def _attach(builder: GlbBuilder, drawable: Drawable, report: list[CharacterLevel], grid: list) -> None:
+    """The chain (diagonal of the grid) on every base node, with the grid beside it."""
+    for index, base in enumerate(drawable.nodes):
+        chain_nodes = [grid[level.mesh_level][level.motion_level][index] for level in report[1:]]
+        for level, node in zip(report[1:], chain_nodes):
+            info = builder.json["nodes"][node]["extras"]["animlod"]
+            info.update(level=level.level, error=level.error)
+        attach_chain(
+            builder,
+            base,
+            chain_nodes,
+            [level.coverage for level in report],
+            LevelInfo(0, 0.0, report[0].faces, 0, 0, report[0].joints),
+        )
+        extras = builder.json["nodes"][base]["extras"]
+        extras[GRID_EXTRA] = [[cells[index] for cells in row] for row in grid]

@@ -1,0 +1,99 @@
+"""A deforming mesh sequence in (OBJ/PLY frames or NPZ), its AQEM levels out in the same format.
+
+Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OBJ/PLY input,
+``<stem>_lod<i>.npz`` for NPZ input, and measured against the input frame by frame (symmetric
+Hausdorff and RMS distance relative to the bounding-box diagonal).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..aqem import Preparation, simplify_animated
+from ..io.detect import input_kind, input_stem
+from ..io.errors import FormatError
+from ..metrics import surface_error
+from ..model import AnimatedMesh
+
+
+@dataclass
+class SequenceLevel:
+    """One written level: its path, faces, AQEM error and measured surface error."""
+
+    path: Path
+    faces: int
+    target_faces: int
+    reached: bool
+    aqem_error: float  # asset units, the largest collapse error (RMS plane distance)
+    surface: dict[str, float] | None  # mean/max over frames of Hausdorff and RMS, relative; None unmeasured
+
+
+@dataclass
+class SequenceReport:
+    """The result of :func:`simplify_sequence`."""
+
+    source: str
+    original: AnimatedMesh
+    levels: list[SequenceLevel]
+    preparation: Preparation
+    seconds: float  # the simplification (all levels), without reading, writing or measuring
+
+
+def simplify_sequence(
+    source: str | os.PathLike,
+    output: str | os.PathLike,
+    ratios: Sequence[float] = (0.5, 0.25, 0.1),
+    *,
+    measure: bool = True,
+    progress: Callable[[int, int], None] | None = None,
+    **aqem_options: object,
+) -> SequenceReport:
+    """Simplify the sequence at ``source`` (a folder, glob or file of OBJ/PLY frames, or an NPZ)
+    and write its levels into the folder ``output``.
+
+    ``aqem_options`` are keyword arguments of :func:`animlod.simplify_animated`; ``progress``
+    receives its (done, total) collapse counts. Raises FormatError for unreadable input.
+    """
+    kind = input_kind(source)
+    if kind == "npz":
+        from ..io.npz import read_npz
+
+        original = read_npz(source)
+    elif kind == "sequence":
+        from ..io.meshseq import read_sequence
+
+        original = read_sequence(source)
+    else:
+        raise FormatError(os.fspath(source), "file", f"a {kind} file is not a mesh sequence")
+    started = time.perf_counter()
+    result = simplify_animated(original, ratios, progress=progress, **aqem_options)
+    seconds = time.perf_counter() - started
+    folder, stem = Path(output), input_stem(source)
+    levels = []
+    for index, level in enumerate(result.levels, start=1):
+        path = _write_level(kind, source, folder / f"{stem}_lod{index}", level.mesh)
+        surface = surface_error(original, level.mesh, samples=10000).summary() if measure else None
+        faces, target = level.mesh.face_count, level.target_face_count
+        levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface))
+    return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds)
+
+
+def _write_level(kind: str, source: str | os.PathLike, target: Path, mesh: AnimatedMesh) -> Path:
+    """Write a level in the input's format; its path."""
+    if kind == "npz":
+        from ..io.npz import write_npz
+
+        path = target.with_suffix(".npz")
+        write_npz(path, mesh)
+        return path
+    from ..io.meshseq import write_sequence
+
+    files = sorted(Path(source).iterdir()) if Path(source).is_dir() else [Path(source)]
+    fmt = "ply" if any(path.suffix.lower() == ".ply" for path in files) else "obj"
+    target.mkdir(parents=True, exist_ok=True)
+    write_sequence(target, mesh, fmt)
+    return target

@@ -1,0 +1,360 @@
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "animlod/mesh_validation.hpp"
+#include "animlod/tdag.hpp"
+#include "animlod/tdag_player.hpp"
+#include "test_aqem_meshes.hpp"
+
+using animlod::ApproximationLevel;
+using animlod::Governing;
+using animlod::TdagCut;
+using animlod::TdagMesh;
+using animlod::TdagOptions;
+using animlod::TemporalDag;
+using animlod::testing::OwnedAnimatedMesh;
+
+namespace {
+
+TemporalDag build(const OwnedAnimatedMesh& mesh, TdagOptions options = {}) {
+  TemporalDag dag;
+  const animlod::Status status = animlod::build_temporal_dag(mesh.view(), options, dag);
+  REQUIRE_MESSAGE(status.ok, status.message);
+  return dag;
+}
+
+// A bending tube that also swings and grows as a whole (an affine part and a bend).
+OwnedAnimatedMesh swinging_tube(int frames) {
+  OwnedAnimatedMesh mesh = animlod::testing::bending_tube(16, 12, frames, 1.4);
+  for (size_t f = 0; f < mesh.frame_count; ++f) {
+    const double a = 0.2 * double(f), s = 1.0 + 0.05 * double(f);
+    for (size_t v = 0; v < mesh.vertex_count; ++v) {
+      float* p = &mesh.frames[(f * mesh.vertex_count + v) * 3];
+      const double x = p[0], y = p[1];
+      p[0] = float(s * (std::cos(a) * x - std::sin(a) * y) + 0.3 * double(f));
+      p[1] = float(s * (std::sin(a) * x + std::cos(a) * y));
+    }
+  }
+  return mesh;
+}
+
+// Nodes and faces (as node triples, smallest node first, orientation kept), sorted.
+struct CanonicalMesh {
+  std::vector<int32_t> nodes;
+  std::vector<std::array<int32_t, 3>> faces;
+  bool operator==(const CanonicalMesh& o) const { return nodes == o.nodes && faces == o.faces; }
+};
+
+CanonicalMesh canonical(const TdagMesh& mesh) {
+  CanonicalMesh out;
+  out.nodes = mesh.nodes;
+  std::sort(out.nodes.begin(), out.nodes.end());
+  for (size_t f = 0; f < mesh.faces.size(); f += 3) {
+    std::array<int32_t, 3> face{mesh.nodes[size_t(mesh.faces[f])], mesh.nodes[size_t(mesh.faces[f + 1])],
+                                mesh.nodes[size_t(mesh.faces[f + 2])]};
+    std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
+    out.faces.push_back(face);
+  }
+  std::sort(out.faces.begin(), out.faces.end());
+  return out;
+}
+
+CanonicalMesh current(const TdagCut& cut) {
+  TdagMesh mesh;
+  cut.mesh(mesh);
+  return canonical(mesh);
+}
+
+CanonicalMesh fresh(const TemporalDag& dag, int32_t frame, double tolerance) {
+  TdagCut cut(dag);
+  const animlod::Status status = cut.query(frame, tolerance);
+  REQUIRE_MESSAGE(status.ok, status.message);
+  return current(cut);
+}
+
+// The mesh is a valid manifold (the checks every algorithm applies to its input) and every
+// input vertex is within `tolerance` of the vertex standing for it (plus float rounding).
+void check_cut(const TemporalDag& dag, const TdagCut& cut, double tolerance) {
+  TdagMesh mesh;
+  cut.mesh(mesh);
+  const animlod::AnimatedMeshView view{mesh.positions.data(), mesh.faces.data(), 1, mesh.nodes.size(),
+                                       mesh.faces.size() / 3};
+  const animlod::Status valid = animlod::validate_animated_mesh(view);
+  REQUIRE_MESSAGE(valid.ok, valid.message);
+  CHECK(mesh.error_bound <= tolerance);
+  std::vector<float> original(dag.vertex_count() * 3);
+  dag.frame_positions(cut.frame(), original.data());
+  std::vector<int32_t> map;
+  cut.input_vertex_map(map);
+  for (size_t v = 0; v < map.size(); ++v) {
+    REQUIRE(map[v] >= 0);
+    double d2 = 0.0;
+    for (int k = 0; k < 3; ++k) d2 += std::pow(double(original[3 * v + k]) - mesh.positions[3 * size_t(map[v]) + k], 2);
+    CHECK(std::sqrt(d2) <= tolerance + 1e-5);
+  }
+}
+
+double largest_bound(const TemporalDag& dag, int32_t frame) {
+  double largest = 0.0;
+  for (size_t c = 0; c < dag.collapse_count(); ++c)
+    if (dag.alive(c).alive_at(frame)) largest = std::max(largest, dag.error_bound(c, frame));
+  return largest;
+}
+
+}  // namespace
+
+TEST_CASE("tdag: governed build, bounds monotone up the hierarchy and along dependencies") {
+  const OwnedAnimatedMesh mesh = swinging_tube(6);
+  for (Governing governing : {Governing::first, Governing::average, Governing::frame, Governing::aqem}) {
+    TdagOptions options;
+    options.governing = governing;
+    options.governing_frame = 4;
+    const TemporalDag dag = build(mesh, options);
+    CAPTURE(static_cast<int>(governing));
+    CHECK(dag.collapse_count() > mesh.vertex_count / 2);
+    const auto frames = static_cast<int32_t>(mesh.frame_count);
+    for (size_t c = 0; c < dag.collapse_count(); ++c) {
+      CHECK(dag.alive(c) == animlod::TimeTag(0, frames));  // one order for every frame
+      for (int32_t t = 0; t < frames; ++t) {
+        const double bound = dag.error_bound(c, t);
+        for (int32_t d : dag.dependencies_at(c, t)) CHECK(dag.error_bound(size_t(d) - mesh.vertex_count, t) <= bound);
+        for (int32_t child : {dag.kept_child(c), dag.removed_child(c)})
+          if (child >= int32_t(mesh.vertex_count))
+            CHECK(dag.error_bound(size_t(child) - mesh.vertex_count, t) <= bound);
+      }
+    }
+  }
+}
+
+TEST_CASE("tdag: random queries give valid manifold meshes within the tolerance") {
+  const OwnedAnimatedMesh mesh = swinging_tube(5);
+  const TemporalDag dag = build(mesh);
+  std::mt19937 random(7);
+  TdagCut cut(dag);
+  for (int i = 0; i < 40; ++i) {
+    const auto frame = int32_t(random() % mesh.frame_count);
+    const double tolerance = largest_bound(dag, frame) * std::pow(std::uniform_real_distribution<double>(0, 1)(random), 2);
+    REQUIRE(cut.query(frame, tolerance).ok);
+    check_cut(dag, cut, tolerance);
+  }
+  // Tolerance 0 is the input itself; a huge tolerance is the coarsest mesh.
+  REQUIRE(cut.query(2, 0.0).ok);
+  CHECK(cut.active_vertex_count() == mesh.vertex_count);
+  CHECK(cut.active_face_count() == mesh.faces.size() / 3);
+  REQUIRE(cut.query(2, 1e9).ok);
+  CHECK(cut.active_face_count() < 40);
+  check_cut(dag, cut, 1e9);
+}
+
+TEST_CASE("tdag: cuts after any sequence of advance and refine equal fresh queries") {
+  const OwnedAnimatedMesh mesh = swinging_tube(8);
+  for (Governing governing : {Governing::first, Governing::online}) {
+    TdagOptions options;
+    options.governing = governing;
+    options.history_weight = 0.5;
+    const TemporalDag dag = build(mesh, options);
+    std::mt19937 random(11);
+    const double scale = largest_bound(dag, 0);
+    TdagCut cut(dag);
+    double tolerance = 0.05 * scale;
+    REQUIRE(cut.query(0, tolerance).ok);
+    for (int step = 0; step < 60; ++step) {
+      if (random() % 3 == 0) {
+        tolerance = scale * std::pow(std::uniform_real_distribution<double>(0, 1)(random), 3);
+        REQUIRE(cut.refine(tolerance).ok);
+      } else {
+        const auto frame = random() % 4 == 0 ? int32_t(random() % mesh.frame_count)
+                                             : std::min<int32_t>(cut.frame() + 1, int32_t(mesh.frame_count) - 1);
+        REQUIRE(cut.advance(frame).ok);
+      }
+      CAPTURE(step);
+      REQUIRE(current(cut) == fresh(dag, cut.frame(), tolerance));
+      check_cut(dag, cut, tolerance);
+    }
+  }
+}
+
+TEST_CASE("tdag: online construction with a huge history weight equals the governed build") {
+  const OwnedAnimatedMesh mesh = swinging_tube(5);
+  TdagOptions governed;
+  governed.check_inversion = false;  // the online build tests flips in every frame, governed in frame 0
+  TdagOptions online = governed;
+  online.governing = Governing::online;
+  online.history_weight = 1e9;
+  const TemporalDag a = build(mesh, governed), b = build(mesh, online);
+  REQUIRE(a.collapse_count() == b.collapse_count());
+  for (size_t c = 0; c < a.collapse_count(); ++c) {
+    CHECK(a.kept_child(c) == b.kept_child(c));
+    CHECK(a.removed_child(c) == b.removed_child(c));
+    CHECK(a.alive(c) == b.alive(c));
+    for (int32_t t = 0; t < int32_t(mesh.frame_count); ++t) {
+      CHECK(a.dependencies_at(c, t) == b.dependencies_at(c, t));
+      CHECK(a.error_bound(c, t) == b.error_bound(c, t));
+    }
+  }
+  // lambda = 0: every frame its own order, so some collapses live on some frames only.
+  online.history_weight = 0.0;
+  const TemporalDag own = build(mesh, online);
+  size_t partial = 0;
+  for (size_t c = 0; c < own.collapse_count(); ++c) partial += own.alive(c) != animlod::TimeTag(0, 5);
+  CHECK(partial > 0);
+  CHECK(own.collapse_count() > a.collapse_count());
+}
+
+TEST_CASE("tdag: view-dependent tolerance refines near the camera") {
+  const OwnedAnimatedMesh mesh = swinging_tube(3);
+  const TemporalDag dag = build(mesh);
+  TdagCut cut(dag);
+  animlod::ViewTolerance view;
+  view.camera[0] = -1.5;  // beyond the left end of the tube (x = -1 in frame 0)
+  view.pixels = 30.0;
+  view.focal_pixels = 300.0;
+  REQUIRE(cut.query_view(0, view).ok);
+  TdagMesh out;
+  cut.mesh(out);
+  const animlod::AnimatedMeshView single{out.positions.data(), out.faces.data(), 1, out.nodes.size(), out.faces.size() / 3};
+  REQUIRE(animlod::validate_animated_mesh(single).ok);
+  size_t near = 0, far = 0;
+  for (size_t i = 0; i < out.nodes.size(); ++i) (out.positions[3 * i] < 0.0f ? near : far) += 1;
+  CHECK(near > far);
+  // Moving the camera to the other end and updating equals a fresh view query there.
+  view.camera[0] = 3.0;
+  REQUIRE(cut.refine_view(view).ok);
+  TdagCut again(dag);
+  REQUIRE(again.query_view(0, view).ok);
+  CHECK(current(cut) == current(again));
+  REQUIRE(cut.advance(2).ok);
+  REQUIRE(again.query_view(2, view).ok);
+  CHECK(current(cut) == current(again));
+}
+
+TEST_CASE("tdag: the three approximation levels of Section 5") {
+  const OwnedAnimatedMesh mesh = swinging_tube(4);
+  const TemporalDag dag = build(mesh);
+  const double tolerance = 0.02 * largest_bound(dag, 0);
+  TdagCut cut(dag);
+  REQUIRE(cut.query(1, tolerance).ok);
+  TdagMesh level1, level2, level3;
+  REQUIRE(cut.approximate(2, ApproximationLevel::affine, level1).ok);
+  REQUIRE(cut.approximate(2, ApproximationLevel::residual, level2).ok);
+  // Levels 1 and 2: the previous cut; level 1 moves frame 1's residuals by A_2.
+  CHECK(level1.cut_frame == 1);
+  CHECK(level1.residual_frame == 1);
+  CHECK(level2.residual_frame == 2);
+  CHECK(level1.faces == level2.faces);
+  for (size_t i = 0; i < level1.nodes.size(); ++i) {
+    float expected[3];
+    animlod::apply_affine(dag.affine_map(2), dag.residuals(1) + 3 * size_t(dag.representative(level1.nodes[i])), 1, expected);
+    for (int k = 0; k < 3; ++k) CHECK(level1.positions[3 * i + k] == doctest::Approx(expected[k]));
+  }
+  REQUIRE(cut.approximate(2, ApproximationLevel::full, level3).ok);
+  CHECK(level3.cut_frame == 2);
+  CHECK(canonical(level3) == fresh(dag, 2, tolerance));
+  check_cut(dag, cut, tolerance);
+}
+
+TEST_CASE("tdag: save and load round trip; damaged files are named errors") {
+  const OwnedAnimatedMesh mesh = swinging_tube(4);
+  TdagOptions options;
+  options.governing = Governing::online;
+  options.history_weight = 0.2;
+  const TemporalDag dag = build(mesh, options);
+  std::vector<uint8_t> bytes, again;
+  REQUIRE(animlod::serialize_temporal_dag(dag, bytes).ok);
+  TemporalDag loaded;
+  const animlod::Status status = animlod::deserialize_temporal_dag(bytes.data(), bytes.size(), loaded);
+  REQUIRE_MESSAGE(status.ok, status.message);
+  REQUIRE(animlod::serialize_temporal_dag(loaded, again).ok);
+  CHECK(again == bytes);
+  CHECK(loaded.governing() == Governing::online);
+  for (size_t c = 0; c < dag.collapse_count(); ++c) CHECK(loaded.alive(c) == dag.alive(c));
+  for (int32_t t = 0; t < 4; ++t) {
+    std::vector<float> a(mesh.vertex_count * 3), b(mesh.vertex_count * 3);
+    dag.frame_positions(t, a.data());
+    loaded.frame_positions(t, b.data());
+    CHECK(a == b);
+    CHECK(fresh(dag, t, 0.03) == fresh(loaded, t, 0.03));
+  }
+
+  auto load_error = [](std::vector<uint8_t> data) {
+    TemporalDag out;
+    const animlod::Status s = animlod::deserialize_temporal_dag(data.data(), data.size(), out);
+    CHECK_FALSE(s.ok);
+    CHECK(out.empty());
+    return s.message;
+  };
+  std::vector<uint8_t> damaged = bytes;
+  damaged[bytes.size() / 2] ^= 0x40;
+  CHECK(load_error(damaged) == "corrupted TDAG file: checksum mismatch");
+  damaged = bytes;
+  damaged[8] = 0;  // format version 0
+  CHECK(load_error(damaged).find("TDAG format version 0 was written by an older animlod") == 0);
+  damaged[8] = 9;
+  CHECK(load_error(damaged).find("written by a newer animlod") != std::string::npos);
+  CHECK(load_error({bytes.begin(), bytes.end() - 10}).find("truncated") != std::string::npos);
+  CHECK(load_error({'h', 'e', 'l', 'l', 'o'}) == "not a TDAG file (no ANLDTDAG signature)");
+}
+
+TEST_CASE("tdag: bad input is a named error") {
+  OwnedAnimatedMesh mesh = swinging_tube(3);
+  TdagOptions options;
+  TemporalDag dag;
+  options.governing = Governing::frame;
+  options.governing_frame = 3;
+  CHECK(animlod::build_temporal_dag(mesh.view(), options, dag).message == "governing_frame: frame 3 outside [0, 3)");
+  options = {};
+  options.history_weight = -1.0;
+  CHECK(animlod::build_temporal_dag(mesh.view(), options, dag).message.find("history_weight") == 0);
+  mesh.frames[(mesh.vertex_count + 5) * 3] = NAN;
+  CHECK(animlod::build_temporal_dag(mesh.view(), {}, dag).message == "frame 1, vertex 5: non-finite position");
+  CHECK(dag.empty());
+
+  const TemporalDag good = build(swinging_tube(3));
+  TdagCut cut(good);
+  CHECK(cut.advance(1).message.find("no query yet") != std::string::npos);
+  CHECK(cut.query(3, 0.1).message == "frame: 3 outside [0, 3)");
+  CHECK(cut.query(0, -0.5).message.find("tolerance: must be >= 0") == 0);
+  CHECK_FALSE(cut.query(0, NAN).ok);
+}
+
+TEST_CASE("tdag player: double-buffered walk hands out the same meshes as one cut") {
+  const OwnedAnimatedMesh mesh = swinging_tube(10);
+  const TemporalDag dag = build(mesh);
+  const double tolerance = 0.03 * largest_bound(dag, 0);
+  animlod::TdagPlayer player(dag);
+  REQUIRE(player.start(tolerance, 0).ok);
+  TdagCut reference(dag);
+  REQUIRE(reference.query(0, tolerance).ok);
+  TdagMesh out, expected;
+  const ApproximationLevel plan[] = {ApproximationLevel::full, ApproximationLevel::full, ApproximationLevel::residual,
+                                     ApproximationLevel::full, ApproximationLevel::affine};
+  for (int32_t t = 0; t < 10; ++t) {
+    const ApproximationLevel level = plan[t % 5];
+    REQUIRE(player.next(level, out).ok);
+    if (level == ApproximationLevel::full) {
+      REQUIRE(reference.approximate(t, level, expected).ok);
+      CHECK(canonical(out) == canonical(expected));
+      CHECK(out.cut_frame == t);
+    } else {
+      CHECK(out.cut_frame < t);
+    }
+  }
+  CHECK(player.done());
+  CHECK_FALSE(player.next(ApproximationLevel::full, out).ok);
+
+  animlod::PlayerOptions options;
+  options.tolerance = tolerance;
+  animlod::PlayerReport report;
+  REQUIRE(animlod::play_temporal_dag(dag, options, report).ok);
+  CHECK(report.frames == 9);
+  CHECK(report.levels[2].max_error <= tolerance + 1e-5);  // level 3 keeps the bound
+  CHECK(report.full_query.max_error <= tolerance + 1e-5);
+  CHECK(report.levels[0].max_error > report.levels[2].max_error);  // the tube bends: level 1 lags
+  CHECK(report.levels[2].mean_faces == doctest::Approx(report.full_query.mean_faces));
+}

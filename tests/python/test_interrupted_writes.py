@@ -1,0 +1,156 @@
+"""Outputs survive SIGKILL: a process writing a multi-level output (level folders of OBJ frames,
+NPZ, BVH, a manifest) is killed at random points; every file or folder under a final name then
+parses and is complete, and the next run removes what the killed one left behind."""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from animlod import synth
+from animlod.io import read_bvh, read_npz, read_sequence, write_bvh, write_npz, write_sequence
+from animlod.io.atomic import _TEMPORARY, atomic_folder, atomic_write, clean_stale
+from animlod.io.manifest import read_lod_manifest, write_lod_manifest
+
+LEVELS = 4
+FRAMES = 12
+KILLS = 8
+MESH = synth.twisting_bar(frames=FRAMES, rings=24, segments=24)
+MOTION = synth.humanoid_motion(synth.humanoid_skeleton(), "walk")
+# Forked writers start at once (no interpreter start-up), so the kills land inside the writes.
+FORK = multiprocessing.get_context("fork")
+
+
+def _write_chain(out: Path) -> None:
+    """What `animlod simplify`/`motion` write for a chain, level after level."""
+    rows = []
+    for level in range(LEVELS):
+        write_sequence(out / f"bar_lod{level}", MESH, "obj")
+        write_npz(out / f"bar_lod{level}.npz", MESH)
+        write_bvh(out / f"walk_lod{level}.bvh", MOTION)
+        rows.append({"files": [f"bar_lod{level}"], "error": float(level)})
+    write_lod_manifest(out / "bar_lod.json", "mesh", rows)
+
+
+def _start(out: Path):
+    process = FORK.Process(target=_write_chain, args=(out,))
+    process.start()
+    return process
+
+
+def _check_final_outputs(out: Path) -> int:
+    """Every entry under a final name is complete; returns how many there are."""
+    expected, walk_frames = MESH, MOTION.frame_count
+    final = [entry for entry in out.iterdir() if not _TEMPORARY.match(entry.name)] if out.is_dir() else []
+    for entry in final:
+        if entry.is_dir():
+            mesh = read_sequence(entry)
+            assert mesh.frame_count == FRAMES, entry
+            np.testing.assert_array_equal(mesh.frames, expected.frames)
+        elif entry.suffix == ".npz":
+            np.testing.assert_array_equal(read_npz(entry).frames, expected.frames)
+        elif entry.suffix == ".bvh":
+            assert read_bvh(entry).frame_count == walk_frames
+        elif entry.suffix == ".json":
+            assert len(read_lod_manifest(entry)["levels"]) == LEVELS
+        else:
+            raise AssertionError(f"unexpected output {entry}")
+    return len(final)
+
+
+def test_sigkill_at_random_points_leaves_only_complete_outputs(tmp_path: Path) -> None:
+    start = time.perf_counter()
+    process = _start(tmp_path / "full")
+    process.join()
+    duration = time.perf_counter() - start
+    assert process.exitcode == 0
+    assert _check_final_outputs(tmp_path / "full") == 3 * LEVELS + 1
+
+    out = tmp_path / "killed"
+    rng = np.random.default_rng(7)
+    seen_partial = 0
+    for delay in rng.uniform(0.0, duration, size=KILLS):
+        process = _start(out)
+        time.sleep(delay)
+        process.kill()  # SIGKILL
+        process.join()
+        _check_final_outputs(out)
+        seen_partial += any(_TEMPORARY.match(entry.name) for entry in out.iterdir()) if out.is_dir() else 0
+    # The kills landed mid-write at least once (a temporary was left), or the test proved nothing.
+    assert seen_partial > 0
+
+    process = _start(out)
+    process.join()
+    assert process.exitcode == 0
+    assert _check_final_outputs(out) == 3 * LEVELS + 1
+    assert not [entry.name for entry in out.iterdir() if _TEMPORARY.match(entry.name)]  # stale ones cleaned
+
+
+def test_stale_temporaries_of_dead_processes_are_removed_and_live_ones_kept(tmp_path: Path) -> None:
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead_pid = int(dead.stdout)
+    (tmp_path / f".a.obj.animlod-{dead_pid}-x1y2.part").write_text("half")
+    (tmp_path / f".lod1.animlod-{dead_pid}-abc_9.partdir").mkdir()
+    (tmp_path / f".lod1.animlod-{dead_pid}-abc_9.partdir" / "frame_0000.obj").write_text("v 0 0 0\n")
+    live = tmp_path / f".b.obj.animlod-{os.getpid()}-zz.part"
+    live.write_text("being written")
+    keep = tmp_path / ".b.obj.part"  # not ours: left alone
+    keep.write_text("x")
+    removed = clean_stale(tmp_path)
+    assert sorted(path.name for path in removed) == sorted(
+        [f".a.obj.animlod-{dead_pid}-x1y2.part", f".lod1.animlod-{dead_pid}-abc_9.partdir"]
+    )
+    assert sorted(path.name for path in tmp_path.iterdir()) == sorted([live.name, keep.name])
+
+
+def test_atomic_folder_replaces_a_longer_old_folder_and_cleans_up_on_error(tmp_path: Path) -> None:
+    target = tmp_path / "lod1"
+    with atomic_folder(target) as folder:
+        for index in range(3):
+            (folder / f"frame_{index}.obj").write_text("old")
+    with pytest.raises(RuntimeError), atomic_folder(target) as folder:
+        (folder / "frame_0.obj").write_text("new")
+        raise RuntimeError("interrupted")
+    assert sorted(path.name for path in target.iterdir()) == ["frame_0.obj", "frame_1.obj", "frame_2.obj"]
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["lod1"]
+    with atomic_folder(target) as folder:
+        (folder / "frame_0.obj").write_text("new")
+    assert [path.read_text() for path in target.iterdir()] == ["new"]  # no stale frame of the longer run
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["lod1"]
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(FileExistsError), atomic_folder(tmp_path / "file"):
+        pass
+
+
+def test_keyboard_interrupt_inside_a_write_removes_the_temporary(tmp_path: Path) -> None:
+    with pytest.raises(KeyboardInterrupt), atomic_write(tmp_path / "out.bvh", "w") as handle:
+        handle.write("HIERARCHY")
+        raise KeyboardInterrupt
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sigterm_during_a_cli_write_removes_the_temporary(tmp_path: Path) -> None:
+    """The CLI turns SIGTERM into an exception, so atomic_write's cleanup runs."""
+    script = (
+        "import os, signal, sys\n"
+        "from animlod.cli import main\n"
+        "import animlod.cli.info as info\n"
+        "from animlod.io.atomic import atomic_write\n"
+        "def run(args):\n"
+        "    with atomic_write(sys.argv[1] + '/out.glb', 'wb') as handle:\n"
+        "        handle.write(b'half')\n"
+        "        os.kill(os.getpid(), signal.SIGTERM)\n"
+        "        handle.write(b'never')\n"
+        "info.run = run\n"
+        "sys.exit(main(['info', 'x']))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script, str(tmp_path)], capture_output=True, text=True)
+    assert done.returncode == 143 and done.stderr == "animlod info: terminated\n"
+    assert list(tmp_path.iterdir()) == []

@@ -1,0 +1,319 @@
+"""Whole glTF documents through animlod.pipelines.simplify_document: nothing lost, levels valid."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+from animlod import synth
+from animlod.cli import main
+from animlod.io import write_glb
+from animlod.io.gltf_document import GltfDocument
+from animlod.io.gltf_drawable import read_drawables
+from animlod.pipelines import simplify_document
+
+# Small enough to keep the suite quick: few drive frames, two measured frames per clip.
+QUICK = {"frame_budget": 12, "measured_frames": 2}
+DEV_FILES = ["gltf/RiggedFigure.glb", "gltf/SimpleSkin.gltf", "morph/MorphStressTest.gltf", "morph/Stork.glb"]
+
+
+@pytest.fixture(scope="module")
+def humanoid_glb(tmp_path_factory):
+    path = tmp_path_factory.mktemp("humanoid") / "humanoid.glb"
+    character = synth.humanoid()
+    write_glb(path, character, [synth.humanoid_motion(character.skeleton, "walk")])
+    return path
+
+
+def _accessor_values(doc: GltfDocument, index: int) -> np.ndarray:
+    return np.asarray(doc.accessor(index, "test"))
+
+
+def _image_bytes(doc: GltfDocument, image: dict) -> bytes:
+    if "bufferView" in image:
+        view = doc.json["bufferViews"][image["bufferView"]]
+        data = doc.buffer_bytes(view.get("buffer", 0), "test")
+        start = view.get("byteOffset", 0)
+        return data[start : start + view["byteLength"]]
+    from animlod.io.glb_builder import _image_bytes as read
+
+    return read(doc, 0, image["uri"])[0]
+
+
+def _without_chain(node: dict) -> dict:
+    """``node`` without what a LoD chain adds to its base node."""
+    node = dict(node)
+    extensions = {k: v for k, v in node.pop("extensions", {}).items() if k != "MSFT_lod"}
+    extras = node.pop("extras", {})
+    if isinstance(extras, dict):
+        extras = {k: v for k, v in extras.items() if k not in ("MSFT_screencoverage", "animlod")}
+    if extensions:
+        node["extensions"] = extensions
+    if extras:
+        node["extras"] = extras
+    return node
+
+
+def _assert_document_kept(source, output) -> None:
+    """Every object of ``source`` is in ``output`` at the same index with the same content."""
+    before, after = GltfDocument(source), GltfDocument(output)
+    for kind in ("materials", "textures", "samplers", "skins", "animations", "scenes", "cameras", "meshes"):
+        assert after.json.get(kind, [])[: len(before.json.get(kind, []))] == before.json.get(kind, []), kind
+    for index, node in enumerate(before.json.get("nodes", [])):
+        assert _without_chain(after.json["nodes"][index]) == _without_chain(node), f"node {index}"
+    for index in range(len(before.json.get("accessors", []))):
+        np.testing.assert_array_equal(_accessor_values(after, index), _accessor_values(before, index))
+    for index, image in enumerate(before.json.get("images", [])):
+        assert _image_bytes(after, after.json["images"][index]) == _image_bytes(before, image), f"image {index}"
+    assert set(before.json.get("extensionsUsed", [])) <= set(after.json.get("extensionsUsed", []))
+
+
+def test_a_no_op_simplification_keeps_the_whole_document(humanoid_glb, tmp_path):
+    output = tmp_path / "out.glb"
+    report = simplify_document(humanoid_glb, output, [1.0], **QUICK)
+    assert report.drawables[0].levels[1].faces == report.drawables[0].faces
+    _assert_document_kept(humanoid_glb, output)
+
+
+@pytest.mark.parametrize("name", DEV_FILES + ["gltf/Soldier.glb"])
+def test_dev_files_keep_every_object_and_get_a_valid_chain(data_dir, tmp_path, name):
+    source = data_dir / name
+    output = tmp_path / "out.glb"
+    report = simplify_document(source, output, [0.5, 0.1], **QUICK)
+    _assert_document_kept(source, output)
+    doc = GltfDocument(output)
+    drawables = read_drawables(GltfDocument(source))
+    for drawable, drawn in zip(drawables, report.drawables):
+        for base in drawable.nodes:
+            node = doc.json["nodes"][base]
+            ids = node["extensions"]["MSFT_lod"]["ids"]
+            coverages = node["extras"]["MSFT_screencoverage"]
+            assert len(coverages) == len(ids) + 1 and coverages[-1] == 0.0
+            assert all(a >= b for a, b in zip(coverages, coverages[1:]))
+            for level, node_index in enumerate(ids, start=1):
+                lod = doc.json["nodes"][node_index]
+                assert lod.get("skin") == drawable.skin_index
+                assert lod["extras"]["animlod"]["level"] == level
+                mesh = doc.json["meshes"][lod["mesh"]]
+                triangles = sum(doc.accessor(p["indices"], "t").shape[0] // 3 for p in mesh["primitives"])
+                assert triangles == drawn.levels[level].faces
+                materials = [p.get("material") for p in mesh["primitives"]]
+                assert set(materials) <= {
+                    p.get("material") for p in doc.json["meshes"][drawable.mesh_index]["primitives"]
+                }
+        # levels that stop early say so; errors grow with the level
+        errors = [level.error for level in drawn.levels]
+        assert errors[0] == 0.0 and all(e >= 0 for e in errors)
+    # the LoD nodes are in no scene, so a viewer that ignores MSFT_lod shows level 0 only
+    in_scenes = {n for scene in doc.json.get("scenes", []) for n in scene.get("nodes", [])}
+    lod_nodes = {i for node in doc.json["nodes"] for i in node.get("extensions", {}).get("MSFT_lod", {}).get("ids", [])}
+    assert not (in_scenes & lod_nodes)
+
+
+def test_the_lod_glb_loads_in_tinygltf_and_trimesh(humanoid_glb, tmp_path):
+    output = tmp_path / "out.glb"
+    simplify_document(humanoid_glb, output, [0.5, 0.25], **QUICK)
+    import trimesh
+
+    scene = trimesh.load(output, force="scene")
+    assert len(scene.geometry) >= 1
+    probe = os.environ.get("ANIMLOD_GLTF_PROBE")
+    if probe:
+        summary = json.loads(subprocess.run([probe, str(output)], capture_output=True, check=True, text=True).stdout)
+        assert summary["triangles"] > 0 and summary["joints"] == 41
+
+
+def test_levels_reach_ten_percent_and_keep_primitives_and_skins(data_dir, tmp_path):
+    report = simplify_document(data_dir / "gltf" / "RiggedFigure.glb", tmp_path / "out.glb", [0.1], **QUICK)
+    level = report.drawables[0].levels[1]
+    assert level.reached and level.faces <= level.target_faces
+    doc = GltfDocument(tmp_path / "out.glb")
+    lod = doc.json["nodes"][doc.json["nodes"][report.drawables[0].nodes[0]]["extensions"]["MSFT_lod"]["ids"][0]]
+    primitive = doc.json["meshes"][lod["mesh"]]["primitives"][0]
+    weights = doc.accessor(primitive["attributes"]["WEIGHTS_0"], "w")
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0, atol=1e-5)
+    normals = doc.accessor(primitive["attributes"]["NORMAL"], "n")
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-5)
+
+
+def test_morph_deltas_of_a_level_match_the_input_at_unmoved_vertices(data_dir, tmp_path):
+    source = data_dir / "morph" / "MorphStressTest.gltf"
+    simplify_document(source, tmp_path / "out.glb", [0.5], **QUICK)
+    before, after = GltfDocument(source), GltfDocument(tmp_path / "out.glb")
+    base = before.json["nodes"].index(next(n for n in before.json["nodes"] if "mesh" in n))
+    lod = after.json["nodes"][after.json["nodes"][base]["extensions"]["MSFT_lod"]["ids"][0]]
+    for original, level in zip(before.json["meshes"][0]["primitives"], after.json["meshes"][lod["mesh"]]["primitives"]):
+        positions = before.accessor(original["attributes"]["POSITION"], "p")
+        level_positions = after.accessor(level["attributes"]["POSITION"], "p")
+        # level vertices that sit exactly on an input vertex (not moved by any collapse)
+        index = {tuple(p): i for i, p in enumerate(positions)}
+        pairs = [(j, index[tuple(p)]) for j, p in enumerate(level_positions) if tuple(p) in index]
+        assert len(pairs) > 10
+        ours, theirs = np.array([j for j, _ in pairs]), np.array([i for _, i in pairs])
+        for t_before, t_after in zip(original["targets"], level["targets"]):
+            np.testing.assert_allclose(
+                after.accessor(t_after["POSITION"], "d")[ours],
+                before.accessor(t_before["POSITION"], "d")[theirs],
+                atol=1e-6,
+            )
+
+
+def test_separate_writes_one_whole_document_per_level(humanoid_glb, tmp_path):
+    report = simplify_document(humanoid_glb, tmp_path / "levels", [0.5, 0.25], separate=True, **QUICK)
+    assert [path.name for path in report.outputs] == ["humanoid_lod1.glb", "humanoid_lod2.glb"]
+    for path, level in zip(report.outputs, report.drawables[0].levels[1:]):
+        doc = GltfDocument(path)
+        assert len(doc.json["meshes"]) == 1
+        (drawable,) = read_drawables(doc)
+        assert len(drawable.geometry.faces) == level.faces
+        assert len(drawable.clips) == 1
+        assert path.stat().st_size < humanoid_glb.stat().st_size
+
+
+def test_cli_writes_one_lod_glb(humanoid_glb, tmp_path, capsys):
+    assert main(["simplify", str(humanoid_glb), "-o", str(tmp_path), "--ratio", "0.5", "--max-frames", "8"]) == 0
+    out = capsys.readouterr().out
+    assert "humanoid_lod.glb" in out and "coverage" in out
+    assert (tmp_path / "humanoid_lod.glb").is_file()
+
+
+def _edited(source, tmp_path, edit) -> str:
+    """A copy of the GLB at ``source`` with its JSON changed by ``edit(json)``."""
+    from animlod.io.glb_builder import GlbBuilder
+
+    builder = GlbBuilder.from_document(GltfDocument(source))
+    edit(builder.json)
+    path = tmp_path / "edited.glb"
+    builder.save(path)
+    return str(path)
+
+
+def _shrink_skin(js: dict, joints: int) -> None:
+    """The first skin keeps only its first ``joints`` joints (and inverse binds): vertices bound
+    to later joints now index past the joint list."""
+    skin = js["skins"][0]
+    skin["joints"] = skin["joints"][:joints]
+    js["accessors"][skin["inverseBindMatrices"]]["count"] = joints
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda js: _shrink_skin(js, 3), "uses joint slot"),
+        (lambda js: js["bufferViews"][0].__setitem__("byteLength", 10**9), "bufferView 0"),
+        (lambda js: js["animations"][0]["channels"][0]["target"].__setitem__("node", 9999), "node 9999"),
+    ],
+)
+def test_bad_documents_exit_with_one_line_and_no_output(humanoid_glb, tmp_path, capsys, edit, message):
+    source = _edited(humanoid_glb, tmp_path, edit)
+    output = tmp_path / "out.glb"
+    assert main(["simplify", source, "-o", str(output)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+    assert not output.exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out.glb")]
+
+
+def test_points_and_lines_are_kept_unchanged_and_reported(humanoid_glb, tmp_path):
+    def add_lines(js):
+        primitive = js["meshes"][0]["primitives"][0]
+        js["meshes"][0]["primitives"].append(
+            {"attributes": {"POSITION": primitive["attributes"]["POSITION"]}, "mode": 1}
+        )
+
+    source = _edited(humanoid_glb, tmp_path, add_lines)
+    report = simplify_document(source, tmp_path / "out.glb", [0.5], **QUICK)
+    assert any("points or lines" in note for note in report.drawables[0].notes)
+    doc = GltfDocument(tmp_path / "out.glb")
+    lod = doc.json["nodes"][report.drawables[0].nodes[0]]["extensions"]["MSFT_lod"]["ids"][0]
+    modes = [p.get("mode", 4) for p in doc.json["meshes"][doc.json["nodes"][lod]["mesh"]]["primitives"]]
+    assert sorted(modes) == [1, 4]
+
+
+def test_character_chain_combines_geometry_and_motion_levels(data_dir, tmp_path):
+    from animlod.io import read_lod_chains
+    from animlod.metrics import surface_error
+    from animlod.pipelines.character import build_character
+
+    output = tmp_path / "character.glb"
+    report = build_character(data_dir / "gltf" / "RiggedFigure.glb", output, [0.5, 0.1], solver="newton", **QUICK)
+    (levels,) = report.chains.values()
+    assert [level.faces for level in levels] == sorted((level.faces for level in levels), reverse=True)
+    assert levels[-1].joints < levels[0].joints
+    (chain,) = read_lod_chains(output)
+    assert [level.motion_level for level in chain.levels] == [0, 1, 2]
+    reference = chain.levels[0].mesh.bake(chain.levels[0].motions[0])
+    for written, level in zip(chain.levels[1:], levels[1:]):
+        # the level as any glTF engine plays it: its own skin and its own re-fitted clip
+        assert written.skeleton.joint_count == level.joints + int(written.skeleton.end_sites.sum())
+        played = written.mesh.bake(written.motions[0])
+        measured = surface_error(reference, played, samples=2000).hausdorff.max()
+        assert measured == pytest.approx(level.error, rel=0.25)
+    grid = GltfDocument(output).json["nodes"][1]["extras"]["animlod_grid"]
+    assert len(grid) == 3 and all(len(row) == 3 for row in grid)
+
+
+def test_character_refuses_a_file_without_a_skinned_animation(data_dir, tmp_path, capsys):
+    assert main(["character", str(data_dir / "gltf" / "LeePerrySmith.glb"), "-o", str(tmp_path / "x.glb")]) == 2
+    assert "no skinned mesh with an animation" in capsys.readouterr().err
+    assert not (tmp_path / "x.glb").exists()
+
+
+def test_a_flat_shaded_mesh_simplifies_like_the_welded_one_and_stays_flat(tmp_path):
+    from animlod.model import SkinnedMesh
+
+    character = synth.humanoid()
+    walk = synth.humanoid_motion(character.skeleton, "walk")
+    corners = character.faces.ravel()
+    positions = character.rest_positions[character.faces].astype(np.float64)
+    normals = np.cross(positions[:, 1] - positions[:, 0], positions[:, 2] - positions[:, 0])
+    normals = np.repeat(normals / np.linalg.norm(normals, axis=1, keepdims=True), 3, axis=0)
+    flat = SkinnedMesh(
+        character.rest_positions[corners],
+        np.arange(corners.size).reshape(-1, 3),
+        character.joints[corners],
+        character.weights[corners],
+        character.inverse_bind,
+        character.skeleton,
+        normals=normals,
+    )
+    write_glb(tmp_path / "welded.glb", character, [walk])
+    write_glb(tmp_path / "flat.glb", flat, [walk])
+    welded = simplify_document(tmp_path / "welded.glb", tmp_path / "welded_lod.glb", [0.5, 0.1], **QUICK)
+    report = simplify_document(tmp_path / "flat.glb", tmp_path / "flat_lod.glb", [0.5, 0.1], **QUICK)
+    assert report.drawables[0].preparation.welded_vertices == corners.size - character.vertex_count
+    assert [level.faces for level in report.drawables[0].levels] == [
+        level.faces for level in welded.drawables[0].levels
+    ]
+    assert any("normals rebuilt" in note for note in report.drawables[0].notes)
+    doc = GltfDocument(tmp_path / "flat_lod.glb")
+    base = report.drawables[0].nodes[0]
+    coarse = doc.json["nodes"][doc.json["nodes"][base]["extensions"]["MSFT_lod"]["ids"][-1]]
+    primitive = doc.json["meshes"][coarse["mesh"]]["primitives"][0]
+    faces = doc.accessor(primitive["indices"], "i").reshape(-1, 3)
+    level_normals = doc.accessor(primitive["attributes"]["NORMAL"], "n")[faces]
+    np.testing.assert_allclose(level_normals[:, 0], level_normals[:, 1], atol=1e-6)  # flat again
+    np.testing.assert_allclose(level_normals[:, 0], level_normals[:, 2], atol=1e-6)
+
+
+def test_a_vertex_whose_weights_are_all_zero_is_named(humanoid_glb, tmp_path, capsys):
+    from animlod.io.glb_builder import GlbBuilder
+
+    builder = GlbBuilder.from_document(GltfDocument(humanoid_glb))
+    weights = builder.json["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"]
+    zero = builder.add(np.zeros((1, 4), np.float32))  # a sparse substitution: vertex 7 weighs nothing
+    index = builder.add(np.array([[7]], np.uint32))
+    builder.json["accessors"][weights]["sparse"] = {
+        "count": 1,
+        "indices": {"bufferView": builder.json["accessors"][index]["bufferView"], "componentType": 5125},
+        "values": {"bufferView": builder.json["accessors"][zero]["bufferView"]},
+    }
+    builder.save(tmp_path / "zero.glb")
+    assert main(["simplify", str(tmp_path / "zero.glb"), "-o", str(tmp_path / "out.glb")]) == 2
+    err = capsys.readouterr().err
+    assert "vertex 7 has no positive skin weight" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out.glb").exists()

@@ -1,0 +1,65 @@
+"""``animlod tdag build|query|play``: files written, tables printed, user mistakes exit 2."""
+
+from __future__ import annotations
+
+import pytest
+
+from animlod import synth
+from animlod.cli import main
+from animlod.io.meshseq import read_mesh
+from animlod.io.npz import write_npz
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("tdag")
+    write_npz(folder / "bar.npz", synth.twisting_bar(frames=6, rings=10, segments=8))
+    assert main(["tdag", "build", str(folder / "bar.npz"), "-o", str(folder / "bar.tdag")]) == 0
+    return folder
+
+
+def test_build_prints_sizes_and_the_figure6_measure(tmp_path, capsys):
+    write_npz(tmp_path / "bar.npz", synth.twisting_bar(frames=4, rings=8, segments=8))
+    assert main(["tdag", "build", str(tmp_path / "bar.npz"), "-o", str(tmp_path / "bar.tdag"), "--governing", "online",
+                 "--history-weight", "0.5"]) == 0  # fmt: skip
+    out = capsys.readouterr().out
+    assert "file bytes / raw float32 frames" in out and "Figure 6 measure" in out and "lambda 0.5" in out
+    assert (tmp_path / "bar.tdag").stat().st_size > 0
+
+
+def test_query_writes_the_mesh_and_the_plot(built, capsys):
+    target = built / "frame3.obj"
+    assert main(["tdag", "query", str(built / "bar.tdag"), "--frame", "3", "--tolerance", "0.02", "--relative",
+                 "-o", str(target), "--plot"]) == 0  # fmt: skip
+    vertices, faces = read_mesh(target)
+    assert 0 < len(faces) < 16 * 9 * 2 + 32
+    assert (built / "frame3_tolerances.png").read_bytes()[:4] == b"\x89PNG"
+    assert "error bound" in capsys.readouterr().out
+    assert main(["tdag", "query", str(built / "bar.tdag"), "--frame", "4", "--tolerance", "0.01", "--level", "1",
+                 "-o", str(built / "level1.ply")]) == 0  # fmt: skip
+    assert "level 1 from the cut of frame 3" in capsys.readouterr().out
+
+
+def test_play_prints_every_level(built, capsys):
+    assert main(["tdag", "play", str(built / "bar.tdag"), "--tolerance", "0.02", "--relative"]) == 0
+    out = capsys.readouterr().out
+    for name in ("1 affine", "2 residual", "3 cut update", "fresh query", "double-buffered"):
+        assert name in out
+
+
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        (["query", "{dir}/bar.tdag", "--frame", "6", "--tolerance", "0.1", "-o", "{dir}/x.obj"], "frame: 6 outside"),
+        (["query", "{dir}/bar.tdag", "--frame", "0", "--tolerance", "-1", "-o", "{dir}/x.obj"], "--tolerance"),
+        (["query", "{dir}/bar.npz", "--frame", "0", "--tolerance", "1", "-o", "{dir}/x.obj"], "not a TDAG file"),
+        (["query", "{dir}/bar.tdag", "--frame", "0", "--tolerance", "1", "-o", "{dir}/x.stl"], "expected an .obj"),
+        (["build", "{dir}/missing.obj", "-o", "{dir}/x.tdag"], "does not exist"),
+        (["build", "{dir}/bar.npz", "-o", "{dir}/x.tdag", "--governing", "best"], "--governing"),
+        (["play", "{dir}/missing.tdag", "--tolerance", "1"], "missing.tdag"),
+    ],
+)
+def test_user_mistakes_exit_2_with_one_line(built, capsys, arguments, message):
+    assert main(["tdag", *[a.format(dir=built) for a in arguments]]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and "Traceback" not in err

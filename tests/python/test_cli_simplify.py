@@ -42,3 +42,15 @@ def test_bad_ratio_and_bad_mesh_exit_with_code_2(tmp_path, capsys):
     write_npz(tmp_path / "bad.npz", type(mesh)(mesh.faces, flat))
     assert main(["simplify", str(tmp_path / "bad.npz"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 2
     assert "every face is degenerate" in capsys.readouterr().err
+
+
+def test_feature_weighting_is_chosen_by_name_and_an_unknown_one_exits_with_code_2(tmp_path, capsys):
+    write_npz(tmp_path / "tube.npz", bending_tube(frames=3))
+    out = str(tmp_path / "out")
+    assert main(["simplify", str(tmp_path / "tube.npz"), "-o", out, "--feature-weighting", "paper", "--no-metrics"]) == 0
+    assert read_npz(tmp_path / "out" / "tube_lod1.npz").face_count > 0
+    capsys.readouterr()
+    assert main(["simplify", str(tmp_path / "tube.npz"), "-o", out, "--feature-weighting", "size"]) == 2
+    error = capsys.readouterr().err
+    assert "--feature-weighting" in error and "'size'" in error and "Traceback" not in error
+    assert len(error.strip().splitlines()) <= 2  # argparse's usage line, then the one message

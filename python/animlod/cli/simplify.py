@@ -40,6 +40,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--no-features", action="store_true", help="ignore motion features (all vertex weights 1)")
     parser.add_argument(
+        "--feature-weighting",
+        choices=("amplitude", "paper"),
+        default="amplitude",
+        help="amplitude (default): bounded weights where dihedral angles move far above their spread; paper: "
+        "Eq. 6 as published (a feature's vertex count)",
+    )
+    parser.add_argument(
         "--max-frames",
         type=non_negative_int,
         default=0,
@@ -67,7 +74,11 @@ def run(args: argparse.Namespace) -> int:
     kind = input_kind(args.input)
     if kind == "bvh":
         raise UserError(f"{args.input}: a BVH file holds motion only; simplify needs a mesh")
-    options = {"max_error": args.max_error, "use_motion_features": not args.no_features}
+    options = {
+        "max_error": args.max_error,
+        "use_motion_features": not args.no_features,
+        "feature_weighting": args.feature_weighting,
+    }
     if args.placement:
         options["placement"] = args.placement
     if kind == "gltf":

@@ -101,9 +101,9 @@ def simplify_drawable(
     position_attributes = None if deltas is None else deltas.transpose(1, 0, 2).reshape(len(geometry.positions), -1)
     animated = drawable.skinned is not None or deltas is not None
     # Motion features are off unless asked for: on skinned and morphed glTF characters, whose levels
-    # are re-skinned or re-morphed, their weights (either weighting) moved the max-over-frames error
-    # between -15% and +47% against features off, with no consistent gain (README, AQEM section:
-    # bench/bench_aqem.py --tables characters).
+    # are re-skinned or re-morphed, the amplitude weights moved the max-over-frames error between
+    # -15% and +47% against features off with no consistent sign, and the paper's were worse almost
+    # everywhere (README, AQEM section: bench/bench_aqem.py --tables characters).
     options = {
         "placement": "on_edge" if animated else "optimal",
         "use_motion_features": False,

@@ -8,6 +8,7 @@
 
 #include "animlod/aqem.hpp"
 #include "array_checks.hpp"
+#include "feature_weighting_name.hpp"
 #include "numpy_from_vector.hpp"
 
 namespace animlod::bindings {
@@ -50,7 +51,8 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
                               const std::optional<py::function>& progress, const std::string& placement,
                               const std::optional<FloatArray>& position_attributes,
                               const std::optional<py::array>& face_group_indices, bool weld,
-                              const std::optional<MaskArray>& guarded) {
+                              const std::optional<MaskArray>& guarded, const std::string& feature_weighting,
+                              double max_feature_weight, double noise_mads) {
   require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
   const IndexArray faces = index_array(face_indices, "faces");
   require_shape(faces, "faces", {-1, 3}, "(M, 3)");
@@ -107,6 +109,9 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   options.motion_features.feature_threshold = feature_threshold;
   options.motion_features.min_angle_change = min_angle_change;
   options.motion_features.boundary_is_feature = boundary_is_feature;
+  options.motion_features.weighting = feature_weighting_from_name(feature_weighting);
+  options.motion_features.max_weight = max_feature_weight;
+  options.motion_features.noise_mads = noise_mads;
   options.boundary_quadrics = boundary_quadrics;
   options.check_inversion = check_inversion;
   options.strict_inversion = strict_inversion;
@@ -181,6 +186,8 @@ void bind_aqem(py::module_& m) {
         py::arg("skin_weights") = py::none(), py::arg("progress") = py::none(),
         py::arg("placement") = "optimal", py::arg("position_attributes") = py::none(),
         py::arg("face_groups") = py::none(), py::arg("weld") = defaults.weld, py::arg("guarded") = py::none(),
+        py::arg("feature_weighting") = "amplitude", py::arg("max_feature_weight") = defaults.motion_features.max_weight,
+        py::arg("noise_mads") = defaults.motion_features.noise_mads,
         R"doc(AQEM simplification of a deforming mesh over all its frames (Yang et al. 2019, Eqs. 1-7).
 
 Parameters
@@ -194,8 +201,10 @@ target_face_counts : level sizes as face counts in [1, M].
 max_error : asset units; stop before a collapse whose error exceeds it. A collapse's error is the
     RMS distance of the new vertex to the planes of its merged quadric, over those planes and the
     frames used.
-use_motion_features, feature_threshold, min_angle_change, boundary_is_feature : Eq. 6 weights
-    (see motion_features).
+use_motion_features, feature_threshold, min_angle_change, boundary_is_feature,
+feature_weighting, max_feature_weight, noise_mads : Eq. 6 weights (see motion_features):
+    "amplitude" (default, bounded weights from the range of dihedral angles above a threshold that
+    adapts to their spread) or "paper" (a feature's vertex count).
 boundary_quadrics : perpendicular planes on open borders and attribute seams (Garland and Heckbert).
 check_inversion : Eq. 7 inversion test summed over every frame; strict_inversion: no flip in any
     single frame (ignored when check_inversion is False).

@@ -7,8 +7,13 @@
 //   edge i is connected when g_i > THR and g_i > 1 degree; boundary edges are connected;
 //   the connected components of connected edges are the features, and every vertex of a
 //   feature with w vertices gets weight w (others 1), the vertex weights of Eq. 6.
+// That is FeatureWeighting::paper. The default, FeatureWeighting::amplitude, keeps the features
+// and Eq. 6 but measures an edge's motion by the range of its dihedral angle over the sequence,
+// puts the threshold above the measured spread of those ranges, and bounds the weight (see
+// motion_features.hpp for why).
 #include "animlod/motion_features.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -46,16 +51,23 @@ double signed_dihedral(const Eigen::Vector3d& n0, const Eigen::Vector3d& n1, con
   return std::atan2(n0.cross(n1).dot(edge) / length, n0.dot(n1));
 }
 
-double wrapped_difference(double a, double b) {
-  double d = std::fabs(a - b);
-  return d > kPi ? 2.0 * kPi - d : d;
+// b - a wrapped into [-pi, pi]: the signed change of an angle between two frames.
+double signed_wrapped_difference(double b, double a) {
+  double d = b - a;
+  if (d > kPi) d -= 2.0 * kPi;
+  else if (d < -kPi) d += 2.0 * kPi;
+  return d;
 }
 
-// g_i for every edge (0 on boundary edges).
-std::vector<float> angle_changes(const AnimatedMeshView& mesh, const detail::EdgeTable& edges) {
+// g_i (the largest change between consecutive frames) and a_i (the range of the unwrapped
+// dihedral angle over all frames) for every edge, 0 on boundary edges.
+void angle_changes(const AnimatedMeshView& mesh, const detail::EdgeTable& edges, std::vector<float>& change,
+                   std::vector<float>& amplitude) {
   const size_t edge_count = edges.size();
-  std::vector<float> change(edge_count, 0.0f);
-  std::vector<double> previous(edge_count, 0.0);
+  change.assign(edge_count, 0.0f);
+  amplitude.assign(edge_count, 0.0f);
+  std::vector<double> previous(edge_count, 0.0), unwrapped(edge_count, 0.0);
+  std::vector<double> lowest(edge_count, 0.0), highest(edge_count, 0.0);
   std::vector<Eigen::Vector3d> normals(mesh.face_count);
   for (size_t t = 0; t < mesh.frame_count; ++t) {
     const float* frame = mesh.frames + t * mesh.vertex_count * 3;
@@ -65,11 +77,40 @@ std::vector<float> angle_changes(const AnimatedMeshView& mesh, const detail::Edg
       const auto [a, b] = edges.vertices[e];
       const double angle = signed_dihedral(normals[edges.faces[e][0]], normals[edges.faces[e][1]],
                                            position(frame, b) - position(frame, a));
-      if (t > 0) change[e] = std::max(change[e], static_cast<float>(wrapped_difference(angle, previous[e])));
+      if (t > 0) {
+        const double step = signed_wrapped_difference(angle, previous[e]);
+        change[e] = std::max(change[e], static_cast<float>(std::fabs(step)));
+        unwrapped[e] += step;
+        lowest[e] = std::min(lowest[e], unwrapped[e]);
+        highest[e] = std::max(highest[e], unwrapped[e]);
+      }
       previous[e] = angle;
     }
   }
-  return change;
+  for (size_t e = 0; e < edge_count; ++e) amplitude[e] = static_cast<float>(highest[e] - lowest[e]);
+}
+
+// The median of `values` (reordered), 0 when empty.
+double median_of(std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  const double upper = *middle;
+  if (values.size() % 2 == 1) return upper;
+  return 0.5 * (upper + *std::max_element(values.begin(), middle));
+}
+
+// FeatureWeighting::amplitude's adaptive threshold: median + noise_mads * MAD of the interior
+// edges' amplitudes.
+double amplitude_threshold(const std::vector<float>& amplitude, const detail::EdgeTable& edges,
+                           double noise_mads) {
+  std::vector<double> values;
+  values.reserve(amplitude.size());
+  for (size_t e = 0; e < amplitude.size(); ++e)
+    if (!edges.is_boundary(e)) values.push_back(amplitude[e]);
+  const double median = median_of(values);
+  for (double& value : values) value = std::fabs(value - median);
+  return median + noise_mads * median_of(values);
 }
 
 }  // namespace
@@ -80,19 +121,30 @@ Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeature
   if (Status status = detail::validate_and_build_edges(mesh, edges); !status) return status;
   if (!(options.feature_threshold >= 0.0) || !(options.min_angle_change >= 0.0))
     return Status::error("motion features: feature_threshold and min_angle_change must be >= 0 radians");
+  if (!(options.max_weight >= 1.0) || !std::isfinite(options.max_weight))
+    return Status::error("motion features: max_weight must be finite and >= 1");
+  if (!(options.noise_mads >= 0.0) || !std::isfinite(options.noise_mads))
+    return Status::error("motion features: noise_mads must be finite and >= 0");
   const size_t edge_count = edges.size();
+  const bool paper = options.weighting == FeatureWeighting::paper;
 
-  // g_i and THR.
-  out.angle_change = angle_changes(mesh, edges);
-  double sum = 0.0;
-  size_t interior = 0;
-  for (size_t e = 0; e < edge_count; ++e) {
-    if (edges.is_boundary(e)) continue;
-    sum += out.angle_change[e];
-    ++interior;
+  // g_i, a_i and the threshold on the weighting's measure of motion (THR or T).
+  angle_changes(mesh, edges, out.angle_change, out.amplitude);
+  const std::vector<float>& motion = paper ? out.angle_change : out.amplitude;
+  if (options.feature_threshold > 0.0) {
+    out.threshold = options.feature_threshold;
+  } else if (paper) {
+    double sum = 0.0;
+    size_t interior = 0;
+    for (size_t e = 0; e < edge_count; ++e) {
+      if (edges.is_boundary(e)) continue;
+      sum += out.angle_change[e];
+      ++interior;
+    }
+    out.threshold = interior ? sum / static_cast<double>(interior) : 0.0;
+  } else {
+    out.threshold = std::max(amplitude_threshold(out.amplitude, edges, options.noise_mads), options.min_angle_change);
   }
-  out.threshold = options.feature_threshold > 0.0 ? options.feature_threshold
-                                                  : (interior ? sum / static_cast<double>(interior) : 0.0);
 
   // Connected edges and their components (the rotation connected graphs).
   out.edges.resize(2 * edge_count);
@@ -103,7 +155,7 @@ Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeature
     const auto [a, b] = edges.vertices[e];
     out.edges[2 * e] = a;
     out.edges[2 * e + 1] = b;
-    const double g = out.angle_change[e];
+    const double g = motion[e];
     const bool connected = edges.is_boundary(e) ? options.boundary_is_feature
                                                 : g > out.threshold && g > options.min_angle_change;
     if (!connected) continue;
@@ -127,8 +179,23 @@ Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeature
     ++out.feature_sizes[feature_of_root[root]];
   }
   out.vertex_weights.assign(mesh.vertex_count, 1.0f);
+  if (paper) {
+    for (size_t v = 0; v < mesh.vertex_count; ++v)
+      if (out.vertex_feature[v] >= 0)
+        out.vertex_weights[v] = static_cast<float>(out.feature_sizes[out.vertex_feature[v]]);
+    return Status::success();
+  }
+  // Amplitude: each vertex takes the strongest of its connected interior edges, so that a vertex
+  // outside every feature keeps exactly 1.
+  std::vector<double> strength(mesh.vertex_count, 0.0);
+  for (size_t e = 0; e < edge_count; ++e) {
+    if (!out.connected[e] || edges.is_boundary(e)) continue;
+    const double excess = out.threshold > 0.0 ? (out.amplitude[e] - out.threshold) / out.threshold : 1.0;
+    const double s = std::clamp(excess, 0.0, 1.0);
+    for (const int32_t v : edges.vertices[e]) strength[v] = std::max(strength[v], s);
+  }
   for (size_t v = 0; v < mesh.vertex_count; ++v)
-    if (out.vertex_feature[v] >= 0) out.vertex_weights[v] = static_cast<float>(out.feature_sizes[out.vertex_feature[v]]);
+    if (strength[v] > 0.0) out.vertex_weights[v] = static_cast<float>(1.0 + (options.max_weight - 1.0) * strength[v]);
   return Status::success();
 }
 

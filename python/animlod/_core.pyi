@@ -24,9 +24,12 @@ def motion_features(
     feature_threshold: float = 0.0,
     min_angle_change: float = 0.017453292519943295,
     boundary_is_feature: bool = True,
+    feature_weighting: str = "amplitude",
+    max_feature_weight: float = 4.0,
+    noise_mads: float = 30.0,
 ) -> dict[str, Any]:
     """Motion features of (F, V, 3) frames and (M, 3) faces: edges, angle_change, connected,
-    threshold, vertex_feature, feature_sizes, vertex_weights."""
+    threshold, vertex_feature, feature_sizes, vertex_weights, amplitude."""
 
 def simplify_animated(
     frames: npt.ArrayLike,
@@ -55,6 +58,9 @@ def simplify_animated(
     face_groups: npt.ArrayLike | None = None,
     weld: bool = True,
     guarded: npt.ArrayLike | None = None,
+    feature_weighting: str = "amplitude",
+    max_feature_weight: float = 4.0,
+    noise_mads: float = 30.0,
 ) -> dict[str, Any]:
     """AQEM over all frames, any topology: {"levels": [...], "collapses": {...}, "frames_used",
     "vertex_weights", "preparation"}."""

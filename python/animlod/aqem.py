@@ -25,6 +25,8 @@ from . import _core
 from .model import AnimatedMesh, LodChain, LodLevel, Motion, SkinnedMesh
 
 DEFAULT_MIN_ANGLE_CHANGE = math.radians(1.0)
+DEFAULT_MAX_FEATURE_WEIGHT = 4.0
+DEFAULT_NOISE_MADS = 30.0
 
 
 @dataclass
@@ -37,10 +39,13 @@ class MotionFeatures:
     angle_change : (E,) float32 g_i, the largest change of the edge's dihedral angle between
         consecutive frames, radians (0 on boundary edges).
     connected : (E,) bool, edges that join a feature.
-    threshold : the THR used, radians.
+    threshold : the threshold used, radians (on ``amplitude`` for the amplitude weighting, on
+        ``angle_change`` for the paper's).
     vertex_feature : (V,) int32 feature index per vertex, -1 outside every feature.
     feature_sizes : (C,) int32 vertex count of each feature.
-    vertex_weights : (V,) float32 weight of Eq. 6: the feature's vertex count, 1 outside.
+    vertex_weights : (V,) float32 weight of Eq. 6 (see :func:`motion_features`), 1 outside features.
+    amplitude : (E,) float32 a_i, the range of the edge's dihedral angle over all frames, radians
+        (0 on boundary edges).
     """
 
     edges: np.ndarray
@@ -50,6 +55,7 @@ class MotionFeatures:
     vertex_feature: np.ndarray
     feature_sizes: np.ndarray
     vertex_weights: np.ndarray
+    amplitude: np.ndarray
 
 
 @dataclass
@@ -170,18 +176,32 @@ def motion_features(
     feature_threshold: float = 0.0,
     min_angle_change: float = DEFAULT_MIN_ANGLE_CHANGE,
     boundary_is_feature: bool = True,
+    feature_weighting: str = "amplitude",
+    max_feature_weight: float = DEFAULT_MAX_FEATURE_WEIGHT,
+    noise_mads: float = DEFAULT_NOISE_MADS,
 ) -> MotionFeatures:
-    """Find the motion features of ``mesh`` over all its frames.
+    """Find the motion features of ``mesh`` over all its frames and their weights (Eq. 6).
 
     Parameters
     ----------
     mesh : the deforming mesh.
-    feature_threshold : radians; 0 selects an adaptive THR, the mean of g_i over the interior
-        edges (the paper averages over all edges; boundary edges are features anyway).
-    min_angle_change : radians; g_i must also exceed this floor (paper: 1 degree).
+    feature_threshold : radians; an edge is connected when its motion exceeds it. 0 selects the
+        weighting's adaptive threshold.
+    min_angle_change : radians; the motion must also exceed this floor (paper: 1 degree).
     boundary_is_feature : count boundary edges as connected, as the paper does.
+    feature_weighting : ``"amplitude"`` (default): an edge's motion is the range a_i of its
+        dihedral angle over all frames (independent of the frame rate), the adaptive threshold is
+        T = median + ``noise_mads`` * MAD of the interior edges' a_i (so capture noise and ordinary
+        deformation find nothing), and a vertex weighs
+        1 + (``max_feature_weight`` - 1) * clamp((a - T) / T, 0, 1) with a its largest edge
+        amplitude: bounded, and exactly 1 where nothing moves above T. ``"paper"``: Eq. 6 as
+        published: g_i, the largest change between consecutive frames, THR = the mean of g_i over
+        the interior edges, and every vertex of a feature of w vertices weighs w.
+    max_feature_weight : the amplitude weighting's largest weight, >= 1.
+    noise_mads : the amplitude weighting's threshold in median absolute deviations above the median.
 
-    Raises ValueError naming the element on bad connectivity (see ``simplify_animated``).
+    Raises ValueError naming the element on bad connectivity (see ``simplify_animated``) or an
+    unknown weighting.
     """
     found = _core.motion_features(
         mesh.frames,
@@ -189,6 +209,9 @@ def motion_features(
         feature_threshold=feature_threshold,
         min_angle_change=min_angle_change,
         boundary_is_feature=boundary_is_feature,
+        feature_weighting=feature_weighting,
+        max_feature_weight=max_feature_weight,
+        noise_mads=noise_mads,
     )
     return MotionFeatures(**found)
 
@@ -203,6 +226,9 @@ def simplify_animated(
     feature_threshold: float = 0.0,
     min_angle_change: float = DEFAULT_MIN_ANGLE_CHANGE,
     boundary_is_feature: bool = True,
+    feature_weighting: str = "amplitude",
+    max_feature_weight: float = DEFAULT_MAX_FEATURE_WEIGHT,
+    noise_mads: float = DEFAULT_NOISE_MADS,
     boundary_quadrics: bool = True,
     check_inversion: bool = True,
     strict_inversion: bool = False,
@@ -231,8 +257,11 @@ def simplify_animated(
         no legal collapse can reach holds the smallest mesh reached, with ``reached`` False.
     max_error : asset units; the run stops before a collapse whose error (an RMS plane distance,
         see ``CollapseRecord.error``) exceeds it.
-    use_motion_features, feature_threshold, min_angle_change, boundary_is_feature : the
-        weights of Eq. 6 (see :func:`motion_features`); off gives every vertex weight 1.
+    use_motion_features, feature_threshold, min_angle_change, boundary_is_feature,
+    feature_weighting, max_feature_weight, noise_mads : the weights of Eq. 6 (see
+        :func:`motion_features`): ``"amplitude"`` (default) bounded weights where the dihedral
+        angles move far above their spread, ``"paper"`` the published rule (a feature's vertex
+        count); ``use_motion_features=False`` gives every vertex weight 1.
     boundary_quadrics : planes perpendicular to open borders and attribute seams keep their shape.
     check_inversion : reject collapses that invert a face by Eq. 7, summed over every frame
         (also those outside the quadrics' frames); ``strict_inversion`` rejects an inversion in
@@ -279,6 +308,9 @@ def simplify_animated(
         feature_threshold=feature_threshold,
         min_angle_change=min_angle_change,
         boundary_is_feature=boundary_is_feature,
+        feature_weighting=feature_weighting,
+        max_feature_weight=max_feature_weight,
+        noise_mads=noise_mads,
         boundary_quadrics=boundary_quadrics,
         check_inversion=check_inversion,
         strict_inversion=strict_inversion,

@@ -134,4 +134,19 @@ inline OwnedAnimatedMesh subdivided_cube(int n) {
   return mesh;
 }
 
+// sphere(rings, segments, 1) in frame 0, then frames whose coordinates each move by a uniform
+// pseudo-random offset in [-amplitude, amplitude] from it: a still surface with capture noise.
+inline OwnedAnimatedMesh jittering_sphere(int rings, int segments, int frame_count, float amplitude) {
+  OwnedAnimatedMesh mesh = sphere(rings, segments, 1);
+  const std::vector<float> rest = mesh.frames;
+  uint32_t state = 12345u;  // a linear congruential generator: the same noise on every platform
+  for (int f = 1; f < frame_count; ++f)
+    for (float value : rest) {
+      state = state * 1664525u + 1013904223u;
+      mesh.frames.push_back(value + amplitude * (2.0f * float(state >> 8) / float(1u << 24) - 1.0f));
+    }
+  mesh.frame_count = size_t(frame_count);
+  return mesh;
+}
+
 }  // namespace animlod::testing

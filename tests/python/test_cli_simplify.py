@@ -42,3 +42,28 @@ def test_bad_ratio_and_bad_mesh_exit_with_code_2(tmp_path, capsys):
     write_npz(tmp_path / "bad.npz", type(mesh)(mesh.faces, flat))
     assert main(["simplify", str(tmp_path / "bad.npz"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 2
     assert "every face is degenerate" in capsys.readouterr().err
+
+
+def test_feature_weighting_is_chosen_by_name_and_an_unknown_one_exits_with_code_2(tmp_path, capsys):
+    write_npz(tmp_path / "tube.npz", bending_tube(frames=3))
+    tube, out = str(tmp_path / "tube.npz"), str(tmp_path / "out")
+    assert main(["simplify", tube, "-o", out, "--feature-weighting", "paper", "--no-metrics"]) == 0
+    assert read_npz(tmp_path / "out" / "tube_lod1.npz").face_count > 0
+    capsys.readouterr()
+    assert main(["simplify", tube, "-o", out, "--feature-weighting", "size"]) == 2
+    error = capsys.readouterr().err
+    assert "--feature-weighting" in error and "'size'" in error and "Traceback" not in error
+    assert len(error.strip().splitlines()) <= 2  # argparse's usage line, then the one message
+    assert main(["simplify", tube, "-o", out, "--feature-weighting", "paper", "--no-features"]) == 2
+    assert "--feature-weighting: cannot be combined with --no-features" in capsys.readouterr().err
+
+
+def test_feature_options_leave_the_pipeline_default_unless_asked():
+    from argparse import Namespace
+
+    from animlod.cli.simplify import feature_options
+
+    assert feature_options(Namespace(no_features=False, feature_weighting=None)) == {}
+    assert feature_options(Namespace(no_features=True, feature_weighting=None)) == {"use_motion_features": False}
+    chosen = feature_options(Namespace(no_features=False, feature_weighting="amplitude"))
+    assert chosen == {"use_motion_features": True, "feature_weighting": "amplitude"}

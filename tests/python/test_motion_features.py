@@ -22,13 +22,16 @@ def test_a_hinge_reports_its_exact_angle_change():
         ],
         np.float32,
     )
-    features = motion_features(
-        AnimatedMesh([[0, 1, 2], [1, 0, 3]], frames), feature_threshold=0.1, boundary_is_feature=False
-    )
+    hinge = AnimatedMesh([[0, 1, 2], [1, 0, 3]], frames)
+    features = motion_features(hinge, feature_threshold=0.1, boundary_is_feature=False, feature_weighting="paper")
     np.testing.assert_array_equal(features.edges[0], [0, 1])
     assert features.angle_change[0] == pytest.approx(fold, rel=1e-6)
+    assert features.amplitude[0] == pytest.approx(fold, rel=1e-6)
     np.testing.assert_array_equal(features.connected, [True, False, False, False, False])
-    np.testing.assert_array_equal(features.vertex_weights, [2, 2, 1, 1])
+    np.testing.assert_array_equal(features.vertex_weights, [2, 2, 1, 1])  # Eq. 6: the feature's size
+    # The default weighs by amplitude: 30 degrees is over twice T = 0.1 rad, the largest weight.
+    amplitude = motion_features(hinge, feature_threshold=0.1, boundary_is_feature=False, max_feature_weight=3.0)
+    np.testing.assert_array_equal(amplitude.vertex_weights, [3, 3, 1, 1])
 
 
 def test_a_rigidly_translating_mesh_has_no_motion_features():
@@ -40,7 +43,7 @@ def test_a_rigidly_translating_mesh_has_no_motion_features():
 
 def test_a_bending_cylinder_has_its_features_at_the_bend():
     mesh = synth.bending_cylinder(frames=8)
-    features = motion_features(mesh)
+    features = motion_features(mesh, feature_weighting="paper")
     in_feature = features.vertex_feature >= 0
     height = mesh.frames[0, :, 1]
     # The skin weights blend over 0.8 <= y <= 1.2: the elbow; nothing else bends.
@@ -49,6 +52,11 @@ def test_a_bending_cylinder_has_its_features_at_the_bend():
     sizes = features.feature_sizes[features.vertex_feature[in_feature]]
     np.testing.assert_array_equal(features.vertex_weights[in_feature], sizes)
     assert np.all(features.vertex_weights[~in_feature] == 1)
+    # The amplitude weighting finds the elbow too, with weights in (1, 4].
+    amplitude = motion_features(mesh)
+    weighted = amplitude.vertex_weights > 1
+    assert weighted.any() and amplitude.vertex_weights.max() <= 4
+    assert height[weighted].min() >= 0.75 and height[weighted].max() <= 1.25
 
 
 def test_a_uniform_twist_stays_below_the_one_degree_floor():
@@ -66,10 +74,26 @@ def test_crane_features_are_found(data_dir):
     from animlod.io.meshseq import read_sequence
 
     mesh = read_sequence(data_dir / "meshseq" / "crane")
-    features = motion_features(mesh)
+    features = motion_features(mesh, feature_weighting="paper")
     assert features.edges.shape == (30000, 2)  # closed genus-0 mesh: E = 3M / 2
     assert 0 < features.threshold < math.pi
     assert features.feature_sizes.sum() == np.count_nonzero(features.vertex_feature >= 0)
+    # The capture noise puts the paper's THR inside the noise: features of over a thousand
+    # vertices, weighing over a thousand each. The amplitude threshold sits above the noise, and
+    # its weights stay bounded on the few edges that move far more than the rest.
+    assert features.vertex_weights.max() > 1000
+    amplitude = motion_features(mesh)
+    assert amplitude.threshold > 5 * np.median(amplitude.amplitude)
+    assert np.count_nonzero(amplitude.vertex_weights > 1) < 0.05 * mesh.vertex_count
+    assert amplitude.vertex_weights.max() <= 4
+
+
+def test_an_unknown_weighting_is_refused_by_name():
+    mesh = bending_tube(frames=3)
+    with pytest.raises(ValueError, match=r"^feature_weighting: expected 'amplitude' or 'paper', got 'size'$"):
+        motion_features(mesh, feature_weighting="size")
+    with pytest.raises(ValueError, match=r"max_weight must be finite and >= 1"):
+        motion_features(mesh, max_feature_weight=0.5)
 
 
 def test_int64_faces_are_range_checked_not_wrapped():

@@ -167,6 +167,27 @@ def test_open_borders_keep_their_outline():
     assert ends.min() == pytest.approx(-1.0) and ends.max() == pytest.approx(1.0)
 
 
+def test_features_that_find_nothing_leave_the_collapse_order_of_features_off():
+    # A still sphere with capture-like jitter: the default weighting finds nothing and must change
+    # nothing, bit for bit; the paper's rule turns the noise into features (the control).
+    from animlod import synth
+
+    rest = synth.translating_mesh(frames=1, subdivisions=3)
+    rng = np.random.default_rng(7)
+    frames = rest.frames + rng.uniform(-0.005, 0.005, (12, rest.vertex_count, 3))
+    mesh = AnimatedMesh(rest.faces, frames.astype(np.float32))
+    plain = simplify_animated(mesh, (0.5, 0.1), use_motion_features=False).collapses
+    default = simplify_animated(mesh, (0.5, 0.1))
+    assert np.all(default.vertex_weights == 1)
+    for name in ("removed", "kept", "positions", "cost", "error"):
+        np.testing.assert_array_equal(getattr(default.collapses, name), getattr(plain, name))
+    paper = simplify_animated(mesh, (0.5, 0.1), feature_weighting="paper")
+    assert paper.vertex_weights.max() > 1
+    assert not np.array_equal(paper.collapses.removed, plain.removed)
+    with pytest.raises(ValueError, match=r"^feature_weighting: expected 'amplitude' or 'paper', got 'Paper'$"):
+        simplify_animated(mesh, (0.5,), feature_weighting="Paper")
+
+
 def test_crane_sequence_at_ten_percent(data_dir):
     from animlod.io.meshseq import read_sequence
 

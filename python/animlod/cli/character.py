@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ..io.detect import input_kind, input_stem
 from . import UserError, positive_int
+from .simplify import feature_options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -30,7 +31,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--solver", choices=("slsqp", "newton"), default="slsqp", help="motion re-fit (default slsqp)")
     parser.add_argument("--workers", type=positive_int, default=1, help="processes for the motion re-fit (default 1)")
-    parser.add_argument("--no-features", action="store_true", help="ignore motion features in AQEM")
+    parser.add_argument("--no-features", action="store_true", help="ignore motion features in AQEM (the default)")
+    parser.add_argument(
+        "--feature-weighting",
+        choices=("amplitude", "paper"),
+        default=None,
+        help="use AQEM's motion features with this weighting (see animlod simplify --help)",
+    )
     parser.add_argument(
         "--max-frames", type=positive_int, default=48, help="frames of all clips that drive AQEM (default 48)"
     )
@@ -54,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
         solver=args.solver,
         workers=args.workers,
         frame_budget=args.max_frames,
-        use_motion_features=not args.no_features,
+        **feature_options(args),
         progress=print,
     )
     print("error: max over frames of every clip of the Hausdorff distance to the input (reduced skin, re-fitted")

@@ -40,6 +40,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--no-features", action="store_true", help="ignore motion features (all vertex weights 1)")
     parser.add_argument(
+        "--feature-weighting",
+        choices=("amplitude", "paper"),
+        default=None,
+        help="motion features weighted by amplitude (bounded weights where dihedral angles move far above their "
+        "spread; the default for sequences and NPZ) or paper (Eq. 6 as published: a feature's vertex count); "
+        "glTF inputs use no motion features unless this is given",
+    )
+    parser.add_argument(
         "--max-frames",
         type=non_negative_int,
         default=0,
@@ -67,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     kind = input_kind(args.input)
     if kind == "bvh":
         raise UserError(f"{args.input}: a BVH file holds motion only; simplify needs a mesh")
-    options = {"max_error": args.max_error, "use_motion_features": not args.no_features}
+    options = {"max_error": args.max_error, **feature_options(args)}
     if args.placement:
         options["placement"] = args.placement
     if kind == "gltf":
@@ -224,3 +232,15 @@ def _plot(path: Path, original: AnimatedMesh, levels: list[AnimatedMesh], show_f
         figure.savefig(handle, format="png", dpi=100, bbox_inches="tight")
     plt.close(figure)
     print(f"wrote {path}")
+
+
+def feature_options(args: argparse.Namespace) -> dict:
+    """AQEM's motion-feature options from --no-features and --feature-weighting; empty when neither
+    is given, so that each pipeline's default applies."""
+    if args.no_features and args.feature_weighting:
+        raise UserError("--feature-weighting: cannot be combined with --no-features")
+    if args.no_features:
+        return {"use_motion_features": False}
+    if args.feature_weighting:
+        return {"use_motion_features": True, "feature_weighting": args.feature_weighting}
+    return {}

@@ -90,13 +90,25 @@ def simplify_drawable(
     measured_frames: int = 12,
     aqem_options: dict | None = None,
 ) -> DrawableLevels:
-    """AQEM levels of ``drawable`` at ``ratios``, each measured over every clip."""
+    """AQEM levels of ``drawable`` at ``ratios``, each measured over every clip.
+
+    ``aqem_options`` are keyword arguments of :func:`animlod.simplify_animated`; unlike there,
+    motion features are off unless ``use_motion_features=True`` is given (see the comment below).
+    """
     geometry = drawable.geometry
     matrix, layout = _attribute_matrix(drawable)
     deltas = drawable.morph_targets
     position_attributes = None if deltas is None else deltas.transpose(1, 0, 2).reshape(len(geometry.positions), -1)
     animated = drawable.skinned is not None or deltas is not None
-    options = {"placement": "on_edge" if animated else "optimal", **(aqem_options or {})}
+    # Motion features are off unless asked for: on skinned and morphed glTF characters, whose levels
+    # are re-skinned or re-morphed, the amplitude weights moved the max-over-frames error between
+    # -15% and +47% against features off with no consistent sign, and the paper's were worse almost
+    # everywhere (README, AQEM section: bench/bench_aqem.py --tables characters).
+    options = {
+        "placement": "on_edge" if animated else "optimal",
+        "use_motion_features": False,
+        **(aqem_options or {}),
+    }
     frames = _drive_frames(drawable, frame_budget)
     result = simplify_animated(
         AnimatedMesh(geometry.faces, frames),

@@ -1,9 +1,11 @@
-// Fuzz harness: compute_motion_features. Input: u8 flags (bit 0 boundary_is_feature), u8
+// Fuzz harness: compute_motion_features. Input: u8 flags (bit 0 boundary_is_feature, bit 1 the
+// paper's weighting instead of amplitude), u8
 // feature_threshold (value / 64 radians), u8 min_angle_change (value / 256 radians), then the
 // mesh layout of fuzz_input.hpp.
 // Invariants on success: edges sorted with the lower vertex first; one angle change, finite and
 // >= 0, per edge; every vertex's feature index in [-1, C); feature sizes add up to the vertices
-// in features; vertex weights >= 1.
+// in features; vertex weights >= 1; amplitude weighting: amplitudes finite and >= 0, weights at
+// most max_weight and exactly 1 outside every feature.
 #include <cmath>
 
 #include "animlod/motion_features.hpp"
@@ -14,6 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   animlod::MotionFeatureOptions options;
   const uint8_t flags = in.take<uint8_t>();
   options.boundary_is_feature = in.flag(flags, 0);
+  if (in.flag(flags, 1)) options.weighting = animlod::FeatureWeighting::paper;
   options.feature_threshold = in.take<uint8_t>() / 64.0;
   options.min_angle_change = in.take<uint8_t>() / 256.0;
   const animlod::fuzz::FuzzMesh mesh = animlod::fuzz::decode_mesh(in);
@@ -34,6 +37,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       ANIMLOD_FUZZ_REQUIRE(ascending);
     }
     ANIMLOD_FUZZ_REQUIRE(std::isfinite(out.angle_change[e]) && out.angle_change[e] >= 0.0f);
+    ANIMLOD_FUZZ_REQUIRE(std::isfinite(out.amplitude[e]) && out.amplitude[e] >= 0.0f);
   }
   ANIMLOD_FUZZ_REQUIRE(out.vertex_feature.size() == mesh.vertex_count && out.vertex_weights.size() == mesh.vertex_count);
   const auto feature_count = static_cast<int32_t>(out.feature_sizes.size());
@@ -41,6 +45,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (size_t v = 0; v < mesh.vertex_count; ++v) {
     ANIMLOD_FUZZ_REQUIRE(out.vertex_feature[v] >= -1 && out.vertex_feature[v] < feature_count);
     ANIMLOD_FUZZ_REQUIRE(out.vertex_weights[v] >= 1.0f);
+    if (options.weighting == animlod::FeatureWeighting::amplitude) {
+      ANIMLOD_FUZZ_REQUIRE(out.vertex_weights[v] <= static_cast<float>(options.max_weight));
+      ANIMLOD_FUZZ_REQUIRE(out.vertex_feature[v] >= 0 || out.vertex_weights[v] == 1.0f);
+    }
     in_features += out.vertex_feature[v] >= 0;
   }
   for (int32_t w : out.feature_sizes) total += static_cast<size_t>(w);

@@ -4,6 +4,8 @@ The command line, ``make demo`` and the batch runner call these; they hold no ar
 and no printing.
 """
 
+from .assets import character_asset, simplify_asset
 from .lod_document import DocumentReport, simplify_document
+from .result import AssetResult, LevelRow
 
-__all__ = ["DocumentReport", "simplify_document"]
+__all__ = ["AssetResult", "DocumentReport", "LevelRow", "character_asset", "simplify_asset", "simplify_document"]

@@ -30,7 +30,6 @@ ALLOWED = {
     ("model.py", "motion has {} joints, the skin's skeleton {}"): "model.py Motion/Skin part: lead's",
     ("model.py", "skeleton has no joint named {}"): "model.py Skeleton part: lead's",
     ("motion_lod/chain.py", "hard constraints need solver='slsqp'"): "motion_lod/: the motion helper's",
-    ("cli/character.py", "--workers and --max-frames must be at least 1"): "lead's; one WHERE per option wanted",
     ("synth/face_animation.py", "seconds and fps must be positive"): "procedural assets: no file, not user input",
 }
 

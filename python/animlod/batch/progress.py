@@ -73,7 +73,7 @@ class TqdmProgress(BatchProgress):
                 self.free.sort()
             if self.overall is not None:
                 self.overall.update(1)
-                if record["status"] != "ok":
+                if record["status"] != "ok" and not self.overall.disable:
                     error = record.get("error") or {}
                     self.overall.write(f"failed {record['name']}: {error.get('reason', '?')}")
 

@@ -73,7 +73,8 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
             return Client(scheduler, timeout=timeout, set_as_default=False), None
         except (OSError, TimeoutError) as error:
             reason = " ".join(str(error).split())
-            raise SchedulerUnreachable(f"{scheduler}: no Dask scheduler answered within {timeout:g} s ({reason})") from None
+            message = f"{scheduler}: no Dask scheduler answered within {timeout:g} s ({reason})"
+            raise SchedulerUnreachable(message) from None
     count = workers or os.cpu_count() or 1
     with dask.config.set(CLUSTER_CONFIG):
         cluster = LocalCluster(
@@ -181,11 +182,11 @@ def _run_pending(client, pending, root: Path, records: dict, ran_flags: dict, pr
         futures[future] = (asset, digest)
     last_write = time.monotonic()
     try:
-        for future in as_completed(futures):
+        for future in as_completed(futures, loop=client.loop):
             asset, digest = futures[future]
             try:
                 record = future.result()
-            except Exception as error:  # noqa: BLE001 - the worker died (KilledWorker) or the cluster failed it
+            except Exception as error:
                 record = _failed(asset, digest, _lost(error, asset))
             records[asset.name], ran_flags[asset.name] = record, True
             progress.asset_done(record)

@@ -27,7 +27,6 @@ and the reason): unknown jobs and options, option types, missing inputs, clashin
 from __future__ import annotations
 
 import glob
-import json
 import os
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -113,7 +112,8 @@ def _scan(folder: Path) -> Iterable[Path]:
 
 def _holds_frames(folder: Path) -> bool:
     try:
-        return any(entry.is_file() and Path(entry.name).suffix.lower() in MESH_SUFFIXES for entry in os.scandir(folder))
+        with os.scandir(folder) as entries:
+            return any(entry.is_file() and Path(entry.name).suffix.lower() in MESH_SUFFIXES for entry in entries)
     except OSError:
         return False
 

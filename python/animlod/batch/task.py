@@ -53,7 +53,7 @@ def run_asset(asset: AssetSpec, root: str, fingerprint: str, topic: str | None =
         _finish(record, started)
         publish(staging, folder, asset.name, record)
         staging = None
-    except Exception as error:  # noqa: BLE001 - every failure of one asset is its record, not the batch's end
+    except Exception as error:
         record.update(status="failed", result=None, error=describe_error(error, asset.input))
         _finish(record, started)
     finally:

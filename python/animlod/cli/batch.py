@@ -27,19 +27,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "spec", help="a folder of assets, a quoted glob ('lib/**/*.glb'), or a .toml/.json manifest (see README)"
     )
     parser.add_argument("-o", "--output", required=True, help="the batch's output folder (created if missing)")
-    parser.add_argument("--job", help="job for every asset of a folder or glob (simplify, character, motion, module:function)")
+    parser.add_argument(
+        "--job", help="job for every asset of a folder or glob (simplify, character, motion, module:function)"
+    )
     parser.add_argument(
         "--set", action="append", default=[], metavar="OPTION=VALUE", dest="options",
         help="a job option for every asset, VALUE in JSON (--set ratios=[0.5,0.2] --set solver=newton); "
         "a manifest's own options win",
     )  # fmt: skip
     parser.add_argument("--workers", type=positive_int, help="local worker processes (default: one per core)")
-    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="use this Dask scheduler instead of a local cluster")
+    parser.add_argument(
+        "--scheduler", metavar="tcp://HOST:PORT", help="use this Dask scheduler instead of a local cluster"
+    )
     parser.add_argument(
         "--connect-timeout", type=float, default=10.0, metavar="SECONDS",
         help="how long to wait for --scheduler to answer (default %(default)g s)",
     )  # fmt: skip
-    parser.add_argument("--force", action="store_true", help="redo every asset, even those unchanged since the last run")
+    parser.add_argument(
+        "--force", action="store_true", help="redo every asset, even those unchanged since the last run"
+    )
     parser.set_defaults(run=run)
 
 

@@ -77,7 +77,8 @@ def simplify_asset(
         ]
         outputs = [level.path for level in report.levels]
         return AssetResult("simplify", os.fspath(source), outputs, rows, time.perf_counter() - started, notes)
-    raise FormatError(os.fspath(source), "file", f"a {kind} file holds no mesh; simplify needs one (try the motion job)")
+    reason = f"a {kind} file holds no mesh; simplify needs one (try the motion job)"
+    raise FormatError(os.fspath(source), "file", reason)
 
 
 def character_asset(

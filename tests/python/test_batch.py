@@ -1,0 +1,195 @@
+"""`animlod batch` on a real LocalCluster with 2 single-threaded workers: outputs equal to the
+direct pipeline, a broken asset reported and the rest written, reruns that do no work, a killed
+worker leaving nothing half-written."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+pytest.importorskip("pyarrow")
+
+from animlod import synth
+from animlod.batch import BatchProgress, SpecError, connect, read_catalogue, read_spec, run_batch
+from animlod.batch.outputs import STATE
+from animlod.cli import main
+from animlod.io import write_glb
+from animlod.io.meshseq import write_sequence
+from animlod.io.npz import write_npz
+from animlod.pipelines import simplify_asset
+
+# Small enough for a quick suite: few drive and measured frames per clip.
+QUICK = {"frame_budget": 6, "measured_frames": 2}
+
+
+@pytest.fixture(scope="module")
+def client():
+    client, cluster = connect(workers=2)
+    yield client
+    client.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def library(tmp_path_factory) -> Path:
+    """Four small procedural assets of three kinds and one broken file."""
+    root = tmp_path_factory.mktemp("library")
+    for index, rings in enumerate((10, 14)):
+        skin, motion = synth.bending_cylinder_skinned(frames=6, rings=rings, segments=10)
+        (root / "characters").mkdir(exist_ok=True)
+        write_glb(root / "characters" / f"cyl{index}.glb", skin, [motion])
+    write_npz(root / "bar.npz", synth.twisting_bar(frames=5, rings=10, segments=8))
+    write_sequence(root / "seq", synth.bending_cylinder(frames=4, rings=8, segments=8))
+    (root / "broken.glb").write_bytes(b"glTF\x02\x00\x00\x00 not a glb")
+    return root
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    """Every file below ``folder`` (relative POSIX path -> bytes), the batch's own record aside."""
+    return {
+        path.relative_to(folder).as_posix(): path.read_bytes()
+        for path in sorted(folder.rglob("*"))
+        if path.is_file() and path.name != ".animlod-asset.json"
+    }
+
+
+class Recorder(BatchProgress):
+    def __init__(self) -> None:
+        self.events: list[str] = []
+        self.done: list[str] = []
+
+    def asset_event(self, name, fraction, message) -> None:
+        self.events.append(name)
+
+    def asset_done(self, record) -> None:
+        self.done.append(record["name"])
+
+
+def test_outputs_equal_the_direct_pipeline_and_broken_asset_is_reported(client, library, tmp_path):
+    assets = read_spec(library, options=QUICK)
+    assert sorted(asset.name for asset in assets) == ["bar", "broken", "characters/cyl0", "characters/cyl1", "seq"]
+    recorder = Recorder()
+    result = run_batch(assets, tmp_path / "out", client=client, progress=recorder)
+    assert (result.ran, result.skipped, result.failed, result.workers) == (5, 0, 1, 2)
+    assert sorted(recorder.done) == sorted(asset.name for asset in assets)
+    assert recorder.events  # the workers' progress reached the client
+
+    for asset in assets:
+        if asset.name == "broken":
+            continue
+        direct = tmp_path / "direct" / asset.name
+        simplify_asset(asset.input, direct, **asset.options)
+        batch = _files(tmp_path / "out" / asset.name)
+        assert batch and batch == _files(direct), asset.name
+
+    broken = next(record for record in result.records if record["name"] == "broken")
+    assert broken["status"] == "failed"
+    assert broken["error"]["file"].endswith("broken.glb") and broken["error"]["element"] and broken["error"]["reason"]
+    assert not (tmp_path / "out" / "broken").exists()
+    assert list((tmp_path / "out" / STATE / "staging").iterdir()) == []
+
+    rows = read_catalogue(result.catalogue).to_pylist()
+    failed = [row for row in rows if row["status"] == "failed"]
+    assert [(row["asset"], row["error_element"]) for row in failed] == [("broken", broken["error"]["element"])]
+    for asset in ("bar", "seq", "characters/cyl0", "characters/cyl1"):
+        levels = [row for row in rows if row["asset"] == asset]
+        assert [row["level"] for row in levels] == [0, 1, 2, 3], asset
+        triangles = [row["triangles"] for row in levels]
+        assert triangles == sorted(triangles, reverse=True) and triangles[-1] > 0
+        assert all(row["worker"].startswith("tcp://") and row["ran"] for row in levels)
+        assert all((tmp_path / "out" / output).exists() for output in levels[0]["outputs"])
+
+
+def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, library, tmp_path):
+    assets = [asset for asset in read_spec(library, options=QUICK) if asset.name != "broken"]
+    first = run_batch(assets, tmp_path / "out", client=client)
+    assert (first.ran, first.failed) == (4, 0)
+    outputs = [path for asset in assets for path in (tmp_path / "out" / asset.name).rglob("*") if path.is_file()]
+    before = {path: path.stat().st_mtime_ns for path in outputs}
+
+    second = run_batch(assets, tmp_path / "out", client=None, workers=1)  # no cluster is started: nothing to do
+    assert (second.ran, second.skipped, second.failed, second.workers) == (0, 4, 0, 0)
+    after = {path: path.stat().st_mtime_ns for path in before}
+    assert after == before
+    rows = read_catalogue(second.catalogue).to_pylist()
+    assert len(rows) == 16 and not any(row["ran"] for row in rows)
+
+    changed = [
+        type(asset)(asset.name, asset.input, asset.kind, asset.job, {**asset.options, "ratios": [0.5]})
+        if asset.name == "bar"
+        else asset
+        for asset in assets
+    ]
+    third = run_batch(changed, tmp_path / "out", client=client)
+    assert (third.ran, third.skipped) == (1, 3)
+    assert sorted(path.name for path in (tmp_path / "out" / "bar").iterdir()) == [".animlod-asset.json", "bar_lod1.npz"]
+
+
+def test_killed_worker_leaves_no_partial_file_and_the_asset_is_redone(client, library, tmp_path):
+    source = library / "characters" / "cyl0.glb"
+    manifest = tmp_path / "assets.json"
+    entries = [
+        {"input": str(source), "name": "crashes_once", "job": "batch_jobs:crash_once",
+         "marker": str(tmp_path / "crashed"), **QUICK},
+        {"input": str(source), "name": "always_crashes", "job": "batch_jobs:always_crash"},
+        {"input": str(library / "bar.npz"), "name": "bar"},
+    ]  # fmt: skip
+    manifest.write_text(json.dumps({"assets": entries}))
+    result = run_batch(read_spec(manifest), tmp_path / "out", client=client)
+    records = {record["name"]: record for record in result.records}
+
+    assert (tmp_path / "crashed").exists()  # the first attempt did die
+    assert records["crashes_once"]["status"] == "ok"
+    direct = tmp_path / "direct"
+    simplify_asset(source, direct, **QUICK)
+    assert _files(tmp_path / "out" / "crashes_once") == _files(direct)  # no half-written file
+
+    assert records["always_crashes"]["status"] == "failed"
+    assert records["always_crashes"]["error"]["element"] == "worker"
+    assert not (tmp_path / "out" / "always_crashes").exists()
+    assert records["bar"]["status"] == "ok"
+    assert not list((tmp_path / "out").rglob("half_written*"))
+    client.wait_for_workers(2, timeout=30)  # the nannies restarted the killed workers
+
+
+def test_cli_bad_inputs_are_one_line_exit_2(library, tmp_path, capsys):
+    manifest = tmp_path / "m.toml"
+    manifest.write_text(f'[[assets]]\ninput = "{library / "bar.npz"}"\nbogus = 1\n')
+    assert main(["batch", str(manifest), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "assets[0]" in err and "'bogus'" in err
+
+    manifest.write_text('[[assets]]\ninput = "missing.glb"\n')
+    assert main(["batch", str(manifest), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "missing.glb" in err and "does not exist" in err
+
+    (tmp_path / "file").write_text("x")
+    assert main(["batch", str(library), "-o", str(tmp_path / "file")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "is a file" in err
+
+    out = str(tmp_path / "o2")
+    assert main(["batch", str(library), "-o", out, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "no Dask scheduler answered within 1 s" in err
+
+    with pytest.raises(SpecError, match="no asset's job takes this option"):
+        read_spec(library, options={"nonsense": 1})
+
+
+def test_manifest_defaults_and_per_asset_options(library, tmp_path):
+    manifest = tmp_path / "lib.toml"
+    manifest.write_text(
+        "[defaults]\nratios = [0.5, 0.25]\nframe_budget = 6\n\n"
+        f'[[assets]]\ninput = "{library / "characters" / "cyl0.glb"}"\nname = "hero"\nmeasured_frames = 2\n\n'
+        f'[[assets]]\nglob = "{library}/*.npz"\nratios = [0.3]\n'
+    )
+    assets = {asset.name: asset for asset in read_spec(manifest)}
+    assert assets["hero"].options == {"measured_frames": 2, "ratios": [0.5, 0.25], "frame_budget": 6}
+    assert assets["bar"].options == {"ratios": [0.3]}  # frame_budget is not a sequence option
+    assert np.isclose(assets["bar"].options["ratios"][0], 0.3)

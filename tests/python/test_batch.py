@@ -13,17 +13,31 @@ import pytest
 pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
-from animlod import synth
+from animlod import Motion, Skeleton, rotations, synth
 from animlod.batch import BatchProgress, SpecError, connect, read_catalogue, read_spec, run_batch
+from animlod.batch.jobs import find_job
 from animlod.batch.outputs import STATE
 from animlod.cli import main
-from animlod.io import write_glb
+from animlod.io import write_bvh, write_glb
 from animlod.io.meshseq import write_sequence
 from animlod.io.npz import write_npz
 from animlod.pipelines import simplify_asset
 
 # Small enough for a quick suite: few drive and measured frames per clip.
 QUICK = {"frame_budget": 6, "measured_frames": 2}
+OPTIONS = {**QUICK, "levels": 3}  # levels: the motion job's, for the BVH
+
+
+def _arm_motion() -> Motion:
+    """Four joints in a chain, each turning a little over 8 frames."""
+    skeleton = Skeleton(
+        ["hips", "a", "b", "c", "c_End"], [-1, 0, 1, 2, 3],
+        [[0, 1, 0], [0, 0.4, 0], [0, 0.4, 0], [0, 0.4, 0], [0, 0.2, 0]], end_sites=[False] * 4 + [True],
+    )  # fmt: skip
+    local = rotations.identity((8, 5))
+    for joint, axis in ((1, [1.0, 0, 0]), (2, [0, 0, 1.0]), (3, [1.0, 0, 0])):
+        local[:, joint] = rotations.from_axis_angle(np.array(axis), np.linspace(0, 0.3 * joint, 8))
+    return Motion(skeleton, np.tile([0.0, 1.0, 0.0], (8, 1)), local, fps=24.0)
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +50,7 @@ def client():
 
 @pytest.fixture(scope="module")
 def library(tmp_path_factory) -> Path:
-    """Four small procedural assets of three kinds and one broken file."""
+    """Five small procedural assets of four kinds and one broken file."""
     root = tmp_path_factory.mktemp("library")
     for index, rings in enumerate((10, 14)):
         skin, motion = synth.bending_cylinder_skinned(frames=6, rings=rings, segments=10)
@@ -44,6 +58,8 @@ def library(tmp_path_factory) -> Path:
         write_glb(root / "characters" / f"cyl{index}.glb", skin, [motion])
     write_npz(root / "bar.npz", synth.twisting_bar(frames=5, rings=10, segments=8))
     write_sequence(root / "seq", synth.bending_cylinder(frames=4, rings=8, segments=8))
+    (root / "motions").mkdir()
+    write_bvh(root / "motions" / "arm.bvh", _arm_motion())
     (root / "broken.glb").write_bytes(b"glTF\x02\x00\x00\x00 not a glb")
     return root
 
@@ -70,11 +86,12 @@ class Recorder(BatchProgress):
 
 
 def test_outputs_equal_the_direct_pipeline_and_broken_asset_is_reported(client, library, tmp_path):
-    assets = read_spec(library, options=QUICK)
-    assert sorted(asset.name for asset in assets) == ["bar", "broken", "characters/cyl0", "characters/cyl1", "seq"]
+    assets = read_spec(library, options=OPTIONS)
+    names = ["bar", "broken", "characters/cyl0", "characters/cyl1", "motions/arm", "seq"]
+    assert sorted(asset.name for asset in assets) == names
     recorder = Recorder()
     result = run_batch(assets, tmp_path / "out", client=client, progress=recorder)
-    assert (result.ran, result.skipped, result.failed, result.workers) == (5, 0, 1, 2)
+    assert (result.ran, result.skipped, result.failed, result.workers) == (6, 0, 1, 2)
     assert sorted(recorder.done) == sorted(asset.name for asset in assets)
     assert recorder.events  # the workers' progress reached the client
 
@@ -82,7 +99,7 @@ def test_outputs_equal_the_direct_pipeline_and_broken_asset_is_reported(client, 
         if asset.name == "broken":
             continue
         direct = tmp_path / "direct" / asset.name
-        simplify_asset(asset.input, direct, **asset.options)
+        find_job(asset.job).function()(asset.input, direct, **asset.options)
         batch = _files(tmp_path / "out" / asset.name)
         assert batch and batch == _files(direct), asset.name
 
@@ -102,21 +119,24 @@ def test_outputs_equal_the_direct_pipeline_and_broken_asset_is_reported(client, 
         assert triangles == sorted(triangles, reverse=True) and triangles[-1] > 0
         assert all(row["worker"].startswith("tcp://") and row["ran"] for row in levels)
         assert all((tmp_path / "out" / output).exists() for output in levels[0]["outputs"])
+    motion = [row for row in rows if row["asset"] == "motions/arm"]
+    assert [(row["level"], row["joints"]) for row in motion][0] == (0, 4)
+    assert len(motion) == 3 and motion[-1]["joints"] < 4 and motion[-1]["error"] > 0
 
 
 def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, library, tmp_path):
-    assets = [asset for asset in read_spec(library, options=QUICK) if asset.name != "broken"]
+    assets = [asset for asset in read_spec(library, options=OPTIONS) if asset.name != "broken"]
     first = run_batch(assets, tmp_path / "out", client=client)
-    assert (first.ran, first.failed) == (4, 0)
+    assert (first.ran, first.failed) == (5, 0)
     outputs = [path for asset in assets for path in (tmp_path / "out" / asset.name).rglob("*") if path.is_file()]
     before = {path: path.stat().st_mtime_ns for path in outputs}
 
     second = run_batch(assets, tmp_path / "out", client=None, workers=1)  # no cluster is started: nothing to do
-    assert (second.ran, second.skipped, second.failed, second.workers) == (0, 4, 0, 0)
+    assert (second.ran, second.skipped, second.failed, second.workers) == (0, 5, 0, 0)
     after = {path: path.stat().st_mtime_ns for path in before}
     assert after == before
     rows = read_catalogue(second.catalogue).to_pylist()
-    assert len(rows) == 16 and not any(row["ran"] for row in rows)
+    assert len(rows) == 19 and not any(row["ran"] for row in rows)
 
     changed = [
         type(asset)(asset.name, asset.input, asset.kind, asset.job, {**asset.options, "ratios": [0.5]})
@@ -125,7 +145,7 @@ def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, l
         for asset in assets
     ]
     third = run_batch(changed, tmp_path / "out", client=client)
-    assert (third.ran, third.skipped) == (1, 3)
+    assert (third.ran, third.skipped) == (1, 4)
     assert sorted(path.name for path in (tmp_path / "out" / "bar").iterdir()) == [".animlod-asset.json", "bar_lod1.npz"]
 
 
@@ -176,7 +196,7 @@ def test_cli_bad_inputs_are_one_line_exit_2(library, tmp_path, capsys):
     out = str(tmp_path / "o2")
     assert main(["batch", str(library), "-o", out, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "no Dask scheduler answered within 1 s" in err
+    assert "\n" not in err and "--scheduler: tcp://127.0.0.1:9: no Dask scheduler answered within 1 s" in err
 
     with pytest.raises(SpecError, match="no asset's job takes this option"):
         read_spec(library, options={"nonsense": 1})

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "bvh": "motion"}
 # Keyword arguments a manifest never sets: the runner owns progress, and a batch spreads its
 # work over assets (one core each), not over the processes of one asset.
-_RESERVED = frozenset({"source", "output", "progress", "workers"})
+_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level"})
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,12 @@ BUILTIN_JOBS = {
         ("gltf",),
         {"gltf": ("animlod.pipelines.character:build_character", _AQEM)},
     ),
+    "motion": Job(
+        "motion",
+        "animlod.pipelines.motion:motion_asset",
+        ("bvh", "gltf"),
+        {"*": ("animlod.pipelines.motion:build_motion_levels",)},
+    ),
 }
 
 
@@ -81,13 +87,13 @@ def find_job(name: str) -> Job:
     if name in BUILTIN_JOBS:
         return BUILTIN_JOBS[name]
     if ":" not in name:
-        raise ValueError(f"unknown job {name!r}; built-in jobs are {', '.join(BUILTIN_JOBS)}, or 'module:function'")
+        raise ValueError(f"job {name!r}: unknown; built-in jobs are {', '.join(BUILTIN_JOBS)}, or 'module:function'")
     try:
         function = _import(name)
     except (ImportError, AttributeError) as error:
-        raise ValueError(f"job {name!r} cannot be imported ({error})") from None
+        raise ValueError(f"job {name!r}: cannot be imported ({error})") from None
     if not callable(function):
-        raise ValueError(f"job {name!r} is not a function")
+        raise ValueError(f"job {name!r}: not a function")
     return Job(name, name, (), {})
 
 

@@ -88,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
             progress=TqdmProgress(args.workers or 4),
         )
     except SchedulerUnreachable as error:
-        raise UserError(f"--scheduler {error}") from None
+        raise UserError(f"--scheduler: {error}") from None
     for note in result.notes:
         print(f"note: {note}")
     failures = [record for record in result.records if record["status"] != "ok"]

@@ -71,75 +71,45 @@ class _Progress:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..motion_lod.analysis import analyze_motion
-    from ..motion_lod.chain import build_motion_chain, level_joint_counts
-    from ..motion_lod.objective import Weights
-    from ..motion_lod.refit import SlsqpOptions
+    from ..pipelines.motion import build_motion_levels
 
     if args.hard and args.solver != "slsqp":
         raise UserError("--hard: bone-length equality constraints need --solver slsqp")
     if args.workers < 1:
         raise UserError(f"--workers: must be at least 1, got {args.workers}")
-    kind = input_kind(args.input)
-    skin = None
-    if kind == "bvh":
-        from ..io.bvh import read_bvh
-
-        motion = read_bvh(args.input)
-    elif kind == "gltf":
-        from ..io.gltf import read_skinned
-
-        skin, motions = read_skinned(args.input)
-        if not motions:
-            raise UserError(f"{args.input}: the skinned mesh has no animation to simplify")
-        if not 0 <= args.clip < len(motions):
-            raise UserError(f"--clip: {args.input} has {len(motions)} animations, got index {args.clip}")
-        motion = motions[args.clip]
-    else:
+    if input_kind(args.input) not in ("bvh", "gltf"):
         raise UserError(f"{args.input}: motion LoD needs a .bvh or a skinned .glb/.gltf")
+    bars: list[_Progress] = []  # made when the first level starts: bad input fails before any bar
 
-    analysis = analyze_motion(motion, locked=args.lock, max_frames=args.max_frames)
-    levels = args.joints if args.joints else args.levels
-    counts = level_joint_counts(motion, analysis, levels)
-    progress = _Progress(len(counts))
+    def on_level(index: int, joints: int, frame_count: int):
+        if not bars:
+            bars.append(_Progress(len(args.joints) if args.joints else args.levels))
+        return bars[0].start_level(index, joints, frame_count)
+
     try:
-        chain = build_motion_chain(
-            motion,
-            counts,
-            weights=Weights(*args.weights),
+        report = build_motion_levels(
+            args.input,
+            args.output,
+            args.levels,
+            joints=args.joints,
+            lock=args.lock,
             solver=args.solver,
-            slsqp_options=SlsqpOptions(hard_constraints=args.hard),
+            hard=args.hard,
+            weights=args.weights,
+            max_frames=args.max_frames,
+            clip=args.clip,
             workers=args.workers,
-            skin=skin,
-            on_level=lambda index, joints: progress.start_level(index, joints, motion.frame_count),
-            analysis=analysis,
+            on_level=on_level,
         )
     finally:
-        progress.close()
-
-    output = Path(args.output)
-    output.mkdir(parents=True, exist_ok=True)
-    stem = input_stem(args.input)
-    from ..io.bvh import write_bvh
-    from ..io.manifest import write_lod_manifest
-
-    rows = []
-    for index, level in enumerate(chain.levels):
-        files = [f"{stem}_lod{index}.bvh"]
-        write_bvh(output / files[0], level.motion)
-        if level.skin is not None:
-            from ..io.gltf import write_glb
-
-            files.append(f"{stem}_lod{index}.glb")
-            write_glb(output / files[1], level.skin, [level.motion])
-        rows.append({"files": files, "joints": level.report.joint_count, "error": level.report.max_error})
-    # The runtime's level chooser: each level's largest joint position error in asset units.
-    write_lod_manifest(output / f"{stem}_motion_lod.json", "motion", rows)
-    _print_summary(chain)
+        for bar in bars:
+            bar.close()
+    _print_summary(report.chain)
     if args.plot:
         from ..motion_lod.plots import plot_chain
 
-        plot_chain(output / f"{stem}_motion_lod.png", chain, motion.skeleton.names)
+        stem = input_stem(args.input)
+        plot_chain(Path(args.output) / f"{stem}_motion_lod.png", report.chain, report.motion.skeleton.names)
     return 0
 
 

@@ -6,6 +6,17 @@ and no printing.
 
 from .assets import character_asset, simplify_asset
 from .lod_document import DocumentReport, simplify_document
+from .motion import MotionReport, build_motion_levels, motion_asset
 from .result import AssetResult, LevelRow
 
-__all__ = ["AssetResult", "DocumentReport", "LevelRow", "character_asset", "simplify_asset", "simplify_document"]
+__all__ = [
+    "AssetResult",
+    "DocumentReport",
+    "LevelRow",
+    "MotionReport",
+    "build_motion_levels",
+    "character_asset",
+    "motion_asset",
+    "simplify_asset",
+    "simplify_document",
+]

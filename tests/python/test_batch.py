@@ -144,7 +144,7 @@ def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, l
         else asset
         for asset in assets
     ]
-    third = run_batch(changed, tmp_path / "out", client=client)
+    third = run_batch(changed, tmp_path / "out", scheduler=client.scheduler.address)  # as --scheduler tcp://...
     assert (third.ran, third.skipped) == (1, 4)
     assert sorted(path.name for path in (tmp_path / "out" / "bar").iterdir()) == [".animlod-asset.json", "bar_lod1.npz"]
 
@@ -213,3 +213,17 @@ def test_manifest_defaults_and_per_asset_options(library, tmp_path):
     assert assets["hero"].options == {"measured_frames": 2, "ratios": [0.5, 0.25], "frame_budget": 6}
     assert assets["bar"].options == {"ratios": [0.3]}  # frame_budget is not a sequence option
     assert np.isclose(assets["bar"].options["ratios"][0], 0.3)
+
+
+def test_scheduler_without_workers_is_a_clear_error_after_the_timeout(library, tmp_path):
+    import logging
+
+    from distributed import LocalCluster
+
+    from animlod.batch import SchedulerUnreachable
+
+    assets = read_spec(library / "bar.npz")
+    with LocalCluster(n_workers=0, dashboard_address=":0", silence_logs=logging.ERROR) as empty:
+        address = empty.scheduler_address
+        with pytest.raises(SchedulerUnreachable, match="the scheduler has no worker after 1 s"):
+            run_batch(assets, tmp_path / "out", scheduler=address, connect_timeout=1)

@@ -81,7 +81,7 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
             n_workers=count,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",
             silence_logs=logging.ERROR,
         )
     return Client(cluster, set_as_default=False), cluster
@@ -142,6 +142,7 @@ def run_batch(
                 if client is None:
                     client, owned = connect(scheduler, workers, connect_timeout)
                 try:
+                    _wait_for_a_worker(client, scheduler, connect_timeout)
                     worker_count, notes = _check_workers(client)
                     _run_pending(client, pending, root, records, ran_flags, progress, assets)
                 finally:
@@ -234,6 +235,16 @@ def _unchanged(record: dict, digest: str, root: Path) -> bool:
         return False
     folder = root / record["name"]
     return all((folder / path).exists() for path in record["result"].get("outputs", []))
+
+
+def _wait_for_a_worker(client, scheduler: str | None, timeout: float) -> None:
+    """SchedulerUnreachable when the cluster has no worker after ``timeout`` seconds (a
+    scheduler started without workers would otherwise hold the batch forever)."""
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except TimeoutError:
+        where = scheduler or "the local cluster"
+        raise SchedulerUnreachable(f"{where}: the scheduler has no worker after {timeout:g} s") from None
 
 
 def _check_workers(client) -> tuple[int, list[str]]:

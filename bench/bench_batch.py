@@ -134,6 +134,7 @@ def main() -> None:
             find_job(asset.job).function()(asset.input, scratch / "direct" / asset.name, **asset.options)
         direct[asset.name] = elapsed[0]
     direct_sum = sum(direct.values())
+    loads = {0: os.getloadavg()[0]}  # 1-minute load average after each run: the machine may be shared
 
     runs = {}
     for workers in (1, 2):
@@ -146,6 +147,7 @@ def main() -> None:
             client.close()
             cluster.close()
         runs[workers] = (result, started[0])
+        loads[workers] = os.getloadavg()[0]
 
     one, two = runs[1][0], runs[2][0]
     failed = [record["name"] for result in (one, two) for record in result.records if record["status"] != "ok"]
@@ -154,15 +156,15 @@ def main() -> None:
     worker_sum = sum(inside.values())
     overhead = (one.seconds - worker_sum) / count  # scheduling, transfer, records, catalogue
     rows = [
-        ("direct (one process)", "", f"{direct_sum:.1f}", "", f"{direct_sum / count:.3f}", ""),
+        ("direct (one process)", "", f"{direct_sum:.1f}", "", f"{direct_sum / count:.3f}", "", f"{loads[0]:.1f}"),
         ("batch, 1 worker", f"{runs[1][1]:.1f}", f"{one.seconds:.1f}", "1.00", f"{one.seconds / count:.3f}",
-         f"{overhead:.3f} s ({100 * overhead / (worker_sum / count):.1f} %)"),
+         f"{overhead:.3f} s ({100 * overhead / (worker_sum / count):.1f} %)", f"{loads[1]:.1f}"),
         ("batch, 2 workers", f"{runs[2][1]:.1f}", f"{two.seconds:.1f}", f"{one.seconds / two.seconds:.2f}",
-         f"{two.seconds / count:.3f}", ""),
+         f"{two.seconds / count:.3f}", "", f"{loads[2]:.1f}"),
     ]  # fmt: skip
     print_table(
         f"Batch of {count} assets (wall seconds)",
-        ("run", "cluster start s", "wall s", "speed-up", "s per asset", "Dask overhead per asset"),
+        ("run", "cluster start s", "wall s", "speed-up", "s per asset", "Dask overhead per asset", "load after"),
         rows,
     )
     if failed:
@@ -171,7 +173,7 @@ def main() -> None:
         f"\nDask overhead per asset: (1-worker wall - the jobs' own time on the worker) / assets. The jobs took "
         f"{worker_sum:.1f} s on the worker against {direct_sum:.1f} s called directly "
         f"({100 * (worker_sum - direct_sum) / direct_sum:+.1f} %: one thread per worker, and whatever else ran on "
-        f"the machine; load average {os.getloadavg()[0]:.1f} at the end, {load_before:.1f} at the start)."
+        f"the machine: 1-minute load average {load_before:.1f} at the start, then as in the table)."
     )
 
     peaks: dict[str, float] = {}

@@ -6,9 +6,12 @@ relative_error, level_seconds, seconds (the whole asset), worker, peak_rss_mb (t
 so far), fingerprint, outputs (paths relative to OUT), error_file, error_element, error_reason,
 finished (UTC). Query it with anything that reads Parquet::
 
+    import pyarrow.compute as pc
     import pyarrow.parquet as pq
-    table = pq.read_table("OUT/catalogue.parquet").to_pandas()
-    table[table.status == "failed"][["asset", "error_file", "error_element", "error_reason"]]
+
+    table = pq.read_table("OUT/catalogue.parquet")
+    failed = table.filter(pc.field("status") == "failed")
+    failed.select(["asset", "error_file", "error_element", "error_reason"]).to_pylist()
 
 The file is rewritten whole (atomically) as assets finish and once at the end.
 """

@@ -124,10 +124,26 @@ def test_outputs_equal_the_direct_pipeline_and_broken_asset_is_reported(client, 
     assert len(motion) == 3 and motion[-1]["joints"] < 4 and motion[-1]["error"] > 0
 
 
-def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, library, tmp_path):
+class CatalogueWatcher(BatchProgress):
+    """Reads the catalogue each time an asset finishes: how many assets it held then."""
+
+    def __init__(self, path: Path) -> None:
+        self.path, self.seen = path, []
+
+    def asset_done(self, record) -> None:
+        rows = read_catalogue(self.path).to_pylist() if self.path.exists() else []
+        self.seen.append(len({row["asset"] for row in rows}))
+
+
+def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, library, tmp_path, monkeypatch):
+    import animlod.batch.runner
+
+    monkeypatch.setattr(animlod.batch.runner, "CATALOGUE_INTERVAL", 0.0)  # rewrite it after every asset
     assets = [asset for asset in read_spec(library, options=OPTIONS) if asset.name != "broken"]
-    first = run_batch(assets, tmp_path / "out", client=client)
+    watcher = CatalogueWatcher(tmp_path / "out" / "catalogue.parquet")
+    first = run_batch(assets, tmp_path / "out", client=client, progress=watcher)
     assert (first.ran, first.failed) == (5, 0)
+    assert watcher.seen == [0, 1, 2, 3, 4]  # the catalogue grew as the assets finished
     outputs = [path for asset in assets for path in (tmp_path / "out" / asset.name).rglob("*") if path.is_file()]
     before = {path: path.stat().st_mtime_ns for path in outputs}
 

@@ -206,8 +206,8 @@ def _lost(error: BaseException, asset: AssetSpec) -> dict:
 
     if isinstance(error, KilledWorker):
         reason = (
-            "the worker running it died twice (a crash in native code or the memory limit); "
-            "it was restarted and the other assets went on"
+            "its worker process died each time it was tried (a crash in native code or the memory limit; "
+            "the scheduler's allowed-failures, 1 on a local cluster); the other assets went on"
         )
         return {"file": asset.input, "element": "worker", "reason": reason, "traceback": None}
     return describe_error(error, asset.input)

@@ -5,6 +5,7 @@ worker leaving nothing half-written."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -243,3 +244,38 @@ def test_scheduler_without_workers_is_a_clear_error_after_the_timeout(library, t
         address = empty.scheduler_address
         with pytest.raises(SchedulerUnreachable, match="the scheduler has no worker after 1 s"):
             run_batch(assets, tmp_path / "out", scheduler=address, connect_timeout=1)
+
+
+def test_spec_forms_and_their_errors(library, tmp_path):
+    by_glob = read_spec(f"{library}/characters/*.glb", options=QUICK)
+    assert [(asset.name, asset.job, asset.kind) for asset in by_glob] == [
+        ("cyl0", "simplify", "gltf"),
+        ("cyl1", "simplify", "gltf"),
+    ]
+    assert [asset.name for asset in read_spec(library / "characters", job="character")] == ["cyl0", "cyl1"]
+    with pytest.raises(SpecError, match="pattern: matches no file"):
+        read_spec(f"{library}/*.nothing")
+    with pytest.raises(SpecError, match="does not take bvh input"):
+        read_spec(library / "motions", job="simplify")
+    with pytest.raises(SpecError, match="job 'nosuchjob': unknown"):
+        read_spec(library / "bar.npz", job="nosuchjob")
+
+    def manifest(text: str) -> Path:
+        path = tmp_path / "m.toml"
+        path.write_text(text)
+        return path
+
+    bar = library / "bar.npz"
+    cases = [
+        (f'[[assets]]\ninput = "{bar}"\nname = "a"\n[[assets]]\ninput = "{bar}"\nname = "a"\n', "given to both"),
+        (f'[[assets]]\ninput = "{bar}"\nname = "../a"\n', "relative path without '.' parts"),
+        (f'[[assets]]\ninput = "{bar}"\nname = "a"\n[[assets]]\ninput = "{bar}"\nname = "a/b"\n', "inside the folder"),
+        (f'[[asset]]\ninput = "{bar}"\n', "asset: unknown key"),
+        (f'[[assets]]\ninput = "{bar}"\nglob = "*.npz"\n', "needs exactly one of 'input'"),
+        (f'[defaults]\ninput = "{bar}"\n[[assets]]\ninput = "{bar}"\n', "defaults.input: belongs to an asset"),
+        (f'[[assets]]\ninput = "{bar}"\nratios = [0.5, "x"]\n', "in the list: expected a number"),
+        ("[[assets]\n", "not valid TOML"),
+    ]
+    for text, message in cases:
+        with pytest.raises(SpecError, match=re.escape(message)):
+            read_spec(manifest(text))

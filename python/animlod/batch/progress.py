@@ -27,7 +27,8 @@ class BatchProgress:
 
 class TqdmProgress(BatchProgress):
     """tqdm bars: position 0 counts assets, the lines below follow the running ones (at most
-    ``slots``, the number of workers). Bars are off when stderr is not a terminal."""
+    ``slots``, the number of workers). When stderr is not a terminal, one line per finished
+    asset on stdout instead."""
 
     def __init__(self, slots: int = 4) -> None:
         self.slots = max(1, slots)
@@ -35,12 +36,15 @@ class TqdmProgress(BatchProgress):
         self.overall = None
         self.bars: dict[str, tuple[object, int]] = {}  # name -> (bar, its line)
         self.free: list[int] = []
+        self.done = 0
+        self.total = 0
 
     def start(self, to_run: int, skipped: int) -> None:
         from tqdm import tqdm
 
         self._tqdm = tqdm
         with self.lock:
+            self.total = to_run
             self.overall = tqdm(total=to_run, desc="assets", unit="asset", position=0, disable=None, dynamic_ncols=True)
             if skipped:
                 self.overall.set_postfix_str(f"{skipped} unchanged, skipped")
@@ -71,11 +75,19 @@ class TqdmProgress(BatchProgress):
                 entry[0].close()
                 self.free.append(entry[1])
                 self.free.sort()
+            self.done += 1
             if self.overall is not None:
                 self.overall.update(1)
-                if record["status"] != "ok" and not self.overall.disable:
-                    error = record.get("error") or {}
-                    self.overall.write(f"failed {record['name']}: {error.get('reason', '?')}")
+                error = record.get("error") or {}
+                if not self.overall.disable:
+                    if record["status"] != "ok":
+                        self.overall.write(f"failed {record['name']}: {error.get('reason', '?')}")
+                    return
+                # No terminal (a log file, a farm's job output): one line per asset instead of bars.
+                seconds = record.get("seconds")
+                took = f" in {seconds:.1f} s" if isinstance(seconds, (int, float)) else ""
+                status = "ok" if record["status"] == "ok" else f"failed: {error.get('reason', '?')}"
+                print(f"[{self.done}/{self.total}] {record['name']}: {status}{took}", flush=True)
 
     def close(self) -> None:
         with self.lock:

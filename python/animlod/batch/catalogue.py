@@ -21,8 +21,12 @@ from __future__ import annotations
 import os
 from datetime import datetime
 from pathlib import PurePosixPath
+from typing import TYPE_CHECKING
 
 from ..io.atomic import atomic_write
+
+if TYPE_CHECKING:
+    import pyarrow as pa
 
 COLUMNS = (
     ("asset", "string"),
@@ -49,7 +53,7 @@ COLUMNS = (
 )
 
 
-def schema():
+def schema() -> pa.Schema:
     """The catalogue's pyarrow schema."""
     import pyarrow as pa
 
@@ -118,7 +122,7 @@ def write_catalogue(path: str | os.PathLike, rows: list[dict]) -> None:
         pq.write_table(table, handle)
 
 
-def read_catalogue(path: str | os.PathLike):
+def read_catalogue(path: str | os.PathLike) -> pa.Table:
     """The catalogue as a pyarrow Table."""
     import pyarrow.parquet as pq
 

@@ -23,6 +23,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .catalogue import record_rows, write_catalogue
 from .fingerprint import fingerprint
@@ -30,6 +31,9 @@ from .outputs import CATALOGUE, clear_staging, output_lock, prepare_output, read
 from .progress import BatchProgress
 from .spec import AssetSpec
 from .task import describe_error, run_asset
+
+if TYPE_CHECKING:
+    from distributed import Client, LocalCluster
 
 # How a LocalCluster and the scheduler behave for a batch (see the module docstring).
 CLUSTER_CONFIG = {
@@ -59,7 +63,9 @@ class BatchResult:
     notes: list[str] = field(default_factory=list)
 
 
-def connect(scheduler: str | None = None, workers: int | None = None, timeout: float = 10.0):
+def connect(
+    scheduler: str | None = None, workers: int | None = None, timeout: float = 10.0
+) -> tuple[Client, LocalCluster | None]:
     """A Dask client: to ``scheduler`` (``tcp://HOST:PORT``), waiting at most ``timeout`` seconds,
     or to a new LocalCluster of ``workers`` single-threaded processes (default: one per core).
 
@@ -91,7 +97,7 @@ def run_batch(
     assets: Sequence[AssetSpec],
     output: str | os.PathLike,
     *,
-    client=None,
+    client: Client | None = None,
     scheduler: str | None = None,
     workers: int | None = None,
     connect_timeout: float = 10.0,

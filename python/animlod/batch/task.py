@@ -15,11 +15,15 @@ import time
 import traceback
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..io.errors import FormatError
 from .jobs import find_job
 from .outputs import discard, publish, staging_folder
 from .spec import AssetSpec
+
+if TYPE_CHECKING:
+    from ..pipelines.result import Progress
 
 # Least time between two progress events of one asset (seconds): enough for a live bar, few
 # enough messages that the scheduler does not notice them.
@@ -102,7 +106,7 @@ def _worker_name() -> str:
         return f"{socket.gethostname()}:{os.getpid()}"
 
 
-def _progress(topic: str | None, name: str):
+def _progress(topic: str | None, name: str) -> Progress | None:
     """A job progress callback that sends (asset, fraction, message) events to the client,
     at most one per PROGRESS_INTERVAL; None outside Dask or without a topic."""
     if topic is None:

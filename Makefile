@@ -6,6 +6,7 @@
 #   make test      ruff, C++ unit tests (ctest), the find_package(animlod) consumer, pytest
 #   make demo      the main job on the embedded procedural character, into out/demo
 #   make bench     benchmark tables (peers in the same run); heavy, not part of test
+#   make bench-crowd  the native crowd benchmark: Table 2 and Fig. 1 of the motion LoD paper
 #   make sanitize  C++ tests and pytest under ASan + UBSan
 #   make fuzz      every fuzz harness of tests/fuzz for FUZZ_SECONDS (default 60) each
 
@@ -18,7 +19,7 @@ CPP_BUILD := build/cpp
 CMAKE_GENERATOR := Ninja
 JOBS ?= 2
 
-.PHONY: setup system-packages python-package lint cpp-test consumer-test test demo bench sanitize fuzz fuzz-build clean
+.PHONY: setup system-packages python-package lint cpp-test consumer-test test demo bench bench-crowd crowd-binary sanitize fuzz fuzz-build clean
 
 setup: python-package
 
@@ -60,11 +61,23 @@ consumer-test: cpp-test
 lint: python-package
 	$(VENV)/bin/ruff check python tests bench
 
+# The crowd smoke test (tests/python/test_crowd.py) runs the binary under xvfb-run.
+CROWD_BIN := $(CURDIR)/$(CPP_BUILD)/bench/crowd/animlod_crowd
 test: python-package lint consumer-test
-	ANIMLOD_GLTF_PROBE=$(CURDIR)/$(CPP_BUILD)/tests/cpp/animlod_gltf_probe $(PY) -m pytest -q tests/python
+	ANIMLOD_GLTF_PROBE=$(CURDIR)/$(CPP_BUILD)/tests/cpp/animlod_gltf_probe ANIMLOD_CROWD_BIN=$(CROWD_BIN) \
+	  $(PY) -m pytest -q tests/python
 
-demo: python-package
+demo: python-package crowd-binary
 	$(VENV)/bin/animlod demo -o out/demo
+	ANIMLOD_CROWD_BIN=$(CROWD_BIN) $(VENV)/bin/animlod crowd out/demo/character_lod.glb --count 100 --frames 30 \
+	  --modes all --level-colors --json out/demo/crowd.json --screenshot 15 out/demo/crowd.png
+
+crowd-binary: $(CPP_BUILD)/build.ninja
+	cmake --build $(CPP_BUILD) --target animlod_crowd --parallel $(JOBS)
+
+# Heavy (tens of minutes on 2 cores): Table 2 on Nav1 and Nav2, 10,000 characters, Fig. 1.
+bench-crowd: python-package crowd-binary
+	ANIMLOD_CROWD_BIN=$(CROWD_BIN) $(PY) bench/crowd/run_bench.py
 
 bench: EXTRAS := test,batch,bench
 bench: python-package

@@ -1,179 +1,234 @@
-"""Motion LoD: preprocessing time (Table 1), bone length stability (Fig. 7), position error per
-level, the 8-level time goal, and SLSQP against the damped-Newton solver.
+"""Motion LoD: levels on every dev clip, the core's SLSQP against the Python reference, the
+speed goals, and the joint-choice comparison.
 
-Run: ``.venv/bin/python bench/bench_motion.py [--quick]``. Tables:
+Run: ``.venv/bin/python bench/bench_motion.py [--quick]`` (part of ``make bench``). Tables:
 
-1. Table 1 of the paper: SLSQP re-fit of one level (about 70 % of the joints, like the paper's
-   24 of 33) with the key posture from motion analysis (ASQP) against the first frame as key
-   posture (SQP): mean objective evaluations per frame and seconds, measured on an evenly spaced
-   frame sample and scaled to the whole clip, on the dev clips and the procedural ones.
-2. All 8 levels of 131_01.bvh (31 joints, 994 frames, 120 fps), once with SLSQP (the default)
-   and once with damped Newton: time per level and in total (goal: under 30 s on this 2-core
-   machine), also with 2 worker processes; joint position error mean and max (asset units and
-   relative to the figure size); Fig. 7's mean summed bone length error and the worst bone's
-   length standard deviation relative to its key length (goal: under 0.5 %); FK residual and
-   frames whose solve did not converge.
-3. SLSQP (the paper's SQP) against damped Newton on the same objective, per level of 131_01,
-   on a frame sample: mean E, worst and best per-frame difference of E relative to the mean,
-   time per frame;
-   and SLSQP with hard length constraints: E, time, Fig. 7's bone length variation.
-4. SLSQP with 1 and 2 worker processes on the same frames (does the pool pay?).
+1. Per clip (the BVH files of ../shared/data/bvh, the longest clip of every skinned glTF of
+   ../shared/data/gltf, the procedural walk), 8 levels (or as many as the skeleton allows) with
+   the default: SLSQP in the C++ core with hard bone lengths. Per level: joints, joint position
+   error mean and max against the original (asset units and relative to the figure size),
+   Fig. 7's bone-length variation (the worst re-fitted bone's standard deviation over frames
+   relative to its key length), FK residual, frames whose first solve failed and frames that
+   fell back to the frozen key motion, seconds.
+2. Speed: 8 levels of 131_01.bvh and of the procedural humanoid with fingers, wall and CPU
+   seconds (goal: 131_01 under 10 s), and the cost per joint-frame.
+3. Both solvers on the same frames: the Python reference (PyPI nlopt, Python callbacks) and the
+   core (nlopt's C library), plain (the reference's variables) and preconditioned (the default),
+   on one thread, per level of 131_01 and the Bandai run: ms per frame, evaluations, and how many
+   frames reach the reference's E within 1e-6 relative.
+4. Joint choice: mean joint position error over every original joint and frame after the same
+   re-fit, per level, for the default ranking (Eq. 3 with zero-length bones looked through), the
+   paper's Eq. 3 as printed, leaf-first by depth and least rotation variance.
+
+Wall times depend on what else runs on the machine; the load average is printed first and CPU
+seconds (all threads of this process) are given beside wall seconds.
 """
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
+import os
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from devdata import DATA_DIR
-from table import print_table, stopwatch
+from table import print_table
 
 from animlod.io.bvh import read_bvh
-from animlod.motion_lod import analyze_motion
-from animlod.motion_lod.chain import SOLVERS, build_motion_chain, level_joint_counts
+from animlod.model import Motion
+from animlod.motion_lod import RANKINGS, analyze_motion, build_motion_chain, joint_floor, level_joint_counts
+from animlod.motion_lod.chain import _cold_starts
+from animlod.motion_lod.clips import merge_split_clips
+from animlod.motion_lod.core_refit import refit_core
 from animlod.motion_lod.frozen import freeze, frozen_motion
-from animlod.motion_lod.newton import refit_newton
 from animlod.motion_lod.objective import build_problem
 from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
 from animlod.synth import humanoid, humanoid_motion
 
-DATA = DATA_DIR / "bvh"
+# The core's SLSQP in the Python reference's variables (no preconditioner, every point a variable).
+PLAIN = SlsqpOptions(precondition=False, eliminate_points=False)
 
 
-def clips(quick: bool) -> list[tuple[str, object]]:
-    skeleton = humanoid().skeleton
-    result = [(f"procedural {kind}", humanoid_motion(skeleton, kind)) for kind in ("walk", "run", "jump")]
-    for name in ("131_01.bvh", "dataset-1_run_proud_001.bvh"):
-        if (DATA / name).exists():
-            result.append((name, read_bvh(DATA / name)))
-    return result[:2] if quick else result
+def subsample(motion: Motion, stride: int) -> Motion:
+    """Every ``stride``-th frame."""
+    if stride <= 1:
+        return motion
+    translations = None if motion.joint_translations is None else motion.joint_translations[::stride]
+    return Motion(
+        motion.skeleton, motion.root_positions[::stride], motion.local_rotations[::stride], motion.fps / stride,
+        motion.name, translations,
+    )  # fmt: skip
 
 
-def sample(frame_count: int, count: int) -> np.ndarray:
-    return np.unique(np.linspace(0, frame_count - 1, min(count, frame_count)).round().astype(int))
+def clips(quick: bool) -> list[tuple[str, Motion]]:
+    """(label, motion) of every dev clip: BVH files, the longest clip of each skinned glTF, the walk."""
+    result = []
+    for path in sorted((DATA_DIR / "bvh").glob("*.bvh")):
+        result.append((path.name, read_bvh(path)))
+    from animlod.io.gltf import read_skinned
+
+    for path in sorted((DATA_DIR / "gltf").glob("*.gl*")):
+        try:
+            _, motions = read_skinned(path)
+        except ValueError:
+            continue  # no skinned mesh
+        merged = merge_split_clips(motions)
+        if merged is not None:  # one motion stored as one animation per joint node (Monster.glb)
+            result.append((f"{path.name} (its {len(motions)} animations as one)", merged))
+            continue
+        usable = [m for m in motions if m.frame_count >= 2 and np.abs(m.skeleton.offsets[1:]).max() > 0.0]
+        if usable:
+            longest = max(usable, key=lambda m: m.frame_count)
+            result.append((f"{path.name} {longest.name or 'clip ' + str(motions.index(longest))}", longest))
+    walk = humanoid_motion(humanoid().skeleton, "walk", cycles=2 if quick else 4)
+    result.append(("procedural walk", walk))
+    return result[:3] if quick else result
 
 
-def table1(quick: bool) -> None:
+def joints_of(motion: Motion) -> int:
+    return int(np.count_nonzero(~motion.skeleton.end_sites))
+
+
+def level_table(label: str, motion: Motion) -> tuple[float, float]:
+    """Table 1 for one clip; returns wall and CPU seconds of the whole chain."""
+    analysis = analyze_motion(motion)
+    floor = joint_floor(motion, analysis)
+    levels = min(8, floor.possible_levels)
+    wall, cpu = time.perf_counter(), time.process_time()
+    chain = build_motion_chain(motion, levels, analysis=analysis)
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    size = chain.figure_size
     rows = []
-    for name, motion in clips(quick):
-        analysis = analyze_motion(motion)
-        joints = int((~motion.skeleton.end_sites).sum())
-        count = max(joints - len(analysis.priority), round(0.7 * joints))
-        frames = sample(motion.frame_count, 12 if quick else 40)
-        original = motion.world_positions()
-        first_frame = dataclasses.replace(analysis, key_frames=np.zeros_like(analysis.key_frames))
-        for label, chosen in (("ASQP (key posture)", analysis), ("SQP (first frame)", first_frame)):
-            level = freeze(motion, chosen, chosen.priority[: joints - count])
-            problem = build_problem(level)
-            fallback = frozen_motion(level, motion).world_positions()
-            with stopwatch() as elapsed:
-                result = refit_slsqp(problem, original[frames], fallback[frames])
-            whole_clip = elapsed[0] * motion.frame_count / frames.size
+    for k, level in enumerate(chain.levels):
+        r = level.report
+        fell_back = sum(f.outcome == "fallback" for f in r.failures)
+        rows.append(
+            (k, r.joint_count, f"{r.mean_error:.4g}", f"{r.max_error:.4g}", f"{100 * r.max_error / size:.2f}%",
+             f"{100 * r.bone_variation:.2e}%", f"{r.fk_residual:.2g}", len(r.failures), fell_back, f"{r.seconds:.2f}")
+        )  # fmt: skip
+    floor_note = "" if floor.fewest <= floor.paper_fewest else f"; floor {floor.fewest} ({floor.explain()})"
+    print_table(
+        f"{label}: {joints_of(motion)} joints, {motion.frame_count} frames, figure size {size:.4g}{floor_note}; "
+        f"{wall:.1f} s wall, {cpu:.1f} s CPU",
+        ("level", "joints", "mean error", "max error", "max/size", "bone variation", "FK residual", "failed",
+         "fell back", "seconds"),
+        rows,
+    )  # fmt: skip
+    return wall, cpu
+
+
+def speed_table(quick: bool) -> None:
+    cases = []
+    path = DATA_DIR / "bvh" / "131_01.bvh"
+    if path.exists():
+        cases.append(("131_01.bvh", read_bvh(path)))
+    cases.append(("procedural humanoid, walk", humanoid_motion(humanoid().skeleton, "walk", cycles=2 if quick else 8)))
+    rows = []
+    for label, motion in cases:
+        for threads in (1, 0) if label == "131_01.bvh" else (0,):
+            wall, cpu = time.perf_counter(), time.process_time()
+            chain = build_motion_chain(motion, 8, workers=threads)
+            wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+            solved = sum(level.report.joint_count * motion.frame_count for level in chain.levels[1:])
             rows.append(
-                (name, label, count, motion.frame_count, f"{result.evaluations.mean():.1f}", whole_clip,
-                 whole_clip / 60.0, f"{result.objective.mean():.3g}", len(result.failures))
+                (label, joints_of(motion), motion.frame_count, threads or os.cpu_count(), f"{wall:.1f}",
+                 f"{cpu:.1f}", f"{1e6 * cpu / solved:.2f}",
+                 sum(len(level.report.failures) for level in chain.levels))
             )  # fmt: skip
     print_table(
-        "Table 1: SLSQP preprocessing of one level, key posture from analysis (ASQP) vs first frame (SQP)",
-        ("clip", "method", "joints", "frames", "evaluations/frame", "seconds", "minutes", "mean E", "failed"),
+        "8 levels with the core's SLSQP (hard bone lengths), analysis included (goal: 131_01 under 10 s)",
+        ("clip", "joints", "frames", "threads", "wall s", "CPU s", "CPU us per joint-frame", "failed frames"),
         rows,
     )
 
 
-def level_table(motion, quick: bool, solver: str) -> None:
-    levels = 4 if quick else 8
-    with stopwatch() as pooled:
-        build_motion_chain(motion, levels, solver=solver, workers=2)
-    with stopwatch() as elapsed:
-        chain = build_motion_chain(motion, levels, solver=solver)
-    size = chain.figure_size
-    rows = [
-        (k, level.report.joint_count, level.report.seconds, level.report.mean_error, level.report.max_error,
-         f"{100 * level.report.max_error / size:.2f}%", level.report.bone_error,
-         f"{100 * level.report.bone_variation:.3f}%", level.report.fk_residual, len(level.report.failures))
-        for k, level in enumerate(chain.levels)
-    ]  # fmt: skip
-    print_table(
-        f"{levels} levels of {motion.name or '131_01'} ({motion.frame_count} frames), solver {solver}: total "
-        f"{elapsed[0]:.1f} s including analysis ({pooled[0]:.1f} s with 2 worker processes); figure size {size:.4g}",
-        ("level", "joints", "seconds", "mean error", "max error", "max/size", "Fig.7 bone error", "bone std/len",
-         "FK residual", "not converged"),
-        rows,
-    )  # fmt: skip
-
-
-def solver_table(motion, quick: bool) -> None:
+def solver_table(label: str, motion: Motion, frame_count: int) -> None:
     analysis = analyze_motion(motion)
-    frames = sample(motion.frame_count, 10 if quick else 30)
-    original = motion.world_positions()[frames]
+    total = joints_of(motion)
+    middle = motion.frame_count // 2
+    frames = np.arange(max(0, middle - frame_count // 2), min(motion.frame_count, middle + frame_count // 2))
+    original_all = motion.world_positions()
     rows = []
     for count in level_joint_counts(motion, analysis, 8)[1:]:
-        level = freeze(motion, analysis, analysis.priority[: int((~motion.skeleton.end_sites).sum()) - count])
+        level = freeze(motion, analysis, analysis.priority[: total - count])
         problem = build_problem(level)
-        fallback = frozen_motion(level, motion).world_positions()[frames]
-        with stopwatch() as slsqp_time:
-            slsqp = refit_slsqp(problem, original, fallback)
-        with stopwatch() as newton_time:
-            newton = refit_newton(problem, original)
-        with stopwatch() as hard_time:
-            hard = refit_slsqp(problem, original, fallback, SlsqpOptions(hard_constraints=True))
-        bones = problem.length_pairs[problem.bone_pair]
-        lengths = np.linalg.norm(hard.positions[:, bones[:, 0]] - hard.positions[:, bones[:, 1]], axis=-1)
-        hard_variation = (lengths.std(axis=0) / problem.key_lengths[problem.bone_pair]).max() if bones.size else 0.0
-        # Relative to the level's mean E: some frames have E ~ 1e-32, where ratios mean nothing.
-        difference = (newton.objective - slsqp.objective) / slsqp.objective.mean()
-        rows.append(
-            (count, f"{slsqp.objective.mean():.4g}", f"{newton.objective.mean():.4g}", f"{difference.max():+.2e}",
-             f"{difference.min():+.2e}", 1e3 * slsqp_time[0] / frames.size, 1e3 * newton_time[0] / frames.size,
-             f"{slsqp.evaluations.mean():.0f}", f"{newton.evaluations.mean():.0f}", f"{hard.objective.mean():.4g}",
-             1e3 * hard_time[0] / frames.size, f"{100 * hard_variation:.2e}%", len(hard.failures))
-        )  # fmt: skip
+        fallback_all = frozen_motion(level, motion).world_positions()
+        cold = _cold_starts(level, problem, motion, original_all, fallback_all)[frames]
+        original, fallback = original_all[frames], fallback_all[frames]
+        chunk = frames.size
+        runs = {
+            "python": (refit_slsqp, {"chunk_frames": chunk}),
+            "plain": (refit_core, {"options": PLAIN, "threads": 1, "chunk_frames": chunk}),
+            "core": (refit_core, {"threads": 1, "chunk_frames": chunk}),
+        }
+        results = {}
+        for name, (solve, settings) in runs.items():
+            start = time.process_time()
+            result = solve(problem, original, fallback, cold_starts=cold, **settings)
+            results[name] = (result, 1e3 * (time.process_time() - start) / frames.size)
+        reference = results["python"][0].objective
+        cells = [count]
+        for name in ("python", "plain", "core"):
+            result, ms = results[name]
+            cells += [f"{ms:.2f}", f"{result.evaluations.mean():.1f}"]
+            if name != "python":
+                relative = (result.objective - reference) / np.maximum(reference, 1e-300)
+                same = int(np.count_nonzero(np.abs(relative) <= 1e-6))
+                cells += [f"{same}/{frames.size}", f"{relative.min():+.1e}", f"{relative.max():+.1e}"]
+        cells.append(sum(len(r.failures) for r, _ in results.values()))
+        rows.append(tuple(cells))
     print_table(
-        f"SLSQP vs damped Newton (same objective, same start: the original positions), {frames.size} frames",
-        ("joints", "E SLSQP", "E Newton", "worst (N-S)/mean S", "best (N-S)/mean S", "ms/frame SLSQP",
-         "ms/frame Newton", "evals SLSQP", "evals Newton", "E SLSQP hard", "ms/frame hard", "bone std/len hard",
-         "hard failed"),
+        f"{label}: Python reference vs the core, {frames.size} consecutive frames, one thread, hard bone lengths "
+        "(CPU ms per frame; E relative to the reference)",
+        ("joints", "Python ms", "Python evals", "core plain ms", "plain evals", "plain within 1e-6", "plain min",
+         "plain max", "core ms", "core evals", "core within 1e-6", "core min", "core max", "failed"),
         rows,
     )  # fmt: skip
 
 
-def workers_table(motion, quick: bool) -> None:
-    """Does a process pool pay for SLSQP? Same level and frames with 1 and 2 workers."""
-    analysis = analyze_motion(motion)
-    count = level_joint_counts(motion, analysis, 8)[2]
-    level = freeze(motion, analysis, analysis.priority[: int((~motion.skeleton.end_sites).sum()) - count])
-    problem = build_problem(level)
-    frames = sample(motion.frame_count, 32 if quick else 128)
-    original = motion.world_positions()[frames]
-    fallback = frozen_motion(level, motion).world_positions()[frames]
+def ranking_table(label: str, motion: Motion) -> None:
+    base = analyze_motion(motion)
+    floor = joint_floor(motion, base)
+    counts = level_joint_counts(motion, base, min(8, floor.possible_levels))
+    errors = {}
+    for ranking in RANKINGS:
+        chain = build_motion_chain(motion, counts, ranking=ranking)
+        errors[ranking] = [level.report.mean_error for level in chain.levels[1:]]
     rows = []
-    for workers in (1, 2):
-        with stopwatch() as elapsed:
-            refit_slsqp(problem, original, fallback, chunk_frames=16, workers=workers)
-        rows.append((count, frames.size, workers, elapsed[0], 1e3 * elapsed[0] / frames.size))
+    for k, count in enumerate(counts[1:]):
+        values = [errors[r][k] for r in RANKINGS]
+        best = min(values)
+        tolerance = 1e-9 * max(best, 1e-12) + 1e-12
+        winners = [r for r, v in zip(RANKINGS, values) if v <= best + max(tolerance, 1e-6 * best)]
+        rows.append((count, *[f"{v:.4g}" for v in values], ", ".join(winners)))
     print_table(
-        "SLSQP over worker processes (chunks of 16 frames, warm starts inside a chunk)",
-        ("joints", "frames", "workers", "seconds", "ms/frame"),
+        f"{label} ({motion.frame_count} frames): mean joint position error per ranking, same re-fit",
+        ("joints", *RANKINGS, "lowest"),
         rows,
     )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="fewer clips, frames and levels")
+    parser.add_argument("--quick", action="store_true", help="fewer clips and frames")
     args = parser.parse_args()
-    table1(args.quick)
-    path = DATA / "131_01.bvh"
-    motion = read_bvh(path) if path.exists() else humanoid_motion(humanoid().skeleton, "walk", cycles=8)
-    for solver in SOLVERS:
-        level_table(motion, args.quick, solver)
-    solver_table(motion, args.quick)
-    workers_table(motion, args.quick)
+    load = os.getloadavg()
+    print(f"load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} on {os.cpu_count()} cores")
+    all_clips = clips(args.quick)
+    for label, motion in all_clips:
+        level_table(label, motion)
+    speed_table(args.quick)
+    by_label = dict(all_clips)
+    for label in ("131_01.bvh", "dataset-1_run_proud_001.bvh"):
+        if label in by_label:
+            solver_table(label, by_label[label], 16 if args.quick else 48)
+    for label, motion in all_clips:
+        # At most ~250 frames: the comparison needs the joints' motion, not every frame of it.
+        ranking_table(label, subsample(motion, max(1, motion.frame_count // 250)))
 
 
 if __name__ == "__main__":

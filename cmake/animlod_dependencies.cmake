@@ -30,3 +30,10 @@ find_package(glm CONFIG QUIET)
 if(NOT TARGET glm::glm)
   message(FATAL_ERROR "animlod needs GLM: install the Debian package libglm-dev")
 endif()
+
+# nlopt's C library: the per-frame SLSQP solve of the motion LoD re-fit (private to the core).
+find_package(NLopt 2.7 CONFIG QUIET)
+if(NOT TARGET NLopt::nlopt)
+  message(FATAL_ERROR "animlod needs nlopt 2.7+ (C library, SLSQP for the motion LoD re-fit): "
+                      "install the Debian package libnlopt-dev")
+endif()

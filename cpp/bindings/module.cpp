@@ -7,7 +7,11 @@ namespace animlod::bindings {
 void bind_skinning(py::module_& m);
 void bind_aqem(py::module_& m);
 void bind_motion_features(py::module_& m);
+void bind_ffd_lattice(py::module_& m);
+void bind_motion_refit(py::module_& m);
 void bind_tdag(py::module_& m);
+void bind_lod_selector(py::module_& m);
+void bind_pose(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -15,5 +19,9 @@ PYBIND11_MODULE(_core, m) {
   animlod::bindings::bind_skinning(m);
   animlod::bindings::bind_aqem(m);
   animlod::bindings::bind_motion_features(m);
+  animlod::bindings::bind_ffd_lattice(m);
+  animlod::bindings::bind_motion_refit(m);
   animlod::bindings::bind_tdag(m);
+  animlod::bindings::bind_lod_selector(m);
+  animlod::bindings::bind_pose(m);
 }

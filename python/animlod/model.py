@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import rotations
+from . import _core, rotations
 
 
 def _require(condition: bool, what: str) -> None:
@@ -428,12 +428,11 @@ class LodChain:
         """Coarsest level whose error, projected to pixels at ``distance``, is within the budget.
 
         ``error / distance * focal_length_px`` is the level's error on screen in pixels; level 0
-        is used when no level fits.
+        is used when no level fits. The rule is the core's runtime selector's
+        (``lod_selector.hpp``, ``level_for_error``), so Python and engines pick alike; a
+        character that moves should keep a ``_core.LodSelector`` for its hysteresis.
         """
         if distance <= 0.0:
             raise ValueError(f"distance: must be positive, got {distance}")
-        chosen = 0
-        for index, level in enumerate(self.levels):
-            if level.error / distance * focal_length_px <= screen_error_budget:
-                chosen = index
-        return chosen
+        errors = np.array([level.error for level in self.levels], dtype=np.float32)
+        return int(_core.level_for_error(errors, distance, focal_length_px, screen_error_budget))

@@ -29,7 +29,7 @@ ALLOWED = {
     ("model.py", None): "_require's own raise: its callers' messages are checked instead",
     ("model.py", "motion has {} joints, the skin's skeleton {}"): "model.py Motion/Skin part: lead's",
     ("model.py", "skeleton has no joint named {}"): "model.py Skeleton part: lead's",
-    ("motion_lod/chain.py", "hard constraints need solver='slsqp'"): "motion_lod/: the motion helper's",
+    ("cli/crowd.py", None): "CrowdError's message: the crowd runner's or animlod_crowd's own, each naming its element",
     ("synth/face_animation.py", "seconds and fps must be positive"): "procedural assets: no file, not user input",
 }
 

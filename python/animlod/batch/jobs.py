@@ -22,7 +22,7 @@ from dataclasses import dataclass
 DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "bvh": "motion"}
 # Keyword arguments a manifest never sets: the runner owns progress, and a batch spreads its
 # work over assets (one core each), not over the processes of one asset.
-_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level"})
+_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level", "on_note"})
 
 
 @dataclass(frozen=True)

@@ -26,7 +26,7 @@ from collections.abc import Iterator
 from ..io.errors import error_line
 
 # Subcommand modules in the order --help lists them.
-COMMAND_MODULES = ("info", "demo", "simplify", "character", "motion", "tdag", "batch")
+COMMAND_MODULES = ("info", "demo", "simplify", "character", "motion", "face", "tdag", "crowd", "batch")
 
 
 class UserError(Exception):
@@ -162,6 +162,8 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as stop:  # --help (0), or the one-line usage error of _Parser (2)
         return int(stop.code or 0)
     source = getattr(args, "input", None) or getattr(args, "path", None)
+    if not isinstance(source, (str, os.PathLike)):
+        source = None  # e.g. crowd's --path, a list of navigation paths, names no input file
     if os.environ.get("ANIMLOD_DEBUG"):
         return int(args.run(args) or 0)  # tracebacks and live output, for telling a bug from a mistake
     try:

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from ..io.detect import input_kind, input_stem
+from ..motion_lod.analysis import TRANSLATION_TOLERANCE
 from ..motion_lod.chain import SOLVERS
+from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from . import UserError
 
 
@@ -23,24 +26,55 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("input", help="a .bvh motion, or a .glb/.gltf with a skinned mesh and an animation")
     parser.add_argument("-o", "--output", required=True, help="folder to write the levels into (created if missing)")
-    parser.add_argument("--levels", type=int, default=8, help="number of levels, the paper's 100..8%% of the joints")
+    parser.add_argument(
+        "--levels", type=int, default=None,
+        help="number of levels, from every joint down to the fewest possible (the paper's 100..8%% of the joints "
+        "where the skeleton allows); default 8, or as many as the skeleton allows",
+    )  # fmt: skip
     parser.add_argument("--joints", type=int, nargs="+", help="joint counts of the levels instead of --levels")
     parser.add_argument("--lock", nargs="+", default=[], metavar="JOINT", help="joints never to freeze")
+    parser.add_argument(
+        "--ranking", default=DEFAULT_RANKING, metavar="NAME",
+        help=f"which joints freeze first, one of {', '.join(RANKINGS)}: importance (Eq. 3 with zero-length bones "
+        "measured through the joints below them, default), paper (Eq. 3 as printed), depth (deepest first) or "
+        "variance (least rotation first)",
+    )  # fmt: skip
     parser.add_argument(
         "--solver",
         choices=SOLVERS,
         default=SOLVERS[0],
-        help="slsqp: nlopt SLSQP per frame (the reference, default); newton: damped Newton on the same objective "
-        "over all frames at once (over ten times faster per frame in bench/bench_motion.py)",
+        help="slsqp: nlopt SLSQP per frame in the C++ core on every core (default); slsqp-python: the same in "
+        "Python (the reference, slower); newton: damped Newton on the penalty objective (no hard constraints)",
     )
-    parser.add_argument("--hard", action="store_true", help="hold bone lengths as equality constraints (slsqp)")
-    parser.add_argument("--workers", type=int, default=1, help="processes solving chunks of frames side by side")
+    constraints = parser.add_mutually_exclusive_group()
+    constraints.add_argument(
+        "--hard", action="store_true",
+        help="hold bone lengths as equality constraints (the default with the SLSQP solvers)",
+    )  # fmt: skip
+    constraints.add_argument(
+        "--penalty", action="store_true",
+        help="hold bone lengths only through the string error Es (the paper's E; the default with newton)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--workers", type=int, default=0,
+        help="threads of the core's solve, or processes of the Python solvers; 0: every core (slsqp), one process "
+        "(others)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--translation-tolerance", type=float, default=TRANSLATION_TOLERANCE, metavar="FRACTION",
+        help="a joint whose translation moves by more than this fraction of its bone length translates and "
+        "never freezes (default %(default)g); smaller moves are float noise or held at the key frame",
+    )  # fmt: skip
     parser.add_argument(
         "--weights", type=float, nargs=3, default=(0.2, 0.4, 0.4), metavar=("ALPHA", "BETA", "GAMMA"),
         help="weights of the distance, string and angle errors (Eq. 5)",
     )  # fmt: skip
     parser.add_argument("--max-frames", type=int, default=600, help="frames motion analysis looks at, at most")
-    parser.add_argument("--clip", type=int, default=0, help="which animation of a glTF file (index)")
+    parser.add_argument(
+        "--clip", type=int, default=None,
+        help="which animation of a glTF file (index); default the first, or all of them as one motion when each "
+        "moves other joints (one animation per joint node)",
+    )  # fmt: skip
     parser.add_argument("--plot", action="store_true", help="write importance, key posture and error charts (PNG)")
     parser.set_defaults(run=run)
 
@@ -73,17 +107,19 @@ class _Progress:
 def run(args: argparse.Namespace) -> int:
     from ..pipelines.motion import build_motion_levels
 
-    if args.hard and args.solver != "slsqp":
-        raise UserError("--hard: bone-length equality constraints need --solver slsqp")
-    if args.workers < 1:
-        raise UserError(f"--workers: must be at least 1, got {args.workers}")
+    if args.hard and args.solver == "newton":
+        raise UserError("--hard: bone-length equality constraints need an SLSQP solver (slsqp or slsqp-python)")
+    if args.workers < 0:
+        raise UserError(f"--workers: must be at least 0, got {args.workers}")
+    if args.ranking not in RANKINGS:
+        raise UserError(f"--ranking: no ranking named {args.ranking!r} (choose from {', '.join(RANKINGS)})")
     if input_kind(args.input) not in ("bvh", "gltf"):
         raise UserError(f"{args.input}: motion LoD needs a .bvh or a skinned .glb/.gltf")
     bars: list[_Progress] = []  # made when the first level starts: bad input fails before any bar
 
-    def on_level(index: int, joints: int, frame_count: int):
+    def on_level(index: int, joints: int, frame_count: int, level_count: int):
         if not bars:
-            bars.append(_Progress(len(args.joints) if args.joints else args.levels))
+            bars.append(_Progress(level_count))
         return bars[0].start_level(index, joints, frame_count)
 
     try:
@@ -93,18 +129,21 @@ def run(args: argparse.Namespace) -> int:
             args.levels,
             joints=args.joints,
             lock=args.lock,
+            ranking=args.ranking,
             solver=args.solver,
-            hard=args.hard,
+            penalty=args.penalty,
+            workers=args.workers,
+            translation_tolerance=args.translation_tolerance,
             weights=args.weights,
             max_frames=args.max_frames,
             clip=args.clip,
-            workers=args.workers,
             on_level=on_level,
+            on_note=lambda text: print(text, file=sys.stderr),
         )
     finally:
         for bar in bars:
             bar.close()
-    _print_summary(report.chain)
+    _print_summary(report.chain, report.floor)
     if args.plot:
         from ..motion_lod.plots import plot_chain
 
@@ -113,9 +152,14 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_summary(chain) -> None:
+def _print_summary(chain, floor) -> None:
     size = chain.figure_size
     print(f"\nfigure size {size:.4g} (asset units); errors over every original joint and frame")
+    if floor.fewest > floor.paper_fewest:
+        print(
+            f"fewest joints: {floor.fewest} of {floor.total}, above the paper's 8% ({floor.paper_fewest}): "
+            f"{floor.explain()} never freeze"
+        )
     header = ("level", "joints", "mean err", "max err", "max/size", "bone err", "bone var", "FK resid", "failed", "s")
     print(" | ".join(f"{h:>9}" for h in header))
     for index, level in enumerate(chain.levels):

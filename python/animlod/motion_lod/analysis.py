@@ -15,12 +15,17 @@ Conventions this implementation fixes where the paper is silent:
   ``(r(t_ref) + r(t)) / 2 * theta`` over the circumference ``2 pi r_max``; ``r_max`` is the summed
   length of the root's child bones (mean over frames), or the longest bone when those are all
   zero. (The printed bracket omits the 1/2; constant factors change neither key frames nor order.)
-- Joints whose local translation is animated (BVH position channels below the root) are never
-  frozen: freezing would pin their translation to one frame.
+- Joints whose local translation moves (BVH position channels below the root that carry
+  motion) are never frozen: freezing would pin their translation to one frame. A translation
+  counts as moving only when its range over the clip exceeds ``translation_tolerance`` times the
+  joint's bone length (the mean length of its translation, at least 1 % of the longest bone):
+  exporters write a translation key on every joint with float noise, and constant keys are not
+  motion. A joint below the tolerance can freeze; its translation is then held at the key frame
+  like its rotation, and the level's error includes what that costs.
 - End sites carry no rotation: they give leaf joints a direction, have importance 0 and are never
   in the priority list (they are not joints of a level). A leaf joint *without* an end site has
   no bone to measure, so its importance is 0 and it is eliminated first.
-- Long clips: the n x n table is never stored; its row sums are accumulated in blocks of rows.
+- Long clips: the n x n table is held one bone at a time; only its row sums are kept.
   Above ``max_frames`` frames, Eqs. 1-3 run on ``max_frames`` evenly spaced frames: key frames
   are then chosen among those frames and eps_j becomes the same mean over a uniform subsample
   (a Riemann sum of the full-rate mean), which changes it by at most the motion between two
@@ -30,15 +35,13 @@ Conventions this implementation fixes where the paper is silent:
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import rotations
 from ..model import Motion
-
-# Rows of the posture-error table evaluated at once: bounds memory to rows x frames x 3 floats.
-_BLOCK_ROWS = 16
+from .ranking import DEFAULT_RANKING, PAPER_RANKING, RANKINGS, rank_scores
 
 
 @dataclass(frozen=True)
@@ -48,12 +51,16 @@ class MotionAnalysis:
     Attributes
     ----------
     key_frames : (J,) int64 key frame t_key_j of every joint (Eq. 2), an index into the motion.
-    importance : (J,) float64 joint importance eps_j (Eq. 3); 0 for end sites.
-    priority : joint indices in elimination order (lowest importance first, ties by index);
-        never the root, end sites, locked joints or joints with animated translation.
+    importance : (J,) float64 joint importance eps_j (Eq. 3); 0 for end sites. With every
+        ranking but "paper", Eqs. 1-3 measure a zero-length bone through the points below it
+        (child_bones, look_through); "paper" takes Eq. 1's direct children as printed.
+    priority : joint indices in elimination order (lowest rank first, ties by index, see
+        ranking.py); never the root, end sites, locked joints or translating joints.
     locked : joint indices the caller locked (never frozen).
     frames : (n,) int64 frames the analysis used (all frames unless subsampled).
     r_max : the normaliser of Eq. 1, in the asset's units.
+    translating : joint indices whose translation moves (see translating_joints), never frozen.
+    ranking : the name of the ranking that ordered ``priority`` (ranking.RANKINGS).
     """
 
     key_frames: np.ndarray
@@ -62,6 +69,8 @@ class MotionAnalysis:
     locked: list[int]
     frames: np.ndarray
     r_max: float
+    translating: list[int] = field(default_factory=list)
+    ranking: str = "importance"
 
     def key_rotations(self, motion: Motion) -> np.ndarray:
         """Key posture (Section 4.2): every joint's local rotation at its key frame, ``(J, 4)``."""
@@ -73,25 +82,71 @@ class MotionAnalysis:
         return motion.local_translations()[self.key_frames, np.arange(motion.skeleton.joint_count)]
 
 
-def animated_translation_joints(motion: Motion) -> np.ndarray:
-    """Non-root joints whose local translation changes over the clip, ``(J,) bool``."""
-    animated = np.zeros(motion.skeleton.joint_count, bool)
-    if motion.joint_translations is not None:
-        animated[1:] = np.ptp(motion.joint_translations[:, 1:], axis=0).max(axis=-1) > 0.0
-    return animated
+# Default of translating_joints: a translation whose range stays under 1 % of its bone is held.
+TRANSLATION_TOLERANCE = 1e-2
 
 
-def child_bones(motion: Motion, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Every non-root joint's bone as seen from its parent's parent frame.
+def translating_joints(motion: Motion, tolerance: float = TRANSLATION_TOLERANCE) -> np.ndarray:
+    """Non-root joints whose local translation moves, ``(J,) bool``.
 
-    Returns ``owners (B,)`` (the joint ``j`` each bone hangs from, B = J - 1) and
-    ``vectors (n, B, 3)``: ``R_j(t) @ offset_c(t)`` for child ``c`` of ``j`` at the given frames.
+    A joint translates when the range of its local translation over the clip (the length of the
+    per-axis peak-to-peak vector) exceeds ``tolerance`` times its bone length: the mean length of
+    that translation, or 1 % of the longest bone when it is shorter (a joint at its parent's
+    position has no length of its own to compare with). Float noise and constant keys stay below.
     """
-    parents = motion.skeleton.parents[1:]
-    children = np.arange(1, motion.skeleton.joint_count)
+    if not (np.isfinite(tolerance) and tolerance >= 0.0):
+        raise ValueError(f"translation_tolerance: must be a finite number >= 0, got {tolerance}")
+    moving = np.zeros(motion.skeleton.joint_count, bool)
+    if motion.joint_translations is None or motion.skeleton.joint_count < 2:
+        return moving
+    translations = motion.joint_translations[:, 1:]
+    bones = np.linalg.norm(translations, axis=-1).mean(axis=0)
+    reference = np.maximum(bones, 1e-2 * bones.max())
+    spread = np.linalg.norm(np.ptp(translations, axis=0), axis=-1)
+    moving[1:] = spread > tolerance * reference
+    return moving
+
+
+def child_bones(
+    motion: Motion, frames: np.ndarray, look_through: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """Every joint's bones as seen from its parent's frame.
+
+    Returns ``owners (B,)`` (the joint ``j`` each bone hangs from) and ``vectors (n, B, 3)`` at
+    the given frames: ``R_j(t) @ offset_c(t)`` for every child ``c`` of ``j`` (B = J - 1), the
+    paper's Eq. 1. With ``look_through``, a child at ``j``'s own position (a zero-length bone,
+    which has no direction) is replaced by its own children, recursively: the bones of ``j`` are
+    then the vectors to its nearest points that are not at its position, which ``j``'s rotation
+    (and the zero-length joints' between them) turns. Eq. 1 as printed gives such a joint (CMU's
+    Chest2 or a wrist above a zero-length hand) importance 0, though it turns a whole limb.
+    """
+    skeleton = motion.skeleton
+    parents = skeleton.parents[1:]
+    children = np.arange(1, skeleton.joint_count)
     offsets = motion.local_translations()[frames][:, children]
     vectors = rotations.rotate(motion.local_rotations[frames][:, parents], offsets)
-    return parents.astype(np.int64), vectors
+    if not look_through:
+        return parents.astype(np.int64), vectors
+    lengths = np.linalg.norm(offsets, axis=-1).max(axis=0)  # (J - 1,)
+    zero = np.concatenate([[False], lengths <= 1e-9 * max(float(lengths.max(initial=0.0)), 1e-300)])
+    # Nearest non-coincident points below each joint: walk down through zero-length children,
+    # composing their rotations: v = R_j R_c1 ... R_ck offset_d (the zero-length offsets add 0).
+    kids = skeleton.children()
+    local = motion.local_rotations[frames]
+    translations = motion.local_translations()[frames]
+    owners, vectors = [], []
+    for joint in range(skeleton.joint_count):  # O(J) Python steps, vectorised over frames
+        stack = [(child, local[:, joint]) for child in kids[joint]]
+        while stack:
+            point, turn = stack.pop()
+            if zero[point]:
+                stack.extend((child, rotations.multiply(turn, local[:, point])) for child in kids[point])
+            else:
+                owners.append(joint)
+                vectors.append(rotations.rotate(turn, translations[:, point]))
+    if not owners:
+        return np.zeros(0, np.int64), np.zeros((frames.size, 0, 3))
+    return np.array(owners, dtype=np.int64), np.stack(vectors, axis=1)
 
 
 def _angles_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -103,25 +158,46 @@ def _angles_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return 2.0 * np.arctan2(np.linalg.norm(a - b, axis=-1), np.linalg.norm(a + b, axis=-1))
 
 
-def posture_error_row_sums(motion: Motion, frames: np.ndarray, r_max: float) -> np.ndarray:
+def posture_error_row_sums(
+    motion: Motion, frames: np.ndarray, r_max: float, look_through: bool = False
+) -> np.ndarray:
     """Row sums ``S[j, a] = sum_b E_j(frames[a], frames[b])`` of Eq. 1's table, ``(J, n)``.
 
-    The table itself is never held: rows are evaluated ``_BLOCK_ROWS`` at a time.
+    One bone's (n, n) table of angles is held at a time.
+    ``look_through``: measure zero-length bones through the points below them (child_bones).
     """
-    owners, vectors = child_bones(motion, frames)
+    owners, vectors = child_bones(motion, frames, look_through)
     lengths = np.linalg.norm(vectors, axis=-1)  # r_jc(t), (n, B)
     units = np.divide(vectors, lengths[..., None], out=np.zeros_like(vectors), where=lengths[..., None] > 0.0)
     n, bone_count = lengths.shape
     per_bone = np.zeros((bone_count, n))
-    for start in range(0, n, _BLOCK_ROWS):
-        rows = slice(start, min(start + _BLOCK_ROWS, n))
-        # theta_jc(t_ref, t) for the block's t_ref against every t: (rows, n, B).
-        theta = _angles_between(units[rows, None], units[None])
-        radius = 0.5 * (lengths[rows, None] + lengths[None])  # mean of r_jc(t_ref) and r_jc(t)
-        per_bone[:, rows] = np.einsum("abk,abk->ka", radius, theta)  # arc lengths
+    for bone in range(bone_count):  # O(B) Python steps, each an (n, n) table
+        u = units[:, bone]
+        if not np.any(np.ptp(u, axis=0)):
+            continue  # one direction in every frame: theta = 0 exactly
+        theta = _angle_table(u)  # theta_jc(t_ref, t), rows t_ref
+        r = lengths[:, bone]
+        per_bone[bone] = 0.5 * (r * theta.sum(axis=1) + theta @ r)  # arcs: mean radius times angle
     sums = np.zeros((motion.skeleton.joint_count, n))
     np.add.at(sums, owners, per_bone)  # sum over the children c of j (Eq. 1)
     return sums / (2.0 * np.pi * r_max)
+
+
+def _angle_table(units: np.ndarray) -> np.ndarray:
+    """Angles ``(n, n)`` between every pair of the vectors ``units (n, 3)`` (unit or zero).
+
+    Kahan's form 2 atan2(|a - b|, |a + b|) with |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b from one
+    matrix product; where the angle is tiny that difference cancels, so those entries take
+    |a - b| directly (exact 0 for identical directions).
+    """
+    dots = units @ units.T
+    squares = np.sum(units * units, axis=-1)
+    base = squares[:, None] + squares[None, :]
+    minus = np.maximum(base - 2.0 * dots, 0.0)
+    theta = 2.0 * np.arctan2(np.sqrt(minus), np.sqrt(np.maximum(base + 2.0 * dots, 0.0)))
+    close = np.nonzero(minus < 1e-8)
+    theta[close] = _angles_between(units[close[0]], units[close[1]])
+    return theta
 
 
 def _r_max(motion: Motion) -> float:
@@ -141,6 +217,8 @@ def analyze_motion(
     motion: Motion,
     locked: Iterable[str] = (),
     max_frames: int = 600,
+    translation_tolerance: float = TRANSLATION_TOLERANCE,
+    ranking: str = DEFAULT_RANKING,
 ) -> MotionAnalysis:
     """Key frames, joint importance and elimination priority of a motion (Eqs. 1-3).
 
@@ -150,12 +228,17 @@ def analyze_motion(
     locked : names of joints never to freeze (the root never is).
     max_frames : above this many frames, analyse an evenly spaced subsample of this size
         (see the module notes for how that changes the result).
+    translation_tolerance : a joint whose translation range exceeds this fraction of its bone
+        length translates and is never frozen (translating_joints).
+    ranking : how joints are ordered for elimination, one of ranking.RANKINGS.
 
     Returns
     -------
     MotionAnalysis
     """
     skeleton = motion.skeleton
+    if ranking not in RANKINGS:
+        raise ValueError(f"ranking: expected one of {', '.join(RANKINGS)}, got {ranking!r}")
     if motion.frame_count < 2:
         raise ValueError(f"motion: needs at least 2 frames for motion analysis, got {motion.frame_count}")
     if max_frames < 2:
@@ -170,16 +253,27 @@ def analyze_motion(
     else:
         frames = np.arange(motion.frame_count, dtype=np.int64)
     r_max = _r_max(motion)
-    sums = posture_error_row_sums(motion, frames, r_max)
+    sums = posture_error_row_sums(motion, frames, r_max, look_through=ranking != PAPER_RANKING)
     best = np.argmin(sums, axis=1)  # Eq. 2 (first minimum on ties)
     key_frames = frames[best]
     importance = sums[np.arange(skeleton.joint_count), best] / frames.size  # Eq. 3
 
+    translating = translating_joints(motion, translation_tolerance)
     candidates = np.ones(skeleton.joint_count, bool)
     candidates[0] = False
     candidates[skeleton.end_sites] = False
     candidates[locked_indices] = False
-    candidates[animated_translation_joints(motion)] = False
-    order = np.lexsort((np.arange(skeleton.joint_count), importance))
+    candidates[translating] = False
+    scores = rank_scores(ranking, motion, importance, key_frames, frames)
+    order = np.lexsort((np.arange(skeleton.joint_count), scores))
     priority = [int(j) for j in order if candidates[j]]
-    return MotionAnalysis(key_frames, importance, priority, locked_indices, frames, r_max)
+    return MotionAnalysis(
+        key_frames,
+        importance,
+        priority,
+        locked_indices,
+        frames,
+        r_max,
+        [int(j) for j in np.flatnonzero(translating)],
+        ranking,
+    )

@@ -16,15 +16,19 @@ import numpy as np
 
 from ..model import Motion, SkinnedMesh
 from .analysis import MotionAnalysis, analyze_motion
+from .core_refit import refit_core
 from .frozen import FrozenLevel, freeze, frozen_motion
 from .grouped_solve import FrameFailure, RefitResult
 from .newton import refit_newton
-from .objective import RefitProblem, Weights, build_problem
+from .objective import RefitProblem, Weights, build_problem, objective
+from .ranking import DEFAULT_RANKING
 from .refit import SlsqpOptions, refit_slsqp
 from .skeleton_reduce import expand_motion, recover_motion
 from .skin_transfer import transfer_skin
 
-SOLVERS = ("slsqp", "newton")  # the first is the default
+# "slsqp": nlopt's SLSQP per frame in the C++ core (default); "slsqp-python": the same solve in
+# Python with the PyPI nlopt (the reference); "newton": damped Newton on the penalty objective.
+SOLVERS = ("slsqp", "slsqp-python", "newton")
 # Joint counts of the paper's 8 levels as fractions of the full skeleton (Fig. 1).
 _PAPER_FRACTIONS = np.array([1.0, 0.82, 0.70, 0.58, 0.45, 0.33, 0.20, 0.08])
 
@@ -79,54 +83,128 @@ class MotionLodChain:
         return float(np.ptp(self.levels[0].frozen.key_positions, axis=0).max())
 
 
+@dataclass(frozen=True)
+class JointFloor:
+    """The fewest joints a level can keep, and why: the root, locked and translating joints
+    stay (names in skeleton order; a locked joint that also translates is listed once, as locked)."""
+
+    total: int
+    fewest: int
+    locked: list[str]
+    translating: list[str]
+
+    @property
+    def possible_levels(self) -> int:
+        """Distinct joint counts from ``total`` down to ``fewest``."""
+        return self.total - self.fewest + 1
+
+    @property
+    def paper_fewest(self) -> int:
+        """The paper's coarsest level, 8 % of the joints (at least 1)."""
+        return max(1, int(round(_PAPER_FRACTIONS[-1] * self.total)))
+
+    def explain(self) -> str:
+        """Why joints stay, e.g. ``root, 2 locked (A, B), 1 translating (Hips)``."""
+        parts = ["root"]
+        for label, names in (("locked", self.locked), ("translating", self.translating)):
+            if names:
+                shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
+                parts.append(f"{len(names)} {label} ({shown})")
+        return ", ".join(parts)
+
+
+def joint_floor(motion: Motion, analysis: MotionAnalysis) -> JointFloor:
+    """Joints of the skeleton (end sites not counted) and the fewest a level keeps."""
+    names = motion.skeleton.names
+    total = int(np.count_nonzero(~motion.skeleton.end_sites))
+    locked = [j for j in analysis.locked if j != 0]
+    translating = [j for j in analysis.translating if j != 0 and j not in locked]
+    return JointFloor(
+        total=total,
+        fewest=total - len(analysis.priority),
+        locked=[names[j] for j in locked],
+        translating=[names[j] for j in translating],
+    )
+
+
 def level_joint_counts(motion: Motion, analysis: MotionAnalysis, levels: int | Sequence[int]) -> list[int]:
     """Joint counts per level, strictly decreasing, first = every joint (end sites not counted).
 
-    An int asks for that many levels at the paper's fractions (8 levels: 100, 82, 70, 58, 45,
-    33, 20, 8 % of the joints), spread evenly for other counts; a list gives the counts.
+    An int asks for that many levels spread from every joint down to the fewest possible
+    (joint_floor): at the paper's fractions (8 levels: 100, 82, 70, 58, 45, 33, 20, 8 % of the
+    joints, interpolated for other counts) where they stay above the floor; where they do not,
+    the same fractions mapped onto the range from the floor to every joint, so that the last
+    level reaches the floor. A list gives the counts.
     """
-    total = int(np.count_nonzero(~motion.skeleton.end_sites))
-    fewest = total - len(analysis.priority)  # root, locked and translating joints stay
+    floor = joint_floor(motion, analysis)
+    total, fewest = floor.total, floor.fewest
     if isinstance(levels, int | np.integer):
         if levels < 1:
             raise ValueError(f"levels: must be at least 1, got {levels}")
-        if levels > total - fewest + 1:
+        if levels > floor.possible_levels:
             raise ValueError(
-                f"levels: {levels} levels need {levels} joint counts, but only {fewest}..{total} are possible"
+                f"levels: {levels} levels need {levels} distinct joint counts, but the skeleton allows "
+                f"{floor.possible_levels} ({total} joints, at least {fewest} kept: {floor.explain()})"
             )
+        if levels == 1:
+            return [total]
         fractions = np.interp(np.linspace(0, 1, levels), np.linspace(0, 1, _PAPER_FRACTIONS.size), _PAPER_FRACTIONS)
-        counts = np.maximum(np.round(fractions * total).astype(int), fewest)
+        paper = fractions * total
+        mapped = fewest + (total - fewest) * (fractions - fractions[-1]) / (1.0 - fractions[-1])
+        counts = np.round(np.maximum(paper, mapped)).astype(int)
         counts[0] = total
-        # Keep them distinct: push collisions down, never below the fewest possible.
-        for k in range(1, counts.size):
+        # Distinct and within reach of the floor: level k keeps room for the levels after it.
+        room = fewest + np.arange(levels - 1, -1, -1)
+        counts = np.clip(counts, room, total - np.arange(levels))
+        for k in range(1, levels):
             counts[k] = min(counts[k], counts[k - 1] - 1)
-        if counts[-1] < fewest:
-            counts = np.arange(total, total - levels, -1)
         return [int(c) for c in counts]
     counts = sorted({int(c) for c in levels}, reverse=True)
     if not counts:
         raise ValueError("levels: empty list of joint counts")
     if counts[0] > total or counts[-1] < fewest:
-        raise ValueError(f"levels: joint counts must lie in {fewest}..{total}, got {counts}")
+        raise ValueError(
+            f"levels: joint counts must lie in {fewest}..{total} (at least {fewest} kept: {floor.explain()}), "
+            f"got {counts}"
+        )
     return counts if counts[0] == total else [total] + counts
+
+
+def _cold_starts(
+    level: FrozenLevel, problem: RefitProblem, motion: Motion, original: np.ndarray, fallback: np.ndarray
+) -> np.ndarray:
+    """Feasible starts for the hard-constrained solve, ``(T, P, 3)``: per frame, of the frozen key
+    motion and the original projected onto the level's rigid skeleton (its joints turned to aim
+    at the original positions, frozen joints at their key rotations), the one with the lower E."""
+    projected = expand_motion(level, recover_motion(level, original, motion), motion).world_positions()
+    lower = objective(problem, projected, original)[0] < objective(problem, fallback, original)[0]
+    return np.where(lower[:, None, None], projected, fallback)
 
 
 def _refit(
     problem: RefitProblem,
     original: np.ndarray,
     fallback: np.ndarray,
+    cold_starts: np.ndarray | None,
     solver: str,
     slsqp_options: SlsqpOptions,
     workers: int,
     progress: Callable[[float], None] | None,
 ) -> RefitResult:
     if solver == "slsqp":
-        return refit_slsqp(problem, original, fallback, slsqp_options, workers=workers, progress=progress)
+        return refit_core(
+            problem, original, fallback, slsqp_options, threads=workers, progress=progress, cold_starts=cold_starts
+        )
+    processes = max(workers, 1)
+    if solver == "slsqp-python":
+        return refit_slsqp(
+            problem, original, fallback, slsqp_options, workers=processes, progress=progress, cold_starts=cold_starts
+        )
     # E has several minima at coarse levels; Newton is cheap enough to try the paper's start
     # (the original positions) and the frozen motion, and keep the lower E per frame.
     half = (lambda frames: progress(frames / 2)) if progress else None
-    from_original = refit_newton(problem, original, workers=workers, progress=half)
-    from_frozen = refit_newton(problem, original, start=fallback, workers=workers, progress=half)
+    from_original = refit_newton(problem, original, workers=processes, progress=half)
+    from_frozen = refit_newton(problem, original, start=fallback, workers=processes, progress=half)
     better = from_frozen.objective < from_original.objective
     keep = [f for f in from_original.failures if not better[f.frame]] + [
         f for f in from_frozen.failures if better[f.frame]
@@ -158,16 +236,16 @@ def build_level(
     weights: Weights | None = None,
     solver: str = SOLVERS[0],
     slsqp_options: SlsqpOptions | None = None,
-    workers: int = 1,
+    workers: int = 0,
     skin: SkinnedMesh | None = None,
     progress: Callable[[float], None] | None = None,
 ) -> MotionLevel:
     """One level with ``joint_count`` joints (see :func:`build_motion_chain` for the options)."""
     if solver not in SOLVERS:
         raise ValueError(f"solver: expected one of {SOLVERS}, got {solver!r}")
-    slsqp_options = slsqp_options or SlsqpOptions()
-    if slsqp_options.hard_constraints and solver != "slsqp":
-        raise ValueError("hard constraints need solver='slsqp' (the Newton solver only minimises E)")
+    slsqp_options = slsqp_options or SlsqpOptions(hard_constraints=solver != "newton")
+    if slsqp_options.hard_constraints and solver == "newton":
+        raise ValueError("solver: hard constraints need an SLSQP solver (the Newton solver only minimises E)")
     start = time.perf_counter()
     total = int(np.count_nonzero(~motion.skeleton.end_sites))
     frozen_joints = analysis.priority[: total - joint_count]
@@ -176,7 +254,9 @@ def build_level(
     original = motion.world_positions()
     if frozen_joints:
         fallback = frozen_motion(level, motion).world_positions()
-        result = _refit(problem, original, fallback, solver, slsqp_options, workers, progress)
+        hard = slsqp_options.hard_constraints
+        cold_starts = _cold_starts(level, problem, motion, original, fallback) if hard else None
+        result = _refit(problem, original, fallback, cold_starts, solver, slsqp_options, workers, progress)
     else:  # E = 0 at the original positions, its global minimum: nothing to solve
         result = RefitResult(original, np.zeros(motion.frame_count), np.zeros(motion.frame_count, dtype=np.int64))
         if progress:
@@ -210,11 +290,12 @@ def build_motion_chain(
     weights: Weights | None = None,
     solver: str = SOLVERS[0],
     slsqp_options: SlsqpOptions | None = None,
-    workers: int = 1,
+    workers: int = 0,
     skin: SkinnedMesh | None = None,
     max_frames: int = 600,
     on_level: Callable[[int, int], Callable[[float], None] | None] | None = None,
     analysis: MotionAnalysis | None = None,
+    ranking: str = DEFAULT_RANKING,
 ) -> MotionLodChain:
     """Analyse ``motion`` and build its levels.
 
@@ -224,17 +305,20 @@ def build_motion_chain(
     levels : number of levels, or the joint counts (end sites not counted) of each level.
     locked : joint names never frozen.
     weights : alpha, beta, gamma of Eq. 5.
-    solver : ``"slsqp"`` (nlopt's SLSQP per frame, the paper's SQP and the reference; needed
-        for hard constraints; default) or ``"newton"`` (damped Newton on the same objective,
-        vectorised over frames, over ten times faster per frame where both converge; see bench/bench_motion.py).
-    slsqp_options : SLSQP stopping rules and the hard-constraint option.
-    workers : processes solving chunks of frames side by side (both solvers).
+    solver : ``"slsqp"`` (nlopt's SLSQP per frame in the C++ core, the paper's SQP; default),
+        ``"slsqp-python"`` (the same in Python, the reference) or ``"newton"`` (damped Newton on
+        the penalty objective, vectorised over frames; no hard constraints).
+    slsqp_options : SLSQP stopping rules and the hard-constraint option (default: hard bone
+        lengths for the SLSQP solvers, penalties for Newton).
+    workers : threads of the core's solve (0: every core), or processes of the Python solvers
+        (0 or 1: this process).
     skin : the character's skin on ``motion.skeleton`` (same joint names), or None.
     max_frames : frames motion analysis uses at most (analysis.py).
     on_level : called with (level index, joint count) before each level; may return a progress
         callback taking the number of frames finished.
-    analysis : a finished :func:`analyze_motion` of ``motion`` (then ``locked`` and
-        ``max_frames`` are not used).
+    analysis : a finished :func:`analyze_motion` of ``motion`` (then ``locked``,
+        ``max_frames`` and ``ranking`` are not used).
+    ranking : the joint elimination order (ranking.RANKINGS; the paper's Eq. 3 importance by default).
 
     Returns
     -------
@@ -242,7 +326,7 @@ def build_motion_chain(
     """
     if skin is not None and skin.skeleton.names != motion.skeleton.names:
         raise ValueError("skin: its skeleton's joint names differ from the motion's")
-    analysis = analysis or analyze_motion(motion, locked=locked, max_frames=max_frames)
+    analysis = analysis or analyze_motion(motion, locked=locked, max_frames=max_frames, ranking=ranking)
     result = []
     for index, count in enumerate(level_joint_counts(motion, analysis, levels)):
         progress = on_level(index, count) if on_level else None

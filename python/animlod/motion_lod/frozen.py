@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton
-from .analysis import MotionAnalysis, animated_translation_joints
+from .analysis import MotionAnalysis
 
 
 @dataclass(frozen=True)
@@ -37,7 +37,7 @@ class FrozenLevel:
     fold_rotations : (J, 4) product of the key rotations of the frozen joints between a kept
         point and its kept parent (identity when there are none).
     fold_translations : (J, 3) their combined translation, in the kept parent's frame.
-    animated : (J,) bool joints whose local translation is animated (their bone is not rigid).
+    animated : (J,) bool translating joints (analysis.translating_joints): their bone is not rigid.
     """
 
     skeleton: Skeleton
@@ -72,13 +72,14 @@ class FrozenLevel:
 def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | np.ndarray) -> FrozenLevel:
     """Freeze ``frozen_joints`` (original indices) of ``motion`` at their key frames.
 
-    Raises ValueError for the root, an end site, a locked joint or one with animated translation.
+    Raises ValueError for the root, an end site, a locked joint or a translating one.
     """
     skeleton = motion.skeleton
     count = skeleton.joint_count
     frozen = np.zeros(count, bool)
     frozen[np.asarray(frozen_joints, dtype=np.int64)] = True
-    animated = animated_translation_joints(motion)
+    animated = np.zeros(count, bool)
+    animated[analysis.translating] = True
     forbidden = frozen & (skeleton.end_sites | animated)
     forbidden[0] |= frozen[0]
     forbidden[analysis.locked] |= frozen[analysis.locked]
@@ -126,7 +127,7 @@ def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | 
 
 
 def frozen_motion(level: FrozenLevel, motion: Motion) -> Motion:
-    """``motion`` with every frozen joint held at its key rotation (no re-fit).
+    """``motion`` with every frozen joint held at its key rotation and translation (no re-fit).
 
     Its positions satisfy every bone length and frozen angle of the level exactly, so they are
     the re-fit's safe fallback and a good starting point.
@@ -134,4 +135,17 @@ def frozen_motion(level: FrozenLevel, motion: Motion) -> Motion:
     local = motion.local_rotations.copy()
     frozen = np.flatnonzero(level.frozen)
     local[:, frozen] = level.key_rotations[frozen]
-    return Motion(motion.skeleton, motion.root_positions, local, motion.fps, motion.name, motion.joint_translations)
+    return Motion(
+        motion.skeleton, motion.root_positions, local, motion.fps, motion.name, held_translations(level, motion)
+    )
+
+
+def held_translations(level: FrozenLevel, motion: Motion) -> np.ndarray | None:
+    """``motion.joint_translations`` with each frozen joint's translation held at its key frame
+    (a joint with a small real translation can freeze), or None when the motion has none."""
+    if motion.joint_translations is None:
+        return None
+    translations = motion.joint_translations.copy()
+    frozen = np.flatnonzero(level.frozen)
+    translations[:, frozen] = level.key_translations[frozen]
+    return translations

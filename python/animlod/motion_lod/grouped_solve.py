@@ -78,7 +78,7 @@ def solve_grouped(
             if progress:
                 progress(result.positions.shape[0] / len(groups))
     per_group = len(tasks) // max(len(groups), 1)
-    return _combine_groups(
+    return combine_groups(
         original,
         [(points, _concatenate(results[k * per_group : (k + 1) * per_group])) for k, (points, _) in enumerate(groups)],
     )
@@ -99,7 +99,7 @@ def _concatenate(results: list[RefitResult]) -> RefitResult:
     )
 
 
-def _combine_groups(original: np.ndarray, solved: list[tuple[np.ndarray, RefitResult]]) -> RefitResult:
+def combine_groups(original: np.ndarray, solved: list[tuple[np.ndarray, RefitResult]]) -> RefitResult:
     """The whole problem's result from its groups': points in no group keep their original
     positions, their exact optimum; E and evaluations add up; a frame is reported once, with its
     first group failure."""

@@ -1,25 +1,26 @@
-"""Per-frame re-fit with nlopt's SLSQP (Section 5.2: "SQP is applied to solve this problem").
+"""Per-frame re-fit with nlopt's SLSQP (Section 5.2: "SQP is applied to solve this problem"),
+in Python with the PyPI nlopt: the reference of the core's solve (core_refit.py,
+cpp/src/motion_refit_solve.cpp), which runs the same loop in C++ on several threads.
 
 E (Eq. 5) does not couple frames, so every frame is one small problem in 3(P - 1) unknowns,
 never one big one (SLSQP's cost grows with the cube of the size); within a frame it splits
-further into independent groups of points (objective.split_problem), each solved on its own. The unknowns are the
-points'
-displacements from the original positions in units of the length scale L, so a frame starts
-at z = 0 (the paper's "initial values: the original positions") and the next frame is
-warm-started from the previous frame's correction z*(t-1), since neighbouring frames need
-nearly the same correction. Frames are split into chunks (warm starts run inside a chunk);
-chunks can run in worker processes (threads would not help: the callbacks are Python).
+further into independent groups of points (objective.split_problem), each solved on its own.
+The unknowns are the points' displacements from the original positions in units of the length
+scale L. A chunk's first frame starts cold: at the original positions (the paper's "initial
+values"), or with hard constraints at the fallback (the original motion with frozen joints at
+their key rotations: feasible, and on the key posture's side of every mirror image). Every next
+frame starts from the previous result: without hard constraints the previous correction x* - x^o
+added to this frame's original; with them the previous result moved by the root's displacement,
+which is feasible because lengths and volumes do not change under translation. A group whose
+original positions or cold start have negligible E (no frozen joint touches it) is solved there. Frames are split into
+chunks; chunks can run in worker processes (threads would not help: the callbacks are Python).
 
 Every solve is checked: the result must be finite, not worse than its start, and, with hard
-bone-length constraints, feasible within ``feasibility_tolerance`` (SLSQP can report success
-with violated constraints). Hard constraints hold every length Es holds, bones and siblings,
-and keep rigid groups of three children from flipping into their mirror image, so that
-forward kinematics of the recovered skeleton reproduces the result. A frame that fails is solved again from z = 0,
-and if that fails too
-it takes the fallback positions (the original motion with frozen joints at their key rotations,
-which satisfies every constraint); every such frame is reported in ``RefitResult.failures``.
-With hard constraints, cold starts begin at the fallback rather than the original positions:
-it is feasible, and on the key posture's side of every mirror image.
+constraints, feasible within ``feasibility_tolerance`` (SLSQP can report success with violated
+constraints) and on the right side of every mirror image. Hard constraints hold every length Es
+holds, bones and siblings, so that forward kinematics of the recovered skeleton reproduces the
+result. A frame that fails is solved again from its cold start, and if that fails too it takes
+the fallback positions; every such frame is reported in ``RefitResult.failures``.
 """
 
 from __future__ import annotations
@@ -30,25 +31,52 @@ from dataclasses import dataclass
 import nlopt
 import numpy as np
 
+from .. import _core
 from .grouped_solve import FrameFailure, RefitResult, solve_grouped
 from .objective import RefitProblem, handedness_constraints, objective, rigidity_constraints
+
+_CORE_DEFAULTS = _core.MotionRefitOptions()
+# E >= alpha |x - x^o|^2 / L^2 (Eq. 6): original positions or a cold start with E below this are
+# the optimum to ~1e-12 L (a group no frozen joint touches), solved without a call to SLSQP.
+_NEGLIGIBLE_OBJECTIVE = 1e-24
 
 
 @dataclass(frozen=True)
 class SlsqpOptions:
-    """Stopping rules and checks of the SLSQP re-fit."""
+    """Stopping rules and checks of the SLSQP re-fit; the defaults are the core's
+    (``animlod._core.MotionRefitOptions``, cpp/include/animlod/motion_refit.hpp).
 
-    hard_constraints: bool = False
-    ftol_rel: float = 1e-8
-    max_evaluations: int = 400
-    feasibility_tolerance: float = 1e-6  # max |b - b0| / L accepted with hard constraints
-    warm_start: bool = True
+    hard_constraints : hold every length of Es as an equality, rigid groups' handedness as
+        inequalities (bones keep their key lengths, Fig. 7).
+    ftol_rel, max_evaluations : SLSQP's stopping rules per solve.
+    feasibility_tolerance : largest |b - b0| / L accepted with hard constraints.
+    warm_start : start each frame from the previous frame's result inside a chunk.
+    precondition : the core solves in variables where E's Hessian at the start is the identity
+        (far fewer iterations); the Python reference always uses the plain scaled displacements
+        (x - x^o) / L and ignores it.
+    eliminate_points : the core places leaves held by one length and points of zero-length pairs
+        in closed form instead of as variables (the same minima); the Python reference ignores it.
+    """
+
+    hard_constraints: bool = _CORE_DEFAULTS.hard_constraints
+    ftol_rel: float = _CORE_DEFAULTS.ftol_rel
+    max_evaluations: int = _CORE_DEFAULTS.max_evaluations
+    feasibility_tolerance: float = _CORE_DEFAULTS.feasibility_tolerance
+    warm_start: bool = _CORE_DEFAULTS.warm_start
+    precondition: bool = _CORE_DEFAULTS.precondition
+    eliminate_points: bool = _CORE_DEFAULTS.eliminate_points
 
 
 def _positions(problem: RefitProblem, original: np.ndarray, z: np.ndarray) -> np.ndarray:
     x = original.copy()
     x[1:] += problem.length_scale * z.reshape(-1, 3)
     return x
+
+
+def _energy(problem: RefitProblem, original: np.ndarray, z: np.ndarray) -> float:
+    """E of one frame at the scaled displacements ``z``."""
+    x = _positions(problem, original, z)
+    return float(objective(problem, x[None], original[None])[0][0])
 
 
 def _solve_frame(
@@ -109,13 +137,20 @@ def _solve_frame(
             handedness(result, z, np.empty(0))
             if result.max() > 0.0:
                 return z, value, evaluations, "a rigid group turned into its mirror image"
-    elif value > start_value:
+    # Every start is feasible (see _solve_chunk), so a result above it is never progress.
+    if value > start_value:
         return z, value, evaluations, "objective rose above its start"
     return z, value, evaluations, ""
 
 
 def _solve_chunk(
-    problem: RefitProblem, first_frame: int, original: np.ndarray, fallback: np.ndarray, options: SlsqpOptions
+    problem: RefitProblem,
+    first_frame: int,
+    original: np.ndarray,
+    fallback: np.ndarray,
+    cold_starts: np.ndarray,
+    options: SlsqpOptions,
+    explicit_cold_starts: bool,
 ) -> RefitResult:
     """Solve consecutive frames ``original (C, P, 3)``, warm-starting each from the previous."""
     frames = original.shape[0]
@@ -123,14 +158,30 @@ def _solve_chunk(
     values = np.empty(frames)
     evaluations = np.zeros(frames, dtype=np.int64)
     failures = []
-    # Cold starts: the original positions (the paper), or with hard constraints the fallback,
-    # which is feasible and on the right side of every mirror image.
-    cold = (fallback - original)[:, 1:].reshape(frames, -1) / problem.length_scale
-    if not options.hard_constraints:
-        cold[:] = 0.0
-    z = cold[0]
+    hard = options.hard_constraints and problem.constraint_count > 0
+    # Cold starts: the caller's, or the original positions (the paper), or with hard constraints
+    # the fallback (cold_starts then holds it), feasible and on the key side of every mirror image.
+    cold_positions = cold_starts if explicit_cold_starts or hard else original
+    cold = (cold_positions - original)[:, 1:].reshape(frames, -1) / problem.length_scale
+    cold_values = objective(problem, cold_positions, original)[0]
+    original_values = objective(problem, original, original)[0]
     for i in range(frames):  # sequential by nature: each frame starts from the previous optimum
-        start = z if options.warm_start else cold[i]
+        if min(cold_values[i], original_values[i]) <= _NEGLIGIBLE_OBJECTIVE:
+            at_original = original_values[i] <= cold_values[i]
+            positions[i] = original[i] if at_original else cold_positions[i]
+            values[i] = min(cold_values[i], original_values[i])
+            evaluations[i] = 1
+            continue
+        if i == 0 or not options.warm_start:
+            start = cold[i]
+        elif hard:  # the previous result moved with the root: feasible (lengths ignore translation)
+            start = (positions[i - 1, 1:] + (original[i, 0] - original[i - 1, 0]) - original[i, 1:]).ravel()
+            start /= problem.length_scale
+        else:  # the previous correction x* - x^o on this frame's original
+            start = (positions[i - 1, 1:] - original[i - 1, 1:]).ravel() / problem.length_scale
+        # Of the warm and the cold start the lower E (both feasible with hard constraints).
+        if _energy(problem, original[i], start) > cold_values[i]:
+            start = cold[i]
         z, value, count, reason = _solve_frame(problem, original[i], start, options)
         evaluations[i] = count
         if reason:
@@ -140,7 +191,6 @@ def _solve_chunk(
             if second:
                 positions[i] = fallback[i]
                 values[i] = float(objective(problem, fallback[i : i + 1], original[i : i + 1])[0][0])
-                z = (fallback[i, 1:] - original[i, 1:]).ravel() / problem.length_scale
                 continue
         positions[i] = _positions(problem, original[i], z)
         values[i] = value
@@ -155,6 +205,7 @@ def refit_slsqp(
     chunk_frames: int = 64,
     workers: int = 1,
     progress: Callable[[float], None] | None = None,
+    cold_starts: np.ndarray | None = None,
 ) -> RefitResult:
     """Re-fit every frame with SLSQP, one solve per frame and independent group of points.
 
@@ -164,9 +215,20 @@ def refit_slsqp(
     original : (T, P, 3) original positions x^o.
     fallback : (T, P, 3) positions kept for a frame whose solves fail (feasible by construction).
     options : stopping rules, hard constraints, checks.
+    cold_starts : (T, P, 3) where chunks start and failed frames restart (feasible with hard
+        constraints), or None: the original positions, or the fallback with hard constraints.
     chunk_frames : frames per warm-started chunk (and per task with ``workers > 1``).
     workers : processes; 1 solves in this process.
     progress : called with the (fractional) number of frames finished after each chunk.
     """
     options = options or SlsqpOptions()
-    return solve_grouped(problem, _solve_chunk, (original, fallback), (options,), chunk_frames, workers, progress)
+    explicit = cold_starts is not None
+    return solve_grouped(
+        problem,
+        _solve_chunk,
+        (original, fallback, cold_starts if explicit else fallback),
+        (options, explicit),
+        chunk_frames,
+        workers,
+        progress,
+    )

@@ -10,9 +10,10 @@ optimisation result x_j(t) and the hierarchical information of each joint". Here
   original twist) and is corrected by the smallest rotation that carries its children's offsets
   onto the re-fitted child positions, aimed from where forward kinematics has put the joint:
   the swing onto the longest child when it has one child (or only collinear ones), the best-fit
-  rotation (Kabsch) when it has several, none when it has no child. Forward kinematics then reproduces the re-fitted
-  positions exactly wherever they are
-  rigid with respect to the level's skeleton, which the string term Es asks for.
+  rotation (Kabsch) when it has several, none when it has no child. A translating joint (no
+  fixed bone) takes the translation that puts it at its re-fitted position. Forward kinematics
+  then reproduces the re-fitted positions exactly wherever they are rigid with respect to the
+  level's skeleton, which the string term Es (or the hard constraints) asks for.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton
-from .frozen import FrozenLevel
+from .frozen import FrozenLevel, held_translations
 
 # Child offsets shorter than this fraction of the level's extent give no direction.
 _SHORT = 1e-9
@@ -102,11 +103,18 @@ def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) ->
     local = np.empty_like(original_world)
     placed = np.empty_like(targets)  # where forward kinematics has put each joint so far
     placed[:, 0] = targets[:, 0]
+    translating = level.animated[kept]
     for joint in range(skeleton.joint_count):
         parent = skeleton.parents[joint]
+        if parent >= 0 and translating[joint]:  # no fixed bone: the translation follows the re-fit
+            translations[:, joint] = rotations.rotate(
+                rotations.conjugate(world[:, parent]), targets[:, joint] - placed[:, parent]
+            )
         if parent >= 0:
             placed[:, joint] = placed[:, parent] + rotations.rotate(world[:, parent], translations[:, joint])
-        useful = [c for c in children[joint] if static_offsets[c] > _SHORT * scale]
+        # Children at a fixed offset give the joint its direction; a translating child is placed
+        # by its own translation below, whatever this rotation is.
+        useful = [c for c in children[joint] if static_offsets[c] > _SHORT * scale and not translating[c]]
         base = original_world[:, joint]
         if useful:
             offsets = rotations.rotate(base[:, None], translations[:, useful])
@@ -133,7 +141,8 @@ def _spans_a_plane(vectors: np.ndarray) -> bool:
 
 
 def expand_motion(level: FrozenLevel, reduced: Motion, motion: Motion) -> Motion:
-    """The level's motion put back on the original skeleton, frozen joints at their key rotations.
+    """The level's motion put back on the original skeleton, frozen joints at their key rotations
+    and translations.
 
     Its forward kinematics equals the level's at every kept point, and places the frozen parts
     where the level implicitly carries them, so errors can be measured on every original point.
@@ -143,4 +152,5 @@ def expand_motion(level: FrozenLevel, reduced: Motion, motion: Motion) -> Motion
     frozen = np.flatnonzero(level.frozen)
     local[:, frozen] = level.key_rotations[frozen]
     local[:, kept] = rotations.multiply(rotations.conjugate(level.fold_rotations[kept]), reduced.local_rotations)
-    return Motion(motion.skeleton, reduced.root_positions, local, motion.fps, motion.name, motion.joint_translations)
+    translations = held_translations(level, motion)
+    return Motion(motion.skeleton, reduced.root_positions, local, motion.fps, motion.name, translations)

@@ -15,8 +15,10 @@ from pathlib import Path
 
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
-from ..model import Motion
-from ..motion_lod.chain import SOLVERS, MotionLodChain
+from ..model import Motion, SkinnedMesh
+from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis
+from ..motion_lod.chain import SOLVERS, JointFloor, MotionLodChain
+from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from .result import AssetResult, LevelRow, Progress
 
 
@@ -29,7 +31,9 @@ class MotionReport:
         skinned glTF input.
     manifest : the level chooser's manifest (``<stem>_motion_lod.json``).
     faces : triangles of the skinned mesh (None for a BVH).
-    motion : the input clip.
+    motion : the clip simplified (several split clips merged into one, see ``notes``).
+    floor : the fewest joints the skeleton allows and why (:func:`animlod.motion_lod.chain.joint_floor`).
+    notes : what the user should know (clips merged, nothing could freeze).
     """
 
     chain: MotionLodChain
@@ -37,22 +41,27 @@ class MotionReport:
     manifest: Path
     faces: int | None
     motion: Motion
+    floor: JointFloor
+    notes: list[str]
 
 
 def build_motion_levels(
     source: str | os.PathLike,
     output: str | os.PathLike,
-    levels: int = 8,
+    levels: int | None = None,
     *,
     joints: Sequence[int] | None = None,
     lock: Sequence[str] = (),
+    ranking: str = DEFAULT_RANKING,
     solver: str = SOLVERS[0],
-    hard: bool = False,
+    penalty: bool = False,
+    workers: int = 0,
+    translation_tolerance: float = TRANSLATION_TOLERANCE,
     weights: Sequence[float] = (0.2, 0.4, 0.4),
     max_frames: int = 600,
-    clip: int = 0,
-    workers: int = 1,
-    on_level: Callable[[int, int, int], Callable[[float], None] | None] | None = None,
+    clip: int | None = None,
+    on_level: Callable[[int, int, int, int], Callable[[float], None] | None] | None = None,
+    on_note: Callable[[str], None] | None = None,
 ) -> MotionReport:
     """Motion levels of ``source`` (a .bvh, or a .glb/.gltf with a skinned mesh and animations)
     written into the folder ``output`` as ``<stem>_lod<i>.bvh`` (and ``.glb`` with the skin moved
@@ -60,62 +69,59 @@ def build_motion_levels(
 
     Parameters
     ----------
-    levels : number of levels at the paper's fractions of the joints (100 .. 8 %).
+    levels : number of levels from every joint down to the fewest possible (the paper's 100 .. 8 %
+        where the skeleton allows); None: 8, or as many as the skeleton allows.
     joints : joint counts of the levels instead of ``levels``.
     lock : names of joints never to freeze.
-    solver, hard : the re-fit, ``"slsqp"`` (with bone lengths as equality constraints when
-        ``hard``) or ``"newton"``.
+    ranking : which joints freeze first (:data:`animlod.motion_lod.ranking.RANKINGS`).
+    solver, penalty : the re-fit (``"slsqp"`` in the core, ``"slsqp-python"``, ``"newton"``);
+        bone lengths are equality constraints with the SLSQP solvers unless ``penalty``.
+    workers : threads of the core's solve (0: every core), or processes of the Python solvers.
+    translation_tolerance : fraction of a bone's length above which a translating joint never freezes.
     weights : (alpha, beta, gamma) of the distance, string and angle errors (Eq. 5).
     max_frames : frames the motion analysis looks at, at most.
-    clip : which animation of a glTF input.
-    workers : processes solving chunks of frames side by side.
-    on_level : called with (level index, joint count, frame count) as each level starts; may
-        return a callback taking the frames done.
+    clip : which animation of a glTF input; None: the first, or all of them as one motion when
+        each moves other joints (one animation per joint node).
+    on_level : called with (level index, joint count, frame count, number of levels) as each
+        level starts; may return a callback taking the frames done.
+    on_note : called with each note as it arises (also kept in the report).
 
     Raises FormatError for unreadable input or a glTF without a skinned, animated mesh;
-    ValueError naming the option for bad options.
+    ValueError naming the option for bad options and impossible level requests.
     """
-    from ..motion_lod.analysis import analyze_motion
-    from ..motion_lod.chain import build_motion_chain, level_joint_counts
+    from ..motion_lod.chain import build_motion_chain
     from ..motion_lod.objective import Weights
     from ..motion_lod.refit import SlsqpOptions
 
-    if hard and solver != "slsqp":
-        raise ValueError("hard: bone-length equality constraints need solver 'slsqp'")
-    if workers < 1:
-        raise ValueError(f"workers: must be at least 1, got {workers}")
+    if workers < 0:
+        raise ValueError(f"workers: must be at least 0, got {workers}")
+    if ranking not in RANKINGS:
+        raise ValueError(f"ranking: no ranking named {ranking!r} (choose from {', '.join(RANKINGS)})")
     if len(weights) != 3:
         raise ValueError(f"weights: expected (alpha, beta, gamma), got {len(weights)} values")
-    path = os.fspath(source)
-    kind = input_kind(source)
-    skin = None
-    if kind == "bvh":
-        from ..io.bvh import read_bvh
+    notes: list[str] = []
 
-        motion = read_bvh(source)
-    elif kind == "gltf":
-        from ..io.gltf import read_skinned
+    def note(text: str) -> None:
+        notes.append(text)
+        if on_note is not None:
+            on_note(text)
 
-        skin, motions = read_skinned(source)
-        if not motions:
-            raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
-        if not 0 <= clip < len(motions):
-            raise FormatError(path, "animations", f"has {len(motions)} animations, clip {clip} was asked for")
-        motion = motions[clip]
-    else:
-        raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or a skinned glTF")
-
-    analysis = analyze_motion(motion, locked=lock, max_frames=max_frames)
-    counts = level_joint_counts(motion, analysis, list(joints) if joints else levels)
+    motion, skin = _read_input(source, clip, note)
+    analysis, counts, floor = _plan_levels(motion, levels, joints, lock, max_frames, translation_tolerance, ranking)
+    if floor.possible_levels == 1:
+        note(
+            f"{os.fspath(source)}: nothing can freeze ({floor.total} joints, all kept: {floor.explain()}); "
+            "writing one level, the input's motion"
+        )
     chain = build_motion_chain(
         motion,
         counts,
         weights=Weights(*weights),
         solver=solver,
-        slsqp_options=SlsqpOptions(hard_constraints=hard),
+        slsqp_options=SlsqpOptions(hard_constraints=solver != "newton" and not penalty),
         workers=workers,
         skin=skin,
-        on_level=(lambda index, count: on_level(index, count, motion.frame_count)) if on_level else None,
+        on_level=(lambda index, count: on_level(index, count, motion.frame_count, len(counts))) if on_level else None,
         analysis=analysis,
     )
 
@@ -140,7 +146,65 @@ def build_motion_levels(
     # The runtime's level chooser: each level's largest joint position error in asset units.
     manifest = Path(f"{stem}_motion_lod.json")
     write_lod_manifest(folder / manifest, "motion", rows)
-    return MotionReport(chain, files, manifest, None if skin is None else int(skin.faces.shape[0]), motion)
+    faces = None if skin is None else int(skin.faces.shape[0])
+    return MotionReport(chain, files, manifest, faces, motion, floor, notes)
+
+
+def _read_input(
+    source: str | os.PathLike, clip: int | None, note: Callable[[str], None]
+) -> tuple[Motion, SkinnedMesh | None]:
+    """The motion to simplify and, for a skinned glTF, its skin."""
+    path = os.fspath(source)
+    kind = input_kind(source)
+    if kind == "bvh":
+        from ..io.bvh import read_bvh
+
+        return read_bvh(source), None
+    if kind != "gltf":
+        raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or a skinned glTF")
+    from ..io.gltf import read_skinned
+
+    skin, motions = read_skinned(source)
+    if not motions:
+        raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
+    if clip is None:
+        from ..motion_lod.clips import merge_split_clips
+
+        merged = merge_split_clips(motions)
+        if merged is not None:
+            note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
+                 "(use --clip to take one)")  # fmt: skip
+            return merged, skin
+        return motions[0], skin
+    if not 0 <= clip < len(motions):
+        raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
+    return motions[clip], skin
+
+
+def _plan_levels(
+    motion: Motion,
+    levels: int | None,
+    joints: Sequence[int] | None,
+    lock: Sequence[str],
+    max_frames: int,
+    translation_tolerance: float,
+    ranking: str,
+) -> tuple[MotionAnalysis, list[int], JointFloor]:
+    """The motion analysis, the joint counts of the levels and the joint floor (ValueError on a
+    bad request)."""
+    from ..motion_lod.analysis import analyze_motion
+    from ..motion_lod.chain import joint_floor, level_joint_counts
+
+    analysis = analyze_motion(
+        motion, locked=lock, max_frames=max_frames, translation_tolerance=translation_tolerance, ranking=ranking
+    )
+    floor = joint_floor(motion, analysis)
+    if joints:
+        return analysis, level_joint_counts(motion, analysis, list(joints)), floor
+    if floor.possible_levels == 1:  # every joint stays: one level, in a note
+        return analysis, [floor.total], floor
+    count = levels if levels is not None else min(8, floor.possible_levels)
+    return analysis, level_joint_counts(motion, analysis, count), floor
 
 
 def motion_asset(
@@ -156,10 +220,11 @@ def motion_asset(
     """
     started = time.perf_counter()
 
-    def on_level(index: int, count: int, frames: int) -> None:
+    def on_level(index: int, count: int, frames: int, levels: int) -> None:
         if progress is not None:
-            progress(None, f"level {index}: {count} joints, {frames} frames")
+            progress(index / levels, f"level {index}: {count} joints, {frames} frames")
 
+    options.setdefault("workers", 1)  # a batch spreads its work over assets, one core each
     report = build_motion_levels(source, output, on_level=on_level, **options)  # type: ignore[arg-type]
     folder = Path(output)
     size = report.chain.figure_size
@@ -170,5 +235,5 @@ def motion_asset(
     ]  # fmt: skip
     outputs = [folder / name for names in report.files for name in names] + [folder / report.manifest]
     failures = sum(len(level.report.failures) for level in report.chain.levels)
-    notes = [f"{failures} frames needed a second solve"] if failures else []
+    notes = report.notes + ([f"{failures} frames needed a second solve"] if failures else [])
     return AssetResult("motion", os.fspath(source), outputs, rows, time.perf_counter() - started, notes)

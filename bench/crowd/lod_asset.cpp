@@ -1,0 +1,696 @@
+// Reads a LoD GLB (the format of /work/shared preamble, "The LoD GLB format": MSFT_lod ids on
+// the level-0 node, MSFT_screencoverage and extras.animlod on every level, reduced skeletons and
+// re-fitted animations for motion levels) with tinygltf, Debian's shared build.
+#include "lod_asset.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <map>
+#include <set>
+
+#define GLM_ENABLE_EXPERIMENTAL
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/gtx/matrix_decompose.hpp>
+#include <tiny_gltf.h>
+
+#include "animlod/skinning.hpp"
+
+namespace crowd {
+
+namespace {
+
+using tinygltf::Model;
+using tinygltf::Value;
+
+// Failure with a message; the loader stops at the first one.
+struct LoadError {
+  std::string message;
+};
+
+[[noreturn]] void fail(const std::string& element, const std::string& reason) { throw LoadError{element + ": " + reason}; }
+
+std::string node_label(const Model& model, int node) {
+  const std::string& name = model.nodes[static_cast<size_t>(node)].name;
+  return "node " + std::to_string(node) + (name.empty() ? "" : " '" + name + "'");
+}
+
+std::string animation_label(const Model& model, int animation) {
+  const std::string& name = model.animations[static_cast<size_t>(animation)].name;
+  return "animation " + std::to_string(animation) + (name.empty() ? "" : " '" + name + "'");
+}
+
+size_t component_size(int type) {
+  switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_INT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+  }
+}
+
+// One component as a double; normalised integers map to [0, 1] or [-1, 1] (glTF 3.11).
+double read_component(const unsigned char* at, int type, bool normalized) {
+  switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+      float v;
+      std::memcpy(&v, at, 4);
+      return v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? at[0] / 255.0 : at[0];
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      const auto v = static_cast<int8_t>(at[0]);
+      return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, at, 2);
+      return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v;
+      std::memcpy(&v, at, 2);
+      return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v;
+      std::memcpy(&v, at, 4);
+      return v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_INT: {
+      int32_t v;
+      std::memcpy(&v, at, 4);
+      return v;
+    }
+    default: return 0.0;
+  }
+}
+
+// Accessor `index` as doubles, `components` per element (checked against its type), bounds
+// checked against its buffer view and buffer.
+std::vector<double> read_accessor(const Model& model, int index, int components, const std::string& element) {
+  const std::string label = element + " accessor " + std::to_string(index);
+  if (index < 0 || static_cast<size_t>(index) >= model.accessors.size()) fail(element, "accessor " + std::to_string(index) + " does not exist");
+  const tinygltf::Accessor& accessor = model.accessors[static_cast<size_t>(index)];
+  const int per_element = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(accessor.type));
+  if (per_element != components)
+    fail(label, std::to_string(per_element) + " components per element, expected " + std::to_string(components));
+  const size_t size = component_size(accessor.componentType);
+  if (size == 0) fail(label, "unknown component type " + std::to_string(accessor.componentType));
+  if (accessor.sparse.isSparse) fail(label, "sparse accessors are not supported by animlod_crowd");
+  std::vector<double> out(accessor.count * static_cast<size_t>(components), 0.0);
+  if (accessor.bufferView < 0) return out;  // all zeros (glTF 3.6.2.3)
+  if (static_cast<size_t>(accessor.bufferView) >= model.bufferViews.size()) fail(label, "buffer view does not exist");
+  const tinygltf::BufferView& view = model.bufferViews[static_cast<size_t>(accessor.bufferView)];
+  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model.buffers.size()) fail(label, "buffer does not exist");
+  const std::vector<unsigned char>& data = model.buffers[static_cast<size_t>(view.buffer)].data;
+  const size_t element_size = size * static_cast<size_t>(components);
+  const size_t stride = view.byteStride ? view.byteStride : element_size;
+  const size_t start = view.byteOffset + accessor.byteOffset;
+  if (accessor.count > 0) {
+    const size_t end = start + stride * (accessor.count - 1) + element_size;
+    if (end > view.byteOffset + view.byteLength || view.byteOffset + view.byteLength > data.size())
+      fail(label, "reaches past its buffer view or buffer (" + std::to_string(end) + " bytes needed)");
+  }
+  for (size_t e = 0; e < accessor.count; ++e)
+    for (int c = 0; c < components; ++c)
+      out[e * static_cast<size_t>(components) + static_cast<size_t>(c)] =
+          read_component(data.data() + start + e * stride + static_cast<size_t>(c) * size, accessor.componentType,
+                         accessor.normalized);
+  return out;
+}
+
+std::vector<float> to_floats(const std::vector<double>& values, const std::string& element) {
+  std::vector<float> out(values.size());
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) fail(element, "non-finite value at component " + std::to_string(i));
+    out[i] = static_cast<float>(values[i]);
+  }
+  return out;
+}
+
+// Rest TRS of a node (a matrix is decomposed).
+void rest_trs(const tinygltf::Node& node, float* t, float* r, float* s) {
+  glm::vec3 translation(0.0f), scale(1.0f);
+  glm::quat rotation(1.0f, 0.0f, 0.0f, 0.0f);
+  if (node.matrix.size() == 16) {
+    glm::mat4 m;
+    for (int i = 0; i < 16; ++i) glm::value_ptr(m)[i] = static_cast<float>(node.matrix[static_cast<size_t>(i)]);
+    glm::vec3 skew;
+    glm::vec4 perspective;
+    glm::decompose(m, scale, rotation, translation, skew, perspective);
+  } else {
+    if (node.translation.size() == 3)
+      translation = glm::vec3(node.translation[0], node.translation[1], node.translation[2]);
+    if (node.rotation.size() == 4)
+      rotation = glm::quat(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
+                           static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]));
+    if (node.scale.size() == 3) scale = glm::vec3(node.scale[0], node.scale[1], node.scale[2]);
+  }
+  const float length = glm::length(rotation);
+  if (!(length > 1e-6f)) rotation = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  else rotation = rotation / length;
+  t[0] = translation.x, t[1] = translation.y, t[2] = translation.z;
+  r[0] = rotation.x, r[1] = rotation.y, r[2] = rotation.z, r[3] = rotation.w;
+  s[0] = scale.x, s[1] = scale.y, s[2] = scale.z;
+}
+
+const Value* object_member(const Value& value, const char* key) {
+  if (!value.IsObject() || !value.Has(key)) return nullptr;
+  return &value.Get(key);
+}
+
+class Loader {
+ public:
+  Loader(const Model& model, Asset& asset) : model_(model), asset_(asset) {}
+
+  void run() {
+    find_parents();
+    const std::vector<int> mesh_nodes = skinned_mesh_nodes();
+    if (mesh_nodes.empty())
+      fail("scene", "no skinned mesh (a node with a mesh and a skin) in the default scene; the crowd needs a skin");
+    find_original_clips(mesh_nodes.front());
+    for (int node : mesh_nodes) asset_.chains.push_back(read_chain(node));
+    compute_bounds();
+  }
+
+ private:
+  void find_parents() {
+    parents_.assign(model_.nodes.size(), -1);
+    for (size_t n = 0; n < model_.nodes.size(); ++n)
+      for (int child : model_.nodes[n].children) {
+        if (child < 0 || static_cast<size_t>(child) >= model_.nodes.size())
+          fail(node_label(model_, static_cast<int>(n)), "child " + std::to_string(child) + " does not exist");
+        if (parents_[static_cast<size_t>(child)] < 0) parents_[static_cast<size_t>(child)] = static_cast<int>(n);
+      }
+  }
+
+  std::vector<int> ancestors(int node) const {
+    std::vector<int> out;
+    for (int p = parents_[static_cast<size_t>(node)]; p >= 0 && out.size() <= model_.nodes.size();
+         p = parents_[static_cast<size_t>(p)])
+      out.push_back(p);
+    if (out.size() > model_.nodes.size()) fail(node_label(model_, node), "its ancestors form a cycle");
+    return out;
+  }
+
+  // Mesh nodes with a skin reachable from the default scene (every root node without scenes).
+  std::vector<int> skinned_mesh_nodes() const {
+    std::vector<int> roots;
+    if (!model_.scenes.empty()) {
+      const size_t scene = model_.defaultScene >= 0 ? static_cast<size_t>(model_.defaultScene) : 0;
+      if (scene >= model_.scenes.size()) fail("scene", "default scene " + std::to_string(scene) + " does not exist");
+      roots = model_.scenes[scene].nodes;
+    } else {
+      for (size_t n = 0; n < model_.nodes.size(); ++n)
+        if (parents_[n] < 0) roots.push_back(static_cast<int>(n));
+    }
+    std::vector<int> out;
+    std::set<int> seen;
+    std::function<void(int)> visit = [&](int node) {
+      if (node < 0 || static_cast<size_t>(node) >= model_.nodes.size()) fail("scene", "node " + std::to_string(node) + " does not exist");
+      if (!seen.insert(node).second) return;
+      const tinygltf::Node& n = model_.nodes[static_cast<size_t>(node)];
+      if (n.mesh >= 0 && n.skin >= 0) out.push_back(node);
+      for (int child : n.children) visit(child);
+    };
+    for (int root : roots) visit(root);
+    return out;
+  }
+
+  // extras.animlod of a node or animation, or null.
+  static const Value* animlod_extras(const Value& extras) { return object_member(extras, "animlod"); }
+
+  static int motion_level_of_animation(const tinygltf::Animation& animation) {
+    const Value* extras = animlod_extras(animation.extras);
+    const Value* level = extras ? object_member(*extras, "motion_level") : nullptr;
+    return level && level->IsNumber() ? level->GetNumberAsInt() : 0;
+  }
+
+  // The original clips: animations of motion level 0 that move the first chain's skin. Exporters
+  // such as COLLADA2GLTF write one clip as one unnamed animation per node; unnamed animations
+  // that move disjoint nodes are played together, as viewers do, as one clip.
+  void find_original_clips(int first_node) {
+    const int rig = rig_for_skin(model_.nodes[static_cast<size_t>(first_node)].skin);
+    std::vector<int> moving;
+    for (size_t a = 0; a < model_.animations.size(); ++a) {
+      if (motion_level_of_animation(model_.animations[a]) != 0) continue;
+      if (asset_.clips[static_cast<size_t>(clip_for(rig, {static_cast<int>(a)}))].channels.empty()) continue;
+      moving.push_back(static_cast<int>(a));
+    }
+    if (moving.empty())
+      fail(node_label(model_, first_node), "no animation moves its skeleton (the crowd needs a clip to play)");
+    bool split_clip = moving.size() > 1;
+    std::set<int> targets;
+    for (int a : moving) {
+      const tinygltf::Animation& animation = model_.animations[static_cast<size_t>(a)];
+      split_clip = split_clip && animation.name.empty();
+      std::set<int> mine;
+      for (const tinygltf::AnimationChannel& channel : animation.channels) mine.insert(channel.target_node);
+      for (int node : mine) split_clip = split_clip && targets.insert(node).second;
+    }
+    if (split_clip) {
+      original_clips_.push_back(moving);
+      asset_.clip_names.push_back(std::to_string(moving.size()) + " per-node animations played together");
+      return;
+    }
+    for (int a : moving) {
+      original_clips_.push_back({a});
+      const std::string& name = model_.animations[static_cast<size_t>(a)].name;
+      asset_.clip_names.push_back(name.empty() ? "animation " + std::to_string(a) : name);
+    }
+  }
+
+  Chain read_chain(int node) {
+    const tinygltf::Node& base = model_.nodes[static_cast<size_t>(node)];
+    Chain chain;
+    chain.node = node;
+    chain.name = base.name.empty() ? "node " + std::to_string(node) : base.name;
+    std::vector<int> level_nodes = {node};
+    const auto lod = base.extensions.find("MSFT_lod");
+    if (lod != base.extensions.end()) {
+      const Value* ids = object_member(lod->second, "ids");
+      if (!ids || !ids->IsArray()) fail(node_label(model_, node), "MSFT_lod has no 'ids' array");
+      for (size_t i = 0; i < ids->ArrayLen(); ++i) {
+        const Value& id = ids->Get(static_cast<int>(i));
+        const int level_node = id.IsNumber() ? id.GetNumberAsInt() : -1;
+        if (level_node < 0 || static_cast<size_t>(level_node) >= model_.nodes.size())
+          fail(node_label(model_, node), "MSFT_lod id " + std::to_string(i) + " is not a node");
+        level_nodes.push_back(level_node);
+      }
+    }
+    std::vector<float> coverages;
+    if (const Value* list = object_member(base.extras, "MSFT_screencoverage")) {
+      for (size_t i = 0; list->IsArray() && i < list->ArrayLen(); ++i)
+        coverages.push_back(static_cast<float>(list->Get(static_cast<int>(i)).GetNumberAsDouble()));
+      if (coverages.size() != level_nodes.size())
+        fail(node_label(model_, node), "MSFT_screencoverage has " + std::to_string(coverages.size()) + " values for " +
+                                           std::to_string(level_nodes.size()) + " levels");
+      chain.has_coverages = true;
+    }
+    chain.has_errors = true;
+    for (size_t i = 0; i < level_nodes.size(); ++i) {
+      chain.levels.push_back(read_level(level_nodes[i], "level " + std::to_string(i), static_cast<int>(i), 0));
+      Level& level = chain.levels.back();
+      if (chain.has_coverages) level.coverage = coverages[i];
+      const Value* extras = animlod_extras(model_.nodes[static_cast<size_t>(level.node)].extras);
+      if (i > 0 && !(extras && object_member(*extras, "error"))) chain.has_errors = false;
+    }
+    chain.selection_count = chain.levels.size();
+    // The rest of a character chain's grid: extras.animlod_grid[g][m] = node of (g, m).
+    if (const Value* grid = object_member(base.extras, "animlod_grid")) {
+      for (size_t g = 0; grid->IsArray() && g < grid->ArrayLen(); ++g) {
+        const Value& row = grid->Get(static_cast<int>(g));
+        for (size_t m = 0; row.IsArray() && m < row.ArrayLen(); ++m) {
+          const Value& id = row.Get(static_cast<int>(m));
+          const int cell = id.IsNumber() ? id.GetNumberAsInt() : -1;
+          const std::string label = "animlod_grid[" + std::to_string(g) + "][" + std::to_string(m) + "]";
+          if (cell < 0 || static_cast<size_t>(cell) >= model_.nodes.size())
+            fail(node_label(model_, node), label + " is not a node");
+          bool listed = false;
+          for (const Level& level : chain.levels) listed = listed || level.node == cell;
+          if (listed) continue;
+          chain.levels.push_back(read_level(cell, label, static_cast<int>(g), static_cast<int>(m)));
+          chain.levels.back().mesh_level = static_cast<int>(g);  // the grid's place wins over extras
+          chain.levels.back().motion_level = static_cast<int>(m);
+        }
+      }
+    }
+    const std::string& root = asset_.rigs[static_cast<size_t>(chain.levels[0].rig)].root_name;
+    for (size_t i = 1; i < chain.levels.size(); ++i) {
+      const std::string& other = asset_.rigs[static_cast<size_t>(chain.levels[i].rig)].root_name;
+      if (other != root)
+        fail(node_label(model_, node), "level node " + std::to_string(i) + " (" + node_label(model_, chain.levels[i].node) +
+                                           ") has skeleton root '" + other + "', level 0 has '" + root +
+                                           "': the levels of a chain must share a skeleton root");
+    }
+    return chain;
+  }
+
+  // A level node; (mesh_level, motion_level) hold where its extras.animlod does not say.
+  Level read_level(int node, const std::string& name, int mesh_level, int motion_level) {
+    const tinygltf::Node& n = model_.nodes[static_cast<size_t>(node)];
+    const std::string label = name + " (" + node_label(model_, node) + ")";
+    if (n.mesh < 0 || static_cast<size_t>(n.mesh) >= model_.meshes.size()) fail(label, "has no mesh");
+    if (n.skin < 0 || static_cast<size_t>(n.skin) >= model_.skins.size()) fail(label, "has no skin");
+    Level level;
+    level.node = node;
+    level.mesh_level = mesh_level;
+    level.motion_level = motion_level;
+    if (const Value* extras = animlod_extras(n.extras)) {
+      auto number = [&](const char* key, double fallback) {
+        const Value* v = object_member(*extras, key);
+        return v && v->IsNumber() ? v->GetNumberAsDouble() : fallback;
+      };
+      level.error = static_cast<float>(number("error", 0.0));
+      level.mesh_level = static_cast<int>(number("mesh_level", level.mesh_level));
+      level.motion_level = static_cast<int>(number("motion_level", level.motion_level));
+      if (!std::isfinite(level.error) || level.error < 0.0f) fail(label, "extras.animlod.error must be a number >= 0");
+    }
+    level.rig = rig_for_skin(n.skin);
+    level.mesh = static_cast<int>(asset_.meshes.size());
+    asset_.meshes.push_back(read_mesh(n.mesh, asset_.rigs[static_cast<size_t>(level.rig)].joint_count(), label));
+    for (size_t k = 0; k < original_clips_.size(); ++k) {
+      std::vector<int> animations;
+      for (int original : original_clips_[k]) animations.push_back(animation_for(level, original, label, k));
+      level.clips.push_back(clip_for(level.rig, animations));
+    }
+    return level;
+  }
+
+  // The animation playing original clip `original` at the level's motion level.
+  int animation_for(const Level& level, int original, const std::string& label, size_t k) {
+    if (level.motion_level == 0) return original;
+    const std::set<int> nodes(asset_.rigs[static_cast<size_t>(level.rig)].nodes.begin(),
+                              asset_.rigs[static_cast<size_t>(level.rig)].nodes.end());
+    for (size_t a = 0; a < model_.animations.size(); ++a) {
+      const tinygltf::Animation& animation = model_.animations[a];
+      const Value* extras = animlod_extras(animation.extras);
+      const Value* clip = extras ? object_member(*extras, "clip") : nullptr;
+      if (!clip || !clip->IsNumber() || clip->GetNumberAsInt() != original) continue;
+      if (motion_level_of_animation(animation) != level.motion_level) continue;
+      for (const tinygltf::AnimationChannel& channel : animation.channels)
+        if (nodes.count(channel.target_node)) return static_cast<int>(a);
+    }
+    fail(label, "motion level " + std::to_string(level.motion_level) + " has no animation for clip '" +
+                    asset_.clip_names[k] + "' (" + animation_label(model_, original) +
+                    ") targeting its skeleton (expected extras.animlod {clip, motion_level})");
+  }
+
+  int rig_for_skin(int skin) {
+    for (size_t r = 0; r < asset_.rigs.size(); ++r)
+      if (asset_.rigs[r].skin == skin) return static_cast<int>(r);
+    asset_.rigs.push_back(read_rig(skin));
+    return static_cast<int>(asset_.rigs.size()) - 1;
+  }
+
+  Rig read_rig(int skin_index) {
+    const tinygltf::Skin& skin = model_.skins[static_cast<size_t>(skin_index)];
+    const std::string label = "skin " + std::to_string(skin_index);
+    if (skin.joints.empty()) fail(label, "has no joints");
+    std::set<int> tree;
+    for (size_t slot = 0; slot < skin.joints.size(); ++slot) {
+      const int joint = skin.joints[slot];
+      if (joint < 0 || static_cast<size_t>(joint) >= model_.nodes.size())
+        fail(label, "joint " + std::to_string(slot) + " is node " + std::to_string(joint) + ", which does not exist");
+      tree.insert(joint);
+      for (int a : ancestors(joint)) tree.insert(a);
+    }
+    std::vector<std::pair<size_t, int>> order;  // (depth, node): parents before children
+    for (int node : tree) order.emplace_back(ancestors(node).size(), node);
+    std::sort(order.begin(), order.end());
+    Rig rig;
+    rig.skin = skin_index;
+    std::map<int, int> pose_of;
+    for (const auto& entry : order) {
+      const int node = entry.second;
+      pose_of[node] = static_cast<int>(rig.nodes.size());
+      rig.nodes.push_back(node);
+      const int parent = parents_[static_cast<size_t>(node)];
+      rig.parents.push_back(parent >= 0 && pose_of.count(parent) ? pose_of[parent] : -1);
+      float t[3], r[4], s[3];
+      rest_trs(model_.nodes[static_cast<size_t>(node)], t, r, s);
+      rig.rest_translations.insert(rig.rest_translations.end(), t, t + 3);
+      rig.rest_rotations.insert(rig.rest_rotations.end(), r, r + 4);
+      rig.rest_scales.insert(rig.rest_scales.end(), s, s + 3);
+    }
+    const std::set<int> joints(skin.joints.begin(), skin.joints.end());
+    for (int joint : skin.joints) {
+      rig.joint_nodes.push_back(pose_of[joint]);
+      if (rig.root_name.empty()) {
+        bool top = true;
+        for (int a : ancestors(joint)) top = top && !joints.count(a);
+        if (top) {
+          const std::string& name = model_.nodes[static_cast<size_t>(joint)].name;
+          rig.root_name = name.empty() ? "node " + std::to_string(joint) : name;
+        }
+      }
+    }
+    const size_t count = skin.joints.size();
+    if (skin.inverseBindMatrices >= 0) {
+      rig.inverse_bind = to_floats(read_accessor(model_, skin.inverseBindMatrices, 16, label + " inverseBindMatrices"),
+                                   label + " inverseBindMatrices");
+      if (rig.inverse_bind.size() < 16 * count)
+        fail(label, "inverseBindMatrices holds " + std::to_string(rig.inverse_bind.size() / 16) + " matrices for " +
+                        std::to_string(count) + " joints");
+      rig.inverse_bind.resize(16 * count);
+    } else {
+      for (size_t j = 0; j < count; ++j) {
+        const glm::mat4 identity(1.0f);
+        rig.inverse_bind.insert(rig.inverse_bind.end(), glm::value_ptr(identity), glm::value_ptr(identity) + 16);
+      }
+    }
+    return rig;
+  }
+
+  int clip_for(int rig_index, const std::vector<int>& animations) {
+    for (size_t c = 0; c < asset_.clips.size(); ++c)
+      if (asset_.clips[c].animations == animations && clip_rigs_[c] == rig_index) return static_cast<int>(c);
+    asset_.clips.push_back(read_clip(rig_index, animations));
+    clip_rigs_.push_back(rig_index);
+    return static_cast<int>(asset_.clips.size()) - 1;
+  }
+
+  // The channels of `animations` (one clip, or one split into per-node animations) that move the rig.
+  Clip read_clip(int rig_index, const std::vector<int>& animations) {
+    const Rig& rig = asset_.rigs[static_cast<size_t>(rig_index)];
+    std::map<int, int> pose_of;
+    for (size_t p = 0; p < rig.nodes.size(); ++p) pose_of[rig.nodes[p]] = static_cast<int>(p);
+    Clip clip;
+    clip.animations = animations;
+    std::vector<animlod::ClipChannel> channels;
+    for (int animation_index : animations) {
+      const tinygltf::Animation& animation = model_.animations[static_cast<size_t>(animation_index)];
+      const std::string label = animation_label(model_, animation_index);
+      for (size_t c = 0; c < animation.channels.size(); ++c) {
+        const tinygltf::AnimationChannel& channel = animation.channels[c];
+        const auto target = pose_of.find(channel.target_node);
+        if (target == pose_of.end()) continue;
+        animlod::ClipChannel out;
+        const std::string element = label + " channel " + std::to_string(c);
+        if (channel.target_path == "translation") out.path = animlod::ChannelPath::translation;
+        else if (channel.target_path == "rotation") out.path = animlod::ChannelPath::rotation;
+        else if (channel.target_path == "scale") out.path = animlod::ChannelPath::scale;
+        else continue;  // morph weights: not drawn by the crowd
+        if (channel.sampler < 0 || static_cast<size_t>(channel.sampler) >= animation.samplers.size())
+          fail(element, "sampler " + std::to_string(channel.sampler) + " does not exist");
+        const tinygltf::AnimationSampler& sampler = animation.samplers[static_cast<size_t>(channel.sampler)];
+        const int width = out.path == animlod::ChannelPath::rotation ? 4 : 3;
+        if (sampler.interpolation.empty() || sampler.interpolation == "LINEAR") out.track.interpolation = animlod::Interpolation::linear;
+        else if (sampler.interpolation == "STEP") out.track.interpolation = animlod::Interpolation::step;
+        else if (sampler.interpolation == "CUBICSPLINE") out.track.interpolation = animlod::Interpolation::cubic_spline;
+        else fail(element, "unknown interpolation '" + sampler.interpolation + "'");
+        clip.times.push_back(to_floats(read_accessor(model_, sampler.input, 1, element + " input"), element + " input"));
+        clip.values.push_back(to_floats(read_accessor(model_, sampler.output, width, element + " output"), element + " output"));
+        const size_t keys = clip.times.back().size();
+        const size_t per_key = out.track.interpolation == animlod::Interpolation::cubic_spline ? 3 : 1;
+        if (clip.values.back().size() != keys * per_key * static_cast<size_t>(width))
+          fail(element, "output holds " + std::to_string(clip.values.back().size()) + " numbers for " + std::to_string(keys) +
+                            " keys");
+        out.track.key_count = keys;
+        out.track.component_count = static_cast<size_t>(width);
+        out.track.times = clip.times.back().data();  // re-pointed below once every channel is read
+        out.track.values = clip.values.back().data();
+        const animlod::Status status = animlod::validate_track(out.track, out.path == animlod::ChannelPath::rotation);
+        if (!status) fail(element, status.message);
+        out.joint = target->second;
+        channels.push_back(out);
+        if (keys > 0) clip.duration = std::max(clip.duration, clip.times.back().back());
+      }
+    }
+    for (size_t c = 0; c < channels.size(); ++c) {
+      channels[c].track.times = clip.times[c].data();
+      channels[c].track.values = clip.values[c].data();
+    }
+    clip.channels = std::move(channels);
+    const animlod::Status status = animlod::validate_clip(clip.view(), rig.pose_count());
+    if (!status) fail(animation_label(model_, animations.front()) + (animations.size() > 1 ? " and the others played with it" : ""),
+                      status.message);
+    return clip;
+  }
+
+  MeshData read_mesh(int mesh_index, size_t joint_count, const std::string& level) {
+    const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(mesh_index)];
+    MeshData out;
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+      const tinygltf::Primitive& primitive = mesh.primitives[p];
+      const std::string label = level + " mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p);
+      if (primitive.mode >= 0 && primitive.mode < TINYGLTF_MODE_TRIANGLES) continue;  // points and lines: not drawn
+      auto attribute = [&](const char* name) {
+        const auto found = primitive.attributes.find(name);
+        return found == primitive.attributes.end() ? -1 : found->second;
+      };
+      if (attribute("POSITION") < 0) fail(label, "has no POSITION");
+      if (attribute("JOINTS_0") < 0 || attribute("WEIGHTS_0") < 0)
+        fail(label, "has no JOINTS_0 / WEIGHTS_0: a skinned mesh needs both");
+      const std::vector<float> positions = to_floats(read_accessor(model_, attribute("POSITION"), 3, label + " POSITION"), label);
+      const size_t count = positions.size() / 3, offset = out.vertex_count();
+      const std::vector<double> joints = read_accessor(model_, attribute("JOINTS_0"), 4, label + " JOINTS_0");
+      const std::vector<double> weights = read_accessor(model_, attribute("WEIGHTS_0"), 4, label + " WEIGHTS_0");
+      if (joints.size() != 4 * count || weights.size() != 4 * count)
+        fail(label, "JOINTS_0 / WEIGHTS_0 do not have one element per vertex");
+      std::vector<uint32_t> corners;
+      if (primitive.indices >= 0) {
+        for (double index : read_accessor(model_, primitive.indices, 1, label + " indices")) {
+          if (index < 0 || index >= static_cast<double>(count))
+            fail(label, "index " + std::to_string(static_cast<long long>(index)) + " outside [0, " + std::to_string(count) + ")");
+          corners.push_back(static_cast<uint32_t>(index));
+        }
+      } else {
+        for (size_t v = 0; v < count; ++v) corners.push_back(static_cast<uint32_t>(v));
+      }
+      const std::vector<uint32_t> triangles = to_triangles(corners, primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode);
+      for (uint32_t index : triangles) out.indices.push_back(static_cast<uint32_t>(offset) + index);
+      out.positions.insert(out.positions.end(), positions.begin(), positions.end());
+      if (attribute("NORMAL") >= 0) {
+        const std::vector<float> normals = to_floats(read_accessor(model_, attribute("NORMAL"), 3, label + " NORMAL"), label);
+        if (normals.size() != positions.size()) fail(label, "NORMAL does not have one element per vertex");
+        out.normals.insert(out.normals.end(), normals.begin(), normals.end());
+      } else {
+        std::vector<float> normals = face_normals(positions, triangles);
+        out.normals.insert(out.normals.end(), normals.begin(), normals.end());
+      }
+      glm::vec3 color(0.8f);
+      if (primitive.material >= 0 && static_cast<size_t>(primitive.material) < model_.materials.size()) {
+        const std::vector<double>& factor = model_.materials[static_cast<size_t>(primitive.material)].pbrMetallicRoughness.baseColorFactor;
+        if (factor.size() >= 3) color = glm::vec3(factor[0], factor[1], factor[2]);
+      }
+      for (size_t v = 0; v < count; ++v) {
+        out.colors.insert(out.colors.end(), {color.r, color.g, color.b});
+        double total = 0.0;
+        for (int k = 0; k < 4; ++k) total += std::max(weights[4 * v + static_cast<size_t>(k)], 0.0);
+        if (!(total > 0.0) || !std::isfinite(total)) fail(label, "vertex " + std::to_string(v) + " has no positive skin weight");
+        for (int k = 0; k < 4; ++k) {
+          const double w = std::max(weights[4 * v + static_cast<size_t>(k)], 0.0) / total;
+          const double j = joints[4 * v + static_cast<size_t>(k)];
+          if (w > 0.0 && (j < 0 || j >= static_cast<double>(joint_count)))
+            fail(label, "vertex " + std::to_string(v) + " uses joint slot " + std::to_string(static_cast<long long>(j)) +
+                            ", the skin has " + std::to_string(joint_count));
+          out.joints.push_back(w > 0.0 ? static_cast<uint16_t>(j) : 0);
+          out.weights.push_back(static_cast<float>(w));
+        }
+      }
+    }
+    if (out.indices.empty()) fail(level + " mesh " + std::to_string(mesh_index), "has no triangles");
+    return out;
+  }
+
+  static std::vector<uint32_t> to_triangles(const std::vector<uint32_t>& corners, int mode) {
+    if (mode == TINYGLTF_MODE_TRIANGLES) return std::vector<uint32_t>(corners.begin(), corners.end() - corners.size() % 3);
+    std::vector<uint32_t> out;
+    for (size_t i = 2; i < corners.size(); ++i) {
+      if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        if (i % 2 == 0) out.insert(out.end(), {corners[i - 2], corners[i - 1], corners[i]});
+        else out.insert(out.end(), {corners[i - 1], corners[i - 2], corners[i]});
+      } else {  // fan
+        out.insert(out.end(), {corners[0], corners[i - 1], corners[i]});
+      }
+    }
+    return out;
+  }
+
+  static std::vector<float> face_normals(const std::vector<float>& positions, const std::vector<uint32_t>& triangles) {
+    std::vector<glm::vec3> sums(positions.size() / 3, glm::vec3(0.0f));
+    auto at = [&](uint32_t v) { return glm::vec3(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]); };
+    for (size_t f = 0; f + 2 < triangles.size(); f += 3) {
+      const glm::vec3 n = glm::cross(at(triangles[f + 1]) - at(triangles[f]), at(triangles[f + 2]) - at(triangles[f]));
+      for (int c = 0; c < 3; ++c) sums[triangles[f + static_cast<size_t>(c)]] += n;
+    }
+    std::vector<float> out;
+    for (const glm::vec3& s : sums) {
+      const glm::vec3 n = glm::length(s) > 0.0f ? glm::normalize(s) : glm::vec3(0.0f, 1.0f, 0.0f);
+      out.insert(out.end(), {n.x, n.y, n.z});
+    }
+    return out;
+  }
+
+  // Rest-pose world bounds: level 0 of every chain posed by the core (FK + palette) and skinned
+  // by bake_lbs.
+  void compute_bounds() {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const Chain& chain : asset_.chains) {
+      const Level& level = chain.levels.front();
+      const Rig& rig = asset_.rigs[static_cast<size_t>(level.rig)];
+      const MeshData& mesh = asset_.meshes[static_cast<size_t>(level.mesh)];
+      std::vector<float> t = rig.rest_translations, r = rig.rest_rotations, s = rig.rest_scales;
+      std::vector<float> world(16 * rig.pose_count()), palette(16 * rig.joint_count());
+      const animlod::LocalPose pose{t.data(), r.data(), s.data(), rig.pose_count()};
+      animlod::Status status = animlod::forward_kinematics(rig.parents.data(), pose, world.data());
+      if (!status) fail("skin " + std::to_string(rig.skin), status.message);
+      animlod::skin_palette(world.data(), rig.joint_nodes.data(), rig.inverse_bind.data(), rig.joint_count(), palette.data());
+      std::vector<int32_t> joints(mesh.joints.begin(), mesh.joints.end());
+      std::vector<float> skinned(mesh.positions.size());
+      animlod::SkinningInput input;
+      input.rest_positions = mesh.positions.data();
+      input.joints = joints.data();
+      input.weights = mesh.weights.data();
+      input.skin_matrices = palette.data();
+      input.vertex_count = mesh.vertex_count();
+      input.influence_count = 4;
+      input.joint_count = rig.joint_count();
+      input.frame_count = 1;
+      status = animlod::bake_lbs(input, skinned.data());
+      if (!status) fail(chain.name, status.message);
+      for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const glm::vec3 p(skinned[3 * v], skinned[3 * v + 1], skinned[3 * v + 2]);
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+      }
+    }
+    asset_.bounds_min = lo;
+    asset_.bounds_max = hi;
+    asset_.sphere_center = 0.5f * (lo + hi);
+    asset_.sphere_radius = 0.5f * glm::length(hi - lo) * 1.1f;  // room for limbs swinging out
+    if (!(asset_.sphere_radius > 0.0f) || !std::isfinite(asset_.sphere_radius))
+      fail("scene", "the skinned meshes have no extent in their rest pose");
+  }
+
+  const Model& model_;
+  Asset& asset_;
+  std::vector<int> parents_;
+  std::vector<std::vector<int>> original_clips_;  // animations of each original clip
+  std::vector<int> clip_rigs_;  // rig of every clip in asset_.clips
+};
+
+}  // namespace
+
+bool load_asset(const std::string& path, Asset& out, std::string& error) {
+  std::error_code status;
+  if (!std::filesystem::is_regular_file(path, status)) {
+    error = path + ": " + (std::filesystem::exists(path, status) ? "not a regular file" : "no such file");
+    return false;
+  }
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string warnings;
+  const bool binary = path.size() >= 4 && path.compare(path.size() - 4, 4, ".glb") == 0;
+  const bool loaded = binary ? loader.LoadBinaryFromFile(&model, &error, &warnings, path)
+                             : loader.LoadASCIIFromFile(&model, &error, &warnings, path);
+  if (!loaded) {
+    if (error.empty()) error = "tinygltf could not load the file";
+    while (!error.empty() && (error.back() == '\n' || error.back() == ' ')) error.pop_back();
+    for (char& c : error)
+      if (c == '\n') c = ' ';
+    error = path + ": " + error;
+    return false;
+  }
+  out = Asset();
+  out.path = path;
+  try {
+    Loader(model, out).run();
+  } catch (const LoadError& failure) {
+    error = path + ": " + failure.message;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace crowd

@@ -1,0 +1,33 @@
+// Per-frame pieces of the motion LoD re-fit (motion_refit_terms.cpp), shared with the solver
+// (motion_refit_solve.cpp). One frame's positions are (P, 3) doubles; Jacobians are dense rows
+// over all 3P coordinates (root included, then zeroed by the callers that need it).
+#pragma once
+
+#include <cstddef>
+
+#include "animlod/motion_refit.hpp"
+
+namespace animlod::detail {
+
+// E (Eq. 5) of one frame; adds nothing to the root's gradient. gradient: (P, 3) or nullptr.
+double refit_objective_frame(const MotionRefitProblem& problem, const double* x, const double* original,
+                             double* gradient);
+
+// Equality values (m,) and, when jacobian is not nullptr, their derivatives (m, P, 3).
+void refit_equalities_frame(const MotionRefitProblem& problem, const double* x, double* values,
+                            double* jacobian);
+
+// Handedness values (Nh,) and, when jacobian is not nullptr, their derivatives (Nh, P, 3).
+void refit_handedness_frame(const MotionRefitProblem& problem, const double* x, double* values,
+                            double* jacobian);
+
+// The Hessian of E at x over the non-root coordinates, n x n row-major with n = 3 (P - 1)
+// (matrix must hold n * n doubles). For each squared residual w r^2 the block is
+// 2 w (grad r grad r^T + r Hess r). With positive_semidefinite, each term's block is made
+// positive semidefinite on its own (a length's curvature only when stretched, an angle's 9 x 9
+// block with negative eigenvalues clipped to 0), so that the sum is positive definite (Ed gives
+// 2 alpha / L^2 I): the solver's preconditioner. Without, the exact Hessian (for tests).
+void refit_hessian_frame(const MotionRefitProblem& problem, const double* x, bool positive_semidefinite,
+                         double* matrix);
+
+}  // namespace animlod::detail

@@ -1,0 +1,188 @@
+// Points of a re-fit frame solved in closed form or by substitution (see the header). Motion LoD
+// re-fit (seeds/000, Eqs. 5-7): a leaf's Ed + Es terms alpha |x_e - x^o_e|^2 + beta (|x_e - x_p|
+// - b)^2 (over L^2) are minimal on the ray from x_p to x^o_e; a coincident pair held as an
+// equality puts both points at one place.
+#include "motion_refit_reduction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace animlod::detail {
+
+namespace {
+
+int32_t find(std::vector<int32_t>& parent, int32_t k) {
+  while (parent[k] != k) {
+    parent[k] = parent[parent[k]];
+    k = parent[k];
+  }
+  return k;
+}
+
+}  // namespace
+
+PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate_leaves,
+                               bool substitute_coincident)
+    : problem_(problem), hard_(hard_constraints) {
+  const size_t p = problem.point_count;
+  index_.assign(p, -1);
+  substitute_.resize(p);
+  std::iota(substitute_.begin(), substitute_.end(), 0);
+  leaf_anchor_.assign(p, -1);
+  leaf_length_.assign(p, 0.0);
+  jacobians_.assign(p, Matrix3{1, 0, 0, 0, 1, 0, 0, 0, 1});
+  const size_t pairs = problem.length_pair_count;
+  kept_equalities_.assign(motion_refit_equality_count(problem), 1);
+
+  // Coincident pairs held exactly: every point of a tied set sits at its lowest index.
+  if (substitute_coincident && hard_constraints) {
+    for (size_t k = 0; k < problem.coincident_pair_count; ++k) {
+      const int32_t a = find(substitute_, problem.coincident_pairs[2 * k]);
+      const int32_t b = find(substitute_, problem.coincident_pairs[2 * k + 1]);
+      substitute_[std::max(a, b)] = std::min(a, b);
+      std::fill_n(kept_equalities_.begin() + static_cast<long>(pairs + 3 * k), 3, uint8_t{0});
+    }
+    for (size_t k = 0; k < p; ++k) substitute_[k] = find(substitute_, static_cast<int32_t>(k));
+  }
+
+  // Leaves: in one term of E, a held length.
+  if (eliminate_leaves) {
+    std::vector<int> terms(p, 0);
+    auto count = [&](const int32_t* rows, size_t n, size_t width) {
+      for (size_t i = 0; i < n * width; ++i) ++terms[rows[i]];
+    };
+    count(problem.length_pairs, pairs, 2);
+    count(problem.coincident_pairs, problem.coincident_pair_count, 2);
+    count(problem.angle_triples, problem.angle_triple_count, 3);
+    count(problem.handed_quads, problem.handed_quad_count, 4);
+    for (size_t k = 0; k < pairs; ++k) {
+      for (int side = 0; side < 2; ++side) {
+        const int32_t leaf = problem.length_pairs[2 * k + side];
+        const int32_t anchor = problem.length_pairs[2 * k + 1 - side];
+        if (leaf == 0 || terms[leaf] != 1 || leaf_anchor_[anchor] >= 0) continue;
+        leaf_anchor_[leaf] = anchor;
+        leaf_length_[leaf] = problem.key_lengths[k];
+        kept_equalities_[k] = 0;
+        break;
+      }
+    }
+  }
+  for (size_t k = 1; k < p; ++k)
+    if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0)
+      index_[k] = static_cast<int32_t>(reduced_points_++);
+  kept_equality_count_ = static_cast<size_t>(std::count(kept_equalities_.begin(), kept_equalities_.end(), 1));
+}
+
+void PointReduction::fill(const double* y, const double* original, double* x) {
+  const size_t p = problem_.point_count;
+  std::copy(original, original + 3, x);
+  for (size_t k = 1; k < p; ++k)
+    if (index_[k] >= 0) std::copy(y + 3 * index_[k], y + 3 * index_[k] + 3, x + 3 * k);
+  for (size_t k = 1; k < p; ++k)
+    if (substitute_[k] != static_cast<int32_t>(k)) std::copy(x + 3 * substitute_[k], x + 3 * substitute_[k] + 3, x + 3 * k);
+  const double alpha = problem_.distance_weight, beta = problem_.string_weight;
+  const double pull = hard_ ? 0.0 : alpha / (alpha + beta);  // dr / dd
+  for (size_t k = 1; k < p; ++k) {
+    const int32_t anchor = leaf_anchor_[k];
+    if (anchor < 0) continue;
+    double u[3];
+    double d = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      u[a] = original[3 * k + a] - x[3 * anchor + a];
+      d += u[a] * u[a];
+    }
+    d = std::sqrt(d);
+    double tangent = 0.0;  // r / d, the part of J across the ray
+    double r = leaf_length_[k];
+    if (d > 1e-12 * problem_.length_scale) {
+      for (double& v : u) v /= d;
+      if (!hard_) r = (alpha * d + beta * leaf_length_[k]) / (alpha + beta);
+      tangent = r / d;
+    } else {  // the anchor on the leaf's original position: along the original bone
+      double norm = 0.0;
+      for (int a = 0; a < 3; ++a) {
+        u[a] = original[3 * k + a] - original[3 * anchor + a];
+        norm += u[a] * u[a];
+      }
+      norm = std::sqrt(norm);
+      if (norm > 0.0) {
+        for (double& v : u) v /= norm;
+      } else {
+        u[0] = 1.0, u[1] = 0.0, u[2] = 0.0;
+      }
+      if (!hard_) r = beta * leaf_length_[k] / (alpha + beta);
+    }
+    Matrix3& j = jacobians_[k];  // I - pull u u^T - (r / d) (I - u u^T)
+    for (int a = 0; a < 3; ++a) {
+      x[3 * k + a] = x[3 * anchor + a] + r * u[a];
+      for (int b = 0; b < 3; ++b) {
+        const double eye = a == b ? 1.0 : 0.0;
+        j[3 * a + b] = eye - pull * u[a] * u[b] - tangent * (eye - u[a] * u[b]);
+      }
+    }
+  }
+}
+
+void PointReduction::gather(const double* x, double* y) const {
+  for (size_t k = 1; k < problem_.point_count; ++k)
+    if (index_[k] >= 0) std::copy(x + 3 * k, x + 3 * k + 3, y + 3 * index_[k]);
+}
+
+int32_t PointReduction::target(size_t k) const {
+  int32_t point = static_cast<int32_t>(k);
+  if (leaf_anchor_[point] >= 0) point = leaf_anchor_[point];
+  return index_[substitute_[point]];
+}
+
+const double* PointReduction::derivative(size_t k) const {
+  static constexpr double kIdentity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  return leaf_anchor_[k] >= 0 ? jacobians_[k].data() : kIdentity;
+}
+
+void PointReduction::reduce_rows(const double* rows, size_t count, double* out) const {
+  const size_t p = problem_.point_count;
+  std::fill(out, out + count * 3 * reduced_points_, 0.0);
+  for (size_t k = 0; k < p; ++k) {
+    const int32_t t = target(k);
+    if (t < 0) continue;
+    const double* j = derivative(k);
+    for (size_t r = 0; r < count; ++r) {
+      const double* g = rows + r * 3 * p + 3 * k;
+      double* o = out + r * 3 * reduced_points_ + 3 * t;
+      for (int b = 0; b < 3; ++b) o[b] += j[b] * g[0] + j[3 + b] * g[1] + j[6 + b] * g[2];  // J^T g
+    }
+  }
+}
+
+void PointReduction::reduce_matrix(const double* full, double* out) const {
+  const size_t p = problem_.point_count;
+  const size_t n = 3 * (p - 1);
+  const size_t nr = 3 * reduced_points_;
+  std::fill(out, out + nr * nr, 0.0);
+  for (size_t a = 1; a < p; ++a) {
+    const int32_t ta = target(a);
+    if (ta < 0) continue;
+    const double* ja = derivative(a);
+    for (size_t b = 1; b < p; ++b) {
+      const int32_t tb = target(b);
+      if (tb < 0) continue;
+      const double* jb = derivative(b);
+      double block[9];  // M_ab Jb
+      for (int i = 0; i < 3; ++i)
+        for (int c = 0; c < 3; ++c) {
+          double sum = 0.0;
+          for (int k = 0; k < 3; ++k) sum += full[(3 * (a - 1) + i) * n + 3 * (b - 1) + k] * jb[3 * k + c];
+          block[3 * i + c] = sum;
+        }
+      for (int r = 0; r < 3; ++r)  // Ja^T (M_ab Jb)
+        for (int c = 0; c < 3; ++c) {
+          double sum = 0.0;
+          for (int i = 0; i < 3; ++i) sum += ja[3 * i + r] * block[3 * i + c];
+          out[(3 * ta + r) * nr + 3 * tb + c] += sum;
+        }
+    }
+  }
+}
+
+}  // namespace animlod::detail

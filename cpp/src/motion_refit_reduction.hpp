@@ -1,0 +1,67 @@
+// Points of a re-fit frame that need no variables of their own (motion_refit_reduction.cpp).
+//
+// SLSQP's cost per iteration grows with the cube of the variable count, so the solve leaves out
+// points whose optimum follows exactly from others':
+// - a point tied to another by a coincident pair (zero key length) under hard constraints is at
+//   that point (x_a = x_b holds exactly), so it is substituted;
+// - a leaf (a point in exactly one term of E, a held length to another point p) lies on the ray
+//   from x_p to its original position, at the held length b with hard constraints, or at
+//   r = (alpha d + beta b) / (alpha + beta) without (d = |x^o - x_p|): its Ed and Es terms are
+//   then minimal given x_p, in closed form.
+// The reduced problem has the same minima as the full one; the map from reduced to full
+// positions is differentiated exactly (chain rule), so gradients and Jacobians stay analytic.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "animlod/motion_refit.hpp"
+
+namespace animlod::detail {
+
+class PointReduction {
+ public:
+  // eliminate_leaves / substitute_coincident switch the two reductions (both off: identity,
+  // every non-root point a variable, in order). substitute_coincident needs hard constraints.
+  PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate_leaves,
+                 bool substitute_coincident);
+
+  size_t reduced_points() const { return reduced_points_; }  // P_r: points that stay variables
+  // (m,) 1 for the equality rows (motion_refit_equalities) the reduced problem keeps.
+  const std::vector<uint8_t>& kept_equalities() const { return kept_equalities_; }
+  size_t kept_equality_count() const { return kept_equality_count_; }
+
+  // Full positions x (P, 3) from the reduced ones y (P_r, 3); the root is original's.
+  // Remembers the leaves' Jacobians for the reduce_* calls that follow.
+  void fill(const double* y, const double* original, double* x);
+  // The reduced positions (P_r, 3) of full positions x (P, 3).
+  void gather(const double* x, double* y) const;
+  // Derivative rows over full positions (count, P, 3) to rows over reduced ones (count, P_r, 3),
+  // at the last fill.
+  void reduce_rows(const double* rows, size_t count, double* out) const;
+  // A matrix over the non-root coordinates (3 (P - 1))^2 to T^T M T over the reduced ones
+  // (3 P_r)^2 (both row-major), T the derivative of fill at the last fill.
+  void reduce_matrix(const double* full, double* out) const;
+
+ private:
+  using Matrix3 = std::array<double, 9>;
+  // Where full point k's derivative goes: reduced point (-1: none, the root) and the 3 x 3
+  // derivative of x_k with respect to it (identity unless k is a leaf).
+  int32_t target(size_t k) const;
+  const double* derivative(size_t k) const;
+
+  const MotionRefitProblem& problem_;
+  bool hard_ = false;
+  size_t reduced_points_ = 0;
+  std::vector<int32_t> index_;        // (P,) reduced index of a variable point, -1 otherwise
+  std::vector<int32_t> substitute_;   // (P,) the point a substituted point sits at, else itself
+  std::vector<int32_t> leaf_anchor_;  // (P,) p of a leaf, -1 otherwise
+  std::vector<double> leaf_length_;   // (P,) b of a leaf
+  std::vector<uint8_t> kept_equalities_;
+  size_t kept_equality_count_ = 0;
+  std::vector<Matrix3> jacobians_;    // (P,) d x_k / d x_anchor of leaves at the last fill
+};
+
+}  // namespace animlod::detail

@@ -1,0 +1,378 @@
+// Motion LoD re-fit terms (seeds/000, Section 5.2): E = alpha Ed + beta Es + gamma Ea (Eq. 5),
+// Ed (Eq. 6) the squared distance of every non-root point to its original position, Es (Eq. 7)
+// the squared change of each held length against the key posture, Ea (Eq. 8) the squared change
+// of cos theta (Eq. 4) at each frozen joint. Lengths are divided by L so that E is unit-free.
+// The same formulas, vectorised over frames, are python/animlod/motion_lod/objective.py (the
+// reference the tests compare against).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+#include "animlod/motion_refit.hpp"
+#include "motion_refit_detail.hpp"
+
+namespace animlod {
+
+namespace {
+
+using Vec3 = std::array<double, 3>;
+
+Vec3 load(const double* x, int32_t point) { return {x[3 * point], x[3 * point + 1], x[3 * point + 2]}; }
+Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+void add_to(double* target, int32_t point, const Vec3& v, double factor) {
+  for (int k = 0; k < 3; ++k) target[3 * point + k] += factor * v[k];
+}
+
+// |a - b| and the unit direction (zero at length 0).
+double length_and_unit(const double* x, int32_t a, int32_t b, Vec3& unit) {
+  const Vec3 d = sub(load(x, a), load(x, b));
+  const double length = std::sqrt(dot(d, d));
+  for (int k = 0; k < 3; ++k) unit[k] = length > 0.0 ? d[k] / length : 0.0;
+  return length;
+}
+
+// cos theta at the middle point of (parent, joint, child) (Eq. 4) and its gradients with respect
+// to the parent, joint and child positions.
+double cosine(const double* x, const int32_t* triple, Vec3& d_parent, Vec3& d_joint, Vec3& d_child) {
+  const Vec3 joint = load(x, triple[1]);
+  const Vec3 u = sub(load(x, triple[0]), joint);
+  const Vec3 v = sub(load(x, triple[2]), joint);
+  const double nu = std::sqrt(dot(u, u));
+  const double nv = std::sqrt(dot(v, v));
+  const double cos = dot(u, v) / (nu * nv);
+  for (int k = 0; k < 3; ++k) {
+    d_parent[k] = v[k] / (nu * nv) - cos * u[k] / (nu * nu);
+    d_child[k] = u[k] / (nu * nv) - cos * v[k] / (nv * nv);
+    d_joint[k] = -(d_parent[k] + d_child[k]);
+  }
+  return cos;
+}
+
+// cos theta of (parent, joint, child) and its Hessian over the three points, 9 x 9 row-major in
+// (parent xyz, joint xyz, child xyz) order. With u = parent - joint and v = child - joint:
+// d2/du2, d2/dv2 and d2/dudv of u.v / (|u||v|), mapped to the points by u = p - j, v = c - j.
+double cosine_hessian(const double* x, const int32_t* triple, double* hessian) {
+  const Vec3 joint = load(x, triple[1]);
+  const Vec3 u = sub(load(x, triple[0]), joint);
+  const Vec3 v = sub(load(x, triple[2]), joint);
+  const double nu = std::sqrt(dot(u, u));
+  const double nv = std::sqrt(dot(v, v));
+  const double cos = dot(u, v) / (nu * nv);
+  Vec3 gu, gv;
+  for (int k = 0; k < 3; ++k) {
+    gu[k] = v[k] / (nu * nv) - cos * u[k] / (nu * nu);
+    gv[k] = u[k] / (nu * nv) - cos * v[k] / (nv * nv);
+  }
+  double huu[9], hvv[9], huv[9];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double eye = i == j ? 1.0 : 0.0;
+      huu[3 * i + j] = -v[i] * u[j] / (nu * nu * nu * nv) - (u[i] * gu[j] + cos * eye) / (nu * nu) +
+                       2.0 * cos * u[i] * u[j] / (nu * nu * nu * nu);
+      hvv[3 * i + j] = -u[i] * v[j] / (nv * nv * nv * nu) - (v[i] * gv[j] + cos * eye) / (nv * nv) +
+                       2.0 * cos * v[i] * v[j] / (nv * nv * nv * nv);
+      huv[3 * i + j] = eye / (nu * nv) - v[i] * v[j] / (nu * nv * nv * nv) - u[i] * gv[j] / (nu * nu);
+    }
+  for (int i = 0; i < 3; ++i)  // symmetrise the diagonal blocks (exact up to rounding)
+    for (int j = 0; j < i; ++j) {
+      huu[3 * i + j] = huu[3 * j + i] = 0.5 * (huu[3 * i + j] + huu[3 * j + i]);
+      hvv[3 * i + j] = hvv[3 * j + i] = 0.5 * (hvv[3 * i + j] + hvv[3 * j + i]);
+    }
+  const double du[3] = {1.0, -1.0, 0.0};  // d u / d (parent, joint, child)
+  const double dv[3] = {0.0, -1.0, 1.0};
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          hessian[9 * (3 * a + i) + 3 * b + j] = du[a] * du[b] * huu[3 * i + j] + dv[a] * dv[b] * hvv[3 * i + j] +
+                                                 du[a] * dv[b] * huv[3 * i + j] + dv[a] * du[b] * huv[3 * j + i];
+  return cos;
+}
+
+// Negative eigenvalues of a symmetric 9 x 9 matrix (row-major) set to zero.
+void clip_to_positive_semidefinite(double* block) {
+  Eigen::Map<Eigen::Matrix<double, 9, 9, Eigen::RowMajor>> m(block);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eigen(m);
+  if (eigen.eigenvalues().minCoeff() >= 0.0) return;
+  const auto values = eigen.eigenvalues().cwiseMax(0.0);
+  m = eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+// det[a - p, b - p, c - p] of a quad (p, a, b, c) and its gradients with respect to p, a, b, c.
+double volume(const double* x, const int32_t* quad, std::array<Vec3, 4>& grads) {
+  const Vec3 p = load(x, quad[0]);
+  const Vec3 u = sub(load(x, quad[1]), p);
+  const Vec3 v = sub(load(x, quad[2]), p);
+  const Vec3 w = sub(load(x, quad[3]), p);
+  grads[1] = cross(v, w);
+  grads[2] = cross(w, u);
+  grads[3] = cross(u, v);
+  for (int k = 0; k < 3; ++k) grads[0][k] = -(grads[1][k] + grads[2][k] + grads[3][k]);
+  return dot(u, grads[1]);
+}
+
+std::string point_range(size_t point_count) { return "[0, " + std::to_string(point_count) + ")"; }
+
+Status check_indices(const int32_t* indices, size_t rows, size_t width, size_t point_count, const char* name) {
+  if (rows > 0 && indices == nullptr) return Status::error(std::string(name) + ": no data for " + std::to_string(rows) + " rows");
+  for (size_t r = 0; r < rows; ++r) {
+    for (size_t k = 0; k < width; ++k) {
+      const int32_t point = indices[r * width + k];
+      if (point < 0 || static_cast<size_t>(point) >= point_count)
+        return Status::error(std::string(name) + "[" + std::to_string(r) + "]: point " + std::to_string(point) +
+                             " is outside " + point_range(point_count));
+      for (size_t other = 0; other < k; ++other)
+        if (indices[r * width + other] == point)
+          return Status::error(std::string(name) + "[" + std::to_string(r) + "]: point " + std::to_string(point) +
+                               " appears twice");
+    }
+  }
+  return Status::success();
+}
+
+Status check_values(const double* values, size_t count, const char* name, bool positive, bool unit_interval) {
+  if (count > 0 && values == nullptr) return Status::error(std::string(name) + ": no data");
+  for (size_t i = 0; i < count; ++i) {
+    const double v = values[i];
+    const bool bad = !std::isfinite(v) || (positive && !(v > 0.0)) || (unit_interval && std::abs(v) > 1.0 + 1e-9) ||
+                     (!positive && !unit_interval && v == 0.0);
+    if (bad) {
+      const char* expected = positive ? "a finite positive length" : unit_interval ? "a cosine in [-1, 1]"
+                                                                                   : "a finite non-zero volume";
+      return Status::error(std::string(name) + "[" + std::to_string(i) + "] = " + std::to_string(v) + ": expected " +
+                           expected);
+    }
+  }
+  return Status::success();
+}
+
+}  // namespace
+
+size_t motion_refit_equality_count(const MotionRefitProblem& problem) {
+  return problem.length_pair_count + 3 * problem.coincident_pair_count;
+}
+
+Status validate_motion_refit_problem(const MotionRefitProblem& problem) {
+  if (problem.point_count < 2)
+    return Status::error("point_count: needs the root and at least one other point, got " +
+                         std::to_string(problem.point_count));
+  if (!(std::isfinite(problem.length_scale) && problem.length_scale > 0.0))
+    return Status::error("length_scale: expected a finite positive length, got " + std::to_string(problem.length_scale));
+  if (!(std::isfinite(problem.distance_weight) && problem.distance_weight > 0.0))
+    return Status::error("weights: distance must be positive, got " + std::to_string(problem.distance_weight));
+  if (!(std::isfinite(problem.string_weight) && problem.string_weight >= 0.0))
+    return Status::error("weights: string must be a finite non-negative number, got " +
+                         std::to_string(problem.string_weight));
+  if (!(std::isfinite(problem.angle_weight) && problem.angle_weight >= 0.0))
+    return Status::error("weights: angle must be a finite non-negative number, got " +
+                         std::to_string(problem.angle_weight));
+  const size_t p = problem.point_count;
+  Status s = check_indices(problem.length_pairs, problem.length_pair_count, 2, p, "length_pairs");
+  if (s) s = check_values(problem.key_lengths, problem.length_pair_count, "key_lengths", true, false);
+  if (s) s = check_indices(problem.coincident_pairs, problem.coincident_pair_count, 2, p, "coincident_pairs");
+  if (s) s = check_indices(problem.handed_quads, problem.handed_quad_count, 4, p, "handed_quads");
+  if (s) s = check_values(problem.key_volumes, problem.handed_quad_count, "key_volumes", false, false);
+  if (s) s = check_indices(problem.angle_triples, problem.angle_triple_count, 3, p, "angle_triples");
+  if (s) s = check_values(problem.key_cosines, problem.angle_triple_count, "key_cosines", false, true);
+  return s;
+}
+
+namespace detail {
+
+double refit_objective_frame(const MotionRefitProblem& problem, const double* x, const double* original,
+                             double* gradient) {
+  const size_t p = problem.point_count;
+  const double scale2 = problem.length_scale * problem.length_scale;
+  const double wd = problem.distance_weight / scale2;
+  const double ws = problem.string_weight / scale2;
+  const double wa = problem.angle_weight;
+  if (gradient) std::fill(gradient, gradient + 3 * p, 0.0);
+
+  double value = 0.0;  // Ed, Eq. 6 (root excluded)
+  for (size_t i = 3; i < 3 * p; ++i) {
+    const double delta = x[i] - original[i];
+    value += wd * delta * delta;
+    if (gradient) gradient[i] = 2.0 * wd * delta;
+  }
+  for (size_t k = 0; k < problem.length_pair_count; ++k) {  // Es, Eq. 7
+    const int32_t a = problem.length_pairs[2 * k], b = problem.length_pairs[2 * k + 1];
+    Vec3 unit;
+    const double excess = length_and_unit(x, a, b, unit) - problem.key_lengths[k];
+    value += ws * excess * excess;
+    if (gradient) {
+      add_to(gradient, a, unit, 2.0 * ws * excess);
+      add_to(gradient, b, unit, -2.0 * ws * excess);
+    }
+  }
+  for (size_t k = 0; k < problem.coincident_pair_count; ++k) {  // Es at zero key length
+    const int32_t a = problem.coincident_pairs[2 * k], b = problem.coincident_pairs[2 * k + 1];
+    const Vec3 d = sub(load(x, a), load(x, b));
+    value += ws * dot(d, d);
+    if (gradient) {
+      add_to(gradient, a, d, 2.0 * ws);
+      add_to(gradient, b, d, -2.0 * ws);
+    }
+  }
+  for (size_t k = 0; k < problem.angle_triple_count; ++k) {  // Ea, Eq. 8
+    const int32_t* triple = problem.angle_triples + 3 * k;
+    Vec3 dp, dj, dc;
+    const double excess = cosine(x, triple, dp, dj, dc) - problem.key_cosines[k];
+    value += wa * excess * excess;
+    if (gradient) {
+      add_to(gradient, triple[0], dp, 2.0 * wa * excess);
+      add_to(gradient, triple[1], dj, 2.0 * wa * excess);
+      add_to(gradient, triple[2], dc, 2.0 * wa * excess);
+    }
+  }
+  if (gradient) gradient[0] = gradient[1] = gradient[2] = 0.0;
+  return value;
+}
+
+void refit_equalities_frame(const MotionRefitProblem& problem, const double* x, double* values, double* jacobian) {
+  const size_t p = problem.point_count;
+  const double inverse = 1.0 / problem.length_scale;
+  const size_t m = motion_refit_equality_count(problem);
+  if (jacobian) std::fill(jacobian, jacobian + m * 3 * p, 0.0);
+  size_t row = 0;
+  for (size_t k = 0; k < problem.length_pair_count; ++k, ++row) {
+    const int32_t a = problem.length_pairs[2 * k], b = problem.length_pairs[2 * k + 1];
+    Vec3 unit;
+    values[row] = (length_and_unit(x, a, b, unit) - problem.key_lengths[k]) * inverse;
+    if (jacobian) {
+      add_to(jacobian + row * 3 * p, a, unit, inverse);
+      add_to(jacobian + row * 3 * p, b, unit, -inverse);
+    }
+  }
+  for (size_t k = 0; k < problem.coincident_pair_count; ++k) {
+    const int32_t a = problem.coincident_pairs[2 * k], b = problem.coincident_pairs[2 * k + 1];
+    for (int axis = 0; axis < 3; ++axis, ++row) {
+      values[row] = (x[3 * a + axis] - x[3 * b + axis]) * inverse;
+      if (jacobian) {
+        jacobian[row * 3 * p + 3 * a + axis] += inverse;
+        jacobian[row * 3 * p + 3 * b + axis] -= inverse;
+      }
+    }
+  }
+  if (jacobian)
+    for (size_t r = 0; r < m; ++r) std::fill(jacobian + r * 3 * p, jacobian + r * 3 * p + 3, 0.0);
+}
+
+void refit_handedness_frame(const MotionRefitProblem& problem, const double* x, double* values, double* jacobian) {
+  const size_t p = problem.point_count;
+  const double scale3 = problem.length_scale * problem.length_scale * problem.length_scale;
+  if (jacobian) std::fill(jacobian, jacobian + problem.handed_quad_count * 3 * p, 0.0);
+  for (size_t k = 0; k < problem.handed_quad_count; ++k) {
+    const int32_t* quad = problem.handed_quads + 4 * k;
+    const double sign = (problem.key_volumes[k] > 0.0 ? -1.0 : 1.0) / scale3;
+    std::array<Vec3, 4> grads;
+    values[k] = sign * volume(x, quad, grads);
+    if (jacobian) {
+      for (int c = 0; c < 4; ++c) add_to(jacobian + k * 3 * p, quad[c], grads[c], sign);
+      std::fill(jacobian + k * 3 * p, jacobian + k * 3 * p + 3, 0.0);
+    }
+  }
+}
+
+void refit_hessian_frame(const MotionRefitProblem& problem, const double* x, bool positive_semidefinite,
+                         double* matrix) {
+  const size_t n = 3 * (problem.point_count - 1);
+  const double scale2 = problem.length_scale * problem.length_scale;
+  std::fill(matrix, matrix + n * n, 0.0);
+  // Adds w * block (3 x 3, row-major) to the (a, b) block, skipping the root (not a variable).
+  auto add_block = [&](int32_t a, int32_t b, const double* block, double w) {
+    if (a == 0 || b == 0) return;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) matrix[(3 * (a - 1) + i) * n + 3 * (b - 1) + j] += w * block[3 * i + j];
+  };
+  auto add_pair = [&](int32_t a, int32_t b, const double* block, double w) {
+    add_block(a, a, block, w);
+    add_block(b, b, block, w);
+    add_block(a, b, block, -w);
+    add_block(b, a, block, -w);
+  };
+  const double wd = 2.0 * problem.distance_weight / scale2;  // Ed
+  for (size_t i = 0; i < n; ++i) matrix[i * n + i] += wd;
+  const double ws = 2.0 * problem.string_weight / scale2;
+  for (size_t k = 0; k < problem.length_pair_count; ++k) {  // Es: u u^T + (r / |d|) (I - u u^T)
+    const int32_t a = problem.length_pairs[2 * k], b = problem.length_pairs[2 * k + 1];
+    Vec3 unit;
+    const double length = length_and_unit(x, a, b, unit);
+    double stretch = length > 0.0 ? (length - problem.key_lengths[k]) / length : 0.0;
+    if (positive_semidefinite) stretch = std::max(stretch, 0.0);
+    double block[9];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        block[3 * i + j] = unit[i] * unit[j] + stretch * ((i == j ? 1.0 : 0.0) - unit[i] * unit[j]);
+    add_pair(a, b, block, ws);
+  }
+  const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  for (size_t k = 0; k < problem.coincident_pair_count; ++k)
+    add_pair(problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1], identity, ws);
+  const double wa = 2.0 * problem.angle_weight;
+  for (size_t k = 0; k < problem.angle_triple_count; ++k) {  // Ea: g g^T + (cos - cos0) Hess cos
+    const int32_t* triple = problem.angle_triples + 3 * k;
+    double block[81];
+    const double residual = cosine_hessian(x, triple, block) - problem.key_cosines[k];
+    Vec3 dp, dj, dc;
+    cosine(x, triple, dp, dj, dc);
+    const double g[9] = {dp[0], dp[1], dp[2], dj[0], dj[1], dj[2], dc[0], dc[1], dc[2]};
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < 9; ++j) block[9 * i + j] = g[i] * g[j] + residual * block[9 * i + j];
+    if (positive_semidefinite) clip_to_positive_semidefinite(block);
+    for (int pi = 0; pi < 3; ++pi)
+      for (int pj = 0; pj < 3; ++pj) {
+        double sub_block[9];
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) sub_block[3 * i + j] = block[9 * (3 * pi + i) + 3 * pj + j];
+        add_block(triple[pi], triple[pj], sub_block, wa);
+      }
+  }
+}
+
+}  // namespace detail
+
+Status motion_refit_objective(const MotionRefitProblem& problem, const double* x, const double* original,
+                              size_t frame_count, double* out_values, double* out_gradient) {
+  const Status status = validate_motion_refit_problem(problem);
+  if (!status) return status;
+  const size_t stride = 3 * problem.point_count;
+  for (size_t f = 0; f < frame_count; ++f)
+    out_values[f] = detail::refit_objective_frame(problem, x + f * stride, original + f * stride,
+                                                  out_gradient ? out_gradient + f * stride : nullptr);
+  return Status::success();
+}
+
+Status motion_refit_equalities(const MotionRefitProblem& problem, const double* x, size_t frame_count,
+                               double* out_values, double* out_jacobian) {
+  const Status status = validate_motion_refit_problem(problem);
+  if (!status) return status;
+  const size_t stride = 3 * problem.point_count;
+  const size_t m = motion_refit_equality_count(problem);
+  for (size_t f = 0; f < frame_count; ++f)
+    detail::refit_equalities_frame(problem, x + f * stride, out_values + f * m,
+                                   out_jacobian ? out_jacobian + f * m * stride : nullptr);
+  return Status::success();
+}
+
+Status motion_refit_handedness(const MotionRefitProblem& problem, const double* x, size_t frame_count,
+                               double* out_values, double* out_jacobian) {
+  const Status status = validate_motion_refit_problem(problem);
+  if (!status) return status;
+  const size_t stride = 3 * problem.point_count;
+  const size_t h = problem.handed_quad_count;
+  for (size_t f = 0; f < frame_count; ++f)
+    detail::refit_handedness_frame(problem, x + f * stride, out_values + f * h,
+                                   out_jacobian ? out_jacobian + f * h * stride : nullptr);
+  return Status::success();
+}
+
+}  // namespace animlod

@@ -1,0 +1,103 @@
+"""The re-fit in the C++ core: E (Eq. 5), its gradient and the constraint Jacobians, and the
+per-frame SLSQP solve (nlopt's C library) on several threads (cpp/include/animlod/motion_refit.hpp).
+
+This module only hands a level's problem to the core, one independent group of points
+(objective.split_problem) at a time, and puts the groups back together. refit.py is the same
+solve in Python with the PyPI nlopt, kept as the reference the tests compare against.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from .. import _core
+from .grouped_solve import FrameFailure, RefitResult, combine_groups
+from .objective import RefitProblem, split_problem
+from .refit import SlsqpOptions
+
+
+def core_problem(problem: RefitProblem) -> _core.MotionRefitProblem:
+    """The core's copy of a level's problem (index arrays as int32, values as float64)."""
+    w = problem.weights
+    return _core.MotionRefitProblem(
+        problem.point_count,
+        problem.length_pairs,
+        problem.key_lengths,
+        problem.coincident_pairs,
+        problem.handed_quads,
+        problem.key_volumes,
+        problem.angle_triples,
+        problem.key_cosines,
+        w.distance,
+        w.string,
+        w.angle,
+        problem.length_scale,
+    )
+
+
+def core_options(options: SlsqpOptions, threads: int = 0, chunk_frames: int = 64) -> _core.MotionRefitOptions:
+    """``options`` as the core's options struct."""
+    result = _core.MotionRefitOptions()
+    result.hard_constraints = options.hard_constraints
+    result.ftol_rel = options.ftol_rel
+    result.max_evaluations = options.max_evaluations
+    result.feasibility_tolerance = options.feasibility_tolerance
+    result.warm_start = options.warm_start
+    result.precondition = options.precondition
+    result.eliminate_points = options.eliminate_points
+    result.threads = threads
+    result.chunk_frames = chunk_frames
+    return result
+
+
+def refit_core(
+    problem: RefitProblem,
+    original: np.ndarray,
+    fallback: np.ndarray,
+    options: SlsqpOptions | None = None,
+    threads: int = 0,
+    chunk_frames: int = 64,
+    progress: Callable[[float], None] | None = None,
+    cold_starts: np.ndarray | None = None,
+) -> RefitResult:
+    """Re-fit every frame with SLSQP in the core, group of points by group.
+
+    Parameters
+    ----------
+    problem : the level's problem (objective.build_problem).
+    original : (T, P, 3) original positions x^o.
+    fallback : (T, P, 3) positions kept where a frame's solves fail (feasible by construction).
+    options : stopping rules, hard constraints, preconditioning (the core's defaults when None).
+    threads : worker threads; 0 uses every hardware thread. The result does not depend on it.
+    chunk_frames : consecutive frames per task (warm starts run inside a chunk).
+    progress : called with the (fractional) number of frames finished after each group.
+    cold_starts : (T, P, 3) where chunks start and failed frames restart (feasible with hard
+        constraints), or None: the original positions, or the fallback with hard constraints.
+
+    Returns
+    -------
+    RefitResult over all frames; ``evaluations`` sums the groups' objective evaluations.
+    """
+    options = options or SlsqpOptions()
+    settings = core_options(options, threads, chunk_frames)
+    groups, _ = split_problem(problem)
+    original = np.ascontiguousarray(original, dtype=np.float64)
+    fallback = np.ascontiguousarray(fallback, dtype=np.float64)
+    solved = []
+    for points, sub in groups:
+        cold = None if cold_starts is None else cold_starts[:, points]
+        out = _core.motion_refit_solve(
+            core_problem(sub), original[:, points], fallback[:, points], settings, cold_starts=cold
+        )
+        failures = [
+            FrameFailure(int(frame), reason, "fallback" if fell_back else "cold restart")
+            for frame, reason, fell_back in out["failures"]
+        ]
+        solved.append((points, RefitResult(out["positions"], out["values"], out["evaluations"], failures)))
+        if progress:
+            progress(original.shape[0] / len(groups))
+    if not groups and progress:
+        progress(original.shape[0])
+    return combine_groups(original, solved)

@@ -1,0 +1,228 @@
+// Motion LoD re-fit in the core: E's gradient, the Hessian used as preconditioner and the
+// constraint Jacobians against finite differences; the solve keeps bones, ends feasible from an
+// infeasible start, does not depend on the thread count, and rejects bad input by name.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "../../cpp/src/motion_refit_detail.hpp"
+#include "animlod/motion_refit.hpp"
+
+using animlod::MotionRefitOptions;
+using animlod::MotionRefitProblem;
+using animlod::MotionRefitResult;
+
+namespace {
+
+// A small figure: root 0, a spine 1-2, a frozen joint 3 with child 4, a coincident point 5 on 1,
+// and three children 6, 7, 8 of 2 spanning a volume (a handed group).
+struct Figure {
+  std::vector<double> key = {0, 0, 0,  0, 1, 0,  0, 2, 0,  1, 2, 0,  2, 2.2, 0,  0, 1, 0,
+                             -0.5, 2.5, 0.2,  0.5, 2.5, 0.1,  0, 2.6, -0.6};
+  std::vector<int32_t> pairs = {1, 0, 2, 1, 6, 2, 7, 2, 8, 2, 7, 6, 8, 6, 8, 7};
+  std::vector<double> key_lengths;
+  std::vector<int32_t> coincident = {5, 1};
+  std::vector<int32_t> quads = {2, 6, 7, 8};
+  std::vector<double> key_volumes;
+  std::vector<int32_t> triples = {2, 3, 4};
+  std::vector<double> key_cosines = {-0.9};
+  MotionRefitProblem problem;
+
+  Figure() {
+    for (size_t k = 0; k < pairs.size() / 2; ++k) {
+      double sum = 0.0;
+      for (int a = 0; a < 3; ++a) {
+        const double d = key[3 * pairs[2 * k] + a] - key[3 * pairs[2 * k + 1] + a];
+        sum += d * d;
+      }
+      key_lengths.push_back(std::sqrt(sum));
+    }
+    problem.point_count = 9;
+    problem.length_pairs = pairs.data();
+    problem.key_lengths = key_lengths.data();
+    problem.length_pair_count = key_lengths.size();
+    problem.coincident_pairs = coincident.data();
+    problem.coincident_pair_count = 1;
+    problem.handed_quads = quads.data();
+    problem.handed_quad_count = 1;
+    problem.angle_triples = triples.data();
+    problem.key_cosines = key_cosines.data();
+    problem.angle_triple_count = 1;
+    problem.length_scale = 2.0;
+    std::vector<double> volume(1);
+    key_volumes = {1.0};  // placeholder with the right size, replaced below
+    problem.key_volumes = key_volumes.data();
+    // The key volume's sign: the handedness value is -sign(V0) V / L^3 <= 0 at the key.
+    animlod::detail::refit_handedness_frame(problem, key.data(), volume.data(), nullptr);
+    key_volumes[0] = volume[0] < 0.0 ? 1.0 : -1.0;
+  }
+
+  std::vector<double> perturbed(unsigned seed, double scale) const {
+    std::mt19937 random(seed);
+    std::normal_distribution<double> normal(0.0, scale);
+    std::vector<double> x = key;
+    for (size_t i = 3; i < x.size(); ++i) x[i] += normal(random);
+    return x;
+  }
+};
+
+double objective_at(const MotionRefitProblem& p, const std::vector<double>& x, const std::vector<double>& o) {
+  return animlod::detail::refit_objective_frame(p, x.data(), o.data(), nullptr);
+}
+
+}  // namespace
+
+TEST_CASE("motion refit: E's gradient and Hessian match finite differences") {
+  const Figure f;
+  const std::vector<double> original = f.perturbed(1, 0.05);
+  const std::vector<double> x = f.perturbed(2, 0.2);
+  const size_t p = f.problem.point_count;
+  std::vector<double> gradient(3 * p);
+  animlod::detail::refit_objective_frame(f.problem, x.data(), original.data(), gradient.data());
+  const double h = 1e-6;
+  for (size_t i = 3; i < 3 * p; ++i) {
+    std::vector<double> plus = x, minus = x;
+    plus[i] += h;
+    minus[i] -= h;
+    const double numeric = (objective_at(f.problem, plus, original) - objective_at(f.problem, minus, original)) / (2 * h);
+    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-6).scale(1.0));
+  }
+  CHECK(gradient[0] == 0.0);
+
+  const size_t n = 3 * (p - 1);
+  std::vector<double> hessian(n * n);
+  animlod::detail::refit_hessian_frame(f.problem, x.data(), false, hessian.data());
+  for (size_t j = 0; j < n; ++j) {
+    std::vector<double> plus = x, minus = x, g_plus(3 * p), g_minus(3 * p);
+    plus[3 + j] += h;
+    minus[3 + j] -= h;
+    animlod::detail::refit_objective_frame(f.problem, plus.data(), original.data(), g_plus.data());
+    animlod::detail::refit_objective_frame(f.problem, minus.data(), original.data(), g_minus.data());
+    for (size_t i = 0; i < n; ++i)
+      CHECK(hessian[i * n + j] == doctest::Approx((g_plus[3 + i] - g_minus[3 + i]) / (2 * h)).epsilon(1e-5).scale(1.0));
+  }
+  // The preconditioner's form is positive definite even where the exact Hessian is not.
+  animlod::detail::refit_hessian_frame(f.problem, x.data(), true, hessian.data());
+  for (size_t k = 0; k < n; ++k) {  // Cholesky without pivoting succeeds
+    for (size_t j = 0; j < k; ++j) hessian[k * n + k] -= hessian[k * n + j] * hessian[k * n + j];
+    REQUIRE(hessian[k * n + k] > 0.0);
+    hessian[k * n + k] = std::sqrt(hessian[k * n + k]);
+    for (size_t i = k + 1; i < n; ++i) {
+      for (size_t j = 0; j < k; ++j) hessian[i * n + k] -= hessian[i * n + j] * hessian[k * n + j];
+      hessian[i * n + k] /= hessian[k * n + k];
+    }
+  }
+}
+
+TEST_CASE("motion refit: constraint Jacobians match finite differences") {
+  const Figure f;
+  const std::vector<double> x = f.perturbed(3, 0.2);
+  const size_t p = f.problem.point_count;
+  const size_t m = animlod::motion_refit_equality_count(f.problem);
+  REQUIRE(m == f.key_lengths.size() + 3);
+  std::vector<double> values(m), jacobian(m * 3 * p), plus_values(m), minus_values(m);
+  REQUIRE(animlod::motion_refit_equalities(f.problem, x.data(), 1, values.data(), jacobian.data()));
+  std::vector<double> handed(1), handed_jacobian(3 * p), handed_plus(1), handed_minus(1);
+  REQUIRE(animlod::motion_refit_handedness(f.problem, x.data(), 1, handed.data(), handed_jacobian.data()));
+  const double h = 1e-6;
+  for (size_t i = 3; i < 3 * p; ++i) {
+    std::vector<double> plus = x, minus = x;
+    plus[i] += h;
+    minus[i] -= h;
+    animlod::detail::refit_equalities_frame(f.problem, plus.data(), plus_values.data(), nullptr);
+    animlod::detail::refit_equalities_frame(f.problem, minus.data(), minus_values.data(), nullptr);
+    for (size_t r = 0; r < m; ++r)
+      CHECK(jacobian[r * 3 * p + i] == doctest::Approx((plus_values[r] - minus_values[r]) / (2 * h)).scale(1.0));
+    animlod::detail::refit_handedness_frame(f.problem, plus.data(), handed_plus.data(), nullptr);
+    animlod::detail::refit_handedness_frame(f.problem, minus.data(), handed_minus.data(), nullptr);
+    CHECK(handed_jacobian[i] == doctest::Approx((handed_plus[0] - handed_minus[0]) / (2 * h)).scale(1.0));
+  }
+  for (size_t r = 0; r < m; ++r) CHECK(jacobian[r * 3 * p + 1] == 0.0);  // the root is not a variable
+  // At the key posture every equality holds and the handed group is on its side.
+  REQUIRE(animlod::motion_refit_equalities(f.problem, f.key.data(), 1, values.data(), nullptr));
+  for (double v : values) CHECK(std::abs(v) < 1e-12);
+  REQUIRE(animlod::motion_refit_handedness(f.problem, f.key.data(), 1, handed.data(), nullptr));
+  CHECK(handed[0] < 0.0);
+}
+
+TEST_CASE("motion refit: a solve started infeasible ends feasible, whatever the thread count") {
+  Figure f;
+  const size_t p = f.problem.point_count;
+  const size_t frames = 12;
+  std::vector<double> original, fallback, cold;
+  for (size_t t = 0; t < frames; ++t) {
+    const std::vector<double> o = f.perturbed(10 + unsigned(t), 0.08);
+    original.insert(original.end(), o.begin(), o.end());
+    fallback.insert(fallback.end(), f.key.begin(), f.key.end());
+    for (size_t i = 0; i < 3; ++i) fallback[t * 3 * p + i] = o[i];  // the root where it is
+  }
+  // Cold starts off every constraint: stretched 10 % away from the root.
+  cold = fallback;
+  for (size_t t = 0; t < frames; ++t)
+    for (size_t i = 3; i < 3 * p; ++i) cold[t * 3 * p + i] = 1.1 * cold[t * 3 * p + i];
+  std::vector<double> violation(animlod::motion_refit_equality_count(f.problem));
+  REQUIRE(animlod::motion_refit_equalities(f.problem, cold.data(), 1, violation.data(), nullptr));
+  REQUIRE(*std::max_element(violation.begin(), violation.end()) > 1e-2);
+
+  MotionRefitOptions options;
+  options.warm_start = false;  // every frame from its (infeasible) cold start
+  options.chunk_frames = 4;
+  options.threads = 1;
+  MotionRefitResult one;
+  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), cold.data(), frames, options, one));
+  CHECK(one.failures.empty());
+  std::vector<double> values(violation.size()), handed(1);
+  for (size_t t = 0; t < frames; ++t) {
+    animlod::detail::refit_equalities_frame(f.problem, one.positions.data() + t * 3 * p, values.data(), nullptr);
+    for (double v : values) CHECK(std::abs(v) <= options.feasibility_tolerance);
+    animlod::detail::refit_handedness_frame(f.problem, one.positions.data() + t * 3 * p, handed.data(), nullptr);
+    CHECK(handed[0] <= 0.0);
+    // The re-fit is better than the feasible fallback.
+    const std::vector<double> o(original.begin() + long(t * 3 * p), original.begin() + long((t + 1) * 3 * p));
+    const std::vector<double> b(fallback.begin() + long(t * 3 * p), fallback.begin() + long((t + 1) * 3 * p));
+    CHECK(one.values[t] < objective_at(f.problem, b, o));
+  }
+
+  options.warm_start = true;
+  options.threads = 1;
+  MotionRefitResult serial, parallel;
+  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, serial));
+  options.threads = 3;
+  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, parallel));
+  CHECK(serial.positions == parallel.positions);
+  CHECK(serial.evaluations == parallel.evaluations);
+}
+
+TEST_CASE("motion refit: bad problems and inputs are refused by name") {
+  Figure f;
+  std::vector<int32_t> bad_triples = {2, 3, 41};
+  MotionRefitProblem problem = f.problem;
+  problem.angle_triples = bad_triples.data();
+  auto status = animlod::validate_motion_refit_problem(problem);
+  REQUIRE_FALSE(status);
+  CHECK(status.message == "angle_triples[0]: point 41 is outside [0, 9)");
+
+  problem = f.problem;
+  std::vector<double> lengths = f.key_lengths;
+  lengths[2] = 0.0;
+  problem.key_lengths = lengths.data();
+  status = animlod::validate_motion_refit_problem(problem);
+  REQUIRE_FALSE(status);
+  CHECK(status.message.rfind("key_lengths[2]", 0) == 0);
+
+  std::vector<double> original = f.key, fallback = f.key;
+  original[3 * 4 + 1] = std::nan("");
+  MotionRefitResult result;
+  status = animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, 1, {}, result);
+  REQUIRE_FALSE(status);
+  CHECK(status.message == "original: frame 0, point 4 is not finite");
+
+  MotionRefitOptions options;
+  options.chunk_frames = 0;
+  status = animlod::motion_refit_solve(f.problem, f.key.data(), f.key.data(), nullptr, 1, options, result);
+  REQUIRE_FALSE(status);
+  CHECK(status.message == "chunk_frames: must be at least 1, got 0");
+}

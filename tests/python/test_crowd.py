@@ -1,0 +1,188 @@
+"""The native crowd benchmark (bench/crowd/animlod_crowd) end to end, under Xvfb: a smoke run on a
+hand-built LoD GLB (report parsed, screenshots checked, a level switch seen as the camera backs
+away), the Fig. 1 grid and its heat map, and bad input refused with one line.
+
+``make test`` builds the binary and points ANIMLOD_CROWD_BIN at it; elsewhere these tests skip.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import matplotlib.image
+import numpy as np
+import pygltflib
+import pytest
+from crowd_chain import write_hand_built_chain
+
+from animlod.cli import main as cli_main
+from animlod.crowd import CrowdError, find_crowd_binary, mode_list, run_crowd, write_heat_map
+
+REQUIRED = ("fps", "frame_ms_p50", "frame_ms_p95", "triangles", "joints", "drawn")
+SMALL = {"count": 24, "warmup": 2, "width": 640, "height": 360}
+
+
+@pytest.fixture(scope="module")
+def binary() -> Path:
+    found = find_crowd_binary()
+    if found is None:
+        pytest.skip("animlod_crowd is not built (make test builds it and sets ANIMLOD_CROWD_BIN)")
+    if not os.environ.get("DISPLAY") and not shutil.which("xvfb-run"):
+        pytest.skip("no display and no xvfb-run")
+    return found
+
+
+@pytest.fixture(scope="module")
+def chain(tmp_path_factory) -> Path:
+    return write_hand_built_chain(tmp_path_factory.mktemp("crowd") / "chain.glb")
+
+
+def _level_pixels(png: Path) -> dict[str, int]:
+    """Pixels of each --level-colors tint (chain level 0 green, level 1 yellow) in a screenshot."""
+    rgb = matplotlib.image.imread(png)[..., :3].astype(np.float64)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    saturated = (rgb.max(axis=-1) - rgb.min(axis=-1) > 0.3) & (b < 0.5 * np.maximum(r, g))
+    return {
+        "green": int(np.count_nonzero(saturated & (g > 1.5 * r))),
+        "yellow": int(np.count_nonzero(saturated & (r > 0.4) & (np.abs(r - g) < 0.2 * r))),
+    }
+
+
+def test_smoke_run_reports_every_mode_and_shows_a_level_switch(binary, chain, tmp_path) -> None:
+    near, far = tmp_path / "near.png", tmp_path / "far.png"
+    report = run_crowd(
+        [chain], frames=12, modes="G+MLoD,Original,GLoD,MLoD,G+MLoD+skip", path="pullback", pixel_error=1.0,
+        level_colors=True, screenshots=[(0, near), (11, far)], json_path=tmp_path / "crowd.json", **SMALL,
+    )  # fmt: skip
+    assert report.renderer
+    assert set(report.modes) == {"G+MLoD", "Original", "GLoD", "MLoD", "G+MLoD+skip"}
+    for name, mode in report.modes.items():
+        assert all(isinstance(mode[key], (int, float)) and mode[key] >= 0 for key in REQUIRED), name
+        assert mode["fps"] > 0 and 0 < mode["drawn"] <= SMALL["count"]
+    modes = report.modes
+    original = modes["Original"]
+    assert original["triangles"] == pytest.approx(original["drawn"] * 3664)  # every drawn character at level 0
+    assert len(modes["G+MLoD"]["levels"]) == 2 and modes["G+MLoD"]["levels"][1] > 0  # level 1 in use
+    # Per drawn character: GLoD draws fewer triangles with every joint, MLoD every triangle with fewer joints.
+    per = {name: (m["triangles"] / m["drawn"], m["joints"] / m["drawn"]) for name, m in modes.items()}
+    assert per["GLoD"][0] < per["Original"][0] and per["GLoD"][1] == pytest.approx(per["Original"][1])
+    assert per["MLoD"][0] == pytest.approx(per["Original"][0]) and per["MLoD"][1] < per["Original"][1]
+    assert per["G+MLoD"][0] < per["Original"][0] and per["G+MLoD"][1] < per["Original"][1]
+    assert per["G+MLoD+skip"][1] < per["G+MLoD"][1]  # skipped poses are not re-animated
+    levels = report.data["chains"][0]["nodes"][0]["levels"]
+    cells = sorted((level["mesh_level"], level["motion_level"], level["chain_level"]) for level in levels)
+    assert cells == [(0, 0, 0), (0, 1, -1), (1, 0, -1), (1, 1, 1)]
+    assert (tmp_path / "crowd.json").is_file()
+    # The screenshots: characters on the background, and the level colours change as the camera backs away.
+    pixels_near, pixels_far = _level_pixels(near), _level_pixels(far)
+    image = matplotlib.image.imread(near)
+    assert image.shape[:2] == (SMALL["height"], SMALL["width"]) and image.std() > 0.02
+    assert pixels_near["green"] > 500 and pixels_near["yellow"] > 500
+    assert pixels_far["yellow"] > 0 and pixels_far["green"] == 0
+
+
+def test_opengl_3_3_with_orphaned_uploads(binary, chain, monkeypatch) -> None:
+    """The GL 3.3 core path (no persistent mapping): Mesa asked for a 3.3 context."""
+    monkeypatch.setenv("MESA_GL_VERSION_OVERRIDE", "3.3")
+    report = run_crowd([chain], frames=3, modes="G+MLoD", extra_args=["--upload", "orphan"], **SMALL)
+    assert report.data["palette_upload"] == "orphaned"
+    if "Mesa" in report.data["gl_version"]:
+        assert report.data["gl_version"].startswith("3.3")
+    assert report.modes["G+MLoD"]["fps"] > 0 and report.modes["G+MLoD"]["drawn"] > 0
+
+
+def test_grid_gives_one_cell_per_level_and_a_heat_map(binary, chain, tmp_path) -> None:
+    report = run_crowd([chain], frames=3, grid=True, **SMALL)
+    cells = report.data["grid"]
+    assert [(c["mesh_level"], c["motion_level"]) for c in cells] == [(0, 0), (0, 1), (1, 0), (1, 1)]
+    assert all(c["fps"] > 0 for c in cells)
+    assert cells[2]["triangles"] == pytest.approx(cells[0]["triangles"] / 2, rel=0.01)
+    assert cells[1]["joints"] < cells[0]["joints"] and cells[3]["joints"] == pytest.approx(cells[1]["joints"])
+    write_heat_map(cells, tmp_path / "fig1.png")
+    assert matplotlib.image.imread(tmp_path / "fig1.png").shape[0] > 100
+
+
+def _edited(chain: Path, tmp_path: Path, edit) -> Path:
+    gltf = pygltflib.GLTF2.load(str(chain))
+    edit(gltf)
+    out = tmp_path / "edited.glb"
+    gltf.save_binary(str(out))
+    return out
+
+
+def _no_skin(gltf: pygltflib.GLTF2) -> None:
+    for node in gltf.nodes:
+        node.skin = None
+
+
+def _no_animation(gltf: pygltflib.GLTF2) -> None:
+    gltf.animations = []
+
+
+def _other_root(gltf: pygltflib.GLTF2) -> None:
+    gltf.nodes[gltf.skins[1].joints[0]].name = "Pelvis"  # the reduced skeleton's root
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (_no_skin, "no skinned mesh"),
+        (_no_animation, "no animation moves its skeleton"),
+        (_other_root, "must share a skeleton root"),
+    ],
+)
+def test_bad_chains_are_refused_with_one_line(binary, chain, tmp_path, edit, message) -> None:
+    broken = _edited(chain, tmp_path, edit)
+    with pytest.raises(CrowdError, match=message) as caught:
+        run_crowd([broken], frames=2, **SMALL)
+    assert caught.value.bad_input
+    assert str(broken) in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [(["--modes", "Fast"], "unknown mode 'Fast'"), (["--count", "0"], "--count"), (["--path", "up"], "--path")],
+)
+def test_bad_arguments_exit_2_with_one_line(binary, chain, arguments, message) -> None:
+    completed = subprocess.run([str(binary), str(chain), *arguments], capture_output=True, text=True, check=False)
+    assert completed.returncode == 2
+    assert completed.stderr.count("\n") == 1 and message in completed.stderr
+
+
+def test_a_folder_or_a_missing_file_is_one_line(binary, tmp_path) -> None:
+    for path, message in ((tmp_path, "not a regular file"), (tmp_path / "missing.glb", "no such file")):
+        completed = subprocess.run([str(binary), str(path)], capture_output=True, text=True, check=False)
+        assert completed.returncode == 2 and message in completed.stderr and completed.stderr.count("\n") == 1
+
+
+def test_no_display_is_one_line_and_exit_3(binary, chain) -> None:
+    environment = {key: value for key, value in os.environ.items() if key not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    completed = subprocess.run([str(binary), str(chain), "--count", "2"], capture_output=True, text=True,
+                               env=environment, check=False, timeout=60)  # fmt: skip
+    assert completed.returncode == 3
+    assert "no display" in completed.stderr and completed.stderr.count("\n") == 1
+
+
+def test_cli_refuses_an_unknown_mode_before_running(capsys) -> None:
+    assert cli_main(["crowd", "--modes", "Original,Faster"]) == 2
+    assert "mode 'Faster'" in capsys.readouterr().err
+
+
+def test_mode_list() -> None:
+    assert mode_list("all") == [
+        "Original",
+        "GLoD",
+        "MLoD",
+        "G+MLoD",
+        "Original+skip",
+        "GLoD+skip",
+        "MLoD+skip",
+        "G+MLoD+skip",
+    ]
+    assert mode_list("GLoD,MLoD+skip") == ["GLoD", "MLoD+skip"]
+    assert mode_list(["GLoD", "MLoD"], frame_skipping=True) == ["GLoD+skip", "MLoD+skip"]
+    with pytest.raises(ValueError, match="'Fast'"):
+        mode_list("Fast")

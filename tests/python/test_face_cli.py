@@ -1,0 +1,89 @@
+"""``animlod face``: the procedural face and blendshape faces end to end, and user mistakes."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pygltflib
+
+from animlod.cli import main
+from animlod.io import write_obj
+
+
+def test_face_procedural_writes_levels_manifest_and_plot(tmp_path, capsys):
+    out = tmp_path / "face"
+    arguments = ["face", "-o", str(out), "--plot", "--repeats", "1", "--expression", "surprise", "--error-frames", "6"]
+    assert main(arguments) == 0
+    printed = capsys.readouterr().out
+    assert "level | triangles | vertices | animated regions | lattices" in printed
+    manifest = json.loads((out / "face_lod.json").read_text())
+    levels = manifest["levels"]
+    assert [level["triangles"] for level in levels] == sorted([level["triangles"] for level in levels], reverse=True)
+    assert levels[0]["error"] < 1e-9 < levels[1]["error"] < levels[2]["error"]
+    assert levels[-1]["screen_coverage"] == 0.0 and levels[-1]["active_regions"] == []
+    assert "2x2x2" in levels[1]["lattices"].values()
+    tree = json.loads((out / "face_lod_animation.json").read_text())["levels"]
+    assert tree[-1]["regions"] == [] and len(tree[0]["regions"]) > len(tree[1]["regions"])
+    # One LoD GLB: the face with one morph target per MPA and the expressions as a weights clip,
+    # its levels attached by MSFT_lod (MPAs a level skips are zero targets there).
+    glb = pygltflib.GLTF2().load(str(out / "face_lod.glb"))
+    base = glb.nodes[glb.scenes[0].nodes[0]]
+    assert len(base.extensions["MSFT_lod"]["ids"]) == len(levels) - 1
+    assert base.extras["MSFT_screencoverage"] == [level["screen_coverage"] for level in levels]
+    assert len(glb.meshes[0].primitives[0].targets) == len(glb.meshes[0].extras["targetNames"]) >= 12
+    assert glb.animations[0].channels[0].target.path == "weights"
+    coarsest = glb.nodes[base.extensions["MSFT_lod"]["ids"][-1]]
+    assert coarsest.extras["animlod"]["targets"] == []
+    png = (out / "face_lod.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10000
+    assert not list(out.glob(".*.part"))
+
+
+def test_face_pose_folder(tmp_path, capsys):
+    from animlod.synth import icosphere
+
+    positions, faces = icosphere(2, 0.1)
+    poses = tmp_path / "poses"
+    poses.mkdir()
+    write_obj(poses / "neutral.obj", positions, faces)
+    bulge = positions * (1.0 + 0.2 * np.clip(positions[:, 1:2] / 0.1, 0, 1))
+    write_obj(poses / "bulge.obj", bulge, faces)
+    out = str(tmp_path / "out")
+    arguments = ["face", str(poses), "-o", out, "--ratio", "0.5", "--repeats", "1", "--error-frames", "4"]
+    assert main(arguments) == 0
+    printed = capsys.readouterr().out
+    assert "1 targets" in printed and "poses_lod.glb" in printed
+    manifest = json.loads((tmp_path / "out" / "poses_face_lod.json").read_text())
+    assert [level["targets"] for level in manifest["levels"]] == [["bulge"], []]
+
+
+def test_face_user_mistakes_exit_2_with_one_line(tmp_path, capsys):
+    poses = tmp_path / "one"
+    poses.mkdir()
+    write_obj(poses / "only.obj", np.eye(3), [[0, 1, 2]])
+    assert main(["face", str(poses), "-o", str(tmp_path / "out")]) == 2
+    assert "holds 1 OBJ/PLY file" in capsys.readouterr().err
+    assert main(["face", "-o", str(tmp_path / "out"), "--ratio", "0.5", "--faces", "100"]) == 2
+    assert "--ratio and --faces: give one of them, not both" in capsys.readouterr().err
+    assert main(["face", "-o", str(tmp_path / "out"), "--targets", "1", "0.5"]) == 2
+    assert "apply to blendshape faces" in capsys.readouterr().err
+    assert main(["face", str(tmp_path / "absent.glb"), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "absent.glb" in err and err.count("\n") == 1
+
+
+def test_face_gltf_without_morph_targets_is_named(tmp_path, capsys):
+    from animlod import synth
+    from animlod.io import write_glb
+
+    skinned, _ = synth.bending_cylinder_skinned()
+    path = tmp_path / "plain.glb"
+    write_glb(path, skinned)
+    assert main(["face", str(path), "-o", str(tmp_path / "out")]) == 2
+    assert "no mesh has morph targets" in capsys.readouterr().err
+
+
+def test_face_unknown_expression(tmp_path, capsys):
+    assert main(["face", "-o", str(tmp_path / "out"), "--plot", "--expression", "boredom", "--repeats", "1"]) == 2
+    assert "no expression 'boredom'" in capsys.readouterr().err

@@ -1,0 +1,133 @@
+"""The re-fit in the C++ core against the numpy reference (objective.py) and the Python SLSQP
+(refit.py): same objective, gradient and Jacobians; same optimum; bones that hold."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_motion_figures import figure_motion
+
+from animlod import _core
+from animlod.motion_lod import analyze_motion, build_motion_chain
+from animlod.motion_lod.chain import _cold_starts
+from animlod.motion_lod.core_refit import core_problem, refit_core
+from animlod.motion_lod.frozen import freeze, frozen_motion
+from animlod.motion_lod.objective import (
+    build_problem,
+    handedness_constraints,
+    objective,
+    rigidity_constraints,
+)
+from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
+from animlod.synth import humanoid, humanoid_motion
+
+
+@pytest.fixture(scope="module")
+def level():
+    motion = figure_motion()
+    analysis = analyze_motion(motion)
+    frozen = freeze(motion, analysis, analysis.priority[:6])
+    problem = build_problem(frozen)
+    return motion, frozen, problem, motion.world_positions(), frozen_motion(frozen, motion).world_positions()
+
+
+def test_core_terms_match_the_numpy_reference(level) -> None:
+    _, _, problem, original, _ = level
+    assert problem.angle_triples.shape[0] > 0 and problem.handed_quads.shape[0] > 0
+    x = original[:5] + np.random.default_rng(4).normal(scale=0.05, size=original[:5].shape)
+    core = core_problem(problem)
+    value, gradient = _core.motion_refit_objective(core, x, original[:5])
+    reference_value, reference_gradient = objective(problem, x, original[:5])
+    np.testing.assert_allclose(value, reference_value, rtol=1e-12)
+    np.testing.assert_allclose(gradient, reference_gradient, rtol=1e-10, atol=1e-12 * np.abs(reference_gradient).max())
+    for core_function, reference in (
+        (_core.motion_refit_equalities, rigidity_constraints),
+        (_core.motion_refit_handedness, handedness_constraints),
+    ):
+        values, jacobian = core_function(core, x)
+        reference_values, reference_jacobian = reference(problem, x)
+        np.testing.assert_allclose(values, reference_values, rtol=1e-10, atol=1e-14)
+        np.testing.assert_allclose(jacobian, reference_jacobian, rtol=1e-10, atol=1e-14)
+
+
+@pytest.mark.parametrize("hard", [False, True])
+def test_core_solve_matches_the_python_reference(level, hard) -> None:
+    motion, frozen, problem, original, fallback = level
+    options = SlsqpOptions(hard_constraints=hard, ftol_rel=1e-12)
+    cold = _cold_starts(frozen, problem, motion, original, fallback) if hard else None
+    reference = refit_slsqp(problem, original, fallback, options, chunk_frames=8, cold_starts=cold)
+    same_variables = SlsqpOptions(hard, 1e-12, precondition=False, eliminate_points=False)
+    plain = refit_core(problem, original, fallback, same_variables, chunk_frames=8, cold_starts=cold)
+    fast = refit_core(problem, original, fallback, options, chunk_frames=8, cold_starts=cold)
+    assert reference.failures == plain.failures == fast.failures == []
+    # The same algorithm in the same variables: the same optimum (nlopt versions may differ in
+    # the last steps). Preconditioned, SLSQP takes other paths, and on this non-convex E a path
+    # can end in another local minimum: the same optimum on most frames, in fewer evaluations.
+    np.testing.assert_allclose(plain.objective, reference.objective, rtol=1e-6)
+    same = np.abs(fast.objective - reference.objective) <= 1e-6 * reference.objective
+    assert same.mean() >= 0.9
+    assert abs(fast.objective.mean() / reference.objective.mean() - 1.0) < 0.01
+    assert fast.evaluations.sum() < reference.evaluations.sum()
+    if hard:
+        violation, _ = rigidity_constraints(problem, fast.positions)
+        assert np.abs(violation).max() <= 1e-6
+
+
+def test_core_solve_is_the_same_on_one_and_two_threads(level) -> None:
+    _, _, problem, original, fallback = level
+    one = refit_core(problem, original, fallback, threads=1, chunk_frames=5)
+    two = refit_core(problem, original, fallback, threads=2, chunk_frames=5)
+    np.testing.assert_array_equal(one.positions, two.positions)
+    np.testing.assert_array_equal(one.evaluations, two.evaluations)
+
+
+def test_core_refuses_bad_shapes_and_problems_by_name(level) -> None:
+    _, _, problem, original, fallback = level
+    core = core_problem(problem)
+    with pytest.raises(ValueError, match=r"fallback: expected shape \(24, 16, 3\) like original, got \(3, 16, 3\)"):
+        _core.motion_refit_solve(core, original, fallback[:3])
+    broken = original.copy()
+    broken[2, 5, 1] = np.nan
+    with pytest.raises(ValueError, match="original: frame 2, point 5 is not finite"):
+        _core.motion_refit_solve(core, broken, fallback)
+    with pytest.raises(ValueError, match=r"length_pairs\[0\]: point 99 is outside \[0, 16\)"):
+        empty = np.zeros(0)
+        _core.MotionRefitProblem(16, np.array([[99, 0]]), [1.0], np.zeros((0, 2), np.int64), np.zeros((0, 4), np.int64),
+                                 empty, np.zeros((0, 3), np.int64), empty, 0.2, 0.4, 0.4, 1.0)  # fmt: skip
+
+
+def test_hard_default_keeps_bones_and_never_falls_back_on_the_walk() -> None:
+    skin = humanoid()
+    motion = humanoid_motion(skin.skeleton, "walk", cycles=1, fps=15.0)
+    chain = build_motion_chain(motion, 5)
+    for level in chain.levels:
+        assert level.report.bone_variation < 1e-5 and level.report.failures == []
+        assert level.report.fk_residual < 1e-5 * chain.figure_size
+
+
+def test_hard_solve_finds_the_zero_error_optimum_when_only_twists_are_frozen() -> None:
+    # Regression: the walk's Spine only twists (importance ~0); freezing it costs nothing once
+    # the re-fit turns the joints above, but a solve started at the frozen key motion stopped at
+    # E ~ 1e-4 (and above its start) until hard solves also start from the projected original.
+    skin = humanoid()
+    motion = humanoid_motion(skin.skeleton, "walk", cycles=1, fps=10.0)
+    chain = build_motion_chain(motion, [38, 28], ranking="paper")
+    assert "Spine" in chain.levels[1].report.frozen
+    assert chain.levels[1].report.energy < 1e-20 and chain.levels[1].report.mean_error < 1e-9
+
+
+def test_core_and_reference_agree_on_a_real_clip_sample(data_dir) -> None:
+    from animlod.io.bvh import read_bvh
+
+    motion = read_bvh(data_dir / "bvh" / "131_01.bvh")
+    analysis = analyze_motion(motion, max_frames=120)
+    frozen = freeze(motion, analysis, analysis.priority[:21])
+    problem = build_problem(frozen)
+    frames = np.arange(300, 312)
+    original = motion.world_positions()[frames]
+    fallback = frozen_motion(frozen, motion).world_positions()[frames]
+    options = SlsqpOptions(ftol_rel=1e-12)
+    reference = refit_slsqp(problem, original, fallback, options, chunk_frames=4)
+    core = refit_core(problem, original, fallback, options, chunk_frames=4)
+    assert reference.failures == core.failures == []
+    np.testing.assert_allclose(core.objective, reference.objective, rtol=1e-6)

@@ -1,0 +1,188 @@
+"""Motion levels spread to the floor: joint counts, translating joints and the CLI's bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_motion_figures import figure_motion
+
+from animlod import rotations
+from animlod.cli import main
+from animlod.model import Motion, Skeleton
+from animlod.motion_lod import analyze_motion, joint_floor, level_joint_counts
+from animlod.motion_lod.analysis import translating_joints
+from animlod.motion_lod.chain import build_level
+from animlod.motion_lod.frozen import freeze
+
+
+def tree_motion(joints: int = 20, translating: tuple[int, ...] = (), frames: int = 16, seed: int = 3) -> Motion:
+    """A root with three chains of joints (an end site each), every joint turning; the joints in
+    ``translating`` also slide along their bone by up to 30 % of it."""
+    rng = np.random.default_rng(seed)
+    parents, offsets = [-1], [[0.0, 1.0, 0.0]]
+    for joint in range(1, joints):
+        parents.append(0 if joint <= 3 else joint - 3)
+        offsets.append([0.1 * (joint % 3 - 1), 0.2, 0.05 * (joint % 2)])
+    ends = list(range(joints - 3, joints))
+    for end in ends:
+        parents.append(end)
+        offsets.append([0.0, 0.1, 0.0])
+    count = len(parents)
+    names = [f"j{k}" for k in range(joints)] + [f"j{e}_End" for e in ends]
+    skeleton = Skeleton(names, parents, offsets, end_sites=[k >= joints for k in range(count)])
+    time = np.linspace(0.0, 2.0 * np.pi, frames)[:, None]
+    angles = 0.4 * np.sin(time + rng.uniform(0, np.pi, count))
+    axes = rng.normal(size=(count, 3))
+    local = rotations.from_axis_angle(axes / np.linalg.norm(axes, axis=-1, keepdims=True), angles)
+    local[:, joints:] = rotations.identity()
+    translations = np.broadcast_to(skeleton.offsets, (frames, count, 3)).copy()
+    for joint in translating:
+        translations[:, joint] *= 1.0 + 0.3 * np.sin(time + joint)
+    root = np.concatenate([time, np.zeros((frames, 1)), 0.1 * np.cos(time)], axis=1)
+    return Motion(skeleton, root, local, 30.0, joint_translations=translations if translating else None)
+
+
+@pytest.mark.parametrize(
+    ("translating", "locked", "floor"),
+    [((1,), (), 2), ((1, 5), ("j2", "j9"), 5), (tuple(range(1, 15)), (), 15)],
+)
+def test_eight_levels_spread_down_to_the_floor(translating, locked, floor) -> None:
+    motion = tree_motion(20, translating)
+    analysis = analyze_motion(motion, locked=locked)
+    info = joint_floor(motion, analysis)
+    assert (info.total, info.fewest) == (20, floor)
+    possible = 20 - floor + 1
+    levels = min(8, possible)
+    counts = level_joint_counts(motion, analysis, levels)
+    assert counts[0] == 20 and counts[-1] == max(floor, info.paper_fewest) and len(counts) == levels
+    assert all(b < a for a, b in zip(counts, counts[1:]))
+    if floor == 2:  # the paper's fractions fit: 100, 82, 70, 58, 45, 33, 20, 8 % of 20 joints
+        assert counts == [20, 16, 14, 12, 9, 7, 4, 2]
+    if floor == 15:  # only 6 counts exist: all of them, and 8 levels are refused by name
+        assert counts == [20, 19, 18, 17, 16, 15]
+        with pytest.raises(ValueError, match=r"8 levels need 8 distinct joint counts, but the skeleton allows 6"):
+            level_joint_counts(motion, analysis, 8)
+    if floor == 5:  # above the paper's 8 %: the fractions are mapped onto 5..20
+        assert counts[-1] == 5 and "2 locked (j2, j9), 2 translating (j1, j5)" in info.explain()
+
+
+def test_a_translating_non_root_joint_stays_and_the_rest_freeze() -> None:
+    # Bandai's shape: the root does not move, its child (Hips) carries the translation.
+    motion = tree_motion(12, translating=(1,))
+    assert translating_joints(motion).tolist() == [False, True] + [False] * 13
+    analysis = analyze_motion(motion)
+    counts = level_joint_counts(motion, analysis, 8)
+    assert counts[-1] == 2 and 1 not in analysis.priority
+    level = build_level(motion, analysis, counts[-1])
+    assert level.report.joint_count == 2 and level.report.failures == []
+
+
+def test_float_noise_and_constant_keys_are_not_translation() -> None:
+    motion = tree_motion(12)
+    noisy = np.broadcast_to(motion.skeleton.offsets, motion.local_rotations.shape[:2] + (3,)).copy()
+    noisy[:, 1:] *= 1.0 + 1e-7 * np.random.default_rng(0).normal(size=noisy[:, 1:].shape)
+    motion = Motion(motion.skeleton, motion.root_positions, motion.local_rotations, 30.0, joint_translations=noisy)
+    assert not translating_joints(motion).any()
+    assert joint_floor(motion, analyze_motion(motion)).fewest == 1
+
+
+def test_a_small_real_translation_freezes_at_its_key_and_its_error_is_reported() -> None:
+    from animlod.motion_lod.frozen import frozen_motion
+
+    motion = tree_motion(12, translating=(4,))
+    # Joint 4 slides over 60 % of its bone (+-30 %): translating at the default tolerance, not at 80 %.
+    assert analyze_motion(motion).translating == [4]
+    analysis = analyze_motion(motion, translation_tolerance=0.8)
+    assert analysis.translating == [] and 4 in analysis.priority
+    level = freeze(motion, analysis, [4])
+    key = motion.joint_translations[analysis.key_frames[4], 4]
+    np.testing.assert_array_equal(level.key_translations[4], key)
+    held = frozen_motion(level, motion)  # the slide held at the key frame, like the rotation
+    np.testing.assert_array_equal(held.joint_translations[:, 4], np.broadcast_to(key, (16, 3)))
+    assert np.linalg.norm(held.world_positions() - motion.world_positions(), axis=-1)[:, 7].max() > 0.01
+    # A level that freezes joint 4 measures what holding the slide costs.
+    count = 11 - analysis.priority.index(4)
+    report = build_level(motion, analysis, count).report
+    assert "j4" in report.frozen and report.failures == [] and report.max_error > 0.01
+
+
+def test_every_skinned_gltf_reaches_a_few_joints_in_eight_levels(data_dir) -> None:
+    from animlod.io.gltf import read_skinned
+
+    checked = 0
+    for path in sorted((data_dir / "gltf").glob("*.gl*")):
+        try:
+            _, motions = read_skinned(path)
+        except ValueError:
+            continue  # no skinned mesh (a static scan)
+        for motion in motions:
+            if motion.frame_count < 2 or np.linalg.norm(motion.skeleton.offsets[1:], axis=-1).max() == 0.0:
+                continue  # a one-frame pose, or every joint at one point (nothing to measure)
+            analysis = analyze_motion(motion, max_frames=60)
+            floor = joint_floor(motion, analysis)
+            counts = level_joint_counts(motion, analysis, min(8, floor.possible_levels))
+            assert counts[-1] == max(floor.fewest, floor.paper_fewest), path.name
+            assert counts[-1] <= max(7, floor.fewest), (path.name, motion.name, counts)
+            checked += 1
+    assert checked >= 10
+
+
+def test_the_bandai_clip_spreads_to_two_joints(data_dir) -> None:
+    from animlod.io.bvh import read_bvh
+
+    motion = read_bvh(data_dir / "bvh" / "dataset-1_run_proud_001.bvh")
+    analysis = analyze_motion(motion)
+    assert [motion.skeleton.names[j] for j in analysis.translating] == ["Hips"]
+    assert level_joint_counts(motion, analysis, 8) == [22, 18, 15, 13, 10, 7, 5, 2]
+
+
+def _write(tmp_path, motion: Motion, name: str = "clip.bvh"):
+    from animlod.io.bvh import write_bvh
+
+    path = tmp_path / name
+    write_bvh(path, motion)
+    return path
+
+
+def test_cli_levels_above_the_skeleton_name_the_file_in_one_line(tmp_path, capsys) -> None:
+    source = _write(tmp_path, tree_motion(20, tuple(range(1, 15))))
+    assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--levels", "8"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert str(source) in err and "the skeleton allows 6" in err and "14 translating" in err
+
+
+def test_cli_unknown_ranking_is_one_line(tmp_path, capsys) -> None:
+    source = _write(tmp_path, figure_motion())
+    assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--ranking", "alphabetical"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "animlod motion: error: --ranking: no ranking named 'alphabetical' (choose from importance, paper, depth, "
+        "variance)"
+    )
+
+
+def test_cli_a_clip_whose_every_joint_translates_writes_one_level(tmp_path, capsys) -> None:
+    source = _write(tmp_path, tree_motion(8, tuple(range(1, 8))))
+    out = tmp_path / "out"
+    assert main(["motion", str(source), "-o", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "nothing can freeze (8 joints, all kept: root, 7 translating" in captured.err
+    assert sorted(p.name for p in out.iterdir()) == ["clip_lod0.bvh", "clip_motion_lod.json"]
+
+
+def test_cli_skeleton_errors_name_the_file(tmp_path, capsys) -> None:
+    skeleton = Skeleton(["root", "a"], [-1, 0], [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    local = rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.linspace(0, 1, 4)[:, None] * [0.0, 1.0])
+    source = _write(tmp_path, Motion(skeleton, np.zeros((4, 3)), local, 30.0))
+    assert main(["motion", str(source), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"animlod motion: error: {source}: skeleton: every bone has zero length, so posture error (Eq. 1) " \
+        "is undefined"
+
+
+def test_cli_summary_says_why_the_floor_is_above_the_paper(tmp_path, capsys) -> None:
+    source = _write(tmp_path, tree_motion(20, (1, 5, 9)))
+    assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--levels", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "fewest joints: 4 of 20, above the paper's 8% (2): root, 3 translating (j1, j5, j9) never freeze" in out

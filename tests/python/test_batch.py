@@ -20,7 +20,7 @@ from animlod.batch.jobs import find_job
 from animlod.batch.outputs import STATE
 from animlod.cli import main
 from animlod.io import write_bvh, write_glb
-from animlod.io.meshseq import write_sequence
+from animlod.io.meshseq import write_obj, write_sequence
 from animlod.io.npz import write_npz
 from animlod.pipelines import simplify_asset
 
@@ -168,12 +168,19 @@ def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, l
 
 def test_killed_worker_leaves_no_partial_file_and_the_asset_is_redone(client, library, tmp_path):
     source = library / "characters" / "cyl0.glb"
+    positions, faces = synth.icosphere(2, 0.1)  # a face job's pose folder: neutral and one expression
+    poses = tmp_path / "poses"
+    poses.mkdir()
+    write_obj(poses / "neutral.obj", positions, faces)
+    write_obj(poses / "bulge.obj", positions * (1.0 + 0.2 * np.clip(positions[:, 1:2] / 0.1, 0, 1)), faces)
     manifest = tmp_path / "assets.json"
     entries = [
         {"input": str(source), "name": "crashes_once", "job": "batch_jobs:crash_once",
          "marker": str(tmp_path / "crashed"), **QUICK},
         {"input": str(source), "name": "always_crashes", "job": "batch_jobs:always_crash"},
         {"input": str(library / "bar.npz"), "name": "bar"},
+        {"input": str(poses), "name": "face", "job": "face", "ratios": [0.5], "repeats": 1,
+         "error_frames": 4},
     ]  # fmt: skip
     manifest.write_text(json.dumps({"assets": entries}))
     result = run_batch(read_spec(manifest), tmp_path / "out", client=client)
@@ -189,6 +196,8 @@ def test_killed_worker_leaves_no_partial_file_and_the_asset_is_redone(client, li
     assert records["always_crashes"]["error"]["element"] == "worker"
     assert not (tmp_path / "out" / "always_crashes").exists()
     assert records["bar"]["status"] == "ok"
+    face = records["face"]["result"]["levels"]  # the face job on a pose folder, beside the crashes
+    assert [(row["level"], row["triangles"]) for row in face] == [(0, 320), (1, 160)] and face[1]["error"] > 0
     assert not list((tmp_path / "out").rglob("half_written*"))
     client.wait_for_workers(2, timeout=30)  # the nannies restarted the killed workers
 

@@ -72,6 +72,12 @@ BUILTIN_JOBS = {
         ("gltf",),
         {"gltf": ("animlod.pipelines.character:build_character", _AQEM)},
     ),
+    "face": Job(
+        "face",
+        "animlod.pipelines.assets:face_asset",
+        ("gltf", "sequence"),
+        {"*": ("animlod.face_lod.pipeline:run_face_lod",)},
+    ),
     "motion": Job(
         "motion",
         "animlod.pipelines.motion:motion_asset",

@@ -28,7 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("-o", "--output", required=True, help="the batch's output folder (created if missing)")
     parser.add_argument(
-        "--job", help="job for every asset of a folder or glob (simplify, character, motion, module:function)"
+        "--job", help="job for every asset of a folder or glob (simplify, character, motion, face, module:function)"
     )
     parser.add_argument(
         "--set", action="append", default=[], metavar="OPTION=VALUE", dest="options",

@@ -4,7 +4,7 @@ The command line, ``make demo`` and the batch runner call these; they hold no ar
 and no printing.
 """
 
-from .assets import character_asset, simplify_asset
+from .assets import character_asset, face_asset, simplify_asset
 from .lod_document import DocumentReport, simplify_document
 from .motion import MotionReport, build_motion_levels, motion_asset
 from .result import AssetResult, LevelRow
@@ -16,6 +16,7 @@ __all__ = [
     "MotionReport",
     "build_motion_levels",
     "character_asset",
+    "face_asset",
     "motion_asset",
     "simplify_asset",
     "simplify_document",

@@ -110,3 +110,37 @@ def character_asset(
         for level in levels
     ]
     return AssetResult("character", os.fspath(source), [target], rows, time.perf_counter() - started, report.notes)
+
+
+def face_asset(
+    source: str | os.PathLike,
+    output: str | os.PathLike,
+    *,
+    progress: Progress | None = None,
+    **options: object,
+) -> AssetResult:
+    """Facial LoD of a glTF with morph targets or a folder of OBJ/PLY poses (neutral first or
+    named ``*neutral*``), written as ``<stem>_lod.glb`` and ``<stem>_face_lod.json`` into the
+    folder ``output`` (see :func:`animlod.face_lod.pipeline.run_face_lod`).
+
+    ``options`` are the keyword arguments of ``run_face_lod`` (``ratios``, ``face_counts``,
+    ``target_fractions``, ``neutral``, ``repeats``, ``error_frames`` ...). Rows: triangles and
+    the measured surface error per level (asset units, from the written manifest, and relative to
+    the bounding-box diagonal). Raises FormatError for input that is not a face.
+    """
+    started = time.perf_counter()
+    from ..face_lod.pipeline import run_face_lod
+    from ..io.manifest import read_lod_manifest
+
+    if progress is not None:
+        progress(None, "face levels")
+    run = run_face_lod(source, output, **options)  # type: ignore[arg-type]
+    manifest = next(path for path in run.files if path.name.endswith("_face_lod.json"))
+    errors = [level["error"] for level in read_lod_manifest(manifest)["levels"]]
+    level, triangles = run.columns.index("level"), run.columns.index("triangles")
+    relative = run.columns.index("Hausdorff (% of diagonal)")
+    rows = [
+        LevelRow(int(row[level]), "", int(row[triangles]), None, float(error), float(row[relative]) / 100.0)
+        for row, error in zip(run.rows, errors)
+    ]
+    return AssetResult("face", os.fspath(source), list(run.files), rows, time.perf_counter() - started, run.notes)

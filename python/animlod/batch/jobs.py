@@ -1,7 +1,7 @@
 """The jobs a batch can run on an asset, and the options each accepts.
 
 A job is a function ``job(source, output_folder, *, progress=None, **options) -> AssetResult``
-(see :mod:`animlod.pipelines`). The built-in ones are named (``simplify``, ``character``,
+(see :mod:`animlod.pipelines`). The built-in ones are named (``simplify``, ``character``, ``face``,
 ``motion``); a studio's own job is named by its import path, ``"package.module:function"``,
 and must be importable on every worker.
 

@@ -2,9 +2,10 @@
 :class:`~animlod.pipelines.result.AssetResult` out.
 
 They wrap the pipelines (:func:`simplify_document`, :func:`simplify_sequence`,
-:func:`build_character`) with one calling convention, ``job(source, output_folder, *,
-progress=None, **options)``, and one result record, so that the batch runner and the command
-line treat every technique alike. The motion job is :func:`animlod.pipelines.motion.motion_asset`.
+:func:`build_character`, :func:`animlod.face_lod.pipeline.run_face_lod`) with one calling
+convention, ``job(source, output_folder, *, progress=None, **options)``, and one result record,
+so that the batch runner treats every technique alike. The motion job is
+:func:`animlod.pipelines.motion.motion_asset`.
 """
 
 from __future__ import annotations

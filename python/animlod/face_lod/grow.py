@@ -90,27 +90,6 @@ def grow_regions(features: np.ndarray, faces: np.ndarray, options: GrowOptions |
     return FaceRegions(names, result.astype(np.int32), groups)
 
 
-def grow_labels(labels: np.ndarray, faces: np.ndarray, free: np.ndarray, max_rings: int) -> np.ndarray:
-    """Labels spread into ``free (V,) bool`` vertices over mesh edges, one ring per step, for at
-    most ``max_rings`` rings; a free vertex takes the smallest label among its labelled neighbours.
-    Returns a new (V,) array (free vertices left unreached keep their label)."""
-    labels = np.asarray(labels, dtype=np.int64).copy()
-    edges = _edges(np.asarray(faces, dtype=np.int64))
-    open_ = np.asarray(free, bool).copy()
-    for _ in range(max_rings):
-        sources = ~open_
-        step = np.concatenate([edges, edges[:, ::-1]])
-        step = step[sources[step[:, 0]] & open_[step[:, 1]]]
-        if step.size == 0:
-            break
-        best = np.full(len(labels), np.iinfo(np.int64).max)
-        np.minimum.at(best, step[:, 1], labels[step[:, 0]])
-        reached = np.unique(step[:, 1])
-        labels[reached] = best[reached]
-        open_[reached] = False
-    return labels
-
-
 def _edges(faces: np.ndarray) -> np.ndarray:
     """(E, 2) unique undirected edges, lower vertex first."""
     pairs = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)

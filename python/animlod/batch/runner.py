@@ -3,9 +3,9 @@
 - Cluster: a ``distributed.LocalCluster`` sized to the machine (one single-threaded worker
   process per core, memory split evenly) unless a client or a scheduler address is given; the
   same code runs on any Dask cluster whose workers share the output folder's file system.
-- One asset per worker at a time: workers have one thread, and the scheduler hands a worker its
-  next asset only when it is free (``worker-saturation`` 1.0), so that a worker's memory holds
-  one asset.
+- One asset per worker at a time: workers have one thread, and the runner submits an asset only
+  when a thread is free (see :func:`_run_pending`), so that a worker's memory holds one asset
+  and a worker's death is counted against the asset that caused it alone.
 - Failures: a job that fails comes back as a failed record (:func:`animlod.batch.task.run_asset`);
   a worker that dies (a crash in native code, the memory limit) is restarted by its nanny and
   the asset is tried once more on another worker, then marked failed (``allowed-failures`` 1).
@@ -168,7 +168,15 @@ def run_batch(
 
 
 def _run_pending(client, pending, root: Path, records: dict, ran_flags: dict, progress: BatchProgress, assets) -> None:
-    """Submit ``pending`` (largest first), collect records as they finish, keep the catalogue."""
+    """Run ``pending`` (largest first), collect records as they finish, keep the catalogue.
+
+    At most one asset per worker thread is in the cluster at a time: the next is submitted as one
+    finishes. Handing a worker a second asset while it runs one would put both in memory, and
+    when the first kills the worker process Dask counts the death against both (its
+    ``allowed-failures``), so an innocent asset could be marked failed.
+    """
+    from collections import deque
+
     from distributed import as_completed
 
     topic = f"animlod-batch-{secrets.token_hex(6)}"
@@ -179,23 +187,35 @@ def _run_pending(client, pending, root: Path, records: dict, ran_flags: dict, pr
             progress.asset_event(str(message.get("asset")), message.get("fraction"), str(message.get("message", "")))
 
     client.subscribe_topic(topic, on_event)
-    ordered = sorted(pending, key=lambda item: -item[2])
-    futures = {}
-    for rank, (asset, digest, _size) in enumerate(ordered):
-        future = client.submit(
-            run_asset, asset, os.fspath(root), digest, topic,
-            key=f"animlod-{rank}-{topic}", pure=False, priority=len(ordered) - rank,
-        )  # fmt: skip
-        futures[future] = (asset, digest)
+    waiting = deque(sorted(pending, key=lambda item: -item[2]))
+    futures: dict = {}  # the assets in the cluster, submitted and not yet collected
+    running = as_completed(loop=client.loop)
+    submitted = 0
+
+    def submit_while_free() -> None:
+        nonlocal submitted
+        slots = max(1, _threads(client))  # read each time: a cluster may grow or shrink
+        while waiting and len(futures) < slots:
+            asset, digest, _size = waiting.popleft()
+            key = f"animlod-{submitted}-{topic}"
+            future = client.submit(run_asset, asset, os.fspath(root), digest, topic, key=key, pure=False)
+            futures[future] = (asset, digest)
+            running.add(future)
+            submitted += 1
+
     last_write = time.monotonic()
     try:
-        for future in as_completed(futures, loop=client.loop):
-            asset, digest = futures[future]
+        submit_while_free()
+        for future in running:
+            asset, digest = futures.pop(future)
             try:
                 record = future.result()
             except Exception as error:
                 record = _failed(asset, digest, _lost(error, asset))
+            # Released at once: a record held on a worker that dies later would be recomputed.
+            future.release()
             records[asset.name], ran_flags[asset.name] = record, True
+            submit_while_free()
             progress.asset_done(record)
             if time.monotonic() - last_write >= CATALOGUE_INTERVAL:
                 _write(root, assets, records, ran_flags)
@@ -205,6 +225,17 @@ def _run_pending(client, pending, root: Path, records: dict, ran_flags: dict, pr
         raise
     finally:
         client.unsubscribe_topic(topic)
+
+
+def _threads(client) -> int:
+    """Worker threads in the cluster now (from the client's cached view of the scheduler)."""
+    return sum(int(worker.get("nthreads", 1)) for worker in _workers(client).values())
+
+
+def _workers(client) -> dict:
+    """The scheduler's workers (address -> info), every one of them."""
+    info = client.scheduler_info(n_workers=-1) if _takes_n_workers(client) else client.scheduler_info()
+    return info.get("workers", {})
 
 
 def _lost(error: BaseException, asset: AssetSpec) -> dict:
@@ -255,8 +286,7 @@ def _wait_for_a_worker(client, scheduler: str | None, timeout: float) -> None:
 
 def _check_workers(client) -> tuple[int, list[str]]:
     """How many workers there are, and a note when some run several assets at once."""
-    info = client.scheduler_info(n_workers=-1) if _takes_n_workers(client) else client.scheduler_info()
-    workers = info.get("workers", {})
+    workers = _workers(client)
     threads = [int(worker.get("nthreads", 1)) for worker in workers.values()]
     notes = []
     if any(count > 1 for count in threads):

@@ -36,7 +36,7 @@ $(VENV)/bin/pip: | system-packages
 # An editable install: Python sources are used from the checkout, and the extension is
 # rebuilt incrementally (build/python-*) whenever this target runs.
 # Optional dependency groups of pyproject.toml; `make bench` adds the benchmark peers.
-EXTRAS := test
+EXTRAS := test,batch
 python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
 	$(VENV)/bin/pip install -q scikit-build-core pybind11
 	$(VENV)/bin/pip install -q --no-build-isolation -e ".[$(EXTRAS)]"
@@ -79,7 +79,7 @@ crowd-binary: $(CPP_BUILD)/build.ninja
 bench-crowd: python-package crowd-binary
 	ANIMLOD_CROWD_BIN=$(CROWD_BIN) $(PY) bench/crowd/run_bench.py
 
-bench: EXTRAS := test,bench
+bench: EXTRAS := test,batch,bench
 bench: python-package
 	bench/openmesh_build/run.sh
 	@for script in bench/bench_*.py; do echo "== $$script"; $(PY) $$script || exit 1; done
@@ -118,7 +118,7 @@ fuzz-build: $(OPENMESH_CONFIG)
 	  -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" > build/fuzz.configure.log
 	cmake --build build/fuzz --parallel $(JOBS)
 
-fuzz: EXTRAS := test,fuzz
+fuzz: EXTRAS := test,batch,fuzz
 fuzz: python-package fuzz-build
 	FUZZ_SECONDS=$(FUZZ_SECONDS) $(PY) tests/fuzz/run.py $(FUZZ_ARGS)
 

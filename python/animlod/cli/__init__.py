@@ -26,7 +26,7 @@ from collections.abc import Iterator
 from ..io.errors import error_line
 
 # Subcommand modules in the order --help lists them.
-COMMAND_MODULES = ("info", "demo", "simplify", "character", "motion", "face", "tdag", "crowd")
+COMMAND_MODULES = ("info", "demo", "simplify", "character", "motion", "face", "tdag", "crowd", "batch")
 
 
 class UserError(Exception):

@@ -105,9 +105,7 @@ class _Progress:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..motion_lod.chain import build_motion_chain, joint_floor
-    from ..motion_lod.objective import Weights
-    from ..motion_lod.refit import SlsqpOptions
+    from ..pipelines.motion import build_motion_levels
 
     if args.hard and args.solver == "newton":
         raise UserError("--hard: bone-length equality constraints need an SLSQP solver (slsqp or slsqp-python)")
@@ -115,107 +113,43 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--workers: must be at least 0, got {args.workers}")
     if args.ranking not in RANKINGS:
         raise UserError(f"--ranking: no ranking named {args.ranking!r} (choose from {', '.join(RANKINGS)})")
-    motion, skin = _read_input(args)
+    if input_kind(args.input) not in ("bvh", "gltf"):
+        raise UserError(f"{args.input}: motion LoD needs a .bvh or a skinned .glb/.gltf")
+    bars: list[_Progress] = []  # made when the first level starts: bad input fails before any bar
+
+    def on_level(index: int, joints: int, frame_count: int, level_count: int):
+        if not bars:
+            bars.append(_Progress(level_count))
+        return bars[0].start_level(index, joints, frame_count)
+
     try:
-        analysis, counts = _plan_levels(args, motion)
-    except ValueError as error:  # the skeleton or the level request: name the file they concern
-        raise UserError(f"{args.input}: {error}") from None
-    floor = joint_floor(motion, analysis)
-    if floor.possible_levels == 1:
-        print(
-            f"{args.input}: nothing can freeze ({floor.total} joints, all kept: {floor.explain()}); "
-            "writing one level, the input's motion",
-            file=sys.stderr,
-        )
-    progress = _Progress(len(counts))
-    try:
-        chain = build_motion_chain(
-            motion,
-            counts,
-            weights=Weights(*args.weights),
+        report = build_motion_levels(
+            args.input,
+            args.output,
+            args.levels,
+            joints=args.joints,
+            lock=args.lock,
+            ranking=args.ranking,
             solver=args.solver,
-            slsqp_options=SlsqpOptions(hard_constraints=args.solver != "newton" and not args.penalty),
+            penalty=args.penalty,
             workers=args.workers,
-            skin=skin,
-            on_level=lambda index, joints: progress.start_level(index, joints, motion.frame_count),
-            analysis=analysis,
+            translation_tolerance=args.translation_tolerance,
+            weights=args.weights,
+            max_frames=args.max_frames,
+            clip=args.clip,
+            on_level=on_level,
+            on_note=lambda text: print(text, file=sys.stderr),
         )
     finally:
-        progress.close()
-
-    output = Path(args.output)
-    output.mkdir(parents=True, exist_ok=True)
-    stem = input_stem(args.input)
-    from ..io.bvh import write_bvh
-    from ..io.manifest import write_lod_manifest
-
-    rows = []
-    for index, level in enumerate(chain.levels):
-        files = [f"{stem}_lod{index}.bvh"]
-        write_bvh(output / files[0], level.motion)
-        if level.skin is not None:
-            from ..io.gltf import write_glb
-
-            files.append(f"{stem}_lod{index}.glb")
-            write_glb(output / files[1], level.skin, [level.motion])
-        rows.append({"files": files, "joints": level.report.joint_count, "error": level.report.max_error})
-    # The runtime's level chooser: each level's largest joint position error in asset units.
-    write_lod_manifest(output / f"{stem}_motion_lod.json", "motion", rows)
-    _print_summary(chain, floor)
+        for bar in bars:
+            bar.close()
+    _print_summary(report.chain, report.floor)
     if args.plot:
         from ..motion_lod.plots import plot_chain
 
-        plot_chain(output / f"{stem}_motion_lod.png", chain, motion.skeleton.names)
+        stem = input_stem(args.input)
+        plot_chain(Path(args.output) / f"{stem}_motion_lod.png", report.chain, report.motion.skeleton.names)
     return 0
-
-
-def _read_input(args: argparse.Namespace):
-    """The motion to simplify and, for a skinned glTF, its skin."""
-    kind = input_kind(args.input)
-    if kind == "bvh":
-        from ..io.bvh import read_bvh
-
-        return read_bvh(args.input), None
-    if kind == "gltf":
-        from ..io.gltf import read_skinned
-
-        skin, motions = read_skinned(args.input)
-        if not motions:
-            raise UserError(f"{args.input}: the skinned mesh has no animation to simplify")
-        if args.clip is None:
-            from ..motion_lod.clips import merge_split_clips
-
-            merged = merge_split_clips(motions)
-            if merged is not None:
-                print(f"{args.input}: its {len(motions)} animations each move other joints: simplifying them as one "
-                      "motion (use --clip to take one)", file=sys.stderr)  # fmt: skip
-                return merged, skin
-            return motions[0], skin
-        if not 0 <= args.clip < len(motions):
-            raise UserError(f"--clip: {args.input} has {len(motions)} animations, got index {args.clip}")
-        return motions[args.clip], skin
-    raise UserError(f"{args.input}: motion LoD needs a .bvh or a skinned .glb/.gltf")
-
-
-def _plan_levels(args: argparse.Namespace, motion):
-    """The motion analysis and the joint counts of the levels (ValueError on a bad request)."""
-    from ..motion_lod.analysis import analyze_motion
-    from ..motion_lod.chain import joint_floor, level_joint_counts
-
-    analysis = analyze_motion(
-        motion,
-        locked=args.lock,
-        max_frames=args.max_frames,
-        translation_tolerance=args.translation_tolerance,
-        ranking=args.ranking,
-    )
-    floor = joint_floor(motion, analysis)
-    if args.joints:
-        return analysis, level_joint_counts(motion, analysis, args.joints)
-    if floor.possible_levels == 1:  # every joint stays: one level, said in run()
-        return analysis, [floor.total]
-    levels = args.levels if args.levels is not None else min(8, floor.possible_levels)
-    return analysis, level_joint_counts(motion, analysis, levels)
 
 
 def _print_summary(chain, floor) -> None:

@@ -4,6 +4,20 @@ The command line, ``make demo`` and the batch runner call these; they hold no ar
 and no printing.
 """
 
+from .assets import character_asset, face_asset, simplify_asset
 from .lod_document import DocumentReport, simplify_document
+from .motion import MotionReport, build_motion_levels, motion_asset
+from .result import AssetResult, LevelRow
 
-__all__ = ["DocumentReport", "simplify_document"]
+__all__ = [
+    "AssetResult",
+    "DocumentReport",
+    "LevelRow",
+    "MotionReport",
+    "build_motion_levels",
+    "character_asset",
+    "face_asset",
+    "motion_asset",
+    "simplify_asset",
+    "simplify_document",
+]

@@ -30,6 +30,7 @@ class SequenceLevel:
     reached: bool
     aqem_error: float  # asset units, the largest collapse error (RMS plane distance)
     surface: dict[str, float] | None  # mean/max over frames of Hausdorff and RMS, relative; None unmeasured
+    error: float | None = None  # asset units, max over frames of the Hausdorff distance; None unmeasured
 
 
 @dataclass
@@ -76,9 +77,11 @@ def simplify_sequence(
     levels = []
     for index, level in enumerate(result.levels, start=1):
         path = _write_level(kind, source, folder / f"{stem}_lod{index}", level.mesh)
-        surface = surface_error(original, level.mesh, samples=10000).summary() if measure else None
+        measured = surface_error(original, level.mesh, samples=10000) if measure else None
+        surface = measured.summary() if measured is not None else None
+        error = float(measured.hausdorff.max()) if measured is not None else None
         faces, target = level.mesh.face_count, level.target_face_count
-        levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface))
+        levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error))
     return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds)
 
 

@@ -1,0 +1,76 @@
+"""Content hashes of an asset's inputs and options: what a rerun compares to skip an asset.
+
+The fingerprint covers every byte the job will read (a .gltf's external buffers and images
+too, every frame of a sequence), the job, its options and the animlod version, so that an
+asset is redone when any of them changes and skipped otherwise, whatever the files' times.
+"""
+
+from __future__ import annotations
+
+import glob
+import hashlib
+import json
+import os
+from pathlib import Path
+from urllib.parse import unquote
+
+from .. import __version__
+from ..io.meshseq import MESH_SUFFIXES
+from .spec import AssetSpec
+
+_CHUNK = 1 << 20
+FORMAT = "animlod-batch-fingerprint/1"
+
+
+def input_files(asset: AssetSpec) -> list[Path]:
+    """Every file the job reads for ``asset``, in a stable order."""
+    source = asset.input
+    if asset.kind == "sequence":
+        if glob.has_magic(source):
+            return sorted(Path(match) for match in glob.glob(source, recursive=True) if Path(match).is_file())
+        path = Path(source)
+        if path.is_dir():
+            return sorted(item for item in path.iterdir() if item.is_file() and item.suffix.lower() in MESH_SUFFIXES)
+        return [path]
+    path = Path(source)
+    if asset.kind == "gltf" and path.suffix.lower() == ".gltf":
+        return [path, *_external_files(path)]
+    return [path]
+
+
+def _external_files(path: Path) -> list[Path]:
+    """Buffers and images a .gltf names by relative URI (data: URIs are inside the file)."""
+    try:
+        document = json.loads(path.read_bytes().decode("utf-8-sig"))
+    except (OSError, ValueError):
+        return []  # the job will say what is wrong with the file
+    if not isinstance(document, dict):
+        return []
+    found = []
+    for key in ("buffers", "images"):
+        items = document.get(key)
+        for item in items if isinstance(items, list) else []:
+            uri = item.get("uri") if isinstance(item, dict) else None
+            if isinstance(uri, str) and uri and not uri.startswith("data:") and "://" not in uri:
+                candidate = path.parent / unquote(uri)
+                if candidate.is_file():
+                    found.append(candidate)
+    return sorted(set(found))
+
+
+def fingerprint(asset: AssetSpec) -> tuple[str, int]:
+    """(hex SHA-256 of the asset's job, options, animlod version and input bytes, total input bytes)."""
+    digest = hashlib.sha256()
+    header = {"format": FORMAT, "version": __version__, "job": asset.job, "kind": asset.kind, "options": asset.options}
+    digest.update(json.dumps(header, sort_keys=True, separators=(",", ":"), default=str).encode())
+    files = input_files(asset)
+    base = Path(os.path.commonpath([os.fspath(file.resolve()) for file in files])) if files else Path()
+    total = 0
+    for file in files:
+        name = file.resolve().relative_to(base).as_posix() if len(files) > 1 else file.name
+        digest.update(f"\0{name}\0".encode())
+        with open(file, "rb") as handle:
+            while chunk := handle.read(_CHUNK):
+                digest.update(chunk)
+                total += len(chunk)
+    return digest.hexdigest(), total

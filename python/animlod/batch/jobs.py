@@ -1,0 +1,172 @@
+"""The jobs a batch can run on an asset, and the options each accepts.
+
+A job is a function ``job(source, output_folder, *, progress=None, **options) -> AssetResult``
+(see :mod:`animlod.pipelines`). The built-in ones are named (``simplify``, ``character``, ``face``,
+``motion``); a studio's own job is named by its import path, ``"package.module:function"``,
+and must be importable on every worker.
+
+The options a job accepts are read from the signatures of the functions it calls, and their
+defaults from those signatures too, so that a manifest is checked against the code that will
+run it, with no second list to keep in step.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+# The job an input gets when the spec names none, by input kind (animlod.io.detect.input_kind).
+DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "bvh": "motion"}
+# Keyword arguments a manifest never sets: the runner owns progress, and a batch spreads its
+# work over assets (one core each), not over the processes of one asset.
+_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level", "on_note"})
+
+
+@dataclass(frozen=True)
+class Job:
+    """A named job: its function and, per input kind, the options it accepts with their defaults."""
+
+    name: str
+    path: str  # "module:function", imported where the job runs
+    kinds: tuple[str, ...]  # input kinds it takes; empty: any
+    option_sources: dict[str, tuple[str, ...]]  # kind -> "module:function" whose keywords are options
+
+    def function(self) -> Callable:
+        return _import(self.path)
+
+    def options(self, kind: str) -> dict[str, object] | None:
+        """Option name -> default for input of ``kind``; None when the job takes any keyword."""
+        sources = self.option_sources.get(kind, self.option_sources.get("*", (self.path,)))
+        accepted: dict[str, object] = {}
+        for source in sources:
+            found = _keywords(_import(source))
+            if found is None:
+                return None
+            if source in _SCALARS_ONLY:  # the per-vertex arrays are the pipeline's to set
+                found = {name: value for name, value in found.items() if isinstance(value, (bool, int, float, str))}
+            accepted.update(found)
+        return accepted
+
+
+_AQEM = "animlod.aqem:simplify_animated"
+# Sources whose keywords are options only when their default is a plain value: simplify_animated
+# also takes per-vertex arrays and the level targets, which the pipelines fill in.
+_SCALARS_ONLY = frozenset({_AQEM})
+BUILTIN_JOBS = {
+    "simplify": Job(
+        "simplify",
+        "animlod.pipelines.assets:simplify_asset",
+        ("gltf", "npz", "sequence"),
+        {
+            "gltf": ("animlod.pipelines.lod_document:simplify_document", _AQEM),
+            "npz": ("animlod.pipelines.lod_sequence:simplify_sequence", _AQEM),
+            "sequence": ("animlod.pipelines.lod_sequence:simplify_sequence", _AQEM),
+        },
+    ),
+    "character": Job(
+        "character",
+        "animlod.pipelines.assets:character_asset",
+        ("gltf",),
+        {"gltf": ("animlod.pipelines.character:build_character", _AQEM)},
+    ),
+    "face": Job(
+        "face",
+        "animlod.pipelines.assets:face_asset",
+        ("gltf", "sequence"),
+        {"*": ("animlod.face_lod.pipeline:run_face_lod",)},
+    ),
+    "motion": Job(
+        "motion",
+        "animlod.pipelines.motion:motion_asset",
+        ("bvh", "gltf"),
+        {"*": ("animlod.pipelines.motion:build_motion_levels",)},
+    ),
+}
+
+
+def find_job(name: str) -> Job:
+    """The built-in job ``name``, or a custom job ``"module:function"`` (imported here, so that
+    a typo is found before anything runs). Raises ValueError naming the job."""
+    if name in BUILTIN_JOBS:
+        return BUILTIN_JOBS[name]
+    if ":" not in name:
+        raise ValueError(f"job {name!r}: unknown; built-in jobs are {', '.join(BUILTIN_JOBS)}, or 'module:function'")
+    try:
+        function = _import(name)
+    except (ImportError, AttributeError) as error:
+        raise ValueError(f"job {name!r}: cannot be imported ({error})") from None
+    if not callable(function):
+        raise ValueError(f"job {name!r}: not a function")
+    return Job(name, name, (), {})
+
+
+def check_options(job: Job, kind: str, options: dict[str, object]) -> str | None:
+    """Why ``options`` do not suit ``job`` on input of ``kind`` (the first problem, naming the
+    option), or None when they do. Types are checked against each option's default."""
+    if job.kinds and kind not in job.kinds:
+        return f"job {job.name} does not take {kind} input (it takes {', '.join(job.kinds)})"
+    accepted = job.options(kind)
+    if accepted is None:
+        return None
+    for name, value in options.items():
+        if name not in accepted:
+            known = ", ".join(sorted(accepted))
+            return f"option {name!r}: unknown for job {job.name} on {kind} input (known: {known})"
+        problem = _type_problem(value, accepted[name])
+        if problem:
+            return f"option {name!r}: {problem}"
+    return None
+
+
+def _type_problem(value: object, default: object) -> str | None:
+    """What is wrong with ``value`` for an option whose default is ``default`` (None if nothing)."""
+    if default is None or default is inspect.Parameter.empty:
+        return None
+    if isinstance(default, bool):
+        return None if isinstance(value, bool) else f"expected true or false, got {value!r}"
+    if isinstance(default, int):
+        if isinstance(value, bool) or not isinstance(value, int):
+            return f"expected a whole number, got {value!r}"
+        return None
+    if isinstance(default, float):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return f"expected a number, got {value!r}"
+        return None if not math.isnan(value) else "expected a number, got nan"
+    if isinstance(default, str):
+        return None if isinstance(value, str) else f"expected a string, got {value!r}"
+    if isinstance(default, Sequence):
+        if not isinstance(value, (list, tuple)):
+            return f"expected a list, got {value!r}"
+        if default:
+            for item in value:
+                problem = _type_problem(item, default[0])
+                if problem:
+                    return f"in the list: {problem}"
+    return None
+
+
+def _keywords(function: Callable) -> dict[str, object] | None:
+    """Keyword parameters of ``function`` (name -> default) but the reserved ones; None when it
+    takes ``**kwargs`` (anything goes)."""
+    accepted = {}
+    for parameter in inspect.signature(function).parameters.values():
+        if parameter.kind is inspect.Parameter.VAR_KEYWORD:
+            if function.__module__.startswith("animlod."):
+                continue  # the pipeline's **aqem_options: listed by the AQEM source
+            return None
+        if parameter.kind in (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.POSITIONAL_ONLY):
+            continue
+        if parameter.name in _RESERVED or parameter.name.startswith("_"):
+            continue
+        if parameter.default is inspect.Parameter.empty and parameter.kind is not inspect.Parameter.KEYWORD_ONLY:
+            continue  # the positional inputs (source, output, mesh)
+        accepted[parameter.name] = parameter.default
+    return accepted
+
+
+def _import(path: str) -> Callable:
+    module, _, attribute = path.partition(":")
+    return getattr(importlib.import_module(module), attribute)

@@ -1,0 +1,239 @@
+"""The motion LoD pipeline: a BVH or a skinned glTF clip in, one BVH (and GLB) per level out.
+
+Joint elimination and re-fit (the motion LoD paper, Sections 4-6) through
+:func:`animlod.build_motion_chain`; ``animlod motion`` and the batch runner's ``motion`` job
+call :func:`build_motion_levels`.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..io.detect import input_kind, input_stem
+from ..io.errors import FormatError
+from ..model import Motion, SkinnedMesh
+from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis
+from ..motion_lod.chain import SOLVERS, JointFloor, MotionLodChain
+from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
+from .result import AssetResult, LevelRow, Progress
+
+
+@dataclass
+class MotionReport:
+    """What :func:`build_motion_levels` did.
+
+    chain : the analysis and the levels, finest first (level 0 keeps every joint).
+    files : per level, the files written (relative to the output folder): a BVH, and a GLB for a
+        skinned glTF input.
+    manifest : the level chooser's manifest (``<stem>_motion_lod.json``).
+    faces : triangles of the skinned mesh (None for a BVH).
+    motion : the clip simplified (several split clips merged into one, see ``notes``).
+    floor : the fewest joints the skeleton allows and why (:func:`animlod.motion_lod.chain.joint_floor`).
+    notes : what the user should know (clips merged, nothing could freeze).
+    """
+
+    chain: MotionLodChain
+    files: list[list[Path]]
+    manifest: Path
+    faces: int | None
+    motion: Motion
+    floor: JointFloor
+    notes: list[str]
+
+
+def build_motion_levels(
+    source: str | os.PathLike,
+    output: str | os.PathLike,
+    levels: int | None = None,
+    *,
+    joints: Sequence[int] | None = None,
+    lock: Sequence[str] = (),
+    ranking: str = DEFAULT_RANKING,
+    solver: str = SOLVERS[0],
+    penalty: bool = False,
+    workers: int = 0,
+    translation_tolerance: float = TRANSLATION_TOLERANCE,
+    weights: Sequence[float] = (0.2, 0.4, 0.4),
+    max_frames: int = 600,
+    clip: int | None = None,
+    on_level: Callable[[int, int, int, int], Callable[[float], None] | None] | None = None,
+    on_note: Callable[[str], None] | None = None,
+) -> MotionReport:
+    """Motion levels of ``source`` (a .bvh, or a .glb/.gltf with a skinned mesh and animations)
+    written into the folder ``output`` as ``<stem>_lod<i>.bvh`` (and ``.glb`` with the skin moved
+    onto the kept joints), plus ``<stem>_motion_lod.json``, each file atomically.
+
+    Parameters
+    ----------
+    levels : number of levels from every joint down to the fewest possible (the paper's 100 .. 8 %
+        where the skeleton allows); None: 8, or as many as the skeleton allows.
+    joints : joint counts of the levels instead of ``levels``.
+    lock : names of joints never to freeze.
+    ranking : which joints freeze first (:data:`animlod.motion_lod.ranking.RANKINGS`).
+    solver, penalty : the re-fit (``"slsqp"`` in the core, ``"slsqp-python"``, ``"newton"``);
+        bone lengths are equality constraints with the SLSQP solvers unless ``penalty``.
+    workers : threads of the core's solve (0: every core), or processes of the Python solvers.
+    translation_tolerance : fraction of a bone's length above which a translating joint never freezes.
+    weights : (alpha, beta, gamma) of the distance, string and angle errors (Eq. 5).
+    max_frames : frames the motion analysis looks at, at most.
+    clip : which animation of a glTF input; None: the first, or all of them as one motion when
+        each moves other joints (one animation per joint node).
+    on_level : called with (level index, joint count, frame count, number of levels) as each
+        level starts; may return a callback taking the frames done.
+    on_note : called with each note as it arises (also kept in the report).
+
+    Raises FormatError for unreadable input or a glTF without a skinned, animated mesh;
+    ValueError naming the option for bad options and impossible level requests.
+    """
+    from ..motion_lod.chain import build_motion_chain
+    from ..motion_lod.objective import Weights
+    from ..motion_lod.refit import SlsqpOptions
+
+    if workers < 0:
+        raise ValueError(f"workers: must be at least 0, got {workers}")
+    if ranking not in RANKINGS:
+        raise ValueError(f"ranking: no ranking named {ranking!r} (choose from {', '.join(RANKINGS)})")
+    if len(weights) != 3:
+        raise ValueError(f"weights: expected (alpha, beta, gamma), got {len(weights)} values")
+    notes: list[str] = []
+
+    def note(text: str) -> None:
+        notes.append(text)
+        if on_note is not None:
+            on_note(text)
+
+    motion, skin = _read_input(source, clip, note)
+    analysis, counts, floor = _plan_levels(motion, levels, joints, lock, max_frames, translation_tolerance, ranking)
+    if floor.possible_levels == 1:
+        note(
+            f"{os.fspath(source)}: nothing can freeze ({floor.total} joints, all kept: {floor.explain()}); "
+            "writing one level, the input's motion"
+        )
+    chain = build_motion_chain(
+        motion,
+        counts,
+        weights=Weights(*weights),
+        solver=solver,
+        slsqp_options=SlsqpOptions(hard_constraints=solver != "newton" and not penalty),
+        workers=workers,
+        skin=skin,
+        on_level=(lambda index, count: on_level(index, count, motion.frame_count, len(counts))) if on_level else None,
+        analysis=analysis,
+    )
+
+    from ..io.bvh import write_bvh
+    from ..io.manifest import write_lod_manifest
+
+    folder = Path(output)
+    folder.mkdir(parents=True, exist_ok=True)
+    stem = input_stem(source)
+    files, rows = [], []
+    for index, level in enumerate(chain.levels):
+        names = [Path(f"{stem}_lod{index}.bvh")]
+        write_bvh(folder / names[0], level.motion)
+        if level.skin is not None:
+            from ..io.gltf import write_glb
+
+            names.append(Path(f"{stem}_lod{index}.glb"))
+            write_glb(folder / names[1], level.skin, [level.motion])
+        files.append(names)
+        rows.append({"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
+                     "error": level.report.max_error})  # fmt: skip
+    # The runtime's level chooser: each level's largest joint position error in asset units.
+    manifest = Path(f"{stem}_motion_lod.json")
+    write_lod_manifest(folder / manifest, "motion", rows)
+    faces = None if skin is None else int(skin.faces.shape[0])
+    return MotionReport(chain, files, manifest, faces, motion, floor, notes)
+
+
+def _read_input(
+    source: str | os.PathLike, clip: int | None, note: Callable[[str], None]
+) -> tuple[Motion, SkinnedMesh | None]:
+    """The motion to simplify and, for a skinned glTF, its skin."""
+    path = os.fspath(source)
+    kind = input_kind(source)
+    if kind == "bvh":
+        from ..io.bvh import read_bvh
+
+        return read_bvh(source), None
+    if kind != "gltf":
+        raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or a skinned glTF")
+    from ..io.gltf import read_skinned
+
+    skin, motions = read_skinned(source)
+    if not motions:
+        raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
+    if clip is None:
+        from ..motion_lod.clips import merge_split_clips
+
+        merged = merge_split_clips(motions)
+        if merged is not None:
+            note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
+                 "(use --clip to take one)")  # fmt: skip
+            return merged, skin
+        return motions[0], skin
+    if not 0 <= clip < len(motions):
+        raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
+    return motions[clip], skin
+
+
+def _plan_levels(
+    motion: Motion,
+    levels: int | None,
+    joints: Sequence[int] | None,
+    lock: Sequence[str],
+    max_frames: int,
+    translation_tolerance: float,
+    ranking: str,
+) -> tuple[MotionAnalysis, list[int], JointFloor]:
+    """The motion analysis, the joint counts of the levels and the joint floor (ValueError on a
+    bad request)."""
+    from ..motion_lod.analysis import analyze_motion
+    from ..motion_lod.chain import joint_floor, level_joint_counts
+
+    analysis = analyze_motion(
+        motion, locked=lock, max_frames=max_frames, translation_tolerance=translation_tolerance, ranking=ranking
+    )
+    floor = joint_floor(motion, analysis)
+    if joints:
+        return analysis, level_joint_counts(motion, analysis, list(joints)), floor
+    if floor.possible_levels == 1:  # every joint stays: one level, in a note
+        return analysis, [floor.total], floor
+    count = levels if levels is not None else min(8, floor.possible_levels)
+    return analysis, level_joint_counts(motion, analysis, count), floor
+
+
+def motion_asset(
+    source: str | os.PathLike,
+    output: str | os.PathLike,
+    *,
+    progress: Progress | None = None,
+    **options: object,
+) -> AssetResult:
+    """The batch job of :func:`build_motion_levels`: its files in the folder ``output`` and one
+    row per level (joints, max joint position error in asset units and over the figure size,
+    the level's re-fit seconds). ``options`` are the keyword arguments of :func:`build_motion_levels`.
+    """
+    started = time.perf_counter()
+
+    def on_level(index: int, count: int, frames: int, levels: int) -> None:
+        if progress is not None:
+            progress(index / levels, f"level {index}: {count} joints, {frames} frames")
+
+    options.setdefault("workers", 1)  # a batch spreads its work over assets, one core each
+    report = build_motion_levels(source, output, on_level=on_level, **options)  # type: ignore[arg-type]
+    folder = Path(output)
+    size = report.chain.figure_size
+    rows = [
+        LevelRow(index, "", report.faces, level.report.joint_count, level.report.max_error,
+                 level.report.max_error / size if size > 0 else None, level.report.seconds)
+        for index, level in enumerate(report.chain.levels)
+    ]  # fmt: skip
+    outputs = [folder / name for names in report.files for name in names] + [folder / report.manifest]
+    failures = sum(len(level.report.failures) for level in report.chain.levels)
+    notes = report.notes + ([f"{failures} frames needed a second solve"] if failures else [])
+    return AssetResult("motion", os.fspath(source), outputs, rows, time.perf_counter() - started, notes)

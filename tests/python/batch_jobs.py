@@ -1,0 +1,29 @@
+"""Custom batch jobs for tests/python/test_batch.py (imported by name on the Dask workers).
+
+They stand for what goes wrong on a farm: a worker process that dies in the middle of an
+asset (a crash in native code, the kernel's out-of-memory killer), once or every time.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+from pathlib import Path
+
+from animlod.pipelines import simplify_asset
+
+
+def crash_once(source: str, output: str, *, progress=None, marker: str = "", **options: object):
+    """First attempt: write half an output, then SIGKILL this worker process. Later attempts
+    (``marker`` exists): the simplify job, as normal."""
+    if not Path(marker).exists():
+        Path(marker).write_text(str(os.getpid()))
+        Path(output, "half_written_lod.glb").write_bytes(b"glTF\x02\x00\x00\x00")
+        os.kill(os.getpid(), signal.SIGKILL)
+    return simplify_asset(source, output, progress=progress, **options)
+
+
+def always_crash(source: str, output: str, *, progress=None, **options: object):
+    """Every attempt writes half an output and kills its worker."""
+    Path(output, "half_written_lod.glb").write_bytes(b"glTF\x02\x00\x00\x00")
+    os.kill(os.getpid(), signal.SIGKILL)

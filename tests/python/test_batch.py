@@ -1,0 +1,293 @@
+"""`animlod batch` on a real LocalCluster with 2 single-threaded workers: outputs equal to the
+direct pipeline, a broken asset reported and the rest written, reruns that do no work, a killed
+worker leaving nothing half-written."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+pytest.importorskip("pyarrow")
+
+from animlod import Motion, Skeleton, rotations, synth
+from animlod.batch import BatchProgress, SpecError, connect, read_catalogue, read_spec, run_batch
+from animlod.batch.jobs import find_job
+from animlod.batch.outputs import STATE
+from animlod.cli import main
+from animlod.io import write_bvh, write_glb
+from animlod.io.meshseq import write_obj, write_sequence
+from animlod.io.npz import write_npz
+from animlod.pipelines import simplify_asset
+
+# Small enough for a quick suite: few drive and measured frames per clip.
+QUICK = {"frame_budget": 6, "measured_frames": 2}
+OPTIONS = {**QUICK, "levels": 3}  # levels: the motion job's, for the BVH
+
+
+def _arm_motion() -> Motion:
+    """Four joints in a chain, each turning a little over 8 frames."""
+    skeleton = Skeleton(
+        ["hips", "a", "b", "c", "c_End"], [-1, 0, 1, 2, 3],
+        [[0, 1, 0], [0, 0.4, 0], [0, 0.4, 0], [0, 0.4, 0], [0, 0.2, 0]], end_sites=[False] * 4 + [True],
+    )  # fmt: skip
+    local = rotations.identity((8, 5))
+    for joint, axis in ((1, [1.0, 0, 0]), (2, [0, 0, 1.0]), (3, [1.0, 0, 0])):
+        local[:, joint] = rotations.from_axis_angle(np.array(axis), np.linspace(0, 0.3 * joint, 8))
+    return Motion(skeleton, np.tile([0.0, 1.0, 0.0], (8, 1)), local, fps=24.0)
+
+
+@pytest.fixture(scope="module")
+def client():
+    client, cluster = connect(workers=2)
+    yield client
+    client.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def library(tmp_path_factory) -> Path:
+    """Five small procedural assets of four kinds and one broken file."""
+    root = tmp_path_factory.mktemp("library")
+    for index, rings in enumerate((10, 14)):
+        skin, motion = synth.bending_cylinder_skinned(frames=6, rings=rings, segments=10)
+        (root / "characters").mkdir(exist_ok=True)
+        write_glb(root / "characters" / f"cyl{index}.glb", skin, [motion])
+    write_npz(root / "bar.npz", synth.twisting_bar(frames=5, rings=10, segments=8))
+    write_sequence(root / "seq", synth.bending_cylinder(frames=4, rings=8, segments=8))
+    (root / "motions").mkdir()
+    write_bvh(root / "motions" / "arm.bvh", _arm_motion())
+    (root / "broken.glb").write_bytes(b"glTF\x02\x00\x00\x00 not a glb")
+    return root
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    """Every file below ``folder`` (relative POSIX path -> bytes), the batch's own record aside."""
+    return {
+        path.relative_to(folder).as_posix(): path.read_bytes()
+        for path in sorted(folder.rglob("*"))
+        if path.is_file() and path.name != ".animlod-asset.json"
+    }
+
+
+class Recorder(BatchProgress):
+    def __init__(self) -> None:
+        self.events: list[str] = []
+        self.done: list[str] = []
+
+    def asset_event(self, name, fraction, message) -> None:
+        self.events.append(name)
+
+    def asset_done(self, record) -> None:
+        self.done.append(record["name"])
+
+
+def test_outputs_equal_the_direct_pipeline_and_broken_asset_is_reported(client, library, tmp_path):
+    assets = read_spec(library, options=OPTIONS)
+    names = ["bar", "broken", "characters/cyl0", "characters/cyl1", "motions/arm", "seq"]
+    assert sorted(asset.name for asset in assets) == names
+    recorder = Recorder()
+    result = run_batch(assets, tmp_path / "out", client=client, progress=recorder)
+    assert (result.ran, result.skipped, result.failed, result.workers) == (6, 0, 1, 2)
+    assert sorted(recorder.done) == sorted(asset.name for asset in assets)
+    assert recorder.events  # the workers' progress reached the client
+
+    for asset in assets:
+        if asset.name == "broken":
+            continue
+        direct = tmp_path / "direct" / asset.name
+        find_job(asset.job).function()(asset.input, direct, **asset.options)
+        batch = _files(tmp_path / "out" / asset.name)
+        assert batch and batch == _files(direct), asset.name
+
+    broken = next(record for record in result.records if record["name"] == "broken")
+    assert broken["status"] == "failed"
+    assert broken["error"]["file"].endswith("broken.glb") and broken["error"]["element"] and broken["error"]["reason"]
+    assert not (tmp_path / "out" / "broken").exists()
+    assert list((tmp_path / "out" / STATE / "staging").iterdir()) == []
+
+    rows = read_catalogue(result.catalogue).to_pylist()
+    failed = [row for row in rows if row["status"] == "failed"]
+    assert [(row["asset"], row["error_element"]) for row in failed] == [("broken", broken["error"]["element"])]
+    for asset in ("bar", "seq", "characters/cyl0", "characters/cyl1"):
+        levels = [row for row in rows if row["asset"] == asset]
+        assert [row["level"] for row in levels] == [0, 1, 2, 3], asset
+        triangles = [row["triangles"] for row in levels]
+        assert triangles == sorted(triangles, reverse=True) and triangles[-1] > 0
+        assert all(row["worker"].startswith("tcp://") and row["ran"] for row in levels)
+        assert all((tmp_path / "out" / output).exists() for output in levels[0]["outputs"])
+    motion = [row for row in rows if row["asset"] == "motions/arm"]
+    assert [(row["level"], row["joints"]) for row in motion][0] == (0, 4)
+    assert len(motion) == 3 and motion[-1]["joints"] < 4 and motion[-1]["error"] > 0
+
+
+class CatalogueWatcher(BatchProgress):
+    """Reads the catalogue each time an asset finishes: how many assets it held then."""
+
+    def __init__(self, path: Path) -> None:
+        self.path, self.seen = path, []
+
+    def asset_done(self, record) -> None:
+        rows = read_catalogue(self.path).to_pylist() if self.path.exists() else []
+        self.seen.append(len({row["asset"] for row in rows}))
+
+
+def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, library, tmp_path, monkeypatch):
+    import animlod.batch.runner
+
+    monkeypatch.setattr(animlod.batch.runner, "CATALOGUE_INTERVAL", 0.0)  # rewrite it after every asset
+    assets = [asset for asset in read_spec(library, options=OPTIONS) if asset.name != "broken"]
+    watcher = CatalogueWatcher(tmp_path / "out" / "catalogue.parquet")
+    first = run_batch(assets, tmp_path / "out", client=client, progress=watcher)
+    assert (first.ran, first.failed) == (5, 0)
+    assert watcher.seen == [0, 1, 2, 3, 4]  # the catalogue grew as the assets finished
+    outputs = [path for asset in assets for path in (tmp_path / "out" / asset.name).rglob("*") if path.is_file()]
+    before = {path: path.stat().st_mtime_ns for path in outputs}
+
+    second = run_batch(assets, tmp_path / "out", client=None, workers=1)  # no cluster is started: nothing to do
+    assert (second.ran, second.skipped, second.failed, second.workers) == (0, 5, 0, 0)
+    after = {path: path.stat().st_mtime_ns for path in before}
+    assert after == before
+    rows = read_catalogue(second.catalogue).to_pylist()
+    assert len(rows) == 19 and not any(row["ran"] for row in rows)
+
+    changed = [
+        type(asset)(asset.name, asset.input, asset.kind, asset.job, {**asset.options, "ratios": [0.5]})
+        if asset.name == "bar"
+        else asset
+        for asset in assets
+    ]
+    third = run_batch(changed, tmp_path / "out", scheduler=client.scheduler.address)  # as --scheduler tcp://...
+    assert (third.ran, third.skipped) == (1, 4)
+    assert sorted(path.name for path in (tmp_path / "out" / "bar").iterdir()) == [".animlod-asset.json", "bar_lod1.npz"]
+
+
+def test_killed_worker_leaves_no_partial_file_and_the_asset_is_redone(client, library, tmp_path):
+    source = library / "characters" / "cyl0.glb"
+    positions, faces = synth.icosphere(2, 0.1)  # a face job's pose folder: neutral and one expression
+    poses = tmp_path / "poses"
+    poses.mkdir()
+    write_obj(poses / "neutral.obj", positions, faces)
+    write_obj(poses / "bulge.obj", positions * (1.0 + 0.2 * np.clip(positions[:, 1:2] / 0.1, 0, 1)), faces)
+    manifest = tmp_path / "assets.json"
+    entries = [
+        {"input": str(source), "name": "crashes_once", "job": "batch_jobs:crash_once",
+         "marker": str(tmp_path / "crashed"), **QUICK},
+        {"input": str(source), "name": "always_crashes", "job": "batch_jobs:always_crash"},
+        {"input": str(library / "bar.npz"), "name": "bar"},
+        {"input": str(library / "bar.npz"), "name": "bar_half", "ratios": [0.5]},
+        {"input": str(library / "seq"), "name": "seq"},
+        {"input": str(poses), "name": "face", "job": "face", "ratios": [0.5], "repeats": 1,
+         "error_frames": 4},
+    ]  # fmt: skip
+    manifest.write_text(json.dumps({"assets": entries}))
+    result = run_batch(read_spec(manifest), tmp_path / "out", client=client)
+    records = {record["name"]: record for record in result.records}
+
+    assert (tmp_path / "crashed").exists()  # the first attempt did die
+    assert records["crashes_once"]["status"] == "ok"
+    direct = tmp_path / "direct"
+    simplify_asset(source, direct, **QUICK)
+    assert _files(tmp_path / "out" / "crashes_once") == _files(direct)  # no half-written file
+
+    assert records["always_crashes"]["status"] == "failed"
+    assert records["always_crashes"]["error"]["element"] == "worker"
+    assert not (tmp_path / "out" / "always_crashes").exists()
+    # The others all finished: none was counted against the deaths of the workers beside it.
+    assert all(records[name]["status"] == "ok" for name in ("bar", "bar_half", "seq", "face"))
+    face = records["face"]["result"]["levels"]  # the face job on a pose folder, beside the crashes
+    assert [(row["level"], row["triangles"]) for row in face] == [(0, 320), (1, 160)] and face[1]["error"] > 0
+    assert not list((tmp_path / "out").rglob("half_written*"))
+    client.wait_for_workers(2, timeout=30)  # the nannies restarted the killed workers
+
+
+def test_cli_bad_inputs_are_one_line_exit_2(library, tmp_path, capsys):
+    manifest = tmp_path / "m.toml"
+    manifest.write_text(f'[[assets]]\ninput = "{library / "bar.npz"}"\nbogus = 1\n')
+    assert main(["batch", str(manifest), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "assets[0]" in err and "'bogus'" in err
+
+    manifest.write_text('[[assets]]\ninput = "missing.glb"\n')
+    assert main(["batch", str(manifest), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "missing.glb" in err and "does not exist" in err
+
+    (tmp_path / "file").write_text("x")
+    assert main(["batch", str(library), "-o", str(tmp_path / "file")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "is a file" in err
+
+    out = str(tmp_path / "o2")
+    assert main(["batch", str(library), "-o", out, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--scheduler: tcp://127.0.0.1:9: no Dask scheduler answered within 1 s" in err
+
+    with pytest.raises(SpecError, match="no asset's job takes this option"):
+        read_spec(library, options={"nonsense": 1})
+
+
+def test_manifest_defaults_and_per_asset_options(library, tmp_path):
+    manifest = tmp_path / "lib.toml"
+    manifest.write_text(
+        "[defaults]\nratios = [0.5, 0.25]\nframe_budget = 6\n\n"
+        f'[[assets]]\ninput = "{library / "characters" / "cyl0.glb"}"\nname = "hero"\nmeasured_frames = 2\n\n'
+        f'[[assets]]\nglob = "{library}/*.npz"\nratios = [0.3]\n'
+    )
+    assets = {asset.name: asset for asset in read_spec(manifest)}
+    assert assets["hero"].options == {"measured_frames": 2, "ratios": [0.5, 0.25], "frame_budget": 6}
+    assert assets["bar"].options == {"ratios": [0.3]}  # frame_budget is not a sequence option
+    assert np.isclose(assets["bar"].options["ratios"][0], 0.3)
+
+
+def test_scheduler_without_workers_is_a_clear_error_after_the_timeout(library, tmp_path):
+    import logging
+
+    from distributed import LocalCluster
+
+    from animlod.batch import SchedulerUnreachable
+
+    assets = read_spec(library / "bar.npz")
+    with LocalCluster(n_workers=0, dashboard_address=":0", silence_logs=logging.ERROR) as empty:
+        address = empty.scheduler_address
+        with pytest.raises(SchedulerUnreachable, match="the scheduler has no worker after 1 s"):
+            run_batch(assets, tmp_path / "out", scheduler=address, connect_timeout=1)
+
+
+def test_spec_forms_and_their_errors(library, tmp_path):
+    by_glob = read_spec(f"{library}/characters/*.glb", options=QUICK)
+    assert [(asset.name, asset.job, asset.kind) for asset in by_glob] == [
+        ("cyl0", "simplify", "gltf"),
+        ("cyl1", "simplify", "gltf"),
+    ]
+    assert [asset.name for asset in read_spec(library / "characters", job="character")] == ["cyl0", "cyl1"]
+    with pytest.raises(SpecError, match="pattern: matches no file"):
+        read_spec(f"{library}/*.nothing")
+    with pytest.raises(SpecError, match="does not take bvh input"):
+        read_spec(library / "motions", job="simplify")
+    with pytest.raises(SpecError, match="job 'nosuchjob': unknown"):
+        read_spec(library / "bar.npz", job="nosuchjob")
+
+    def manifest(text: str) -> Path:
+        path = tmp_path / "m.toml"
+        path.write_text(text)
+        return path
+
+    bar = library / "bar.npz"
+    cases = [
+        (f'[[assets]]\ninput = "{bar}"\nname = "a"\n[[assets]]\ninput = "{bar}"\nname = "a"\n', "given to both"),
+        (f'[[assets]]\ninput = "{bar}"\nname = "../a"\n', "relative path without '.' parts"),
+        (f'[[assets]]\ninput = "{bar}"\nname = "a"\n[[assets]]\ninput = "{bar}"\nname = "a/b"\n', "inside the folder"),
+        (f'[[asset]]\ninput = "{bar}"\n', "asset: unknown key"),
+        (f'[[assets]]\ninput = "{bar}"\nglob = "*.npz"\n', "needs exactly one of 'input'"),
+        (f'[defaults]\ninput = "{bar}"\n[[assets]]\ninput = "{bar}"\n', "defaults.input: belongs to an asset"),
+        (f'[[assets]]\ninput = "{bar}"\nratios = [0.5, "x"]\n', "in the list: expected a number"),
+        ("[[assets]\n", "not valid TOML"),
+    ]
+    for text, message in cases:
+        with pytest.raises(SpecError, match=re.escape(message)):
+            read_spec(manifest(text))

@@ -86,6 +86,7 @@ bench: python-package
 
 # The C++ tests, then pytest against an extension built with the same sanitizers (in its own
 # venv, so that the normal one stays fast). Debian's libasan is preloaded into python.
+# The extension's build runs at most $(JOBS) compilers too (Ninja's default is cores + 2).
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer
 SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 
@@ -97,7 +98,7 @@ sanitize: $(OPENMESH_CONFIG) $(VENV)/bin/pip
 	$(SANITIZE_ENV) ctest --test-dir build/sanitize --output-on-failure
 	test -x .venv-sanitize/bin/pip || $(PYTHON) -m venv .venv-sanitize
 	.venv-sanitize/bin/pip install -q scikit-build-core pybind11
-	.venv-sanitize/bin/pip install -q --no-build-isolation -e ".[test]" -Cbuild-dir=build/python-sanitize \
+	CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) .venv-sanitize/bin/pip install -q --no-build-isolation -e ".[test]" -Cbuild-dir=build/python-sanitize \
 	  -Ccmake.build-type=RelWithDebInfo -Ccmake.define.CMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)"
 	$(SANITIZE_ENV) LD_PRELOAD="$$(g++ -print-file-name=libasan.so) $$(g++ -print-file-name=libubsan.so)" \
 	  .venv-sanitize/bin/python -m pytest -q -p no:cacheprovider tests/python

@@ -393,8 +393,12 @@ class Loader {
   }
 
   Rig read_rig(int skin_index) {
-    const tinygltf::Skin& skin = model_.skins[static_cast<size_t>(skin_index)];
     const std::string label = "skin " + std::to_string(skin_index);
+    // The clips are read for the first skinned node before its level checks its skin index
+    // (tests/fuzz/crashes/crowd_glb).
+    if (skin_index < 0 || static_cast<size_t>(skin_index) >= model_.skins.size())
+      fail(label, "does not exist (the file has " + std::to_string(model_.skins.size()) + " skins)");
+    const tinygltf::Skin& skin = model_.skins[static_cast<size_t>(skin_index)];
     if (skin.joints.empty()) fail(label, "has no joints");
     std::set<int> tree;
     for (size_t slot = 0; slot < skin.joints.size(); ++slot) {
@@ -662,6 +666,32 @@ class Loader {
 
 }  // namespace
 
+namespace {
+
+// What tinygltf reported, on one line and prefixed with the file.
+bool tinygltf_failure(const std::string& name, std::string& error) {
+  if (error.empty()) error = "tinygltf could not load the file";
+  while (!error.empty() && (error.back() == '\n' || error.back() == ' ')) error.pop_back();
+  for (char& c : error)
+    if (c == '\n') c = ' ';
+  error = name + ": " + error;
+  return false;
+}
+
+bool read_model(const Model& model, const std::string& name, Asset& out, std::string& error) {
+  out = Asset();
+  out.path = name;
+  try {
+    Loader(model, out).run();
+  } catch (const LoadError& failure) {
+    error = name + ": " + failure.message;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool load_asset(const std::string& path, Asset& out, std::string& error) {
   std::error_code status;
   if (!std::filesystem::is_regular_file(path, status)) {
@@ -674,23 +704,31 @@ bool load_asset(const std::string& path, Asset& out, std::string& error) {
   const bool binary = path.size() >= 4 && path.compare(path.size() - 4, 4, ".glb") == 0;
   const bool loaded = binary ? loader.LoadBinaryFromFile(&model, &error, &warnings, path)
                              : loader.LoadASCIIFromFile(&model, &error, &warnings, path);
-  if (!loaded) {
-    if (error.empty()) error = "tinygltf could not load the file";
-    while (!error.empty() && (error.back() == '\n' || error.back() == ' ')) error.pop_back();
-    for (char& c : error)
-      if (c == '\n') c = ' ';
-    error = path + ": " + error;
+  if (!loaded) return tinygltf_failure(path, error);
+  return read_model(model, path, out, error);
+}
+
+bool load_asset_from_memory(const uint8_t* bytes, size_t size, const std::string& name, Asset& out, std::string& error) {
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  // No file system: every external URI is "not found".
+  tinygltf::FsCallbacks no_files{};
+  no_files.FileExists = [](const std::string&, void*) { return false; };
+  no_files.ExpandFilePath = [](const std::string& path, void*) { return path; };
+  no_files.ReadWholeFile = [](std::vector<unsigned char>*, std::string* why, const std::string& path, void*) {
+    if (why) *why += "external file '" + path + "' not read (embedded data only)";
     return false;
-  }
-  out = Asset();
-  out.path = path;
-  try {
-    Loader(model, out).run();
-  } catch (const LoadError& failure) {
-    error = path + ": " + failure.message;
-    return false;
-  }
-  return true;
+  };
+  no_files.WriteWholeFile = [](std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; };
+  loader.SetFsCallbacks(no_files);
+  std::string warnings;
+  const bool binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
+  const bool loaded =
+      binary ? loader.LoadBinaryFromMemory(&model, &error, &warnings, bytes, static_cast<unsigned int>(size), "")
+             : loader.LoadASCIIFromString(&model, &error, &warnings, reinterpret_cast<const char*>(bytes),
+                                          static_cast<unsigned int>(size), "");
+  if (!loaded) return tinygltf_failure(name, error);
+  return read_model(model, name, out, error);
 }
 
 }  // namespace crowd

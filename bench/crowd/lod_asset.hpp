@@ -5,6 +5,7 @@
 // motion level 0, the re-fitted ones with extras.animlod {clip, motion_level} otherwise).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -109,5 +110,10 @@ struct Asset {
 // Reads `path` (.glb or .gltf). On failure returns false with `error` naming the file, the
 // element (node, skin, animation, accessor) and the reason.
 bool load_asset(const std::string& path, Asset& out, std::string& error);
+
+// The same from the bytes of a .glb (they start with "glTF") or a .gltf; `name` stands for the
+// file in error messages. Only embedded data is read (the GLB's BIN chunk, data URIs): a URI
+// naming a file is an error. The fuzz harness tests/fuzz/cpp/fuzz_crowd_glb.cpp calls it.
+bool load_asset_from_memory(const uint8_t* bytes, size_t size, const std::string& name, Asset& out, std::string& error);
 
 }  // namespace crowd

@@ -191,7 +191,8 @@ Status ffd_displace(const LatticeSetView& lattices, const float* rest, const flo
   for (size_t v = 0; v < vertex_count; ++v)
     if (vertex_lattice[v] < -1 || vertex_lattice[v] >= static_cast<int64_t>(lattice_count))
       return Status::error("vertex_lattice: vertex " + std::to_string(v) + " names lattice " +
-                           std::to_string(vertex_lattice[v]) + ", expected -1 to " + std::to_string(lattice_count - 1));
+                           std::to_string(vertex_lattice[v]) + ", expected -1 to " +
+                           std::to_string(static_cast<int64_t>(lattice_count) - 1));  // -1 to -1 without lattices
 
   // Phase 2: per vertex, its rational basis once, then every frame's displacement.
   const size_t frame_stride = 3 * vertex_count;

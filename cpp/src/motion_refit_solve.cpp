@@ -190,7 +190,11 @@ class FrameSolver {
     reduction_.gather(start, c_.start.data());
     if (c_.precondition) {
       std::fill(variables_.begin(), variables_.end(), 0.0);
-      to_positions(c_, variables_.data());  // the start with its eliminated points placed
+      // The start with its eliminated points placed: to_positions at v = 0, which needs no
+      // factor (on the first frame there is none yet; solving with its 0 x 0 matrix broke
+      // Eigen's size check, tests/fuzz/crashes/motion_refit).
+      std::copy(c_.start.begin(), c_.start.end(), c_.reduced.begin());
+      reduction_.fill(c_.reduced.data(), c_.original, c_.x.data());
       prepare_preconditioner();
     } else {
       reduction_.gather(original, c_.reduced.data());

@@ -117,8 +117,10 @@ void sample_track(const KeyframeTrack& track, float time, bool rotation, Rotatio
     if (quaternion) normalize4(out);
   };
 
-  // The key interval [start, start + 1] holding `time` (the ends hold outside the keys).
-  if (last == 0 || time <= times[0]) return finish(value(0));
+  // The key interval [start, start + 1] holding `time` (the ends hold outside the keys). A NaN
+  // time holds the first key: it compares false everywhere, so upper_bound below would give the
+  // last key as `start` and read past the end (tests/fuzz/crashes/pose).
+  if (last == 0 || !(time > times[0])) return finish(value(0));
   if (time >= times[last]) return finish(value(last));
   const size_t start = static_cast<size_t>(std::upper_bound(times, times + track.key_count, time) - times) - 1;
   if (track.interpolation == Interpolation::step) return finish(value(start));
@@ -142,7 +144,14 @@ void sample_track(const KeyframeTrack& track, float time, bool rotation, Rotatio
   const double h01 = -2 * s3 + 3 * s2, h11 = (s3 - s2) * span;
   for (size_t c = 0; c < count; ++c)
     out[c] = static_cast<float>(h00 * a[c] + h10 * out_tangent[c] + h01 * b[c] + h11 * in_tangent[c]);
-  if (quaternion) normalize4(out);
+  if (quaternion) {
+    // Keys q and -q (the same rotation) with small tangents blend through zero, and huge
+    // tangents overflow: the nearer key holds instead of a NaN (tests/fuzz/crashes/pose).
+    double length2 = 0.0;
+    for (size_t c = 0; c < 4; ++c) length2 += double(out[c]) * out[c];
+    if (!(length2 > 0.0) || !std::isfinite(length2)) return finish(s < 0.5 ? a : b);
+    normalize4(out);
+  }
 }
 
 Status validate_clip(const ClipView& clip, size_t joint_count) {

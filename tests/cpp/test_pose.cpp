@@ -183,3 +183,39 @@ TEST_CASE("sample_clip writes only the animated joints and properties") {
   CHECK(translations[3] == doctest::Approx(2));
   CHECK(translations[4] == doctest::Approx(0));
 }
+
+// Found by tests/fuzz/cpp/fuzz_pose.cpp (tests/fuzz/crashes/pose): a NaN time compared false
+// everywhere and the LINEAR blend read the key after the last one.
+TEST_CASE("sample_track: a NaN time gives the first key for every interpolation") {
+  const std::vector<float> times = {1.0f, 2.0f, 4.0f};
+  const std::vector<float> values = {1, 2, 3, 10, 20, 30, 30, 20, 10};
+  std::vector<float> cubic_values;
+  for (size_t k = 0; k < 3; ++k)
+    cubic_values.insert(cubic_values.end(), {0, 0, 0, values[3 * k], values[3 * k + 1], values[3 * k + 2], 0, 0, 0});
+  for (Interpolation interpolation : {Interpolation::linear, Interpolation::step, Interpolation::cubic_spline}) {
+    const bool cubic = interpolation == Interpolation::cubic_spline;
+    const KeyframeTrack t = track(times, cubic ? cubic_values : values, 3, interpolation);
+    REQUIRE(animlod::validate_track(t, false).ok);
+    float out[3] = {-1, -1, -1};
+    animlod::sample_track(t, std::nanf(""), false, RotationBlend::slerp, out);
+    CHECK(out[0] == 1.0f);
+    CHECK(out[1] == 2.0f);
+    CHECK(out[2] == 3.0f);
+  }
+}
+
+// A CUBICSPLINE rotation between q and -q (the same rotation) with zero tangents passes through
+// the zero quaternion halfway: the nearer key holds instead of a NaN.
+TEST_CASE("sample_track: a CUBICSPLINE rotation through zero stays a unit quaternion") {
+  const std::vector<float> times = {0.0f, 1.0f};
+  const std::vector<float> values = {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0,    // key 0: in, value, out
+                                     0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, 0};  // key 1
+  const KeyframeTrack t = track(times, values, 4, Interpolation::cubic_spline);
+  REQUIRE(animlod::validate_track(t, true).ok);
+  for (float time : {0.25f, 0.5f, 0.75f}) {
+    float q[4];
+    animlod::sample_track(t, time, true, RotationBlend::slerp, q);
+    const float length = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    CHECK(length == doctest::Approx(1.0f));
+  }
+}

@@ -141,6 +141,160 @@ def seeds_lbs(data_dir: Path | None) -> dict[str, bytes]:
     return {"cylinder": header + body + matrices.tobytes()}
 
 
+def _int16(values) -> bytes:
+    """Numbers in the int16 / 64 coding of FuzzInput::coordinate (rounded to the grid)."""
+    return np.clip(np.round(np.asarray(values, np.float64) * 64), -32767, 32767).astype("<i2").tobytes()
+
+
+def seeds_pose(data_dir: Path | None) -> dict[str, bytes]:
+    """Skeletons and clips in the layout of fuzz_pose.cpp (int16 mode): a 3-joint chain with one
+    channel of each path and interpolation, and the procedural humanoid's walk (rotations)."""
+    from animlod import synth
+
+    def encode(parents, channels, samples, rest_t, rest_r, flags=0b110) -> bytes:
+        out = bytes([flags, len(parents) - 1])
+        out += bytes(0 if p < 0 else p + 1 for p in parents)  # value % (j + 1) - 1
+        out += bytes([len(channels)])
+        for path, interpolation, joint, times, values in channels:
+            out += bytes([path | interpolation << 2]) + struct.pack("<H", joint) + bytes([len(times)])
+            out += _int16([times[0]]) + bytes(int(round((b - a) * 64)) for a, b in zip(times, times[1:]))
+            out += _int16(values)
+        out += bytes([len(samples) - 1]) + _int16(samples)
+        out += _int16(rest_t) + _int16(rest_r)
+        if flags & 0b100:
+            out += _int16(np.ones((len(parents), 3)))
+        return out + bytes([len(parents) - 1]) + bytes(range(len(parents))) + _int16(np.tile(np.eye(4), len(parents)))
+
+    quarter = [0.0, 0.0, 0.7071, 0.7071]
+    chain = [
+        (1, 0, 1, [0.0, 0.5, 1.0], [[0, 0, 0, 1], quarter, [0, 0, 1, 0]]),  # rotation, linear
+        (0, 2, 0, [0.0, 1.0], [[0, 0, 0], [1, 0, 0], [0, 0, 0], [0, 0, 0], [0, 1, 0], [0, 0, 0]]),  # cubic
+        (2, 1, 2, [0.25, 0.75], [[1, 1, 1], [2, 2, 2]]),  # scale, step
+        (1, 2, 2, [0.0, 1.0], [[0, 0, 0, 0], [0, 0, 0, 1], [0, 0, 0, 0]] * 2),  # rotation, cubic
+    ]
+    rest_t, rest_r = [[0, 0, 0], [0, 1, 0], [0, 1, 0]], [[0, 0, 0, 1]] * 3
+    seeds = {"chain": encode([-1, 0, 1], chain, [-1.0, 0.0, 0.3, 0.5, 1.0, 2.0], rest_t, rest_r)}
+    seeds["chain_slerp"] = encode([-1, 0, 1], chain[:1], [0.1, 0.9], rest_t, rest_r, flags=0)
+    skeleton = synth.humanoid_skeleton()
+    motion = synth.humanoid_motion(skeleton, "walk")
+    joints = min(skeleton.joint_count, 32)
+    times = [k / 8 for k in range(4)]
+    walk = [(1, 0, j, times, motion.local_rotations[:4, j]) for j in range(min(joints, 12))]
+    parents = [int(p) for p in skeleton.parents[:joints]]
+    seeds["walk"] = encode(parents, walk, [0.0, 0.2, 0.37], skeleton.offsets[:joints], [[0, 0, 0, 1]] * joints)
+    return seeds
+
+
+def seeds_ffd(data_dir: Path | None) -> dict[str, bytes]:
+    """Lattices in the layout of fuzz_ffd_lattice.cpp (int16 mode): the face's 3x3x3 and 2x2x2
+    lattices over a box around mesh points, weighted and plain, with two lattices displaced."""
+    seeds = {}
+    for name, (frames, _) in list(_all_meshes(data_dir).items())[:4]:
+        points = frames[0][:200].astype(np.float64)
+        low, high = points.min(axis=0), points.max(axis=0)
+        extent = np.maximum(high - low, 0.25)
+        for size, flags in ((3, 0b010), (2, 0b100), (4, 0b000)):
+            controls = size**3
+            grid = np.stack(np.meshgrid(*[np.linspace(0, 1, size)] * 3, indexing="ij"), -1).reshape(-1, 3)
+            out = bytes([flags, size, size, size]) + struct.pack("<H", len(points) - 1)
+            out += _int16(low) + _int16(np.diag(extent)) + _int16(points)
+            if flags & 0b010:
+                out += bytes([32 + (c % 5) * 8 for c in range(controls)])
+            out += _int16(low + grid * extent + 0.05)
+            # ffd_displace: lattices (size^3, 2^3), 2 frames, vertices alternating, displacements
+            out += bytes([1, size, size, size, 2, 2, 2, 1])
+            out += struct.pack(f"<{len(points)}H", *[v % 3 for v in range(len(points))])  # 2 -> index 2 % 2 = 0
+            total = controls + 8
+            out += _int16(np.sin(np.arange(2 * total * 3)) * 0.1)
+            if flags & 0b010:
+                out += bytes([32] * total)
+            out += bytes([0, 0, 1, 16, 16]) + _int16(points + 0.01)
+            if flags & 0b100:
+                out += _int16(np.zeros((8, 3)))
+            if flags & 0b010:
+                out += bytes([32] * 12)
+            seeds[f"{name}_{size}"] = out
+    return seeds
+
+
+def seeds_refit(data_dir: Path | None) -> dict[str, bytes]:
+    """Re-fit problems in the layout of fuzz_motion_refit.cpp (int16 mode): a bent chain of unit
+    bones with a branching point, its lengths, a handed group and frozen-joint angles, over 3
+    frames of a swaying motion; soft and hard, each solved."""
+    key = np.array([[0, 0, 0], [0, 1, 0], [0, 2, 0], [1, 2, 0], [-1, 2, 0], [0, 2, 1], [1, 3, 0], [0, 3, 0]], float)
+    parents = [-1, 0, 1, 2, 2, 2, 3, 2]
+    pairs = [(j, parents[j]) for j in range(1, len(key))]
+    lengths = [np.linalg.norm(key[a] - key[b]) for a, b in pairs]
+    triples = [(1, 2, 3), (0, 1, 2), (2, 3, 6)]
+    cosines = []
+    for p, j, c in triples:
+        u, v = key[p] - key[j], key[c] - key[j]
+        cosines.append(float(u @ v / np.linalg.norm(u) / np.linalg.norm(v)))
+    quad = (2, 3, 4, 5)
+    volume = float(np.linalg.det(np.stack([key[q] - key[quad[0]] for q in quad[1:]])))
+    frames = np.stack([key + np.array([0.1 * t, 0.0, 0.05 * t]) * (np.arange(len(key)) > 1)[:, None] for t in range(3)])
+    seeds = {}
+    for name, flags in (("soft", 0b01011100), ("hard", 0b01011110), ("hard_cold", 0b01111110), ("plain", 0b01000000)):
+        out = bytes([flags, len(key), 2, len(pairs)])
+        out += struct.pack(f"<{2 * len(pairs)}H", *[i for pair in pairs for i in pair])
+        out += bytes(int(round(length * 32)) for length in lengths)
+        out += bytes([1]) + struct.pack("<2H", 6, 7)  # a coincident pair
+        out += bytes([1]) + struct.pack("<4H", *quad) + struct.pack("<b", int(np.clip(volume * 8, -127, 127)))
+        out += bytes([len(triples)]) + struct.pack(f"<{3 * len(triples)}H", *[i for t in triples for i in t])
+        out += struct.pack(f"<{len(cosines)}b", *[int(round(c * 120)) for c in cosines])
+        out += bytes([13, 26, 26, 16, 39, 1]) + _int16(frames)
+        if flags & 0b00100000:
+            out += _int16(frames)
+        seeds[name] = out
+    return seeds
+
+
+def seeds_tdag(data_dir: Path | None) -> dict[str, bytes]:
+    """TDAG bodies (fuzz_tdag.cpp wraps them in a valid header and CRC) of small meshes, built
+    with several governing meshes, and whole files (flag bit 0)."""
+    from animlod.model import AnimatedMesh
+    from animlod.tdag import TemporalDag
+
+    seeds = {}
+    meshes = list(_procedural_meshes().items()) + list(_real_meshes(data_dir).items())[:1]
+    for name, (frames, faces) in meshes:
+        mesh = AnimatedMesh(faces, frames, 30.0)
+        for governing in ("first", "online"):
+            data = TemporalDag.build(mesh, governing=governing).to_bytes()
+            seeds[f"{name}_{governing}"] = bytes([0, 4, 0]) + data[20:-4]  # header 20 bytes, CRC 4
+        seeds[f"{name}_file"] = bytes([1, 253, 1]) + data
+    return seeds
+
+
+def seeds_crowd_glb(data_dir: Path | None) -> dict[str, bytes]:
+    """GLBs split into JSON and BIN for fuzz_crowd_glb.cpp (which writes the container): the
+    skinned cylinder as a one-level chain and as a two-level MSFT_lod chain, and the small
+    skinned characters of the development data; plus a whole file (flag bit 0)."""
+    import pygltflib
+
+    def split(glb: bytes) -> bytes:
+        json_length = struct.unpack_from("<I", glb, 12)[0]
+        body = glb[20 : 20 + json_length]
+        bin_chunk = glb[20 + json_length + 8 :] if len(glb) > 20 + json_length else b""
+        return bytes([0]) + struct.pack("<I", len(body)) + body + bin_chunk
+
+    cylinder = _small_glb()
+    seeds = {"cylinder": split(cylinder), "cylinder_file": bytes([1]) + cylinder}
+    gltf = pygltflib.GLTF2.load_from_bytes(cylinder)
+    base = next(i for i, node in enumerate(gltf.nodes) if node.mesh is not None and node.skin is not None)
+    extras = {"animlod": {"level": 1, "error": 0.01, "mesh_level": 1, "motion_level": 0}}
+    level = pygltflib.Node(mesh=gltf.nodes[base].mesh, skin=gltf.nodes[base].skin, extras=extras)
+    gltf.nodes.append(level)
+    gltf.nodes[base].extensions = {"MSFT_lod": {"ids": [len(gltf.nodes) - 1]}}
+    gltf.nodes[base].extras = {"MSFT_screencoverage": [0.5, 0.0], "animlod": {"level": 0, "error": 0.0}}
+    gltf.extensionsUsed = [*(gltf.extensionsUsed or []), "MSFT_lod"]
+    seeds["cylinder_lod"] = split(b"".join(gltf.save_to_bytes()))
+    for path in (data_dir / "gltf").glob("*.glb") if data_dir else ():
+        if path.stat().st_size <= 60_000:
+            seeds[path.stem] = split(path.read_bytes())
+    return seeds
+
+
 # ---------------------------------------------------------------------------------------------
 # Python readers
 
@@ -277,6 +431,11 @@ SEEDS: dict[str, Callable[[Path | None], dict[str, bytes]]] = {
     "features": seeds_features,
     "aqem": seeds_aqem,
     "lbs": seeds_lbs,
+    "pose": seeds_pose,
+    "ffd": seeds_ffd,
+    "refit": seeds_refit,
+    "tdag": seeds_tdag,
+    "crowd_glb": seeds_crowd_glb,
     "bvh": seeds_bvh,
     "obj": seeds_obj,
     "ply": seeds_ply,

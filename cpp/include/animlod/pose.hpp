@@ -42,7 +42,7 @@ struct KeyframeTrack {
 Status validate_track(const KeyframeTrack& track, bool rotation);
 
 // Writes the track's C components at `time` into out (C floats). Before the first key and after
-// the last one the end keys hold. With `rotation` (C == 4) LINEAR keys are blended along the
+// the last one the end keys hold; a NaN time gives the first key. With `rotation` (C == 4) LINEAR keys are blended along the
 // shortest arc and the result of every interpolation is a unit quaternion. The track must have
 // passed validate_track (not re-checked here, asserted in debug builds).
 void sample_track(const KeyframeTrack& track, float time, bool rotation, RotationBlend blend, float* out);

@@ -228,7 +228,8 @@ class TdagCut {
   Status approximate(int32_t frame, ApproximationLevel level, TdagMesh& out);
   // The current cut at its frame (level 3 without moving).
   void mesh(TdagMesh& out) const;
-  // (V,) for each input vertex, the index in mesh().positions of the vertex standing for it.
+  // (V,) for each input vertex (leaf 0 .. V-1, a TDAG vertex; compose with input_points() for the
+  // caller's input_vertex_count() vertices), the index in mesh().positions of the vertex standing for it.
   void input_vertex_map(std::vector<int32_t>& out) const;
 
   int32_t frame() const;

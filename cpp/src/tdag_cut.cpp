@@ -92,6 +92,10 @@ struct CutState {
   std::vector<int32_t> face_ids;         // (M',) live faces
   std::vector<std::vector<int32_t>> faces_of;  // (N,) live faces around an active node
   size_t splits = 0, collapses = 0;
+  // A node a split or collapse found inactive (-1: none): the dependencies do not order the
+  // collapses after their children, which the reader refuses (tdag_io.cpp); kept as a cheap
+  // guard so that such a TDAG gives an error instead of a write outside the arrays.
+  int32_t inactive_node = -1;
   std::vector<int32_t> stack, queue, anc;  // scratch
   std::vector<int8_t> closure;             // scratch: -1 unknown, 0 no, 1 yes, 2 visiting
 
@@ -137,6 +141,10 @@ struct CutState {
     vertex_residuals.insert(vertex_residuals.end(), r, r + 3);
   }
   void deactivate_vertex(int32_t node) {
+    if (slot_of[static_cast<size_t>(node)] < 0) {
+      inactive_node = node;
+      return;
+    }
     const auto slot = static_cast<size_t>(slot_of[static_cast<size_t>(node)]);
     const size_t last = vertex_nodes.size() - 1;
     const int32_t moved = vertex_nodes[last];
@@ -511,6 +519,19 @@ Status check_view(const ViewTolerance& view) {
   return Status::success();
 }
 
+// After an update: an error naming the node when the TDAG proved inconsistent (see
+// CutState::inactive_node); the cut is then rebuilt from scratch at its frame, so that it stays a
+// valid mesh of the collapses it holds.
+Status check_consistent(detail::CutState& s, const char* what) {
+  if (s.inactive_node < 0) return Status::success();
+  const int32_t node = s.inactive_node;
+  s.rebuild();
+  s.inactive_node = -1;
+  return Status::error(std::string(what) + ": node " + std::to_string(node) +
+                       " was split or merged while not in the cut: the TDAG's dependencies do not order its "
+                       "collapses after their children (a damaged TDAG)");
+}
+
 }  // namespace
 
 TdagCut::TdagCut(const TemporalDag& dag) : state_(std::make_unique<detail::CutState>(dag.data_)) {}
@@ -559,7 +580,7 @@ Status TdagCut::advance(int32_t frame) {
     return Status::success();
   }
   s.move_to(frame);
-  return Status::success();
+  return check_consistent(s, "advance");
 }
 
 Status TdagCut::refine(double tolerance) {
@@ -572,7 +593,7 @@ Status TdagCut::refine(double tolerance) {
   s.splits = s.collapses = 0;
   s.queue_fronts();
   s.settle();
-  return Status::success();
+  return check_consistent(s, "refine");
 }
 
 Status TdagCut::refine_view(const ViewTolerance& view) {
@@ -583,7 +604,7 @@ Status TdagCut::refine_view(const ViewTolerance& view) {
   s.view = view;
   s.splits = s.collapses = 0;
   s.transition_to_closure();
-  return Status::success();
+  return check_consistent(s, "refine_view");
 }
 
 Status TdagCut::approximate(int32_t frame, ApproximationLevel level, TdagMesh& out) {
@@ -593,6 +614,7 @@ Status TdagCut::approximate(int32_t frame, ApproximationLevel level, TdagMesh& o
   switch (level) {
     case ApproximationLevel::full:
       if (frame != s.frame) s.move_to(frame);
+      if (Status status = check_consistent(s, "approximate"); !status) return status;
       s.refresh_residuals(frame);
       break;
     case ApproximationLevel::residual:

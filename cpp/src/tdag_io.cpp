@@ -29,6 +29,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 
 #include "animlod/tdag.hpp"
@@ -174,6 +175,149 @@ class Reader {
   const uint8_t* p_;
   const uint8_t* end_;
   std::string error_;
+};
+
+// The order the cuts rely on (tdag_cut.cpp): a cut is a set of collapses closed under the
+// dependencies of its frame, and it applies a collapse only with both children active, so a
+// collapse child must be in the dependency closure of its parent at every frame the parent is
+// alive. The builder links a collapse to the collapses that last changed the faces around its
+// endpoints (tdag_hierarchy.cpp), which reach the children only through chains of such links,
+// so the check is reachability, not a direct link. Per frame segment of one structure (the
+// frames between two structure events), with a topological rank so that a search from a
+// collapse only visits collapses ranked above the child it looks for. Also: no dependency
+// cycle, children and linked collapses alive where the collapse (or link) is.
+class DependencyOrderCheck {
+ public:
+  explicit DependencyOrderCheck(const detail::TdagData& d)
+      : d_(d), collapse_count_(d.collapse_count()), rank_(collapse_count_), stamp_(collapse_count_, 0) {}
+
+  Status run() {
+    if (Status status = check_tags(); !status) return status;
+    recheck_.assign(collapse_count_, 1);
+    if (d_.static_structure) return check_frame(0);
+    if (Status status = check_frame(0); !status) return status;
+    // A later frame only changes the structure at its events. A path that held at the frame
+    // before and broke crosses a link of an event collapse, which the start of the path still
+    // reaches, so only the collapses that reach an event collapse (and those) are searched again.
+    for (int32_t t = 1; t < d_.frame_count; ++t) {
+      const auto begin = static_cast<size_t>(d_.event_offsets[static_cast<size_t>(t)]);
+      const auto end = static_cast<size_t>(d_.event_offsets[static_cast<size_t>(t) + 1]);
+      if (begin == end) continue;
+      std::fill(recheck_.begin(), recheck_.end(), 0);
+      stack_.clear();
+      for (size_t i = begin; i < end; ++i) {
+        const size_t c = collapse_of(d_.event_nodes[i]);
+        if (!recheck_[c]) stack_.push_back(static_cast<int32_t>(c));
+        recheck_[c] = 1;
+      }
+      while (!stack_.empty()) {
+        const auto x = static_cast<size_t>(stack_.back());
+        stack_.pop_back();
+        for (int32_t k = d_.dependent_offsets[x]; k < d_.dependent_offsets[x + 1]; ++k) {
+          if (!d_.link_alive(static_cast<size_t>(d_.dependent_links[static_cast<size_t>(k)]), t)) continue;
+          const size_t m = collapse_of(d_.dependent_nodes[static_cast<size_t>(k)]);
+          if (!recheck_[m]) stack_.push_back(static_cast<int32_t>(m));
+          recheck_[m] = 1;
+        }
+      }
+      if (Status status = check_frame(t); !status) return status;
+    }
+    return Status::success();
+  }
+
+ private:
+  static std::string name(size_t c) { return "collapse " + std::to_string(c); }
+  int32_t node(size_t c) const { return d_.vertex_count + static_cast<int32_t>(c); }
+  bool is_collapse(int32_t n) const { return n >= d_.vertex_count; }
+  size_t collapse_of(int32_t n) const { return static_cast<size_t>(n - d_.vertex_count); }
+
+  // Children and dependencies alive wherever the collapse (or the link) is.
+  Status check_tags() const {
+    if (d_.static_structure) return Status::success();
+    for (size_t c = 0; c < collapse_count_; ++c) {
+      for (const int32_t child : {d_.kept_child[c], d_.removed_child[c]})
+        if (is_collapse(child) && !d_.alive[c].minus(d_.alive[collapse_of(child)]).empty())
+          return Status::error(name(c) + ": child node " + std::to_string(child) +
+                               " is not in the hierarchy on every frame the collapse is");
+      for (int32_t link = d_.dep_offsets[c]; link < d_.dep_offsets[c + 1]; ++link) {
+        const TimeTag& tag = d_.dep_tags[static_cast<size_t>(link)];
+        const int32_t dep = d_.dep_nodes[static_cast<size_t>(link)];
+        if (!tag.minus(d_.alive[c]).empty() || !tag.minus(d_.alive[collapse_of(dep)]).empty())
+          return Status::error(name(c) + ": dependency " + std::to_string(dep) +
+                               " is linked on frames where it or the collapse is not in the hierarchy");
+      }
+    }
+    return Status::success();
+  }
+
+  template <typename Visit>
+  void for_each_dependency(size_t c, int32_t frame, Visit&& visit) const {
+    for (int32_t link = d_.dep_offsets[c]; link < d_.dep_offsets[c + 1]; ++link)
+      if (d_.link_alive(static_cast<size_t>(link), frame)) visit(collapse_of(d_.dep_nodes[static_cast<size_t>(link)]));
+  }
+
+  Status check_frame(int32_t frame) {
+    const std::string at = d_.static_structure ? std::string() : " at frame " + std::to_string(frame);
+    // Topological ranks (Kahn): a collapse ranks above every collapse it depends on.
+    std::vector<int32_t> waiting(collapse_count_, 0), ready;
+    for (size_t c = 0; c < collapse_count_; ++c) {
+      if (!d_.collapse_alive(c, frame)) continue;
+      for_each_dependency(c, frame, [&](size_t) { ++waiting[c]; });
+      if (waiting[c] == 0) ready.push_back(static_cast<int32_t>(c));
+    }
+    std::fill(rank_.begin(), rank_.end(), -1);
+    int32_t next = 0;
+    for (size_t i = 0; i < ready.size(); ++i) {
+      const auto c = static_cast<size_t>(ready[i]);
+      rank_[c] = next++;
+      for (int32_t k = d_.dependent_offsets[c]; k < d_.dependent_offsets[c + 1]; ++k) {
+        if (!d_.link_alive(static_cast<size_t>(d_.dependent_links[static_cast<size_t>(k)]), frame)) continue;
+        const size_t m = collapse_of(d_.dependent_nodes[static_cast<size_t>(k)]);
+        if (d_.collapse_alive(m, frame) && --waiting[m] == 0) ready.push_back(static_cast<int32_t>(m));
+      }
+    }
+    for (size_t c = 0; c < collapse_count_; ++c)
+      if (d_.collapse_alive(c, frame) && rank_[c] < 0)
+        return Status::error(name(c) + ": its dependencies form a cycle" + at);
+
+    // Each collapse child within the dependency closure of its parent.
+    for (size_t c = 0; c < collapse_count_; ++c) {
+      if (!recheck_[c] || !d_.collapse_alive(c, frame)) continue;
+      const std::array<int32_t, 2> children = {d_.kept_child[c], d_.removed_child[c]};
+      std::array<bool, 2> found = {!is_collapse(children[0]), !is_collapse(children[1])};
+      if (found[0] && found[1]) continue;
+      int32_t lowest = std::numeric_limits<int32_t>::max();
+      for (size_t i = 0; i < 2; ++i)
+        if (!found[i]) lowest = std::min(lowest, rank_[collapse_of(children[i])]);
+      ++generation_;
+      stack_.assign(1, static_cast<int32_t>(c));
+      while (!stack_.empty() && !(found[0] && found[1])) {
+        const auto x = static_cast<size_t>(stack_.back());
+        stack_.pop_back();
+        for_each_dependency(x, frame, [&](size_t k) {
+          for (size_t i = 0; i < 2; ++i) found[i] = found[i] || node(k) == children[i];
+          if (rank_[k] > lowest && stamp_[k] != generation_) {
+            stamp_[k] = generation_;
+            stack_.push_back(static_cast<int32_t>(k));
+          }
+        });
+      }
+      for (size_t i = 0; i < 2; ++i)
+        if (!found[i])
+          return Status::error(name(c) + ": its " + (i == 0 ? "kept" : "removed") + " child, node " +
+                               std::to_string(children[i]) + ", is not among the collapses it depends on" + at +
+                               " (a cut could apply the collapse before its child)");
+    }
+    return Status::success();
+  }
+
+  const detail::TdagData& d_;
+  size_t collapse_count_;
+  std::vector<int32_t> rank_;   // (C,) topological rank at the frame checked, -1 not alive
+  std::vector<uint32_t> stamp_; // (C,) search that last visited the collapse
+  uint32_t generation_ = 0;
+  std::vector<int32_t> stack_;
+  std::vector<uint8_t> recheck_;  // (C,) whether the frame checked searches from the collapse
 };
 
 }  // namespace
@@ -414,6 +558,7 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
   if (r.ok() && r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " unexpected bytes after the last collapse");
   if (!r.ok()) return Status::error("corrupted TDAG file: " + r.error());
   if (Status status = detail::derive_links(*d); !status) return Status::error("corrupted TDAG file: " + status.message);
+  if (Status status = DependencyOrderCheck(*d).run(); !status) return Status::error("corrupted TDAG file: " + status.message);
   out.data_ = std::move(d);
   return Status::success();
 }

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -299,6 +302,72 @@ TEST_CASE("tdag: save and load round trip; damaged files are named errors") {
   CHECK(load_error(damaged).find("written by a newer animlod") != std::string::npos);
   CHECK(load_error({bytes.begin(), bytes.end() - 10}).find("truncated") != std::string::npos);
   CHECK(load_error({'h', 'e', 'l', 'l', 'o'}) == "not a TDAG file (no ANLDTDAG signature)");
+}
+
+TEST_CASE("tdag: every file the builder writes loads; a collapse ordered before its child does not") {
+  // The reader checks that each collapse child is in the dependency closure of its parent on
+  // every frame (tdag_io.cpp); the builder links children only through chains of dependencies,
+  // so this walks several meshes and every governing mode, online with several history weights.
+  const std::vector<OwnedAnimatedMesh> meshes = {swinging_tube(6),
+                                                 animlod::testing::sphere(9, 12, 4),
+                                                 animlod::testing::jittering_sphere(8, 10, 5, 0.03f),
+                                                 animlod::testing::bending_tube(14, 9, 5, 1.5),
+                                                 animlod::testing::subdivided_cube(4),
+                                                 animlod::testing::grid(7)};
+  size_t files = 0;
+  for (size_t m = 0; m < meshes.size(); ++m) {
+    const OwnedAnimatedMesh& mesh = meshes[m];
+    for (int mode = 0; mode < 8; ++mode) {
+      TdagOptions options;
+      const Governing modes[] = {Governing::first, Governing::average, Governing::frame, Governing::aqem};
+      options.governing = mode < 4 ? modes[mode] : Governing::online;
+      options.governing_frame = int32_t(mesh.frame_count) - 1;
+      options.history_weight = mode == 4 ? 0.0 : mode == 5 ? 0.3 : mode == 6 ? 2.0 : 1e9;
+      options.weld = mode != 2;
+      CAPTURE(m);
+      CAPTURE(mode);
+      const TemporalDag dag = build(mesh, options);
+      std::vector<uint8_t> bytes;
+      REQUIRE(animlod::serialize_temporal_dag(dag, bytes).ok);
+      TemporalDag loaded;
+      const animlod::Status status = animlod::deserialize_temporal_dag(bytes.data(), bytes.size(), loaded);
+      CHECK_MESSAGE(status.ok, status.message);
+      files += status.ok;
+    }
+  }
+  CHECK(files == 48);
+
+  // The fuzz finding (tests/fuzz/crashes/tdag/): a crane body whose collapse names another kept
+  // child, wrapped in a valid header and checksum, is refused, naming the collapse and child.
+  const std::filesystem::path crash =
+      std::filesystem::path(__FILE__).parent_path() / "../fuzz/crashes/tdag/crash-2cf496c94f55c031";
+  std::ifstream stream(crash, std::ios::binary);
+  REQUIRE_MESSAGE(stream.good(), crash.string());
+  const std::vector<uint8_t> input((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  REQUIRE(input.size() > 3);
+  REQUIRE(input[0] == 0);  // flag bit 0 clear: the rest is a body (fuzz_tdag.cpp)
+  const std::vector<uint8_t> body(input.begin() + 3, input.end());
+  uint32_t crc = 0xFFFFFFFFu;
+  for (uint8_t byte : body) {
+    crc ^= byte;
+    for (int k = 0; k < 8; ++k) crc = (crc & 1u) ? 0xEDB88320u ^ (crc >> 1) : crc >> 1;
+  }
+  crc ^= 0xFFFFFFFFu;
+  std::vector<uint8_t> file = {'A', 'N', 'L', 'D', 'T', 'D', 'A', 'G'};
+  const uint32_t version = animlod::kTdagFormatVersion;
+  const uint64_t length = body.size();
+  file.insert(file.end(), reinterpret_cast<const uint8_t*>(&version), reinterpret_cast<const uint8_t*>(&version) + 4);
+  file.insert(file.end(), reinterpret_cast<const uint8_t*>(&length), reinterpret_cast<const uint8_t*>(&length) + 8);
+  file.insert(file.end(), body.begin(), body.end());
+  file.insert(file.end(), reinterpret_cast<const uint8_t*>(&crc), reinterpret_cast<const uint8_t*>(&crc) + 4);
+  TemporalDag damaged;
+  const animlod::Status refused = animlod::deserialize_temporal_dag(file.data(), file.size(), damaged);
+  CHECK_FALSE(refused.ok);
+  CHECK(damaged.empty());
+  INFO(refused.message);
+  CHECK(refused.message.find("corrupted TDAG file: collapse ") == 0);
+  CHECK(refused.message.find("child, node ") != std::string::npos);
+  CHECK(refused.message.find("is not among the collapses it depends on") != std::string::npos);
 }
 
 TEST_CASE("tdag: bad input is a named error") {

@@ -219,7 +219,7 @@ TEST_CASE("ffd_displace with unit weights equals the FFD of the displaced regula
   for (size_t q = 0; q < out.size(); ++q) CHECK(out[q] == doctest::Approx(expected[q]).epsilon(1e-5));
 }
 
-TEST_CASE("a 2x2x2 lattice fitted to a trilinear field reproduces it; a 3x3x3 fit reproduces a quadratic one") {
+TEST_CASE("a 2x2x2 lattice fitted to a trilinear field reproduces it, a 3x3x3 fit reproduces a quadratic one") {
   const std::vector<float> local = sample_local();
   const size_t count = local.size() / 3;
   // Trilinear field: corner vectors blended by s, t, u.

@@ -262,7 +262,7 @@ TEST_CASE("tdag: the three approximation levels of Section 5") {
   check_cut(dag, cut, tolerance);
 }
 
-TEST_CASE("tdag: save and load round trip; damaged files are named errors") {
+TEST_CASE("tdag: save and load round trip, damaged files are named errors") {
   const OwnedAnimatedMesh mesh = swinging_tube(4);
   TdagOptions options;
   options.governing = Governing::online;
@@ -304,7 +304,7 @@ TEST_CASE("tdag: save and load round trip; damaged files are named errors") {
   CHECK(load_error({'h', 'e', 'l', 'l', 'o'}) == "not a TDAG file (no ANLDTDAG signature)");
 }
 
-TEST_CASE("tdag: every file the builder writes loads; a collapse ordered before its child does not") {
+TEST_CASE("tdag: every file the builder writes loads, a collapse ordered before its child does not") {
   // The reader checks that each collapse child is in the dependency closure of its parent on
   // every frame (tdag_io.cpp); the builder links children only through chains of dependencies,
   // so this walks several meshes and every governing mode, online with several history weights.

@@ -53,7 +53,7 @@ TEST_CASE("affine split recovers a known affine motion: the residuals equal the 
     CHECK(rebuilt[i] == doctest::Approx(mesh.frames[3 * sphere.vertex_count * 3 + i]).epsilon(1e-5));
 }
 
-TEST_CASE("affine split against the average mesh; a non-affine bend leaves a residual") {
+TEST_CASE("affine split against the average mesh, a non-affine bend leaves a residual") {
   const OwnedAnimatedMesh tube = animlod::testing::bending_tube(12, 10, 5, 1.2);
   AffineSplit split;
   REQUIRE(animlod::affine_split(tube.view(), AffineBase::average, split).ok);
@@ -65,7 +65,7 @@ TEST_CASE("affine split against the average mesh; a non-affine bend leaves a res
   CHECK(moved_most > 0.05);
 }
 
-TEST_CASE("affine split of a flat base falls back on translations; bad input is named") {
+TEST_CASE("affine split of a flat base falls back on translations, bad input is named") {
   OwnedAnimatedMesh grid = animlod::testing::grid(4);  // z = 0: a singular base
   grid.frame_count = 2;
   const std::vector<float> first = grid.frames;

@@ -47,7 +47,7 @@ TEST_CASE("time tag: adding merges overlapping and touching ranges, in any order
   CHECK(frames.ranges() == ranges({{3, 9}, {10, 11}}));
 }
 
-TEST_CASE("time tag: removing splits a range; union, intersection and difference") {
+TEST_CASE("time tag: removing splits a range, union, intersection and difference") {
   TimeTag tag(0, 10);
   tag.remove({3, 5});
   CHECK(tag.ranges() == ranges({{0, 3}, {5, 10}}));
@@ -69,7 +69,7 @@ TEST_CASE("time tag: removing splits a range; union, intersection and difference
   CHECK(c == d);
 }
 
-TEST_CASE("tagged value: a value constant over time is one run; lookups by frame") {
+TEST_CASE("tagged value: a value constant over time is one run, lookups by frame") {
   TaggedValue<int> field;
   CHECK(field.append({0, 1}, 7));
   CHECK(field.append({1, 2}, 7));

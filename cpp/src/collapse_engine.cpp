@@ -284,6 +284,18 @@ EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
     if (point_vertex[wedge_point[v]] < 0) point_vertex[wedge_point[v]] = new_index[v];
     level.kept_vertices.push_back(static_cast<int32_t>(v));
   }
+  // A wedge cut apart at a non-manifold spot stands at several (split) points, and wedge_point
+  // keeps only one of them: the others get the lowest output vertex used at their corners, so
+  // that a vertex merged into such a point maps to it (fuzz: tests/fuzz/crashes/simplify_animated).
+  std::vector<int32_t> corner_vertex(point_count_, -1);
+  for (int32_t f : live_faces)
+    for (size_t c = 0; c < 3; ++c) {
+      const int32_t point = corner_points_[3 * static_cast<size_t>(f) + c];
+      const int32_t index = new_index[corner_wedges_[3 * static_cast<size_t>(f) + c]];
+      if (point_vertex[point] < 0 && (corner_vertex[point] < 0 || index < corner_vertex[point])) corner_vertex[point] = index;
+    }
+  for (size_t p = 0; p < point_count_; ++p)
+    if (point_vertex[p] < 0) point_vertex[p] = corner_vertex[p];
   for (int32_t f : live_faces) {
     level.face_sources.push_back(prepared_.face_sources[f]);
     for (size_t c = 0; c < 3; ++c) level.faces.push_back(new_index[corner_wedges_[3 * static_cast<size_t>(f) + c]]);

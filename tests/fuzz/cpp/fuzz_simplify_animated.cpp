@@ -18,23 +18,76 @@
 //   attributes (B int16 / 64) and face groups (M x u8).
 // Invariants on success: one level per target, finest first; level faces index the kept
 // vertices and come from input faces; kept vertices ascend; the vertex map points at kept
-// vertices (-1 only for vertices no face uses); positions (F, V', 3) are finite; a reached
+// vertices (-1 only for vertices no kept face uses, or whose every piece lost all its faces, as
+// aqem.hpp says; pieces are those of the engine's mesh preparation); positions (F, V', 3) are finite; a reached
 // level has at most its target of faces; a locked vertex that a face uses stays where it was in
 // every frame; per-vertex outputs have one row per kept vertex.
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 #include <vector>
 
 #include "animlod/aqem.hpp"
 #include "fuzz_input.hpp"
+#include "mesh_preparation.hpp"
 
 namespace {
 
+// The manifold pieces the collapse engine works on (mesh_preparation.hpp, the same weld input as
+// simplify_animated): piece of each input face (-1 for faces the preparation dropped), and the
+// pieces holding a corner of each input vertex.
+struct Pieces {
+  std::vector<int32_t> of_face;                    // (M,)
+  std::vector<std::vector<int32_t>> of_vertex;     // (V,)
+  size_t count = 0;
+};
+
+Pieces engine_pieces(const animlod::fuzz::FuzzMesh& mesh, const animlod::AqemVertexData& data, bool weld) {
+  animlod::detail::WeldInput input;
+  input.position_attributes = data.position_attributes;
+  input.position_attribute_count = data.position_attribute_count;
+  input.attributes = data.attributes;
+  input.attribute_count = data.attribute_count;
+  input.skin_joints = data.skin_joints;
+  input.skin_weights = data.skin_weights;
+  input.influence_count = data.influence_count;
+  input.face_groups = data.face_groups;
+  input.weld = weld;
+  const animlod::detail::PreparedMesh prepared = animlod::detail::prepare_mesh(mesh.view(), input);
+  // Faces joined across an edge of two points (the prepared faces are manifold): union-find.
+  const size_t face_count = prepared.face_sources.size();
+  std::vector<size_t> root(face_count);
+  for (size_t f = 0; f < face_count; ++f) root[f] = f;
+  auto find = [&](size_t x) {
+    while (root[x] != x) x = root[x] = root[root[x]];
+    return x;
+  };
+  std::map<std::pair<int32_t, int32_t>, size_t> edge_face;
+  for (size_t f = 0; f < face_count; ++f)
+    for (size_t k = 0; k < 3; ++k) {
+      const int32_t a = prepared.faces[3 * f + k], b = prepared.faces[3 * f + (k + 1) % 3];
+      const auto [it, added] = edge_face.emplace(std::make_pair(std::min(a, b), std::max(a, b)), f);
+      if (!added) root[find(f)] = find(it->second);
+    }
+  Pieces pieces;
+  pieces.of_face.assign(mesh.face_count, -1);
+  pieces.of_vertex.resize(mesh.vertex_count);
+  std::map<size_t, int32_t> number;
+  for (size_t f = 0; f < face_count; ++f) {
+    const auto [it, added] = number.emplace(find(f), static_cast<int32_t>(number.size()));
+    const auto source = static_cast<size_t>(prepared.face_sources[f]);
+    pieces.of_face[source] = it->second;
+    for (size_t k = 0; k < 3; ++k) pieces.of_vertex[static_cast<size_t>(mesh.faces[3 * source + k])].push_back(it->second);
+  }
+  pieces.count = number.size();
+  return pieces;
+}
+
 void check_result(const animlod::fuzz::FuzzMesh& mesh, const animlod::AqemVertexData& data,
-                  const std::vector<uint8_t>& locked, size_t level_count, const animlod::AqemResult& result) {
+                  const std::vector<uint8_t>& locked, size_t level_count, bool weld, const animlod::AqemResult& result) {
   ANIMLOD_FUZZ_REQUIRE(result.levels.size() == level_count);
-  std::vector<bool> referenced(mesh.vertex_count, false);
-  for (int32_t index : mesh.faces) referenced[static_cast<size_t>(index)] = true;
+  const Pieces pieces = engine_pieces(mesh, data, weld);
   ANIMLOD_FUZZ_REQUIRE(result.vertex_weights.size() == mesh.vertex_count);
   for (int32_t f : result.frames_used) ANIMLOD_FUZZ_REQUIRE(f >= 0 && static_cast<size_t>(f) < mesh.frame_count);
   size_t previous_target = mesh.face_count;
@@ -51,14 +104,19 @@ void check_result(const animlod::fuzz::FuzzMesh& mesh, const animlod::AqemVertex
     }
     ANIMLOD_FUZZ_REQUIRE(level.face_sources.size() == level.faces.size() / 3);
     ANIMLOD_FUZZ_REQUIRE(level.vertex_map.size() == mesh.vertex_count);
+    // -1 only where aqem.hpp says: no kept face uses the vertex (unreferenced, or only in faces
+    // dropped as degenerate or repeated), or every piece with a corner of it collapsed away.
+    std::vector<uint8_t> piece_alive(pieces.count, 0);
+    for (int32_t source : level.face_sources)
+      if (source >= 0 && static_cast<size_t>(source) < mesh.face_count && pieces.of_face[static_cast<size_t>(source)] >= 0)
+        piece_alive[static_cast<size_t>(pieces.of_face[static_cast<size_t>(source)])] = 1;
     for (size_t v = 0; v < mesh.vertex_count; ++v) {
       const int32_t target = level.vertex_map[v];
-      // -1: no face uses the vertex, or only faces dropped as degenerate or repeated. With
-      // attributes or face groups (seams), a wedge whose chart vanished also maps to -1, which
-      // aqem.hpp does not say (open finding, tests/fuzz/open/simplify_animated/); not checked.
-      const bool seams = data.attribute_count > 0 || data.face_groups != nullptr;
-      const bool dropped = result.preparation.degenerate_faces + result.preparation.duplicate_faces > 0;
-      ANIMLOD_FUZZ_REQUIRE(target == -1 ? !referenced[v] || dropped || seams : static_cast<size_t>(target) < kept);
+      if (target >= 0) {
+        ANIMLOD_FUZZ_REQUIRE(static_cast<size_t>(target) < kept);
+        continue;
+      }
+      for (int32_t piece : pieces.of_vertex[v]) ANIMLOD_FUZZ_REQUIRE(!piece_alive[static_cast<size_t>(piece)]);
     }
     for (int32_t source : level.face_sources) {
       ANIMLOD_FUZZ_REQUIRE(source >= 0 && static_cast<size_t>(source) < mesh.face_count);
@@ -194,6 +252,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     ANIMLOD_FUZZ_REQUIRE(!status.message.empty() && result.levels.empty());
     return 0;
   }
-  check_result(mesh, vertex_data, locked, level_count, result);
+  check_result(mesh, vertex_data, locked, level_count, options.weld, result);
   return 0;
 }

@@ -84,24 +84,30 @@ bench: python-package
 	bench/openmesh_build/run.sh
 	@for script in bench/bench_*.py; do echo "== $$script"; $(PY) $$script || exit 1; done
 
-# The C++ tests, then pytest against an extension built with the same sanitizers (in its own
-# venv, so that the normal one stays fast). Debian's libasan is preloaded into python.
-# The extension's build runs at most $(JOBS) compilers too (Ninja's default is cores + 2).
+# The sanitizers: one ASan + UBSan build tree (build/sanitize) of the core, the doctest suite, the
+# fuzz replays, the crowd (SANITIZE_CROWD=OFF leaves it and its loader's replay out) and the
+# extension, so the core is compiled once; ctest, then pytest in the normal venv with the
+# sanitized extension loaded in place of the release one (scripts/sanitize_site/sitecustomize.py,
+# in every Python process the tests start too) and Debian's libasan preloaded into python.
+# SANITIZE_PYTEST picks the tests (default: all of tests/python). -O1 -g1: line tables for the
+# reports, and much less to compile than RelWithDebInfo's -O2 -g.
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer
 SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+SANITIZE_CROWD ?= ON
+SANITIZE_PYTEST ?= tests/python
 
-sanitize: $(OPENMESH_CONFIG) $(VENV)/bin/pip
+sanitize: python-package
 	@mkdir -p build
 	cmake -S . -B build/sanitize -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" > build/sanitize.configure.log
+	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
+	  -DANIMLOD_BUILD_PYTHON=ON -DANIMLOD_BUILD_CROWD=$(SANITIZE_CROWD) -DANIMLOD_INSTALL=OFF \
+	  -DPython_EXECUTABLE=$(CURDIR)/$(PY) -Dpybind11_DIR="$$($(PY) -m pybind11 --cmakedir)" > build/sanitize.configure.log
 	cmake --build build/sanitize --parallel $(JOBS)
 	$(SANITIZE_ENV) ctest --test-dir build/sanitize --output-on-failure
-	test -x .venv-sanitize/bin/pip || $(PYTHON) -m venv .venv-sanitize
-	.venv-sanitize/bin/pip install -q scikit-build-core pybind11
-	CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) .venv-sanitize/bin/pip install -q --no-build-isolation -e ".[test]" -Cbuild-dir=build/python-sanitize \
-	  -Ccmake.build-type=RelWithDebInfo -Ccmake.define.CMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)"
-	$(SANITIZE_ENV) LD_PRELOAD="$$(g++ -print-file-name=libasan.so) $$(g++ -print-file-name=libubsan.so)" \
-	  .venv-sanitize/bin/python -m pytest -q -p no:cacheprovider tests/python
+	$(SANITIZE_ENV) PYTHONPATH=$(CURDIR)/scripts/sanitize_site \
+	  ANIMLOD_SANITIZED_CORE="$$(ls $(CURDIR)/build/sanitize/cpp/bindings/_core*.so)" \
+	  LD_PRELOAD="$$(g++ -print-file-name=libasan.so) $$(g++ -print-file-name=libubsan.so)" \
+	  $(PY) -m pytest -q -p no:cacheprovider $(SANITIZE_PYTEST)
 
 # Fuzzing (tests/fuzz/README.md): clang's libFuzzer for the C++ harnesses, atheris for the
 # readers. Its packages are installed here, not by `make test`, which replays saved crashes

@@ -51,10 +51,12 @@ def load_registry(path: Path = FUZZ_DIR / "harnesses.txt") -> list[Harness]:
     return harnesses
 
 
-def command(harness: Harness, seconds: int, corpus: Path, seeds: Path, artifacts: Path) -> list[str]:
+def command(
+    harness: Harness, seconds: int, corpus: Path, seeds: Path, artifacts: Path, timeout: int | None = None
+) -> list[str]:
     flags = [
         f"-max_total_time={seconds}",
-        f"-timeout={1 if harness.language == 'cpp' else 5}",
+        f"-timeout={timeout or (1 if harness.language == 'cpp' else 5)}",
         "-rss_limit_mb=2048",
         "-print_final_stats=1",
         f"-artifact_prefix={artifacts}/",
@@ -67,7 +69,7 @@ def command(harness: Harness, seconds: int, corpus: Path, seeds: Path, artifacts
     return [sys.executable, str(FUZZ_DIR / "run_atheris.py"), harness.name, *flags, str(corpus), str(seeds)]
 
 
-def run_one(harness: Harness, seconds: int) -> dict:
+def run_one(harness: Harness, seconds: int, timeout: int | None = None) -> dict:
     sys.path.insert(0, str(FUZZ_DIR))
     from seeds import write_seeds
 
@@ -83,7 +85,7 @@ def run_one(harness: Harness, seconds: int) -> dict:
     sanitizers = {"ASAN_OPTIONS": "detect_leaks=1:allocator_may_return_null=1", "UBSAN_OPTIONS": "print_stacktrace=1"}
     env = dict(os.environ, **sanitizers)
     with open(log, "w") as output:
-        code = subprocess.run(command(harness, seconds, corpus, seeds, artifacts), stdout=output,
+        code = subprocess.run(command(harness, seconds, corpus, seeds, artifacts, timeout), stdout=output,
                               stderr=subprocess.STDOUT, env=env, cwd=ROOT).returncode  # fmt: skip
     text = log.read_text(errors="replace")
     found = _keep_artifacts(harness.name, artifacts)
@@ -103,6 +105,25 @@ def run_one(harness: Harness, seconds: int) -> dict:
         "exit": code,
         "log": log,
     }
+
+
+def replay_corpus(harness: Harness) -> list[Path]:
+    """Every input of the harness's corpus once, at libFuzzer's default timeout for C++ (1 s):
+    the check of a run made with a longer --timeout. Returns what it found (kept as artifacts)."""
+    corpus, artifacts = BUILD / "corpus" / harness.name, BUILD / "artifacts" / harness.name
+    shutil.rmtree(artifacts, ignore_errors=True)
+    artifacts.mkdir(parents=True)
+    binary = BUILD / "tests" / "fuzz" / "cpp" / f"animlod_fuzz_{harness.name}"
+    flags = ["-runs=0", "-timeout=1", "-rss_limit_mb=2048", f"-artifact_prefix={artifacts}/", "-max_len=65536"]
+    log = BUILD / "logs" / f"{harness.name}.replay.log"
+    sanitizers = {"ASAN_OPTIONS": "detect_leaks=1:allocator_may_return_null=1", "UBSAN_OPTIONS": "print_stacktrace=1"}
+    env = dict(os.environ, **sanitizers)
+    with open(log, "w") as output:
+        subprocess.run([str(binary), *flags, str(corpus)], stdout=output, stderr=subprocess.STDOUT, env=env, cwd=ROOT)
+    found = _keep_artifacts(harness.name, artifacts)
+    names = ", ".join(p.name for p in found) or "nothing found"
+    print(f"{harness.name}: corpus replayed at -timeout=1 ({log}): {names}")
+    return found
 
 
 def _keep_artifacts(name: str, artifacts: Path) -> list[Path]:
@@ -130,13 +151,27 @@ def main(argv: list[str] | None = None) -> int:
         "--fail-on", default=",".join(ARTIFACT_KINDS),
         help="artifact kinds that fail the run (CI's smoke leaves out timeouts, which a loaded machine can cause)",
     )  # fmt: skip
+    parser.add_argument(
+        "--timeout", type=int,
+        help="seconds per input before libFuzzer calls it a timeout (default 1 for C++, 5 for Python); "
+        "libFuzzer counts wall time, so a run at nice 19 on a loaded machine needs more, and the corpus "
+        "is then replayed at the default (--replay-corpus)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--replay-corpus", action="store_true",
+        help="after fuzzing, run every corpus input once with the default timeout (C++ harnesses)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     harnesses = [h for h in load_registry() if not args.only or h.name in args.only]
     unknown = set(args.only or ()) - {h.name for h in harnesses}
     if unknown:
         parser.error(f"no harness named {', '.join(sorted(unknown))} in harnesses.txt")
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        rows = list(pool.map(lambda h: run_one(h, args.seconds), harnesses))
+        rows = list(pool.map(lambda h: run_one(h, args.seconds, args.timeout), harnesses))
+    if args.replay_corpus:
+        for r in rows:
+            if r["language"] == "cpp":
+                r["found"] += replay_corpus(next(h for h in harnesses if h.name == r["harness"]))
     print("| harness | language | seconds | seeds | executions | exec/s | coverage (edges) | features | corpus "
           "| found |")  # fmt: skip
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---|")

@@ -89,11 +89,13 @@ bench: python-package
 # extension, so the core is compiled once; ctest, then pytest in the normal venv with the
 # sanitized extension loaded in place of the release one (scripts/sanitize_site/sitecustomize.py,
 # in every Python process the tests start too) and Debian's libasan preloaded into python.
-# SANITIZE_PYTEST picks the tests (default: all of tests/python). -O1 -g1: line tables for the
+# SANITIZE_BINDINGS=OFF compiles the thin pybind11 layer without sanitizers (most of the build's
+# time). SANITIZE_PYTEST picks the tests (default: all of tests/python). -O1 -g1: line tables for the
 # reports, and much less to compile than RelWithDebInfo's -O2 -g.
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer
 SANITIZE_ENV := ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 SANITIZE_CROWD ?= ON
+SANITIZE_BINDINGS ?= ON
 SANITIZE_PYTEST ?= tests/python
 
 sanitize: python-package
@@ -101,6 +103,7 @@ sanitize: python-package
 	cmake -S . -B build/sanitize -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
 	  -DANIMLOD_BUILD_PYTHON=ON -DANIMLOD_BUILD_CROWD=$(SANITIZE_CROWD) -DANIMLOD_INSTALL=OFF \
+	  -DANIMLOD_SANITIZE_BINDINGS=$(SANITIZE_BINDINGS) \
 	  -DPython_EXECUTABLE=$(CURDIR)/$(PY) -Dpybind11_DIR="$$($(PY) -m pybind11 --cmakedir)" > build/sanitize.configure.log
 	cmake --build build/sanitize --parallel $(JOBS)
 	$(SANITIZE_ENV) ctest --test-dir build/sanitize --output-on-failure

@@ -158,7 +158,10 @@ constexpr uint32_t kTdagFormatVersion = 1;
 Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out);
 // Reads bytes written by serialize_temporal_dag. Errors: not a TDAG (bad magic), a format
 // version this build does not read (older or newer, both named), a truncated or corrupted
-// file (checksum, sizes, out-of-range indices), each saying which.
+// file (checksum, sizes, out-of-range indices, dependencies that do not order a collapse after
+// its children on some frame, naming the collapse, child and frame), each saying which. Cost:
+// linear in the file, plus for the order check a search from each collapse through the ones
+// ranked between it and its children (again on frames where the structure changes).
 Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& out);
 // File versions: the message of an error starts with the path. save writes `path` through a
 // temporary file renamed into place.

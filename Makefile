@@ -38,7 +38,7 @@ $(VENV)/bin/pip: | system-packages
 # Optional dependency groups of pyproject.toml; `make bench` adds the benchmark peers.
 EXTRAS := test,batch
 python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
-	$(VENV)/bin/pip install -q scikit-build-core pybind11
+	$(VENV)/bin/pip install -q scikit-build-core pybind11 pybind11-stubgen
 	$(VENV)/bin/pip install -q --no-build-isolation -e ".[$(EXTRAS)]"
 
 $(CPP_BUILD)/build.ninja: $(OPENMESH_CONFIG)
@@ -99,7 +99,7 @@ sanitize: $(OPENMESH_CONFIG) $(VENV)/bin/pip
 	test -x .venv-sanitize/bin/pip || $(PYTHON) -m venv .venv-sanitize
 	.venv-sanitize/bin/pip install -q scikit-build-core pybind11
 	CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) .venv-sanitize/bin/pip install -q --no-build-isolation -e ".[test]" -Cbuild-dir=build/python-sanitize \
-	  -Ccmake.build-type=RelWithDebInfo -Ccmake.define.CMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)"
+	  -Ccmake.build-type=RelWithDebInfo -Ccmake.define.CMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -Ccmake.define.ANIMLOD_PYTHON_STUB=OFF
 	$(SANITIZE_ENV) LD_PRELOAD="$$(g++ -print-file-name=libasan.so) $$(g++ -print-file-name=libubsan.so)" \
 	  .venv-sanitize/bin/python -m pytest -q -p no:cacheprovider tests/python
 

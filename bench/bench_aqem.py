@@ -363,7 +363,7 @@ def character_table(quick: bool, max_triangles: int) -> None:
 
     from animlod.io.gltf_document import GltfDocument
     from animlod.io.gltf_drawable import read_drawables
-    from animlod.pipelines.drawable_levels import simplify_drawable
+    from animlod.pipelines.drawable_levels import DrawableSettings, simplify_drawable
 
     variants = {  # the pipeline's default is features off
         "amplitude": {"use_motion_features": True},
@@ -380,7 +380,7 @@ def character_table(quick: bool, max_triangles: int) -> None:
                 errors, seconds = {}, {}
                 for name, options in variants.items():
                     with stopwatch() as elapsed:
-                        levels = simplify_drawable(drawable, RATIOS, aqem_options=options)
+                        levels = simplify_drawable(drawable, RATIOS, DrawableSettings(aqem=options))
                     errors[name] = [level.error / levels.size for level in levels.levels]
                     seconds[name] = elapsed[0]
                 for k, ratio in enumerate(RATIOS):

@@ -23,7 +23,8 @@ from dataclasses import dataclass
 DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "bvh": "motion"}
 # Keyword arguments a manifest never sets: the runner owns progress, and a batch spreads its
 # work over assets (one core each), not over the processes of one asset.
-_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level", "on_note"})
+# A pipeline's settings object is given by its fields (DrawableSettings, listed as a source).
+_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level", "on_note", "settings", "aqem"})
 
 
 @dataclass(frozen=True)
@@ -53,13 +54,15 @@ class Job:
 
 # The AQEM options a pipeline passes on to simplify_animated (its keywords are this class's fields).
 _AQEM = "animlod.options:AqemOptions"
+# The settings the glTF pipelines share, as keywords.
+_DRAWABLE = "animlod.pipelines.drawable_levels:DrawableSettings"
 BUILTIN_JOBS = {
     "simplify": Job(
         "simplify",
         "animlod.pipelines.assets:simplify_asset",
         ("gltf", "npz", "sequence"),
         {
-            "gltf": ("animlod.pipelines.lod_document:simplify_document", _AQEM),
+            "gltf": ("animlod.pipelines.lod_document:simplify_document", _DRAWABLE, _AQEM),
             "npz": ("animlod.pipelines.lod_sequence:simplify_sequence", _AQEM),
             "sequence": ("animlod.pipelines.lod_sequence:simplify_sequence", _AQEM),
         },
@@ -68,7 +71,7 @@ BUILTIN_JOBS = {
         "character",
         "animlod.pipelines.assets:character_asset",
         ("gltf",),
-        {"gltf": ("animlod.pipelines.character:build_character", _AQEM)},
+        {"gltf": ("animlod.pipelines.character:build_character", _DRAWABLE, _AQEM)},
     ),
     "face": Job(
         "face",

@@ -38,7 +38,7 @@ $(VENV)/bin/pip: | system-packages
 # Optional dependency groups of pyproject.toml; `make bench` adds the benchmark peers.
 EXTRAS := test,batch
 python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
-	$(VENV)/bin/pip install -q scikit-build-core pybind11 pybind11-stubgen
+	$(VENV)/bin/pip install -q scikit-build-core pybind11 pybind11-stubgen numpy
 	$(VENV)/bin/pip install -q --no-build-isolation -e ".[$(EXTRAS)]"
 
 $(CPP_BUILD)/build.ninja: $(OPENMESH_CONFIG)

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include <Eigen/Core>
@@ -175,7 +176,8 @@ class AqemPolicy final : public detail::CollapsePolicy {
 
  private:
   void accumulate_quadrics();
-  void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides);
+  void accumulate_frames(size_t begin, size_t end);
+  void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, size_t begin, size_t end);
   // Placement of the candidate being evaluated, per worker.
   struct Scratch {
     std::vector<Eigen::Vector3d> new_positions;  // (K,) placement in the quadrics' frames
@@ -210,10 +212,32 @@ void AqemPolicy::accumulate_quadrics() {
   const std::vector<int32_t>& faces = engine_.prepared().faces;
   quadrics_.assign(point_count * used_count_, Quadric{});
   plane_counts_.assign(point_count, 0.0);
+  for (const int32_t point : faces) plane_counts_[point] += 1.0;
+  if (options_.boundary_quadrics)
+    for (const auto* sides : {&engine_.border_sides(), &engine_.seam_sides()})
+      for (const auto& side : *sides) {
+        plane_counts_[side[0]] += 1.0;
+        plane_counts_[side[1]] += 1.0;
+      }
+  // The frames are independent: two workers take half of them each, every quadric summing its
+  // planes in the same order as one worker would.
+  const size_t workers = used_count_ >= 2 && faces.size() * used_count_ >= 3 * 65536 ? 2 : 1;
+  auto accumulate = [&](size_t worker) {
+    const size_t begin = used_count_ * worker / workers, end = used_count_ * (worker + 1) / workers;
+    accumulate_frames(begin, end);
+  };
+  std::thread second;
+  if (workers == 2) second = std::thread(accumulate, 1);
+  accumulate(0);
+  if (second.joinable()) second.join();
+}
+
+// The quadrics of used frames [begin, end): every face's plane, then the border and seam sides'.
+void AqemPolicy::accumulate_frames(size_t begin, size_t end) {
+  const std::vector<int32_t>& faces = engine_.prepared().faces;
   for (size_t f = 0; f < faces.size() / 3; ++f) {
     const int32_t* v = &faces[3 * f];
-    for (int corner = 0; corner < 3; ++corner) plane_counts_[v[corner]] += 1.0;
-    for (size_t k = 0; k < used_count_; ++k) {
+    for (size_t k = begin; k < end; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d p0 = engine_.position(v[0], frame), p1 = engine_.position(v[1], frame),
                             p2 = engine_.position(v[2], frame);
@@ -225,16 +249,14 @@ void AqemPolicy::accumulate_quadrics() {
     }
   }
   if (!options_.boundary_quadrics) return;
-  add_side_planes(engine_.border_sides());
-  add_side_planes(engine_.seam_sides());
+  add_side_planes(engine_.border_sides(), begin, end);
+  add_side_planes(engine_.seam_sides(), begin, end);
 }
 
 // A plane through each side (a, b) perpendicular to the face (a, b, c) beside it.
-void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& sides) {
+void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, size_t begin, size_t end) {
   for (const auto& [a, b, c] : sides) {
-    plane_counts_[a] += 1.0;
-    plane_counts_[b] += 1.0;
-    for (size_t k = 0; k < used_count_; ++k) {
+    for (size_t k = begin; k < end; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d pa = engine_.position(a, frame), pb = engine_.position(b, frame),
                             pc = engine_.position(c, frame);

@@ -1,16 +1,20 @@
 // AQEM's collapse passes (meshoptimizer's scheme, collapse_engine.cpp run_passes) on meshes
 // large enough to use them (more than EngineOptions::greedy_tail_edges edges; smaller meshes run
-// the greedy order, which test_aqem.cpp covers).
+// the greedy order, which test_aqem.cpp covers), and the quadric's 3x3 solve.
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <random>
 #include <set>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 
 #include "animlod/aqem.hpp"
+#include "quadric.hpp"
 #include "test_aqem_meshes.hpp"
 
 using animlod::AqemLevel;
@@ -136,4 +140,31 @@ TEST_CASE("collapse passes stop at max_error like the greedy order") {
   CHECK_FALSE(result.levels[1].reached);
   CHECK(result.levels[1].error <= bound);
   for (double error : result.collapses.error) CHECK(error <= bound);
+}
+
+TEST_CASE("the quadric's minimiser solves A v = b and refuses a singular A") {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    animlod::detail::Quadric quadric;
+    for (int plane = 0; plane < 4; ++plane) {  // four random planes: A is (almost surely) regular
+      const Eigen::Vector3d normal = Eigen::Vector3d(uniform(random), uniform(random), uniform(random)).normalized();
+      quadric += animlod::detail::Quadric::plane(normal, Eigen::Vector3d(uniform(random), uniform(random), 0.0), 1.0);
+    }
+    Eigen::Matrix3d a;
+    a << quadric.a00, quadric.a01, quadric.a02, quadric.a01, quadric.a11, quadric.a12, quadric.a02, quadric.a12,
+        quadric.a22;
+    const Eigen::Vector3d b(quadric.b0, quadric.b1, quadric.b2);
+    Eigen::Vector3d v;
+    if (std::abs(a.determinant()) <= 1e-6) continue;
+    REQUIRE(quadric.minimizer(v));
+    CHECK((a * v - b).norm() <= 1e-9 * (1.0 + b.norm()) * a.norm() / std::abs(a.determinant()));
+    CHECK((v - a.lu().solve(b)).norm() <= 1e-8 * (1.0 + v.norm()));
+  }
+  // Two planes meet in a line: every point of it is a minimiser, so there is no unique one.
+  animlod::detail::Quadric ridge = animlod::detail::Quadric::plane(Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(), 1.0);
+  ridge += animlod::detail::Quadric::plane(Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero(), 1.0);
+  Eigen::Vector3d v;
+  CHECK_FALSE(ridge.minimizer(v));
+  CHECK_FALSE(animlod::detail::Quadric{}.minimizer(v));
 }

@@ -385,7 +385,8 @@ void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targ
   next_level_ = 0;
   take_reached_levels(targets, levels);
   if (options_.progress) options_.progress(0, planned_);
-  if (options_.collapse_passes) run_passes(policy, targets, levels, record);
+  if (options_.collapse_passes && connectivity_.n_edges() > options_.passes_above_edges)
+    run_passes(policy, targets, levels, record);
   else run_greedy(policy, targets, levels, record);
   for (; next_level_ < targets.size(); ++next_level_) levels.push_back(snapshot(targets[next_level_], false));
   if (options_.progress) options_.progress(collapse_count_, planned_);

@@ -1,6 +1,6 @@
 // AQEM's collapse passes (meshoptimizer's scheme, collapse_engine.cpp run_passes) on meshes
-// large enough to use them (more than EngineOptions::greedy_tail_edges edges; smaller meshes run
-// the greedy order, which test_aqem.cpp covers), and the quadric's 3x3 solve.
+// large enough to use them (more than EngineOptions::passes_above_edges = 100k edges; smaller
+// meshes run the greedy order, which test_aqem.cpp covers), and the quadric's 3x3 solve.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -69,8 +69,8 @@ size_t inward_faces(const AqemLevel& level, size_t frame_count) {
 }  // namespace
 
 TEST_CASE("collapse passes reach every level without flipping a face in any frame") {
-  const OwnedAnimatedMesh mesh = animlod::testing::sphere(48, 64, 4);  // 6,016 faces
-  REQUIRE(edge_count(mesh) > 4096);  // above the greedy tail: passes run
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(200, 340, 2);  // 135,320 faces
+  REQUIRE(edge_count(mesh) > 100000);  // passes run
   AqemOptions options;
   options.target_ratios = {0.5, 0.2, 0.05};
   const AqemResult result = run(mesh, options);
@@ -90,8 +90,8 @@ TEST_CASE("collapse passes reach every level without flipping a face in any fram
 }
 
 TEST_CASE("collapse passes are deterministic") {
-  const OwnedAnimatedMesh mesh = animlod::testing::jittering_sphere(40, 60, 3, 0.02f);
-  REQUIRE(edge_count(mesh) > 4096);
+  const OwnedAnimatedMesh mesh = animlod::testing::jittering_sphere(200, 340, 2, 0.02f);
+  REQUIRE(edge_count(mesh) > 100000);
   AqemOptions options;
   options.target_ratios = {0.1};
   const AqemResult first = run(mesh, options), second = run(mesh, options);
@@ -101,8 +101,8 @@ TEST_CASE("collapse passes are deterministic") {
 }
 
 TEST_CASE("collapse passes keep guarded vertices while other collapses remain, then free them") {
-  const OwnedAnimatedMesh mesh = animlod::testing::sphere(48, 64, 2);
-  REQUIRE(edge_count(mesh) > 4096);
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(200, 340, 1);
+  REQUIRE(edge_count(mesh) > 100000);
   std::vector<uint8_t> guarded(mesh.vertex_count, 0);
   for (size_t v = 0; v < mesh.vertex_count; v += 5) guarded[v] = 1;
   const size_t guarded_count = static_cast<size_t>(std::count(guarded.begin(), guarded.end(), 1));
@@ -128,7 +128,7 @@ TEST_CASE("collapse passes keep guarded vertices while other collapses remain, t
 }
 
 TEST_CASE("collapse passes stop at max_error like the greedy order") {
-  const OwnedAnimatedMesh mesh = animlod::testing::jittering_sphere(40, 60, 2, 0.02f);
+  const OwnedAnimatedMesh mesh = animlod::testing::jittering_sphere(200, 340, 1, 0.02f);
   AqemOptions options;
   options.target_ratios = {0.8, 0.05};
   const AqemResult unbounded = run(mesh, options);

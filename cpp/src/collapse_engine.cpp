@@ -164,6 +164,7 @@ bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandl
     if (connectivity_.is_boundary(side)) continue;
     const auto opposite = connectivity_.to_vertex_handle(connectivity_.next_halfedge_handle(side));
     assert(valence_[opposite.idx()] == static_cast<int32_t>(connectivity_.valence(opposite)));
+
     if (valence_[opposite.idx()] <= 3 && !connectivity_.is_boundary(opposite)) return false;
   }
   if (!map_wedges(candidate, collapse)) return false;
@@ -174,10 +175,15 @@ bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandl
     const int32_t other = moved == candidate.kept ? candidate.removed : candidate.kept;
     for (const auto face : connectivity_.vf_range(connectivity_.vertex_handle(moved))) {
       std::array<const float*, 3> corners{};
-      int moved_corner = -1, corner = 0;
+      int moved_corner = -1;
       bool collapses = false;
-      for (; corner < 3; ++corner) {  // the flat corner array, not OpenMesh's face circulator
-        const int32_t point = corner_points_[3 * static_cast<size_t>(face.idx()) + static_cast<size_t>(corner)];
+      // The flat corner array, not OpenMesh's face circulator, read from the corner OpenMesh
+      // starts at (the same rounding in the test as before).
+      const int32_t* face_points = &corner_points_[3 * static_cast<size_t>(face.idx())];
+      const int32_t first = connectivity_.to_vertex_handle(connectivity_.halfedge_handle(face)).idx();
+      const int start = face_points[0] == first ? 0 : face_points[1] == first ? 1 : 2;
+      for (int corner = 0; corner < 3; ++corner) {
+        const int32_t point = face_points[(start + corner) % 3];
         if (point == moved) moved_corner = corner;
         collapses |= point == other;
         corners[corner] = &positions_[static_cast<size_t>(point) * frame_count_ * 3];

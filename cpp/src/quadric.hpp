@@ -3,9 +3,8 @@
 // quadric of Eq. 4 is block-diagonal, so AQEM stores F of these per vertex, contiguously.
 #pragma once
 
-#include <cmath>
-
 #include <Eigen/Core>
+#include <Eigen/LU>
 
 namespace animlod::detail {
 
@@ -52,19 +51,18 @@ struct Quadric {
 
   // Eq. 5: the minimiser v = A^-1 b. Returns false when A is (nearly) singular, i.e. its
   // determinant is tiny against the cube of its scale (flat or ridge-like neighbourhoods).
-  // Cramer's rule on the symmetric A (its adjugate is symmetric too): the costs of every frame
-  // of every candidate go through here, so no general 3x3 inverse.
   bool minimizer(Eigen::Vector3d& v) const {
+    Eigen::Matrix3d a;
+    a << a00, a01, a02, a01, a11, a12, a02, a12, a22;
     const double scale = a00 + a11 + a22;
     if (!(scale > 0.0)) return false;
-    const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
-    const double determinant = a00 * c00 + a01 * c01 + a02 * c02;
-    if (!(std::abs(determinant) > 1e-9 * scale * scale * scale)) return false;
-    const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
-    const double inverse = 1.0 / determinant;
-    v = Eigen::Vector3d((c00 * b0 + c01 * b1 + c02 * b2) * inverse, (c01 * b0 + c11 * b1 + c12 * b2) * inverse,
-                        (c02 * b0 + c12 * b1 + c22 * b2) * inverse);
-    return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+    Eigen::Matrix3d inverse;
+    double determinant = 0.0;
+    bool invertible = false;
+    a.computeInverseAndDetWithCheck(inverse, determinant, invertible, 1e-9 * scale * scale * scale);
+    if (!invertible) return false;
+    v = inverse * Eigen::Vector3d(b0, b1, b2);
+    return v.allFinite();
   }
 };
 

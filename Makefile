@@ -38,7 +38,7 @@ $(VENV)/bin/pip: | system-packages
 # Optional dependency groups of pyproject.toml; `make bench` adds the benchmark peers.
 EXTRAS := test,batch
 python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
-	$(VENV)/bin/pip install -q scikit-build-core pybind11
+	$(VENV)/bin/pip install -q scikit-build-core pybind11 pybind11-stubgen numpy
 	$(VENV)/bin/pip install -q --no-build-isolation -e ".[$(EXTRAS)]"
 
 $(CPP_BUILD)/build.ninja: $(OPENMESH_CONFIG)
@@ -103,7 +103,7 @@ sanitize: python-package
 	cmake -S . -B build/sanitize -G $(CMAKE_GENERATOR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
 	  -DANIMLOD_BUILD_PYTHON=ON -DANIMLOD_BUILD_CROWD=$(SANITIZE_CROWD) -DANIMLOD_INSTALL=OFF \
-	  -DANIMLOD_SANITIZE_BINDINGS=$(SANITIZE_BINDINGS) \
+	  -DANIMLOD_SANITIZE_BINDINGS=$(SANITIZE_BINDINGS) -DANIMLOD_PYTHON_STUB=OFF \
 	  -DPython_EXECUTABLE=$(CURDIR)/$(PY) -Dpybind11_DIR="$$($(PY) -m pybind11 --cmakedir)" > build/sanitize.configure.log
 	cmake --build build/sanitize --parallel $(JOBS)
 	$(SANITIZE_ENV) ctest --test-dir build/sanitize --output-on-failure

@@ -46,11 +46,12 @@ from animlod.motion_lod.clips import merge_split_clips
 from animlod.motion_lod.core_refit import refit_core
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.objective import build_problem
-from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
+from animlod.motion_lod.refit import refit_slsqp
+from animlod.options import MotionRefitOptions
 from animlod.synth import humanoid, humanoid_motion
 
 # The core's SLSQP in the Python reference's variables (no preconditioner, every point a variable).
-PLAIN = SlsqpOptions(precondition=False, eliminate_points=False)
+PLAIN = MotionRefitOptions(precondition=False, eliminate_points=False)
 
 
 def subsample(motion: Motion, stride: int) -> Motion:

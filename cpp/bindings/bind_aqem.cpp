@@ -8,7 +8,6 @@
 
 #include "animlod/aqem.hpp"
 #include "array_checks.hpp"
-#include "feature_weighting_name.hpp"
 #include "numpy_from_vector.hpp"
 
 namespace animlod::bindings {
@@ -39,20 +38,14 @@ py::dict level_to_dict(AqemLevel&& level, py::ssize_t frame_count, py::ssize_t a
   return out;
 }
 
-py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_indices,
-                              std::vector<double> target_ratios, std::vector<size_t> target_face_counts,
-                              double max_error, bool use_motion_features,
-                              double feature_threshold, double min_angle_change, bool boundary_is_feature,
-                              bool boundary_quadrics, bool check_inversion, bool strict_inversion, size_t max_frames,
-                              std::vector<int32_t> frame_subset, const std::optional<MaskArray>& locked,
+py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_indices, AqemOptions options,
+                              const std::optional<MaskArray>& locked, const std::optional<MaskArray>& guarded,
                               const std::optional<FloatArray>& importance, const std::optional<FloatArray>& attributes,
+                              const std::optional<FloatArray>& position_attributes,
                               const std::optional<py::array>& skin_joint_indices,
                               const std::optional<FloatArray>& skin_weights,
-                              const std::optional<py::function>& progress, const std::string& placement,
-                              const std::optional<FloatArray>& position_attributes,
-                              const std::optional<py::array>& face_group_indices, bool weld,
-                              const std::optional<MaskArray>& guarded, const std::string& feature_weighting,
-                              double max_feature_weight, double noise_mads) {
+                              const std::optional<py::array>& face_group_indices,
+                              const std::optional<py::function>& progress) {
   require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
   const IndexArray faces = index_array(face_indices, "faces");
   require_shape(faces, "faces", {-1, 3}, "(M, 3)");
@@ -101,26 +94,6 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
     data.influence_count = static_cast<size_t>(skin_joints->shape(1));
   }
 
-  AqemOptions options;
-  options.target_ratios = std::move(target_ratios);
-  options.target_face_counts = std::move(target_face_counts);
-  options.max_error = max_error;
-  options.use_motion_features = use_motion_features;
-  options.motion_features.feature_threshold = feature_threshold;
-  options.motion_features.min_angle_change = min_angle_change;
-  options.motion_features.boundary_is_feature = boundary_is_feature;
-  options.motion_features.weighting = feature_weighting_from_name(feature_weighting);
-  options.motion_features.max_weight = max_feature_weight;
-  options.motion_features.noise_mads = noise_mads;
-  options.boundary_quadrics = boundary_quadrics;
-  options.check_inversion = check_inversion;
-  options.strict_inversion = strict_inversion;
-  options.max_frames = max_frames;
-  options.frame_subset = std::move(frame_subset);
-  options.weld = weld;
-  if (placement == "optimal") options.placement = Placement::optimal;
-  else if (placement == "on_edge") options.placement = Placement::on_edge;
-  else throw py::value_error("placement: expected 'optimal' or 'on_edge', got '" + placement + "'");
   if (progress) {
     const py::function callback = *progress;
     options.progress = [callback](size_t done, size_t total) {
@@ -172,22 +145,11 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
 }  // namespace
 
 void bind_aqem(py::module_& m) {
-  const AqemOptions defaults;
-  m.def("simplify_animated", &simplify_animated_py, py::arg("frames"), py::arg("faces"), py::kw_only(),
-        py::arg("target_ratios") = defaults.target_ratios, py::arg("target_face_counts") = defaults.target_face_counts,
-        py::arg("max_error") = defaults.max_error, py::arg("use_motion_features") = defaults.use_motion_features,
-        py::arg("feature_threshold") = defaults.motion_features.feature_threshold,
-        py::arg("min_angle_change") = defaults.motion_features.min_angle_change,
-        py::arg("boundary_is_feature") = defaults.motion_features.boundary_is_feature,
-        py::arg("boundary_quadrics") = defaults.boundary_quadrics, py::arg("check_inversion") = defaults.check_inversion,
-        py::arg("strict_inversion") = defaults.strict_inversion, py::arg("max_frames") = defaults.max_frames,
-        py::arg("frame_subset") = defaults.frame_subset, py::arg("locked") = py::none(),
-        py::arg("importance") = py::none(), py::arg("attributes") = py::none(), py::arg("skin_joints") = py::none(),
-        py::arg("skin_weights") = py::none(), py::arg("progress") = py::none(),
-        py::arg("placement") = "optimal", py::arg("position_attributes") = py::none(),
-        py::arg("face_groups") = py::none(), py::arg("weld") = defaults.weld, py::arg("guarded") = py::none(),
-        py::arg("feature_weighting") = "amplitude", py::arg("max_feature_weight") = defaults.motion_features.max_weight,
-        py::arg("noise_mads") = defaults.motion_features.noise_mads,
+  m.def("simplify_animated", &simplify_animated_py, py::arg("frames"), py::arg("faces"),
+        py::arg("options") = AqemOptions{}, py::kw_only(), py::arg("locked") = py::none(),
+        py::arg("guarded") = py::none(), py::arg("importance") = py::none(), py::arg("attributes") = py::none(),
+        py::arg("position_attributes") = py::none(), py::arg("skin_joints") = py::none(),
+        py::arg("skin_weights") = py::none(), py::arg("face_groups") = py::none(), py::arg("progress") = py::none(),
         R"doc(AQEM simplification of a deforming mesh over all its frames (Yang et al. 2019, Eqs. 1-7).
 
 Parameters
@@ -195,31 +157,15 @@ Parameters
 frames : (F, V, 3) float32 positions per frame (float64 is converted).
 faces : (M, 3) int32 or int64 triangles (values must fit int32). Any topology: seam copies are
     welded, degenerate and repeated faces dropped, non-manifold spots cut and locked.
-target_ratios : level sizes as fractions of the faces left after preparation, in (0, 1]; ignored
-    when target_face_counts is given.
-target_face_counts : level sizes as face counts in [1, M].
-max_error : asset units; stop before a collapse whose error exceeds it. A collapse's error is the
-    RMS distance of the new vertex to the planes of its merged quadric, over those planes and the
-    frames used.
-use_motion_features, feature_threshold, min_angle_change, boundary_is_feature,
-feature_weighting, max_feature_weight, noise_mads : Eq. 6 weights (see motion_features):
-    "amplitude" (default, bounded weights from the range of dihedral angles above a threshold that
-    adapts to their spread) or "paper" (a feature's vertex count).
-boundary_quadrics : perpendicular planes on open borders and attribute seams (Garland and Heckbert).
-check_inversion : Eq. 7 inversion test summed over every frame; strict_inversion: no flip in any
-    single frame (ignored when check_inversion is False).
-max_frames : 0 for all frames, else K frames by farthest-point sampling; frame_subset: explicit.
+options : AqemOptions (the levels, Eq. 6 weights, quadrics, inversion test, placement, weld).
 locked : (V,) bool, vertices never removed or moved.  importance : (V,) float32 > 0 weights.
 attributes : (V, A) float32 interpolated along collapses (UVs, normals, colours); copies of a
     position with different attributes form a seam that only collapses along itself.
 skin_joints, skin_weights : (V, K) int32 or int64 / float32, merged keeping the top K.
 progress : callable(done, total) called with the GIL held now and then.
-placement : "optimal" (Eq. 5 in every frame) or "on_edge" (one point of the edge for all
-    frames, so UVs and skin weights stay consistent with the positions).
 position_attributes : (V, B) float32 that follow the position (morph target deltas): copies weld
     only when they agree; blended once per collapse.
 face_groups : (M,) int32 material or primitive per face; group borders are seams.
-weld : weld copies of a position (equal in every frame, position_attributes and skin).
 guarded : (V,) bool, vertices kept in place until no other collapse is legal.
 
 Returns

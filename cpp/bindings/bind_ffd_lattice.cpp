@@ -108,7 +108,7 @@ py::array_t<float> ffd_displace_py(const FloatArray& rest, const FloatArray& loc
 
 py::array_t<double> ffd_fit_py(const FloatArray& local, const FloatArray& targets, const std::vector<size_t>& size,
                                const std::optional<DoubleArray>& weights, const std::optional<DoubleArray>& prior,
-                               double smoothness, double ridge) {
+                               const FfdFitOptions& options) {
   require_shape(local, "local", {-1, 3}, "(V, 3)");
   require_shape(targets, "targets", {local.shape(0), 3}, "(V, 3) like local");
   if (size.size() != 3) throw py::value_error("size: expected 3 control-point counts (l, m, n)");
@@ -119,9 +119,6 @@ py::array_t<double> ffd_fit_py(const FloatArray& local, const FloatArray& target
     throw py::value_error("prior: expected " + std::to_string(count) + " control points (l, m, n, 3), got shape " +
                           shape_string(*prior));
   const double* prior_data = prior ? prior->data() : nullptr;
-  FfdFitOptions options;
-  options.smoothness = smoothness;
-  options.ridge = ridge;
   py::array_t<double> out({static_cast<py::ssize_t>(size[0]), static_cast<py::ssize_t>(size[1]),
                            static_cast<py::ssize_t>(size[2]), py::ssize_t{3}});
   double* out_data = out.mutable_data();
@@ -188,13 +185,11 @@ Returns
 (V, 3) or (F, V, 3) float32 (as displacements has one frame or F), a new array. Raises
 ValueError on wrong shapes, bad sizes or weights, or a vertex_lattice entry out of range (naming
 the vertex). The GIL is released.)doc");
-  const FfdFitOptions fit_defaults;
   m.def("ffd_fit", &ffd_fit_py, py::arg("local"), py::arg("targets"), py::arg("size"), py::arg("weights") = py::none(),
-        py::kw_only(), py::arg("prior") = py::none(), py::arg("smoothness") = fit_defaults.smoothness,
-        py::arg("ridge") = fit_defaults.ridge,
+        py::kw_only(), py::arg("prior") = py::none(), py::arg("options") = FfdFitOptions{},
         R"doc(Least-squares lattice: control points P minimising sum_v |X_P(local[v]) - targets[v]|^2,
-plus, on the correction Q = P - prior, smoothness * (V / C) * the squared second differences of Q
-along the lattice lines and ridge * (V / C) * |Q|^2 (C control points), so that control points
+plus, on the correction Q = P - prior, options.smoothness * (V / C) * the squared second differences of Q
+along the lattice lines and options.ridge * (V / C) * |Q|^2 (C control points), so that control points
 the points hardly determine stay at the prior.
 
 Parameters
@@ -204,8 +199,8 @@ targets : (V, 3) float32 positions (or displacements) to reproduce.
 size : (l, m, n), each in [2, 16] (e.g. (2, 2, 2) to replace a 3x3x3 lattice).
 weights : (l, m, n) float64 > 0, or None.
 prior : (l, m, n, 3) float64, or None for zeros.
-smoothness, ridge : regularisation weights >= 0 (0 and 0: plain least squares, least norm where
-    the points leave control points free).
+options : FfdFitOptions, the regularisation weights smoothness and ridge, >= 0 (0 and 0: plain
+    least squares, least norm where the points leave control points free).
 
 Returns
 -------

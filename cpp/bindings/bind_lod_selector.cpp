@@ -115,21 +115,6 @@ ValueError (naming the level) when the list is empty, negative, non-finite or in
 hysteresis: the coarsest level whose error / distance * focal_length_px <= pixel_error; 0 when
 none fits. ValueError (naming the level) on an empty, negative or non-finite list.)doc");
 
-  py::class_<LodSelectorOptions>(m, "LodSelectorOptions", "Options of LodSelector.")
-      .def(py::init([](float hysteresis, float pixel_error) {
-             if (!(hysteresis >= 0.0f))
-               throw py::value_error("hysteresis: must be >= 0, got " + std::to_string(hysteresis));
-             if (!(pixel_error > 0.0f))
-               throw py::value_error("pixel_error: must be > 0 pixels, got " + std::to_string(pixel_error));
-             return LodSelectorOptions{hysteresis, pixel_error};
-           }),
-           py::arg("hysteresis") = LodSelectorOptions{}.hysteresis, py::arg("pixel_error") = LodSelectorOptions{}.pixel_error)
-      .def_readwrite("hysteresis", &LodSelectorOptions::hysteresis,
-                     "Relative dead band around each threshold: coarser below c / (1 + h) or beyond d (1 + h), "
-                     "finer again above c (1 + h) or within d / (1 + h).")
-      .def_readwrite("pixel_error", &LodSelectorOptions::pixel_error,
-                     "Screen-space error budget in pixels for select_by_error.");
-
   py::class_<LodSelector>(m, "LodSelector",
                           "Per-character LoD state: the level shown now, kept inside each threshold's dead band so "
                           "that a character at a threshold does not flicker.")
@@ -154,20 +139,6 @@ none fits. ValueError (naming the level) on an empty, negative or non-finite lis
       .def_property_readonly("level", &LodSelector::level, "The level shown now; -1 before the first selection.")
       .def_property_readonly("options", &LodSelector::options)
       .def("reset", &LodSelector::reset, "Forget the level (the next selection has no hysteresis).");
-
-  py::class_<AnimationRateOptions>(m, "AnimationRateOptions", "Options of animation_update_interval.")
-      .def(py::init([](float full_rate_coverage, int max_interval) {
-             if (!(full_rate_coverage > 0.0f))
-               throw py::value_error("full_rate_coverage: must be > 0, got " + std::to_string(full_rate_coverage));
-             if (max_interval < 1)
-               throw py::value_error("max_interval: must be >= 1 frame, got " + std::to_string(max_interval));
-             return AnimationRateOptions{full_rate_coverage, max_interval};
-           }),
-           py::arg("full_rate_coverage") = AnimationRateOptions{}.full_rate_coverage,
-           py::arg("max_interval") = AnimationRateOptions{}.max_interval)
-      .def_readwrite("full_rate_coverage", &AnimationRateOptions::full_rate_coverage,
-                     "Projected coverage at or above which the pose updates every frame.")
-      .def_readwrite("max_interval", &AnimationRateOptions::max_interval, "Longest interval between updates, frames.");
 
   m.def("animation_update_interval", &animation_update_interval, py::arg("coverage"),
         py::arg("options") = AnimationRateOptions{},

@@ -1,32 +1,21 @@
-#include <string>
-
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include "animlod/motion_features.hpp"
 #include "array_checks.hpp"
-#include "feature_weighting_name.hpp"
 #include "numpy_from_vector.hpp"
 
 namespace animlod::bindings {
 
 namespace {
 
-py::dict motion_features_py(const FloatArray& frames, const py::array& face_indices, double feature_threshold,
-                            double min_angle_change, bool boundary_is_feature, const std::string& feature_weighting,
-                            double max_feature_weight, double noise_mads) {
+py::dict motion_features_py(const FloatArray& frames, const py::array& face_indices,
+                            const MotionFeatureOptions& options) {
   require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
   const IndexArray faces = index_array(face_indices, "faces");
   require_shape(faces, "faces", {-1, 3}, "(M, 3)");
   const AnimatedMeshView mesh{frames.data(), faces.data(), static_cast<size_t>(frames.shape(0)),
                               static_cast<size_t>(frames.shape(1)), static_cast<size_t>(faces.shape(0))};
-  MotionFeatureOptions options;
-  options.feature_threshold = feature_threshold;
-  options.min_angle_change = min_angle_change;
-  options.boundary_is_feature = boundary_is_feature;
-  options.weighting = feature_weighting_from_name(feature_weighting);
-  options.max_weight = max_feature_weight;
-  options.noise_mads = noise_mads;
   MotionFeatures features;
   Status status;
   {
@@ -51,29 +40,18 @@ py::dict motion_features_py(const FloatArray& frames, const py::array& face_indi
 }  // namespace
 
 void bind_motion_features(py::module_& m) {
-  const MotionFeatureOptions defaults;
-  m.def("motion_features", &motion_features_py, py::arg("frames"), py::arg("faces"), py::kw_only(),
-        py::arg("feature_threshold") = defaults.feature_threshold,
-        py::arg("min_angle_change") = defaults.min_angle_change,
-        py::arg("boundary_is_feature") = defaults.boundary_is_feature, py::arg("feature_weighting") = "amplitude",
-        py::arg("max_feature_weight") = defaults.max_weight, py::arg("noise_mads") = defaults.noise_mads,
+  m.def("motion_features", &motion_features_py, py::arg("frames"), py::arg("faces"),
+        py::arg("options") = MotionFeatureOptions{},
         R"doc(Motion features of a deforming mesh (Yang et al. 2019): regions whose dihedral angles change.
 
 Parameters
 ----------
 frames : (F, V, 3) float32 positions per frame (float64 is converted).
 faces : (M, 3) int32 or int64 triangles (values must fit int32).
-feature_threshold : radians; an edge is connected when its motion exceeds it (amplitude: the
-    range of its dihedral angle over all frames; paper: the largest change between consecutive
-    frames). 0 selects the adaptive threshold: median + noise_mads * MAD of the amplitudes
-    (amplitude), the mean of the changes over the interior edges (paper).
-min_angle_change : radians; connected edges must also move by more than this (1 degree).
-boundary_is_feature : boundary edges count as connected, as in the paper.
-feature_weighting : "amplitude" (default): a vertex weighs 1 + (max_feature_weight - 1) *
-    clamp((a - T) / T, 0, 1), a its largest edge amplitude, T the threshold, 1 outside features;
-    "paper": Eq. 6 as published, every vertex of a feature of w vertices weighs w.
-max_feature_weight : amplitude's largest weight (>= 1).
-noise_mads : amplitude's adaptive threshold in median absolute deviations above the median.
+options : MotionFeatureOptions: the threshold (adaptive when 0), the 1-degree floor, boundary
+    edges, and the weighting: "amplitude" (default, a vertex weighs 1 + (max_feature_weight - 1) *
+    clamp((a - T) / T, 0, 1), a its largest edge amplitude, T the threshold, 1 outside features)
+    or "paper" (Eq. 6 as published: every vertex of a feature of w vertices weighs w).
 
 Returns
 -------
@@ -84,8 +62,8 @@ vertex_weights (V,) float32 (Eq. 6 weights of the chosen weighting), amplitude (
 radians (0 on boundary edges).
 
 Raises ValueError naming the element on a non-finite position, an index out of range, a
-degenerate, duplicate or non-manifold face, an unreferenced vertex, an unknown weighting or a
-max_feature_weight below 1. The GIL is released.)doc");
+degenerate, duplicate or non-manifold face, an unreferenced vertex or a max_feature_weight
+below 1. The GIL is released.)doc");
 }
 
 }  // namespace animlod::bindings

@@ -160,23 +160,6 @@ outside [0, P), a repeated point, a non-positive key length, a zero key volume, 
       .def_property_readonly("equality_count", [](const ProblemHolder& h) { return motion_refit_equality_count(h.view); });
 
   const MotionRefitOptions defaults;
-  py::class_<MotionRefitOptions>(m, "MotionRefitOptions", "How the per-frame SLSQP solves run (nlopt's LD_SLSQP).")
-      .def(py::init<>())
-      .def_readwrite("hard_constraints", &MotionRefitOptions::hard_constraints,
-                     "Hold every length of Es as an equality (and rigid groups' handedness as inequalities).")
-      .def_readwrite("ftol_rel", &MotionRefitOptions::ftol_rel, "Stop when E changes by less than this fraction.")
-      .def_readwrite("max_evaluations", &MotionRefitOptions::max_evaluations, "Objective evaluations per solve.")
-      .def_readwrite("feasibility_tolerance", &MotionRefitOptions::feasibility_tolerance,
-                     "Largest |b - b(0)| / L accepted with hard constraints.")
-      .def_readwrite("warm_start", &MotionRefitOptions::warm_start,
-                     "Start each frame from the previous frame's result inside a chunk.")
-      .def_readwrite("precondition", &MotionRefitOptions::precondition,
-                     "Solve in variables where E's Gauss-Newton matrix at the start is the identity.")
-      .def_readwrite("eliminate_points", &MotionRefitOptions::eliminate_points,
-                     "Solve leaves and zero-length pairs in closed form, not as variables (the same minima).")
-      .def_readwrite("chunk_frames", &MotionRefitOptions::chunk_frames, "Consecutive frames per task.")
-      .def_readwrite("threads", &MotionRefitOptions::threads, "Worker threads; 0 uses every hardware thread.");
-
   m.def("motion_refit_objective", &objective_py, py::arg("problem"), py::arg("x"), py::arg("original"),
         R"doc(E (Eq. 5) per frame and its gradient.
 

@@ -14,36 +14,12 @@
 #include "animlod/tdag_affine.hpp"
 #include "animlod/tdag_player.hpp"
 #include "array_checks.hpp"
+#include "enum_names.hpp"
 #include "numpy_from_vector.hpp"
 
 namespace animlod::bindings {
 
 namespace {
-
-const char* governing_name(Governing g) {
-  switch (g) {
-    case Governing::first: return "first";
-    case Governing::average: return "average";
-    case Governing::frame: return "frame";
-    case Governing::aqem: return "aqem";
-    case Governing::online: return "online";
-  }
-  return "first";
-}
-
-Governing governing_from(const std::string& name) {
-  for (Governing g : {Governing::first, Governing::average, Governing::frame, Governing::aqem, Governing::online})
-    if (name == governing_name(g)) return g;
-  throw py::value_error("governing: expected 'first', 'average', 'frame', 'aqem' or 'online', got '" + name + "'");
-}
-
-const char* base_name(AffineBase b) { return b == AffineBase::first ? "first" : "average"; }
-
-AffineBase base_from(const std::string& name) {
-  if (name == "first") return AffineBase::first;
-  if (name == "average") return AffineBase::average;
-  throw py::value_error("affine_base: expected 'first' or 'average', got '" + name + "'");
-}
 
 ApproximationLevel level_from(int level) {
   if (level < 1 || level > 3) throw py::value_error("level: expected 1, 2 or 3, got " + std::to_string(level));
@@ -135,7 +111,7 @@ py::dict affine_split_py(const FloatArray& frames, const std::string& base) {
   const AnimatedMeshView mesh{frames.data(), nullptr, static_cast<size_t>(frames.shape(0)),
                               static_cast<size_t>(frames.shape(1)), 0};
   AffineSplit split;
-  const AffineBase b = base_from(base);
+  const AffineBase b = enum_from_name<AffineBase>(base, "base");
   released([&] { return affine_split(mesh, b, split); });
   const py::ssize_t f = frames.shape(0), v = frames.shape(1);
   py::dict out;
@@ -159,35 +135,14 @@ void check_collapse(const TemporalDag& dag, int64_t c) {
 }  // namespace
 
 void bind_tdag(py::module_& m) {
-  py::class_<TdagOptions>(m, "TdagOptions", "Options of build_temporal_dag (animlod/tdag.hpp, TdagOptions).")
-      .def(py::init<>())
-      .def_property(
-          "governing", [](const TdagOptions& o) { return std::string(governing_name(o.governing)); },
-          [](TdagOptions& o, const std::string& name) { o.governing = governing_from(name); },
-          "'first', 'average', 'frame' (governing_frame), 'aqem' or 'online' (Section 4).")
-      .def_readwrite("governing_frame", &TdagOptions::governing_frame, "frame in [0, F) for governing='frame'")
-      .def_readwrite("history_weight", &TdagOptions::history_weight,
-                     "lambda >= 0 of the online construction: 0 gives every frame its own order, a very large "
-                     "value frame 0's order everywhere")
-      .def_property(
-          "affine_base", [](const TdagOptions& o) { return std::string(base_name(o.affine_base)); },
-          [](TdagOptions& o, const std::string& name) { o.affine_base = base_from(name); },
-          "base mesh of the affine split: 'first' or 'average' (Section 3)")
-      .def_readwrite("boundary_quadrics", &TdagOptions::boundary_quadrics, "planes along open borders")
-      .def_readwrite("check_inversion", &TdagOptions::check_inversion,
-                     "reject collapses that flip a face of the decimated frame")
-      .def_readwrite("use_motion_features", &TdagOptions::use_motion_features, "governing='aqem': Eq. 6 weights")
-      .def_readwrite("weld", &TdagOptions::weld,
-                     "weld vertices equal in every frame (seam copies) into one TDAG vertex, as AQEM does");
-
   py::class_<TemporalDag>(m, "TemporalDag", "A TDAG (animlod/tdag.hpp): immutable; copies share the data.")
       .def_property_readonly("frame_count", &TemporalDag::frame_count)
       .def_property_readonly("vertex_count", &TemporalDag::vertex_count)
       .def_property_readonly("face_count", &TemporalDag::face_count)
       .def_property_readonly("collapse_count", &TemporalDag::collapse_count)
       .def_property_readonly("node_count", &TemporalDag::node_count)
-      .def_property_readonly("governing", [](const TemporalDag& d) { return std::string(governing_name(d.governing())); })
-      .def_property_readonly("affine_base", [](const TemporalDag& d) { return std::string(base_name(d.affine_base())); })
+      .def_property_readonly("governing", [](const TemporalDag& d) { return enum_name(d.governing()); })
+      .def_property_readonly("affine_base", [](const TemporalDag& d) { return enum_name(d.affine_base()); })
       .def_property_readonly(
           "faces",
           [](const TemporalDag& d) {
@@ -430,12 +385,7 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
 
   m.def(
       "play_temporal_dag",
-      [](const TemporalDag& dag, double tolerance, int32_t first_frame, int32_t frame_count, bool measure_error) {
-        PlayerOptions options;
-        options.tolerance = tolerance;
-        options.first_frame = first_frame;
-        options.frame_count = frame_count;
-        options.measure_error = measure_error;
+      [](const TemporalDag& dag, const PlayerOptions& options) {
         PlayerReport report;
         released([&] { return play_temporal_dag(dag, options, report); });
         py::dict out;
@@ -452,8 +402,7 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
         out["median_fresh_cut_seconds"] = report.median_fresh_cut_seconds;
         return out;
       },
-      py::arg("dag"), py::arg("tolerance"), py::arg("first_frame") = 0, py::arg("frame_count") = -1,
-      py::arg("measure_error") = true,
+      py::arg("dag"), py::arg("options") = PlayerOptions{},
       "Walks the frames and measures levels 1-3, a fresh query, and the level-3 walk single- and "
       "double-buffered (animlod/tdag_player.hpp, PlayerReport) as a dict.");
 }

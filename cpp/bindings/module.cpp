@@ -4,6 +4,7 @@
 namespace py = pybind11;
 
 namespace animlod::bindings {
+void bind_options(py::module_& m);
 void bind_skinning(py::module_& m);
 void bind_aqem(py::module_& m);
 void bind_motion_features(py::module_& m);
@@ -16,6 +17,7 @@ void bind_pose(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "animlod C++ core (level of detail for animated content). Users import animlod.";
+  animlod::bindings::bind_options(m);  // first: the functions below take these classes
   animlod::bindings::bind_skinning(m);
   animlod::bindings::bind_aqem(m);
   animlod::bindings::bind_motion_features(m);

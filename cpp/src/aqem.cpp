@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include <Eigen/Core>
@@ -154,12 +155,16 @@ class AqemPolicy final : public detail::CollapsePolicy {
         frames_(frames),
         used_count_(frames.size()),
         vertex_weights_(std::move(weights)),
-        new_positions_(used_count_),
-        singular_(used_count_) {
+        scratch_(kWorkers, Scratch{std::vector<Eigen::Vector3d>(used_count_), std::vector<uint8_t>(used_count_)}) {
     accumulate_quadrics();
   }
 
-  void evaluate(Candidate& candidate) override;
+  void evaluate(Candidate& candidate) override { evaluate_with(candidate, scratch_[0]); }
+  // Collapse passes: costs on both cores (reads quadrics, weights and positions only).
+  size_t concurrency() const override { return kWorkers; }
+  void evaluate_concurrently(Candidate& candidate, size_t worker) override {
+    evaluate_with(candidate, scratch_[worker]);
+  }
   void place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) override;
   void merge(const Candidate& candidate) override {
     Quadric* kept_quadrics = quadrics_of(candidate.kept);
@@ -171,8 +176,16 @@ class AqemPolicy final : public detail::CollapsePolicy {
 
  private:
   void accumulate_quadrics();
-  void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides);
-  void evaluate_on_edge(Candidate& candidate, bool pinned);
+  void accumulate_frames(size_t begin, size_t end);
+  void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, size_t begin, size_t end);
+  // Placement of the candidate being evaluated, per worker.
+  struct Scratch {
+    std::vector<Eigen::Vector3d> new_positions;  // (K,) placement in the quadrics' frames
+    std::vector<uint8_t> singular;               // (K,) frames using the fallback
+  };
+  static constexpr size_t kWorkers = 2;
+  void evaluate_with(Candidate& candidate, Scratch& scratch) const;
+  void evaluate_on_edge(Candidate& candidate, bool pinned, Scratch& scratch) const;
   double rms_plane_distance(const Candidate& candidate, double total) const;
   double weight(const Candidate& candidate) const {
     return 0.5 * (vertex_weights_[candidate.kept] + vertex_weights_[candidate.removed]);
@@ -187,8 +200,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
   std::vector<double> vertex_weights_;  // (P,) Eq. 6 weights, passed on by collapses (step 9)
   std::vector<Quadric> quadrics_;       // (P, K) per-frame quadrics, contiguous per point
   std::vector<double> plane_counts_;    // (P,) planes summed into each of the point's K quadrics
-  std::vector<Eigen::Vector3d> new_positions_;  // (K,) placement of the candidate being evaluated
-  std::vector<uint8_t> singular_;               // (K,) frames of that candidate using the fallback
+  std::vector<Scratch> scratch_;  // (kWorkers,) worker 0's holds the placement place() uses
 };
 
 // Steps 1-2 (Eqs. 1-4): every face's plane in every used frame goes into its three points'
@@ -200,10 +212,32 @@ void AqemPolicy::accumulate_quadrics() {
   const std::vector<int32_t>& faces = engine_.prepared().faces;
   quadrics_.assign(point_count * used_count_, Quadric{});
   plane_counts_.assign(point_count, 0.0);
+  for (const int32_t point : faces) plane_counts_[point] += 1.0;
+  if (options_.boundary_quadrics)
+    for (const auto* sides : {&engine_.border_sides(), &engine_.seam_sides()})
+      for (const auto& side : *sides) {
+        plane_counts_[side[0]] += 1.0;
+        plane_counts_[side[1]] += 1.0;
+      }
+  // The frames are independent: two workers take half of them each, every quadric summing its
+  // planes in the same order as one worker would.
+  const size_t workers = used_count_ >= 2 && faces.size() * used_count_ >= 3 * 65536 ? 2 : 1;
+  auto accumulate = [&](size_t worker) {
+    const size_t begin = used_count_ * worker / workers, end = used_count_ * (worker + 1) / workers;
+    accumulate_frames(begin, end);
+  };
+  std::thread second;
+  if (workers == 2) second = std::thread(accumulate, 1);
+  accumulate(0);
+  if (second.joinable()) second.join();
+}
+
+// The quadrics of used frames [begin, end): every face's plane, then the border and seam sides'.
+void AqemPolicy::accumulate_frames(size_t begin, size_t end) {
+  const std::vector<int32_t>& faces = engine_.prepared().faces;
   for (size_t f = 0; f < faces.size() / 3; ++f) {
     const int32_t* v = &faces[3 * f];
-    for (int corner = 0; corner < 3; ++corner) plane_counts_[v[corner]] += 1.0;
-    for (size_t k = 0; k < used_count_; ++k) {
+    for (size_t k = begin; k < end; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d p0 = engine_.position(v[0], frame), p1 = engine_.position(v[1], frame),
                             p2 = engine_.position(v[2], frame);
@@ -215,16 +249,14 @@ void AqemPolicy::accumulate_quadrics() {
     }
   }
   if (!options_.boundary_quadrics) return;
-  add_side_planes(engine_.border_sides());
-  add_side_planes(engine_.seam_sides());
+  add_side_planes(engine_.border_sides(), begin, end);
+  add_side_planes(engine_.seam_sides(), begin, end);
 }
 
 // A plane through each side (a, b) perpendicular to the face (a, b, c) beside it.
-void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& sides) {
+void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, size_t begin, size_t end) {
   for (const auto& [a, b, c] : sides) {
-    plane_counts_[a] += 1.0;
-    plane_counts_[b] += 1.0;
-    for (size_t k = 0; k < used_count_; ++k) {
+    for (size_t k = begin; k < end; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d pa = engine_.position(a, frame), pb = engine_.position(b, frame),
                             pc = engine_.position(c, frame);
@@ -243,10 +275,10 @@ void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& side
 // Eq. 6. Frames whose X is singular share one fallback, the best in sum over those frames of
 // the kept endpoint, the removed endpoint and the midpoint (ties in that order), so that the
 // point does not slide to a different spot of a flat region in every frame. Leaves the
-// placement in new_positions_.
-void AqemPolicy::evaluate(Candidate& candidate) {
+// placement in scratch.new_positions.
+void AqemPolicy::evaluate_with(Candidate& candidate, Scratch& scratch) const {
   const bool pinned = engine_.locked(candidate.kept);
-  if (pinned || options_.placement == Placement::on_edge) return evaluate_on_edge(candidate, pinned);
+  if (pinned || options_.placement == Placement::on_edge) return evaluate_on_edge(candidate, pinned, scratch);
   const Quadric* kept_quadrics = quadrics_of(candidate.kept);
   const Quadric* removed_quadrics = quadrics_of(candidate.removed);
   constexpr double kFallbacks[3] = {0.0, 1.0, 0.5};  // kept, removed, midpoint along the edge
@@ -255,9 +287,9 @@ void AqemPolicy::evaluate(Candidate& candidate) {
   for (size_t k = 0; k < used_count_; ++k) {
     const size_t frame = static_cast<size_t>(frames_[k]);
     const Quadric merged = kept_quadrics[k] + removed_quadrics[k];
-    Eigen::Vector3d& v = new_positions_[k];
-    singular_[k] = !merged.minimizer(v);
-    if (!singular_[k]) {
+    Eigen::Vector3d& v = scratch.new_positions[k];
+    scratch.singular[k] = !merged.minimizer(v);
+    if (!scratch.singular[k]) {
       total += merged.evaluate(v);
       continue;
     }
@@ -276,8 +308,9 @@ void AqemPolicy::evaluate(Candidate& candidate) {
     const size_t frame = static_cast<size_t>(frames_[k]);
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame),
                           p_removed = engine_.position(candidate.removed, frame);
-    if (singular_[k]) new_positions_[k] = p_kept + kFallbacks[fallback] * (p_removed - p_kept);
-    along += (new_positions_[k] - p_kept).dot(p_removed - p_kept);
+    Eigen::Vector3d& v = scratch.new_positions[k];
+    if (scratch.singular[k]) v = p_kept + kFallbacks[fallback] * (p_removed - p_kept);
+    along += (v - p_kept).dot(p_removed - p_kept);
     length2 += (p_removed - p_kept).squaredNorm();
   }
   candidate.t = length2 > 0.0 ? std::clamp(along / length2, 0.0, 1.0) : 0.0;
@@ -295,7 +328,7 @@ double AqemPolicy::rms_plane_distance(const Candidate& candidate, double total) 
 
 // Placement::on_edge (and a locked kept point, t = 0): the t in [0, 1] minimising
 // sum_f Q_f(kept_f + t (removed_f - kept_f)), a quadratic in t.
-void AqemPolicy::evaluate_on_edge(Candidate& candidate, bool pinned) {
+void AqemPolicy::evaluate_on_edge(Candidate& candidate, bool pinned, Scratch& scratch) const {
   const Quadric* kept_quadrics = quadrics_of(candidate.kept);
   const Quadric* removed_quadrics = quadrics_of(candidate.removed);
   double curvature = 0.0, slope = 0.0;
@@ -312,20 +345,20 @@ void AqemPolicy::evaluate_on_edge(Candidate& candidate, bool pinned) {
   for (size_t k = 0; k < used_count_; ++k) {
     const size_t frame = static_cast<size_t>(frames_[k]);
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame);
-    new_positions_[k] = p_kept + candidate.t * (engine_.position(candidate.removed, frame) - p_kept);
-    total += (kept_quadrics[k] + removed_quadrics[k]).evaluate(new_positions_[k]);
+    scratch.new_positions[k] = p_kept + candidate.t * (engine_.position(candidate.removed, frame) - p_kept);
+    total += (kept_quadrics[k] + removed_quadrics[k]).evaluate(scratch.new_positions[k]);
   }
   candidate.cost = weight(candidate) * total;
   candidate.error = rms_plane_distance(candidate, total);
 }
 
-// The candidate's point in every frame F: its Eq. 5 placement (new_positions_) in the
+// The candidate's point in every frame F: its Eq. 5 placement (worker 0's scratch) in the
 // quadrics' frames, kept + t (removed - kept) in the others.
 void AqemPolicy::place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) {
   size_t used = 0;
   for (size_t frame = 0; frame < engine_.frame_count(); ++frame) {
     if (used < used_count_ && static_cast<size_t>(frames_[used]) == frame) {
-      placed[frame] = new_positions_[used++];
+      placed[frame] = scratch_[0].new_positions[used++];
       continue;
     }
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame);
@@ -421,6 +454,7 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   engine_options.strict_inversion = options.strict_inversion;
   engine_options.max_error = options.max_error;
   engine_options.progress = options.progress;
+  engine_options.collapse_passes = true;
   CollapseEngine engine(mesh, prepared, carried, engine_options);
   AqemPolicy policy(engine, options, result.frames_used, std::move(weights));
   std::vector<detail::EngineLevel> levels;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <thread>
 #include <utility>
 
 #include "inversion_test.hpp"
@@ -63,15 +64,24 @@ void CollapseEngine::build_connectivity() {
   connectivity_.request_vertex_status();
   connectivity_.request_edge_status();
   connectivity_.request_face_status();
+  const size_t face_count = corner_points_.size() / 3;
+  connectivity_.reserve(point_count_, face_count * 3 / 2 + point_count_, face_count);
   std::vector<TriMesh::VertexHandle> handles(point_count_);
   for (size_t p = 0; p < point_count_; ++p) handles[p] = connectivity_.new_vertex();
-  const size_t face_count = corner_points_.size() / 3;
   for (size_t f = 0; f < face_count; ++f) {
     const int32_t* v = &corner_points_[3 * f];
     [[maybe_unused]] const auto face = connectivity_.add_face(handles[v[0]], handles[v[1]], handles[v[2]]);
     assert(face.is_valid() && face.idx() == static_cast<int>(f));
   }
   face_count_ = face_count;
+  valence_.resize(point_count_);
+  for (size_t p = 0; p < point_count_; ++p)
+    valence_[p] = static_cast<int32_t>(connectivity_.valence(connectivity_.vertex_handle(static_cast<int>(p))));
+  point_wedge_.assign(point_count_, -2);  // -2: no corner seen yet
+  for (size_t c = 0; c < corner_points_.size(); ++c) {
+    int32_t& wedge = point_wedge_[corner_points_[c]];
+    wedge = wedge == -2 || wedge == corner_wedges_[c] ? corner_wedges_[c] : -1;
+  }
 }
 
 void CollapseEngine::find_border_and_seam_sides() {
@@ -122,6 +132,11 @@ Candidate CollapseEngine::evaluate(CollapsePolicy& policy, int32_t edge) const {
 // one wedge to two, makes the collapse illegal. Leaves the mapping in wedge_moves_.
 bool CollapseEngine::map_wedges(const Candidate& candidate, TriMesh::HalfedgeHandle collapse) {
   wedge_moves_.clear();
+  // Two points without seams: every corner of the removed point takes the kept point's wedge.
+  if (point_wedge_[candidate.removed] >= 0 && point_wedge_[candidate.kept] >= 0) {
+    wedge_moves_.emplace_back(point_wedge_[candidate.removed], point_wedge_[candidate.kept]);
+    return true;
+  }
   for (const auto side : {collapse, connectivity_.opposite_halfedge_handle(collapse)}) {
     const auto face = connectivity_.face_handle(side);
     if (!face.is_valid()) continue;
@@ -148,7 +163,9 @@ bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandl
   for (const auto side : {collapse, connectivity_.opposite_halfedge_handle(collapse)}) {
     if (connectivity_.is_boundary(side)) continue;
     const auto opposite = connectivity_.to_vertex_handle(connectivity_.next_halfedge_handle(side));
-    if (!connectivity_.is_boundary(opposite) && connectivity_.valence(opposite) <= 3) return false;
+    assert(valence_[opposite.idx()] == static_cast<int32_t>(connectivity_.valence(opposite)));
+
+    if (valence_[opposite.idx()] <= 3 && !connectivity_.is_boundary(opposite)) return false;
   }
   if (!map_wedges(candidate, collapse)) return false;
   if (!options_.check_inversion) return true;
@@ -158,12 +175,18 @@ bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandl
     const int32_t other = moved == candidate.kept ? candidate.removed : candidate.kept;
     for (const auto face : connectivity_.vf_range(connectivity_.vertex_handle(moved))) {
       std::array<const float*, 3> corners{};
-      int moved_corner = -1, corner = 0;
+      int moved_corner = -1;
       bool collapses = false;
-      for (const auto vertex : face.vertices()) {
-        if (vertex.idx() == moved) moved_corner = corner;
-        collapses |= vertex.idx() == other;
-        corners[corner++] = &positions_[static_cast<size_t>(vertex.idx()) * frame_count_ * 3];
+      // The flat corner array, not OpenMesh's face circulator, read from the corner OpenMesh
+      // starts at (the same rounding in the test as before).
+      const int32_t* face_points = &corner_points_[3 * static_cast<size_t>(face.idx())];
+      const int32_t first = connectivity_.to_vertex_handle(connectivity_.halfedge_handle(face)).idx();
+      const int start = face_points[0] == first ? 0 : face_points[1] == first ? 1 : 2;
+      for (int corner = 0; corner < 3; ++corner) {
+        const int32_t point = face_points[(start + corner) % 3];
+        if (point == moved) moved_corner = corner;
+        collapses |= point == other;
+        corners[corner] = &positions_[static_cast<size_t>(point) * frame_count_ * 3];
       }
       if (collapses) continue;  // the faces on the edge disappear
       if (!face_keeps_orientation(corners, moved_corner, placed_.data(), frame_count_, options_.strict_inversion))
@@ -173,8 +196,9 @@ bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandl
   return true;
 }
 
-// Steps 9-10: move the kept point to placed_ in every frame, let the policy merge its state,
-// carry wedges, attributes and skin weights over, collapse, and re-key the affected edges.
+// Step 9: move the kept point to placed_ in every frame, let the policy merge its state, carry
+// wedges, attributes and skin weights over, and collapse. Leaves the removed point's former
+// edges in old_edges_.
 void CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
                               EngineRecord& record) {
   record.removed.push_back(prepared_.point_source[candidate.removed]);
@@ -222,19 +246,32 @@ void CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate
         if (corner_wedges_[base + c] == from) corner_wedges_[base + c] = to;
     }
   }
-  // Connectivity: the edges of the removed point either move to the kept one or vanish.
-  std::vector<int32_t> old_edges;
-  for (const auto edge : connectivity_.ve_range(removed)) old_edges.push_back(edge.idx());
-  face_count_ -= connectivity_.is_boundary(connectivity_.edge_handle(halfedge)) ? 1 : 2;
+  // Connectivity: the edges of the removed point either move to the kept one or vanish (the
+  // greedy loop takes the vanished ones out of its heap).
+  old_edges_.clear();
+  if (!options_.collapse_passes)
+    for (const auto edge : connectivity_.ve_range(removed)) old_edges_.push_back(edge.idx());
+  // Valences (the link condition holds): the points facing the edge lose one neighbour, the
+  // kept point gains the removed point's neighbours but the shared ones and the two themselves.
+  int32_t faces_removed = 0;
+  for (const auto side : {halfedge, connectivity_.opposite_halfedge_handle(halfedge)}) {
+    if (connectivity_.is_boundary(side)) continue;
+    --valence_[connectivity_.to_vertex_handle(connectivity_.next_halfedge_handle(side)).idx()];
+    ++faces_removed;
+  }
+  valence_[candidate.kept] += valence_[candidate.removed] - 2 - faces_removed;
+  if (point_wedge_[candidate.removed] < 0) point_wedge_[candidate.kept] = -1;
+  face_count_ -= static_cast<size_t>(faces_removed);
   connectivity_.collapse(halfedge);
-  for (int32_t edge : old_edges)
-    if (connectivity_.status(connectivity_.edge_handle(edge)).deleted()) heap_.remove(edge);
+}
 
-  // Step 10: the costs of the edges at the kept point changed; the legality of edges one ring
-  // further may have changed, so parked edges there are tried again.
-  const auto kept = connectivity_.vertex_handle(candidate.kept);
-  rekey_around(policy, kept, true);
-  for (const auto neighbour : connectivity_.vv_range(kept)) rekey_around(policy, neighbour, false);
+// The halfedge from the removed point to the kept one (OpenMesh keeps the "to" vertex).
+CollapseEngine::TriMesh::HalfedgeHandle CollapseEngine::removed_to_kept(const Candidate& candidate,
+                                                                        int32_t edge) const {
+  auto halfedge = connectivity_.halfedge_handle(connectivity_.edge_handle(edge), 0);
+  if (connectivity_.from_vertex_handle(halfedge).idx() != candidate.removed)
+    halfedge = connectivity_.opposite_halfedge_handle(halfedge);
+  return halfedge;
 }
 
 // Re-evaluates the edges at `vertex`: all of them when its state changed, otherwise only the
@@ -345,6 +382,8 @@ EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
 bool CollapseEngine::release_guards(CollapsePolicy& policy) {
   if (released_) return false;
   released_ = true;
+  if (in_passes_)  // the next pass evaluates every edge anyway
+    return std::find(locked_.begin(), locked_.end(), kGuarded) != locked_.end();
   for (size_t p = 0; p < point_count_; ++p) {
     if (locked_[p] != kGuarded) continue;
     const auto vertex = connectivity_.vertex_handle(static_cast<int>(p));
@@ -353,41 +392,53 @@ bool CollapseEngine::release_guards(CollapsePolicy& policy) {
   return !heap_.empty();
 }
 
+void CollapseEngine::take_reached_levels(const std::vector<size_t>& targets, std::vector<EngineLevel>& levels) {
+  for (; next_level_ < targets.size() && face_count_ <= targets[next_level_]; ++next_level_)
+    levels.push_back(snapshot(targets[next_level_], true));
+}
+
 void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
                          EngineRecord& record) {
+  planned_ = face_count_ > targets.back() ? (face_count_ - targets.back() + 1) / 2 : 0;
+  next_level_ = 0;
+  take_reached_levels(targets, levels);
+  if (options_.progress) options_.progress(0, planned_);
+  if (options_.collapse_passes && connectivity_.n_edges() > options_.passes_above_edges)
+    run_passes(policy, targets, levels, record);
+  else run_greedy(policy, targets, levels, record);
+  for (; next_level_ < targets.size(); ++next_level_) levels.push_back(snapshot(targets[next_level_], false));
+  if (options_.progress) options_.progress(collapse_count_, planned_);
+}
+
+// Steps 7-12 in one global greedy order: an indexed heap of every edge, re-keyed around each
+// collapse.
+void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<size_t>& targets,
+                                std::vector<EngineLevel>& levels, EngineRecord& record) {
   // Step 7: every collapsible edge into the heap.
   const size_t edge_count = connectivity_.n_edges();
   heap_ = IndexedMinHeap(edge_count);
   parked_.assign(edge_count, 0);
   may_have_parked_.assign(point_count_, 0);
   std::vector<int32_t> ids;
-  std::vector<double> keys;
+  std::vector<Candidate> candidates;
   ids.reserve(edge_count);
-  keys.reserve(edge_count);
+  candidates.reserve(edge_count);
   for (const auto edge : connectivity_.edges()) {
     if (locked(edge.v0().idx()) && locked(edge.v1().idx())) continue;  // can never collapse
     ids.push_back(edge.idx());
-    keys.push_back(evaluate(policy, edge.idx()).cost);
+    candidates.push_back(candidate_for(edge.idx()));
   }
+  evaluate_all(policy, candidates);
+  std::vector<double> keys(candidates.size());
+  for (size_t i = 0; i < candidates.size(); ++i) keys[i] = candidates[i].cost;
   heap_.assign(ids, keys);
 
   // Steps 8-12, taking a level each time the face count reaches a target.
-  const size_t planned = face_count_ > targets.back() ? (face_count_ - targets.back() + 1) / 2 : 0;
-  size_t next_level = 0;
-  auto take_reached_levels = [&] {
-    for (; next_level < targets.size() && face_count_ <= targets[next_level]; ++next_level)
-      levels.push_back(snapshot(targets[next_level], true));
-  };
-  take_reached_levels();
-  if (options_.progress) options_.progress(0, planned);
-  while (next_level < targets.size() && (!heap_.empty() || release_guards(policy))) {
+  while (next_level_ < targets.size() && (!heap_.empty() || release_guards(policy))) {
     const int32_t edge = heap_.top();
     const Candidate candidate = evaluate(policy, edge);
     policy.place(candidate, placed_);
-    // The halfedge from the removed point to the kept one (OpenMesh keeps the "to" vertex).
-    auto halfedge = connectivity_.halfedge_handle(connectivity_.edge_handle(edge), 0);
-    if (connectivity_.from_vertex_handle(halfedge).idx() != candidate.removed)
-      halfedge = connectivity_.opposite_halfedge_handle(halfedge);
+    const auto halfedge = removed_to_kept(candidate, edge);
     if (!is_legal(candidate, halfedge)) {
       park(edge);
       continue;
@@ -395,11 +446,136 @@ void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targ
     if (candidate.error > options_.max_error) break;
     error_so_far_ = std::max(error_so_far_, candidate.error);
     collapse(policy, candidate, halfedge, record);
-    take_reached_levels();
-    if (options_.progress && collapse_count_ % 4096 == 0) options_.progress(collapse_count_, planned);
+    for (int32_t old_edge : old_edges_)
+      if (connectivity_.status(connectivity_.edge_handle(old_edge)).deleted()) heap_.remove(old_edge);
+    // Step 10: the costs of the edges at the kept point changed; the legality of edges one ring
+    // further may have changed, so parked edges there are tried again.
+    const auto kept = connectivity_.vertex_handle(candidate.kept);
+    rekey_around(policy, kept, true);
+    for (const auto neighbour : connectivity_.vv_range(kept)) rekey_around(policy, neighbour, false);
+    take_reached_levels(targets, levels);
+    if (options_.progress && collapse_count_ % 4096 == 0) options_.progress(collapse_count_, planned_);
   }
-  for (; next_level < targets.size(); ++next_level) levels.push_back(snapshot(targets[next_level], false));
-  if (options_.progress) options_.progress(collapse_count_, planned);
+}
+
+// Fills cost, error and t of every candidate (kept and removed set) on up to the policy's
+// concurrency() threads, in contiguous chunks: each candidate's values do not depend on the
+// thread that computed them.
+void CollapseEngine::evaluate_all(CollapsePolicy& policy, std::vector<Candidate>& candidates) {
+  constexpr size_t kMinimumChunk = 8192;
+  const size_t hardware = std::max<size_t>(std::thread::hardware_concurrency(), 1);
+  const size_t workers = std::min({policy.concurrency(), hardware, std::max<size_t>(candidates.size() / kMinimumChunk, 1)});
+  auto work = [&](size_t worker) {
+    const size_t begin = candidates.size() * worker / workers, end = candidates.size() * (worker + 1) / workers;
+    for (size_t i = begin; i < end; ++i) policy.evaluate_concurrently(candidates[i], worker);
+  };
+  std::vector<std::thread> threads;
+  for (size_t worker = 1; worker < workers; ++worker) threads.emplace_back(work, worker);
+  work(0);
+  for (auto& thread : threads) thread.join();
+}
+
+// Sorts `items` by `less` (a total order), the two halves on two threads, then merges them.
+template <typename T, typename Less>
+void sort_in_halves(std::vector<T>& items, std::vector<T>& scratch, Less less) {
+  constexpr size_t kMinimumHalf = 65536;
+  if (items.size() < 2 * kMinimumHalf || std::thread::hardware_concurrency() < 2) {
+    std::sort(items.begin(), items.end(), less);
+    return;
+  }
+  const auto middle = items.begin() + static_cast<std::ptrdiff_t>(items.size() / 2);
+  std::thread first([&] { std::sort(items.begin(), middle, less); });
+  std::sort(middle, items.end(), less);
+  first.join();
+  scratch.resize(items.size());
+  std::merge(items.begin(), middle, middle, items.end(), scratch.begin(), less);
+  items.swap(scratch);
+}
+
+// Steps 7-12 as meshoptimizer's collapse passes (simplifier.cpp: pickEdgeCollapses,
+// sortEdgeCollapses, performEdgeCollapses): every live edge is evaluated, the candidates are
+// sorted by (cost, edge), and collapsed in that order. A point that took part in a collapse of
+// the pass is not touched again in it, so every other candidate's cost stays exact (it depends
+// only on its two points); legality is checked against the current mesh. A pass stops at the
+// next level's face count, or once the cost exceeds pass_cost_growth times the cost of the
+// candidate the pass would reach if every collapse succeeded, so that the order stays close to
+// the greedy one.
+void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t>& targets,
+                                std::vector<EngineLevel>& levels, EngineRecord& record) {
+  std::vector<Candidate> candidates;
+  std::vector<int32_t> edges;
+  struct Ranked {
+    double cost;
+    int32_t edge, kept, removed;
+  };
+  std::vector<Ranked> ranked, merged;
+  std::vector<uint8_t> touched(point_count_, 0);
+  const size_t edge_count = connectivity_.n_edges();
+  in_passes_ = true;
+  while (next_level_ < targets.size()) {
+    // Step 7: every collapsible edge, evaluated.
+    candidates.clear();
+    edges.clear();
+    for (size_t e = 0; e < edge_count; ++e) {
+      const auto handle = connectivity_.edge_handle(static_cast<int>(e));
+      if (connectivity_.status(handle).deleted()) continue;
+      const Candidate candidate = candidate_for(static_cast<int32_t>(e));
+      if (locked(candidate.kept) && locked(candidate.removed)) continue;  // cannot collapse (yet)
+      candidates.push_back(candidate);
+      edges.push_back(static_cast<int32_t>(e));
+    }
+    if (candidates.size() <= options_.greedy_tail_edges) {
+      // The last few edges in one greedy order: re-keying them costs little, and on small
+      // meshes and coarse levels the order matters most.
+      in_passes_ = false;
+      run_greedy(policy, targets, levels, record);
+      return;
+    }
+    evaluate_all(policy, candidates);
+    ranked.resize(candidates.size());
+    for (size_t i = 0; i < candidates.size(); ++i)
+      ranked[i] = {candidates[i].cost, edges[i], candidates[i].kept, candidates[i].removed};
+    auto less = [](const Ranked& a, const Ranked& b) { return a.cost < b.cost || (a.cost == b.cost && a.edge < b.edge); };
+    sort_in_halves(ranked, merged, less);
+
+    // Steps 8-12 over the sorted candidates.
+    const size_t face_goal = face_count_ - targets[next_level_];
+    size_t edge_goal = face_goal / 2, removed_faces = 0, pass_collapses = 0;
+    bool over_max_error = false;
+    std::fill(touched.begin(), touched.end(), 0);
+    for (const Ranked& entry : ranked) {
+      if (next_level_ >= targets.size() || removed_faces >= face_goal) break;
+      const double cost_goal = edge_goal < ranked.size() ? options_.pass_cost_growth * ranked[edge_goal].cost
+                                                         : std::numeric_limits<double>::infinity();
+      if (entry.cost > cost_goal && removed_faces > face_goal / 6) break;
+      if (touched[entry.kept] || touched[entry.removed]) continue;
+      Candidate candidate;
+      candidate.kept = entry.kept;
+      candidate.removed = entry.removed;
+      policy.evaluate(candidate);  // again, for its placement
+      policy.place(candidate, placed_);
+      const auto halfedge = removed_to_kept(candidate, entry.edge);
+      if (!is_legal(candidate, halfedge)) {
+        ++edge_goal;  // an illegal collapse does not count towards the pass's goal
+        continue;
+      }
+      if (candidate.error > options_.max_error) {
+        over_max_error = true;
+        break;
+      }
+      error_so_far_ = std::max(error_so_far_, candidate.error);
+      const size_t faces_before = face_count_;
+      collapse(policy, candidate, halfedge, record);
+      removed_faces += faces_before - face_count_;
+      touched[candidate.kept] = touched[candidate.removed] = 1;
+      ++pass_collapses;
+      take_reached_levels(targets, levels);
+      if (options_.progress && collapse_count_ % 4096 == 0) options_.progress(collapse_count_, planned_);
+    }
+    // A pass without a collapse went through every candidate: nothing legal remains (or the
+    // cheapest legal collapse exceeds max_error), unless guarded points can be released.
+    if (pass_collapses == 0 && (over_max_error || !release_guards(policy))) break;
+  }
 }
 
 }  // namespace animlod::detail

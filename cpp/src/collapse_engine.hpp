@@ -45,6 +45,11 @@ class CollapsePolicy {
   virtual void place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) = 0;
   // The engine is applying `candidate`: merge the policy's per-point state into `kept`.
   virtual void merge(const Candidate& candidate) = 0;
+  // Collapse passes evaluate every edge at once on up to concurrency() threads: worker w in
+  // [0, concurrency()) calls evaluate_concurrently, which fills cost, error and t like
+  // evaluate() and must not write state another worker reads (no merge() runs meanwhile).
+  virtual size_t concurrency() const { return 1; }
+  virtual void evaluate_concurrently(Candidate& candidate, size_t /*worker*/) { evaluate(candidate); }
 };
 
 // Per-vertex data the engine carries through collapses (all optional).
@@ -66,6 +71,18 @@ struct EngineOptions {
   bool strict_inversion = false; // also reject a flip in any one frame
   double max_error = std::numeric_limits<double>::infinity();
   std::function<void(size_t, size_t)> progress;
+  // false: one global greedy order (an indexed heap, re-keyed after every collapse). true:
+  // meshoptimizer's collapse passes: every edge is evaluated (on several threads), sorted by
+  // cost, and collapsed in that order while neither endpoint moved in the pass and the cost
+  // stays within pass_cost_growth times the cost of the pass's goal-th candidate.
+  bool collapse_passes = false;
+  double pass_cost_growth = 1.5;
+  // Collapse passes hand over to the greedy order once this few edges can collapse; meshes
+  // with no more than passes_above_edges edges use the greedy order throughout (they take well
+  // under a second, and their Hausdorff errors at coarse levels move by tens of percent with the
+  // order: see README's AQEM speed section).
+  size_t greedy_tail_edges = 4096;
+  size_t passes_above_edges = 100000;
 };
 
 // One level: the surviving faces over the surviving wedges (input vertex indices).
@@ -127,6 +144,12 @@ class CollapseEngine {
   bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
   void collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
                 EngineRecord& record);
+  TriMesh::HalfedgeHandle removed_to_kept(const Candidate& candidate, int32_t edge) const;
+  void run_greedy(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
+                  EngineRecord& record);
+  void run_passes(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
+                  EngineRecord& record);
+  void evaluate_all(CollapsePolicy& policy, std::vector<Candidate>& candidates);
   void rekey_around(CollapsePolicy& policy, TriMesh::VertexHandle vertex, bool all_edges);
   void park(int32_t edge);
   EngineLevel snapshot(size_t target, bool reached);
@@ -142,6 +165,7 @@ class CollapseEngine {
   bool release_guards(CollapsePolicy& policy);
   std::vector<uint8_t> locked_;             // (P,) 0, kLocked, or kGuarded (locked until released_)
   bool released_ = false;                   // set once nothing but guarded points could collapse
+  bool in_passes_ = false;                  // run_passes is running (no heap to fill on release)
   std::vector<float> attributes_;           // (V, A) by wedge (input vertex)
   std::vector<float> position_attributes_;  // (P, B)
   std::vector<int32_t> skin_joints_;        // (P, K)
@@ -151,6 +175,10 @@ class CollapseEngine {
   std::vector<int32_t> merged_into_;        // (P,) a point each removed point merged into
   std::vector<int32_t> wedge_merged_into_;  // (V,) a wedge each removed wedge merged into
   std::vector<std::pair<int32_t, int32_t>> wedge_moves_;  // removed wedge -> kept wedge, current collapse
+  std::vector<int32_t> old_edges_;          // edges of the removed point before the current collapse
+  std::vector<int32_t> valence_;            // (P,) points around each point (OpenMesh's valence, kept flat)
+  std::vector<int32_t> point_wedge_;        // (P,) the wedge of every corner of the point, -1 when it may
+                                            //      have several (a seam point)
   std::vector<uint8_t> parked_;             // (E,) popped while illegal; re-tried when the area changes
   std::vector<uint8_t> may_have_parked_;    // (P,) set when an edge of the point is parked
   std::vector<Eigen::Vector3d> placed_;     // (F,) the top candidate's position in every frame
@@ -160,6 +188,9 @@ class CollapseEngine {
   size_t face_count_ = 0;
   double error_so_far_ = 0.0;
   size_t collapse_count_ = 0;
+  size_t next_level_ = 0;
+  size_t planned_ = 0;
+  void take_reached_levels(const std::vector<size_t>& targets, std::vector<EngineLevel>& levels);
 };
 
 }  // namespace animlod::detail

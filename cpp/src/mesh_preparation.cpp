@@ -98,25 +98,50 @@ uint64_t edge_key(int32_t a, int32_t b) {
   return (static_cast<uint64_t>(low) << 32) | high;
 }
 
+// Items bucketed by a point in [0, point_count) with a counting sort: bucket p holds
+// [offsets[p], offsets[p + 1]) of the order, items in increasing index within a bucket. O(n),
+// and the buckets are small (a point's edges), so sorting inside them is cheap.
+template <typename PointOf>
+void bucket_by_point(size_t item_count, size_t point_count, PointOf point_of, std::vector<int32_t>& offsets,
+                     std::vector<int32_t>& order) {
+  offsets.assign(point_count + 1, 0);
+  for (size_t i = 0; i < item_count; ++i) ++offsets[static_cast<size_t>(point_of(i)) + 1];
+  for (size_t p = 0; p < point_count; ++p) offsets[p + 1] += offsets[p];
+  order.resize(item_count);
+  std::vector<int32_t> cursor(offsets.begin(), offsets.end() - 1);
+  for (size_t i = 0; i < item_count; ++i) order[static_cast<size_t>(cursor[static_cast<size_t>(point_of(i))]++)] =
+      static_cast<int32_t>(i);
+}
+
 // Step 3: corner labels such that corners with one label form one fan. Across every undirected
 // edge, sides are paired first-come in face order, one forward with one backward; unpaired sides
-// are borders of their piece.
-std::vector<int32_t> corner_fans(const std::vector<int32_t>& corner_points) {
+// are borders of their piece. Sides are visited in (edge, corner) order: bucketed by their lower
+// point, then sorted by (higher point, corner) inside the bucket.
+std::vector<int32_t> corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) {
   const size_t corner_count = corner_points.size();
   std::vector<Side> sides(corner_count);
   for (size_t c = 0; c < corner_count; ++c) {
     const int32_t a = corner_points[c], b = corner_points[next_corner(static_cast<int32_t>(c))];
     sides[c] = {edge_key(a, b), static_cast<int32_t>(c), a < b ? 1 : 0};
   }
-  std::sort(sides.begin(), sides.end(),
-            [](const Side& x, const Side& y) { return x.key != y.key ? x.key < y.key : x.corner < y.corner; });
+  std::vector<int32_t> offsets, order;
+  bucket_by_point(corner_count, point_count, [&](size_t c) { return static_cast<int32_t>(sides[c].key >> 32); },
+                  offsets, order);
+  std::vector<Side> sorted(corner_count);
+  for (size_t i = 0; i < corner_count; ++i) sorted[i] = sides[static_cast<size_t>(order[i])];
+  for (size_t p = 0; p < point_count; ++p)
+    std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1],
+              [](const Side& x, const Side& y) { return x.key != y.key ? x.key < y.key : x.corner < y.corner; });
   UnionFind fans(corner_count);
-  for (size_t i = 0; i < sides.size();) {
+  std::vector<int32_t> forward, backward;
+  std::vector<uint8_t> taken;
+  for (size_t i = 0; i < sorted.size();) {
     size_t j = i;
-    while (j < sides.size() && sides[j].key == sides[i].key) ++j;
-    std::vector<int32_t> forward, backward;
-    for (size_t k = i; k < j; ++k) (sides[k].forward ? forward : backward).push_back(sides[k].corner);
-    std::vector<uint8_t> taken(backward.size(), 0);
+    while (j < sorted.size() && sorted[j].key == sorted[i].key) ++j;
+    forward.clear();
+    backward.clear();
+    for (size_t k = i; k < j; ++k) (sorted[k].forward ? forward : backward).push_back(sorted[k].corner);
+    taken.assign(backward.size(), 0);
     for (const int32_t ca : forward) {
       // The first free opposite side, unless its face is the same triangle turned over (a
       // two-sided sheet): joining those would fold the surface onto itself.
@@ -136,6 +161,29 @@ std::vector<int32_t> corner_fans(const std::vector<int32_t>& corner_points) {
   std::vector<int32_t> label(corner_count);
   for (size_t c = 0; c < corner_count; ++c) label[c] = fans.find(static_cast<int32_t>(c));
   return label;
+}
+
+// Faces that repeat a directed edge of a face before them (the lowest face keeps it): bucketed
+// by the edge's start point, sorted by (end point, face) inside the bucket. Returns whether any.
+bool repeated_directed_edges(const std::vector<int32_t>& corner_points, size_t point_count,
+                             std::vector<uint8_t>& loose) {
+  const size_t corner_count = corner_points.size();
+  std::vector<int32_t> offsets, order;
+  bucket_by_point(corner_count, point_count, [&](size_t c) { return corner_points[c]; }, offsets, order);
+  loose.assign(corner_count / 3, 0);
+  bool any = false;
+  std::vector<std::pair<int32_t, int32_t>> outgoing;  // (end point, face)
+  for (size_t p = 0; p < point_count; ++p) {
+    outgoing.clear();
+    for (int32_t k = offsets[p]; k < offsets[p + 1]; ++k) {
+      const int32_t c = order[static_cast<size_t>(k)];
+      outgoing.emplace_back(corner_points[static_cast<size_t>(next_corner(c))], c / 3);
+    }
+    std::sort(outgoing.begin(), outgoing.end());
+    for (size_t i = 1; i < outgoing.size(); ++i)
+      if (outgoing[i].first == outgoing[i - 1].first) loose[static_cast<size_t>(outgoing[i].second)] = any = true;
+  }
+  return any;
 }
 
 }  // namespace
@@ -176,15 +224,18 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
     const int first = static_cast<int>(std::min_element(p.begin(), p.end()) - p.begin());
     rotated.push_back({{p[first], p[(first + 1) % 3], p[(first + 2) % 3]}, static_cast<int32_t>(f)});
   }
+  // Repeats: faces sorted by (rotated corners, face), bucketed by their lowest point.
   std::vector<uint8_t> repeated(mesh.face_count, 0);
   {
-    std::vector<size_t> by_corners(rotated.size());
-    std::iota(by_corners.begin(), by_corners.end(), 0);
-    std::stable_sort(by_corners.begin(), by_corners.end(),
-                     [&](size_t a, size_t b) { return rotated[a].first < rotated[b].first; });
-    for (size_t i = 1; i < by_corners.size(); ++i)
-      if (rotated[by_corners[i]].first == rotated[by_corners[i - 1]].first)
-        repeated[rotated[by_corners[i]].second] = 1;
+    std::vector<int32_t> offsets, order;
+    bucket_by_point(rotated.size(), out.point_source.size(), [&](size_t i) { return rotated[i].first[0]; }, offsets,
+                    order);
+    std::vector<std::pair<std::array<int32_t, 3>, int32_t>> sorted(rotated.size());
+    for (size_t i = 0; i < rotated.size(); ++i) sorted[i] = rotated[static_cast<size_t>(order[i])];
+    for (size_t p = 0; p < out.point_source.size(); ++p)
+      std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1]);
+    for (size_t i = 1; i < sorted.size(); ++i)
+      if (sorted[i].first == sorted[i - 1].first) repeated[sorted[i].second] = 1;
   }
   std::vector<int32_t> corner_points, corner_inputs;
   for (const auto& entry : rotated) {
@@ -205,7 +256,7 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   // (three new points), which ends the loop since its points are its own.
   out.point_split.assign(out.point_source.size(), 0);
   while (true) {
-    const std::vector<int32_t> label = corner_fans(corner_points);
+    const std::vector<int32_t> label = corner_fans(corner_points, out.point_source.size());
     // One point per (point, fan); the fan of the lowest corner keeps the point's index.
     std::vector<int32_t> fan_point(corner_points.size(), -1);
     std::vector<int32_t> first_fan(out.point_source.size(), -1);
@@ -225,17 +276,8 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
     }
     for (size_t c = 0; c < corner_points.size(); ++c) corner_points[c] = fan_point[label[c]];
 
-    std::vector<std::pair<uint64_t, int32_t>> directed;  // (a << 32 | b, face)
-    for (size_t c = 0; c < corner_points.size(); ++c) {
-      const uint64_t key = (static_cast<uint64_t>(static_cast<uint32_t>(corner_points[c])) << 32) |
-                           static_cast<uint32_t>(corner_points[next_corner(static_cast<int32_t>(c))]);
-      directed.push_back({key, static_cast<int32_t>(c / 3)});
-    }
-    std::sort(directed.begin(), directed.end());
-    std::vector<uint8_t> loose(corner_points.size() / 3, 0);
-    bool any = false;
-    for (size_t i = 1; i < directed.size(); ++i)
-      if (directed[i].first == directed[i - 1].first) loose[directed[i].second] = any = true;
+    std::vector<uint8_t> loose;
+    const bool any = repeated_directed_edges(corner_points, out.point_source.size(), loose);
     if (!any) break;
     for (size_t f = 0; f < loose.size(); ++f) {
       if (!loose[f]) continue;

@@ -121,12 +121,12 @@ Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeature
   if (Status status = detail::validate_and_build_edges(mesh, edges); !status) return status;
   if (!(options.feature_threshold >= 0.0) || !(options.min_angle_change >= 0.0))
     return Status::error("motion features: feature_threshold and min_angle_change must be >= 0 radians");
-  if (!(options.max_weight >= 1.0) || !std::isfinite(options.max_weight))
-    return Status::error("motion features: max_weight must be finite and >= 1");
+  if (!(options.max_feature_weight >= 1.0) || !std::isfinite(options.max_feature_weight))
+    return Status::error("motion features: max_feature_weight must be finite and >= 1");
   if (!(options.noise_mads >= 0.0) || !std::isfinite(options.noise_mads))
     return Status::error("motion features: noise_mads must be finite and >= 0");
   const size_t edge_count = edges.size();
-  const bool paper = options.weighting == FeatureWeighting::paper;
+  const bool paper = options.feature_weighting == FeatureWeighting::paper;
 
   // g_i, a_i and the threshold on the weighting's measure of motion (THR or T).
   angle_changes(mesh, edges, out.angle_change, out.amplitude);
@@ -195,7 +195,7 @@ Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeature
     for (const int32_t v : edges.vertices[e]) strength[v] = std::max(strength[v], s);
   }
   for (size_t v = 0; v < mesh.vertex_count; ++v)
-    if (strength[v] > 0.0) out.vertex_weights[v] = static_cast<float>(1.0 + (options.max_weight - 1.0) * strength[v]);
+    if (strength[v] > 0.0) out.vertex_weights[v] = static_cast<float>(1.0 + (options.max_feature_weight - 1.0) * strength[v]);
   return Status::success();
 }
 

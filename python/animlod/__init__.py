@@ -7,17 +7,21 @@ assets in :mod:`animlod.synth`. Heavy lifting is done by the C++ core, ``animlod
 from .aqem import motion_features, simplify_animated, simplify_skinned
 from .model import AnimatedMesh, LodChain, LodLevel, Motion, Skeleton, SkinnedMesh
 from .motion_lod import analyze_motion, build_motion_chain
+from .options import AqemOptions, MotionFeatureOptions, TdagOptions
 from .tdag import TemporalDag
 
 __version__ = "0.1.0"
 
 __all__ = [
     "AnimatedMesh",
+    "AqemOptions",
     "LodChain",
     "LodLevel",
     "Motion",
+    "MotionFeatureOptions",
     "Skeleton",
     "SkinnedMesh",
+    "TdagOptions",
     "TemporalDag",
     "__version__",
     "analyze_motion",

@@ -15,7 +15,6 @@ Shapes: ``F`` frames, ``V`` vertices, ``M`` faces, ``K`` skin influences, ``C`` 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -23,10 +22,7 @@ import numpy as np
 
 from . import _core
 from .model import AnimatedMesh, LodChain, LodLevel, Motion, SkinnedMesh
-
-DEFAULT_MIN_ANGLE_CHANGE = math.radians(1.0)
-DEFAULT_MAX_FEATURE_WEIGHT = 4.0
-DEFAULT_NOISE_MADS = 30.0
+from .options import AqemOptions, MotionFeatureOptions, resolve_options
 
 
 @dataclass
@@ -171,69 +167,38 @@ class SkinnedLevel:
 
 
 def motion_features(
-    mesh: AnimatedMesh,
-    *,
-    feature_threshold: float = 0.0,
-    min_angle_change: float = DEFAULT_MIN_ANGLE_CHANGE,
-    boundary_is_feature: bool = True,
-    feature_weighting: str = "amplitude",
-    max_feature_weight: float = DEFAULT_MAX_FEATURE_WEIGHT,
-    noise_mads: float = DEFAULT_NOISE_MADS,
+    mesh: AnimatedMesh, options: MotionFeatureOptions | None = None, **option_fields: object
 ) -> MotionFeatures:
     """Find the motion features of ``mesh`` over all its frames and their weights (Eq. 6).
 
     Parameters
     ----------
     mesh : the deforming mesh.
-    feature_threshold : radians; an edge is connected when its motion exceeds it. 0 selects the
-        weighting's adaptive threshold.
-    min_angle_change : radians; the motion must also exceed this floor (paper: 1 degree).
-    boundary_is_feature : count boundary edges as connected, as the paper does.
-    feature_weighting : ``"amplitude"`` (default): an edge's motion is the range a_i of its
-        dihedral angle over all frames (independent of the frame rate), the adaptive threshold is
-        T = median + ``noise_mads`` * MAD of the interior edges' a_i (so capture noise and ordinary
-        deformation find nothing), and a vertex weighs
-        1 + (``max_feature_weight`` - 1) * clamp((a - T) / T, 0, 1) with a its largest edge
-        amplitude: bounded, and exactly 1 where nothing moves above T. ``"paper"``: Eq. 6 as
-        published: g_i, the largest change between consecutive frames, THR = the mean of g_i over
-        the interior edges, and every vertex of a feature of w vertices weighs w.
-    max_feature_weight : the amplitude weighting's largest weight, >= 1.
-    noise_mads : the amplitude weighting's threshold in median absolute deviations above the median.
+    options, **option_fields : a :class:`~animlod.MotionFeatureOptions` and/or its fields by
+        name: ``feature_threshold`` (radians; 0 selects the weighting's adaptive threshold),
+        ``min_angle_change`` (the 1-degree floor), ``boundary_is_feature``,
+        ``feature_weighting``, ``max_feature_weight``, ``noise_mads``. ``"amplitude"``
+        weighting (default): an edge's motion is the range a_i of its dihedral angle over all
+        frames (independent of the frame rate), the adaptive threshold is T = median +
+        ``noise_mads`` * MAD of the interior edges' a_i (so capture noise and ordinary
+        deformation find nothing), and a vertex weighs 1 + (``max_feature_weight`` - 1) *
+        clamp((a - T) / T, 0, 1) with a its largest edge amplitude: bounded, and exactly 1 where
+        nothing moves above T. ``"paper"``: Eq. 6 as published: g_i, the largest change between
+        consecutive frames, THR = the mean of g_i over the interior edges, and every vertex of a
+        feature of w vertices weighs w.
 
-    Raises ValueError naming the element on bad connectivity (see ``simplify_animated``) or an
-    unknown weighting.
+    Raises ValueError naming the element on bad connectivity (see ``simplify_animated``), the
+    option for an unknown option or a bad value.
     """
-    found = _core.motion_features(
-        mesh.frames,
-        mesh.faces,
-        feature_threshold=feature_threshold,
-        min_angle_change=min_angle_change,
-        boundary_is_feature=boundary_is_feature,
-        feature_weighting=feature_weighting,
-        max_feature_weight=max_feature_weight,
-        noise_mads=noise_mads,
-    )
-    return MotionFeatures(**found)
+    resolved = resolve_options(MotionFeatureOptions, options, option_fields)
+    return MotionFeatures(**_core.motion_features(mesh.frames, mesh.faces, resolved))
 
 
 def simplify_animated(
     mesh: AnimatedMesh,
-    target_ratios: Sequence[float] = (0.5,),
+    target_ratios: Sequence[float] | None = None,
+    options: AqemOptions | None = None,
     *,
-    target_face_counts: Sequence[int] | None = None,
-    max_error: float = math.inf,
-    use_motion_features: bool = True,
-    feature_threshold: float = 0.0,
-    min_angle_change: float = DEFAULT_MIN_ANGLE_CHANGE,
-    boundary_is_feature: bool = True,
-    feature_weighting: str = "amplitude",
-    max_feature_weight: float = DEFAULT_MAX_FEATURE_WEIGHT,
-    noise_mads: float = DEFAULT_NOISE_MADS,
-    boundary_quadrics: bool = True,
-    check_inversion: bool = True,
-    strict_inversion: bool = False,
-    max_frames: int = 0,
-    frame_subset: Sequence[int] | None = None,
     locked_vertices: Sequence[int] | np.ndarray | None = None,
     guarded_vertices: Sequence[int] | np.ndarray | None = None,
     importance: np.ndarray | None = None,
@@ -242,9 +207,8 @@ def simplify_animated(
     skin_joints: np.ndarray | None = None,
     skin_weights: np.ndarray | None = None,
     face_groups: np.ndarray | None = None,
-    weld: bool = True,
     progress: Callable[[int, int], None] | None = None,
-    placement: str = "optimal",
+    **option_fields: object,
 ) -> SimplifyResult:
     """Simplify a deforming mesh over all its frames with AQEM; several levels from one run.
 
@@ -252,22 +216,19 @@ def simplify_animated(
     ----------
     mesh : (F, V, 3) frames and (M, 3) faces, any topology (see the module docstring).
     target_ratios : level sizes as fractions in (0, 1] of the faces left after dropping
-        degenerate and repeated ones.
-    target_face_counts : level sizes as face counts in [1, M]; replaces ``target_ratios``. A level
-        no legal collapse can reach holds the smallest mesh reached, with ``reached`` False.
-    max_error : asset units; the run stops before a collapse whose error (an RMS plane distance,
-        see ``CollapseRecord.error``) exceeds it.
-    use_motion_features, feature_threshold, min_angle_change, boundary_is_feature,
-    feature_weighting, max_feature_weight, noise_mads : the weights of Eq. 6 (see
-        :func:`motion_features`): ``"amplitude"`` (default) bounded weights where the dihedral
-        angles move far above their spread, ``"paper"`` the published rule (a feature's vertex
-        count); ``use_motion_features=False`` gives every vertex weight 1.
-    boundary_quadrics : planes perpendicular to open borders and attribute seams keep their shape.
-    check_inversion : reject collapses that invert a face by Eq. 7, summed over every frame
-        (also those outside the quadrics' frames); ``strict_inversion`` rejects an inversion in
-        any single frame and is ignored when ``check_inversion`` is False.
-    max_frames : quadrics over K frames chosen by farthest-point sampling of the poses (0: all).
-    frame_subset : explicit frames for the quadrics; replaces ``max_frames``.
+        degenerate and repeated ones (``AqemOptions.target_ratios``; default one level at 0.5).
+    options, **option_fields : an :class:`~animlod.AqemOptions` and/or its fields by name (also
+        those of its ``motion_features``); ``help(animlod.AqemOptions)`` describes each:
+        ``target_face_counts`` (replaces ``target_ratios``; a level no legal collapse can reach
+        holds the smallest mesh reached, with ``reached`` False), ``max_error`` (asset units;
+        stop before a collapse whose error, an RMS plane distance, exceeds it),
+        ``use_motion_features`` and the weights of Eq. 6 (see :func:`motion_features`:
+        ``"amplitude"`` by default, ``"paper"`` the published rule), ``boundary_quadrics``,
+        ``check_inversion`` and ``strict_inversion`` (Eq. 7 summed over every frame, or per
+        frame), ``max_frames`` and ``frame_subset`` (the frames of the quadrics), ``placement``
+        (``"optimal"``: Eq. 5 in every frame; ``"on_edge"``: one point of the collapsed edge for
+        all frames, so that UVs and skin weights stay consistent with its positions) and
+        ``weld`` (weld copies of a position; off, seams are open borders).
     locked_vertices : indices of vertices that are never removed nor moved.
     guarded_vertices : indices of vertices kept like locked ones until no other collapse is
         legal, then free (sharp corners kept while the targets allow).
@@ -280,12 +241,7 @@ def simplify_animated(
     skin_joints, skin_weights : (V, K) int32 / float32 skin influences, merged along collapses
         (union, blended, the K largest kept, renormalised); the levels carry them.
     face_groups : (M,) int32 primitive or material per face; borders between groups are seams.
-    weld : weld copies of a position (equal in every frame, in ``position_attributes`` and in
-        skin); off, every input vertex is its own point and seams are open borders.
     progress : ``progress(done, total)`` called now and then from the simplifier.
-    placement : ``"optimal"``, the paper's Eq. 5 in every frame, or ``"on_edge"``, one point of
-        the collapsed edge for all frames (the vertex keeps one identity, so UVs and skin
-        weights stay consistent with its positions; a little more error).
 
     Returns
     -------
@@ -294,39 +250,25 @@ def simplify_animated(
     Raises
     ------
     ValueError naming the element: non-finite position, index out of range, a locked vertex
-    index outside [0, V), target out of range, bad per-vertex data.
+    index outside [0, V), target out of range, bad per-vertex data, an unknown option or a value
+    an option cannot hold.
     """
-    locked = _vertex_mask("locked_vertices", locked_vertices, mesh.vertex_count)
-    guarded = _vertex_mask("guarded_vertices", guarded_vertices, mesh.vertex_count)
+    if target_ratios is not None:
+        option_fields["target_ratios"] = list(target_ratios)
+    resolved = resolve_options(AqemOptions, options, option_fields)
     raw = _core.simplify_animated(
         mesh.frames,
         mesh.faces,
-        target_ratios=list(target_ratios),
-        target_face_counts=list(target_face_counts or []),
-        max_error=max_error,
-        use_motion_features=use_motion_features,
-        feature_threshold=feature_threshold,
-        min_angle_change=min_angle_change,
-        boundary_is_feature=boundary_is_feature,
-        feature_weighting=feature_weighting,
-        max_feature_weight=max_feature_weight,
-        noise_mads=noise_mads,
-        boundary_quadrics=boundary_quadrics,
-        check_inversion=check_inversion,
-        strict_inversion=strict_inversion,
-        max_frames=max_frames,
-        frame_subset=list(frame_subset or []),
-        locked=locked,
+        resolved,
+        locked=_vertex_mask("locked_vertices", locked_vertices, mesh.vertex_count),
+        guarded=_vertex_mask("guarded_vertices", guarded_vertices, mesh.vertex_count),
         importance=importance,
         attributes=attributes,
+        position_attributes=position_attributes,
         skin_joints=skin_joints,
         skin_weights=skin_weights,
-        progress=progress,
-        placement=placement,
-        position_attributes=position_attributes,
         face_groups=face_groups,
-        weld=weld,
-        guarded=guarded,
+        progress=progress,
     )
     return _result(raw, mesh.fps)
 
@@ -347,8 +289,9 @@ def skinned_lod_chain(
 def simplify_skinned(
     skinned: SkinnedMesh,
     motions: Sequence[Motion],
-    target_ratios: Sequence[float] = (0.5,),
-    **options: object,
+    target_ratios: Sequence[float] | None = None,
+    options: AqemOptions | None = None,
+    **option_fields: object,
 ) -> list[SkinnedLevel]:
     """Simplify a skinned mesh over its rest pose and the baked poses of ``motions``.
 
@@ -363,15 +306,16 @@ def simplify_skinned(
     skinned : the mesh to simplify.
     motions : clips whose poses the levels must fit; their skeleton must match ``skinned``.
     target_ratios : level sizes as fractions of the face count.
-    **options : any keyword argument of :func:`simplify_animated` except ``attributes`` and
-        ``position_attributes``; ``placement`` defaults to ``"on_edge"`` here, so that the merged weights
-        and the positions describe the same point.
+    options, **option_fields : as for :func:`simplify_animated`, and its other keyword arguments
+        except ``attributes`` and ``position_attributes``. Without an ``options`` object,
+        ``placement`` defaults to ``"on_edge"`` here, so that the merged weights and the positions
+        describe the same point.
 
     Returns
     -------
     One SkinnedLevel per target, finest first.
     """
-    if "attributes" in options or "position_attributes" in options:
+    if "attributes" in option_fields or "position_attributes" in option_fields:
         raise ValueError("simplify_skinned: attributes come from the SkinnedMesh (uvs, normals, morph targets)")
     baked = [skinned.bake(motion).frames for motion in motions]
     poses = AnimatedMesh(skinned.faces, np.concatenate([skinned.rest_positions[None], *baked], axis=0))
@@ -385,10 +329,11 @@ def simplify_skinned(
     result = simplify_animated(
         poses,
         target_ratios,
+        options,
         attributes=np.concatenate(columns, axis=1),
         skin_joints=skinned.joints,
         skin_weights=skinned.weights,
-        **{"placement": "on_edge", **options},
+        **({"placement": "on_edge", **option_fields} if options is None else option_fields),
     )
     # Frame 0 is the rest pose, then each motion's poses in order.
     starts = np.cumsum([1] + [len(frames) for frames in baked])

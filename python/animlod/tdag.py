@@ -29,6 +29,7 @@ import numpy as np
 
 from . import _core
 from .model import AnimatedMesh
+from .options import PlayerOptions, TdagOptions, resolve_options
 
 GOVERNING_CHOICES = ("first", "average", "aqem", "online")
 
@@ -299,14 +300,10 @@ class TemporalDag:
         cls,
         mesh: AnimatedMesh,
         governing: str | int = "first",
+        options: TdagOptions | None = None,
         *,
-        history_weight: float = 1.0,
-        base: str = "first",
-        check_inversion: bool = True,
-        boundary_quadrics: bool = True,
-        use_motion_features: bool = True,
-        weld: bool = True,
         progress: Callable[[int, int], None] | None = None,
+        **option_fields: object,
     ) -> TemporalDag:
         """Build the TDAG of ``mesh`` (Sections 3-4).
 
@@ -316,17 +313,14 @@ class TemporalDag:
         governing : the collapse order: ``"first"`` (decimate frame 0), ``"average"`` (the average
             mesh), a frame number (that frame), ``"aqem"`` (AQEM over all frames) or ``"online"``
             (every frame decimated in turn with a history term).
-        history_weight : lambda >= 0 of the online construction (ignored otherwise): the
-            priority of a collapse is its quadric cost plus lambda times the previous frame's mean
-            cost times its rank in the previous frame's order (2 when that frame lacks it). 0
-            gives every frame its own order; a very large value frame 0's order everywhere.
-        base : base mesh of the affine split, ``"first"`` or ``"average"``.
-        check_inversion : reject collapses that flip a face of the decimated frame.
-        boundary_quadrics : planes along open borders keep their shape.
-        use_motion_features : ``governing="aqem"`` only: the weights of Eq. 6.
-        weld : weld vertices equal in every frame (UV-seam copies) into one TDAG vertex, as AQEM
-            does. Either way degenerate and repeated faces are dropped and non-manifold spots cut
-            apart, so any indexed triangle mesh is taken (see :attr:`input_points`).
+        options, **option_fields : a :class:`~animlod.TdagOptions` and/or its fields by name
+            (``help(animlod.TdagOptions)``): ``history_weight`` (lambda >= 0 of the online
+            construction: 0 gives every frame its own order, a very large value frame 0's order
+            everywhere), ``affine_base`` (``"first"`` or ``"average"``), ``check_inversion``,
+            ``boundary_quadrics``, ``use_motion_features`` (``governing="aqem"`` only) and
+            ``weld`` (weld vertices equal in every frame into one TDAG vertex, as AQEM does;
+            either way degenerate and repeated faces are dropped and non-manifold spots cut
+            apart, so any indexed triangle mesh is taken, see :attr:`input_points`).
         progress : ``progress(frames_done, F)`` called as the build goes.
 
         Raises
@@ -334,22 +328,15 @@ class TemporalDag:
         ValueError naming the element: non-finite position, index out of range, every face
         degenerate, bad option.
         """
-        options = _core.TdagOptions()
         if isinstance(governing, bool) or not isinstance(governing, (str, int, np.integer)):
             raise ValueError(f"governing: expected one of {GOVERNING_CHOICES} or a frame number, got {governing!r}")
         if isinstance(governing, str):
             if governing not in GOVERNING_CHOICES:
                 raise ValueError(f"governing: expected one of {GOVERNING_CHOICES} or a frame number, got {governing!r}")
-            options.governing = governing
+            option_fields["governing"] = governing
         else:
-            options.governing = "frame"
-            options.governing_frame = int(governing)
-        options.history_weight = float(history_weight)
-        options.affine_base = base
-        options.check_inversion = bool(check_inversion)
-        options.boundary_quadrics = bool(boundary_quadrics)
-        options.use_motion_features = bool(use_motion_features)
-        options.weld = bool(weld)
+            option_fields.update(governing="frame", governing_frame=int(governing))
+        options = resolve_options(TdagOptions, options, option_fields)
         core, raw = _core.build_temporal_dag(mesh.frames, mesh.faces, options, progress)
         return cls(core, TdagBuildReport(**raw))
 
@@ -509,9 +496,13 @@ class TemporalDag:
     ) -> PlayerReport:
         """Walk the frames from ``first_frame`` at ``tolerance`` and measure every approximation
         level, a fresh query, and the level-3 walk single- and double-buffered (in C++)."""
-        raw = _core.play_temporal_dag(
-            self._core, tolerance, first_frame, -1 if frame_count is None else frame_count, measure_error
+        options = PlayerOptions(
+            tolerance=tolerance,
+            first_frame=first_frame,
+            frame_count=-1 if frame_count is None else frame_count,
+            measure_error=measure_error,
         )
+        raw = _core.play_temporal_dag(self._core, options)
         return PlayerReport(
             frames=int(raw["frames"]),
             levels=[LevelStats(**stats) for stats in raw["levels"]],

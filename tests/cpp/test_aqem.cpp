@@ -632,7 +632,7 @@ TEST_CASE("amplitude weights that find no feature leave the collapse order of fe
   CHECK(weighted.collapses.positions == plain.collapses.positions);
   CHECK(weighted.collapses.cost == plain.collapses.cost);
   options.use_motion_features = true;
-  options.motion_features.weighting = animlod::FeatureWeighting::paper;
+  options.motion_features.feature_weighting = animlod::FeatureWeighting::paper;
   const AqemResult paper = simplify(mesh, options);
   CHECK(paper.collapses.removed != plain.collapses.removed);
 }

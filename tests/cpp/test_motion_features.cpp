@@ -35,7 +35,7 @@ TEST_CASE("motion features measure the change of a hinge's dihedral angle exactl
   MotionFeatureOptions options;
   options.boundary_is_feature = false;
   options.feature_threshold = 0.1;
-  options.weighting = FeatureWeighting::paper;
+  options.feature_weighting = FeatureWeighting::paper;
   const MotionFeatures features = features_of(mesh, options);
   REQUIRE(features.edges.size() == 10);
   CHECK(features.edges[0] == 0);  // edges sorted: (0, 1) first
@@ -50,7 +50,7 @@ TEST_CASE("motion features measure the change of a hinge's dihedral angle exactl
 
   // Amplitude weighting: the fold is 0.3 radians above T = 0.1 (at least 2 T), so both hinge
   // vertices take the largest weight.
-  options.weighting = FeatureWeighting::amplitude;
+  options.feature_weighting = FeatureWeighting::amplitude;
   const MotionFeatures amplitude = features_of(mesh, options);
   CHECK(amplitude.connected == std::vector<uint8_t>{1, 0, 0, 0, 0});
   CHECK(amplitude.vertex_weights == std::vector<float>{4, 4, 1, 1});
@@ -86,32 +86,32 @@ TEST_CASE("amplitude weighting finds nothing in noise that the paper turns into 
   // frames, as a capture's reconstruction noise does.
   const OwnedAnimatedMesh mesh = animlod::testing::jittering_sphere(16, 24, 12, 0.01f);
   MotionFeatureOptions options;
-  options.weighting = FeatureWeighting::paper;
+  options.feature_weighting = FeatureWeighting::paper;
   const MotionFeatures paper = features_of(mesh, options);
   int32_t largest = 0;
   for (int32_t size : paper.feature_sizes) largest = std::max(largest, size);
   CHECK(largest > 50);  // the mean of noisy g_i sits inside the noise: features everywhere
-  options.weighting = FeatureWeighting::amplitude;
+  options.feature_weighting = FeatureWeighting::amplitude;
   const MotionFeatures amplitude = features_of(mesh, options);
   CHECK(amplitude.feature_sizes.empty());
   for (float w : amplitude.vertex_weights) CHECK(w == 1.0f);
 }
 
-TEST_CASE("amplitude weights are bounded by max_weight and need a threshold above the noise") {
+TEST_CASE("amplitude weights are bounded by max_feature_weight and need a threshold above the noise") {
   const OwnedAnimatedMesh mesh = animlod::testing::bending_tube(21, 12, 5, 1.2);
   MotionFeatureOptions options;
-  options.max_weight = 2.5;
+  options.max_feature_weight = 2.5;
   const MotionFeatures features = features_of(mesh, options);
   REQUIRE_FALSE(features.feature_sizes.empty());
   float largest = 0.0f;
   for (float w : features.vertex_weights) largest = std::max(largest, w);
   CHECK(largest == 2.5f);
   CHECK(features.threshold >= options.min_angle_change);
-  options.max_weight = 0.5;
+  options.max_feature_weight = 0.5;
   MotionFeatures rejected;
   CHECK(animlod::compute_motion_features(mesh.view(), options, rejected).message ==
-        "motion features: max_weight must be finite and >= 1");
-  options.max_weight = 4.0;
+        "motion features: max_feature_weight must be finite and >= 1");
+  options.max_feature_weight = 4.0;
   options.noise_mads = -1.0;
   CHECK(animlod::compute_motion_features(mesh.view(), options, rejected).message ==
         "motion features: noise_mads must be finite and >= 0");
@@ -131,13 +131,13 @@ TEST_CASE("a rigidly translating mesh has no motion features") {
 
   // With the paper's boundary rule the two open ends are features of 12 vertices each.
   options.boundary_is_feature = true;
-  options.weighting = FeatureWeighting::paper;
+  options.feature_weighting = FeatureWeighting::paper;
   const MotionFeatures with_boundary = features_of(mesh, options);
   CHECK(with_boundary.feature_sizes == std::vector<int32_t>{12, 12});
   CHECK(with_boundary.vertex_weights[0] == 12.0f);
   CHECK(with_boundary.vertex_weights[12] == 1.0f);
   // The amplitude weighting reports them as features too but gives them no weight.
-  options.weighting = FeatureWeighting::amplitude;
+  options.feature_weighting = FeatureWeighting::amplitude;
   const MotionFeatures amplitude = features_of(mesh, options);
   CHECK(amplitude.feature_sizes == std::vector<int32_t>{12, 12});
   for (float w : amplitude.vertex_weights) CHECK(w == 1.0f);
@@ -148,7 +148,7 @@ TEST_CASE("a bending tube has its motion feature at the elbow") {
   const OwnedAnimatedMesh mesh = animlod::testing::bending_tube(rings, segments, 5, 1.2);
   MotionFeatureOptions options;
   options.boundary_is_feature = false;
-  options.weighting = FeatureWeighting::paper;
+  options.feature_weighting = FeatureWeighting::paper;
   const MotionFeatures features = features_of(mesh, options);
   // The elbow's two kinks (rings 9 and 11, where the blend zone starts and ends) bend most.
   REQUIRE_FALSE(features.feature_sizes.empty());

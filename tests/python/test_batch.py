@@ -244,6 +244,16 @@ def test_manifest_defaults_and_per_asset_options(library, tmp_path):
     assert np.isclose(assets["bar"].options["ratios"][0], 0.3)
 
 
+def test_manifest_takes_the_aqem_options_by_their_field_names(library, tmp_path):
+    manifest = tmp_path / "lib.toml"
+    source = library / "characters" / "cyl0.glb"
+    manifest.write_text(f'[[assets]]\ninput = "{source}"\nname = "hero"\nnoise_mads = 3.0\nplacement = "on_edge"\n')
+    assert read_spec(manifest)[0].options == {"noise_mads": 3.0, "placement": "on_edge"}
+    manifest.write_text(f'[[assets]]\ninput = "{source}"\nname = "hero"\nnoise_mad = 3.0\n')
+    with pytest.raises(SpecError, match=r"option 'noise_mad': unknown for job simplify on gltf input"):
+        read_spec(manifest)
+
+
 def test_scheduler_without_workers_is_a_clear_error_after_the_timeout(library, tmp_path):
     import logging
 

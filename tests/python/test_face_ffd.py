@@ -81,7 +81,9 @@ def test_displace_with_unit_weights_is_the_ffd_of_the_displaced_regular_lattice(
 def test_a_2x2x2_fit_reproduces_a_trilinear_displacement_exactly(local):
     corners = np.random.default_rng(11).normal(size=(2, 2, 2, 3))
     trilinear = bezier_ffd(local.astype(np.float64), corners)  # degree 1 Bernstein = trilinear
-    fitted = _core.ffd_fit(local, trilinear.astype(np.float32), [2, 2, 2], smoothness=0.0, ridge=0.0)
+    fitted = _core.ffd_fit(
+        local, trilinear.astype(np.float32), [2, 2, 2], options=_core.FfdFitOptions(smoothness=0.0, ridge=0.0)
+    )
     np.testing.assert_allclose(fitted, corners, atol=1e-4)
     np.testing.assert_allclose(_core.ffd_evaluate(local, fitted), trilinear, atol=1e-5)
     # Control: a quadratic field is not trilinear; the 2x2x2 fit leaves a residual there.

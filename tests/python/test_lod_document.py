@@ -14,7 +14,7 @@ from animlod.cli import main
 from animlod.io import write_glb
 from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_drawable import read_drawables
-from animlod.pipelines import simplify_document
+from animlod.pipelines import DrawableSettings, simplify_document
 
 # Small enough to keep the suite quick: few drive frames, two measured frames per clip.
 QUICK = {"frame_budget": 12, "measured_frames": 2}
@@ -160,6 +160,18 @@ def test_morph_deltas_of_a_level_match_the_input_at_unmoved_vertices(data_dir, t
                 before.accessor(t_before["POSITION"], "d")[theirs],
                 atol=1e-6,
             )
+
+
+def test_settings_take_their_fields_and_aqem_options_by_name(humanoid_glb, tmp_path):
+    settings = DrawableSettings.resolve(None, {"frame_budget": 6, "max_error": 0.1})
+    assert settings.frame_budget == 6 and settings.aqem == {"max_error": 0.1}
+    changed = DrawableSettings.resolve(settings, {"placement": "on_edge", "measured_frames": 2})
+    assert changed.aqem == {"max_error": 0.1, "placement": "on_edge"} and changed.frame_budget == 6
+    assert changed.measured_frames == 2 and settings.measured_frames == DrawableSettings().measured_frames
+    output = tmp_path / "out.glb"
+    with pytest.raises(ValueError, match=r"^AqemOptions: unknown option 'frame_budjet'"):
+        simplify_document(humanoid_glb, output, [0.5], frame_budjet=6)
+    assert not output.exists()
 
 
 def test_separate_writes_one_whole_document_per_level(humanoid_glb, tmp_path):

@@ -18,7 +18,8 @@ from animlod.motion_lod.objective import (
     objective,
     rigidity_constraints,
 )
-from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
+from animlod.motion_lod.refit import refit_slsqp
+from animlod.options import MotionRefitOptions
 from animlod.synth import humanoid, humanoid_motion
 
 
@@ -53,10 +54,12 @@ def test_core_terms_match_the_numpy_reference(level) -> None:
 @pytest.mark.parametrize("hard", [False, True])
 def test_core_solve_matches_the_python_reference(level, hard) -> None:
     motion, frozen, problem, original, fallback = level
-    options = SlsqpOptions(hard_constraints=hard, ftol_rel=1e-12)
+    options = MotionRefitOptions(hard_constraints=hard, ftol_rel=1e-12)
     cold = _cold_starts(frozen, problem, motion, original, fallback) if hard else None
     reference = refit_slsqp(problem, original, fallback, options, chunk_frames=8, cold_starts=cold)
-    same_variables = SlsqpOptions(hard, 1e-12, precondition=False, eliminate_points=False)
+    same_variables = MotionRefitOptions(
+        hard_constraints=hard, ftol_rel=1e-12, precondition=False, eliminate_points=False
+    )
     plain = refit_core(problem, original, fallback, same_variables, chunk_frames=8, cold_starts=cold)
     fast = refit_core(problem, original, fallback, options, chunk_frames=8, cold_starts=cold)
     assert reference.failures == plain.failures == fast.failures == []
@@ -126,7 +129,7 @@ def test_core_and_reference_agree_on_a_real_clip_sample(data_dir) -> None:
     frames = np.arange(300, 312)
     original = motion.world_positions()[frames]
     fallback = frozen_motion(frozen, motion).world_positions()[frames]
-    options = SlsqpOptions(ftol_rel=1e-12)
+    options = MotionRefitOptions(ftol_rel=1e-12)
     reference = refit_slsqp(problem, original, fallback, options, chunk_frames=4)
     core = refit_core(problem, original, fallback, options, chunk_frames=4)
     assert reference.failures == core.failures == []

@@ -90,9 +90,10 @@ def test_crane_features_are_found(data_dir):
 
 def test_an_unknown_weighting_is_refused_by_name():
     mesh = bending_tube(frames=3)
-    with pytest.raises(ValueError, match=r"^feature_weighting: expected 'amplitude' or 'paper', got 'size'$"):
+    expected = r"^MotionFeatureOptions.feature_weighting: expected one of 'amplitude', 'paper', got 'size'$"
+    with pytest.raises(ValueError, match=expected):
         motion_features(mesh, feature_weighting="size")
-    with pytest.raises(ValueError, match=r"max_weight must be finite and >= 1"):
+    with pytest.raises(ValueError, match=r"max_feature_weight must be finite and >= 1"):
         motion_features(mesh, max_feature_weight=0.5)
 
 

@@ -18,8 +18,9 @@ from animlod.motion_lod.objective import (
     rigidity_constraints,
     split_problem,
 )
-from animlod.motion_lod.refit import SlsqpOptions, refit_slsqp
+from animlod.motion_lod.refit import refit_slsqp
 from animlod.motion_lod.skeleton_reduce import expand_motion, recover_motion, reduce_skeleton
+from animlod.options import MotionRefitOptions
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +80,7 @@ def test_slsqp_and_newton_reach_the_same_optimum(figure) -> None:
     level = freeze(motion, analysis, analysis.priority[:6])
     problem = build_problem(level)
     fallback = frozen_motion(level, motion).world_positions()
-    slsqp = refit_slsqp(problem, original, fallback, SlsqpOptions(hard_constraints=False, ftol_rel=1e-12))
+    slsqp = refit_slsqp(problem, original, fallback, MotionRefitOptions(hard_constraints=False, ftol_rel=1e-12))
     newton = refit_newton(problem, original)
     assert slsqp.failures == [] and newton.failures == []
     start = objective(problem, original, original)[0]
@@ -93,7 +94,7 @@ def test_hard_constraints_keep_lengths_and_fk_reproduces_the_refit(figure) -> No
     level = freeze(motion, analysis, analysis.priority[:6])
     problem = build_problem(level)
     fallback = frozen_motion(level, motion).world_positions()
-    result = refit_slsqp(problem, original, fallback, SlsqpOptions(hard_constraints=True), chunk_frames=8)
+    result = refit_slsqp(problem, original, fallback, MotionRefitOptions(hard_constraints=True), chunk_frames=8)
     assert result.failures == []
     violation, _ = rigidity_constraints(problem, result.positions)
     assert np.abs(violation).max() <= 1e-6
@@ -187,7 +188,7 @@ def test_a_zero_length_bone_is_held_together_and_survives_hard_constraints() -> 
     assert problem.coincident_pairs.tolist() == [[skeleton.index("LeftHip"), 0]]
     original = motion.world_positions()
     fallback = frozen_motion(level, motion).world_positions()
-    result = refit_slsqp(problem, original, fallback, SlsqpOptions(hard_constraints=True))
+    result = refit_slsqp(problem, original, fallback, MotionRefitOptions(hard_constraints=True))
     assert result.failures == []
     np.testing.assert_allclose(result.positions[:, skeleton.index("LeftHip")], original[:, 0], atol=1e-9)
     reduced = recover_motion(level, result.positions, motion)

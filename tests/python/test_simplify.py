@@ -184,7 +184,8 @@ def test_features_that_find_nothing_leave_the_collapse_order_of_features_off():
     paper = simplify_animated(mesh, (0.5, 0.1), feature_weighting="paper")
     assert paper.vertex_weights.max() > 1
     assert not np.array_equal(paper.collapses.removed, plain.removed)
-    with pytest.raises(ValueError, match=r"^feature_weighting: expected 'amplitude' or 'paper', got 'Paper'$"):
+    expected = r"^MotionFeatureOptions.feature_weighting: expected one of 'amplitude', 'paper', got 'Paper'$"
+    with pytest.raises(ValueError, match=expected):
         simplify_animated(mesh, (0.5,), feature_weighting="Paper")
 
 
@@ -319,8 +320,8 @@ def test_an_exception_in_progress_stops_the_run_cleanly():
 def test_int64_indices_are_range_checked_not_wrapped():
     # Regression: forcecast turned index 2**32 + 5 into 5, silently simplifying another mesh.
     mesh = bending_tube(frames=3)
-    narrow = _core.simplify_animated(mesh.frames, mesh.faces, target_ratios=[0.5])
-    wide = _core.simplify_animated(mesh.frames, mesh.faces.astype(np.int64), target_ratios=[0.5])
+    narrow = _core.simplify_animated(mesh.frames, mesh.faces)
+    wide = _core.simplify_animated(mesh.frames, mesh.faces.astype(np.int64))
     np.testing.assert_array_equal(wide["levels"][0]["faces"], narrow["levels"][0]["faces"])
     faces = mesh.faces.astype(np.int64)
     faces[3, 1] += 2**32

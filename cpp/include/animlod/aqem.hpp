@@ -35,6 +35,8 @@ enum class Placement {
   on_edge,
 };
 
+// What simplify_animated builds and how: the levels, the weights of Eq. 6, the quadrics, the
+// inversion test and where collapsed vertices go.
 struct AqemOptions {
   // Levels as fractions of the face count M' left after dropping degenerate and repeated faces,
   // each in (0, 1]. Ignored when target_face_counts is not empty. A level that no legal collapse
@@ -48,6 +50,7 @@ struct AqemOptions {
   double max_error = std::numeric_limits<double>::infinity();
   // Weights of Eq. 6 from the motion features; off gives every vertex weight 1.
   bool use_motion_features = true;
+  // How motion features are found and weighted when use_motion_features is on.
   MotionFeatureOptions motion_features;
   // Adds, per frame, a plane through every boundary edge and every attribute-seam edge
   // perpendicular to its face, so that open borders and seams keep their shape (Garland and
@@ -70,6 +73,7 @@ struct AqemOptions {
   std::vector<int32_t> frame_subset;
   // Called now and then with (collapses done, collapses needed for the last level).
   std::function<void(size_t, size_t)> progress;
+  // Where the vertex of a collapse goes (see Placement).
   Placement placement = Placement::optimal;
   // Welds vertices that are equal in every frame, in position_attributes and in skin, so that
   // seam copies form one surface. Off: every input vertex is its own point (seams are borders).

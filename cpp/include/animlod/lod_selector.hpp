@@ -69,6 +69,7 @@ int level_for_coverage(const float* coverages, size_t level_count, float coverag
 int level_for_error(const float* errors, size_t level_count, float distance, float focal_length_px,
                     float pixel_error);
 
+// How LodSelector switches levels: the dead band and the screen-space error budget.
 struct LodSelectorOptions {
   // Relative dead band around every threshold: a character moves to a coarser level only when
   // its metric has passed the threshold by this factor (coverage below c / (1 + h), or distance
@@ -105,6 +106,7 @@ class LodSelector {
   int level_ = -1;
 };
 
+// How animation_update_interval lowers the pose update rate of small characters.
 struct AnimationRateOptions {
   // At or above this projected coverage (fraction of the viewport height) the pose is updated
   // every frame. Must be > 0.

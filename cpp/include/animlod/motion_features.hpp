@@ -19,8 +19,8 @@ enum class FeatureWeighting {
   // measured spread of the amplitudes, T = median + noise_mads * MAD over the interior edges
   // (and at least min_angle_change): on captured data the bulk of the edges carries noise and
   // ordinary deformation, and a feature is an outlier far outside it. A vertex weighs
-  // 1 + (max_weight - 1) * clamp((a - T) / T, 0, 1) with a the largest amplitude of its interior
-  // edges: bounded (a feature's collapse costs at most max_weight times its quadric error) and
+  // 1 + (max_feature_weight - 1) * clamp((a - T) / T, 0, 1) with a the largest amplitude of its interior
+  // edges: bounded (a feature's collapse costs at most max_feature_weight times its quadric error) and
   // exactly 1 where nothing moves above T, so that a mesh without features simplifies exactly
   // as with use_motion_features off.
   amplitude,
@@ -30,6 +30,7 @@ enum class FeatureWeighting {
   paper,
 };
 
+// How motion features are found (paper, "Rotation connected graph") and weighted (Eq. 6).
 struct MotionFeatureOptions {
   // Radians. An edge is "connected" when its motion (g_i for paper, the amplitude a_i for
   // amplitude) exceeds this threshold; 0 selects the adaptive threshold of the weighting: the
@@ -44,9 +45,10 @@ struct MotionFeatureOptions {
   // reported as features either way; amplitude weighting gives them no weight of their own, as
   // the boundary quadrics already keep open borders.)
   bool boundary_is_feature = true;
-  FeatureWeighting weighting = FeatureWeighting::amplitude;
-  // amplitude: the largest vertex weight, > = 1.
-  double max_weight = 4.0;
+  // How a motion becomes a vertex weight (see FeatureWeighting).
+  FeatureWeighting feature_weighting = FeatureWeighting::amplitude;
+  // amplitude: the largest vertex weight, >= 1.
+  double max_feature_weight = 4.0;
   // amplitude: the adaptive threshold in median absolute deviations above the median, >= 0.
   double noise_mads = 30.0;
 };
@@ -71,7 +73,7 @@ struct MotionFeatures {
 // Finds the motion features of `mesh` over all its frames.
 // Errors: the input checks of validate_animated_mesh (NaN, index out of range, degenerate,
 // duplicate or non-manifold faces, unreferenced vertices), each naming the element; a negative
-// or NaN threshold, max_weight below 1 or negative noise_mads.
+// or NaN threshold, max_feature_weight below 1 or negative noise_mads.
 Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeatureOptions& options,
                                MotionFeatures& out);
 

@@ -46,7 +46,9 @@ enum class Governing {
   online,   // every frame decimated in turn, with a history term favouring the TDAG so far
 };
 
+// How build_temporal_dag orders, splits and checks the collapses of the TDAG.
 struct TdagOptions {
+  // The collapse order of the hierarchy (see Governing).
   Governing governing = Governing::first;
   // The frame that governs with Governing::frame, in [0, F).
   int32_t governing_frame = 0;

@@ -52,9 +52,10 @@ struct PlayerLevelStats {
   double median_seconds = 0.0;  // robust to the odd preempted frame
 };
 
+// Which frames play_temporal_dag walks and at what tolerance.
 struct PlayerOptions {
   double tolerance = 0.0;     // asset units
-  int32_t first_frame = 0;
+  int32_t first_frame = 0;    // the frame the walk starts from
   int32_t frame_count = -1;   // frames to walk after the first; -1: to the last frame
   bool measure_error = true;  // compute the errors (not timed)
 };

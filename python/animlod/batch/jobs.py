@@ -5,9 +5,10 @@ A job is a function ``job(source, output_folder, *, progress=None, **options) ->
 ``motion``); a studio's own job is named by its import path, ``"package.module:function"``,
 and must be importable on every worker.
 
-The options a job accepts are read from the signatures of the functions it calls, and their
-defaults from those signatures too, so that a manifest is checked against the code that will
-run it, with no second list to keep in step.
+The options a job accepts are read from the signatures of the functions it calls and from the
+core's options classes they take (:mod:`animlod.options`), and their defaults from those too,
+so that a manifest is checked against the code that will run it, with no second list to keep in
+step.
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ from dataclasses import dataclass
 DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "bvh": "motion"}
 # Keyword arguments a manifest never sets: the runner owns progress, and a batch spreads its
 # work over assets (one core each), not over the processes of one asset.
-_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level", "on_note"})
+# A pipeline's settings object is given by its fields (DrawableSettings, listed as a source).
+_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level", "on_note", "settings", "aqem"})
 
 
 @dataclass(frozen=True)
@@ -42,26 +44,25 @@ class Job:
         sources = self.option_sources.get(kind, self.option_sources.get("*", (self.path,)))
         accepted: dict[str, object] = {}
         for source in sources:
-            found = _keywords(_import(source))
+            imported = _import(source)
+            found = _option_fields(imported) if hasattr(imported, "fields") else _keywords(imported)
             if found is None:
                 return None
-            if source in _SCALARS_ONLY:  # the per-vertex arrays are the pipeline's to set
-                found = {name: value for name, value in found.items() if isinstance(value, (bool, int, float, str))}
             accepted.update(found)
         return accepted
 
 
-_AQEM = "animlod.aqem:simplify_animated"
-# Sources whose keywords are options only when their default is a plain value: simplify_animated
-# also takes per-vertex arrays and the level targets, which the pipelines fill in.
-_SCALARS_ONLY = frozenset({_AQEM})
+# The AQEM options a pipeline passes on to simplify_animated (its keywords are this class's fields).
+_AQEM = "animlod.options:AqemOptions"
+# The settings the glTF pipelines share, as keywords.
+_DRAWABLE = "animlod.pipelines.drawable_levels:DrawableSettings"
 BUILTIN_JOBS = {
     "simplify": Job(
         "simplify",
         "animlod.pipelines.assets:simplify_asset",
         ("gltf", "npz", "sequence"),
         {
-            "gltf": ("animlod.pipelines.lod_document:simplify_document", _AQEM),
+            "gltf": ("animlod.pipelines.lod_document:simplify_document", _DRAWABLE, _AQEM),
             "npz": ("animlod.pipelines.lod_sequence:simplify_sequence", _AQEM),
             "sequence": ("animlod.pipelines.lod_sequence:simplify_sequence", _AQEM),
         },
@@ -70,7 +71,7 @@ BUILTIN_JOBS = {
         "character",
         "animlod.pipelines.assets:character_asset",
         ("gltf",),
-        {"gltf": ("animlod.pipelines.character:build_character", _AQEM)},
+        {"gltf": ("animlod.pipelines.character:build_character", _DRAWABLE, _AQEM)},
     ),
     "face": Job(
         "face",
@@ -155,7 +156,7 @@ def _keywords(function: Callable) -> dict[str, object] | None:
     for parameter in inspect.signature(function).parameters.values():
         if parameter.kind is inspect.Parameter.VAR_KEYWORD:
             if function.__module__.startswith("animlod."):
-                continue  # the pipeline's **aqem_options: listed by the AQEM source
+                continue  # the pipeline's AQEM keywords: listed by the AqemOptions source
             return None
         if parameter.kind in (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.POSITIONAL_ONLY):
             continue
@@ -165,6 +166,20 @@ def _keywords(function: Callable) -> dict[str, object] | None:
             continue  # the positional inputs (source, output, mesh)
         accepted[parameter.name] = parameter.default
     return accepted
+
+
+def _option_fields(options_type: type) -> dict[str, object]:
+    """Fields of a bound options class and of its nested options (name -> default) that hold a
+    plain value; the lists (level targets, frame subsets) are the pipeline's to fill in."""
+    defaults = options_type()
+    found: dict[str, object] = {}
+    for name in options_type.fields:
+        value = getattr(defaults, name)
+        if hasattr(type(value), "fields"):
+            found.update(_option_fields(type(value)))
+        elif isinstance(value, (bool, int, float, str)):
+            found[name] = value
+    return found
 
 
 def _import(path: str) -> Callable:

@@ -130,7 +130,7 @@ def run_build(args: argparse.Namespace) -> int:
             mesh,
             governing,
             history_weight=args.history_weight,
-            base=args.base,
+            affine_base=args.base,
             check_inversion=not args.no_inversion_check,
             weld=not args.no_weld,
             progress=progress,

@@ -105,10 +105,10 @@ def gltf_face_levels(source: GltfFace, options: BlendshapeLodOptions | None = No
         else list(options.ratios)
     )
     check_fractions(options.target_fractions, len(ratios) + 1)
-    aqem_options = {}
+    importance = None
     if options.grow is not None and np.any(face.targets):
-        aqem_options["importance"] = target_regions(face, options.grow).vertex_importance()
-    drawn = simplify_drawable(source.drawable, ratios, aqem_options=aqem_options)
+        importance = target_regions(face, options.grow).vertex_importance()
+    drawn = simplify_drawable(source.drawable, ratios, importance=importance)
     everything = np.arange(face.target_count)
     identity = np.arange(face.vertex_count, dtype=np.int32)
     levels = [BlendshapeLevel(face.faces, face.neutral, face.targets, everything, identity, face.uvs, 0.0, 0.0)]

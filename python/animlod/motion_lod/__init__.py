@@ -21,7 +21,6 @@ from .chain import (
 from .grouped_solve import FrameFailure
 from .objective import Weights
 from .ranking import RANKINGS
-from .refit import SlsqpOptions
 
 __all__ = [
     "RANKINGS",
@@ -32,7 +31,6 @@ __all__ = [
     "MotionAnalysis",
     "MotionLevel",
     "MotionLodChain",
-    "SlsqpOptions",
     "Weights",
     "analyze_motion",
     "build_motion_chain",

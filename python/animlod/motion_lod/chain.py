@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import Motion, SkinnedMesh
+from ..options import MotionRefitOptions
 from .analysis import MotionAnalysis, analyze_motion
 from .core_refit import refit_core
 from .frozen import FrozenLevel, freeze, frozen_motion
@@ -22,7 +23,7 @@ from .grouped_solve import FrameFailure, RefitResult
 from .newton import refit_newton
 from .objective import RefitProblem, Weights, build_problem, objective
 from .ranking import DEFAULT_RANKING
-from .refit import SlsqpOptions, refit_slsqp
+from .refit import refit_slsqp
 from .skeleton_reduce import expand_motion, recover_motion
 from .skin_transfer import transfer_skin
 
@@ -187,7 +188,7 @@ def _refit(
     fallback: np.ndarray,
     cold_starts: np.ndarray | None,
     solver: str,
-    slsqp_options: SlsqpOptions,
+    slsqp_options: MotionRefitOptions,
     workers: int,
     progress: Callable[[float], None] | None,
 ) -> RefitResult:
@@ -235,7 +236,7 @@ def build_level(
     joint_count: int,
     weights: Weights | None = None,
     solver: str = SOLVERS[0],
-    slsqp_options: SlsqpOptions | None = None,
+    slsqp_options: MotionRefitOptions | None = None,
     workers: int = 0,
     skin: SkinnedMesh | None = None,
     progress: Callable[[float], None] | None = None,
@@ -243,7 +244,7 @@ def build_level(
     """One level with ``joint_count`` joints (see :func:`build_motion_chain` for the options)."""
     if solver not in SOLVERS:
         raise ValueError(f"solver: expected one of {SOLVERS}, got {solver!r}")
-    slsqp_options = slsqp_options or SlsqpOptions(hard_constraints=solver != "newton")
+    slsqp_options = slsqp_options or MotionRefitOptions(hard_constraints=solver != "newton")
     if slsqp_options.hard_constraints and solver == "newton":
         raise ValueError("solver: hard constraints need an SLSQP solver (the Newton solver only minimises E)")
     start = time.perf_counter()
@@ -289,7 +290,7 @@ def build_motion_chain(
     locked: Sequence[str] = (),
     weights: Weights | None = None,
     solver: str = SOLVERS[0],
-    slsqp_options: SlsqpOptions | None = None,
+    slsqp_options: MotionRefitOptions | None = None,
     workers: int = 0,
     skin: SkinnedMesh | None = None,
     max_frames: int = 600,

@@ -13,9 +13,9 @@ from collections.abc import Callable
 import numpy as np
 
 from .. import _core
+from ..options import MotionRefitOptions, resolve_options
 from .grouped_solve import FrameFailure, RefitResult, combine_groups
 from .objective import RefitProblem, split_problem
-from .refit import SlsqpOptions
 
 
 def core_problem(problem: RefitProblem) -> _core.MotionRefitProblem:
@@ -37,30 +37,14 @@ def core_problem(problem: RefitProblem) -> _core.MotionRefitProblem:
     )
 
 
-def core_options(options: SlsqpOptions, threads: int = 0, chunk_frames: int = 64) -> _core.MotionRefitOptions:
-    """``options`` as the core's options struct."""
-    result = _core.MotionRefitOptions()
-    result.hard_constraints = options.hard_constraints
-    result.ftol_rel = options.ftol_rel
-    result.max_evaluations = options.max_evaluations
-    result.feasibility_tolerance = options.feasibility_tolerance
-    result.warm_start = options.warm_start
-    result.precondition = options.precondition
-    result.eliminate_points = options.eliminate_points
-    result.threads = threads
-    result.chunk_frames = chunk_frames
-    return result
-
-
 def refit_core(
     problem: RefitProblem,
     original: np.ndarray,
     fallback: np.ndarray,
-    options: SlsqpOptions | None = None,
-    threads: int = 0,
-    chunk_frames: int = 64,
+    options: MotionRefitOptions | None = None,
     progress: Callable[[float], None] | None = None,
     cold_starts: np.ndarray | None = None,
+    **option_fields: object,
 ) -> RefitResult:
     """Re-fit every frame with SLSQP in the core, group of points by group.
 
@@ -69,9 +53,10 @@ def refit_core(
     problem : the level's problem (objective.build_problem).
     original : (T, P, 3) original positions x^o.
     fallback : (T, P, 3) positions kept where a frame's solves fail (feasible by construction).
-    options : stopping rules, hard constraints, preconditioning (the core's defaults when None).
-    threads : worker threads; 0 uses every hardware thread. The result does not depend on it.
-    chunk_frames : consecutive frames per task (warm starts run inside a chunk).
+    options, **option_fields : a :class:`~animlod.options.MotionRefitOptions` and/or its fields
+        by name: stopping rules, hard constraints, preconditioning, ``threads`` (0: every
+        hardware thread; the result does not depend on it) and ``chunk_frames`` (consecutive
+        frames per task; warm starts run inside a chunk).
     progress : called with the (fractional) number of frames finished after each group.
     cold_starts : (T, P, 3) where chunks start and failed frames restart (feasible with hard
         constraints), or None: the original positions, or the fallback with hard constraints.
@@ -80,8 +65,7 @@ def refit_core(
     -------
     RefitResult over all frames; ``evaluations`` sums the groups' objective evaluations.
     """
-    options = options or SlsqpOptions()
-    settings = core_options(options, threads, chunk_frames)
+    settings = resolve_options(MotionRefitOptions, options, option_fields)
     groups, _ = split_problem(problem)
     original = np.ascontiguousarray(original, dtype=np.float64)
     fallback = np.ascontiguousarray(fallback, dtype=np.float64)

@@ -26,45 +26,17 @@ the fallback positions; every such frame is reported in ``RefitResult.failures``
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import nlopt
 import numpy as np
 
-from .. import _core
+from ..options import MotionRefitOptions, resolve_options
 from .grouped_solve import FrameFailure, RefitResult, solve_grouped
 from .objective import RefitProblem, handedness_constraints, objective, rigidity_constraints
 
-_CORE_DEFAULTS = _core.MotionRefitOptions()
 # E >= alpha |x - x^o|^2 / L^2 (Eq. 6): original positions or a cold start with E below this are
 # the optimum to ~1e-12 L (a group no frozen joint touches), solved without a call to SLSQP.
 _NEGLIGIBLE_OBJECTIVE = 1e-24
-
-
-@dataclass(frozen=True)
-class SlsqpOptions:
-    """Stopping rules and checks of the SLSQP re-fit; the defaults are the core's
-    (``animlod._core.MotionRefitOptions``, cpp/include/animlod/motion_refit.hpp).
-
-    hard_constraints : hold every length of Es as an equality, rigid groups' handedness as
-        inequalities (bones keep their key lengths, Fig. 7).
-    ftol_rel, max_evaluations : SLSQP's stopping rules per solve.
-    feasibility_tolerance : largest |b - b0| / L accepted with hard constraints.
-    warm_start : start each frame from the previous frame's result inside a chunk.
-    precondition : the core solves in variables where E's Hessian at the start is the identity
-        (far fewer iterations); the Python reference always uses the plain scaled displacements
-        (x - x^o) / L and ignores it.
-    eliminate_points : the core places leaves held by one length and points of zero-length pairs
-        in closed form instead of as variables (the same minima); the Python reference ignores it.
-    """
-
-    hard_constraints: bool = _CORE_DEFAULTS.hard_constraints
-    ftol_rel: float = _CORE_DEFAULTS.ftol_rel
-    max_evaluations: int = _CORE_DEFAULTS.max_evaluations
-    feasibility_tolerance: float = _CORE_DEFAULTS.feasibility_tolerance
-    warm_start: bool = _CORE_DEFAULTS.warm_start
-    precondition: bool = _CORE_DEFAULTS.precondition
-    eliminate_points: bool = _CORE_DEFAULTS.eliminate_points
 
 
 def _positions(problem: RefitProblem, original: np.ndarray, z: np.ndarray) -> np.ndarray:
@@ -80,7 +52,7 @@ def _energy(problem: RefitProblem, original: np.ndarray, z: np.ndarray) -> float
 
 
 def _solve_frame(
-    problem: RefitProblem, original: np.ndarray, z0: np.ndarray, options: SlsqpOptions
+    problem: RefitProblem, original: np.ndarray, z0: np.ndarray, options: MotionRefitOptions
 ) -> tuple[np.ndarray, float, int, str]:
     """One SLSQP solve; returns ``z``, E, evaluations and "" or the reason it is not acceptable."""
     n = problem.variable_count
@@ -149,7 +121,7 @@ def _solve_chunk(
     original: np.ndarray,
     fallback: np.ndarray,
     cold_starts: np.ndarray,
-    options: SlsqpOptions,
+    options: MotionRefitOptions,
     explicit_cold_starts: bool,
 ) -> RefitResult:
     """Solve consecutive frames ``original (C, P, 3)``, warm-starting each from the previous."""
@@ -201,11 +173,11 @@ def refit_slsqp(
     problem: RefitProblem,
     original: np.ndarray,
     fallback: np.ndarray,
-    options: SlsqpOptions | None = None,
-    chunk_frames: int = 64,
+    options: MotionRefitOptions | None = None,
     workers: int = 1,
     progress: Callable[[float], None] | None = None,
     cold_starts: np.ndarray | None = None,
+    **option_fields: object,
 ) -> RefitResult:
     """Re-fit every frame with SLSQP, one solve per frame and independent group of points.
 
@@ -214,21 +186,23 @@ def refit_slsqp(
     problem : the level's problem (objective.build_problem).
     original : (T, P, 3) original positions x^o.
     fallback : (T, P, 3) positions kept for a frame whose solves fail (feasible by construction).
-    options : stopping rules, hard constraints, checks.
+    options, **option_fields : a :class:`~animlod.options.MotionRefitOptions` and/or its fields
+        by name: stopping rules, hard constraints, checks, ``chunk_frames`` (frames per
+        warm-started chunk, and per task with ``workers > 1``). ``precondition``,
+        ``eliminate_points`` and ``threads`` belong to the core's solve and are ignored here.
     cold_starts : (T, P, 3) where chunks start and failed frames restart (feasible with hard
         constraints), or None: the original positions, or the fallback with hard constraints.
-    chunk_frames : frames per warm-started chunk (and per task with ``workers > 1``).
     workers : processes; 1 solves in this process.
     progress : called with the (fractional) number of frames finished after each chunk.
     """
-    options = options or SlsqpOptions()
+    options = resolve_options(MotionRefitOptions, options, option_fields)
     explicit = cold_starts is not None
     return solve_grouped(
         problem,
         _solve_chunk,
         (original, fallback, cold_starts if explicit else fallback),
         (options, explicit),
-        chunk_frames,
+        options.chunk_frames,
         workers,
         progress,
     )

@@ -5,6 +5,7 @@ and no printing.
 """
 
 from .assets import character_asset, face_asset, simplify_asset
+from .drawable_levels import DrawableSettings
 from .lod_document import DocumentReport, simplify_document
 from .motion import MotionReport, build_motion_levels, motion_asset
 from .result import AssetResult, LevelRow
@@ -12,6 +13,7 @@ from .result import AssetResult, LevelRow
 __all__ = [
     "AssetResult",
     "DocumentReport",
+    "DrawableSettings",
     "LevelRow",
     "MotionReport",
     "build_motion_levels",

@@ -44,7 +44,7 @@ from ..model import AnimatedMesh, Motion, SkinnedMesh
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
-from .drawable_levels import DrawableLevel, DrawableLevels, simplify_drawable, spread_frames
+from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable, spread_frames
 from .lod_document import DEFAULT_RATIOS
 
 
@@ -81,13 +81,9 @@ def build_character(
     *,
     solver: str = "slsqp",
     workers: int = 1,
-    fps: float = 30.0,
-    frame_budget: int = 48,
-    measured_frames: int = 12,
-    pixel_error: float = 1.0,
-    viewport_px: float = 1080.0,
+    settings: DrawableSettings | None = None,
     progress: Callable[[str], None] | None = None,
-    **aqem_options: object,
+    **keywords: object,
 ) -> CharacterReport:
     """Build geometry x motion levels of every skinned drawable of ``source`` into one LoD GLB.
 
@@ -98,16 +94,17 @@ def build_character(
         spread down to the fewest the skeleton allows, see :func:`animlod.build_motion_chain`).
     solver, workers : the motion re-fit (``"slsqp"``, the paper's SQP, or ``"newton"``) and the
         processes it uses.
-    fps, frame_budget, measured_frames, pixel_error, viewport_px, aqem_options : as for
-        :func:`animlod.pipelines.simplify_document`.
+    settings, **keywords : a :class:`~animlod.pipelines.DrawableSettings` and/or its fields and
+        AQEM options by name, as for :func:`animlod.pipelines.simplify_document`.
 
     Raises
     ------
     FormatError when the file has no skinned mesh with an animation, or cannot be read.
     """
     say = progress or (lambda _line: None)
+    settings = DrawableSettings.resolve(settings, keywords)
     doc = GltfDocument(source)
-    drawables = [d for d in read_drawables(doc, fps) if d.skinned is not None]
+    drawables = [d for d in read_drawables(doc, settings.fps) if d.skinned is not None]
     animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]
     if not animated:
         raise FormatError(doc.path, "skins", "no skinned mesh with an animation: a character chain needs both")
@@ -139,7 +136,7 @@ def build_character(
     geometry = {}
     for drawable in animated:
         say(f"{drawable.label}: geometry levels of {len(drawable.geometry.faces)} triangles")
-        geometry[drawable.label] = simplify_drawable(drawable, ratios, frame_budget, measured_frames, aqem_options)
+        geometry[drawable.label] = simplify_drawable(drawable, ratios, settings)
     geometry_seconds = time.perf_counter() - started
 
     builder = GlbBuilder.from_document(doc)
@@ -150,15 +147,17 @@ def build_character(
         levels = geometry[drawable.label]
         say(f"{drawable.label}: writing the grid, measuring the chain")
         grid = _write_grid(builder, doc, drawable, levels, chain, motion_nodes[drawable.skin_index])
-        report = _measure_chain(drawable, levels, chain, clips, measured_frames)
-        coverages = screen_coverages([level.error for level in report], levels.size, pixel_error, viewport_px)
+        report = _measure_chain(drawable, levels, chain, clips, settings.measured_frames)
+        coverages = screen_coverages(
+            [level.error for level in report], levels.size, settings.pixel_error, settings.viewport_px
+        )
         for level, coverage in zip(report, coverages):
             level.coverage = coverage
             level.relative_error = level.error / levels.size if levels.size > 0 else 0.0
         _attach(builder, drawable, report, grid)
         chains[drawable.label] = report
         notes += [f"{drawable.label}: {note}" for note in levels.notes]
-    skipped = [d.label for d in read_drawables(doc, fps) if d.label not in chains]
+    skipped = [d.label for d in read_drawables(doc, settings.fps) if d.label not in chains]
     if skipped:
         notes.append(f"left as they are (no skin or no animation): {', '.join(skipped)}")
     builder.save(output)

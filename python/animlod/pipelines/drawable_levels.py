@@ -19,7 +19,8 @@ moving them.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import dataclasses
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -30,6 +31,7 @@ from ..io.gltf_lod import PrimitiveArrays
 from ..io.gltf_mesh import PrimitiveGeometry, transform_points
 from ..metrics import surface_error
 from ..model import AnimatedMesh, SkinnedMesh
+from ..options import AqemOptions
 
 _SKIN_PREFIXES = ("JOINTS_", "WEIGHTS_")
 # A primitive is flat shaded when this share of its faces has equal corner normals along the
@@ -40,6 +42,44 @@ CREASE_ANGLE = np.radians(60.0)
 _NORMAL_ATTRIBUTES = ("NORMAL", "TANGENT")
 # Points sampled on each surface per measured frame (on top of the vertices).
 _MEASURE_SAMPLES = 4000
+
+
+@dataclass(frozen=True)
+class DrawableSettings:
+    """How each drawable of a glTF document becomes levels: the settings that
+    :func:`~animlod.pipelines.simplify_document` and
+    :func:`~animlod.pipelines.character.build_character` share.
+
+    Attributes
+    ----------
+    fps : rate at which animations are sampled.
+    frame_budget : most frames that drive AQEM per drawable (the rest pose, each morph target at
+        full weight and frames spread over every clip).
+    measured_frames : frames per clip at which each level's error is measured.
+    pixel_error, viewport_px : the screen error a level may show where its coverage starts
+        (see :func:`animlod.io.gltf_lod.screen_coverages`).
+    aqem : fields of :class:`~animlod.AqemOptions` that replace the pipeline's AQEM defaults
+        (motion features off; ``placement`` ``"on_edge"`` for skinned or morphed drawables, so
+        that the carried weights and deltas reproduce the poses, else ``"optimal"``).
+    """
+
+    fps: float = 30.0
+    frame_budget: int = 48
+    measured_frames: int = 12
+    pixel_error: float = 1.0
+    viewport_px: float = 1080.0
+    aqem: Mapping[str, object] = field(default_factory=dict)
+
+    @classmethod
+    def resolve(cls, settings: DrawableSettings | None, keywords: Mapping[str, object]) -> DrawableSettings:
+        """``settings`` (the defaults when None) changed by ``keywords``: a keyword naming a
+        field above replaces it, any other is an AQEM option. Raises ValueError naming an unknown
+        option or a value it cannot hold, before any work."""
+        settings = settings or cls()
+        own = {name for name in cls.__dataclass_fields__ if name != "aqem"}
+        aqem = {**settings.aqem, **{name: value for name, value in keywords.items() if name not in own}}
+        AqemOptions(**aqem)
+        return dataclasses.replace(settings, aqem=aqem, **{name: keywords[name] for name in own & keywords.keys()})
 
 
 @dataclass
@@ -86,15 +126,17 @@ class _Layout:
 def simplify_drawable(
     drawable: Drawable,
     ratios: Sequence[float],
-    frame_budget: int = 48,
-    measured_frames: int = 12,
-    aqem_options: dict | None = None,
+    settings: DrawableSettings | None = None,
+    importance: np.ndarray | None = None,
 ) -> DrawableLevels:
     """AQEM levels of ``drawable`` at ``ratios``, each measured over every clip.
 
-    ``aqem_options`` are keyword arguments of :func:`animlod.simplify_animated`; unlike there,
-    motion features are off unless ``use_motion_features=True`` is given (see the comment below).
+    ``settings`` says how many frames drive and measure the levels and which AQEM options
+    replace the pipeline's (unlike :func:`animlod.simplify_animated`, motion features are off
+    unless ``use_motion_features=True`` is given; see the comment below). ``importance`` (V,)
+    float32 > 0 multiplies each vertex's weight (the face's regions).
     """
+    settings = settings or DrawableSettings()
     geometry = drawable.geometry
     matrix, layout = _attribute_matrix(drawable)
     deltas = drawable.morph_targets
@@ -107,9 +149,9 @@ def simplify_drawable(
     options = {
         "placement": "on_edge" if animated else "optimal",
         "use_motion_features": False,
-        **(aqem_options or {}),
+        **settings.aqem,
     }
-    frames = _drive_frames(drawable, frame_budget)
+    frames = _drive_frames(drawable, settings.frame_budget)
     result = simplify_animated(
         AnimatedMesh(geometry.faces, frames),
         ratios,
@@ -119,6 +161,7 @@ def simplify_drawable(
         skin_weights=None if drawable.skinned is None else drawable.skinned.weights,
         face_groups=geometry.face_groups,
         guarded_vertices=_sharp_corners(drawable, layout),
+        importance=importance,
         **options,
     )
     rest = drawable.rest_positions()
@@ -130,7 +173,7 @@ def simplify_drawable(
         notes.append(f"primitives {rebuilt}: hard normal edges; normals rebuilt on each level (crease angle)")
     if geometry.other_primitives:
         notes.append(f"primitives {geometry.other_primitives}: points or lines, kept unchanged")
-    _measure(drawable, levels, measured_frames)
+    _measure(drawable, levels, settings.measured_frames)
     return DrawableLevels(levels, size, result.preparation, notes)
 
 

@@ -22,7 +22,7 @@ from ..io.gltf_document import GltfDocument
 from ..io.gltf_drawable import Drawable, read_drawables
 from ..io.gltf_lod import LevelInfo, add_level_mesh, add_level_node, attach_chain, screen_coverages
 from ..model import AnimatedMesh
-from .drawable_levels import DrawableLevels, simplify_drawable
+from .drawable_levels import DrawableLevels, DrawableSettings, simplify_drawable
 
 DEFAULT_RATIOS = (0.5, 0.25, 0.1)
 
@@ -71,13 +71,9 @@ def simplify_document(
     ratios: Sequence[float] = DEFAULT_RATIOS,
     *,
     separate: bool = False,
-    fps: float = 30.0,
-    frame_budget: int = 48,
-    measured_frames: int = 12,
-    pixel_error: float = 1.0,
-    viewport_px: float = 1080.0,
+    settings: DrawableSettings | None = None,
     progress: Callable[[str], None] | None = None,
-    **aqem_options: object,
+    **keywords: object,
 ) -> DocumentReport:
     """Simplify every drawable of the glTF file ``source`` and write the LoD GLB ``output``.
 
@@ -87,15 +83,11 @@ def simplify_document(
     output : the LoD GLB to write (atomically); with ``separate``, a folder that receives one
         ``<stem>_lod<i>.glb`` per level instead, each the whole document at that level.
     ratios : face ratios of the levels below level 0, in (0, 1].
-    fps : rate at which animations are sampled.
-    frame_budget : most frames that drive AQEM per drawable (the rest pose, each morph target
-        at full weight and frames spread over every clip).
-    measured_frames : frames per clip at which each level's error is measured.
-    pixel_error, viewport_px : the screen error a level may show where its coverage starts
-        (see :func:`animlod.io.gltf_lod.screen_coverages`).
+    settings, **keywords : a :class:`~animlod.pipelines.DrawableSettings` and/or its fields by
+        name (``fps``, ``frame_budget``, ``measured_frames``, ``pixel_error``, ``viewport_px``)
+        and AQEM options (``use_motion_features``, ``max_error``, ``placement`` ..., see
+        :class:`~animlod.AqemOptions`).
     progress : called with a line of text as each drawable starts.
-    **aqem_options : keyword arguments of :func:`animlod.simplify_animated` (``use_motion_features``,
-        ``max_error``, ``placement`` ...).
 
     Raises
     ------
@@ -104,16 +96,17 @@ def simplify_document(
     started = time.perf_counter()
     if not ratios or any(not 0.0 < ratio <= 1.0 for ratio in ratios):
         raise ValueError(f"ratios: each must be in (0, 1], got {list(ratios)}")
+    settings = DrawableSettings.resolve(settings, keywords)
     doc = GltfDocument(source)
-    drawables = read_drawables(doc, fps)
+    drawables = read_drawables(doc, settings.fps)
     if not drawables:
         raise FormatError(doc.path, "meshes", "no node draws a triangle mesh, nothing to simplify")
     simplified = []
     for drawable in drawables:
         if progress:
             progress(f"{drawable.label}: {drawable.geometry.faces.shape[0]} triangles, {len(drawable.clips)} clips")
-        simplified.append(simplify_drawable(drawable, ratios, frame_budget, measured_frames, aqem_options=aqem_options))
-    reports = [_report(d, s, pixel_error, viewport_px) for d, s in zip(drawables, simplified)]
+        simplified.append(simplify_drawable(drawable, ratios, settings))
+    reports = [_report(d, s, settings) for d, s in zip(drawables, simplified)]
     if separate:
         outputs = _write_separate(doc, drawables, simplified, reports, Path(output), Path(source).stem)
     else:
@@ -122,9 +115,9 @@ def simplify_document(
     return DocumentReport(Path(source), outputs, reports, time.perf_counter() - started)
 
 
-def _report(drawable: Drawable, levels: DrawableLevels, pixel_error: float, viewport_px: float) -> DrawableReport:
+def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettings) -> DrawableReport:
     errors = [0.0] + [level.error for level in levels.levels]
-    coverages = screen_coverages(errors, levels.size, pixel_error, viewport_px)
+    coverages = screen_coverages(errors, levels.size, settings.pixel_error, settings.viewport_px)
     report = DrawableReport(
         label=drawable.label,
         nodes=drawable.nodes,

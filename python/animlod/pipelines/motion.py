@@ -91,7 +91,7 @@ def build_motion_levels(
     """
     from ..motion_lod.chain import build_motion_chain
     from ..motion_lod.objective import Weights
-    from ..motion_lod.refit import SlsqpOptions
+    from ..options import MotionRefitOptions
 
     if workers < 0:
         raise ValueError(f"workers: must be at least 0, got {workers}")
@@ -118,7 +118,7 @@ def build_motion_levels(
         counts,
         weights=Weights(*weights),
         solver=solver,
-        slsqp_options=SlsqpOptions(hard_constraints=solver != "newton" and not penalty),
+        slsqp_options=MotionRefitOptions(hard_constraints=solver != "newton" and not penalty),
         workers=workers,
         skin=skin,
         on_level=(lambda index, count: on_level(index, count, motion.frame_count, len(counts))) if on_level else None,

@@ -5,7 +5,7 @@
 // Invariants on success: edges sorted with the lower vertex first; one angle change, finite and
 // >= 0, per edge; every vertex's feature index in [-1, C); feature sizes add up to the vertices
 // in features; vertex weights >= 1; amplitude weighting: amplitudes finite and >= 0, weights at
-// most max_weight and exactly 1 outside every feature.
+// most max_feature_weight and exactly 1 outside every feature.
 #include <cmath>
 
 #include "animlod/motion_features.hpp"
@@ -16,7 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   animlod::MotionFeatureOptions options;
   const uint8_t flags = in.take<uint8_t>();
   options.boundary_is_feature = in.flag(flags, 0);
-  if (in.flag(flags, 1)) options.weighting = animlod::FeatureWeighting::paper;
+  if (in.flag(flags, 1)) options.feature_weighting = animlod::FeatureWeighting::paper;
   options.feature_threshold = in.take<uint8_t>() / 64.0;
   options.min_angle_change = in.take<uint8_t>() / 256.0;
   const animlod::fuzz::FuzzMesh mesh = animlod::fuzz::decode_mesh(in);
@@ -45,8 +45,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (size_t v = 0; v < mesh.vertex_count; ++v) {
     ANIMLOD_FUZZ_REQUIRE(out.vertex_feature[v] >= -1 && out.vertex_feature[v] < feature_count);
     ANIMLOD_FUZZ_REQUIRE(out.vertex_weights[v] >= 1.0f);
-    if (options.weighting == animlod::FeatureWeighting::amplitude) {
-      ANIMLOD_FUZZ_REQUIRE(out.vertex_weights[v] <= static_cast<float>(options.max_weight));
+    if (options.feature_weighting == animlod::FeatureWeighting::amplitude) {
+      ANIMLOD_FUZZ_REQUIRE(out.vertex_weights[v] <= static_cast<float>(options.max_feature_weight));
       ANIMLOD_FUZZ_REQUIRE(out.vertex_feature[v] >= 0 || out.vertex_weights[v] == 1.0f);
     }
     in_features += out.vertex_feature[v] >= 0;

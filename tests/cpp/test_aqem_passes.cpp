@@ -1,0 +1,170 @@
+// AQEM's collapse passes (meshoptimizer's scheme, collapse_engine.cpp run_passes) on meshes
+// large enough to use them (more than EngineOptions::passes_above_edges = 100k edges; smaller
+// meshes run the greedy order, which test_aqem.cpp covers), and the quadric's 3x3 solve.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include "animlod/aqem.hpp"
+#include "quadric.hpp"
+#include "test_aqem_meshes.hpp"
+
+using animlod::AqemLevel;
+using animlod::AqemOptions;
+using animlod::AqemResult;
+using animlod::AqemVertexData;
+using animlod::testing::OwnedAnimatedMesh;
+
+namespace {
+
+AqemResult run(const OwnedAnimatedMesh& mesh, const AqemOptions& options, const AqemVertexData& data = {}) {
+  AqemResult result;
+  const animlod::Status status = animlod::simplify_animated(mesh.view(), data, options, result);
+  REQUIRE_MESSAGE(status.ok, status.message);
+  return result;
+}
+
+size_t edge_count(const OwnedAnimatedMesh& mesh) {
+  std::set<std::pair<int32_t, int32_t>> edges;
+  for (size_t f = 0; f < mesh.faces.size(); f += 3)
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = mesh.faces[f + k], b = mesh.faces[f + (k + 1) % 3];
+      edges.insert({std::min(a, b), std::max(a, b)});
+    }
+  return edges.size();
+}
+
+bool directed_edges_unique(const AqemLevel& level) {
+  std::set<std::pair<int32_t, int32_t>> directed;
+  for (size_t f = 0; f < level.faces.size(); f += 3)
+    for (int k = 0; k < 3; ++k)
+      if (!directed.insert({level.faces[f + k], level.faces[f + (k + 1) % 3]}).second) return false;
+  return true;
+}
+
+// Faces whose normal points towards the origin in some frame (the sphere is convex and centred).
+size_t inward_faces(const AqemLevel& level, size_t frame_count) {
+  const size_t kept = level.kept_vertices.size();
+  size_t inward = 0;
+  for (size_t f = 0; f < frame_count; ++f) {
+    const float* p = &level.positions[f * kept * 3];
+    for (size_t t = 0; t < level.faces.size(); t += 3) {
+      Eigen::Vector3d corner[3];
+      for (int k = 0; k < 3; ++k) corner[k] = Eigen::Vector3f(p + 3 * level.faces[t + k]).cast<double>();
+      const Eigen::Vector3d normal = (corner[1] - corner[0]).cross(corner[2] - corner[0]);
+      if (normal.dot(corner[0] + corner[1] + corner[2]) <= 0.0) ++inward;
+    }
+  }
+  return inward;
+}
+
+}  // namespace
+
+TEST_CASE("collapse passes reach every level without flipping a face in any frame") {
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(200, 340, 2);  // 135,320 faces
+  REQUIRE(edge_count(mesh) > 100000);  // passes run
+  AqemOptions options;
+  options.target_ratios = {0.5, 0.2, 0.05};
+  const AqemResult result = run(mesh, options);
+  REQUIRE(result.levels.size() == 3);
+  double previous_error = 0.0;
+  for (const AqemLevel& level : result.levels) {
+    CHECK(level.reached);
+    CHECK(level.faces.size() / 3 <= level.target_face_count);
+    CHECK(level.faces.size() / 3 + 2 > level.target_face_count);  // a collapse removes at most two
+    CHECK(directed_edges_unique(level));
+    CHECK(inward_faces(level, mesh.frame_count) == 0);
+    CHECK(level.error >= previous_error);
+    previous_error = level.error;
+  }
+  // The record replays the levels: level i is its first collapse_count collapses.
+  CHECK(result.collapses.removed.size() == result.levels.back().collapse_count);
+}
+
+TEST_CASE("collapse passes are deterministic") {
+  const OwnedAnimatedMesh mesh = animlod::testing::jittering_sphere(200, 340, 2, 0.02f);
+  REQUIRE(edge_count(mesh) > 100000);
+  AqemOptions options;
+  options.target_ratios = {0.1};
+  const AqemResult first = run(mesh, options), second = run(mesh, options);
+  CHECK(first.levels[0].faces == second.levels[0].faces);
+  CHECK(first.levels[0].positions == second.levels[0].positions);
+  CHECK(first.collapses.cost == second.collapses.cost);
+}
+
+TEST_CASE("collapse passes keep guarded vertices while other collapses remain, then free them") {
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(200, 340, 1);
+  REQUIRE(edge_count(mesh) > 100000);
+  std::vector<uint8_t> guarded(mesh.vertex_count, 0);
+  for (size_t v = 0; v < mesh.vertex_count; v += 5) guarded[v] = 1;
+  const size_t guarded_count = static_cast<size_t>(std::count(guarded.begin(), guarded.end(), 1));
+  auto guarded_kept = [&](const AqemLevel& level) {
+    size_t kept = 0;
+    for (size_t v = 0; v < mesh.vertex_count; ++v) {
+      if (!guarded[v]) continue;
+      const int32_t out = level.vertex_map[v];
+      bool same = level.kept_vertices[out] == static_cast<int32_t>(v);
+      for (int axis = 0; axis < 3; ++axis) same &= level.positions[3 * out + axis] == mesh.frames[3 * v + axis];
+      kept += same;
+    }
+    return kept;
+  };
+  AqemOptions options;
+  options.target_face_counts = {mesh.faces.size() / 3 / 2, 16};
+  AqemVertexData data;
+  data.guarded = guarded.data();
+  const AqemResult result = run(mesh, options, data);
+  CHECK(guarded_kept(result.levels[0]) == guarded_count);
+  CHECK(result.levels[1].reached);
+  CHECK(guarded_kept(result.levels[1]) < guarded_count);
+}
+
+TEST_CASE("collapse passes stop at max_error like the greedy order") {
+  const OwnedAnimatedMesh mesh = animlod::testing::jittering_sphere(200, 340, 1, 0.02f);
+  AqemOptions options;
+  options.target_ratios = {0.8, 0.05};
+  const AqemResult unbounded = run(mesh, options);
+  const double bound = unbounded.levels[0].error;
+  REQUIRE(bound < unbounded.levels[1].error);
+  options.max_error = bound;
+  const AqemResult result = run(mesh, options);
+  CHECK(result.levels[0].reached);
+  CHECK_FALSE(result.levels[1].reached);
+  CHECK(result.levels[1].error <= bound);
+  for (double error : result.collapses.error) CHECK(error <= bound);
+}
+
+TEST_CASE("the quadric's minimiser solves A v = b and refuses a singular A") {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    animlod::detail::Quadric quadric;
+    for (int plane = 0; plane < 4; ++plane) {  // four random planes: A is (almost surely) regular
+      const Eigen::Vector3d normal = Eigen::Vector3d(uniform(random), uniform(random), uniform(random)).normalized();
+      quadric += animlod::detail::Quadric::plane(normal, Eigen::Vector3d(uniform(random), uniform(random), 0.0), 1.0);
+    }
+    Eigen::Matrix3d a;
+    a << quadric.a00, quadric.a01, quadric.a02, quadric.a01, quadric.a11, quadric.a12, quadric.a02, quadric.a12,
+        quadric.a22;
+    const Eigen::Vector3d b(quadric.b0, quadric.b1, quadric.b2);
+    Eigen::Vector3d v;
+    if (std::abs(a.determinant()) <= 1e-6) continue;
+    REQUIRE(quadric.minimizer(v));
+    CHECK((a * v - b).norm() <= 1e-9 * (1.0 + b.norm()) * a.norm() / std::abs(a.determinant()));
+    CHECK((v - a.lu().solve(b)).norm() <= 1e-8 * (1.0 + v.norm()));
+  }
+  // Two planes meet in a line: every point of it is a minimiser, so there is no unique one.
+  animlod::detail::Quadric ridge = animlod::detail::Quadric::plane(Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(), 1.0);
+  ridge += animlod::detail::Quadric::plane(Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero(), 1.0);
+  Eigen::Vector3d v;
+  CHECK_FALSE(ridge.minimizer(v));
+  CHECK_FALSE(animlod::detail::Quadric{}.minimizer(v));
+}

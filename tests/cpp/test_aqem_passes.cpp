@@ -15,6 +15,7 @@
 
 #include "animlod/aqem.hpp"
 #include "quadric.hpp"
+#include "aqem_level_checks.hpp"
 #include "test_aqem_meshes.hpp"
 
 using animlod::AqemLevel;
@@ -22,15 +23,11 @@ using animlod::AqemOptions;
 using animlod::AqemResult;
 using animlod::AqemVertexData;
 using animlod::testing::OwnedAnimatedMesh;
+using animlod::testing::inward_faces;
+using animlod::testing::is_manifold;
+using animlod::testing::simplify;
 
 namespace {
-
-AqemResult run(const OwnedAnimatedMesh& mesh, const AqemOptions& options, const AqemVertexData& data = {}) {
-  AqemResult result;
-  const animlod::Status status = animlod::simplify_animated(mesh.view(), data, options, result);
-  REQUIRE_MESSAGE(status.ok, status.message);
-  return result;
-}
 
 size_t edge_count(const OwnedAnimatedMesh& mesh) {
   std::set<std::pair<int32_t, int32_t>> edges;
@@ -42,30 +39,6 @@ size_t edge_count(const OwnedAnimatedMesh& mesh) {
   return edges.size();
 }
 
-bool directed_edges_unique(const AqemLevel& level) {
-  std::set<std::pair<int32_t, int32_t>> directed;
-  for (size_t f = 0; f < level.faces.size(); f += 3)
-    for (int k = 0; k < 3; ++k)
-      if (!directed.insert({level.faces[f + k], level.faces[f + (k + 1) % 3]}).second) return false;
-  return true;
-}
-
-// Faces whose normal points towards the origin in some frame (the sphere is convex and centred).
-size_t inward_faces(const AqemLevel& level, size_t frame_count) {
-  const size_t kept = level.kept_vertices.size();
-  size_t inward = 0;
-  for (size_t f = 0; f < frame_count; ++f) {
-    const float* p = &level.positions[f * kept * 3];
-    for (size_t t = 0; t < level.faces.size(); t += 3) {
-      Eigen::Vector3d corner[3];
-      for (int k = 0; k < 3; ++k) corner[k] = Eigen::Vector3f(p + 3 * level.faces[t + k]).cast<double>();
-      const Eigen::Vector3d normal = (corner[1] - corner[0]).cross(corner[2] - corner[0]);
-      if (normal.dot(corner[0] + corner[1] + corner[2]) <= 0.0) ++inward;
-    }
-  }
-  return inward;
-}
-
 }  // namespace
 
 TEST_CASE("collapse passes reach every level without flipping a face in any frame") {
@@ -73,14 +46,14 @@ TEST_CASE("collapse passes reach every level without flipping a face in any fram
   REQUIRE(edge_count(mesh) > 100000);  // passes run
   AqemOptions options;
   options.target_ratios = {0.5, 0.2, 0.05};
-  const AqemResult result = run(mesh, options);
+  const AqemResult result = simplify(mesh, options);
   REQUIRE(result.levels.size() == 3);
   double previous_error = 0.0;
   for (const AqemLevel& level : result.levels) {
     CHECK(level.reached);
     CHECK(level.faces.size() / 3 <= level.target_face_count);
     CHECK(level.faces.size() / 3 + 2 > level.target_face_count);  // a collapse removes at most two
-    CHECK(directed_edges_unique(level));
+    CHECK(is_manifold(level));
     CHECK(inward_faces(level, mesh.frame_count) == 0);
     CHECK(level.error >= previous_error);
     previous_error = level.error;
@@ -94,7 +67,7 @@ TEST_CASE("collapse passes are deterministic") {
   REQUIRE(edge_count(mesh) > 100000);
   AqemOptions options;
   options.target_ratios = {0.1};
-  const AqemResult first = run(mesh, options), second = run(mesh, options);
+  const AqemResult first = simplify(mesh, options), second = simplify(mesh, options);
   CHECK(first.levels[0].faces == second.levels[0].faces);
   CHECK(first.levels[0].positions == second.levels[0].positions);
   CHECK(first.collapses.cost == second.collapses.cost);
@@ -121,7 +94,7 @@ TEST_CASE("collapse passes keep guarded vertices while other collapses remain, t
   options.target_face_counts = {mesh.faces.size() / 3 / 2, 16};
   AqemVertexData data;
   data.guarded = guarded.data();
-  const AqemResult result = run(mesh, options, data);
+  const AqemResult result = simplify(mesh, options, data);
   CHECK(guarded_kept(result.levels[0]) == guarded_count);
   CHECK(result.levels[1].reached);
   CHECK(guarded_kept(result.levels[1]) < guarded_count);
@@ -131,11 +104,11 @@ TEST_CASE("collapse passes stop at max_error like the greedy order") {
   const OwnedAnimatedMesh mesh = animlod::testing::jittering_sphere(200, 340, 1, 0.02f);
   AqemOptions options;
   options.target_ratios = {0.8, 0.05};
-  const AqemResult unbounded = run(mesh, options);
+  const AqemResult unbounded = simplify(mesh, options);
   const double bound = unbounded.levels[0].error;
   REQUIRE(bound < unbounded.levels[1].error);
   options.max_error = bound;
-  const AqemResult result = run(mesh, options);
+  const AqemResult result = simplify(mesh, options);
   CHECK(result.levels[0].reached);
   CHECK_FALSE(result.levels[1].reached);
   CHECK(result.levels[1].error <= bound);

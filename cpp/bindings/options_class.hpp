@@ -46,12 +46,6 @@ struct OptionsLayout {
   std::vector<std::pair<std::string, std::string>> fields;  // name, what it holds
   std::vector<std::string> nested;                          // fields that are options themselves
 
-  bool has(const std::string& name) const {
-    for (const auto& field : fields)
-      if (field.first == name) return true;
-    return false;
-  }
-
   // Sets the field `name` of `self` or of one of its nested options.
   void set(py::object self, const std::string& name, const py::handle& value) const {
     for (const auto& [field, kind] : fields) {
@@ -67,7 +61,7 @@ struct OptionsLayout {
     }
     for (const std::string& field : nested) {
       py::object inner = self.attr(field.c_str());
-      if (py::hasattr(inner, name.c_str()) && inner.attr("fields").contains(name)) {
+      if (inner.attr("fields").contains(name)) {
         py::dict keyword;
         keyword[name.c_str()] = value;
         inner.attr("update")(**keyword);
@@ -78,6 +72,11 @@ struct OptionsLayout {
     for (const auto& field : fields) known += (known.empty() ? "" : ", ") + field.first;
     for (const std::string& field : nested) known += ", the fields of " + field;
     throw py::value_error(class_name + ": unknown option '" + name + "' (options: " + known + ")");
+  }
+
+  // Sets every (name, value) of `values`, as `set` does.
+  void update(const py::object& self, const py::dict& values) const {
+    for (const auto& [name, value] : values) set(self, text(name), value);
   }
 
   py::dict state(const py::object& self) const {
@@ -153,18 +152,19 @@ class OptionsClass {
     py::tuple names(layout->fields.size());
     for (size_t i = 0; i < layout->fields.size(); ++i) names[i] = py::str(layout->fields[i].first);
     cls_.attr("fields") = names;
-    cls_.def(py::init([layout](const py::kwargs& values) {
-               py::object made = py::cast(Options{});
-               for (const auto& [name, value] : values) layout->set(made, detail::text(name), value);
-               return made.cast<Options>();
-             }),
+    // The struct's defaults changed by `values`, set through the Python fields so that they
+    // are checked and named like any other assignment.
+    const auto made_from = [layout](const py::dict& values) {
+      py::object made = py::cast(Options{});
+      layout->update(made, values);
+      return made.cast<Options>();
+    };
+    cls_.def(py::init([made_from](const py::kwargs& values) { return made_from(values); }),
              "Options with the defaults of the C++ struct, changed by keyword (a field of this class or of its "
              "nested options).")
         .def(
             "update",
-            [layout](const py::object& self, const py::kwargs& values) {
-              for (const auto& [name, value] : values) layout->set(self, detail::text(name), value);
-            },
+            [layout](const py::object& self, const py::kwargs& values) { layout->update(self, values); },
             "Set fields by keyword (a field of this class or of its nested options); ValueError naming an unknown "
             "option or a value of the wrong kind.")
         .def("__eq__",
@@ -181,12 +181,7 @@ class OptionsClass {
              })
         .def("__copy__", [](const Options& self) { return Options(self); })
         .def("__deepcopy__", [](const Options& self, const py::dict&) { return Options(self); }, py::arg("memo"))
-        .def(py::pickle([layout](const py::object& self) { return layout->state(self); },
-                        [layout](const py::dict& state) {
-                          py::object made = py::cast(Options{});
-                          for (const auto& [name, value] : state) layout->set(made, detail::text(name), value);
-                          return made.cast<Options>();
-                        }));
+        .def(py::pickle([layout](const py::object& self) { return layout->state(self); }, made_from));
     return cls_;
   }
 

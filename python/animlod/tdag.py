@@ -328,14 +328,12 @@ class TemporalDag:
         ValueError naming the element: non-finite position, index out of range, every face
         degenerate, bad option.
         """
-        if isinstance(governing, bool) or not isinstance(governing, (str, int, np.integer)):
-            raise ValueError(f"governing: expected one of {GOVERNING_CHOICES} or a frame number, got {governing!r}")
-        if isinstance(governing, str):
-            if governing not in GOVERNING_CHOICES:
-                raise ValueError(f"governing: expected one of {GOVERNING_CHOICES} or a frame number, got {governing!r}")
+        if isinstance(governing, str) and governing in GOVERNING_CHOICES:
             option_fields["governing"] = governing
-        else:
+        elif isinstance(governing, (int, np.integer)) and not isinstance(governing, bool):
             option_fields.update(governing="frame", governing_frame=int(governing))
+        else:
+            raise ValueError(f"governing: expected one of {GOVERNING_CHOICES} or a frame number, got {governing!r}")
         options = resolve_options(TdagOptions, options, option_fields)
         core, raw = _core.build_temporal_dag(mesh.frames, mesh.faces, options, progress)
         return cls(core, TdagBuildReport(**raw))

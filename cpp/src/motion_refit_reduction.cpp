@@ -1,30 +1,43 @@
 // Points of a re-fit frame solved in closed form or by substitution (see the header). Motion LoD
 // re-fit (seeds/000, Eqs. 5-7): a leaf's Ed + Es terms alpha |x_e - x^o_e|^2 + beta (|x_e - x_p|
 // - b)^2 (over L^2) are minimal on the ray from x_p to x^o_e; a coincident pair held as an
-// equality puts both points at one place.
+// equality puts both points at one place; free points follow the others through their own
+// minimisation (motion_refit_free_points.hpp).
 #include "motion_refit_reduction.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include "union_find.hpp"
+
 namespace animlod::detail {
 
 namespace {
 
-int32_t find(std::vector<int32_t>& parent, int32_t k) {
-  while (parent[k] != k) {
-    parent[k] = parent[parent[k]];
-    k = parent[k];
-  }
-  return k;
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+constexpr double kIdentity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+// (P,) 1 for the points no held length, coincident pair or handed group touches (not the root).
+std::vector<uint8_t> free_points(const MotionRefitProblem& problem, bool eliminate) {
+  std::vector<uint8_t> free(problem.point_count, eliminate ? 1 : 0);
+  auto hold = [&](const int32_t* rows, size_t n, size_t width) {
+    for (size_t i = 0; i < n * width; ++i) free[rows[i]] = 0;
+  };
+  hold(problem.length_pairs, problem.length_pair_count, 2);
+  hold(problem.coincident_pairs, problem.coincident_pair_count, 2);
+  hold(problem.handed_quads, problem.handed_quad_count, 4);
+  free[0] = 0;
+  return free;
 }
 
 }  // namespace
 
-PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate_leaves,
-                               bool substitute_coincident)
-    : problem_(problem), hard_(hard_constraints) {
+PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate)
+    : problem_(problem), hard_(hard_constraints), free_points_(problem, free_points(problem, eliminate)) {
   const size_t p = problem.point_count;
   index_.assign(p, -1);
   substitute_.resize(p);
@@ -36,18 +49,17 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
   kept_equalities_.assign(motion_refit_equality_count(problem), 1);
 
   // Coincident pairs held exactly: every point of a tied set sits at its lowest index.
-  if (substitute_coincident && hard_constraints) {
+  if (eliminate && hard_constraints) {
+    UnionFind tied(p);  // a set's root is its lowest index
     for (size_t k = 0; k < problem.coincident_pair_count; ++k) {
-      const int32_t a = find(substitute_, problem.coincident_pairs[2 * k]);
-      const int32_t b = find(substitute_, problem.coincident_pairs[2 * k + 1]);
-      substitute_[std::max(a, b)] = std::min(a, b);
+      tied.unite(problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1]);
       std::fill_n(kept_equalities_.begin() + static_cast<long>(pairs + 3 * k), 3, uint8_t{0});
     }
-    for (size_t k = 0; k < p; ++k) substitute_[k] = find(substitute_, static_cast<int32_t>(k));
+    for (size_t k = 0; k < p; ++k) substitute_[k] = tied.find(static_cast<int32_t>(k));
   }
 
   // Leaves: in one term of E, a held length.
-  if (eliminate_leaves) {
+  if (eliminate) {
     std::vector<int> terms(p, 0);
     auto count = [&](const int32_t* rows, size_t n, size_t width) {
       for (size_t i = 0; i < n * width; ++i) ++terms[rows[i]];
@@ -68,9 +80,13 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
       }
     }
   }
-  for (size_t k = 1; k < p; ++k)
-    if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0)
+  const std::vector<uint8_t> free = free_points(problem, eliminate);
+  free_index_.assign(p, -1);
+  for (size_t k = 1; k < p; ++k) {
+    if (free[k]) free_index_[k] = static_cast<int32_t>(free_count_++);
+    else if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0)
       index_[k] = static_cast<int32_t>(reduced_points_++);
+  }
   kept_equality_count_ = static_cast<size_t>(std::count(kept_equalities_.begin(), kept_equalities_.end(), 1));
 }
 
@@ -122,6 +138,7 @@ void PointReduction::fill(const double* y, const double* original, double* x) {
       }
     }
   }
+  free_points_.minimise(x, original);
 }
 
 void PointReduction::gather(const double* x, double* y) const {
@@ -136,7 +153,6 @@ int32_t PointReduction::target(size_t k) const {
 }
 
 const double* PointReduction::derivative(size_t k) const {
-  static constexpr double kIdentity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   return leaf_anchor_[k] >= 0 ? jacobians_[k].data() : kIdentity;
 }
 
@@ -158,16 +174,22 @@ void PointReduction::reduce_rows(const double* rows, size_t count, double* out) 
 void PointReduction::reduce_matrix(const double* full, double* out) const {
   const size_t p = problem_.point_count;
   const size_t n = 3 * (p - 1);
-  const size_t nr = 3 * reduced_points_;
-  std::fill(out, out + nr * nr, 0.0);
+  const auto nr = static_cast<Eigen::Index>(3 * reduced_points_);
+  const auto nf = static_cast<Eigen::Index>(3 * free_count_);
+  Eigen::Map<RowMatrix> reduced(out, nr, nr);
+  RowMatrix coupling = RowMatrix::Zero(nr, nf);  // T^T M over the free points' columns
+  RowMatrix free = RowMatrix::Zero(nf, nf);
+  reduced.setZero();
   for (size_t a = 1; a < p; ++a) {
     const int32_t ta = target(a);
-    if (ta < 0) continue;
+    const int32_t fa = free_index_[a];
+    if (ta < 0 && fa < 0) continue;
     const double* ja = derivative(a);
     for (size_t b = 1; b < p; ++b) {
       const int32_t tb = target(b);
-      if (tb < 0) continue;
-      const double* jb = derivative(b);
+      const int32_t fb = free_index_[b];
+      if (tb < 0 && fb < 0) continue;
+      const double* jb = fb >= 0 ? kIdentity : derivative(b);
       double block[9];  // M_ab Jb
       for (int i = 0; i < 3; ++i)
         for (int c = 0; c < 3; ++c) {
@@ -175,14 +197,25 @@ void PointReduction::reduce_matrix(const double* full, double* out) const {
           for (int k = 0; k < 3; ++k) sum += full[(3 * (a - 1) + i) * n + 3 * (b - 1) + k] * jb[3 * k + c];
           block[3 * i + c] = sum;
         }
+      if (fa >= 0) {  // a free row: only the free-free block is needed (M is symmetric)
+        if (fb >= 0) free.block<3, 3>(3 * fa, 3 * fb) = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(block);
+        continue;
+      }
+      double* target_row = fb >= 0 ? &coupling(3 * ta, 3 * fb) : &reduced(3 * ta, 3 * tb);
+      const Eigen::Index stride = fb >= 0 ? nf : nr;
       for (int r = 0; r < 3; ++r)  // Ja^T (M_ab Jb)
         for (int c = 0; c < 3; ++c) {
           double sum = 0.0;
           for (int i = 0; i < 3; ++i) sum += ja[3 * i + r] * block[3 * i + c];
-          out[(3 * ta + r) * nr + 3 * tb + c] += sum;
+          target_row[r * stride + c] += sum;
         }
     }
   }
+  if (nf == 0) return;
+  // The free points follow the others (x_f = argmin E): E's Hessian over the reduced points is
+  // the Schur complement A - B C^-1 B^T.
+  const Eigen::LLT<Eigen::MatrixXd> llt(free);
+  if (llt.info() == Eigen::Success) reduced -= coupling * llt.solve(Eigen::MatrixXd(coupling.transpose()));
 }
 
 }  // namespace animlod::detail

@@ -7,9 +7,13 @@
 // - a leaf (a point in exactly one term of E, a held length to another point p) lies on the ray
 //   from x_p to its original position, at the held length b with hard constraints, or at
 //   r = (alpha d + beta b) / (alpha + beta) without (d = |x^o - x_p|): its Ed and Es terms are
-//   then minimal given x_p, in closed form.
+//   then minimal given x_p, in closed form;
+// - a free point (in no held length, coincident pair or handed group: a frozen joint or an end
+//   site below one at a coarse level) is at the minimum of its Ed and angle terms given the
+//   others, found by Newton's method (motion_refit_free_points.hpp).
 // The reduced problem has the same minima as the full one; the map from reduced to full
-// positions is differentiated exactly (chain rule), so gradients and Jacobians stay analytic.
+// positions is differentiated exactly (chain rule; a free point adds nothing, as E's derivative
+// with respect to it is zero at its minimum), so gradients and Jacobians stay analytic.
 #pragma once
 
 #include <array>
@@ -18,23 +22,26 @@
 #include <vector>
 
 #include "animlod/motion_refit.hpp"
+#include "motion_refit_free_points.hpp"
 
 namespace animlod::detail {
 
 class PointReduction {
  public:
-  // eliminate_leaves / substitute_coincident switch the two reductions (both off: identity,
-  // every non-root point a variable, in order). substitute_coincident needs hard constraints.
-  PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate_leaves,
-                 bool substitute_coincident);
+  // eliminate switches the reductions (off: identity, every non-root point a variable, in
+  // order); coincident points are substituted only under hard constraints.
+  PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate);
 
   size_t reduced_points() const { return reduced_points_; }  // P_r: points that stay variables
   // (m,) 1 for the equality rows (motion_refit_equalities) the reduced problem keeps.
   const std::vector<uint8_t>& kept_equalities() const { return kept_equalities_; }
   size_t kept_equality_count() const { return kept_equality_count_; }
 
-  // Full positions x (P, 3) from the reduced ones y (P_r, 3); the root is original's.
-  // Remembers the leaves' Jacobians for the reduce_* calls that follow.
+  // Where the free points start their minimisation in every fill until the next call (see
+  // FreePointClusters::set_start): the free points of x (P, 3).
+  void set_free_start(const double* x, const double* original) { free_points_.set_start(x, original); }
+  // Full positions x (P, 3) from the reduced ones y (P_r, 3); the root is original's. Remembers
+  // the leaves' Jacobians for the reduce_* calls that follow.
   void fill(const double* y, const double* original, double* x);
   // The reduced positions (P_r, 3) of full positions x (P, 3).
   void gather(const double* x, double* y) const;
@@ -42,7 +49,9 @@ class PointReduction {
   // at the last fill.
   void reduce_rows(const double* rows, size_t count, double* out) const;
   // A matrix over the non-root coordinates (3 (P - 1))^2 to T^T M T over the reduced ones
-  // (3 P_r)^2 (both row-major), T the derivative of fill at the last fill.
+  // (3 P_r)^2 (both row-major), T the derivative of fill at the last fill; the free points
+  // enter through their own derivative, -M_ff^-1 M_f. (the implicit function theorem at their
+  // minimum), which makes it the Schur complement of M's free block.
   void reduce_matrix(const double* full, double* out) const;
 
  private:
@@ -54,10 +63,13 @@ class PointReduction {
 
   const MotionRefitProblem& problem_;
   bool hard_ = false;
+  FreePointClusters free_points_;
   size_t reduced_points_ = 0;
   std::vector<int32_t> index_;        // (P,) reduced index of a variable point, -1 otherwise
   std::vector<int32_t> substitute_;   // (P,) the point a substituted point sits at, else itself
   std::vector<int32_t> leaf_anchor_;  // (P,) p of a leaf, -1 otherwise
+  std::vector<int32_t> free_index_;   // (P,) index among the free points, -1 otherwise
+  size_t free_count_ = 0;
   std::vector<double> leaf_length_;   // (P,) b of a leaf
   std::vector<uint8_t> kept_equalities_;
   size_t kept_equality_count_ = 0;

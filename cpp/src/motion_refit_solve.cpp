@@ -52,12 +52,18 @@ struct FrameContext {
   std::vector<double> jacobian;      // (rows, P, 3)
   std::vector<double> values;        // (rows,) every equality before the kept ones are picked
   std::vector<double> rows;          // (rows, P_r, 3)
+  std::vector<double> placed_at;     // (n,) the variables x was last filled for, when placed
+  bool placed = false;
 };
 
 // Positions from variables: reduced positions y = y^o + L z (plain), or y = y_start + L^-T v
 // (preconditioned), then the full positions (the root is always the original root).
 void to_positions(FrameContext& c, const double* v) {
   const size_t n = c.variable_count;
+  // nlopt asks for E and the constraints at the same point one after the other.
+  if (c.placed && std::equal(v, v + n, c.placed_at.begin())) return;
+  c.placed = true;
+  std::copy(v, v + n, c.placed_at.begin());
   if (!c.precondition) {
     c.reduction->gather(c.original, c.reduced.data());
     const double scale = c.problem->length_scale;
@@ -138,7 +144,7 @@ class FrameSolver {
       : problem_(problem),
         options_(options),
         hard_(options.hard_constraints && motion_refit_equality_count(problem) > 0),
-        reduction_(problem, hard_, options.eliminate_points, options.eliminate_points) {
+        reduction_(problem, hard_, options.eliminate_points) {
     const size_t p = problem.point_count;
     const size_t m = motion_refit_equality_count(problem);
     c_.problem = &problem_;
@@ -148,6 +154,7 @@ class FrameSolver {
     c_.precondition = options.precondition;
     c_.start.assign(c_.variable_count, 0.0);
     c_.reduced.assign(c_.variable_count, 0.0);
+    c_.placed_at.assign(c_.variable_count, 0.0);
     c_.x.assign(3 * p, 0.0);
     c_.gradient.assign(3 * p, 0.0);
     c_.values.assign(m, 0.0);
@@ -160,6 +167,7 @@ class FrameSolver {
     equality_values_.assign(m, 0.0);
     handed_values_.assign(problem.handed_quad_count, 0.0);
 
+    if (c_.variable_count == 0) return;  // every point free or placed: nothing for SLSQP
     opt_.reset(nlopt_create(NLOPT_LD_SLSQP, static_cast<unsigned>(c_.variable_count)));
     if (!opt_) return;
     nlopt_set_min_objective(opt_.get(), objective_callback, &c_);
@@ -178,7 +186,7 @@ class FrameSolver {
     nlopt_set_maxeval(opt_.get(), options.max_evaluations);
   }
 
-  bool ok() const { return opt_ != nullptr; }
+  bool ok() const { return opt_ != nullptr || c_.variable_count == 0; }
 
   double energy(const double* x, const double* original) const {
     return detail::refit_objective_frame(problem_, x, original, nullptr);
@@ -187,6 +195,8 @@ class FrameSolver {
   Outcome solve(const double* original, const double* start, double* result) {
     const size_t n = c_.variable_count;
     c_.original = original;
+    c_.placed = false;
+    reduction_.set_free_start(start, original);
     reduction_.gather(start, c_.start.data());
     if (c_.precondition) {
       std::fill(variables_.begin(), variables_.end(), 0.0);
@@ -204,8 +214,12 @@ class FrameSolver {
     Outcome outcome;
     const double start_value = energy(c_.x.data(), original);
     double minimum = 0.0;
-    const nlopt_result code = nlopt_optimize(opt_.get(), variables_.data(), &minimum);
-    outcome.evaluations = nlopt_get_numevals(opt_.get());
+    nlopt_result code = NLOPT_SUCCESS;
+    outcome.evaluations = 1;
+    if (opt_) {
+      code = nlopt_optimize(opt_.get(), variables_.data(), &minimum);
+      outcome.evaluations = nlopt_get_numevals(opt_.get());
+    }
     to_positions(c_, variables_.data());
     std::copy(c_.x.begin(), c_.x.end(), result);
     const bool finite = std::all_of(c_.x.begin(), c_.x.end(), [](double v) { return std::isfinite(v); });

@@ -317,25 +317,35 @@ void refit_hessian_frame(const MotionRefitProblem& problem, const double* x, boo
   const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   for (size_t k = 0; k < problem.coincident_pair_count; ++k)
     add_pair(problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1], identity, ws);
-  const double wa = 2.0 * problem.angle_weight;
-  for (size_t k = 0; k < problem.angle_triple_count; ++k) {  // Ea: g g^T + (cos - cos0) Hess cos
+  for (size_t k = 0; k < problem.angle_triple_count; ++k) {  // Ea
     const int32_t* triple = problem.angle_triples + 3 * k;
-    double block[81];
-    const double residual = cosine_hessian(x, triple, block) - problem.key_cosines[k];
-    Vec3 dp, dj, dc;
-    cosine(x, triple, dp, dj, dc);
-    const double g[9] = {dp[0], dp[1], dp[2], dj[0], dj[1], dj[2], dc[0], dc[1], dc[2]};
-    for (int i = 0; i < 9; ++i)
-      for (int j = 0; j < 9; ++j) block[9 * i + j] = g[i] * g[j] + residual * block[9 * i + j];
-    if (positive_semidefinite) clip_to_positive_semidefinite(block);
+    double gradient[9], block[81];
+    angle_term(problem, x, k, positive_semidefinite, gradient, block);
     for (int pi = 0; pi < 3; ++pi)
       for (int pj = 0; pj < 3; ++pj) {
         double sub_block[9];
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j) sub_block[3 * i + j] = block[9 * (3 * pi + i) + 3 * pj + j];
-        add_block(triple[pi], triple[pj], sub_block, wa);
+        add_block(triple[pi], triple[pj], sub_block, 1.0);
       }
   }
+}
+
+double angle_term(const MotionRefitProblem& problem, const double* x, size_t k, bool positive_semidefinite,
+                  double* gradient, double* hessian) {
+  const int32_t* triple = problem.angle_triples + 3 * k;
+  const double w = problem.angle_weight;
+  Vec3 dp, dj, dc;
+  const double residual = cosine(x, triple, dp, dj, dc) - problem.key_cosines[k];
+  if (!gradient) return w * residual * residual;
+  cosine_hessian(x, triple, hessian);
+  const double g[9] = {dp[0], dp[1], dp[2], dj[0], dj[1], dj[2], dc[0], dc[1], dc[2]};
+  for (int i = 0; i < 9; ++i) {
+    gradient[i] = 2.0 * w * residual * g[i];
+    for (int j = 0; j < 9; ++j) hessian[9 * i + j] = 2.0 * w * (g[i] * g[j] + residual * hessian[9 * i + j]);
+  }
+  if (positive_semidefinite) clip_to_positive_semidefinite(hessian);
+  return w * residual * residual;
 }
 
 }  // namespace detail

@@ -7,7 +7,7 @@
 // the root stays at its original position. Python builds the problem (which lengths, angles and
 // handed groups a level holds: python/animlod/motion_lod/objective.py, build_problem) and the
 // core evaluates and solves it. Frames do not couple, so the solve runs chunks of consecutive
-// frames on several threads, warm-starting each frame from the previous one inside a chunk.
+// frames on several threads (optionally warm-starting each frame from the previous one).
 #pragma once
 
 #include <cstddef>
@@ -77,20 +77,26 @@ struct MotionRefitOptions {
   int max_evaluations = 400;    // per solve
   // Largest |b - b(0)| / L accepted with hard constraints; a solve ending further off is retried.
   double feasibility_tolerance = 1e-6;
-  // Start each frame from the previous frame's result inside a chunk. With hard constraints the
-  // previous result moved by the root's displacement (feasible: lengths are translation
-  // invariant); without, the previous correction x* - x^o added to this frame's original.
-  bool warm_start = true;
+  // Start each frame from the previous frame's result inside a chunk (when its E is below the
+  // cold start's). With hard constraints the previous result moved by the root's displacement
+  // (feasible: lengths are translation invariant); without, the previous correction x* - x^o
+  // added to this frame's original. Off by default: a warm start carries the previous frame's
+  // minimum of the angle terms (one of several) into the next frame, and on the dev clips
+  // every frame from its cold start ends as low or lower (the Bandai run's two coarsest levels:
+  // E 3x lower) at about the same cost once free points are eliminated (bench/bench_motion.py).
+  bool warm_start = false;
   // Solve in variables where E's Hessian at the start, each term's part made positive
   // semidefinite, is the identity (y = R (x - x_start), R^T R = that matrix): SLSQP's first
   // quasi-Newton matrix is then close to the right one and it needs fewer iterations. Off: the
   // scaled displacements (x - x^o) / L, as the Python reference (motion_lod/refit.py) when
   // eliminate_points is off too.
   bool precondition = true;
-  // Leave out points whose optimum follows in closed form from another's (a
-  // leaf held by one length lies on the ray to its original position) or that hard constraints
-  // put onto another point (a zero-length pair); SLSQP's cost grows with the cube of the
-  // variable count. The minima are the same.
+  // Leave out points whose optimum follows in closed form from another's (a leaf held by one
+  // length lies on the ray to its original position), that hard constraints put onto another
+  // point (a zero-length pair), or that no constraint touches (frozen joints and the end sites
+  // below them: minimised by Newton's method for given positions of the others, so that SLSQP
+  // sees neither their variables nor the curved valleys of their angle terms). SLSQP's cost
+  // grows with the cube of the variable count. The minima are the same.
   bool eliminate_points = true;
   int chunk_frames = 64;        // consecutive frames per task (warm starts run inside a chunk)
   int threads = 0;              // worker threads; 0 uses every hardware thread
@@ -115,10 +121,10 @@ struct MotionRefitResult {
 // original: (T, P, 3) original positions x^o (Ed's targets, and the root's positions).
 // fallback: (T, P, 3) positions kept for a frame whose solves fail; with hard constraints they
 //   must satisfy the constraints (the frozen key motion does).
-// cold_starts: (T, P, 3) where a chunk's first frame starts (feasible with hard constraints), or
-//   nullptr: the original positions (the paper's start), or the fallback with hard constraints.
-// Each next frame of a chunk starts from the previous result (see warm_start), or from its cold
-// start when E is lower there. A frame whose original positions or cold start have E <= 1e-24
+// cold_starts: (T, P, 3) where each frame starts (feasible with hard constraints), or nullptr:
+//   the original positions (the paper's start), or the fallback with hard constraints.
+// With warm_start, each next frame of a chunk starts from the previous result instead when E is
+// lower there. A frame whose original positions or cold start have E <= 1e-24
 // keeps them (E >= alpha |x - x^o|^2 / L^2, so no point could move by more than ~1e-12 L). A solve is accepted when its
 // result is finite, nlopt did not fail (ROUNDOFF_LIMITED is accepted), E did not rise above its
 // start, and with hard constraints it is feasible within feasibility_tolerance and keeps every

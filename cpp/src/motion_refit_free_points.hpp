@@ -1,0 +1,62 @@
+// Points of a re-fit frame that SLSQP does not need to see (motion_refit_free_points.cpp).
+//
+// At coarse levels most points are frozen joints and the end sites below them: no held length,
+// coincident pair or handed group touches them, only Ed (Eq. 6) and the angles of Ea (Eq. 8). E
+// is smooth in them and has no constraint on them, so for given positions of the other points
+// their optimum is an unconstrained minimum, found here by Newton's method, cluster by cluster
+// (points linked by angle triples). SLSQP then works on the other points only, whose count sets
+// its cost (cubic), and no longer crawls along the curved valleys that the angle terms of short
+// frozen bones make. At the inner minimum dE/dx_free = 0, so E's gradient over the other points
+// is the same with or without the inner solve (the envelope theorem), and the minima of the
+// reduced problem are those of the full one.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "animlod/motion_refit.hpp"
+
+namespace animlod::detail {
+
+class FreePointClusters {
+ public:
+  // free: (P,) 1 for the points to minimise here (never the root, never a point of a length,
+  // coincident pair or handed group).
+  FreePointClusters(const MotionRefitProblem& problem, const std::vector<uint8_t>& free);
+
+  bool empty() const { return clusters_.empty(); }
+
+  // Where every minimisation starts until the next call: of the minima over the free points
+  // reached from x (P, 3) and from the original positions (Ed's minimum), with x's other points,
+  // the lower one. The angle terms have several minima; the lower one is what a solve over every
+  // point finds from either start. A fixed start per frame also makes the minimum a function of
+  // the other points alone: starting from the last minimum instead would let a far trial step of
+  // SLSQP carry the free points into another basin, and E would differ at the same variables.
+  void set_start(const double* x, const double* original);
+
+  // Moves the free points of x (P, 3) to the minimum of E over them with every other point
+  // held, reached from set_start's positions.
+  void minimise(double* x, const double* original);
+
+ private:
+  struct Cluster {
+    std::vector<int32_t> points;   // free points, in increasing order
+    std::vector<int32_t> triples;  // angle triples with at least one of them
+  };
+  // E's part that depends on the cluster's points at x, with its gradient (3 n) and Hessian
+  // (3 n x 3 n, row-major; exact, or positive semidefinite per term) when asked.
+  double cluster_energy(const Cluster& cluster, const double* x, const double* original, double* gradient,
+                        double* hessian, bool positive_semidefinite);
+
+  // Newton's method on one cluster from where x has its points; returns the cluster's E there.
+  double newton(const Cluster& cluster, double* x, const double* original);
+
+  const MotionRefitProblem& problem_;
+  std::vector<Cluster> clusters_;
+  std::vector<int32_t> local_;  // (P,) a free point's index in its cluster, -1 otherwise
+  std::vector<double> start_;   // (P, 3) set_start's positions (only free points are read)
+  std::vector<double> gradient_, hessian_, step_, trial_, best_;
+};
+
+}  // namespace animlod::detail

@@ -1,0 +1,67 @@
+// The small figure the motion re-fit tests solve (test_motion_refit.cpp,
+// test_motion_refit_free_points.cpp), and E at a point.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "../../cpp/src/motion_refit_detail.hpp"
+#include "animlod/motion_refit.hpp"
+
+// A small figure: root 0, a spine 1-2, a frozen joint 3 with child 4, a coincident point 5 on 1,
+// and three children 6, 7, 8 of 2 spanning a volume (a handed group).
+struct Figure {
+  std::vector<double> key = {0, 0, 0,  0, 1, 0,  0, 2, 0,  1, 2, 0,  2, 2.2, 0,  0, 1, 0,
+                             -0.5, 2.5, 0.2,  0.5, 2.5, 0.1,  0, 2.6, -0.6};
+  std::vector<int32_t> pairs = {1, 0, 2, 1, 6, 2, 7, 2, 8, 2, 7, 6, 8, 6, 8, 7};
+  std::vector<double> key_lengths;
+  std::vector<int32_t> coincident = {5, 1};
+  std::vector<int32_t> quads = {2, 6, 7, 8};
+  std::vector<double> key_volumes;
+  std::vector<int32_t> triples = {2, 3, 4};
+  std::vector<double> key_cosines = {-0.9};
+  animlod::MotionRefitProblem problem;
+
+  Figure() {
+    for (size_t k = 0; k < pairs.size() / 2; ++k) {
+      double sum = 0.0;
+      for (int a = 0; a < 3; ++a) {
+        const double d = key[3 * pairs[2 * k] + a] - key[3 * pairs[2 * k + 1] + a];
+        sum += d * d;
+      }
+      key_lengths.push_back(std::sqrt(sum));
+    }
+    problem.point_count = 9;
+    problem.length_pairs = pairs.data();
+    problem.key_lengths = key_lengths.data();
+    problem.length_pair_count = key_lengths.size();
+    problem.coincident_pairs = coincident.data();
+    problem.coincident_pair_count = 1;
+    problem.handed_quads = quads.data();
+    problem.handed_quad_count = 1;
+    problem.angle_triples = triples.data();
+    problem.key_cosines = key_cosines.data();
+    problem.angle_triple_count = 1;
+    problem.length_scale = 2.0;
+    std::vector<double> volume(1);
+    key_volumes = {1.0};  // placeholder with the right size, replaced below
+    problem.key_volumes = key_volumes.data();
+    // The key volume's sign: the handedness value is -sign(V0) V / L^3 <= 0 at the key.
+    animlod::detail::refit_handedness_frame(problem, key.data(), volume.data(), nullptr);
+    key_volumes[0] = volume[0] < 0.0 ? 1.0 : -1.0;
+  }
+
+  std::vector<double> perturbed(unsigned seed, double scale) const {
+    std::mt19937 random(seed);
+    std::normal_distribution<double> normal(0.0, scale);
+    std::vector<double> x = key;
+    for (size_t i = 3; i < x.size(); ++i) x[i] += normal(random);
+    return x;
+  }
+};
+
+inline double objective_at(const animlod::MotionRefitProblem& p, const std::vector<double>& x, const std::vector<double>& o) {
+  return animlod::detail::refit_objective_frame(p, x.data(), o.data(), nullptr);
+}

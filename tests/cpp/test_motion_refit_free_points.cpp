@@ -1,0 +1,120 @@
+// Free points of the motion re-fit (cpp/src/motion_refit_free_points.hpp): minimised for given
+// positions of the others, they leave E's gradient over the others unchanged (the envelope
+// theorem) and the reduced Hessian is the Schur complement; the solve without their variables
+// ends where the solve with them does, and a problem of free points only needs no SLSQP.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "../../cpp/src/motion_refit_detail.hpp"
+#include "../../cpp/src/motion_refit_reduction.hpp"
+#include "animlod/motion_refit.hpp"
+#include "motion_refit_figure.hpp"
+
+using animlod::MotionRefitOptions;
+using animlod::MotionRefitResult;
+using animlod::detail::PointReduction;
+
+namespace {
+
+// E at the full positions of the reduced variables y, and its gradient over y.
+double reduced_energy(PointReduction& reduction, const Figure& f, const std::vector<double>& y,
+                      const std::vector<double>& original, std::vector<double>& gradient) {
+  std::vector<double> x(original), full(original.size());
+  reduction.fill(y.data(), original.data(), x.data());
+  const double value = animlod::detail::refit_objective_frame(f.problem, x.data(), original.data(), full.data());
+  reduction.reduce_rows(full.data(), 1, gradient.data());
+  return value;
+}
+
+}  // namespace
+
+TEST_CASE("free points: the reduced gradient and Hessian are those of E minimised over them") {
+  const Figure f;  // points 3 and 4 (a frozen joint and its child) are in no length
+  const size_t p = f.problem.point_count;
+  const std::vector<double> original = f.perturbed(1, 0.05);
+  const std::vector<double> x = f.perturbed(2, 0.1);
+  // Without hard constraints nothing is substituted: points 1, 2, 5, 6, 7, 8 stay variables.
+  PointReduction reduction(f.problem, false, true);
+  REQUIRE(reduction.reduced_points() == 6);
+  reduction.set_free_start(x.data(), original.data());
+  std::vector<double> y(3 * reduction.reduced_points());
+  reduction.gather(x.data(), y.data());
+  const size_t n = y.size();
+
+  std::vector<double> gradient(n);
+  reduced_energy(reduction, f, y, original, gradient);
+  std::vector<double> placed(x), full(3 * p);  // the free points sit where their gradient vanishes
+  reduction.fill(y.data(), original.data(), placed.data());
+  animlod::detail::refit_objective_frame(f.problem, placed.data(), original.data(), full.data());
+  double scale = 0.0;
+  for (double g : full) scale = std::max(scale, std::abs(g));
+  for (size_t i = 9; i < 15; ++i) CHECK(std::abs(full[i]) < 1e-8 * scale);
+
+  const double h = 1e-6;
+  std::vector<double> g_plus(n), g_minus(n), numeric_hessian(n * n);
+  for (size_t i = 0; i < n; ++i) {
+    std::vector<double> plus = y, minus = y;
+    plus[i] += h;
+    minus[i] -= h;
+    const double numeric =
+        (reduced_energy(reduction, f, plus, original, g_plus) - reduced_energy(reduction, f, minus, original, g_minus)) /
+        (2 * h);
+    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-6).scale(1.0));
+    for (size_t j = 0; j < n; ++j) numeric_hessian[j * n + i] = (g_plus[j] - g_minus[j]) / (2 * h);
+  }
+  const size_t m = 3 * (p - 1);
+  std::vector<double> hessian(m * m), reduced(n * n);
+  animlod::detail::refit_hessian_frame(f.problem, placed.data(), false, hessian.data());
+  reduction.reduce_matrix(hessian.data(), reduced.data());
+  for (size_t k = 0; k < n * n; ++k) CHECK(reduced[k] == doctest::Approx(numeric_hessian[k]).epsilon(1e-5).scale(1.0));
+}
+
+TEST_CASE("free points: the solve without their variables ends where the solve with them does") {
+  const Figure f;
+  const size_t p = f.problem.point_count;
+  const size_t frames = 6;
+  std::vector<double> original, fallback;
+  for (size_t t = 0; t < frames; ++t) {
+    const std::vector<double> o = f.perturbed(10 + static_cast<unsigned>(t), 0.05);
+    original.insert(original.end(), o.begin(), o.end());
+    fallback.insert(fallback.end(), f.key.begin(), f.key.end());  // the key posture: feasible
+  }
+  MotionRefitOptions options;
+  options.ftol_rel = 1e-12;
+  options.threads = 1;
+  MotionRefitResult with, without;
+  options.eliminate_points = false;
+  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, with));
+  options.eliminate_points = true;
+  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, without));
+  CHECK(with.failures.empty());
+  CHECK(without.failures.empty());
+  for (size_t t = 0; t < frames; ++t) {
+    CHECK(without.values[t] == doctest::Approx(with.values[t]).epsilon(1e-6));
+    for (size_t i = 0; i < 3 * p; ++i)
+      CHECK(without.positions[t * 3 * p + i] == doctest::Approx(with.positions[t * 3 * p + i]).epsilon(1e-4).scale(1.0));
+  }
+}
+
+TEST_CASE("free points: a problem of free points only is solved without SLSQP") {
+  // Root 0, a frozen joint 1 and its child 2: no length, one angle.
+  const std::vector<int32_t> triple = {0, 1, 2};
+  const std::vector<double> key_cosine = {-0.5};
+  animlod::MotionRefitProblem problem;
+  problem.point_count = 3;
+  problem.angle_triples = triple.data();
+  problem.key_cosines = key_cosine.data();
+  problem.angle_triple_count = 1;
+  const std::vector<double> original = {0, 0, 0, 0, 1, 0, 0.1, 2, 0};  // nearly straight
+  MotionRefitResult out;
+  REQUIRE(animlod::motion_refit_solve(problem, original.data(), original.data(), nullptr, 1, MotionRefitOptions{}, out));
+  CHECK(out.failures.empty());
+  CHECK(out.evaluations[0] == 1);
+  CHECK(out.values[0] < animlod::detail::refit_objective_frame(problem, original.data(), original.data(), nullptr));
+  std::vector<double> gradient(9);
+  animlod::detail::refit_objective_frame(problem, out.positions.data(), original.data(), gradient.data());
+  for (double g : gradient) CHECK(std::abs(g) < 1e-10);
+}

@@ -58,7 +58,7 @@ def refit_core(
         hardware thread; the result does not depend on it) and ``chunk_frames`` (consecutive
         frames per task; warm starts run inside a chunk).
     progress : called with the (fractional) number of frames finished after each group.
-    cold_starts : (T, P, 3) where chunks start and failed frames restart (feasible with hard
+    cold_starts : (T, P, 3) where frames start and failed frames restart (feasible with hard
         constraints), or None: the original positions, or the fallback with hard constraints.
 
     Returns

@@ -124,7 +124,8 @@ def _solve_chunk(
     options: MotionRefitOptions,
     explicit_cold_starts: bool,
 ) -> RefitResult:
-    """Solve consecutive frames ``original (C, P, 3)``, warm-starting each from the previous."""
+    """Solve consecutive frames ``original (C, P, 3)``, each from its cold start or, with
+    ``options.warm_start``, from the previous result where E is lower there."""
     frames = original.shape[0]
     positions = np.empty_like(original)
     values = np.empty(frames)
@@ -187,10 +188,10 @@ def refit_slsqp(
     original : (T, P, 3) original positions x^o.
     fallback : (T, P, 3) positions kept for a frame whose solves fail (feasible by construction).
     options, **option_fields : a :class:`~animlod.options.MotionRefitOptions` and/or its fields
-        by name: stopping rules, hard constraints, checks, ``chunk_frames`` (frames per
-        warm-started chunk, and per task with ``workers > 1``). ``precondition``,
+        by name: stopping rules, hard constraints, checks, ``warm_start``, ``chunk_frames``
+        (frames per warm-started chunk, and per task with ``workers > 1``). ``precondition``,
         ``eliminate_points`` and ``threads`` belong to the core's solve and are ignored here.
-    cold_starts : (T, P, 3) where chunks start and failed frames restart (feasible with hard
+    cold_starts : (T, P, 3) where frames start and failed frames restart (feasible with hard
         constraints), or None: the original positions, or the fallback with hard constraints.
     workers : processes; 1 solves in this process.
     progress : called with the (fractional) number of frames finished after each chunk.

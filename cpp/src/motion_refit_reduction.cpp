@@ -211,7 +211,7 @@ void PointReduction::reduce_matrix(const double* full, double* out) const {
         }
     }
   }
-  if (nf == 0) return;
+  if (nf == 0 || nr == 0) return;
   // The free points follow the others (x_f = argmin E): E's Hessian over the reduced points is
   // the Schur complement A - B C^-1 B^T.
   const Eigen::LLT<Eigen::MatrixXd> llt(free);

@@ -71,7 +71,7 @@ void to_positions(FrameContext& c, const double* v) {
   } else {
     Eigen::Map<Eigen::VectorXd> d(c.reduced.data(), static_cast<Eigen::Index>(n));
     d = Eigen::Map<const Eigen::VectorXd>(v, static_cast<Eigen::Index>(n));
-    c.factor.triangularView<Eigen::Lower>().transpose().solveInPlace(d);
+    if (n > 0) c.factor.triangularView<Eigen::Lower>().transpose().solveInPlace(d);
     for (size_t i = 0; i < n; ++i) c.reduced[i] += c.start[i];
   }
   c.reduction->fill(c.reduced.data(), c.original, c.x.data());
@@ -251,6 +251,7 @@ class FrameSolver {
   // reduced coordinates (T^T H T), and its Cholesky factor.
   void prepare_preconditioner() {
     const auto n = static_cast<Eigen::Index>(c_.variable_count);
+    if (n == 0) return;  // every point free or placed: no variables to precondition
     detail::refit_hessian_frame(problem_, c_.x.data(), true, full_hessian_.data());
     reduction_.reduce_matrix(full_hessian_.data(), hessian_.data());
     Eigen::LLT<Eigen::MatrixXd> llt(hessian_);  // symmetric: row-major = column-major

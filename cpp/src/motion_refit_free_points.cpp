@@ -2,8 +2,8 @@
 // per cluster, alpha |x - x^o|^2 / L^2 over its points plus gamma (cos theta - cos theta_0)^2
 // over the angle triples that touch it, minimised by Newton's method with a backtracking line
 // search. The exact Hessian is used where it is positive definite (quadratic convergence at
-// the minimum); elsewhere (an angle term can be concave) each term's part made positive
-// semidefinite, which Ed's 2 alpha / L^2 I keeps positive definite, so every step descends.
+// the minimum); elsewhere (an angle term can be concave) it is shifted by a multiple of the
+// identity until it is, so every step descends.
 #include "motion_refit_free_points.hpp"
 
 #include <algorithm>
@@ -72,7 +72,7 @@ FreePointClusters::FreePointClusters(const MotionRefitProblem& problem, const st
 }
 
 double FreePointClusters::cluster_energy(const Cluster& cluster, const double* x, const double* original,
-                                         double* gradient, double* hessian, bool positive_semidefinite) {
+                                         double* gradient, double* hessian) {
   const size_t n = 3 * cluster.points.size();
   const double wd = problem_.distance_weight / (problem_.length_scale * problem_.length_scale);
   double value = 0.0;
@@ -87,8 +87,7 @@ double FreePointClusters::cluster_energy(const Cluster& cluster, const double* x
     }
   double term_gradient[9], term_hessian[81];
   for (int32_t k : cluster.triples) {  // Ea
-    value += angle_term(problem_, x, static_cast<size_t>(k), positive_semidefinite,
-                        gradient ? term_gradient : nullptr, term_hessian);
+    value += angle_term(problem_, x, static_cast<size_t>(k), false, gradient ? term_gradient : nullptr, term_hessian);
     if (!gradient) continue;
     const int32_t* triple = problem_.angle_triples + 3 * k;
     for (int pi = 0; pi < 3; ++pi) {
@@ -130,17 +129,19 @@ void FreePointClusters::minimise(double* x, const double* original) {
 
 double FreePointClusters::newton(const Cluster& cluster, double* x, const double* original) {
   const double tolerance = kStepTolerance * problem_.length_scale;
+  const double curvature = 2.0 * problem_.distance_weight / (problem_.length_scale * problem_.length_scale);
   const auto n = static_cast<Eigen::Index>(3 * cluster.points.size());
   Eigen::Map<Eigen::VectorXd> gradient(gradient_.data(), n), step(step_.data(), n), saved(trial_.data(), n);
   Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> hessian(hessian_.data(), n, n);
   double value = 0.0;
   for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
-    value = cluster_energy(cluster, x, original, gradient_.data(), hessian_.data(), false);
+    value = cluster_energy(cluster, x, original, gradient_.data(), hessian_.data());
+    // Where an angle term makes the Hessian indefinite, shift it towards Ed's curvature until
+    // it is positive definite (Levenberg): every step then descends.
     Eigen::LLT<Eigen::MatrixXd> llt(hessian);
-    if (llt.info() != Eigen::Success) {
-      cluster_energy(cluster, x, original, gradient_.data(), hessian_.data(), true);
-      llt.compute(hessian);
-    }
+    for (double shift = curvature; llt.info() != Eigen::Success && std::isfinite(shift); shift *= 4.0)
+      llt.compute(Eigen::MatrixXd(hessian) + shift * Eigen::MatrixXd::Identity(n, n));
+    if (llt.info() != Eigen::Success) break;  // not finite: nothing to step along
     step = -llt.solve(gradient);
     // -slope, the Newton decrement, is about twice the value left to gain: stop when that is
     // below what rounding resolves.
@@ -152,7 +153,7 @@ double FreePointClusters::newton(const Cluster& cluster, double* x, const double
     double trial = value;
     for (;;) {
       for (Eigen::Index i = 0; i < n; ++i) x[3 * cluster.points[i / 3] + i % 3] = saved[i] + t * step[i];
-      trial = cluster_energy(cluster, x, original, nullptr, nullptr, false);
+      trial = cluster_energy(cluster, x, original, nullptr, nullptr);
       if (trial <= value + 1e-4 * t * slope) break;
       if (++halvings == kMaxHalvings) break;
       t *= 0.5;

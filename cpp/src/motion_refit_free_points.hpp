@@ -44,10 +44,10 @@ class FreePointClusters {
     std::vector<int32_t> points;   // free points, in increasing order
     std::vector<int32_t> triples;  // angle triples with at least one of them
   };
-  // E's part that depends on the cluster's points at x, with its gradient (3 n) and Hessian
-  // (3 n x 3 n, row-major; exact, or positive semidefinite per term) when asked.
+  // E's part that depends on the cluster's points at x, with its gradient (3 n) and exact
+  // Hessian (3 n x 3 n, row-major) when asked.
   double cluster_energy(const Cluster& cluster, const double* x, const double* original, double* gradient,
-                        double* hessian, bool positive_semidefinite);
+                        double* hessian);
 
   // Newton's method on one cluster from where x has its points; returns the cluster's E there.
   double newton(const Cluster& cluster, double* x, const double* original);

@@ -19,7 +19,7 @@ namespace animlod::detail {
 
 namespace {
 
-// Newton iterations per cluster and frame evaluation; the warm start is usually a few steps away.
+// Newton iterations per cluster and evaluation; from set_start's minimum a few steps usually do.
 constexpr int kMaxIterations = 50;
 constexpr int kMaxHalvings = 40;
 // A step shorter than this fraction of L, or a Newton decrement below this fraction of the
@@ -111,7 +111,7 @@ void FreePointClusters::set_start(const double* x, const double* original) {
   start_.assign(x, x + 3 * problem_.point_count);
   for (const Cluster& cluster : clusters_) {
     // The minima reached from x and from the original positions (Ed's minimum), the lower one:
-    // the angle terms have several minima, and this keeps the one a solve over every point finds.
+    // the angle terms have several minima.
     const double from_start = newton(cluster, start_.data(), original);
     best_.assign(start_.begin(), start_.end());
     for (int32_t point : cluster.points) std::copy_n(original + 3 * point, 3, best_.begin() + 3 * point);

@@ -25,14 +25,12 @@ class FreePointClusters {
   // coincident pair or handed group).
   FreePointClusters(const MotionRefitProblem& problem, const std::vector<uint8_t>& free);
 
-  bool empty() const { return clusters_.empty(); }
-
   // Where every minimisation starts until the next call: of the minima over the free points
   // reached from x (P, 3) and from the original positions (Ed's minimum), with x's other points,
-  // the lower one. The angle terms have several minima; the lower one is what a solve over every
-  // point finds from either start. A fixed start per frame also makes the minimum a function of
-  // the other points alone: starting from the last minimum instead would let a far trial step of
-  // SLSQP carry the free points into another basin, and E would differ at the same variables.
+  // the lower one (the angle terms have several minima). A fixed start per frame makes the
+  // minimum a function of the other points alone: starting from the last minimum instead would
+  // let a far trial step of SLSQP carry the free points into another basin, and E would differ
+  // at the same variables.
   void set_start(const double* x, const double* original);
 
   // Moves the free points of x (P, 3) to the minimum of E over them with every other point

@@ -30,9 +30,9 @@ void refit_handedness_frame(const MotionRefitProblem& problem, const double* x, 
 void refit_hessian_frame(const MotionRefitProblem& problem, const double* x, bool positive_semidefinite,
                          double* matrix);
 
-// Ea's term of angle triple k at x: gamma (cos - cos0)^2, its gradient (9,) over the triple's
-// (parent, joint, child) coordinates and its Hessian (9 x 9 row-major), made positive
-// semidefinite as in refit_hessian_frame when asked; the value only when gradient is nullptr.
+// Ea's term of angle triple k at x: gamma (cos - cos0)^2, and where not nullptr its gradient
+// (9,) over the triple's (parent, joint, child) coordinates and its Hessian (9 x 9 row-major),
+// made positive semidefinite as in refit_hessian_frame when asked.
 double angle_term(const MotionRefitProblem& problem, const double* x, size_t k, bool positive_semidefinite,
                   double* gradient, double* hessian);
 

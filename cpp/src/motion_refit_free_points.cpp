@@ -87,7 +87,8 @@ double FreePointClusters::cluster_energy(const Cluster& cluster, const double* x
     }
   double term_gradient[9], term_hessian[81];
   for (int32_t k : cluster.triples) {  // Ea
-    value += angle_term(problem_, x, static_cast<size_t>(k), false, gradient ? term_gradient : nullptr, term_hessian);
+    value += angle_term(problem_, x, static_cast<size_t>(k), false, gradient ? term_gradient : nullptr,
+                        hessian ? term_hessian : nullptr);
     if (!gradient) continue;
     const int32_t* triple = problem_.angle_triples + 3 * k;
     for (int pi = 0; pi < 3; ++pi) {
@@ -109,11 +110,12 @@ double FreePointClusters::cluster_energy(const Cluster& cluster, const double* x
 
 void FreePointClusters::set_start(const double* x, const double* original) {
   start_.assign(x, x + 3 * problem_.point_count);
+  // Clusters share no point and no triple, so one copy serves every cluster's second start.
+  best_.assign(start_.begin(), start_.end());
   for (const Cluster& cluster : clusters_) {
     // The minima reached from x and from the original positions (Ed's minimum), the lower one:
     // the angle terms have several minima.
     const double from_start = newton(cluster, start_.data(), original);
-    best_.assign(start_.begin(), start_.end());
     for (int32_t point : cluster.points) std::copy_n(original + 3 * point, 3, best_.begin() + 3 * point);
     if (newton(cluster, best_.data(), original) < from_start)
       for (int32_t point : cluster.points) std::copy_n(best_.begin() + 3 * point, 3, start_.begin() + 3 * point);

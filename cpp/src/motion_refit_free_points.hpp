@@ -25,6 +25,8 @@ class FreePointClusters {
   // coincident pair or handed group).
   FreePointClusters(const MotionRefitProblem& problem, const std::vector<uint8_t>& free);
 
+  bool contains(size_t point) const { return local_[point] >= 0; }
+
   // Where every minimisation starts until the next call: of the minima over the free points
   // reached from x (P, 3) and from the original positions (Ed's minimum), with x's other points,
   // the lower one (the angle terms have several minima). A fixed start per frame makes the

@@ -80,10 +80,9 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
       }
     }
   }
-  const std::vector<uint8_t> free = free_points(problem, eliminate);
   free_index_.assign(p, -1);
   for (size_t k = 1; k < p; ++k) {
-    if (free[k]) free_index_[k] = static_cast<int32_t>(free_count_++);
+    if (free_points_.contains(k)) free_index_[k] = static_cast<int32_t>(free_count_++);
     else if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0)
       index_[k] = static_cast<int32_t>(reduced_points_++);
   }

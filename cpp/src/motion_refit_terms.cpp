@@ -194,7 +194,6 @@ double refit_objective_frame(const MotionRefitProblem& problem, const double* x,
   const double scale2 = problem.length_scale * problem.length_scale;
   const double wd = problem.distance_weight / scale2;
   const double ws = problem.string_weight / scale2;
-  const double wa = problem.angle_weight;
   if (gradient) std::fill(gradient, gradient + 3 * p, 0.0);
 
   double value = 0.0;  // Ed, Eq. 6 (root excluded)
@@ -223,15 +222,12 @@ double refit_objective_frame(const MotionRefitProblem& problem, const double* x,
     }
   }
   for (size_t k = 0; k < problem.angle_triple_count; ++k) {  // Ea, Eq. 8
+    double term_gradient[9];
+    value += angle_term(problem, x, k, false, gradient ? term_gradient : nullptr, nullptr);
+    if (!gradient) continue;
     const int32_t* triple = problem.angle_triples + 3 * k;
-    Vec3 dp, dj, dc;
-    const double excess = cosine(x, triple, dp, dj, dc) - problem.key_cosines[k];
-    value += wa * excess * excess;
-    if (gradient) {
-      add_to(gradient, triple[0], dp, 2.0 * wa * excess);
-      add_to(gradient, triple[1], dj, 2.0 * wa * excess);
-      add_to(gradient, triple[2], dc, 2.0 * wa * excess);
-    }
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) gradient[3 * triple[c] + a] += term_gradient[3 * c + a];
   }
   if (gradient) gradient[0] = gradient[1] = gradient[2] = 0.0;
   return value;
@@ -319,8 +315,8 @@ void refit_hessian_frame(const MotionRefitProblem& problem, const double* x, boo
     add_pair(problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1], identity, ws);
   for (size_t k = 0; k < problem.angle_triple_count; ++k) {  // Ea
     const int32_t* triple = problem.angle_triples + 3 * k;
-    double gradient[9], block[81];
-    angle_term(problem, x, k, positive_semidefinite, gradient, block);
+    double block[81];
+    angle_term(problem, x, k, positive_semidefinite, nullptr, block);
     for (int pi = 0; pi < 3; ++pi)
       for (int pj = 0; pj < 3; ++pj) {
         double sub_block[9];
@@ -337,14 +333,15 @@ double angle_term(const MotionRefitProblem& problem, const double* x, size_t k, 
   const double w = problem.angle_weight;
   Vec3 dp, dj, dc;
   const double residual = cosine(x, triple, dp, dj, dc) - problem.key_cosines[k];
-  if (!gradient) return w * residual * residual;
-  cosine_hessian(x, triple, hessian);
   const double g[9] = {dp[0], dp[1], dp[2], dj[0], dj[1], dj[2], dc[0], dc[1], dc[2]};
-  for (int i = 0; i < 9; ++i) {
-    gradient[i] = 2.0 * w * residual * g[i];
-    for (int j = 0; j < 9; ++j) hessian[9 * i + j] = 2.0 * w * (g[i] * g[j] + residual * hessian[9 * i + j]);
+  if (gradient)
+    for (int i = 0; i < 9; ++i) gradient[i] = 2.0 * w * residual * g[i];
+  if (hessian) {  // 2 w (g g^T + (cos - cos0) Hess cos)
+    cosine_hessian(x, triple, hessian);
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < 9; ++j) hessian[9 * i + j] = 2.0 * w * (g[i] * g[j] + residual * hessian[9 * i + j]);
+    if (positive_semidefinite) clip_to_positive_semidefinite(hessian);
   }
-  if (positive_semidefinite) clip_to_positive_semidefinite(hessian);
   return w * residual * residual;
 }
 

@@ -6,12 +6,13 @@ E (Eq. 5) does not couple frames, so every frame is one small problem in 3(P - 1
 never one big one (SLSQP's cost grows with the cube of the size); within a frame it splits
 further into independent groups of points (objective.split_problem), each solved on its own.
 The unknowns are the points' displacements from the original positions in units of the length
-scale L. A chunk's first frame starts cold: at the original positions (the paper's "initial
-values"), or with hard constraints at the fallback (the original motion with frozen joints at
-their key rotations: feasible, and on the key posture's side of every mirror image). Every next
-frame starts from the previous result: without hard constraints the previous correction x* - x^o
-added to this frame's original; with them the previous result moved by the root's displacement,
-which is feasible because lengths and volumes do not change under translation. A group whose
+scale L. Every frame starts cold: at the original positions (the paper's "initial values"), or
+with hard constraints at the fallback (the original motion with frozen joints at their key
+rotations: feasible, and on the key posture's side of every mirror image). With ``warm_start``
+(off by default, as in the core) every next frame of a chunk starts from the previous result
+where E is lower there: without hard constraints the previous correction x* - x^o added to this
+frame's original; with them the previous result moved by the root's displacement, which is
+feasible because lengths and volumes do not change under translation. A group whose
 original positions or cold start have negligible E (no frozen joint touches it) is solved there. Frames are split into
 chunks; chunks can run in worker processes (threads would not help: the callbacks are Python).
 
@@ -138,7 +139,7 @@ def _solve_chunk(
     cold = (cold_positions - original)[:, 1:].reshape(frames, -1) / problem.length_scale
     cold_values = objective(problem, cold_positions, original)[0]
     original_values = objective(problem, original, original)[0]
-    for i in range(frames):  # sequential by nature: each frame starts from the previous optimum
+    for i in range(frames):  # sequential: with warm_start a frame starts from the previous optimum
         if min(cold_values[i], original_values[i]) <= _NEGLIGIBLE_OBJECTIVE:
             at_original = original_values[i] <= cold_values[i]
             positions[i] = original[i] if at_original else cold_positions[i]

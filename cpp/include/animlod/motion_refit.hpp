@@ -76,7 +76,11 @@ struct MotionRefitOptions {
   double ftol_rel = 1e-8;       // stop when E changes by less than this fraction
   int max_evaluations = 400;    // per solve
   // Largest |b - b(0)| / L accepted with hard constraints; a solve ending further off is retried.
-  double feasibility_tolerance = 1e-6;
+  // SLSQP holds the lengths to a tenth of it. Tight because a kept joint whose kept children are
+  // nearly coplanar with it (the procedural humanoid's chest, neck and shoulders) is pinned out
+  // of that plane only weakly by distances: at 1e-6 their positions left the rigid shape by up
+  // to 760 times the length error (3.4e-5 of the figure in the walk's forward kinematics).
+  double feasibility_tolerance = 1e-8;
   // Start each frame from the previous frame's result inside a chunk (when its E is below the
   // cold start's). With hard constraints the previous result moved by the root's displacement
   // (feasible: lengths are translation invariant); without, the previous correction x* - x^o

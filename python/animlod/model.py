@@ -232,6 +232,13 @@ class Motion:
         translations[:, 0] = self.root_positions
         return translations
 
+    def take_frames(self, frames: np.ndarray) -> Motion:
+        """The motion at ``frames`` (indices into this motion), same skeleton, name and fps."""
+        translations = None if self.joint_translations is None else self.joint_translations[frames]
+        return Motion(
+            self.skeleton, self.root_positions[frames], self.local_rotations[frames], self.fps, self.name, translations
+        )
+
     def world_transforms(self) -> np.ndarray:
         """Forward kinematics: world transforms ``(T, J, 4, 4)`` of every joint.
 

@@ -157,8 +157,8 @@ def test_cli_unknown_ranking_is_one_line(tmp_path, capsys) -> None:
     assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--ranking", "alphabetical"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        "animlod motion: error: --ranking: no ranking named 'alphabetical' (choose from importance, paper, depth, "
-        "variance)"
+        "animlod motion: error: --ranking: no ranking named 'alphabetical' (choose from refit, importance, paper, "
+        "depth, variance, cumulative)"
     )
 
 

@@ -1,7 +1,8 @@
 """Motion level of detail (seeds/000): analysis, frozen joints, re-fit and level chains.
 
 Start with :func:`build_motion_chain` (or ``animlod motion`` on the command line); the pieces:
-analysis.py (Eqs. 1-3), ranking.py (elimination orders), frozen.py (Section 5.1), objective.py
+analysis.py (Eqs. 1-3), ranking.py (elimination orders), refit_choice.py (the default order,
+chosen level by level by a trial re-fit), frozen.py (Section 5.1), objective.py
 (Eqs. 4-8), core_refit.py (SLSQP in the C++ core, the default), refit.py (the same SLSQP in
 Python, the reference), newton.py (damped Newton on the penalty objective), grouped_solve.py (how
 the Python solvers cut and run the work), skeleton_reduce.py, skin_transfer.py, chain.py, plots.py.

@@ -55,7 +55,9 @@ class MotionAnalysis:
         ranking but "paper", Eqs. 1-3 measure a zero-length bone through the points below it
         (child_bones, look_through); "paper" takes Eq. 1's direct children as printed.
     priority : joint indices in elimination order (lowest rank first, ties by index, see
-        ranking.py); never the root, end sites, locked joints or translating joints.
+        ranking.py); never the root, end sites, locked joints or translating joints. With the
+        "refit" ranking, the importance order until build_motion_chain chooses each level's
+        joints (refit_choice.py; the chain's analysis holds the chosen order).
     locked : joint indices the caller locked (never frozen).
     frames : (n,) int64 frames the analysis used (all frames unless subsampled).
     r_max : the normaliser of Eq. 1, in the asset's units.
@@ -264,7 +266,7 @@ def analyze_motion(
     candidates[skeleton.end_sites] = False
     candidates[locked_indices] = False
     candidates[translating] = False
-    scores = rank_scores(ranking, motion, importance, key_frames, frames)
+    scores = rank_scores(ranking, motion, importance, key_frames, frames, candidates)
     order = np.lexsort((np.arange(skeleton.joint_count), scores))
     priority = [int(j) for j in order if candidates[j]]
     return MotionAnalysis(

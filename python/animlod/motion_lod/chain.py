@@ -24,6 +24,7 @@ from .newton import refit_newton
 from .objective import RefitProblem, Weights, build_problem, objective
 from .ranking import DEFAULT_RANKING
 from .refit import refit_slsqp
+from .refit_choice import choose_by_refit
 from .skeleton_reduce import expand_motion, recover_motion
 from .skin_transfer import transfer_skin
 
@@ -230,6 +231,54 @@ def _bone_statistics(problem: RefitProblem, positions: np.ndarray) -> tuple[floa
     return error, variation
 
 
+def _resolve_solver(solver: str, slsqp_options: MotionRefitOptions | None) -> MotionRefitOptions:
+    """The SLSQP options a solver runs with (hard bone lengths for SLSQP, penalties for Newton)."""
+    if solver not in SOLVERS:
+        raise ValueError(f"solver: expected one of {SOLVERS}, got {solver!r}")
+    slsqp_options = slsqp_options or MotionRefitOptions(hard_constraints=solver != "newton")
+    if slsqp_options.hard_constraints and solver == "newton":
+        raise ValueError("solver: hard constraints need an SLSQP solver (the Newton solver only minimises E)")
+    return slsqp_options
+
+
+@dataclass
+class _Solved:
+    """A level re-fitted on a motion's frames: the problem, the solve, the level's output motion,
+    every original point placed by it (frozen parts by their key posture) and the original."""
+
+    problem: RefitProblem
+    result: RefitResult
+    output: Motion
+    placed: np.ndarray
+    original: np.ndarray
+
+
+def _solve_level(
+    level: FrozenLevel,
+    motion: Motion,
+    weights: Weights | None,
+    solver: str,
+    slsqp_options: MotionRefitOptions,
+    workers: int,
+    progress: Callable[[float], None] | None,
+) -> _Solved:
+    """Re-fits ``level`` on every frame of ``motion`` and places every original point."""
+    problem = build_problem(level, weights)
+    original = motion.world_positions()
+    if level.frozen.any():
+        fallback = frozen_motion(level, motion).world_positions()
+        hard = slsqp_options.hard_constraints
+        cold_starts = _cold_starts(level, problem, motion, original, fallback) if hard else None
+        result = _refit(problem, original, fallback, cold_starts, solver, slsqp_options, workers, progress)
+    else:  # E = 0 at the original positions, its global minimum: nothing to solve
+        result = RefitResult(original, np.zeros(motion.frame_count), np.zeros(motion.frame_count, dtype=np.int64))
+        if progress:
+            progress(motion.frame_count)
+    output = recover_motion(level, result.positions, motion)
+    placed = expand_motion(level, output, motion).world_positions()
+    return _Solved(problem, result, output, placed, original)
+
+
 def build_level(
     motion: Motion,
     analysis: MotionAnalysis,
@@ -242,31 +291,16 @@ def build_level(
     progress: Callable[[float], None] | None = None,
 ) -> MotionLevel:
     """One level with ``joint_count`` joints (see :func:`build_motion_chain` for the options)."""
-    if solver not in SOLVERS:
-        raise ValueError(f"solver: expected one of {SOLVERS}, got {solver!r}")
-    slsqp_options = slsqp_options or MotionRefitOptions(hard_constraints=solver != "newton")
-    if slsqp_options.hard_constraints and solver == "newton":
-        raise ValueError("solver: hard constraints need an SLSQP solver (the Newton solver only minimises E)")
+    slsqp_options = _resolve_solver(solver, slsqp_options)
     start = time.perf_counter()
     total = int(np.count_nonzero(~motion.skeleton.end_sites))
     frozen_joints = analysis.priority[: total - joint_count]
     level = freeze(motion, analysis, frozen_joints)
-    problem = build_problem(level, weights)
-    original = motion.world_positions()
-    if frozen_joints:
-        fallback = frozen_motion(level, motion).world_positions()
-        hard = slsqp_options.hard_constraints
-        cold_starts = _cold_starts(level, problem, motion, original, fallback) if hard else None
-        result = _refit(problem, original, fallback, cold_starts, solver, slsqp_options, workers, progress)
-    else:  # E = 0 at the original positions, its global minimum: nothing to solve
-        result = RefitResult(original, np.zeros(motion.frame_count), np.zeros(motion.frame_count, dtype=np.int64))
-        if progress:
-            progress(motion.frame_count)
-    output = recover_motion(level, result.positions, motion)
-    fk = output.world_positions()
-    placed = expand_motion(level, output, motion).world_positions()
-    error = np.linalg.norm(placed - original, axis=-1)
-    bone_error, bone_variation = _bone_statistics(problem, result.positions)
+    solved = _solve_level(level, motion, weights, solver, slsqp_options, workers, progress)
+    result = solved.result
+    fk = solved.output.world_positions()
+    error = np.linalg.norm(solved.placed - solved.original, axis=-1)
+    bone_error, bone_variation = _bone_statistics(solved.problem, result.positions)
     report = LevelReport(
         joint_count=level.joint_count,
         frozen=[motion.skeleton.names[j] for j in frozen_joints],
@@ -281,7 +315,7 @@ def build_level(
         failures=result.failures,
     )
     level_skin = transfer_skin(skin, level) if skin is not None else None
-    return MotionLevel(level, result.positions, output, report, level_skin)
+    return MotionLevel(level, result.positions, solved.output, report, level_skin)
 
 
 def build_motion_chain(
@@ -319,7 +353,8 @@ def build_motion_chain(
         callback taking the number of frames finished.
     analysis : a finished :func:`analyze_motion` of ``motion`` (then ``locked``,
         ``max_frames`` and ``ranking`` are not used).
-    ranking : the joint elimination order (ranking.RANKINGS; the paper's Eq. 3 importance by default).
+    ranking : the joint elimination order (ranking.RANKINGS; by default "refit": each level's next
+        joints chosen by their error after a trial re-fit, refit_choice.py).
 
     Returns
     -------
@@ -328,8 +363,17 @@ def build_motion_chain(
     if skin is not None and skin.skeleton.names != motion.skeleton.names:
         raise ValueError("skin: its skeleton's joint names differ from the motion's")
     analysis = analysis or analyze_motion(motion, locked=locked, max_frames=max_frames, ranking=ranking)
+    counts = level_joint_counts(motion, analysis, levels)
+    if analysis.ranking == "refit":
+        slsqp_options = _resolve_solver(solver, slsqp_options)
+
+        def trial_error(level: FrozenLevel, sample: Motion) -> float:
+            solved = _solve_level(level, sample, weights, solver, slsqp_options, workers, None)
+            return float(np.linalg.norm(solved.placed - solved.original, axis=-1).mean())
+
+        analysis = choose_by_refit(motion, analysis, counts, trial_error)
     result = []
-    for index, count in enumerate(level_joint_counts(motion, analysis, levels)):
+    for index, count in enumerate(counts):
         progress = on_level(index, count) if on_level else None
         result.append(build_level(motion, analysis, count, weights, solver, slsqp_options, workers, skin, progress))
     return MotionLodChain(analysis, result)

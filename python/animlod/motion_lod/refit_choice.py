@@ -1,0 +1,78 @@
+"""The default ranking, "refit": each level's next joints chosen by the error they leave after
+the re-fit, among what the other rankings propose.
+
+Every other ranking guesses a freeze's cost before the re-fit (Section 6), and the re-fit
+changes which freezes are cheap: it repairs a nearly still joint between two kept ones almost
+exactly (the procedural walk's Spine and Spine1 cost 0.013 units before it and 2e-6 after), but
+not a finger or a chain of several frozen joints. Eq. 3 alone loses levels of the dev clips to
+leaf-first or least-variance (bench/bench_motion.py's joint-choice table), each for a reason
+the others do not share. So at every level, going from fine to coarse, each ranking of
+ranking.PROPOSING_RANKINGS proposes its next joints after those already frozen; each distinct
+proposal is frozen and re-fitted on TRIAL_FRAMES evenly spaced frames of the clip, and the one
+with the lowest mean joint position error over every original point is kept (ties: the earlier
+ranking, importance first). A joint frozen at one level stays frozen at every coarser one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from ..model import Motion
+from .analysis import MotionAnalysis
+from .frozen import FrozenLevel, freeze
+from .ranking import PROPOSING_RANKINGS, rank_scores
+
+# Frames each proposal is re-fitted on: the error is a mean over frames, and the proposals of one
+# level differ by whole joints, so a few frames tell them apart (the chain re-fits every frame).
+TRIAL_FRAMES = 16
+
+
+def proposal_orders(motion: Motion, analysis: MotionAnalysis) -> list[list[int]]:
+    """The elimination order of every ranking of PROPOSING_RANKINGS over the analysis's candidates."""
+    count = motion.skeleton.joint_count
+    candidates = np.zeros(count, bool)
+    candidates[analysis.priority] = True
+    orders = []
+    for name in PROPOSING_RANKINGS:
+        scores = rank_scores(name, motion, analysis.importance, analysis.key_frames, analysis.frames, candidates)
+        orders.append([int(j) for j in np.lexsort((np.arange(count), scores)) if candidates[j]])
+    return orders
+
+
+def choose_by_refit(
+    motion: Motion,
+    analysis: MotionAnalysis,
+    counts: Sequence[int],
+    trial_error: Callable[[FrozenLevel, Motion], float],
+) -> MotionAnalysis:
+    """``analysis`` with its priority chosen level by level by the re-fit's error.
+
+    Parameters
+    ----------
+    motion : the clip.
+    analysis : its analysis (key frames, importance, candidates in ``priority``).
+    counts : joint counts of the levels, strictly decreasing, the first every joint.
+    trial_error : mean joint position error of a frozen level re-fitted on a sample motion.
+
+    Returns
+    -------
+    MotionAnalysis whose ``priority`` freezes, for each count, the chosen joints first.
+    """
+    orders = proposal_orders(motion, analysis)
+    sample = motion.take_frames(np.unique(np.round(np.linspace(0, motion.frame_count - 1, TRIAL_FRAMES)).astype(int)))
+    frozen: list[int] = []
+    for count in counts[1:]:
+        need = counts[0] - count - len(frozen)
+        proposals: list[list[int]] = []
+        for order in orders:
+            proposal = [j for j in order if j not in frozen][:need]
+            if proposal and sorted(proposal) not in [sorted(p) for p in proposals]:
+                proposals.append(proposal)
+        if len(proposals) > 1:
+            errors = [trial_error(freeze(motion, analysis, frozen + p), sample) for p in proposals]
+            proposals = [proposals[int(np.argmin(errors))]]  # first lowest: the earlier ranking
+        frozen += proposals[0] if proposals else []
+    return dataclasses.replace(analysis, priority=frozen + [j for j in analysis.priority if j not in frozen])

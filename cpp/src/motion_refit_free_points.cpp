@@ -3,14 +3,14 @@
 // over the angle triples that touch it, minimised by Newton's method with a backtracking line
 // search. The exact Hessian is used where it is positive definite (quadratic convergence at
 // the minimum); elsewhere (an angle term can be concave) it is shifted by a multiple of the
-// identity until it is, so every step descends.
+// identity until it is, so every step descends. The Hessian is sparse (a triple couples a point
+// with its parent, grandparent, children and grandchildren only) and is factorised as such
+// (motion_refit_block_cholesky.hpp): linear in the cluster's size, not cubic.
 #include "motion_refit_free_points.hpp"
 
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Core>
+#include <utility>
 
 #include "motion_refit_detail.hpp"
 #include "union_find.hpp"
@@ -64,28 +64,39 @@ FreePointClusters::FreePointClusters(const MotionRefitProblem& problem, const st
     }
     if (cluster >= 0) clusters_[cluster].triples.push_back(static_cast<int32_t>(k));
   }
-  for (const Cluster& cluster : clusters_) largest = std::max(largest, 3 * cluster.points.size());
+  for (Cluster& cluster : clusters_) {
+    largest = std::max(largest, 3 * cluster.points.size());
+    std::vector<std::pair<int32_t, int32_t>> coupled;  // free points of one triple
+    for (int32_t k : cluster.triples)
+      for (int a = 0; a < 3; ++a)
+        for (int b = a + 1; b < 3; ++b) {
+          const int32_t la = local_[problem.angle_triples[3 * k + a]], lb = local_[problem.angle_triples[3 * k + b]];
+          if (la >= 0 && lb >= 0) coupled.emplace_back(la, lb);
+        }
+    cluster.hessian = BlockCholesky(cluster.points.size(), coupled);
+  }
   gradient_.resize(largest);
-  hessian_.resize(largest * largest);
   step_.resize(largest);
   trial_.resize(largest);
 }
 
-double FreePointClusters::cluster_energy(const Cluster& cluster, const double* x, const double* original,
-                                         double* gradient, double* hessian) {
+double FreePointClusters::cluster_energy(Cluster& cluster, const double* x, const double* original,
+                                         double* gradient, bool hessian) {
   const size_t n = 3 * cluster.points.size();
   const double wd = problem_.distance_weight / (problem_.length_scale * problem_.length_scale);
   double value = 0.0;
   if (gradient) std::fill(gradient, gradient + n, 0.0);
-  if (hessian) std::fill(hessian, hessian + n * n, 0.0);
-  for (size_t i = 0; i < cluster.points.size(); ++i)  // Ed
+  if (hessian) cluster.hessian.clear();
+  const double ed_hessian[9] = {2.0 * wd, 0, 0, 0, 2.0 * wd, 0, 0, 0, 2.0 * wd};
+  for (size_t i = 0; i < cluster.points.size(); ++i) {  // Ed
     for (int a = 0; a < 3; ++a) {
       const double delta = x[3 * cluster.points[i] + a] - original[3 * cluster.points[i] + a];
       value += wd * delta * delta;
       if (gradient) gradient[3 * i + a] = 2.0 * wd * delta;
-      if (hessian) hessian[(3 * i + a) * n + 3 * i + a] = 2.0 * wd;
     }
-  double term_gradient[9], term_hessian[81];
+    if (hessian) cluster.hessian.add(static_cast<int32_t>(i), static_cast<int32_t>(i), ed_hessian);
+  }
+  double term_gradient[9], term_hessian[81], block[9];
   for (int32_t k : cluster.triples) {  // Ea
     value += angle_term(problem_, x, static_cast<size_t>(k), false, gradient ? term_gradient : nullptr,
                         hessian ? term_hessian : nullptr);
@@ -96,12 +107,12 @@ double FreePointClusters::cluster_energy(const Cluster& cluster, const double* x
       if (li < 0) continue;  // a held point of the triple
       for (int a = 0; a < 3; ++a) gradient[3 * li + a] += term_gradient[3 * pi + a];
       if (!hessian) continue;
-      for (int pj = 0; pj < 3; ++pj) {
+      for (int pj = pi; pj < 3; ++pj) {  // (li, lj) stands for (lj, li) too: the matrix is symmetric
         const int32_t lj = local_[triple[pj]];
         if (lj < 0) continue;
         for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b)
-            hessian[(3 * li + a) * n + 3 * lj + b] += term_hessian[9 * (3 * pi + a) + 3 * pj + b];
+          for (int b = 0; b < 3; ++b) block[3 * a + b] = term_hessian[9 * (3 * pi + a) + 3 * pj + b];
+        cluster.hessian.add(li, lj, block);
       }
     }
   }
@@ -112,7 +123,7 @@ void FreePointClusters::set_start(const double* x, const double* original) {
   start_.assign(x, x + 3 * problem_.point_count);
   // Clusters share no point and no triple, so one copy serves every cluster's second start.
   best_.assign(start_.begin(), start_.end());
-  for (const Cluster& cluster : clusters_) {
+  for (Cluster& cluster : clusters_) {
     // The minima reached from x and from the original positions (Ed's minimum), the lower one:
     // the angle terms have several minima.
     const double from_start = newton(cluster, start_.data(), original);
@@ -123,49 +134,55 @@ void FreePointClusters::set_start(const double* x, const double* original) {
 }
 
 void FreePointClusters::minimise(double* x, const double* original) {
-  for (const Cluster& cluster : clusters_) {
+  for (Cluster& cluster : clusters_) {
     for (int32_t point : cluster.points) std::copy_n(start_.begin() + 3 * point, 3, x + 3 * point);
     newton(cluster, x, original);
   }
 }
 
-double FreePointClusters::newton(const Cluster& cluster, double* x, const double* original) {
+double FreePointClusters::newton(Cluster& cluster, double* x, const double* original) {
   const double tolerance = kStepTolerance * problem_.length_scale;
   const double curvature = 2.0 * problem_.distance_weight / (problem_.length_scale * problem_.length_scale);
-  const auto n = static_cast<Eigen::Index>(3 * cluster.points.size());
-  Eigen::Map<Eigen::VectorXd> gradient(gradient_.data(), n), step(step_.data(), n), saved(trial_.data(), n);
-  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> hessian(hessian_.data(), n, n);
+  const size_t n = 3 * cluster.points.size();
+  double* gradient = gradient_.data();
+  double* step = step_.data();
+  double* saved = trial_.data();
   double value = 0.0;
   for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
-    value = cluster_energy(cluster, x, original, gradient_.data(), hessian_.data());
+    value = cluster_energy(cluster, x, original, gradient, true);
     // Where an angle term makes the Hessian indefinite, shift it towards Ed's curvature until
     // it is positive definite (Levenberg): every step then descends.
-    Eigen::LLT<Eigen::MatrixXd> llt(hessian);
-    for (double shift = curvature; llt.info() != Eigen::Success && std::isfinite(shift); shift *= 4.0)
-      llt.compute(Eigen::MatrixXd(hessian) + shift * Eigen::MatrixXd::Identity(n, n));
-    if (llt.info() != Eigen::Success) break;  // not finite: nothing to step along
-    step = -llt.solve(gradient);
+    bool factored = cluster.hessian.factor(0.0);
+    for (double shift = curvature; !factored && std::isfinite(shift); shift *= 4.0)
+      factored = cluster.hessian.factor(shift);
+    if (!factored) break;  // not finite: nothing to step along
+    cluster.hessian.solve(gradient, step);
     // -slope, the Newton decrement, is about twice the value left to gain: stop when that is
     // below what rounding resolves.
-    const double slope = gradient.dot(step);
+    double slope = 0.0, largest = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      step[i] = -step[i];
+      slope += gradient[i] * step[i];
+      largest = std::max(largest, std::abs(step[i]));
+    }
     if (!(slope < -kDecrementTolerance * value)) break;
-    for (Eigen::Index i = 0; i < n; ++i) saved[i] = x[3 * cluster.points[i / 3] + i % 3];
+    for (size_t i = 0; i < n; ++i) saved[i] = x[3 * cluster.points[i / 3] + i % 3];
     double t = 1.0;
     int halvings = 0;
     double trial = value;
     for (;;) {
-      for (Eigen::Index i = 0; i < n; ++i) x[3 * cluster.points[i / 3] + i % 3] = saved[i] + t * step[i];
-      trial = cluster_energy(cluster, x, original, nullptr, nullptr);
+      for (size_t i = 0; i < n; ++i) x[3 * cluster.points[i / 3] + i % 3] = saved[i] + t * step[i];
+      trial = cluster_energy(cluster, x, original, nullptr, false);
       if (trial <= value + 1e-4 * t * slope) break;
       if (++halvings == kMaxHalvings) break;
       t *= 0.5;
     }
     if (halvings == kMaxHalvings) {  // no decrease along a descent direction: rounding
-      for (Eigen::Index i = 0; i < n; ++i) x[3 * cluster.points[i / 3] + i % 3] = saved[i];
+      for (size_t i = 0; i < n; ++i) x[3 * cluster.points[i / 3] + i % 3] = saved[i];
       break;
     }
     value = trial;
-    if (t * step.cwiseAbs().maxCoeff() <= tolerance) break;
+    if (t * largest <= tolerance) break;
   }
   return value;
 }

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "animlod/motion_refit.hpp"
+#include "motion_refit_block_cholesky.hpp"
 
 namespace animlod::detail {
 
@@ -43,20 +44,21 @@ class FreePointClusters {
   struct Cluster {
     std::vector<int32_t> points;   // free points, in increasing order
     std::vector<int32_t> triples;  // angle triples with at least one of them
+    BlockCholesky hessian;         // over the points (in cluster order), coupled by the triples
   };
   // E's part that depends on the cluster's points at x, with its gradient (3 n) and exact
-  // Hessian (3 n x 3 n, row-major) when asked.
-  double cluster_energy(const Cluster& cluster, const double* x, const double* original, double* gradient,
-                        double* hessian);
+  // Hessian (into cluster.hessian) when asked.
+  double cluster_energy(Cluster& cluster, const double* x, const double* original, double* gradient,
+                        bool hessian);
 
   // Newton's method on one cluster from where x has its points; returns the cluster's E there.
-  double newton(const Cluster& cluster, double* x, const double* original);
+  double newton(Cluster& cluster, double* x, const double* original);
 
   const MotionRefitProblem& problem_;
   std::vector<Cluster> clusters_;
   std::vector<int32_t> local_;  // (P,) a free point's index in its cluster, -1 otherwise
   std::vector<double> start_;   // (P, 3) set_start's positions (only free points are read)
-  std::vector<double> gradient_, hessian_, step_, trial_, best_;
+  std::vector<double> gradient_, step_, trial_, best_;
 };
 
 }  // namespace animlod::detail

@@ -31,6 +31,15 @@ namespace {
 
 // E below this at a cold start counts as solved there (see motion_refit_solve).
 constexpr double kNegligibleObjective = 1e-24;
+// SLSQP also stops when E changes by less than this between iterations (nlopt's ftol_abs), as
+// well as by less than ftol_rel of itself. E >= alpha |x - x^o|^2 / L^2, so a change this small
+// moves points by ~1e-11 L, far below the float32 keys the levels are written with (~6e-8 L).
+// It only acts where E < kObjectiveResolution / ftol_rel: where a level reproduces the clip
+// almost exactly (Xbot's finest levels, E ~ 1e-20), there E's own rounding (changing each
+// position by one ulp changes E by ~1e-7 of itself) is above ftol_rel, and SLSQP kept iterating
+// on rounding noise until its line search failed: 16 evaluations per frame instead of 7 at Xbot's
+// 47-joint level, ending at the same E to 8 digits (bench/bench_motion.py).
+constexpr double kObjectiveResolution = 1e-22;
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -183,6 +192,7 @@ class FrameSolver {
                                        handedness_callback, &c_, zero.data());
     }
     nlopt_set_ftol_rel(opt_.get(), options.ftol_rel);
+    nlopt_set_ftol_abs(opt_.get(), kObjectiveResolution);
     nlopt_set_maxeval(opt_.get(), options.max_evaluations);
   }
 

@@ -73,7 +73,7 @@ struct MotionRefitOptions {
   // Hold every length of Es as an equality (and the handedness of rigid groups as inequalities):
   // bones keep their key lengths exactly instead of approximately (Fig. 7).
   bool hard_constraints = true;
-  double ftol_rel = 1e-8;       // stop when E changes by less than this fraction
+  double ftol_rel = 1e-8;       // stop when E changes by less than this fraction (or by < 1e-22)
   int max_evaluations = 400;    // per solve
   // Largest |b - b(0)| / L accepted with hard constraints; a solve ending further off is retried.
   // SLSQP holds the lengths to a tenth of it. Tight because a kept joint whose kept children are

@@ -18,8 +18,8 @@ using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecas
 
 // A MotionRefitProblem that owns its arrays (the core's struct is a view of them).
 struct ProblemHolder {
-  IndexArray length_pairs, coincident_pairs, handed_quads, angle_triples;
-  DoubleArray key_lengths, key_volumes, key_cosines;
+  IndexArray length_pairs, coincident_pairs, handed_quads, angle_triples, flat_quads;
+  DoubleArray key_lengths, key_volumes, key_cosines, flat_volumes, flat_areas;
   MotionRefitProblem view;
 };
 
@@ -33,18 +33,24 @@ ProblemHolder make_problem(size_t point_count, const py::array& length_pairs, co
                            const py::array& coincident_pairs, const py::array& handed_quads,
                            const DoubleArray& key_volumes, const py::array& angle_triples,
                            const DoubleArray& key_cosines, double distance_weight, double string_weight,
-                           double angle_weight, double length_scale) {
+                           double angle_weight, double length_scale, const py::array& flat_quads,
+                           const DoubleArray& flat_volumes, const DoubleArray& flat_areas) {
   ProblemHolder h;
   h.length_pairs = rows_of(length_pairs, "length_pairs", 2, "(Np, 2)");
   h.coincident_pairs = rows_of(coincident_pairs, "coincident_pairs", 2, "(Nc, 2)");
   h.handed_quads = rows_of(handed_quads, "handed_quads", 4, "(Nh, 4)");
   h.angle_triples = rows_of(angle_triples, "angle_triples", 3, "(Na, 3)");
+  h.flat_quads = rows_of(flat_quads, "flat_quads", 4, "(Nf, 4)");
   h.key_lengths = key_lengths;
   h.key_volumes = key_volumes;
   h.key_cosines = key_cosines;
+  h.flat_volumes = flat_volumes;
+  h.flat_areas = flat_areas;
   require_shape(h.key_lengths, "key_lengths", {h.length_pairs.shape(0)}, "(Np,) like length_pairs");
   require_shape(h.key_volumes, "key_volumes", {h.handed_quads.shape(0)}, "(Nh,) like handed_quads");
   require_shape(h.key_cosines, "key_cosines", {h.angle_triples.shape(0)}, "(Na,) like angle_triples");
+  require_shape(h.flat_volumes, "flat_volumes", {h.flat_quads.shape(0)}, "(Nf,) like flat_quads");
+  require_shape(h.flat_areas, "flat_areas", {h.flat_quads.shape(0)}, "(Nf,) like flat_quads");
   MotionRefitProblem& v = h.view;
   v.point_count = point_count;
   v.length_pairs = h.length_pairs.data();
@@ -58,6 +64,10 @@ ProblemHolder make_problem(size_t point_count, const py::array& length_pairs, co
   v.angle_triples = h.angle_triples.data();
   v.key_cosines = h.key_cosines.data();
   v.angle_triple_count = static_cast<size_t>(h.angle_triples.shape(0));
+  v.flat_quads = h.flat_quads.data();
+  v.flat_volumes = h.flat_volumes.data();
+  v.flat_areas = h.flat_areas.data();
+  v.flat_quad_count = static_cast<size_t>(h.flat_quads.shape(0));
   v.distance_weight = distance_weight;
   v.string_weight = string_weight;
   v.angle_weight = angle_weight;
@@ -150,12 +160,15 @@ arrays as int32, values as float64). P points, point 0 the root.)doc")
       .def(py::init(&make_problem), py::arg("point_count"), py::arg("length_pairs"), py::arg("key_lengths"),
            py::arg("coincident_pairs"), py::arg("handed_quads"), py::arg("key_volumes"), py::arg("angle_triples"),
            py::arg("key_cosines"), py::arg("distance_weight"), py::arg("string_weight"), py::arg("angle_weight"),
-           py::arg("length_scale"),
+           py::arg("length_scale"), py::arg("flat_quads") = py::array_t<int32_t>(std::vector<py::ssize_t>{0, 4}),
+           py::arg("flat_volumes") = DoubleArray(0), py::arg("flat_areas") = DoubleArray(0),
            R"doc(length_pairs (Np, 2), key_lengths (Np,), coincident_pairs (Nc, 2), handed_quads (Nh, 4),
 key_volumes (Nh,), angle_triples (Na, 3), key_cosines (Na,); weights alpha, beta, gamma of Eq. 5;
-length_scale L in the asset's units. Raises ValueError naming the array and element on an index
-outside [0, P), a repeated point, a non-positive key length, a zero key volume, a cosine outside
-[-1, 1], alpha <= 0 or L <= 0.)doc")
+length_scale L in the asset's units; flat_quads (Nf, 4), flat_volumes (Nf,), flat_areas (Nf,):
+rigid groups held by their child's height over the base plane (none by default). Raises
+ValueError naming the array and element on an index outside [0, P), a repeated point, a
+non-positive key length or flat area, a zero key volume, a cosine outside [-1, 1], alpha <= 0
+or L <= 0.)doc")
       .def_property_readonly("point_count", [](const ProblemHolder& h) { return h.view.point_count; })
       .def_property_readonly("equality_count", [](const ProblemHolder& h) { return motion_refit_equality_count(h.view); });
 

@@ -21,7 +21,7 @@ namespace {
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 constexpr double kIdentity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
 
-// (P,) 1 for the points no held length, coincident pair or handed group touches (not the root).
+// (P,) 1 for the points no held length, coincident pair, handed or flat group touches (not the root).
 std::vector<uint8_t> free_points(const MotionRefitProblem& problem, bool eliminate) {
   std::vector<uint8_t> free(problem.point_count, eliminate ? 1 : 0);
   auto hold = [&](const int32_t* rows, size_t n, size_t width) {
@@ -30,6 +30,7 @@ std::vector<uint8_t> free_points(const MotionRefitProblem& problem, bool elimina
   hold(problem.length_pairs, problem.length_pair_count, 2);
   hold(problem.coincident_pairs, problem.coincident_pair_count, 2);
   hold(problem.handed_quads, problem.handed_quad_count, 4);
+  hold(problem.flat_quads, problem.flat_quad_count, 4);
   free[0] = 0;
   return free;
 }
@@ -68,6 +69,7 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
     count(problem.coincident_pairs, problem.coincident_pair_count, 2);
     count(problem.angle_triples, problem.angle_triple_count, 3);
     count(problem.handed_quads, problem.handed_quad_count, 4);
+    count(problem.flat_quads, problem.flat_quad_count, 4);
     for (size_t k = 0; k < pairs; ++k) {
       for (int side = 0; side < 2; ++side) {
         const int32_t leaf = problem.length_pairs[2 * k + side];

@@ -244,7 +244,7 @@ class FrameSolver {
       double violation = 0.0;
       for (double v : equality_values_) violation = std::max(violation, std::abs(v));
       if (violation > options_.feasibility_tolerance) {
-        outcome.reason = format("a held length is off by %.3g L", violation);
+        outcome.reason = format("a held length or flat group's height is off by %.3g L", violation);
       } else if (!handed_values_.empty()) {
         detail::refit_handedness_frame(problem_, result, handed_values_.data(), nullptr);
         if (*std::max_element(handed_values_.begin(), handed_values_.end()) > 0.0)

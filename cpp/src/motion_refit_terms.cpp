@@ -139,15 +139,20 @@ Status check_indices(const int32_t* indices, size_t rows, size_t width, size_t p
   return Status::success();
 }
 
-Status check_values(const double* values, size_t count, const char* name, bool positive, bool unit_interval) {
+enum class Expect { positive, unit_interval, non_zero, finite };
+
+Status check_values(const double* values, size_t count, const char* name, Expect expect) {
   if (count > 0 && values == nullptr) return Status::error(std::string(name) + ": no data");
   for (size_t i = 0; i < count; ++i) {
     const double v = values[i];
-    const bool bad = !std::isfinite(v) || (positive && !(v > 0.0)) || (unit_interval && std::abs(v) > 1.0 + 1e-9) ||
-                     (!positive && !unit_interval && v == 0.0);
+    const bool bad = !std::isfinite(v) || (expect == Expect::positive && !(v > 0.0)) ||
+                     (expect == Expect::unit_interval && std::abs(v) > 1.0 + 1e-9) ||
+                     (expect == Expect::non_zero && v == 0.0);
     if (bad) {
-      const char* expected = positive ? "a finite positive length" : unit_interval ? "a cosine in [-1, 1]"
-                                                                                   : "a finite non-zero volume";
+      const char* expected = expect == Expect::positive        ? "a finite positive number"
+                             : expect == Expect::unit_interval ? "a cosine in [-1, 1]"
+                             : expect == Expect::non_zero      ? "a finite non-zero volume"
+                                                               : "a finite number";
       return Status::error(std::string(name) + "[" + std::to_string(i) + "] = " + std::to_string(v) + ": expected " +
                            expected);
     }
@@ -158,7 +163,7 @@ Status check_values(const double* values, size_t count, const char* name, bool p
 }  // namespace
 
 size_t motion_refit_equality_count(const MotionRefitProblem& problem) {
-  return problem.length_pair_count + 3 * problem.coincident_pair_count;
+  return problem.length_pair_count + 3 * problem.coincident_pair_count + problem.flat_quad_count;
 }
 
 Status validate_motion_refit_problem(const MotionRefitProblem& problem) {
@@ -177,12 +182,15 @@ Status validate_motion_refit_problem(const MotionRefitProblem& problem) {
                          std::to_string(problem.angle_weight));
   const size_t p = problem.point_count;
   Status s = check_indices(problem.length_pairs, problem.length_pair_count, 2, p, "length_pairs");
-  if (s) s = check_values(problem.key_lengths, problem.length_pair_count, "key_lengths", true, false);
+  if (s) s = check_values(problem.key_lengths, problem.length_pair_count, "key_lengths", Expect::positive);
   if (s) s = check_indices(problem.coincident_pairs, problem.coincident_pair_count, 2, p, "coincident_pairs");
   if (s) s = check_indices(problem.handed_quads, problem.handed_quad_count, 4, p, "handed_quads");
-  if (s) s = check_values(problem.key_volumes, problem.handed_quad_count, "key_volumes", false, false);
+  if (s) s = check_values(problem.key_volumes, problem.handed_quad_count, "key_volumes", Expect::non_zero);
+  if (s) s = check_indices(problem.flat_quads, problem.flat_quad_count, 4, p, "flat_quads");
+  if (s) s = check_values(problem.flat_volumes, problem.flat_quad_count, "flat_volumes", Expect::finite);
+  if (s) s = check_values(problem.flat_areas, problem.flat_quad_count, "flat_areas", Expect::positive);
   if (s) s = check_indices(problem.angle_triples, problem.angle_triple_count, 3, p, "angle_triples");
-  if (s) s = check_values(problem.key_cosines, problem.angle_triple_count, "key_cosines", false, true);
+  if (s) s = check_values(problem.key_cosines, problem.angle_triple_count, "key_cosines", Expect::unit_interval);
   return s;
 }
 
@@ -257,6 +265,14 @@ void refit_equalities_frame(const MotionRefitProblem& problem, const double* x, 
         jacobian[row * 3 * p + 3 * b + axis] -= inverse;
       }
     }
+  }
+  for (size_t k = 0; k < problem.flat_quad_count; ++k, ++row) {
+    const int32_t* quad = problem.flat_quads + 4 * k;
+    const double scale = inverse / problem.flat_areas[k];
+    std::array<Vec3, 4> grads;
+    values[row] = (volume(x, quad, grads) - problem.flat_volumes[k]) * scale;
+    if (jacobian)
+      for (int c = 0; c < 4; ++c) add_to(jacobian + row * 3 * p, quad[c], grads[c], scale);
   }
   if (jacobian)
     for (size_t r = 0; r < m; ++r) std::fill(jacobian + r * 3 * p, jacobian + r * 3 * p + 3, 0.0);

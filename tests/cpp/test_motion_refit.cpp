@@ -167,3 +167,65 @@ TEST_CASE("motion refit: bad problems and inputs are refused by name") {
   REQUIRE_FALSE(status);
   CHECK(status.message == "chunk_frames: must be at least 1, got 0");
 }
+
+TEST_CASE("motion refit: a flat group is held by its child's height over the base plane") {
+  // Parent 1 with children 2, 4 (the base) and 3 in one plane z = 0: distances alone pin 3 out of
+  // that plane only to second order; the flat quad's row is its height change over L. Child 3
+  // keeps its distance to base child 4 (with which it spans the larger triangle), not to 2.
+  std::vector<double> key = {0, 0, 0,  0, 2, 0,  1, 2, 0,  -1, 2.1, 0,  0.1, 3, 0};
+  std::vector<int32_t> pairs = {1, 0, 2, 1, 3, 1, 4, 1, 4, 2, 3, 4};
+  std::vector<double> lengths;
+  for (size_t k = 0; k < pairs.size() / 2; ++k) {
+    double sum = 0.0;
+    for (int a = 0; a < 3; ++a) sum += std::pow(key[3 * pairs[2 * k] + a] - key[3 * pairs[2 * k + 1] + a], 2);
+    lengths.push_back(std::sqrt(sum));
+  }
+  std::vector<int32_t> quad = {1, 2, 4, 3};
+  const std::vector<double> volume = {0.0};
+  const std::vector<double> base_area = {1.0};  // |(1, 0, 0) x (0.1, 1, 0)|
+  MotionRefitProblem problem;
+  problem.point_count = 5;
+  problem.length_pairs = pairs.data();
+  problem.key_lengths = lengths.data();
+  problem.length_pair_count = lengths.size();
+  problem.flat_quads = quad.data();
+  problem.flat_volumes = volume.data();
+  problem.flat_areas = base_area.data();
+  problem.flat_quad_count = 1;
+  problem.length_scale = 3.0;
+  const size_t p = 5, m = animlod::motion_refit_equality_count(problem);
+  REQUIRE(m == lengths.size() + 1);
+  std::vector<double> values(m), jacobian(m * 3 * p), plus_values(m), minus_values(m);
+  REQUIRE(animlod::motion_refit_equalities(problem, key.data(), 1, values.data(), nullptr));
+  for (double v : values) CHECK(std::abs(v) < 1e-12);
+  // Lifting the child by h changes its row by h / L.
+  std::vector<double> lifted = key;
+  lifted[3 * 3 + 2] += 0.03;
+  REQUIRE(animlod::motion_refit_equalities(problem, lifted.data(), 1, values.data(), jacobian.data()));
+  CHECK(std::abs(values[m - 1]) == doctest::Approx(0.03 / 3.0));
+  const double h = 1e-6;
+  for (size_t i = 3; i < 3 * p; ++i) {
+    std::vector<double> plus = lifted, minus = lifted;
+    plus[i] += h;
+    minus[i] -= h;
+    animlod::detail::refit_equalities_frame(problem, plus.data(), plus_values.data(), nullptr);
+    animlod::detail::refit_equalities_frame(problem, minus.data(), minus_values.data(), nullptr);
+    for (size_t r = 0; r < m; ++r)
+      CHECK(jacobian[r * 3 * p + i] == doctest::Approx((plus_values[r] - minus_values[r]) / (2 * h)).scale(1.0));
+  }
+  // A hard solve pulled out of the plane by the original positions keeps the group's shape.
+  std::vector<double> original = lifted;
+  original[3 * 2 + 2] -= 0.02;
+  MotionRefitResult result;
+  REQUIRE(animlod::motion_refit_solve(problem, original.data(), key.data(), nullptr, 1, {}, result));
+  CHECK(result.failures.empty());
+  REQUIRE(animlod::motion_refit_equalities(problem, result.positions.data(), 1, values.data(), nullptr));
+  for (double v : values) CHECK(std::abs(v) < 1e-8);
+  // The distance the flat quad replaced (child 3 to base child 2) holds too: the shape is rigid.
+  double sum = 0.0, key_sum = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    sum += std::pow(result.positions[3 * 3 + a] - result.positions[3 * 2 + a], 2);
+    key_sum += std::pow(key[3 * 3 + a] - key[3 * 2 + a], 2);
+  }
+  CHECK(std::sqrt(sum) == doctest::Approx(std::sqrt(key_sum)).epsilon(1e-7));
+}

@@ -31,9 +31,10 @@ def chain_motion(angles_a: np.ndarray, root_angles: np.ndarray | None = None) ->
     return Motion(skeleton, np.zeros((frames, 3)), local, fps=30.0)
 
 
-def figure_motion(frames: int = 24) -> Motion:
+def figure_motion(frames: int = 24, spine_lean: float = 0.0) -> Motion:
     """A 12-joint, 4-end-site figure with two legs, a spine and two arms, every joint moving
-    except ``LeftWrist``; the root walks forward and sways."""
+    except ``LeftWrist``; the root walks forward and sways. The hips and the spine's base lie in
+    one plane (a flat rigid group) unless ``spine_lean`` moves the spine's base out of it."""
     rows = [
         ("Hips", -1, (0.0, 1.0, 0.0)),
         ("LeftHip", 0, (0.1, -0.05, 0.0)),
@@ -42,7 +43,7 @@ def figure_motion(frames: int = 24) -> Motion:
         ("RightHip", 0, (-0.1, -0.05, 0.0)),
         ("RightKnee", 4, (0.0, -0.45, 0.02)),
         ("RightKnee_End", 5, (0.0, -0.45, -0.02)),
-        ("Spine", 0, (0.0, 0.2, 0.0)),
+        ("Spine", 0, (0.0, 0.2, spine_lean)),
         ("Chest", 7, (0.0, 0.25, 0.01)),
         ("LeftShoulder", 8, (0.18, 0.1, 0.0)),
         ("LeftElbow", 9, (0.28, 0.0, 0.0)),

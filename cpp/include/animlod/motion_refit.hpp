@@ -34,17 +34,25 @@ struct MotionRefitProblem {
   const int32_t* angle_triples = nullptr;     // (Na, 3) (parent, frozen joint, child) for Ea (Eq. 8)
   const double* key_cosines = nullptr;        // (Na,) cos theta in the key posture (Eq. 4)
   size_t angle_triple_count = 0;              // Na
+  // (Nf, 4) (parent, a, b, c) of a rigid group whose child c lies nearly in the plane of the
+  // parent and the base children a, b: distances pin c out of that plane only to second order,
+  // so the hard option holds its height over the plane, (V - V0) / A0 with V = det[a-p, b-p, c-p].
+  const int32_t* flat_quads = nullptr;
+  const double* flat_volumes = nullptr;       // (Nf,) V0, the key-posture volumes
+  const double* flat_areas = nullptr;         // (Nf,) A0 = |(a - p) x (b - p)| in the key posture, > 0
+  size_t flat_quad_count = 0;                 // Nf
   double distance_weight = 0.2;               // alpha of Eq. 5
   double string_weight = 0.4;                 // beta
   double angle_weight = 0.4;                  // gamma
   double length_scale = 1.0;                  // L: Ed and Es are divided by L^2 (unit-free E)
 };
 
-// Equality constraints of the hard option: Np + 3 Nc rows.
+// Equality constraints of the hard option: Np + 3 Nc + Nf rows.
 size_t motion_refit_equality_count(const MotionRefitProblem& problem);
 
 // Checks indices (in range, no pair or triple repeating a point), finite positive key lengths,
-// finite key cosines in [-1, 1], non-zero key volumes, weights >= 0 with alpha > 0, L > 0.
+// finite key cosines in [-1, 1], non-zero key volumes, finite flat volumes over finite positive
+// areas, weights >= 0 with alpha > 0, L > 0.
 // Errors name the array and the element, e.g. "angle_triples[3]: point 41 is outside [0, 38)".
 Status validate_motion_refit_problem(const MotionRefitProblem& problem);
 
@@ -56,7 +64,8 @@ Status motion_refit_objective(const MotionRefitProblem& problem, const double* x
                               size_t frame_count, double* out_values, double* out_gradient);
 
 // The hard equalities, scaled by 1/L: (|x_a - x_b| - b(0)) / L per length pair, then
-// (x_a - x_b) / L (3 rows) per coincident pair; zero when every length holds.
+// (x_a - x_b) / L (3 rows) per coincident pair, then (V - V0) / (A0 L) per flat quad (the change
+// of its child's height over the base plane); zero when every length and height holds.
 // x: (F, P, 3). out_values: (F, m) with m = motion_refit_equality_count. out_jacobian:
 // (F, m, P, 3) derivatives (root column zero), or nullptr.
 Status motion_refit_equalities(const MotionRefitProblem& problem, const double* x, size_t frame_count,
@@ -76,10 +85,11 @@ struct MotionRefitOptions {
   double ftol_rel = 1e-8;       // stop when E changes by less than this fraction (or by < 1e-22)
   int max_evaluations = 400;    // per solve
   // Largest |b - b(0)| / L accepted with hard constraints; a solve ending further off is retried.
-  // SLSQP holds the lengths to a tenth of it. Tight because a kept joint whose kept children are
-  // nearly coplanar with it (the procedural humanoid's chest, neck and shoulders) is pinned out
-  // of that plane only weakly by distances: at 1e-6 their positions left the rigid shape by up
-  // to 760 times the length error (3.4e-5 of the figure in the walk's forward kinematics).
+  // SLSQP holds the lengths to a tenth of it. Tight at no cost in evaluations on the dev clips:
+  // a rigid group whose children lie close to, but above _FLAT of, their base plane
+  // (objective.py) is pinned out of it by distances only weakly, which multiplies a length
+  // error in its shape (before flat quads, 3.4e-5 of the figure in the walk's forward kinematics
+  // at 1e-6).
   double feasibility_tolerance = 1e-8;
   // Start each frame from the previous frame's result inside a chunk (when its E is below the
   // cold start's). With hard constraints the previous result moved by the root's displacement
@@ -109,7 +119,8 @@ struct MotionRefitOptions {
 // One frame whose first solve was not kept.
 struct MotionRefitFailure {
   int32_t frame = 0;
-  std::string reason;   // "non-finite result", "nlopt result -1", "a held length is off by ...", ...
+  std::string reason;   // "non-finite result", "nlopt result -1",
+                        // "a held length or flat group's height is off by ...", ...
   bool fell_back = false;  // false: a cold restart succeeded; true: the fallback positions were kept
 };
 

@@ -34,6 +34,9 @@ def core_problem(problem: RefitProblem) -> _core.MotionRefitProblem:
         w.string,
         w.angle,
         problem.length_scale,
+        problem.flat_quads,
+        problem.flat_volumes,
+        problem.flat_areas,
     )
 
 

@@ -21,7 +21,7 @@ the same for an asset in metres or centimetres: Ed and Es are unit-free like Ea.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -29,6 +29,9 @@ from .frozen import FrozenLevel
 
 # Key lengths below this fraction of the length scale count as zero-length ("coincident") pairs.
 _COINCIDENT = 1e-9
+# A rigid group's child whose height over its base plane is below this fraction of its distance
+# to the parent (about 3 degrees) is held by its height (a flat quad), not by distances alone.
+_FLAT = 0.05
 
 
 @dataclass(frozen=True)
@@ -63,6 +66,14 @@ class RefitProblem:
         lengths fix such a group only up to a mirror image, which no rotation reproduces, so
         the hard option also keeps the sign of their volume.
     key_volumes : (Nh,) float64 the signed volumes det[a - p, b - p, c - p] in the key posture.
+    flat_quads : (Nf, 4) int64 (parent, a, b, child) of a rigid group whose child lies nearly in
+        the plane of the parent and the two base children: distances pin such a child out of
+        that plane only to second order (the procedural humanoid's chest and neck, a hand and
+        its finger bases), so the hard option holds its height over the plane instead of its
+        distance to one of the base children.
+    flat_volumes : (Nf,) float64 their key volumes det[a - p, b - p, c - p].
+    flat_areas : (Nf,) float64 |(a - p) x (b - p)| in the key posture: the volume over it is the
+        child's height over the plane.
     angle_triples : (Na, 3) int64 (parent, frozen joint, child) for Ea.
     key_cosines : (Na,) float64 cos theta_r in the key posture.
     weights : alpha, beta, gamma.
@@ -80,6 +91,9 @@ class RefitProblem:
     key_cosines: np.ndarray
     weights: Weights
     length_scale: float
+    flat_quads: np.ndarray = field(default_factory=lambda: np.zeros((0, 4), np.int64))
+    flat_volumes: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    flat_areas: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def variable_count(self) -> int:
@@ -88,8 +102,9 @@ class RefitProblem:
 
     @property
     def constraint_count(self) -> int:
-        """Equalities of the hard option: one per held length, three per zero-length pair."""
-        return self.length_pairs.shape[0] + 3 * self.coincident_pairs.shape[0]
+        """Equalities of the hard option: one per held length, three per zero-length pair, one per
+        flat quad."""
+        return self.length_pairs.shape[0] + 3 * self.coincident_pairs.shape[0] + self.flat_quads.shape[0]
 
 
 def _cosines(x: np.ndarray, triples: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -256,10 +271,12 @@ def half_hessian(problem: RefitProblem, x: np.ndarray) -> np.ndarray:
 
 def rigidity_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Hard equalities, scaled by 1/L, and their Jacobian: every length Es holds (bones and
-    siblings), so the kept points move exactly as the level's rigid skeleton can.
+    siblings) and every flat quad's height, so the kept points move exactly as the level's rigid
+    skeleton can.
 
     Returns ``values (F, m)`` (zero when every pair has its key length; zero-length pairs give
-    three rows, x_a - x_b) and ``jacobian (F, m, P, 3)``.
+    three rows, x_a - x_b; a flat quad (V - V0) / (A0 L), its child's height change) and
+    ``jacobian (F, m, P, 3)``.
     """
     frames, p = x.shape[0], problem.point_count
     pairs = problem.length_pairs
@@ -278,6 +295,15 @@ def rigidity_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.ndarr
             rows[:, k, :, a, :] = np.eye(3) / problem.length_scale
             rows[:, k, :, b, :] = -np.eye(3) / problem.length_scale
         jacobians.append(rows.reshape(frames, -1, p, 3))
+    if problem.flat_quads.size:
+        volumes, grads = _volumes(x, problem.flat_quads)
+        scale = 1.0 / (problem.flat_areas * problem.length_scale)
+        values.append((volumes - problem.flat_volumes) * scale)
+        rows = np.zeros((frames, problem.flat_quads.shape[0], p, 3))
+        index = np.arange(problem.flat_quads.shape[0])
+        for column, grad in enumerate(grads):
+            rows[:, index, problem.flat_quads[:, column]] += scale[:, None] * grad
+        jacobians.append(rows)
     jacobian = np.concatenate(jacobians, axis=1)
     jacobian[:, :, 0] = 0.0
     return np.concatenate(values, axis=1), jacobian
@@ -301,16 +327,20 @@ def handedness_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.nda
 
 def _rigid_set(
     parent: int, children: list[int], key: np.ndarray, tolerance: float
-) -> tuple[list[tuple[int, int]], list[tuple[int, int]], list[tuple[int, int, int, int]]]:
-    """The lengths that make a kept joint and its kept children one rigid body, none redundant.
+) -> tuple[list[tuple[int, int]], list[tuple[int, int]], list[tuple[int, int, int, int]], list[tuple[int, int, int, int]]]:
+    """The constraints that make a kept joint and its kept children one rigid body, none redundant.
 
     A child at the parent's position is tied to the parent, one at an earlier child's position
     to that child; the others (distinct points) get their bone to the parent (Eq. 7) and, when
-    they span a plane with it, the distances that pin them to the two children spanning the
-    largest triangle with the parent (3k - 3 lengths for k distinct children, the count of a
-    rigid body's shape). Each child off that plane also gets a handedness quad.
+    they span a plane with it, the two children spanning the largest triangle with the parent
+    are tied to each other. Every further child c is pinned to that base by 3 constraints (3k - 3
+    for k distinct children, the count of a rigid body's shape): away from the base's plane, its
+    distances to both base children, plus a handedness quad (distances fix c only up to its
+    mirror image); within _FLAT of that plane, where distances pin it out of the plane only to
+    second order, its distance to one base child (the one making the larger triangle with c and
+    the parent) and a flat quad holding its height over the plane.
 
-    Returns bone pairs, sibling pairs and quads (parent, base a, base b, child).
+    Returns bone pairs, sibling pairs, handed quads and flat quads (parent, base a, base b, child).
     """
     bones, siblings, distinct = [], [], []
     for child in children:
@@ -324,16 +354,26 @@ def _rigid_set(
             distinct.append(child)
             bones.append((child, parent))
     if len(distinct) < 2:
-        return bones, siblings, []
+        return bones, siblings, [], []
     arms = key[distinct] - key[parent]
     areas = np.linalg.norm(np.cross(arms[:, None], arms[None]), axis=-1)
     i, j = np.unravel_index(int(np.argmax(areas)), areas.shape)
     if areas[i, j] <= tolerance * float(np.linalg.norm(arms, axis=-1).max()):
-        return bones, siblings, []  # all on one line through the parent: the bones hold it
+        return bones, siblings, [], []  # all on one line through the parent: the bones hold it
     a, b = distinct[min(i, j)], distinct[max(i, j)]
-    others = [c for c in distinct if c not in (a, b)]
-    siblings += [(b, a)] + [(c, base) for c in others for base in (a, b)]
-    return bones, siblings, [(parent, a, b, c) for c in others]
+    normal = np.cross(key[a] - key[parent], key[b] - key[parent]) / areas[i, j]
+    siblings.append((b, a))
+    handed, flat = [], []
+    for k, c in enumerate(distinct):
+        if c in (a, b):
+            continue
+        if abs(float(normal @ arms[k])) > _FLAT * float(np.linalg.norm(arms[k])):
+            siblings += [(c, a), (c, b)]
+            handed.append((parent, a, b, c))
+        else:
+            siblings.append((c, a if areas[k, distinct.index(a)] >= areas[k, distinct.index(b)] else b))
+            flat.append((parent, a, b, c))
+    return bones, siblings, handed, flat
 
 
 def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitProblem:
@@ -345,18 +385,21 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
     kept = level.kept_indices[1:]
     rigid = ~level.animated  # an animated translation has no fixed length to hold
 
-    bones, siblings, quads = [], [], []
+    bones, siblings, quads, flat = [], [], [], []
     for parent in np.unique(level.kept_parent[kept]):
         group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c]]
         rigid_set = _rigid_set(int(parent), group, key, _COINCIDENT * scale)
         bones += rigid_set[0]
         siblings += rigid_set[1]
         quads += [q for q in rigid_set[2] if abs(_volumes(key[None], np.array([q]))[0][0, 0]) > 1e-6 * scale**3]
+        flat += rigid_set[3]
     pairs = np.array(bones + siblings, dtype=np.int64).reshape(-1, 2)
     is_bone = np.arange(pairs.shape[0]) < len(bones)
     lengths = np.linalg.norm(key[pairs[:, 0]] - key[pairs[:, 1]], axis=-1)
     coincident = lengths <= _COINCIDENT * scale
     quads_array = np.array(quads, dtype=np.int64).reshape(-1, 4)
+    flat_array = np.array(flat, dtype=np.int64).reshape(-1, 4)
+    base = np.cross(key[flat_array[:, 1]] - key[flat_array[:, 0]], key[flat_array[:, 2]] - key[flat_array[:, 0]])
 
     triples = []
     children = skeleton.children()
@@ -383,6 +426,9 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
         key_cosines=cosines[0],
         weights=weights,
         length_scale=scale,
+        flat_quads=flat_array,
+        flat_volumes=_volumes(key[None], flat_array)[0][0],
+        flat_areas=np.linalg.norm(base, axis=-1),
     )
 
 
@@ -406,16 +452,9 @@ def split_problem(problem: RefitProblem) -> tuple[list[tuple[np.ndarray, RefitPr
             point = label[point]
         return point
 
-    triples, quads = problem.angle_triples, problem.handed_quads
-    edges = [
-        problem.length_pairs,
-        problem.coincident_pairs,
-        triples[:, :2],
-        triples[:, 1:],
-        quads[:, :2],
-        quads[:, 1:3],
-        quads[:, 2:],
-    ]
+    triples, quads, flat = problem.angle_triples, problem.handed_quads, problem.flat_quads
+    edges = [problem.length_pairs, problem.coincident_pairs, triples[:, :2], triples[:, 1:]]
+    edges += [q[:, k : k + 2] for q in (quads, flat) for k in range(3)]
     coupled = np.zeros(problem.point_count, bool)
     for a, b in np.concatenate([e.reshape(-1, 2) for e in edges]):
         coupled[[a, b]] = True
@@ -430,9 +469,9 @@ def split_problem(problem: RefitProblem) -> tuple[list[tuple[np.ndarray, RefitPr
         renumber[points] = np.arange(points.size)
 
         # A term belongs to the group holding all its points.
-        pairs, together, angles, handed = (
+        pairs, together, angles, handed, flat_held = (
             np.all(renumber[terms] >= 0, axis=1)
-            for terms in (problem.length_pairs, problem.coincident_pairs, triples, quads)
+            for terms in (problem.length_pairs, problem.coincident_pairs, triples, quads, flat)
         )
         result.append(
             (
@@ -449,6 +488,9 @@ def split_problem(problem: RefitProblem) -> tuple[list[tuple[np.ndarray, RefitPr
                     key_cosines=problem.key_cosines[angles],
                     weights=problem.weights,
                     length_scale=problem.length_scale,
+                    flat_quads=renumber[flat[flat_held]].reshape(-1, 4),
+                    flat_volumes=problem.flat_volumes[flat_held],
+                    flat_areas=problem.flat_areas[flat_held],
                 ),
             )
         )

@@ -104,7 +104,7 @@ def _solve_frame(
         constraints(result, z, np.empty(0))
         violation = float(np.abs(result).max())
         if violation > options.feasibility_tolerance:
-            return z, value, evaluations, f"a held length is off by {violation:.3g} L"
+            return z, value, evaluations, f"a held length or flat group's height is off by {violation:.3g} L"
         if problem.handed_quads.size:
             result = np.empty(problem.handed_quads.shape[0])
             handedness(result, z, np.empty(0))

@@ -325,9 +325,13 @@ def handedness_constraints(problem: RefitProblem, x: np.ndarray) -> tuple[np.nda
     return sign * volumes, jacobian
 
 
+Pairs = list[tuple[int, int]]
+Quads = list[tuple[int, int, int, int]]
+
+
 def _rigid_set(
     parent: int, children: list[int], key: np.ndarray, tolerance: float
-) -> tuple[list[tuple[int, int]], list[tuple[int, int]], list[tuple[int, int, int, int]], list[tuple[int, int, int, int]]]:
+) -> tuple[Pairs, Pairs, Quads, Quads]:
     """The constraints that make a kept joint and its kept children one rigid body, none redundant.
 
     A child at the parent's position is tied to the parent, one at an earlier child's position

@@ -19,8 +19,9 @@ chunks; chunks can run in worker processes (threads would not help: the callback
 Every solve is checked: the result must be finite, not worse than its start, and, with hard
 constraints, feasible within ``feasibility_tolerance`` (SLSQP can report success with violated
 constraints) and on the right side of every mirror image. Hard constraints hold every length Es
-holds, bones and siblings, so that forward kinematics of the recovered skeleton reproduces the
-result. A frame that fails is solved again from its cold start, and if that fails too it takes
+holds, bones and siblings, and the height of every flat group's child over its base plane
+(objective.RefitProblem.flat_quads), so that forward kinematics of the recovered skeleton
+reproduces the result. A frame that fails is solved again from its cold start, and if that fails too it takes
 the fallback positions; every such frame is reported in ``RefitResult.failures``.
 """
 

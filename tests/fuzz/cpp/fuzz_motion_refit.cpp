@@ -116,6 +116,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (!cold.empty()) cold[t * stride + k] = original[t * stride + k];
     }
 
+  // Flat quads last, so that inputs written before they existed decode as they did.
+  const size_t nf = in.take<uint8_t>() % 4;
+  const std::vector<int32_t> flat_quads = take_indices(in, nf, 4, points);
+  std::vector<double> flat_volumes(nf), flat_areas(nf);
+  for (size_t k = 0; k < nf; ++k) {
+    flat_volumes[k] = in.take<int8_t>() / 8.0;
+    flat_areas[k] = in.take<int8_t>() / 16.0;  // zero or negative: refused
+  }
+  problem.flat_quads = data_or_null(flat_quads);
+  problem.flat_volumes = data_or_null(flat_volumes);
+  problem.flat_areas = data_or_null(flat_areas);
+  problem.flat_quad_count = nf;
+
   const animlod::Status valid = animlod::validate_motion_refit_problem(problem);
   if (!valid) ANIMLOD_FUZZ_REQUIRE(!valid.message.empty());
 

@@ -10,6 +10,20 @@
 #include "../../cpp/src/motion_refit_detail.hpp"
 #include "animlod/motion_refit.hpp"
 
+// |x_a - x_b| of every pair (a, b) of `pairs` at positions `x` (P, 3).
+inline std::vector<double> pair_lengths(const std::vector<double>& x, const std::vector<int32_t>& pairs) {
+  std::vector<double> lengths;
+  for (size_t k = 0; k < pairs.size() / 2; ++k) {
+    double sum = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const double d = x[3 * pairs[2 * k] + a] - x[3 * pairs[2 * k + 1] + a];
+      sum += d * d;
+    }
+    lengths.push_back(std::sqrt(sum));
+  }
+  return lengths;
+}
+
 // A small figure: root 0, a spine 1-2, a frozen joint 3 with child 4, a coincident point 5 on 1,
 // and three children 6, 7, 8 of 2 spanning a volume (a handed group).
 struct Figure {
@@ -25,14 +39,7 @@ struct Figure {
   animlod::MotionRefitProblem problem;
 
   Figure() {
-    for (size_t k = 0; k < pairs.size() / 2; ++k) {
-      double sum = 0.0;
-      for (int a = 0; a < 3; ++a) {
-        const double d = key[3 * pairs[2 * k] + a] - key[3 * pairs[2 * k + 1] + a];
-        sum += d * d;
-      }
-      key_lengths.push_back(std::sqrt(sum));
-    }
+    key_lengths = pair_lengths(key, pairs);
     problem.point_count = 9;
     problem.length_pairs = pairs.data();
     problem.key_lengths = key_lengths.data();

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import rotations
 from .frozen import FrozenLevel
 
 # Key lengths below this fraction of the length scale count as zero-length ("coincident") pairs.
@@ -137,7 +138,7 @@ def _volumes(x: np.ndarray, quads: np.ndarray) -> tuple[np.ndarray, tuple[np.nda
     u = x[:, quads[:, 1]] - x[:, quads[:, 0]]
     v = x[:, quads[:, 2]] - x[:, quads[:, 0]]
     w = x[:, quads[:, 3]] - x[:, quads[:, 0]]
-    d_u, d_v, d_w = np.cross(v, w), np.cross(w, u), np.cross(u, v)
+    d_u, d_v, d_w = rotations.cross(v, w), rotations.cross(w, u), rotations.cross(u, v)
     return np.sum(u * d_u, axis=-1), (-(d_u + d_v + d_w), d_u, d_v, d_w)
 
 

@@ -55,7 +55,7 @@ def _swing(from_vectors: np.ndarray, to_vectors: np.ndarray) -> np.ndarray:
     """
     a = from_vectors / np.maximum(np.linalg.norm(from_vectors, axis=-1, keepdims=True), 1e-300)
     b = to_vectors / np.maximum(np.linalg.norm(to_vectors, axis=-1, keepdims=True), 1e-300)
-    q = np.concatenate([np.cross(a, b), 1.0 + np.sum(a * b, axis=-1, keepdims=True)], axis=-1)
+    q = np.concatenate([rotations.cross(a, b), 1.0 + np.sum(a * b, axis=-1, keepdims=True)], axis=-1)
     opposite = np.linalg.norm(q, axis=-1) < 1e-12
     if opposite.any():
         helper = np.where(np.abs(a[opposite, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])

@@ -109,7 +109,9 @@ def test_refit_choice_takes_the_proposal_with_the_lowest_trial_error_and_stays_n
         chosen = set(np.flatnonzero(level.frozen))
         return float(len(chosen - set(depth_first[: len(chosen)])))
 
-    chosen = choose_by_refit(motion, analysis, counts, trial_error)
+    calls: list[tuple[int, int]] = []
+    chosen = choose_by_refit(motion, analysis, counts, trial_error, lambda *call: calls.append(call))
+    assert calls == [(1, 3), (2, 3), (3, 3)]
     assert chosen.priority[:9] == depth_first[:9] or sorted(chosen.priority[:9]) == sorted(depth_first[:9])
     assert sorted(chosen.priority) == sorted(analysis.priority)
     assert trials and set(trials) == {16}

@@ -82,16 +82,27 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 class _Progress:
-    """tqdm over levels, and over frames inside each level."""
+    """tqdm over the default ranking's choice of joints, then over levels, and over frames inside
+    each level."""
 
-    def __init__(self, level_count: int) -> None:
+    def __init__(self) -> None:
         from tqdm import tqdm
 
         self._tqdm = tqdm
-        self.levels = tqdm(total=level_count, desc="levels", unit="level", position=0)
+        self.choice = None
+        self.levels = None
         self.frames = None
 
-    def start_level(self, index: int, joints: int, frame_count: int):
+    def chose(self, chosen: int, to_choose: int) -> None:
+        if self.choice is None:
+            self.choice = self._tqdm(total=to_choose, desc="choosing joints (trial re-fits)", unit="level", position=0)
+        self.choice.update(chosen - self.choice.n)
+        if chosen == to_choose:
+            self.choice.close()
+
+    def start_level(self, index: int, joints: int, frame_count: int, level_count: int):
+        if self.levels is None:
+            self.levels = self._tqdm(total=level_count, desc="levels", unit="level", position=0)
         if self.frames is not None:
             self.frames.close()
             self.levels.update(1)
@@ -103,7 +114,9 @@ class _Progress:
         if self.frames is not None:
             self.frames.close()
             self.levels.update(1)
-        self.levels.close()
+        for bar in (self.choice, self.levels):
+            if bar is not None:
+                bar.close()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -117,12 +130,15 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--ranking: no ranking named {args.ranking!r} (choose from {', '.join(RANKINGS)})")
     if input_kind(args.input) not in ("bvh", "gltf"):
         raise UserError(f"{args.input}: motion LoD needs a .bvh or a skinned .glb/.gltf")
-    bars: list[_Progress] = []  # made when the first level starts: bad input fails before any bar
+    bars: list[_Progress] = []  # made when the work starts: bad input fails before any bar
+
+    def progress() -> _Progress:
+        if not bars:
+            bars.append(_Progress())
+        return bars[0]
 
     def on_level(index: int, joints: int, frame_count: int, level_count: int):
-        if not bars:
-            bars.append(_Progress(level_count))
-        return bars[0].start_level(index, joints, frame_count)
+        return progress().start_level(index, joints, frame_count, level_count)
 
     try:
         report = build_motion_levels(
@@ -140,6 +156,7 @@ def run(args: argparse.Namespace) -> int:
             max_frames=args.max_frames,
             clip=args.clip,
             on_level=on_level,
+            on_choice=lambda chosen, to_choose: progress().chose(chosen, to_choose),
             on_note=lambda text: print(text, file=sys.stderr),
         )
     finally:

@@ -331,6 +331,7 @@ def build_motion_chain(
     on_level: Callable[[int, int], Callable[[float], None] | None] | None = None,
     analysis: MotionAnalysis | None = None,
     ranking: str = DEFAULT_RANKING,
+    on_choice: Callable[[int, int], None] | None = None,
 ) -> MotionLodChain:
     """Analyse ``motion`` and build its levels.
 
@@ -355,6 +356,8 @@ def build_motion_chain(
         ``max_frames`` and ``ranking`` are not used).
     ranking : the joint elimination order (ranking.RANKINGS; by default "refit": each level's next
         joints chosen by their error after a trial re-fit, refit_choice.py).
+    on_choice : with the "refit" ranking, called with (levels chosen, levels to choose) as its
+        trial re-fits, which run before the first level, finish each level.
 
     Returns
     -------
@@ -371,7 +374,7 @@ def build_motion_chain(
             solved = _solve_level(level, sample, weights, solver, slsqp_options, workers, None)
             return float(np.linalg.norm(solved.placed - solved.original, axis=-1).mean())
 
-        analysis = choose_by_refit(motion, analysis, counts, trial_error)
+        analysis = choose_by_refit(motion, analysis, counts, trial_error, on_choice)
     result = []
     for index, count in enumerate(counts):
         progress = on_level(index, count) if on_level else None

@@ -47,6 +47,7 @@ def choose_by_refit(
     analysis: MotionAnalysis,
     counts: Sequence[int],
     trial_error: Callable[[FrozenLevel, Motion], float],
+    progress: Callable[[int, int], None] | None = None,
 ) -> MotionAnalysis:
     """``analysis`` with its priority chosen level by level by the re-fit's error.
 
@@ -56,6 +57,7 @@ def choose_by_refit(
     analysis : its analysis (key frames, importance, candidates in ``priority``).
     counts : joint counts of the levels, strictly decreasing, the first every joint.
     trial_error : mean joint position error of a frozen level re-fitted on a sample motion.
+    progress : called with (levels chosen, levels to choose) after each level.
 
     Returns
     -------
@@ -64,7 +66,7 @@ def choose_by_refit(
     orders = proposal_orders(motion, analysis)
     sample = motion.take_frames(np.unique(np.round(np.linspace(0, motion.frame_count - 1, TRIAL_FRAMES)).astype(int)))
     frozen: list[int] = []
-    for count in counts[1:]:
+    for chosen, count in enumerate(counts[1:], start=1):
         need = counts[0] - count - len(frozen)
         proposals: list[list[int]] = []
         for order in orders:
@@ -75,4 +77,6 @@ def choose_by_refit(
             errors = [trial_error(freeze(motion, analysis, frozen + p), sample) for p in proposals]
             proposals = [proposals[int(np.argmin(errors))]]  # first lowest: the earlier ranking
         frozen += proposals[0] if proposals else []
+        if progress:
+            progress(chosen, len(counts) - 1)
     return dataclasses.replace(analysis, priority=frozen + [j for j in analysis.priority if j not in frozen])

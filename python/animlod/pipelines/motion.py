@@ -61,6 +61,7 @@ def build_motion_levels(
     max_frames: int = 600,
     clip: int | None = None,
     on_level: Callable[[int, int, int, int], Callable[[float], None] | None] | None = None,
+    on_choice: Callable[[int, int], None] | None = None,
     on_note: Callable[[str], None] | None = None,
 ) -> MotionReport:
     """Motion levels of ``source`` (a .bvh, or a .glb/.gltf with a skinned mesh and animations)
@@ -84,6 +85,8 @@ def build_motion_levels(
         each moves other joints (one animation per joint node).
     on_level : called with (level index, joint count, frame count, number of levels) as each
         level starts; may return a callback taking the frames done.
+    on_choice : called with (levels chosen, levels to choose) while the "refit" ranking's trial
+        re-fits choose the joints, before the first level.
     on_note : called with each note as it arises (also kept in the report).
 
     Raises FormatError for unreadable input or a glTF without a skinned, animated mesh;
@@ -123,6 +126,7 @@ def build_motion_levels(
         skin=skin,
         on_level=(lambda index, count: on_level(index, count, motion.frame_count, len(counts))) if on_level else None,
         analysis=analysis,
+        on_choice=on_choice,
     )
 
     from ..io.bvh import write_bvh

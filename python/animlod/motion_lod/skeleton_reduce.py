@@ -23,6 +23,7 @@ import numpy as np
 from .. import rotations
 from ..model import Motion, Skeleton
 from .frozen import FrozenLevel, held_translations
+from .ranking import joint_depths
 
 # Child offsets shorter than this fraction of the level's extent give no direction.
 _SHORT = 1e-9
@@ -100,34 +101,39 @@ def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) ->
     static_offsets = np.linalg.norm(skeleton.offsets, axis=-1)
 
     world = np.empty_like(original_world)
-    local = np.empty_like(original_world)
     placed = np.empty_like(targets)  # where forward kinematics has put each joint so far
     placed[:, 0] = targets[:, 0]
     translating = level.animated[kept]
-    for joint in range(skeleton.joint_count):
-        parent = skeleton.parents[joint]
-        if parent >= 0 and translating[joint]:  # no fixed bone: the translation follows the re-fit
-            translations[:, joint] = rotations.rotate(
-                rotations.conjugate(world[:, parent]), targets[:, joint] - placed[:, parent]
-            )
-        if parent >= 0:
-            placed[:, joint] = placed[:, parent] + rotations.rotate(world[:, parent], translations[:, joint])
-        # Children at a fixed offset give the joint its direction; a translating child is placed
-        # by its own translation below, whatever this rotation is.
-        useful = [c for c in children[joint] if static_offsets[c] > _SHORT * scale and not translating[c]]
-        base = original_world[:, joint]
-        if useful:
-            offsets = rotations.rotate(base[:, None], translations[:, useful])
-            # Aim from where the joint really is, so that misfits do not pile up down a chain.
-            wanted = targets[:, useful] - placed[:, joint, None]
-            if _spans_a_plane(skeleton.offsets[useful]):
-                correction = _best_fit_rotation(offsets, wanted)
-            else:
-                longest = int(np.argmax(static_offsets[useful]))
-                correction = _swing(offsets[:, longest], wanted[:, longest])
-            base = rotations.multiply(correction, base)
-        world[:, joint] = base
-        local[:, joint] = base if parent < 0 else rotations.multiply(rotations.conjugate(world[:, parent]), base)
+    # Children at a fixed offset give a joint its direction; a translating child is placed by its
+    # own translation, whatever this rotation is. Aimed by a best-fit rotation when they span a
+    # plane, else by the swing towards the longest.
+    useful = [[c for c in children[j] if static_offsets[c] > _SHORT * scale and not translating[c]]
+              for j in range(skeleton.joint_count)]  # fmt: skip
+    planar = np.array([_spans_a_plane(skeleton.offsets[u]) for u in useful], bool)
+    depth = joint_depths(skeleton.parents)
+    for layer in range(int(depth.max()) + 1):  # joints of one depth at once: O(depth) numpy steps
+        joints = np.flatnonzero(depth == layer)
+        parents = skeleton.parents[joints]
+        if layer > 0:
+            moving = translating[joints]  # no fixed bone: the translation follows the re-fit
+            if moving.any():
+                j, p = joints[moving], parents[moving]
+                translations[:, j] = rotations.rotate(rotations.conjugate(world[:, p]), targets[:, j] - placed[:, p])
+            placed[:, joints] = placed[:, parents] + rotations.rotate(world[:, parents], translations[:, joints])
+        world[:, joints] = original_world[:, joints]
+        # Aim from where each joint really is, so that misfits do not pile up down a chain.
+        aimed = [j for j in joints if useful[j] and not planar[j]]
+        if aimed:
+            longest = [useful[j][int(np.argmax(static_offsets[useful[j]]))] for j in aimed]
+            offsets = rotations.rotate(world[:, aimed], translations[:, longest])
+            wanted = targets[:, longest] - placed[:, aimed]
+            world[:, aimed] = rotations.multiply(_swing(offsets, wanted), world[:, aimed])
+        for j in (j for j in joints if planar[j]):  # a few per skeleton (hips, chest, hands)
+            offsets = rotations.rotate(world[:, j, None], translations[:, useful[j]])
+            wanted = targets[:, useful[j]] - placed[:, j, None]
+            world[:, j] = rotations.multiply(_best_fit_rotation(offsets, wanted), world[:, j])
+    local = world.copy()
+    local[:, 1:] = rotations.multiply(rotations.conjugate(world[:, skeleton.parents[1:]]), world[:, 1:])
     joint_translations = translations if motion.joint_translations is not None else None
     return Motion(skeleton, positions[:, 0], local, motion.fps, motion.name, joint_translations)
 

@@ -37,8 +37,8 @@ from animlod.io import write_glb
 from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_drawable import Drawable, read_drawables
 from animlod.metrics import surface_error
-from animlod.model import AnimatedMesh
-from animlod.pipelines.drawable_levels import posed_frames, simplify_drawable, spread_frames
+from animlod.model import AnimatedMesh, spread_frames
+from animlod.pipelines.drawable_levels import posed_frames, simplify_drawable
 
 RATIOS = (0.5, 0.25, 0.1)
 MEASURED_FRAMES = 16  # per clip

@@ -29,6 +29,7 @@ seconds (all threads of this process) are given beside wall seconds.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import sys
 import time
@@ -60,11 +61,7 @@ def subsample(motion: Motion, stride: int) -> Motion:
     """Every ``stride``-th frame."""
     if stride <= 1:
         return motion
-    translations = None if motion.joint_translations is None else motion.joint_translations[::stride]
-    return Motion(
-        motion.skeleton, motion.root_positions[::stride], motion.local_rotations[::stride], motion.fps / stride,
-        motion.name, translations,
-    )  # fmt: skip
+    return dataclasses.replace(motion.take_frames(slice(None, None, stride)), fps=motion.fps / stride)
 
 
 def clips(quick: bool) -> list[tuple[str, Motion]]:

@@ -14,6 +14,11 @@ import numpy as np
 from . import _core, rotations
 
 
+def spread_frames(frame_count: int, count: int) -> np.ndarray:
+    """(<= count,) int frame indices spread evenly over [0, frame_count), both ends included."""
+    return np.unique(np.linspace(0, frame_count - 1, min(count, frame_count)).round().astype(np.int64))
+
+
 def _require(condition: bool, what: str) -> None:
     if not condition:
         raise ValueError(what)
@@ -232,8 +237,9 @@ class Motion:
         translations[:, 0] = self.root_positions
         return translations
 
-    def take_frames(self, frames: np.ndarray) -> Motion:
-        """The motion at ``frames`` (indices into this motion), same skeleton, name and fps."""
+    def take_frames(self, frames: np.ndarray | slice) -> Motion:
+        """The motion at ``frames`` (indices into this motion, or a slice), same skeleton, name
+        and fps."""
         translations = None if self.joint_translations is None else self.joint_translations[frames]
         return Motion(
             self.skeleton, self.root_positions[frames], self.local_rotations[frames], self.fps, self.name, translations

@@ -91,7 +91,7 @@ class Drawable:
         frames = np.arange(clip.frame_count) if frames is None else np.asarray(frames)
         weights = None if clip.morph_weights is None else clip.morph_weights[frames]
         if self.skinned is not None:
-            motion = motion_frames(clip.motion, frames)
+            motion = clip.motion.take_frames(frames)
             return self.skinned.bake(motion, weights).frames
         rest = self.rest_positions().astype(np.float64)
         if weights is None:
@@ -186,17 +186,4 @@ def _rest_motion(rig: SkinRig, frame_count: int, fps: float) -> Motion:
         np.repeat(skeleton.offsets[None, 0], frame_count, axis=0),
         np.repeat(skeleton.rest_rotations[None], frame_count, axis=0),
         fps=fps,
-    )
-
-
-def motion_frames(motion: Motion, frames: np.ndarray) -> Motion:
-    """``motion`` restricted to the given frame indices."""
-    translations = None if motion.joint_translations is None else motion.joint_translations[frames]
-    return Motion(
-        motion.skeleton,
-        motion.root_positions[frames],
-        motion.local_rotations[frames],
-        fps=motion.fps,
-        name=motion.name,
-        joint_translations=translations,
     )

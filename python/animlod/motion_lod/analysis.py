@@ -40,8 +40,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import rotations
-from ..model import Motion
-from .ranking import DEFAULT_RANKING, PAPER_RANKING, RANKINGS, rank_scores
+from ..model import Motion, spread_frames
+from .ranking import DEFAULT_RANKING, PAPER_RANKING, RANKINGS, elimination_order, rank_scores
 
 
 @dataclass(frozen=True)
@@ -251,7 +251,7 @@ def analyze_motion(
         raise ValueError(f"locked: {end_site_locks[0]!r} is an end site, not a joint")
 
     if motion.frame_count > max_frames:
-        frames = np.unique(np.round(np.linspace(0, motion.frame_count - 1, max_frames)).astype(np.int64))
+        frames = spread_frames(motion.frame_count, max_frames)
     else:
         frames = np.arange(motion.frame_count, dtype=np.int64)
     r_max = _r_max(motion)
@@ -267,12 +267,10 @@ def analyze_motion(
     candidates[locked_indices] = False
     candidates[translating] = False
     scores = rank_scores(ranking, motion, importance, key_frames, frames, candidates)
-    order = np.lexsort((np.arange(skeleton.joint_count), scores))
-    priority = [int(j) for j in order if candidates[j]]
     return MotionAnalysis(
         key_frames,
         importance,
-        priority,
+        elimination_order(scores, candidates),
         locked_indices,
         frames,
         r_max,

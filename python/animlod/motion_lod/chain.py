@@ -252,6 +252,10 @@ class _Solved:
     placed: np.ndarray
     original: np.ndarray
 
+    def errors(self) -> np.ndarray:
+        """(T, J) distance of every original point from its original position."""
+        return np.linalg.norm(self.placed - self.original, axis=-1)
+
 
 def _solve_level(
     level: FrozenLevel,
@@ -299,7 +303,7 @@ def build_level(
     solved = _solve_level(level, motion, weights, solver, slsqp_options, workers, progress)
     result = solved.result
     fk = solved.output.world_positions()
-    error = np.linalg.norm(solved.placed - solved.original, axis=-1)
+    error = solved.errors()
     bone_error, bone_variation = _bone_statistics(solved.problem, result.positions)
     report = LevelReport(
         joint_count=level.joint_count,
@@ -372,7 +376,7 @@ def build_motion_chain(
 
         def trial_error(level: FrozenLevel, sample: Motion) -> float:
             solved = _solve_level(level, sample, weights, solver, slsqp_options, workers, None)
-            return float(np.linalg.norm(solved.placed - solved.original, axis=-1).mean())
+            return float(solved.errors().mean())
 
         analysis = choose_by_refit(motion, analysis, counts, trial_error, on_choice)
     result = []

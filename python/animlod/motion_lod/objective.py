@@ -365,7 +365,8 @@ def _rigid_set(
     i, j = np.unravel_index(int(np.argmax(areas)), areas.shape)
     if areas[i, j] <= tolerance * float(np.linalg.norm(arms, axis=-1).max()):
         return bones, siblings, [], []  # all on one line through the parent: the bones hold it
-    a, b = distinct[min(i, j)], distinct[max(i, j)]
+    ia, ib = min(i, j), max(i, j)
+    a, b = distinct[ia], distinct[ib]
     normal = np.cross(key[a] - key[parent], key[b] - key[parent]) / areas[i, j]
     siblings.append((b, a))
     handed, flat = [], []
@@ -376,7 +377,7 @@ def _rigid_set(
             siblings += [(c, a), (c, b)]
             handed.append((parent, a, b, c))
         else:
-            siblings.append((c, a if areas[k, distinct.index(a)] >= areas[k, distinct.index(b)] else b))
+            siblings.append((c, a if areas[k, ia] >= areas[k, ib] else b))
             flat.append((parent, a, b, c))
     return bones, siblings, handed, flat
 

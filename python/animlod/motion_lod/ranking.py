@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import rotations
-from ..model import Motion
+from ..model import Motion, spread_frames
 
 RANKINGS = ("refit", "importance", "paper", "depth", "variance", "cumulative")
 DEFAULT_RANKING = "refit"
@@ -100,7 +100,7 @@ def cumulative_scores(
     count = skeleton.joint_count
     joints = np.arange(count)
     if frames.size > CUMULATIVE_FRAMES:
-        frames = frames[np.round(np.linspace(0, frames.size - 1, CUMULATIVE_FRAMES)).astype(np.int64)]
+        frames = frames[spread_frames(frames.size, CUMULATIVE_FRAMES)]
     key_local = rotations.compose_transform(
         motion.local_translations()[key_frames, joints], motion.local_rotations[key_frames, joints]
     )  # (J, 4, 4)
@@ -114,6 +114,7 @@ def cumulative_scores(
     cost = np.full(count, np.inf)  # mean growth of the summed error if the joint froze next
     stale = candidates.copy()
     scores = np.full(count, np.inf)
+
     def moves(joints: np.ndarray) -> np.ndarray:
         """(n, len(joints), 4, 4): how each joint's subtree moves if it froze now (its frozen world
         transform times the inverse of its current one)."""
@@ -136,6 +137,11 @@ def cumulative_scores(
         error[:, below] = np.linalg.norm(positions[:, below] - original[:, below], axis=-1)
         stale = (below | subtree[:, chosen]) & candidates & np.isfinite(cost)
     return scores
+
+
+def elimination_order(scores: np.ndarray, candidates: np.ndarray) -> list[int]:
+    """The candidates (``(J,) bool``) by ascending ``scores (J,)``, ties by index."""
+    return [int(j) for j in np.lexsort((np.arange(scores.size), scores)) if candidates[j]]
 
 
 def rank_scores(

@@ -20,10 +20,10 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..model import Motion
+from ..model import Motion, spread_frames
 from .analysis import MotionAnalysis
 from .frozen import FrozenLevel, freeze
-from .ranking import PROPOSING_RANKINGS, rank_scores
+from .ranking import PROPOSING_RANKINGS, elimination_order, rank_scores
 
 # Frames each proposal is re-fitted on: the error is a mean over frames, and the proposals of one
 # level differ by whole joints, so a few frames tell them apart (the chain re-fits every frame).
@@ -32,14 +32,15 @@ TRIAL_FRAMES = 16
 
 def proposal_orders(motion: Motion, analysis: MotionAnalysis) -> list[list[int]]:
     """The elimination order of every ranking of PROPOSING_RANKINGS over the analysis's candidates."""
-    count = motion.skeleton.joint_count
-    candidates = np.zeros(count, bool)
+    candidates = np.zeros(motion.skeleton.joint_count, bool)
     candidates[analysis.priority] = True
-    orders = []
-    for name in PROPOSING_RANKINGS:
-        scores = rank_scores(name, motion, analysis.importance, analysis.key_frames, analysis.frames, candidates)
-        orders.append([int(j) for j in np.lexsort((np.arange(count), scores)) if candidates[j]])
-    return orders
+    return [
+        elimination_order(
+            rank_scores(name, motion, analysis.importance, analysis.key_frames, analysis.frames, candidates),
+            candidates,
+        )
+        for name in PROPOSING_RANKINGS
+    ]
 
 
 def choose_by_refit(
@@ -64,7 +65,7 @@ def choose_by_refit(
     MotionAnalysis whose ``priority`` freezes, for each count, the chosen joints first.
     """
     orders = proposal_orders(motion, analysis)
-    sample = motion.take_frames(np.unique(np.round(np.linspace(0, motion.frame_count - 1, TRIAL_FRAMES)).astype(int)))
+    sample = motion.take_frames(spread_frames(motion.frame_count, TRIAL_FRAMES))
     frozen: list[int] = []
     for chosen, count in enumerate(counts[1:], start=1):
         need = counts[0] - count - len(frozen)

@@ -28,7 +28,7 @@ import numpy as np
 from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
-from ..io.gltf_drawable import Clip, Drawable, motion_frames, read_drawables
+from ..io.gltf_drawable import Clip, Drawable, read_drawables
 from ..io.gltf_lod import (
     GRID_EXTRA,
     LevelInfo,
@@ -40,11 +40,11 @@ from ..io.gltf_lod import (
 )
 from ..io.gltf_write import add_animation, add_skeleton, add_skin
 from ..metrics import surface_error
-from ..model import AnimatedMesh, Motion, SkinnedMesh
+from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
-from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable, spread_frames
+from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
 
 
@@ -200,7 +200,7 @@ def _add_motion_levels(builder: GlbBuilder, chain: MotionLodChain, clips: list) 
         for clip, span in clips:
             name = f"{clip.name or f'animation {clip.index}'}@motion{m}"
             extras = {"animlod": {"clip": clip.index, "motion_level": m}}
-            clip_motion = motion_frames(level.motion, np.arange(span.start, span.stop))
+            clip_motion = level.motion.take_frames(np.arange(span.start, span.stop))
             add_animation(builder, clip_motion, joint_nodes, name, extras)
         nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))
     return nodes
@@ -307,7 +307,7 @@ def _measure_chain(
             frames = spread_frames(clip.frame_count, measured_frames)
             weights = None if clip.morph_weights is None else clip.morph_weights[frames]
             original = AnimatedMesh(drawable.geometry.faces, drawable.clip_frames(clip, frames))
-            posed = reduced.bake(motion_frames(motion_level.motion, span.start + frames), weights)
+            posed = reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
             error = max(error, float(surface_error(original, posed, samples=4000).hausdorff.max()))
         faces = level.simplified.mesh.face_count
         report.append(CharacterLevel(i, i, m, faces, motion_level.report.joint_count, error, 0.0, 0.0))

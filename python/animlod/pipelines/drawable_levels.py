@@ -26,11 +26,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aqem import Preparation, SimplifiedLevel, simplify_animated
-from ..io.gltf_drawable import Clip, Drawable, motion_frames
+from ..io.gltf_drawable import Clip, Drawable
 from ..io.gltf_lod import PrimitiveArrays
 from ..io.gltf_mesh import PrimitiveGeometry, transform_points
 from ..metrics import surface_error
-from ..model import AnimatedMesh, SkinnedMesh
+from ..model import AnimatedMesh, SkinnedMesh, spread_frames
 from ..options import AqemOptions
 
 _SKIN_PREFIXES = ("JOINTS_", "WEIGHTS_")
@@ -192,11 +192,6 @@ def _drive_frames(drawable: Drawable, budget: int) -> np.ndarray:
         count = int(np.clip(round(share * remaining), 2, clip.frame_count))
         frames.append(drawable.clip_frames(clip, spread_frames(clip.frame_count, count)))
     return np.concatenate(frames).astype(np.float32)
-
-
-def spread_frames(frame_count: int, count: int) -> np.ndarray:
-    """(<= count,) int frame indices spread evenly over [0, frame_count), both ends included."""
-    return np.unique(np.linspace(0, frame_count - 1, min(count, frame_count)).round().astype(np.int64))
 
 
 def _attribute_matrix(drawable: Drawable) -> tuple[np.ndarray, _Layout]:
@@ -437,7 +432,7 @@ def posed_frames(drawable: Drawable, level: DrawableLevel, clip: Clip | None, fr
         return level.rest[None]
     weights = None if clip.morph_weights is None else clip.morph_weights[frames]
     if level.skinned is not None:
-        return level.skinned.bake(motion_frames(clip.motion, frames), weights).frames
+        return level.skinned.bake(clip.motion.take_frames(frames), weights).frames
     if weights is None:
         return np.broadcast_to(level.rest, (len(frames),) + level.rest.shape)
     return (level.rest + np.einsum("tn,nvc->tvc", weights, level.morph_targets)).astype(np.float32)

@@ -50,6 +50,7 @@ from animlod.motion_lod.core_refit import refit_core
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.objective import build_problem
 from animlod.motion_lod.refit import refit_slsqp
+from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR
 from animlod.options import MotionRefitOptions
 from animlod.synth import humanoid, humanoid_motion
 
@@ -215,8 +216,9 @@ def ranking_table(label: str, motion: Motion) -> None:
         for k, count in enumerate(counts[1:]):
             values = [getattr(chains[r][k].report, f"{statistic}_error") for r in RANKINGS]
             best = min(values)
-            tolerance = 1e-9 * max(best, 1e-12) + 1e-12
-            winners = [r for r, v in zip(RANKINGS, values) if v <= best + max(tolerance, 1e-6 * best)]
+            # Below the float32 keys' resolution (refit_choice.NEGLIGIBLE_ERROR) errors are ties.
+            tolerance = max(1e-6 * best, NEGLIGIBLE_ERROR * chains["refit"][k].frozen.length_scale())
+            winners = [r for r, v in zip(RANKINGS, values) if v <= best + tolerance]
             rows.append((count, *[f"{v:.4g}" for v in values], ", ".join(winners)))
         print_table(
             f"{label} ({motion.frame_count} frames): {statistic} joint position error per ranking, same re-fit",

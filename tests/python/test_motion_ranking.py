@@ -13,7 +13,7 @@ from animlod.motion_lod import RANKINGS, analyze_motion, build_motion_chain, lev
 from animlod.motion_lod.chain import build_level
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.ranking import PROPOSING_RANKINGS, joint_depths, rotation_variance
-from animlod.motion_lod.refit_choice import choose_by_refit, proposal_orders
+from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR, choose_by_refit, proposal_orders
 from animlod.synth import humanoid, humanoid_motion
 
 
@@ -115,9 +115,17 @@ def test_refit_choice_takes_the_proposal_with_the_lowest_trial_error_and_stays_n
     assert chosen.priority[:9] == depth_first[:9] or sorted(chosen.priority[:9]) == sorted(depth_first[:9])
     assert sorted(chosen.priority) == sorted(analysis.priority)
     assert trials and set(trials) == {16}
-    # A trial error that cannot tell the proposals apart keeps the first: importance.
-    tied = choose_by_refit(motion, analysis, counts, lambda level, sample: 0.0)
-    assert tied.priority == analysis.priority
+    # Trial errors that cannot tell the proposals apart keep the first: importance. At the float32
+    # keys' resolution the first proposal ends its level's trials; above it every one is tried.
+    for error, tries_all in ((NEGLIGIBLE_ERROR, False), (2 * NEGLIGIBLE_ERROR, True)):
+        tried: list[int] = []
+
+        def tie(level, sample, error=error, tried=tried) -> float:
+            tried.append(int(level.frozen.sum()))
+            return error * level.length_scale()
+
+        assert choose_by_refit(motion, analysis, counts, tie).priority == analysis.priority
+        assert (len(set(tried)) < len(tried)) == tries_all, tried
 
 
 def test_refit_choice_beats_importance_and_depth_on_the_walk() -> None:

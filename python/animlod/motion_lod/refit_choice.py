@@ -11,6 +11,11 @@ ranking.PROPOSING_RANKINGS proposes its next joints after those already frozen; 
 proposal is frozen and re-fitted on TRIAL_FRAMES evenly spaced frames of the clip, and the one
 with the lowest mean joint position error over every original point is kept (ties: the earlier
 ranking, importance first). A joint frozen at one level stays frozen at every coarser one.
+
+Proposals are tried in ranking order, and one whose error is at the resolution of the float32 keys
+the levels are written with (NEGLIGIBLE_ERROR) is kept without trying the rest: below it the
+proposals cannot be told apart (the dev clips' finest levels differ by 1e-16 of the figure, and
+trying them all was most of the choice's cost on short clips with fingers).
 """
 
 from __future__ import annotations
@@ -28,6 +33,10 @@ from .ranking import PROPOSING_RANKINGS, elimination_order, rank_scores
 # Frames each proposal is re-fitted on: the error is a mean over frames, and the proposals of one
 # level differ by whole joints, so a few frames tell them apart (the chain re-fits every frame).
 TRIAL_FRAMES = 16
+# A trial error at most this fraction of the figure's size (the level's length scale) is float32
+# round-off: storing a dev clip's own keys as float32 moves its joints by 1e-8 to 3e-8 of the
+# figure on average and 1.1e-7 at most.
+NEGLIGIBLE_ERROR = 1e-7
 
 
 def proposal_orders(motion: Motion, analysis: MotionAnalysis) -> list[list[int]]:
@@ -75,9 +84,23 @@ def choose_by_refit(
             if proposal and sorted(proposal) not in [sorted(p) for p in proposals]:
                 proposals.append(proposal)
         if len(proposals) > 1:
-            errors = [trial_error(freeze(motion, analysis, frozen + p), sample) for p in proposals]
-            proposals = [proposals[int(np.argmin(errors))]]  # first lowest: the earlier ranking
+            levels = [freeze(motion, analysis, frozen + p) for p in proposals]
+            proposals = [proposals[_lowest_error(levels, sample, trial_error)]]
         frozen += proposals[0] if proposals else []
         if progress:
             progress(chosen, len(counts) - 1)
     return dataclasses.replace(analysis, priority=frozen + [j for j in analysis.priority if j not in frozen])
+
+
+def _lowest_error(
+    levels: list[FrozenLevel], sample: Motion, trial_error: Callable[[FrozenLevel, Motion], float]
+) -> int:
+    """Index of the first level with the lowest trial error, or of the first whose error is negligible."""
+    best, best_error = 0, np.inf
+    for index, level in enumerate(levels):
+        error = trial_error(level, sample)
+        if error < best_error:
+            best, best_error = index, error
+        if best_error <= NEGLIGIBLE_ERROR * level.length_scale():
+            break
+    return best

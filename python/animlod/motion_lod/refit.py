@@ -39,6 +39,10 @@ from .objective import RefitProblem, handedness_constraints, objective, rigidity
 # E >= alpha |x - x^o|^2 / L^2 (Eq. 6): original positions or a cold start with E below this are
 # the optimum to ~1e-12 L (a group no frozen joint touches), solved without a call to SLSQP.
 _NEGLIGIBLE_OBJECTIVE = 1e-24
+# SLSQP also stops when E changes by less than this (~1e-11 L in the positions): on a level that
+# reproduces the clip almost exactly, E's own rounding is above ftol_rel. The core's
+# kObjectiveResolution (cpp/src/motion_refit_solve.cpp), where the reason is measured.
+_OBJECTIVE_RESOLUTION = 1e-22
 
 
 def _positions(problem: RefitProblem, original: np.ndarray, z: np.ndarray) -> np.ndarray:
@@ -88,6 +92,7 @@ def _solve_frame(
         if problem.handed_quads.size:
             opt.add_inequality_mconstraint(handedness, np.zeros(problem.handed_quads.shape[0]))
     opt.set_ftol_rel(options.ftol_rel)
+    opt.set_ftol_abs(_OBJECTIVE_RESOLUTION)
     opt.set_maxeval(options.max_evaluations)
     start_value = energy(z0, np.empty(0))
     z = np.asarray(opt.optimize(z0.copy()), dtype=np.float64)

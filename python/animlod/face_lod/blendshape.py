@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aqem import simplify_animated
-from ..model import AnimatedMesh
+from ..model import AnimatedMesh, spread_frames
 from .grow import GrowOptions, grow_regions, motion_of_targets
 from .regions import FaceRegions
 
@@ -315,7 +315,7 @@ def measure_blendshape_lod(
     bounding-box diagonal."""
     from ..metrics import surface_error
 
-    picked = np.unique(np.linspace(0, len(face.weights) - 1, min(max_frames, len(face.weights))).round().astype(int))
+    picked = spread_frames(len(face.weights), max_frames)
     weights = face.weights[picked]
     reference = face.frames(weights)
     rows = []

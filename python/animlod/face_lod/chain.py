@@ -27,7 +27,7 @@ import numpy as np
 
 from ..aqem import simplify_animated
 from ..metrics import surface_error
-from ..model import AnimatedMesh
+from ..model import AnimatedMesh, spread_frames
 from .active_tree import ActiveTree
 from .mpa import MpaAnimation
 from .regions import FaceRegions
@@ -158,7 +158,7 @@ def build_face_lod(
         raise ValueError("face LoD: the animation's MPAs are not the rig's (same names, same order expected)")
     full = rig.animator()
     # Phase 1: the frames AQEM sees: the rest pose, then evenly spaced animation frames.
-    picked = np.unique(np.linspace(0, animation.frame_count - 1, max(1, options.max_frames - 1)).round().astype(int))
+    picked = spread_frames(animation.frame_count, max(1, options.max_frames - 1))
     frames = np.concatenate([rig.positions[None], full.frames(animation.intensities[picked])])
     importance = rig.regions.vertex_importance() if options.region_importance else None
     if options.face_counts is not None:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..metrics import surface_error
-from ..model import AnimatedMesh
+from ..model import AnimatedMesh, spread_frames
 from .chain import FaceLodChain
 from .mpa import MpaAnimation
 from .rig import LevelAnimator
@@ -175,7 +175,7 @@ def every_nth(animation: MpaAnimation, count: int) -> MpaAnimation:
     """At most ``count`` evenly spaced frames of ``animation`` (all of them when ``count`` is 0)."""
     if count <= 0 or count >= animation.frame_count:
         return animation
-    picked = np.unique(np.linspace(0, animation.frame_count - 1, count).round().astype(int))
+    picked = spread_frames(animation.frame_count, count)
     return MpaAnimation(animation.mpa_names, animation.intensities[picked], animation.fps)
 
 

@@ -414,8 +414,7 @@ def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: i
     faces = drawable.geometry.faces
     samples: list[tuple[Clip | None, np.ndarray]] = [(None, np.zeros(1, int))]
     for clip in drawable.clips:
-        count = min(measured_frames, clip.frame_count)
-        samples.append((clip, np.unique(np.linspace(0, clip.frame_count - 1, count).round().astype(int))))
+        samples.append((clip, spread_frames(clip.frame_count, measured_frames)))
     for clip, frames in samples:
         original = AnimatedMesh(
             faces, drawable.rest_positions()[None] if clip is None else drawable.clip_frames(clip, frames)

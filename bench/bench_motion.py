@@ -94,6 +94,24 @@ def joints_of(motion: Motion) -> int:
     return int(np.count_nonzero(~motion.skeleton.end_sites))
 
 
+def float32_keys_error(motion: Motion, size: float) -> tuple[float, float]:
+    """Mean and max distance, over ``size``, that storing the clip's keys and offsets as float32
+    moves its joints: the resolution below which refit_choice.NEGLIGIBLE_ERROR ties trial errors."""
+
+    def rounded(values: np.ndarray | None) -> np.ndarray | None:
+        return None if values is None else values.astype(np.float32).astype(np.float64)
+
+    stored = dataclasses.replace(
+        motion,
+        skeleton=dataclasses.replace(motion.skeleton, offsets=rounded(motion.skeleton.offsets)),
+        root_positions=rounded(motion.root_positions),
+        local_rotations=rounded(motion.local_rotations),
+        joint_translations=rounded(motion.joint_translations),
+    )
+    moved = np.linalg.norm(stored.world_positions() - motion.world_positions(), axis=-1) / size
+    return float(moved.mean()), float(moved.max())
+
+
 def level_table(label: str, motion: Motion) -> tuple[float, float]:
     """Table 1 for one clip; returns wall and CPU seconds of the whole chain."""
     analysis = analyze_motion(motion)
@@ -113,9 +131,11 @@ def level_table(label: str, motion: Motion) -> tuple[float, float]:
              fell_back, f"{r.seconds:.2f}")
         )  # fmt: skip
     floor_note = "" if floor.fewest <= floor.paper_fewest else f"; floor {floor.fewest} ({floor.explain()})"
+    rounding = float32_keys_error(motion, size)
     print_table(
         f"{label}: {joints_of(motion)} joints, {motion.frame_count} frames, figure size {size:.4g}{floor_note}; "
-        f"{wall:.1f} s wall, {cpu:.1f} s CPU",
+        f"{wall:.1f} s wall, {cpu:.1f} s CPU; float32 keys move the joints by {rounding[0]:.1e} of the size "
+        f"(at most {rounding[1]:.1e})",
         ("level", "joints", "mean error", "max error", "max/size", "bone variation", "FK residual",
          "evaluations per frame", "failed", "fell back", "seconds"),
         rows,

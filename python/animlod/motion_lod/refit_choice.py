@@ -34,8 +34,8 @@ from .ranking import PROPOSING_RANKINGS, elimination_order, rank_scores
 # level differ by whole joints, so a few frames tell them apart (the chain re-fits every frame).
 TRIAL_FRAMES = 16
 # A trial error at most this fraction of the figure's size (the level's length scale) is float32
-# round-off: storing a dev clip's own keys as float32 moves its joints by 1e-8 to 3e-8 of the
-# figure on average and 1.1e-7 at most.
+# round-off: storing a dev clip's own keys as float32 moves its joints by 1.3e-8 to 3.7e-8 of the
+# figure on average and 1.2e-7 at most (bench/bench_motion.py's level tables).
 NEGLIGIBLE_ERROR = 1e-7
 
 

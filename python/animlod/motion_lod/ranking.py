@@ -3,7 +3,7 @@
 Every ranking gives each joint a score; joints are frozen lowest score first (ties by index), and
 a joint frozen at one level stays frozen at every coarser one.
 
-- ``importance`` (default): joint importance eps_j (Eq. 3) with zero-length bones measured
+- ``importance``: joint importance eps_j (Eq. 3) with zero-length bones measured
   through the points below them (analysis.child_bones). Eq. 1 as printed measures a joint by its
   direct children only, so a joint whose children all sit at its own position (CMU's Chest2 under
   the neck and both collars, a wrist above a zero-length hand) gets importance 0 and is frozen

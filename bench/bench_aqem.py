@@ -1,6 +1,6 @@
 """AQEM against static and per-frame baselines: surface error over frames and time.
 
-Run: ``.venv/bin/python bench/bench_aqem.py [--quick]`` (needs libigl, meshoptimizer and
+Run: ``.venv/bin/python bench/bench_aqem.py [--quick]`` (needs meshoptimizer and
 fast-simplification from the ``bench`` extra). Tables:
 
 1. Quality on every dev sequence (../shared/data/meshseq: crane, face-poses, the Flamingo's

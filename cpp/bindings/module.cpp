@@ -13,6 +13,7 @@ void bind_motion_refit(py::module_& m);
 void bind_tdag(py::module_& m);
 void bind_lod_selector(py::module_& m);
 void bind_pose(py::module_& m);
+void bind_point_mesh_distance(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -26,4 +27,5 @@ PYBIND11_MODULE(_core, m) {
   animlod::bindings::bind_tdag(m);
   animlod::bindings::bind_lod_selector(m);
   animlod::bindings::bind_pose(m);
+  animlod::bindings::bind_point_mesh_distance(m);
 }

@@ -4,11 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-pytest.importorskip("igl")
-
 from simplify_inputs import ellipsoid
 
+from animlod import _core
 from animlod.metrics import sample_surface, surface_error
 from animlod.model import AnimatedMesh
 
@@ -54,3 +52,27 @@ def test_samples_follow_the_surface_and_are_reproducible():
 def test_frame_counts_must_match():
     with pytest.raises(ValueError, match="simplified: 2 frames, the original has 3"):
         surface_error(flat_square(np.zeros(3)), flat_square(np.zeros(2)))
+
+
+def test_point_mesh_distance_matches_libigl_on_a_deformed_surface():
+    igl = pytest.importorskip("igl")  # the reference the metrics used before the core's
+    mesh = ellipsoid(frames=3)
+    vertices = mesh.frames[2].astype(np.float64)
+    faces = np.concatenate([mesh.faces, [[0, 0, 1], [2, 2, 2]]])  # a segment and a point
+    rng = np.random.default_rng(5)
+    points = np.concatenate([vertices * (1.0 + 0.1 * rng.normal(size=(len(vertices), 1))), rng.normal(size=(500, 3))])
+    expected = igl.point_mesh_squared_distance(points, vertices, faces.astype(np.int64))[0]
+    for threads in (1, 2):
+        np.testing.assert_allclose(
+            _core.point_mesh_squared_distance(points, vertices, faces, threads=threads), expected, rtol=1e-9, atol=1e-14
+        )
+
+
+def test_point_mesh_distance_names_bad_input():
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0]], np.float64)
+    with pytest.raises(ValueError, match=r"faces\[0\]: vertex index 3 is outside \[0, 3\)"):
+        _core.point_mesh_squared_distance(np.zeros((1, 3)), square, np.array([[0, 1, 3]]))
+    with pytest.raises(ValueError, match="no triangle"):
+        _core.point_mesh_squared_distance(np.zeros((1, 3)), square, np.zeros((0, 3), np.int32))
+    with pytest.raises(ValueError, match=r"points\[1\]: not a finite position"):
+        _core.point_mesh_squared_distance([[0, 0, 0], [np.nan, 0, 0]], square, np.array([[0, 1, 2]]))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from simplify_inputs import directed_edges_unique, two_bone_tube
 
 from animlod import synth
@@ -31,7 +30,6 @@ def test_skinned_levels_skin_with_valid_merged_weights():
 
 
 def test_reskinned_level_stays_close_to_the_original_animation():
-    pytest.importorskip("igl")
     from animlod.metrics import surface_error
 
     skinned, motion = two_bone_tube()
@@ -58,7 +56,6 @@ def test_procedural_humanoid_walk_still_skins():
 
 
 def test_bending_cylinder_level_follows_the_bend_after_reskinning():
-    pytest.importorskip("igl")
     from animlod.metrics import surface_error
 
     skinned, motion = synth.bending_cylinder_skinned(frames=8)

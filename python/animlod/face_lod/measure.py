@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _core
 from ..metrics import surface_error
 from ..model import AnimatedMesh, spread_frames
 from .chain import FaceLodChain
@@ -144,15 +145,11 @@ def measure_level(
 
 def focus_distances(reference: AnimatedMesh, simplified: AnimatedMesh, focus: np.ndarray) -> np.ndarray:
     """(F,) per frame, the largest distance from ``reference``'s vertices where ``focus`` is True
-    to ``simplified``'s surface (libigl's AABB tree)."""
-    import igl
-
+    to ``simplified``'s surface."""
     distances = np.empty(reference.frame_count)
     for frame in range(reference.frame_count):  # O(F), vectorised inside
         points = reference.frames[frame][focus].astype(np.float64)
-        squared = igl.point_mesh_squared_distance(
-            points, simplified.frames[frame].astype(np.float64), simplified.faces.astype(np.int64)
-        )[0]
+        squared = _core.point_mesh_squared_distance(points, simplified.frames[frame], simplified.faces)
         distances[frame] = np.sqrt(squared.max(initial=0.0))
     return distances
 

@@ -1,0 +1,28 @@
+// Distance from points to the surface of a triangle mesh: the nearest-point query behind the
+// Hausdorff and RMS errors of python/animlod/metrics.py, run twice per measured frame and level.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "animlod/status.hpp"
+
+namespace animlod {
+
+// Non-owning view of a triangle mesh.
+struct TriangleMeshView {
+  const double* vertices = nullptr;  // (V, 3)
+  const int32_t* faces = nullptr;    // (F, 3) vertex indices
+  size_t vertex_count = 0;           // V
+  size_t face_count = 0;             // F
+};
+
+// Writes out (N,): the squared distance from each point (N, 3) to the nearest point of any
+// triangle (degenerate triangles count as their edges). A bounding-volume hierarchy over the
+// triangles, queried on up to `threads` threads (0: every core); a point's result does not
+// depend on the thread count.
+// Errors: no triangle, a face index outside [0, V), a non-finite vertex or point (naming it).
+Status point_mesh_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
+                                   unsigned threads, double* out);
+
+}  // namespace animlod

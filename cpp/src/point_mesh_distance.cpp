@@ -1,0 +1,228 @@
+// Point-to-mesh squared distance: a binary bounding-volume hierarchy (median split of triangle
+// centroids along the widest axis, leaves of at most kLeafSize triangles) and, per point, a
+// depth-first search that visits the nearer child first and skips boxes no closer than the best
+// triangle so far. The nearest point on a triangle is Ericson's region test (Real-Time Collision
+// Detection, 5.1.5), the same quantity libigl's point_mesh_squared_distance returns.
+#include "animlod/point_mesh_distance.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace animlod {
+
+namespace {
+
+using Vec3 = std::array<double, 3>;
+
+constexpr size_t kLeafSize = 4;
+constexpr size_t kStackSize = 96;
+// Points per thread below which another thread costs more than it saves.
+constexpr size_t kPointsPerThread = 2048;
+
+Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 along(const Vec3& a, const Vec3& d, double t) { return {a[0] + t * d[0], a[1] + t * d[1], a[2] + t * d[2]}; }
+double distance_squared(const Vec3& a, const Vec3& b) { return dot(sub(a, b), sub(a, b)); }
+
+// Nearest point of segment [a, b] to p.
+Vec3 nearest_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = sub(b, a);
+  const double length2 = dot(ab, ab);
+  const double t = length2 > 0.0 ? std::clamp(dot(sub(p, a), ab) / length2, 0.0, 1.0) : 0.0;
+  return along(a, ab, t);
+}
+
+// Ericson's ClosestPtPointTriangle; a degenerate triangle (no inside region: va + vb + vc <= 0)
+// is its three edges.
+Vec3 nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  const Vec3 bp = sub(p, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return along(a, ab, d1 / (d1 - d3));
+  const Vec3 cp = sub(p, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return along(a, ac, d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
+    return along(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const double sum = va + vb + vc;
+  if (!(sum > 0.0)) {
+    const std::array<Vec3, 3> candidates{nearest_on_segment(p, a, b), nearest_on_segment(p, b, c),
+                                         nearest_on_segment(p, c, a)};
+    return *std::min_element(candidates.begin(), candidates.end(), [&](const Vec3& x, const Vec3& y) {
+      return distance_squared(p, x) < distance_squared(p, y);
+    });
+  }
+  const double v = vb / sum, w = vc / sum;
+  return {a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w};
+}
+
+struct Box {
+  Vec3 low{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+           std::numeric_limits<double>::infinity()};
+  Vec3 high{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+            -std::numeric_limits<double>::infinity()};
+
+  void add(const Vec3& p) {
+    for (int axis = 0; axis < 3; ++axis) {
+      low[axis] = std::min(low[axis], p[axis]);
+      high[axis] = std::max(high[axis], p[axis]);
+    }
+  }
+  void add(const Box& box) {
+    add(box.low);
+    add(box.high);
+  }
+  double squared_distance(const Vec3& p) const {
+    double sum = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double gap = std::max({low[axis] - p[axis], 0.0, p[axis] - high[axis]});
+      sum += gap * gap;
+    }
+    return sum;
+  }
+};
+
+// A node covers triangles order[first, first + count) (a leaf) or has two children, the first
+// right after it and the second at `second`.
+struct Node {
+  Box box;
+  uint32_t first = 0, count = 0;
+  uint32_t second = 0;
+};
+
+class TriangleTree {
+ public:
+  explicit TriangleTree(const TriangleMeshView& mesh) : mesh_(mesh) {
+    const size_t face_count = mesh.face_count;
+    order_.resize(face_count);
+    std::iota(order_.begin(), order_.end(), uint32_t{0});
+    boxes_.resize(face_count);
+    centroids_.resize(face_count);
+    for (size_t f = 0; f < face_count; ++f) {
+      for (int corner = 0; corner < 3; ++corner) boxes_[f].add(vertex(f, corner));
+      for (int axis = 0; axis < 3; ++axis)
+        centroids_[f][axis] = (vertex(f, 0)[axis] + vertex(f, 1)[axis] + vertex(f, 2)[axis]) / 3.0;
+    }
+    nodes_.reserve(2 * face_count / kLeafSize + 1);
+    build(0, static_cast<uint32_t>(face_count));
+  }
+
+  double squared_distance(const Vec3& p) const {
+    double best = std::numeric_limits<double>::infinity();
+    // Pending nodes with their box's distance: a median split halves the triangles at each level,
+    // so the depth is below 32 and the stack (one pending sibling per level) below kStackSize.
+    std::array<std::pair<uint32_t, double>, kStackSize> stack{};
+    size_t top = 0;
+    stack[top++] = {0, nodes_[0].box.squared_distance(p)};
+    while (top > 0) {
+      const auto [index, box_distance] = stack[--top];
+      if (box_distance >= best) continue;
+      const Node& node = nodes_[index];
+      if (node.count > 0) {
+        for (uint32_t k = node.first; k < node.first + node.count; ++k) {
+          const size_t f = order_[k];
+          best = std::min(best, distance_squared(p, nearest_on_triangle(p, vertex(f, 0), vertex(f, 1), vertex(f, 2))));
+        }
+        continue;
+      }
+      const uint32_t first = index + 1, second = node.second;
+      const double to_first = nodes_[first].box.squared_distance(p), to_second = nodes_[second].box.squared_distance(p);
+      if (to_first <= to_second) {  // the nearer child is searched first
+        stack[top++] = {second, to_second};
+        stack[top++] = {first, to_first};
+      } else {
+        stack[top++] = {first, to_first};
+        stack[top++] = {second, to_second};
+      }
+    }
+    return best;
+  }
+
+ private:
+  Vec3 vertex(size_t face, int corner) const {
+    const double* v = mesh_.vertices + 3 * static_cast<size_t>(mesh_.faces[3 * face + corner]);
+    return {v[0], v[1], v[2]};
+  }
+
+  // Builds the node of order_[first, last) and its subtree; returns its index. Boxes grow from
+  // the leaves up, so each level of the tree reads only the centroids.
+  uint32_t build(uint32_t first, uint32_t last) {
+    const auto index = static_cast<uint32_t>(nodes_.size());
+    nodes_.emplace_back();
+    if (last - first <= kLeafSize) {
+      for (uint32_t k = first; k < last; ++k) nodes_[index].box.add(boxes_[order_[k]]);
+      nodes_[index].first = first;
+      nodes_[index].count = last - first;
+      return index;
+    }
+    Box centres;
+    for (uint32_t k = first; k < last; ++k) centres.add(centroids_[order_[k]]);
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (centres.high[a] - centres.low[a] > centres.high[axis] - centres.low[axis]) axis = a;
+    const uint32_t middle = first + (last - first) / 2;
+    std::nth_element(order_.begin() + first, order_.begin() + middle, order_.begin() + last,
+                     [&](uint32_t x, uint32_t y) { return centroids_[x][axis] < centroids_[y][axis]; });
+    build(first, middle);
+    const uint32_t second = build(middle, last);
+    nodes_[index].second = second;
+    nodes_[index].box = nodes_[index + 1].box;
+    nodes_[index].box.add(nodes_[second].box);
+    return index;
+  }
+
+  const TriangleMeshView& mesh_;
+  std::vector<uint32_t> order_;
+  std::vector<Box> boxes_;
+  std::vector<Vec3> centroids_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace
+
+Status point_mesh_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
+                                   unsigned threads, double* out) {
+  if (mesh.face_count == 0) return Status::error("faces: the mesh has no triangle to measure the distance to");
+  if (mesh.face_count > std::numeric_limits<uint32_t>::max() / 2)
+    return Status::error("faces: " + std::to_string(mesh.face_count) + " triangles, more than the tree indexes");
+  for (size_t i = 0; i < 3 * mesh.face_count; ++i)
+    if (mesh.faces[i] < 0 || static_cast<size_t>(mesh.faces[i]) >= mesh.vertex_count)
+      return Status::error("faces[" + std::to_string(i / 3) + "]: vertex index " + std::to_string(mesh.faces[i]) +
+                           " is outside [0, " + std::to_string(mesh.vertex_count) + ")");
+  for (size_t i = 0; i < 3 * mesh.vertex_count; ++i)
+    if (!std::isfinite(mesh.vertices[i]))
+      return Status::error("vertices[" + std::to_string(i / 3) + "]: not a finite position");
+  for (size_t i = 0; i < 3 * point_count; ++i)
+    if (!std::isfinite(points[i])) return Status::error("points[" + std::to_string(i / 3) + "]: not a finite position");
+
+  const TriangleTree tree(mesh);
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const size_t workers =
+      std::clamp<size_t>(point_count / kPointsPerThread, 1, threads == 0 ? cores : std::min(threads, cores));
+  auto run = [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) out[i] = tree.squared_distance({points[3 * i], points[3 * i + 1], points[3 * i + 2]});
+  };
+  std::vector<std::thread> pool;
+  const size_t chunk = (point_count + workers - 1) / workers;
+  for (size_t w = 1; w < workers; ++w)
+    pool.emplace_back(run, std::min(point_count, w * chunk), std::min(point_count, (w + 1) * chunk));
+  run(0, std::min(point_count, chunk));
+  for (auto& thread : pool) thread.join();
+  return Status::success();
+}
+
+}  // namespace animlod

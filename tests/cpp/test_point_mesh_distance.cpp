@@ -1,0 +1,93 @@
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "animlod/point_mesh_distance.hpp"
+
+namespace {
+
+using Vec3 = std::array<double, 3>;
+
+Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+double segment_distance2(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = sub(b, a);
+  const double t = dot(ab, ab) > 0.0 ? std::clamp(dot(sub(p, a), ab) / dot(ab, ab), 0.0, 1.0) : 0.0;
+  const Vec3 q{a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]};
+  return dot(sub(p, q), sub(p, q));
+}
+
+// An independent formulation: the plane distance when the projection falls inside (all three
+// edge normals agree), else the nearest of the three edges.
+double brute_force(const std::vector<double>& v, const std::vector<int32_t>& f, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t t = 0; t < f.size() / 3; ++t) {
+    std::array<Vec3, 3> c;
+    for (int k = 0; k < 3; ++k) c[k] = {v[3 * f[3 * t + k]], v[3 * f[3 * t + k] + 1], v[3 * f[3 * t + k] + 2]};
+    const Vec3 n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+    bool inside = dot(n, n) > 1e-24;
+    for (int k = 0; k < 3 && inside; ++k) inside = dot(cross(sub(c[(k + 1) % 3], c[k]), sub(p, c[k])), n) >= 0.0;
+    double d2 = std::min({segment_distance2(p, c[0], c[1]), segment_distance2(p, c[1], c[2]), segment_distance2(p, c[2], c[0])});
+    if (inside) d2 = std::min(d2, dot(sub(p, c[0]), n) * dot(sub(p, c[0]), n) / dot(n, n));
+    best = std::min(best, d2);
+  }
+  return best;
+}
+
+animlod::TriangleMeshView view(const std::vector<double>& v, const std::vector<int32_t>& f) {
+  return {v.data(), f.data(), v.size() / 3, f.size() / 3};
+}
+
+}  // namespace
+
+TEST_CASE("point_mesh_squared_distance matches brute force, degenerate triangles included") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<double> v;
+  for (int i = 0; i < 300; ++i) v.push_back(uniform(rng));
+  std::vector<int32_t> f;
+  std::uniform_int_distribution<int32_t> pick(0, 99);
+  for (int t = 0; t < 500; ++t)
+    for (int k = 0; k < 3; ++k) f.push_back(pick(rng));
+  f.insert(f.end(), {0, 0, 0, 1, 2, 1});  // a point and a segment
+  v.insert(v.end(), {0, 0, 0, 1, 1, 1, 2, 2, 2});  // three collinear vertices, 100..102
+  f.insert(f.end(), {100, 101, 102});
+  std::vector<double> points;
+  for (int i = 0; i < 3 * 5000; ++i) points.push_back(2.0 * uniform(rng));
+  points.insert(points.end(), {v[0], v[1], v[2], 1.5, 1.5, 1.5});  // on a vertex, on the segment
+  const size_t count = points.size() / 3;
+  std::vector<double> one(count), two(count);
+  REQUIRE(animlod::point_mesh_squared_distance(view(v, f), points.data(), count, 1, one.data()));
+  REQUIRE(animlod::point_mesh_squared_distance(view(v, f), points.data(), count, 2, two.data()));
+  CHECK(one == two);  // the thread count does not change a bit
+  for (size_t i = 0; i < count; ++i) {
+    const double expected = brute_force(v, f, {points[3 * i], points[3 * i + 1], points[3 * i + 2]});
+    REQUIRE(one[i] == doctest::Approx(expected).epsilon(1e-9).scale(1e-12));
+  }
+  CHECK(one[count - 2] == 0.0);
+  CHECK(one[count - 1] == doctest::Approx(0.0).scale(1e-12));
+}
+
+TEST_CASE("point_mesh_squared_distance names bad input") {
+  const std::vector<double> v{0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const std::vector<int32_t> f{0, 1, 3};
+  const std::vector<double> p{0, 0, 1};
+  double out = 0.0;
+  auto status = animlod::point_mesh_squared_distance(view(v, f), p.data(), 1, 0, &out);
+  CHECK_FALSE(status);
+  CHECK(status.message.find("faces[0]") != std::string::npos);
+  status = animlod::point_mesh_squared_distance(view(v, {}), p.data(), 1, 0, &out);
+  CHECK(status.message.find("no triangle") != std::string::npos);
+  const std::vector<double> nan_point{0, std::nan(""), 0};
+  status = animlod::point_mesh_squared_distance(view(v, {0, 1, 2}), nan_point.data(), 1, 0, &out);
+  CHECK(status.message.find("points[0]") != std::string::npos);
+}

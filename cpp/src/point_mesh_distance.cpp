@@ -1,7 +1,8 @@
 // Point-to-mesh squared distance: a binary bounding-volume hierarchy (median split of triangle
 // centroids along the widest axis, leaves of at most kLeafSize triangles) and, per point, a
 // depth-first search that visits the nearer child first and skips boxes no closer than the best
-// triangle so far. The nearest point on a triangle is Ericson's region test (Real-Time Collision
+// triangle so far. Later frames of an animated mesh keep the first frame's tree and only refit
+// its boxes (building it cost as much as the queries on a 28k-triangle character). The nearest point on a triangle is Ericson's region test (Real-Time Collision
 // Detection, 5.1.5), the same quantity libigl's point_mesh_squared_distance returns.
 #include "animlod/point_mesh_distance.hpp"
 
@@ -89,7 +90,7 @@ struct Box {
   double squared_distance(const Vec3& p) const {
     double sum = 0.0;
     for (int axis = 0; axis < 3; ++axis) {
-      const double gap = std::max({low[axis] - p[axis], 0.0, p[axis] - high[axis]});
+      const double gap = std::max(0.0, std::max(low[axis] - p[axis], p[axis] - high[axis]));
       sum += gap * gap;
     }
     return sum;
@@ -106,26 +107,45 @@ struct Node {
 
 class TriangleTree {
  public:
-  explicit TriangleTree(const TriangleMeshView& mesh) : mesh_(mesh) {
+  // The tree of the mesh in its first frame.
+  explicit TriangleTree(const TriangleMeshView& mesh) : mesh_(mesh), vertices_(mesh.vertices) {
     const size_t face_count = mesh.face_count;
     order_.resize(face_count);
     std::iota(order_.begin(), order_.end(), uint32_t{0});
-    boxes_.resize(face_count);
-    centroids_.resize(face_count);
-    for (size_t f = 0; f < face_count; ++f) {
-      for (int corner = 0; corner < 3; ++corner) boxes_[f].add(vertex(f, corner));
+    bound_triangles();
+    std::vector<Vec3> centroids(face_count);
+    for (size_t f = 0; f < face_count; ++f)
       for (int axis = 0; axis < 3; ++axis)
-        centroids_[f][axis] = (vertex(f, 0)[axis] + vertex(f, 1)[axis] + vertex(f, 2)[axis]) / 3.0;
-    }
+        centroids[f][axis] = (vertex(f, 0)[axis] + vertex(f, 1)[axis] + vertex(f, 2)[axis]) / 3.0;
     nodes_.reserve(2 * face_count / kLeafSize + 1);
-    build(0, static_cast<uint32_t>(face_count));
+    build(0, static_cast<uint32_t>(face_count), centroids);
+  }
+
+  // The same tree over the mesh's vertices in another frame (V, 3): new boxes, same nodes.
+  void refit(const double* vertices) {
+    vertices_ = vertices;
+    bound_triangles();
+    for (size_t index = nodes_.size(); index-- > 0;) {  // children come after their parent
+      Node& node = nodes_[index];
+      node.box = Box();
+      if (node.count > 0) {
+        for (uint32_t k = node.first; k < node.first + node.count; ++k) node.box.add(boxes_[order_[k]]);
+      } else {
+        node.box.add(nodes_[index + 1].box);
+        node.box.add(nodes_[node.second].box);
+      }
+    }
   }
 
   double squared_distance(const Vec3& p) const {
     double best = std::numeric_limits<double>::infinity();
     // Pending nodes with their box's distance: a median split halves the triangles at each level,
     // so the depth is below 32 and the stack (one pending sibling per level) below kStackSize.
-    std::array<std::pair<uint32_t, double>, kStackSize> stack{};
+    struct Pending {
+      uint32_t node;
+      double distance;
+    };
+    std::array<Pending, kStackSize> stack;  // uninitialised: only [0, top) is read
     size_t top = 0;
     stack[top++] = {0, nodes_[0].box.squared_distance(p)};
     while (top > 0) {
@@ -154,13 +174,19 @@ class TriangleTree {
 
  private:
   Vec3 vertex(size_t face, int corner) const {
-    const double* v = mesh_.vertices + 3 * static_cast<size_t>(mesh_.faces[3 * face + corner]);
+    const double* v = vertices_ + 3 * static_cast<size_t>(mesh_.faces[3 * face + corner]);
     return {v[0], v[1], v[2]};
+  }
+
+  void bound_triangles() {
+    boxes_.assign(mesh_.face_count, Box());
+    for (size_t f = 0; f < mesh_.face_count; ++f)
+      for (int corner = 0; corner < 3; ++corner) boxes_[f].add(vertex(f, corner));
   }
 
   // Builds the node of order_[first, last) and its subtree; returns its index. Boxes grow from
   // the leaves up, so each level of the tree reads only the centroids.
-  uint32_t build(uint32_t first, uint32_t last) {
+  uint32_t build(uint32_t first, uint32_t last, const std::vector<Vec3>& centroids) {
     const auto index = static_cast<uint32_t>(nodes_.size());
     nodes_.emplace_back();
     if (last - first <= kLeafSize) {
@@ -170,15 +196,15 @@ class TriangleTree {
       return index;
     }
     Box centres;
-    for (uint32_t k = first; k < last; ++k) centres.add(centroids_[order_[k]]);
+    for (uint32_t k = first; k < last; ++k) centres.add(centroids[order_[k]]);
     int axis = 0;
     for (int a = 1; a < 3; ++a)
       if (centres.high[a] - centres.low[a] > centres.high[axis] - centres.low[axis]) axis = a;
     const uint32_t middle = first + (last - first) / 2;
     std::nth_element(order_.begin() + first, order_.begin() + middle, order_.begin() + last,
-                     [&](uint32_t x, uint32_t y) { return centroids_[x][axis] < centroids_[y][axis]; });
-    build(first, middle);
-    const uint32_t second = build(middle, last);
+                     [&](uint32_t x, uint32_t y) { return centroids[x][axis] < centroids[y][axis]; });
+    build(first, middle, centroids);
+    const uint32_t second = build(middle, last, centroids);
     nodes_[index].second = second;
     nodes_[index].box = nodes_[index + 1].box;
     nodes_[index].box.add(nodes_[second].box);
@@ -186,9 +212,9 @@ class TriangleTree {
   }
 
   const TriangleMeshView& mesh_;
+  const double* vertices_;  // (V, 3) of the frame the boxes bound
   std::vector<uint32_t> order_;
-  std::vector<Box> boxes_;
-  std::vector<Vec3> centroids_;
+  std::vector<Box> boxes_;  // (F,) per triangle
   std::vector<Node> nodes_;
 };
 
@@ -203,25 +229,36 @@ Status point_mesh_squared_distance(const TriangleMeshView& mesh, const double* p
     if (mesh.faces[i] < 0 || static_cast<size_t>(mesh.faces[i]) >= mesh.vertex_count)
       return Status::error("faces[" + std::to_string(i / 3) + "]: vertex index " + std::to_string(mesh.faces[i]) +
                            " is outside [0, " + std::to_string(mesh.vertex_count) + ")");
-  for (size_t i = 0; i < 3 * mesh.vertex_count; ++i)
+  const size_t frames = std::max<size_t>(mesh.frame_count, 1);
+  const auto where = [](size_t row, size_t rows, size_t frame_count) {
+    return frame_count > 1 ? std::to_string(row / rows) + ", " + std::to_string(row % rows) : std::to_string(row);
+  };
+  for (size_t i = 0; i < 3 * mesh.vertex_count * frames; ++i)
     if (!std::isfinite(mesh.vertices[i]))
-      return Status::error("vertices[" + std::to_string(i / 3) + "]: not a finite position");
-  for (size_t i = 0; i < 3 * point_count; ++i)
-    if (!std::isfinite(points[i])) return Status::error("points[" + std::to_string(i / 3) + "]: not a finite position");
+      return Status::error("vertices[" + where(i / 3, mesh.vertex_count, frames) + "]: not a finite position");
+  for (size_t i = 0; i < 3 * point_count * frames; ++i)
+    if (!std::isfinite(points[i]))
+      return Status::error("points[" + where(i / 3, point_count, frames) + "]: not a finite position");
 
-  const TriangleTree tree(mesh);
+  TriangleTree tree(mesh);
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const size_t workers =
       std::clamp<size_t>(point_count / kPointsPerThread, 1, threads == 0 ? cores : std::min(threads, cores));
-  auto run = [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) out[i] = tree.squared_distance({points[3 * i], points[3 * i + 1], points[3 * i + 2]});
-  };
-  std::vector<std::thread> pool;
   const size_t chunk = (point_count + workers - 1) / workers;
-  for (size_t w = 1; w < workers; ++w)
-    pool.emplace_back(run, std::min(point_count, w * chunk), std::min(point_count, (w + 1) * chunk));
-  run(0, std::min(point_count, chunk));
-  for (auto& thread : pool) thread.join();
+  for (size_t frame = 0; frame < frames; ++frame) {
+    if (frame > 0) tree.refit(mesh.vertices + 3 * mesh.vertex_count * frame);
+    const double* frame_points = points + 3 * point_count * frame;
+    double* frame_out = out + point_count * frame;
+    auto run = [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i)
+        frame_out[i] = tree.squared_distance({frame_points[3 * i], frame_points[3 * i + 1], frame_points[3 * i + 2]});
+    };
+    std::vector<std::thread> pool;
+    for (size_t w = 1; w < workers; ++w)
+      pool.emplace_back(run, std::min(point_count, w * chunk), std::min(point_count, (w + 1) * chunk));
+    run(0, std::min(point_count, chunk));
+    for (auto& thread : pool) thread.join();
+  }
   return Status::success();
 }
 

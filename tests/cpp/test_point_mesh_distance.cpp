@@ -91,3 +91,34 @@ TEST_CASE("point_mesh_squared_distance names bad input") {
   status = animlod::point_mesh_squared_distance(view(v, {0, 1, 2}), nan_point.data(), 1, 0, &out);
   CHECK(status.message.find("points[0]") != std::string::npos);
 }
+
+TEST_CASE("point_mesh_squared_distance refits the first frame's tree to the others") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<double> first;
+  for (int i = 0; i < 3 * 200; ++i) first.push_back(uniform(rng));
+  std::vector<int32_t> f;
+  std::uniform_int_distribution<int32_t> pick(0, 199);
+  for (int t = 0; t < 3 * 300; ++t) f.push_back(pick(rng));
+  // Frame 1 moves every vertex far (the first frame's tree no longer fits it at all).
+  std::vector<double> both = first;
+  for (double x : first) both.push_back(3.0 * x * x - 1.0);
+  std::vector<double> points;
+  for (int i = 0; i < 3 * 2 * 3000; ++i) points.push_back(2.0 * uniform(rng));
+  animlod::TriangleMeshView mesh{both.data(), f.data(), 200, 300, 2};
+  std::vector<double> out(2 * 3000);
+  REQUIRE(animlod::point_mesh_squared_distance(mesh, points.data(), 3000, 0, out.data()));
+  const std::vector<double> second(both.begin() + 600, both.end());
+  for (size_t i = 0; i < 3000; ++i) {
+    REQUIRE(out[i] == doctest::Approx(brute_force(first, f, {points[3 * i], points[3 * i + 1], points[3 * i + 2]}))
+                          .epsilon(1e-9)
+                          .scale(1e-12));
+    const size_t j = 3000 + i;
+    REQUIRE(out[j] == doctest::Approx(brute_force(second, f, {points[3 * j], points[3 * j + 1], points[3 * j + 2]}))
+                          .epsilon(1e-9)
+                          .scale(1e-12));
+  }
+  both[600 + 4] = std::nan("");
+  const auto status = animlod::point_mesh_squared_distance(mesh, points.data(), 3000, 0, out.data());
+  CHECK(status.message.find("vertices[1, 1]") != std::string::npos);
+}

@@ -66,6 +66,11 @@ def test_point_mesh_distance_matches_libigl_on_a_deformed_surface():
         np.testing.assert_allclose(
             _core.point_mesh_squared_distance(points, vertices, faces, threads=threads), expected, rtol=1e-9, atol=1e-14
         )
+    # Every frame at once: frames 1 and 2 refit frame 0's tree.
+    frames = mesh.frames.astype(np.float64)
+    moved = points[None] * np.array([1.0, 1.5, 0.5])[:, None, None]
+    each = [igl.point_mesh_squared_distance(moved[t], frames[t], faces.astype(np.int64))[0] for t in range(3)]
+    np.testing.assert_allclose(_core.point_mesh_squared_distance(moved, frames, faces), each, rtol=1e-9, atol=1e-14)
 
 
 def test_point_mesh_distance_names_bad_input():

@@ -9,18 +9,20 @@
 
 namespace animlod {
 
-// Non-owning view of a triangle mesh.
+// Non-owning view of a triangle mesh in one or several frames (same faces, moving vertices).
 struct TriangleMeshView {
-  const double* vertices = nullptr;  // (V, 3)
+  const double* vertices = nullptr;  // (T, V, 3)
   const int32_t* faces = nullptr;    // (F, 3) vertex indices
   size_t vertex_count = 0;           // V
   size_t face_count = 0;             // F
+  size_t frame_count = 1;            // T
 };
 
-// Writes out (N,): the squared distance from each point (N, 3) to the nearest point of any
-// triangle (degenerate triangles count as their edges). A bounding-volume hierarchy over the
-// triangles, queried on up to `threads` threads (0: every core); a point's result does not
-// depend on the thread count.
+// Writes out (T, N): the squared distance from each point (T, N, 3) to the nearest point of any
+// triangle of the mesh in the same frame (degenerate triangles count as their edges). A
+// bounding-volume hierarchy over the triangles, built on the first frame and refitted to the
+// others, queried on up to `threads` threads (0: every core); a point's result does not depend
+// on the thread count.
 // Errors: no triangle, a face index outside [0, V), a non-finite vertex or point (naming it).
 Status point_mesh_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
                                    unsigned threads, double* out);

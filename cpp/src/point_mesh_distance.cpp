@@ -1,9 +1,10 @@
 // Point-to-mesh squared distance: a binary bounding-volume hierarchy (median split of triangle
 // centroids along the widest axis, leaves of at most kLeafSize triangles) and, per point, a
 // depth-first search that visits the nearer child first and skips boxes no closer than the best
-// triangle so far. Later frames of an animated mesh keep the first frame's tree and only refit
-// its boxes (building it cost as much as the queries on a 28k-triangle character). The nearest point on a triangle is Ericson's region test (Real-Time Collision
-// Detection, 5.1.5), the same quantity libigl's point_mesh_squared_distance returns.
+// triangle so far. Later frames of an animated mesh keep the first frame's tree and refit its
+// boxes instead of building another. A triangle's distance is Ericson's (Real-Time Collision
+// Detection 5.1.5), checked against its vertices: the quantity libigl's
+// point_mesh_squared_distance returns.
 #include "animlod/point_mesh_distance.hpp"
 
 #include <algorithm>
@@ -32,43 +33,48 @@ double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[
 Vec3 along(const Vec3& a, const Vec3& d, double t) { return {a[0] + t * d[0], a[1] + t * d[1], a[2] + t * d[2]}; }
 double distance_squared(const Vec3& a, const Vec3& b) { return dot(sub(a, b), sub(a, b)); }
 
-// Nearest point of segment [a, b] to p.
-Vec3 nearest_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+// Squared distance from p to segment [a, b].
+double segment_distance_squared(const Vec3& p, const Vec3& a, const Vec3& b) {
   const Vec3 ab = sub(b, a);
   const double length2 = dot(ab, ab);
   const double t = length2 > 0.0 ? std::clamp(dot(sub(p, a), ab) / length2, 0.0, 1.0) : 0.0;
-  return along(a, ab, t);
+  return distance_squared(p, along(a, ab, t));
 }
 
-// Ericson's ClosestPtPointTriangle; a degenerate triangle (no inside region: va + vb + vc <= 0)
-// is its three edges.
-Vec3 nearest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+// Squared distance from p to triangle abc by Ericson's ClosestPtPointTriangle (Real-Time Collision
+// Detection 5.1.5): Voronoi regions of the vertices and edges, else the inside.
+double ericson_distance_squared(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
   const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  if (d1 <= 0.0 && d2 <= 0.0) return distance_squared(p, a);
   const Vec3 bp = sub(p, b);
   const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0.0 && d4 <= d3) return b;
+  if (d3 >= 0.0 && d4 <= d3) return distance_squared(p, b);
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return along(a, ab, d1 / (d1 - d3));
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return distance_squared(p, along(a, ab, d1 / (d1 - d3)));
   const Vec3 cp = sub(p, c);
   const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0.0 && d5 <= d6) return c;
+  if (d6 >= 0.0 && d5 <= d6) return distance_squared(p, c);
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return along(a, ac, d2 / (d2 - d6));
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return distance_squared(p, along(a, ac, d2 / (d2 - d6)));
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
-    return along(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    return distance_squared(p, along(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
   const double sum = va + vb + vc;
-  if (!(sum > 0.0)) {
-    const std::array<Vec3, 3> candidates{nearest_on_segment(p, a, b), nearest_on_segment(p, b, c),
-                                         nearest_on_segment(p, c, a)};
-    return *std::min_element(candidates.begin(), candidates.end(), [&](const Vec3& x, const Vec3& y) {
-      return distance_squared(p, x) < distance_squared(p, y);
-    });
-  }
   const double v = vb / sum, w = vc / sum;
-  return {a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w};
+  if (!(sum > 0.0 && v >= 0.0 && w >= 0.0 && v + w <= 1.0)) return std::numeric_limits<double>::infinity();
+  return distance_squared(p, {a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w});
+}
+
+// Squared distance from p to triangle abc. Ericson's regions are decided by products that lose
+// their sign on slivers (fuzz: vertices 1e22 apart, where they picked a far vertex); an answer
+// beyond the nearest vertex, or from a degenerate triangle, is replaced by the nearest of the
+// three edges by clamped projection, exact to each edge's own length.
+double triangle_distance_squared(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double fast = ericson_distance_squared(p, a, b, c);
+  if (fast <= std::min({distance_squared(p, a), distance_squared(p, b), distance_squared(p, c)})) return fast;
+  return std::min({segment_distance_squared(p, a, b), segment_distance_squared(p, b, c),
+                   segment_distance_squared(p, c, a)});
 }
 
 struct Box {
@@ -155,7 +161,7 @@ class TriangleTree {
       if (node.count > 0) {
         for (uint32_t k = node.first; k < node.first + node.count; ++k) {
           const size_t f = order_[k];
-          best = std::min(best, distance_squared(p, nearest_on_triangle(p, vertex(f, 0), vertex(f, 1), vertex(f, 2))));
+          best = std::min(best, triangle_distance_squared(p, vertex(f, 0), vertex(f, 1), vertex(f, 2)));
         }
         continue;
       }

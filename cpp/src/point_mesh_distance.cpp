@@ -3,9 +3,9 @@
 // depth-first search that visits the nearer child first and skips boxes no closer than the best
 // triangle so far. Later frames of an animated mesh keep the first frame's tree and refit its
 // boxes instead of building another, and each point starts from its nearest triangle of the
-// previous frame (15-20% less CPU on the dev characters' measurement). A triangle's distance is Ericson's (Real-Time Collision
-// Detection 5.1.5), checked against its vertices: the quantity libigl's
-// point_mesh_squared_distance returns.
+// previous frame (15-20% less CPU on the dev characters' measurement). A triangle's distance is
+// Ericson's (Real-Time Collision Detection 5.1.5), checked against its vertices: the quantity
+// libigl's point_mesh_squared_distance returns.
 #include "animlod/point_mesh_distance.hpp"
 
 #include <algorithm>

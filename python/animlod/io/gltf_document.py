@@ -9,10 +9,8 @@ a silently wrong array.
 from __future__ import annotations
 
 import base64
-import dataclasses
 import os
 import struct
-import warnings
 from pathlib import Path
 from typing import Any
 from urllib.parse import unquote
@@ -22,12 +20,14 @@ import pygltflib
 
 from .. import rotations
 from .errors import FormatError
+from .gltf_decode import decode_gltf
 from .gltf_keyframes import INTERPOLATIONS, frame_times
 from .json_limits import load_json
 
 _GLB_MAGIC = b"glTF"
 _GLB_HEADER_BYTES = 12
 _GLB_JSON_CHUNK = 0x4E4F534A  # "JSON"
+_GLB_BIN_CHUNK = 0x004E4942  # "BIN\0"
 _DATA_URI_BASE64 = ";base64,"
 # Required extensions that leave geometry, skins and animation readable as plain glTF
 # (quantized attributes are ordinary normalised or integer accessors); any other required
@@ -435,33 +435,21 @@ def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
         data = Path(path).read_bytes()
     except OSError as error:
         raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
-    if data[:4] == _GLB_MAGIC:
-        json_chunk = _check_glb_header(path, data)
-        parse = pygltflib.GLTF2.load_from_bytes
-        source: bytes | str = data
-    else:
+    glb = data[:4] == _GLB_MAGIC
+    json_chunk, binary_chunk = _glb_chunks(path, data) if glb else (data, None)
+    if not glb:
         try:
-            source = data.decode("utf-8-sig")
+            data.decode("utf-8-sig")
         except UnicodeDecodeError:
             raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor JSON") from None
-        json_chunk = data
-    # Parsed here first with bounded nesting (json.loads recurses per level) and checked for the
-    # shape pygltflib silently bends ("nodes": {} would become an empty list).
-    raw = load_json(path, json_chunk, "GLB JSON chunk" if data[:4] == _GLB_MAGIC else "JSON")
+    # Parsed with bounded nesting (json.loads recurses per level) and checked for the shape the
+    # object model would otherwise bend ("nodes": {} is not a list); parsed twice, so that the
+    # raw JSON kept for the writers shares nothing with the object model (2 ms on Xbot.glb).
+    raw = load_json(path, json_chunk, "GLB JSON chunk" if glb else "JSON")
     _check_top_level(path, raw)
-    if data[:4] != _GLB_MAGIC:
-        parse = pygltflib.GLTF2.gltf_from_json
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # pygltflib warns about unknown chunks; we check what we use
-            gltf = parse(source)
-    except (ValueError, KeyError, TypeError, AttributeError, struct.error, UnicodeDecodeError, RecursionError) as error:
-        raise FormatError(path, "JSON", f"not a valid glTF document ({type(error).__name__}: {error})") from None
-    if gltf is None:
-        raise FormatError(path, "GLB", "no JSON chunk")
-    null = _first_null_entry(gltf, "")
-    if null is not None:
-        raise FormatError(path, "JSON", f"{null} is null (glTF arrays hold no nulls)")
+    gltf = decode_gltf(path, load_json(path, json_chunk))
+    if binary_chunk is not None:
+        gltf.set_binary_blob(binary_chunk)
     version = str(getattr(gltf.asset, "version", "") or "")
     if not version.startswith("2."):
         raise FormatError(path, "asset", f"glTF version {version!r} is not 2.x")
@@ -469,26 +457,6 @@ def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
     if unsupported:
         raise FormatError(path, "extensionsRequired", f"needs {', '.join(unsupported)}, which animlod cannot read")
     return gltf, raw
-
-
-def _first_null_entry(node: Any, where: str) -> str | None:
-    """Path such as ``accessors[2]`` of the first null inside an array of the document, or None.
-
-    pygltflib keeps a null where an object belongs, which would otherwise surface later as an
-    AttributeError. ``extras`` and ``extensions`` are free JSON and are not looked into.
-    """
-    if isinstance(node, list):
-        for index, item in enumerate(node):
-            found = f"{where}[{index}]" if item is None else _first_null_entry(item, f"{where}[{index}]")
-            if found is not None:
-                return found
-    elif dataclasses.is_dataclass(node):
-        for field in dataclasses.fields(node):
-            if field.name not in ("extras", "extensions"):
-                found = _first_null_entry(getattr(node, field.name), f"{where}.{field.name}".lstrip("."))
-                if found is not None:
-                    return found
-    return None
 
 
 def _frame_limit(limit: int | None) -> int:
@@ -517,8 +485,9 @@ def _check_top_level(path: str, document: Any) -> None:
         raise FormatError(path, "scene", f"must be an index, got {scene!r}")
 
 
-def _check_glb_header(path: str, data: bytes) -> bytes:
-    """Check the GLB header and chunk table; return the bytes of the first (JSON) chunk."""
+def _glb_chunks(path: str, data: bytes) -> tuple[bytes, bytes | None]:
+    """Check the GLB header and chunk table; return the JSON chunk's bytes and the first BIN
+    chunk's (None without one). Chunks of other types are skipped (glTF 2.0 section 4.4.3)."""
     if len(data) < _GLB_HEADER_BYTES + 8:
         raise FormatError(path, "GLB header", f"file is truncated ({len(data)} bytes)")
     version, length = struct.unpack_from("<II", data, 4)
@@ -527,20 +496,23 @@ def _check_glb_header(path: str, data: bytes) -> bytes:
     if length > len(data):
         raise FormatError(path, "GLB header", f"file is truncated: header says {length} bytes, file has {len(data)}")
     offset = _GLB_HEADER_BYTES
-    json_chunk = None
+    json_chunk = binary_chunk = None
     while offset < length:
         if offset + 8 > length:
             raise FormatError(path, f"GLB chunk at byte {offset}", "chunk header is truncated")
-        chunk_length = struct.unpack_from("<I", data, offset)[0]
+        chunk_length, chunk_type = struct.unpack_from("<II", data, offset)
         if offset + 8 + chunk_length > length:
             raise FormatError(
                 path, f"GLB chunk at byte {offset}", f"declares {chunk_length} bytes, only {length - offset - 8} remain"
             )
+        chunk = data[offset + 8 : offset + 8 + chunk_length]
         if json_chunk is None:
-            if struct.unpack_from("<I", data, offset + 4)[0] != _GLB_JSON_CHUNK:
+            if chunk_type != _GLB_JSON_CHUNK:
                 raise FormatError(path, f"GLB chunk at byte {offset}", "the first chunk must be the JSON chunk")
-            json_chunk = data[offset + 8 : offset + 8 + chunk_length]
+            json_chunk = chunk
+        elif chunk_type == _GLB_BIN_CHUNK and binary_chunk is None:
+            binary_chunk = chunk
         offset += 8 + chunk_length
     if json_chunk is None:
         raise FormatError(path, "GLB", "no JSON chunk")
-    return json_chunk
+    return json_chunk, binary_chunk

@@ -195,7 +195,7 @@ def flamingo_keyframes(path: Path) -> AnimatedMesh:
     from animlod.io.gltf_drawable import read_drawables
 
     drawable = read_drawables(GltfDocument(path))[0]
-    rest = drawable.rest_positions()
+    rest = drawable.bind_positions()
     frames = (rest[None] + drawable.morph_targets).astype(np.float32)  # (T, V, 3)
     # Copies of a position weld when they agree in every keyframe.
     _, first, inverse = np.unique(

@@ -70,7 +70,7 @@ def meshopt_faces(drawable: Drawable, ratio: float) -> np.ndarray:
     """meshoptimizer's triangles (input vertex indices) at ``ratio`` of each primitive."""
     import meshoptimizer
 
-    rest = drawable.rest_positions()
+    rest = drawable.bind_positions()
     starts = drawable.geometry.vertex_starts
     kept = []
     for k, primitive in enumerate(drawable.geometry.primitives):
@@ -102,7 +102,7 @@ def main() -> None:
                 for ratio, level in zip(RATIOS, ours.levels):
                     our_faces = level.simplified.mesh.face_count
                     level_faces = level.simplified.mesh.faces
-                    posed = [AnimatedMesh(level_faces, level.rest[None])]
+                    posed = [AnimatedMesh(level_faces, level.rest_positions()[None])]
                     posed += [AnimatedMesh(level_faces, _posed(drawable, level, clip)) for clip in drawable.clips]
                     our_error = worst_error(originals, posed) / size
                     theirs = meshopt_faces(drawable, ratio)

@@ -164,10 +164,18 @@ class Skeleton:
             result[parent].append(joint)
         return result
 
+    def rest_motion(self, frame_count: int = 1, fps: float = 30.0) -> Motion:
+        """The skeleton held in its rest pose (root at its offset) for ``frame_count`` frames."""
+        return Motion(
+            self,
+            np.repeat(self.offsets[None, 0], frame_count, axis=0),
+            np.repeat(self.rest_rotations[None], frame_count, axis=0),
+            fps=fps,
+        )
+
     def rest_world_transforms(self) -> np.ndarray:
         """World transforms ``(J, 4, 4)`` of the rest pose (root at its offset)."""
-        motion = Motion(self, self.offsets[None, 0], self.rest_rotations[None], fps=1.0)
-        return motion.world_transforms()[0]
+        return self.rest_motion(1, fps=1.0).world_transforms()[0]
 
 
 @dataclass

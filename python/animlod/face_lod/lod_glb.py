@@ -74,7 +74,7 @@ def read_gltf_face(path: str | os.PathLike, fps: float = 30.0, frames_each: int 
         names = drawable.geometry.target_names or [f"target_{index}" for index in range(len(targets))]
         try:
             face = BlendshapeFace(
-                neutral=drawable.rest_positions(), faces=drawable.geometry.faces, targets=targets, names=names,
+                neutral=drawable.bind_positions(), faces=drawable.geometry.faces, targets=targets, names=names,
                 weights=weights, fps=fps, uvs=drawable.geometry.uvs,
             )  # fmt: skip
         except ValueError as error:
@@ -115,7 +115,7 @@ def gltf_face_levels(source: GltfFace, options: BlendshapeLodOptions | None = No
     for level in drawn.levels:
         levels.append(
             BlendshapeLevel(
-                faces=level.simplified.mesh.faces, neutral=level.rest, targets=np.asarray(level.morph_targets),
+                faces=level.simplified.mesh.faces, neutral=level.bind, targets=np.asarray(level.morph_targets),
                 kept_targets=everything, kept_vertices=level.simplified.kept_vertices, uvs=None,
                 aqem_error=level.simplified.error,
             )

@@ -77,14 +77,28 @@ class Drawable:
 
     @property
     def morph_targets(self) -> np.ndarray | None:
-        """(N, V, 3) world-space morph position deltas, or None."""
+        """(N, V, 3) morph position deltas in the space of :meth:`bind_positions`, or None."""
         if self.geometry.targets is None:
             return None
         return self.geometry.targets @ self.world[:3, :3].T
 
-    def rest_positions(self) -> np.ndarray:
-        """(V, 3) float32 world-space rest positions (morph weights 0)."""
+    def bind_positions(self) -> np.ndarray:
+        """(V, 3) float32 bind shape: POSITION under the node's rest world transform (morph
+        weights 0). The space of ``skinned.rest_positions`` and of the vertices a writer stores."""
         return transform_points(self.world, self.geometry.positions).astype(np.float32)
+
+    def rest_positions(self) -> np.ndarray:
+        """(V, 3) float32 world positions a viewer shows with no animation playing (morph weights
+        0): a skinned mesh posed by its skeleton's rest pose, the bind shape otherwise.
+
+        The two differ where the rest pose is not the bind pose, and where the bind shape has
+        another scale than what the skin makes of it: a centimetre mesh under a 0.01 armature
+        (Xbot.glb: 100x), or positions quantized with the scale folded into the inverse bind
+        matrices (KHR_mesh_quantization). Sizes and errors are taken on this one.
+        """
+        if self.skinned is None:
+            return self.bind_positions()
+        return self.skinned.bake(self.rig.skeleton.rest_motion(1)).frames[0]
 
     def clip_frames(self, clip: Clip, frames: np.ndarray | None = None) -> np.ndarray:
         """(T', V, 3) world positions of the drawable in the given frames of ``clip`` (all when None)."""
@@ -93,7 +107,7 @@ class Drawable:
         if self.skinned is not None:
             motion = clip.motion.take_frames(frames)
             return self.skinned.bake(motion, weights).frames
-        rest = self.rest_positions().astype(np.float64)
+        rest = self.bind_positions().astype(np.float64)
         if weights is None:
             return np.broadcast_to(rest, (len(frames),) + rest.shape).astype(np.float32)
         return (rest + np.einsum("tn,nvc->tvc", weights, self.morph_targets)).astype(np.float32)
@@ -173,17 +187,6 @@ def _clips(doc: GltfDocument, drawable: Drawable, fps: float) -> list[Clip]:
             continue
         frame_count = motion.frame_count if motion is not None else len(weights)
         if motion is None and drawable.rig is not None:
-            motion = _rest_motion(drawable.rig, frame_count, fps)
+            motion = drawable.rig.skeleton.rest_motion(frame_count, fps)
         clips.append(Clip(index, animation.name or "", frame_count, motion, weights))
     return clips
-
-
-def _rest_motion(rig: SkinRig, frame_count: int, fps: float) -> Motion:
-    """The skeleton held in its rest pose for ``frame_count`` frames."""
-    skeleton = rig.skeleton
-    return Motion(
-        skeleton,
-        np.repeat(skeleton.offsets[None, 0], frame_count, axis=0),
-        np.repeat(skeleton.rest_rotations[None], frame_count, axis=0),
-        fps=fps,
-    )

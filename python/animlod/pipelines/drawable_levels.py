@@ -91,21 +91,29 @@ class DrawableLevel:
     simplified : the AQEM level (faces, kept vertices, carried data; positions of the drive frames).
     primitives : the level's triangle primitives, node-local, ready to write.
     skinned : the level as a world-space skinned mesh (skinned drawables), else None.
-    rest : (V', 3) world-space rest positions of the level.
+    bind : (V', 3) the level's bind shape (the space of the drawable's ``bind_positions``).
+    morph_targets : (N, V', 3) its morph deltas in that space, or None.
     error : asset units, max over measured frames of the Hausdorff distance to the input.
     """
 
     simplified: SimplifiedLevel
     primitives: list[PrimitiveArrays]
     skinned: SkinnedMesh | None
-    rest: np.ndarray
+    bind: np.ndarray
     morph_targets: np.ndarray | None
     error: float = 0.0
+
+    def rest_positions(self) -> np.ndarray:
+        """(V', 3) what a viewer shows of the level with no animation (see Drawable.rest_positions)."""
+        if self.skinned is None:
+            return self.bind
+        return self.skinned.bake(self.skinned.skeleton.rest_motion(1)).frames[0]
 
 
 @dataclass
 class DrawableLevels:
-    """Levels of a drawable, finest first, with its size (rest bounding-box diagonal)."""
+    """Levels of a drawable, finest first, with its size (bounding-box diagonal of its rest pose as
+    a viewer shows it)."""
 
     levels: list[DrawableLevel]
     size: float
@@ -164,8 +172,7 @@ def simplify_drawable(
         importance=importance,
         **options,
     )
-    rest = drawable.rest_positions()
-    size = float(np.linalg.norm(np.ptp(rest, axis=0)))
+    size = float(np.linalg.norm(np.ptp(drawable.rest_positions(), axis=0)))
     levels = [_level(drawable, level, layout) for level in result.levels]
     notes = []
     rebuilt = [geometry.primitives[k].index for k, crease in enumerate(layout.crease) if crease is not None]
@@ -181,7 +188,7 @@ def _drive_frames(drawable: Drawable, budget: int) -> np.ndarray:
     """(F, V, 3) world positions AQEM works over: the rest pose, each morph target at full weight,
     then frames spread evenly over every clip (at least two per clip), F <= ``budget`` where the
     clips allow."""
-    rest = drawable.rest_positions()
+    rest = drawable.bind_positions()  # frame 0 carries the levels' bind shape (_level)
     frames = [rest[None]]
     if drawable.morph_targets is not None:
         frames.append((rest[None] + drawable.morph_targets).astype(np.float32))
@@ -287,9 +294,9 @@ def _is_flat_shaded(normals: np.ndarray | None, positions: np.ndarray, faces: np
 
 
 def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> DrawableLevel:
-    """The level's world-space rest, deltas and skin, and its primitives in node-local space."""
+    """The level's bind shape, deltas and skin, and its primitives in node-local space."""
     geometry = drawable.geometry
-    rest = level.mesh.frames[0]
+    rest = level.mesh.frames[0]  # the bind shape (_drive_frames)
     deltas = None
     if level.position_attributes is not None:
         deltas = level.position_attributes.reshape(len(rest), -1, 3).transpose(1, 0, 2)
@@ -428,10 +435,10 @@ def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: i
 def posed_frames(drawable: Drawable, level: DrawableLevel, clip: Clip | None, frames: np.ndarray) -> np.ndarray:
     """(T, V', 3) world positions of the level in the given frames of ``clip`` (None: rest)."""
     if clip is None:
-        return level.rest[None]
+        return level.rest_positions()[None]
     weights = None if clip.morph_weights is None else clip.morph_weights[frames]
     if level.skinned is not None:
         return level.skinned.bake(clip.motion.take_frames(frames), weights).frames
     if weights is None:
-        return np.broadcast_to(level.rest, (len(frames),) + level.rest.shape)
-    return (level.rest + np.einsum("tn,nvc->tvc", weights, level.morph_targets)).astype(np.float32)
+        return np.broadcast_to(level.bind, (len(frames),) + level.bind.shape)
+    return (level.bind + np.einsum("tn,nvc->tvc", weights, level.morph_targets)).astype(np.float32)

@@ -127,7 +127,7 @@ def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettin
         renormalised_weights=drawable.renormalised_weights,
         notes=list(levels.notes),
         rest_meshes=[AnimatedMesh(drawable.geometry.faces, drawable.rest_positions()[None])]
-        + [AnimatedMesh(level.simplified.mesh.faces, level.rest[None]) for level in levels.levels],
+        + [AnimatedMesh(level.simplified.mesh.faces, level.rest_positions()[None]) for level in levels.levels],
     )
     for index, (level, coverage) in enumerate(zip(levels.levels, coverages[1:]), start=1):
         simplified: SimplifiedLevel = level.simplified

@@ -6,6 +6,7 @@ not of the stored positions' scale."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -21,9 +22,20 @@ from animlod.synth import humanoid, humanoid_motion
 SHORT = 5122
 
 
+def _quantized_accessor(builder: GlbBuilder, values: np.ndarray) -> int:
+    """``values`` (V, 3) in [-1, 1] as a normalized int16 accessor with a 4-byte-aligned stride."""
+    padded = np.zeros((len(values), 4), np.int16)
+    padded[:, :3] = np.round(values * 32767)
+    view = {"buffer": 0, "byteOffset": builder._append(padded.tobytes()), "byteLength": padded.nbytes, "byteStride": 8}
+    accessor = {"bufferView": builder.append("bufferViews", view), "componentType": SHORT, "normalized": True,
+                "count": len(values), "type": "VEC3", "min": padded[:, :3].min(0).tolist(),
+                "max": padded[:, :3].max(0).tolist()}  # fmt: skip
+    return builder.append("accessors", accessor)
+
+
 def _quantize(source: Path, target: Path) -> float:
-    """``source`` with every POSITION stored as normalized int16 (stride 8) over a scale folded
-    into the inverse bind matrices; the scale."""
+    """``source`` with every POSITION (and morph target POSITION) stored as normalized int16 over
+    a scale folded into the inverse bind matrices; the scale."""
     doc = GltfDocument(source)
     builder = GlbBuilder.from_document(doc)
     document = builder.json
@@ -31,14 +43,9 @@ def _quantize(source: Path, target: Path) -> float:
     scale = float(max(np.abs(p).max() for p in positions)) * 1.001
     for mesh in document["meshes"]:
         for primitive in mesh["primitives"]:
-            stored = doc.accessor(primitive["attributes"]["POSITION"], "test") / scale
-            padded = np.zeros((len(stored), 4), np.int16)
-            padded[:, :3] = np.round(stored * 32767)
-            view = {"buffer": 0, "byteOffset": builder._append(padded.tobytes()), "byteLength": padded.nbytes}
-            accessor = {"bufferView": builder.append("bufferViews", {**view, "byteStride": 8}), "componentType": SHORT,
-                        "normalized": True, "count": len(stored), "type": "VEC3",
-                        "min": padded[:, :3].min(0).tolist(), "max": padded[:, :3].max(0).tolist()}  # fmt: skip
-            primitive["attributes"]["POSITION"] = builder.append("accessors", accessor)
+            for attributes in [primitive["attributes"], *primitive.get("targets", [])]:
+                stored = doc.accessor(attributes["POSITION"], "test") / scale
+                attributes["POSITION"] = _quantized_accessor(builder, stored)
     for skin in document["skins"]:
         inverse_bind = doc.accessor(skin["inverseBindMatrices"], "test").reshape(-1, 4, 4)  # column-major
         folded = inverse_bind * np.array([scale, scale, scale, 1.0])[None, :, None]  # IBM @ S(scale)
@@ -54,6 +61,10 @@ def _quantize(source: Path, target: Path) -> float:
 def character(tmp_path_factory) -> tuple[Path, Path, float]:
     folder = tmp_path_factory.mktemp("bind_scale")
     mesh = humanoid()
+    # One morph target: the upper body swells by 5% of the figure's height.
+    height = np.ptp(mesh.rest_positions[:, 1])
+    swell = np.where(mesh.rest_positions[:, 1:2] > np.median(mesh.rest_positions[:, 1]), 0.05 * height, 0.0)
+    mesh = dataclasses.replace(mesh, morph_targets=(swell * np.array([1.0, 0.0, 0.0]))[None].astype(np.float32))
     plain = folder / "humanoid.glb"
     write_glb(plain, mesh, [humanoid_motion(mesh.skeleton, "walk")])
     quantized = folder / "humanoid_quantized.glb"
@@ -67,6 +78,8 @@ def test_the_rest_pose_is_what_the_skin_shows(character):
     assert scale > 1.5  # the stored positions are smaller than the figure by that much
     np.testing.assert_allclose(stored.bind_positions() * scale, original.bind_positions(), atol=1e-3 * size)
     np.testing.assert_allclose(stored.rest_positions(), original.rest_positions(), atol=1e-3 * size)
+    assert np.abs(original.rest_morph_targets()).max() > 0.01 * size
+    np.testing.assert_allclose(stored.rest_morph_targets(), original.rest_morph_targets(), atol=1e-3 * size)
 
 
 def test_errors_and_coverages_do_not_depend_on_the_stored_scale(character, tmp_path):

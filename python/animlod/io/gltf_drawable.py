@@ -100,6 +100,17 @@ class Drawable:
             return self.bind_positions()
         return self.skinned.bake(self.rig.skeleton.rest_motion(1)).frames[0]
 
+    def rest_morph_targets(self) -> np.ndarray | None:
+        """(N, V, 3) morph deltas as they move :meth:`rest_positions` (glTF morphs before it
+        skins: through each vertex's blended skinning matrix of the rest pose), or None."""
+        deltas = self.morph_targets
+        if deltas is None or self.skinned is None:
+            return deltas
+        skin = self.skinned
+        matrices = self.rig.skeleton.rest_motion(1).skin_matrices(skin.inverse_bind)[0, :, :3, :3]  # (J, 3, 3)
+        blended = np.einsum("vk,vkij->vij", skin.weights, matrices[skin.joints])
+        return np.einsum("vij,nvj->nvi", blended, deltas).astype(np.float32)
+
     def clip_frames(self, clip: Clip, frames: np.ndarray | None = None) -> np.ndarray:
         """(T', V, 3) world positions of the drawable in the given frames of ``clip`` (all when None)."""
         frames = np.arange(clip.frame_count) if frames is None else np.asarray(frames)

@@ -1,9 +1,10 @@
 """Checked access to a loaded glTF 2.0 document: buffers, accessors and the node tree.
 
-pygltflib parses the JSON and splits a GLB into its chunks; this module turns what it gives
-into numpy arrays and checks every reference on the way, so that a broken file fails with
-:class:`FormatError` naming the file, the element and the reason instead of an IndexError or
-a silently wrong array.
+This module splits a GLB into its chunks, parses the JSON with bounded nesting and has it
+decoded into pygltflib's object model with every value's JSON type checked (gltf_decode.py);
+then it turns accessors into numpy arrays and checks every reference on the way, so that a
+broken file fails with :class:`FormatError` naming the file, the element and the reason
+instead of an IndexError or a silently wrong array.
 """
 
 from __future__ import annotations

@@ -38,7 +38,10 @@ std::vector<uint8_t> free_points(const MotionRefitProblem& problem, bool elimina
 }  // namespace
 
 PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate)
-    : problem_(problem), hard_(hard_constraints), free_points_(problem, free_points(problem, eliminate)) {
+    : problem_(problem),
+      hard_(hard_constraints),
+      free_points_(problem, free_points(problem, eliminate)),
+      trees_(problem, eliminate && hard_constraints) {
   const size_t p = problem.point_count;
   index_.assign(p, -1);
   substitute_.resize(p);
@@ -48,6 +51,8 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
   jacobians_.assign(p, Matrix3{1, 0, 0, 0, 1, 0, 0, 0, 1});
   const size_t pairs = problem.length_pair_count;
   kept_equalities_.assign(motion_refit_equality_count(problem), 1);
+  for (size_t k = 0; k < pairs; ++k)
+    if (trees_.inner_pairs()[k]) kept_equalities_[k] = 0;
 
   // Coincident pairs held exactly: every point of a tied set sits at its lowest index.
   if (eliminate && hard_constraints) {
@@ -74,7 +79,11 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
       for (int side = 0; side < 2; ++side) {
         const int32_t leaf = problem.length_pairs[2 * k + side];
         const int32_t anchor = problem.length_pairs[2 * k + 1 - side];
-        if (leaf == 0 || terms[leaf] != 1 || leaf_anchor_[anchor] >= 0) continue;
+        // A tree's points and anchors are placed by the tree (the anchor is one of its leaves
+        // only when nothing else holds either: then it stays a variable).
+        if (leaf == 0 || terms[leaf] != 1 || leaf_anchor_[anchor] >= 0 || trees_.contains(leaf) ||
+            trees_.contains(anchor))
+          continue;
         leaf_anchor_[leaf] = anchor;
         leaf_length_[leaf] = problem.key_lengths[k];
         kept_equalities_[k] = 0;
@@ -85,7 +94,7 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
   free_index_.assign(p, -1);
   for (size_t k = 1; k < p; ++k) {
     if (free_points_.contains(k)) free_index_[k] = static_cast<int32_t>(free_count_++);
-    else if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0)
+    else if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0 && !trees_.contains(k))
       index_[k] = static_cast<int32_t>(reduced_points_++);
   }
   kept_equality_count_ = static_cast<size_t>(std::count(kept_equalities_.begin(), kept_equalities_.end(), 1));
@@ -98,6 +107,7 @@ void PointReduction::fill(const double* y, const double* original, double* x) {
     if (index_[k] >= 0) std::copy(y + 3 * index_[k], y + 3 * index_[k] + 3, x + 3 * k);
   for (size_t k = 1; k < p; ++k)
     if (substitute_[k] != static_cast<int32_t>(k)) std::copy(x + 3 * substitute_[k], x + 3 * substitute_[k] + 3, x + 3 * k);
+  trees_.place(x, original);
   const double alpha = problem_.distance_weight, beta = problem_.string_weight;
   const double pull = hard_ ? 0.0 : alpha / (alpha + beta);  // dr / dd
   for (size_t k = 1; k < p; ++k) {
@@ -150,10 +160,12 @@ void PointReduction::gather(const double* x, double* y) const {
 int32_t PointReduction::target(size_t k) const {
   int32_t point = static_cast<int32_t>(k);
   if (leaf_anchor_[point] >= 0) point = leaf_anchor_[point];
+  if (trees_.contains(point)) point = trees_.anchor(point);
   return index_[substitute_[point]];
 }
 
 const double* PointReduction::derivative(size_t k) const {
+  if (trees_.contains(k)) return trees_.derivative(k);
   return leaf_anchor_[k] >= 0 ? jacobians_[k].data() : kIdentity;
 }
 

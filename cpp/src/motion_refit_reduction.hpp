@@ -8,6 +8,9 @@
 //   from x_p to its original position, at the held length b with hard constraints, or at
 //   r = (alpha d + beta b) / (alpha + beta) without (d = |x^o - x_p|): its Ed and Es terms are
 //   then minimal given x_p, in closed form;
+// - a point of a pendant tree (held lengths only, hanging from one other point, under hard
+//   constraints) is at the minimum of its tree's Ed terms given that point, found by Newton's
+//   method over the bone directions (motion_refit_pendant_trees.hpp);
 // - a free point (in no held length, coincident pair or handed group: a frozen joint or an end
 //   site below one at a coarse level) is at the minimum of its Ed and angle terms given the
 //   others, found by Newton's method (motion_refit_free_points.hpp).
@@ -23,6 +26,7 @@
 
 #include "animlod/motion_refit.hpp"
 #include "motion_refit_free_points.hpp"
+#include "motion_refit_pendant_trees.hpp"
 
 namespace animlod::detail {
 
@@ -41,7 +45,7 @@ class PointReduction {
   // FreePointClusters::set_start): the free points of x (P, 3).
   void set_free_start(const double* x, const double* original) { free_points_.set_start(x, original); }
   // Full positions x (P, 3) from the reduced ones y (P_r, 3); the root is original's. Remembers
-  // the leaves' Jacobians for the reduce_* calls that follow.
+  // the leaves' and the trees' Jacobians for the reduce_* calls that follow.
   void fill(const double* y, const double* original, double* x);
   // The reduced positions (P_r, 3) of full positions x (P, 3).
   void gather(const double* x, double* y) const;
@@ -57,13 +61,15 @@ class PointReduction {
  private:
   using Matrix3 = std::array<double, 9>;
   // Where full point k's derivative goes: reduced point (-1: none, the root) and the 3 x 3
-  // derivative of x_k with respect to it (identity unless k is a leaf).
+  // derivative of x_k with respect to it (identity unless k is a leaf or a tree point, whose
+  // derivatives go to its anchor).
   int32_t target(size_t k) const;
   const double* derivative(size_t k) const;
 
   const MotionRefitProblem& problem_;
   bool hard_ = false;
   FreePointClusters free_points_;
+  PendantTrees trees_;
   size_t reduced_points_ = 0;
   std::vector<int32_t> index_;        // (P,) reduced index of a variable point, -1 otherwise
   std::vector<int32_t> substitute_;   // (P,) the point a substituted point sits at, else itself

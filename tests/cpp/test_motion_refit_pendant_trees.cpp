@@ -1,0 +1,114 @@
+// Pendant trees of the motion re-fit (cpp/src/motion_refit_pendant_trees.hpp): a chain hanging
+// by held lengths alone is solved inside; E's gradient over the others through it matches finite
+// differences of E at the placed tree, and the solve without its variables ends where the solve
+// with them does, its lengths held.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "../../cpp/src/motion_refit_detail.hpp"
+#include "../../cpp/src/motion_refit_reduction.hpp"
+#include "animlod/motion_refit.hpp"
+#include "motion_refit_figure.hpp"
+
+using animlod::MotionRefitOptions;
+using animlod::MotionRefitResult;
+using animlod::detail::PointReduction;
+
+namespace {
+
+// Root 0; points 1, 2, 3 in a loop of lengths with the root (0-1, 0-2, 1-3, 2-3), so none of them
+// hangs; the chain 4-5-6 hangs from 3, and 7 is a leaf on 1 (a one-point tree: closed form).
+struct ChainFigure {
+  std::vector<double> key = {0, 0, 0,  -0.5, 1, 0,  0.5, 1, 0.1,  0, 2, 0,  0.2, 3, 0,  0.1, 4, 0.3,
+                             0.4, 5, 0.2,  -1.2, 1.3, 0};
+  std::vector<int32_t> pairs = {0, 1, 0, 2, 1, 3, 2, 3, 3, 4, 4, 5, 5, 6, 1, 7};
+  std::vector<double> key_lengths = pair_lengths(key, pairs);
+  animlod::MotionRefitProblem problem;
+
+  ChainFigure() {
+    problem.point_count = 8;
+    problem.length_pairs = pairs.data();
+    problem.key_lengths = key_lengths.data();
+    problem.length_pair_count = key_lengths.size();
+    problem.length_scale = 5.0;
+  }
+
+  std::vector<double> perturbed(unsigned seed, double scale) const {
+    std::mt19937 random(seed);
+    std::normal_distribution<double> normal(0.0, scale);
+    std::vector<double> x = key;
+    for (size_t i = 3; i < x.size(); ++i) x[i] += normal(random);
+    return x;
+  }
+};
+
+double reduced_energy(PointReduction& reduction, const ChainFigure& f, const std::vector<double>& y,
+                      const std::vector<double>& original, std::vector<double>& gradient) {
+  std::vector<double> x(original), full(original.size());
+  reduction.fill(y.data(), original.data(), x.data());
+  const double value = animlod::detail::refit_objective_frame(f.problem, x.data(), original.data(), full.data());
+  reduction.reduce_rows(full.data(), 1, gradient.data());
+  return value;
+}
+
+}  // namespace
+
+TEST_CASE("pendant trees: the chain leaves the variables and E's gradient through it is exact") {
+  const ChainFigure f;
+  PointReduction reduction(f.problem, true, true);
+  CHECK(reduction.reduced_points() == 3);       // 1, 2 and 3
+  CHECK(reduction.kept_equality_count() == 4);  // the loop's lengths
+  const std::vector<double> original = f.perturbed(1, 0.3);
+  const std::vector<double> x = f.perturbed(2, 0.1);
+  std::vector<double> y(9);
+  reduction.gather(x.data(), y.data());
+  std::vector<double> placed(x);
+  reduction.fill(y.data(), original.data(), placed.data());
+  const std::vector<double> lengths = pair_lengths(placed, f.pairs);
+  for (size_t k = 4; k < 7; ++k) CHECK(lengths[k] == doctest::Approx(f.key_lengths[k]).epsilon(1e-12));
+
+  std::vector<double> gradient(9), g_plus(9), g_minus(9);
+  reduced_energy(reduction, f, y, original, gradient);
+  const double h = 1e-6;
+  for (size_t i = 0; i < 9; ++i) {
+    std::vector<double> plus = y, minus = y;
+    plus[i] += h;
+    minus[i] -= h;
+    const double numeric =
+        (reduced_energy(reduction, f, plus, original, g_plus) - reduced_energy(reduction, f, minus, original, g_minus)) /
+        (2 * h);
+    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-6).scale(1.0));
+  }
+}
+
+TEST_CASE("pendant trees: the solve without their variables ends where the solve with them does") {
+  const ChainFigure f;
+  const size_t p = f.problem.point_count;
+  const size_t frames = 8;
+  std::vector<double> original, fallback;
+  for (size_t t = 0; t < frames; ++t) {
+    const std::vector<double> o = f.perturbed(20 + static_cast<unsigned>(t), 0.2);
+    original.insert(original.end(), o.begin(), o.end());
+    fallback.insert(fallback.end(), f.key.begin(), f.key.end());  // the key posture: feasible
+  }
+  MotionRefitOptions options;
+  options.ftol_rel = 1e-12;
+  options.threads = 1;
+  MotionRefitResult with, without;
+  options.eliminate_points = false;
+  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, with));
+  options.eliminate_points = true;
+  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, without));
+  CHECK(with.failures.empty());
+  CHECK(without.failures.empty());
+  for (size_t t = 0; t < frames; ++t) {
+    CHECK(without.values[t] == doctest::Approx(with.values[t]).epsilon(1e-6));
+    const std::vector<double> x(without.positions.begin() + static_cast<long>(t * 3 * p),
+                                without.positions.begin() + static_cast<long>((t + 1) * 3 * p));
+    const std::vector<double> lengths = pair_lengths(x, f.pairs);
+    for (size_t k = 0; k < lengths.size(); ++k) CHECK(std::abs(lengths[k] - f.key_lengths[k]) < 1e-8 * 5.0);
+  }
+}

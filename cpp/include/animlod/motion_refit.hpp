@@ -109,8 +109,10 @@ struct MotionRefitOptions {
   // length lies on the ray to its original position), that hard constraints put onto another
   // point (a zero-length pair), or that no constraint touches (frozen joints and the end sites
   // below them: minimised by Newton's method for given positions of the others, so that SLSQP
-  // sees neither their variables nor the curved valleys of their angle terms). SLSQP's cost
-  // grows with the cube of the variable count. The minima are the same.
+  // sees neither their variables nor the curved valleys of their angle terms), and, with hard
+  // constraints, trees of points held by lengths alone that hang from one other point (a leg,
+  // a finger: placed by Newton's method over their bone directions). SLSQP's cost grows with the
+  // cube of the variable count. The minima are the same.
   bool eliminate_points = true;
   int chunk_frames = 64;        // consecutive frames per task (warm starts run inside a chunk)
   int threads = 0;              // worker threads; 0 uses every hardware thread

@@ -9,6 +9,16 @@
 
 namespace animlod::detail {
 
+// Stopping rules of the inner Newton solves (free points, pendant trees): per solve and
+// evaluation at most kNewtonIterations steps of at most kNewtonHalvings line-search halvings; a
+// step shorter than kNewtonStep (a fraction of L, or radians), or a Newton decrement below
+// kNewtonDecrement of the value, ends it: at quadratic convergence the gradient left is then far
+// below what SLSQP's stopping rule can see.
+constexpr int kNewtonIterations = 50;
+constexpr int kNewtonHalvings = 40;
+constexpr double kNewtonStep = 1e-13;
+constexpr double kNewtonDecrement = 1e-15;
+
 // E (Eq. 5) of one frame; adds nothing to the root's gradient. gradient: (P, 3) or nullptr.
 double refit_objective_frame(const MotionRefitProblem& problem, const double* x, const double* original,
                              double* gradient);

@@ -17,19 +17,6 @@
 
 namespace animlod::detail {
 
-namespace {
-
-// Newton iterations per cluster and evaluation; from set_start's minimum a few steps usually do.
-constexpr int kMaxIterations = 50;
-constexpr int kMaxHalvings = 40;
-// A step shorter than this fraction of L, or a Newton decrement below this fraction of the
-// value, ends the iteration: at quadratic convergence the gradient left is then far below what
-// SLSQP's stopping rule can see.
-constexpr double kStepTolerance = 1e-13;
-constexpr double kDecrementTolerance = 1e-15;
-
-}  // namespace
-
 FreePointClusters::FreePointClusters(const MotionRefitProblem& problem, const std::vector<uint8_t>& free)
     : problem_(problem), local_(problem.point_count, -1), start_(3 * problem.point_count, 0.0) {
   const size_t p = problem.point_count;
@@ -141,14 +128,14 @@ void FreePointClusters::minimise(double* x, const double* original) {
 }
 
 double FreePointClusters::newton(Cluster& cluster, double* x, const double* original) {
-  const double tolerance = kStepTolerance * problem_.length_scale;
+  const double tolerance = kNewtonStep * problem_.length_scale;
   const double curvature = 2.0 * problem_.distance_weight / (problem_.length_scale * problem_.length_scale);
   const size_t n = 3 * cluster.points.size();
   double* gradient = gradient_.data();
   double* step = step_.data();
   double* saved = trial_.data();
   double value = 0.0;
-  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+  for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
     value = cluster_energy(cluster, x, original, gradient, true);
     // Where an angle term makes the Hessian indefinite, shift it towards Ed's curvature until
     // it is positive definite (Levenberg): every step then descends.
@@ -165,7 +152,7 @@ double FreePointClusters::newton(Cluster& cluster, double* x, const double* orig
       slope += gradient[i] * step[i];
       largest = std::max(largest, std::abs(step[i]));
     }
-    if (!(slope < -kDecrementTolerance * value)) break;
+    if (!(slope < -kNewtonDecrement * value)) break;
     for (size_t i = 0; i < n; ++i) saved[i] = x[3 * cluster.points[i / 3] + i % 3];
     double t = 1.0;
     int halvings = 0;
@@ -174,10 +161,10 @@ double FreePointClusters::newton(Cluster& cluster, double* x, const double* orig
       for (size_t i = 0; i < n; ++i) x[3 * cluster.points[i / 3] + i % 3] = saved[i] + t * step[i];
       trial = cluster_energy(cluster, x, original, nullptr, false);
       if (trial <= value + 1e-4 * t * slope) break;
-      if (++halvings == kMaxHalvings) break;
+      if (++halvings == kNewtonHalvings) break;
       t *= 0.5;
     }
-    if (halvings == kMaxHalvings) {  // no decrease along a descent direction: rounding
+    if (halvings == kNewtonHalvings) {  // no decrease along a descent direction: rounding
       for (size_t i = 0; i < n; ++i) x[3 * cluster.points[i / 3] + i % 3] = saved[i];
       break;
     }

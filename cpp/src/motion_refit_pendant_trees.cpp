@@ -16,16 +16,11 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "motion_refit_detail.hpp"
+
 namespace animlod::detail {
 
 namespace {
-
-constexpr int kMaxIterations = 50;
-constexpr int kMaxHalvings = 40;
-// A step below this (radians) or a Newton decrement below this fraction of the value ends the
-// iteration: quadratic convergence has then left far less than SLSQP's stopping rule can see.
-constexpr double kStepTolerance = 1e-13;
-constexpr double kDecrementTolerance = 1e-15;
 
 struct Vec3 {
   double v[3];
@@ -211,14 +206,14 @@ void PendantTrees::place_tree(const Tree& tree, double* x, const double* origina
     for (int a = 0; a < 3; ++a) at[i][a] = base[a] + tree.length[i] * d[a];
   }
   double value = positions(u, at);
-  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+  for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
     assemble();
     if (gradient.squaredNorm() == 0.0 || !factor()) break;
     step = -llt.solve(gradient);
     const double decrease = -gradient.dot(step);
-    if (!(decrease > kDecrementTolerance * value)) break;
+    if (!(decrease > kNewtonDecrement * value)) break;
     double t = 1.0, trial_value = value;
-    for (int halving = 0; halving < kMaxHalvings; ++halving, t *= 0.5) {
+    for (int halving = 0; halving < kNewtonHalvings; ++halving, t *= 0.5) {
       for (size_t k = 0; k < n; ++k) {
         for (int a = 0; a < 3; ++a) trial_u[k][a] = u[k][a] + t * (step(2 * k) * e1[k][a] + step(2 * k + 1) * e2[k][a]);
         normalised(trial_u[k]);
@@ -229,7 +224,7 @@ void PendantTrees::place_tree(const Tree& tree, double* x, const double* origina
     if (!(trial_value < value)) break;  // no descent left at rounding level
     u.swap(trial_u);
     value = positions(u, at);
-    if (t * step.cwiseAbs().maxCoeff() < kStepTolerance) break;
+    if (t * step.cwiseAbs().maxCoeff() < kNewtonStep) break;
   }
 
   // How the minimum follows the anchor (implicit function theorem): the gradient's derivative

@@ -2,12 +2,15 @@
 // test_motion_refit_free_points.cpp), and E at a point.
 #pragma once
 
+#include <doctest/doctest.h>
+
 #include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
 
 #include "../../cpp/src/motion_refit_detail.hpp"
+#include "../../cpp/src/motion_refit_reduction.hpp"
 #include "animlod/motion_refit.hpp"
 
 // |x_a - x_b| of every pair (a, b) of `pairs` at positions `x` (P, 3).
@@ -22,6 +25,44 @@ inline std::vector<double> pair_lengths(const std::vector<double>& x, const std:
     lengths.push_back(std::sqrt(sum));
   }
   return lengths;
+}
+
+// `key` (P, 3) with N(0, scale) noise on every coordinate but the root's.
+inline std::vector<double> perturbed_positions(const std::vector<double>& key, unsigned seed, double scale) {
+  std::mt19937 random(seed);
+  std::normal_distribution<double> normal(0.0, scale);
+  std::vector<double> x = key;
+  for (size_t i = 3; i < x.size(); ++i) x[i] += normal(random);
+  return x;
+}
+
+// The solve of `frames` perturbations of `key` (seeds first_seed, ...; the key posture as the
+// feasible fallback), with and without eliminate_points, on one thread; checks that both solve
+// every frame and end at the same E.
+struct EliminationRun {
+  animlod::MotionRefitResult with, without;  // every point a variable / points eliminated
+};
+inline EliminationRun solve_with_and_without_elimination(const animlod::MotionRefitProblem& problem,
+                                                         const std::vector<double>& key, unsigned first_seed,
+                                                         double scale, size_t frames) {
+  std::vector<double> original, fallback;
+  for (size_t t = 0; t < frames; ++t) {
+    const std::vector<double> o = perturbed_positions(key, first_seed + static_cast<unsigned>(t), scale);
+    original.insert(original.end(), o.begin(), o.end());
+    fallback.insert(fallback.end(), key.begin(), key.end());
+  }
+  animlod::MotionRefitOptions options;
+  options.ftol_rel = 1e-12;
+  options.threads = 1;
+  EliminationRun run;
+  options.eliminate_points = false;
+  REQUIRE(animlod::motion_refit_solve(problem, original.data(), fallback.data(), nullptr, frames, options, run.with));
+  options.eliminate_points = true;
+  REQUIRE(animlod::motion_refit_solve(problem, original.data(), fallback.data(), nullptr, frames, options, run.without));
+  CHECK(run.with.failures.empty());
+  CHECK(run.without.failures.empty());
+  for (size_t t = 0; t < frames; ++t) CHECK(run.without.values[t] == doctest::Approx(run.with.values[t]).epsilon(1e-6));
+  return run;
 }
 
 // A small figure: root 0, a spine 1-2, a frozen joint 3 with child 4, a coincident point 5 on 1,
@@ -60,15 +101,34 @@ struct Figure {
     key_volumes[0] = volume[0] < 0.0 ? 1.0 : -1.0;
   }
 
-  std::vector<double> perturbed(unsigned seed, double scale) const {
-    std::mt19937 random(seed);
-    std::normal_distribution<double> normal(0.0, scale);
-    std::vector<double> x = key;
-    for (size_t i = 3; i < x.size(); ++i) x[i] += normal(random);
-    return x;
-  }
+  std::vector<double> perturbed(unsigned seed, double scale) const { return perturbed_positions(key, seed, scale); }
 };
 
 inline double objective_at(const animlod::MotionRefitProblem& p, const std::vector<double>& x, const std::vector<double>& o) {
   return animlod::detail::refit_objective_frame(p, x.data(), o.data(), nullptr);
+}
+
+// E at the full positions of the reduced variables y, and its gradient over y.
+inline double reduced_energy(animlod::detail::PointReduction& reduction, const animlod::MotionRefitProblem& problem,
+                             const std::vector<double>& y, const std::vector<double>& original,
+                             std::vector<double>& gradient) {
+  std::vector<double> x(original), full(original.size());
+  reduction.fill(y.data(), original.data(), x.data());
+  const double value = animlod::detail::refit_objective_frame(problem, x.data(), original.data(), full.data());
+  reduction.reduce_rows(full.data(), 1, gradient.data());
+  return value;
+}
+
+// The central difference of reduced_energy along y[i] with step h; g_plus and g_minus receive
+// the reduced gradients at y + h e_i and y - h e_i.
+inline double reduced_energy_slope(animlod::detail::PointReduction& reduction,
+                                   const animlod::MotionRefitProblem& problem, const std::vector<double>& y,
+                                   const std::vector<double>& original, size_t i, double h,
+                                   std::vector<double>& g_plus, std::vector<double>& g_minus) {
+  std::vector<double> plus = y, minus = y;
+  plus[i] += h;
+  minus[i] -= h;
+  return (reduced_energy(reduction, problem, plus, original, g_plus) -
+          reduced_energy(reduction, problem, minus, original, g_minus)) /
+         (2 * h);
 }

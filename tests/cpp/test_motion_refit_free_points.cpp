@@ -17,20 +17,6 @@ using animlod::MotionRefitOptions;
 using animlod::MotionRefitResult;
 using animlod::detail::PointReduction;
 
-namespace {
-
-// E at the full positions of the reduced variables y, and its gradient over y.
-double reduced_energy(PointReduction& reduction, const Figure& f, const std::vector<double>& y,
-                      const std::vector<double>& original, std::vector<double>& gradient) {
-  std::vector<double> x(original), full(original.size());
-  reduction.fill(y.data(), original.data(), x.data());
-  const double value = animlod::detail::refit_objective_frame(f.problem, x.data(), original.data(), full.data());
-  reduction.reduce_rows(full.data(), 1, gradient.data());
-  return value;
-}
-
-}  // namespace
-
 TEST_CASE("free points: the reduced gradient and Hessian are those of E minimised over them") {
   const Figure f;  // points 3 and 4 (a frozen joint and its child) are in no length
   const size_t p = f.problem.point_count;
@@ -45,7 +31,7 @@ TEST_CASE("free points: the reduced gradient and Hessian are those of E minimise
   const size_t n = y.size();
 
   std::vector<double> gradient(n);
-  reduced_energy(reduction, f, y, original, gradient);
+  reduced_energy(reduction, f.problem, y, original, gradient);
   std::vector<double> placed(x), full(3 * p);  // the free points sit where their gradient vanishes
   reduction.fill(y.data(), original.data(), placed.data());
   animlod::detail::refit_objective_frame(f.problem, placed.data(), original.data(), full.data());
@@ -56,12 +42,7 @@ TEST_CASE("free points: the reduced gradient and Hessian are those of E minimise
   const double h = 1e-6;
   std::vector<double> g_plus(n), g_minus(n), numeric_hessian(n * n);
   for (size_t i = 0; i < n; ++i) {
-    std::vector<double> plus = y, minus = y;
-    plus[i] += h;
-    minus[i] -= h;
-    const double numeric =
-        (reduced_energy(reduction, f, plus, original, g_plus) - reduced_energy(reduction, f, minus, original, g_minus)) /
-        (2 * h);
+    const double numeric = reduced_energy_slope(reduction, f.problem, y, original, i, h, g_plus, g_minus);
     CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-6).scale(1.0));
     for (size_t j = 0; j < n; ++j) numeric_hessian[j * n + i] = (g_plus[j] - g_minus[j]) / (2 * h);
   }
@@ -76,24 +57,8 @@ TEST_CASE("free points: the solve without their variables ends where the solve w
   const Figure f;
   const size_t p = f.problem.point_count;
   const size_t frames = 6;
-  std::vector<double> original, fallback;
+  const auto [with, without] = solve_with_and_without_elimination(f.problem, f.key, 10, 0.05, frames);
   for (size_t t = 0; t < frames; ++t) {
-    const std::vector<double> o = f.perturbed(10 + static_cast<unsigned>(t), 0.05);
-    original.insert(original.end(), o.begin(), o.end());
-    fallback.insert(fallback.end(), f.key.begin(), f.key.end());  // the key posture: feasible
-  }
-  MotionRefitOptions options;
-  options.ftol_rel = 1e-12;
-  options.threads = 1;
-  MotionRefitResult with, without;
-  options.eliminate_points = false;
-  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, with));
-  options.eliminate_points = true;
-  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, without));
-  CHECK(with.failures.empty());
-  CHECK(without.failures.empty());
-  for (size_t t = 0; t < frames; ++t) {
-    CHECK(without.values[t] == doctest::Approx(with.values[t]).epsilon(1e-6));
     for (size_t i = 0; i < 3 * p; ++i)
       CHECK(without.positions[t * 3 * p + i] == doctest::Approx(with.positions[t * 3 * p + i]).epsilon(1e-4).scale(1.0));
   }

@@ -5,7 +5,6 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include "../../cpp/src/motion_refit_detail.hpp"
@@ -13,8 +12,6 @@
 #include "animlod/motion_refit.hpp"
 #include "motion_refit_figure.hpp"
 
-using animlod::MotionRefitOptions;
-using animlod::MotionRefitResult;
 using animlod::detail::PointReduction;
 
 namespace {
@@ -36,23 +33,8 @@ struct ChainFigure {
     problem.length_scale = 5.0;
   }
 
-  std::vector<double> perturbed(unsigned seed, double scale) const {
-    std::mt19937 random(seed);
-    std::normal_distribution<double> normal(0.0, scale);
-    std::vector<double> x = key;
-    for (size_t i = 3; i < x.size(); ++i) x[i] += normal(random);
-    return x;
-  }
+  std::vector<double> perturbed(unsigned seed, double scale) const { return perturbed_positions(key, seed, scale); }
 };
-
-double reduced_energy(PointReduction& reduction, const ChainFigure& f, const std::vector<double>& y,
-                      const std::vector<double>& original, std::vector<double>& gradient) {
-  std::vector<double> x(original), full(original.size());
-  reduction.fill(y.data(), original.data(), x.data());
-  const double value = animlod::detail::refit_objective_frame(f.problem, x.data(), original.data(), full.data());
-  reduction.reduce_rows(full.data(), 1, gradient.data());
-  return value;
-}
 
 }  // namespace
 
@@ -71,15 +53,10 @@ TEST_CASE("pendant trees: the chain leaves the variables and E's gradient throug
   for (size_t k = 4; k < 7; ++k) CHECK(lengths[k] == doctest::Approx(f.key_lengths[k]).epsilon(1e-12));
 
   std::vector<double> gradient(9), g_plus(9), g_minus(9);
-  reduced_energy(reduction, f, y, original, gradient);
+  reduced_energy(reduction, f.problem, y, original, gradient);
   const double h = 1e-6;
   for (size_t i = 0; i < 9; ++i) {
-    std::vector<double> plus = y, minus = y;
-    plus[i] += h;
-    minus[i] -= h;
-    const double numeric =
-        (reduced_energy(reduction, f, plus, original, g_plus) - reduced_energy(reduction, f, minus, original, g_minus)) /
-        (2 * h);
+    const double numeric = reduced_energy_slope(reduction, f.problem, y, original, i, h, g_plus, g_minus);
     CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-6).scale(1.0));
   }
 }
@@ -88,24 +65,8 @@ TEST_CASE("pendant trees: the solve without their variables ends where the solve
   const ChainFigure f;
   const size_t p = f.problem.point_count;
   const size_t frames = 8;
-  std::vector<double> original, fallback;
+  const auto [with, without] = solve_with_and_without_elimination(f.problem, f.key, 20, 0.2, frames);
   for (size_t t = 0; t < frames; ++t) {
-    const std::vector<double> o = f.perturbed(20 + static_cast<unsigned>(t), 0.2);
-    original.insert(original.end(), o.begin(), o.end());
-    fallback.insert(fallback.end(), f.key.begin(), f.key.end());  // the key posture: feasible
-  }
-  MotionRefitOptions options;
-  options.ftol_rel = 1e-12;
-  options.threads = 1;
-  MotionRefitResult with, without;
-  options.eliminate_points = false;
-  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, with));
-  options.eliminate_points = true;
-  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, without));
-  CHECK(with.failures.empty());
-  CHECK(without.failures.empty());
-  for (size_t t = 0; t < frames; ++t) {
-    CHECK(without.values[t] == doctest::Approx(with.values[t]).epsilon(1e-6));
     const std::vector<double> x(without.positions.begin() + static_cast<long>(t * 3 * p),
                                 without.positions.begin() + static_cast<long>((t + 1) * 3 * p));
     const std::vector<double> lengths = pair_lengths(x, f.pairs);

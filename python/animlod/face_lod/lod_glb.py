@@ -108,7 +108,8 @@ def gltf_face_levels(source: GltfFace, options: BlendshapeLodOptions | None = No
     importance = None
     if options.grow is not None and np.any(face.targets):
         importance = target_regions(face, options.grow).vertex_importance()
-    drawn = simplify_drawable(source.drawable, ratios, importance=importance)
+    # The levels are measured as blendshape levels (prune_levels and the caller), not here.
+    drawn = simplify_drawable(source.drawable, ratios, importance=importance, measure=False)
     everything = np.arange(face.target_count)
     identity = np.arange(face.vertex_count, dtype=np.int32)
     levels = [BlendshapeLevel(face.faces, face.neutral, face.targets, everything, identity, face.uvs, 0.0, 0.0)]

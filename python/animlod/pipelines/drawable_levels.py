@@ -96,7 +96,8 @@ class DrawableLevel:
     skinned : the level as a world-space skinned mesh (skinned drawables), else None.
     bind : (V', 3) the level's bind shape (the space of the drawable's ``bind_positions``).
     morph_targets : (N, V', 3) its morph deltas in that space, or None.
-    error : asset units, max over measured frames of the Hausdorff distance to the input.
+    error : asset units, max over measured frames of the Hausdorff distance to the input (0 when
+        simplify_drawable was asked not to measure).
     """
 
     simplified: SimplifiedLevel
@@ -139,13 +140,16 @@ def simplify_drawable(
     ratios: Sequence[float],
     settings: DrawableSettings | None = None,
     importance: np.ndarray | None = None,
+    measure: bool = True,
 ) -> DrawableLevels:
     """AQEM levels of ``drawable`` at ``ratios``, each measured over every clip.
 
     ``settings`` says how many frames drive and measure the levels and which AQEM options
     replace the pipeline's (unlike :func:`animlod.simplify_animated`, motion features are off
     unless ``use_motion_features=True`` is given; see the comment below). ``importance`` (V,)
-    float32 > 0 multiplies each vertex's weight (the face's regions).
+    float32 > 0 multiplies each vertex's weight (the face's regions). ``measure=False`` leaves
+    every level's ``error`` at 0, for callers that measure what they write themselves (the
+    character chain, the face levels): measuring is most of the work on characters with clips.
     """
     settings = settings or DrawableSettings()
     geometry = drawable.geometry
@@ -183,7 +187,8 @@ def simplify_drawable(
         notes.append(f"primitives {rebuilt}: hard normal edges; normals rebuilt on each level (crease angle)")
     if geometry.other_primitives:
         notes.append(f"primitives {geometry.other_primitives}: points or lines, kept unchanged")
-    _measure(drawable, levels, settings.measured_frames)
+    if measure:
+        _measure(drawable, levels, settings.measured_frames)
     return DrawableLevels(levels, size, result.preparation, notes)
 
 

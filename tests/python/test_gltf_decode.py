@@ -211,6 +211,8 @@ def test_a_value_of_the_wrong_json_type_is_named(edit, where, reason):
         (lambda d: d["accessors"][0].update(count=3.0), lambda g: g.accessors[0].count == 3),
         # glTF 2.0 allows extras of any JSON type (pygltflib refuses all but objects).
         (lambda d: d["nodes"][0].update(extras="note"), lambda g: g.nodes[0].extras == "note"),
+        # A number where a name belongs is its text (pygltflib's reading), not a refused file.
+        (lambda d: d["nodes"][0].update(name=7), lambda g: g.nodes[0].name == "7"),
         # A null property is taken as absent: the field's default.
         (lambda d: d["accessors"][0].update(byteOffset=None), lambda g: g.accessors[0].byteOffset == 0),
         # Empty attributes are Attributes with nothing set (pygltflib leaves a dict).

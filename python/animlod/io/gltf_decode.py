@@ -6,7 +6,7 @@ hints again for every object: 2.4 s for the 7,163 objects of a Mixamo character 
 2.5 becomes 2, a translation "123" becomes [1.0, 2.0, 3.0]). Here each class's fields are
 resolved once and every value is checked against glTF's JSON types, so a wrong one fails with
 FormatError naming the file and the property (``accessors[3].count: expected an integer, got
-2.5``). Valid documents decode to the same objects as pygltflib's decoder
+2.5``); only labels (names, the generator) take a number as its text. Valid documents decode to the same objects as pygltflib's decoder
 (tests/python/test_gltf_decode.py compares them on every dev file), with two deliberate
 differences: a primitive's ``attributes`` and ``targets`` are always
 :class:`pygltflib.Attributes` (pygltflib leaves targets, and empty attributes, as dicts), and
@@ -71,6 +71,14 @@ def _string(value: Any, where: str) -> str:
     raise _WrongType(where, f"expected a string, got {_describe(value)}")
 
 
+def _label(value: Any, where: str) -> str:
+    """A descriptive string (a name, the generator): a number is taken as its text, as pygltflib
+    does, rather than refusing a whole file over a label nothing reads."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return str(value)
+    return _string(value, where)
+
+
 def _boolean(value: Any, where: str) -> bool:
     if isinstance(value, bool):
         return value
@@ -92,6 +100,7 @@ def _attributes(value: Any, where: str) -> pygltflib.Attributes:
 
 
 _SCALARS: dict[Any, _Decode] = {int: _integer, float: _number, str: _string, bool: _boolean}
+_LABELS = ("name", "generator", "copyright")
 
 
 def _array_of(item: _Decode) -> _Decode:
@@ -141,6 +150,8 @@ def _decoder_for_hint(hint: Any, owner: str) -> _Decode:
         return _array_of(_decoder_for_hint(arguments[0], owner))
     if hint is pygltflib.Attributes:
         return _attributes
+    if hint is str and field_name in _LABELS:
+        return _label
     if hint in _SCALARS:
         return _SCALARS[hint]
     if dataclasses.is_dataclass(hint):

@@ -6,11 +6,12 @@ hints again for every object: 2.4 s for the 7,163 objects of a Mixamo character 
 2.5 becomes 2, a translation "123" becomes [1.0, 2.0, 3.0]). Here each class's fields are
 resolved once and every value is checked against glTF's JSON types, so a wrong one fails with
 FormatError naming the file and the property (``accessors[3].count: expected an integer, got
-2.5``); only labels (names, the generator) take a number as its text. Valid documents decode to the same objects as pygltflib's decoder
-(tests/python/test_gltf_decode.py compares them on every dev file), with two deliberate
-differences: a primitive's ``attributes`` and ``targets`` are always
-:class:`pygltflib.Attributes` (pygltflib leaves targets, and empty attributes, as dicts), and
-``extras`` may be any JSON value, as glTF 2.0 allows (pygltflib refuses all but objects).
+2.5``); only labels (names, the generator) take a number as its text. Valid documents decode
+to the same objects as pygltflib's decoder (tests/python/test_gltf_decode.py compares them on
+every dev file), with two deliberate differences: a primitive's ``attributes`` and ``targets``
+are always :class:`pygltflib.Attributes` (pygltflib leaves targets, and empty attributes, as
+dicts), and ``extras`` may be any JSON value, as glTF 2.0 allows (pygltflib refuses all but
+objects).
 """
 
 from __future__ import annotations

@@ -124,6 +124,28 @@ def test_flat_rigid_groups_hold_their_shape_on_the_walk() -> None:
         assert level.report.evaluations < 15 and level.report.failures == []
 
 
+def test_pendant_trees_end_where_every_point_as_a_variable_does_on_the_walk() -> None:
+    # At the walk's 27-joint level both legs and the head hang from the hips' and spine's rigid
+    # groups by held lengths alone: solved inside each evaluation (pendant trees), they leave
+    # SLSQP's variables but not its optimum.
+    walk = humanoid_motion(humanoid().skeleton, "walk", cycles=1, fps=15.0)
+    analysis = analyze_motion(walk, ranking="importance")
+    total = len(analysis.priority) + 1
+    frozen = freeze(walk, analysis, analysis.priority[: total - 27])
+    assert frozen.joint_count == 27
+    problem = build_problem(frozen)
+    original = walk.world_positions()
+    fallback = frozen_motion(frozen, walk).world_positions()
+    cold = _cold_starts(frozen, problem, walk, original, fallback)
+    options = MotionRefitOptions(ftol_rel=1e-12)
+    trees = refit_core(problem, original, fallback, options, cold_starts=cold)
+    every_point = refit_core(problem, original, fallback, options, eliminate_points=False, cold_starts=cold)
+    assert trees.failures == every_point.failures == []
+    np.testing.assert_allclose(trees.objective, every_point.objective, rtol=1e-6, atol=1e-14)
+    violation, _ = rigidity_constraints(problem, trees.positions)
+    assert np.abs(violation).max() <= 1e-8
+
+
 def test_hard_solve_finds_the_zero_error_optimum_when_only_twists_are_frozen() -> None:
     # Regression: the walk's Spine only twists (importance ~0); freezing it costs nothing once
     # the re-fit turns the joints above, but a solve started at the frozen key motion stopped at

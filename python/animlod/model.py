@@ -388,6 +388,22 @@ class SkinnedMesh:
             frames[t] = bake_lbs(rest.astype(np.float32), self.joints, self.weights, matrices[t : t + 1])[0]
         return AnimatedMesh(self.faces, frames, fps=motion.fps)
 
+    def rest_pose(self) -> np.ndarray:
+        """(V, 3) float32 positions skinned by the skeleton's rest pose: what a viewer shows with no
+        animation. ``rest_positions`` (the bind shape) can differ from it in pose and in scale (a
+        centimetre mesh under a 0.01 armature, positions quantized with the scale folded into the
+        inverse bind matrices)."""
+        return self.bake(self.skeleton.rest_motion(1)).frames[0]
+
+    def rest_pose_morph_targets(self) -> np.ndarray | None:
+        """(N, V, 3) float32 morph deltas as they move :meth:`rest_pose` (glTF morphs before it
+        skins: each vertex's deltas through its blended skinning matrix of the rest pose), or None."""
+        if self.morph_targets is None:
+            return None
+        matrices = self.skeleton.rest_motion(1).skin_matrices(self.inverse_bind)[0, :, :3, :3]  # (J, 3, 3)
+        blended = np.einsum("vk,vkij->vij", self.weights, matrices[self.joints])
+        return np.einsum("vij,nvj->nvi", blended, self.morph_targets).astype(np.float32)
+
 
 def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Sort influences by decreasing weight and normalise them to sum 1 per vertex.

@@ -89,27 +89,14 @@ class Drawable:
 
     def rest_positions(self) -> np.ndarray:
         """(V, 3) float32 world positions a viewer shows with no animation playing (morph weights
-        0): a skinned mesh posed by its skeleton's rest pose, the bind shape otherwise.
-
-        The two differ where the rest pose is not the bind pose, and where the bind shape has
-        another scale than what the skin makes of it: a centimetre mesh under a 0.01 armature
-        (Xbot.glb: 100x), or positions quantized with the scale folded into the inverse bind
-        matrices (KHR_mesh_quantization). Sizes and errors are taken on this one.
-        """
-        if self.skinned is None:
-            return self.bind_positions()
-        return self.skinned.bake(self.rig.skeleton.rest_motion(1)).frames[0]
+        0): a skinned mesh posed by its skeleton's rest pose (SkinnedMesh.rest_pose, which can
+        differ from the bind shape in pose and scale: Xbot.glb's is 100x), the bind shape
+        otherwise. Sizes and errors are taken on this one."""
+        return self.bind_positions() if self.skinned is None else self.skinned.rest_pose()
 
     def rest_morph_targets(self) -> np.ndarray | None:
-        """(N, V, 3) morph deltas as they move :meth:`rest_positions` (glTF morphs before it
-        skins: through each vertex's blended skinning matrix of the rest pose), or None."""
-        deltas = self.morph_targets
-        if deltas is None or self.skinned is None:
-            return deltas
-        skin = self.skinned
-        matrices = self.rig.skeleton.rest_motion(1).skin_matrices(skin.inverse_bind)[0, :, :3, :3]  # (J, 3, 3)
-        blended = np.einsum("vk,vkij->vij", skin.weights, matrices[skin.joints])
-        return np.einsum("vij,nvj->nvi", blended, deltas).astype(np.float32)
+        """(N, V, 3) morph deltas as they move :meth:`rest_positions`, or None."""
+        return self.morph_targets if self.skinned is None else self.skinned.rest_pose_morph_targets()
 
     def clip_frames(self, clip: Clip, frames: np.ndarray | None = None) -> np.ndarray:
         """(T', V, 3) world positions of the drawable in the given frames of ``clip`` (all when None)."""

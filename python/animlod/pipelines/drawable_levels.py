@@ -109,9 +109,7 @@ class DrawableLevel:
 
     def rest_positions(self) -> np.ndarray:
         """(V', 3) what a viewer shows of the level with no animation (see Drawable.rest_positions)."""
-        if self.skinned is None:
-            return self.bind
-        return self.skinned.bake(self.skinned.skeleton.rest_motion(1)).frames[0]
+        return self.bind if self.skinned is None else self.skinned.rest_pose()
 
 
 @dataclass
@@ -166,7 +164,9 @@ def simplify_drawable(
         "use_motion_features": False,
         **settings.aqem,
     }
-    frames = _drive_frames(drawable, settings.frame_budget)
+    rest = drawable.rest_positions()
+    size = float(np.linalg.norm(np.ptp(rest, axis=0)))
+    frames = _drive_frames(drawable, rest, size, settings.frame_budget)
     result = simplify_animated(
         AnimatedMesh(geometry.faces, frames),
         ratios,
@@ -179,7 +179,6 @@ def simplify_drawable(
         importance=importance,
         **options,
     )
-    size = float(np.linalg.norm(np.ptp(drawable.rest_positions(), axis=0)))
     levels = [_level(drawable, level, layout) for level in result.levels]
     notes = []
     rebuilt = [geometry.primitives[k].index for k, crease in enumerate(layout.crease) if crease is not None]
@@ -192,14 +191,13 @@ def simplify_drawable(
     return DrawableLevels(levels, size, result.preparation, notes)
 
 
-def _drive_frames(drawable: Drawable, budget: int) -> np.ndarray:
+def _drive_frames(drawable: Drawable, rest: np.ndarray, size: float, budget: int) -> np.ndarray:
     """(F, V, 3) world positions AQEM works over: the bind shape (frame 0, from which _level reads
-    the levels' stored positions), the rest pose where a viewer shows something else, each morph
-    target at full weight on the rest pose, then frames spread evenly over every clip (at least
-    two per clip), F <= ``budget`` where the clips allow."""
-    bind, rest = drawable.bind_positions(), drawable.rest_positions()
+    the levels' stored positions), the rest pose ``rest`` (diagonal ``size``) where a viewer shows
+    something else, each morph target at full weight on the rest pose, then frames spread evenly
+    over every clip (at least two per clip), F <= ``budget`` where the clips allow."""
+    bind = drawable.bind_positions()
     frames = [bind[None]]
-    size = float(np.linalg.norm(np.ptp(rest, axis=0)))
     if np.abs(rest - bind).max() > _SAME_SHAPE * size:
         frames.append(rest[None])
     if drawable.morph_targets is not None:

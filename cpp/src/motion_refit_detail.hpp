@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "animlod/motion_refit.hpp"
 
@@ -18,6 +20,12 @@ constexpr int kNewtonIterations = 50;
 constexpr int kNewtonHalvings = 40;
 constexpr double kNewtonStep = 1e-13;
 constexpr double kNewtonDecrement = 1e-15;
+
+// flags[k] = value for every point k of the (count, width) index rows (a term's points).
+inline void set_points_of(const int32_t* rows, size_t count, size_t width, uint8_t value,
+                          std::vector<uint8_t>& flags) {
+  for (size_t i = 0; i < count * width; ++i) flags[rows[i]] = value;
+}
 
 // E (Eq. 5) of one frame; adds nothing to the root's gradient. gradient: (P, 3) or nullptr.
 double refit_objective_frame(const MotionRefitProblem& problem, const double* x, const double* original,

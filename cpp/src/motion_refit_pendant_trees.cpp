@@ -58,13 +58,10 @@ PendantTrees::PendantTrees(const MotionRefitProblem& problem, bool enabled)
   if (!enabled) return;
   const size_t p = problem.point_count;
   std::vector<uint8_t> other(p, 0);  // in a term other than Ed and held lengths (or the root)
-  auto mark = [&](const int32_t* rows, size_t n, size_t width) {
-    for (size_t i = 0; i < n * width; ++i) other[rows[i]] = 1;
-  };
-  mark(problem.coincident_pairs, problem.coincident_pair_count, 2);
-  mark(problem.angle_triples, problem.angle_triple_count, 3);
-  mark(problem.handed_quads, problem.handed_quad_count, 4);
-  mark(problem.flat_quads, problem.flat_quad_count, 4);
+  set_points_of(problem.coincident_pairs, problem.coincident_pair_count, 2, 1, other);
+  set_points_of(problem.angle_triples, problem.angle_triple_count, 3, 1, other);
+  set_points_of(problem.handed_quads, problem.handed_quad_count, 4, 1, other);
+  set_points_of(problem.flat_quads, problem.flat_quad_count, 4, 1, other);
   other[0] = 1;
   std::vector<std::vector<std::pair<int32_t, int32_t>>> links(p);  // (neighbour, pair)
   for (size_t k = 0; k < problem.length_pair_count; ++k) {

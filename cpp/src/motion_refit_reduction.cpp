@@ -12,6 +12,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "motion_refit_detail.hpp"
 #include "union_find.hpp"
 
 namespace animlod::detail {
@@ -24,13 +25,10 @@ constexpr double kIdentity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
 // (P,) 1 for the points no held length, coincident pair, handed or flat group touches (not the root).
 std::vector<uint8_t> free_points(const MotionRefitProblem& problem, bool eliminate) {
   std::vector<uint8_t> free(problem.point_count, eliminate ? 1 : 0);
-  auto hold = [&](const int32_t* rows, size_t n, size_t width) {
-    for (size_t i = 0; i < n * width; ++i) free[rows[i]] = 0;
-  };
-  hold(problem.length_pairs, problem.length_pair_count, 2);
-  hold(problem.coincident_pairs, problem.coincident_pair_count, 2);
-  hold(problem.handed_quads, problem.handed_quad_count, 4);
-  hold(problem.flat_quads, problem.flat_quad_count, 4);
+  set_points_of(problem.length_pairs, problem.length_pair_count, 2, 0, free);
+  set_points_of(problem.coincident_pairs, problem.coincident_pair_count, 2, 0, free);
+  set_points_of(problem.handed_quads, problem.handed_quad_count, 4, 0, free);
+  set_points_of(problem.flat_quads, problem.flat_quad_count, 4, 0, free);
   free[0] = 0;
   return free;
 }

@@ -245,7 +245,8 @@ void PendantTrees::place_tree(const Tree& tree, double* x, const double* origina
     for (int32_t bone = static_cast<int32_t>(i); bone >= 0; bone = tree.parent[bone])
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
-          j[3 * a + b] += tree.length[bone] * (e1[bone][a] * follow(2 * bone, b) + e2[bone][a] * follow(2 * bone + 1, b));
+          j[3 * a + b] +=
+              tree.length[bone] * (e1[bone][a] * follow(2 * bone, b) + e2[bone][a] * follow(2 * bone + 1, b));
   }
 }
 

@@ -58,7 +58,8 @@ inline EliminationRun solve_with_and_without_elimination(const animlod::MotionRe
   options.eliminate_points = false;
   REQUIRE(animlod::motion_refit_solve(problem, original.data(), fallback.data(), nullptr, frames, options, run.with));
   options.eliminate_points = true;
-  REQUIRE(animlod::motion_refit_solve(problem, original.data(), fallback.data(), nullptr, frames, options, run.without));
+  REQUIRE(
+      animlod::motion_refit_solve(problem, original.data(), fallback.data(), nullptr, frames, options, run.without));
   CHECK(run.with.failures.empty());
   CHECK(run.without.failures.empty());
   for (size_t t = 0; t < frames; ++t) CHECK(run.without.values[t] == doctest::Approx(run.with.values[t]).epsilon(1e-6));

@@ -2,7 +2,9 @@
 
 Run: ``.venv/bin/python bench/bench_io.py``. Each row is the best of a few runs; inputs that
 are absent are skipped. The crane sequence is also converted to binary PLY and NPZ in a
-temporary folder, to show what the faster containers buy over OBJ text.
+temporary folder, to show what the faster containers buy over OBJ text. Every dev glTF is parsed
+into its checked document (io/gltf_decode.py builds pygltflib's object model), with pygltflib's
+own loader (dataclasses_json) as the peer.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from devdata import DATA_DIR
 from table import print_table, stopwatch
 
 from animlod.io import read_bvh, read_npz, read_sequence, write_npz, write_sequence
+from animlod.io.gltf_document import GltfDocument
 
 REPEATS = 3
 
@@ -57,7 +60,26 @@ def main() -> None:
             rows.append(("read NPZ (crane)", size, seconds * 1e3, mesh.frame_count / seconds))
     else:
         print(f"skipped {crane}: not found")
+    rows += gltf_rows()
     print_table("File reading (best of 3)", ["case", "size", "time (ms)", "frames/s"], rows)
+
+
+def gltf_rows() -> list[tuple]:
+    """Parsing every dev glTF: animlod's checked document against pygltflib's own loader."""
+    import warnings
+
+    import pygltflib
+
+    rows = []
+    for path in sorted(p for folder in ("gltf", "morph") for p in (DATA_DIR / folder).glob("*.gl*")):
+        seconds, doc = best_time(lambda path=path: GltfDocument(path))
+        size = f"{len(doc.gltf.accessors)} accessors, {path.stat().st_size / 1e6:.1f} MB"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # pygltflib warns about unknown chunks
+            peer, _ = best_time(lambda path=path: pygltflib.GLTF2.load(str(path)))
+        rows.append((f"parse glTF {path.name} (animlod)", size, seconds * 1e3, "-"))
+        rows.append((f"parse glTF {path.name} (pygltflib.GLTF2.load)", size, peer * 1e3, "-"))
+    return rows
 
 
 if __name__ == "__main__":

@@ -36,9 +36,11 @@ $(VENV)/bin/pip: | system-packages
 # An editable install: Python sources are used from the checkout, and the extension is
 # rebuilt incrementally (build/python-*) whenever this target runs.
 # Optional dependency groups of pyproject.toml; `make bench` adds the benchmark peers.
+# wheel: without build isolation, setuptools before 70 needs it to build an sdist (meshoptimizer's
+# Python package, a bench peer, comes as one).
 EXTRAS := test,batch
 python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
-	$(VENV)/bin/pip install -q scikit-build-core pybind11 pybind11-stubgen numpy
+	$(VENV)/bin/pip install -q scikit-build-core pybind11 pybind11-stubgen numpy wheel
 	$(VENV)/bin/pip install -q --no-build-isolation -e ".[$(EXTRAS)]"
 
 $(CPP_BUILD)/build.ninja: $(OPENMESH_CONFIG)

@@ -41,61 +41,54 @@ double length_and_unit(const double* x, int32_t a, int32_t b, Vec3& unit) {
 }
 
 // cos theta at the middle point of (parent, joint, child) (Eq. 4) and its gradients with respect
-// to the parent, joint and child positions.
-double cosine(const double* x, const int32_t* triple, Vec3& d_parent, Vec3& d_joint, Vec3& d_child) {
+// to the parent, joint and child positions; with `hessian` also its Hessian over the three
+// points, 9 x 9 row-major in (parent xyz, joint xyz, child xyz) order. With u = parent - joint,
+// v = child - joint, their unit vectors e, f, a = 1/|u|, b = 1/|v| and c = cos theta = e.f:
+//   d/du = a (f - c e),  d/dv = b (e - c f),
+//   d2/du2 = a^2 (3c e e^T - e f^T - f e^T - c I),  d2/dv2 = b^2 (3c f f^T - e f^T - f e^T - c I),
+//   d2/du dv = a b (I - e e^T - f f^T + c e f^T),
+// mapped to the points by u = p - j, v = c - j.
+double cosine(const double* x, const int32_t* triple, Vec3& d_parent, Vec3& d_joint, Vec3& d_child,
+              double* hessian = nullptr) {
   const Vec3 joint = load(x, triple[1]);
   const Vec3 u = sub(load(x, triple[0]), joint);
   const Vec3 v = sub(load(x, triple[2]), joint);
-  const double nu = std::sqrt(dot(u, u));
-  const double nv = std::sqrt(dot(v, v));
-  const double cos = dot(u, v) / (nu * nv);
+  const double a = 1.0 / std::sqrt(dot(u, u));
+  const double b = 1.0 / std::sqrt(dot(v, v));
+  const Vec3 e = {u[0] * a, u[1] * a, u[2] * a};
+  const Vec3 f = {v[0] * b, v[1] * b, v[2] * b};
+  const double c = dot(e, f);
   for (int k = 0; k < 3; ++k) {
-    d_parent[k] = v[k] / (nu * nv) - cos * u[k] / (nu * nu);
-    d_child[k] = u[k] / (nu * nv) - cos * v[k] / (nv * nv);
+    d_parent[k] = a * (f[k] - c * e[k]);
+    d_child[k] = b * (e[k] - c * f[k]);
     d_joint[k] = -(d_parent[k] + d_child[k]);
   }
-  return cos;
-}
-
-// cos theta of (parent, joint, child) and its Hessian over the three points, 9 x 9 row-major in
-// (parent xyz, joint xyz, child xyz) order. With u = parent - joint and v = child - joint:
-// d2/du2, d2/dv2 and d2/dudv of u.v / (|u||v|), mapped to the points by u = p - j, v = c - j.
-double cosine_hessian(const double* x, const int32_t* triple, double* hessian) {
-  const Vec3 joint = load(x, triple[1]);
-  const Vec3 u = sub(load(x, triple[0]), joint);
-  const Vec3 v = sub(load(x, triple[2]), joint);
-  const double nu = std::sqrt(dot(u, u));
-  const double nv = std::sqrt(dot(v, v));
-  const double cos = dot(u, v) / (nu * nv);
-  Vec3 gu, gv;
-  for (int k = 0; k < 3; ++k) {
-    gu[k] = v[k] / (nu * nv) - cos * u[k] / (nu * nu);
-    gv[k] = u[k] / (nu * nv) - cos * v[k] / (nv * nv);
-  }
+  if (!hessian) return c;
   double huu[9], hvv[9], huv[9];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       const double eye = i == j ? 1.0 : 0.0;
-      huu[3 * i + j] = -v[i] * u[j] / (nu * nu * nu * nv) - (u[i] * gu[j] + cos * eye) / (nu * nu) +
-                       2.0 * cos * u[i] * u[j] / (nu * nu * nu * nu);
-      hvv[3 * i + j] = -u[i] * v[j] / (nv * nv * nv * nu) - (v[i] * gv[j] + cos * eye) / (nv * nv) +
-                       2.0 * cos * v[i] * v[j] / (nv * nv * nv * nv);
-      huv[3 * i + j] = eye / (nu * nv) - v[i] * v[j] / (nu * nv * nv * nv) - u[i] * gv[j] / (nu * nu);
+      const double mixed = e[i] * f[j] + f[i] * e[j];
+      huu[3 * i + j] = a * a * (3.0 * c * e[i] * e[j] - mixed - c * eye);
+      hvv[3 * i + j] = b * b * (3.0 * c * f[i] * f[j] - mixed - c * eye);
+      huv[3 * i + j] = a * b * (eye - e[i] * e[j] - f[i] * f[j] + c * e[i] * f[j]);
     }
-  for (int i = 0; i < 3; ++i)  // symmetrise the diagonal blocks (exact up to rounding)
-    for (int j = 0; j < i; ++j) {
-      huu[3 * i + j] = huu[3 * j + i] = 0.5 * (huu[3 * i + j] + huu[3 * j + i]);
-      hvv[3 * i + j] = hvv[3 * j + i] = 0.5 * (hvv[3 * i + j] + hvv[3 * j + i]);
+  // Blocks (row point, column point): pp = huu, cc = hvv, pc = huv, pj = -huu - huv,
+  // cj = -hvv - huv^T, jj = huu + hvv + huv + huv^T; the others by symmetry.
+  auto put = [hessian](int row, int column, int i, int j, double value) {
+    hessian[9 * (3 * row + i) + 3 * column + j] = value;
+    hessian[9 * (3 * column + j) + 3 * row + i] = value;
+  };
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      put(0, 0, i, j, huu[3 * i + j]);
+      put(2, 2, i, j, hvv[3 * i + j]);
+      put(0, 2, i, j, huv[3 * i + j]);
+      put(0, 1, i, j, -huu[3 * i + j] - huv[3 * i + j]);
+      put(2, 1, i, j, -hvv[3 * i + j] - huv[3 * j + i]);
+      put(1, 1, i, j, huu[3 * i + j] + hvv[3 * i + j] + huv[3 * i + j] + huv[3 * j + i]);
     }
-  const double du[3] = {1.0, -1.0, 0.0};  // d u / d (parent, joint, child)
-  const double dv[3] = {0.0, -1.0, 1.0};
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          hessian[9 * (3 * a + i) + 3 * b + j] = du[a] * du[b] * huu[3 * i + j] + dv[a] * dv[b] * hvv[3 * i + j] +
-                                                 du[a] * dv[b] * huv[3 * i + j] + dv[a] * du[b] * huv[3 * j + i];
-  return cos;
+  return c;
 }
 
 // Negative eigenvalues of a symmetric 9 x 9 matrix (row-major) set to zero.
@@ -348,12 +341,11 @@ double angle_term(const MotionRefitProblem& problem, const double* x, size_t k, 
   const int32_t* triple = problem.angle_triples + 3 * k;
   const double w = problem.angle_weight;
   Vec3 dp, dj, dc;
-  const double residual = cosine(x, triple, dp, dj, dc) - problem.key_cosines[k];
+  const double residual = cosine(x, triple, dp, dj, dc, hessian) - problem.key_cosines[k];
   const double g[9] = {dp[0], dp[1], dp[2], dj[0], dj[1], dj[2], dc[0], dc[1], dc[2]};
   if (gradient)
     for (int i = 0; i < 9; ++i) gradient[i] = 2.0 * w * residual * g[i];
   if (hessian) {  // 2 w (g g^T + (cos - cos0) Hess cos)
-    cosine_hessian(x, triple, hessian);
     for (int i = 0; i < 9; ++i)
       for (int j = 0; j < 9; ++j) hessian[9 * i + j] = 2.0 * w * (g[i] * g[j] + residual * hessian[9 * i + j]);
     if (positive_semidefinite) clip_to_positive_semidefinite(hessian);

@@ -6,7 +6,8 @@ fast-simplification from the ``bench`` extra). Tables:
 1. Quality on every dev sequence (../shared/data/meshseq: crane, face-poses, the Flamingo's
    morph keyframes), a procedural bending tube and the synth humanoid's walk (baked) at 50%,
    25% and 10% of the faces: AQEM with its default motion-feature weights (``amplitude``), with
-   features off, and with the paper's Eq. 6 weights (``feature_weighting="paper"``); static QEM
+   features off, with the paper's Eq. 6 weights (``feature_weighting="paper"``), and its default
+   without the needle tips' point quadrics (``tip_quadrics=False``: the paper's quadrics); static QEM
    on frame 0 applied to every frame (meshoptimizer, keeping its vertex subset);
    fast-simplification on frame 0 with its collapses replayed on every frame; meshoptimizer's
    simplifyWithAttributes given other frames' positions as attributes. Errors are symmetric
@@ -25,7 +26,8 @@ fast-simplification from the ``bench`` extra). Tables:
    ``--max-triangles`` triangles each (default 12,000; Xbot's two meshes of 21k and 28k take
    minutes per run): the pipeline's own level error (max-over-frames Hausdorff over every clip,
    the value written to the LoD GLB) relative to the rest pose's diagonal, with features off (the
-   pipeline's default), the amplitude weights (simplify_animated's default) and the paper's.
+   pipeline's default), the amplitude weights (simplify_animated's default) and the paper's, and
+   features off without tip quadrics (the paper's quadrics).
 
 5. All frames against a replay: AQEM over every frame of a synthesized 24-frame sequence of
    about 17k triangles (and crane) against fast-simplification's frame-0 collapses replayed on
@@ -286,11 +288,13 @@ def fast_simplification_replayed(mesh: AnimatedMesh, ratio: float) -> AnimatedMe
 
 
 DEFAULT, OFF, PAPER = "AQEM default (amplitude weights)", "AQEM, features off", "AQEM, paper's Eq. 6 weights"
+NO_TIPS = "AQEM default without tip quadrics (the paper's quadrics)"
 STATIC = ("meshoptimizer on frame 0", "fast-simplification frame 0, replayed")
 METHODS = {
     DEFAULT: aqem(),
     OFF: aqem(use_motion_features=False),
     PAPER: aqem(feature_weighting="paper"),
+    NO_TIPS: aqem(tip_quadrics=False),
     "meshoptimizer on frame 0": meshopt_frame0,
     "fast-simplification frame 0, replayed": fast_simplification_replayed,
     "meshoptimizer + other frames as attributes": meshopt_attributes,
@@ -338,6 +342,9 @@ def quality_table(quick: bool) -> None:
                     measured[PAPER]["hausdorff_max"],
                     _ratio(measured[DEFAULT]["hausdorff_max"], measured[OFF]["hausdorff_max"]),
                     f"{measured[DEFAULT]['rms_mean'] / best_static:.3f}",
+                    measured[NO_TIPS]["hausdorff_max"],
+                    _ratio(measured[DEFAULT]["hausdorff_max"], measured[NO_TIPS]["hausdorff_max"]),
+                    f"{measured[NO_TIPS]['rms_mean'] / best_static:.3f}",
                 )
             )
     print_table(
@@ -355,6 +362,9 @@ def quality_table(quick: bool) -> None:
             "paper's Eq. 6",
             "default / off (goal <= 1.05)",
             "default mean RMS / best static (goal <= 1)",
+            "default without tip quadrics",
+            "default / without",
+            "without: mean RMS / best static",
         ),
         goals,
     )
@@ -373,6 +383,7 @@ def character_table(quick: bool, max_triangles: int) -> None:
         "amplitude": {"use_motion_features": True},
         "off": {},
         "paper": {"use_motion_features": True, "feature_weighting": "paper"},
+        "off, no tips": {"tip_quadrics": False},  # the paper's quadrics
     }
     rows = []
     with tempfile.TemporaryDirectory() as scratch:
@@ -388,7 +399,7 @@ def character_table(quick: bool, max_triangles: int) -> None:
                     errors[name] = [level.error / levels.size for level in levels.levels]
                     seconds[name] = elapsed[0]
                 for k, ratio in enumerate(RATIOS):
-                    amplitude, off, paper = (errors[name][k] for name in variants)
+                    amplitude, off, paper, no_tips = (errors[name][k] for name in variants)
                     rows.append(
                         (
                             path.name,
@@ -399,6 +410,8 @@ def character_table(quick: bool, max_triangles: int) -> None:
                             amplitude,
                             paper,
                             f"{amplitude / off:.3f}" if off > 0 else "-",
+                            no_tips,
+                            f"{off / no_tips:.3f}" if no_tips > 0 else "-",
                             f"{seconds['off']:.1f} / {seconds['amplitude']:.1f} / {seconds['paper']:.1f}",
                         )
                     )
@@ -414,6 +427,8 @@ def character_table(quick: bool, max_triangles: int) -> None:
             "amplitude weights",
             "paper's Eq. 6",
             "amplitude / off",
+            "off without tip quadrics (the paper's quadrics)",
+            "off / without tips",
             "s, all levels (off / amplitude / paper)",
         ),
         rows,

@@ -38,6 +38,7 @@ void bind_options(py::module_& m) {
       .field("use_motion_features", &AqemOptions::use_motion_features)
       .nested("motion_features", &AqemOptions::motion_features)
       .field("boundary_quadrics", &AqemOptions::boundary_quadrics)
+      .field("tip_quadrics", &AqemOptions::tip_quadrics)
       .field("check_inversion", &AqemOptions::check_inversion)
       .field("strict_inversion", &AqemOptions::strict_inversion)
       .field("max_frames", &AqemOptions::max_frames)

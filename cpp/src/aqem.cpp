@@ -4,7 +4,8 @@
 //
 // Implements the 12-step outline of the paper:
 //   steps 1-2  per-point quadrics of every frame (Eqs. 1-4; block-diagonal, so F quadrics of
-//              ten doubles per point, stored contiguously per point);
+//              ten doubles per point, stored contiguously per point), plus a point quadric at
+//              every needle tip (option tip_quadrics, needle_tips.hpp; not in the paper);
 //   steps 3-4  motion features and vertex weights (motion_features.cpp);
 //   steps 5-6  per edge: merged quadric Q = Q_i + Q_j (the text after Eq. 4; step 5.1 writes
 //              (Q_i + Q_j) / 2, which only rescales), weight w = (w_i + w_j) / 2, optimal
@@ -28,6 +29,7 @@
 #include "frame_sampling.hpp"
 #include "mesh_preparation.hpp"
 #include "mesh_validation_detail.hpp"
+#include "needle_tips.hpp"
 #include "quadric.hpp"
 
 namespace animlod {
@@ -178,6 +180,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
   void accumulate_quadrics();
   void accumulate_frames(size_t begin, size_t end);
   void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, size_t begin, size_t end);
+  void add_tip_points(size_t begin, size_t end);
   // Placement of the candidate being evaluated, per worker.
   struct Scratch {
     std::vector<Eigen::Vector3d> new_positions;  // (K,) placement in the quadrics' frames
@@ -205,7 +208,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
 
 // Steps 1-2 (Eqs. 1-4): every face's plane in every used frame goes into its three points'
 // quadrics of that frame; border and seam sides add a perpendicular plane (option
-// boundary_quadrics). plane_counts_ counts the planes of each point, so that the error can be a
+// boundary_quadrics), needle tips a point quadric (option tip_quadrics). plane_counts_ counts the planes of each point, so that the error can be a
 // mean; a face with no area in a frame counts there as a plane at distance 0.
 void AqemPolicy::accumulate_quadrics() {
   const size_t point_count = engine_.point_count();
@@ -248,9 +251,24 @@ void AqemPolicy::accumulate_frames(size_t begin, size_t end) {
       for (int corner = 0; corner < 3; ++corner) quadrics_of(v[corner])[k] += plane;
     }
   }
-  if (!options_.boundary_quadrics) return;
-  add_side_planes(engine_.border_sides(), begin, end);
-  add_side_planes(engine_.seam_sides(), begin, end);
+  if (options_.boundary_quadrics) {
+    add_side_planes(engine_.border_sides(), begin, end);
+    add_side_planes(engine_.seam_sides(), begin, end);
+  }
+  if (options_.tip_quadrics) add_tip_points(begin, end);
+}
+
+// Every needle tip of a used frame gets the squared distance from where it is in that frame,
+// once per plane of the point (so it weighs like the planes do): moving a tip then costs at
+// least its displacement, which its nearly parallel planes do not charge.
+void AqemPolicy::add_tip_points(size_t begin, size_t end) {
+  const std::vector<int32_t>& faces = engine_.prepared().faces;
+  for (size_t k = begin; k < end; ++k) {
+    const size_t frame = static_cast<size_t>(frames_[k]);
+    auto position_of = [&](int32_t point) { return engine_.position(point, frame); };
+    for (int32_t tip : detail::find_needle_tips(faces, engine_.point_count(), position_of))
+      quadrics_of(tip)[k] += Quadric::point(position_of(tip), plane_counts_[tip]);
+  }
 }
 
 // A plane through each side (a, b) perpendicular to the face (a, b, c) beside it.

@@ -24,6 +24,12 @@ struct Quadric {
             weight * d * d};
   }
 
+  // weight |v - point|^2: the squared distance from a point.
+  static Quadric point(const Eigen::Vector3d& point, double weight) {
+    return {weight, 0, 0, weight, 0, weight, weight * point.x(), weight * point.y(), weight * point.z(),
+            weight * point.squaredNorm()};
+  }
+
   Quadric& operator+=(const Quadric& q) {
     a00 += q.a00; a01 += q.a01; a02 += q.a02; a11 += q.a11; a12 += q.a12; a22 += q.a22;
     b0 += q.b0; b1 += q.b1; b2 += q.b2;

@@ -253,6 +253,7 @@ Status aqem_hierarchy(const AnimatedMeshView& mesh, const PointMesh& points, con
   aqem.target_face_counts = {1};
   aqem.use_motion_features = options.use_motion_features;
   aqem.boundary_quadrics = options.boundary_quadrics;
+  aqem.tip_quadrics = false;  // the paper's quadrics, like the TDAG's own (Fig. 6 compares them)
   aqem.check_inversion = options.check_inversion;
   aqem.weld = options.weld;
   AqemResult result;

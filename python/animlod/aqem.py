@@ -224,6 +224,7 @@ def simplify_animated(
         stop before a collapse whose error, an RMS plane distance, exceeds it),
         ``use_motion_features`` and the weights of Eq. 6 (see :func:`motion_features`:
         ``"amplitude"`` by default, ``"paper"`` the published rule), ``boundary_quadrics``,
+        ``tip_quadrics`` (needle tips cost their displacement; off: the paper's quadrics),
         ``check_inversion`` and ``strict_inversion`` (Eq. 7 summed over every frame, or per
         frame), ``max_frames`` and ``frame_subset`` (the frames of the quadrics), ``placement``
         (``"optimal"``: Eq. 5 in every frame; ``"on_edge"``: one point of the collapsed edge for

@@ -56,6 +56,13 @@ struct AqemOptions {
   // perpendicular to its face, so that open borders and seams keep their shape (Garland and
   // Heckbert 1997, section 6.1).
   bool boundary_quadrics = true;
+  // Adds, per frame, the squared distance from its position (once per plane of the point) to
+  // the quadric of every needle tip, a point whose edges all leave within 45 degrees of their
+  // mean direction (the end of a leg, a beak, a spike). A spike's faces lie nearly parallel to
+  // it, so plane quadrics charge moving its tip onto its base only a small part of the distance
+  // it moves, and quadric simplification removes spikes first; with this, a tip's error is its
+  // displacement. Off: the paper's quadrics. Meshes without tips simplify bit for bit alike.
+  bool tip_quadrics = true;
   // Rejects collapses that invert a face according to Eq. 7, summed over every frame F (also
   // the frames outside frames_used, at their on-edge positions). The sum lets a face flip in a
   // few frames when it gains area in the others.

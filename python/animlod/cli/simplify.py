@@ -61,6 +61,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="optimal: Eq. 5 per frame (default for sequences and static meshes); on_edge: one point of the "
         "edge (default for skinned and morphed meshes)",
     )
+    parser.add_argument(
+        "--no-tip-quadrics",
+        action="store_true",
+        help="the paper's quadrics only: no point quadric at needle tips (the ends of legs, beaks and spikes, whose "
+        "faces lie nearly parallel to them, then collapse first)",
+    )
     parser.add_argument("--separate", action="store_true", help="glTF: one whole GLB per level instead of one LoD GLB")
     parser.add_argument("--no-metrics", action="store_true", help="sequences: skip the Hausdorff/RMS measurement")
     parser.add_argument(
@@ -78,6 +84,8 @@ def run(args: argparse.Namespace) -> int:
     options = {"max_error": args.max_error, **feature_options(args)}
     if args.placement:
         options["placement"] = args.placement
+    if args.no_tip_quadrics:
+        options["tip_quadrics"] = False
     if kind == "gltf":
         return _simplify_document(args, options)
     return _simplify_sequence(args, options)

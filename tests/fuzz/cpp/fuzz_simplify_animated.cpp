@@ -9,7 +9,8 @@
 //   u8 levels     1 + value % 4
 //   4 x u8        level sizes: ratio value / 255 (0 is an error), or face count value * M / 255
 //   u8 max_frames, u8 max_error (value / 16), u8 feature_threshold (value / 64 rad),
-//   u8 counts     bits 0-1 attribute count A, bit 2 weld off, bits 3-4 position attribute count B
+//   u8 counts     bits 0-1 attribute count A, bit 2 weld off, bits 3-4 position attribute count B,
+//                 bit 5 tip quadrics off
 //   u8 influences (1 + value % 8)
 //   the mesh layout of fuzz_input.hpp
 //   then, each for V vertices when its flag is set: locked (u8, odd = locked), importance
@@ -175,6 +176,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.motion_features.feature_threshold = threshold / 64.0;
   options.placement = in.flag(flags, 5) ? animlod::Placement::on_edge : animlod::Placement::optimal;
   options.weld = !in.flag(counts, 2);
+  options.tip_quadrics = !in.flag(counts, 5);
   options.max_frames = max_frames;
   if (in.flag(flags2, 4)) options.max_error = max_error / 16.0;
   options.target_ratios.clear();

@@ -26,31 +26,48 @@ inline const double kNeedleTipCosine = std::sqrt(0.5);
 template <class PositionOf>
 std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, size_t point_count,
                                       const PositionOf& position_of) {
-  std::vector<Eigen::Vector3d> mean(point_count, Eigen::Vector3d::Zero());
-  std::vector<double> least(point_count, 2.0);  // smallest cosine of an edge to the mean
   // Each edge of a point is seen once per face beside it, which changes neither the mean's
-  // direction much nor the smallest cosine.
-  auto for_each_edge = [&](auto&& visit) {
-    for (size_t corner = 0; corner < faces.size(); ++corner) {
-      const size_t face = corner - corner % 3;
-      const int32_t point = faces[corner];
-      const Eigen::Vector3d at = position_of(point);
-      for (size_t step : {size_t{1}, size_t{2}}) {
-        const Eigen::Vector3d edge = position_of(faces[face + (corner - face + step) % 3]) - at;
+  // direction much nor the smallest cosine. Per face, its three sides' unit vectors serve both
+  // of their points (the one they leave and, reversed, the one they reach).
+  auto for_each_face_side = [&](auto&& wanted, auto&& visit) {
+    for (size_t face = 0; face < faces.size(); face += 3) {
+      const int32_t corners[3] = {faces[face], faces[face + 1], faces[face + 2]};
+      if (!wanted(corners[0]) && !wanted(corners[1]) && !wanted(corners[2])) continue;
+      const Eigen::Vector3d at[3] = {position_of(corners[0]), position_of(corners[1]), position_of(corners[2])};
+      for (int side = 0; side < 3; ++side) {
+        const int32_t from = corners[side], to = corners[(side + 1) % 3];
+        const Eigen::Vector3d edge = at[(side + 1) % 3] - at[side];
         const double length = edge.norm();
-        if (length > 0.0) visit(point, edge / length);
+        if (length == 0.0) continue;
+        visit(from, edge / length);
+        visit(to, -edge / length);
       }
     }
   };
-  for_each_edge([&](int32_t point, const Eigen::Vector3d& unit) { mean[point] += unit; });
-  for (Eigen::Vector3d& m : mean) m = m.norm() > 0.0 ? Eigen::Vector3d(m.normalized()) : Eigen::Vector3d::Zero();
-  for_each_edge([&](int32_t point, const Eigen::Vector3d& unit) {
-    least[point] = std::min(least[point], unit.dot(mean[point]));
+  std::vector<Eigen::Vector3d> sum(point_count, Eigen::Vector3d::Zero());
+  std::vector<int32_t> count(point_count, 0);
+  for_each_face_side([](int32_t) { return true; }, [&](int32_t point, const Eigen::Vector3d& unit) {
+    sum[point] += unit;
+    ++count[point];
   });
+  // Every unit vector within the cone puts the sum's length above count * cos: the other
+  // points (all but a few on any surface) need no second look.
+  std::vector<uint8_t> candidate(point_count, 0);
+  std::vector<double> least(point_count, 2.0);  // smallest cosine of an edge to the mean
+  for (size_t point = 0; point < point_count; ++point) {
+    const double length = sum[point].norm();
+    if (length > kNeedleTipCosine * count[point] && length > 0.0) {
+      candidate[point] = 1;
+      sum[point] /= length;
+    }
+  }
+  for_each_face_side([&](int32_t point) { return candidate[point] != 0; },
+                     [&](int32_t point, const Eigen::Vector3d& unit) {
+                       if (candidate[point]) least[point] = std::min(least[point], unit.dot(sum[point]));
+                     });
   std::vector<int32_t> tips;
   for (size_t point = 0; point < point_count; ++point)
-    if (mean[point].squaredNorm() > 0.0 && least[point] > kNeedleTipCosine)  // a zero mean: no edge, or they cancel
-      tips.push_back(static_cast<int32_t>(point));
+    if (candidate[point] && least[point] > kNeedleTipCosine) tips.push_back(static_cast<int32_t>(point));
   return tips;
 }
 

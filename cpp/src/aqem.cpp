@@ -203,13 +203,15 @@ class AqemPolicy final : public detail::CollapsePolicy {
   std::vector<double> vertex_weights_;  // (P,) Eq. 6 weights, passed on by collapses (step 9)
   std::vector<Quadric> quadrics_;       // (P, K) per-frame quadrics, contiguous per point
   std::vector<double> plane_counts_;    // (P,) planes summed into each of the point's K quadrics
+  std::vector<int32_t> tips_;           // needle tips in every used frame (option tip_quadrics)
   std::vector<Scratch> scratch_;  // (kWorkers,) worker 0's holds the placement place() uses
 };
 
 // Steps 1-2 (Eqs. 1-4): every face's plane in every used frame goes into its three points'
 // quadrics of that frame; border and seam sides add a perpendicular plane (option
-// boundary_quadrics), needle tips a point quadric (option tip_quadrics). plane_counts_ counts the planes of each point, so that the error can be a
-// mean; a face with no area in a frame counts there as a plane at distance 0.
+// boundary_quadrics), needle tips a point quadric (option tip_quadrics). plane_counts_ counts
+// the planes of each point, so that the error can be a mean; a face with no area in a frame
+// counts there as a plane at distance 0.
 void AqemPolicy::accumulate_quadrics() {
   const size_t point_count = engine_.point_count();
   const std::vector<int32_t>& faces = engine_.prepared().faces;
@@ -225,14 +227,33 @@ void AqemPolicy::accumulate_quadrics() {
   // The frames are independent: two workers take half of them each, every quadric summing its
   // planes in the same order as one worker would.
   const size_t workers = used_count_ >= 2 && faces.size() * used_count_ >= 3 * 65536 ? 2 : 1;
-  auto accumulate = [&](size_t worker) {
-    const size_t begin = used_count_ * worker / workers, end = used_count_ * (worker + 1) / workers;
-    accumulate_frames(begin, end);
+  auto on_workers = [&](auto&& frames_from_to) {
+    auto run = [&](size_t worker) {
+      frames_from_to(worker, used_count_ * worker / workers, used_count_ * (worker + 1) / workers);
+    };
+    std::thread second;
+    if (workers == 2) second = std::thread(run, 1);
+    run(0);
+    if (second.joinable()) second.join();
   };
-  std::thread second;
-  if (workers == 2) second = std::thread(accumulate, 1);
-  accumulate(0);
-  if (second.joinable()) second.join();
+  if (options_.tip_quadrics) {
+    // Tips in every used frame: a spike stays one, while a point that folds into a narrow cone
+    // in some poses only (a bent finger, a creased strip) is no needle.
+    std::vector<std::vector<int32_t>> counts(workers, std::vector<int32_t>(point_count, 0));
+    on_workers([&](size_t worker, size_t begin, size_t end) {
+      for (size_t k = begin; k < end; ++k) {
+        const size_t frame = static_cast<size_t>(frames_[k]);
+        auto position_of = [&](int32_t point) { return engine_.position(point, frame); };
+        for (int32_t tip : detail::find_needle_tips(faces, point_count, position_of)) ++counts[worker][tip];
+      }
+    });
+    for (size_t point = 0; point < point_count; ++point) {
+      size_t frames_as_tip = 0;
+      for (const std::vector<int32_t>& count : counts) frames_as_tip += static_cast<size_t>(count[point]);
+      if (frames_as_tip == used_count_) tips_.push_back(static_cast<int32_t>(point));
+    }
+  }
+  on_workers([&](size_t, size_t begin, size_t end) { accumulate_frames(begin, end); });
 }
 
 // The quadrics of used frames [begin, end): every face's plane, then the border and seam sides'.
@@ -255,20 +276,16 @@ void AqemPolicy::accumulate_frames(size_t begin, size_t end) {
     add_side_planes(engine_.border_sides(), begin, end);
     add_side_planes(engine_.seam_sides(), begin, end);
   }
-  if (options_.tip_quadrics) add_tip_points(begin, end);
+  add_tip_points(begin, end);
 }
 
-// Every needle tip of a used frame gets the squared distance from where it is in that frame,
-// once per plane of the point (so it weighs like the planes do): moving a tip then costs at
-// least its displacement, which its nearly parallel planes do not charge.
+// Every needle tip gets, in each used frame, the squared distance from where it is, once per
+// plane of the point (so it weighs like the planes do): moving a tip then costs at least its
+// displacement, which its nearly parallel planes do not charge.
 void AqemPolicy::add_tip_points(size_t begin, size_t end) {
-  const std::vector<int32_t>& faces = engine_.prepared().faces;
-  for (size_t k = begin; k < end; ++k) {
-    const size_t frame = static_cast<size_t>(frames_[k]);
-    auto position_of = [&](int32_t point) { return engine_.position(point, frame); };
-    for (int32_t tip : detail::find_needle_tips(faces, engine_.point_count(), position_of))
-      quadrics_of(tip)[k] += Quadric::point(position_of(tip), plane_counts_[tip]);
-  }
+  for (size_t k = begin; k < end; ++k)
+    for (int32_t tip : tips_)
+      quadrics_of(tip)[k] += Quadric::point(engine_.position(tip, static_cast<size_t>(frames_[k])), plane_counts_[tip]);
 }
 
 // A plane through each side (a, b) perpendicular to the face (a, b, c) beside it.

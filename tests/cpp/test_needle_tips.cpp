@@ -71,3 +71,27 @@ TEST_CASE("tip quadrics change nothing on a mesh without needle tips") {
   }
   CHECK(a.collapses.error == b.collapses.error);
 }
+
+TEST_CASE("tip quadrics hold a spike that is one in every frame, not a point that folds into one") {
+  // A 4 x 4 grid whose middle point rises in frame 1 only (a transient cone), or in both.
+  auto raised_grid = [](bool in_both_frames) {
+    animlod::testing::OwnedAnimatedMesh mesh = animlod::testing::grid(4);
+    const size_t middle = 12;  // (2, 2) of the 5 x 5 points
+    std::vector<float> second = mesh.frames;
+    second[3 * middle + 2] = 3.0f;
+    if (in_both_frames) mesh.frames[3 * middle + 2] = 3.0f;
+    mesh.frames.insert(mesh.frames.end(), second.begin(), second.end());
+    mesh.frame_count = 2;
+    return mesh;
+  };
+  for (bool in_both_frames : {false, true}) {
+    CAPTURE(in_both_frames);
+    const animlod::testing::OwnedAnimatedMesh mesh = raised_grid(in_both_frames);
+    animlod::AqemOptions with_tips, without;
+    with_tips.target_face_counts = without.target_face_counts = {2};  // the spike must go
+    without.tip_quadrics = false;
+    const animlod::AqemResult a = animlod::testing::simplify(mesh, with_tips);
+    const animlod::AqemResult b = animlod::testing::simplify(mesh, without);
+    CHECK((a.collapses.error == b.collapses.error) == !in_both_frames);
+  }
+}

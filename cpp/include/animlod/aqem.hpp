@@ -58,7 +58,7 @@ struct AqemOptions {
   bool boundary_quadrics = true;
   // Adds, per frame, the squared distance from its position (once per plane of the point) to
   // the quadric of every needle tip, a point whose edges all leave within 45 degrees of their
-  // mean direction (the end of a leg, a beak, a spike). A spike's faces lie nearly parallel to
+  // mean direction in every frame of the quadrics (the end of a leg, a beak, a spike). A spike's faces lie nearly parallel to
   // it, so plane quadrics charge moving its tip onto its base only a small part of the distance
   // it moves, and quadric simplification removes spikes first; with this, a tip's error is its
   // displacement. Off: the paper's quadrics. Meshes without tips simplify bit for bit alike.

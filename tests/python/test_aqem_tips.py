@@ -27,13 +27,13 @@ def test_a_mesh_without_needle_tips_simplifies_alike_with_and_without_tip_quadri
         assert (a.mesh.faces == b.mesh.faces).all() and (a.mesh.frames == b.mesh.frames).all()
 
 
-@pytest.mark.parametrize("name", ["Stork.glb", "Parrot.glb"])
-def test_the_birds_keep_their_spikes_at_half_their_faces(data_dir, name):
+@pytest.mark.parametrize(("name", "ratio"), [("Stork.glb", 0.5), ("Parrot.glb", 0.25)])
+def test_the_birds_keep_their_spikes(data_dir, name, ratio):
     drawable = read_drawables(GltfDocument(data_dir / "morph" / name))[0]
-    with_tips = simplify_drawable(drawable, (0.5,)).levels[0].error
-    without = simplify_drawable(drawable, (0.5,), DrawableSettings(aqem={"tip_quadrics": False})).levels[0].error
-    # Measured: Stork 0.46x, Parrot 0.22x (max-over-frames Hausdorff over every clip).
-    assert with_tips < 0.6 * without
+    with_tips = simplify_drawable(drawable, (ratio,)).levels[0].error
+    without = simplify_drawable(drawable, (ratio,), DrawableSettings(aqem={"tip_quadrics": False})).levels[0].error
+    # Measured: Stork 0.46x (its legs' tips), Parrot 0.17x (its tail); the pipeline's level error.
+    assert with_tips < 0.7 * without
 
 
 def test_the_cli_turns_tip_quadrics_off_by_name(data_dir, tmp_path, capsys):

@@ -224,36 +224,31 @@ void AqemPolicy::accumulate_quadrics() {
         plane_counts_[side[0]] += 1.0;
         plane_counts_[side[1]] += 1.0;
       }
+  if (options_.tip_quadrics) {
+    // Tips in every used frame: a spike stays one, while a point that folds into a narrow cone
+    // in some poses only (a bent finger, a creased strip) is no needle. After the first frame
+    // only the tips so far are looked at.
+    std::vector<uint8_t> tip_so_far(point_count, 1);
+    for (size_t k = 0; k < used_count_; ++k) {
+      const size_t frame = static_cast<size_t>(frames_[k]);
+      auto position_of = [&](int32_t point) { return engine_.position(point, frame); };
+      tips_ = detail::find_needle_tips(faces, point_count, position_of, tip_so_far.data());
+      std::fill(tip_so_far.begin(), tip_so_far.end(), 0);
+      for (int32_t tip : tips_) tip_so_far[tip] = 1;
+      if (tips_.empty()) break;
+    }
+  }
   // The frames are independent: two workers take half of them each, every quadric summing its
   // planes in the same order as one worker would.
   const size_t workers = used_count_ >= 2 && faces.size() * used_count_ >= 3 * 65536 ? 2 : 1;
-  auto on_workers = [&](auto&& frames_from_to) {
-    auto run = [&](size_t worker) {
-      frames_from_to(worker, used_count_ * worker / workers, used_count_ * (worker + 1) / workers);
-    };
-    std::thread second;
-    if (workers == 2) second = std::thread(run, 1);
-    run(0);
-    if (second.joinable()) second.join();
+  auto accumulate = [&](size_t worker) {
+    const size_t begin = used_count_ * worker / workers, end = used_count_ * (worker + 1) / workers;
+    accumulate_frames(begin, end);
   };
-  if (options_.tip_quadrics) {
-    // Tips in every used frame: a spike stays one, while a point that folds into a narrow cone
-    // in some poses only (a bent finger, a creased strip) is no needle.
-    std::vector<std::vector<int32_t>> counts(workers, std::vector<int32_t>(point_count, 0));
-    on_workers([&](size_t worker, size_t begin, size_t end) {
-      for (size_t k = begin; k < end; ++k) {
-        const size_t frame = static_cast<size_t>(frames_[k]);
-        auto position_of = [&](int32_t point) { return engine_.position(point, frame); };
-        for (int32_t tip : detail::find_needle_tips(faces, point_count, position_of)) ++counts[worker][tip];
-      }
-    });
-    for (size_t point = 0; point < point_count; ++point) {
-      size_t frames_as_tip = 0;
-      for (const std::vector<int32_t>& count : counts) frames_as_tip += static_cast<size_t>(count[point]);
-      if (frames_as_tip == used_count_) tips_.push_back(static_cast<int32_t>(point));
-    }
-  }
-  on_workers([&](size_t, size_t begin, size_t end) { accumulate_frames(begin, end); });
+  std::thread second;
+  if (workers == 2) second = std::thread(accumulate, 1);
+  accumulate(0);
+  if (second.joinable()) second.join();
 }
 
 // The quadrics of used frames [begin, end): every face's plane, then the border and seam sides'.

@@ -21,11 +21,13 @@ namespace animlod::detail {
 inline const double kNeedleTipCosine = std::sqrt(0.5);
 
 // The points of `faces` (M, 3) that are needle tips with the positions position_of(point)
-// (an Eigen::Vector3d), in increasing order. Zero-length edges give no direction; a point
-// whose edge directions cancel out is no tip.
+// (an Eigen::Vector3d), in increasing order; with `among` (P,), only points where it is nonzero
+// are looked at. Zero-length edges give no direction; a point whose edge directions cancel out
+// is no tip.
 template <class PositionOf>
 std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, size_t point_count,
-                                      const PositionOf& position_of) {
+                                      const PositionOf& position_of, const uint8_t* among = nullptr) {
+  auto looked_at = [among](int32_t point) { return among == nullptr || among[point] != 0; };
   // Each edge of a point is seen once per face beside it, which changes neither the mean's
   // direction much nor the smallest cosine. Per face, its three sides' unit vectors serve both
   // of their points (the one they leave and, reversed, the one they reach).
@@ -39,14 +41,14 @@ std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, size_t 
         const Eigen::Vector3d edge = at[(side + 1) % 3] - at[side];
         const double length = edge.norm();
         if (length == 0.0) continue;
-        visit(from, edge / length);
-        visit(to, -edge / length);
+        if (wanted(from)) visit(from, edge / length);
+        if (wanted(to)) visit(to, -edge / length);
       }
     }
   };
   std::vector<Eigen::Vector3d> sum(point_count, Eigen::Vector3d::Zero());
   std::vector<int32_t> count(point_count, 0);
-  for_each_face_side([](int32_t) { return true; }, [&](int32_t point, const Eigen::Vector3d& unit) {
+  for_each_face_side(looked_at, [&](int32_t point, const Eigen::Vector3d& unit) {
     sum[point] += unit;
     ++count[point];
   });
@@ -63,7 +65,7 @@ std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, size_t 
   }
   for_each_face_side([&](int32_t point) { return candidate[point] != 0; },
                      [&](int32_t point, const Eigen::Vector3d& unit) {
-                       if (candidate[point]) least[point] = std::min(least[point], unit.dot(sum[point]));
+                       least[point] = std::min(least[point], unit.dot(sum[point]));
                      });
   std::vector<int32_t> tips;
   for (size_t point = 0; point < point_count; ++point)

@@ -52,13 +52,13 @@ std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, size_t 
     sum[point] += unit;
     ++count[point];
   });
-  // Every unit vector within the cone puts the sum's length above count * cos: the other
-  // points (all but a few on any surface) need no second look.
+  // Every unit vector within the cone puts the sum's length above count * cos (so above 0):
+  // the other points (all but a few on any surface, and those with no edge) need no second look.
   std::vector<uint8_t> candidate(point_count, 0);
   std::vector<double> least(point_count, 2.0);  // smallest cosine of an edge to the mean
   for (size_t point = 0; point < point_count; ++point) {
     const double length = sum[point].norm();
-    if (length > kNeedleTipCosine * count[point] && length > 0.0) {
+    if (length > kNeedleTipCosine * count[point]) {
       candidate[point] = 1;
       sum[point] /= length;
     }

@@ -78,6 +78,7 @@ void bind_options(py::module_& m) {
       .field("warm_start", &MotionRefitOptions::warm_start)
       .field("precondition", &MotionRefitOptions::precondition)
       .field("eliminate_points", &MotionRefitOptions::eliminate_points)
+      .field("rigid_bodies", &MotionRefitOptions::rigid_bodies)
       .field("chunk_frames", &MotionRefitOptions::chunk_frames)
       .field("threads", &MotionRefitOptions::threads)
       .finish();

@@ -2,7 +2,7 @@
 // re-fit (seeds/000, Eqs. 5-7): a leaf's Ed + Es terms alpha |x_e - x^o_e|^2 + beta (|x_e - x_p|
 // - b)^2 (over L^2) are minimal on the ray from x_p to x^o_e; a coincident pair held as an
 // equality puts both points at one place; free points follow the others through their own
-// minimisation (motion_refit_free_points.hpp).
+// minimisation (motion_refit_free_points.hpp); trees and bodies are placed by their own classes.
 #include "motion_refit_reduction.hpp"
 
 #include <algorithm>
@@ -33,13 +33,30 @@ std::vector<uint8_t> free_points(const MotionRefitProblem& problem, bool elimina
   return free;
 }
 
+// (P,) points a rigid body may not hold: the coincident pairs' (substituted) and the trees'.
+std::vector<uint8_t> body_exclusions(const MotionRefitProblem& problem, const PendantTrees& trees) {
+  std::vector<uint8_t> excluded(problem.point_count, 0);
+  set_points_of(problem.coincident_pairs, problem.coincident_pair_count, 2, 1, excluded);
+  for (size_t k = 0; k < problem.point_count; ++k)
+    if (trees.contains(k)) excluded[k] = 1;
+  return excluded;
+}
+
+// out = a b (3 x 3, row-major).
+void multiply(const double* a, const double* b, double* out) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
+}
+
 }  // namespace
 
-PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate)
+PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate,
+                               bool rigid_bodies)
     : problem_(problem),
       hard_(hard_constraints),
       free_points_(problem, free_points(problem, eliminate)),
-      trees_(problem, eliminate && hard_constraints) {
+      trees_(problem, eliminate && hard_constraints),
+      bodies_(problem, body_exclusions(problem, trees_), eliminate && hard_constraints && rigid_bodies) {
   const size_t p = problem.point_count;
   index_.assign(p, -1);
   substitute_.resize(p);
@@ -51,6 +68,11 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
   kept_equalities_.assign(motion_refit_equality_count(problem), 1);
   for (size_t k = 0; k < pairs; ++k)
     if (trees_.inner_pairs()[k]) kept_equalities_[k] = 0;
+  for (size_t r = 0; r < kept_equalities_.size(); ++r)
+    if (bodies_.inner_equalities()[r]) kept_equalities_[r] = 0;
+  kept_handed_.resize(problem.handed_quad_count);
+  for (size_t k = 0; k < problem.handed_quad_count; ++k) kept_handed_[k] = bodies_.inner_handed()[k] ? 0 : 1;
+  kept_handed_count_ = static_cast<size_t>(std::count(kept_handed_.begin(), kept_handed_.end(), 1));
 
   // Coincident pairs held exactly: every point of a tied set sits at its lowest index.
   if (eliminate && hard_constraints) {
@@ -92,10 +114,72 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
   free_index_.assign(p, -1);
   for (size_t k = 1; k < p; ++k) {
     if (free_points_.contains(k)) free_index_[k] = static_cast<int32_t>(free_count_++);
-    else if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0 && !trees_.contains(k))
+    else if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0 && !trees_.contains(k) &&
+             bodies_.body_of(k) < 0)
       index_[k] = static_cast<int32_t>(reduced_points_++);
   }
+  for (size_t b = 0; b < bodies_.count(); ++b) body_slot_.push_back(static_cast<int32_t>(reduced_points_++));
   kept_equality_count_ = static_cast<size_t>(std::count(kept_equalities_.begin(), kept_equalities_.end(), 1));
+  build_links();
+}
+
+int32_t PointReduction::link_source(size_t k) const {
+  if (k == 0 || free_index_[k] >= 0 || index_[k] >= 0) return -1;
+  if (substitute_[k] != static_cast<int32_t>(k)) return substitute_[k];
+  if (bodies_.body_of(k) >= 0) return bodies_.base(bodies_.body_of(k));
+  if (trees_.contains(k)) return trees_.anchor(k);
+  return leaf_anchor_[k];
+}
+
+void PointReduction::build_links() {
+  const size_t p = problem_.point_count;
+  std::vector<std::vector<int32_t>> slots(p);
+  std::vector<uint8_t> done(p, 0);
+  // Depth first: a point's links are its source's, plus its body's slot for a member.
+  auto visit = [&](auto& self, size_t k) -> void {
+    if (done[k]) return;
+    done[k] = 1;
+    if (k == 0 || free_index_[k] >= 0) return;
+    if (index_[k] >= 0) {
+      slots[k] = {index_[k]};
+    } else {
+      const int32_t source = link_source(k);
+      self(self, static_cast<size_t>(source));
+      slots[k] = slots[source];
+      if (bodies_.body_of(k) >= 0) slots[k].push_back(body_slot_[bodies_.body_of(k)]);
+    }
+    link_order_.push_back(static_cast<int32_t>(k));
+  };
+  for (size_t k = 0; k < p; ++k) visit(visit, k);
+  link_offsets_.assign(p + 1, 0);
+  for (size_t k = 0; k < p; ++k) link_offsets_[k + 1] = link_offsets_[k] + static_cast<int32_t>(slots[k].size());
+  for (size_t k = 0; k < p; ++k) link_slots_.insert(link_slots_.end(), slots[k].begin(), slots[k].end());
+  link_blocks_.assign(link_slots_.size(), Matrix3{});
+}
+
+void PointReduction::update_links() {
+  for (int32_t k : link_order_) {
+    Matrix3* out = link_blocks_.data() + link_offsets_[k];
+    if (index_[k] >= 0) {
+      std::copy(kIdentity, kIdentity + 9, out->begin());
+      continue;
+    }
+    const int32_t source = link_source(k);
+    const Matrix3* in = link_blocks_.data() + link_offsets_[source];
+    const int32_t inherited = link_offsets_[source + 1] - link_offsets_[source];
+    if (trees_.contains(k) || leaf_anchor_[k] >= 0) {  // d x_k / d x_anchor times the anchor's
+      const double* j = trees_.contains(k) ? trees_.derivative(k) : jacobians_[k].data();
+      for (int32_t i = 0; i < inherited; ++i) multiply(j, in[i].data(), out[i].data());
+    } else {  // a substitute or a body's member moves with its source
+      std::copy(in, in + inherited, out);
+      if (bodies_.body_of(k) >= 0) std::copy_n(bodies_.derivative(k), 9, out[inherited].begin());
+    }
+  }
+}
+
+void PointReduction::set_start(const double* x, const double* original) {
+  free_points_.set_start(x, original);
+  bodies_.set_start(x);
 }
 
 void PointReduction::fill(const double* y, const double* original, double* x) {
@@ -105,6 +189,7 @@ void PointReduction::fill(const double* y, const double* original, double* x) {
     if (index_[k] >= 0) std::copy(y + 3 * index_[k], y + 3 * index_[k] + 3, x + 3 * k);
   for (size_t k = 1; k < p; ++k)
     if (substitute_[k] != static_cast<int32_t>(k)) std::copy(x + 3 * substitute_[k], x + 3 * substitute_[k] + 3, x + 3 * k);
+  for (int32_t b : bodies_.order()) bodies_.place(static_cast<size_t>(b), y + 3 * body_slot_[b], x);
   trees_.place(x, original);
   const double alpha = problem_.distance_weight, beta = problem_.string_weight;
   const double pull = hard_ ? 0.0 : alpha / (alpha + beta);  // dr / dd
@@ -148,38 +233,28 @@ void PointReduction::fill(const double* y, const double* original, double* x) {
     }
   }
   free_points_.minimise(x, original);
+  update_links();
 }
 
 void PointReduction::gather(const double* x, double* y) const {
   for (size_t k = 1; k < problem_.point_count; ++k)
     if (index_[k] >= 0) std::copy(x + 3 * k, x + 3 * k + 3, y + 3 * index_[k]);
-}
-
-int32_t PointReduction::target(size_t k) const {
-  int32_t point = static_cast<int32_t>(k);
-  if (leaf_anchor_[point] >= 0) point = leaf_anchor_[point];
-  if (trees_.contains(point)) point = trees_.anchor(point);
-  return index_[substitute_[point]];
-}
-
-const double* PointReduction::derivative(size_t k) const {
-  if (trees_.contains(k)) return trees_.derivative(k);
-  return leaf_anchor_[k] >= 0 ? jacobians_[k].data() : kIdentity;
+  for (int32_t slot : body_slot_) std::fill_n(y + 3 * slot, 3, 0.0);
 }
 
 void PointReduction::reduce_rows(const double* rows, size_t count, double* out) const {
   const size_t p = problem_.point_count;
   std::fill(out, out + count * 3 * reduced_points_, 0.0);
-  for (size_t k = 0; k < p; ++k) {
-    const int32_t t = target(k);
-    if (t < 0) continue;
-    const double* j = derivative(k);
-    for (size_t r = 0; r < count; ++r) {
-      const double* g = rows + r * 3 * p + 3 * k;
-      double* o = out + r * 3 * reduced_points_ + 3 * t;
-      for (int b = 0; b < 3; ++b) o[b] += j[b] * g[0] + j[3 + b] * g[1] + j[6 + b] * g[2];  // J^T g
+  for (size_t k = 0; k < p; ++k)
+    for (int32_t link = link_offsets_[k]; link < link_offsets_[k + 1]; ++link) {
+      const int32_t t = link_slots_[link];
+      const double* j = link_blocks_[link].data();
+      for (size_t r = 0; r < count; ++r) {
+        const double* g = rows + r * 3 * p + 3 * k;
+        double* o = out + r * 3 * reduced_points_ + 3 * t;
+        for (int b = 0; b < 3; ++b) o[b] += j[b] * g[0] + j[3 + b] * g[1] + j[6 + b] * g[2];  // J^T g
+      }
     }
-  }
 }
 
 void PointReduction::reduce_matrix(const double* full, double* out) const {
@@ -191,35 +266,52 @@ void PointReduction::reduce_matrix(const double* full, double* out) const {
   RowMatrix coupling = RowMatrix::Zero(nr, nf);  // T^T M over the free points' columns
   RowMatrix free = RowMatrix::Zero(nf, nf);
   reduced.setZero();
-  for (size_t a = 1; a < p; ++a) {
-    const int32_t ta = target(a);
-    const int32_t fa = free_index_[a];
-    if (ta < 0 && fa < 0) continue;
-    const double* ja = derivative(a);
-    for (size_t b = 1; b < p; ++b) {
-      const int32_t tb = target(b);
-      const int32_t fb = free_index_[b];
-      if (tb < 0 && fb < 0) continue;
-      const double* jb = fb >= 0 ? kIdentity : derivative(b);
-      double block[9];  // M_ab Jb
-      for (int i = 0; i < 3; ++i)
-        for (int c = 0; c < 3; ++c) {
-          double sum = 0.0;
-          for (int k = 0; k < 3; ++k) sum += full[(3 * (a - 1) + i) * n + 3 * (b - 1) + k] * jb[3 * k + c];
-          block[3 * i + c] = sum;
-        }
-      if (fa >= 0) {  // a free row: only the free-free block is needed (M is symmetric)
-        if (fb >= 0) free.block<3, 3>(3 * fa, 3 * fb) = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(block);
-        continue;
-      }
-      double* target_row = fb >= 0 ? &coupling(3 * ta, 3 * fb) : &reduced(3 * ta, 3 * tb);
-      const Eigen::Index stride = fb >= 0 ? nf : nr;
-      for (int r = 0; r < 3; ++r)  // Ja^T (M_ab Jb)
+  // Ja^T `block` (3 x 3, row-major) added to the rows of every slot of point a's links, in the
+  // matrix whose column block starts at `base` (rows `stride` apart).
+  auto add = [&](size_t a, const double* block, double* base, Eigen::Index stride) {
+    for (int32_t link = link_offsets_[a]; link < link_offsets_[a + 1]; ++link) {
+      const double* ja = link_blocks_[link].data();
+      double* row = base + 3 * link_slots_[link] * stride;
+      for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) {
           double sum = 0.0;
           for (int i = 0; i < 3; ++i) sum += ja[3 * i + r] * block[3 * i + c];
-          target_row[r * stride + c] += sum;
+          row[r * stride + c] += sum;
         }
+    }
+  };
+  for (size_t a = 1; a < p; ++a) {
+    const int32_t fa = free_index_[a];
+    const bool linked_a = link_offsets_[a + 1] > link_offsets_[a];
+    if (!linked_a && fa < 0) continue;
+    for (size_t b = 1; b < p; ++b) {
+      const int32_t fb = free_index_[b];
+      if (link_offsets_[b + 1] == link_offsets_[b] && fb < 0) continue;
+      const double* m_ab = full + 3 * (a - 1) * n + 3 * (b - 1);
+      if (fa >= 0) {  // a free row: only the free-free block is needed (M is symmetric)
+        if (fb >= 0)
+          for (int i = 0; i < 3; ++i)
+            for (int c = 0; c < 3; ++c) free(3 * fa + i, 3 * fb + c) = m_ab[i * n + c];
+        continue;
+      }
+      if (fb >= 0) {  // Ja^T M_ab into the coupling with free point b
+        double block[9];
+        for (int i = 0; i < 3; ++i)
+          for (int c = 0; c < 3; ++c) block[3 * i + c] = m_ab[i * n + c];
+        add(a, block, &coupling(0, 3 * fb), nf);
+        continue;
+      }
+      for (int32_t link = link_offsets_[b]; link < link_offsets_[b + 1]; ++link) {
+        const double* jb = link_blocks_[link].data();
+        double block[9];  // M_ab Jb
+        for (int i = 0; i < 3; ++i)
+          for (int c = 0; c < 3; ++c) {
+            double sum = 0.0;
+            for (int k = 0; k < 3; ++k) sum += m_ab[i * n + k] * jb[3 * k + c];
+            block[3 * i + c] = sum;
+          }
+        add(a, block, &reduced(0, 3 * link_slots_[link]), nr);
+      }
     }
   }
   if (nf == 0 || nr == 0) return;

@@ -13,10 +13,15 @@
 //   method over the bone directions (motion_refit_pendant_trees.hpp);
 // - a free point (in no held length, coincident pair or handed group: a frozen joint or an end
 //   site below one at a coarse level) is at the minimum of its Ed and angle terms given the
-//   others, found by Newton's method (motion_refit_free_points.hpp).
+//   others, found by Newton's method (motion_refit_free_points.hpp);
+// - the members of a rigid body (a kept joint's kept children held by a minimal rigid set,
+//   under hard constraints) follow their base and the body's rotation vector, a slot of three
+//   variables of its own (motion_refit_rigid_bodies.hpp).
 // The reduced problem has the same minima as the full one; the map from reduced to full
 // positions is differentiated exactly (chain rule; a free point adds nothing, as E's derivative
-// with respect to it is zero at its minimum), so gradients and Jacobians stay analytic.
+// with respect to it is zero at its minimum), so gradients and Jacobians stay analytic. A full
+// point depends on one slot or several (a body's member on its base's slots and its body's;
+// a tree hanging from a member on the same), kept as links: (slot, 3 x 3 derivative).
 #pragma once
 
 #include <array>
@@ -27,27 +32,35 @@
 #include "animlod/motion_refit.hpp"
 #include "motion_refit_free_points.hpp"
 #include "motion_refit_pendant_trees.hpp"
+#include "motion_refit_rigid_bodies.hpp"
 
 namespace animlod::detail {
 
 class PointReduction {
  public:
   // eliminate switches the reductions (off: identity, every non-root point a variable, in
-  // order); coincident points are substituted only under hard constraints.
-  PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate);
+  // order); coincident points are substituted, trees placed and rigid groups made bodies only
+  // under hard constraints, bodies only with `rigid_bodies` too.
+  PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate, bool rigid_bodies);
 
-  size_t reduced_points() const { return reduced_points_; }  // P_r: points that stay variables
-  // (m,) 1 for the equality rows (motion_refit_equalities) the reduced problem keeps.
+  // P_r: slots of three variables, the points that stay variables and then one per rigid body.
+  size_t reduced_points() const { return reduced_points_; }
+  // (m,) 1 for the equality rows (motion_refit_equalities) the reduced problem keeps; (Nh,)
+  // the same for the handed groups (motion_refit_handedness).
   const std::vector<uint8_t>& kept_equalities() const { return kept_equalities_; }
   size_t kept_equality_count() const { return kept_equality_count_; }
+  const std::vector<uint8_t>& kept_handed() const { return kept_handed_; }
+  size_t kept_handed_count() const { return kept_handed_count_; }
 
-  // Where the free points start their minimisation in every fill until the next call (see
-  // FreePointClusters::set_start): the free points of x (P, 3).
-  void set_free_start(const double* x, const double* original) { free_points_.set_start(x, original); }
+  // The start of a solve, x (P, 3): where the free points start their minimisation in every
+  // fill until the next call (see FreePointClusters::set_start), and the shape of every rigid
+  // body (its slot's zero is x's orientation).
+  void set_start(const double* x, const double* original);
   // Full positions x (P, 3) from the reduced ones y (P_r, 3); the root is original's. Remembers
-  // the leaves' and the trees' Jacobians for the reduce_* calls that follow.
+  // the links' derivatives for the reduce_* calls that follow.
   void fill(const double* y, const double* original, double* x);
-  // The reduced positions (P_r, 3) of full positions x (P, 3).
+  // The reduced positions (P_r, 3) of full positions x (P, 3); a body's slot is 0 (its shape at
+  // set_start's orientation).
   void gather(const double* x, double* y) const;
   // Derivative rows over full positions (count, P, 3) to rows over reduced ones (count, P_r, 3),
   // at the last fill.
@@ -60,17 +73,27 @@ class PointReduction {
 
  private:
   using Matrix3 = std::array<double, 9>;
-  // Where full point k's derivative goes: reduced point (-1: none, the root) and the 3 x 3
-  // derivative of x_k with respect to it (identity unless k is a leaf or a tree point, whose
-  // derivatives go to its anchor).
-  int32_t target(size_t k) const;
-  const double* derivative(size_t k) const;
+  // The point whose links point k's are built from (its substitute, body base, tree or leaf
+  // anchor; -1 for a variable, the root and free points), and the links in an order where that
+  // point comes first.
+  int32_t link_source(size_t k) const;
+  void build_links();
+  // The links' derivatives at the positions of the last fill.
+  void update_links();
 
   const MotionRefitProblem& problem_;
   bool hard_ = false;
   FreePointClusters free_points_;
   PendantTrees trees_;
+  RigidBodies bodies_;
   size_t reduced_points_ = 0;
+  std::vector<int32_t> body_slot_;    // (bodies,) reduced index of each body's rotation vector
+  std::vector<int32_t> link_order_;   // points with links, each after its link_source
+  std::vector<int32_t> link_offsets_;  // (P + 1,) CSR offsets into link_slots_ / link_blocks_
+  std::vector<int32_t> link_slots_;
+  std::vector<Matrix3> link_blocks_;  // d x_k / d y_slot
+  std::vector<uint8_t> kept_handed_;
+  size_t kept_handed_count_ = 0;
   std::vector<int32_t> index_;        // (P,) reduced index of a variable point, -1 otherwise
   std::vector<int32_t> substitute_;   // (P,) the point a substituted point sits at, else itself
   std::vector<int32_t> leaf_anchor_;  // (P,) p of a leaf, -1 otherwise

@@ -59,7 +59,7 @@ struct FrameContext {
   std::vector<double> x;             // (P, 3) positions of the current variables
   std::vector<double> gradient;      // (P, 3)
   std::vector<double> jacobian;      // (rows, P, 3)
-  std::vector<double> values;        // (rows,) every equality before the kept ones are picked
+  std::vector<double> values;        // (rows,) every row before the kept ones are picked
   std::vector<double> rows;          // (rows, P_r, 3)
   std::vector<double> placed_at;     // (n,) the variables x was last filled for, when placed
   bool placed = false;
@@ -110,12 +110,10 @@ double objective_callback(unsigned, const double* v, double* grad, void* data) {
   return value;
 }
 
-void equality_callback(unsigned m, double* result, unsigned, const double* v, double* grad, void* data) {
-  auto& c = *static_cast<FrameContext*>(data);
-  to_positions(c, v);
+// The rows `kept` marks of c.values and c.jacobian (all rows), packed into result and, when
+// grad is not nullptr, their derivatives over the variables.
+void keep_rows(FrameContext& c, const std::vector<uint8_t>& kept, unsigned m, double* result, double* grad) {
   const size_t stride = 3 * c.point_count;
-  detail::refit_equalities_frame(*c.problem, c.x.data(), c.values.data(), grad ? c.jacobian.data() : nullptr);
-  const auto& kept = c.reduction->kept_equalities();
   size_t row = 0;  // the kept rows, packed to the front
   for (size_t k = 0; k < kept.size(); ++k) {
     if (!kept[k]) continue;
@@ -127,11 +125,18 @@ void equality_callback(unsigned m, double* result, unsigned, const double* v, do
   if (grad) to_variables(c, c.jacobian.data(), m, grad);
 }
 
+void equality_callback(unsigned m, double* result, unsigned, const double* v, double* grad, void* data) {
+  auto& c = *static_cast<FrameContext*>(data);
+  to_positions(c, v);
+  detail::refit_equalities_frame(*c.problem, c.x.data(), c.values.data(), grad ? c.jacobian.data() : nullptr);
+  keep_rows(c, c.reduction->kept_equalities(), m, result, grad);
+}
+
 void handedness_callback(unsigned m, double* result, unsigned, const double* v, double* grad, void* data) {
   auto& c = *static_cast<FrameContext*>(data);
   to_positions(c, v);
-  detail::refit_handedness_frame(*c.problem, c.x.data(), result, grad ? c.jacobian.data() : nullptr);
-  if (grad) to_variables(c, c.jacobian.data(), m, grad);
+  detail::refit_handedness_frame(*c.problem, c.x.data(), c.values.data(), grad ? c.jacobian.data() : nullptr);
+  keep_rows(c, c.reduction->kept_handed(), m, result, grad);
 }
 
 std::string format(const char* pattern, double value) {
@@ -153,7 +158,7 @@ class FrameSolver {
       : problem_(problem),
         options_(options),
         hard_(options.hard_constraints && motion_refit_equality_count(problem) > 0),
-        reduction_(problem, hard_, options.eliminate_points) {
+        reduction_(problem, hard_, options.eliminate_points, options.rigid_bodies && options.precondition) {
     const size_t p = problem.point_count;
     const size_t m = motion_refit_equality_count(problem);
     c_.problem = &problem_;
@@ -166,7 +171,7 @@ class FrameSolver {
     c_.placed_at.assign(c_.variable_count, 0.0);
     c_.x.assign(3 * p, 0.0);
     c_.gradient.assign(3 * p, 0.0);
-    c_.values.assign(m, 0.0);
+    c_.values.assign(std::max(m, problem.handed_quad_count), 0.0);
     c_.jacobian.assign(std::max(m, problem.handed_quad_count) * 3 * p, 0.0);
     if (options.precondition) {
       full_hessian_.assign(9 * (p - 1) * (p - 1), 0.0);
@@ -186,10 +191,11 @@ class FrameSolver {
       nlopt_add_equality_mconstraint(opt_.get(), static_cast<unsigned>(kept), equality_callback, &c_,
                                      tolerance.data());
     }
-    if (hard_ && problem.handed_quad_count > 0) {
-      const std::vector<double> zero(problem.handed_quad_count, 0.0);
-      nlopt_add_inequality_mconstraint(opt_.get(), static_cast<unsigned>(problem.handed_quad_count),
-                                       handedness_callback, &c_, zero.data());
+    const size_t handed = reduction_.kept_handed_count();
+    if (hard_ && handed > 0) {
+      const std::vector<double> zero(handed, 0.0);
+      nlopt_add_inequality_mconstraint(opt_.get(), static_cast<unsigned>(handed), handedness_callback, &c_,
+                                        zero.data());
     }
     nlopt_set_ftol_rel(opt_.get(), options.ftol_rel);
     nlopt_set_ftol_abs(opt_.get(), kObjectiveResolution);
@@ -206,7 +212,7 @@ class FrameSolver {
     const size_t n = c_.variable_count;
     c_.original = original;
     c_.placed = false;
-    reduction_.set_free_start(start, original);
+    reduction_.set_start(start, original);
     reduction_.gather(start, c_.start.data());
     if (c_.precondition) {
       std::fill(variables_.begin(), variables_.end(), 0.0);

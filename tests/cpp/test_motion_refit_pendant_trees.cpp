@@ -40,7 +40,7 @@ struct ChainFigure {
 
 TEST_CASE("pendant trees: the chain leaves the variables and E's gradient through it is exact") {
   const ChainFigure f;
-  PointReduction reduction(f.problem, true, true);
+  PointReduction reduction(f.problem, true, true, true);
   CHECK(reduction.reduced_points() == 3);       // 1, 2 and 3
   CHECK(reduction.kept_equality_count() == 4);  // the loop's lengths
   const std::vector<double> original = f.perturbed(1, 0.3);

@@ -220,11 +220,11 @@ def seeds_ffd(data_dir: Path | None) -> dict[str, bytes]:
 def seeds_refit(data_dir: Path | None) -> dict[str, bytes]:
     """Re-fit problems in the layout of fuzz_motion_refit.cpp (int16 mode): a bent chain of unit
     bones with a branching point, its lengths, a handed group and frozen-joint angles, over 3
-    frames of a swaying motion; soft and hard, each solved."""
+    frames of a swaying motion; soft and hard, each solved; and with the branch's children tied to
+    each other (a minimal rigid set: a rigid body of the core's reduction)."""
     key = np.array([[0, 0, 0], [0, 1, 0], [0, 2, 0], [1, 2, 0], [-1, 2, 0], [0, 2, 1], [1, 3, 0], [0, 3, 0]], float)
     parents = [-1, 0, 1, 2, 2, 2, 3, 2]
-    pairs = [(j, parents[j]) for j in range(1, len(key))]
-    lengths = [np.linalg.norm(key[a] - key[b]) for a, b in pairs]
+    bones = [(j, parents[j]) for j in range(1, len(key))]
     triples = [(1, 2, 3), (0, 1, 2), (2, 3, 6)]
     cosines = []
     for p, j, c in triples:
@@ -234,7 +234,11 @@ def seeds_refit(data_dir: Path | None) -> dict[str, bytes]:
     volume = float(np.linalg.det(np.stack([key[q] - key[quad[0]] for q in quad[1:]])))
     frames = np.stack([key + np.array([0.1 * t, 0.0, 0.05 * t]) * (np.arange(len(key)) > 1)[:, None] for t in range(3)])
     seeds = {}
-    for name, flags in (("soft", 0b01011100), ("hard", 0b01011110), ("hard_cold", 0b01111110), ("plain", 0b01000000)):
+    siblings = [(4, 3), (5, 3), (5, 4)]
+    cases = (("soft", 0b01011100, bones), ("hard", 0b01011110, bones), ("hard_cold", 0b01111110, bones),
+             ("plain", 0b01000000, bones), ("hard_body", 0b01011110, bones + siblings))  # fmt: skip
+    for name, flags, pairs in cases:
+        lengths = [np.linalg.norm(key[a] - key[b]) for a, b in pairs]
         out = bytes([flags, len(key), 2, len(pairs)])
         out += struct.pack(f"<{2 * len(pairs)}H", *[i for pair in pairs for i in pair])
         out += bytes(int(round(length * 32)) for length in lengths)

@@ -114,6 +114,11 @@ struct MotionRefitOptions {
   // a finger: placed by Newton's method over their bone directions). SLSQP's cost grows with the
   // cube of the variable count. The minima are the same.
   bool eliminate_points = true;
+  // With eliminate_points, hard constraints and precondition: a kept joint's kept children held
+  // by a minimal rigid set of lengths move as one rigid body, three rotation variables instead of
+  // three per child, and their group's lengths, heights and handedness leave SLSQP (they hold by
+  // construction). A hand with its finger bases, the hips, the chest. The minima are the same.
+  bool rigid_bodies = true;
   int chunk_frames = 64;        // consecutive frames per task (warm starts run inside a chunk)
   int threads = 0;              // worker threads; 0 uses every hardware thread
 };

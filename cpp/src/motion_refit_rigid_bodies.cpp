@@ -1,0 +1,226 @@
+// Rigid bodies of the motion re-fit (see the header); seeds/000, Eq. 7 held as hard constraints.
+// A member sits at x_base + R(w) d_k with R(w) = exp([w]x) (Rodrigues), and
+// d(R(w) d) / dw = -[R(w) d]x J_l(w), J_l the left Jacobian of SO(3):
+// I + (1 - cos t) / t^2 [w]x + (t - sin t) / t^3 [w]x^2, t = |w| (series below t = 1e-4).
+#include "motion_refit_rigid_bodies.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Core>
+#include <Eigen/QR>
+
+#include "motion_refit_detail.hpp"
+
+namespace animlod::detail {
+
+namespace {
+
+// A body's rows below this (scaled like the equalities, by 1 / L) count as held at the start:
+// a feasible start's rounding (~1e-16) is left alone, so its solve is unchanged.
+constexpr double kRigidTolerance = 1e-14;
+constexpr int kRigidIterations = 30;
+
+// [w]x as a row-major 3 x 3 matrix.
+std::array<double, 9> cross_matrix(const double* w) {
+  return {0.0, -w[2], w[1], w[2], 0.0, -w[0], -w[1], w[0], 0.0};
+}
+
+// The points of every equality row (motion_refit_equalities order) and how many there are.
+struct EqualityRows {
+  std::vector<std::array<int32_t, 4>> points;
+  std::vector<int> width;
+};
+
+EqualityRows equality_rows(const MotionRefitProblem& problem) {
+  EqualityRows rows;
+  for (size_t k = 0; k < problem.length_pair_count; ++k) {
+    rows.points.push_back({problem.length_pairs[2 * k], problem.length_pairs[2 * k + 1], 0, 0});
+    rows.width.push_back(2);
+  }
+  for (size_t k = 0; k < problem.coincident_pair_count; ++k)
+    for (int axis = 0; axis < 3; ++axis) {
+      rows.points.push_back({problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1], 0, 0});
+      rows.width.push_back(2);
+    }
+  for (size_t k = 0; k < problem.flat_quad_count; ++k) {
+    const int32_t* q = problem.flat_quads + 4 * k;
+    rows.points.push_back({q[0], q[1], q[2], q[3]});
+    rows.width.push_back(4);
+  }
+  return rows;
+}
+
+}  // namespace
+
+RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<uint8_t>& excluded, bool enabled)
+    : problem_(problem),
+      body_of_(problem.point_count, -1),
+      inner_equalities_(motion_refit_equality_count(problem), 0),
+      inner_handed_(problem.handed_quad_count, 0),
+      offsets_(3 * problem.point_count, 0.0),
+      jacobians_(problem.point_count) {
+  if (!enabled) return;
+  const size_t p = problem.point_count;
+  const EqualityRows rows = equality_rows(problem);
+  std::vector<std::vector<int32_t>> children(p);  // child sides of each point's held lengths
+  for (size_t k = 0; k < problem.length_pair_count; ++k)
+    children[problem.length_pairs[2 * k + 1]].push_back(problem.length_pairs[2 * k]);
+
+  std::vector<int32_t> in_set(p, 0);  // stamp: 1 + the candidate's base
+  // 1 when every point of row r is in the candidate set.
+  auto inside = [&](size_t r, int32_t stamp) {
+    for (int c = 0; c < rows.width[r]; ++c)
+      if (in_set[rows.points[r][c]] != stamp) return false;
+    return true;
+  };
+  std::vector<std::vector<size_t>> rows_of(p);  // equality rows touching each point
+  for (size_t r = 0; r < rows.points.size(); ++r)
+    for (int c = 0; c < rows.width[r]; ++c) rows_of[rows.points[r][c]].push_back(r);
+
+  for (size_t base = 0; base < p; ++base) {
+    if (excluded[base] || children[base].size() < 2) continue;
+    const int32_t stamp = static_cast<int32_t>(base) + 1;
+    std::vector<int32_t> set;
+    for (int32_t c : children[base])
+      if (c != 0 && !excluded[c] && body_of_[c] < 0 && in_set[c] != stamp) set.push_back(c), in_set[c] = stamp;
+    in_set[base] = stamp;
+    // Keep the children tied to another child by a row inside the set, until none drops out.
+    for (bool dropped = true; dropped;) {
+      dropped = false;
+      for (size_t i = 0; i < set.size(); ++i) {
+        const int32_t c = set[i];
+        const bool tied = std::any_of(rows_of[c].begin(), rows_of[c].end(), [&](size_t r) {
+          if (!inside(r, stamp)) return false;
+          for (int k = 0; k < rows.width[r]; ++k)
+            if (rows.points[r][k] != c && rows.points[r][k] != static_cast<int32_t>(base)) return true;
+          return false;
+        });
+        if (tied) continue;
+        in_set[c] = 0;
+        set.erase(set.begin() + static_cast<long>(i));
+        dropped = true;
+        break;
+      }
+    }
+    if (set.size() < 2) {
+      for (int32_t c : set) in_set[c] = 0;
+      continue;
+    }
+    std::vector<size_t> held;
+    for (size_t r = 0; r < rows.points.size(); ++r)
+      if (inside(r, stamp)) held.push_back(r);
+    if (held.size() != 3 * set.size() - 3) {  // not a minimal rigid set: leave it to SLSQP
+      for (int32_t c : set) in_set[c] = 0;
+      continue;
+    }
+    const auto body = static_cast<int32_t>(bases_.size());
+    bases_.push_back(static_cast<int32_t>(base));
+    std::sort(set.begin(), set.end());
+    for (int32_t c : set) body_of_[c] = body;
+    members_.push_back(set);
+    for (size_t r : held) inner_equalities_[r] = 1;
+    for (size_t k = 0; k < problem.handed_quad_count; ++k) {
+      const int32_t* q = problem.handed_quads + 4 * k;
+      if (std::all_of(q, q + 4, [&](int32_t point) { return in_set[point] == stamp; })) inner_handed_[k] = 1;
+    }
+  }
+
+  // Bases before their bodies; a cycle (bases that are members of each other's bodies) cannot
+  // be placed, so its bodies are dropped and their rows go back to SLSQP.
+  std::vector<uint8_t> placed(bases_.size(), 0);
+  for (bool progress = true; progress;) {
+    progress = false;
+    for (size_t b = 0; b < bases_.size(); ++b) {
+      const int32_t owner = body_of_[bases_[b]];
+      if (placed[b] || (owner >= 0 && !placed[owner])) continue;
+      placed[b] = 1;
+      order_.push_back(static_cast<int32_t>(b));
+      progress = true;
+    }
+  }
+  if (order_.size() == bases_.size()) {
+    for (size_t r = 0; r < inner_equalities_.size(); ++r)
+      if (inner_equalities_[r]) held_rows_.push_back(r);
+    return;
+  }
+  std::fill(inner_equalities_.begin(), inner_equalities_.end(), uint8_t{0});
+  std::fill(inner_handed_.begin(), inner_handed_.end(), uint8_t{0});
+  std::fill(body_of_.begin(), body_of_.end(), -1);
+  bases_.clear();
+  members_.clear();
+  order_.clear();
+}
+
+void RigidBodies::set_start(const double* x) {
+  if (bases_.empty()) return;
+  shape_.assign(x, x + 3 * problem_.point_count);
+  make_rigid();
+  for (size_t b = 0; b < bases_.size(); ++b)
+    for (int32_t k : members_[b])
+      for (int a = 0; a < 3; ++a) offsets_[3 * k + a] = shape_[3 * k + a] - shape_[3 * bases_[b] + a];
+}
+
+void RigidBodies::make_rigid() {
+  const size_t p = problem_.point_count;
+  const size_t m = inner_equalities_.size();
+  values_.resize(m);
+  std::vector<int32_t> columns;  // the members' coordinates
+  for (size_t k = 0; k < p; ++k)
+    if (body_of_[k] >= 0)
+      for (int a = 0; a < 3; ++a) columns.push_back(static_cast<int32_t>(3 * k + a));
+  const auto rows = static_cast<Eigen::Index>(held_rows_.size());
+  const auto cols = static_cast<Eigen::Index>(columns.size());
+  for (int iteration = 0; iteration < kRigidIterations; ++iteration) {
+    refit_equalities_frame(problem_, shape_.data(), values_.data(), nullptr);
+    double worst = 0.0;
+    for (size_t r : held_rows_) worst = std::max(worst, std::abs(values_[r]));
+    if (!(worst > kRigidTolerance)) return;  // held (or not finite: left to the solve's check)
+    jacobian_.resize(m * 3 * p);
+    refit_equalities_frame(problem_, shape_.data(), values_.data(), jacobian_.data());
+    Eigen::MatrixXd j(rows, cols);
+    Eigen::VectorXd residual(rows);
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      residual(r) = -values_[held_rows_[r]];
+      for (Eigen::Index c = 0; c < cols; ++c) j(r, c) = jacobian_[held_rows_[r] * 3 * p + columns[c]];
+    }
+    const Eigen::VectorXd step = j.completeOrthogonalDecomposition().solve(residual);
+    for (Eigen::Index c = 0; c < cols; ++c) shape_[columns[c]] += step(c);
+  }
+}
+
+void RigidBodies::place(size_t body, const double* w, double* x) {
+  const double t2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+  const double t = std::sqrt(t2);
+  // sin t / t, (1 - cos t) / t^2, (t - sin t) / t^3
+  const bool small = t < 1e-4;
+  const double s = small ? 1.0 - t2 / 6.0 : std::sin(t) / t;
+  const double c = small ? 0.5 - t2 / 24.0 : (1.0 - std::cos(t)) / t2;
+  const double e = small ? 1.0 / 6.0 - t2 / 120.0 : (t - std::sin(t)) / (t2 * t);
+  const std::array<double, 9> wx = cross_matrix(w);
+  std::array<double, 9> wx2{}, left{};  // [w]x^2, J_l
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) wx2[3 * i + j] += wx[3 * i + k] * wx[3 * k + j];
+      left[3 * i + j] = (i == j ? 1.0 : 0.0) + c * wx[3 * i + j] + e * wx2[3 * i + j];
+    }
+  const double* origin = x + 3 * bases_[body];
+  for (int32_t k : members_[body]) {
+    const double* d = offsets_.data() + 3 * k;
+    double v[3];  // R d = d + s [w]x d + c [w]x^2 d
+    for (int i = 0; i < 3; ++i)
+      v[i] = d[i] + s * (wx[3 * i] * d[0] + wx[3 * i + 1] * d[1] + wx[3 * i + 2] * d[2]) +
+             c * (wx2[3 * i] * d[0] + wx2[3 * i + 1] * d[1] + wx2[3 * i + 2] * d[2]);
+    for (int i = 0; i < 3; ++i) x[3 * k + i] = origin[i] + v[i];
+    const std::array<double, 9> vx = cross_matrix(v);
+    Matrix3& j = jacobians_[k];  // -[v]x J_l
+    for (int i = 0; i < 3; ++i)
+      for (int col = 0; col < 3; ++col) {
+        double sum = 0.0;
+        for (int k2 = 0; k2 < 3; ++k2) sum -= vx[3 * i + k2] * left[3 * k2 + col];
+        j[3 * i + col] = sum;
+      }
+  }
+}
+
+}  // namespace animlod::detail

@@ -1,0 +1,115 @@
+// Rigid bodies of the motion re-fit (cpp/src/motion_refit_rigid_bodies.hpp): a kept joint's
+// children held by a minimal rigid set become one rotation slot; their lengths hold at any
+// value of it, E's gradient through a chain of bodies (and a tree and a leaf hanging from their
+// members) matches finite differences away from the start orientation, and the solve without
+// the members' variables ends where the solve with every point a variable does.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "../../cpp/src/motion_refit_detail.hpp"
+#include "../../cpp/src/motion_refit_reduction.hpp"
+#include "../../cpp/src/motion_refit_rigid_bodies.hpp"
+#include "animlod/motion_refit.hpp"
+#include "motion_refit_figure.hpp"
+
+using animlod::detail::PointReduction;
+using animlod::detail::RigidBodies;
+
+namespace {
+
+// Root 0 with children 1, 2 (a triangle: body A); 1 with children 3, 4 (body B, its base a
+// member of A); a chain 5-6 hanging from 3 (a pendant tree); a leaf 7 on 4; point 8 tied to 2
+// and 4, so it stays a variable and its lengths stay equalities.
+struct BodyChain {
+  std::vector<double> key = {0, 0, 0,  -0.4, 1, 0,  0.5, 0.9, 0.2,  -0.8, 2, 0.1,  0, 2.1, -0.3,
+                             -1.0, 3, 0.2,  -1.1, 4, 0,  0.3, 3, -0.5,  0.6, 2.0, 0.4};
+  std::vector<int32_t> pairs = {1, 0, 2, 0, 2, 1, 3, 1, 4, 1, 4, 3, 5, 3, 6, 5, 7, 4, 8, 2, 8, 4};
+  std::vector<double> key_lengths = pair_lengths(key, pairs);
+  animlod::MotionRefitProblem problem;
+
+  BodyChain() {
+    problem.point_count = 9;
+    problem.length_pairs = pairs.data();
+    problem.key_lengths = key_lengths.data();
+    problem.length_pair_count = key_lengths.size();
+    problem.length_scale = 4.0;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("rigid bodies: minimal rigid sets are found, other groups are not") {
+  const BodyChain f;
+  const RigidBodies bodies(f.problem, std::vector<uint8_t>(9, 0), true);
+  REQUIRE(bodies.count() == 2);
+  CHECK(bodies.base(0) == 0);
+  CHECK(bodies.members(0) == std::vector<int32_t>{1, 2});
+  CHECK(bodies.base(1) == 1);
+  CHECK(bodies.members(1) == std::vector<int32_t>{3, 4});
+  CHECK(bodies.order() == std::vector<int32_t>{0, 1});
+  // The two triangles' six lengths are held by the bodies; 8's two lengths and the chain's are not.
+  const std::vector<uint8_t> inner = {1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0};
+  CHECK(bodies.inner_equalities() == inner);
+  CHECK(RigidBodies(f.problem, std::vector<uint8_t>(9, 0), false).count() == 0);
+  std::vector<uint8_t> excluded(9, 0);
+  excluded[3] = 1;  // B cannot take 3: a lone child (4) is no body
+  CHECK(RigidBodies(f.problem, excluded, true).count() == 1);
+
+  // The figure of the solver tests: 2's children 6, 7, 8 (six lengths and a handed group) form
+  // a body; its base 2 hangs from 1 by one length (no body there).
+  const Figure figure;
+  const RigidBodies handed(figure.problem, std::vector<uint8_t>(9, 0), true);
+  REQUIRE(handed.count() == 1);
+  CHECK(handed.base(0) == 2);
+  CHECK(handed.inner_handed() == std::vector<uint8_t>{1});
+}
+
+TEST_CASE("rigid bodies: lengths hold at any rotation and E's gradient through the chain is exact") {
+  const BodyChain f;
+  PointReduction reduction(f.problem, true, true, true);
+  // Variables: 8, then A's and B's rotation vectors (5, 6 a tree, 7 a leaf, 1-4 members).
+  REQUIRE(reduction.reduced_points() == 3);
+  CHECK(reduction.kept_equality_count() == 2);  // 8-2 and 8-4
+  const std::vector<double> original = perturbed_positions(f.key, 1, 0.3);
+  const std::vector<double> start = f.key;
+  reduction.set_start(start.data(), original.data());
+  std::vector<double> y(9);
+  reduction.gather(start.data(), y.data());
+  CHECK(y[3] == 0.0);
+  y[3] = 0.4, y[4] = -0.7, y[5] = 0.2;  // A turned by about 0.83 rad
+  y[6] = -0.1, y[7] = 0.3, y[8] = 0.5;
+  y[0] += 0.2;                          // 8 moved
+  std::vector<double> placed(start);
+  reduction.fill(y.data(), original.data(), placed.data());
+  const std::vector<double> lengths = pair_lengths(placed, f.pairs);
+  for (size_t k = 0; k < 9; ++k) CHECK(lengths[k] == doctest::Approx(f.key_lengths[k]).epsilon(1e-12));
+
+  std::vector<double> gradient(9), g_plus(9), g_minus(9);
+  reduced_energy(reduction, f.problem, y, original, gradient);
+  for (size_t i = 0; i < 9; ++i) {
+    const double numeric = reduced_energy_slope(reduction, f.problem, y, original, i, 1e-6, g_plus, g_minus);
+    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-6).scale(1.0));
+  }
+  // Near the start orientation (the series branch of the rotation) as well.
+  std::fill(y.begin() + 3, y.end(), 1e-6);
+  reduced_energy(reduction, f.problem, y, original, gradient);
+  for (size_t i = 3; i < 9; ++i) {
+    const double numeric = reduced_energy_slope(reduction, f.problem, y, original, i, 1e-7, g_plus, g_minus);
+    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-5).scale(1.0));
+  }
+}
+
+TEST_CASE("rigid bodies: the solve over rotations ends where the solve over every point does") {
+  const BodyChain f;
+  const size_t p = f.problem.point_count;
+  const size_t frames = 8;
+  const auto [with, without] = solve_with_and_without_elimination(f.problem, f.key, 40, 0.2, frames);
+  for (size_t t = 0; t < frames; ++t) {
+    const std::vector<double> x(without.positions.begin() + static_cast<long>(t * 3 * p),
+                                without.positions.begin() + static_cast<long>((t + 1) * 3 * p));
+    const std::vector<double> lengths = pair_lengths(x, f.pairs);
+    for (size_t k = 0; k < lengths.size(); ++k) CHECK(std::abs(lengths[k] - f.key_lengths[k]) < 1e-8 * 4.0);
+  }
+}

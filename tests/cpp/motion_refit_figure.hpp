@@ -1,5 +1,5 @@
-// The small figure the motion re-fit tests solve (test_motion_refit.cpp,
-// test_motion_refit_free_points.cpp), and E at a point.
+// The small figure the motion re-fit tests solve (test_motion_refit*.cpp), E at a point, and
+// the checks those tests share (reduced gradients against finite differences, held lengths).
 #pragma once
 
 #include <doctest/doctest.h>
@@ -132,4 +132,30 @@ inline double reduced_energy_slope(animlod::detail::PointReduction& reduction,
   return (reduced_energy(reduction, problem, plus, original, g_plus) -
           reduced_energy(reduction, problem, minus, original, g_minus)) /
          (2 * h);
+}
+
+// Checks the reduced gradient at y against central differences (step h) along y[first], ...
+inline void check_reduced_gradient(animlod::detail::PointReduction& reduction,
+                                   const animlod::MotionRefitProblem& problem, const std::vector<double>& y,
+                                   const std::vector<double>& original, size_t first, double h, double epsilon) {
+  std::vector<double> gradient(y.size()), g_plus(y.size()), g_minus(y.size());
+  reduced_energy(reduction, problem, y, original, gradient);
+  for (size_t i = first; i < y.size(); ++i) {
+    const double numeric = reduced_energy_slope(reduction, problem, y, original, i, h, g_plus, g_minus);
+    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(epsilon).scale(1.0));
+  }
+}
+
+// Checks that every frame of `positions` (frames, P, 3) holds the pairs' key lengths within
+// `tolerance`.
+inline void check_lengths_held(const std::vector<double>& positions, size_t point_count,
+                               const std::vector<int32_t>& pairs, const std::vector<double>& key_lengths,
+                               double tolerance) {
+  const size_t stride = 3 * point_count;
+  for (size_t t = 0; t < positions.size() / stride; ++t) {
+    const std::vector<double> x(positions.begin() + static_cast<long>(t * stride),
+                                positions.begin() + static_cast<long>((t + 1) * stride));
+    const std::vector<double> lengths = pair_lengths(x, pairs);
+    for (size_t k = 0; k < lengths.size(); ++k) CHECK(std::abs(lengths[k] - key_lengths[k]) < tolerance);
+  }
 }

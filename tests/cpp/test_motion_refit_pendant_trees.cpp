@@ -52,24 +52,11 @@ TEST_CASE("pendant trees: the chain leaves the variables and E's gradient throug
   const std::vector<double> lengths = pair_lengths(placed, f.pairs);
   for (size_t k = 4; k < 7; ++k) CHECK(lengths[k] == doctest::Approx(f.key_lengths[k]).epsilon(1e-12));
 
-  std::vector<double> gradient(9), g_plus(9), g_minus(9);
-  reduced_energy(reduction, f.problem, y, original, gradient);
-  const double h = 1e-6;
-  for (size_t i = 0; i < 9; ++i) {
-    const double numeric = reduced_energy_slope(reduction, f.problem, y, original, i, h, g_plus, g_minus);
-    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-6).scale(1.0));
-  }
+  check_reduced_gradient(reduction, f.problem, y, original, 0, 1e-6, 1e-6);
 }
 
 TEST_CASE("pendant trees: the solve without their variables ends where the solve with them does") {
   const ChainFigure f;
-  const size_t p = f.problem.point_count;
-  const size_t frames = 8;
-  const auto [with, without] = solve_with_and_without_elimination(f.problem, f.key, 20, 0.2, frames);
-  for (size_t t = 0; t < frames; ++t) {
-    const std::vector<double> x(without.positions.begin() + static_cast<long>(t * 3 * p),
-                                without.positions.begin() + static_cast<long>((t + 1) * 3 * p));
-    const std::vector<double> lengths = pair_lengths(x, f.pairs);
-    for (size_t k = 0; k < lengths.size(); ++k) CHECK(std::abs(lengths[k] - f.key_lengths[k]) < 1e-8 * 5.0);
-  }
+  const auto run = solve_with_and_without_elimination(f.problem, f.key, 20, 0.2, 8);
+  check_lengths_held(run.without.positions, f.problem.point_count, f.pairs, f.key_lengths, 1e-8 * 5.0);
 }

@@ -86,30 +86,14 @@ TEST_CASE("rigid bodies: lengths hold at any rotation and E's gradient through t
   const std::vector<double> lengths = pair_lengths(placed, f.pairs);
   for (size_t k = 0; k < 9; ++k) CHECK(lengths[k] == doctest::Approx(f.key_lengths[k]).epsilon(1e-12));
 
-  std::vector<double> gradient(9), g_plus(9), g_minus(9);
-  reduced_energy(reduction, f.problem, y, original, gradient);
-  for (size_t i = 0; i < 9; ++i) {
-    const double numeric = reduced_energy_slope(reduction, f.problem, y, original, i, 1e-6, g_plus, g_minus);
-    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-6).scale(1.0));
-  }
+  check_reduced_gradient(reduction, f.problem, y, original, 0, 1e-6, 1e-6);
   // Near the start orientation (the series branch of the rotation) as well.
   std::fill(y.begin() + 3, y.end(), 1e-6);
-  reduced_energy(reduction, f.problem, y, original, gradient);
-  for (size_t i = 3; i < 9; ++i) {
-    const double numeric = reduced_energy_slope(reduction, f.problem, y, original, i, 1e-7, g_plus, g_minus);
-    CHECK(gradient[i] == doctest::Approx(numeric).epsilon(1e-5).scale(1.0));
-  }
+  check_reduced_gradient(reduction, f.problem, y, original, 3, 1e-7, 1e-5);
 }
 
 TEST_CASE("rigid bodies: the solve over rotations ends where the solve over every point does") {
   const BodyChain f;
-  const size_t p = f.problem.point_count;
-  const size_t frames = 8;
-  const auto [with, without] = solve_with_and_without_elimination(f.problem, f.key, 40, 0.2, frames);
-  for (size_t t = 0; t < frames; ++t) {
-    const std::vector<double> x(without.positions.begin() + static_cast<long>(t * 3 * p),
-                                without.positions.begin() + static_cast<long>((t + 1) * 3 * p));
-    const std::vector<double> lengths = pair_lengths(x, f.pairs);
-    for (size_t k = 0; k < lengths.size(); ++k) CHECK(std::abs(lengths[k] - f.key_lengths[k]) < 1e-8 * 4.0);
-  }
+  const auto run = solve_with_and_without_elimination(f.problem, f.key, 40, 0.2, 8);
+  check_lengths_held(run.without.positions, f.problem.point_count, f.pairs, f.key_lengths, 1e-8 * 4.0);
 }

@@ -127,7 +127,8 @@ def test_flat_rigid_groups_hold_their_shape_on_the_walk() -> None:
 def test_pendant_trees_end_where_every_point_as_a_variable_does_on_the_walk() -> None:
     # At the walk's 27-joint level both legs and the head hang from the hips' and spine's rigid
     # groups by held lengths alone: solved inside each evaluation (pendant trees), they leave
-    # SLSQP's variables but not its optimum.
+    # SLSQP's variables but not its optimum; so do the hips, chest and hands, moved as rigid
+    # bodies (a rotation each, their groups' lengths and flat heights held by construction).
     walk = humanoid_motion(humanoid().skeleton, "walk", cycles=1, fps=15.0)
     analysis = analyze_motion(walk, ranking="importance")
     total = len(analysis.priority) + 1

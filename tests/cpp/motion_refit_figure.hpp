@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "../../cpp/src/motion_refit_detail.hpp"
@@ -35,6 +36,27 @@ inline std::vector<double> perturbed_positions(const std::vector<double>& key, u
   for (size_t i = 3; i < x.size(); ++i) x[i] += normal(random);
   return x;
 }
+
+// A figure held by lengths alone: key positions (P, 3), its length pairs and their key lengths.
+struct LengthFigure {
+  std::vector<double> key;
+  std::vector<int32_t> pairs;
+  std::vector<double> key_lengths;
+  animlod::MotionRefitProblem problem;
+
+  LengthFigure(std::vector<double> key_positions, std::vector<int32_t> length_pairs, double length_scale)
+      : key(std::move(key_positions)), pairs(std::move(length_pairs)), key_lengths(pair_lengths(key, pairs)) {
+    problem.point_count = key.size() / 3;
+    problem.length_pairs = pairs.data();
+    problem.key_lengths = key_lengths.data();
+    problem.length_pair_count = key_lengths.size();
+    problem.length_scale = length_scale;
+  }
+  LengthFigure(const LengthFigure&) = delete;  // problem points into the vectors
+  LengthFigure& operator=(const LengthFigure&) = delete;
+
+  std::vector<double> perturbed(unsigned seed, double scale) const { return perturbed_positions(key, seed, scale); }
+};
 
 // The solve of `frames` perturbations of `key` (seeds first_seed, ...; the key posture as the
 // feasible fallback), with and without eliminate_points, on one thread; checks that both solve

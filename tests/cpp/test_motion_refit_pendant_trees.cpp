@@ -18,22 +18,11 @@ namespace {
 
 // Root 0; points 1, 2, 3 in a loop of lengths with the root (0-1, 0-2, 1-3, 2-3), so none of them
 // hangs; the chain 4-5-6 hangs from 3, and 7 is a leaf on 1 (a one-point tree: closed form).
-struct ChainFigure {
-  std::vector<double> key = {0, 0, 0,  -0.5, 1, 0,  0.5, 1, 0.1,  0, 2, 0,  0.2, 3, 0,  0.1, 4, 0.3,
-                             0.4, 5, 0.2,  -1.2, 1.3, 0};
-  std::vector<int32_t> pairs = {0, 1, 0, 2, 1, 3, 2, 3, 3, 4, 4, 5, 5, 6, 1, 7};
-  std::vector<double> key_lengths = pair_lengths(key, pairs);
-  animlod::MotionRefitProblem problem;
-
-  ChainFigure() {
-    problem.point_count = 8;
-    problem.length_pairs = pairs.data();
-    problem.key_lengths = key_lengths.data();
-    problem.length_pair_count = key_lengths.size();
-    problem.length_scale = 5.0;
-  }
-
-  std::vector<double> perturbed(unsigned seed, double scale) const { return perturbed_positions(key, seed, scale); }
+struct ChainFigure : LengthFigure {
+  ChainFigure()
+      : LengthFigure({0, 0, 0,  -0.5, 1, 0,  0.5, 1, 0.1,  0, 2, 0,  0.2, 3, 0,  0.1, 4, 0.3,  0.4, 5, 0.2,
+                      -1.2, 1.3, 0},
+                     {0, 1, 0, 2, 1, 3, 2, 3, 3, 4, 4, 5, 5, 6, 1, 7}, 5.0) {}
 };
 
 }  // namespace

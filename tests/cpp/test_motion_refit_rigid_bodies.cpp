@@ -22,20 +22,11 @@ namespace {
 // Root 0 with children 1, 2 (a triangle: body A); 1 with children 3, 4 (body B, its base a
 // member of A); a chain 5-6 hanging from 3 (a pendant tree); a leaf 7 on 4; point 8 tied to 2
 // and 4, so it stays a variable and its lengths stay equalities.
-struct BodyChain {
-  std::vector<double> key = {0, 0, 0,  -0.4, 1, 0,  0.5, 0.9, 0.2,  -0.8, 2, 0.1,  0, 2.1, -0.3,
-                             -1.0, 3, 0.2,  -1.1, 4, 0,  0.3, 3, -0.5,  0.6, 2.0, 0.4};
-  std::vector<int32_t> pairs = {1, 0, 2, 0, 2, 1, 3, 1, 4, 1, 4, 3, 5, 3, 6, 5, 7, 4, 8, 2, 8, 4};
-  std::vector<double> key_lengths = pair_lengths(key, pairs);
-  animlod::MotionRefitProblem problem;
-
-  BodyChain() {
-    problem.point_count = 9;
-    problem.length_pairs = pairs.data();
-    problem.key_lengths = key_lengths.data();
-    problem.length_pair_count = key_lengths.size();
-    problem.length_scale = 4.0;
-  }
+struct BodyChain : LengthFigure {
+  BodyChain()
+      : LengthFigure({0, 0, 0,  -0.4, 1, 0,  0.5, 0.9, 0.2,  -0.8, 2, 0.1,  0, 2.1, -0.3,  -1.0, 3, 0.2,
+                      -1.1, 4, 0,  0.3, 3, -0.5,  0.6, 2.0, 0.4},
+                     {1, 0, 2, 0, 2, 1, 3, 1, 4, 1, 4, 3, 5, 3, 6, 5, 7, 4, 8, 2, 8, 4}, 4.0) {}
 };
 
 }  // namespace
@@ -72,7 +63,7 @@ TEST_CASE("rigid bodies: lengths hold at any rotation and E's gradient through t
   // Variables: 8, then A's and B's rotation vectors (5, 6 a tree, 7 a leaf, 1-4 members).
   REQUIRE(reduction.reduced_points() == 3);
   CHECK(reduction.kept_equality_count() == 2);  // 8-2 and 8-4
-  const std::vector<double> original = perturbed_positions(f.key, 1, 0.3);
+  const std::vector<double> original = f.perturbed(1, 0.3);
   const std::vector<double> start = f.key;
   reduction.set_start(start.data(), original.data());
   std::vector<double> y(9);

@@ -269,6 +269,22 @@ def test_character_chain_combines_geometry_and_motion_levels(data_dir, tmp_path)
     assert len(grid) == 3 and all(len(row) == 3 for row in grid)
 
 
+def test_character_keeps_the_motion_whole_where_no_joint_can_freeze(data_dir, tmp_path):
+    # SimpleSkin's two joints coincide: joint positions cannot show its rotations, so nothing
+    # freezes; the geometry levels are still written, each with the input's motion.
+    from animlod.io import read_lod_chains
+    from animlod.pipelines.character import build_character
+
+    output = tmp_path / "character.glb"
+    report = build_character(data_dir / "gltf" / "SimpleSkin.gltf", output, [0.5], **QUICK)
+    assert any("1 motion level(s) for 2 geometry levels" in note and "every bone of zero length" in note
+               for note in report.notes)  # fmt: skip
+    (levels,) = report.chains.values()
+    assert [level.faces for level in levels] == [8, 4] and levels[0].joints == levels[1].joints == 2
+    (chain,) = read_lod_chains(output)
+    assert [level.motion_level for level in chain.levels] == [0, 0]
+
+
 def test_character_refuses_a_file_without_a_skinned_animation(data_dir, tmp_path, capsys):
     assert main(["character", str(data_dir / "gltf" / "LeePerrySmith.glb"), "-o", str(tmp_path / "x.glb")]) == 2
     assert "no skinned mesh with an animation" in capsys.readouterr().err

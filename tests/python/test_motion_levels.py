@@ -171,14 +171,18 @@ def test_cli_a_clip_whose_every_joint_translates_writes_one_level(tmp_path, caps
     assert sorted(p.name for p in out.iterdir()) == ["clip_lod0.bvh", "clip_motion_lod.json"]
 
 
-def test_cli_skeleton_errors_name_the_file(tmp_path, capsys) -> None:
+def test_cli_a_skeleton_of_zero_length_bones_writes_one_level(tmp_path, capsys) -> None:
+    # Every joint on the root in every frame: positions show no rotation, Eqs. 1-3 are undefined
+    # and nothing freezes (the input's motion is the one level).
     skeleton = Skeleton(["root", "a"], [-1, 0], [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
     local = rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.linspace(0, 1, 4)[:, None] * [0.0, 1.0])
     source = _write(tmp_path, Motion(skeleton, np.zeros((4, 3)), local, 30.0))
-    assert main(["motion", str(source), "-o", str(tmp_path / "out")]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err == f"animlod motion: error: {source}: skeleton: every bone has zero length, so posture error (Eq. 1) " \
-        "is undefined"
+    out = tmp_path / "out"
+    assert main(["motion", str(source), "-o", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "nothing can freeze (2 joints, all kept: root, every bone of zero length (joint positions show no " \
+        "rotation))" in captured.err
+    assert sorted(p.name for p in out.iterdir()) == ["clip_lod0.bvh", "clip_motion_lod.json"]
 
 
 def test_cli_summary_says_why_the_floor_is_above_the_paper(tmp_path, capsys) -> None:

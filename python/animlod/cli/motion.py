@@ -184,7 +184,8 @@ def _print_summary(chain, floor) -> None:
     for index, level in enumerate(chain.levels):
         r = level.report
         cells = (
-            index, r.joint_count, f"{r.mean_error:.4g}", f"{r.max_error:.4g}", f"{100 * r.max_error / size:.2f}%",
+            index, r.joint_count, f"{r.mean_error:.4g}", f"{r.max_error:.4g}",
+            f"{100 * r.max_error / size:.2f}%" if size > 0.0 else "-",
             f"{r.bone_error:.3g}", f"{100 * r.bone_variation:.3f}%", f"{r.fk_residual:.2g}", len(r.failures),
             f"{r.seconds:.1f}",
         )  # fmt: skip

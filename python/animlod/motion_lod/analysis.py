@@ -60,7 +60,7 @@ class MotionAnalysis:
         joints (refit_choice.py; the chain's analysis holds the chosen order).
     locked : joint indices the caller locked (never frozen).
     frames : (n,) int64 frames the analysis used (all frames unless subsampled).
-    r_max : the normaliser of Eq. 1, in the asset's units.
+    r_max : the normaliser of Eq. 1, in the asset's units; 0 where every bone has zero length.
     translating : joint indices whose translation moves (see translating_joints), never frozen.
     ranking : the name of the ranking that ordered ``priority`` (ranking.RANKINGS).
     """
@@ -203,16 +203,14 @@ def _angle_table(units: np.ndarray) -> np.ndarray:
 
 
 def _r_max(motion: Motion) -> float:
-    """Summed mean length of the root's child bones (Eq. 1's normaliser), longest bone if zero."""
+    """Summed mean length of the root's child bones (Eq. 1's normaliser), longest bone if zero;
+    0 when every bone has zero length."""
     lengths = np.linalg.norm(motion.local_translations()[:, 1:], axis=-1).mean(axis=0)
     root_children = motion.skeleton.parents[1:] == 0
     total = float(lengths[root_children].sum())
     if total > 0.0:
         return total
-    longest = float(lengths.max()) if lengths.size else 0.0
-    if longest <= 0.0:
-        raise ValueError("skeleton: every bone has zero length, so posture error (Eq. 1) is undefined")
-    return longest
+    return float(lengths.max()) if lengths.size else 0.0
 
 
 def analyze_motion(
@@ -236,7 +234,9 @@ def analyze_motion(
 
     Returns
     -------
-    MotionAnalysis
+    MotionAnalysis; where every bone has zero length (every joint sits on the root in every
+    frame), joint positions show no rotation, so Eqs. 1-3 are undefined: r_max 0, importance 0
+    and no joint in ``priority`` (nothing freezes).
     """
     skeleton = motion.skeleton
     if ranking not in RANKINGS:
@@ -255,13 +255,17 @@ def analyze_motion(
     else:
         frames = np.arange(motion.frame_count, dtype=np.int64)
     r_max = _r_max(motion)
-    sums = posture_error_row_sums(motion, frames, r_max, look_through=ranking != PAPER_RANKING)
-    best = np.argmin(sums, axis=1)  # Eq. 2 (first minimum on ties)
-    key_frames = frames[best]
-    importance = sums[np.arange(skeleton.joint_count), best] / frames.size  # Eq. 3
-
     translating = translating_joints(motion, translation_tolerance)
     candidates = np.ones(skeleton.joint_count, bool)
+    if r_max > 0.0:
+        sums = posture_error_row_sums(motion, frames, r_max, look_through=ranking != PAPER_RANKING)
+        best = np.argmin(sums, axis=1)  # Eq. 2 (first minimum on ties)
+        key_frames = frames[best]
+        importance = sums[np.arange(skeleton.joint_count), best] / frames.size  # Eq. 3
+    else:  # every joint on the root in every frame: positions show no rotation, nothing freezes
+        key_frames = np.full(skeleton.joint_count, frames[0])
+        importance = np.zeros(skeleton.joint_count)
+        candidates[:] = False
     candidates[0] = False
     candidates[skeleton.end_sites] = False
     candidates[locked_indices] = False

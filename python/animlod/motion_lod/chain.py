@@ -88,12 +88,14 @@ class MotionLodChain:
 @dataclass(frozen=True)
 class JointFloor:
     """The fewest joints a level can keep, and why: the root, locked and translating joints
-    stay (names in skeleton order; a locked joint that also translates is listed once, as locked)."""
+    stay (names in skeleton order; a locked joint that also translates is listed once, as locked),
+    and every joint of a skeleton whose bones all have zero length (``zero_length``)."""
 
     total: int
     fewest: int
     locked: list[str]
     translating: list[str]
+    zero_length: bool = False
 
     @property
     def possible_levels(self) -> int:
@@ -112,6 +114,8 @@ class JointFloor:
             if names:
                 shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
                 parts.append(f"{len(names)} {label} ({shown})")
+        if self.zero_length:
+            parts.append("every bone of zero length (joint positions show no rotation)")
         return ", ".join(parts)
 
 
@@ -126,6 +130,7 @@ def joint_floor(motion: Motion, analysis: MotionAnalysis) -> JointFloor:
         fewest=total - len(analysis.priority),
         locked=[names[j] for j in locked],
         translating=[names[j] for j in translating],
+        zero_length=analysis.r_max == 0.0,
     )
 
 

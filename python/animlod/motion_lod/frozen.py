@@ -62,11 +62,11 @@ class FrozenLevel:
         return int(np.count_nonzero(self.kept & ~self.skeleton.end_sites))
 
     def length_scale(self) -> float:
-        """Diagonal of the key posture's bounding box, the objective's length unit."""
+        """Diagonal of the key posture's bounding box, the objective's length unit; 1 where every
+        point coincides (every bone of zero length: analyze_motion freezes nothing then, so the
+        only level is the input's, with nothing to re-fit)."""
         extent = float(np.linalg.norm(np.ptp(self.key_positions, axis=0)))
-        if extent <= 0.0:
-            raise ValueError("skeleton: all points coincide in the key posture, there is nothing to re-fit")
-        return extent
+        return extent if extent > 0.0 else 1.0
 
 
 def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | np.ndarray) -> FrozenLevel:

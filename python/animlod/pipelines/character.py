@@ -41,7 +41,7 @@ from ..io.gltf_lod import (
 from ..io.gltf_write import add_animation, add_skeleton, add_skin
 from ..metrics import surface_error
 from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
-from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain
+from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
@@ -123,11 +123,17 @@ def build_character(
         joined, spans = _joined_motion([clip.motion for clip in clips])
         analysis = analyze_motion(joined)
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
-        levels = min(levels_wanted, len(analysis.priority) + 1)
+        floor = joint_floor(joined, analysis)
+        levels = min(levels_wanted, floor.possible_levels)
         covering = [other for other in motion_chains if joints_of[skin] < joints_of[other]]
         if covering:
             levels = 1
             notes.append(f"skin {skin}: its joints belong to skin {covering[0]}; it keeps them at every level")
+        elif levels < levels_wanted:
+            notes.append(
+                f"skin {skin}: {levels} motion level(s) for {levels_wanted} geometry levels ({floor.total} joints, "
+                f"at least {floor.fewest} kept: {floor.explain()})"
+            )
         say(f"skin {skin}: {levels} motion levels over {len(clips)} clips")
         chain = build_motion_chain(joined, levels=levels, solver=solver, workers=workers, analysis=analysis)
         motion_chains[skin] = (chain, list(zip(clips, spans)))

@@ -179,7 +179,8 @@ def posture_error_row_sums(
             continue  # one direction in every frame: theta = 0 exactly
         theta = _angle_table(u)  # theta_jc(t_ref, t), rows t_ref
         r = lengths[:, bone]
-        per_bone[bone] = 0.5 * (r * theta.sum(axis=1) + theta @ r)  # arcs: mean radius times angle
+        # Arcs: mean radius times angle (a row sum, not theta @ r: no BLAS, see _angle_table).
+        per_bone[bone] = 0.5 * (r * theta.sum(axis=1) + (theta * r).sum(axis=1))
     sums = np.zeros((motion.skeleton.joint_count, n))
     np.add.at(sums, owners, per_bone)  # sum over the children c of j (Eq. 1)
     return sums / (2.0 * np.pi * r_max)
@@ -188,11 +189,13 @@ def posture_error_row_sums(
 def _angle_table(units: np.ndarray) -> np.ndarray:
     """Angles ``(n, n)`` between every pair of the vectors ``units (n, 3)`` (unit or zero).
 
-    Kahan's form 2 atan2(|a - b|, |a + b|) with |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b from one
-    matrix product; where the angle is tiny that difference cancels, so those entries take
-    |a - b| directly (exact 0 for identical directions).
+    Kahan's form 2 atan2(|a - b|, |a + b|) with |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b from the
+    table of dot products; where the angle is tiny that difference cancels, so those entries take
+    |a - b| directly (exact 0 for identical directions). The dot products are three outer
+    products, not a matrix product: BLAS would run them on its threads, which then spin and take
+    the cores from the re-fit that follows (about half of the analysis's CPU on 131_01).
     """
-    dots = units @ units.T
+    dots = sum(np.multiply.outer(units[:, k], units[:, k]) for k in range(3))
     squares = np.sum(units * units, axis=-1)
     base = squares[:, None] + squares[None, :]
     minus = np.maximum(base - 2.0 * dots, 0.0)

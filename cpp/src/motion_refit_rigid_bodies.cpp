@@ -103,17 +103,11 @@ RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<ui
         break;
       }
     }
-    if (set.size() < 2) {
-      for (int32_t c : set) in_set[c] = 0;
-      continue;
-    }
+    if (set.size() < 2) continue;
     std::vector<size_t> held;
     for (size_t r = 0; r < rows.points.size(); ++r)
       if (inside(r, stamp)) held.push_back(r);
-    if (held.size() != 3 * set.size() - 3) {  // not a minimal rigid set: leave it to SLSQP
-      for (int32_t c : set) in_set[c] = 0;
-      continue;
-    }
+    if (held.size() != 3 * set.size() - 3) continue;  // not a minimal rigid set: leave it to SLSQP
     const auto body = static_cast<int32_t>(bases_.size());
     bases_.push_back(static_cast<int32_t>(base));
     std::sort(set.begin(), set.end());

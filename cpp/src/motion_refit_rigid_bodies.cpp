@@ -159,19 +159,23 @@ void RigidBodies::make_rigid() {
   const size_t p = problem_.point_count;
   const size_t m = inner_equalities_.size();
   values_.resize(m);
+  auto held = [&] {  // every body's rows within tolerance (or not finite: left to the solve's check)
+    double worst = 0.0;
+    for (size_t r : held_rows_) worst = std::max(worst, std::abs(values_[r]));
+    return !(worst > kRigidTolerance);
+  };
+  refit_equalities_frame(problem_, shape_.data(), values_.data(), nullptr);
+  if (held()) return;  // a feasible start, the usual case
   std::vector<int32_t> columns;  // the members' coordinates
   for (size_t k = 0; k < p; ++k)
     if (body_of_[k] >= 0)
       for (int a = 0; a < 3; ++a) columns.push_back(static_cast<int32_t>(3 * k + a));
   const auto rows = static_cast<Eigen::Index>(held_rows_.size());
   const auto cols = static_cast<Eigen::Index>(columns.size());
+  jacobian_.resize(m * 3 * p);
   for (int iteration = 0; iteration < kRigidIterations; ++iteration) {
-    refit_equalities_frame(problem_, shape_.data(), values_.data(), nullptr);
-    double worst = 0.0;
-    for (size_t r : held_rows_) worst = std::max(worst, std::abs(values_[r]));
-    if (!(worst > kRigidTolerance)) return;  // held (or not finite: left to the solve's check)
-    jacobian_.resize(m * 3 * p);
     refit_equalities_frame(problem_, shape_.data(), values_.data(), jacobian_.data());
+    if (held()) return;
     Eigen::MatrixXd j(rows, cols);
     Eigen::VectorXd residual(rows);
     for (Eigen::Index r = 0; r < rows; ++r) {

@@ -12,7 +12,6 @@
 namespace animlod::bindings {
 
 namespace {
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 LatticeBox box_from(const DoubleArray& box) {
   require_shape(box, "box", {4, 3}, "(4, 3): origin, then the S, T, U edge vectors");

@@ -14,7 +14,6 @@ namespace animlod::bindings {
 
 namespace {
 
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 // A MotionRefitProblem that owns its arrays (the core's struct is a view of them).
 struct ProblemHolder {

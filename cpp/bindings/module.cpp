@@ -14,6 +14,7 @@ void bind_tdag(py::module_& m);
 void bind_lod_selector(py::module_& m);
 void bind_pose(py::module_& m);
 void bind_point_mesh_distance(py::module_& m);
+void bind_posture_error(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -28,4 +29,5 @@ PYBIND11_MODULE(_core, m) {
   animlod::bindings::bind_lod_selector(m);
   animlod::bindings::bind_pose(m);
   animlod::bindings::bind_point_mesh_distance(m);
+  animlod::bindings::bind_posture_error(m);
 }

@@ -7,7 +7,7 @@ import pytest
 from test_motion_figures import chain_motion, figure_motion
 
 from animlod.motion_lod import analyze_motion
-from animlod.motion_lod.analysis import posture_error_row_sums
+from animlod.motion_lod.analysis import child_bones, posture_error_row_sums
 
 
 def test_eq1_to_eq3_on_a_three_joint_chain() -> None:
@@ -24,6 +24,29 @@ def test_eq1_to_eq3_on_a_three_joint_chain() -> None:
     assert analysis.importance[2] == 0.0  # B never rotates
     assert analysis.importance[3] == 0.0  # an end site
     assert analysis.priority == [2, 1]  # lowest first; never the root or an end site
+
+
+def _numpy_row_sums(motion, frames, r_max, look_through):
+    """Eq. 1's row sums from full (n, n) angle tables (Kahan's form on every pair), per bone."""
+    owners, vectors = child_bones(motion, frames, look_through)
+    lengths = np.linalg.norm(vectors, axis=-1)
+    units = np.divide(vectors, lengths[..., None], out=np.zeros_like(vectors), where=lengths[..., None] > 0.0)
+    a, b = units[:, None], units[None, :]  # (n, 1, B, 3), (1, n, B, 3)
+    theta = 2.0 * np.arctan2(np.linalg.norm(a - b, axis=-1), np.linalg.norm(a + b, axis=-1))  # (n, n, B)
+    arcs = 0.5 * (lengths[:, None] + lengths[None, :]) * theta
+    sums = np.zeros((motion.skeleton.joint_count, frames.size))
+    np.add.at(sums, owners, arcs.sum(axis=1).T)
+    return sums / (2.0 * np.pi * r_max)
+
+
+@pytest.mark.parametrize("look_through", [False, True])
+def test_core_row_sums_match_full_angle_tables(look_through: bool) -> None:
+    motion = figure_motion(frames=30)
+    frames = np.arange(30)
+    expected = _numpy_row_sums(motion, frames, 0.7, look_through)
+    for workers in (1, 2):
+        got = posture_error_row_sums(motion, frames, 0.7, look_through, workers)
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-15 * expected.max())
 
 
 def test_a_still_joint_has_zero_importance_however_its_ancestors_move() -> None:

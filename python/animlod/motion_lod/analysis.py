@@ -25,7 +25,7 @@ Conventions this implementation fixes where the paper is silent:
 - End sites carry no rotation: they give leaf joints a direction, have importance 0 and are never
   in the priority list (they are not joints of a level). A leaf joint *without* an end site has
   no bone to measure, so its importance is 0 and it is eliminated first.
-- Long clips: the n x n table is held one bone at a time; only its row sums are kept.
+- Long clips: the n x n table is never stored; the core sums each bone's rows (posture_error.hpp).
   Above ``max_frames`` frames, Eqs. 1-3 run on ``max_frames`` evenly spaced frames: key frames
   are then chosen among those frames and eps_j becomes the same mean over a uniform subsample
   (a Riemann sum of the full-rate mean), which changes it by at most the motion between two
@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import rotations
+from .. import _core, rotations
 from ..model import Motion, spread_frames
 from .ranking import DEFAULT_RANKING, PAPER_RANKING, RANKINGS, elimination_order, rank_scores
 
@@ -151,58 +151,22 @@ def child_bones(
     return np.array(owners, dtype=np.int64), np.stack(vectors, axis=1)
 
 
-def _angles_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Angles between vectors ``a (..., 3)`` and ``b (..., 3)`` (0 where either has zero length).
-
-    Kahan's form 2 atan2(|a'-b'|, |a'+b'|) on unit vectors: exact 0 for identical directions,
-    accurate near 0 and pi, where arccos of a dot product is not.
-    """
-    return 2.0 * np.arctan2(np.linalg.norm(a - b, axis=-1), np.linalg.norm(a + b, axis=-1))
-
-
 def posture_error_row_sums(
-    motion: Motion, frames: np.ndarray, r_max: float, look_through: bool = False
+    motion: Motion, frames: np.ndarray, r_max: float, look_through: bool = False, workers: int = 0
 ) -> np.ndarray:
     """Row sums ``S[j, a] = sum_b E_j(frames[a], frames[b])`` of Eq. 1's table, ``(J, n)``.
 
-    One bone's (n, n) table of angles is held at a time.
+    The arcs of every bone are summed in the core (posture_error.hpp: each pair of frames once,
+    no table stored, bones shared by ``workers`` threads, 0 for every core).
     ``look_through``: measure zero-length bones through the points below them (child_bones).
     """
     owners, vectors = child_bones(motion, frames, look_through)
     lengths = np.linalg.norm(vectors, axis=-1)  # r_jc(t), (n, B)
     units = np.divide(vectors, lengths[..., None], out=np.zeros_like(vectors), where=lengths[..., None] > 0.0)
-    n, bone_count = lengths.shape
-    per_bone = np.zeros((bone_count, n))
-    for bone in range(bone_count):  # O(B) Python steps, each an (n, n) table
-        u = units[:, bone]
-        if not np.any(np.ptp(u, axis=0)):
-            continue  # one direction in every frame: theta = 0 exactly
-        theta = _angle_table(u)  # theta_jc(t_ref, t), rows t_ref
-        r = lengths[:, bone]
-        # Arcs: mean radius times angle (a row sum, not theta @ r: no BLAS, see _angle_table).
-        per_bone[bone] = 0.5 * (r * theta.sum(axis=1) + (theta * r).sum(axis=1))
-    sums = np.zeros((motion.skeleton.joint_count, n))
+    per_bone = _core.posture_error_row_sums(units, lengths, workers)  # (B, n) arcs, mean radius x angle
+    sums = np.zeros((motion.skeleton.joint_count, frames.size))
     np.add.at(sums, owners, per_bone)  # sum over the children c of j (Eq. 1)
     return sums / (2.0 * np.pi * r_max)
-
-
-def _angle_table(units: np.ndarray) -> np.ndarray:
-    """Angles ``(n, n)`` between every pair of the vectors ``units (n, 3)`` (unit or zero).
-
-    Kahan's form 2 atan2(|a - b|, |a + b|) with |a -+ b|^2 = |a|^2 + |b|^2 -+ 2 a.b from the
-    table of dot products; where the angle is tiny that difference cancels, so those entries take
-    |a - b| directly (exact 0 for identical directions). The dot products are three outer
-    products, not a matrix product: BLAS would run them on its threads, which then spin and take
-    the cores from the re-fit that follows (about half of the analysis's CPU on 131_01).
-    """
-    dots = sum(np.multiply.outer(units[:, k], units[:, k]) for k in range(3))
-    squares = np.sum(units * units, axis=-1)
-    base = squares[:, None] + squares[None, :]
-    minus = np.maximum(base - 2.0 * dots, 0.0)
-    theta = 2.0 * np.arctan2(np.sqrt(minus), np.sqrt(np.maximum(base + 2.0 * dots, 0.0)))
-    close = np.nonzero(minus < 1e-8)
-    theta[close] = _angles_between(units[close[0]], units[close[1]])
-    return theta
 
 
 def _r_max(motion: Motion) -> float:
@@ -222,6 +186,7 @@ def analyze_motion(
     max_frames: int = 600,
     translation_tolerance: float = TRANSLATION_TOLERANCE,
     ranking: str = DEFAULT_RANKING,
+    workers: int = 0,
 ) -> MotionAnalysis:
     """Key frames, joint importance and elimination priority of a motion (Eqs. 1-3).
 
@@ -234,6 +199,7 @@ def analyze_motion(
     translation_tolerance : a joint whose translation range exceeds this fraction of its bone
         length translates and is never frozen (translating_joints).
     ranking : how joints are ordered for elimination, one of ranking.RANKINGS.
+    workers : threads of Eq. 1's table (0: every core); the result does not depend on it.
 
     Returns
     -------
@@ -261,7 +227,7 @@ def analyze_motion(
     translating = translating_joints(motion, translation_tolerance)
     candidates = np.ones(skeleton.joint_count, bool)
     if r_max > 0.0:
-        sums = posture_error_row_sums(motion, frames, r_max, look_through=ranking != PAPER_RANKING)
+        sums = posture_error_row_sums(motion, frames, r_max, ranking != PAPER_RANKING, workers)
         best = np.argmin(sums, axis=1)  # Eq. 2 (first minimum on ties)
         key_frames = frames[best]
         importance = sums[np.arange(skeleton.joint_count), best] / frames.size  # Eq. 3

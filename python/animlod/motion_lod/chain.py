@@ -355,8 +355,8 @@ def build_motion_chain(
         the penalty objective, vectorised over frames; no hard constraints).
     slsqp_options : SLSQP stopping rules and the hard-constraint option (default: hard bone
         lengths for the SLSQP solvers, penalties for Newton).
-    workers : threads of the core's solve (0: every core), or processes of the Python solvers
-        (0 or 1: this process).
+    workers : threads of the core's solve and of the motion analysis (0: every core), or
+        processes of the Python solvers (0 or 1: this process).
     skin : the character's skin on ``motion.skeleton`` (same joint names), or None.
     max_frames : frames motion analysis uses at most (analysis.py).
     on_level : called with (level index, joint count) before each level; may return a progress
@@ -374,7 +374,9 @@ def build_motion_chain(
     """
     if skin is not None and skin.skeleton.names != motion.skeleton.names:
         raise ValueError("skin: its skeleton's joint names differ from the motion's")
-    analysis = analysis or analyze_motion(motion, locked=locked, max_frames=max_frames, ranking=ranking)
+    analysis = analysis or analyze_motion(
+        motion, locked=locked, max_frames=max_frames, ranking=ranking, workers=workers
+    )
     counts = level_joint_counts(motion, analysis, levels)
     if analysis.ranking == "refit":
         slsqp_options = _resolve_solver(solver, slsqp_options)

@@ -106,6 +106,25 @@ py::array_t<float> forward_kinematics_py(const py::object& parent_indices, const
   return out;
 }
 
+py::array_t<double> clip_forward_kinematics_py(const py::object& parent_indices, const DoubleArray& translations,
+                                               const DoubleArray& rotations) {
+  const IndexArray parents = index_array(as_array(parent_indices, "parents"), "parents");
+  require_shape(parents, "parents", {-1}, "(J,)");
+  const py::ssize_t joints = parents.shape(0);
+  require_shape(translations, "translations", {-1, joints, 3}, "(T, J, 3)");
+  const py::ssize_t frames = translations.shape(0);
+  require_shape(rotations, "rotations", {frames, joints, 4}, "(T, J, 4) like translations");
+  py::array_t<double> out({frames, joints, py::ssize_t{4}, py::ssize_t{4}});
+  Status status;
+  {
+    py::gil_scoped_release release;
+    status = clip_forward_kinematics(parents.data(), static_cast<size_t>(joints), translations.data(),
+                                     rotations.data(), static_cast<size_t>(frames), out.mutable_data());
+  }
+  raise_if_error(status);
+  return out;
+}
+
 py::array_t<float> skin_palette_py(const FloatArray& world, const FloatArray& inverse_bind,
                                    const std::optional<py::object>& joint_node_indices) {
   require_shape(world, "world", {-1, -1, 4, 4}, "(T, J, 4, 4)");
@@ -176,6 +195,23 @@ Returns
 -------
 (T, J, 4, 4) float32 in numpy's layout (acting on column vectors), a new array. ValueError
 naming the joint (and the frame) on a bad parent or a zero-length rotation.)doc");
+
+  m.def("clip_forward_kinematics", &clip_forward_kinematics_py, py::arg("parents"), py::arg("translations"),
+        py::arg("rotations"),
+        R"doc(World transforms of every joint in every frame, in double precision (motion processing).
+
+world[t, j] = world[t, parents[j]] @ T(translation) @ R(rotation).
+
+Parameters
+----------
+parents : (J,) int32 or int64, -1 or a joint before j (topological order).
+translations : (T, J, 3) float64 local translations (the root's is its world position).
+rotations : (T, J, 4) float64 unit local rotations (x, y, z, w), used as given.
+
+Returns
+-------
+(T, J, 4, 4) float64 in numpy's layout (acting on column vectors), a new array. ValueError
+naming the joint on a bad parent, or the frame and the joint on a non-finite value.)doc");
 
   m.def("skin_palette", &skin_palette_py, py::arg("world"), py::arg("inverse_bind"), py::arg("joint_nodes") = py::none(),
         R"doc(Skinning palette world[joint_nodes[s]] @ inverse_bind[s] for every frame.

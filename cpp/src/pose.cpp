@@ -218,6 +218,37 @@ Status forward_kinematics(const int32_t* parents, const LocalPose& pose, float* 
   return Status::success();
 }
 
+Status clip_forward_kinematics(const int32_t* parents, size_t joint_count, const double* translations,
+                               const double* rotations, size_t frame_count, double* out_world) {
+  Status status = validate_parents(parents, joint_count);
+  if (!status) return status;
+  for (size_t f = 0; f < frame_count; ++f)
+    for (size_t j = 0; j < joint_count; ++j) {
+      const size_t k = f * joint_count + j;
+      const double *t = translations + 3 * k, *q = rotations + 4 * k;
+      double* world = out_world + 16 * k;
+      if (!std::isfinite(t[0] + t[1] + t[2]) || !std::isfinite(q[0] + q[1] + q[2] + q[3]))
+        return Status::error("frame " + std::to_string(f) + ", joint " + std::to_string(j) +
+                             ": non-finite translation or rotation");
+      const double x = q[0], y = q[1], z = q[2], w = q[3];
+      const double local[12] = {1 - 2 * (y * y + z * z), 2 * (x * y - z * w),     2 * (x * z + y * w),     t[0],
+                                2 * (x * y + z * w),     1 - 2 * (x * x + z * z), 2 * (y * z - x * w),     t[1],
+                                2 * (x * z - y * w),     2 * (y * z + x * w),     1 - 2 * (x * x + y * y), t[2]};
+      if (parents[j] < 0) {
+        std::copy(local, local + 12, world);
+      } else {  // the parent's rows times the local matrix (whose last row is 0 0 0 1)
+        const double* parent = out_world + 16 * (f * joint_count + static_cast<size_t>(parents[j]));
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 4; ++c)
+            world[4 * r + c] = parent[4 * r] * local[c] + parent[4 * r + 1] * local[4 + c] +
+                               parent[4 * r + 2] * local[8 + c] + (c == 3 ? parent[4 * r + 3] : 0.0);
+      }
+      world[12] = world[13] = world[14] = 0.0;
+      world[15] = 1.0;
+    }
+  return Status::success();
+}
+
 void skin_palette(const float* world, const int32_t* joint_nodes, const float* inverse_bind, size_t skin_joint_count,
                   float* out_palette) {
   for (size_t s = 0; s < skin_joint_count; ++s) {

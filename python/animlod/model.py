@@ -254,17 +254,9 @@ class Motion:
         )
 
     def world_transforms(self) -> np.ndarray:
-        """Forward kinematics: world transforms ``(T, J, 4, 4)`` of every joint.
-
-        One numpy step per joint (O(J) Python work, vectorised over frames).
-        """
-        skeleton = self.skeleton
-        local = rotations.compose_transform(self.local_translations(), self.local_rotations)
-        world = np.empty_like(local)
-        world[:, 0] = local[:, 0]
-        for joint in range(1, skeleton.joint_count):
-            world[:, joint] = world[:, skeleton.parents[joint]] @ local[:, joint]
-        return world
+        """Forward kinematics: world transforms ``(T, J, 4, 4)`` of every joint (float64, in the
+        core: pose.hpp's clip_forward_kinematics)."""
+        return _core.clip_forward_kinematics(self.skeleton.parents, self.local_translations(), self.local_rotations)
 
     def world_positions(self) -> np.ndarray:
         """World positions ``(T, J, 3)`` of every joint."""

@@ -167,6 +167,36 @@ TEST_CASE("forward_kinematics and skin_palette on a bent two-bone arm") {
   CHECK(status.message.find("joint 1") != std::string::npos);
 }
 
+TEST_CASE("clip_forward_kinematics chains double transforms frame by frame") {
+  // Frame 0: joint 0 at (0, 1, 0) turned 90 degrees about z, joint 1 one unit along its x, joint
+  // 2 two units further; frame 1: no turn.
+  const std::vector<int32_t> parents = {-1, 0, 1};
+  const double half = std::sqrt(0.5);
+  const std::vector<double> translations = {0, 1, 0, 1, 0, 0, 2, 0, 0, 0, 1, 0, 1, 0, 0, 2, 0, 0};
+  std::vector<double> rotations(2 * 3 * 4, 0.0);
+  for (int k = 0; k < 6; ++k) rotations[4 * k + 3] = 1.0;
+  rotations[2] = rotations[3] = half;  // frame 0, joint 0: 90 degrees about z
+  std::vector<double> world(2 * 3 * 16);
+  REQUIRE(animlod::clip_forward_kinematics(parents.data(), 3, translations.data(), rotations.data(), 2,
+                                           world.data()).ok);
+  // Row-major: the translation is the last column. Frame 0, joint 2: (0, 1, 0) + R(90) (3, 0, 0).
+  CHECK(world[32 + 3] == doctest::Approx(0.0).epsilon(1e-15));
+  CHECK(world[32 + 7] == doctest::Approx(4.0).epsilon(1e-15));
+  CHECK(world[32 + 1] == doctest::Approx(-1.0).epsilon(1e-15));  // x turned onto y: R[0][1] = -1
+  CHECK(world[48 + 32 + 3] == doctest::Approx(3.0).epsilon(1e-15));  // frame 1, joint 2: (3, 1, 0)
+  CHECK(world[48 + 32 + 7] == doctest::Approx(1.0).epsilon(1e-15));
+  CHECK(world[48 + 32 + 15] == 1.0);
+
+  rotations[4 * 4 + 1] = NAN;  // frame 1, joint 1
+  const animlod::Status status =
+      animlod::clip_forward_kinematics(parents.data(), 3, translations.data(), rotations.data(), 2, world.data());
+  CHECK_FALSE(status.ok);
+  CHECK(status.message.find("frame 1, joint 1") != std::string::npos);
+  const std::vector<int32_t> bad = {-1, 2, 0};
+  CHECK_FALSE(animlod::clip_forward_kinematics(bad.data(), 3, translations.data(), rotations.data(), 2,
+                                               world.data()).ok);
+}
+
 TEST_CASE("sample_clip writes only the animated joints and properties") {
   const std::vector<float> times = {0.0f, 1.0f};
   const std::vector<float> moves = {0, 0, 0, 4, 0, 0};

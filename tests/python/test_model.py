@@ -39,6 +39,15 @@ def test_world_transforms_are_rigid():
     np.testing.assert_allclose(rot @ np.swapaxes(rot, -1, -2), np.broadcast_to(np.eye(3), rot.shape), atol=1e-12)
 
 
+def test_world_transforms_match_numpy_products():
+    motion = _bend(np.linspace(0, 1, 5))
+    local = rotations.compose_transform(motion.local_translations(), motion.local_rotations)
+    expected = local.copy()
+    for joint in range(1, motion.skeleton.joint_count):
+        expected[:, joint] = expected[:, motion.skeleton.parents[joint]] @ local[:, joint]
+    np.testing.assert_allclose(motion.world_transforms(), expected, rtol=0, atol=1e-14)
+
+
 def _numpy_lbs(rest, joints, weights, matrices):
     homogeneous = np.concatenate([rest, np.ones((len(rest), 1))], axis=1)
     per_influence = np.einsum("tvkij,vj->tvki", matrices[:, joints], homogeneous)

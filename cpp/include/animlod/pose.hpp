@@ -90,6 +90,16 @@ Status validate_parents(const int32_t* parents, size_t joint_count);
 // (naming the joint); out_world is then left partially written.
 Status forward_kinematics(const int32_t* parents, const LocalPose& pose, float* out_world);
 
+// Forward kinematics of T frames in double precision, for motion processing (motion LoD's
+// re-fit resolves 1e-13 of a figure, float 1e-7): world (T, J, 4, 4) row-major, acting on
+// column vectors (numpy's layout), world[t, j] = world[t, parents[j]] * T(translation) *
+// R(rotation) from translations (T, J, 3) and unit quaternions (x, y, z, w) (T, J, 4), used as
+// given (a caller's rotations are already unit). Errors: the checks of validate_parents, a
+// non-finite translation or rotation (naming the frame and the joint); out_world is then left
+// partially written.
+Status clip_forward_kinematics(const int32_t* parents, size_t joint_count, const double* translations,
+                               const double* rotations, size_t frame_count, double* out_world);
+
 // The skinning palette for S skin joints: out[s] = world[joint_nodes[s]] * inverse_bind[s]
 // (column-major (S, 16) each). joint_nodes (S,) maps a skin joint to the posed node it follows
 // (a glTF skin's joints may be a subset of a larger node tree); null means s -> s. The indices

@@ -17,11 +17,11 @@ import numpy as np
 from ..model import Motion, SkinnedMesh
 from ..options import MotionRefitOptions
 from .analysis import MotionAnalysis, analyze_motion
-from .core_refit import refit_core
+from .core_refit import core_energy, refit_core
 from .frozen import FrozenLevel, freeze, frozen_motion
 from .grouped_solve import FrameFailure, RefitResult
 from .newton import refit_newton
-from .objective import RefitProblem, Weights, build_problem, objective
+from .objective import RefitProblem, Weights, build_problem
 from .ranking import DEFAULT_RANKING
 from .refit import refit_slsqp
 from .refit_choice import choose_by_refit
@@ -184,7 +184,7 @@ def _cold_starts(
     motion and the original projected onto the level's rigid skeleton (its joints turned to aim
     at the original positions, frozen joints at their key rotations), the one with the lower E."""
     projected = expand_motion(level, recover_motion(level, original, motion), motion).world_positions()
-    lower = objective(problem, projected, original)[0] < objective(problem, fallback, original)[0]
+    lower = core_energy(problem, projected, original) < core_energy(problem, fallback, original)
     return np.where(lower[:, None, None], projected, fallback)
 
 

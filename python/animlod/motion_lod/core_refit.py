@@ -40,6 +40,11 @@ def core_problem(problem: RefitProblem) -> _core.MotionRefitProblem:
     )
 
 
+def core_energy(problem: RefitProblem, x: np.ndarray, original: np.ndarray) -> np.ndarray:
+    """E (Eq. 5) per frame of positions ``x`` against ``original`` (both (T, P, 3)), in the core."""
+    return _core.motion_refit_objective(core_problem(problem), x, original)[0]
+
+
 def refit_core(
     problem: RefitProblem,
     original: np.ndarray,

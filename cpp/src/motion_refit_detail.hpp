@@ -3,6 +3,7 @@
 // over all 3P coordinates (root included, then zeroed by the callers that need it).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -30,6 +31,18 @@ inline void set_points_of(const int32_t* rows, size_t count, size_t width, uint8
 // E (Eq. 5) of one frame; adds nothing to the root's gradient. gradient: (P, 3) or nullptr.
 double refit_objective_frame(const MotionRefitProblem& problem, const double* x, const double* original,
                              double* gradient);
+
+// The equality rows of refit_equalities_frame, in order: one per held length, three (x, y, z)
+// per coincident pair, one per flat quad; each with the points it reads.
+struct EqualityRow {
+  std::array<int32_t, 4> points;
+  int width;  // 2 or 4
+};
+std::vector<EqualityRow> equality_rows(const MotionRefitProblem& problem);
+// The first of coincident pair k's three rows.
+inline size_t first_coincident_row(const MotionRefitProblem& problem, size_t k) {
+  return problem.length_pair_count + 3 * k;
+}
 
 // Equality values (m,) and, when jacobian is not nullptr, their derivatives (m, P, 3).
 void refit_equalities_frame(const MotionRefitProblem& problem, const double* x, double* values,

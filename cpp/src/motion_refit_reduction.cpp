@@ -79,7 +79,7 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
     UnionFind tied(p);  // a set's root is its lowest index
     for (size_t k = 0; k < problem.coincident_pair_count; ++k) {
       tied.unite(problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1]);
-      std::fill_n(kept_equalities_.begin() + static_cast<long>(pairs + 3 * k), 3, uint8_t{0});
+      std::fill_n(kept_equalities_.begin() + static_cast<long>(first_coincident_row(problem, k)), 3, uint8_t{0});
     }
     for (size_t k = 0; k < p; ++k) substitute_[k] = tied.find(static_cast<int32_t>(k));
   }

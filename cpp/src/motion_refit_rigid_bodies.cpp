@@ -26,31 +26,6 @@ std::array<double, 9> cross_matrix(const double* w) {
   return {0.0, -w[2], w[1], w[2], 0.0, -w[0], -w[1], w[0], 0.0};
 }
 
-// The points of every equality row (motion_refit_equalities order) and how many there are.
-struct EqualityRows {
-  std::vector<std::array<int32_t, 4>> points;
-  std::vector<int> width;
-};
-
-EqualityRows equality_rows(const MotionRefitProblem& problem) {
-  EqualityRows rows;
-  for (size_t k = 0; k < problem.length_pair_count; ++k) {
-    rows.points.push_back({problem.length_pairs[2 * k], problem.length_pairs[2 * k + 1], 0, 0});
-    rows.width.push_back(2);
-  }
-  for (size_t k = 0; k < problem.coincident_pair_count; ++k)
-    for (int axis = 0; axis < 3; ++axis) {
-      rows.points.push_back({problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1], 0, 0});
-      rows.width.push_back(2);
-    }
-  for (size_t k = 0; k < problem.flat_quad_count; ++k) {
-    const int32_t* q = problem.flat_quads + 4 * k;
-    rows.points.push_back({q[0], q[1], q[2], q[3]});
-    rows.width.push_back(4);
-  }
-  return rows;
-}
-
 }  // namespace
 
 RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<uint8_t>& excluded, bool enabled)
@@ -62,7 +37,7 @@ RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<ui
       jacobians_(problem.point_count) {
   if (!enabled) return;
   const size_t p = problem.point_count;
-  const EqualityRows rows = equality_rows(problem);
+  const std::vector<EqualityRow> rows = equality_rows(problem);
   std::vector<std::vector<int32_t>> children(p);  // child sides of each point's held lengths
   for (size_t k = 0; k < problem.length_pair_count; ++k)
     children[problem.length_pairs[2 * k + 1]].push_back(problem.length_pairs[2 * k]);
@@ -70,13 +45,13 @@ RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<ui
   std::vector<int32_t> in_set(p, 0);  // stamp: 1 + the candidate's base
   // 1 when every point of row r is in the candidate set.
   auto inside = [&](size_t r, int32_t stamp) {
-    for (int c = 0; c < rows.width[r]; ++c)
-      if (in_set[rows.points[r][c]] != stamp) return false;
+    for (int c = 0; c < rows[r].width; ++c)
+      if (in_set[rows[r].points[c]] != stamp) return false;
     return true;
   };
   std::vector<std::vector<size_t>> rows_of(p);  // equality rows touching each point
-  for (size_t r = 0; r < rows.points.size(); ++r)
-    for (int c = 0; c < rows.width[r]; ++c) rows_of[rows.points[r][c]].push_back(r);
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (int c = 0; c < rows[r].width; ++c) rows_of[rows[r].points[c]].push_back(r);
 
   for (size_t base = 0; base < p; ++base) {
     if (excluded[base] || children[base].size() < 2) continue;
@@ -92,8 +67,8 @@ RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<ui
         const int32_t c = set[i];
         const bool tied = std::any_of(rows_of[c].begin(), rows_of[c].end(), [&](size_t r) {
           if (!inside(r, stamp)) return false;
-          for (int k = 0; k < rows.width[r]; ++k)
-            if (rows.points[r][k] != c && rows.points[r][k] != static_cast<int32_t>(base)) return true;
+          for (int k = 0; k < rows[r].width; ++k)
+            if (rows[r].points[k] != c && rows[r].points[k] != static_cast<int32_t>(base)) return true;
           return false;
         });
         if (tied) continue;
@@ -105,7 +80,7 @@ RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<ui
     }
     if (set.size() < 2) continue;
     std::vector<size_t> held;
-    for (size_t r = 0; r < rows.points.size(); ++r)
+    for (size_t r = 0; r < rows.size(); ++r)
       if (inside(r, stamp)) held.push_back(r);
     if (held.size() != 3 * set.size() - 3) continue;  // not a minimal rigid set: leave it to SLSQP
     const auto body = static_cast<int32_t>(bases_.size());

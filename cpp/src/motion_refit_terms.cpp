@@ -234,6 +234,21 @@ double refit_objective_frame(const MotionRefitProblem& problem, const double* x,
   return value;
 }
 
+std::vector<EqualityRow> equality_rows(const MotionRefitProblem& problem) {
+  std::vector<EqualityRow> rows;
+  rows.reserve(motion_refit_equality_count(problem));
+  for (size_t k = 0; k < problem.length_pair_count; ++k)
+    rows.push_back({{problem.length_pairs[2 * k], problem.length_pairs[2 * k + 1], 0, 0}, 2});
+  for (size_t k = 0; k < problem.coincident_pair_count; ++k)
+    for (int axis = 0; axis < 3; ++axis)
+      rows.push_back({{problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1], 0, 0}, 2});
+  for (size_t k = 0; k < problem.flat_quad_count; ++k) {
+    const int32_t* q = problem.flat_quads + 4 * k;
+    rows.push_back({{q[0], q[1], q[2], q[3]}, 4});
+  }
+  return rows;
+}
+
 void refit_equalities_frame(const MotionRefitProblem& problem, const double* x, double* values, double* jacobian) {
   const size_t p = problem.point_count;
   const double inverse = 1.0 / problem.length_scale;

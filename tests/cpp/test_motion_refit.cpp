@@ -16,6 +16,25 @@ using animlod::MotionRefitOptions;
 using animlod::MotionRefitProblem;
 using animlod::MotionRefitResult;
 
+namespace {
+// equality_rows describes refit_equalities_frame's rows: each row's Jacobian (rows of (P, 3) at
+// x) is zero outside the points equality_rows gives it.
+void check_rows_read_their_points(const MotionRefitProblem& problem, const std::vector<double>& jacobian) {
+  const std::vector<animlod::detail::EqualityRow> rows = animlod::detail::equality_rows(problem);
+  REQUIRE(rows.size() == animlod::motion_refit_equality_count(problem));
+  const size_t p = problem.point_count;
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (size_t k = 0; k < p; ++k) {
+      const bool read = std::find(rows[r].points.begin(), rows[r].points.begin() + rows[r].width,
+                                  static_cast<int32_t>(k)) != rows[r].points.begin() + rows[r].width;
+      double largest = 0.0;
+      for (int a = 0; a < 3; ++a) largest = std::max(largest, std::abs(jacobian[r * 3 * p + 3 * k + a]));
+      if (!read) CHECK(largest == 0.0);
+      else if (k != 0) CHECK(largest > 0.0);
+    }
+}
+}  // namespace
+
 TEST_CASE("motion refit: E's gradient and Hessian match finite differences") {
   const Figure f;
   const std::vector<double> original = f.perturbed(1, 0.05);
@@ -82,6 +101,7 @@ TEST_CASE("motion refit: constraint Jacobians match finite differences") {
     CHECK(handed_jacobian[i] == doctest::Approx((handed_plus[0] - handed_minus[0]) / (2 * h)).scale(1.0));
   }
   for (size_t r = 0; r < m; ++r) CHECK(jacobian[r * 3 * p + 1] == 0.0);  // the root is not a variable
+  check_rows_read_their_points(f.problem, jacobian);
   // At the key posture every equality holds and the handed group is on its side.
   REQUIRE(animlod::motion_refit_equalities(f.problem, f.key.data(), 1, values.data(), nullptr));
   for (double v : values) CHECK(std::abs(v) < 1e-12);
@@ -208,6 +228,7 @@ TEST_CASE("motion refit: a flat group is held by its child's height over the bas
     for (size_t r = 0; r < m; ++r)
       CHECK(jacobian[r * 3 * p + i] == doctest::Approx((plus_values[r] - minus_values[r]) / (2 * h)).scale(1.0));
   }
+  check_rows_read_their_points(problem, jacobian);
   // A hard solve pulled out of the plane by the original positions keeps the group's shape.
   std::vector<double> original = lifted;
   original[3 * 2 + 2] -= 0.02;

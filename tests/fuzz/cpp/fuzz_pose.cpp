@@ -19,7 +19,9 @@
 //   u8  skin joints  S = 1 + value % J; S joint nodes (value % J); S * 16 inverse bind entries
 // Invariants: an error has a message; sampling a valid clip at any time (NaN included) writes
 // only the joints it targets, and a rotation it writes is a unit quaternion; forward kinematics
-// of a pose without scales, in int16 mode, is finite.
+// of a pose without scales, in int16 mode, is finite. The sampled poses (rotations normalised)
+// as one clip through clip_forward_kinematics: refused exactly when a parent is invalid or a
+// value is not finite; else last rows (0, 0, 0, 1), finite in int16 mode.
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -113,6 +115,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!clip_status) ANIMLOD_FUZZ_REQUIRE(!clip_status.message.empty());
 
   std::vector<float> world(16 * joint_count), palette(16 * skin_count);
+  // The sampled poses as a clip in double, rotations normalised as Motion does, for
+  // clip_forward_kinematics: every sample time a frame.
+  std::vector<double> clip_t, clip_r;
   for (float time : sample_times) {
     std::vector<float> t = rest_t, r = rest_r, s = rest_s;
     const animlod::LocalPose pose{t.data(), r.data(), with_scales ? s.data() : nullptr, joint_count};
@@ -125,6 +130,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (!targeted[j])
           for (int k = 0; k < 4; ++k)
             ANIMLOD_FUZZ_REQUIRE(std::memcmp(&r[4 * j + k], &rest_r[4 * j + k], sizeof(float)) == 0);
+    }
+    clip_t.insert(clip_t.end(), t.begin(), t.end());
+    for (size_t j = 0; j < joint_count; ++j) {
+      const float* q = &r[4 * j];
+      const double length = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
+      for (int k = 0; k < 4; ++k) clip_r.push_back(length > 0.0 ? q[k] / length : q[k]);
     }
     const animlod::Status status = animlod::forward_kinematics(parents.data(), pose, world.data());
     if (!status) {
@@ -139,6 +150,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         for (float value : world) ANIMLOD_FUZZ_REQUIRE(std::isfinite(value));
     }
     animlod::skin_palette(world.data(), joint_nodes.data(), inverse_bind.data(), skin_count, palette.data());
+  }
+  std::vector<double> clip_world(16 * clip_r.size() / 4);
+  const animlod::Status clip_fk = animlod::clip_forward_kinematics(parents.data(), joint_count, clip_t.data(),
+                                                                   clip_r.data(), sample_times.size(), clip_world.data());
+  bool valid = animlod::validate_parents(parents.data(), joint_count).ok;
+  for (double value : clip_t) valid = valid && std::isfinite(value);
+  for (double value : clip_r) valid = valid && std::isfinite(value);
+  ANIMLOD_FUZZ_REQUIRE(clip_fk.ok == valid);
+  if (!clip_fk) ANIMLOD_FUZZ_REQUIRE(!clip_fk.message.empty());
+  // Last rows (0, 0, 0, 1); unit rotations and translations of at most 512 (int16 mode): finite.
+  for (size_t i = 0; clip_fk && i < clip_world.size(); ++i) {
+    if (!raw) ANIMLOD_FUZZ_REQUIRE(std::isfinite(clip_world[i]));
+    if (i % 16 >= 12) ANIMLOD_FUZZ_REQUIRE(clip_world[i] == (i % 16 == 15 ? 1.0 : 0.0));
   }
   return 0;
 }

@@ -71,14 +71,20 @@ py::array as_array(const py::object& values, const char* name) {
   return array;
 }
 
+// The parents (J,) of T poses, checked with their translations (T, J, 3) and rotations (T, J, 4).
+template <typename Array>
+IndexArray pose_parents(const py::object& parent_indices, const Array& translations, const Array& rotations) {
+  IndexArray parents = index_array(as_array(parent_indices, "parents"), "parents");
+  require_shape(parents, "parents", {-1}, "(J,)");
+  require_shape(translations, "translations", {-1, parents.shape(0), 3}, "(T, J, 3)");
+  require_shape(rotations, "rotations", {translations.shape(0), parents.shape(0), 4}, "(T, J, 4) like translations");
+  return parents;
+}
+
 py::array_t<float> forward_kinematics_py(const py::object& parent_indices, const FloatArray& translations,
                                          const FloatArray& rotations, const std::optional<FloatArray>& scales) {
-  const IndexArray parents = index_array(as_array(parent_indices, "parents"), "parents");
-  require_shape(parents, "parents", {-1}, "(J,)");
-  const py::ssize_t joints = parents.shape(0);
-  require_shape(translations, "translations", {-1, joints, 3}, "(T, J, 3)");
-  const py::ssize_t frames = translations.shape(0);
-  require_shape(rotations, "rotations", {frames, joints, 4}, "(T, J, 4) like translations");
+  const IndexArray parents = pose_parents(parent_indices, translations, rotations);
+  const py::ssize_t joints = parents.shape(0), frames = translations.shape(0);
   if (scales) require_shape(*scales, "scales", {frames, joints, 3}, "(T, J, 3) like translations");
   raise_if_error(validate_parents(parents.data(), static_cast<size_t>(joints)));
 
@@ -108,12 +114,8 @@ py::array_t<float> forward_kinematics_py(const py::object& parent_indices, const
 
 py::array_t<double> clip_forward_kinematics_py(const py::object& parent_indices, const DoubleArray& translations,
                                                const DoubleArray& rotations) {
-  const IndexArray parents = index_array(as_array(parent_indices, "parents"), "parents");
-  require_shape(parents, "parents", {-1}, "(J,)");
-  const py::ssize_t joints = parents.shape(0);
-  require_shape(translations, "translations", {-1, joints, 3}, "(T, J, 3)");
-  const py::ssize_t frames = translations.shape(0);
-  require_shape(rotations, "rotations", {frames, joints, 4}, "(T, J, 4) like translations");
+  const IndexArray parents = pose_parents(parent_indices, translations, rotations);
+  const py::ssize_t joints = parents.shape(0), frames = translations.shape(0);
   py::array_t<double> out({frames, joints, py::ssize_t{4}, py::ssize_t{4}});
   Status status;
   {

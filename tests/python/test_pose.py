@@ -121,3 +121,11 @@ def test_bad_pose_input_names_the_element() -> None:
         _core.sample_keyframes([0.0, 1.0], np.zeros((2, 3)), "CUBICSPLINE", [0.2])
     with pytest.raises(ValueError, match="joint_nodes"):
         _core.skin_palette(np.zeros((1, 2, 4, 4)), np.zeros((1, 4, 4)), [5])
+    unit = np.tile([0, 0, 0, 1.0], (2, 2, 1))
+    with pytest.raises(ValueError, match="joint 1 has parent 1"):
+        _core.clip_forward_kinematics([-1, 1], np.zeros((2, 2, 3)), unit)
+    with pytest.raises(ValueError, match=r"rotations: expected shape \(T, J, 4\)"):
+        _core.clip_forward_kinematics([-1, 0], np.zeros((2, 2, 3)), unit[:1])
+    unit[1, 0, 2] = np.nan
+    with pytest.raises(ValueError, match="frame 1, joint 0: non-finite"):
+        _core.clip_forward_kinematics([-1, 0], np.zeros((2, 2, 3)), unit)

@@ -92,6 +92,8 @@ def test_bad_input_is_refused_with_a_reason() -> None:
         analyze_motion(chain_motion([0.0, 1.0]), locked=["Elbow"])
     with pytest.raises(ValueError, match="end site"):
         analyze_motion(chain_motion([0.0, 1.0]), locked=["B_End"])
+    with pytest.raises(ValueError, match="workers: must be >= 0"):
+        analyze_motion(chain_motion([0.0, 1.0]), workers=-1)
 
 
 def test_real_clip_analysis(data_dir) -> None:

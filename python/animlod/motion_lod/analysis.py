@@ -214,6 +214,8 @@ def analyze_motion(
         raise ValueError(f"motion: needs at least 2 frames for motion analysis, got {motion.frame_count}")
     if max_frames < 2:
         raise ValueError(f"max_frames: must be at least 2, got {max_frames}")
+    if workers < 0:
+        raise ValueError(f"workers: must be >= 0 (0: every core), got {workers}")
     locked_indices = sorted({skeleton.index(name) for name in locked})
     end_site_locks = [skeleton.names[j] for j in locked_indices if skeleton.end_sites[j]]
     if end_site_locks:

@@ -121,7 +121,7 @@ def build_character(
             continue
         clips = [clip for clip in drawable.clips if clip.motion is not None]
         joined, spans = _joined_motion([clip.motion for clip in clips])
-        analysis = analyze_motion(joined)
+        analysis = analyze_motion(joined, workers=workers)
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
         floor = joint_floor(joined, analysis)
         levels = min(levels_wanted, floor.possible_levels)

@@ -77,7 +77,8 @@ def build_motion_levels(
     ranking : which joints freeze first (:data:`animlod.motion_lod.ranking.RANKINGS`).
     solver, penalty : the re-fit (``"slsqp"`` in the core, ``"slsqp-python"``, ``"newton"``);
         bone lengths are equality constraints with the SLSQP solvers unless ``penalty``.
-    workers : threads of the core's solve (0: every core), or processes of the Python solvers.
+    workers : threads of the motion analysis and the core's solve (0: every core), or processes of
+        the Python solvers.
     translation_tolerance : fraction of a bone's length above which a translating joint never freezes.
     weights : (alpha, beta, gamma) of the distance, string and angle errors (Eq. 5).
     max_frames : frames the motion analysis looks at, at most.
@@ -110,7 +111,9 @@ def build_motion_levels(
             on_note(text)
 
     motion, skin = _read_input(source, clip, note)
-    analysis, counts, floor = _plan_levels(motion, levels, joints, lock, max_frames, translation_tolerance, ranking)
+    analysis, counts, floor = _plan_levels(
+        motion, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
+    )
     if floor.possible_levels == 1:
         note(
             f"{os.fspath(source)}: nothing can freeze ({floor.total} joints, all kept: {floor.explain()}); "
@@ -193,6 +196,7 @@ def _plan_levels(
     max_frames: int,
     translation_tolerance: float,
     ranking: str,
+    workers: int,
 ) -> tuple[MotionAnalysis, list[int], JointFloor]:
     """The motion analysis, the joint counts of the levels and the joint floor (ValueError on a
     bad request)."""
@@ -200,7 +204,12 @@ def _plan_levels(
     from ..motion_lod.chain import joint_floor, level_joint_counts
 
     analysis = analyze_motion(
-        motion, locked=lock, max_frames=max_frames, translation_tolerance=translation_tolerance, ranking=ranking
+        motion,
+        locked=lock,
+        max_frames=max_frames,
+        translation_tolerance=translation_tolerance,
+        ranking=ranking,
+        workers=workers,
     )
     floor = joint_floor(motion, analysis)
     if joints:

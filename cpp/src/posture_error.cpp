@@ -29,24 +29,27 @@ double angle_between(const double* u, const double* v, double squared_u, double 
   return 2.0 * std::atan2(std::sqrt(difference), std::sqrt(sum));
 }
 
+// One bone's row (n,) of sums. The bone's directions, squared lengths and radii are first
+// gathered into `scratch` (5 n), so that the pair loop reads contiguous memory.
 void bone_row_sums(const double* directions, const double* radii, size_t n, size_t bone_count, size_t bone,
-                   std::vector<double>& units, std::vector<double>& squares, double* row) {
-  std::fill(row, row + n, 0.0);
+                   std::vector<double>& scratch, double* row) {
+  double* units = scratch.data();
+  double* squares = units + 3 * n;
+  double* r = squares + n;
   for (size_t a = 0; a < n; ++a) {
     const double* d = directions + 3 * (a * bone_count + bone);
-    std::copy(d, d + 3, units.begin() + 3 * a);
+    std::copy(d, d + 3, units + 3 * a);
     squares[a] = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    r[a] = radii[a * bone_count + bone];
   }
+  std::fill(row, row + n, 0.0);
   bool turns = false;
-  for (size_t a = 1; a < n && !turns; ++a)
-    turns = !std::equal(units.begin(), units.begin() + 3, units.begin() + 3 * a);
+  for (size_t a = 1; a < n && !turns; ++a) turns = !std::equal(units, units + 3, units + 3 * a);
   if (!turns) return;  // one direction in every frame: theta = 0
   for (size_t a = 0; a < n; ++a) {
-    const double ra = radii[a * bone_count + bone];
     double sum = 0.0;
     for (size_t b = a + 1; b < n; ++b) {
-      const double theta = angle_between(&units[3 * a], &units[3 * b], squares[a], squares[b]);
-      const double arc = 0.5 * (ra + radii[b * bone_count + bone]) * theta;
+      const double arc = 0.5 * (r[a] + r[b]) * angle_between(units + 3 * a, units + 3 * b, squares[a], squares[b]);
       sum += arc;
       row[b] += arc;
     }
@@ -68,9 +71,9 @@ Status posture_error_row_sums(const double* directions, const double* radii, siz
     }
   std::atomic<size_t> next{0};
   auto worker = [&]() {
-    std::vector<double> units(3 * frame_count), squares(frame_count);
+    std::vector<double> scratch(5 * frame_count);
     for (size_t bone = next++; bone < bone_count; bone = next++)
-      bone_row_sums(directions, radii, frame_count, bone_count, bone, units, squares, out + bone * frame_count);
+      bone_row_sums(directions, radii, frame_count, bone_count, bone, scratch, out + bone * frame_count);
   };
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   threads = static_cast<unsigned>(std::min<size_t>(threads, std::max<size_t>(bone_count, 1)));

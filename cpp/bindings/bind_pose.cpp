@@ -127,6 +127,16 @@ py::array_t<double> clip_forward_kinematics_py(const py::object& parent_indices,
   return out;
 }
 
+py::array_t<double> quaternions_from_matrices_py(const DoubleArray& matrices) {
+  require_shape(matrices, "matrices", {-1, 3, 3}, "(N, 3, 3)");
+  py::array_t<double> out({matrices.shape(0), py::ssize_t{4}});
+  {
+    py::gil_scoped_release release;
+    quaternions_from_matrices(matrices.data(), static_cast<size_t>(matrices.shape(0)), out.mutable_data());
+  }
+  return out;
+}
+
 py::array_t<float> skin_palette_py(const FloatArray& world, const FloatArray& inverse_bind,
                                    const std::optional<py::object>& joint_node_indices) {
   require_shape(world, "world", {-1, -1, 4, 4}, "(T, J, 4, 4)");
@@ -214,6 +224,17 @@ Returns
 -------
 (T, J, 4, 4) float64 in numpy's layout (acting on column vectors), a new array. ValueError
 naming the joint on a bad parent, or the frame and the joint on a non-finite value.)doc");
+
+  m.def("quaternions_from_matrices", &quaternions_from_matrices_py, py::arg("matrices"),
+        R"doc(Unit quaternions (x, y, z, w), w >= 0, of rotation matrices (Shepperd's method).
+
+Parameters
+----------
+matrices : (N, 3, 3) float64 rotation matrices acting on column vectors.
+
+Returns
+-------
+(N, 4) float64, a new array.)doc");
 
   m.def("skin_palette", &skin_palette_py, py::arg("world"), py::arg("inverse_bind"), py::arg("joint_nodes") = py::none(),
         R"doc(Skinning palette world[joint_nodes[s]] @ inverse_bind[s] for every frame.

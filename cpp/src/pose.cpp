@@ -249,6 +249,25 @@ Status clip_forward_kinematics(const int32_t* parents, size_t joint_count, const
   return Status::success();
 }
 
+void quaternions_from_matrices(const double* matrices, size_t count, double* out_quaternions) {
+  for (size_t i = 0; i < count; ++i) {
+    const double* m = matrices + 9 * i;
+    double* q = out_quaternions + 4 * i;
+    const double m00 = m[0], m11 = m[4], m22 = m[8];
+    const double candidates[4] = {1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22, 1 + m00 + m11 + m22};
+    int choice = 0;  // the first largest; the first NaN, as numpy's argmax
+    for (int k = 0; k < 4 && !std::isnan(candidates[choice]); ++k)
+      if (std::isnan(candidates[k]) || candidates[k] > candidates[choice]) choice = k;
+    const double s = std::sqrt(std::max(candidates[choice], 1e-300));
+    const double d21 = m[7] - m[5], d02 = m[2] - m[6], d10 = m[3] - m[1];
+    const double s01 = m[1] + m[3], s02 = m[2] + m[6], s12 = m[5] + m[7];
+    const double rows[4][4] = {{s * s, s01, s02, d21}, {s01, s * s, s12, d02}, {s02, s12, s * s, d10}, {d21, d02, d10, s * s}};
+    for (int k = 0; k < 4; ++k) q[k] = rows[choice][k] / (2.0 * s);
+    if (q[3] < 0.0)
+      for (int k = 0; k < 4; ++k) q[k] *= -1.0;
+  }
+}
+
 void skin_palette(const float* world, const int32_t* joint_nodes, const float* inverse_bind, size_t skin_joint_count,
                   float* out_palette) {
   for (size_t s = 0; s < skin_joint_count; ++s) {

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _core
+
 _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
 
@@ -89,30 +91,12 @@ def to_matrix(q: np.ndarray) -> np.ndarray:
 def from_matrix(m: np.ndarray) -> np.ndarray:
     """Unit quaternions ``(..., 4)`` with ``w >= 0`` from rotation matrices ``(..., 3, 3)``.
 
-    Shepperd's method: pick the largest of the four diagonal combinations for stability.
+    Shepperd's method (the largest of the four diagonal combinations sets the divisor, for
+    stability), in the core: pose.hpp's quaternions_from_matrices.
     """
     m = np.asarray(m, dtype=np.float64)
-    m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
-    candidates = np.stack(
-        [1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22, 1 + m00 + m11 + m22],
-        axis=-1,
-    )
-    choice = np.argmax(candidates, axis=-1)
-    s = np.sqrt(np.maximum(np.take_along_axis(candidates, choice[..., None], -1)[..., 0], 1e-300))
-    q = np.empty(m.shape[:-2] + (4,))
-    d21, d02, d10 = m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]
-    s01, s02, s12 = m[..., 0, 1] + m[..., 1, 0], m[..., 0, 2] + m[..., 2, 0], m[..., 1, 2] + m[..., 2, 1]
-    rows = [
-        np.stack([s * s, s01, s02, d21], -1),
-        np.stack([s01, s * s, s12, d02], -1),
-        np.stack([s02, s12, s * s, d10], -1),
-        np.stack([d21, d02, d10, s * s], -1),
-    ]
-    for k in range(4):
-        mask = choice == k
-        q[mask] = rows[k][mask] / (2.0 * s[mask, None])
-    q *= np.where(q[..., 3:4] < 0.0, -1.0, 1.0)
-    return q
+    flat = _core.quaternions_from_matrices(m.reshape(-1, 3, 3))
+    return flat.reshape(m.shape[:-2] + (4,))
 
 
 def from_axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:

@@ -197,6 +197,26 @@ TEST_CASE("clip_forward_kinematics chains double transforms frame by frame") {
                                                world.data()).ok);
 }
 
+TEST_CASE("quaternions_from_matrices inverts clip_forward_kinematics' rotations, w >= 0") {
+  // Four turns, each making a different diagonal combination the largest (Shepperd's choice).
+  const double h = std::sqrt(0.5);
+  const std::vector<double> quaternions = {0, 0, 0, 1, 1, 0, 0, 0, 0, h, 0, -h, 0.5, -0.5, 0.5, 0.5};
+  const std::vector<int32_t> parents = {-1, -1, -1, -1};
+  const std::vector<double> translations(12, 0.0);
+  std::vector<double> world(4 * 16), rotations_3x3(4 * 9), back(4 * 4);
+  REQUIRE(animlod::clip_forward_kinematics(parents.data(), 4, translations.data(), quaternions.data(), 1,
+                                           world.data()).ok);
+  for (int j = 0; j < 4; ++j)
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) rotations_3x3[9 * j + 3 * r + c] = world[16 * j + 4 * r + c];
+  animlod::quaternions_from_matrices(rotations_3x3.data(), 4, back.data());
+  for (int j = 0; j < 4; ++j) {
+    const double sign = quaternions[4 * j + 3] < 0.0 ? -1.0 : 1.0;  // q and -q are one rotation
+    for (int k = 0; k < 4; ++k) CHECK(back[4 * j + k] == doctest::Approx(sign * quaternions[4 * j + k]).epsilon(1e-15));
+    CHECK(back[4 * j + 3] >= 0.0);
+  }
+}
+
 TEST_CASE("sample_clip writes only the animated joints and properties") {
   const std::vector<float> times = {0.0f, 1.0f};
   const std::vector<float> moves = {0, 0, 0, 4, 0, 0};

@@ -100,6 +100,11 @@ Status forward_kinematics(const int32_t* parents, const LocalPose& pose, float* 
 Status clip_forward_kinematics(const int32_t* parents, size_t joint_count, const double* translations,
                                const double* rotations, size_t frame_count, double* out_world);
 
+// Unit quaternions (x, y, z, w) with w >= 0 of `count` rotation matrices (3 x 3 row-major),
+// Shepperd's method: the largest of the four diagonal combinations sets the divisor. The same
+// operations as python/animlod/rotations.py's from_matrix did in numpy, element for element.
+void quaternions_from_matrices(const double* matrices, size_t count, double* out_quaternions);
+
 // The skinning palette for S skin joints: out[s] = world[joint_nodes[s]] * inverse_bind[s]
 // (column-major (S, 16) each). joint_nodes (S,) maps a skin joint to the posed node it follows
 // (a glTF skin's joints may be a subset of a larger node tree); null means s -> s. The indices

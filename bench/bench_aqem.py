@@ -31,7 +31,7 @@ fast-simplification from the ``bench`` extra). Tables:
 
 5. All frames against a replay: AQEM over every frame of a synthesized 24-frame sequence of
    about 17k triangles (and crane) against fast-simplification's frame-0 collapses replayed on
-   every frame (issue 8's second speed goal).
+   every frame (issue 8's second speed goal); best of 5 rounds, the methods taking turns.
 
 ``--tables quality,characters,speed,frames,allframes`` picks tables (default: all).
 """

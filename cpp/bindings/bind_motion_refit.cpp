@@ -14,7 +14,6 @@ namespace animlod::bindings {
 
 namespace {
 
-
 // A MotionRefitProblem that owns its arrays (the core's struct is a view of them).
 struct ProblemHolder {
   IndexArray length_pairs, coincident_pairs, handed_quads, angle_triples, flat_quads;

@@ -13,7 +13,6 @@
 #include <limits>
 #include <memory>
 #include <string>
-#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -24,6 +23,7 @@
 #include "animlod/motion_refit.hpp"
 #include "motion_refit_detail.hpp"
 #include "motion_refit_reduction.hpp"
+#include "worker_threads.hpp"
 
 namespace animlod {
 
@@ -404,16 +404,7 @@ Status motion_refit_solve(const MotionRefitProblem& problem, const double* origi
     }
   };
 
-  unsigned threads = options.threads > 0 ? static_cast<unsigned>(options.threads)
-                                         : std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<size_t>(threads, std::max<size_t>(chunk_count, 1)));
-  if (threads <= 1) {
-    worker();
-  } else {
-    std::vector<std::thread> pool;
-    for (unsigned i = 0; i < threads; ++i) pool.emplace_back(worker);
-    for (auto& thread : pool) thread.join();
-  }
+  detail::run_workers(static_cast<unsigned>(options.threads), chunk_count, worker);  // threads >= 0 (checked)
   if (out_of_memory) return Status::error("motion refit: nlopt could not allocate its SLSQP solver");
   for (auto& failures : chunk_failures)
     out.failures.insert(out.failures.end(), failures.begin(), failures.end());

@@ -6,8 +6,9 @@
 #include <atomic>
 #include <cmath>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "worker_threads.hpp"
 
 namespace animlod {
 
@@ -75,15 +76,7 @@ Status posture_error_row_sums(const double* directions, const double* radii, siz
     for (size_t bone = next++; bone < bone_count; bone = next++)
       bone_row_sums(directions, radii, frame_count, bone_count, bone, scratch, out + bone * frame_count);
   };
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<size_t>(threads, std::max<size_t>(bone_count, 1)));
-  if (threads <= 1) {
-    worker();
-    return Status::success();
-  }
-  std::vector<std::thread> pool;
-  for (unsigned i = 0; i < threads; ++i) pool.emplace_back(worker);
-  for (std::thread& thread : pool) thread.join();
+  detail::run_workers(threads, bone_count, worker);
   return Status::success();
 }
 

@@ -198,9 +198,11 @@ TEST_CASE("clip_forward_kinematics chains double transforms frame by frame") {
 }
 
 TEST_CASE("quaternions_from_matrices inverts clip_forward_kinematics' rotations, w >= 0") {
-  // Four turns, each making a different diagonal combination the largest (Shepperd's choice).
+  // Four turns, each making a different diagonal combination the largest (Shepperd's choice):
+  // none (w), a half turn about x (x), a quarter turn about -y (y ties w: the first), a half turn
+  // about z (z).
   const double h = std::sqrt(0.5);
-  const std::vector<double> quaternions = {0, 0, 0, 1, 1, 0, 0, 0, 0, h, 0, -h, 0.5, -0.5, 0.5, 0.5};
+  const std::vector<double> quaternions = {0, 0, 0, 1, 1, 0, 0, 0, 0, h, 0, -h, 0, 0, 1, 0};
   const std::vector<int32_t> parents = {-1, -1, -1, -1};
   const std::vector<double> translations(12, 0.0);
   std::vector<double> world(4 * 16), rotations_3x3(4 * 9), back(4 * 4);

@@ -157,7 +157,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
         frames_(frames),
         used_count_(frames.size()),
         vertex_weights_(std::move(weights)),
-        scratch_(kWorkers, Scratch{std::vector<Eigen::Vector3d>(used_count_), std::vector<uint8_t>(used_count_)}) {
+        scratch_(kWorkers, Scratch{std::vector<Eigen::Vector3d>(used_count_), std::vector<uint8_t>(used_count_), {}}) {
     accumulate_quadrics();
   }
 
@@ -185,6 +185,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
   struct Scratch {
     std::vector<Eigen::Vector3d> new_positions;  // (K,) placement in the quadrics' frames
     std::vector<uint8_t> singular;               // (K,) frames using the fallback
+    detail::MergedMinimizers minimizers;         // Eq. 5 in the quadrics' frames
   };
   static constexpr size_t kWorkers = 2;
   void evaluate_with(Candidate& candidate, Scratch& scratch) const;
@@ -314,15 +315,16 @@ void AqemPolicy::evaluate_with(Candidate& candidate, Scratch& scratch) const {
   constexpr double kFallbacks[3] = {0.0, 1.0, 0.5};  // kept, removed, midpoint along the edge
   double fallback_cost[3] = {0.0, 0.0, 0.0};
   double total = 0.0;
+  scratch.minimizers.solve(kept_quadrics, removed_quadrics, used_count_);
   for (size_t k = 0; k < used_count_; ++k) {
-    const size_t frame = static_cast<size_t>(frames_[k]);
-    const Quadric merged = kept_quadrics[k] + removed_quadrics[k];
-    Eigen::Vector3d& v = scratch.new_positions[k];
-    scratch.singular[k] = !merged.minimizer(v);
+    scratch.singular[k] = !scratch.minimizers.solved(k);
     if (!scratch.singular[k]) {
-      total += merged.evaluate(v);
+      scratch.new_positions[k] = scratch.minimizers.position(k);
+      total += scratch.minimizers.value(k);
       continue;
     }
+    const size_t frame = static_cast<size_t>(frames_[k]);
+    const Quadric merged = kept_quadrics[k] + removed_quadrics[k];
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame),
                           p_removed = engine_.position(candidate.removed, frame);
     for (int option = 0; option < 3; ++option)

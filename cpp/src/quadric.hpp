@@ -3,8 +3,11 @@
 // quadric of Eq. 4 is block-diagonal, so AQEM stores F of these per vertex, contiguously.
 #pragma once
 
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
 #include <Eigen/Core>
-#include <Eigen/LU>
 
 namespace animlod::detail {
 
@@ -55,21 +58,64 @@ struct Quadric {
     slope += ad.dot(p) - (b0 * d.x() + b1 * d.y() + b2 * d.z());
   }
 
-  // Eq. 5: the minimiser v = A^-1 b. Returns false when A is (nearly) singular, i.e. its
-  // determinant is tiny against the cube of its scale (flat or ridge-like neighbourhoods).
-  bool minimizer(Eigen::Vector3d& v) const {
-    Eigen::Matrix3d a;
-    a << a00, a01, a02, a01, a11, a12, a02, a12, a22;
-    const double scale = a00 + a11 + a22;
-    if (!(scale > 0.0)) return false;
-    Eigen::Matrix3d inverse;
-    double determinant = 0.0;
-    bool invertible = false;
-    a.computeInverseAndDetWithCheck(inverse, determinant, invertible, 1e-9 * scale * scale * scale);
-    if (!invertible) return false;
-    v = inverse * Eigen::Vector3d(b0, b1, b2);
-    return v.allFinite();
+};
+
+// Eq. 5 for the merged quadrics kept[k] + removed[k] of K frames at once: the minimiser
+// v = A^-1 b of each and Q(v) there. A frame is unsolved when A is (nearly) singular, i.e. its
+// determinant is tiny against the cube of its scale (flat or ridge-like neighbourhoods), or v
+// is not finite. The frames sit in arrays (one per coefficient) and the loop has no branch, so
+// the compiler works on several frames per instruction: every edge cost runs it, K frames deep.
+class MergedMinimizers {
+ public:
+  void solve(const Quadric* kept, const Quadric* removed, size_t frame_count) {
+    frame_count_ = frame_count;
+    if (columns_.size() < kColumns * frame_count) columns_.resize(kColumns * frame_count);
+    double* merged = columns_.data();
+    for (size_t k = 0; k < frame_count; ++k) {
+      const Quadric q = kept[k] + removed[k];
+      const double coefficients[10] = {q.a00, q.a01, q.a02, q.a11, q.a12, q.a22, q.b0, q.b1, q.b2, q.c};
+      for (size_t i = 0; i < 10; ++i) merged[i * frame_count + k] = coefficients[i];
+    }
+    minimise(frame_count, merged, merged + kX * frame_count, merged + kDeterminant * frame_count);
   }
+
+  bool solved(size_t k) const {
+    const double scale = column(kScale)[k], x = column(kX)[k], y = column(kY)[k], z = column(kZ)[k];
+    const bool finite = x - x == 0.0 && y - y == 0.0 && z - z == 0.0;  // not inf, not NaN
+    return scale > 0.0 && std::abs(column(kDeterminant)[k]) > 1e-9 * scale * scale * scale && finite;
+  }
+  Eigen::Vector3d position(size_t k) const { return {column(kX)[k], column(kY)[k], column(kZ)[k]}; }
+  double value(size_t k) const { return column(kValue)[k]; }
+
+ private:
+  // Columns of K: the merged quadrics' ten coefficients, then the results.
+  enum : size_t { kX = 10, kY, kZ, kValue, kDeterminant, kScale, kColumns };
+  const double* column(size_t i) const { return columns_.data() + i * frame_count_; }
+
+  // n frames: ten columns of coefficients in; x, y, z and Q out, and A's determinant and scale
+  // into `checks` (GCC 12 vectorised the loop with two output pointers, not with one).
+  static void minimise(size_t n, const double* __restrict in, double* __restrict out, double* __restrict checks) {
+    for (size_t k = 0; k < n; ++k) {
+      const double a00 = in[k], a01 = in[n + k], a02 = in[2 * n + k], a11 = in[3 * n + k], a12 = in[4 * n + k],
+                   a22 = in[5 * n + k], b0 = in[6 * n + k], b1 = in[7 * n + k], b2 = in[8 * n + k], c = in[9 * n + k];
+      // The adjugate over the determinant. The products and sums are those of Eigen's 3x3
+      // inverse and product, which this replaced, in the same order: levels stay bit for bit.
+      const double c0 = a11 * a22 - a12 * a12, c1 = a12 * a02 - a22 * a01, c2 = a01 * a12 - a02 * a11;
+      const double determinant = (c0 * a00 + c1 * a01) + c2 * a02;
+      const double inverse = 1.0 / determinant;
+      const double x = (c0 * inverse * b0 + c1 * inverse * b1) + c2 * inverse * b2;
+      const double y = ((a12 * a02 - a01 * a22) * inverse * b0 + (a22 * a00 - a02 * a02) * inverse * b1) +
+                       (a02 * a01 - a00 * a12) * inverse * b2;
+      const double z = (a01 * a12 - a11 * a02) * inverse * b0 +
+                       ((a02 * a01 - a12 * a00) * inverse * b1 + (a00 * a11 - a01 * a01) * inverse * b2);
+      out[k] = x, out[n + k] = y, out[2 * n + k] = z;
+      out[3 * n + k] = Quadric{a00, a01, a02, a11, a12, a22, b0, b1, b2, c}.evaluate(Eigen::Vector3d(x, y, z));
+      checks[k] = determinant, checks[n + k] = a00 + a11 + a22;
+    }
+  }
+
+  size_t frame_count_ = 0;
+  std::vector<double> columns_;  // (kColumns, K)
 };
 
 }  // namespace animlod::detail

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <utility>
@@ -115,29 +116,51 @@ TEST_CASE("collapse passes stop at max_error like the greedy order") {
   for (double error : result.collapses.error) CHECK(error <= bound);
 }
 
-TEST_CASE("the quadric's minimiser solves A v = b and refuses a singular A") {
+TEST_CASE("merged minimisers solve A v = b frame by frame and refuse a singular A") {
+  using animlod::detail::Quadric;
   std::mt19937 random(11);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  for (int trial = 0; trial < 200; ++trial) {
-    animlod::detail::Quadric quadric;
-    for (int plane = 0; plane < 4; ++plane) {  // four random planes: A is (almost surely) regular
-      const Eigen::Vector3d normal = Eigen::Vector3d(uniform(random), uniform(random), uniform(random)).normalized();
-      quadric += animlod::detail::Quadric::plane(normal, Eigen::Vector3d(uniform(random), uniform(random), 0.0), 1.0);
-    }
+  // Frames 0-199: two random planes in the kept quadric, two in the removed one (A is almost
+  // surely regular); 200: two planes meeting in a line (every point of it is a minimiser);
+  // 201: no plane at all; 202: a non-finite coefficient.
+  constexpr size_t kRandom = 200, kFrames = kRandom + 3;
+  std::vector<Quadric> kept(kFrames), removed(kFrames);
+  auto random_plane = [&]() {
+    const Eigen::Vector3d normal = Eigen::Vector3d(uniform(random), uniform(random), uniform(random)).normalized();
+    return Quadric::plane(normal, Eigen::Vector3d(uniform(random), uniform(random), 0.0), 1.0);
+  };
+  for (size_t k = 0; k < kRandom; ++k) {
+    kept[k] = random_plane() + random_plane();
+    removed[k] = random_plane() + random_plane();
+  }
+  kept[kRandom] = Quadric::plane(Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(), 1.0);
+  removed[kRandom] = Quadric::plane(Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero(), 1.0);
+  kept[kRandom + 2] = random_plane();
+  kept[kRandom + 2].b1 = std::numeric_limits<double>::infinity();
+  animlod::detail::MergedMinimizers minimizers;
+  minimizers.solve(kept.data(), removed.data(), kFrames);
+  size_t regular = 0;
+  for (size_t k = 0; k < kRandom; ++k) {
+    const Quadric q = kept[k] + removed[k];
     Eigen::Matrix3d a;
-    a << quadric.a00, quadric.a01, quadric.a02, quadric.a01, quadric.a11, quadric.a12, quadric.a02, quadric.a12,
-        quadric.a22;
-    const Eigen::Vector3d b(quadric.b0, quadric.b1, quadric.b2);
-    Eigen::Vector3d v;
+    a << q.a00, q.a01, q.a02, q.a01, q.a11, q.a12, q.a02, q.a12, q.a22;
+    const Eigen::Vector3d b(q.b0, q.b1, q.b2);
     if (std::abs(a.determinant()) <= 1e-6) continue;
-    REQUIRE(quadric.minimizer(v));
+    ++regular;
+    REQUIRE(minimizers.solved(k));
+    const Eigen::Vector3d v = minimizers.position(k);
     CHECK((a * v - b).norm() <= 1e-9 * (1.0 + b.norm()) * a.norm() / std::abs(a.determinant()));
     CHECK((v - a.lu().solve(b)).norm() <= 1e-8 * (1.0 + v.norm()));
+    CHECK(minimizers.value(k) == q.evaluate(v));
   }
-  // Two planes meet in a line: every point of it is a minimiser, so there is no unique one.
-  animlod::detail::Quadric ridge = animlod::detail::Quadric::plane(Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero(), 1.0);
-  ridge += animlod::detail::Quadric::plane(Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero(), 1.0);
-  Eigen::Vector3d v;
-  CHECK_FALSE(ridge.minimizer(v));
-  CHECK_FALSE(animlod::detail::Quadric{}.minimizer(v));
+  CHECK(regular > kRandom / 2);
+  CHECK_FALSE(minimizers.solved(kRandom));
+  CHECK_FALSE(minimizers.solved(kRandom + 1));
+  CHECK_FALSE(minimizers.solved(kRandom + 2));
+  // Fewer frames in the same object: the columns are laid out for the new count.
+  minimizers.solve(kept.data() + kRandom, removed.data() + kRandom, 2);
+  CHECK_FALSE(minimizers.solved(0));
+  minimizers.solve(kept.data() + kRandom - 1, removed.data() + kRandom - 1, 1);
+  CHECK(minimizers.solved(0));
+  CHECK(minimizers.value(0) == (kept[kRandom - 1] + removed[kRandom - 1]).evaluate(minimizers.position(0)));
 }

@@ -4,28 +4,52 @@
 
 namespace animlod::detail {
 
-bool face_keeps_orientation(const std::array<const float*, 3>& corners, int moved, const Eigen::Vector3d* placed,
-                            size_t frame_count, bool strict) {
+namespace {
+
+struct Vec3 {
+  double x, y, z;
+};
+
+Vec3 minus(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+// Eigen's cross and dot products term for term (and its order of sums): the same bits as the
+// Eigen code this replaced, with the moved corner known at compile time (kMoved).
+Vec3 cross(const Vec3& a, const Vec3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double dot(const Vec3& a, const Vec3& b) { return (a.x * b.x + a.y * b.y) + a.z * b.z; }
+
+template <int kMoved>
+bool keeps_orientation(const std::array<const float*, 3>& corners, const Eigen::Vector3d* placed, size_t frame_count,
+                       bool strict) {
   double agreement = 0.0;
   bool has_area = false;
   for (size_t frame = 0; frame < frame_count; ++frame) {
-    Eigen::Vector3d before[3], after[3];
+    Vec3 before[3], after[3];
     for (int c = 0; c < 3; ++c) {
       const float* p = corners[c] + 3 * frame;
-      before[c] = Eigen::Vector3d(p[0], p[1], p[2]);
-      after[c] = c == moved ? placed[frame] : before[c];
+      before[c] = after[c] = {p[0], p[1], p[2]};
     }
-    const Eigen::Vector3d n_before = (before[1] - before[0]).cross(before[2] - before[0]);
-    const Eigen::Vector3d n_after = (after[1] - after[0]).cross(after[2] - after[0]);
-    const double area_product = n_before.norm() * n_after.norm();
+    after[kMoved] = {placed[frame].x(), placed[frame].y(), placed[frame].z()};
+    const Vec3 n_before = cross(minus(before[1], before[0]), minus(before[2], before[0]));
+    const Vec3 n_after = cross(minus(after[1], after[0]), minus(after[2], after[0]));
+    const double area_product = std::sqrt(dot(n_before, n_before)) * std::sqrt(dot(n_after, n_after));
     if (area_product == 0.0) continue;
     has_area = true;
-    const double dot = n_before.dot(n_after);
-    if (strict && dot < 0.0) return false;
+    const double normals = dot(n_before, n_after);
+    if (strict && normals < 0.0) return false;
     // n . n' sqrt(A A') with n = N / |N| and A = |N| / 2.
-    agreement += dot / (2.0 * std::sqrt(area_product));
+    agreement += normals / (2.0 * std::sqrt(area_product));
   }
   return has_area && agreement >= 0.0;
+}
+
+}  // namespace
+
+bool face_keeps_orientation(const std::array<const float*, 3>& corners, int moved, const Eigen::Vector3d* placed,
+                            size_t frame_count, bool strict) {
+  switch (moved) {
+    case 0: return keeps_orientation<0>(corners, placed, frame_count, strict);
+    case 1: return keeps_orientation<1>(corners, placed, frame_count, strict);
+    default: return keeps_orientation<2>(corners, placed, frame_count, strict);
+  }
 }
 
 }  // namespace animlod::detail

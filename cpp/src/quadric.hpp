@@ -76,25 +76,21 @@ class MergedMinimizers {
       const double coefficients[10] = {q.a00, q.a01, q.a02, q.a11, q.a12, q.a22, q.b0, q.b1, q.b2, q.c};
       for (size_t i = 0; i < 10; ++i) merged[i * frame_count + k] = coefficients[i];
     }
-    minimise(frame_count, merged, merged + kX * frame_count, merged + kDeterminant * frame_count);
+    minimise(frame_count, merged, merged + kX * frame_count, merged + kSolved * frame_count);
   }
 
-  bool solved(size_t k) const {
-    const double scale = column(kScale)[k], x = column(kX)[k], y = column(kY)[k], z = column(kZ)[k];
-    const bool finite = x - x == 0.0 && y - y == 0.0 && z - z == 0.0;  // not inf, not NaN
-    return scale > 0.0 && std::abs(column(kDeterminant)[k]) > 1e-9 * scale * scale * scale && finite;
-  }
+  bool solved(size_t k) const { return column(kSolved)[k] != 0.0; }
   Eigen::Vector3d position(size_t k) const { return {column(kX)[k], column(kY)[k], column(kZ)[k]}; }
   double value(size_t k) const { return column(kValue)[k]; }
 
  private:
   // Columns of K: the merged quadrics' ten coefficients, then the results.
-  enum : size_t { kX = 10, kY, kZ, kValue, kDeterminant, kScale, kColumns };
+  enum : size_t { kX = 10, kY, kZ, kValue, kSolved, kColumns };
   const double* column(size_t i) const { return columns_.data() + i * frame_count_; }
 
-  // n frames: ten columns of coefficients in; x, y, z and Q out, and A's determinant and scale
-  // into `checks` (GCC 12 vectorised the loop with two output pointers, not with one).
-  static void minimise(size_t n, const double* __restrict in, double* __restrict out, double* __restrict checks) {
+  // n frames: ten columns of coefficients in; x, y, z and Q out, and 1 or 0 into `solved`
+  // (GCC 12 vectorised the loop with two output pointers, not with one).
+  static void minimise(size_t n, const double* __restrict in, double* __restrict out, double* __restrict solved) {
     for (size_t k = 0; k < n; ++k) {
       const double a00 = in[k], a01 = in[n + k], a02 = in[2 * n + k], a11 = in[3 * n + k], a12 = in[4 * n + k],
                    a22 = in[5 * n + k], b0 = in[6 * n + k], b1 = in[7 * n + k], b2 = in[8 * n + k], c = in[9 * n + k];
@@ -110,7 +106,11 @@ class MergedMinimizers {
                        ((a02 * a01 - a12 * a00) * inverse * b1 + (a00 * a11 - a01 * a01) * inverse * b2);
       out[k] = x, out[n + k] = y, out[2 * n + k] = z;
       out[3 * n + k] = Quadric{a00, a01, a02, a11, a12, a22, b0, b1, b2, c}.evaluate(Eigen::Vector3d(x, y, z));
-      checks[k] = determinant, checks[n + k] = a00 + a11 + a22;
+      // Selects, not && (a branch would stop the vectorisation); x - x is NaN for inf and NaN.
+      const double scale = a00 + a11 + a22;
+      double regular = scale > 0.0 ? 1.0 : 0.0;
+      regular = std::abs(determinant) > 1e-9 * scale * scale * scale ? regular : 0.0;
+      solved[k] = (x - x) + (y - y) + (z - z) == 0.0 ? regular : 0.0;
     }
   }
 

@@ -1,6 +1,7 @@
 #include "edge_table.hpp"
 
 #include <algorithm>
+#include <cstddef>
 
 namespace animlod::detail {
 
@@ -11,19 +12,32 @@ EdgeTable build_edge_table(const int32_t* faces, size_t face_count) {
     int32_t face;
     int32_t reversed;  // 1 when the face goes from the higher to the lower vertex
   };
-  std::vector<Side> sides;
-  sides.reserve(3 * face_count);
-  for (size_t f = 0; f < face_count; ++f) {
+  // Sorted by (key, face): a counting sort by the lower vertex, then each vertex's few sides
+  // sorted alone (sorting all 3M sides at once was 11% of AQEM's time on a 17k-face sequence).
+  uint32_t vertex_count = 0;
+  for (size_t i = 0; i < 3 * face_count; ++i) vertex_count = std::max(vertex_count, static_cast<uint32_t>(faces[i]) + 1);
+  std::vector<size_t> offsets(static_cast<size_t>(vertex_count) + 1, 0);
+  for (size_t f = 0; f < face_count; ++f)
     for (int corner = 0; corner < 3; ++corner) {
       const uint32_t a = static_cast<uint32_t>(faces[3 * f + corner]);
       const uint32_t b = static_cast<uint32_t>(faces[3 * f + (corner + 1) % 3]);
-      const uint64_t key = (static_cast<uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
-      sides.push_back({key, static_cast<int32_t>(f), a > b ? 1 : 0});
+      ++offsets[std::min(a, b) + 1];
     }
+  for (size_t v = 0; v < vertex_count; ++v) offsets[v + 1] += offsets[v];
+  std::vector<Side> sides(3 * face_count);
+  {
+    std::vector<size_t> next(offsets.begin(), offsets.end() - 1);
+    for (size_t f = 0; f < face_count; ++f)
+      for (int corner = 0; corner < 3; ++corner) {
+        const uint32_t a = static_cast<uint32_t>(faces[3 * f + corner]);
+        const uint32_t b = static_cast<uint32_t>(faces[3 * f + (corner + 1) % 3]);
+        const uint64_t key = (static_cast<uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+        sides[next[std::min(a, b)]++] = {key, static_cast<int32_t>(f), a > b ? 1 : 0};
+      }
   }
-  std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) {
-    return x.key != y.key ? x.key < y.key : x.face < y.face;
-  });
+  for (size_t v = 0; v < vertex_count; ++v)
+    std::sort(sides.begin() + static_cast<ptrdiff_t>(offsets[v]), sides.begin() + static_cast<ptrdiff_t>(offsets[v + 1]),
+              [](const Side& x, const Side& y) { return x.key != y.key ? x.key < y.key : x.face < y.face; });
 
   EdgeTable table;
   table.vertices.reserve(sides.size() / 2 + 1);

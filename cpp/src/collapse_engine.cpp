@@ -9,6 +9,7 @@
 
 #include "inversion_test.hpp"
 #include "skin_merge.hpp"
+#include "worker_threads.hpp"
 
 namespace animlod::detail {
 
@@ -465,14 +466,9 @@ void CollapseEngine::evaluate_all(CollapsePolicy& policy, std::vector<Candidate>
   constexpr size_t kMinimumChunk = 8192;
   const size_t hardware = std::max<size_t>(std::thread::hardware_concurrency(), 1);
   const size_t workers = std::min({policy.concurrency(), hardware, std::max<size_t>(candidates.size() / kMinimumChunk, 1)});
-  auto work = [&](size_t worker) {
-    const size_t begin = candidates.size() * worker / workers, end = candidates.size() * (worker + 1) / workers;
+  run_in_ranges(candidates.size(), workers, [&](size_t begin, size_t end, size_t worker) {
     for (size_t i = begin; i < end; ++i) policy.evaluate_concurrently(candidates[i], worker);
-  };
-  std::vector<std::thread> threads;
-  for (size_t worker = 1; worker < workers; ++worker) threads.emplace_back(work, worker);
-  work(0);
-  for (auto& thread : threads) thread.join();
+  });
 }
 
 // Sorts `items` by `less` (a total order), the two halves on two threads, then merges them.

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -22,6 +23,7 @@
 #include "edge_table.hpp"
 #include "mesh_validation_detail.hpp"
 #include "union_find.hpp"
+#include "worker_threads.hpp"
 
 namespace animlod {
 
@@ -59,35 +61,44 @@ double signed_wrapped_difference(double b, double a) {
   return d;
 }
 
+// Edges per thread below which another thread costs more than it saves.
+constexpr size_t kEdgesPerThread = 4096;
+
 // g_i (the largest change between consecutive frames) and a_i (the range of the unwrapped
-// dihedral angle over all frames) for every edge, 0 on boundary edges.
+// dihedral angle over all frames) for every edge, 0 on boundary edges. Edges are independent:
+// each thread takes a range of them through every frame (with its own face normals).
 void angle_changes(const AnimatedMeshView& mesh, const detail::EdgeTable& edges, std::vector<float>& change,
                    std::vector<float>& amplitude) {
   const size_t edge_count = edges.size();
   change.assign(edge_count, 0.0f);
   amplitude.assign(edge_count, 0.0f);
-  std::vector<double> previous(edge_count, 0.0), unwrapped(edge_count, 0.0);
-  std::vector<double> lowest(edge_count, 0.0), highest(edge_count, 0.0);
-  std::vector<Eigen::Vector3d> normals(mesh.face_count);
-  for (size_t t = 0; t < mesh.frame_count; ++t) {
-    const float* frame = mesh.frames + t * mesh.vertex_count * 3;
-    face_normals(mesh, frame, normals);
-    for (size_t e = 0; e < edge_count; ++e) {
-      if (edges.is_boundary(e)) continue;
-      const auto [a, b] = edges.vertices[e];
-      const double angle = signed_dihedral(normals[edges.faces[e][0]], normals[edges.faces[e][1]],
-                                           position(frame, b) - position(frame, a));
-      if (t > 0) {
-        const double step = signed_wrapped_difference(angle, previous[e]);
-        change[e] = std::max(change[e], static_cast<float>(std::fabs(step)));
-        unwrapped[e] += step;
-        lowest[e] = std::min(lowest[e], unwrapped[e]);
-        highest[e] = std::max(highest[e], unwrapped[e]);
+  const size_t workers =
+      std::min<size_t>(std::max(std::thread::hardware_concurrency(), 1u), edge_count / kEdgesPerThread);
+  detail::run_in_ranges(edge_count, workers, [&](size_t begin, size_t end, size_t) {
+    const size_t count = end - begin;
+    std::vector<double> previous(count, 0.0), unwrapped(count, 0.0), lowest(count, 0.0), highest(count, 0.0);
+    std::vector<Eigen::Vector3d> normals(mesh.face_count);
+    for (size_t t = 0; t < mesh.frame_count; ++t) {
+      const float* frame = mesh.frames + t * mesh.vertex_count * 3;
+      face_normals(mesh, frame, normals);
+      for (size_t e = begin; e < end; ++e) {
+        if (edges.is_boundary(e)) continue;
+        const size_t i = e - begin;
+        const auto [a, b] = edges.vertices[e];
+        const double angle = signed_dihedral(normals[edges.faces[e][0]], normals[edges.faces[e][1]],
+                                             position(frame, b) - position(frame, a));
+        if (t > 0) {
+          const double step = signed_wrapped_difference(angle, previous[i]);
+          change[e] = std::max(change[e], static_cast<float>(std::fabs(step)));
+          unwrapped[i] += step;
+          lowest[i] = std::min(lowest[i], unwrapped[i]);
+          highest[i] = std::max(highest[i], unwrapped[i]);
+        }
+        previous[i] = angle;
       }
-      previous[e] = angle;
     }
-  }
-  for (size_t e = 0; e < edge_count; ++e) amplitude[e] = static_cast<float>(highest[e] - lowest[e]);
+    for (size_t e = begin; e < end; ++e) amplitude[e] = static_cast<float>(highest[e - begin] - lowest[e - begin]);
+  });
 }
 
 // The median of `values` (reordered), 0 when empty.

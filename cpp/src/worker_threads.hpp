@@ -1,5 +1,6 @@
-// The worker pool of the core's parallel loops (motion re-fit chunks, posture-error bones): each
-// worker takes tasks from a counter it shares with the others until none is left.
+// The core's parallel loops: a worker pool taking tasks from a shared counter (motion re-fit
+// chunks, posture-error bones), and fixed contiguous ranges (AQEM's candidate costs, motion
+// features' edges).
 #pragma once
 
 #include <algorithm>
@@ -22,6 +23,18 @@ void run_workers(unsigned requested, size_t tasks, const Worker& worker) {
   std::vector<std::thread> pool;
   for (unsigned i = 0; i < threads; ++i) pool.emplace_back(worker);
   for (std::thread& thread : pool) thread.join();
+}
+
+// Splits [0, count) into `workers` contiguous ranges and runs range(begin, end, worker) for each,
+// the calling thread taking the first.
+template <typename Range>
+void run_in_ranges(size_t count, size_t workers, const Range& range) {
+  workers = std::max<size_t>(workers, 1);
+  auto work = [&](size_t worker) { range(count * worker / workers, count * (worker + 1) / workers, worker); };
+  std::vector<std::thread> threads;
+  for (size_t worker = 1; worker < workers; ++worker) threads.emplace_back(work, worker);
+  work(0);
+  for (std::thread& thread : threads) thread.join();
 }
 
 }  // namespace animlod::detail

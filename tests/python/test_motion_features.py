@@ -106,3 +106,43 @@ def test_int64_faces_are_range_checked_not_wrapped():
     faces[0, 2] = -(2**31) - 1
     with pytest.raises(ValueError, match=r"^faces: element \(0, 2\) = -2147483649 does not fit int32$"):
         _core.motion_features(mesh.frames, faces)
+
+
+def _dihedral_reference(mesh: AnimatedMesh, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """numpy's g_i (largest step) and a_i (range of the unwrapped angle) per edge: the signed
+    angle between the normals of the faces going lower -> higher and higher -> lower along it."""
+    faces = np.asarray(mesh.faces, np.int64)
+    starts, ends = faces.ravel(), np.roll(faces, -1, axis=1).ravel()
+    vertex_count = mesh.frames.shape[1]
+    keys = np.minimum(starts, ends) * vertex_count + np.maximum(starts, ends)
+    edge_of_side = np.searchsorted(edges[:, 0].astype(np.int64) * vertex_count + edges[:, 1], keys)
+    face_of_side = np.repeat(np.arange(len(faces)), 3)
+    sided = np.full((len(edges), 2), -1)
+    sided[edge_of_side, (starts > ends).astype(int)] = face_of_side
+    interior = (sided >= 0).all(axis=1)
+    frames = mesh.frames.astype(np.float64)
+    corners = frames[:, faces]
+    normals = np.cross(corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0])
+    n0, n1 = normals[:, sided[interior, 0]], normals[:, sided[interior, 1]]
+    along = frames[:, edges[interior, 1]] - frames[:, edges[interior, 0]]
+    along /= np.linalg.norm(along, axis=2, keepdims=True)
+    angles = np.arctan2(np.einsum("fei,fei->fe", np.cross(n0, n1), along), np.einsum("fei,fei->fe", n0, n1))
+    steps = np.diff(angles, axis=0)
+    steps = np.where(steps > np.pi, steps - 2 * np.pi, np.where(steps < -np.pi, steps + 2 * np.pi, steps))
+    unwrapped = np.concatenate([np.zeros((1, steps.shape[1])), np.cumsum(steps, axis=0)])
+    change, amplitude = np.zeros(len(edges)), np.zeros(len(edges))
+    change[interior] = np.abs(steps).max(axis=0)
+    amplitude[interior] = unwrapped.max(axis=0) - unwrapped.min(axis=0)
+    return change, amplitude
+
+
+def test_dihedral_changes_of_a_mesh_split_over_threads_match_numpy():
+    # Over 8,192 edges: the core splits the edges between threads (kEdgesPerThread = 4,096).
+    mesh = synth.bending_cylinder(frames=6, rings=100, segments=48)
+    noise = np.random.default_rng(3).normal(scale=0.004, size=mesh.frames.shape).astype(np.float32)
+    mesh = AnimatedMesh(mesh.faces, mesh.frames + noise)
+    features = motion_features(mesh, feature_weighting="paper")
+    assert len(features.edges) > 2 * 4096
+    change, amplitude = _dihedral_reference(mesh, np.asarray(features.edges))
+    np.testing.assert_allclose(features.angle_change, change, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(features.amplitude, amplitude, rtol=1e-5, atol=1e-6)

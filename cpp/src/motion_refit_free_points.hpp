@@ -27,6 +27,9 @@ class FreePointClusters {
   FreePointClusters(const MotionRefitProblem& problem, const std::vector<uint8_t>& free);
 
   bool contains(size_t point) const { return local_[point] >= 0; }
+  // Clusters share no term, so E's Hessian over the free points is block diagonal by cluster.
+  size_t cluster_count() const { return clusters_.size(); }
+  const std::vector<int32_t>& cluster_points(size_t cluster) const { return clusters_[cluster].points; }
 
   // Where every minimisation starts until the next call: of the minima over the free points
   // reached from x (P, 3) and from the original positions (Ed's minimum), with x's other points,

@@ -119,6 +119,10 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
       index_[k] = static_cast<int32_t>(reduced_points_++);
   }
   for (size_t b = 0; b < bodies_.count(); ++b) body_slot_.push_back(static_cast<int32_t>(reduced_points_++));
+  free_blocks_.resize(free_points_.cluster_count());
+  for (size_t c = 0; c < free_blocks_.size(); ++c)
+    for (int32_t point : free_points_.cluster_points(c))
+      for (int a = 0; a < 3; ++a) free_blocks_[c].push_back(3 * free_index_[point] + a);
   kept_equality_count_ = static_cast<size_t>(std::count(kept_equalities_.begin(), kept_equalities_.end(), 1));
   build_links();
 }
@@ -316,9 +320,13 @@ void PointReduction::reduce_matrix(const double* full, double* out) const {
   }
   if (nf == 0 || nr == 0) return;
   // The free points follow the others (x_f = argmin E): E's Hessian over the reduced points is
-  // the Schur complement A - B C^-1 B^T.
-  const Eigen::LLT<Eigen::MatrixXd> llt(free);
-  if (llt.info() == Eigen::Success) reduced -= coupling * llt.solve(Eigen::MatrixXd(coupling.transpose()));
+  // the Schur complement A - B C^-1 B^T, C block diagonal by cluster (one small solve each).
+  for (const std::vector<int32_t>& block : free_blocks_) {
+    const Eigen::LLT<Eigen::MatrixXd> llt(free(block, block));
+    if (llt.info() != Eigen::Success) continue;
+    const Eigen::MatrixXd b = coupling(Eigen::all, block);
+    reduced -= b * llt.solve(Eigen::MatrixXd(b.transpose()));
+  }
 }
 
 }  // namespace animlod::detail

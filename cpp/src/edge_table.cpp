@@ -13,7 +13,8 @@ EdgeTable build_edge_table(const int32_t* faces, size_t face_count) {
     int32_t reversed;  // 1 when the face goes from the higher to the lower vertex
   };
   // Sorted by (key, face): a counting sort by the lower vertex, then each vertex's few sides
-  // sorted alone (sorting all 3M sides at once was 11% of AQEM's time on a 17k-face sequence).
+  // sorted alone, instead of one sort of all 3M sides (about 1% of AQEM's instructions on the
+  // 24-frame 17k-face sphere, whose motion features build this table).
   uint32_t vertex_count = 0;
   for (size_t i = 0; i < 3 * face_count; ++i) vertex_count = std::max(vertex_count, static_cast<uint32_t>(faces[i]) + 1);
   std::vector<size_t> offsets(static_cast<size_t>(vertex_count) + 1, 0);

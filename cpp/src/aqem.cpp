@@ -157,7 +157,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
         frames_(frames),
         used_count_(frames.size()),
         vertex_weights_(std::move(weights)),
-        scratch_(kWorkers, Scratch{std::vector<Eigen::Vector3d>(used_count_), std::vector<uint8_t>(used_count_), {}}) {
+        scratch_(kWorkers, Scratch{std::vector<Eigen::Vector3d>(used_count_), {}}) {
     accumulate_quadrics();
   }
 
@@ -184,8 +184,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
   // Placement of the candidate being evaluated, per worker.
   struct Scratch {
     std::vector<Eigen::Vector3d> new_positions;  // (K,) placement in the quadrics' frames
-    std::vector<uint8_t> singular;               // (K,) frames using the fallback
-    detail::MergedMinimizers minimizers;         // Eq. 5 in the quadrics' frames
+    detail::MergedMinimizers minimizers;         // Eq. 5 in the quadrics' frames (unsolved: the fallback)
   };
   static constexpr size_t kWorkers = 2;
   void evaluate_with(Candidate& candidate, Scratch& scratch) const;
@@ -317,8 +316,7 @@ void AqemPolicy::evaluate_with(Candidate& candidate, Scratch& scratch) const {
   double total = 0.0;
   scratch.minimizers.solve(kept_quadrics, removed_quadrics, used_count_);
   for (size_t k = 0; k < used_count_; ++k) {
-    scratch.singular[k] = !scratch.minimizers.solved(k);
-    if (!scratch.singular[k]) {
+    if (scratch.minimizers.solved(k)) {
       scratch.new_positions[k] = scratch.minimizers.position(k);
       total += scratch.minimizers.value(k);
       continue;
@@ -341,7 +339,7 @@ void AqemPolicy::evaluate_with(Candidate& candidate, Scratch& scratch) const {
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame),
                           p_removed = engine_.position(candidate.removed, frame);
     Eigen::Vector3d& v = scratch.new_positions[k];
-    if (scratch.singular[k]) v = p_kept + kFallbacks[fallback] * (p_removed - p_kept);
+    if (!scratch.minimizers.solved(k)) v = p_kept + kFallbacks[fallback] * (p_removed - p_kept);
     along += (v - p_kept).dot(p_removed - p_kept);
     length2 += (p_removed - p_kept).squaredNorm();
   }

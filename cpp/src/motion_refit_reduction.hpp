@@ -99,7 +99,7 @@ class PointReduction {
   std::vector<int32_t> leaf_anchor_;  // (P,) p of a leaf, -1 otherwise
   std::vector<int32_t> free_index_;   // (P,) index among the free points, -1 otherwise
   size_t free_count_ = 0;
-  std::vector<std::vector<int32_t>> free_blocks_;       // per cluster: its points' rows among the free ones
+  std::vector<std::vector<int32_t>> free_blocks_;  // per cluster: its points' rows among the free ones
   std::vector<double> leaf_length_;   // (P,) b of a leaf
   std::vector<uint8_t> kept_equalities_;
   size_t kept_equality_count_ = 0;

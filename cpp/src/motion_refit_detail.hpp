@@ -61,10 +61,23 @@ void refit_handedness_frame(const MotionRefitProblem& problem, const double* x, 
 void refit_hessian_frame(const MotionRefitProblem& problem, const double* x, bool positive_semidefinite,
                          double* matrix);
 
-// Ea's term of angle triple k at x: gamma (cos - cos0)^2, and where not nullptr its gradient
-// (9,) over the triple's (parent, joint, child) coordinates and its Hessian (9 x 9 row-major),
-// made positive semidefinite as in refit_hessian_frame when asked.
-double angle_term(const MotionRefitProblem& problem, const double* x, size_t k, bool positive_semidefinite,
-                  double* gradient, double* hessian);
+// Ea's term of angle triple k at x (Eq. 8): gamma (cos - cos0)^2, its gradient over the
+// triple's (parent, joint, child) coordinates and, when built with curvature, its Hessian
+// 2 gamma (grad cos grad cos^T + (cos - cos0) Hess cos) block by block: a caller that holds
+// only some of the three points (a free-point cluster) builds only their blocks.
+class AngleTerm {
+ public:
+  AngleTerm(const MotionRefitProblem& problem, const double* x, size_t k, bool curvature);
+  double value() const { return weight_ * residual_ * residual_; }
+  void gradient(double* out) const;  // (9,)
+  // The (row, column) 3 x 3 block (row-major) of the Hessian; points 0, 1, 2 are the parent,
+  // the joint and the child. Needs curvature.
+  void hessian_block(int row, int column, double* block) const;
+
+ private:
+  double weight_, residual_;
+  double cosine_gradient_[9];
+  double huu_[9], hvv_[9], huv_[9];  // cos's second derivatives in u = p - j, v = c - j
+};
 
 }  // namespace animlod::detail

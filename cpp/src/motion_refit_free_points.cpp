@@ -83,11 +83,12 @@ double FreePointClusters::cluster_energy(Cluster& cluster, const double* x, cons
     }
     if (hessian) cluster.hessian.add(static_cast<int32_t>(i), static_cast<int32_t>(i), ed_hessian);
   }
-  double term_gradient[9], term_hessian[81], block[9];
+  double term_gradient[9], block[9];
   for (int32_t k : cluster.triples) {  // Ea
-    value += angle_term(problem_, x, static_cast<size_t>(k), false, gradient ? term_gradient : nullptr,
-                        hessian ? term_hessian : nullptr);
+    const AngleTerm term(problem_, x, static_cast<size_t>(k), hessian);
+    value += term.value();
     if (!gradient) continue;
+    term.gradient(term_gradient);
     const int32_t* triple = problem_.angle_triples + 3 * k;
     for (int pi = 0; pi < 3; ++pi) {
       const int32_t li = local_[triple[pi]];
@@ -97,8 +98,7 @@ double FreePointClusters::cluster_energy(Cluster& cluster, const double* x, cons
       for (int pj = pi; pj < 3; ++pj) {  // (li, lj) stands for (lj, li) too: the matrix is symmetric
         const int32_t lj = local_[triple[pj]];
         if (lj < 0) continue;
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) block[3 * a + b] = term_hessian[9 * (3 * pi + a) + 3 * pj + b];
+        term.hessian_block(pi, pj, block);
         cluster.hessian.add(li, lj, block);
       }
     }

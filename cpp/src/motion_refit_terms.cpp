@@ -41,15 +41,14 @@ double length_and_unit(const double* x, int32_t a, int32_t b, Vec3& unit) {
 }
 
 // cos theta at the middle point of (parent, joint, child) (Eq. 4) and its gradients with respect
-// to the parent, joint and child positions; with `hessian` also its Hessian over the three
-// points, 9 x 9 row-major in (parent xyz, joint xyz, child xyz) order. With u = parent - joint,
+// to the parent, joint and child positions; with `curvature` also the three 3 x 3 pieces of its
+// Hessian (AngleTerm::hessian_block maps them to the points). With u = parent - joint,
 // v = child - joint, their unit vectors e, f, a = 1/|u|, b = 1/|v| and c = cos theta = e.f:
 //   d/du = a (f - c e),  d/dv = b (e - c f),
 //   d2/du2 = a^2 (3c e e^T - e f^T - f e^T - c I),  d2/dv2 = b^2 (3c f f^T - e f^T - f e^T - c I),
-//   d2/du dv = a b (I - e e^T - f f^T + c e f^T),
-// mapped to the points by u = p - j, v = c - j.
-double cosine(const double* x, const int32_t* triple, Vec3& d_parent, Vec3& d_joint, Vec3& d_child,
-              double* hessian = nullptr) {
+//   d2/du dv = a b (I - e e^T - f f^T + c e f^T).
+double cosine(const double* x, const int32_t* triple, double* gradient, bool curvature, double* huu, double* hvv,
+              double* huv) {
   const Vec3 joint = load(x, triple[1]);
   const Vec3 u = sub(load(x, triple[0]), joint);
   const Vec3 v = sub(load(x, triple[2]), joint);
@@ -59,12 +58,11 @@ double cosine(const double* x, const int32_t* triple, Vec3& d_parent, Vec3& d_jo
   const Vec3 f = {v[0] * b, v[1] * b, v[2] * b};
   const double c = dot(e, f);
   for (int k = 0; k < 3; ++k) {
-    d_parent[k] = a * (f[k] - c * e[k]);
-    d_child[k] = b * (e[k] - c * f[k]);
-    d_joint[k] = -(d_parent[k] + d_child[k]);
+    gradient[k] = a * (f[k] - c * e[k]);
+    gradient[6 + k] = b * (e[k] - c * f[k]);
+    gradient[3 + k] = -(gradient[k] + gradient[6 + k]);
   }
-  if (!hessian) return c;
-  double huu[9], hvv[9], huv[9];
+  if (!curvature) return c;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       const double eye = i == j ? 1.0 : 0.0;
@@ -72,21 +70,6 @@ double cosine(const double* x, const int32_t* triple, Vec3& d_parent, Vec3& d_jo
       huu[3 * i + j] = a * a * (3.0 * c * e[i] * e[j] - mixed - c * eye);
       hvv[3 * i + j] = b * b * (3.0 * c * f[i] * f[j] - mixed - c * eye);
       huv[3 * i + j] = a * b * (eye - e[i] * e[j] - f[i] * f[j] + c * e[i] * f[j]);
-    }
-  // Blocks (row point, column point): pp = huu, cc = hvv, pc = huv, pj = -huu - huv,
-  // cj = -hvv - huv^T, jj = huu + hvv + huv + huv^T; the others by symmetry.
-  auto put = [hessian](int row, int column, int i, int j, double value) {
-    hessian[9 * (3 * row + i) + 3 * column + j] = value;
-    hessian[9 * (3 * column + j) + 3 * row + i] = value;
-  };
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      put(0, 0, i, j, huu[3 * i + j]);
-      put(2, 2, i, j, hvv[3 * i + j]);
-      put(0, 2, i, j, huv[3 * i + j]);
-      put(0, 1, i, j, -huu[3 * i + j] - huv[3 * i + j]);
-      put(2, 1, i, j, -hvv[3 * i + j] - huv[3 * j + i]);
-      put(1, 1, i, j, huu[3 * i + j] + hvv[3 * i + j] + huv[3 * i + j] + huv[3 * j + i]);
     }
   return c;
 }
@@ -223,9 +206,11 @@ double refit_objective_frame(const MotionRefitProblem& problem, const double* x,
     }
   }
   for (size_t k = 0; k < problem.angle_triple_count; ++k) {  // Ea, Eq. 8
-    double term_gradient[9];
-    value += angle_term(problem, x, k, false, gradient ? term_gradient : nullptr, nullptr);
+    const AngleTerm term(problem, x, k, false);
+    value += term.value();
     if (!gradient) continue;
+    double term_gradient[9];
+    term.gradient(term_gradient);
     const int32_t* triple = problem.angle_triples + 3 * k;
     for (int c = 0; c < 3; ++c)
       for (int a = 0; a < 3; ++a) gradient[3 * triple[c] + a] += term_gradient[3 * c + a];
@@ -339,8 +324,15 @@ void refit_hessian_frame(const MotionRefitProblem& problem, const double* x, boo
     add_pair(problem.coincident_pairs[2 * k], problem.coincident_pairs[2 * k + 1], identity, ws);
   for (size_t k = 0; k < problem.angle_triple_count; ++k) {  // Ea
     const int32_t* triple = problem.angle_triples + 3 * k;
-    double block[81];
-    angle_term(problem, x, k, positive_semidefinite, nullptr, block);
+    const AngleTerm term(problem, x, k, true);
+    double block[81];  // 9 x 9 over the triple's (parent, joint, child) coordinates
+    for (int pi = 0; pi < 3; ++pi)
+      for (int pj = 0; pj < 3; ++pj) {
+        double sub_block[9];
+        term.hessian_block(pi, pj, sub_block);
+        for (int i = 0; i < 3; ++i) std::copy_n(sub_block + 3 * i, 3, block + 9 * (3 * pi + i) + 3 * pj);
+      }
+    if (positive_semidefinite) clip_to_positive_semidefinite(block);
     for (int pi = 0; pi < 3; ++pi)
       for (int pj = 0; pj < 3; ++pj) {
         double sub_block[9];
@@ -351,21 +343,46 @@ void refit_hessian_frame(const MotionRefitProblem& problem, const double* x, boo
   }
 }
 
-double angle_term(const MotionRefitProblem& problem, const double* x, size_t k, bool positive_semidefinite,
-                  double* gradient, double* hessian) {
-  const int32_t* triple = problem.angle_triples + 3 * k;
-  const double w = problem.angle_weight;
-  Vec3 dp, dj, dc;
-  const double residual = cosine(x, triple, dp, dj, dc, hessian) - problem.key_cosines[k];
-  const double g[9] = {dp[0], dp[1], dp[2], dj[0], dj[1], dj[2], dc[0], dc[1], dc[2]};
-  if (gradient)
-    for (int i = 0; i < 9; ++i) gradient[i] = 2.0 * w * residual * g[i];
-  if (hessian) {  // 2 w (g g^T + (cos - cos0) Hess cos)
-    for (int i = 0; i < 9; ++i)
-      for (int j = 0; j < 9; ++j) hessian[9 * i + j] = 2.0 * w * (g[i] * g[j] + residual * hessian[9 * i + j]);
-    if (positive_semidefinite) clip_to_positive_semidefinite(hessian);
+AngleTerm::AngleTerm(const MotionRefitProblem& problem, const double* x, size_t k, bool curvature)
+    : weight_(problem.angle_weight) {
+  residual_ = cosine(x, problem.angle_triples + 3 * k, cosine_gradient_, curvature, huu_, hvv_, huv_) -
+              problem.key_cosines[k];
+}
+
+void AngleTerm::gradient(double* out) const {
+  for (int i = 0; i < 9; ++i) out[i] = 2.0 * weight_ * residual_ * cosine_gradient_[i];
+}
+
+void AngleTerm::hessian_block(int row, int column, double* block) const {
+  // cos's Hessian over the points, by u = p - j, v = c - j: pp = huu, cc = hvv, pc = huv,
+  // pj = -huu - huv, cj = -hvv - huv^T, jj = huu + hvv + huv + huv^T, the others their
+  // transposes. The diagonal blocks read their lower triangle (index l, lt its mirror), so that
+  // the matrix is symmetric to the last bit.
+  double h[9];
+  auto fill = [&h](auto entry) {  // entry(ij, ji): one loop per block kind, unrolled
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) h[3 * i + j] = entry(3 * i + j, 3 * j + i);
+  };
+  switch (3 * row + column) {
+    case 0: fill([&](int ij, int ji) { return huu_[std::max(ij, ji)]; }); break;
+    case 1: fill([&](int ij, int) { return -huu_[ij] - huv_[ij]; }); break;
+    case 2: fill([&](int ij, int) { return huv_[ij]; }); break;
+    case 3: fill([&](int, int ji) { return -huu_[ji] - huv_[ji]; }); break;
+    case 4:
+      fill([&](int ij, int ji) {
+        const int l = std::max(ij, ji), lt = std::min(ij, ji);
+        return huu_[l] + hvv_[l] + huv_[l] + huv_[lt];
+      });
+      break;
+    case 5: fill([&](int ij, int ji) { return -hvv_[ji] - huv_[ij]; }); break;
+    case 6: fill([&](int, int ji) { return huv_[ji]; }); break;
+    case 7: fill([&](int ij, int ji) { return -hvv_[ij] - huv_[ji]; }); break;
+    default: fill([&](int ij, int ji) { return hvv_[std::max(ij, ji)]; }); break;
   }
-  return w * residual * residual;
+  const double* gr = cosine_gradient_ + 3 * row;
+  const double* gc = cosine_gradient_ + 3 * column;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) block[3 * i + j] = 2.0 * weight_ * (gr[i] * gc[j] + residual_ * h[3 * i + j]);
 }
 
 }  // namespace detail

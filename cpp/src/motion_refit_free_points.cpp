@@ -135,11 +135,13 @@ double FreePointClusters::newton(Cluster& cluster, double* x, const double* orig
   double* step = step_.data();
   double* saved = trial_.data();
   double value = 0.0;
+  double last_exact_step = 0.0;  // the previous step's length if it was a full, unshifted one
   for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
     value = cluster_energy(cluster, x, original, gradient, true);
     // Where an angle term makes the Hessian indefinite, shift it towards Ed's curvature until
     // it is positive definite (Levenberg): every step then descends.
-    bool factored = cluster.hessian.factor(0.0);
+    const bool exact = cluster.hessian.factor(0.0);
+    bool factored = exact;
     for (double shift = curvature; !factored && std::isfinite(shift); shift *= 4.0)
       factored = cluster.hessian.factor(shift);
     if (!factored) break;  // not finite: nothing to step along
@@ -169,7 +171,16 @@ double FreePointClusters::newton(Cluster& cluster, double* x, const double* orig
       break;
     }
     value = trial;
-    if (t * largest <= tolerance) break;
+    const double length = t * largest;
+    if (length <= tolerance) break;
+    // Two full exact Newton steps in a row: convergence is quadratic, the next step about
+    // length^2 (length / last^2); below the tolerance, it would only confirm this one.
+    if (!exact || t < 1.0) {
+      last_exact_step = 0.0;
+    } else {
+      if (length * length * length <= tolerance * last_exact_step * last_exact_step) break;
+      last_exact_step = length;
+    }
   }
   return value;
 }

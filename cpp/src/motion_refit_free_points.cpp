@@ -61,6 +61,13 @@ FreePointClusters::FreePointClusters(const MotionRefitProblem& problem, const st
           if (la >= 0 && lb >= 0) coupled.emplace_back(la, lb);
         }
     cluster.hessian = BlockCholesky(cluster.points.size(), coupled);
+    for (int32_t k : cluster.triples)
+      for (int c = 0; c < 3; ++c)
+        if (!free[problem.angle_triples[3 * k + c]]) cluster.held.push_back(problem.angle_triples[3 * k + c]);
+    std::sort(cluster.held.begin(), cluster.held.end());
+    cluster.held.erase(std::unique(cluster.held.begin(), cluster.held.end()), cluster.held.end());
+    cluster.held_at.resize(3 * cluster.held.size());
+    cluster.minimum.resize(3 * cluster.points.size());
   }
   gradient_.resize(largest);
   step_.resize(largest);
@@ -111,6 +118,7 @@ void FreePointClusters::set_start(const double* x, const double* original) {
   // Clusters share no point and no triple, so one copy serves every cluster's second start.
   best_.assign(start_.begin(), start_.end());
   for (Cluster& cluster : clusters_) {
+    cluster.remembered = false;
     // The minima reached from x and from the original positions (Ed's minimum), the lower one:
     // the angle terms have several minima.
     const double from_start = newton(cluster, start_.data(), original);
@@ -122,8 +130,21 @@ void FreePointClusters::set_start(const double* x, const double* original) {
 
 void FreePointClusters::minimise(double* x, const double* original) {
   for (Cluster& cluster : clusters_) {
+    bool moved = !cluster.remembered;
+    for (size_t i = 0; i < cluster.held.size() && !moved; ++i)
+      moved = !std::equal(x + 3 * cluster.held[i], x + 3 * cluster.held[i] + 3, cluster.held_at.begin() + 3 * i);
+    if (!moved) {
+      for (size_t i = 0; i < cluster.points.size(); ++i)
+        std::copy_n(cluster.minimum.begin() + 3 * i, 3, x + 3 * cluster.points[i]);
+      continue;
+    }
     for (int32_t point : cluster.points) std::copy_n(start_.begin() + 3 * point, 3, x + 3 * point);
     newton(cluster, x, original);
+    for (size_t i = 0; i < cluster.held.size(); ++i)
+      std::copy_n(x + 3 * cluster.held[i], 3, cluster.held_at.begin() + 3 * i);
+    for (size_t i = 0; i < cluster.points.size(); ++i)
+      std::copy_n(x + 3 * cluster.points[i], 3, cluster.minimum.begin() + 3 * i);
+    cluster.remembered = true;
   }
 }
 

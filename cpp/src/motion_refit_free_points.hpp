@@ -40,7 +40,7 @@ class FreePointClusters {
   void set_start(const double* x, const double* original);
 
   // Moves the free points of x (P, 3) to the minimum of E over them with every other point
-  // held, reached from set_start's positions.
+  // held, reached from set_start's positions. original: the one given to set_start.
   void minimise(double* x, const double* original);
 
  private:
@@ -48,6 +48,12 @@ class FreePointClusters {
     std::vector<int32_t> points;   // free points, in increasing order
     std::vector<int32_t> triples;  // angle triples with at least one of them
     BlockCholesky hessian;         // over the points (in cluster order), coupled by the triples
+    // Newton from the same start with the same held points ends at the same minimum, so
+    // minimise keeps its last one: the held points of the triples (the other points of E's part
+    // that depends on the cluster), where they were, and the minimum; until set_start.
+    std::vector<int32_t> held;
+    std::vector<double> held_at, minimum;
+    bool remembered = false;
   };
   // E's part that depends on the cluster's points at x, with its gradient (3 n) and exact
   // Hessian (into cluster.hessian) when asked.

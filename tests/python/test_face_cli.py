@@ -82,6 +82,7 @@ def test_face_gltf_without_morph_targets_is_named(tmp_path, capsys):
     write_glb(path, skinned)
     assert main(["face", str(path), "-o", str(tmp_path / "out")]) == 2
     assert "no mesh has morph targets" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()  # a refused run leaves no empty output folder
 
 
 def test_face_unknown_expression(tmp_path, capsys):

@@ -75,7 +75,7 @@ def run_face_lod(
     Parameters
     ----------
     source : None for the procedural face, a .glb/.gltf with morph targets, or a pose folder.
-    output : folder for the files (created).
+    output : folder for the files (created when the first one is written).
     ratios, face_counts : triangle fractions or counts of the levels after the full face.
     target_fractions : blendshape faces: fraction of targets kept per level (the full face included).
     neutral : pose folders: the file name of the neutral face.
@@ -84,8 +84,7 @@ def run_face_lod(
     repeats : timing runs per frame (the fastest is kept).
     error_frames : animation frames the surface error is measured on, at most.
     """
-    output = Path(output)
-    output.mkdir(parents=True, exist_ok=True)
+    output = Path(output)  # created by the first file written (io.atomic), so a refused run leaves nothing
     if source is None:
         return _run_procedural(output, ratios, face_counts, plot, expression, repeats, error_frames)
     return _run_blendshape(

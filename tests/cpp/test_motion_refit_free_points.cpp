@@ -1,7 +1,8 @@
 // Free points of the motion re-fit (cpp/src/motion_refit_free_points.hpp): minimised for given
 // positions of the others, they leave E's gradient over the others unchanged (the envelope
 // theorem) and the reduced Hessian is the Schur complement; the solve without their variables
-// ends where the solve with them does, and a problem of free points only needs no SLSQP.
+// ends where the solve with them does, a problem of free points only needs no SLSQP, and a
+// cluster's remembered minimum is reused only for the same frame and held points.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -9,12 +10,14 @@
 #include <vector>
 
 #include "../../cpp/src/motion_refit_detail.hpp"
+#include "../../cpp/src/motion_refit_free_points.hpp"
 #include "../../cpp/src/motion_refit_reduction.hpp"
 #include "animlod/motion_refit.hpp"
 #include "motion_refit_figure.hpp"
 
 using animlod::MotionRefitOptions;
 using animlod::MotionRefitResult;
+using animlod::detail::FreePointClusters;
 using animlod::detail::PointReduction;
 
 TEST_CASE("free points: the reduced gradient and Hessian are those of E minimised over them") {
@@ -82,4 +85,37 @@ TEST_CASE("free points: a problem of free points only is solved without SLSQP") 
   std::vector<double> gradient(9);
   animlod::detail::refit_objective_frame(problem, out.positions.data(), original.data(), gradient.data());
   for (double g : gradient) CHECK(std::abs(g) < 1e-10);
+}
+
+TEST_CASE("free points: a remembered minimum answers only the same frame and held points") {
+  const Figure f;  // triple (2, 3, 4): 3 and 4 free, 2 held
+  const size_t p = f.problem.point_count;
+  std::vector<uint8_t> free(p, 0);
+  free[3] = free[4] = 1;
+  const std::vector<double> original_a = f.perturbed(1, 0.05), original_b = f.perturbed(3, 0.05);
+  const std::vector<double> x = f.perturbed(2, 0.1);
+  // Each case against clusters that never minimised before.
+  auto fresh = [&](const std::vector<double>& at, const std::vector<double>& original) {
+    FreePointClusters clusters(f.problem, free);
+    clusters.set_start(x.data(), original.data());
+    std::vector<double> out(at);
+    clusters.minimise(out.data(), original.data());
+    return out;
+  };
+  FreePointClusters clusters(f.problem, free);
+  clusters.set_start(x.data(), original_a.data());
+  std::vector<double> first(x), again(x);
+  clusters.minimise(first.data(), original_a.data());
+  clusters.minimise(again.data(), original_a.data());
+  CHECK(again == first);
+  std::vector<double> moved(x);  // the held point moves
+  moved[3 * 2] += 0.05;
+  clusters.minimise(moved.data(), original_a.data());
+  CHECK(moved == fresh(moved, original_a));
+  CHECK(moved[3 * 3] != first[3 * 3]);
+  clusters.set_start(x.data(), original_b.data());  // the next frame, the held point as last time
+  std::vector<double> next(moved);
+  clusters.minimise(next.data(), original_b.data());
+  CHECK(next == fresh(moved, original_b));
+  CHECK(next[3 * 3] != moved[3 * 3]);
 }

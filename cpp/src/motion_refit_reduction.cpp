@@ -124,6 +124,21 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
     for (int32_t point : free_points_.cluster_points(c))
       for (int a = 0; a < 3; ++a) free_blocks_[c].push_back(3 * free_index_[point] + a);
   kept_equality_count_ = static_cast<size_t>(std::count(kept_equalities_.begin(), kept_equalities_.end(), 1));
+  coupled_.resize(p);
+  auto couple = [&](const int32_t* rows, size_t n, size_t width) {
+    for (size_t r = 0; r < n; ++r)
+      for (size_t i = 0; i < width; ++i)
+        for (size_t j = 0; j < width; ++j)
+          if (rows[r * width + i] > 0 && rows[r * width + j] > 0) coupled_[rows[r * width + i]].push_back(rows[r * width + j]);
+  };
+  for (size_t k = 1; k < p; ++k) coupled_[k].push_back(static_cast<int32_t>(k));  // Ed
+  couple(problem.length_pairs, pairs, 2);                                         // Es
+  couple(problem.coincident_pairs, problem.coincident_pair_count, 2);
+  couple(problem.angle_triples, problem.angle_triple_count, 3);  // Ea
+  for (std::vector<int32_t>& row : coupled_) {
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+  }
   build_links();
 }
 
@@ -288,7 +303,7 @@ void PointReduction::reduce_matrix(const double* full, double* out) const {
     const int32_t fa = free_index_[a];
     const bool linked_a = link_offsets_[a + 1] > link_offsets_[a];
     if (!linked_a && fa < 0) continue;
-    for (size_t b = 1; b < p; ++b) {
+    for (const int32_t b : coupled_[a]) {  // the other blocks of row a are zero
       const int32_t fb = free_index_[b];
       if (link_offsets_[b + 1] == link_offsets_[b] && fb < 0) continue;
       const double* m_ab = full + 3 * (a - 1) * n + 3 * (b - 1);

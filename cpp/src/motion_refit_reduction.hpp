@@ -100,6 +100,9 @@ class PointReduction {
   std::vector<int32_t> free_index_;   // (P,) index among the free points, -1 otherwise
   size_t free_count_ = 0;
   std::vector<std::vector<int32_t>> free_blocks_;  // per cluster: its points' rows among the free ones
+  // (P,) per non-root point a, the non-root points b (increasing, a included) whose block M_ab of
+  // E's Hessian can be non-zero: a term of E holds both. reduce_matrix reads only these.
+  std::vector<std::vector<int32_t>> coupled_;
   std::vector<double> leaf_length_;   // (P,) b of a leaf
   std::vector<uint8_t> kept_equalities_;
   size_t kept_equality_count_ = 0;

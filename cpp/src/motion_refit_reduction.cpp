@@ -125,11 +125,11 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
       for (int a = 0; a < 3; ++a) free_blocks_[c].push_back(3 * free_index_[point] + a);
   kept_equality_count_ = static_cast<size_t>(std::count(kept_equalities_.begin(), kept_equalities_.end(), 1));
   coupled_.resize(p);
-  auto couple = [&](const int32_t* rows, size_t n, size_t width) {
-    for (size_t r = 0; r < n; ++r)
+  auto couple = [&](const int32_t* rows, size_t n, size_t width) {  // every two points of a term
+    for (const int32_t* row = rows; row < rows + n * width; row += width)
       for (size_t i = 0; i < width; ++i)
         for (size_t j = 0; j < width; ++j)
-          if (rows[r * width + i] > 0 && rows[r * width + j] > 0) coupled_[rows[r * width + i]].push_back(rows[r * width + j]);
+          if (row[i] > 0 && row[j] > 0) coupled_[row[i]].push_back(row[j]);
   };
   for (size_t k = 1; k < p; ++k) coupled_[k].push_back(static_cast<int32_t>(k));  // Ed
   couple(problem.length_pairs, pairs, 2);                                         // Es

@@ -208,6 +208,14 @@ class FrameSolver {
     return detail::refit_objective_frame(problem_, x, original, nullptr);
   }
 
+  // The largest |residual| of the held lengths and flat groups' heights at x (P, 3).
+  double largest_violation(const double* x) {
+    detail::refit_equalities_frame(problem_, x, equality_values_.data(), nullptr);
+    double violation = 0.0;
+    for (double v : equality_values_) violation = std::max(violation, std::abs(v));
+    return violation;
+  }
+
   Outcome solve(const double* original, const double* start, double* result) {
     const size_t n = c_.variable_count;
     c_.original = original;
@@ -229,6 +237,10 @@ class FrameSolver {
     }
     Outcome outcome;
     const double start_value = energy(c_.x.data(), original);
+    // A start is feasible up to the rounding of the clip's keys: a joint whose translation keys
+    // differ from the key posture's by float noise (not a translating joint) moves its held
+    // lengths by ~1e-7 L, and holding them then costs E. Only a feasible start bounds the result.
+    const bool feasible_start = !hard_ || largest_violation(c_.x.data()) <= options_.feasibility_tolerance;
     double minimum = 0.0;
     nlopt_result code = NLOPT_SUCCESS;
     outcome.evaluations = 1;
@@ -246,9 +258,7 @@ class FrameSolver {
       // NLopt documents ROUNDOFF_LIMITED as usually still a useful result: it passes the checks.
       outcome.reason = "nlopt result " + std::to_string(static_cast<int>(code));
     } else if (hard_) {
-      detail::refit_equalities_frame(problem_, result, equality_values_.data(), nullptr);
-      double violation = 0.0;
-      for (double v : equality_values_) violation = std::max(violation, std::abs(v));
+      const double violation = largest_violation(result);
       if (violation > options_.feasibility_tolerance) {
         outcome.reason = format("a held length or flat group's height is off by %.3g L", violation);
       } else if (!handed_values_.empty()) {
@@ -257,8 +267,9 @@ class FrameSolver {
           outcome.reason = "a rigid group turned into its mirror image";
       }
     }
-    // Every start is feasible (see motion_refit_solve), so a result above it is never progress.
-    if (outcome.reason.empty() && outcome.value > start_value) outcome.reason = "objective rose above its start";
+    // From a feasible start (see motion_refit_solve), a result above it is never progress.
+    if (outcome.reason.empty() && feasible_start && outcome.value > start_value)
+      outcome.reason = "objective rose above its start";
     return outcome;
   }
 

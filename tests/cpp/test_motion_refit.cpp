@@ -1,6 +1,7 @@
 // Motion LoD re-fit in the core: E's gradient, the Hessian used as preconditioner and the
 // constraint Jacobians against finite differences; the solve keeps bones, ends feasible from an
-// infeasible start, does not depend on the thread count, and rejects bad input by name.
+// infeasible start (also one off by rounding only, whose E must rise), does not depend on the
+// thread count, and rejects bad input by name.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -155,6 +156,32 @@ TEST_CASE("motion refit: a solve started infeasible ends feasible, whatever the 
   REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), fallback.data(), nullptr, frames, options, parallel));
   CHECK(serial.positions == parallel.positions);
   CHECK(serial.evaluations == parallel.evaluations);
+}
+
+TEST_CASE("motion refit: a start off its lengths by key rounding is solved, not refused") {
+  // A clip whose joint translations are float32 keys moves its held lengths by ~1e-7 L from the
+  // key posture's, so its own positions, the start, are feasible only up to that. Holding the
+  // lengths can then cost more Ed than the Es it removes (Xbot's hips: a rigid set of 10 lengths
+  // over 8 points, 3x), and E rises above the start's: the solve's work, not a failure (which
+  // fell back to the frozen key motion). Here Es weighs little, for the same effect.
+  LengthFigure f({0, 0, 0, 0, 1, 0, 0, 2, 0, 1, 2, 0, 1, 3, 0}, {1, 0, 2, 1, 3, 2, 4, 3}, 2.0);
+  f.problem.string_weight = 0.02;
+  const size_t p = f.problem.point_count;
+  std::vector<double> start(f.key);
+  for (size_t i = 3; i < 3 * p; ++i) start[i] *= 1.0 + 1e-7;  // lengths 1e-7 longer
+  const std::vector<double>& original = start;
+  std::vector<double> violation(animlod::motion_refit_equality_count(f.problem));
+  REQUIRE(animlod::motion_refit_equalities(f.problem, start.data(), 1, violation.data(), nullptr));
+  MotionRefitOptions options;
+  options.threads = 1;
+  options.eliminate_points = false;  // eliminated points would be placed on their lengths at once
+  REQUIRE(*std::max_element(violation.begin(), violation.end()) > options.feasibility_tolerance);
+  MotionRefitResult out;
+  REQUIRE(animlod::motion_refit_solve(f.problem, original.data(), start.data(), start.data(), 1, options, out));
+  CHECK(out.failures.empty());
+  CHECK(out.values[0] > objective_at(f.problem, start, original));  // E rose: the lengths hold
+  animlod::detail::refit_equalities_frame(f.problem, out.positions.data(), violation.data(), nullptr);
+  for (double v : violation) CHECK(std::abs(v) <= options.feasibility_tolerance);
 }
 
 TEST_CASE("motion refit: bad problems and inputs are refused by name") {

@@ -66,12 +66,11 @@ FreePointClusters::FreePointClusters(const MotionRefitProblem& problem, const st
         if (!free[problem.angle_triples[3 * k + c]]) cluster.held.push_back(problem.angle_triples[3 * k + c]);
     std::sort(cluster.held.begin(), cluster.held.end());
     cluster.held.erase(std::unique(cluster.held.begin(), cluster.held.end()), cluster.held.end());
-    cluster.held_at.resize(3 * cluster.held.size());
-    cluster.minimum.resize(3 * cluster.points.size());
   }
   gradient_.resize(largest);
   step_.resize(largest);
   trial_.resize(largest);
+  from_start_.resize(largest);
 }
 
 double FreePointClusters::cluster_energy(Cluster& cluster, const double* x, const double* original,
@@ -118,7 +117,8 @@ void FreePointClusters::set_start(const double* x, const double* original) {
   // Clusters share no point and no triple, so one copy serves every cluster's second start.
   best_.assign(start_.begin(), start_.end());
   for (Cluster& cluster : clusters_) {
-    cluster.remembered = false;
+    cluster.held_at.clear();
+    cluster.minima.clear();
     // The minima reached from x and from the original positions (Ed's minimum), the lower one:
     // the angle terms have several minima.
     const double from_start = newton(cluster, start_.data(), original);
@@ -128,23 +128,35 @@ void FreePointClusters::set_start(const double* x, const double* original) {
   }
 }
 
+bool FreePointClusters::held_where(const Cluster& cluster, size_t entry, const double* x) const {
+  const double* at = cluster.held_at.data() + 3 * cluster.held.size() * entry;
+  for (size_t i = 0; i < cluster.held.size(); ++i)
+    if (!std::equal(at + 3 * i, at + 3 * i + 3, x + 3 * cluster.held[i])) return false;
+  return true;
+}
+
 void FreePointClusters::minimise(double* x, const double* original) {
   for (Cluster& cluster : clusters_) {
-    bool moved = !cluster.remembered;
-    for (size_t i = 0; i < cluster.held.size() && !moved; ++i)
-      moved = !std::equal(x + 3 * cluster.held[i], x + 3 * cluster.held[i] + 3, cluster.held_at.begin() + 3 * i);
-    if (!moved) {
-      for (size_t i = 0; i < cluster.points.size(); ++i)
-        std::copy_n(cluster.minimum.begin() + 3 * i, 3, x + 3 * cluster.points[i]);
+    const size_t n = 3 * cluster.points.size(), met = cluster.minima.size() / n;
+    auto place = [&](const double* minimum) {  // cluster order into x
+      for (size_t i = 0; i < cluster.points.size(); ++i) std::copy_n(minimum + 3 * i, 3, x + 3 * cluster.points[i]);
+    };
+    size_t seen = met;  // the newest first: SLSQP returns to its latest points most
+    while (seen > 0 && !held_where(cluster, seen - 1, x)) --seen;
+    if (seen > 0) {
+      place(cluster.minima.data() + (seen - 1) * n);
       continue;
     }
     for (int32_t point : cluster.points) std::copy_n(start_.begin() + 3 * point, 3, x + 3 * point);
-    newton(cluster, x, original);
-    for (size_t i = 0; i < cluster.held.size(); ++i)
-      std::copy_n(x + 3 * cluster.held[i], 3, cluster.held_at.begin() + 3 * i);
-    for (size_t i = 0; i < cluster.points.size(); ++i)
-      std::copy_n(x + 3 * cluster.points[i], 3, cluster.minimum.begin() + 3 * i);
-    cluster.remembered = true;
+    const double from_start = newton(cluster, x, original);
+    if (met > 0) {
+      for (size_t i = 0; i < cluster.points.size(); ++i)
+        std::copy_n(x + 3 * cluster.points[i], 3, from_start_.begin() + 3 * i);
+      place(cluster.minima.data() + (met - 1) * n);
+      if (newton(cluster, x, original) >= from_start) place(from_start_.data());
+    }
+    for (int32_t point : cluster.held) cluster.held_at.insert(cluster.held_at.end(), x + 3 * point, x + 3 * point + 3);
+    for (int32_t point : cluster.points) cluster.minima.insert(cluster.minima.end(), x + 3 * point, x + 3 * point + 3);
   }
 }
 

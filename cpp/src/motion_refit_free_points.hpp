@@ -31,16 +31,19 @@ class FreePointClusters {
   size_t cluster_count() const { return clusters_.size(); }
   const std::vector<int32_t>& cluster_points(size_t cluster) const { return clusters_[cluster].points; }
 
-  // Where every minimisation starts until the next call: of the minima over the free points
-  // reached from x (P, 3) and from the original positions (Ed's minimum), with x's other points,
-  // the lower one (the angle terms have several minima). A fixed start per frame makes the
-  // minimum a function of the other points alone: starting from the last minimum instead would
-  // let a far trial step of SLSQP carry the free points into another basin, and E would differ
-  // at the same variables.
+  // Starts a frame's minimisations. The fixed start: of the minima over the free points reached
+  // from x (P, 3) and from the original positions (Ed's minimum), with x's other points, the
+  // lower one (the angle terms have several minima). Forgets the previous frame's minima.
   void set_start(const double* x, const double* original);
 
-  // Moves the free points of x (P, 3) to the minimum of E over them with every other point
-  // held, reached from set_start's positions. original: the one given to set_start.
+  // Moves the free points of x (P, 3) to a minimum of E over them with every other point held:
+  // of Newton's method from the fixed start and from the cluster's latest minimum of this frame,
+  // the lower one. From the fixed start alone, a step of the held points can carry Newton into
+  // another of the angle terms' minima, and E jumps where it should vary smoothly: on Xbot's
+  // fingers, SLSQP then stalled at such a jump for hundreds of evaluations. The latest minimum
+  // follows the valley SLSQP is in. Held points met before in this frame get the minimum they
+  // got then, so E is a function of the variables within a solve, and the point SLSQP returns
+  // (one it evaluated) is placed as it was when evaluated. original: the one given to set_start.
   void minimise(double* x, const double* original);
 
  private:
@@ -48,17 +51,18 @@ class FreePointClusters {
     std::vector<int32_t> points;   // free points, in increasing order
     std::vector<int32_t> triples;  // angle triples with at least one of them
     BlockCholesky hessian;         // over the points (in cluster order), coupled by the triples
-    // Newton from the same start with the same held points ends at the same minimum, so
-    // minimise keeps its last one: the held points of the triples (the other points of E's part
-    // that depends on the cluster), where they were, and the minimum; until set_start.
+    // This frame's minima: the held points of the triples (the other points of E's part that
+    // depends on the cluster) where they were, and the minimum placed for them, oldest first.
     std::vector<int32_t> held;
-    std::vector<double> held_at, minimum;
-    bool remembered = false;
+    std::vector<double> held_at, minima;  // (entries, 3 held) and (entries, 3 points)
   };
   // E's part that depends on the cluster's points at x, with its gradient (3 n) and exact
   // Hessian (into cluster.hessian) when asked.
   double cluster_energy(Cluster& cluster, const double* x, const double* original, double* gradient,
                         bool hessian);
+
+  // Whether the held points of x (P, 3) are where they were for the cluster's minimum `entry`.
+  bool held_where(const Cluster& cluster, size_t entry, const double* x) const;
 
   // Newton's method on one cluster from where x has its points; returns the cluster's E there.
   double newton(Cluster& cluster, double* x, const double* original);
@@ -67,7 +71,7 @@ class FreePointClusters {
   std::vector<Cluster> clusters_;
   std::vector<int32_t> local_;  // (P,) a free point's index in its cluster, -1 otherwise
   std::vector<double> start_;   // (P, 3) set_start's positions (only free points are read)
-  std::vector<double> gradient_, step_, trial_, best_;
+  std::vector<double> gradient_, step_, trial_, best_, from_start_;
 };
 
 }  // namespace animlod::detail

@@ -10,10 +10,11 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]`` (part of ``make bench`
    Fig. 7's bone-length variation (the worst re-fitted bone's standard deviation over frames
    relative to its key length), FK residual, SLSQP evaluations per frame, frames whose first
    solve failed and frames that fell back to the frozen key motion, seconds.
-2. Speed: 8 levels of 131_01.bvh and of the procedural humanoid with fingers (594 frames), with
-   the default ranking and with Eq. 3 alone (whose chain has no trial re-fits), best of 3
-   interleaved rounds: wall and CPU seconds (goal: 131_01 under 10 s), the cost per joint-frame
-   and its ratio to 131_01's with the same ranking (goal: 1).
+2. Speed: 8 levels of 131_01.bvh, of the procedural humanoid with fingers (594 frames) and of
+   Xbot.glb's clips end to end (captured fingers, 67 joints, 268 frames), with the default
+   ranking and with Eq. 3 alone (whose chain has no trial re-fits), best of 3 interleaved
+   rounds: wall and CPU seconds (goal: 131_01 under 10 s), the cost per joint-frame and its
+   ratio to 131_01's with the same ranking (goal: 1).
 3. Both solvers on the same frames: the Python reference (PyPI nlopt, Python callbacks) and the
    core (nlopt's C library), plain (the reference's variables) and preconditioned (the default),
    on one thread, per level of 131_01 and the Bandai run: ms per frame, evaluations, and how many
@@ -94,6 +95,26 @@ def clips(quick: bool) -> list[tuple[str, Motion]]:
     return result[:3] if quick else result
 
 
+def clips_end_to_end(path: Path) -> Motion:
+    """The clips of a skinned glTF on its skeleton, one after the other (Xbot: 7 clips, 268 frames)."""
+    from animlod.io.gltf import read_skinned
+
+    _, motions = read_skinned(path)
+    first = motions[0]
+    same = [m for m in motions if m.skeleton.names == first.skeleton.names]
+    translations = None
+    if any(m.joint_translations is not None for m in same):
+        translations = np.concatenate([m.local_translations() for m in same])
+    return Motion(
+        first.skeleton,
+        np.concatenate([m.root_positions for m in same]),
+        np.concatenate([m.local_rotations for m in same]),
+        first.fps,
+        f"{path.stem} clips",
+        translations,
+    )
+
+
 def joints_of(motion: Motion) -> int:
     return int(np.count_nonzero(~motion.skeleton.end_sites))
 
@@ -158,6 +179,9 @@ def speed_table(quick: bool) -> None:
         cases.append(("131_01.bvh", read_bvh(path)))
     # 18 cycles: 594 frames, the length of the issue's 43-joint clip with fingers (592).
     cases.append(("procedural humanoid, walk", humanoid_motion(humanoid().skeleton, "walk", cycles=2 if quick else 18)))
+    xbot = DATA_DIR / "gltf" / "Xbot.glb"
+    if xbot.exists() and not quick:  # captured fingers: 67 joints, 30 of them in the hands
+        cases.append(("Xbot.glb, its clips end to end", clips_end_to_end(xbot)))
     runs = [(label, motion, threads, ranking) for label, motion in cases
             for threads, ranking in ((0, "refit"), (0, "importance"))]  # fmt: skip
     if cases[0][0] == "131_01.bvh":
@@ -185,7 +209,7 @@ def speed_table(quick: bool) -> None:
         )  # fmt: skip
     print_table(
         f"8 levels with the core's SLSQP (hard bone lengths), analysis included, best of {rounds} rounds "
-        "(goals: 131_01 under 10 s; the walk at 1.00x 131_01's CPU per joint-frame)",
+        "(goals: 131_01 under 10 s; a clip with fingers at 1.00x 131_01's CPU per joint-frame)",
         (
             "clip",
             "ranking",

@@ -140,3 +140,33 @@ def test_frozen_joints_keep_their_key_angle_on_the_walk(walk_chain) -> None:
         key = level.frozen.key_rotations[frozen]
         np.testing.assert_allclose(np.abs(np.sum(placed * key, axis=-1)), 1.0, atol=1e-12)
         assert set(frozen.tolist()) == {motion.skeleton.index(name) for name in level.report.frozen}
+
+
+def test_a_level_reuses_its_chosen_trial_refit_for_those_frames(monkeypatch) -> None:
+    # The refit ranking re-fits each proposal on 16 frames; the chosen one's frames are the
+    # level's own solves (every frame is solved on its own), so the level solves only the others.
+    import animlod.motion_lod.chain as chain
+
+    motion = humanoid_motion(humanoid().skeleton, "walk", cycles=1, fps=20.0)
+    solved_frames: list[int] = []
+    refit = chain._refit
+
+    def counting_refit(problem, original, *args, **kwargs):
+        solved_frames.append(original.shape[0])
+        return refit(problem, original, *args, **kwargs)
+
+    monkeypatch.setattr(chain, "_refit", counting_refit)
+    reused = build_motion_chain(motion, [38, 28, 18, 10], workers=1)
+    level_frames = solved_frames[-3:]  # the three re-fitted levels come after the trials
+    assert 16 in solved_frames[:-3]  # the trials
+    assert all(count == motion.frame_count - 16 for count in level_frames), (level_frames, motion.frame_count)
+
+    solve_level = chain._solve_level
+    monkeypatch.setattr(chain, "_solve_level", lambda *args: solve_level(*args[:7]))  # no reuse
+    solved_frames.clear()
+    alone = build_motion_chain(motion, [38, 28, 18, 10], workers=1)
+    assert solved_frames[-3:] == [motion.frame_count] * 3
+    size = reused.figure_size
+    for a, b in zip(reused.levels, alone.levels):
+        assert a.report.frozen == b.report.frozen
+        assert np.abs(a.positions - b.positions).max() <= 1e-7 * size  # the same solves, inputs equal to rounding

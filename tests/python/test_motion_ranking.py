@@ -104,8 +104,8 @@ def test_refit_choice_takes_the_proposal_with_the_lowest_trial_error_and_stays_n
     counts = level_joint_counts(motion, analysis, [12, 10, 7, 3])
     trials = []
 
-    def trial_error(level, sample) -> float:  # prefers whatever depth proposes
-        trials.append(sample.frame_count)
+    def trial_error(level, frames) -> float:  # prefers whatever depth proposes
+        trials.append(frames.size)
         chosen = set(np.flatnonzero(level.frozen))
         return float(len(chosen - set(depth_first[: len(chosen)])))
 
@@ -120,7 +120,7 @@ def test_refit_choice_takes_the_proposal_with_the_lowest_trial_error_and_stays_n
     for error, tries_all in ((NEGLIGIBLE_ERROR, False), (2 * NEGLIGIBLE_ERROR, True)):
         tried: list[int] = []
 
-        def tie(level, sample, error=error, tried=tried) -> float:
+        def tie(level, frames, error=error, tried=tried) -> float:
             tried.append(int(level.frozen.sum()))
             return error * level.length_scale()
 

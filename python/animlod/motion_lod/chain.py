@@ -19,7 +19,7 @@ from ..options import MotionRefitOptions
 from .analysis import MotionAnalysis, analyze_motion
 from .core_refit import core_energy, refit_core
 from .frozen import FrozenLevel, freeze, frozen_motion
-from .grouped_solve import FrameFailure, RefitResult
+from .grouped_solve import FrameFailure, RefitResult, combine_frames
 from .newton import refit_newton
 from .objective import RefitProblem, Weights, build_problem
 from .ranking import DEFAULT_RANKING
@@ -247,6 +247,14 @@ def _resolve_solver(solver: str, slsqp_options: MotionRefitOptions | None) -> Mo
 
 
 @dataclass
+class _KnownFrames:
+    """A level's re-fit on some frames of the clip (the refit ranking's trial of the chosen joints)."""
+
+    frames: np.ndarray
+    result: RefitResult
+
+
+@dataclass
 class _Solved:
     """A level re-fitted on a motion's frames: the problem, the solve, the level's output motion,
     every original point placed by it (frozen parts by their key posture) and the original."""
@@ -270,15 +278,28 @@ def _solve_level(
     slsqp_options: MotionRefitOptions,
     workers: int,
     progress: Callable[[float], None] | None,
+    known: _KnownFrames | None = None,
 ) -> _Solved:
-    """Re-fits ``level`` on every frame of ``motion`` and places every original point."""
+    """Re-fits ``level`` on every frame of ``motion`` (but ``known``'s, whose re-fit is given) and
+    places every original point."""
     problem = build_problem(level, weights)
     original = motion.world_positions()
     if level.frozen.any():
         fallback = frozen_motion(level, motion).world_positions()
         hard = slsqp_options.hard_constraints
         cold_starts = _cold_starts(level, problem, motion, original, fallback) if hard else None
-        result = _refit(problem, original, fallback, cold_starts, solver, slsqp_options, workers, progress)
+        rest = np.arange(motion.frame_count)
+        parts = []
+        if known is not None:
+            rest = np.setdiff1d(rest, known.frames)
+            parts.append((known.frames, known.result))
+            if progress:
+                progress(known.frames.size)
+        if rest.size:
+            starts = None if cold_starts is None else cold_starts[rest]
+            solved = _refit(problem, original[rest], fallback[rest], starts, solver, slsqp_options, workers, progress)
+            parts.append((rest, solved))
+        result = combine_frames(motion.frame_count, parts)
     else:  # E = 0 at the original positions, its global minimum: nothing to solve
         result = RefitResult(original, np.zeros(motion.frame_count), np.zeros(motion.frame_count, dtype=np.int64))
         if progress:
@@ -298,14 +319,16 @@ def build_level(
     workers: int = 0,
     skin: SkinnedMesh | None = None,
     progress: Callable[[float], None] | None = None,
+    known: _KnownFrames | None = None,
 ) -> MotionLevel:
-    """One level with ``joint_count`` joints (see :func:`build_motion_chain` for the options)."""
+    """One level with ``joint_count`` joints (see :func:`build_motion_chain` for the options);
+    ``known``: its re-fit on some frames, already done."""
     slsqp_options = _resolve_solver(solver, slsqp_options)
     start = time.perf_counter()
     total = int(np.count_nonzero(~motion.skeleton.end_sites))
     frozen_joints = analysis.priority[: total - joint_count]
     level = freeze(motion, analysis, frozen_joints)
-    solved = _solve_level(level, motion, weights, solver, slsqp_options, workers, progress)
+    solved = _solve_level(level, motion, weights, solver, slsqp_options, workers, progress, known)
     result = solved.result
     fk = solved.output.world_positions()
     error = solved.errors()
@@ -378,16 +401,28 @@ def build_motion_chain(
         motion, locked=locked, max_frames=max_frames, ranking=ranking, workers=workers
     )
     counts = level_joint_counts(motion, analysis, levels)
+    # Each trial's re-fit by its frozen joints: a level reuses its chosen trial's frames (every
+    # frame's solve is its own, so those frames' results are the level's; not with warm starts,
+    # which carry a frame's result into the next).
+    trials: dict[bytes, _KnownFrames] = {}
     if analysis.ranking == "refit":
         slsqp_options = _resolve_solver(solver, slsqp_options)
 
-        def trial_error(level: FrozenLevel, sample: Motion) -> float:
-            solved = _solve_level(level, sample, weights, solver, slsqp_options, workers, None)
+        def trial_error(level: FrozenLevel, frames: np.ndarray) -> float:
+            solved = _solve_level(level, motion.take_frames(frames), weights, solver, slsqp_options, workers, None)
+            if not slsqp_options.warm_start:
+                trials[level.frozen.tobytes()] = _KnownFrames(frames, solved.result)
             return float(solved.errors().mean())
 
         analysis = choose_by_refit(motion, analysis, counts, trial_error, on_choice)
+    total = int(np.count_nonzero(~motion.skeleton.end_sites))
     result = []
     for index, count in enumerate(counts):
         progress = on_level(index, count) if on_level else None
-        result.append(build_level(motion, analysis, count, weights, solver, slsqp_options, workers, skin, progress))
+        frozen = np.zeros(motion.skeleton.joint_count, bool)
+        frozen[analysis.priority[: total - count]] = True
+        known = trials.get(frozen.tobytes())
+        result.append(
+            build_level(motion, analysis, count, weights, solver, slsqp_options, workers, skin, progress, known)
+        )
     return MotionLodChain(analysis, result)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import nullcontext
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -114,3 +114,19 @@ def combine_groups(original: np.ndarray, solved: list[tuple[np.ndarray, RefitRes
         for failure in result.failures:
             failures.setdefault(failure.frame, failure)
     return RefitResult(positions, value, evaluations, [failures[f] for f in sorted(failures)])
+
+
+def combine_frames(frame_count: int, parts: list[tuple[np.ndarray, RefitResult]]) -> RefitResult:
+    """The result over ``frame_count`` frames from results over disjoint sets of them
+    (``(frames, result)``, each result's frames in the order of its indices), which cover all."""
+    first = parts[0][1]
+    positions = np.empty((frame_count,) + first.positions.shape[1:])
+    value = np.empty(frame_count)
+    evaluations = np.empty(frame_count, dtype=first.evaluations.dtype)
+    failures = []
+    for frames, result in parts:
+        positions[frames] = result.positions
+        value[frames] = result.objective
+        evaluations[frames] = result.evaluations
+        failures += [replace(f, frame=int(frames[f.frame])) for f in result.failures]
+    return RefitResult(positions, value, evaluations, sorted(failures, key=lambda f: f.frame))

@@ -10,7 +10,8 @@ the others do not share. So at every level, going from fine to coarse, each rank
 ranking.PROPOSING_RANKINGS proposes its next joints after those already frozen; each distinct
 proposal is frozen and re-fitted on TRIAL_FRAMES evenly spaced frames of the clip, and the one
 with the lowest mean joint position error over every original point is kept (ties: the earlier
-ranking, importance first). A joint frozen at one level stays frozen at every coarser one.
+ranking, importance first). A joint frozen at one level stays frozen at every coarser one. The
+kept proposal's trial is the level's own re-fit of those frames (chain.py reuses it).
 
 Proposals are tried in ranking order, and one whose error is at the resolution of the float32 keys
 the levels are written with (NEGLIGIBLE_ERROR) is kept without trying the rest: below it the
@@ -56,7 +57,7 @@ def choose_by_refit(
     motion: Motion,
     analysis: MotionAnalysis,
     counts: Sequence[int],
-    trial_error: Callable[[FrozenLevel, Motion], float],
+    trial_error: Callable[[FrozenLevel, np.ndarray], float],
     progress: Callable[[int, int], None] | None = None,
 ) -> MotionAnalysis:
     """``analysis`` with its priority chosen level by level by the re-fit's error.
@@ -66,7 +67,8 @@ def choose_by_refit(
     motion : the clip.
     analysis : its analysis (key frames, importance, candidates in ``priority``).
     counts : joint counts of the levels, strictly decreasing, the first every joint.
-    trial_error : mean joint position error of a frozen level re-fitted on a sample motion.
+    trial_error : mean joint position error of a frozen level re-fitted on the given frames of
+        ``motion`` (TRIAL_FRAMES evenly spaced ones, the same for every call).
     progress : called with (levels chosen, levels to choose) after each level.
 
     Returns
@@ -74,7 +76,7 @@ def choose_by_refit(
     MotionAnalysis whose ``priority`` freezes, for each count, the chosen joints first.
     """
     orders = proposal_orders(motion, analysis)
-    sample = motion.take_frames(spread_frames(motion.frame_count, TRIAL_FRAMES))
+    frames = spread_frames(motion.frame_count, TRIAL_FRAMES)
     frozen: list[int] = []
     for chosen, count in enumerate(counts[1:], start=1):
         need = counts[0] - count - len(frozen)
@@ -85,7 +87,7 @@ def choose_by_refit(
                 proposals.append(proposal)
         if len(proposals) > 1:
             levels = [freeze(motion, analysis, frozen + p) for p in proposals]
-            proposals = [proposals[_lowest_error(levels, sample, trial_error)]]
+            proposals = [proposals[_lowest_error(levels, frames, trial_error)]]
         frozen += proposals[0] if proposals else []
         if progress:
             progress(chosen, len(counts) - 1)
@@ -93,12 +95,12 @@ def choose_by_refit(
 
 
 def _lowest_error(
-    levels: list[FrozenLevel], sample: Motion, trial_error: Callable[[FrozenLevel, Motion], float]
+    levels: list[FrozenLevel], frames: np.ndarray, trial_error: Callable[[FrozenLevel, np.ndarray], float]
 ) -> int:
     """Index of the first level with the lowest trial error, or of the first whose error is negligible."""
     best, best_error = 0, np.inf
     for index, level in enumerate(levels):
-        error = trial_error(level, sample)
+        error = trial_error(level, frames)
         if error < best_error:
             best, best_error = index, error
         if best_error <= NEGLIGIBLE_ERROR * level.length_scale():

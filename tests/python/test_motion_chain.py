@@ -132,6 +132,23 @@ def test_cli_on_a_skinned_glb_writes_a_glb_per_level(tmp_path) -> None:
     assert len(motions) == 1 and motions[0].skeleton.joint_count == coarse.skeleton.joint_count
 
 
+def test_cli_takes_a_glb_clip_by_name_and_names_the_clips_it_has(tmp_path, capsys) -> None:
+    from animlod.io.gltf import read_skinned, write_glb
+
+    skin = humanoid()
+    clips = [humanoid_motion(skin.skeleton, kind, cycles=1, fps=10.0) for kind in ("walk", "jump")]
+    source = tmp_path / "mover.glb"
+    write_glb(source, skin, clips)
+    names = [m.name for m in read_skinned(source)[1]]
+    assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--joints", "20", "--clip", names[1]]) == 0
+    _, written = read_skinned(tmp_path / "out" / "mover_lod0.glb")
+    assert [m.name for m in written] == [names[1]]
+    assert main(["motion", str(source), "-o", str(tmp_path / "bad"), "--clip", "dance"]) == 2
+    error = capsys.readouterr().err
+    assert "no animation named 'dance'" in error and f"1: {names[1]!r}" in error
+    assert not (tmp_path / "bad").exists()
+
+
 def test_frozen_joints_keep_their_key_angle_on_the_walk(walk_chain) -> None:
     _, motion, chain = walk_chain
     for level in chain.levels[1:]:

@@ -73,9 +73,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )  # fmt: skip
     parser.add_argument("--max-frames", type=int, default=600, help="frames motion analysis looks at, at most")
     parser.add_argument(
-        "--clip", type=int, default=None,
-        help="which animation of a glTF file (index); default the first, or all of them as one motion when each "
-        "moves other joints (one animation per joint node)",
+        "--clip", type=_clip, default=None,
+        help="which animation of a glTF file, by index or name; default the first, or all of them as one motion "
+        "when each moves other joints (one animation per joint node)",
     )  # fmt: skip
     parser.add_argument("--plot", action="store_true", help="write importance, key posture and error charts (PNG)")
     parser.set_defaults(run=run)
@@ -117,6 +117,14 @@ class _Progress:
         for bar in (self.choice, self.levels):
             if bar is not None:
                 bar.close()
+
+
+def _clip(text: str) -> int | str:
+    """--clip's value: an index when it is a whole number, else an animation's name."""
+    try:
+        return int(text)
+    except ValueError:
+        return text
 
 
 def run(args: argparse.Namespace) -> int:

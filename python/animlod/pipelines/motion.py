@@ -59,7 +59,7 @@ def build_motion_levels(
     translation_tolerance: float = TRANSLATION_TOLERANCE,
     weights: Sequence[float] = (0.2, 0.4, 0.4),
     max_frames: int = 600,
-    clip: int | None = None,
+    clip: int | str | None = None,
     on_level: Callable[[int, int, int, int], Callable[[float], None] | None] | None = None,
     on_choice: Callable[[int, int], None] | None = None,
     on_note: Callable[[str], None] | None = None,
@@ -82,8 +82,8 @@ def build_motion_levels(
     translation_tolerance : fraction of a bone's length above which a translating joint never freezes.
     weights : (alpha, beta, gamma) of the distance, string and angle errors (Eq. 5).
     max_frames : frames the motion analysis looks at, at most.
-    clip : which animation of a glTF input; None: the first, or all of them as one motion when
-        each moves other joints (one animation per joint node).
+    clip : which animation of a glTF input, by index or name; None: the first, or all of them as
+        one motion when each moves other joints (one animation per joint node).
     on_level : called with (level index, joint count, frame count, number of levels) as each
         level starts; may return a callback taking the frames done.
     on_choice : called with (levels chosen, levels to choose) while the "refit" ranking's trial
@@ -158,7 +158,7 @@ def build_motion_levels(
 
 
 def _read_input(
-    source: str | os.PathLike, clip: int | None, note: Callable[[str], None]
+    source: str | os.PathLike, clip: int | str | None, note: Callable[[str], None]
 ) -> tuple[Motion, SkinnedMesh | None]:
     """The motion to simplify and, for a skinned glTF, its skin."""
     path = os.fspath(source)
@@ -183,6 +183,12 @@ def _read_input(
                  "(use --clip to take one)")  # fmt: skip
             return merged, skin
         return motions[0], skin
+    if isinstance(clip, str):
+        names = [m.name for m in motions]
+        if clip not in names:
+            listed = ", ".join(f"{i}: {name!r}" for i, name in enumerate(names))
+            raise FormatError(path, "clip", f"no animation named {clip!r}; the file has {listed}")
+        return motions[names.index(clip)], skin
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
     return motions[clip], skin

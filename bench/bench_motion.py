@@ -96,12 +96,13 @@ def clips(quick: bool) -> list[tuple[str, Motion]]:
 
 
 def clips_end_to_end(path: Path) -> Motion:
-    """The clips of a skinned glTF on its skeleton, one after the other (Xbot: 7 clips, 268 frames)."""
+    """The clips of a skinned glTF on the first one's skeleton and frame rate, one after the other
+    (Xbot: 7 clips, 268 frames)."""
     from animlod.io.gltf import read_skinned
 
     _, motions = read_skinned(path)
     first = motions[0]
-    same = [m for m in motions if m.skeleton.names == first.skeleton.names]
+    same = [m for m in motions if m.skeleton.names == first.skeleton.names and m.fps == first.fps]
     translations = None
     if any(m.joint_translations is not None for m in same):
         translations = np.concatenate([m.local_translations() for m in same])

@@ -9,7 +9,7 @@ the level's skeleton and motion (skeleton_reduce.py) and, for a skinned characte
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -254,6 +254,11 @@ class _KnownFrames:
     result: RefitResult
 
 
+def _trial_key(level: FrozenLevel) -> bytes:
+    """What identifies a level among the refit ranking's trials: its frozen joints."""
+    return level.frozen.tobytes()
+
+
 @dataclass
 class _Solved:
     """A level re-fitted on a motion's frames: the problem, the solve, the level's output motion,
@@ -319,15 +324,16 @@ def build_level(
     workers: int = 0,
     skin: SkinnedMesh | None = None,
     progress: Callable[[float], None] | None = None,
-    known: _KnownFrames | None = None,
+    trials: Mapping[bytes, _KnownFrames] | None = None,
 ) -> MotionLevel:
     """One level with ``joint_count`` joints (see :func:`build_motion_chain` for the options);
-    ``known``: its re-fit on some frames, already done."""
+    ``trials``: re-fits on some frames already done, by :func:`_trial_key`; the level's is reused."""
     slsqp_options = _resolve_solver(solver, slsqp_options)
     start = time.perf_counter()
     total = int(np.count_nonzero(~motion.skeleton.end_sites))
     frozen_joints = analysis.priority[: total - joint_count]
     level = freeze(motion, analysis, frozen_joints)
+    known = trials.get(_trial_key(level)) if trials else None
     solved = _solve_level(level, motion, weights, solver, slsqp_options, workers, progress, known)
     result = solved.result
     fk = solved.output.world_positions()
@@ -411,18 +417,14 @@ def build_motion_chain(
         def trial_error(level: FrozenLevel, frames: np.ndarray) -> float:
             solved = _solve_level(level, motion.take_frames(frames), weights, solver, slsqp_options, workers, None)
             if not slsqp_options.warm_start:
-                trials[level.frozen.tobytes()] = _KnownFrames(frames, solved.result)
+                trials[_trial_key(level)] = _KnownFrames(frames, solved.result)
             return float(solved.errors().mean())
 
         analysis = choose_by_refit(motion, analysis, counts, trial_error, on_choice)
-    total = int(np.count_nonzero(~motion.skeleton.end_sites))
     result = []
     for index, count in enumerate(counts):
         progress = on_level(index, count) if on_level else None
-        frozen = np.zeros(motion.skeleton.joint_count, bool)
-        frozen[analysis.priority[: total - count]] = True
-        known = trials.get(frozen.tobytes())
         result.append(
-            build_level(motion, analysis, count, weights, solver, slsqp_options, workers, skin, progress, known)
+            build_level(motion, analysis, count, weights, solver, slsqp_options, workers, skin, progress, trials)
         )
     return MotionLodChain(analysis, result)

@@ -15,6 +15,7 @@ void bind_lod_selector(py::module_& m);
 void bind_pose(py::module_& m);
 void bind_point_mesh_distance(py::module_& m);
 void bind_posture_error(py::module_& m);
+void bind_cumulative_ranking(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -30,4 +31,5 @@ PYBIND11_MODULE(_core, m) {
   animlod::bindings::bind_pose(m);
   animlod::bindings::bind_point_mesh_distance(m);
   animlod::bindings::bind_posture_error(m);
+  animlod::bindings::bind_cumulative_ranking(m);
 }

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from test_motion_figures import Z, figure_motion
 
-from animlod import rotations
+from animlod import _core, rotations
 from animlod.model import Motion, Skeleton
 from animlod.motion_lod import RANKINGS, analyze_motion, build_motion_chain, level_joint_counts
 from animlod.motion_lod.chain import build_level
@@ -93,6 +93,14 @@ def test_cumulative_order_freezes_the_joint_that_moves_the_figure_least() -> Non
         assert errors[joint] <= min(errors.values()) * (1 + 1e-9) + 1e-15
         frozen.append(joint)
     assert analysis.priority[0] == motion.skeleton.index("LeftWrist")  # never turns: costs nothing
+
+
+def test_the_core_cumulative_ranking_names_bad_arrays() -> None:
+    eye = np.broadcast_to(np.eye(4), (2, 3, 4, 4))
+    with pytest.raises(ValueError, match=r"key_local: expected shape \(J, 4, 4\) like world, got \(2, 4, 4\)"):
+        _core.cumulative_freeze_steps(eye, np.eye(4)[None].repeat(2, 0), np.array([-1, 0, 1]), np.array([0, 1, 1]))
+    with pytest.raises(ValueError, match=r"candidates\[0\]: the root cannot freeze"):
+        _core.cumulative_freeze_steps(eye, eye[0], np.array([-1, 0, 1]), np.array([1, 1, 1]))
 
 
 def test_refit_choice_takes_the_proposal_with_the_lowest_trial_error_and_stays_nested() -> None:

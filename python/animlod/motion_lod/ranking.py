@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import rotations
+from .. import _core, rotations
 from ..model import Motion, spread_frames
 
 RANKINGS = ("refit", "importance", "paper", "depth", "variance", "cumulative")
@@ -64,79 +64,25 @@ def rotation_variance(motion: Motion, frames: np.ndarray) -> np.ndarray:
     return np.mean((2.0 * np.arccos(cosine)) ** 2, axis=0)
 
 
-def descendants(parents: np.ndarray) -> np.ndarray:
-    """``(J, J) bool``: ``[j, d]`` is True when ``d`` is below ``j`` (not ``j`` itself)."""
-    count = parents.size
-    below = np.zeros((count, count), bool)
-    for joint in range(count - 1, 0, -1):  # children before parents: O(J^2) booleans
-        parent = parents[joint]
-        below[parent, joint] = True
-        below[parent] |= below[joint]
-    return below
-
-
-def _rigid_inverse(transforms: np.ndarray) -> np.ndarray:
-    """Inverses of rigid 4x4 transforms ``(..., 4, 4)``."""
-    rotation = np.swapaxes(transforms[..., :3, :3], -1, -2)
-    inverse = np.zeros_like(transforms)
-    inverse[..., :3, :3] = rotation
-    inverse[..., :3, 3] = -np.einsum("...ij,...j->...i", rotation, transforms[..., :3, 3])
-    inverse[..., 3, 3] = 1.0
-    return inverse
-
-
 def cumulative_scores(
     motion: Motion, key_frames: np.ndarray, frames: np.ndarray, candidates: np.ndarray
 ) -> np.ndarray:
     """Step at which the ``cumulative`` ranking freezes each candidate, ``(J,)`` (inf for others).
 
     Freezing joint j at its key frame's local transform moves j and every point below it by one
-    rigid transform, so each candidate's cost is O(points below it) per frame, with no forward
-    kinematics per candidate; after a freeze only the costs of the frozen joint's ancestors and
-    descendants change, and only those are measured again. At most ``CUMULATIVE_FRAMES`` of the
-    analysis frames (evenly spaced) are used: the cost is a mean over frames.
+    rigid transform per frame, so no candidate needs forward kinematics, and after a freeze only
+    the frozen joint's ancestors and descendants are measured again (the core's
+    ``cumulative_freeze_steps``). At most ``CUMULATIVE_FRAMES`` of the analysis frames (evenly
+    spaced) are used: the cost is a mean over frames.
     """
-    skeleton = motion.skeleton
-    count = skeleton.joint_count
-    joints = np.arange(count)
+    joints = np.arange(motion.skeleton.joint_count)
     if frames.size > CUMULATIVE_FRAMES:
         frames = frames[spread_frames(frames.size, CUMULATIVE_FRAMES)]
     key_local = rotations.compose_transform(
         motion.local_translations()[key_frames, joints], motion.local_rotations[key_frames, joints]
     )  # (J, 4, 4)
-    world = motion.world_transforms()[frames]  # (n, J, 4, 4): the current (partly frozen) figure
-    positions = world[..., :3, 3]  # a view: follows every update of world
-    original = positions.copy()
-    subtree = descendants(skeleton.parents) | np.eye(count, dtype=bool)  # [j, d]: d is j or below it
-    pair_joint, pair_point = np.nonzero(subtree & candidates[:, None])
-    parents = np.maximum(skeleton.parents, 0)  # the root is never a candidate
-    error = np.zeros((frames.size, count))  # every point's distance from its original position
-    cost = np.full(count, np.inf)  # mean growth of the summed error if the joint froze next
-    stale = candidates.copy()
-    scores = np.full(count, np.inf)
-
-    def moves(joints: np.ndarray) -> np.ndarray:
-        """(n, len(joints), 4, 4): how each joint's subtree moves if it froze now (its frozen world
-        transform times the inverse of its current one)."""
-        return world[:, parents[joints]] @ key_local[joints] @ _rigid_inverse(world[:, joints])
-
-    for step in range(int(np.count_nonzero(candidates))):  # O(J) steps, vectorised over frames
-        measured = np.flatnonzero(stale)
-        move = moves(measured)
-        rows = stale[pair_joint]
-        joint, point = pair_joint[rows], pair_point[rows]
-        slot = np.searchsorted(measured, joint)
-        moved = np.einsum("npij,npj->npi", move[:, slot, :3, :3], positions[:, point]) + move[..., :3, 3][:, slot]
-        growth = np.linalg.norm(moved - original[:, point], axis=-1) - error[:, point]
-        cost[measured] = np.bincount(slot, weights=growth.sum(axis=0), minlength=measured.size)
-        chosen = int(np.argmin(cost))  # ties: the lowest index
-        scores[chosen] = step
-        cost[chosen] = np.inf
-        below = subtree[chosen]
-        world[:, below] = moves(np.array([chosen]))[:, :1] @ world[:, below]
-        error[:, below] = np.linalg.norm(positions[:, below] - original[:, below], axis=-1)
-        stale = (below | subtree[:, chosen]) & candidates & np.isfinite(cost)
-    return scores
+    world = motion.world_transforms()[frames]  # (n, J, 4, 4)
+    return _core.cumulative_freeze_steps(world, key_local, motion.skeleton.parents, candidates)
 
 
 def elimination_order(scores: np.ndarray, candidates: np.ndarray) -> list[int]:

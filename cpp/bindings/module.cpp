@@ -16,6 +16,7 @@ void bind_pose(py::module_& m);
 void bind_point_mesh_distance(py::module_& m);
 void bind_posture_error(py::module_& m);
 void bind_cumulative_ranking(py::module_& m);
+void bind_motion_recovery(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -32,4 +33,5 @@ PYBIND11_MODULE(_core, m) {
   animlod::bindings::bind_point_mesh_distance(m);
   animlod::bindings::bind_posture_error(m);
   animlod::bindings::bind_cumulative_ranking(m);
+  animlod::bindings::bind_motion_recovery(m);
 }

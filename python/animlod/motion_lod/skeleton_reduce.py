@@ -20,10 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import rotations
+from .. import _core, rotations
 from ..model import Motion, Skeleton
 from .frozen import FrozenLevel, held_translations
-from .ranking import joint_depths
 
 # Child offsets shorter than this fraction of the level's extent give no direction.
 _SHORT = 1e-9
@@ -49,35 +48,6 @@ def _folded_offsets(level: FrozenLevel, translations: np.ndarray) -> np.ndarray:
     return level.fold_translations[kept] + rotations.rotate(level.fold_rotations[kept], translations[:, kept])
 
 
-def _swing(from_vectors: np.ndarray, to_vectors: np.ndarray) -> np.ndarray:
-    """Smallest rotations ``(T, 4)`` turning ``from_vectors (T, 3)`` towards ``to_vectors (T, 3)``.
-
-    Identity where either vector is zero; a half turn about a perpendicular axis when opposite.
-    """
-    a = from_vectors / np.maximum(np.linalg.norm(from_vectors, axis=-1, keepdims=True), 1e-300)
-    b = to_vectors / np.maximum(np.linalg.norm(to_vectors, axis=-1, keepdims=True), 1e-300)
-    q = np.concatenate([rotations.cross(a, b), 1.0 + np.sum(a * b, axis=-1, keepdims=True)], axis=-1)
-    opposite = np.linalg.norm(q, axis=-1) < 1e-12
-    if opposite.any():
-        helper = np.where(np.abs(a[opposite, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-        axis = np.cross(a[opposite], helper)
-        q[opposite] = np.concatenate(
-            [axis / np.linalg.norm(axis, axis=-1, keepdims=True), np.zeros((axis.shape[0], 1))], -1
-        )
-    zero = (np.linalg.norm(from_vectors, axis=-1) == 0.0) | (np.linalg.norm(to_vectors, axis=-1) == 0.0)
-    q[zero] = rotations.identity()
-    return rotations.normalize(q)
-
-
-def _best_fit_rotation(from_vectors: np.ndarray, to_vectors: np.ndarray) -> np.ndarray:
-    """Rotations ``(T, 4)`` minimising sum_i |R a_i - d_i|^2 (Kabsch), ``a, d (T, N, 3)``."""
-    covariance = np.einsum("tni,tnj->tij", to_vectors, from_vectors)
-    u, _, vt = np.linalg.svd(covariance)
-    sign = np.sign(np.linalg.det(u @ vt))
-    u[:, :, 2] *= sign[:, None]
-    return rotations.from_matrix(u @ vt)
-
-
 def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) -> Motion:
     """The level's motion whose forward kinematics follows the re-fitted ``positions``.
 
@@ -93,45 +63,27 @@ def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) ->
     """
     skeleton = reduce_skeleton(level)
     kept = level.kept_indices
-    translations = _folded_offsets(level, motion.local_translations())  # (T, K, 3)
-    original_world = rotations.from_matrix(motion.world_transforms()[:, kept, :3, :3])
-    targets = positions[:, kept]
     scale = level.length_scale()
-    children = skeleton.children()
     static_offsets = np.linalg.norm(skeleton.offsets, axis=-1)
-
-    world = np.empty_like(original_world)
-    placed = np.empty_like(targets)  # where forward kinematics has put each joint so far
-    placed[:, 0] = targets[:, 0]
     translating = level.animated[kept]
     # Children at a fixed offset give a joint its direction; a translating child is placed by its
     # own translation, whatever this rotation is. Aimed by a best-fit rotation when they span a
     # plane, else by the swing towards the longest.
-    useful = [[c for c in children[j] if static_offsets[c] > _SHORT * scale and not translating[c]]
-              for j in range(skeleton.joint_count)]  # fmt: skip
-    planar = np.array([_spans_a_plane(skeleton.offsets[u]) for u in useful], bool)
-    depth = joint_depths(skeleton.parents)
-    for layer in range(int(depth.max()) + 1):  # joints of one depth at once: O(depth) numpy steps
-        joints = np.flatnonzero(depth == layer)
-        parents = skeleton.parents[joints]
-        if layer > 0:
-            moving = translating[joints]  # no fixed bone: the translation follows the re-fit
-            if moving.any():
-                j, p = joints[moving], parents[moving]
-                translations[:, j] = rotations.rotate(rotations.conjugate(world[:, p]), targets[:, j] - placed[:, p])
-            placed[:, joints] = placed[:, parents] + rotations.rotate(world[:, parents], translations[:, joints])
-        world[:, joints] = original_world[:, joints]
-        # Aim from where each joint really is, so that misfits do not pile up down a chain.
-        aimed = [j for j in joints if useful[j] and not planar[j]]
-        if aimed:
-            longest = [useful[j][int(np.argmax(static_offsets[useful[j]]))] for j in aimed]
-            offsets = rotations.rotate(world[:, aimed], translations[:, longest])
-            wanted = targets[:, longest] - placed[:, aimed]
-            world[:, aimed] = rotations.multiply(_swing(offsets, wanted), world[:, aimed])
-        for j in (j for j in joints if planar[j]):  # a few per skeleton (hips, chest, hands)
-            offsets = rotations.rotate(world[:, j, None], translations[:, useful[j]])
-            wanted = targets[:, useful[j]] - placed[:, j, None]
-            world[:, j] = rotations.multiply(_best_fit_rotation(offsets, wanted), world[:, j])
+    aims = []
+    for children in skeleton.children():
+        useful = [c for c in children if static_offsets[c] > _SHORT * scale and not translating[c]]
+        if useful and not _spans_a_plane(skeleton.offsets[useful]):
+            useful = [useful[int(np.argmax(static_offsets[useful]))]]
+        aims.append(useful)
+    world, translations = _core.recover_world_rotations(
+        skeleton.parents,
+        translating,
+        np.cumsum([0] + [len(a) for a in aims]),
+        np.array([c for a in aims for c in a], dtype=np.int64),
+        rotations.from_matrix(motion.world_transforms()[:, kept, :3, :3]),
+        positions[:, kept],
+        _folded_offsets(level, motion.local_translations()),
+    )
     local = world.copy()
     local[:, 1:] = rotations.multiply(rotations.conjugate(world[:, skeleton.parents[1:]]), world[:, 1:])
     joint_translations = translations if motion.joint_translations is not None else None

@@ -147,7 +147,12 @@ void FreePointClusters::minimise(double* x, const double* original) {
       place(cluster.minima.data() + (seen - 1) * n);
       continue;
     }
-    for (int32_t point : cluster.points) std::copy_n(start_.begin() + 3 * point, 3, x + 3 * point);
+    double shift[3] = {0.0, 0.0, 0.0};  // the held points' mean move since set_start
+    for (int32_t point : cluster.held)
+      for (int a = 0; a < 3; ++a)
+        shift[a] += (x[3 * point + a] - start_[3 * point + a]) / static_cast<double>(cluster.held.size());
+    for (int32_t point : cluster.points)
+      for (int a = 0; a < 3; ++a) x[3 * point + a] = start_[3 * point + a] + shift[a];
     const double from_start = newton(cluster, x, original);
     if (met > 0) {
       for (size_t i = 0; i < cluster.points.size(); ++i)

@@ -13,7 +13,9 @@ optimisation result x_j(t) and the hierarchical information of each joint". Here
   rotation (Kabsch) when it has several, none when it has no child. A translating joint (no
   fixed bone) takes the translation that puts it at its re-fitted position. Forward kinematics
   then reproduces the re-fitted positions exactly wherever they are rigid with respect to the
-  level's skeleton, which the string term Es (or the hard constraints) asks for.
+  level's skeleton, which the string term Es (or the hard constraints) asks for. The per-frame
+  loop is the core's (``recover_world_rotations``, motion_recovery.hpp); this module prepares the
+  level's skeleton and which children aim each joint.
 """
 
 from __future__ import annotations

@@ -152,6 +152,17 @@ bool BlockCholesky::factor(double shift) {
   return true;
 }
 
+bool BlockCholesky::factor_least_shift(double base, int& rung) {
+  const auto shift = [base](int k) { return std::ldexp(base, 2 * k); };  // base 4^k, exactly
+  bool factored = false;  // whether the last factorisation succeeded
+  while (rung > 0 && (factored = factor(shift(rung - 1)))) --rung;
+  while (!factored) {
+    if (!std::isfinite(shift(rung))) return false;
+    if (!(factored = factor(shift(rung)))) ++rung;
+  }
+  return true;
+}
+
 void BlockCholesky::solve(const double* rhs, double* x) {
   const size_t n = order_.size();
   std::vector<double>& y = work_;

@@ -40,6 +40,11 @@ class BlockCholesky {
   // not positive definite (or not finite). The matrix added so far is kept, so a failed call
   // can be repeated with a larger shift.
   bool factor(double shift);
+  // Factorises the matrix plus the least shift base * 4^k (k >= 0) that makes it positive
+  // definite; false if none is finite. rung: the k to search from, set to the k found. Positive
+  // definiteness only grows with the shift, so stepping down or up from the last k finds the same
+  // k as counting up from 0, in two factorisations where k repeats (counting up takes k + 1).
+  bool factor_least_shift(double base, int& rung);
   // Solves (matrix + shift) x = rhs with the last successful factorisation; rhs and x are
   // (nodes, 3) in node order and may be the same array.
   void solve(const double* rhs, double* x);

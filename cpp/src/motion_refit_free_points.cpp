@@ -179,10 +179,7 @@ double FreePointClusters::newton(Cluster& cluster, double* x, const double* orig
     // Where an angle term makes the Hessian indefinite, shift it towards Ed's curvature until
     // it is positive definite (Levenberg): every step then descends.
     const bool exact = cluster.hessian.factor(0.0);
-    bool factored = exact;
-    for (double shift = curvature; !factored && std::isfinite(shift); shift *= 4.0)
-      factored = cluster.hessian.factor(shift);
-    if (!factored) break;  // not finite: nothing to step along
+    if (!exact && !cluster.hessian.factor_least_shift(curvature, cluster.rung)) break;  // not finite: nothing to step along
     cluster.hessian.solve(gradient, step);
     // -slope, the Newton decrement, is about twice the value left to gain: stop when that is
     // below what rounding resolves.

@@ -58,6 +58,7 @@ class FreePointClusters {
     // depends on the cluster) where they were, and the minimum placed for them, oldest first.
     std::vector<int32_t> held;
     std::vector<double> held_at, minima;  // (entries, 3 held) and (entries, 3 points)
+    int rung = 0;  // the last Levenberg shift's k (BlockCholesky::factor_least_shift)
   };
   // E's part that depends on the cluster's points at x, with its gradient (3 n) and exact
   // Hessian (into cluster.hessian) when asked.

@@ -1,7 +1,8 @@
 // The sparse block Cholesky of free-point clusters (cpp/src/motion_refit_block_cholesky.hpp):
 // on the coupling pattern of angle triples along a skeleton (a point with its parent and
 // grandparent) and on a pattern that needs fill, its solve matches Eigen's dense LLT; it
-// refuses an indefinite matrix and factorises it once shifted, as the Newton step needs.
+// refuses an indefinite matrix and factorises it once shifted, as the Newton step needs, with
+// the least shift of a ladder found from any starting rung.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -128,4 +129,26 @@ TEST_CASE("block Cholesky: an indefinite matrix is refused, and factorised once 
   CHECK_FALSE(matrix.factor(0.0));
   REQUIRE(matrix.factor(40.0));
   CHECK(solve_error(matrix, 40.0, 7) < 1e-12);
+}
+
+TEST_CASE("block Cholesky: the least shift is found from any rung, as counting up from 0 finds it") {
+  std::vector<int32_t> parent = {-1, 0, 1, 2, 1, 4};
+  const Pairs pairs = skeleton_pattern(parent);
+  BlockCholesky matrix(parent.size(), pairs);
+  fill_random(matrix, pairs, -3.0, 5);
+  const double base = 0.01;
+  int counted = 0;  // the first k whose shift base 4^k factorises, counting up
+  while (!matrix.factor(std::ldexp(base, 2 * counted))) ++counted;
+  REQUIRE(counted > 2);
+  for (int start : {0, counted - 1, counted, counted + 1, counted + 7}) {
+    int rung = start;
+    REQUIRE(matrix.factor_least_shift(base, rung));
+    CHECK(rung == counted);
+    CHECK(solve_error(matrix, std::ldexp(base, 2 * counted), 8) < 1e-12);  // the factors are the shifted matrix's
+  }
+  int rung = 0;
+  matrix.clear();  // a matrix with no finite positive definite shift: NaN on the diagonal
+  const double nan_block[9] = {std::nan(""), 0, 0, 0, 1, 0, 0, 0, 1};
+  matrix.add(0, 0, nan_block);
+  CHECK_FALSE(matrix.factor_least_shift(base, rung));
 }

@@ -103,17 +103,7 @@ def clips_end_to_end(path: Path) -> Motion:
     _, motions = read_skinned(path)
     first = motions[0]
     same = [m for m in motions if m.skeleton.names == first.skeleton.names and m.fps == first.fps]
-    translations = None
-    if any(m.joint_translations is not None for m in same):
-        translations = np.concatenate([m.local_translations() for m in same])
-    return Motion(
-        first.skeleton,
-        np.concatenate([m.root_positions for m in same]),
-        np.concatenate([m.local_rotations for m in same]),
-        first.fps,
-        f"{path.stem} clips",
-        translations,
-    )
+    return Motion.concatenate(same, f"{path.stem} clips")
 
 
 def joints_of(motion: Motion) -> int:

@@ -253,6 +253,22 @@ class Motion:
             self.skeleton, self.root_positions[frames], self.local_rotations[frames], self.fps, self.name, translations
         )
 
+    @staticmethod
+    def concatenate(motions: list[Motion], name: str) -> Motion:
+        """The motions one after another as one, on the first one's skeleton and fps (the
+        caller's to check they share them)."""
+        translations = None
+        if any(motion.joint_translations is not None for motion in motions):
+            translations = np.concatenate([motion.local_translations() for motion in motions])
+        return Motion(
+            motions[0].skeleton,
+            np.concatenate([motion.root_positions for motion in motions]),
+            np.concatenate([motion.local_rotations for motion in motions]),
+            motions[0].fps,
+            name,
+            translations,
+        )
+
     def world_transforms(self) -> np.ndarray:
         """Forward kinematics: world transforms ``(T, J, 4, 4)`` of every joint (float64, in the
         core: pose.hpp's clip_forward_kinematics)."""

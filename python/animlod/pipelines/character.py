@@ -176,18 +176,7 @@ def _joined_motion(motions: list[Motion]) -> tuple[Motion, list[slice]]:
     and each clip's frames in it."""
     starts = np.cumsum([0] + [motion.frame_count for motion in motions])
     spans = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
-    translations = None
-    if any(motion.joint_translations is not None for motion in motions):
-        translations = np.concatenate([motion.local_translations() for motion in motions])
-    joined = Motion(
-        motions[0].skeleton,
-        np.concatenate([motion.root_positions for motion in motions]),
-        np.concatenate([motion.local_rotations for motion in motions]),
-        fps=motions[0].fps,
-        name="+".join(motion.name for motion in motions),
-        joint_translations=translations,
-    )
-    return joined, spans
+    return Motion.concatenate(motions, "+".join(motion.name for motion in motions)), spans
 
 
 @dataclass

@@ -20,6 +20,8 @@ namespace py = pybind11;
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 // Solver inputs that must keep double precision (motion re-fit, lattice fits, motion analysis).
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+// Masks: one byte per element, any bool or integer dtype converted.
+using MaskArray = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>;
 // Indices: int32. Bindings take indices as py::array and convert them with index_array, never
 // as an IndexArray argument, whose forcecast would wrap 2**32 + 5 to 5.
 using IndexArray = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;

@@ -13,7 +13,6 @@
 namespace animlod::bindings {
 
 namespace {
-using MaskArray = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>;
 
 py::dict level_to_dict(AqemLevel&& level, py::ssize_t frame_count, py::ssize_t attribute_count,
                        py::ssize_t influence_count, py::ssize_t position_attribute_count) {

@@ -9,8 +9,6 @@ namespace animlod::bindings {
 
 namespace {
 
-using MaskArray = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>;
-
 py::array_t<double> cumulative_freeze_steps_py(const DoubleArray& world, const DoubleArray& key_local,
                                                const py::array& parents, const MaskArray& candidates) {
   require_shape(world, "world", {-1, -1, 4, 4}, "(n, J, 4, 4)");

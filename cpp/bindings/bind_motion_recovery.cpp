@@ -11,8 +11,6 @@ namespace animlod::bindings {
 
 namespace {
 
-using MaskArray = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>;
-
 std::tuple<py::array_t<double>, py::array_t<double>> recover_world_rotations_py(
     const py::array& parents, const MaskArray& translating, const py::array& aim_offsets,
     const py::array& aim_children, const DoubleArray& original_world, const DoubleArray& targets,

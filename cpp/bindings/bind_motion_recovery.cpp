@@ -53,14 +53,15 @@ void bind_motion_recovery(py::module_& m) {
         py::arg("translations"),
         R"doc(World rotations of a motion level recovered from re-fitted positions, every frame at once.
 
-Per frame, in joint order, each joint is placed by forward kinematics from its parent (a
-translating joint first takes the translation that puts it at its target), and its original
-world rotation is corrected by the rotation that aims its children from there at their targets:
-the swing towards its one aim child, the best-fit rotation (Kabsch) of several.
+Per frame, in joint order, a root is placed at its target and any other joint by forward
+kinematics from its parent (a translating joint first takes the translation that puts it at its
+target), and its original world rotation is corrected by the rotation that aims its children
+from there at their targets: the swing towards its one aim child, the best-fit rotation (Kabsch)
+of several.
 
 Parameters
 ----------
-parents : (K,) int, -1 for the root (joint 0), parents before children.
+parents : (K,) int, -1 for a root (placed at its target), parents before children.
 translating : (K,) bool joints with no fixed bone.
 aim_offsets, aim_children : each joint's aim children, aim_children[aim_offsets[j]:aim_offsets[j + 1]].
 original_world : (T, K, 4) float64 unit quaternions (x, y, z, w), the original world rotations.

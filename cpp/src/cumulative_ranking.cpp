@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "animlod/pose.hpp"
+
 namespace animlod {
 
 namespace {
@@ -146,13 +148,10 @@ class GreedyFreezes {
 
 Status cumulative_freeze_steps(const double* world, const double* key_local, const int32_t* parents,
                                const uint8_t* candidates, size_t frame_count, size_t joint_count, double* scores) {
-  for (size_t j = 0; j < joint_count; ++j) {
-    const bool root = parents[j] < 0;
-    if (!root && static_cast<size_t>(parents[j]) >= j)
-      return Status::error("parents[" + std::to_string(j) + "]: " + std::to_string(parents[j]) +
-                           " is not a joint before it (parents come before their children)");
-    if (root && candidates[j]) return Status::error("candidates[" + std::to_string(j) + "]: the root cannot freeze");
-  }
+  if (Status status = validate_parents(parents, joint_count); !status.ok) return status;
+  for (size_t j = 0; j < joint_count; ++j)
+    if (parents[j] < 0 && candidates[j])
+      return Status::error("candidates[" + std::to_string(j) + "]: the root cannot freeze");
   for (size_t i = 0; i < 16 * frame_count * joint_count; ++i)
     if (!std::isfinite(world[i]))
       return Status::error("world[" + std::to_string(i / 16 / joint_count) + ", " +

@@ -78,12 +78,7 @@ Quaternion best_fit_rotation(const Eigen::Matrix3d& covariance) {  // sum_i d_i 
 Status validate(const AimedSkeleton& skeleton, size_t frame_count, const double* original_world,
                 const double* targets, const double* translations) {
   const size_t k = skeleton.joint_count;
-  for (size_t j = 0; j < k; ++j) {
-    const int32_t parent = skeleton.parents[j];
-    if (j == 0 ? parent != -1 : (parent < 0 || static_cast<size_t>(parent) >= j))
-      return Status::error("parents[" + std::to_string(j) + "]: " + std::to_string(parent) +
-                           (j == 0 ? " for the root (expected -1)" : " is not a joint before it"));
-  }
+  if (Status status = validate_parents(skeleton.parents, k); !status.ok) return status;
   for (size_t j = 0; j < k; ++j) {
     if (skeleton.aim_offsets[j + 1] < skeleton.aim_offsets[j])
       return Status::error("aim_offsets[" + std::to_string(j + 1) + "]: decreasing");
@@ -122,8 +117,8 @@ Status recover_world_rotations(const AimedSkeleton& skeleton, size_t frame_count
     const auto target = [&](size_t j) { return Eigen::Vector3d(frame_targets + 3 * j); };
     const auto offset = [&](size_t j) { return Eigen::Vector3d(frame_translations + 3 * j); };
     for (size_t j = 0; j < k; ++j) {
-      if (j == 0) {
-        placed[0] = target(0);
+      if (skeleton.parents[j] < 0) {  // a root is where the re-fit put it
+        placed[j] = target(j);
       } else {
         const auto parent = static_cast<size_t>(skeleton.parents[j]);
         const Quaternion parent_world = load(world + 4 * parent);

@@ -112,7 +112,7 @@ TEST_CASE("cumulative ranking names bad input") {
   const int32_t late_parent[5] = {-1, 2, 0, 0, 3};
   animlod::Status status =
       animlod::cumulative_freeze_steps(world.data(), key.data(), late_parent, candidates, 3, 5, scores.data());
-  CHECK(status.message == "parents[1]: 2 is not a joint before it (parents come before their children)");
+  CHECK(status.message == "skeleton: joint 1 has parent 2, expected -1 or a joint before it (topological order)");
   const uint8_t root_candidate[5] = {1, 1, 1, 1, 1};
   status = animlod::cumulative_freeze_steps(world.data(), key.data(), figure.parents, root_candidate, 3, 5,
                                             scores.data());

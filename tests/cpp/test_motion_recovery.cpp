@@ -82,6 +82,24 @@ TEST_CASE("a translating joint takes the translation that puts it on its target"
   CHECK(out[4 * 1 + 3] == doctest::Approx(1.0));
 }
 
+TEST_CASE("a second root is placed at its target and aims its child there") {
+  const int32_t parents[4] = {-1, 0, -1, 2};
+  const uint8_t translating[4] = {0, 0, 0, 0};
+  const int32_t aim_offsets[5] = {0, 1, 1, 2, 2};
+  const int32_t aim_children[2] = {1, 3};
+  const animlod::AimedSkeleton view{parents, translating, aim_offsets, aim_children, 4};
+  std::vector<double> original(16, 0.0), out(16);
+  for (int j = 0; j < 4; ++j) original[4 * j + 3] = 1.0;
+  std::vector<double> translations = {0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0};
+  const std::vector<double> targets = {0, 0, 0, 0, 1, 0, 5, 0, 0, 6, 0, 0};  // the second arm points along x
+  REQUIRE(animlod::recover_world_rotations(view, 1, original.data(), targets.data(), translations.data(), out.data()));
+  double tip[3];
+  rotate(&out[4 * 2], &translations[3 * 3], tip);
+  CHECK(5.0 + tip[0] == doctest::Approx(6.0));
+  CHECK(tip[1] == doctest::Approx(0.0).epsilon(1e-12));
+  CHECK(out[4 * 0 + 3] == doctest::Approx(1.0));  // the first arm already points at its target
+}
+
 TEST_CASE("motion recovery names bad input") {
   Hand hand;
   std::vector<double> original(24, 0.0), targets(18, 0.0), translations(18, 0.0), out(24);
@@ -91,7 +109,8 @@ TEST_CASE("motion recovery names bad input") {
         .message;
   };
   const int32_t late[6] = {-1, 0, 1, 1, 5, 2};
-  CHECK(run({late, hand.translating, hand.aim_offsets, hand.aim_children, 6}) == "parents[4]: 5 is not a joint before it");
+  CHECK(run({late, hand.translating, hand.aim_offsets, hand.aim_children, 6}) ==
+        "skeleton: joint 4 has parent 5, expected -1 or a joint before it (topological order)");
   const int32_t stranger[5] = {1, 2, 3, 5, 5};
   CHECK(run({hand.parents, hand.translating, hand.aim_offsets, stranger, 6}) ==
         "aim_children[3]: 5 is not a child of joint 1");

@@ -19,10 +19,10 @@ namespace animlod {
 //
 // world: (n, J, 4, 4) row-major world transforms of the J joints at the n measured frames (the
 // joints in parent-before-child order). key_local: (J, 4, 4) each joint's local transform at its
-// key frame. parents: (J,) parent index, -1 for the root only. candidates: (J,) 1 for joints that
-// may freeze (never the root). Writes `scores` (J,): the step at which each candidate is frozen
-// (0 first), infinity for the others; ties go to the lowest index. Errors (named by element): a
-// parent out of order, a candidate root, a non-finite transform.
+// key frame. parents: (J,) parent index, -1 for a root. candidates: (J,) 1 for joints that may
+// freeze (never a root). Writes `scores` (J,): the step at which each candidate is frozen
+// (0 first), infinity for the others; ties go to the lowest index. Errors (named by element): the
+// checks of pose.hpp's validate_parents, a candidate root, a non-finite transform.
 Status cumulative_freeze_steps(const double* world, const double* key_local, const int32_t* parents,
                                const uint8_t* candidates, size_t frame_count, size_t joint_count, double* scores);
 

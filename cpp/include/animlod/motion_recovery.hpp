@@ -17,15 +17,16 @@ namespace animlod {
 // that turns it towards its re-fitted position; several (spanning a plane), the best-fit
 // rotation (Kabsch) of all of them; none, no correction.
 struct AimedSkeleton {
-  const int32_t* parents = nullptr;       // (K,) -1 for the root only, parents before children
+  const int32_t* parents = nullptr;       // (K,) -1 for a root, parents before children
   const uint8_t* translating = nullptr;   // (K,) 1: no fixed bone, placed by its own translation
   const int32_t* aim_offsets = nullptr;   // (K + 1,)
   const int32_t* aim_children = nullptr;  // (aim_offsets[K],) children of each joint, none translating
   size_t joint_count = 0;                 // K
 };
 
-// Per frame, in joint order: a joint is placed by forward kinematics from its parent (a
-// translating joint first takes the translation that puts it at its target); its world rotation
+// Per frame, in joint order: a root is placed at its target, any other joint by forward
+// kinematics from its parent (a translating joint first takes the translation that puts it at
+// its target); its world rotation
 // starts from `original_world` (so a bone keeps its twist) and is corrected by the rotation that
 // aims its children's offsets from where the joint was placed at their targets, so misfits do
 // not pile up down a chain.
@@ -35,7 +36,7 @@ struct AimedSkeleton {
 // translations: (T, K, 3) the joints' offsets in their parents' frames; a translating joint's is
 // replaced by the recovered one. out_world: (T, K, 4) recovered world rotations (not normalised
 // again after the correction, as the quaternion products leave them).
-// Errors (naming the element): a parent that does not come before its joint, a child index out of
+// Errors (naming the element): the checks of pose.hpp's validate_parents, a child index out of
 // range or not a child of its joint, a translating aim child, a non-finite input.
 Status recover_world_rotations(const AimedSkeleton& skeleton, size_t frame_count, const double* original_world,
                                const double* targets, double* translations, double* out_world);

@@ -12,7 +12,8 @@ geometry level, then motion level) so that a benchmark can walk the whole grid.
 
 Motion level m >= 1 adds, per skin, a reduced skeleton as joint nodes of its own, a skin over
 them and one animation per input clip (``extras.animlod = {"clip", "motion_level"}``); a level
-node at motion level m uses that skin, so any glTF engine can play it.
+node at motion level m uses that skin, so any glTF engine can play it. Nodes hung from the
+input's joints (props, sockets) are copied onto each level's skeleton (:mod:`.attachments`).
 """
 
 from __future__ import annotations
@@ -38,12 +39,14 @@ from ..io.gltf_lod import (
     attach_chain,
     screen_coverages,
 )
+from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import add_animation, add_skeleton, add_skin
 from ..metrics import surface_error
 from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
+from .attachments import add_level_attachments, find_attachments
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
 
@@ -111,6 +114,7 @@ def build_character(
     levels_wanted = len(ratios) + 1
     started = time.perf_counter()
     motion_chains: dict[int, tuple[MotionLodChain, list[tuple[Clip, slice]]]] = {}
+    reduced_motions: dict[int, tuple[SkinRig, Motion]] = {}  # the rig and the motion each chain reduces
     notes = []
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
     # Larger skeletons first: a skin whose joints all belong to a larger skin (a helmet bound to
@@ -137,6 +141,7 @@ def build_character(
         say(f"skin {skin}: {levels} motion levels over {len(clips)} clips")
         chain = build_motion_chain(joined, levels=levels, solver=solver, workers=workers, analysis=analysis)
         motion_chains[skin] = (chain, list(zip(clips, spans)))
+        reduced_motions[skin] = (drawable.rig, joined)
     motion_seconds = time.perf_counter() - started
     started = time.perf_counter()
     geometry = {}
@@ -147,7 +152,14 @@ def build_character(
     geometry_seconds = time.perf_counter() - started
 
     builder = GlbBuilder.from_document(doc)
-    motion_nodes = {skin: _add_motion_levels(builder, chain, clips) for skin, (chain, clips) in motion_chains.items()}
+    motion_nodes = {}
+    for skin, (chain, clips) in motion_chains.items():
+        motion_nodes[skin] = _add_motion_levels(builder, chain, clips)
+        rig, joined = reduced_motions[skin]
+        attachments, attachment_notes = find_attachments(doc, rig)
+        notes += [f"skin {skin}: {note}" for note in attachment_notes]
+        for m, level in enumerate(chain.levels[1:], start=1):
+            add_level_attachments(builder, doc, rig, attachments, joined, level, m, motion_nodes[skin][m].joint_nodes)
     chains = {}
     for drawable in animated:
         chain, clips = motion_chains[drawable.skin_index]

@@ -38,12 +38,21 @@ def character_with_sockets(tmp_path_factory):
         socket = {"name": f"socket {joint}", "translation": [0.03, 0.05, -0.02], "rotation": turn, "scale": [2.0] * 3}
         socket = builder.append("nodes", socket)
         nodes[by_name[joint]].setdefault("children", []).append(socket)
+    # A socket that slides on the right hand, and a morph target whose weight the clip animates.
     moving = builder.append("nodes", {"name": "moving socket"})
     nodes[by_name["RightHand"]].setdefault("children", []).append(moving)
     animation = builder.json["animations"][0]
-    animation["channels"].append({"sampler": 0, "target": {"node": moving, "path": "translation"}})
-    still = builder.add(np.zeros((_key_count(builder, animation), 3), np.float32))
-    animation["samplers"].append({"input": animation["samplers"][0]["input"], "output": still})
+    keys = builder.json["accessors"][animation["samplers"][0]["input"]]["count"]
+    slide = builder.add(np.linspace([0.0, 0.0, 0.0], [0.0, 0.1, 0.0], keys).astype(np.float32))
+    _animate(animation, moving, "translation", slide)
+    (base,) = [index for index, node in enumerate(nodes) if "skin" in node]
+    mesh = builder.json["meshes"][nodes[base]["mesh"]]
+    vertices = builder.json["accessors"][mesh["primitives"][0]["attributes"]["POSITION"]]["count"]
+    bulge = np.zeros((vertices, 3), np.float32)
+    bulge[:, 2] = 0.01
+    mesh["primitives"][0]["targets"] = [{"POSITION": builder.add(bulge, bounds=True)}]
+    mesh["weights"] = [0.0]
+    _animate(animation, base, "weights", builder.add(np.linspace(0.0, 1.0, keys).astype(np.float32)[:, None]))
     source = folder / "sockets.glb"
     builder.save(source)
     output = folder / "sockets_lod.glb"
@@ -51,8 +60,10 @@ def character_with_sockets(tmp_path_factory):
     return source, output, report
 
 
-def _key_count(builder: GlbBuilder, animation: dict) -> int:
-    return builder.json["accessors"][animation["samplers"][0]["input"]]["count"]
+def _animate(animation: dict, node: int, path: str, output: int) -> None:
+    """A channel of ``animation`` on ``node``'s ``path``, keyed at the animation's first input."""
+    animation["samplers"].append({"input": animation["samplers"][0]["input"], "output": output})
+    animation["channels"].append({"sampler": len(animation["samplers"]) - 1, "target": {"node": node, "path": path}})
 
 
 def _posed_worlds(doc: GltfDocument, animation: int) -> list[np.ndarray]:
@@ -117,7 +128,8 @@ def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(cha
         worlds = _posed_worlds(doc_out, animation)
         copy = _node(doc_out, f"socket {joint}@motion{m}")
         level_skin = doc_out.gltf.skins[doc_out.gltf.nodes[grid[m]].skin]
-        assert doc_out.parents[copy] in level_skin.joints  # hung from the level's own skeleton
+        hung = doc_out.parents[copy]  # from the level's own skeleton, or a static frame node on it
+        assert hung in level_skin.joints or doc_out.parents[hung] in level_skin.joints
         frozen_somewhere |= joint not in {doc_out.gltf.nodes[n].name for n in level_skin.joints}
         vertex_world = _skinned_vertex(doc_out, grid[m], vertex, worlds)
         seen = (np.linalg.inv(worlds[copy]) @ np.append(vertex_world, 1.0))[:3]
@@ -126,7 +138,28 @@ def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(cha
         assert frozen_somewhere  # the frozen path (key posture between the kept ancestor) is tested
 
 
-def test_an_animated_node_on_a_joint_is_reported_not_copied(character_with_sockets):
-    _, output, report = character_with_sockets
-    assert any("'moving socket'" in note and "animated" in note for note in report.notes)
-    assert not any((node.name or "").startswith("moving socket@") for node in GltfDocument(output).gltf.nodes)
+def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(character_with_sockets):
+    # The sliding socket's channel goes to its copy, the morph weights' to the same mesh node;
+    # both read the input clip's keys.
+    source, output, _ = character_with_sockets
+    doc_in, doc_out = GltfDocument(source), GltfDocument(output)
+    clip = doc_in.gltf.animations[0]
+    outputs = {
+        (doc_in.gltf.nodes[channel.target.node].name, channel.target.path): clip.samplers[channel.sampler].output
+        for channel in clip.channels
+    }
+    levels = [animation for animation in doc_out.gltf.animations if "@motion" in (animation.name or "")]
+    assert levels
+    for animation in levels:
+        m = animation.name.rsplit("@motion", 1)[1]
+        carried = {
+            (doc_out.gltf.nodes[channel.target.node].name, path): animation.samplers[channel.sampler].output
+            for channel in animation.channels
+            for path in [channel.target.path]
+            if path == "weights" or "socket" in (doc_out.gltf.nodes[channel.target.node].name or "")
+        }
+        base_name = next(node.name for node in doc_in.gltf.nodes if node.skin is not None)
+        assert carried == {
+            (f"moving socket@motion{m}", "translation"): outputs[("moving socket", "translation")],
+            (base_name, "weights"): outputs[(base_name, "weights")],
+        }

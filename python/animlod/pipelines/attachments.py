@@ -1,14 +1,18 @@
-"""Nodes hung from a character's joints (props, sockets, eyes), carried to every motion level.
+"""What moves with a character besides its skeleton, carried to every motion level: the nodes
+hung from its joints (props, sockets, eyes) and its clips' other channels (morph weights, those
+nodes' own animation, anything else the clip moves).
 
-A motion level is a skeleton of its own (see :mod:`animlod.pipelines.character`): a level's
-animation moves its joint nodes, not the input's. A node hung from a joint of the input (a sword
-in a hand, a hat on the head, an empty socket node an engine attaches things to) follows the
-input's skeleton only, so wherever a level plays it would stand still in its rest pose. Each
-such attachment is copied for every motion level: under the level's node of its joint, or, where
-that joint is frozen, under its nearest kept ancestor with the frozen joints' key posture in
-between (seeds/000, Section 5.1: a frozen joint keeps the local transformation of its key
-frame), so that it moves as the level's skin moves the vertices bound to its joint. The copies
-share the input's meshes, cameras and lights.
+A motion level is a skeleton of its own (see :mod:`animlod.pipelines.character`) with a clip of
+its own per input clip: playing a level's clip moves the level's joint nodes, not the input's. A
+node hung from a joint of the input (a sword in a hand, a hat on the head, an empty socket node
+an engine attaches things to) would stand still in its rest pose there, and whatever else the
+input clip animates (a face's morph weights) would not move. Each attachment is copied for every
+motion level: under the level's node of its joint, or, where that joint is frozen, under its
+nearest kept ancestor with the frozen joints' key posture in between (seeds/000, Section 5.1: a
+frozen joint keeps the local transformation of its key frame), so that it moves as the level's
+skin moves the vertices bound to its joint. The copies share the input's meshes, cameras and
+lights. Each level clip then takes the input clip's channels that target no skeleton, retargeted
+to the copies where they animate an attachment.
 """
 
 from __future__ import annotations
@@ -34,28 +38,27 @@ class Attachment:
     node: int
 
 
-def find_attachments(doc: GltfDocument, rig: SkinRig) -> tuple[list[Attachment], list[str]]:
-    """The rig's attachments, and notes on the nodes hung from its joints that cannot follow a
-    motion level: an animated node (the level's clips animate joints only)."""
+def find_attachments(doc: GltfDocument, rig: SkinRig) -> list[Attachment]:
+    """The subtrees hung from the rig's joint nodes that hold no joint and no skinned mesh."""
     joint_of = {node: j for j, node in enumerate(rig.joint_nodes)}
-    # Nodes that are part of a skeleton or skinned: posed by their own rules, never attachments.
-    skeletal = {node for skin in doc.gltf.skins for node in skin.joints}
-    skeletal |= {n for n, node in enumerate(doc.gltf.nodes) if node.skin is not None}
-    animated = {channel.target.node for animation in doc.gltf.animations for channel in animation.channels}
-    attachments, notes = [], []
+    skeletal = posing_nodes(doc) | {n for n, node in enumerate(doc.gltf.nodes) if node.skin is not None}
+    attachments = []
     for node, joint in joint_of.items():
         for child in doc.gltf.nodes[node].children or []:
-            subtree = _subtree(doc, child)
-            if child in joint_of or not skeletal.isdisjoint(subtree):
+            if child in joint_of or not skeletal.isdisjoint(_subtree(doc, child)):
                 continue  # a joint, a node between joints, or a skinned mesh (LoD'd on its own)
-            if not animated.isdisjoint(subtree):
-                notes.append(
-                    f"{doc.node_label(child)} hangs from joint {rig.skeleton.names[joint]!r} and is animated: "
-                    "the motion levels do not carry it"
-                )
-                continue
             attachments.append(Attachment(joint, child))
-    return attachments, notes
+    return attachments
+
+
+def posing_nodes(doc: GltfDocument) -> set[int]:
+    """Nodes that pose a skeleton: every skin's joints and their ancestors (a level's clip poses
+    its own skeleton in their place)."""
+    joints = {node for skin in doc.gltf.skins for node in skin.joints}
+    found = set(joints)
+    for joint in joints:
+        found.update(doc.ancestors(joint))
+    return found
 
 
 def add_level_attachments(
@@ -67,9 +70,10 @@ def add_level_attachments(
     level: MotionLevel,
     level_index: int,
     joint_nodes: list[int],
-) -> None:
+) -> dict[int, int]:
     """Copies of ``attachments`` on motion level ``level_index``'s skeleton, whose joint nodes
-    (level joint order) are ``joint_nodes``. ``original`` is the motion the level reduces."""
+    (level joint order) are ``joint_nodes``; ``original`` is the motion the level reduces.
+    Returns the copy of each node of the copied subtrees."""
     frozen = level.frozen
     level_joint = np.full(frozen.frozen.size, -1, dtype=np.int64)
     level_joint[frozen.kept_indices] = np.arange(frozen.kept_indices.size)
@@ -78,21 +82,43 @@ def add_level_attachments(
     first = np.array([0])
     world = expand_motion(frozen, level.motion.take_frames(first), original.take_frames(first)).world_transforms()[0]
     parents = frozen.skeleton.parents
+    suffix = f"@motion{level_index}"
+    copies: dict[int, int] = {}
     for attachment in attachments:
         ancestor = attachment.joint
         while level_joint[ancestor] < 0:
             ancestor = int(parents[ancestor])
-        relative = np.linalg.inv(world[ancestor]) @ world[attachment.joint]  # identity where kept
         # The document's joint node carries its accumulated uniform scale, the rigid level joint
         # does not (gltf_skin.py: W = W_rigid S(c)).
-        scale = np.diag([*[rig.scales[attachment.joint]] * 3, 1.0])
-        local = relative @ scale @ doc.rest_matrix(attachment.node)
-        copy = _copy_subtree(builder, attachment.node, f"@motion{level_index}")
-        node = builder.json["nodes"][copy]
-        for key in ("translation", "rotation", "scale"):
-            node.pop(key, None)
-        node["matrix"] = local.T.reshape(16).tolist()  # column-major
-        builder.json["nodes"][joint_nodes[level_joint[ancestor]]].setdefault("children", []).append(copy)
+        scale = np.diag([rig.scales[attachment.joint]] * 3 + [1.0])
+        frame = np.linalg.inv(world[ancestor]) @ world[attachment.joint] @ scale
+        parent = joint_nodes[level_joint[ancestor]]
+        if not np.allclose(frame, np.eye(4), rtol=0.0, atol=1e-12):  # a static node between: the
+            name = f"{doc.node_label(attachment.node)} frame{suffix}"  # copy keeps its own TRS
+            between = builder.append("nodes", {"name": name, "matrix": frame.T.reshape(16).tolist()})
+            builder.json["nodes"][parent].setdefault("children", []).append(between)
+            parent = between
+        top = _copy_subtree(builder, attachment.node, suffix, copies)
+        builder.json["nodes"][parent].setdefault("children", []).append(top)
+    return copies
+
+
+def carry_other_channels(
+    builder: GlbBuilder, doc: GltfDocument, animation: int, level_animation: int, copies: dict[int, int]
+) -> None:
+    """Adds to ``level_animation`` the channels of the document's ``animation`` that pose no
+    skeleton (:func:`posing_nodes`), on the attachments' copies where they have one. The samplers
+    reuse the input's accessors: both clips' times start at 0."""
+    skeletal = posing_nodes(doc)
+    source = builder.json["animations"][animation]
+    target = builder.json["animations"][level_animation]
+    for channel in source.get("channels", []):
+        node = channel["target"].get("node")
+        if node is None or node in skeletal:
+            continue
+        target["samplers"].append(deepcopy(source["samplers"][channel["sampler"]]))
+        retargeted = {**channel["target"], "node": copies.get(node, node)}
+        target["channels"].append({"sampler": len(target["samplers"]) - 1, "target": retargeted})
 
 
 def _subtree(doc: GltfDocument, node: int) -> set[int]:
@@ -105,13 +131,14 @@ def _subtree(doc: GltfDocument, node: int) -> set[int]:
     return found
 
 
-def _copy_subtree(builder: GlbBuilder, node: int, suffix: str) -> int:
-    """A copy of node ``node`` and its descendants (names suffixed, same meshes, cameras and
-    extensions); the copy's index. It is in no scene and no children list yet."""
+def _copy_subtree(builder: GlbBuilder, node: int, suffix: str, copies: dict[int, int]) -> int:
+    """A copy of node ``node`` and its descendants (names suffixed; same transforms, meshes,
+    cameras and extensions), recorded in ``copies``; the copy's index, in no children list yet."""
     source = builder.json["nodes"][node]
     copy = {key: deepcopy(value) for key, value in source.items() if key not in ("children", "name")}
     copy["name"] = f"{source.get('name') or f'node{node}'}{suffix}"
-    children = [_copy_subtree(builder, child, suffix) for child in source.get("children", [])]
+    children = [_copy_subtree(builder, child, suffix, copies) for child in source.get("children", [])]
     if children:
         copy["children"] = children
-    return builder.append("nodes", copy)
+    copies[node] = builder.append("nodes", copy)
+    return copies[node]

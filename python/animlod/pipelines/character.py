@@ -13,7 +13,8 @@ geometry level, then motion level) so that a benchmark can walk the whole grid.
 Motion level m >= 1 adds, per skin, a reduced skeleton as joint nodes of its own, a skin over
 them and one animation per input clip (``extras.animlod = {"clip", "motion_level"}``); a level
 node at motion level m uses that skin, so any glTF engine can play it. Nodes hung from the
-input's joints (props, sockets) are copied onto each level's skeleton (:mod:`.attachments`).
+input's joints (props, sockets) are copied onto each level's skeleton, and each level clip also
+plays what its input clip moves besides the skeleton (morph weights; :mod:`.attachments`).
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
-from .attachments import add_level_attachments, find_attachments
+from .attachments import add_level_attachments, carry_other_channels, find_attachments
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
 
@@ -152,14 +153,10 @@ def build_character(
     geometry_seconds = time.perf_counter() - started
 
     builder = GlbBuilder.from_document(doc)
-    motion_nodes = {}
-    for skin, (chain, clips) in motion_chains.items():
-        motion_nodes[skin] = _add_motion_levels(builder, chain, clips)
-        rig, joined = reduced_motions[skin]
-        attachments, attachment_notes = find_attachments(doc, rig)
-        notes += [f"skin {skin}: {note}" for note in attachment_notes]
-        for m, level in enumerate(chain.levels[1:], start=1):
-            add_level_attachments(builder, doc, rig, attachments, joined, level, m, motion_nodes[skin][m].joint_nodes)
+    motion_nodes = {
+        skin: _add_motion_levels(builder, doc, *reduced_motions[skin], chain, clips)
+        for skin, (chain, clips) in motion_chains.items()
+    }
     chains = {}
     for drawable in animated:
         chain, clips = motion_chains[drawable.skin_index]
@@ -200,16 +197,22 @@ class _MotionLevelNodes:
     joints: int
 
 
-def _add_motion_levels(builder: GlbBuilder, chain: MotionLodChain, clips: list) -> list[_MotionLevelNodes]:
-    """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's)."""
+def _add_motion_levels(
+    builder: GlbBuilder, doc: GltfDocument, rig: SkinRig, joined: Motion, chain: MotionLodChain, clips: list
+) -> list[_MotionLevelNodes]:
+    """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's),
+    with what hangs from the skeleton and the clips' other channels (:mod:`.attachments`)."""
     nodes = [_MotionLevelNodes(None, chain.levels[0].report.joint_count)]
+    attachments = find_attachments(doc, rig)
     for m, level in enumerate(chain.levels[1:], start=1):
         joint_nodes = add_skeleton(builder, level.motion.skeleton)
+        copies = add_level_attachments(builder, doc, rig, attachments, joined, level, m, joint_nodes)
         for clip, span in clips:
             name = f"{clip.name or f'animation {clip.index}'}@motion{m}"
             extras = {"animlod": {"clip": clip.index, "motion_level": m}}
             clip_motion = level.motion.take_frames(np.arange(span.start, span.stop))
-            add_animation(builder, clip_motion, joint_nodes, name, extras)
+            animation = add_animation(builder, clip_motion, joint_nodes, name, extras)
+            carry_other_channels(builder, doc, clip.index, animation, copies)
         nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))
     return nodes
 

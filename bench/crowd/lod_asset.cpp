@@ -434,7 +434,9 @@ class Loader {
         for (int a : ancestors(joint)) top = top && !joints.count(a);
         if (top) {
           const std::string& name = model_.nodes[static_cast<size_t>(joint)].name;
-          rig.root_name = name.empty() ? "node " + std::to_string(joint) : name;
+          // Unnamed: "node<i>", the name animlod gives an unnamed joint (gltf_skin.py), which a
+          // character chain's reduced skeletons carry: their roots then match this one's.
+          rig.root_name = name.empty() ? "node" + std::to_string(joint) : name;
         }
       }
     }

@@ -84,6 +84,25 @@ def test_smoke_run_reports_every_mode_and_shows_a_level_switch(binary, chain, tm
     assert pixels_far["yellow"] > 0 and pixels_far["green"] == 0
 
 
+def test_a_character_chain_of_unnamed_joints_loads(binary, tmp_path) -> None:
+    # animlod names an unnamed joint node<i>, and so do a character chain's reduced skeletons;
+    # the crowd names the input's unnamed root alike, so that every level shares it (RiggedFigure's
+    # joints are unnamed: its chain was refused).
+    from animlod import synth
+    from animlod.io import write_glb
+    from animlod.pipelines.character import build_character
+
+    character = synth.humanoid()
+    write_glb(tmp_path / "named.glb", character, [synth.humanoid_motion(character.skeleton, "walk")])
+    gltf = pygltflib.GLTF2().load(tmp_path / "named.glb")
+    for joint in gltf.skins[0].joints:
+        gltf.nodes[joint].name = None
+    gltf.save(tmp_path / "unnamed.glb")
+    build_character(tmp_path / "unnamed.glb", tmp_path / "lod.glb", [0.5], solver="newton", frame_budget=12)
+    report = run_crowd([tmp_path / "lod.glb"], frames=2, modes="MLoD", **SMALL)
+    assert report.modes["MLoD"]["drawn"] > 0
+
+
 def test_opengl_3_3_with_orphaned_uploads(binary, chain, monkeypatch) -> None:
     """The GL 3.3 core path (no persistent mapping): Mesa asked for a 3.3 context."""
     monkeypatch.setenv("MESA_GL_VERSION_OVERRIDE", "3.3")

@@ -94,7 +94,7 @@ def add_level_attachments(
         frame = np.linalg.inv(world[ancestor]) @ world[attachment.joint] @ scale
         parent = joint_nodes[level_joint[ancestor]]
         if not np.allclose(frame, np.eye(4), rtol=0.0, atol=1e-12):  # a static node between: the
-            name = f"{doc.node_label(attachment.node)} frame{suffix}"  # copy keeps its own TRS
+            name = f"{_name(builder, attachment.node)} frame{suffix}"  # copy keeps its own TRS
             between = builder.append("nodes", {"name": name, "matrix": frame.T.reshape(16).tolist()})
             builder.json["nodes"][parent].setdefault("children", []).append(between)
             parent = between
@@ -136,9 +136,14 @@ def _copy_subtree(builder: GlbBuilder, node: int, suffix: str, copies: dict[int,
     cameras and extensions), recorded in ``copies``; the copy's index, in no children list yet."""
     source = builder.json["nodes"][node]
     copy = {key: deepcopy(value) for key, value in source.items() if key not in ("children", "name")}
-    copy["name"] = f"{source.get('name') or f'node{node}'}{suffix}"
+    copy["name"] = f"{_name(builder, node)}{suffix}"
     children = [_copy_subtree(builder, child, suffix, copies) for child in source.get("children", [])]
     if children:
         copy["children"] = children
     copies[node] = builder.append("nodes", copy)
     return copies[node]
+
+
+def _name(builder: GlbBuilder, node: int) -> str:
+    """A node's name, ``node<i>`` when it has none (as animlod names unnamed joints)."""
+    return builder.json["nodes"][node].get("name") or f"node{node}"

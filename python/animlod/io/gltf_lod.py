@@ -89,11 +89,12 @@ def add_level_mesh(
     builder: GlbBuilder, mesh_index: int, primitives: list[PrimitiveArrays], shared: list[int], name: str
 ) -> int:
     """A new mesh like input mesh ``mesh_index`` with the triangle primitives ``primitives`` and
-    the input primitives ``shared`` (points and lines) as they are. Returns its index."""
+    the input primitives ``shared`` (points and lines) as they are, in the input's order. Returns
+    its index."""
     source = builder.json["meshes"][mesh_index]
     mesh = {key: copy.deepcopy(value) for key, value in source.items() if key != "primitives"}
     mesh["name"] = name
-    mesh["primitives"] = [copy.deepcopy(source["primitives"][k]) for k in shared]
+    placed = [(k, copy.deepcopy(source["primitives"][k])) for k in shared]
     for arrays in primitives:
         primitive = {
             key: copy.deepcopy(value)
@@ -115,7 +116,8 @@ def add_level_mesh(
                 }
                 for t in arrays.targets
             ]
-        mesh["primitives"].append(primitive)
+        placed.append((arrays.source, primitive))
+    mesh["primitives"] = [primitive for _, primitive in sorted(placed, key=lambda item: item[0])]
     return builder.append("meshes", mesh)
 
 

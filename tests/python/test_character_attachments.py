@@ -53,6 +53,13 @@ def character_with_sockets(tmp_path_factory):
     mesh["primitives"][0]["targets"] = [{"POSITION": builder.add(bulge, bounds=True)}]
     mesh["weights"] = [0.0]
     _animate(animation, base, "weights", builder.add(np.linspace(0.0, 1.0, keys).astype(np.float32)[:, None]))
+    # A rigid hat drawn by the head joint's node itself, with a morph target the clip animates.
+    corners = builder.add(np.array([[0.0, 0.1, 0.0], [0.1, 0.1, 0.0], [0.0, 0.1, 0.1]], np.float32), bounds=True)
+    lift = builder.add(np.array([[0.0, 0.02, 0.0]] * 3, np.float32), bounds=True)
+    hat = {"primitives": [{"attributes": {"POSITION": corners}, "targets": [{"POSITION": lift}]}], "weights": [0.0]}
+    nodes[by_name["Head"]]["mesh"] = builder.append("meshes", hat)
+    lowering = builder.add(np.linspace(1.0, 0.0, keys).astype(np.float32)[:, None])
+    _animate(animation, by_name["Head"], "weights", lowering)
     source = folder / "sockets.glb"
     builder.save(source)
     output = folder / "sockets_lod.glb"
@@ -104,11 +111,12 @@ def _node(doc: GltfDocument, name: str) -> int:
     return next(n for n, node in enumerate(doc.gltf.nodes) if node.name == name)
 
 
-@pytest.mark.parametrize("joint", SOCKET_JOINTS)
-def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(character_with_sockets, joint):
-    # A vertex bound to the socket's joint alone is rigid with the socket: in the input, and at
-    # each motion level (where a frozen joint's vertices move with its kept ancestor, posed at the
-    # key posture), the vertex sits at the same place in the socket's frame.
+@pytest.mark.parametrize("joint, holder", [*[(joint, f"socket {joint}") for joint in SOCKET_JOINTS], ("Head", "Head")])
+def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(character_with_sockets, joint, holder):
+    # A vertex bound to the socket's joint alone is rigid with the socket (holder: the socket node,
+    # or the joint node for the hat it draws): in the input, and at each motion level (where a
+    # frozen joint's vertices move with its kept ancestor, posed at the key posture), the vertex
+    # sits at the same place in the holder's frame as in its copy's.
     source, output, report = character_with_sockets
     doc_in, doc_out = GltfDocument(source), GltfDocument(output)
     base = _node(doc_in, next(node.name for node in doc_in.gltf.nodes if node.skin is not None))
@@ -118,7 +126,7 @@ def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(cha
     slot = doc_in.gltf.skins[doc_in.gltf.nodes[base].skin].joints.index(_node(doc_in, joint))
     vertex = int(np.flatnonzero((joints[:, 0] == slot) & (weights[:, 0] > 0.999))[0])
     worlds = _posed_worlds(doc_in, 0)
-    socket = worlds[_node(doc_in, f"socket {joint}")]
+    socket = worlds[_node(doc_in, holder)]
     expected = (np.linalg.inv(socket) @ np.append(_skinned_vertex(doc_in, base, vertex, worlds), 1.0))[:3]
     grid = doc_out.gltf.nodes[base].extras["animlod_grid"][0]  # geometry level 0, each motion level
     size = np.ptp(np.asarray(doc_in.accessor(primitive.attributes.POSITION, "test")), axis=0).max()
@@ -126,21 +134,21 @@ def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(cha
     for m in range(1, len(grid)):
         animation = next(a for a, clip in enumerate(doc_out.gltf.animations) if clip.name.endswith(f"@motion{m}"))
         worlds = _posed_worlds(doc_out, animation)
-        copy = _node(doc_out, f"socket {joint}@motion{m}")
+        copy = _node(doc_out, f"{holder}@motion{m}")
         level_skin = doc_out.gltf.skins[doc_out.gltf.nodes[grid[m]].skin]
         hung = doc_out.parents[copy]  # from the level's own skeleton, or a static frame node on it
         assert hung in level_skin.joints or doc_out.parents[hung] in level_skin.joints
         frozen_somewhere |= joint not in {doc_out.gltf.nodes[n].name for n in level_skin.joints}
         vertex_world = _skinned_vertex(doc_out, grid[m], vertex, worlds)
         seen = (np.linalg.inv(worlds[copy]) @ np.append(vertex_world, 1.0))[:3]
-        np.testing.assert_allclose(seen * 2.0, expected * 2.0, atol=1e-5 * size)  # socket scale 2
+        np.testing.assert_allclose(seen, expected, atol=1e-5 * size)
     if joint == "LeftHandIndex2":
         assert frozen_somewhere  # the frozen path (key posture between the kept ancestor) is tested
 
 
 def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(character_with_sockets):
-    # The sliding socket's channel goes to its copy, the morph weights' to the same mesh node;
-    # both read the input clip's keys.
+    # The sliding socket's channel and the hat's morph weights go to their copies, the skinned
+    # mesh's morph weights to the same mesh node; all read the input clip's keys.
     source, output, _ = character_with_sockets
     doc_in, doc_out = GltfDocument(source), GltfDocument(output)
     clip = doc_in.gltf.animations[0]
@@ -162,4 +170,5 @@ def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(ch
         assert carried == {
             (f"moving socket@motion{m}", "translation"): outputs[("moving socket", "translation")],
             (base_name, "weights"): outputs[(base_name, "weights")],
+            (f"Head@motion{m}", "weights"): outputs[("Head", "weights")],  # the hat's, on its copy
         }

@@ -1,18 +1,19 @@
 """What moves with a character besides its skeleton, carried to every motion level: the nodes
-hung from its joints (props, sockets, eyes) and its clips' other channels (morph weights, those
-nodes' own animation, anything else the clip moves).
+hung from its joints (props, sockets, eyes), what its joint nodes draw, and its clips' other
+channels (morph weights, those nodes' own animation, anything else the clip moves).
 
 A motion level is a skeleton of its own (see :mod:`animlod.pipelines.character`) with a clip of
 its own per input clip: playing a level's clip moves the level's joint nodes, not the input's. A
 node hung from a joint of the input (a sword in a hand, a hat on the head, an empty socket node
 an engine attaches things to) would stand still in its rest pose there, and whatever else the
-input clip animates (a face's morph weights) would not move. Each attachment is copied for every
-motion level: under the level's node of its joint, or, where that joint is frozen, under its
-nearest kept ancestor with the frozen joints' key posture in between (seeds/000, Section 5.1: a
-frozen joint keeps the local transformation of its key frame), so that it moves as the level's
-skin moves the vertices bound to its joint. The copies share the input's meshes, cameras and
-lights. Each level clip then takes the input clip's channels that target no skeleton, retargeted
-to the copies where they animate an attachment.
+input clip animates (a face's morph weights) would not move. Each attachment (such a node with
+its subtree, or what a joint's own node draws: an unskinned mesh, a camera, a light) is copied
+for every motion level: under the level's node of its joint, or, where that joint is frozen,
+under its nearest kept ancestor with the frozen joints' key posture in between (seeds/000,
+Section 5.1: a frozen joint keeps the local transformation of its key frame), so that it moves
+as the level's skin moves the vertices bound to its joint. The copies share the input's meshes,
+cameras and lights. Each level clip then takes the input clip's channels that pose no skeleton,
+retargeted to the copies where they animate an attachment.
 """
 
 from __future__ import annotations
@@ -29,22 +30,32 @@ from ..model import Motion
 from ..motion_lod.chain import MotionLevel
 from ..motion_lod.skeleton_reduce import expand_motion
 
+# What a joint node draws or holds besides its transform and children (lights are an extension).
+_CONTENT = ("mesh", "camera", "weights", "extensions")
+
 
 @dataclass(frozen=True)
 class Attachment:
-    """A node (with its subtree) hung from joint ``joint`` (skeleton order) of a rig."""
+    """A node (with its subtree) hung from joint ``joint`` (skeleton order) of a rig, or, with
+    ``content_only``, the joint's own node for what it draws (a mesh, camera or light on it)."""
 
     joint: int
     node: int
+    content_only: bool = False
 
 
 def find_attachments(doc: GltfDocument, rig: SkinRig) -> list[Attachment]:
-    """The subtrees hung from the rig's joint nodes that hold no joint and no skinned mesh."""
+    """The subtrees hung from the rig's joint nodes that hold no joint and no skinned mesh, and
+    the joint nodes that draw an unskinned mesh or hold a camera or a light."""
     joint_of = {node: j for j, node in enumerate(rig.joint_nodes)}
     skeletal = posing_nodes(doc) | {n for n, node in enumerate(doc.gltf.nodes) if node.skin is not None}
     attachments = []
     for node, joint in joint_of.items():
-        for child in doc.gltf.nodes[node].children or []:
+        own = doc.gltf.nodes[node]
+        light = "KHR_lights_punctual" in (own.extensions or {})
+        if (own.mesh is not None and own.skin is None) or own.camera is not None or light:
+            attachments.append(Attachment(joint, node, content_only=True))
+        for child in own.children or []:
             if child in joint_of or not skeletal.isdisjoint(_subtree(doc, child)):
                 continue  # a joint, a node between joints, or a skinned mesh (LoD'd on its own)
             attachments.append(Attachment(joint, child))
@@ -98,7 +109,14 @@ def add_level_attachments(
             between = builder.append("nodes", {"name": name, "matrix": frame.T.reshape(16).tolist()})
             builder.json["nodes"][parent].setdefault("children", []).append(between)
             parent = between
-        top = _copy_subtree(builder, attachment.node, suffix, copies)
+        if attachment.content_only:
+            source = builder.json["nodes"][attachment.node]
+            content = {key: deepcopy(source[key]) for key in _CONTENT if key in source}
+            top = copies[attachment.node] = builder.append(
+                "nodes", {"name": f"{_name(builder, attachment.node)}{suffix}", **content}
+            )
+        else:
+            top = _copy_subtree(builder, attachment.node, suffix, copies)
         builder.json["nodes"][parent].setdefault("children", []).append(top)
     return copies
 
@@ -107,14 +125,15 @@ def carry_other_channels(
     builder: GlbBuilder, doc: GltfDocument, animation: int, level_animation: int, copies: dict[int, int]
 ) -> None:
     """Adds to ``level_animation`` the channels of the document's ``animation`` that pose no
-    skeleton (:func:`posing_nodes`), on the attachments' copies where they have one. The samplers
-    reuse the input's accessors: both clips' times start at 0."""
+    skeleton (:func:`posing_nodes`; a joint's morph weights do not pose it), on the attachments'
+    copies where they have one. The samplers reuse the input's accessors: both clips' times start
+    at 0."""
     skeletal = posing_nodes(doc)
     source = builder.json["animations"][animation]
     target = builder.json["animations"][level_animation]
     for channel in source.get("channels", []):
         node = channel["target"].get("node")
-        if node is None or node in skeletal:
+        if node is None or (node in skeletal and channel["target"].get("path") != "weights"):
             continue
         target["samplers"].append(deepcopy(source["samplers"][channel["sampler"]]))
         retargeted = {**channel["target"], "node": copies.get(node, node)}

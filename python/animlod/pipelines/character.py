@@ -175,7 +175,7 @@ def build_character(
         notes += [f"{drawable.label}: {note}" for note in levels.notes]
     skipped = [d.label for d in read_drawables(doc, settings.fps) if d.label not in chains]
     if skipped:
-        notes.append(f"left as they are (no skin or no animation): {', '.join(skipped)}")
+        notes.append(f"not simplified (no skin or no animation): {', '.join(skipped)}")
     builder.save(output)
     return CharacterReport(Path(source), Path(output), chains, motion_seconds, geometry_seconds, notes)
 

@@ -108,7 +108,8 @@ def build_character(
     say = progress or (lambda _line: None)
     settings = DrawableSettings.resolve(settings, keywords)
     doc = GltfDocument(source)
-    drawables = [d for d in read_drawables(doc, settings.fps) if d.skinned is not None]
+    all_drawables = read_drawables(doc, settings.fps)
+    drawables = [d for d in all_drawables if d.skinned is not None]
     animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]
     if not animated:
         raise FormatError(doc.path, "skins", "no skinned mesh with an animation: a character chain needs both")
@@ -173,7 +174,7 @@ def build_character(
         _attach(builder, drawable, report, grid)
         chains[drawable.label] = report
         notes += [f"{drawable.label}: {note}" for note in levels.notes]
-    skipped = [d.label for d in read_drawables(doc, settings.fps) if d.label not in chains]
+    skipped = [d.label for d in all_drawables if d.label not in chains]
     if skipped:
         notes.append(f"not simplified (no skin or no animation): {', '.join(skipped)}")
     builder.save(output)

@@ -122,18 +122,17 @@ def add_level_attachments(
 
 
 def carry_other_channels(
-    builder: GlbBuilder, doc: GltfDocument, animation: int, level_animation: int, copies: dict[int, int]
+    builder: GlbBuilder, posing: set[int], animation: int, level_animation: int, copies: dict[int, int]
 ) -> None:
     """Adds to ``level_animation`` the channels of the document's ``animation`` that pose no
-    skeleton (:func:`posing_nodes`; a joint's morph weights do not pose it), on the attachments'
-    copies where they have one. The samplers reuse the input's accessors: both clips' times start
-    at 0."""
-    skeletal = posing_nodes(doc)
+    skeleton (not on a node of ``posing``, :func:`posing_nodes`; a joint's morph weights do not
+    pose it), on the attachments' copies where they have one. The samplers reuse the input's
+    accessors: both clips' times start at 0."""
     source = builder.json["animations"][animation]
     target = builder.json["animations"][level_animation]
     for channel in source.get("channels", []):
         node = channel["target"].get("node")
-        if node is None or (node in skeletal and channel["target"].get("path") != "weights"):
+        if node is None or (node in posing and channel["target"].get("path") != "weights"):
             continue
         target["samplers"].append(deepcopy(source["samplers"][channel["sampler"]]))
         retargeted = {**channel["target"], "node": copies.get(node, node)}

@@ -47,7 +47,7 @@ from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
-from .attachments import add_level_attachments, carry_other_channels, find_attachments
+from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
 
@@ -204,7 +204,7 @@ def _add_motion_levels(
     """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's),
     with what hangs from the skeleton and the clips' other channels (:mod:`.attachments`)."""
     nodes = [_MotionLevelNodes(None, chain.levels[0].report.joint_count)]
-    attachments = find_attachments(doc, rig)
+    attachments, posing = find_attachments(doc, rig), posing_nodes(doc)
     for m, level in enumerate(chain.levels[1:], start=1):
         joint_nodes = add_skeleton(builder, level.motion.skeleton)
         copies = add_level_attachments(builder, doc, rig, attachments, joined, level, m, joint_nodes)
@@ -213,7 +213,7 @@ def _add_motion_levels(
             extras = {"animlod": {"clip": clip.index, "motion_level": m}}
             clip_motion = level.motion.take_frames(np.arange(span.start, span.stop))
             animation = add_animation(builder, clip_motion, joint_nodes, name, extras)
-            carry_other_channels(builder, doc, clip.index, animation, copies)
+            carry_other_channels(builder, posing, clip.index, animation, copies)
         nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))
     return nodes
 

@@ -115,8 +115,7 @@ def build_character(
         raise FormatError(doc.path, "skins", "no skinned mesh with an animation: a character chain needs both")
     levels_wanted = len(ratios) + 1
     started = time.perf_counter()
-    motion_chains: dict[int, tuple[MotionLodChain, list[tuple[Clip, slice]]]] = {}
-    reduced_motions: dict[int, tuple[SkinRig, Motion]] = {}  # the rig and the motion each chain reduces
+    motion_chains: dict[int, _SkinMotion] = {}
     notes = []
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
     # Larger skeletons first: a skin whose joints all belong to a larger skin (a helmet bound to
@@ -142,8 +141,7 @@ def build_character(
             )
         say(f"skin {skin}: {levels} motion levels over {len(clips)} clips")
         chain = build_motion_chain(joined, levels=levels, solver=solver, workers=workers, analysis=analysis)
-        motion_chains[skin] = (chain, list(zip(clips, spans)))
-        reduced_motions[skin] = (drawable.rig, joined)
+        motion_chains[skin] = _SkinMotion(chain, list(zip(clips, spans)), drawable.rig, joined)
     motion_seconds = time.perf_counter() - started
     started = time.perf_counter()
     geometry = {}
@@ -154,17 +152,14 @@ def build_character(
     geometry_seconds = time.perf_counter() - started
 
     builder = GlbBuilder.from_document(doc)
-    motion_nodes = {
-        skin: _add_motion_levels(builder, doc, *reduced_motions[skin], chain, clips)
-        for skin, (chain, clips) in motion_chains.items()
-    }
+    motion_nodes = {skin: _add_motion_levels(builder, doc, motion) for skin, motion in motion_chains.items()}
     chains = {}
     for drawable in animated:
-        chain, clips = motion_chains[drawable.skin_index]
+        motion = motion_chains[drawable.skin_index]
         levels = geometry[drawable.label]
         say(f"{drawable.label}: writing the grid, measuring the chain")
-        grid = _write_grid(builder, doc, drawable, levels, chain, motion_nodes[drawable.skin_index])
-        report = _measure_chain(drawable, levels, chain, clips, settings.measured_frames)
+        grid = _write_grid(builder, doc, drawable, levels, motion.chain, motion_nodes[drawable.skin_index])
+        report = _measure_chain(drawable, levels, motion.chain, motion.clips, settings.measured_frames)
         coverages = screen_coverages(
             [level.error for level in report], levels.size, settings.pixel_error, settings.viewport_px
         )
@@ -190,6 +185,17 @@ def _joined_motion(motions: list[Motion]) -> tuple[Motion, list[slice]]:
 
 
 @dataclass
+class _SkinMotion:
+    """A skin's motion chain: the clips (with their frames in the joined motion), the rig and the
+    joined motion the chain reduces."""
+
+    chain: MotionLodChain
+    clips: list[tuple[Clip, slice]]
+    rig: SkinRig
+    joined: Motion
+
+
+@dataclass
 class _MotionLevelNodes:
     """What one motion level adds to the document for one skin: the joint nodes of its reduced
     skeleton (None at level 0, which keeps the input's joints) and its joint count."""
@@ -198,17 +204,15 @@ class _MotionLevelNodes:
     joints: int
 
 
-def _add_motion_levels(
-    builder: GlbBuilder, doc: GltfDocument, rig: SkinRig, joined: Motion, chain: MotionLodChain, clips: list
-) -> list[_MotionLevelNodes]:
+def _add_motion_levels(builder: GlbBuilder, doc: GltfDocument, motion: _SkinMotion) -> list[_MotionLevelNodes]:
     """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's),
     with what hangs from the skeleton and the clips' other channels (:mod:`.attachments`)."""
-    nodes = [_MotionLevelNodes(None, chain.levels[0].report.joint_count)]
-    attachments, posing = find_attachments(doc, rig), posing_nodes(doc)
-    for m, level in enumerate(chain.levels[1:], start=1):
+    nodes = [_MotionLevelNodes(None, motion.chain.levels[0].report.joint_count)]
+    attachments, posing = find_attachments(doc, motion.rig), posing_nodes(doc)
+    for m, level in enumerate(motion.chain.levels[1:], start=1):
         joint_nodes = add_skeleton(builder, level.motion.skeleton)
-        copies = add_level_attachments(builder, doc, rig, attachments, joined, level, m, joint_nodes)
-        for clip, span in clips:
+        copies = add_level_attachments(builder, doc, motion.rig, attachments, motion.joined, level, m, joint_nodes)
+        for clip, span in motion.clips:
             name = f"{clip.name or f'animation {clip.index}'}@motion{m}"
             extras = {"animlod": {"clip": clip.index, "motion_level": m}}
             clip_motion = level.motion.take_frames(np.arange(span.start, span.stop))

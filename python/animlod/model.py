@@ -195,6 +195,11 @@ class Motion:
     joint_translations : (T, J, 3) float64 or None. Per-frame local translations that replace
         ``offsets`` for non-root joints (BVH position channels on non-root joints); column 0
         is ignored, the root uses ``root_positions``. None when the offsets hold in every frame.
+    joint_deformations : (T, J, 3, 3) float64 or None. What a joint's world transform does
+        beyond its rigid frame, in that frame: ``world_linear = R_world @ D`` (glTF's animated
+        scale, and the shear a parent's non-uniform scale gives a turned child). Only skinning
+        (:meth:`skin_matrices`) applies it; joint positions and rotations are the rigid ones.
+        None for a rigid motion, the only kind motion LoD re-fits (:meth:`require_rigid`).
     """
 
     skeleton: Skeleton
@@ -203,6 +208,7 @@ class Motion:
     fps: float
     name: str = ""
     joint_translations: np.ndarray | None = None
+    joint_deformations: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.root_positions = np.asarray(self.root_positions, dtype=np.float64)
@@ -225,6 +231,13 @@ class Motion:
                 f"joint_translations: expected shape {expected[:2] + (3,)}, got {self.joint_translations.shape}",
             )
             _check_finite("joint_translations", self.joint_translations)
+        if self.joint_deformations is not None:
+            self.joint_deformations = np.asarray(self.joint_deformations, dtype=np.float64)
+            _require(
+                self.joint_deformations.shape == expected[:2] + (3, 3),
+                f"joint_deformations: expected shape {expected[:2] + (3, 3)}, got {self.joint_deformations.shape}",
+            )
+            _check_finite("joint_deformations", self.joint_deformations)
 
     @property
     def frame_count(self) -> int:
@@ -249,17 +262,26 @@ class Motion:
         """The motion at ``frames`` (indices into this motion, or a slice), same skeleton, name
         and fps."""
         translations = None if self.joint_translations is None else self.joint_translations[frames]
+        deformations = None if self.joint_deformations is None else self.joint_deformations[frames]
         return Motion(
-            self.skeleton, self.root_positions[frames], self.local_rotations[frames], self.fps, self.name, translations
+            self.skeleton,
+            self.root_positions[frames],
+            self.local_rotations[frames],
+            self.fps,
+            self.name,
+            translations,
+            deformations,
         )
 
     @staticmethod
     def concatenate(motions: list[Motion], name: str) -> Motion:
         """The motions one after another as one, on the first one's skeleton and fps (the
         caller's to check they share them)."""
-        translations = None
+        translations = deformations = None
         if any(motion.joint_translations is not None for motion in motions):
             translations = np.concatenate([motion.local_translations() for motion in motions])
+        if any(motion.joint_deformations is not None for motion in motions):
+            deformations = np.concatenate([motion.local_deformations() for motion in motions])
         return Motion(
             motions[0].skeleton,
             np.concatenate([motion.root_positions for motion in motions]),
@@ -267,7 +289,28 @@ class Motion:
             motions[0].fps,
             name,
             translations,
+            deformations,
         )
+
+    def local_deformations(self) -> np.ndarray:
+        """``joint_deformations`` ``(T, J, 3, 3)``, identities for a rigid motion; a new array."""
+        if self.joint_deformations is None:
+            return np.broadcast_to(np.eye(3), self.local_rotations.shape[:2] + (3, 3)).copy()
+        return self.joint_deformations.copy()
+
+    def deforming_joint(self) -> str | None:
+        """The joint whose deformation strays furthest from the identity; None for a rigid motion."""
+        if self.joint_deformations is None:
+            return None
+        deviation = np.abs(self.joint_deformations - np.eye(3)).max(axis=(0, 2, 3))
+        return self.skeleton.names[int(np.argmax(deviation))]
+
+    def require_rigid(self, what: str) -> None:
+        """ValueError saying that ``what`` takes rigid motions only, when joints of this one deform."""
+        joint = self.deforming_joint()
+        if joint is not None:
+            label = repr(self.name) if self.name else "(unnamed)"
+            raise ValueError(f"motion {label}: joint {joint!r} scales; {what} takes rigid motions only")
 
     def world_transforms(self) -> np.ndarray:
         """Forward kinematics: world transforms ``(T, J, 4, 4)`` of every joint (float64, in the
@@ -279,8 +322,12 @@ class Motion:
         return self.world_transforms()[..., :3, 3]
 
     def skin_matrices(self, inverse_bind: np.ndarray) -> np.ndarray:
-        """Skinning matrices ``world @ inverse_bind``, ``(T, J, 4, 4)``."""
-        return self.world_transforms() @ np.asarray(inverse_bind, dtype=np.float64)
+        """Skinning matrices ``world @ inverse_bind``, ``(T, J, 4, 4)``; ``world`` includes the
+        joint deformations."""
+        world = self.world_transforms()
+        if self.joint_deformations is not None:
+            world[..., :3, :3] = world[..., :3, :3] @ self.joint_deformations
+        return world @ np.asarray(inverse_bind, dtype=np.float64)
 
 
 @dataclass

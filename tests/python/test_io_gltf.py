@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pygltflib
 import pytest
+from gltf_edits import add_scale_channel, edit_glb, squash_and_stretch
 
 from animlod import rotations, synth
 from animlod.io import FormatError
@@ -100,17 +101,6 @@ def chain_glb(tmp_path: Path) -> tuple[Path, SkinnedMesh, Motion]:
     path = tmp_path / "chain.glb"
     write_glb(path, mesh, [motion])
     return path, mesh, motion
-
-
-def _edit_glb(source: Path, target: Path, edit: Callable[[pygltflib.GLTF2, bytearray], None]) -> Path:
-    """Copy a GLB through pygltflib, letting ``edit`` change its JSON and binary chunk."""
-    gltf = pygltflib.GLTF2.load_from_bytes(source.read_bytes())
-    blob = bytearray(gltf.binary_blob())
-    edit(gltf, blob)
-    gltf.set_binary_blob(bytes(blob))
-    gltf.buffers[0].byteLength = len(blob)
-    target.write_bytes(b"".join(gltf.save_to_bytes()))
-    return target
 
 
 def _accessor_view(gltf: pygltflib.GLTF2, blob: bytearray, index: int, dtype: str) -> np.ndarray:
@@ -341,7 +331,7 @@ def test_joints_out_of_topological_order_are_reordered_and_remapped(chain_glb, t
         joints = _accessor_view(gltf, blob, attributes.JOINTS_0, "u1")
         joints[:] = 2 - joints
 
-    read, motions = read_skinned(_edit_glb(path, tmp_path / "reversed.glb", reverse_joints), fps=motion.fps)
+    read, motions = read_skinned(edit_glb(path, tmp_path / "reversed.glb", reverse_joints), fps=motion.fps)
     assert read.skeleton.names == ["root", "mid", "tip"]
     np.testing.assert_array_equal(read.skeleton.parents, [-1, 0, 1])
     np.testing.assert_allclose(read.bake(motions[0]).frames, mesh.bake(motion).frames, atol=1e-5)
@@ -358,7 +348,7 @@ def test_armature_above_the_root_is_folded_into_the_pose(chain_glb, tmp_path):
         gltf.nodes.append(armature_node)
         gltf.scenes[0].nodes = [len(gltf.nodes) - 1, 3]
 
-    read, motions = read_skinned(_edit_glb(path, tmp_path / "armature.glb", add_armature), fps=motion.fps)
+    read, motions = read_skinned(edit_glb(path, tmp_path / "armature.glb", add_armature), fps=motion.fps)
     expected = _transform(armature, mesh.bake(motion).frames.astype(np.float64))
     np.testing.assert_allclose(read.bake(motions[0]).frames, expected, atol=1e-6)
     # The rigid skeleton carries the 0.01 in its offsets, the inverse bind matrices the rest.
@@ -374,7 +364,7 @@ def _split_chain_under_an_armature(gltf: pygltflib.GLTF2, blob: bytearray) -> No
 
 def test_joints_in_several_trees_get_their_common_ancestor_as_root(chain_glb, tmp_path):
     path, _, motion = chain_glb
-    split = _edit_glb(path, tmp_path / "split.glb", _split_chain_under_an_armature)
+    split = edit_glb(path, tmp_path / "split.glb", _split_chain_under_an_armature)
     read, (read_motion,) = read_skinned(split, fps=motion.fps)
     assert read.skeleton.names == ["Armature", "root", "mid", "tip"]
     np.testing.assert_array_equal(read.skeleton.parents, [-1, 0, 0, 2])
@@ -394,7 +384,7 @@ def test_joints_in_trees_without_a_common_node_are_refused(chain_glb, tmp_path):
         gltf.scenes[0].nodes = [0, 1, 3]
 
     with pytest.raises(FormatError, match=r"skin 0: joints form 2 separate trees \(node 0 'root', node 1 'mid'\)"):
-        read_skinned(_edit_glb(path, tmp_path / "forest.glb", two_scene_roots))
+        read_skinned(edit_glb(path, tmp_path / "forest.glb", two_scene_roots))
 
 
 def test_mesh_node_transform_moves_the_rest_mesh_but_not_the_skinned_result(chain_glb, tmp_path):
@@ -403,7 +393,7 @@ def test_mesh_node_transform_moves_the_rest_mesh_but_not_the_skinned_result(chai
     def move_mesh_node(gltf, blob):
         gltf.nodes[3].translation = [5.0, 0.0, 0.0]
 
-    read, motions = read_skinned(_edit_glb(path, tmp_path / "moved.glb", move_mesh_node), fps=motion.fps)
+    read, motions = read_skinned(edit_glb(path, tmp_path / "moved.glb", move_mesh_node), fps=motion.fps)
     np.testing.assert_allclose(read.rest_positions, mesh.rest_positions + [5.0, 0.0, 0.0], atol=1e-6)
     np.testing.assert_allclose(read.bake(motions[0]).frames, mesh.bake(motion).frames, atol=1e-5)
 
@@ -417,7 +407,7 @@ def test_primitives_of_one_mesh_are_merged(chain_glb, tmp_path):
             pygltflib.Primitive(attributes=primitive.attributes, indices=primitive.indices, targets=primitive.targets)
         )
 
-    read, _ = read_skinned(_edit_glb(path, tmp_path / "two.glb", duplicate_primitive))
+    read, _ = read_skinned(edit_glb(path, tmp_path / "two.glb", duplicate_primitive))
     vertex_count = mesh.vertex_count
     assert read.vertex_count == 2 * vertex_count
     np.testing.assert_array_equal(read.faces[mesh.face_count :], mesh.faces + vertex_count)
@@ -548,7 +538,7 @@ def test_required_extension_animlod_cannot_read(chain_glb, tmp_path):
         gltf.extensionsUsed = gltf.extensionsRequired = ["KHR_draco_mesh_compression"]
 
     with pytest.raises(FormatError, match=r"extensionsRequired: needs KHR_draco_mesh_compression"):
-        read_gltf(_edit_glb(path, tmp_path / "draco.glb", require_draco))
+        read_gltf(edit_glb(path, tmp_path / "draco.glb", require_draco))
 
 
 def test_accessor_index_out_of_range(chain_glb, tmp_path):
@@ -558,7 +548,7 @@ def test_accessor_index_out_of_range(chain_glb, tmp_path):
         gltf.meshes[0].primitives[0].attributes.POSITION = 999
 
     with pytest.raises(FormatError, match=r"mesh 0 primitive 0 POSITION: refers to accessor 999"):
-        read_skinned(_edit_glb(path, tmp_path / "oob.glb", break_position))
+        read_skinned(edit_glb(path, tmp_path / "oob.glb", break_position))
 
 
 def test_nan_in_positions(chain_glb, tmp_path):
@@ -568,7 +558,7 @@ def test_nan_in_positions(chain_glb, tmp_path):
         _accessor_view(gltf, blob, gltf.meshes[0].primitives[0].attributes.POSITION, "<f4")[3, 1] = np.nan
 
     with pytest.raises(FormatError, match=r"accessor 1 \(mesh 0 primitive 0 POSITION\): non-finite value at element 3"):
-        read_skinned(_edit_glb(path, tmp_path / "nan.glb", poison))
+        read_skinned(edit_glb(path, tmp_path / "nan.glb", poison))
 
 
 def test_non_uniform_joint_scale_is_rejected(chain_glb, tmp_path):
@@ -578,24 +568,28 @@ def test_non_uniform_joint_scale_is_rejected(chain_glb, tmp_path):
         gltf.nodes[1].scale = [1.0, 2.0, 1.0]
 
     with pytest.raises(FormatError, match=r"skin 0: scale \[1.0, 2.0, 1.0\] of node 1 'mid' is not uniform"):
-        read_skinned(_edit_glb(path, tmp_path / "scaled.glb", stretch))
+        read_skinned(edit_glb(path, tmp_path / "scaled.glb", stretch))
 
 
-def test_animated_scale_is_rejected(chain_glb, tmp_path):
-    path, _, _ = chain_glb
+def test_animated_scale_is_skinned_as_a_viewer_does(chain_glb, tmp_path):
+    path, _, motion = chain_glb
+    scaled = edit_glb(path, tmp_path / "squash.glb", squash_and_stretch)
+    read, (read_motion,) = read_skinned(scaled, fps=motion.fps)
+    assert read_motion.joint_deformations is not None
+    gltf = pygltflib.GLTF2.load_from_bytes(scaled.read_bytes())
+    baked = read.bake(read_motion).frames
+    for frame in range(motion.frame_count):
+        expected = _viewer_skinning(gltf, bytearray(gltf.binary_blob()), 3, "bend", frame)
+        np.testing.assert_allclose(baked[frame], expected, atol=1e-5)
+    # A joint's position follows its parent's scale; the skeleton's rest pose does not scale.
+    np.testing.assert_allclose(np.linalg.norm(read_motion.local_translations()[-1, 1:], axis=1), [1.5, 1.6 * 1.5])
+    np.testing.assert_allclose(read.rest_pose(), read.bake(read.skeleton.rest_motion(1)).frames[0])
 
-    def animate_scale(gltf, blob):
-        animation = gltf.animations[0]
-        rotation_channel = animation.channels[1]
-        sampler = animation.samplers[rotation_channel.sampler]
-        # Reuse a VEC3 output (the root translation keys) as scale keys of joint 1.
-        scale_output = animation.samplers[animation.channels[0].sampler].output
-        animation.samplers.append(pygltflib.AnimationSampler(input=sampler.input, output=scale_output))
-        target = pygltflib.AnimationChannelTarget(node=1, path="scale")
-        animation.channels.append(pygltflib.AnimationChannel(sampler=len(animation.samplers) - 1, target=target))
 
-    with pytest.raises(FormatError, match=r"animation 'bend' channel 4: animated scale is not supported"):
-        read_skinned(_edit_glb(path, tmp_path / "animated_scale.glb", animate_scale))
+def test_scale_keys_at_the_rest_scale_leave_the_motion_rigid(chain_glb, tmp_path):
+    path, _, motion = chain_glb
+    held = edit_glb(path, tmp_path / "held.glb", lambda g, b: add_scale_channel(g, b, 1, np.full((6, 3), 1.00001)))
+    assert read_skinned(held, fps=motion.fps)[1][0].joint_deformations is None
 
 
 # ---- the tinygltf probe -------------------------------------------------------------------
@@ -799,7 +793,7 @@ def test_key_time_far_beyond_any_clip_is_refused(chain_glb, tmp_path):
 
     message = r"animation 'bend': lasts 1e\+07 s: 300000001 frames at 30 fps, more than the limit of 100000"
     with pytest.raises(FormatError, match=message):
-        read_skinned(_edit_glb(path, tmp_path / "long.glb", stretch_last_key))
+        read_skinned(edit_glb(path, tmp_path / "long.glb", stretch_last_key))
 
 
 def test_zero_rotation_key_is_refused(chain_glb, tmp_path):
@@ -811,7 +805,7 @@ def test_zero_rotation_key_is_refused(chain_glb, tmp_path):
         _accessor_view(gltf, blob, animation.samplers[channel.sampler].output, "<f4")[:] = 0.0
 
     with pytest.raises(FormatError, match=r"animation 'bend' channel \d+: quaternion: zero or non-finite norm"):
-        read_skinned(_edit_glb(path, tmp_path / "zero.glb", zero_rotation))
+        read_skinned(edit_glb(path, tmp_path / "zero.glb", zero_rotation))
 
 
 def test_null_inside_an_array_is_refused(tmp_path):

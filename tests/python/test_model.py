@@ -97,6 +97,28 @@ def test_bake_follows_the_skeleton():
     np.testing.assert_allclose(mesh.frames[1, 1], expected_mid, atol=1e-6)
 
 
+def test_joint_deformations_act_in_the_joints_frame_and_travel_with_the_frames():
+    skinned = _skinned_bar()
+    bend = _bend(np.array([0.0, np.pi / 2]))
+    stretch = np.broadcast_to(np.eye(3), (2, 3, 3, 3)).copy()
+    stretch[1, 1] = np.diag([2.0, 1.0, 1.0])  # 'mid' doubles along its bone in frame 1
+    stretched = Motion(bend.skeleton, bend.root_positions, bend.local_rotations, bend.fps, "s", None, stretch)
+    frames = skinned.bake(stretched).frames
+    np.testing.assert_allclose(frames[0], skinned.bake(bend).frames[0], atol=1e-6)
+    # Half a unit beyond 'mid' along its bone becomes a whole unit, turned to +Y with the bone.
+    expected_mid = 0.75 * np.array([1.0, 1.0, 0.0]) + 0.25 * np.array([1.5, 0.0, 0.0])
+    np.testing.assert_allclose(frames[1, 1], expected_mid, atol=1e-6)
+    np.testing.assert_allclose(stretched.world_positions(), bend.world_positions())  # joints stay rigid
+    np.testing.assert_array_equal(stretched.take_frames([1]).joint_deformations[0], stretch[1])
+    joined = Motion.concatenate([bend, stretched], "both")
+    np.testing.assert_array_equal(
+        joined.joint_deformations, np.concatenate([np.broadcast_to(np.eye(3), (2, 3, 3, 3)), stretch])
+    )
+    assert bend.deforming_joint() is None and stretched.deforming_joint() == "mid"
+    with pytest.raises(ValueError, match="motion 's': joint 'mid' scales; motion LoD takes rigid motions only"):
+        stretched.require_rigid("motion LoD")
+
+
 def test_bake_rejects_a_motion_for_another_skeleton():
     other = Skeleton(["a", "b"], [-1, 0], np.zeros((2, 3)))
     motion = Motion(other, np.zeros((1, 3)), rotations.identity((1, 2)), fps=30.0)

@@ -362,11 +362,16 @@ def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZX
     Raises
     ------
     ValueError
-        For an unsupported ``rotation_order`` or an end site whose translation is animated.
+        For an unsupported ``rotation_order``, an end site whose translation is animated, or a
+        motion whose joints scale (BVH has no scale channels).
     """
     order = rotation_order.upper()
     if len(order) != 3 or set(order) != set("XYZ"):
         raise ValueError(f"{os.fspath(path)}: rotation_order: must be a permutation of XYZ, got {rotation_order!r}")
+    try:
+        motion.require_rigid("BVH")
+    except ValueError as error:
+        raise ValueError(f"{os.fspath(path)}: {error}") from None
     skeleton = motion.skeleton
     translations = motion.local_translations()
     has_position = np.zeros(skeleton.joint_count, dtype=bool)

@@ -9,10 +9,13 @@ rotation relative to its parent joint's, and the root's position is its world po
 Joints that form several trees (several root bones under one armature) get the lowest node
 above all of them as an extra root joint.
 
-Scale: glTF nodes may scale, animlod motions are rigid. A uniform scale ``c`` accumulated down
-the tree scales the bone offsets below it, and ``diag(c, c, c, 1)`` moves into the joint's
-inverse bind matrix (``W = W_rigid @ S(c)``, so ``W @ IBM = W_rigid @ (S(c) @ IBM)``).
-Non-uniform scale and animated scale have no rigid equivalent and raise FormatError.
+Scale: glTF nodes may scale, animlod skeletons are rigid. A uniform rest scale ``c``
+accumulated down the tree scales the bone offsets below it, and ``diag(c, c, c, 1)`` moves into
+the joint's inverse bind matrix (``W = W_rigid @ S(c)``, so ``W @ IBM = W_rigid @ (S(c) @ IBM)``).
+A non-uniform rest scale raises FormatError. An animation that scales nodes of the tree (squash
+and stretch, parts shrunk to nothing) poses the full transforms: the joints' rigid frames move
+with the scaled offsets, and the rest of each joint's world transform becomes the motion's
+``joint_deformations`` (``W = W_rigid @ D @ S(c)``), which skinning applies and motion LoD refuses.
 """
 
 from __future__ import annotations
@@ -77,7 +80,7 @@ class SkinRig:
             self._world_scale[node] = self._local_scale[node] * self._world_scale.get(self._node_parents[node], 1.0)
         self.scales = np.array([self._world_scale[n] for n in self.joint_nodes])
         self.inverse_bind = self._inverse_bind(doc, len(order))[order]
-        positions, world_rotations = self._pose(self.rest_translation, self.rest_rotation, frames=1)
+        positions, world_rotations, _ = self._pose(self.rest_translation, self.rest_rotation, frames=1)
         offsets = self._offsets(positions, world_rotations)[0]
         self._translation_tolerance = _HELD_TRANSLATION_TOLERANCE * max(np.abs(offsets[1:]).max(initial=0.0), 1e-12)
         names = _unique_names(doc, self.joint_nodes)
@@ -107,6 +110,8 @@ class SkinRig:
             return None
         at = doc.animation_frame_times(animation_index, fps)
         translations, local_rotations = dict(self.rest_translation), dict(self.rest_rotation)
+        scales = {node: np.full((1, 3), scale) for node, scale in self._local_scale.items()}
+        scaled = False
         for index, channel in channels:
             element = f"{label} channel {index}"
             node, path = channel.target.node, channel.target.path
@@ -114,7 +119,8 @@ class SkinRig:
                 animation_index, channel.sampler, 4 if path == "rotation" else 3, element
             )
             if path == "scale":
-                self._check_scale_held(doc, node, values, element)
+                scales[node] = sample_keyframes(times, values, interpolation, at)
+                scaled |= self._scale_moves(node, values)
             elif path == "translation":
                 translations[node] = sample_keyframes(times, values, interpolation, at)
             else:
@@ -122,7 +128,10 @@ class SkinRig:
                     local_rotations[node] = sample_keyframes(times, values, interpolation, at, rotation=True)
                 except ValueError as error:  # a zero or non-finite quaternion among the keys
                     raise doc.fail(element, str(error)) from None
-        positions, world_rotations = self._pose(translations, local_rotations, frames=len(at))
+        # Scale keys within float noise of the rest scale leave the motion rigid.
+        positions, world_rotations, deformations = self._pose(
+            translations, local_rotations, frames=len(at), scales=scales if scaled else None
+        )
         offsets = self._offsets(positions, world_rotations)
         bones_move = np.abs(offsets[:, 1:] - self.skeleton.offsets[1:]).max(initial=0.0) > self._translation_tolerance
         try:
@@ -133,6 +142,7 @@ class SkinRig:
                 fps=fps,
                 name=animation.name or "",
                 joint_translations=offsets if bones_move else None,
+                joint_deformations=deformations,
             )
         except ValueError as error:
             raise doc.fail(label, str(error)) from None
@@ -195,23 +205,40 @@ class SkinRig:
             raise doc.fail(f"{self.element} inverseBindMatrices", reason + "is singular (cannot be inverted)")
         return matrices
 
-    def _pose(self, translations: dict, local_rotations: dict, frames: int) -> tuple[np.ndarray, np.ndarray]:
-        """World positions ``(T, J, 3)`` and rotations ``(T, J, 4)`` of the joints, T = ``frames``.
+    def _pose(
+        self, translations: dict, local_rotations: dict, frames: int, scales: dict | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """World positions ``(T, J, 3)``, rotations ``(T, J, 4)`` and deformations ``(T, J, 3, 3)``
+        (None without ``scales``) of the joints, T = ``frames``.
 
         ``translations[node] (T or 1, 3)`` and ``local_rotations[node] (T or 1, 4)`` give the
         local transform of every node of the tree. A node's position is its parent's plus the
-        parent's accumulated scale times its translation turned by the parent's rotation.
+        parent's accumulated scale times its translation turned by the parent's rotation. With
+        ``scales[node] (T or 1, 3)``, the parent's full linear part ``L`` (rotations and scales
+        down the tree) takes the place of that scale and rotation, and a joint's deformation is
+        ``R_world^T @ L / c``, ``c`` its accumulated rest scale (in the inverse bind already).
         """
-        position, rotation = {}, {}
+        position, rotation, linear = {}, {}, {}
         for node in self._nodes:
             parent = self._node_parents[node]
+            if scales is not None:
+                own = rotations.to_matrix(local_rotations[node]) * scales[node][:, None, :]  # R @ diag(s)
+                linear[node] = own if parent < 0 else linear[parent] @ own
             if parent < 0:
                 position[node], rotation[node] = translations[node], local_rotations[node]
                 continue
-            turned = rotations.rotate(rotation[parent], translations[node])
-            position[node] = position[parent] + self._world_scale[parent] * turned
+            if scales is None:
+                turned = self._world_scale[parent] * rotations.rotate(rotation[parent], translations[node])
+            else:
+                turned = (linear[parent] @ translations[node][..., None])[..., 0]
+            position[node] = position[parent] + turned
             rotation[node] = rotations.multiply(rotation[parent], local_rotations[node])
-        return self._per_joint(position, frames), self._per_joint(rotation, frames)
+        world_rotations = self._per_joint(rotation, frames)
+        if scales is None:
+            return self._per_joint(position, frames), world_rotations, None
+        linears = np.stack([np.broadcast_to(linear[n], (frames, 3, 3)) for n in self.joint_nodes], axis=1)
+        unturned = np.swapaxes(rotations.to_matrix(world_rotations), -1, -2) @ linears
+        return self._per_joint(position, frames), world_rotations, unturned / self.scales[:, None, None]
 
     def _per_joint(self, values: dict, frames: int) -> np.ndarray:
         """``(T, J, C)`` from per-node ``(T or 1, C)`` arrays."""
@@ -233,14 +260,11 @@ class SkinRig:
         local[:, 1:] = rotations.multiply(rotations.conjugate(world_rotations[:, parents]), world_rotations[:, 1:])
         return local
 
-    def _check_scale_held(self, doc: GltfDocument, node: int, values: np.ndarray, element: str) -> None:
-        """A scale channel must keep its node's rest scale: rigid motions cannot scale."""
+    def _scale_moves(self, node: int, values: np.ndarray) -> bool:
+        """Whether a scale channel's keys leave the node's rest scale by more than float noise."""
         keys = values[:, 1] if values.ndim == 3 else values  # CUBICSPLINE: the values between tangents
         rest = self._local_scale[node]
-        deviation = float(np.abs(keys - rest).max())
-        if deviation > UNIFORM_SCALE_TOLERANCE * rest:
-            reason = f"animated scale is not supported (motions are rigid); it leaves the rest scale by {deviation:.6g}"
-            raise doc.fail(element, reason)
+        return float(np.abs(keys - rest).max()) > UNIFORM_SCALE_TOLERANCE * rest
 
 
 def _topological_order(parent_slots: list[int]) -> list[int]:

@@ -93,7 +93,9 @@ def add_skin(builder: GlbBuilder, joint_nodes: Sequence[int], inverse_bind: np.n
 def add_animation(
     builder: GlbBuilder, motion: Motion, joint_nodes: Sequence[int], name: str, extras: dict | None = None
 ) -> int:
-    """``motion`` as a LINEAR animation of ``joint_nodes`` (one per joint of its skeleton); its index."""
+    """``motion`` as a LINEAR animation of ``joint_nodes`` (one per joint of its skeleton); its index.
+    A rigid motion only: joint deformations have no TRS channels of their own (ValueError)."""
+    motion.require_rigid("a glTF animation of a skeleton")
     times = (np.arange(motion.frame_count) / motion.fps).astype(np.float32)[:, None]
     time_accessor = builder.add(times, bounds=True)
     joint_count = motion.skeleton.joint_count

@@ -207,6 +207,7 @@ def analyze_motion(
     frame), joint positions show no rotation, so Eqs. 1-3 are undefined: r_max 0, importance 0
     and no joint in ``priority`` (nothing freezes).
     """
+    motion.require_rigid("motion LoD")
     skeleton = motion.skeleton
     if ranking not in RANKINGS:
         raise ValueError(f"ranking: expected one of {', '.join(RANKINGS)}, got {ranking!r}")

@@ -45,10 +45,11 @@ from ..io.gltf_write import add_animation, add_skeleton, add_skin
 from ..metrics import surface_error
 from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
+from ..motion_lod.chain import MotionLevel
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
-from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
+from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, posed_frames, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
 
 
@@ -126,6 +127,14 @@ def build_character(
             continue
         clips = [clip for clip in drawable.clips if clip.motion is not None]
         joined, spans = _joined_motion([clip.motion for clip in clips])
+        scaling = joined.deforming_joint()
+        if scaling is not None:
+            notes.append(
+                f"skin {skin}: joint {scaling!r} scales in its clips, and motion LoD re-fits rigid motions only; "
+                "the skin keeps every joint at every level"
+            )
+            motion_chains[skin] = _SkinMotion(None, list(zip(clips, spans)), drawable.rig, joined)
+            continue
         analysis = analyze_motion(joined, workers=workers)
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
         floor = joint_floor(joined, analysis)
@@ -158,8 +167,8 @@ def build_character(
         motion = motion_chains[drawable.skin_index]
         levels = geometry[drawable.label]
         say(f"{drawable.label}: writing the grid, measuring the chain")
-        grid = _write_grid(builder, doc, drawable, levels, motion.chain, motion_nodes[drawable.skin_index])
-        report = _measure_chain(drawable, levels, motion.chain, motion.clips, settings.measured_frames)
+        grid = _write_grid(builder, doc, drawable, levels, motion, motion_nodes[drawable.skin_index])
+        report = _measure_chain(drawable, levels, motion, settings.measured_frames)
         coverages = screen_coverages(
             [level.error for level in report], levels.size, settings.pixel_error, settings.viewport_px
         )
@@ -186,13 +195,24 @@ def _joined_motion(motions: list[Motion]) -> tuple[Motion, list[slice]]:
 
 @dataclass
 class _SkinMotion:
-    """A skin's motion chain: the clips (with their frames in the joined motion), the rig and the
+    """A skin's motion chain (None when its clips scale joints: the input's skeleton and clips
+    serve every level), the clips (with their frames in the joined motion), the rig and the
     joined motion the chain reduces."""
 
-    chain: MotionLodChain
+    chain: MotionLodChain | None
     clips: list[tuple[Clip, slice]]
     rig: SkinRig
     joined: Motion
+
+    @property
+    def reduced_levels(self) -> list[MotionLevel]:
+        """Motion levels 1, 2, ... (level 0 is the input's skeleton and clips)."""
+        return [] if self.chain is None else self.chain.levels[1:]
+
+    @property
+    def joint_count(self) -> int:
+        """Joints of motion level 0 (end sites not counted)."""
+        return int(np.count_nonzero(~self.joined.skeleton.end_sites))
 
 
 @dataclass
@@ -207,9 +227,9 @@ class _MotionLevelNodes:
 def _add_motion_levels(builder: GlbBuilder, doc: GltfDocument, motion: _SkinMotion) -> list[_MotionLevelNodes]:
     """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's),
     with what hangs from the skeleton and the clips' other channels (:mod:`.attachments`)."""
-    nodes = [_MotionLevelNodes(None, motion.chain.levels[0].report.joint_count)]
+    nodes = [_MotionLevelNodes(None, motion.joint_count)]
     attachments, posing = find_attachments(doc, motion.rig), posing_nodes(doc)
-    for m, level in enumerate(motion.chain.levels[1:], start=1):
+    for m, level in enumerate(motion.reduced_levels, start=1):
         joint_nodes = add_skeleton(builder, level.motion.skeleton)
         copies = add_level_attachments(builder, doc, motion.rig, attachments, motion.joined, level, m, joint_nodes)
         for clip, span in motion.clips:
@@ -227,27 +247,28 @@ def _write_grid(
     doc: GltfDocument,
     drawable: Drawable,
     levels: DrawableLevels,
-    chain: MotionLodChain,
+    motion: _SkinMotion,
     motion_nodes: list[_MotionLevelNodes],
 ) -> list[list[list[int]]]:
     """Every (geometry g, motion m) combination of ``drawable`` as level nodes, one per base
     node; returns ``grid[g][m]`` -> those nodes ((0, 0) is the base nodes themselves)."""
     geometry: list[DrawableLevel | None] = [None, *levels.levels]  # geometry level 0 is the input
     input_joints = len(doc.gltf.skins[drawable.skin_index].joints)
+    frozen = [None] + [level.frozen for level in motion.reduced_levels]  # motion level 0 freezes nothing
     skins = [drawable.skin_index]
-    for m in range(1, len(chain.levels)):  # a reduced skin's inverse binds do not depend on the geometry
-        reduced = transfer_skin(drawable.skinned, chain.levels[m].frozen)
+    for m in range(1, len(frozen)):  # a reduced skin's inverse binds do not depend on the geometry
+        reduced = transfer_skin(drawable.skinned, frozen[m])
         skins.append(add_skin(builder, motion_nodes[m].joint_nodes, reduced.inverse_bind))
     mesh_name = doc.gltf.meshes[drawable.mesh_index].name or f"mesh{drawable.mesh_index}"
-    grid = [[list(drawable.nodes) for _ in chain.levels] for _ in geometry]
+    grid = [[list(drawable.nodes) for _ in frozen] for _ in geometry]
     for g, level in enumerate(geometry):
-        for m, motion_level in enumerate(chain.levels):
+        for m, frozen_level in enumerate(frozen):
             if g == 0 and m == 0:
                 continue
             primitives = _input_primitives(drawable) if level is None else level.primitives
             skinned = drawable.skinned if level is None else level.skinned
-            if m > 0:
-                primitives = _reposed(drawable, skinned, motion_level.frozen, primitives)
+            if frozen_level is not None:
+                primitives = _reposed(drawable, skinned, frozen_level, primitives)
             mesh = add_level_mesh(
                 builder, drawable.mesh_index, primitives, drawable.geometry.other_primitives, f"{mesh_name}_G{g}M{m}"
             )
@@ -306,27 +327,32 @@ def _reposed(
 def _measure_chain(
     drawable: Drawable,
     levels: DrawableLevels,
-    chain: MotionLodChain,
-    clips: list[tuple[Clip, slice]],
+    motion: _SkinMotion,
     measured_frames: int,
 ) -> list[CharacterLevel]:
     """The chain's levels (geometry level i with motion level i, or the coarsest motion level
-    there is), each measured: the reduced skin played with the re-fitted clips against the
-    input's clips, max Hausdorff distance."""
-    report = [CharacterLevel(0, 0, 0, len(drawable.geometry.faces), chain.levels[0].report.joint_count, 0.0, 0.0, 0.0)]
+    there is), each measured as it is written: the level's skin played with its clips (the
+    input's at motion level 0, the re-fitted ones on the reduced skin above) against the input's
+    clips, max Hausdorff distance."""
+    report = [CharacterLevel(0, 0, 0, len(drawable.geometry.faces), motion.joint_count, 0.0, 0.0, 0.0)]
     for i in range(1, len(levels.levels) + 1):
-        m = min(i, len(chain.levels) - 1)  # a small skeleton runs out of motion levels first
-        level, motion_level = levels.levels[i - 1], chain.levels[m]
-        reduced = transfer_skin(level.skinned, motion_level.frozen)
+        m = min(i, len(motion.reduced_levels))  # a small skeleton runs out of motion levels first
+        level = levels.levels[i - 1]
+        motion_level = motion.reduced_levels[m - 1] if m > 0 else None
         error = 0.0
-        for clip, span in clips:
+        for clip, span in motion.clips:
             frames = spread_frames(clip.frame_count, measured_frames)
-            weights = None if clip.morph_weights is None else clip.morph_weights[frames]
             original = AnimatedMesh(drawable.geometry.faces, drawable.clip_frames(clip, frames))
-            posed = reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
+            if motion_level is None:
+                posed = AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
+            else:
+                weights = None if clip.morph_weights is None else clip.morph_weights[frames]
+                reduced = transfer_skin(level.skinned, motion_level.frozen)
+                posed = reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
             error = max(error, float(surface_error(original, posed, samples=4000).hausdorff.max()))
         faces = level.simplified.mesh.face_count
-        report.append(CharacterLevel(i, i, m, faces, motion_level.report.joint_count, error, 0.0, 0.0))
+        joints = motion.joint_count if motion_level is None else motion_level.report.joint_count
+        report.append(CharacterLevel(i, i, m, faces, joints, error, 0.0, 0.0))
     return report
 
 

@@ -181,17 +181,28 @@ def _read_input(
         if merged is not None:
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
-            return merged, skin
-        return motions[0], skin
+            return _rigid(path, motions, range(len(motions)), merged), skin
+        return _rigid(path, motions, range(1), motions[0]), skin
     if isinstance(clip, str):
         names = [m.name for m in motions]
         if clip not in names:
             listed = ", ".join(f"{i}: {name!r}" for i, name in enumerate(names))
             raise FormatError(path, "clip", f"no animation named {clip!r}; the file has {listed}")
-        return motions[names.index(clip)], skin
+        clip = names.index(clip)
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
-    return motions[clip], skin
+    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), skin
+
+
+def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Motion:
+    """``motion``, made of ``motions[used]``, when none of those scales a joint; FormatError otherwise."""
+    for index in used:
+        joint = motions[index].deforming_joint()
+        if joint is not None:
+            element = f"animation {motions[index].name!r}" if motions[index].name else f"animation {index}"
+            reason = f"joint {joint!r} scales; motion LoD re-fits rigid motions only (animlod simplify takes it)"
+            raise FormatError(path, element, reason)
+    return motion
 
 
 def _plan_levels(

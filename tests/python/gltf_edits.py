@@ -1,0 +1,45 @@
+"""Edits of GLB files through pygltflib for the tests: the shapes exporters write that animlod's
+own writer does not (animated scale, among others)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pygltflib
+
+
+def edit_glb(source: Path, target: Path, edit: Callable[[pygltflib.GLTF2, bytearray], None]) -> Path:
+    """Copy a GLB through pygltflib, letting ``edit`` change its JSON and binary chunk."""
+    gltf = pygltflib.GLTF2.load_from_bytes(source.read_bytes())
+    blob = bytearray(gltf.binary_blob())
+    edit(gltf, blob)
+    gltf.set_binary_blob(bytes(blob))
+    gltf.buffers[0].byteLength = len(blob)
+    target.write_bytes(b"".join(gltf.save_to_bytes()))
+    return target
+
+
+def add_scale_channel(gltf: pygltflib.GLTF2, blob: bytearray, node: int, keys: np.ndarray) -> None:
+    """A scale channel on ``node`` of the first animation, keyed at its first sampler's times."""
+    offset = len(blob) + (-len(blob)) % 4
+    blob.extend(bytes(offset - len(blob)) + keys.astype("<f4").tobytes())
+    gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=offset, byteLength=keys.size * 4))
+    view = len(gltf.bufferViews) - 1
+    accessor = pygltflib.Accessor(bufferView=view, componentType=pygltflib.FLOAT, count=len(keys), type="VEC3")
+    gltf.accessors.append(accessor)
+    animation = gltf.animations[0]
+    sampler = pygltflib.AnimationSampler(input=animation.samplers[0].input, output=len(gltf.accessors) - 1)
+    animation.samplers.append(sampler)
+    target = pygltflib.AnimationChannelTarget(node=node, path="scale")
+    animation.channels.append(pygltflib.AnimationChannel(sampler=len(animation.samplers) - 1, target=target))
+
+
+def squash_and_stretch(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+    """The root grows by half, the middle joint stretches along y and thins along x, and the tip
+    shrinks to nothing (how clips hide a part), over the 'bend' clip's six keys."""
+    k = np.linspace(0.0, 1.0, 6)[:, None]
+    add_scale_channel(gltf, blob, 0, np.repeat(1.0 + 0.5 * k, 3, axis=1))
+    add_scale_channel(gltf, blob, 1, np.c_[1.0 - 0.3 * k, 1.0 + 0.6 * k, np.ones_like(k)])
+    add_scale_channel(gltf, blob, 2, np.repeat(1.0 - k, 3, axis=1))

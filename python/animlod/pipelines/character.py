@@ -5,7 +5,8 @@ Here every skinned drawable gets AQEM geometry levels (as :func:`simplify_docume
 them) and every skin gets motion levels: the clips of all its animations are analysed as one
 (so one reduced skeleton serves them all), joints are frozen level by level, each clip is
 re-fitted with SLSQP, and the weights of frozen joints move to their kept ancestors (seeds/000,
-Sections 4-5). Level i of the written chain combines geometry level i with motion level i (or
+Sections 4-5). A skin whose clips scale a joint keeps every joint, with the input's clips, at
+every level: the re-fit is rigid. Level i of the written chain combines geometry level i with motion level i (or
 the coarsest one a small skeleton has);
 every other combination is written too (``extras.animlod_grid`` on the base node lists them by
 geometry level, then motion level) so that a benchmark can walk the whole grid.

@@ -60,6 +60,13 @@ def character_with_sockets(tmp_path_factory):
     nodes[by_name["Head"]]["mesh"] = builder.append("meshes", hat)
     lowering = builder.add(np.linspace(1.0, 0.0, keys).astype(np.float32)[:, None])
     _animate(animation, by_name["Head"], "weights", lowering)
+    # A material colour the clip animates through KHR_animation_pointer.
+    colour = builder.add(np.linspace([1.0, 1.0, 1.0, 1.0], [1.0, 0.2, 0.2, 1.0], keys).astype(np.float32))
+    animation["samplers"].append({"input": animation["samplers"][0]["input"], "output": colour})
+    pointer = {"KHR_animation_pointer": {"pointer": "/materials/0/pbrMetallicRoughness/baseColorFactor"}}
+    target = {"path": "pointer", "extensions": pointer}
+    animation["channels"].append({"sampler": len(animation["samplers"]) - 1, "target": target})
+    builder.json.setdefault("extensionsUsed", []).append("KHR_animation_pointer")
     source = folder / "sockets.glb"
     builder.save(source)
     output = folder / "sockets_lod.glb"
@@ -79,6 +86,8 @@ def _posed_worlds(doc: GltfDocument, animation: int) -> list[np.ndarray]:
     keyed: dict[int, dict[str, np.ndarray]] = {}
     clip = doc.gltf.animations[animation]
     for channel in clip.channels:
+        if channel.target.node is None:  # the material colour's pointer channel
+            continue
         values = np.asarray(doc.accessor(clip.samplers[channel.sampler].output, "test"))
         keyed.setdefault(channel.target.node, {})[channel.target.path] = values[0]
     for node, paths in keyed.items():
@@ -148,14 +157,17 @@ def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(cha
 
 def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(character_with_sockets):
     # The sliding socket's channel and the hat's morph weights go to their copies, the skinned
-    # mesh's morph weights to the same mesh node; all read the input clip's keys.
+    # mesh's morph weights to the same mesh node, the material colour's pointer channel as it is;
+    # all read the input clip's keys.
     source, output, _ = character_with_sockets
     doc_in, doc_out = GltfDocument(source), GltfDocument(output)
     clip = doc_in.gltf.animations[0]
     outputs = {
         (doc_in.gltf.nodes[channel.target.node].name, channel.target.path): clip.samplers[channel.sampler].output
         for channel in clip.channels
+        if channel.target.node is not None
     }
+    (colour,) = [channel for channel in clip.channels if channel.target.path == "pointer"]
     levels = [animation for animation in doc_out.gltf.animations if "@motion" in (animation.name or "")]
     assert levels
     for animation in levels:
@@ -164,8 +176,12 @@ def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(ch
             (doc_out.gltf.nodes[channel.target.node].name, path): animation.samplers[channel.sampler].output
             for channel in animation.channels
             for path in [channel.target.path]
-            if path == "weights" or "socket" in (doc_out.gltf.nodes[channel.target.node].name or "")
+            if path != "pointer"
+            and (path == "weights" or "socket" in (doc_out.gltf.nodes[channel.target.node].name or ""))
         }
+        (carried_colour,) = [channel for channel in animation.channels if channel.target.path == "pointer"]
+        assert carried_colour.target.extensions == colour.target.extensions
+        assert animation.samplers[carried_colour.sampler].output == clip.samplers[colour.sampler].output
         base_name = next(node.name for node in doc_in.gltf.nodes if node.skin is not None)
         assert carried == {
             (f"moving socket@motion{m}", "translation"): outputs[("moving socket", "translation")],

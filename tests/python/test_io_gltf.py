@@ -586,6 +586,34 @@ def test_animated_scale_is_skinned_as_a_viewer_does(chain_glb, tmp_path):
     np.testing.assert_allclose(read.rest_pose(), read.bake(read.skeleton.rest_motion(1)).frames[0])
 
 
+def _as_pointer_channels(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+    """Every channel written as KHR_animation_pointer, plus one animating a material's colour."""
+    animation = gltf.animations[0]
+    for channel in animation.channels:
+        pointer = f"/nodes/{channel.target.node}/{channel.target.path}"
+        channel.target = pygltflib.AnimationChannelTarget(path="pointer")
+        channel.target.extensions = {"KHR_animation_pointer": {"pointer": pointer}}
+    colour = pygltflib.AnimationChannelTarget(path="pointer")
+    colour.extensions = {"KHR_animation_pointer": {"pointer": "/materials/0/pbrMetallicRoughness/baseColorFactor"}}
+    animation.channels.append(pygltflib.AnimationChannel(sampler=1, target=colour))  # a VEC4 output
+    gltf.extensionsUsed = [*(gltf.extensionsUsed or []), "KHR_animation_pointer"]
+
+
+def test_pointer_channels_of_nodes_pose_them_and_others_are_left_alone(chain_glb, tmp_path):
+    path, _, motion = chain_glb
+    pointers = edit_glb(path, tmp_path / "pointers.glb", _as_pointer_channels)
+    _, (expected,) = read_skinned(path, fps=motion.fps)
+    _, (read,) = read_skinned(pointers, fps=motion.fps)
+    np.testing.assert_array_equal(read.local_rotations, expected.local_rotations)
+    np.testing.assert_array_equal(read.root_positions, expected.root_positions)
+
+    def without_pointer(gltf, blob):
+        gltf.animations[0].channels[0].target = pygltflib.AnimationChannelTarget(path="pointer")
+
+    with pytest.raises(FormatError, match=r"animation 0 channel 0 target: path 'pointer' needs a KHR_animation"):
+        read_skinned(edit_glb(path, tmp_path / "bare.glb", without_pointer))
+
+
 def test_scale_keys_at_the_rest_scale_leave_the_motion_rigid(chain_glb, tmp_path):
     path, _, motion = chain_glb
     held = edit_glb(path, tmp_path / "held.glb", lambda g, b: add_scale_channel(g, b, 1, np.full((6, 3), 1.00001)))

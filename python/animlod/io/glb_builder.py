@@ -36,7 +36,9 @@ _ACCESSOR_TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
 _IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".webp": "image/webp"}
 _GLB_MAGIC, _GLB_VERSION = b"glTF", 2
 # Extensions known not to refer to accessors or buffer views from places prune() does not scan.
-_PRUNE_SAFE_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_mesh_quantization", "MSFT_lod")
+_PRUNE_SAFE_EXTENSIONS = (
+    "KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_mesh_quantization", "KHR_animation_pointer", "MSFT_lod",
+)  # fmt: skip
 _JSON_CHUNK, _BIN_CHUNK = 0x4E4F534A, 0x004E4942
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import base64
 import os
+import re
 import struct
 from pathlib import Path
 from typing import Any
@@ -65,6 +66,10 @@ _TOP_LEVEL_ARRAYS = (
     "samplers", "scenes", "skins", "textures", "extensionsUsed", "extensionsRequired",
 )  # fmt: skip
 _CHANNEL_PATHS = ("translation", "rotation", "scale", "weights")
+# KHR_animation_pointer: a channel of path "pointer" animates the property its JSON pointer
+# names; those of a node's TRS or weights are read as that node's channels.
+POINTER_EXTENSION = "KHR_animation_pointer"
+_NODE_POINTER = re.compile(r"/nodes/(\d+)/(translation|rotation|scale|weights)")
 # Top-level arrays whose singular is not the name without its last letter.
 _IRREGULAR_SINGULARS = {"meshes": "mesh"}
 
@@ -83,6 +88,8 @@ class GltfDocument:
     json : the document's JSON as parsed, every property kept (pygltflib drops some, such as a
         node's morph ``weights``); what whole-document writers start from.
     parents : (N,) int, parent node of every node, -1 for nodes at the top of the tree.
+    channel_targets : per animation, per channel, the (node, path) it animates (a
+        KHR_animation_pointer channel resolved; ``(None, "pointer")`` when it animates no node).
     """
 
     def __init__(self, path: str | os.PathLike, max_animation_frames: int | None = None) -> None:
@@ -286,23 +293,43 @@ class GltfDocument:
 
     def _check_scenes_and_channels(self) -> None:
         """The default scene, the scenes' root nodes and every animation channel's target refer to
-        things the file has (a channel on node 9999 or a scene past the list is an error)."""
+        things the file has (a channel on node 9999 or a scene past the list is an error); the
+        targets are resolved into ``channel_targets``."""
         gltf = self.gltf
         if gltf.scene is not None:
             self.item("scenes", gltf.scene, "scene")
         for index, scene in enumerate(gltf.scenes or []):
             for node in scene.nodes or []:
                 self.item("nodes", node, f"scene {index} nodes")
-        for a, animation in enumerate(gltf.animations or []):
-            for c, channel in enumerate(animation.channels or []):
-                element = f"animation {a} channel {c} target"
-                if channel.target is None:
-                    raise self.fail(f"animation {a} channel {c}", "has no target")
-                if channel.target.node is not None:
-                    self.item("nodes", channel.target.node, element)
-                if channel.target.path not in _CHANNEL_PATHS:
-                    reason = f"path {channel.target.path!r} is not one of {', '.join(_CHANNEL_PATHS)}"
-                    raise self.fail(element, reason)
+        self.channel_targets = [
+            [self._channel_target(a, c, channel) for c, channel in enumerate(animation.channels or [])]
+            for a, animation in enumerate(gltf.animations or [])
+        ]
+
+    def _channel_target(self, a: int, c: int, channel: pygltflib.AnimationChannel) -> tuple[int | None, str]:
+        """The (node, path) channel ``c`` of animation ``a`` animates: its target's, or for a
+        KHR_animation_pointer channel the node TRS or weights its pointer names, else (None, "pointer")
+        for a property of anything else (a material's colour, a light), which nothing here reads."""
+        element = f"animation {a} channel {c} target"
+        if channel.target is None:
+            raise self.fail(f"animation {a} channel {c}", "has no target")
+        if channel.target.path == "pointer":
+            extension = (channel.target.extensions or {}).get(POINTER_EXTENSION)
+            pointer = extension.get("pointer") if isinstance(extension, dict) else None
+            if not isinstance(pointer, str):
+                raise self.fail(element, f"path 'pointer' needs a {POINTER_EXTENSION} pointer string")
+            match = _NODE_POINTER.fullmatch(pointer)
+            if match is None:
+                return None, "pointer"
+            node = int(match.group(1))
+            self.item("nodes", node, f"{element} pointer")
+            return node, match.group(2)
+        if channel.target.node is not None:
+            self.item("nodes", channel.target.node, element)
+        if channel.target.path not in _CHANNEL_PATHS:
+            reason = f"path {channel.target.path!r} is not one of {', '.join(_CHANNEL_PATHS)}, or 'pointer'"
+            raise self.fail(element, reason)
+        return channel.target.node, channel.target.path
 
     def node_label(self, index: int) -> str:
         """``node 5 'Hips'`` for messages."""

@@ -116,7 +116,6 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
     sampled at ``fps``. Nodes that are lower levels of an MSFT_lod chain are alternates of their
     base node, not drawables of their own. Raises FormatError naming the element for anything
     it cannot read."""
-    _check_channel_targets(doc)
     nodes = doc.json.get("nodes", [])
     alternates = {other for index, node in enumerate(nodes) for other in _alternate_nodes(node) if other != index}
     pairs: dict[tuple[int, int | None], list[int]] = {}
@@ -163,14 +162,6 @@ def _alternate_nodes(node: dict) -> list[int]:
     grid = extras.get(GRID_EXTRA, []) if isinstance(extras, dict) else []
     ids += [index for row in grid if isinstance(row, list) for index in row]
     return [index for index in ids if isinstance(index, int)]
-
-
-def _check_channel_targets(doc: GltfDocument) -> None:
-    """Every animation channel must target a node of the document."""
-    for a, animation in enumerate(doc.gltf.animations or []):
-        for index, channel in enumerate(animation.channels or []):
-            if channel.target is not None and channel.target.node is not None:
-                doc.item("nodes", channel.target.node, f"{doc.animation_label(a)} channel {index} target")
 
 
 def _clips(doc: GltfDocument, drawable: Drawable, fps: float) -> list[Clip]:

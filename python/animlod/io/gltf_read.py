@@ -197,8 +197,8 @@ def morph_weight_tracks(doc: GltfDocument, node: int, target_count: int, fps: fl
     tracks = []
     for a, animation in enumerate(doc.gltf.animations or []):
         label = doc.animation_label(a)
-        for index, channel in enumerate(animation.channels or []):
-            if channel.target is None or channel.target.node != node or channel.target.path != "weights":
+        for index, (channel, target) in enumerate(zip(animation.channels or [], doc.channel_targets[a])):
+            if target != (node, "weights"):
                 continue
             element = f"{label} channel {index}"
             times, values, interpolation = doc.sampler_keys(a, channel.sampler, target_count, element)

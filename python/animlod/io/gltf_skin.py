@@ -100,11 +100,11 @@ class SkinRig:
         animation = doc.gltf.animations[animation_index]
         label = doc.animation_label(animation_index)
         channels = [
-            (index, channel)
-            for index, channel in enumerate(animation.channels or [])
-            if channel.target is not None
-            and channel.target.node in self.rest_translation
-            and channel.target.path in _NODE_PATHS
+            (index, channel.sampler, node, path)
+            for index, (channel, (node, path)) in enumerate(
+                zip(animation.channels or [], doc.channel_targets[animation_index])
+            )
+            if node in self.rest_translation and path in _NODE_PATHS
         ]
         if not channels:
             return None
@@ -112,11 +112,10 @@ class SkinRig:
         translations, local_rotations = dict(self.rest_translation), dict(self.rest_rotation)
         scales = {node: np.full((1, 3), scale) for node, scale in self._local_scale.items()}
         scaled = False
-        for index, channel in channels:
+        for index, sampler, node, path in channels:
             element = f"{label} channel {index}"
-            node, path = channel.target.node, channel.target.path
             times, values, interpolation = doc.sampler_keys(
-                animation_index, channel.sampler, 4 if path == "rotation" else 3, element
+                animation_index, sampler, 4 if path == "rotation" else 3, element
             )
             if path == "scale":
                 scales[node] = sample_keyframes(times, values, interpolation, at)

@@ -122,21 +122,29 @@ def add_level_attachments(
 
 
 def carry_other_channels(
-    builder: GlbBuilder, posing: set[int], animation: int, level_animation: int, copies: dict[int, int]
+    builder: GlbBuilder,
+    doc: GltfDocument,
+    posing: set[int],
+    animation: int,
+    level_animation: int,
+    copies: dict[int, int],
 ) -> None:
     """Adds to ``level_animation`` the channels of the document's ``animation`` that pose no
     skeleton (not on a node of ``posing``, :func:`posing_nodes`; a joint's morph weights do not
-    pose it), on the attachments' copies where they have one. The samplers reuse the input's
+    pose it), on the attachments' copies where they have one; KHR_animation_pointer channels of
+    anything but a node (a material's colour) as they are. The samplers reuse the input's
     accessors: both clips' times start at 0."""
     source = builder.json["animations"][animation]
     target = builder.json["animations"][level_animation]
-    for channel in source.get("channels", []):
-        node = channel["target"].get("node")
-        if node is None or (node in posing and channel["target"].get("path") != "weights"):
+    for channel, (node, path) in zip(source.get("channels", []), doc.channel_targets[animation]):
+        if path == "pointer":
+            carried = deepcopy(channel["target"])
+        elif node is None or (node in posing and path != "weights"):
             continue
+        else:
+            carried = {"node": copies.get(node, node), "path": path}
         target["samplers"].append(deepcopy(source["samplers"][channel["sampler"]]))
-        retargeted = {**channel["target"], "node": copies.get(node, node)}
-        target["channels"].append({"sampler": len(target["samplers"]) - 1, "target": retargeted})
+        target["channels"].append({"sampler": len(target["samplers"]) - 1, "target": carried})
 
 
 def _subtree(doc: GltfDocument, node: int) -> set[int]:

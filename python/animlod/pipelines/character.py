@@ -238,7 +238,7 @@ def _add_motion_levels(builder: GlbBuilder, doc: GltfDocument, motion: _SkinMoti
             extras = {"animlod": {"clip": clip.index, "motion_level": m}}
             clip_motion = level.motion.take_frames(np.arange(span.start, span.stop))
             animation = add_animation(builder, clip_motion, joint_nodes, name, extras)
-            carry_other_channels(builder, posing, clip.index, animation, copies)
+            carry_other_channels(builder, doc, posing, clip.index, animation, copies)
         nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))
     return nodes
 

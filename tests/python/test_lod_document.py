@@ -186,6 +186,20 @@ def test_separate_writes_one_whole_document_per_level(humanoid_glb, tmp_path):
         assert path.stat().st_size < humanoid_glb.stat().st_size
 
 
+def test_separate_keeps_the_meshes_an_animation_points_at(humanoid_glb, tmp_path):
+    # A KHR_animation_pointer channel names the input mesh by index: dropping that mesh, now
+    # drawn by no node, would renumber the meshes under the pointer.
+    def point_at_mesh_0(js):
+        pointer = {"KHR_animation_pointer": {"pointer": "/meshes/0/weights"}}
+        js["animations"][0]["channels"].append({"sampler": 0, "target": {"path": "pointer", "extensions": pointer}})
+        js.setdefault("extensionsUsed", []).append("KHR_animation_pointer")
+
+    source = _edited(humanoid_glb, tmp_path, point_at_mesh_0)
+    report = simplify_document(source, tmp_path / "levels", [0.5], separate=True, **QUICK)
+    doc = GltfDocument(report.outputs[0])
+    assert [mesh.get("name") for mesh in doc.json["meshes"]] == ["skinned mesh", "skinned mesh_LOD1"]
+
+
 def test_cli_writes_one_lod_glb(humanoid_glb, tmp_path, capsys):
     assert main(["simplify", str(humanoid_glb), "-o", str(tmp_path), "--ratio", "0.5", "--max-frames", "8"]) == 0
     out = capsys.readouterr().out

@@ -106,11 +106,14 @@ class GlbBuilder:
         return self.append("accessors", accessor)
 
     def prune(self) -> None:
-        """Drops meshes no node draws; then, when no extension could refer to them unseen, the
-        accessors and buffer views nothing refers to, and repacks the binary chunk."""
+        """Drops meshes no node draws (all kept when an animation points at a mesh by index, through
+        KHR_animation_pointer); then, when no extension could refer to them unseen, the accessors
+        and buffer views nothing refers to, and repacks the binary chunk."""
         js = self.json
         nodes = js.get("nodes", [])
         kept_meshes = sorted({node["mesh"] for node in nodes if "mesh" in node})
+        if _animates_meshes(js):
+            kept_meshes = list(range(len(js.get("meshes", []))))
         new_mesh = {old: new for new, old in enumerate(kept_meshes)}
         for node in nodes:
             if "mesh" in node:
@@ -187,6 +190,13 @@ def _accessor_references(js: dict):
         for sampler in animation.get("samplers", []):
             yield sampler, "input"
             yield sampler, "output"
+
+
+def _animates_meshes(js: dict) -> bool:
+    """Whether a KHR_animation_pointer channel names a mesh (``/meshes/<index>/weights``)."""
+    targets = (channel.get("target", {}) for a in js.get("animations", []) for channel in a.get("channels", []))
+    pointers = ((target.get("extensions") or {}).get("KHR_animation_pointer") for target in targets)
+    return any(isinstance(p, dict) and str(p.get("pointer", "")).startswith("/meshes/") for p in pointers)
 
 
 def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | None]:

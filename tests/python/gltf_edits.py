@@ -43,3 +43,41 @@ def squash_and_stretch(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
     add_scale_channel(gltf, blob, 0, np.repeat(1.0 + 0.5 * k, 3, axis=1))
     add_scale_channel(gltf, blob, 1, np.c_[1.0 - 0.3 * k, 1.0 + 0.6 * k, np.ones_like(k)])
     add_scale_channel(gltf, blob, 2, np.repeat(1.0 - k, 3, axis=1))
+
+
+def draco_compressed(source: Path, target: Path) -> Path:
+    """A copy of the GLB at ``source`` whose triangle primitives keep their attributes and indices
+    only in a KHR_draco_mesh_compression buffer view (positions quantized to 16 bits, the other
+    attributes exact, the point order kept), the extension required, as Draco encoders write it."""
+    import DracoPy
+
+    from animlod.io.gltf_document import GltfDocument
+
+    doc = GltfDocument(source)
+
+    def compress(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        for mesh in gltf.meshes:
+            for primitive in mesh.primitives:
+                if primitive.mode not in (None, pygltflib.TRIANGLES) or primitive.indices is None:
+                    continue
+                names = [name for name, value in vars(primitive.attributes).items() if isinstance(value, int)]
+                values = {name: doc.accessor(getattr(primitive.attributes, name), "draco test") for name in names}
+                others = {20 + k: values[name] for k, name in enumerate(names) if name != "POSITION"}
+                faces = doc.accessor(primitive.indices, "draco test").reshape(-1, 3)
+                data = DracoPy.encode(
+                    values["POSITION"], faces, quantization_bits=16, preserve_order=True, generic_attributes=others
+                )
+                decoded = DracoPy.decode(data)
+                (position_id,) = [a["unique_id"] for a in decoded.attributes if a["attribute_type"] == 0]
+                ids = {name: 20 + k for k, name in enumerate(names) if name != "POSITION"}
+                offset = len(blob) + (-len(blob)) % 4
+                blob.extend(bytes(offset - len(blob)) + data)
+                gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=offset, byteLength=len(data)))
+                extension = {"bufferView": len(gltf.bufferViews) - 1, "attributes": {"POSITION": position_id, **ids}}
+                primitive.extensions = {**(primitive.extensions or {}), "KHR_draco_mesh_compression": extension}
+                for accessor in [primitive.indices, *(getattr(primitive.attributes, name) for name in names)]:
+                    gltf.accessors[accessor].bufferView = gltf.accessors[accessor].byteOffset = None
+        for listed in ("extensionsUsed", "extensionsRequired"):
+            setattr(gltf, listed, [*(getattr(gltf, listed) or []), "KHR_draco_mesh_compression"])
+
+    return edit_glb(source, target, compress)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pygltflib
 import pytest
-from gltf_edits import add_scale_channel, edit_glb, squash_and_stretch
+from gltf_edits import add_scale_channel, draco_compressed, edit_glb, squash_and_stretch
 
 from animlod import rotations, synth
 from animlod.io import FormatError
@@ -534,11 +534,11 @@ def test_missing_skin_names_the_file_and_the_skin(chain_glb):
 def test_required_extension_animlod_cannot_read(chain_glb, tmp_path):
     path, _, _ = chain_glb
 
-    def require_draco(gltf, blob):
-        gltf.extensionsUsed = gltf.extensionsRequired = ["KHR_draco_mesh_compression"]
+    def require_meshopt(gltf, blob):
+        gltf.extensionsUsed = gltf.extensionsRequired = ["EXT_meshopt_compression"]
 
-    with pytest.raises(FormatError, match=r"extensionsRequired: needs KHR_draco_mesh_compression"):
-        read_gltf(edit_glb(path, tmp_path / "draco.glb", require_draco))
+    with pytest.raises(FormatError, match=r"extensionsRequired: needs EXT_meshopt_compression"):
+        read_gltf(edit_glb(path, tmp_path / "meshopt.glb", require_meshopt))
 
 
 def test_accessor_index_out_of_range(chain_glb, tmp_path):
@@ -559,6 +559,37 @@ def test_nan_in_positions(chain_glb, tmp_path):
 
     with pytest.raises(FormatError, match=r"accessor 1 \(mesh 0 primitive 0 POSITION\): non-finite value at element 3"):
         read_skinned(edit_glb(path, tmp_path / "nan.glb", poison))
+
+
+def test_draco_compressed_primitives_read_as_the_uncompressed_ones(chain_glb, tmp_path):
+    path, _, motion = chain_glb
+    compressed = draco_compressed(path, tmp_path / "draco.glb")
+    gltf = pygltflib.GLTF2.load_from_bytes(compressed.read_bytes())
+    primitive = gltf.meshes[0].primitives[0]
+    assert gltf.accessors[primitive.attributes.POSITION].bufferView is None  # only Draco holds them
+    expected, (expected_motion,) = read_skinned(path, fps=motion.fps)
+    read, (read_motion,) = read_skinned(compressed, fps=motion.fps)
+    np.testing.assert_array_equal(read.faces, expected.faces)
+    np.testing.assert_array_equal(read.joints, expected.joints)
+    np.testing.assert_array_equal(read.weights, expected.weights)
+    np.testing.assert_array_equal(read.uvs, expected.uvs)
+    np.testing.assert_array_equal(read.morph_targets, expected.morph_targets)  # Draco leaves targets alone
+    extent = float(np.ptp(expected.rest_positions, axis=0).max())
+    np.testing.assert_allclose(read.rest_positions, expected.rest_positions, atol=extent / 2**15)  # 16-bit grid
+    np.testing.assert_array_equal(read_motion.local_rotations, expected_motion.local_rotations)
+
+
+def test_draco_data_that_does_not_decode_is_named(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+    compressed = draco_compressed(path, tmp_path / "draco.glb")
+
+    def garble(gltf, blob):
+        view = gltf.bufferViews[gltf.meshes[0].primitives[0].extensions["KHR_draco_mesh_compression"]["bufferView"]]
+        blob[view.byteOffset : view.byteOffset + 8] = b"notdraco"
+
+    broken = edit_glb(compressed, tmp_path / "broken.glb", garble)
+    with pytest.raises(FormatError, match=r"mesh 0 primitive 0 KHR_draco_mesh_compression: the compressed data does"):
+        read_skinned(broken)
 
 
 def test_non_uniform_joint_scale_is_rejected(chain_glb, tmp_path):

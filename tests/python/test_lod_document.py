@@ -8,6 +8,7 @@ import subprocess
 
 import numpy as np
 import pytest
+from gltf_edits import draco_compressed
 
 from animlod import synth
 from animlod.cli import main
@@ -198,6 +199,25 @@ def test_separate_keeps_the_meshes_an_animation_points_at(humanoid_glb, tmp_path
     report = simplify_document(source, tmp_path / "levels", [0.5], separate=True, **QUICK)
     doc = GltfDocument(report.outputs[0])
     assert [mesh.get("name") for mesh in doc.json["meshes"]] == ["skinned mesh", "skinned mesh_LOD1"]
+
+
+def test_a_draco_compressed_character_gets_uncompressed_levels_and_keeps_its_own(humanoid_glb, tmp_path):
+    from animlod.io import read_lod_chains
+    from animlod.pipelines.character import build_character
+
+    compressed = draco_compressed(humanoid_glb, tmp_path / "draco.glb")
+    output = tmp_path / "chain.glb"
+    report = build_character(compressed, output, [0.5, 0.25], solver="newton", **QUICK)
+    (levels,) = report.chains.values()
+    assert [level.faces for level in levels] == sorted((level.faces for level in levels), reverse=True)
+    doc = GltfDocument(output)
+    assert doc.json["extensionsRequired"] == ["KHR_draco_mesh_compression"]  # the input's mesh, as it was
+    compressed_meshes = [
+        mesh["name"] for mesh in doc.json["meshes"] for p in mesh["primitives"] if "extensions" in p
+    ]  # fmt: skip
+    assert compressed_meshes == [GltfDocument(compressed).json["meshes"][0]["name"]]
+    (chain,) = read_lod_chains(output)
+    assert [level.mesh.face_count for level in chain.levels] == [level.faces for level in levels]
 
 
 def test_cli_writes_one_lod_glb(humanoid_glb, tmp_path, capsys):

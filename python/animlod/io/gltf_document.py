@@ -23,6 +23,7 @@ import pygltflib
 from .. import rotations
 from .errors import FormatError
 from .gltf_decode import decode_gltf
+from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
 from .gltf_keyframes import INTERPOLATIONS, frame_times
 from .json_limits import load_json
 
@@ -31,10 +32,13 @@ _GLB_HEADER_BYTES = 12
 _GLB_JSON_CHUNK = 0x4E4F534A  # "JSON"
 _GLB_BIN_CHUNK = 0x004E4942  # "BIN\0"
 _DATA_URI_BASE64 = ";base64,"
-# Required extensions that leave geometry, skins and animation readable as plain glTF
-# (quantized attributes are ordinary normalised or integer accessors); any other required
-# extension (Draco, meshopt, ...) changes what the buffers mean and is refused.
-_HARMLESS_EXTENSIONS = ("KHR_mesh_quantization", "KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_")
+# Required extensions animlod reads: those that leave geometry, skins and animation readable as
+# plain glTF (quantized attributes are ordinary normalised or integer accessors), and Draco's,
+# decoded into its accessors (gltf_draco.py); any other required extension (meshopt, ...)
+# changes what the buffers mean and is refused.
+_READABLE_EXTENSIONS = (
+    "KHR_mesh_quantization", "KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_", DRACO_EXTENSION,
+)  # fmt: skip
 
 _COMPONENT_DTYPES = {
     5120: np.dtype("<i1"),
@@ -98,6 +102,8 @@ class GltfDocument:
         self.gltf, self.json = _parse(self.path)
         self._buffers: dict[int, bytes] = {}
         self._accessors: dict[int, np.ndarray] = {}
+        self._draco_meshes: dict[int, Any] = {}  # decoded per compressed buffer view
+        self._draco = draco_sources(self.gltf, self.fail)
         self.parents = self._node_parents()
         self._check_scenes_and_channels()
 
@@ -138,7 +144,9 @@ class GltfDocument:
             raise self.fail(element, f"invalid count {count!r}")
         width = _TYPE_WIDTHS[accessor.type]
         dtype = _COMPONENT_DTYPES[component]
-        if accessor.bufferView is None:
+        if accessor.bufferView is None and index in self._draco:
+            values = self._draco_elements(index, count, width, dtype)
+        elif accessor.bufferView is None:
             # All zeros unless sparse says otherwise: nothing in the file backs the elements, so
             # their number is bounded by what the file holds elsewhere (a sparse morph target is
             # as long as its POSITION accessor, whose bytes are in a buffer).
@@ -162,10 +170,17 @@ class GltfDocument:
         values.flags.writeable = False
         return values
 
-    def _strided_elements(
-        self, accessor: pygltflib.Accessor, count: int, width: int, dtype: np.dtype, element: str
-    ) -> np.ndarray:
-        view_index = accessor.bufferView
+    def _draco_elements(self, index: int, count: int, width: int, dtype: np.dtype) -> np.ndarray:
+        """Accessor ``index``'s elements decoded from its primitive's Draco buffer view."""
+        source = self._draco[index]
+        if source.view not in self._draco_meshes:
+            data, offset, length, _ = self._view_range(source.view, source.element)
+            self._draco_meshes[source.view] = decode_draco(data[offset : offset + length], source.element, self.fail)
+        return draco_elements(self._draco_meshes[source.view], source, count, width, dtype, self.fail)
+
+    def _view_range(self, view_index: Any, element: str) -> tuple[bytes, int, int, pygltflib.BufferView]:
+        """Buffer view ``view_index``: its buffer's bytes, its offset and length in them (checked)
+        and the view itself."""
         view = self.item("bufferViews", view_index, element)
         data = self.buffer_bytes(view.buffer, f"bufferView {view_index}")
         view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {view_index}")
@@ -176,6 +191,13 @@ class GltfDocument:
                 f"bytes [{view_offset}, {view_offset + view_length}) lie outside buffer {view.buffer} "
                 f"of {len(data)} bytes (truncated file?)",
             )
+        return data, view_offset, view_length, view
+
+    def _strided_elements(
+        self, accessor: pygltflib.Accessor, count: int, width: int, dtype: np.dtype, element: str
+    ) -> np.ndarray:
+        view_index = accessor.bufferView
+        data, view_offset, view_length, view = self._view_range(view_index, element)
         element_bytes = dtype.itemsize * width
         stride = view.byteStride
         if stride is None:
@@ -481,7 +503,7 @@ def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
     version = str(getattr(gltf.asset, "version", "") or "")
     if not version.startswith("2."):
         raise FormatError(path, "asset", f"glTF version {version!r} is not 2.x")
-    unsupported = [name for name in gltf.extensionsRequired or [] if not name.startswith(_HARMLESS_EXTENSIONS)]
+    unsupported = [name for name in gltf.extensionsRequired or [] if not name.startswith(_READABLE_EXTENSIONS)]
     if unsupported:
         raise FormatError(path, "extensionsRequired", f"needs {', '.join(unsupported)}, which animlod cannot read")
     return gltf, raw

@@ -28,6 +28,7 @@ import numpy as np
 from ..model import AnimatedMesh, LodChain, LodLevel
 from .glb_builder import ARRAY_BUFFER, GlbBuilder
 from .gltf_document import GltfDocument
+from .gltf_draco import DRACO_EXTENSION
 from .gltf_mesh import read_mesh_geometry, transform_points
 from .gltf_read import skinned_mesh_of_node
 from .gltf_skin import SkinRig
@@ -101,6 +102,10 @@ def add_level_mesh(
             for key, value in source["primitives"][arrays.source].items()
             if key not in ("attributes", "indices", "targets", "mode")
         }
+        extensions = primitive.pop("extensions", {})
+        extensions.pop(DRACO_EXTENSION, None)  # the level's data is its own, uncompressed
+        if extensions:
+            primitive["extensions"] = extensions
         vertex_count = len(arrays.attributes["POSITION"])
         primitive["attributes"] = {
             attribute: builder.add(_storable(values), ARRAY_BUFFER, bounds=attribute == "POSITION")

@@ -37,7 +37,7 @@ $(VENV)/bin/pip: | system-packages
 # rebuilt incrementally (build/python-*) whenever this target runs.
 # Optional dependency groups of pyproject.toml; `make bench` adds the benchmark peers.
 # wheel: without build isolation, setuptools before 70 needs it to build an sdist (meshoptimizer's
-# Python package, a bench peer, comes as one).
+# Python package, which decodes EXT_meshopt_compression, comes as one).
 EXTRAS := test,batch
 python-package: $(OPENMESH_CONFIG) $(VENV)/bin/pip
 	$(VENV)/bin/pip install -q scikit-build-core pybind11 pybind11-stubgen numpy wheel

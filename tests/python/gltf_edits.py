@@ -81,3 +81,46 @@ def draco_compressed(source: Path, target: Path) -> Path:
             setattr(gltf, listed, [*(getattr(gltf, listed) or []), "KHR_draco_mesh_compression"])
 
     return edit_glb(source, target, compress)
+
+
+def meshopt_compressed(source: Path, target: Path) -> Path:
+    """A copy of the GLB at ``source`` whose buffer views (one accessor each, as animlod writes
+    them) hold meshoptimizer-coded data (without filters), EXT_meshopt_compression required, as
+    gltfpack writes it. The views' own bytes, the fallback, are zeroed: only decoding reads right.
+    Written with animlod's GlbBuilder: pygltflib repacks the binary chunk by buffer view and would
+    drop the compressed bytes, which only the extension refers to."""
+    import meshoptimizer
+
+    from animlod.io.glb_builder import GlbBuilder
+    from animlod.io.gltf_document import GltfDocument
+
+    builder = GlbBuilder.from_document(GltfDocument(source))
+    js, blob = builder.json, builder.blob
+    index_accessors = {p["indices"] for mesh in js["meshes"] for p in mesh["primitives"] if "indices" in p}
+    sizes = {pygltflib.UNSIGNED_BYTE: 1, pygltflib.UNSIGNED_SHORT: 2, pygltflib.UNSIGNED_INT: 4, pygltflib.FLOAT: 4}
+    widths = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+    views = [a["bufferView"] for a in js["accessors"] if "bufferView" in a]
+    for index, accessor in enumerate(js["accessors"]):
+        if "bufferView" not in accessor or views.count(accessor["bufferView"]) != 1:
+            continue
+        view = js["bufferViews"][accessor["bufferView"]]
+        stride = sizes[accessor["componentType"]] * widths[accessor["type"]]
+        start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+        if view.get("byteStride", stride) != stride or (index not in index_accessors and stride % 4):
+            continue
+        raw = bytes(blob[start : start + stride * accessor["count"]])
+        if index in index_accessors:
+            indices = np.frombuffer(raw, {2: np.uint16, 4: np.uint32}[stride]).astype(np.uint32)
+            data = meshoptimizer.encode_index_buffer(indices, len(indices), int(indices.max()) + 1)
+            mode = "TRIANGLES"
+        else:
+            vertices = np.frombuffer(raw, np.float32).reshape(accessor["count"], stride // 4)
+            data, mode = meshoptimizer.encode_vertex_buffer(vertices, accessor["count"], stride), "ATTRIBUTES"
+        blob[start : start + len(raw)] = bytes(len(raw))
+        offset = builder._append(data)
+        extension = {"buffer": 0, "byteOffset": offset, "byteLength": len(data), "byteStride": stride}
+        view["extensions"] = {"EXT_meshopt_compression": {**extension, "count": accessor["count"], "mode": mode}}
+    for listed in ("extensionsUsed", "extensionsRequired"):
+        js.setdefault(listed, []).append("EXT_meshopt_compression")
+    builder.save(target)
+    return target

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pygltflib
 import pytest
-from gltf_edits import add_scale_channel, draco_compressed, edit_glb, squash_and_stretch
+from gltf_edits import add_scale_channel, draco_compressed, edit_glb, meshopt_compressed, squash_and_stretch
 
 from animlod import rotations, synth
 from animlod.io import FormatError
@@ -535,9 +535,9 @@ def test_required_extension_animlod_cannot_read(chain_glb, tmp_path):
     path, _, _ = chain_glb
 
     def require_meshopt(gltf, blob):
-        gltf.extensionsUsed = gltf.extensionsRequired = ["EXT_meshopt_compression"]
+        gltf.extensionsUsed = gltf.extensionsRequired = ["KHR_meshopt_compression"]
 
-    with pytest.raises(FormatError, match=r"extensionsRequired: needs EXT_meshopt_compression"):
+    with pytest.raises(FormatError, match=r"extensionsRequired: needs KHR_meshopt_compression"):
         read_gltf(edit_glb(path, tmp_path / "meshopt.glb", require_meshopt))
 
 
@@ -590,6 +590,39 @@ def test_draco_data_that_does_not_decode_is_named(chain_glb, tmp_path):
     broken = edit_glb(compressed, tmp_path / "broken.glb", garble)
     with pytest.raises(FormatError, match=r"mesh 0 primitive 0 KHR_draco_mesh_compression: the compressed data does"):
         read_skinned(broken)
+
+
+def _rotated_to_lowest(faces: np.ndarray) -> np.ndarray:
+    """Each triangle rotated to start at its lowest index (the same triangle, same winding)."""
+    first = np.argmin(faces, axis=1)[:, None]
+    return np.take_along_axis(faces, (first + np.arange(3)) % 3, axis=1)
+
+
+def test_meshopt_compressed_views_read_as_the_uncompressed_ones(chain_glb, tmp_path):
+    path, _, motion = chain_glb
+    compressed = meshopt_compressed(path, tmp_path / "meshopt.glb")
+    expected, (expected_motion,) = read_skinned(path, fps=motion.fps)
+    read, (read_motion,) = read_skinned(compressed, fps=motion.fps)
+    # The index codec may start a triangle at another corner; the triangles are the same.
+    np.testing.assert_array_equal(_rotated_to_lowest(read.faces), _rotated_to_lowest(expected.faces))
+    for name in ("rest_positions", "joints", "weights", "uvs", "normals", "inverse_bind", "morph_targets"):
+        np.testing.assert_array_equal(getattr(read, name), getattr(expected, name), err_msg=name)
+    np.testing.assert_array_equal(read_motion.local_rotations, expected_motion.local_rotations)
+
+
+def test_meshopt_filters_turn_decoded_integers_into_vectors():
+    import meshoptimizer
+
+    from animlod.io.gltf_meshopt import decode_meshopt_view
+
+    # Octahedral int8 (x, y, K, w): (127, 0) is +X, whatever the raw third component says.
+    raw = np.array([[127, 0, 127, 7], [0, 0, 127, 9]], np.int8)
+    coded = meshoptimizer.encode_vertex_buffer(raw.view(np.float32), 2, 4)
+    extension = {"count": 2, "byteStride": 4, "mode": "ATTRIBUTES", "filter": "OCTAHEDRAL"}
+    decoded = np.frombuffer(decode_meshopt_view(extension, coded, "bufferView 0", ValueError), np.int8).reshape(2, 4)
+    np.testing.assert_array_equal(decoded, [[127, 0, 0, 7], [0, 0, 127, 9]])
+    with pytest.raises(ValueError, match="mode 'QUADS' or filter 'NONE' is not defined"):
+        decode_meshopt_view({**extension, "mode": "QUADS", "filter": "NONE"}, coded, "bufferView 0", ValueError)
 
 
 def test_non_uniform_joint_scale_is_rejected(chain_glb, tmp_path):

@@ -8,7 +8,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from gltf_edits import draco_compressed
+from gltf_edits import draco_compressed, meshopt_compressed
 
 from animlod import synth
 from animlod.cli import main
@@ -218,6 +218,23 @@ def test_a_draco_compressed_character_gets_uncompressed_levels_and_keeps_its_own
     assert compressed_meshes == [GltfDocument(compressed).json["meshes"][0]["name"]]
     (chain,) = read_lod_chains(output)
     assert [level.mesh.face_count for level in chain.levels] == [level.faces for level in levels]
+
+
+def test_a_meshopt_compressed_document_comes_out_whole_and_decoded(humanoid_glb, tmp_path):
+    compressed = meshopt_compressed(humanoid_glb, tmp_path / "meshopt.glb")
+    output = tmp_path / "out.glb"
+    report = simplify_document(compressed, output, [0.5], **QUICK)
+    plain = simplify_document(humanoid_glb, tmp_path / "plain.glb", [0.5], **QUICK)
+    assert [level.faces for level in report.drawables[0].levels] == [level.faces for level in plain.drawables[0].levels]
+    doc = GltfDocument(output)
+    assert "EXT_meshopt_compression" not in json.dumps(doc.json)  # any glTF reader takes it
+    (drawable,) = read_drawables(doc)
+    (expected,) = read_drawables(GltfDocument(humanoid_glb))
+    np.testing.assert_array_equal(drawable.geometry.positions, expected.geometry.positions)
+    probe = os.environ.get("ANIMLOD_GLTF_PROBE")
+    if probe:
+        summary = json.loads(subprocess.run([probe, str(output)], capture_output=True, check=True, text=True).stdout)
+        assert summary["triangles"] > 0 and summary["joints"] == 41
 
 
 def test_cli_writes_one_lod_glb(humanoid_glb, tmp_path, capsys):

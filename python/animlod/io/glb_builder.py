@@ -23,6 +23,7 @@ import numpy as np
 
 from .atomic import atomic_write
 from .gltf_document import GltfDocument
+from .gltf_meshopt import MESHOPT_EXTENSION
 
 FLOAT, UNSIGNED_BYTE, UNSIGNED_SHORT, UNSIGNED_INT = 5126, 5121, 5123, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
@@ -55,11 +56,18 @@ class GlbBuilder:
         builder = cls(copy.deepcopy(doc.json))
         views = builder.json.get("bufferViews", [])
         for index, view in enumerate(views):
-            data = doc.buffer_bytes(view.get("buffer"), f"bufferView {index}")
-            start, length = view.get("byteOffset", 0), view.get("byteLength")
-            if not isinstance(length, int) or start + length > len(data):
-                raise doc.fail(f"bufferView {index}", f"byteLength {length!r} does not fit its buffer")
-            view["buffer"], view["byteOffset"] = 0, builder._append(data[start : start + length])
+            data = doc.view_bytes(index, f"bufferView {index}")
+            view["buffer"], view["byteOffset"], view["byteLength"] = 0, builder._append(data), len(data)
+            # Written decoded: the output needs no meshopt decoder.
+            if MESHOPT_EXTENSION in view.get("extensions", {}):
+                del view["extensions"][MESHOPT_EXTENSION]
+                if not view["extensions"]:
+                    del view["extensions"]
+        for listed in ("extensionsUsed", "extensionsRequired"):
+            if MESHOPT_EXTENSION in builder.json.get(listed, []):
+                builder.json[listed].remove(MESHOPT_EXTENSION)
+                if not builder.json[listed]:
+                    del builder.json[listed]
         for index, image in enumerate(builder.json.get("images", [])):
             if "uri" in image:
                 data, mime = _image_bytes(doc, index, image.pop("uri"))

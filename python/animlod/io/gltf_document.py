@@ -25,6 +25,7 @@ from .errors import FormatError
 from .gltf_decode import decode_gltf
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
 from .gltf_keyframes import INTERPOLATIONS, frame_times
+from .gltf_meshopt import MESHOPT_EXTENSION, decode_meshopt_view
 from .json_limits import load_json
 
 _GLB_MAGIC = b"glTF"
@@ -33,11 +34,12 @@ _GLB_JSON_CHUNK = 0x4E4F534A  # "JSON"
 _GLB_BIN_CHUNK = 0x004E4942  # "BIN\0"
 _DATA_URI_BASE64 = ";base64,"
 # Required extensions animlod reads: those that leave geometry, skins and animation readable as
-# plain glTF (quantized attributes are ordinary normalised or integer accessors), and Draco's,
-# decoded into its accessors (gltf_draco.py); any other required extension (meshopt, ...)
-# changes what the buffers mean and is refused.
+# plain glTF (quantized attributes are ordinary normalised or integer accessors), Draco's, decoded
+# into its accessors (gltf_draco.py), and meshopt's, decoded into its buffer views
+# (gltf_meshopt.py); any other required extension changes what the buffers mean and is refused.
 _READABLE_EXTENSIONS = (
     "KHR_mesh_quantization", "KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_", DRACO_EXTENSION,
+    MESHOPT_EXTENSION,
 )  # fmt: skip
 
 _COMPONENT_DTYPES = {
@@ -103,6 +105,7 @@ class GltfDocument:
         self._buffers: dict[int, bytes] = {}
         self._accessors: dict[int, np.ndarray] = {}
         self._draco_meshes: dict[int, Any] = {}  # decoded per compressed buffer view
+        self._decoded_views: dict[int, bytes] = {}  # EXT_meshopt_compression's
         self._draco = draco_sources(self.gltf, self.fail)
         self.parents = self._node_parents()
         self._check_scenes_and_channels()
@@ -174,30 +177,42 @@ class GltfDocument:
         """Accessor ``index``'s elements decoded from its primitive's Draco buffer view."""
         source = self._draco[index]
         if source.view not in self._draco_meshes:
-            data, offset, length, _ = self._view_range(source.view, source.element)
-            self._draco_meshes[source.view] = decode_draco(data[offset : offset + length], source.element, self.fail)
+            data = self.view_bytes(source.view, source.element)
+            self._draco_meshes[source.view] = decode_draco(data, source.element, self.fail)
         return draco_elements(self._draco_meshes[source.view], source, count, width, dtype, self.fail)
 
-    def _view_range(self, view_index: Any, element: str) -> tuple[bytes, int, int, pygltflib.BufferView]:
-        """Buffer view ``view_index``: its buffer's bytes, its offset and length in them (checked)
-        and the view itself."""
-        view = self.item("bufferViews", view_index, element)
-        data = self.buffer_bytes(view.buffer, f"bufferView {view_index}")
-        view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {view_index}")
-        view_length = self._whole_number(view.byteLength, "byteLength", f"bufferView {view_index}")
-        if view_offset + view_length > len(data):
-            raise self.fail(
-                f"bufferView {view_index}",
-                f"bytes [{view_offset}, {view_offset + view_length}) lie outside buffer {view.buffer} "
-                f"of {len(data)} bytes (truncated file?)",
+    def view_bytes(self, view_index: Any, referrer: str) -> memoryview:
+        """The bytes of buffer view ``view_index``, decoded where EXT_meshopt_compression compresses
+        them; FormatError naming ``referrer`` or the view if they cannot be had."""
+        view = self.item("bufferViews", view_index, referrer)
+        element = f"bufferView {view_index}"
+        extension = (view.extensions or {}).get(MESHOPT_EXTENSION)
+        if extension is None:
+            return self._buffer_range(view.buffer, view.byteOffset, view.byteLength, element)
+        if view_index not in self._decoded_views:
+            where = extension if isinstance(extension, dict) else {}
+            compressed = self._buffer_range(
+                where.get("buffer"), where.get("byteOffset"), where.get("byteLength"), f"{element} {MESHOPT_EXTENSION}"
             )
-        return data, view_offset, view_length, view
+            self._decoded_views[view_index] = decode_meshopt_view(extension, compressed, element, self.fail)
+        return memoryview(self._decoded_views[view_index])
+
+    def _buffer_range(self, buffer: Any, offset: Any, length: Any, element: str) -> memoryview:
+        """``length`` bytes at ``offset`` of buffer ``buffer`` (checked to lie inside it)."""
+        data = self.buffer_bytes(buffer, element)
+        offset = self._whole_number(offset, "byteOffset", element)
+        length = self._whole_number(length, "byteLength", element)
+        if offset + length > len(data):
+            reason = f"bytes [{offset}, {offset + length}) lie outside buffer {buffer} of {len(data)} bytes"
+            raise self.fail(element, f"{reason} (truncated file?)")
+        return memoryview(data)[offset : offset + length]
 
     def _strided_elements(
         self, accessor: pygltflib.Accessor, count: int, width: int, dtype: np.dtype, element: str
     ) -> np.ndarray:
         view_index = accessor.bufferView
-        data, view_offset, view_length, view = self._view_range(view_index, element)
+        data = self.view_bytes(view_index, element)
+        view, view_length = self.gltf.bufferViews[view_index], len(data)
         element_bytes = dtype.itemsize * width
         stride = view.byteStride
         if stride is None:
@@ -215,7 +230,7 @@ class GltfDocument:
             raise self.fail(element, f"needs {needed} bytes but bufferView {view_index} has {view_length}")
         if count == 0:
             return np.zeros((0, width), dtype)
-        window = np.frombuffer(data, np.uint8, needed - start, view_offset + start)
+        window = np.frombuffer(data, np.uint8, needed - start, start)
         rows = np.lib.stride_tricks.as_strided(window, (count, element_bytes), (stride, 1))
         return rows.copy().view(dtype).reshape(count, width)
 
@@ -238,13 +253,12 @@ class GltfDocument:
         values[rows] = new_values
 
     def _sparse_part(self, part: Any, count: int, width: int, dtype: np.dtype, element: str) -> np.ndarray:
-        view = self.item("bufferViews", part.bufferView, element)
-        data = self.buffer_bytes(view.buffer, f"bufferView {part.bufferView}")
-        view_offset = self._whole_number(view.byteOffset, "byteOffset", f"bufferView {part.bufferView}")
-        start = view_offset + self._whole_number(part.byteOffset, "byteOffset", element)
+        data = self.view_bytes(part.bufferView, element)
+        start = self._whole_number(part.byteOffset, "byteOffset", element)
         length = count * width * dtype.itemsize
         if start + length > len(data):
-            raise self.fail(element, f"needs bytes up to {start + length}, buffer has {len(data)}")
+            reason = f"needs bytes up to {start + length}, bufferView {part.bufferView} has {len(data)}"
+            raise self.fail(element, reason)
         return np.frombuffer(data, dtype, count * width, start).reshape(count, width)
 
     def _file_bytes(self) -> int:

@@ -619,10 +619,12 @@ def test_meshopt_filters_turn_decoded_integers_into_vectors():
     raw = np.array([[127, 0, 127, 7], [0, 0, 127, 9]], np.int8)
     coded = meshoptimizer.encode_vertex_buffer(raw.view(np.float32), 2, 4)
     extension = {"count": 2, "byteStride": 4, "mode": "ATTRIBUTES", "filter": "OCTAHEDRAL"}
-    decoded = np.frombuffer(decode_meshopt_view(extension, coded, "bufferView 0", ValueError), np.int8).reshape(2, 4)
-    np.testing.assert_array_equal(decoded, [[127, 0, 0, 7], [0, 0, 127, 9]])
+    decoded = decode_meshopt_view(extension, coded, "bufferView 0", ValueError, 2**20)
+    np.testing.assert_array_equal(np.frombuffer(decoded, np.int8).reshape(2, 4), [[127, 0, 0, 7], [0, 0, 127, 9]])
     with pytest.raises(ValueError, match="mode 'QUADS' or filter 'NONE' is not defined"):
-        decode_meshopt_view({**extension, "mode": "QUADS", "filter": "NONE"}, coded, "bufferView 0", ValueError)
+        decode_meshopt_view({**extension, "mode": "QUADS", "filter": "NONE"}, coded, "bufferView 0", ValueError, 2**20)
+    with pytest.raises(ValueError, match="claims 1000000 x 4 bytes, more than the file can justify"):
+        decode_meshopt_view({**extension, "count": 10**6}, coded, "bufferView 0", ValueError, 2**20)
 
 
 def test_non_uniform_joint_scale_is_rejected(chain_glb, tmp_path):

@@ -58,8 +58,9 @@ _SPARSE_INDEX_COMPONENTS = (5121, 5123, 5125)
 # bufferView.byteStride is a multiple of 4 no larger than 252 (glTF 2.0 section 3.6.2.4).
 _MAX_BYTE_STRIDE = 252
 _MAX_ACCESSOR_COUNT = 2**32 - 1
-# An accessor without a bufferView is zeros (plus sparse values); it may take at most this many
-# times the bytes of the file and its buffers (+1 MiB).
+# An accessor without a bufferView is zeros (plus sparse values), and a meshopt-compressed buffer
+# view decodes to count x byteStride bytes; either may take at most this many times the bytes
+# of the file and its buffers (+1 MiB).
 _ZERO_FILL_FACTOR = 16
 # Most frames an animation is sampled to by default: 100,000 is 55 minutes at 30 fps. A file whose
 # keys run longer is refused (naming the animation and its duration) rather than sampled: a
@@ -194,7 +195,8 @@ class GltfDocument:
             compressed = self._buffer_range(
                 where.get("buffer"), where.get("byteOffset"), where.get("byteLength"), f"{element} {MESHOPT_EXTENSION}"
             )
-            self._decoded_views[view_index] = decode_meshopt_view(extension, compressed, element, self.fail)
+            limit = _ZERO_FILL_FACTOR * (self._file_bytes() + 2**20)
+            self._decoded_views[view_index] = decode_meshopt_view(extension, compressed, element, self.fail, limit)
         return memoryview(self._decoded_views[view_index])
 
     def _buffer_range(self, buffer: Any, offset: Any, length: Any, element: str) -> memoryview:

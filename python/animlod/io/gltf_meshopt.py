@@ -21,9 +21,10 @@ _MODES = ("ATTRIBUTES", "TRIANGLES", "INDICES")
 _FILTERS = ("NONE", "OCTAHEDRAL", "QUATERNION", "EXPONENTIAL")
 
 
-def decode_meshopt_view(extension: object, compressed: bytes, element: str, fail: Fail) -> bytes:
+def decode_meshopt_view(extension: object, compressed: bytes, element: str, fail: Fail, limit: int) -> bytes:
     """The ``count * byteStride`` bytes that buffer view ``element``'s ``extension`` decodes to,
-    from its ``compressed`` bytes; ``fail``'s error for a malformed extension or data."""
+    from its ``compressed`` bytes; ``fail``'s error for a malformed extension or data, or for more
+    than ``limit`` bytes (a few bytes of zeros can claim gigabytes)."""
     import meshoptimizer  # only files that use the extension need it
 
     if not isinstance(extension, dict):
@@ -34,6 +35,9 @@ def decode_meshopt_view(extension: object, compressed: bytes, element: str, fail
         raise fail(element, f"{MESHOPT_EXTENSION} needs a count and a byteStride in (0, 256]")
     if mode not in _MODES or filter_name not in _FILTERS:
         raise fail(element, f"{MESHOPT_EXTENSION} mode {mode!r} or filter {filter_name!r} is not defined")
+    if count * stride > limit:
+        reason = f"claims {count} x {stride} bytes, more than the file can justify ({limit})"
+        raise fail(element, f"{MESHOPT_EXTENSION} {reason}")
     if (mode == "ATTRIBUTES" and stride % 4) or (mode != "ATTRIBUTES" and stride not in (2, 4)):
         raise fail(element, f"{MESHOPT_EXTENSION} byteStride {stride} does not suit mode {mode}")
     decode = {

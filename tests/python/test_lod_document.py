@@ -220,6 +220,16 @@ def test_a_draco_compressed_character_gets_uncompressed_levels_and_keeps_its_own
     assert [level.mesh.face_count for level in chain.levels] == [level.faces for level in levels]
 
 
+def test_separate_levels_of_a_draco_document_do_not_require_draco(humanoid_glb, tmp_path):
+    # Each level document draws its level mesh, written uncompressed; the compressed input mesh
+    # is dropped, and the extension with it.
+    compressed = draco_compressed(humanoid_glb, tmp_path / "draco.glb")
+    report = simplify_document(compressed, tmp_path / "levels", [0.5], separate=True, **QUICK)
+    doc = GltfDocument(report.outputs[0])
+    assert "KHR_draco_mesh_compression" not in json.dumps(doc.json)
+    assert len(read_drawables(doc)[0].geometry.faces) == report.drawables[0].levels[1].faces
+
+
 def test_a_meshopt_compressed_document_comes_out_whole_and_decoded(humanoid_glb, tmp_path):
     compressed = meshopt_compressed(humanoid_glb, tmp_path / "meshopt.glb")
     output = tmp_path / "out.glb"

@@ -23,6 +23,7 @@ import numpy as np
 
 from .atomic import atomic_write
 from .gltf_document import GltfDocument
+from .gltf_draco import DRACO_EXTENSION
 from .gltf_meshopt import MESHOPT_EXTENSION
 
 FLOAT, UNSIGNED_BYTE, UNSIGNED_SHORT, UNSIGNED_INT = 5126, 5121, 5123, 5125
@@ -63,11 +64,7 @@ class GlbBuilder:
                 del view["extensions"][MESHOPT_EXTENSION]
                 if not view["extensions"]:
                     del view["extensions"]
-        for listed in ("extensionsUsed", "extensionsRequired"):
-            if MESHOPT_EXTENSION in builder.json.get(listed, []):
-                builder.json[listed].remove(MESHOPT_EXTENSION)
-                if not builder.json[listed]:
-                    del builder.json[listed]
+        _drop_extension(builder.json, MESHOPT_EXTENSION)
         for index, image in enumerate(builder.json.get("images", [])):
             if "uri" in image:
                 data, mime = _image_bytes(doc, index, image.pop("uri"))
@@ -128,6 +125,9 @@ class GlbBuilder:
                 node["mesh"] = new_mesh[node["mesh"]]
         if "meshes" in js:
             js["meshes"] = [js["meshes"][old] for old in kept_meshes]
+        primitives = [p for mesh in js.get("meshes", []) for p in mesh.get("primitives", [])]
+        if not any(DRACO_EXTENSION in p.get("extensions", {}) for p in primitives):
+            _drop_extension(js, DRACO_EXTENSION)  # the compressed meshes were the input's, now replaced
         if any(not name.startswith(_PRUNE_SAFE_EXTENSIONS) for name in js.get("extensionsUsed", [])):
             return
         accessor_refs = list(_accessor_references(js))
@@ -198,6 +198,15 @@ def _accessor_references(js: dict):
         for sampler in animation.get("samplers", []):
             yield sampler, "input"
             yield sampler, "output"
+
+
+def _drop_extension(js: dict, name: str) -> None:
+    """``name`` out of the document's extensionsUsed and extensionsRequired."""
+    for listed in ("extensionsUsed", "extensionsRequired"):
+        if name in js.get(listed, []):
+            js[listed].remove(name)
+            if not js[listed]:
+                del js[listed]
 
 
 def _animates_meshes(js: dict) -> bool:

@@ -141,8 +141,9 @@ def carry_other_channels(
             carried = deepcopy(channel["target"])
         elif node is None or (node in posing and path != "weights"):
             continue
-        else:
-            carried = {"node": copies.get(node, node), "path": path}
+        else:  # a node's channel, or a pointer at a node's property written as one
+            kept = {} if channel["target"].get("path") == "pointer" else channel["target"]
+            carried = {**kept, "node": copies.get(node, node), "path": path}
         target["samplers"].append(deepcopy(source["samplers"][channel["sampler"]]))
         target["channels"].append({"sampler": len(target["samplers"]) - 1, "target": carried})
 

@@ -33,6 +33,9 @@ def character_with_sockets(tmp_path_factory):
     armature = {"name": "Armature", "scale": [0.5] * 3, "rotation": [0.0, 0.0, 0.38268343, 0.92387953]}
     armature = builder.append("nodes", {**armature, "children": [by_name["Hips"]]})
     scene[scene.index(by_name["Hips"])] = armature
+    # The head joint stretched along its bone at rest: a non-uniform scale its end site does not
+    # turn under, so the motion stays rigid and the scale goes into the inverse binds.
+    nodes[by_name["Head"]]["scale"] = [1.0, 1.3, 1.0]
     turn = rotations.normalize(np.array([0.2, -0.4, 0.1, 0.9])).tolist()
     for joint in SOCKET_JOINTS:
         socket = {"name": f"socket {joint}", "translation": [0.03, 0.05, -0.02], "rotation": turn, "scale": [2.0] * 3}

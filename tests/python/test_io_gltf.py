@@ -627,14 +627,45 @@ def test_meshopt_filters_turn_decoded_integers_into_vectors():
         decode_meshopt_view({**extension, "count": 10**6}, coded, "bufferView 0", ValueError, 2**20)
 
 
-def test_non_uniform_joint_scale_is_rejected(chain_glb, tmp_path):
+def _rest_scale(node: int, scale: list[float]) -> Callable[[pygltflib.GLTF2, bytearray], None]:
+    """An edit giving ``node`` the rest ``scale``."""
+    return lambda gltf, blob: setattr(gltf.nodes[node], "scale", scale)
+
+
+def _viewer_frame(path: Path, frame: int, animated: bool = True) -> np.ndarray:
+    """_viewer_skinning of the chain's skinned node at key ``frame`` (the rest pose when not animated)."""
+    gltf = pygltflib.GLTF2.load_from_bytes(path.read_bytes())
+    if not animated:
+        gltf.animations[0].channels = []
+    return _viewer_skinning(gltf, bytearray(gltf.binary_blob()), 3, "bend", frame)
+
+
+def test_a_non_uniform_rest_scale_is_skinned_as_a_viewer_does(chain_glb, tmp_path):
+    # 'mid' stretched along y in the rest pose: its children turn under it, a shear in glTF.
+    path, _, motion = chain_glb
+    stretched = edit_glb(path, tmp_path / "stretched.glb", _rest_scale(1, [1.0, 2.0, 1.0]))
+    read, (read_motion,) = read_skinned(stretched, fps=motion.fps)
+    assert read_motion.joint_deformations is not None
+    baked = read.bake(read_motion).frames
+    for frame in range(motion.frame_count):
+        np.testing.assert_allclose(baked[frame], _viewer_frame(stretched, frame), atol=1e-5)
+    # The rest pose a viewer shows (no animation) has the stretch too.
+    np.testing.assert_allclose(read.rest_pose(), _viewer_frame(stretched, 0, animated=False), atol=1e-5)
+
+
+def test_a_stretched_leaf_leaves_the_motion_rigid(chain_glb, tmp_path):
+    path, _, motion = chain_glb
+    stretched = edit_glb(path, tmp_path / "leaf.glb", _rest_scale(2, [1.0, 3.0, 1.0]))
+    read, (read_motion,) = read_skinned(stretched, fps=motion.fps)
+    assert read_motion.joint_deformations is None  # nothing turns under the tip: motion LoD can take it
+    np.testing.assert_allclose(read.bake(read_motion).frames[4], _viewer_frame(stretched, 4), atol=1e-5)
+
+
+def test_a_mirrored_joint_is_refused(chain_glb, tmp_path):
     path, _, _ = chain_glb
-
-    def stretch(gltf, blob):
-        gltf.nodes[1].scale = [1.0, 2.0, 1.0]
-
-    with pytest.raises(FormatError, match=r"skin 0: scale \[1.0, 2.0, 1.0\] of node 1 'mid' is not uniform"):
-        read_skinned(edit_glb(path, tmp_path / "scaled.glb", stretch))
+    mirrored = edit_glb(path, tmp_path / "mirrored.glb", _rest_scale(1, [-1.0, 1.0, 1.0]))
+    with pytest.raises(FormatError, match=r"skin 0: scale \[-1.0, 1.0, 1.0\] of node 1 'mid' is not positive"):
+        read_skinned(mirrored)
 
 
 def test_animated_scale_is_skinned_as_a_viewer_does(chain_glb, tmp_path):

@@ -431,16 +431,14 @@ class GltfDocument:
             world = self.rest_matrix(ancestor) @ world
         return world
 
-    def uniform_scale(self, index: int, scale: np.ndarray, element: str) -> float:
-        """The common value of a uniform positive ``scale (3,)``; FormatError otherwise."""
+    def uniform_scale(self, index: int, scale: np.ndarray, element: str) -> float | None:
+        """The common value of a uniform ``scale (3,)``, None when it is not uniform; FormatError
+        when a component is not positive (a mirrored or flattened node)."""
+        if not np.all(scale > 0.0):
+            reason = f"scale {np.round(scale, 6).tolist()} of {self.node_label(index)} is not positive"
+            raise self.fail(element, f"{reason}; skeletons take no mirrored or flattened joint")
         value = float(np.mean(scale))
-        if value <= 0.0 or np.max(np.abs(scale - value)) > UNIFORM_SCALE_TOLERANCE * value:
-            raise self.fail(
-                element,
-                f"scale {np.round(scale, 6).tolist()} of {self.node_label(index)} is not uniform and positive; "
-                "animlod skeletons fold only uniform scale into bone offsets",
-            )
-        return value
+        return value if np.max(np.abs(scale - value)) <= UNIFORM_SCALE_TOLERANCE * value else None
 
     # ---- animations -------------------------------------------------------------------------
 

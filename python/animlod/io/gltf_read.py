@@ -144,7 +144,10 @@ def skinned_mesh_of_node(
         raise doc.fail(doc.node_label(node), "its world transform is singular (a zero scale): the mesh has no extent")
     row_scale = np.ones((len(rig.scales), 4, 1))
     row_scale[:, :3] = rig.scales[:, None, None]
-    inverse_bind = (row_scale * rig.inverse_bind) @ np.linalg.inv(mesh_world)
+    inverse_bind = row_scale * rig.inverse_bind
+    if rig.rest_shape is not None:  # a non-uniform rest scale, in the joint's frame
+        inverse_bind[:, :3] = rig.rest_shape @ inverse_bind[:, :3]
+    inverse_bind = inverse_bind @ np.linalg.inv(mesh_world)
     try:
         return SkinnedMesh(
             rest_positions=transform_points(mesh_world, geometry.positions),

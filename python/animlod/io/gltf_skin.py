@@ -12,10 +12,13 @@ above all of them as an extra root joint.
 Scale: glTF nodes may scale, animlod skeletons are rigid. A uniform rest scale ``c``
 accumulated down the tree scales the bone offsets below it, and ``diag(c, c, c, 1)`` moves into
 the joint's inverse bind matrix (``W = W_rigid @ S(c)``, so ``W @ IBM = W_rigid @ (S(c) @ IBM)``).
-A non-uniform rest scale raises FormatError. An animation that scales nodes of the tree (squash
-and stretch, parts shrunk to nothing) poses the full transforms: the joints' rigid frames move
-with the scaled offsets, and the rest of each joint's world transform becomes the motion's
-``joint_deformations`` (``W = W_rigid @ D @ S(c)``), which skinning applies and motion LoD refuses.
+A non-uniform rest scale (a node stretched along one axis) poses the full transforms, and what
+each joint's world transform does beyond ``S(c)`` at rest, ``rest_shape``, moves into the
+inverse bind too. An animation that scales nodes of the tree (squash and stretch, parts shrunk to
+nothing), or turns a joint under a non-uniformly scaled one (a shear), poses the full transforms:
+the joints' rigid frames move with the scaled offsets, and the rest of each joint's world
+transform becomes the motion's ``joint_deformations``
+(``W = W_rigid @ D @ rest_shape @ S(c)``), which skinning applies and motion LoD refuses.
 """
 
 from __future__ import annotations
@@ -36,6 +39,9 @@ _NODE_PATHS = ("translation", "rotation", "scale")
 # Below this relative volume (|det| over the product of the column lengths) a 3x3 part counts as
 # singular: its inverse would amplify float32 noise by more than a million.
 _SINGULAR_VOLUME = 1e-6
+# A joint whose deformation relative to its rest shape stays this close to the identity in every
+# frame (a stretched leaf, a stretched joint whose children do not turn) leaves the motion rigid.
+_RIGID_DEFORMATION_TOLERANCE = 1e-6
 # Node extras key marking a joint as an end site (a BVH "End Site": a leaf without rotation);
 # animlod writes it and reads it back, other tools ignore it.
 END_SITE_EXTRA = "animlod_end_site"
@@ -51,7 +57,9 @@ class SkinRig:
         the skeleton as its root (no vertex is bound to it, its inverse bind is identity).
     skin_slots : S, the number of joints the skin lists (JOINTS_0 indexes them).
     remap : (J,) skeleton joint of each skin slot, then of the added common root if any.
-    scales : (J,) accumulated uniform scale of each joint's node at rest.
+    scales : (J,) accumulated uniform scale of each joint's node at rest (non-uniform nodes count 1).
+    rest_shape : (J, 3, 3) what each joint's rest world transform does beyond its rotation and
+        ``scales`` (a non-uniform rest scale), in the joint's frame; None when every node is uniform.
     inverse_bind : (J, 4, 4) the skin's inverse bind matrices in skeleton order, as stored.
     """
 
@@ -72,15 +80,23 @@ class SkinRig:
         tree = {n for joint in joint_nodes for n in [joint, *doc.ancestors(joint)]}
         self._nodes = sorted(tree, key=lambda n: len(doc.ancestors(n)))
         self._node_parents = {n: int(doc.parents[n]) for n in self._nodes}
-        self.rest_translation, self.rest_rotation, self._local_scale, self._world_scale = {}, {}, {}, {}
+        self.rest_translation, self.rest_rotation, self._rest_scale = {}, {}, {}
+        self._local_scale, self._world_scale = {}, {}
+        uniform = True
         for node in self._nodes:
             translation, rotation, scale = doc.rest_trs(node)
             self.rest_translation[node], self.rest_rotation[node] = translation[None], rotation[None]
-            self._local_scale[node] = doc.uniform_scale(node, scale, self.element)
+            self._rest_scale[node] = scale[None]
+            common = doc.uniform_scale(node, scale, self.element)
+            uniform &= common is not None
+            self._local_scale[node] = 1.0 if common is None else common
             self._world_scale[node] = self._local_scale[node] * self._world_scale.get(self._node_parents[node], 1.0)
         self.scales = np.array([self._world_scale[n] for n in self.joint_nodes])
         self.inverse_bind = self._inverse_bind(doc, len(order))[order]
-        positions, world_rotations, _ = self._pose(self.rest_translation, self.rest_rotation, frames=1)
+        positions, world_rotations, rest_shape = self._pose(
+            self.rest_translation, self.rest_rotation, frames=1, scales=None if uniform else self._rest_scale
+        )
+        self.rest_shape = None if uniform else rest_shape[0]
         offsets = self._offsets(positions, world_rotations)[0]
         self._translation_tolerance = _HELD_TRANSLATION_TOLERANCE * max(np.abs(offsets[1:]).max(initial=0.0), 1e-12)
         names = _unique_names(doc, self.joint_nodes)
@@ -110,8 +126,8 @@ class SkinRig:
             return None
         at = doc.animation_frame_times(animation_index, fps)
         translations, local_rotations = dict(self.rest_translation), dict(self.rest_rotation)
-        scales = {node: np.full((1, 3), scale) for node, scale in self._local_scale.items()}
-        scaled = False
+        scales = dict(self._rest_scale)
+        scaled = self.rest_shape is not None
         for index, sampler, node, path in channels:
             element = f"{label} channel {index}"
             times, values, interpolation = doc.sampler_keys(
@@ -131,6 +147,10 @@ class SkinRig:
         positions, world_rotations, deformations = self._pose(
             translations, local_rotations, frames=len(at), scales=scales if scaled else None
         )
+        if self.rest_shape is not None:  # the rest shape is in the inverse binds already
+            deformations = deformations @ np.linalg.inv(self.rest_shape)
+            if np.abs(deformations - np.eye(3)).max() <= _RIGID_DEFORMATION_TOLERANCE:
+                deformations = None
         offsets = self._offsets(positions, world_rotations)
         bones_move = np.abs(offsets[:, 1:] - self.skeleton.offsets[1:]).max(initial=0.0) > self._translation_tolerance
         try:
@@ -262,8 +282,8 @@ class SkinRig:
     def _scale_moves(self, node: int, values: np.ndarray) -> bool:
         """Whether a scale channel's keys leave the node's rest scale by more than float noise."""
         keys = values[:, 1] if values.ndim == 3 else values  # CUBICSPLINE: the values between tangents
-        rest = self._local_scale[node]
-        return float(np.abs(keys - rest).max()) > UNIFORM_SCALE_TOLERANCE * rest
+        rest = self._rest_scale[node]
+        return float(np.abs(keys - rest).max()) > UNIFORM_SCALE_TOLERANCE * float(rest.max())
 
 
 def _topological_order(parent_slots: list[int]) -> list[int]:

@@ -83,10 +83,13 @@ def draco_compressed(source: Path, target: Path) -> Path:
     return edit_glb(source, target, compress)
 
 
-def meshopt_compressed(source: Path, target: Path) -> Path:
+def meshopt_compressed(
+    source: Path, target: Path, extension_name: str = "EXT_meshopt_compression", vertex_codec: int = 0
+) -> Path:
     """A copy of the GLB at ``source`` whose buffer views (one accessor each, as animlod writes
-    them) hold meshoptimizer-coded data (without filters), EXT_meshopt_compression required, as
-    gltfpack writes it. The views' own bytes, the fallback, are zeroed: only decoding reads right.
+    them) hold meshoptimizer-coded data (without filters, vertex codec version ``vertex_codec``),
+    ``extension_name`` required, as gltfpack writes it. The views' own bytes, the fallback, are
+    zeroed: only decoding reads right.
     Written with animlod's GlbBuilder: pygltflib repacks the binary chunk by buffer view and would
     drop the compressed bytes, which only the extension refers to."""
     import meshoptimizer
@@ -115,12 +118,16 @@ def meshopt_compressed(source: Path, target: Path) -> Path:
             mode = "TRIANGLES"
         else:
             vertices = np.frombuffer(raw, np.float32).reshape(accessor["count"], stride // 4)
-            data, mode = meshoptimizer.encode_vertex_buffer(vertices, accessor["count"], stride), "ATTRIBUTES"
+            meshoptimizer.encode_vertex_version(vertex_codec)
+            try:
+                data, mode = meshoptimizer.encode_vertex_buffer(vertices, accessor["count"], stride), "ATTRIBUTES"
+            finally:
+                meshoptimizer.encode_vertex_version(0)
         blob[start : start + len(raw)] = bytes(len(raw))
         offset = builder._append(data)
         extension = {"buffer": 0, "byteOffset": offset, "byteLength": len(data), "byteStride": stride}
-        view["extensions"] = {"EXT_meshopt_compression": {**extension, "count": accessor["count"], "mode": mode}}
+        view["extensions"] = {extension_name: {**extension, "count": accessor["count"], "mode": mode}}
     for listed in ("extensionsUsed", "extensionsRequired"):
-        js.setdefault(listed, []).append("EXT_meshopt_compression")
+        js.setdefault(listed, []).append(extension_name)
     builder.save(target)
     return target

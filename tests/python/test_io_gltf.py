@@ -535,9 +535,9 @@ def test_required_extension_animlod_cannot_read(chain_glb, tmp_path):
     path, _, _ = chain_glb
 
     def require_meshopt(gltf, blob):
-        gltf.extensionsUsed = gltf.extensionsRequired = ["KHR_meshopt_compression"]
+        gltf.extensionsUsed = gltf.extensionsRequired = ["VENDOR_mesh_compression"]
 
-    with pytest.raises(FormatError, match=r"extensionsRequired: needs KHR_meshopt_compression"):
+    with pytest.raises(FormatError, match=r"extensionsRequired: needs VENDOR_mesh_compression"):
         read_gltf(edit_glb(path, tmp_path / "meshopt.glb", require_meshopt))
 
 
@@ -598,9 +598,12 @@ def _rotated_to_lowest(faces: np.ndarray) -> np.ndarray:
     return np.take_along_axis(faces, (first + np.arange(3)) % 3, axis=1)
 
 
-def test_meshopt_compressed_views_read_as_the_uncompressed_ones(chain_glb, tmp_path):
+@pytest.mark.parametrize(
+    "extension, codec", [("EXT_meshopt_compression", 0), ("KHR_meshopt_compression", 1)], ids=["EXT", "KHR-v1"]
+)
+def test_meshopt_compressed_views_read_as_the_uncompressed_ones(chain_glb, tmp_path, extension, codec):
     path, _, motion = chain_glb
-    compressed = meshopt_compressed(path, tmp_path / "meshopt.glb")
+    compressed = meshopt_compressed(path, tmp_path / "meshopt.glb", extension, codec)
     expected, (expected_motion,) = read_skinned(path, fps=motion.fps)
     read, (read_motion,) = read_skinned(compressed, fps=motion.fps)
     # The index codec may start a triangle at another corner; the triangles are the same.
@@ -623,6 +626,8 @@ def test_meshopt_filters_turn_decoded_integers_into_vectors():
     np.testing.assert_array_equal(np.frombuffer(decoded, np.int8).reshape(2, 4), [[127, 0, 0, 7], [0, 0, 127, 9]])
     with pytest.raises(ValueError, match="mode 'QUADS' or filter 'NONE' is not defined"):
         decode_meshopt_view({**extension, "mode": "QUADS", "filter": "NONE"}, coded, "bufferView 0", ValueError, 2**20)
+    with pytest.raises(ValueError, match="filter 'COLOR' is not decoded"):  # KHR_meshopt_compression's
+        decode_meshopt_view({**extension, "filter": "COLOR"}, coded, "bufferView 0", ValueError, 2**20)
     with pytest.raises(ValueError, match="claims 1000000 x 4 bytes, more than the file can justify"):
         decode_meshopt_view({**extension, "count": 10**6}, coded, "bufferView 0", ValueError, 2**20)
 

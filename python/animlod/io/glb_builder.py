@@ -24,7 +24,7 @@ import numpy as np
 from .atomic import atomic_write
 from .gltf_document import GltfDocument
 from .gltf_draco import DRACO_EXTENSION
-from .gltf_meshopt import MESHOPT_EXTENSION
+from .gltf_meshopt import MESHOPT_EXTENSIONS
 
 FLOAT, UNSIGNED_BYTE, UNSIGNED_SHORT, UNSIGNED_INT = 5126, 5121, 5123, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
@@ -60,11 +60,13 @@ class GlbBuilder:
             data = doc.view_bytes(index, f"bufferView {index}")
             view["buffer"], view["byteOffset"], view["byteLength"] = 0, builder._append(data), len(data)
             # Written decoded: the output needs no meshopt decoder.
-            if MESHOPT_EXTENSION in view.get("extensions", {}):
-                del view["extensions"][MESHOPT_EXTENSION]
-                if not view["extensions"]:
-                    del view["extensions"]
-        _drop_extension(builder.json, MESHOPT_EXTENSION)
+            extensions = view.pop("extensions", {})
+            for name in MESHOPT_EXTENSIONS:
+                extensions.pop(name, None)
+            if extensions:
+                view["extensions"] = extensions
+        for name in MESHOPT_EXTENSIONS:
+            _drop_extension(builder.json, name)
         for index, image in enumerate(builder.json.get("images", [])):
             if "uri" in image:
                 data, mime = _image_bytes(doc, index, image.pop("uri"))

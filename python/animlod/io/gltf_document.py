@@ -25,7 +25,7 @@ from .errors import FormatError
 from .gltf_decode import decode_gltf
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
 from .gltf_keyframes import INTERPOLATIONS, frame_times
-from .gltf_meshopt import MESHOPT_EXTENSION, decode_meshopt_view
+from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
 from .json_limits import load_json
 
 _GLB_MAGIC = b"glTF"
@@ -39,7 +39,7 @@ _DATA_URI_BASE64 = ";base64,"
 # (gltf_meshopt.py); any other required extension changes what the buffers mean and is refused.
 _READABLE_EXTENSIONS = (
     "KHR_mesh_quantization", "KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_", DRACO_EXTENSION,
-    MESHOPT_EXTENSION,
+    *MESHOPT_EXTENSIONS,
 )  # fmt: skip
 
 _COMPONENT_DTYPES = {
@@ -183,18 +183,19 @@ class GltfDocument:
         return draco_elements(self._draco_meshes[source.view], source, count, width, dtype, self.fail)
 
     def view_bytes(self, view_index: Any, referrer: str) -> memoryview:
-        """The bytes of buffer view ``view_index``, decoded where EXT_meshopt_compression compresses
+        """The bytes of buffer view ``view_index``, decoded where a meshopt extension compresses
         them; FormatError naming ``referrer`` or the view if they cannot be had."""
         view = self.item("bufferViews", view_index, referrer)
         element = f"bufferView {view_index}"
-        extension = (view.extensions or {}).get(MESHOPT_EXTENSION)
-        if extension is None:
+        meshopt = meshopt_extension(view.extensions)
+        if meshopt is None:
             return self._buffer_range(view.buffer, view.byteOffset, view.byteLength, element)
         if view_index not in self._decoded_views:
+            name, extension = meshopt
             where = extension if isinstance(extension, dict) else {}
-            compressed = self._buffer_range(
-                where.get("buffer"), where.get("byteOffset"), where.get("byteLength"), f"{element} {MESHOPT_EXTENSION}"
-            )
+            element = f"{element} {name}"
+            start, length = where.get("byteOffset"), where.get("byteLength")
+            compressed = self._buffer_range(where.get("buffer"), start, length, element)
             limit = _ZERO_FILL_FACTOR * (self._file_bytes() + 2**20)
             self._decoded_views[view_index] = decode_meshopt_view(extension, compressed, element, self.fail, limit)
         return memoryview(self._decoded_views[view_index])

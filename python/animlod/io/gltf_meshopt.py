@@ -1,5 +1,7 @@
-"""EXT_meshopt_compression: buffer views stored compressed by meshoptimizer's codecs (gltfpack
-writes them, usually with KHR_mesh_quantization), decoded with meshoptimizer's Python package.
+"""EXT_meshopt_compression and KHR_meshopt_compression: buffer views stored compressed by
+meshoptimizer's codecs (gltfpack writes them, usually with KHR_mesh_quantization), decoded with
+meshoptimizer's Python package. The KHR extension adds version 1 of the vertex codec, which the
+decoder reads from the data's header, and a colour filter, which the package does not decode.
 
 The extension on a buffer view names where the compressed bytes are (its own buffer, byte offset
 and length), how many elements of which stride they decode to, the codec (``mode``: vertex
@@ -14,32 +16,41 @@ from collections.abc import Callable
 
 import numpy as np
 
-MESHOPT_EXTENSION = "EXT_meshopt_compression"
+MESHOPT_EXTENSIONS = ("EXT_meshopt_compression", "KHR_meshopt_compression")
 # Builds the error to raise from (element, reason): the document's FormatError.
 Fail = Callable[[str, str], Exception]
 _MODES = ("ATTRIBUTES", "TRIANGLES", "INDICES")
 _FILTERS = ("NONE", "OCTAHEDRAL", "QUATERNION", "EXPONENTIAL")
 
 
+def meshopt_extension(extensions: object) -> tuple[str, object] | None:
+    """(name, value) of the meshopt extension among a buffer view's ``extensions``, if any."""
+    if not isinstance(extensions, dict):
+        return None
+    return next(((name, extensions[name]) for name in MESHOPT_EXTENSIONS if name in extensions), None)
+
+
 def decode_meshopt_view(extension: object, compressed: bytes, element: str, fail: Fail, limit: int) -> bytes:
-    """The ``count * byteStride`` bytes that buffer view ``element``'s ``extension`` decodes to,
-    from its ``compressed`` bytes; ``fail``'s error for a malformed extension or data, or for more
-    than ``limit`` bytes (a few bytes of zeros can claim gigabytes)."""
+    """The ``count * byteStride`` bytes that a buffer view's meshopt ``extension`` (``element``
+    names both) decodes to, from its ``compressed`` bytes; ``fail``'s error for a malformed
+    extension or data, or for more than ``limit`` bytes (a few bytes of zeros can claim gigabytes)."""
     import meshoptimizer  # only files that use the extension need it
 
     if not isinstance(extension, dict):
-        raise fail(element, f"{MESHOPT_EXTENSION} must be an object")
+        raise fail(element, "must be an object")
     count, stride = extension.get("count"), extension.get("byteStride")
     mode, filter_name = extension.get("mode"), extension.get("filter", "NONE")
     if not (_whole(count) and _whole(stride) and 0 < stride <= 256):
-        raise fail(element, f"{MESHOPT_EXTENSION} needs a count and a byteStride in (0, 256]")
+        raise fail(element, "needs a count and a byteStride in (0, 256]")
+    if filter_name == "COLOR":
+        raise fail(element, "filter 'COLOR' is not decoded by the meshoptimizer package animlod uses")
     if mode not in _MODES or filter_name not in _FILTERS:
-        raise fail(element, f"{MESHOPT_EXTENSION} mode {mode!r} or filter {filter_name!r} is not defined")
+        raise fail(element, f"mode {mode!r} or filter {filter_name!r} is not defined")
     if count * stride > limit:
         reason = f"claims {count} x {stride} bytes, more than the file can justify ({limit})"
-        raise fail(element, f"{MESHOPT_EXTENSION} {reason}")
+        raise fail(element, reason)
     if (mode == "ATTRIBUTES" and stride % 4) or (mode != "ATTRIBUTES" and stride not in (2, 4)):
-        raise fail(element, f"{MESHOPT_EXTENSION} byteStride {stride} does not suit mode {mode}")
+        raise fail(element, f"byteStride {stride} does not suit mode {mode}")
     decode = {
         "ATTRIBUTES": meshoptimizer.decode_vertex_buffer,
         "TRIANGLES": meshoptimizer.decode_index_buffer,
@@ -55,9 +66,9 @@ def decode_meshopt_view(extension: object, compressed: bytes, element: str, fail
             }[filter_name]
             decoded = np.asarray(apply(np.frombuffer(decoded, np.uint8).copy(), count, stride)).tobytes()
     except (ValueError, RuntimeError) as error:
-        raise fail(element, f"the {MESHOPT_EXTENSION} data does not decode ({error})") from None
+        raise fail(element, f"the data does not decode ({error})") from None
     if len(decoded) != count * stride:
-        raise fail(element, f"{MESHOPT_EXTENSION} decodes to {len(decoded)} bytes, not {count} x {stride}")
+        raise fail(element, f"decodes to {len(decoded)} bytes, not {count} x {stride}")
     return decoded
 
 

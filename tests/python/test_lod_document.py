@@ -247,6 +247,30 @@ def test_a_meshopt_compressed_document_comes_out_whole_and_decoded(humanoid_glb,
         assert summary["triangles"] > 0 and summary["joints"] == 41
 
 
+def test_gpu_instanced_meshes_have_their_levels_instanced_too(tmp_path):
+    import trimesh
+
+    from animlod.io.glb_builder import GlbBuilder
+
+    plain = tmp_path / "sphere.glb"
+    trimesh.creation.icosphere(subdivisions=3).export(plain)
+    builder = GlbBuilder.from_document(GltfDocument(plain))
+    offsets = builder.add(np.array([[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.0, 3.0, 0.0]], np.float32))
+    instancing = {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": offsets}}}
+    (drawn,) = [node for node in builder.json["nodes"] if "mesh" in node]
+    drawn["extensions"] = instancing
+    for listed in ("extensionsUsed", "extensionsRequired"):
+        builder.json[listed] = ["EXT_mesh_gpu_instancing"]
+    source = tmp_path / "instanced.glb"
+    builder.save(source)
+    report = simplify_document(source, tmp_path / "out.glb", [0.5], **QUICK)
+    doc = GltfDocument(tmp_path / "out.glb")
+    level_nodes = [node for node in doc.json["nodes"] if node.get("extras", {}).get("animlod", {}).get("level") == 1]
+    assert [node.get("extensions") for node in level_nodes] == [instancing]
+    assert doc.json["extensionsRequired"] == ["EXT_mesh_gpu_instancing"]
+    assert read_drawables(doc)[0].geometry.faces.shape[0] == report.drawables[0].levels[0].faces
+
+
 def test_cli_writes_one_lod_glb(humanoid_glb, tmp_path, capsys):
     assert main(["simplify", str(humanoid_glb), "-o", str(tmp_path), "--ratio", "0.5", "--max-frames", "8"]) == 0
     out = capsys.readouterr().out

@@ -33,14 +33,18 @@ _GLB_HEADER_BYTES = 12
 _GLB_JSON_CHUNK = 0x4E4F534A  # "JSON"
 _GLB_BIN_CHUNK = 0x004E4942  # "BIN\0"
 _DATA_URI_BASE64 = ";base64,"
+INSTANCING_EXTENSION = "EXT_mesh_gpu_instancing"
 # Required extensions animlod reads: those that leave geometry, skins and animation readable as
 # plain glTF (quantized attributes are ordinary normalised or integer accessors), Draco's, decoded
 # into its accessors (gltf_draco.py), and meshopt's, decoded into its buffer views
-# (gltf_meshopt.py); any other required extension changes what the buffers mean and is refused.
+# (gltf_meshopt.py), and GPU instancing, whose per-instance transforms leave each mesh as it is
+# (level nodes repeat them, gltf_lod.py); any other required extension changes what the buffers
+# mean and is refused.
 _READABLE_EXTENSIONS = (
     "KHR_mesh_quantization", "KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_", DRACO_EXTENSION,
-    *MESHOPT_EXTENSIONS,
+    *MESHOPT_EXTENSIONS, INSTANCING_EXTENSION,
 )  # fmt: skip
+
 
 _COMPONENT_DTYPES = {
     5120: np.dtype("<i1"),

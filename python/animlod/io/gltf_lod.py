@@ -27,7 +27,7 @@ import numpy as np
 
 from ..model import AnimatedMesh, LodChain, LodLevel
 from .glb_builder import ARRAY_BUFFER, GlbBuilder
-from .gltf_document import GltfDocument
+from .gltf_document import INSTANCING_EXTENSION, GltfDocument
 from .gltf_draco import DRACO_EXTENSION
 from .gltf_mesh import read_mesh_geometry, transform_points
 from .gltf_read import skinned_mesh_of_node
@@ -130,6 +130,9 @@ def add_level_node(builder: GlbBuilder, base: int, mesh: int, skin: int | None, 
     """A node drawing ``mesh`` (with ``skin``) where node ``base`` is; in no scene. Its index."""
     base_node = builder.json["nodes"][base]
     node = {key: copy.deepcopy(base_node[key]) for key in _NODE_TRANSFORM if key in base_node}
+    instances = base_node.get("extensions", {}).get(INSTANCING_EXTENSION)
+    if instances is not None:  # every instance draws the level too
+        node["extensions"] = {INSTANCING_EXTENSION: copy.deepcopy(instances)}
     node["name"] = f"{base_node.get('name', f'node{base}')}_LOD{info.level}"
     node["mesh"] = mesh
     if skin is not None:

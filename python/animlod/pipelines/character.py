@@ -6,10 +6,10 @@ them) and every skin gets motion levels: the clips of all its animations are ana
 (so one reduced skeleton serves them all), joints are frozen level by level, each clip is
 re-fitted with SLSQP, and the weights of frozen joints move to their kept ancestors (seeds/000,
 Sections 4-5). A skin whose clips scale a joint keeps every joint, with the input's clips, at
-every level: the re-fit is rigid. Level i of the written chain combines geometry level i with motion level i (or
-the coarsest one a small skeleton has);
-every other combination is written too (``extras.animlod_grid`` on the base node lists them by
-geometry level, then motion level) so that a benchmark can walk the whole grid.
+every level: the re-fit is rigid. Level i of the written chain combines geometry level i with
+motion level i (or the coarsest one a small skeleton has); every other combination is written
+too (``extras.animlod_grid`` on the base node lists them by geometry level, then motion level)
+so that a benchmark can walk the whole grid.
 
 Motion level m >= 1 adds, per skin, a reduced skeleton as joint nodes of its own, a skin over
 them and one animation per input clip (``extras.animlod = {"clip", "motion_level"}``); a level
@@ -340,6 +340,7 @@ def _measure_chain(
         m = min(i, len(motion.reduced_levels))  # a small skeleton runs out of motion levels first
         level = levels.levels[i - 1]
         motion_level = motion.reduced_levels[m - 1] if m > 0 else None
+        reduced = None if motion_level is None else transfer_skin(level.skinned, motion_level.frozen)
         error = 0.0
         for clip, span in motion.clips:
             frames = spread_frames(clip.frame_count, measured_frames)
@@ -348,7 +349,6 @@ def _measure_chain(
                 posed = AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
             else:
                 weights = None if clip.morph_weights is None else clip.morph_weights[frames]
-                reduced = transfer_skin(level.skinned, motion_level.frozen)
                 posed = reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
             error = max(error, float(surface_error(original, posed, samples=4000).hausdorff.max()))
         faces = level.simplified.mesh.face_count

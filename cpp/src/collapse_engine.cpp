@@ -420,33 +420,23 @@ void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<size_t
   heap_ = IndexedMinHeap(edge_count);
   parked_.assign(edge_count, 0);
   may_have_parked_.assign(point_count_, 0);
-  std::vector<int32_t> ids;
-  std::vector<Candidate> candidates;
-  ids.reserve(edge_count);
-  candidates.reserve(edge_count);
-  for (const auto edge : connectivity_.edges()) {
-    if (locked(edge.v0().idx()) && locked(edge.v1().idx())) continue;  // can never collapse
-    ids.push_back(edge.idx());
-    candidates.push_back(candidate_for(edge.idx()));
-  }
-  evaluate_all(policy, candidates);
-  std::vector<double> keys(candidates.size());
-  for (size_t i = 0; i < candidates.size(); ++i) keys[i] = candidates[i].cost;
+  std::vector<RankedEdge> ranked;
+  rank_collapsible_edges(policy, ranked);
+  std::vector<int32_t> ids(ranked.size());
+  std::vector<double> keys(ranked.size());
+  for (size_t i = 0; i < ranked.size(); ++i) ids[i] = ranked[i].edge, keys[i] = ranked[i].cost;
   heap_.assign(ids, keys);
 
   // Steps 8-12, taking a level each time the face count reaches a target.
   while (next_level_ < targets.size() && (!heap_.empty() || release_guards(policy))) {
     const int32_t edge = heap_.top();
-    const Candidate candidate = evaluate(policy, edge);
-    policy.place(candidate, placed_);
-    const auto halfedge = removed_to_kept(candidate, edge);
-    if (!is_legal(candidate, halfedge)) {
+    const Candidate candidate = candidate_for(edge);
+    const Attempt attempt = try_collapse(policy, candidate, edge, targets, levels, record);
+    if (attempt == Attempt::over_max_error) break;
+    if (attempt == Attempt::illegal) {
       park(edge);
       continue;
     }
-    if (candidate.error > options_.max_error) break;
-    error_so_far_ = std::max(error_so_far_, candidate.error);
-    collapse(policy, candidate, halfedge, record);
     for (int32_t old_edge : old_edges_)
       if (connectivity_.status(connectivity_.edge_handle(old_edge)).deleted()) heap_.remove(old_edge);
     // Step 10: the costs of the edges at the kept point changed; the legality of edges one ring
@@ -454,119 +444,183 @@ void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<size_t
     const auto kept = connectivity_.vertex_handle(candidate.kept);
     rekey_around(policy, kept, true);
     for (const auto neighbour : connectivity_.vv_range(kept)) rekey_around(policy, neighbour, false);
-    take_reached_levels(targets, levels);
-    if (options_.progress && collapse_count_ % 4096 == 0) options_.progress(collapse_count_, planned_);
   }
 }
 
-// Fills cost, error and t of every candidate (kept and removed set) on up to the policy's
-// concurrency() threads, in contiguous chunks: each candidate's values do not depend on the
-// thread that computed them.
-void CollapseEngine::evaluate_all(CollapsePolicy& policy, std::vector<Candidate>& candidates) {
-  constexpr size_t kMinimumChunk = 8192;
-  const size_t hardware = std::max<size_t>(std::thread::hardware_concurrency(), 1);
-  const size_t workers = std::min({policy.concurrency(), hardware, std::max<size_t>(candidates.size() / kMinimumChunk, 1)});
-  run_in_ranges(candidates.size(), workers, [&](size_t begin, size_t end, size_t worker) {
-    for (size_t i = begin; i < end; ++i) policy.evaluate_concurrently(candidates[i], worker);
-  });
+// Steps 8-9 for one candidate (kept and removed set): evaluate it again for its placement, test
+// legality and max_error, collapse, take the levels reached.
+CollapseEngine::Attempt CollapseEngine::try_collapse(CollapsePolicy& policy, Candidate candidate, int32_t edge,
+                                                     const std::vector<size_t>& targets,
+                                                     std::vector<EngineLevel>& levels, EngineRecord& record) {
+  policy.evaluate(candidate);
+  policy.place(candidate, placed_);
+  const auto halfedge = removed_to_kept(candidate, edge);
+  if (!is_legal(candidate, halfedge)) return Attempt::illegal;
+  if (candidate.error > options_.max_error) return Attempt::over_max_error;
+  error_so_far_ = std::max(error_so_far_, candidate.error);
+  collapse(policy, candidate, halfedge, record);
+  take_reached_levels(targets, levels);
+  if (options_.progress && collapse_count_ % 4096 == 0) options_.progress(collapse_count_, planned_);
+  return Attempt::collapsed;
 }
 
-// Sorts `items` by `less` (a total order), the two halves on two threads, then merges them.
+// Every live edge that can collapse, with its cost, in edge order. The edges are split in
+// contiguous ranges over up to the policy's concurrency() threads (each candidate's values do
+// not depend on the thread that computed them), each writing its part of `ranked` from the
+// start of its range; the parts are then moved together.
+void CollapseEngine::rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) const {
+  constexpr size_t kMinimumChunk = 8192;
+  const size_t edge_count = connectivity_.n_edges();
+  const size_t hardware = std::max<size_t>(std::thread::hardware_concurrency(), 1);
+  const size_t workers = std::min({policy.concurrency(), hardware, std::max<size_t>(edge_count / kMinimumChunk, 1)});
+  ranked.resize(edge_count);
+  std::vector<size_t> ends(workers);
+  run_in_ranges(edge_count, workers, [&](size_t begin, size_t end, size_t worker) {
+    size_t out = begin;
+    for (size_t e = begin; e < end; ++e) {
+      if (connectivity_.status(connectivity_.edge_handle(static_cast<int>(e))).deleted()) continue;
+      Candidate candidate = candidate_for(static_cast<int32_t>(e));
+      if (locked(candidate.kept) && locked(candidate.removed)) continue;  // cannot collapse (yet)
+      policy.evaluate_concurrently(candidate, worker);
+      ranked[out++] = {candidate.cost, candidate.error, static_cast<int32_t>(e), candidate.kept, candidate.removed};
+    }
+    ends[worker] = out;
+  });
+  size_t size = ends[0];
+  for (size_t worker = 1; worker < workers; ++worker) {
+    const auto begin = ranked.begin() + static_cast<std::ptrdiff_t>(edge_count * worker / workers);
+    size = static_cast<size_t>(std::copy(begin, ranked.begin() + static_cast<std::ptrdiff_t>(ends[worker]),
+                                         ranked.begin() + static_cast<std::ptrdiff_t>(size)) -
+                               ranked.begin());
+  }
+  ranked.resize(size);
+}
+
+// Sorts [begin, end) by `less` (a total order), the two halves on two threads, then merges them.
 template <typename T, typename Less>
-void sort_in_halves(std::vector<T>& items, std::vector<T>& scratch, Less less) {
-  constexpr size_t kMinimumHalf = 65536;
-  if (items.size() < 2 * kMinimumHalf || std::thread::hardware_concurrency() < 2) {
-    std::sort(items.begin(), items.end(), less);
+void sort_in_halves(typename std::vector<T>::iterator begin, typename std::vector<T>::iterator end,
+                    std::vector<T>& scratch, Less less) {
+  constexpr std::ptrdiff_t kMinimumHalf = 65536;
+  if (end - begin < 2 * kMinimumHalf || std::thread::hardware_concurrency() < 2) {
+    std::sort(begin, end, less);
     return;
   }
-  const auto middle = items.begin() + static_cast<std::ptrdiff_t>(items.size() / 2);
-  std::thread first([&] { std::sort(items.begin(), middle, less); });
-  std::sort(middle, items.end(), less);
+  const auto middle = begin + (end - begin) / 2;
+  std::thread first([&] { std::sort(begin, middle, less); });
+  std::sort(middle, end, less);
   first.join();
-  scratch.resize(items.size());
-  std::merge(items.begin(), middle, middle, items.end(), scratch.begin(), less);
-  items.swap(scratch);
+  scratch.resize(static_cast<size_t>(end - begin));
+  std::merge(begin, middle, middle, end, scratch.begin(), less);
+  std::copy(scratch.begin(), scratch.end(), begin);
 }
 
+// `items` read in the order of `less` (a total order), sorted only as far as it is read: a
+// collapse pass reads the cheapest third to half of its candidates. nth_element leaves every
+// item before the sorted prefix no greater than those after it, so the order read is the full
+// sort's.
+template <typename T, typename Less>
+class SortedOnDemand {
+ public:
+  SortedOnDemand(std::vector<T>& items, std::vector<T>& scratch, Less less, size_t first_prefix)
+      : items_(items), scratch_(scratch), less_(less), first_prefix_(first_prefix) {}
+  size_t size() const { return items_.size(); }
+  const T& operator[](size_t i) {
+    if (i >= sorted_) sort_through(i);
+    return items_[i];
+  }
+
+ private:
+  void sort_through(size_t i) {
+    const size_t end = std::min(items_.size(), std::max({i + 1, sorted_ + sorted_ / 2, first_prefix_}));
+    const auto begin = items_.begin() + static_cast<std::ptrdiff_t>(sorted_);
+    const auto last = items_.begin() + static_cast<std::ptrdiff_t>(end);
+    if (last != items_.end()) std::nth_element(begin, last, items_.end(), less_);
+    sort_in_halves(begin, last, scratch_, less_);
+    sorted_ = end;
+  }
+
+  std::vector<T>& items_;
+  std::vector<T>& scratch_;
+  Less less_;
+  size_t first_prefix_, sorted_ = 0;
+};
+
 // Steps 7-12 as meshoptimizer's collapse passes (simplifier.cpp: pickEdgeCollapses,
-// sortEdgeCollapses, performEdgeCollapses): every live edge is evaluated, the candidates are
-// sorted by (cost, edge), and collapsed in that order. A point that took part in a collapse of
-// the pass is not touched again in it, so every other candidate's cost stays exact (it depends
-// only on its two points); legality is checked against the current mesh. A pass stops at the
-// next level's face count, or once the cost exceeds pass_cost_growth times the cost of the
-// candidate the pass would reach if every collapse succeeded, so that the order stays close to
-// the greedy one.
+// sortEdgeCollapses, performEdgeCollapses): every live edge is evaluated and the candidates
+// ranked by (cost, edge). A pass chooses its collapses in that order, each point at most once
+// (so every chosen cost stays exact: it depends only on its two points), as if each removed two
+// faces, until the next level's face count, or until the cost exceeds pass_cost_growth times
+// the cost of the candidate the pass would reach if every collapse succeeded (the order stays
+// close to the greedy one). The chosen collapses are then performed in edge order, whose
+// neighbours share OpenMesh's records in memory (the cost order scatters them: the 1M-triangle
+// sphere's collapses took 2.5 s that way), legality checked against the current mesh. Where
+// illegal or boundary collapses leave the pass short of its goal, it goes on down the ranking
+// one collapse at a time.
 void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t>& targets,
                                 std::vector<EngineLevel>& levels, EngineRecord& record) {
-  std::vector<Candidate> candidates;
-  std::vector<int32_t> edges;
-  struct Ranked {
-    double cost;
-    int32_t edge, kept, removed;
-  };
-  std::vector<Ranked> ranked, merged;
+  std::vector<RankedEdge> ranked, scratch;
+  std::vector<int32_t> chosen_rank(connectivity_.n_edges(), -1);  // place in ranked of the pass's chosen edges
   std::vector<uint8_t> touched(point_count_, 0);
-  const size_t edge_count = connectivity_.n_edges();
   in_passes_ = true;
   while (next_level_ < targets.size()) {
     // Step 7: every collapsible edge, evaluated.
-    candidates.clear();
-    edges.clear();
-    for (size_t e = 0; e < edge_count; ++e) {
-      const auto handle = connectivity_.edge_handle(static_cast<int>(e));
-      if (connectivity_.status(handle).deleted()) continue;
-      const Candidate candidate = candidate_for(static_cast<int32_t>(e));
-      if (locked(candidate.kept) && locked(candidate.removed)) continue;  // cannot collapse (yet)
-      candidates.push_back(candidate);
-      edges.push_back(static_cast<int32_t>(e));
-    }
-    if (candidates.size() <= options_.greedy_tail_edges) {
+    rank_collapsible_edges(policy, ranked);
+    if (ranked.size() <= options_.greedy_tail_edges) {
       // The last few edges in one greedy order: re-keying them costs little, and on small
       // meshes and coarse levels the order matters most.
       in_passes_ = false;
       run_greedy(policy, targets, levels, record);
       return;
     }
-    evaluate_all(policy, candidates);
-    ranked.resize(candidates.size());
-    for (size_t i = 0; i < candidates.size(); ++i)
-      ranked[i] = {candidates[i].cost, edges[i], candidates[i].kept, candidates[i].removed};
-    auto less = [](const Ranked& a, const Ranked& b) { return a.cost < b.cost || (a.cost == b.cost && a.edge < b.edge); };
-    sort_in_halves(ranked, merged, less);
-
-    // Steps 8-12 over the sorted candidates.
+    auto less = [](const RankedEdge& a, const RankedEdge& b) {
+      return a.cost < b.cost || (a.cost == b.cost && a.edge < b.edge);
+    };
     const size_t face_goal = face_count_ - targets[next_level_];
-    size_t edge_goal = face_goal / 2, removed_faces = 0, pass_collapses = 0;
-    bool over_max_error = false;
+    size_t edge_goal = face_goal / 2;  // an illegal collapse does not count towards the goal
+    SortedOnDemand order(ranked, scratch, less, edge_goal + edge_goal / 2);
+    auto within_cost_goal = [&](double cost, size_t removed_faces) {
+      return removed_faces <= face_goal / 6 || edge_goal >= order.size() ||
+             cost <= options_.pass_cost_growth * order[edge_goal].cost;
+    };
+
+    // Steps 8-12: choose, then perform in edge order.
     std::fill(touched.begin(), touched.end(), 0);
-    for (const Ranked& entry : ranked) {
-      if (next_level_ >= targets.size() || removed_faces >= face_goal) break;
-      const double cost_goal = edge_goal < ranked.size() ? options_.pass_cost_growth * ranked[edge_goal].cost
-                                                         : std::numeric_limits<double>::infinity();
-      if (entry.cost > cost_goal && removed_faces > face_goal / 6) break;
+    size_t next = 0;
+    bool over_max_error = false;  // the pass stops at the first candidate whose error exceeds max_error
+    for (size_t planned_faces = 0; next < order.size() && planned_faces < face_goal; ++next) {
+      const RankedEdge& entry = order[next];
+      if (!within_cost_goal(entry.cost, planned_faces)) break;
       if (touched[entry.kept] || touched[entry.removed]) continue;
+      over_max_error = entry.error > options_.max_error;
+      if (over_max_error) break;
+      touched[entry.kept] = touched[entry.removed] = 1;
+      chosen_rank[entry.edge] = static_cast<int32_t>(next);
+      planned_faces += 2;
+    }
+    const size_t faces_before = face_count_;
+    size_t pass_collapses = 0;
+    auto try_entry = [&](const RankedEdge& entry) {
       Candidate candidate;
       candidate.kept = entry.kept;
       candidate.removed = entry.removed;
-      policy.evaluate(candidate);  // again, for its placement
-      policy.place(candidate, placed_);
-      const auto halfedge = removed_to_kept(candidate, entry.edge);
-      if (!is_legal(candidate, halfedge)) {
-        ++edge_goal;  // an illegal collapse does not count towards the pass's goal
-        continue;
-      }
-      if (candidate.error > options_.max_error) {
-        over_max_error = true;
-        break;
-      }
-      error_so_far_ = std::max(error_so_far_, candidate.error);
-      const size_t faces_before = face_count_;
-      collapse(policy, candidate, halfedge, record);
-      removed_faces += faces_before - face_count_;
-      touched[candidate.kept] = touched[candidate.removed] = 1;
-      ++pass_collapses;
-      take_reached_levels(targets, levels);
-      if (options_.progress && collapse_count_ % 4096 == 0) options_.progress(collapse_count_, planned_);
+      const Attempt attempt = try_collapse(policy, candidate, entry.edge, targets, levels, record);
+      if (attempt == Attempt::illegal) ++edge_goal;
+      if (attempt == Attempt::collapsed) ++pass_collapses;
+      return attempt == Attempt::collapsed;
+    };
+    for (int32_t& rank : chosen_rank) {
+      if (rank < 0) continue;
+      try_entry(ranked[static_cast<size_t>(rank)]);
+      rank = -1;
+    }
+    for (; !over_max_error && next < order.size(); ++next) {
+      const size_t removed_faces = faces_before - face_count_;
+      if (removed_faces >= face_goal) break;
+      const RankedEdge& entry = order[next];
+      if (!within_cost_goal(entry.cost, removed_faces)) break;
+      if (touched[entry.kept] || touched[entry.removed]) continue;
+      over_max_error = entry.error > options_.max_error;
+      if (!over_max_error && try_entry(entry)) touched[entry.kept] = touched[entry.removed] = 1;
     }
     // A pass without a collapse went through every candidate: nothing legal remains (or the
     // cheapest legal collapse exceeds max_error), unless guarded points can be released.

@@ -35,6 +35,13 @@ struct Candidate {
   double t = 0.0;      // attributes and skin weights blend as kept + t (removed - kept)
 };
 
+// An edge that can collapse, with its cost: what collapse passes rank and the greedy order's
+// heap starts from.
+struct RankedEdge {
+  double cost, error;  // Candidate's
+  int32_t edge, kept, removed;
+};
+
 class CollapsePolicy {
  public:
   virtual ~CollapsePolicy() = default;
@@ -72,9 +79,10 @@ struct EngineOptions {
   double max_error = std::numeric_limits<double>::infinity();
   std::function<void(size_t, size_t)> progress;
   // false: one global greedy order (an indexed heap, re-keyed after every collapse). true:
-  // meshoptimizer's collapse passes: every edge is evaluated (on several threads), sorted by
-  // cost, and collapsed in that order while neither endpoint moved in the pass and the cost
-  // stays within pass_cost_growth times the cost of the pass's goal-th candidate.
+  // meshoptimizer's collapse passes: every edge is evaluated (on several threads) and ranked by
+  // cost; a pass chooses collapses in that order while neither endpoint is taken in the pass
+  // and the cost stays within pass_cost_growth times the cost of the pass's goal-th candidate,
+  // then performs them in edge order (see run_passes).
   bool collapse_passes = false;
   double pass_cost_growth = 1.5;
   // Collapse passes hand over to the greedy order once this few edges can collapse; meshes
@@ -144,12 +152,15 @@ class CollapseEngine {
   bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
   void collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
                 EngineRecord& record);
+  enum class Attempt { collapsed, illegal, over_max_error };
+  Attempt try_collapse(CollapsePolicy& policy, Candidate candidate, int32_t edge, const std::vector<size_t>& targets,
+                       std::vector<EngineLevel>& levels, EngineRecord& record);
   TriMesh::HalfedgeHandle removed_to_kept(const Candidate& candidate, int32_t edge) const;
   void run_greedy(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
                   EngineRecord& record);
   void run_passes(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
                   EngineRecord& record);
-  void evaluate_all(CollapsePolicy& policy, std::vector<Candidate>& candidates);
+  void rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) const;
   void rekey_around(CollapsePolicy& policy, TriMesh::VertexHandle vertex, bool all_edges);
   void park(int32_t edge);
   EngineLevel snapshot(size_t target, bool reached);

@@ -142,11 +142,8 @@ def skinned_mesh_of_node(
     mesh_world = doc.rest_world_matrix(node) if mesh_world is None else mesh_world
     if abs(np.linalg.det(mesh_world[:3, :3])) < 1e-30:
         raise doc.fail(doc.node_label(node), "its world transform is singular (a zero scale): the mesh has no extent")
-    row_scale = np.ones((len(rig.scales), 4, 1))
-    row_scale[:, :3] = rig.scales[:, None, None]
-    inverse_bind = row_scale * rig.inverse_bind
-    if rig.rest_shape is not None:  # a non-uniform rest scale, in the joint's frame
-        inverse_bind[:, :3] = rig.rest_shape @ inverse_bind[:, :3]
+    inverse_bind = rig.inverse_bind.copy()
+    inverse_bind[:, :3] = rig.rest_linear @ inverse_bind[:, :3]
     inverse_bind = inverse_bind @ np.linalg.inv(mesh_world)
     try:
         return SkinnedMesh(

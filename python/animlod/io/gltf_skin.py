@@ -107,6 +107,14 @@ class SkinRig:
         except ValueError as error:
             raise doc.fail(self.element, str(error)) from None
 
+    @property
+    def rest_linear(self) -> np.ndarray:
+        """(J, 3, 3) what each joint's rest world transform does beyond its rotation, in the joint's
+        frame: ``rest_shape @ S(c)``, ``S(c)`` alone when every node is uniform. The inverse binds
+        fold it in (the rigid skeleton's joints do not carry it), and so does a node hung from a joint."""
+        scale = self.scales[:, None, None] * np.eye(3)
+        return scale if self.rest_shape is None else self.rest_shape @ scale
+
     def motion(self, doc: GltfDocument, animation_index: int, fps: float) -> Motion | None:
         """Animation ``animation_index`` sampled at ``fps`` on this skeleton; None if it moves none of its nodes.
 

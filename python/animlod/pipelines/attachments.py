@@ -99,12 +99,10 @@ def add_level_attachments(
         ancestor = attachment.joint
         while level_joint[ancestor] < 0:
             ancestor = int(parents[ancestor])
-        # The document's joint node carries its accumulated rest scale, the rigid level joint
-        # does not (gltf_skin.py: W = W_rigid rest_shape S(c)).
-        scale = np.diag([rig.scales[attachment.joint]] * 3 + [1.0])
-        if rig.rest_shape is not None:
-            scale[:3, :3] = rig.rest_shape[attachment.joint] @ scale[:3, :3]
-        frame = np.linalg.inv(world[ancestor]) @ world[attachment.joint] @ scale
+        # The document's joint node carries its rest scale, the rigid level joint does not.
+        rest_linear = np.eye(4)
+        rest_linear[:3, :3] = rig.rest_linear[attachment.joint]
+        frame = np.linalg.inv(world[ancestor]) @ world[attachment.joint] @ rest_linear
         parent = joint_nodes[level_joint[ancestor]]
         if not np.allclose(frame, np.eye(4), rtol=0.0, atol=1e-12):  # a static node between: the
             name = f"{_name(builder, attachment.node)} frame{suffix}"  # copy keeps its own TRS

@@ -201,6 +201,20 @@ def test_separate_keeps_the_meshes_an_animation_points_at(humanoid_glb, tmp_path
     assert [mesh.get("name") for mesh in doc.json["meshes"]] == ["skinned mesh", "skinned mesh_LOD1"]
 
 
+def test_separate_keeps_the_meshes_an_unknown_extension_may_name(humanoid_glb, tmp_path):
+    # VRM 0.x avatars name meshes by index in their root extension (blend shape binds): dropping
+    # the input mesh, drawn by no node in a level document, would renumber the meshes under it.
+    def vrm_blend_shape(js):
+        js.setdefault("extensions", {})["VRM"] = {"blendShapeMaster": {"blendShapeGroups": [{"binds": [{"mesh": 0}]}]}}
+        js.setdefault("extensionsUsed", []).append("VRM")
+
+    source = _edited(humanoid_glb, tmp_path, vrm_blend_shape)
+    report = simplify_document(source, tmp_path / "levels", [0.5], separate=True, **QUICK)
+    doc = GltfDocument(report.outputs[0])
+    (bind,) = doc.json["extensions"]["VRM"]["blendShapeMaster"]["blendShapeGroups"][0]["binds"]
+    assert doc.json["meshes"][bind["mesh"]]["name"] == "skinned mesh"
+
+
 def test_a_draco_compressed_character_gets_uncompressed_levels_and_keeps_its_own(humanoid_glb, tmp_path):
     from animlod.io import read_lod_chains
     from animlod.pipelines.character import build_character

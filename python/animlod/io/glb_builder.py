@@ -41,6 +41,11 @@ _GLB_MAGIC, _GLB_VERSION = b"glTF", 2
 _PRUNE_SAFE_EXTENSIONS = (
     "KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_mesh_quantization", "KHR_animation_pointer", "MSFT_lod",
 )  # fmt: skip
+# Extensions known to refer to no mesh by index (KHR_animation_pointer's mesh pointers are looked
+# for); an extension unknown here may (VRM 0.x's blend shapes and first-person annotations do).
+_NO_MESH_REFERENCES = (
+    *_PRUNE_SAFE_EXTENSIONS, DRACO_EXTENSION, *MESHOPT_EXTENSIONS, "EXT_mesh_gpu_instancing", "EXT_texture_",
+)  # fmt: skip
 _JSON_CHUNK, _BIN_CHUNK = 0x4E4F534A, 0x004E4942
 
 
@@ -114,12 +119,14 @@ class GlbBuilder:
 
     def prune(self) -> None:
         """Drops meshes no node draws (all kept when an animation points at a mesh by index, through
-        KHR_animation_pointer); then, when no extension could refer to them unseen, the accessors
-        and buffer views nothing refers to, and repacks the binary chunk."""
+        KHR_animation_pointer, or an extension that may refer to meshes is used); then, when no
+        extension could refer to them unseen, the accessors and buffer views nothing refers to, and
+        repacks the binary chunk."""
         js = self.json
         nodes = js.get("nodes", [])
         kept_meshes = sorted({node["mesh"] for node in nodes if "mesh" in node})
-        if _animates_meshes(js):
+        used = js.get("extensionsUsed", [])
+        if _animates_meshes(js) or any(not name.startswith(_NO_MESH_REFERENCES) for name in used):
             kept_meshes = list(range(len(js.get("meshes", []))))
         new_mesh = {old: new for new, old in enumerate(kept_meshes)}
         for node in nodes:
@@ -130,7 +137,7 @@ class GlbBuilder:
         primitives = [p for mesh in js.get("meshes", []) for p in mesh.get("primitives", [])]
         if not any(DRACO_EXTENSION in p.get("extensions", {}) for p in primitives):
             _drop_extension(js, DRACO_EXTENSION)  # the compressed meshes were the input's, now replaced
-        if any(not name.startswith(_PRUNE_SAFE_EXTENSIONS) for name in js.get("extensionsUsed", [])):
+        if any(not name.startswith(_PRUNE_SAFE_EXTENSIONS) for name in used):
             return
         accessor_refs = list(_accessor_references(js))
         kept_accessors = sorted({holder[key] for holder, key in accessor_refs})

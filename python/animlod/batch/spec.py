@@ -32,12 +32,11 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
-from ..io.detect import input_kind
+from ..io.detect import MODEL_SUFFIXES, input_kind
 from ..io.errors import FormatError
 from ..io.meshseq import MESH_SUFFIXES
 from .jobs import DEFAULT_JOBS, check_options, find_job
 
-ASSET_SUFFIXES = (".glb", ".gltf", ".bvh", ".npz")
 MANIFEST_SUFFIXES = (".toml", ".json")
 _ENTRY_KEYS = frozenset({"input", "glob", "name", "job"})
 _MANIFEST_KEYS = frozenset({"defaults", "assets"})
@@ -92,7 +91,7 @@ def read_spec(spec: str | os.PathLike, job: str | None = None, options: dict | N
     if path.is_dir() and not _holds_frames(path):
         found = [(os.fspath(item), _default_name(item, path)) for item in _scan(path)]
         if not found:
-            raise SpecError(text, "folder", f"holds no asset ({', '.join(ASSET_SUFFIXES)} files or folders of frames)")
+            raise SpecError(text, "folder", f"holds no asset ({', '.join(MODEL_SUFFIXES)} files or folders of frames)")
         return _checked(text, "folder", found, job, options)
     return _checked(text, "input", [(text, _default_name(path, path.parent))], job, options)
 
@@ -103,7 +102,7 @@ def _scan(folder: Path) -> Iterable[Path]:
         folders.sort()
         here = Path(root)
         for name in sorted(files):
-            if Path(name).suffix.lower() in ASSET_SUFFIXES:
+            if Path(name).suffix.lower() in MODEL_SUFFIXES:
                 yield here / name
         framed = [name for name in folders if _holds_frames(here / name)]
         yield from (here / name for name in framed)
@@ -134,7 +133,7 @@ def _default_name(path: Path, base: Path) -> str:
         relative = path.resolve().relative_to(base.resolve())
     except ValueError:
         relative = Path(path.name)
-    if path.is_file() and relative.suffix.lower() in ASSET_SUFFIXES + MESH_SUFFIXES:
+    if path.is_file() and relative.suffix.lower() in MODEL_SUFFIXES + MESH_SUFFIXES:
         relative = relative.with_suffix("")
     return PurePosixPath(*relative.parts).as_posix() if relative.parts else path.resolve().name
 

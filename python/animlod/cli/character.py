@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..io.detect import input_kind, input_stem
+from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind
 from . import UserError, positive_int
 from .simplify import feature_options
 
@@ -22,9 +22,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "input document stays whole; a viewer without MSFT_lod shows level 0."
         ),
     )
-    parser.add_argument("input", help="a .glb/.gltf with a skinned mesh and at least one animation")
+    parser.add_argument("input", help="a .glb/.gltf/.vrm with a skinned mesh and at least one animation")
     parser.add_argument(
-        "-o", "--output", required=True, help="the LoD .glb to write, or a folder for <name>_character.glb"
+        "-o", "--output", required=True, help="the LoD .glb (or .vrm) to write, or a folder for <name>_character.glb"
     )
     parser.add_argument(
         "--ratio", type=float, nargs="+", default=[0.5, 0.25, 0.1], help="face ratios of levels 1, 2, ..."
@@ -50,10 +50,10 @@ def run(args: argparse.Namespace) -> int:
     if any(not 0.0 < ratio <= 1.0 for ratio in args.ratio):
         raise UserError(f"--ratio: every ratio must be in (0, 1], got {args.ratio}")
     if input_kind(args.input) != "gltf":
-        raise UserError(f"{args.input}: animlod character needs a .glb or .gltf")
+        raise UserError(f"{args.input}: animlod character needs a .glb, .gltf or .vrm")
     output = Path(args.output)
-    if output.is_dir() or output.suffix.lower() != ".glb":
-        output = output / f"{input_stem(args.input)}_character.glb"
+    if output.is_dir() or output.suffix.lower() not in GLB_OUTPUT_SUFFIXES:
+        output = output / glb_name(args.input, "_character")
     report = build_character(
         args.input,
         output,

@@ -7,10 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.detect import input_kind
+from ..io.detect import MODEL_SUFFIXES, input_kind
 from ..model import AnimatedMesh, Motion
-
-_MODEL_SUFFIXES = (".glb", ".gltf", ".bvh", ".npz")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -37,7 +35,7 @@ def _single_model(path: str) -> str:
     folder = Path(path)
     if not folder.is_dir():
         return path
-    models = [p for p in sorted(folder.iterdir()) if p.suffix.lower() in _MODEL_SUFFIXES]
+    models = [p for p in sorted(folder.iterdir()) if p.suffix.lower() in MODEL_SUFFIXES]
     return str(models[0]) if len(models) == 1 else path
 
 

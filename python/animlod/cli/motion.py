@@ -24,7 +24,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "for a skinned glTF, one GLB per level with the skin moved onto the kept joints."
         ),
     )
-    parser.add_argument("input", help="a .bvh motion, or a .glb/.gltf with a skinned mesh and an animation")
+    parser.add_argument("input", help="a .bvh motion, or a .glb/.gltf/.vrm with a skinned mesh and an animation")
     parser.add_argument("-o", "--output", required=True, help="folder to write the levels into (created if missing)")
     parser.add_argument(
         "--levels", type=int, default=None,

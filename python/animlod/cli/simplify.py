@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.detect import input_kind, input_stem
+from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind, input_stem
 from ..model import AnimatedMesh
 from . import UserError, non_negative_int
 
@@ -26,12 +26,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "as sequences and NPZ as NPZ, one per level."
         ),
     )
-    parser.add_argument("input", help="a .glb/.gltf, an .npz, or a folder, glob or file of OBJ/PLY frames")
+    parser.add_argument("input", help="a .glb/.gltf/.vrm, an .npz, or a folder, glob or file of OBJ/PLY frames")
     parser.add_argument(
         "-o",
         "--output",
         required=True,
-        help="glTF input: the LoD .glb to write, or a folder for <name>_lod.glb (with --separate: the folder "
+        help="glTF input: the LoD .glb (or .vrm) to write, or a folder for <name>_lod.glb (with --separate: the folder "
         "for the level files); sequences and NPZ: the folder for the levels",
     )
     parser.add_argument("--ratio", type=float, nargs="+", default=[0.5, 0.25, 0.1], help="face ratios of the levels")
@@ -95,8 +95,8 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
     from ..pipelines import simplify_document
 
     output = Path(args.output)
-    if not args.separate and (output.is_dir() or output.suffix.lower() != ".glb"):
-        output = output / f"{input_stem(args.input)}_lod.glb"
+    if not args.separate and (output.is_dir() or output.suffix.lower() not in GLB_OUTPUT_SUFFIXES):
+        output = output / glb_name(args.input, "_lod")
     frame_budget = {"frame_budget": args.max_frames} if args.max_frames else {}
     report = simplify_document(
         args.input, output, args.ratio, separate=args.separate, progress=print, **frame_budget, **options

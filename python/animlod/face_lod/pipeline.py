@@ -167,7 +167,7 @@ def _run_procedural(output, ratios, face_counts, plot, expression, repeats, erro
 
 def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutral, plot, expression, repeats,
                     error_frames) -> FaceRun:  # fmt: skip
-    from ..io.detect import input_kind, input_stem
+    from ..io.detect import glb_name, input_kind, input_stem
     from ..io.manifest import write_lod_manifest
     from .sources import read_pose_face
 
@@ -203,7 +203,7 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
         notes=[f"{source}: {face.vertex_count} vertices, {len(face.faces)} triangles, {face.target_count} targets, "
                f"{len(face.weights)} animation frames"],
     )  # fmt: skip
-    glb = output / f"{stem}_lod.glb"
+    glb = output / glb_name(source, "_lod")
     if gltf is not None:
         write_gltf_face_lod(glb, gltf, gltf_levels, errors, thresholds)
         run.notes += gltf_levels.notes

@@ -9,6 +9,11 @@ from pathlib import Path
 from .errors import FormatError
 from .meshseq import MESH_SUFFIXES
 
+# A .vrm is a VRM avatar (VRoid, UniVRM): a binary glTF whose VRM extensions animlod carries.
+GLTF_SUFFIXES = (".glb", ".gltf", ".vrm")
+MODEL_SUFFIXES = (*GLTF_SUFFIXES, ".bvh", ".npz")
+GLB_OUTPUT_SUFFIXES = (".glb", ".vrm")
+
 
 def input_kind(path: str | os.PathLike) -> str:
     """``"bvh"``, ``"gltf"``, ``"npz"`` or ``"sequence"`` (a folder, glob or single OBJ/PLY).
@@ -28,13 +33,13 @@ def input_kind(path: str | os.PathLike) -> str:
     suffix = candidate.suffix.lower()
     if suffix == ".bvh":
         return "bvh"
-    if suffix in (".glb", ".gltf"):
+    if suffix in GLTF_SUFFIXES:
         return "gltf"
     if suffix == ".npz":
         return "npz"
     if suffix in MESH_SUFFIXES:
         return "sequence"
-    expected = ".bvh, .glb, .gltf, .npz, .obj, .ply or a folder"
+    expected = ".bvh, .glb, .gltf, .npz, .obj, .ply, .vrm or a folder"
     raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}")
 
 
@@ -49,3 +54,10 @@ def input_stem(path: str | os.PathLike) -> str:
         return fixed.resolve().name or "mesh"
     candidate = Path(text)
     return (candidate.resolve().name if candidate.is_dir() else candidate.stem) or "mesh"
+
+
+def glb_name(source: str | os.PathLike, tag: str) -> str:
+    """``<stem><tag>.glb``, the name of a binary glTF written from ``source`` (see
+    :func:`input_stem`); ``.vrm`` for a VRM avatar's, the suffix VRM tools look for."""
+    suffix = ".vrm" if Path(os.fspath(source)).suffix.lower() == ".vrm" else ".glb"
+    return f"{input_stem(source)}{tag}{suffix}"

@@ -14,7 +14,7 @@ import os
 import time
 from pathlib import Path
 
-from ..io.detect import input_kind, input_stem
+from ..io.detect import glb_name, input_kind
 from ..io.errors import FormatError
 from .result import AssetResult, LevelRow, Progress
 
@@ -28,9 +28,10 @@ def simplify_asset(
 ) -> AssetResult:
     """AQEM levels of a glTF document or a deforming mesh sequence, written into the folder ``output``.
 
-    A .glb/.gltf becomes ``<stem>_lod.glb`` (one LoD GLB, see :func:`simplify_document`; with
-    ``separate=True`` one ``<stem>_lod<i>.glb`` per level); an NPZ or OBJ/PLY sequence becomes
-    one ``<stem>_lod<i>`` per level in its own format (see :func:`simplify_sequence`).
+    A .glb/.gltf/.vrm becomes ``<stem>_lod.glb`` (.vrm for a .vrm; one LoD GLB, see
+    :func:`simplify_document`; with ``separate=True`` one ``<stem>_lod<i>.glb`` per level); an
+    NPZ or OBJ/PLY sequence becomes one ``<stem>_lod<i>`` per level in its own format (see
+    :func:`simplify_sequence`).
 
     Parameters
     ----------
@@ -47,12 +48,11 @@ def simplify_asset(
     started = time.perf_counter()
     kind = input_kind(source)
     folder = Path(output)
-    stem = input_stem(source)
     if kind == "gltf":
         from .lod_document import simplify_document
 
         separate = bool(options.get("separate", False))
-        target = folder if separate else folder / f"{stem}_lod.glb"
+        target = folder if separate else folder / glb_name(source, "_lod")
         lines = (lambda line: progress(None, line)) if progress else None
         report = simplify_document(source, target, progress=lines, **options)
         rows = [
@@ -99,10 +99,11 @@ def character_asset(
     started = time.perf_counter()
     kind = input_kind(source)
     if kind != "gltf":
-        raise FormatError(os.fspath(source), "file", f"a {kind} file is not a character; the job needs a .glb/.gltf")
+        needs = "the job needs a .glb/.gltf/.vrm"
+        raise FormatError(os.fspath(source), "file", f"a {kind} file is not a character; {needs}")
     from .character import build_character
 
-    target = Path(output) / f"{input_stem(source)}_character.glb"
+    target = Path(output) / glb_name(source, "_character")
     lines = (lambda line: progress(None, line)) if progress else None
     report = build_character(source, target, progress=lines, **options)
     rows = [

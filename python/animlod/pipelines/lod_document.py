@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..aqem import Preparation, SimplifiedLevel
+from ..io.detect import glb_name
 from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
@@ -79,7 +80,7 @@ def simplify_document(
 
     Parameters
     ----------
-    source : a .glb or .gltf file.
+    source : a .glb, .gltf or .vrm file.
     output : the LoD GLB to write (atomically); with ``separate``, a folder that receives one
         ``<stem>_lod<i>.glb`` per level instead, each the whole document at that level.
     ratios : face ratios of the levels below level 0, in (0, 1].
@@ -108,7 +109,7 @@ def simplify_document(
         simplified.append(simplify_drawable(drawable, ratios, settings))
     reports = [_report(d, s, settings) for d, s in zip(drawables, simplified)]
     if separate:
-        outputs = _write_separate(doc, drawables, simplified, reports, Path(output), Path(source).stem)
+        outputs = _write_separate(doc, drawables, simplified, reports, Path(output), source)
     else:
         outputs = [Path(output)]
         _write_chain(doc, drawables, simplified, reports).save(output)
@@ -179,7 +180,7 @@ def _write_separate(
     simplified: list[DrawableLevels],
     reports: list[DrawableReport],
     folder: Path,
-    stem: str,
+    source: str | os.PathLike,
 ) -> list[Path]:
     """One whole document per level, every drawable's nodes drawing that level's mesh."""
     if folder.exists() and not folder.is_dir():
@@ -199,7 +200,7 @@ def _write_separate(
                 extras = node.get("extras") if isinstance(node.get("extras"), dict) else {}
                 node["extras"] = {**extras, "animlod": info.extras()}
         builder.prune()
-        path = folder / f"{stem}_lod{index + 1}.glb"
+        path = folder / glb_name(source, f"_lod{index + 1}")
         builder.save(path)
         outputs.append(path)
     return outputs

@@ -36,6 +36,29 @@ def add_scale_channel(gltf: pygltflib.GLTF2, blob: bytearray, node: int, keys: n
     animation.channels.append(pygltflib.AnimationChannel(sampler=len(animation.samplers) - 1, target=target))
 
 
+def share_one_vertex_buffer(gltf: pygltflib.GLTF2, blob: bytearray, parts: int = 2) -> None:
+    """Every mesh's first primitive split into ``parts`` primitives by runs of its triangles, all
+    on the same attribute accessors (each primitive listing every vertex of the mesh), with
+    their own index accessors, as UniVRM writes VRM avatars (one primitive per material)."""
+    for mesh in gltf.meshes:
+        primitive = mesh.primitives[0]
+        accessor = gltf.accessors[primitive.indices]
+        dtype = {pygltflib.UNSIGNED_BYTE: "<u1", pygltflib.UNSIGNED_SHORT: "<u2", pygltflib.UNSIGNED_INT: "<u4"}
+        start = (gltf.bufferViews[accessor.bufferView].byteOffset or 0) + (accessor.byteOffset or 0)
+        indices = np.frombuffer(bytes(blob), dtype[accessor.componentType], accessor.count, start).reshape(-1, 3)
+        split = []
+        for run in np.array_split(indices, parts):
+            offset = len(blob) + (-len(blob)) % 4
+            blob.extend(bytes(offset - len(blob)) + run.astype("<u4").tobytes())
+            gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=offset, byteLength=run.size * 4))
+            view = len(gltf.bufferViews) - 1
+            gltf.accessors.append(
+                pygltflib.Accessor(bufferView=view, componentType=pygltflib.UNSIGNED_INT, count=run.size, type="SCALAR")
+            )
+            split.append(pygltflib.Primitive(**{**vars(primitive), "indices": len(gltf.accessors) - 1}))
+        mesh.primitives[:1] = split
+
+
 def squash_and_stretch(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
     """The root grows by half, the middle joint stretches along y and thins along x, and the tip
     shrinks to nothing (how clips hide a part), over the 'bend' clip's six keys."""

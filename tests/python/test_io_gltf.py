@@ -12,12 +12,21 @@ from pathlib import Path
 import numpy as np
 import pygltflib
 import pytest
-from gltf_edits import add_scale_channel, draco_compressed, edit_glb, meshopt_compressed, squash_and_stretch
+from gltf_edits import (
+    add_scale_channel,
+    draco_compressed,
+    edit_glb,
+    meshopt_compressed,
+    share_one_vertex_buffer,
+    squash_and_stretch,
+)
 
 from animlod import rotations, synth
 from animlod.io import FormatError
 from animlod.io.gltf import read_gltf, read_skinned, write_glb
+from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_keyframes import frame_times, sample_keyframes
+from animlod.io.gltf_mesh import read_mesh_geometry
 from animlod.model import Motion, Skeleton, SkinnedMesh
 
 # ---- a 3-joint chain skinning a box, built by hand --------------------------------------
@@ -714,6 +723,23 @@ def test_pointer_channels_of_nodes_pose_them_and_others_are_left_alone(chain_glb
 
     with pytest.raises(FormatError, match=r"animation 0 channel 0 target: path 'pointer' needs a KHR_animation"):
         read_skinned(edit_glb(path, tmp_path / "bare.glb", without_pointer))
+
+
+def test_primitives_sharing_one_vertex_buffer_keep_only_the_vertices_they_use(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+    shared = edit_glb(path, tmp_path / "shared.glb", lambda gltf, blob: share_one_vertex_buffer(gltf, blob, 3))
+    geometry = read_mesh_geometry(GltfDocument(shared), 0, skinned=True)
+    plain = read_mesh_geometry(GltfDocument(path), 0, skinned=True)
+    assert len(geometry.primitives) == 3
+    for primitive in geometry.primitives:
+        assert np.unique(primitive.faces).size == primitive.vertex_count  # nothing unused
+    # The same triangles at the same positions, with the same skin, as the one primitive had.
+    def corners(g):
+        rows = np.concatenate([g.positions[g.faces], g.weights[g.faces]], axis=2).reshape(len(g.faces), -1)
+        return rows[np.lexsort(rows.T[::-1])]
+
+    np.testing.assert_array_equal(corners(geometry), corners(plain))
+    assert len(geometry.positions) < 2 * len(plain.positions)  # each vertex once, but at the runs' borders
 
 
 def test_scale_keys_at_the_rest_scale_leave_the_motion_rigid(chain_glb, tmp_path):

@@ -114,7 +114,8 @@ def build_character(
     drawables = [d for d in all_drawables if d.skinned is not None]
     animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]
     if not animated:
-        raise FormatError(doc.path, "skins", "no skinned mesh with an animation: a character chain needs both")
+        reason = "no skinned mesh with an animation: a character chain needs both"
+        raise FormatError(doc.path, "skins", f"{reason} (`animlod simplify` gives mesh levels alone)")
     levels_wanted = len(ratios) + 1
     started = time.perf_counter()
     motion_chains: dict[int, _SkinMotion] = {}

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -692,6 +693,13 @@ bool read_model(const Model& model, const std::string& name, Asset& out, std::st
   return true;
 }
 
+// A GLB by its magic, whatever its name (a VRM avatar's is .vrm), as the Python reader decides.
+bool has_glb_magic(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  char magic[4] = {};
+  return file.read(magic, sizeof magic) && std::memcmp(magic, "glTF", sizeof magic) == 0;
+}
+
 }  // namespace
 
 bool load_asset(const std::string& path, Asset& out, std::string& error) {
@@ -703,8 +711,7 @@ bool load_asset(const std::string& path, Asset& out, std::string& error) {
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
   std::string warnings;
-  const bool binary = path.size() >= 4 && path.compare(path.size() - 4, 4, ".glb") == 0;
-  const bool loaded = binary ? loader.LoadBinaryFromFile(&model, &error, &warnings, path)
+  const bool loaded = has_glb_magic(path) ? loader.LoadBinaryFromFile(&model, &error, &warnings, path)
                              : loader.LoadASCIIFromFile(&model, &error, &warnings, path);
   if (!loaded) return tinygltf_failure(path, error);
   return read_model(model, path, out, error);

@@ -103,6 +103,14 @@ def test_a_character_chain_of_unnamed_joints_loads(binary, tmp_path) -> None:
     assert report.modes["MLoD"]["drawn"] > 0
 
 
+def test_a_chain_named_vrm_loads_as_the_glb_it_is(binary, chain, tmp_path) -> None:
+    # animlod writes a VRM avatar's chain as .vrm; the loader took every name but .glb for JSON.
+    renamed = tmp_path / "avatar_character.vrm"
+    shutil.copyfile(chain, renamed)
+    report = run_crowd([renamed], frames=2, modes="Original", **SMALL)
+    assert report.modes["Original"]["drawn"] > 0
+
+
 def test_opengl_3_3_with_orphaned_uploads(binary, chain, monkeypatch) -> None:
     """The GL 3.3 core path (no persistent mapping): Mesa asked for a 3.3 context."""
     monkeypatch.setenv("MESA_GL_VERSION_OVERRIDE", "3.3")

@@ -63,6 +63,17 @@ def test_reads_hierarchy_channels_and_end_sites(tmp_path: Path) -> None:
     np.testing.assert_array_equal(motion.joint_translations[:, 3], [[5, 0, 0], [7, 0, 0]])
 
 
+def test_a_file_converted_to_crlf_twice_reads_like_the_original(tmp_path: Path) -> None:
+    # CR CR LF: a blank line after every line, between MOTION, Frames: and Frame Time: too.
+    twice = read_bvh(_write(tmp_path, SMALL_BVH.replace("\n", "\r\n"), "twice.bvh"))
+    once = read_bvh(_write(tmp_path, SMALL_BVH))
+    assert twice.skeleton.names == once.skeleton.names and twice.fps == once.fps
+    np.testing.assert_array_equal(twice.local_rotations, once.local_rotations)
+    np.testing.assert_array_equal(twice.joint_translations, once.joint_translations)
+    message = _read_error(tmp_path, SMALL_BVH.replace("\n", "\r\n").replace("Frames: 2", "Frames: x"))
+    assert "line 27: expected 'Frames: N', found 'Frames: x'" in message  # as an editor counts
+
+
 def test_euler_angles_follow_the_written_channel_order(tmp_path: Path) -> None:
     world = read_bvh(_write(tmp_path, SMALL_BVH)).world_positions()
     # Frame 0: no rotation.

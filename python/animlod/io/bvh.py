@@ -218,27 +218,36 @@ def _unique_name(name: str, joints: list[_JointSpec]) -> str:
 
 
 def _parse_motion_header(path: Path, text: str, motion_line: int) -> tuple[int, float, int, str]:
-    """Read ``Frames:`` and ``Frame Time:`` after MOTION.
+    """Read ``Frames:`` and ``Frame Time:`` after MOTION, blank lines around them skipped (a file
+    converted to CRLF twice, CR CR LF, has one after every line).
 
     Returns the frame count, the frame rate, the line number of the first row and the rows' text.
     """
-    header = text.split("\n", 3)
-    if len(header) < 3:
+    header: list[tuple[int, str]] = []  # (line, text) of the two lines
+    line, position = motion_line, text.find("\n") + 1  # position 0: no line left
+    while len(header) < 2 and position > 0:
+        end = text.find("\n", position)
+        row = text[position:] if end < 0 else text[position:end]
+        line, position = line + 1, end + 1
+        if row.strip():
+            header.append((line, row))
+    if len(header) < 2:
         raise FormatError(path, f"line {motion_line}", "MOTION is not followed by Frames: and Frame Time: lines")
-    frames_match = re.fullmatch(r"\s*Frames:\s*(\d+)\s*", header[1])
+    (frames_line, frames_text), (time_line, time_text) = header
+    frames_match = re.fullmatch(r"\s*Frames:\s*(\d+)\s*", frames_text)
     if frames_match is None:
-        raise FormatError(path, f"line {motion_line + 1}", f"expected 'Frames: N', found {header[1].strip()!r}")
-    time_match = re.fullmatch(r"\s*Frame\s+Time:\s*(\S+)\s*", header[2])
+        raise FormatError(path, f"line {frames_line}", f"expected 'Frames: N', found {frames_text.strip()!r}")
+    time_match = re.fullmatch(r"\s*Frame\s+Time:\s*(\S+)\s*", time_text)
     frame_time = float(time_match.group(1)) if time_match and parses(time_match.group(1), np.float64) else None
     # The rate 1 / Frame Time must be finite too: Frame Time: 1e-320 is positive but its inverse is not.
     if frame_time is None or not (frame_time > 0.0 and np.isfinite(frame_time) and np.isfinite(1.0 / frame_time)):
-        found = header[2].strip()
+        found = time_text.strip()
         reason = f"expected 'Frame Time: SECONDS' > 0 with a finite frame rate, found {found!r}"
-        raise FormatError(path, f"line {motion_line + 2}", reason)
+        raise FormatError(path, f"line {time_line}", reason)
     frame_count = int(frames_match.group(1))
     if frame_count < 1:
-        raise FormatError(path, f"line {motion_line + 1}", "Frames: must be at least 1")
-    return frame_count, _frame_rate(time_match.group(1)), motion_line + 3, header[3] if len(header) > 3 else ""
+        raise FormatError(path, f"line {frames_line}", "Frames: must be at least 1")
+    return frame_count, _frame_rate(time_match.group(1)), line + 1, text[position:] if position > 0 else ""
 
 
 def _frame_rate(frame_time: str) -> float:

@@ -203,7 +203,8 @@ class Loader {
     return out;
   }
 
-  // Mesh nodes with a skin reachable from the default scene (every root node without scenes).
+  // Mesh nodes with a skin reachable from the default scene (without scenes, from every root
+  // node but the lower levels of a chain, which are roots too).
   std::vector<int> skinned_mesh_nodes() const {
     std::vector<int> roots;
     if (!model_.scenes.empty()) {
@@ -211,8 +212,9 @@ class Loader {
       if (scene >= model_.scenes.size()) fail("scene", "default scene " + std::to_string(scene) + " does not exist");
       roots = model_.scenes[scene].nodes;
     } else {
+      const std::set<int> levels = lower_level_nodes();
       for (size_t n = 0; n < model_.nodes.size(); ++n)
-        if (parents_[n] < 0) roots.push_back(static_cast<int>(n));
+        if (parents_[n] < 0 && !levels.count(static_cast<int>(n))) roots.push_back(static_cast<int>(n));
     }
     std::vector<int> out;
     std::set<int> seen;
@@ -224,6 +226,27 @@ class Loader {
       for (int child : n.children) visit(child);
     };
     for (int root : roots) visit(root);
+    return out;
+  }
+
+  // Nodes that another node lists as its levels: MSFT_lod ids and extras.animlod_grid cells
+  // (whose first is the base itself).
+  std::set<int> lower_level_nodes() const {
+    std::set<int> out;
+    for (size_t n = 0; n < model_.nodes.size(); ++n) {
+      auto add_levels = [&](const Value* list) {
+        for (size_t i = 0; list && list->IsArray() && i < list->ArrayLen(); ++i) {
+          const Value& id = list->Get(static_cast<int>(i));
+          if (id.IsNumber() && id.GetNumberAsInt() != static_cast<int>(n)) out.insert(id.GetNumberAsInt());
+        }
+      };
+      const tinygltf::Node& node = model_.nodes[n];
+      const auto lod = node.extensions.find("MSFT_lod");
+      if (lod != node.extensions.end()) add_levels(object_member(lod->second, "ids"));
+      const Value* grid = object_member(node.extras, "animlod_grid");
+      for (size_t g = 0; grid && grid->IsArray() && g < grid->ArrayLen(); ++g)
+        add_levels(&grid->Get(static_cast<int>(g)));
+    }
     return out;
   }
 

@@ -111,6 +111,17 @@ def test_a_chain_named_vrm_loads_as_the_glb_it_is(binary, chain, tmp_path) -> No
     assert report.modes["Original"]["drawn"] > 0
 
 
+def test_a_chain_without_scenes_draws_one_level_per_character(binary, chain, tmp_path) -> None:
+    # Without scenes every root node is drawn, and a chain's lower levels are roots too: each
+    # character drew all its levels at once.
+    gltf = pygltflib.GLTF2().load(chain)
+    gltf.scene, gltf.scenes = None, []
+    gltf.save(tmp_path / "no_scenes.glb")
+    reports = [run_crowd([path], frames=2, modes="Original", **SMALL) for path in (chain, tmp_path / "no_scenes.glb")]
+    with_scenes, without = (report.modes["Original"] for report in reports)
+    assert without["triangles"] / without["drawn"] == with_scenes["triangles"] / with_scenes["drawn"]
+
+
 def test_opengl_3_3_with_orphaned_uploads(binary, chain, monkeypatch) -> None:
     """The GL 3.3 core path (no persistent mapping): Mesa asked for a 3.3 context."""
     monkeypatch.setenv("MESA_GL_VERSION_OVERRIDE", "3.3")

@@ -22,7 +22,7 @@ import numpy as np
 from ..model import AnimatedMesh
 from .atomic import atomic_folder, atomic_write
 from .errors import FormatError
-from .tokens import parses, tokens_per_line
+from .tokens import parse_all, parses, tokens_per_line
 
 MESH_SUFFIXES = (".obj", ".ply")
 _PLY_TYPES = {
@@ -187,25 +187,37 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if nul >= 0:
         raise FormatError(path, f"byte {nul}", "NUL byte: an OBJ file is text, this looks like binary data")
     data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
-    data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
+    if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
+        data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
     (vertex_block, vertex_lines), (face_block, face_lines) = _obj_statements(data, (b"v", b"f"))
 
     def name_vertex(vertex: int) -> str:
         return f"vertex {vertex} (line {vertex_lines[vertex]})"
 
-    tokens, starts, sizes = _tagged_rows(vertex_block, len(vertex_lines))
+    sizes = _row_sizes(vertex_block, len(vertex_lines))
     _require_sizes(path, sizes, 3, name_vertex, "coordinates")
-    columns = tokens[starts[:, None] + np.arange(1, 4)]
-    vertices = _parse_numbers(path, columns, np.float64, lambda token: name_vertex(token // 3)).astype(np.float32)
+    values = _untagged_values(vertex_block, np.float64, sizes)
+    if values is not None:
+        vertices = values[(np.cumsum(sizes) - sizes)[:, None] + np.arange(3)]
+    else:  # find the bad one among x, y, z (extra values are dropped unread)
+        tokens, starts = _row_tokens(vertex_block, sizes)
+        columns = tokens[starts[:, None] + np.arange(1, 4)]
+        vertices = _parse_numbers(path, columns, np.float64, lambda token: name_vertex(token // 3))
+    vertices = vertices.astype(np.float32)
     _check_finite_vertices(path, vertices, name_vertex)
 
     def name_face(face: int) -> str:
         return f"face {face} (line {face_lines[face]})"
 
-    tokens, starts, sizes = _tagged_rows(re.sub(rb"/\S*", b"", face_block), len(face_lines))  # v of v/vt/vn
+    if b"/" in face_block:
+        face_block = re.sub(rb"/\S*", b"", face_block)  # v of v/vt/vn
+    sizes = _row_sizes(face_block, len(face_lines))
     _require_sizes(path, sizes, 3, name_face, "vertices")
     owner = np.repeat(np.arange(sizes.size), sizes)
-    written = _parse_numbers(path, np.delete(tokens, starts), np.int64, lambda corner: name_face(owner[corner]))
+    written = _untagged_values(face_block, np.int64, sizes)
+    if written is None:
+        tokens, starts = _row_tokens(face_block, sizes)
+        written = _parse_numbers(path, np.delete(tokens, starts), np.int64, lambda corner: name_face(owner[corner]))
     # Negative indices count back from the last vertex defined above the face's line.
     defined = np.searchsorted(vertex_lines, face_lines)[owner]
     resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
@@ -236,26 +248,36 @@ def _checked(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.nd
 def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:
     """For each one-letter tag: the bytes of all lines starting with it, and their 1-based line numbers."""
     codes = np.frombuffer(data + b"\n\n", dtype=np.uint8)  # padding: every line start has two bytes
-    newline = codes[: len(data)] == ord("\n")
-    line_starts = np.concatenate(([0], np.flatnonzero(newline) + 1))
+    line_starts = np.concatenate(([0], np.flatnonzero(codes[: len(data)] == ord("\n")) + 1))
+    line_lengths = np.diff(line_starts, append=len(data))
     separated = np.isin(codes[line_starts + 1], np.frombuffer(b" \t", dtype=np.uint8))
-    line_of_byte = np.cumsum(newline) - newline
     result = []
     for tag in tags:
         selected = (codes[line_starts] == tag[0]) & separated
-        result.append((codes[: len(data)][selected[line_of_byte]].tobytes(), np.flatnonzero(selected) + 1))
+        result.append((codes[: len(data)][np.repeat(selected, line_lengths)].tobytes(), np.flatnonzero(selected) + 1))
     return result
 
 
-def _tagged_rows(block: bytes, line_count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Tokens of the ``line_count`` tag-led lines of ``block``, the index of each line's tag and
-    the number of values after it. Rows are counted by line, not by tag token: ``v v 1 2`` is one
-    row (whose "v" then fails to parse), not two."""
-    tokens = np.array(block.split(), dtype=np.bytes_)
-    counts = tokens_per_line(block)[:line_count]
-    starts = np.cumsum(counts) - counts
-    sizes = counts - 1
-    return tokens, starts, sizes
+def _row_sizes(block: bytes, line_count: int) -> np.ndarray:
+    """The number of values after the tag on each of the ``line_count`` tag-led lines of ``block``.
+    Rows are counted by line, not by tag token: ``v v 1 2`` is one row (whose "v" then fails to
+    parse), not two."""
+    return tokens_per_line(block)[:line_count] - 1
+
+
+def _untagged_values(block: bytes, dtype: type, sizes: np.ndarray) -> np.ndarray | None:
+    """Every value after the tags of ``block``'s lines, in order, as ``dtype``; None when one does
+    not parse (then :func:`_row_tokens` and :func:`_parse_numbers` name it)."""
+    codes = np.frombuffer(block, dtype=np.uint8).copy()
+    codes[np.concatenate(([0], np.flatnonzero(codes[:-1] == ord("\n")) + 1))[: sizes.size]] = ord(" ")
+    values = parse_all(codes.tobytes(), dtype)
+    return values if values is not None and values.size == sizes.sum() else None
+
+
+def _row_tokens(block: bytes, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The tokens of ``block`` and the index of each row's tag among them (rows of ``sizes`` values)."""
+    counts = sizes + 1
+    return np.array(block.split(), dtype=np.bytes_), np.cumsum(counts) - counts
 
 
 def _require_sizes(path: Path, sizes: np.ndarray, minimum: int, element: Callable[[int], str], what: str) -> None:

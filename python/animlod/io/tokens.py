@@ -6,9 +6,12 @@ bytes of the whole table at once.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-_WHITESPACE = np.frombuffer(b" \t\r\n\v\f", dtype=np.uint8)
+_IS_SPACE = np.zeros(256, dtype=bool)
+_IS_SPACE[list(b" \t\r\n\v\f")] = True
 
 
 def tokens_per_line(data: bytes) -> np.ndarray:
@@ -17,11 +20,28 @@ def tokens_per_line(data: bytes) -> np.ndarray:
     Returns ``(L,) int64`` where ``L = data.count(b"\\n") + 1``; entry ``i`` is for line ``i``.
     """
     codes = np.frombuffer(data, dtype=np.uint8)
-    space = np.isin(codes, _WHITESPACE)
-    token_start = ~space & np.concatenate(([True], space[:-1]))
-    newline = codes == ord("\n")
-    line_of_byte = np.cumsum(newline) - newline
-    return np.bincount(line_of_byte[token_start], minlength=int(newline.sum()) + 1)
+    space = _IS_SPACE[codes]
+    token_starts = np.flatnonzero(~space & np.concatenate(([True], space[:-1])))
+    line_starts = np.concatenate(([0], np.flatnonzero(codes == ord("\n")) + 1, [codes.size + 1]))
+    return np.diff(np.searchsorted(token_starts, line_starts)).astype(np.int64)
+
+
+def parse_all(data: bytes, dtype: type) -> np.ndarray | None:
+    """Every whitespace-separated token of ``data`` as ``dtype``, in one pass of numpy's C parser
+    (ten times as fast as converting an array of byte-string tokens); None when a token does not
+    parse, or an integer reaches the type's limit (the parser saturates), so that the caller
+    finds and names it token by token."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", DeprecationWarning)  # numpy < 2 warns where 2 raises
+            values = np.fromstring(data.decode("ascii"), dtype=dtype, sep=" ")
+    except (ValueError, DeprecationWarning, UnicodeDecodeError):
+        return None
+    if values.dtype.kind == "i" and values.size:
+        limits = np.iinfo(values.dtype)
+        if values.max() == limits.max or values.min() == limits.min:
+            return None
+    return values
 
 
 def parses(token: str | bytes, dtype: type) -> bool:

@@ -37,6 +37,15 @@ def test_info_npz(tmp_path, capsys):
     assert "vertices: 4, triangles: 2" in capsys.readouterr().out
 
 
+def test_info_on_a_folder_of_models_describes_each(tmp_path, capsys):
+    # It took such a folder for a sequence of frames ("no .obj or .ply frame found").
+    write_bvh(tmp_path / "a.bvh", _small_motion())
+    write_npz(tmp_path / "b.npz", AnimatedMesh([[0, 1, 2]], np.eye(3)[None], fps=10.0))
+    assert main(["info", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert f"{tmp_path / 'a.bvh'}: bvh" in out and f"{tmp_path / 'b.npz'}: npz" in out
+
+
 def test_info_real_files(data_dir, capsys):
     assert main(["info", str(data_dir / "bvh" / "131_01.bvh")]) == 0
     assert "joints: 31 (+7 end sites)" in capsys.readouterr().out

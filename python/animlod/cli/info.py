@@ -17,26 +17,29 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="describe a BVH, glTF/GLB, OBJ/PLY sequence or NPZ file",
         description="Print what a file holds: joints, frames, fps, vertices, faces, skins, animations, morph targets.",
     )
-    parser.add_argument("path", help="a .bvh, .glb/.gltf, .npz file, an OBJ/PLY file, a folder of frames or a glob")
+    parser.add_argument(
+        "path", help="a .bvh, .glb/.gltf/.vrm, .npz file, an OBJ/PLY file, a folder of frames or of models, or a glob"
+    )
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    path = _single_model(args.path)
-    kind = input_kind(path)
-    print(f"{path}: {kind}")
-    for line in _describe(kind, path):
-        print(f"  {line}")
+    for path in _models(args.path):
+        kind = input_kind(path)
+        print(f"{path}: {kind}")
+        for line in _describe(kind, path):
+            print(f"  {line}")
     return 0
 
 
-def _single_model(path: str) -> str:
-    """A folder holding exactly one model file (glTF, BVH or NPZ) stands for that file."""
+def _models(path: str) -> list[str]:
+    """``path`` itself, or for a folder holding model files (glTF, VRM, BVH, NPZ) each of them in
+    name order; a folder of OBJ/PLY frames alone is one sequence."""
     folder = Path(path)
     if not folder.is_dir():
-        return path
-    models = [p for p in sorted(folder.iterdir()) if p.suffix.lower() in MODEL_SUFFIXES]
-    return str(models[0]) if len(models) == 1 else path
+        return [path]
+    models = [str(p) for p in sorted(folder.iterdir()) if p.suffix.lower() in MODEL_SUFFIXES]
+    return models or [path]
 
 
 def _describe(kind: str, path: str) -> list[str]:

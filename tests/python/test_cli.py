@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -44,6 +47,18 @@ def test_info_on_a_folder_of_models_describes_each(tmp_path, capsys):
     assert main(["info", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert f"{tmp_path / 'a.bvh'}: bvh" in out and f"{tmp_path / 'b.npz'}: npz" in out
+
+
+def test_info_into_a_pipe_closed_early_exits_quietly(tmp_path):
+    # `animlod info DIR | head -1`: the reader leaves; not an error of the input.
+    for index in range(200):
+        write_bvh(tmp_path / f"clip{index:03d}.bvh", _small_motion())
+    command = [sys.executable, "-c", "import sys; from animlod.cli import main; sys.exit(main(sys.argv[1:]))"]
+    info = subprocess.Popen([*command, "info", str(tmp_path)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    info.stdout.readline()
+    info.stdout.close()
+    assert info.wait(timeout=120) == 141
+    assert info.stderr.read() == b""
 
 
 def test_info_real_files(data_dir, capsys):

@@ -17,6 +17,7 @@ import contextlib
 import importlib
 import io
 import os
+import select
 import signal
 import sys
 import threading
@@ -155,6 +156,20 @@ def _sigterm_unwinds() -> Iterator[None]:
         signal.signal(signal.SIGTERM, previous)
 
 
+def _stdout_gone() -> bool:
+    """Whether stdout is a pipe whose reader has left (poll reports an error on its write end);
+    if so, later writes, the interpreter's final flush included, go to the null device."""
+    try:
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        gone = any(events & select.POLLERR for _, events in poller.poll(0))
+    except (AttributeError, OSError, ValueError):  # no poll (Windows), or no real stdout
+        return False
+    if gone:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    return gone
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     try:
@@ -172,6 +187,11 @@ def main(argv: list[str] | None = None) -> int:
     except UserError as error:
         print(f"animlod {args.command}: error: {' '.join(str(error).split())}", file=sys.stderr)
         return 2
+    except BrokenPipeError as error:
+        if not _stdout_gone():
+            print(f"animlod {args.command}: error: {error_line(error, source)}", file=sys.stderr)
+            return 2
+        return 141  # stdout's reader left (`animlod info DIR | head`): quiet, as 128 + SIGPIPE
     except (ValueError, OSError, MemoryError) as error:
         # Readers, validators and the core report bad input as ValueError (FormatError names the
         # file); the data model and the core name only the element, so the input is added.

@@ -742,6 +742,17 @@ def test_primitives_sharing_one_vertex_buffer_keep_only_the_vertices_they_use(ch
     assert len(geometry.positions) < 2 * len(plain.positions)  # each vertex once, but at the runs' borders
 
 
+def test_morph_target_names_on_the_primitive_as_univrm_writes_them(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+
+    def names_on_the_primitive(gltf, blob):
+        gltf.meshes[0].primitives[0].extras = {"targetNames": gltf.meshes[0].extras.pop("targetNames")}
+
+    moved = edit_glb(path, tmp_path / "moved.glb", names_on_the_primitive)
+    assert "targetNames" not in GltfDocument(moved).json["meshes"][0].get("extras", {})
+    assert read_mesh_geometry(GltfDocument(moved), 0, skinned=True).target_names == ["bulge", "twist"]
+
+
 def test_scale_keys_at_the_rest_scale_leave_the_motion_rigid(chain_glb, tmp_path):
     path, _, motion = chain_glb
     held = edit_glb(path, tmp_path / "held.glb", lambda g, b: add_scale_channel(g, b, 1, np.full((6, 3), 1.00001)))

@@ -63,7 +63,8 @@ class MeshGeometry:
     joints : (V, K) skin joint slots (indices into ``skin.joints``), K = 4 or 8; None unskinned.
     weights : (V, K) skin weights as stored (not yet normalised), or None.
     targets : (N, V, 3) morph target position deltas, or None.
-    target_names : N names from ``mesh.extras.targetNames``, or None.
+    target_names : N names from ``mesh.extras.targetNames`` (or, as UniVRM writes them, the first
+        triangle primitive's ``extras.targetNames``), or None.
     default_weights : (N,) morph weights of the mesh, or None.
     face_groups : (M,) int32 position in ``primitives`` of the primitive of each face.
     primitives : the triangle primitives, in mesh order; their vertices follow one another.
@@ -111,8 +112,9 @@ def read_mesh_geometry(doc: GltfDocument, mesh_index: int, skinned: bool) -> Mes
         raise doc.fail(element, f"primitives have different numbers of morph targets {target_counts}")
     target_count = target_counts[0]
     starts = np.cumsum([0] + [part.vertex_count for part in parts])
-    names = mesh.extras.get("targetNames") if isinstance(mesh.extras, dict) else None
-    names_fit = isinstance(names, list) and len(names) == target_count > 0
+    names = _target_names(mesh.extras, target_count)
+    if names is None:  # UniVRM puts them on each primitive
+        names = _target_names(mesh.primitives[parts[0].index].extras, target_count)
     defaults = np.asarray(mesh.weights if mesh.weights else np.zeros(target_count), np.float64)
     if defaults.shape != (target_count,):
         raise doc.fail(element, f"has {defaults.size} default weights for {target_count} morph targets")
@@ -125,12 +127,18 @@ def read_mesh_geometry(doc: GltfDocument, mesh_index: int, skinned: bool) -> Mes
         joints=_influences(parts, "JOINTS", influence_sets) if skinned else None,
         weights=_influences(parts, "WEIGHTS", influence_sets) if skinned else None,
         targets=_position_deltas(parts, target_count),
-        target_names=[str(n) for n in names] if names_fit else None,
+        target_names=names,
         default_weights=defaults if target_count else None,
         face_groups=np.concatenate([np.full(len(part.faces), k, np.int32) for k, part in enumerate(parts)]),
         primitives=parts,
         other_primitives=others,
     )
+
+
+def _target_names(extras: object, target_count: int) -> list[str] | None:
+    """``extras.targetNames`` when it names each of the ``target_count`` morph targets."""
+    names = extras.get("targetNames") if isinstance(extras, dict) else None
+    return [str(name) for name in names] if isinstance(names, list) and len(names) == target_count > 0 else None
 
 
 def transform_points(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:

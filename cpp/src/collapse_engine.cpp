@@ -404,24 +404,27 @@ void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targ
   next_level_ = 0;
   take_reached_levels(targets, levels);
   if (options_.progress) options_.progress(0, planned_);
-  if (options_.collapse_passes && connectivity_.n_edges() > options_.passes_above_edges)
+  if (options_.collapse_passes && connectivity_.n_edges() > options_.passes_above_edges) {
     run_passes(policy, targets, levels, record);
-  else run_greedy(policy, targets, levels, record);
+  } else {
+    std::vector<RankedEdge> ranked;
+    rank_collapsible_edges(policy, ranked);
+    run_greedy(policy, ranked, targets, levels, record);
+  }
   for (; next_level_ < targets.size(); ++next_level_) levels.push_back(snapshot(targets[next_level_], false));
   if (options_.progress) options_.progress(collapse_count_, planned_);
 }
 
 // Steps 7-12 in one global greedy order: an indexed heap of every edge, re-keyed around each
 // collapse.
-void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<size_t>& targets,
-                                std::vector<EngineLevel>& levels, EngineRecord& record) {
-  // Step 7: every collapsible edge into the heap.
+void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<RankedEdge>& ranked,
+                                const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
+                                EngineRecord& record) {
+  // Step 7: every collapsible edge (`ranked`, rank_collapsible_edges) into the heap.
   const size_t edge_count = connectivity_.n_edges();
   heap_ = IndexedMinHeap(edge_count);
   parked_.assign(edge_count, 0);
   may_have_parked_.assign(point_count_, 0);
-  std::vector<RankedEdge> ranked;
-  rank_collapsible_edges(policy, ranked);
   std::vector<int32_t> ids(ranked.size());
   std::vector<double> keys(ranked.size());
   for (size_t i = 0; i < ranked.size(); ++i) ids[i] = ranked[i].edge, keys[i] = ranked[i].cost;
@@ -569,7 +572,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       // The last few edges in one greedy order: re-keying them costs little, and on small
       // meshes and coarse levels the order matters most.
       in_passes_ = false;
-      run_greedy(policy, targets, levels, record);
+      run_greedy(policy, ranked, targets, levels, record);
       return;
     }
     auto less = [](const RankedEdge& a, const RankedEdge& b) {

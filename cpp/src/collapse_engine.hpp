@@ -156,8 +156,8 @@ class CollapseEngine {
   Attempt try_collapse(CollapsePolicy& policy, Candidate candidate, int32_t edge, const std::vector<size_t>& targets,
                        std::vector<EngineLevel>& levels, EngineRecord& record);
   TriMesh::HalfedgeHandle removed_to_kept(const Candidate& candidate, int32_t edge) const;
-  void run_greedy(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
-                  EngineRecord& record);
+  void run_greedy(CollapsePolicy& policy, const std::vector<RankedEdge>& ranked, const std::vector<size_t>& targets,
+                  std::vector<EngineLevel>& levels, EngineRecord& record);
   void run_passes(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
                   EngineRecord& record);
   void rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) const;

@@ -47,6 +47,11 @@ def decode_gltf(path: str, document: dict) -> pygltflib.GLTF2:
         raise FormatError(path, error.where or "JSON", error.reason) from None
 
 
+def is_whole_number(value: object) -> bool:
+    """Whether a JSON value is an integer >= 0 (an index, a count, a byte offset; not a bool)."""
+    return isinstance(value, int) and not isinstance(value, bool) and value >= 0
+
+
 def _describe(value: Any) -> str:
     text = repr(value)
     return text if len(text) <= 40 else f"a {type(value).__name__}"

@@ -22,7 +22,7 @@ import pygltflib
 
 from .. import rotations
 from .errors import FormatError
-from .gltf_decode import decode_gltf
+from .gltf_decode import decode_gltf, is_whole_number
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
 from .gltf_keyframes import INTERPOLATIONS, frame_times
 from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
@@ -282,7 +282,7 @@ class GltfDocument:
         """A byteOffset, byteLength or count of ``element``: 0 when absent, else a whole number >= 0."""
         if value is None:
             return 0
-        if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+        if not is_whole_number(value):
             raise self.fail(element, f"{name} {value!r} is not a whole number >= 0")
         return value
 

@@ -18,6 +18,8 @@ from typing import Any
 import numpy as np
 import pygltflib
 
+from .gltf_decode import is_whole_number
+
 DRACO_EXTENSION = "KHR_draco_mesh_compression"
 # Builds the error to raise from (element, reason): the document's FormatError.
 Fail = Callable[[str, str], Exception]
@@ -46,12 +48,13 @@ def draco_sources(gltf: pygltflib.GLTF2, fail: Fail) -> dict[int, DracoSource]:
             element = f"mesh {m} primitive {p} {DRACO_EXTENSION}"
             view = extension.get("bufferView") if isinstance(extension, dict) else None
             ids = extension.get("attributes") if isinstance(extension, dict) else None
-            if not _is_index(view) or not isinstance(ids, dict) or not all(_is_index(i) for i in ids.values()):
+            well_formed = isinstance(ids, dict) and all(is_whole_number(i) for i in [view, *ids.values()])
+            if not well_formed:
                 raise fail(element, "needs a bufferView index and an attributes object of Draco ids")
             wanted = [(primitive.indices, None)] if primitive.indices is not None else []
             wanted += [(getattr(primitive.attributes, name, None), unique_id) for name, unique_id in ids.items()]
             for accessor, unique_id in wanted:
-                known = _is_index(accessor) and accessor < len(gltf.accessors or [])
+                known = is_whole_number(accessor) and accessor < len(gltf.accessors or [])
                 if known and gltf.accessors[accessor].bufferView is None:
                     sources[accessor] = DracoSource(view, unique_id, element)
     return sources
@@ -87,7 +90,3 @@ def draco_elements(mesh: Any, source: DracoSource, count: int, width: int, dtype
     if limits is not None and values.size and (values.min() < limits.min or values.max() > limits.max):
         raise fail(source.element, f"{what} hold values outside the accessor's {dtype.name}")
     return values.astype(dtype)
-
-
-def _is_index(value: object) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool) and value >= 0

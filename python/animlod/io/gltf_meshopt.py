@@ -16,6 +16,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .gltf_decode import is_whole_number
+
 MESHOPT_EXTENSIONS = ("EXT_meshopt_compression", "KHR_meshopt_compression")
 # Builds the error to raise from (element, reason): the document's FormatError.
 Fail = Callable[[str, str], Exception]
@@ -40,7 +42,7 @@ def decode_meshopt_view(extension: object, compressed: bytes, element: str, fail
         raise fail(element, "must be an object")
     count, stride = extension.get("count"), extension.get("byteStride")
     mode, filter_name = extension.get("mode"), extension.get("filter", "NONE")
-    if not (_whole(count) and _whole(stride) and 0 < stride <= 256):
+    if not (is_whole_number(count) and is_whole_number(stride) and 0 < stride <= 256):
         raise fail(element, "needs a count and a byteStride in (0, 256]")
     if filter_name == "COLOR":
         raise fail(element, "filter 'COLOR' is not decoded by the meshoptimizer package animlod uses")
@@ -70,7 +72,3 @@ def decode_meshopt_view(extension: object, compressed: bytes, element: str, fail
     if len(decoded) != count * stride:
         raise fail(element, f"decodes to {len(decoded)} bytes, not {count} x {stride}")
     return decoded
-
-
-def _whole(value: object) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool) and value >= 0

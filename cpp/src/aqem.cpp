@@ -162,12 +162,16 @@ class AqemPolicy final : public detail::CollapsePolicy {
   }
 
   void evaluate(Candidate& candidate) override { evaluate_with(candidate, scratch_[0]); }
-  // Collapse passes: costs on both cores (reads quadrics, weights and positions only).
+  // Collapse passes: costs and collapses on both cores (an evaluation reads the two points'
+  // quadrics, weights and positions; a merge writes the kept point's).
   size_t concurrency() const override { return kWorkers; }
   void evaluate_concurrently(Candidate& candidate, size_t worker) override {
     evaluate_with(candidate, scratch_[worker]);
   }
-  void place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) override;
+  void place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) override {
+    place_concurrently(candidate, placed, 0);
+  }
+  void place_concurrently(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed, size_t worker) override;
   void merge(const Candidate& candidate) override {
     Quadric* kept_quadrics = quadrics_of(candidate.kept);
     const Quadric* removed_quadrics = quadrics_of(candidate.removed);
@@ -205,7 +209,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
   std::vector<Quadric> quadrics_;       // (P, K) per-frame quadrics, contiguous per point
   std::vector<double> plane_counts_;    // (P,) planes summed into each of the point's K quadrics
   std::vector<int32_t> tips_;           // needle tips in every used frame (option tip_quadrics)
-  std::vector<Scratch> scratch_;  // (kWorkers,) worker 0's holds the placement place() uses
+  std::vector<Scratch> scratch_;  // (kWorkers,) each holds its worker's last placement
 };
 
 // Steps 1-2 (Eqs. 1-4): every face's plane in every used frame goes into its three points'
@@ -383,13 +387,14 @@ void AqemPolicy::evaluate_on_edge(Candidate& candidate, bool pinned, Scratch& sc
   candidate.error = rms_plane_distance(candidate, total);
 }
 
-// The candidate's point in every frame F: its Eq. 5 placement (worker 0's scratch) in the
-// quadrics' frames, kept + t (removed - kept) in the others.
-void AqemPolicy::place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) {
+// The candidate's point in every frame F: its Eq. 5 placement (the worker's last evaluation) in
+// the quadrics' frames, kept + t (removed - kept) in the others.
+void AqemPolicy::place_concurrently(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed,
+                                    size_t worker) {
   size_t used = 0;
   for (size_t frame = 0; frame < engine_.frame_count(); ++frame) {
     if (used < used_count_ && static_cast<size_t>(frames_[used]) == frame) {
-      placed[frame] = scratch_[0].new_positions[used++];
+      placed[frame] = scratch_[worker].new_positions[used++];
       continue;
     }
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame);

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <iterator>
+#include <limits>
 #include <thread>
 #include <utility>
 
@@ -20,8 +22,8 @@ CollapseEngine::CollapseEngine(const AnimatedMeshView& mesh, const PreparedMesh&
       data_(data),
       options_(options),
       frame_count_(mesh.frame_count),
-      point_count_(prepared.point_source.size()),
-      placed_(mesh.frame_count) {
+      point_count_(prepared.point_source.size()) {
+  for (Workspace& workspace : workspaces_) workspace.placed.resize(frame_count_);
   // Working copies, laid out per point: (F, V, 3) -> (P, F, 3).
   positions_.resize(point_count_ * frame_count_ * 3);
   for (size_t frame = 0; frame < frame_count_; ++frame)
@@ -130,33 +132,35 @@ Candidate CollapseEngine::evaluate(CollapsePolicy& policy, int32_t edge) const {
 // Seams: every wedge of the removed point must go to the kept point's wedge on the same side of
 // the collapsed edge. The faces on the edge define the mapping (one pair per side); a wedge of
 // the removed point that no side defines (it lies on another seam), or a side that would send
-// one wedge to two, makes the collapse illegal. Leaves the mapping in wedge_moves_.
-bool CollapseEngine::map_wedges(const Candidate& candidate, TriMesh::HalfedgeHandle collapse) {
-  wedge_moves_.clear();
+// one wedge to two, makes the collapse illegal. Leaves the mapping in workspace.wedge_moves.
+bool CollapseEngine::map_wedges(const Candidate& candidate, TriMesh::HalfedgeHandle collapse,
+                                Workspace& workspace) const {
+  auto& wedge_moves = workspace.wedge_moves;
+  wedge_moves.clear();
   // Two points without seams: every corner of the removed point takes the kept point's wedge.
   if (point_wedge_[candidate.removed] >= 0 && point_wedge_[candidate.kept] >= 0) {
-    wedge_moves_.emplace_back(point_wedge_[candidate.removed], point_wedge_[candidate.kept]);
+    wedge_moves.emplace_back(point_wedge_[candidate.removed], point_wedge_[candidate.kept]);
     return true;
   }
   for (const auto side : {collapse, connectivity_.opposite_halfedge_handle(collapse)}) {
     const auto face = connectivity_.face_handle(side);
     if (!face.is_valid()) continue;
     const int32_t from = corner_wedge(face, candidate.removed), to = corner_wedge(face, candidate.kept);
-    const auto known = std::find_if(wedge_moves_.begin(), wedge_moves_.end(),
+    const auto known = std::find_if(wedge_moves.begin(), wedge_moves.end(),
                                     [from](const auto& move) { return move.first == from; });
-    if (known == wedge_moves_.end()) wedge_moves_.emplace_back(from, to);
+    if (known == wedge_moves.end()) wedge_moves.emplace_back(from, to);
     else if (known->second != to) return false;
   }
   for (const auto face : connectivity_.vf_range(connectivity_.vertex_handle(candidate.removed))) {
     const int32_t wedge = corner_wedge(face, candidate.removed);
-    const bool mapped = std::any_of(wedge_moves_.begin(), wedge_moves_.end(),
+    const bool mapped = std::any_of(wedge_moves.begin(), wedge_moves.end(),
                                     [wedge](const auto& move) { return move.first == wedge; });
     if (!mapped) return false;
   }
   return true;
 }
 
-bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse) {
+bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse, Workspace& workspace) {
   if (locked(candidate.removed)) return false;  // both endpoints locked
   if (!connectivity_.is_collapse_ok(collapse)) return false;
   // A valence-3 interior vertex beside the edge would be left with two faces on the same three
@@ -168,10 +172,10 @@ bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandl
 
     if (valence_[opposite.idx()] <= 3 && !connectivity_.is_boundary(opposite)) return false;
   }
-  if (!map_wedges(candidate, collapse)) return false;
+  if (!map_wedges(candidate, collapse, workspace)) return false;
   if (!options_.check_inversion) return true;
   // Eq. 7 for every face that survives around the collapse, in every frame F: the kept and the
-  // removed point both move to placed_.
+  // removed point both move to workspace.placed.
   for (const int32_t moved : {candidate.kept, candidate.removed}) {
     const int32_t other = moved == candidate.kept ? candidate.removed : candidate.kept;
     for (const auto face : connectivity_.vf_range(connectivity_.vertex_handle(moved))) {
@@ -190,18 +194,19 @@ bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandl
         corners[corner] = &positions_[static_cast<size_t>(point) * frame_count_ * 3];
       }
       if (collapses) continue;  // the faces on the edge disappear
-      if (!face_keeps_orientation(corners, moved_corner, placed_.data(), frame_count_, options_.strict_inversion))
+      if (!face_keeps_orientation(corners, moved_corner, workspace.placed.data(), frame_count_,
+                                  options_.strict_inversion))
         return false;
     }
   }
   return true;
 }
 
-// Step 9: move the kept point to placed_ in every frame, let the policy merge its state, carry
-// wedges, attributes and skin weights over, and collapse. Leaves the removed point's former
-// edges in old_edges_.
-void CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
-                              EngineRecord& record) {
+// Step 9: move the kept point to workspace.placed in every frame, let the policy merge its
+// state, carry wedges, attributes and skin weights over, and collapse. Returns the number of
+// faces removed; leaves the removed point's former edges in old_edges_ (greedy order only).
+int32_t CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
+                                 const Workspace& workspace, EngineRecord& record) {
   record.removed.push_back(prepared_.point_source[candidate.removed]);
   record.kept.push_back(prepared_.point_source[candidate.kept]);
   record.cost.push_back(candidate.cost);
@@ -209,14 +214,14 @@ void CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate
   for (size_t frame = 0; frame < frame_count_; ++frame) {
     float* out = &positions_[(static_cast<size_t>(candidate.kept) * frame_count_ + frame) * 3];
     for (int axis = 0; axis < 3; ++axis) {
-      out[axis] = static_cast<float>(placed_[frame][axis]);
+      out[axis] = static_cast<float>(workspace.placed[frame][axis]);
       record.positions.push_back(out[axis]);
     }
   }
   policy.merge(candidate);
   const auto t = static_cast<float>(candidate.t);
   const size_t attribute_count = data_.attribute_count;
-  for (const auto& [from, to] : wedge_moves_)
+  for (const auto& [from, to] : workspace.wedge_moves)
     for (size_t a = 0; a < attribute_count; ++a) {
       float& kept = attributes_[static_cast<size_t>(to) * attribute_count + a];
       kept += t * (attributes_[static_cast<size_t>(from) * attribute_count + a] - kept);
@@ -233,8 +238,7 @@ void CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate
                        candidate.t);
   }
   merged_into_[candidate.removed] = candidate.kept;
-  for (const auto& [from, to] : wedge_moves_) wedge_merged_into_[from] = to;
-  ++collapse_count_;
+  for (const auto& [from, to] : workspace.wedge_moves) wedge_merged_into_[from] = to;
 
   // Corners of the removed point now belong to the kept point, with the mapped wedge.
   const auto removed = connectivity_.vertex_handle(candidate.removed);
@@ -243,7 +247,7 @@ void CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate
     for (size_t c = 0; c < 3; ++c) {
       if (corner_points_[base + c] != candidate.removed) continue;
       corner_points_[base + c] = candidate.kept;
-      for (const auto& [from, to] : wedge_moves_)
+      for (const auto& [from, to] : workspace.wedge_moves)
         if (corner_wedges_[base + c] == from) corner_wedges_[base + c] = to;
     }
   }
@@ -262,8 +266,8 @@ void CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candidate
   }
   valence_[candidate.kept] += valence_[candidate.removed] - 2 - faces_removed;
   if (point_wedge_[candidate.removed] < 0) point_wedge_[candidate.kept] = -1;
-  face_count_ -= static_cast<size_t>(faces_removed);
   connectivity_.collapse(halfedge);
+  return faces_removed;
 }
 
 // The halfedge from the removed point to the kept one (OpenMesh keeps the "to" vertex).
@@ -450,18 +454,32 @@ void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<Ranked
   }
 }
 
-// Steps 8-9 for one candidate (kept and removed set): evaluate it again for its placement, test
-// legality and max_error, collapse, take the levels reached.
+// Steps 8-9 for one candidate (kept and removed set) on `worker`: evaluate it again for its
+// placement, test legality and max_error, collapse into `record`. Leaves the collapse's values
+// in `candidate`; the caller counts the collapse and its removed faces.
+CollapseEngine::Attempt CollapseEngine::attempt_collapse(CollapsePolicy& policy, Candidate& candidate, int32_t edge,
+                                                         size_t worker, EngineRecord& record,
+                                                         int32_t& faces_removed) {
+  Workspace& workspace = workspaces_[worker];
+  policy.evaluate_concurrently(candidate, worker);
+  policy.place_concurrently(candidate, workspace.placed, worker);
+  const auto halfedge = removed_to_kept(candidate, edge);
+  if (!is_legal(candidate, halfedge, workspace)) return Attempt::illegal;
+  if (candidate.error > options_.max_error) return Attempt::over_max_error;
+  faces_removed = collapse(policy, candidate, halfedge, workspace, record);
+  return Attempt::collapsed;
+}
+
+// attempt_collapse on the engine's own thread, counted; takes the levels reached.
 CollapseEngine::Attempt CollapseEngine::try_collapse(CollapsePolicy& policy, Candidate candidate, int32_t edge,
                                                      const std::vector<size_t>& targets,
                                                      std::vector<EngineLevel>& levels, EngineRecord& record) {
-  policy.evaluate(candidate);
-  policy.place(candidate, placed_);
-  const auto halfedge = removed_to_kept(candidate, edge);
-  if (!is_legal(candidate, halfedge)) return Attempt::illegal;
-  if (candidate.error > options_.max_error) return Attempt::over_max_error;
+  int32_t faces_removed = 0;
+  const Attempt attempt = attempt_collapse(policy, candidate, edge, 0, record, faces_removed);
+  if (attempt != Attempt::collapsed) return attempt;
   error_so_far_ = std::max(error_so_far_, candidate.error);
-  collapse(policy, candidate, halfedge, record);
+  face_count_ -= static_cast<size_t>(faces_removed);
+  ++collapse_count_;
   take_reached_levels(targets, levels);
   if (options_.progress && collapse_count_ % 4096 == 0) options_.progress(collapse_count_, planned_);
   return Attempt::collapsed;
@@ -548,6 +566,112 @@ class SortedOnDemand {
   size_t first_prefix_, sorted_ = 0;
 };
 
+namespace {
+
+void append(EngineRecord& to, const EngineRecord& from) {
+  auto append_vector = [](auto& destination, const auto& source) {
+    destination.insert(destination.end(), source.begin(), source.end());
+  };
+  append_vector(to.removed, from.removed);
+  append_vector(to.kept, from.kept);
+  append_vector(to.positions, from.positions);
+  append_vector(to.cost, from.cost);
+  append_vector(to.error, from.error);
+}
+
+}  // namespace
+
+// half_: the side of a plane each point is on, the plane across the axis along which the chosen
+// collapses' kept points spread most, through their median (each worker gets half of them).
+void CollapseEngine::split_points_in_halves(const std::vector<RankedEdge>& chosen) {
+  const size_t stride = frame_count_ * 3;  // a point's frame 0 in positions_
+  Eigen::Array3f low = Eigen::Array3f::Constant(std::numeric_limits<float>::infinity()), high = -low;
+  for (const RankedEdge& entry : chosen) {
+    const Eigen::Map<const Eigen::Array3f> position(&positions_[static_cast<size_t>(entry.kept) * stride]);
+    low = low.min(position);
+    high = high.max(position);
+  }
+  Eigen::Index axis = 0;
+  (high - low).maxCoeff(&axis);
+  std::vector<float> coordinates(chosen.size());
+  for (size_t i = 0; i < chosen.size(); ++i)
+    coordinates[i] = positions_[static_cast<size_t>(chosen[i].kept) * stride + static_cast<size_t>(axis)];
+  const auto middle = coordinates.begin() + static_cast<std::ptrdiff_t>(coordinates.size() / 2);
+  std::nth_element(coordinates.begin(), middle, coordinates.end());
+  const float median = *middle;
+  half_.resize(point_count_);
+  for (size_t p = 0; p < point_count_; ++p) half_[p] = positions_[p * stride + static_cast<size_t>(axis)] < median ? 0 : 1;
+}
+
+// Whether collapsing `entry` reads and writes only points of `half`: OpenMesh's collapse and
+// is_collapse_ok touch the two endpoints, the points around them and the elements between those;
+// the engine and the policy likewise. A split point's wedge stands at other points too.
+bool CollapseEngine::stays_in_half(const RankedEdge& entry, uint8_t half) const {
+  for (const int32_t point : {entry.kept, entry.removed}) {
+    if (half_[point] != half || prepared_.point_split[point]) return false;
+    for (const auto neighbour : connectivity_.vv_range(connectivity_.vertex_handle(point)))
+      if (half_[neighbour.idx()] != half) return false;
+  }
+  return true;
+}
+
+// A pass's chosen collapses on two workers, one per half of the mesh (split_points_in_halves),
+// each in edge order; those near the other half are left in `deferred` (edge order) for the
+// engine's thread. Both halves touch disjoint points, faces and edges, so each worker's
+// collapses are those it would make alone, in any interleaving: the levels do not depend on
+// timing. The records follow one another, the first half's first: a valid order of the same
+// collapses.
+CollapseEngine::Performed CollapseEngine::perform_in_halves(CollapsePolicy& policy,
+                                                            const std::vector<RankedEdge>& chosen,
+                                                            const std::vector<size_t>& targets,
+                                                            std::vector<EngineLevel>& levels, EngineRecord& record,
+                                                            std::vector<RankedEdge>& deferred) {
+  struct Half {
+    EngineRecord record;
+    std::vector<RankedEdge> deferred;
+    size_t collapses = 0, illegal = 0, faces_removed = 0;
+    double error = 0.0;
+  };
+  std::array<Half, 2> halves;
+  split_points_in_halves(chosen);
+  run_in_ranges(2, 2, [&](size_t, size_t, size_t worker) {
+    Half& half = halves[worker];
+    for (const RankedEdge& entry : chosen) {
+      if (half_[entry.kept] != worker) continue;
+      if (!stays_in_half(entry, static_cast<uint8_t>(worker))) {
+        half.deferred.push_back(entry);
+        continue;
+      }
+      Candidate candidate;
+      candidate.kept = entry.kept;
+      candidate.removed = entry.removed;
+      int32_t faces_removed = 0;
+      const Attempt attempt = attempt_collapse(policy, candidate, entry.edge, worker, half.record, faces_removed);
+      if (attempt == Attempt::illegal) ++half.illegal;
+      if (attempt != Attempt::collapsed) continue;
+      ++half.collapses;
+      half.faces_removed += static_cast<size_t>(faces_removed);
+      half.error = std::max(half.error, candidate.error);
+    }
+  });
+  Performed performed;
+  for (const Half& half : halves) {
+    append(record, half.record);
+    collapse_count_ += half.collapses;
+    face_count_ -= half.faces_removed;
+    error_so_far_ = std::max(error_so_far_, half.error);
+    performed.collapses += half.collapses;
+    performed.illegal += half.illegal;
+  }
+  deferred.clear();
+  std::merge(halves[0].deferred.begin(), halves[0].deferred.end(), halves[1].deferred.begin(),
+             halves[1].deferred.end(), std::back_inserter(deferred),
+             [](const RankedEdge& a, const RankedEdge& b) { return a.edge < b.edge; });
+  take_reached_levels(targets, levels);
+  if (options_.progress) options_.progress(collapse_count_, planned_);
+  return performed;
+}
+
 // Steps 7-12 as meshoptimizer's collapse passes (simplifier.cpp: pickEdgeCollapses,
 // sortEdgeCollapses, performEdgeCollapses): every live edge is evaluated and the candidates
 // ranked by (cost, edge). A pass chooses its collapses in that order, each point at most once
@@ -556,12 +680,13 @@ class SortedOnDemand {
 // the cost of the candidate the pass would reach if every collapse succeeded (the order stays
 // close to the greedy one). The chosen collapses are then performed in edge order, whose
 // neighbours share OpenMesh's records in memory (the cost order scatters them: the 1M-triangle
-// sphere's collapses took 2.5 s that way), legality checked against the current mesh. Where
-// illegal or boundary collapses leave the pass short of its goal, it goes on down the ranking
-// one collapse at a time.
+// sphere's collapses took 2.5 s that way), legality checked against the current mesh, on two
+// workers where the policy allows (perform_in_halves). Where illegal or boundary collapses
+// leave the pass short of its goal, it goes on down the ranking one collapse at a time.
 void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t>& targets,
                                 std::vector<EngineLevel>& levels, EngineRecord& record) {
-  std::vector<RankedEdge> ranked, scratch;
+  constexpr size_t kMinimumHalves = 2048;  // fewer chosen collapses go one by one
+  std::vector<RankedEdge> ranked, scratch, chosen, deferred;
   std::vector<int32_t> chosen_rank(connectivity_.n_edges(), -1);  // place in ranked of the pass's chosen edges
   std::vector<uint8_t> touched(point_count_, 0);
   in_passes_ = true;
@@ -600,6 +725,12 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       chosen_rank[entry.edge] = static_cast<int32_t>(next);
       planned_faces += 2;
     }
+    chosen.clear();
+    for (int32_t& rank : chosen_rank) {
+      if (rank < 0) continue;
+      chosen.push_back(ranked[static_cast<size_t>(rank)]);
+      rank = -1;
+    }
     const size_t faces_before = face_count_;
     size_t pass_collapses = 0;
     auto try_entry = [&](const RankedEdge& entry) {
@@ -611,11 +742,14 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       if (attempt == Attempt::collapsed) ++pass_collapses;
       return attempt == Attempt::collapsed;
     };
-    for (int32_t& rank : chosen_rank) {
-      if (rank < 0) continue;
-      try_entry(ranked[static_cast<size_t>(rank)]);
-      rank = -1;
+    const std::vector<RankedEdge>* one_by_one = &chosen;
+    if (chosen.size() >= kMinimumHalves && policy.concurrency() >= 2 && std::thread::hardware_concurrency() >= 2) {
+      const Performed performed = perform_in_halves(policy, chosen, targets, levels, record, deferred);
+      pass_collapses += performed.collapses;
+      edge_goal += performed.illegal;
+      one_by_one = &deferred;
     }
+    for (const RankedEdge& entry : *one_by_one) try_entry(entry);
     for (; !over_max_error && next < order.size(); ++next) {
       const size_t removed_faces = faces_before - face_count_;
       if (removed_faces >= face_goal) break;

@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <limits>
 #include <vector>
 
@@ -55,8 +56,17 @@ class CollapsePolicy {
   // Collapse passes evaluate every edge at once on up to concurrency() threads: worker w in
   // [0, concurrency()) calls evaluate_concurrently, which fills cost, error and t like
   // evaluate() and must not write state another worker reads (no merge() runs meanwhile).
+  // With two or more, they also perform collapses on workers 0 and 1 at once, in parts of the
+  // mesh that share no point: then evaluate_concurrently, place_concurrently (the placement of
+  // the worker's last evaluation) and merge run concurrently, and may only read and write the
+  // state of the candidate's two points and the worker's own scratch. Worker 0 is the engine's
+  // own thread, whose evaluations are those of evaluate() and place().
   virtual size_t concurrency() const { return 1; }
   virtual void evaluate_concurrently(Candidate& candidate, size_t /*worker*/) { evaluate(candidate); }
+  virtual void place_concurrently(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed,
+                                  size_t /*worker*/) {
+    place(candidate, placed);
+  }
 };
 
 // Per-vertex data the engine carries through collapses (all optional).
@@ -148,11 +158,19 @@ class CollapseEngine {
   Candidate candidate_for(int32_t edge) const;
   Candidate evaluate(CollapsePolicy& policy, int32_t edge) const;
   int32_t corner_wedge(TriMesh::FaceHandle face, int32_t point) const;
-  bool map_wedges(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
-  bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse);
-  void collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
-                EngineRecord& record);
+  // What one collapse at a time needs, per worker (a cache line of its own: both workers write
+  // theirs at every collapse).
+  struct alignas(64) Workspace {
+    std::vector<Eigen::Vector3d> placed;                    // (F,) the candidate's position in every frame
+    std::vector<std::pair<int32_t, int32_t>> wedge_moves;  // removed wedge -> kept wedge
+  };
+  bool map_wedges(const Candidate& candidate, TriMesh::HalfedgeHandle collapse, Workspace& workspace) const;
+  bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse, Workspace& workspace);
+  int32_t collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
+                   const Workspace& workspace, EngineRecord& record);
   enum class Attempt { collapsed, illegal, over_max_error };
+  Attempt attempt_collapse(CollapsePolicy& policy, Candidate& candidate, int32_t edge, size_t worker,
+                           EngineRecord& record, int32_t& faces_removed);
   Attempt try_collapse(CollapsePolicy& policy, Candidate candidate, int32_t edge, const std::vector<size_t>& targets,
                        std::vector<EngineLevel>& levels, EngineRecord& record);
   TriMesh::HalfedgeHandle removed_to_kept(const Candidate& candidate, int32_t edge) const;
@@ -160,6 +178,14 @@ class CollapseEngine {
                   std::vector<EngineLevel>& levels, EngineRecord& record);
   void run_passes(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
                   EngineRecord& record);
+  struct Performed {
+    size_t collapses = 0, illegal = 0;
+  };
+  Performed perform_in_halves(CollapsePolicy& policy, const std::vector<RankedEdge>& chosen,
+                              const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
+                              EngineRecord& record, std::vector<RankedEdge>& deferred);
+  void split_points_in_halves(const std::vector<RankedEdge>& chosen);
+  bool stays_in_half(const RankedEdge& entry, uint8_t half) const;
   void rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) const;
   void rekey_around(CollapsePolicy& policy, TriMesh::VertexHandle vertex, bool all_edges);
   void park(int32_t edge);
@@ -185,14 +211,14 @@ class CollapseEngine {
   std::vector<int32_t> corner_wedges_;      // (M', 3) current wedge of every face corner
   std::vector<int32_t> merged_into_;        // (P,) a point each removed point merged into
   std::vector<int32_t> wedge_merged_into_;  // (V,) a wedge each removed wedge merged into
-  std::vector<std::pair<int32_t, int32_t>> wedge_moves_;  // removed wedge -> kept wedge, current collapse
   std::vector<int32_t> old_edges_;          // edges of the removed point before the current collapse
   std::vector<int32_t> valence_;            // (P,) points around each point (OpenMesh's valence, kept flat)
   std::vector<int32_t> point_wedge_;        // (P,) the wedge of every corner of the point, -1 when it may
                                             //      have several (a seam point)
   std::vector<uint8_t> parked_;             // (E,) popped while illegal; re-tried when the area changes
   std::vector<uint8_t> may_have_parked_;    // (P,) set when an edge of the point is parked
-  std::vector<Eigen::Vector3d> placed_;     // (F,) the top candidate's position in every frame
+  std::array<Workspace, 2> workspaces_;     // per worker; the engine's own thread uses the first
+  std::vector<uint8_t> half_;               // (P,) the half of the mesh each point is in (perform_in_halves)
   std::vector<std::array<int32_t, 3>> border_sides_, seam_sides_;
   TriMesh connectivity_;
   IndexedMinHeap heap_{0};

@@ -1,7 +1,8 @@
 // Checks of AQEM levels shared by the doctest files: run to success, manifold output, no face
-// turned inside out.
+// turned inside out, attribute seams kept.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <set>
@@ -50,6 +51,25 @@ inline size_t inward_faces(const AqemLevel& level, size_t frame_count) {
     }
   }
   return inward;
+}
+
+// A level of grid_with_uv_seam: every face lies on one side of the seam x = 0.5 with all its UVs
+// from that side's chart, and both sides keep vertices on the seam line, at equal positions.
+inline void check_uv_seam_kept(const AqemLevel& level) {
+  for (size_t f = 0; f < level.faces.size(); f += 3) {
+    float centre = 0.0f;
+    int right_uvs = 0;
+    for (int k = 0; k < 3; ++k) {
+      centre += level.positions[3 * level.faces[f + k]] / 3.0f;
+      right_uvs += level.attributes[2 * level.faces[f + k]] > 5.0f;
+    }
+    CHECK(right_uvs == (centre > 0.5f ? 3 : 0));
+  }
+  size_t left = 0, right = 0;
+  for (size_t i = 0; i < level.kept_vertices.size(); ++i)
+    if (std::fabs(level.positions[3 * i] - 0.5f) < 1e-6f) ++(level.attributes[2 * i] > 5.0f ? right : left);
+  CHECK(left >= 2);
+  CHECK(left == right);
 }
 
 }  // namespace animlod::testing

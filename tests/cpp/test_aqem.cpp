@@ -344,26 +344,8 @@ TEST_CASE("aqem welds seam copies and keeps the seam") {
   // A grid cut along x = 0.5 into two UV charts: the copies of the seam vertices carry different
   // UVs. Welded, the grid simplifies as one surface; the seam survives with its two UV sides.
   const int n = 8;
-  OwnedAnimatedMesh mesh = animlod::testing::grid(n);
   std::vector<float> uvs;
-  for (size_t v = 0; v < mesh.vertex_count; ++v) {  // the right chart's UVs lie 10 units over
-    const float x = mesh.frames[3 * v];
-    uvs.insert(uvs.end(), {x > 0.5f ? x + 10.0f : x, mesh.frames[3 * v + 1]});
-  }
-  std::map<int32_t, int32_t> copy_of;  // seam vertex -> its copy for the right chart
-  for (int j = 0; j <= n; ++j) {
-    const int32_t v = j * (n + 1) + n / 2;
-    copy_of[v] = static_cast<int32_t>(mesh.vertex_count++);
-    mesh.frames.insert(mesh.frames.end(), {mesh.frames[3 * v], mesh.frames[3 * v + 1], mesh.frames[3 * v + 2]});
-    uvs.insert(uvs.end(), {mesh.frames[3 * v] + 10.0f, mesh.frames[3 * v + 1]});  // the right chart's UVs
-  }
-  for (size_t f = 0; f < mesh.faces.size(); f += 3) {
-    float centre = 0.0f;
-    for (int k = 0; k < 3; ++k) centre += mesh.frames[3 * mesh.faces[f + k]] / 3.0f;
-    if (centre > 0.5f)
-      for (int k = 0; k < 3; ++k)
-        if (copy_of.count(mesh.faces[f + k])) mesh.faces[f + k] = copy_of[mesh.faces[f + k]];
-  }
+  const OwnedAnimatedMesh mesh = animlod::testing::grid_with_uv_seam(n, uvs);
   AqemVertexData data;
   data.attributes = uvs.data();
   data.attribute_count = 2;
@@ -374,22 +356,7 @@ TEST_CASE("aqem welds seam copies and keeps the seam") {
   CHECK(result.preparation.seam_vertices == size_t(n + 1));
   const AqemLevel& level = result.levels[0];
   CHECK(level.reached);
-  // Every face is on one side of the seam and all its UVs come from that side's chart.
-  for (size_t f = 0; f < level.faces.size(); f += 3) {
-    float centre = 0.0f;
-    int right_uvs = 0;
-    for (int k = 0; k < 3; ++k) {
-      centre += level.positions[3 * level.faces[f + k]] / 3.0f;
-      right_uvs += level.attributes[2 * level.faces[f + k]] > 5.0f;
-    }
-    CHECK(right_uvs == (centre > 0.5f ? 3 : 0));
-  }
-  // Both sides of the seam line x = 0.5 still have vertices on it, at equal positions.
-  size_t left = 0, right = 0;
-  for (size_t i = 0; i < level.kept_vertices.size(); ++i)
-    if (std::fabs(level.positions[3 * i] - 0.5f) < 1e-6f) ++(level.attributes[2 * i] > 5.0f ? right : left);
-  CHECK(left >= 2);
-  CHECK(left == right);
+  animlod::testing::check_uv_seam_kept(level);
 }
 
 TEST_CASE("aqem keeps a point where three or more attribute charts meet in place") {

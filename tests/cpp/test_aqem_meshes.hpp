@@ -37,6 +37,32 @@ inline OwnedAnimatedMesh grid(int n) {
   return mesh;
 }
 
+// grid(n) cut along x = 0.5 into two UV charts: the seam vertices get a copy for the right
+// chart, whose UVs (x, y) lie 10 units over in u. `uvs` gets (V, 2).
+inline OwnedAnimatedMesh grid_with_uv_seam(int n, std::vector<float>& uvs) {
+  OwnedAnimatedMesh mesh = grid(n);
+  uvs.clear();
+  for (size_t v = 0; v < mesh.vertex_count; ++v) {
+    const float x = mesh.frames[3 * v];
+    uvs.insert(uvs.end(), {x > 0.5f ? x + 10.0f : x, mesh.frames[3 * v + 1]});
+  }
+  std::map<int32_t, int32_t> copy_of;  // seam vertex -> its copy for the right chart
+  for (int j = 0; j <= n; ++j) {
+    const int32_t v = j * (n + 1) + n / 2;
+    copy_of[v] = static_cast<int32_t>(mesh.vertex_count++);
+    mesh.frames.insert(mesh.frames.end(), {mesh.frames[3 * v], mesh.frames[3 * v + 1], mesh.frames[3 * v + 2]});
+    uvs.insert(uvs.end(), {mesh.frames[3 * v] + 10.0f, mesh.frames[3 * v + 1]});
+  }
+  for (size_t f = 0; f < mesh.faces.size(); f += 3) {
+    float centre = 0.0f;
+    for (int k = 0; k < 3; ++k) centre += mesh.frames[3 * mesh.faces[f + k]] / 3.0f;
+    if (centre > 0.5f)
+      for (int k = 0; k < 3; ++k)
+        if (copy_of.count(mesh.faces[f + k])) mesh.faces[f + k] = copy_of[mesh.faces[f + k]];
+  }
+  return mesh;
+}
+
 // An open tube of radius 0.2 along x in [-1, 1] (rings x segments vertices), faces facing out.
 // Frame f bends the half x > 0 about the z axis by angle f * bend / (F - 1), with a short
 // blend zone around x = 0, like an elbow.

@@ -74,6 +74,49 @@ TEST_CASE("collapse passes are deterministic") {
   CHECK(first.collapses.cost == second.collapses.cost);
 }
 
+TEST_CASE("collapse passes on two workers keep seams and carry attributes and skin weights") {
+  // Passes perform their chosen collapses on two workers, one per half of the mesh, and leave
+  // those near the other half to one thread afterwards (collapse_engine.cpp perform_in_halves):
+  // wedges, UVs and weights must cross over as they do one collapse at a time.
+  std::vector<float> uvs;
+  const OwnedAnimatedMesh mesh = animlod::testing::grid_with_uv_seam(240, uvs);  // 115,200 faces
+  REQUIRE(edge_count(mesh) > 100000);
+  std::vector<int32_t> joints(mesh.vertex_count * 2);
+  std::vector<float> weights(mesh.vertex_count * 2);
+  for (size_t v = 0; v < mesh.vertex_count; ++v) {
+    joints[2 * v] = mesh.frames[3 * v + 1] < 0.5f ? 0 : 1;
+    joints[2 * v + 1] = 2;
+    weights[2 * v] = 0.75f;
+    weights[2 * v + 1] = 0.25f;
+  }
+  AqemVertexData data;
+  data.attributes = uvs.data();
+  data.attribute_count = 2;
+  data.skin_joints = joints.data();
+  data.skin_weights = weights.data();
+  data.influence_count = 2;
+  AqemOptions options;
+  options.target_ratios = {0.1};
+  const AqemResult result = simplify(mesh, options, data);
+  const AqemLevel& level = result.levels[0];
+  REQUIRE(level.reached);
+  CHECK(is_manifold(level));
+  animlod::testing::check_uv_seam_kept(level);
+  for (size_t i = 0; i < level.kept_vertices.size(); ++i) {
+    // UVs are x, y (10 over on the right chart) and the grid stays flat, so they agree.
+    const float u = level.attributes[2 * i] > 5.0f ? level.attributes[2 * i] - 10.0f : level.attributes[2 * i];
+    CHECK(u == doctest::Approx(level.positions[3 * i]).epsilon(1e-5));
+    CHECK(level.attributes[2 * i + 1] == doctest::Approx(level.positions[3 * i + 1]).epsilon(1e-5));
+    float sum = 0.0f;
+    for (int k = 0; k < 2; ++k) sum += level.skin_weights[2 * i + k];
+    CHECK(sum == doctest::Approx(1.0));
+  }
+  const AqemResult again = simplify(mesh, options, data);
+  CHECK(again.levels[0].faces == level.faces);
+  CHECK(again.levels[0].attributes == level.attributes);
+  CHECK(again.levels[0].skin_weights == level.skin_weights);
+}
+
 TEST_CASE("collapse passes keep guarded vertices while other collapses remain, then free them") {
   const OwnedAnimatedMesh mesh = animlod::testing::sphere(200, 340, 1);
   REQUIRE(edge_count(mesh) > 100000);

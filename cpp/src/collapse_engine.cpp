@@ -68,13 +68,18 @@ void CollapseEngine::build_connectivity() {
   connectivity_.request_edge_status();
   connectivity_.request_face_status();
   const size_t face_count = corner_points_.size() / 3;
-  connectivity_.reserve(point_count_, face_count * 3 / 2 + point_count_, face_count);
-  std::vector<TriMesh::VertexHandle> handles(point_count_);
-  for (size_t p = 0; p < point_count_; ++p) handles[p] = connectivity_.new_vertex();
-  for (size_t f = 0; f < face_count; ++f) {
-    const int32_t* v = &corner_points_[3 * f];
-    [[maybe_unused]] const auto face = connectivity_.add_face(handles[v[0]], handles[v[1]], handles[v[2]]);
-    assert(face.is_valid() && face.idx() == static_cast<int>(f));
+  if (!prepared_.side_partners.empty()) {
+    link_paired_sides();
+  } else {
+    connectivity_.reserve(point_count_, face_count * 3 / 2 + point_count_, face_count);
+    connectivity_.resize(point_count_, 0, 0);
+    for (size_t f = 0; f < face_count; ++f) {
+      const int32_t* v = &corner_points_[3 * f];
+      [[maybe_unused]] const auto face =
+          connectivity_.add_face(connectivity_.vertex_handle(v[0]), connectivity_.vertex_handle(v[1]),
+                                 connectivity_.vertex_handle(v[2]));
+      assert(face.is_valid() && face.idx() == static_cast<int>(f));
+    }
   }
   face_count_ = face_count;
   valence_.resize(point_count_);
@@ -85,6 +90,55 @@ void CollapseEngine::build_connectivity() {
     int32_t& wedge = point_wedge_[corner_points_[c]];
     wedge = wedge == -2 || wedge == corner_wedges_[c] ? corner_wedges_[c] : -1;
   }
+}
+
+// The halfedge structure add_face builds face by face, linked directly from prepare_mesh's
+// paired sides instead (add_face searches the fan of each corner's point for every side), with
+// every element created at once: edges numbered in order of their first side, halfedge 0
+// running that side's way; a face's halfedge is its side into its first corner; a border
+// halfedge is followed by the border halfedge leaving its end point (one per point: the fans
+// are simple), which is also that point's outgoing halfedge, as add_face leaves it. An inner
+// point's outgoing halfedge may differ from add_face's, which changes only where circulators
+// start.
+void CollapseEngine::link_paired_sides() {
+  const std::vector<int32_t>& partners = prepared_.side_partners;
+  const size_t corner_count = corner_points_.size();
+  auto next_corner = [](size_t c) { return c - c % 3 + (c % 3 + 1) % 3; };
+  auto vertex = [&](size_t c) { return connectivity_.vertex_handle(corner_points_[c]); };
+  std::vector<TriMesh::HalfedgeHandle> sides(corner_count);  // the halfedge of each corner's side
+  int edge_count = 0;
+  for (size_t c = 0; c < corner_count; ++c) {
+    const int32_t partner = partners[c];
+    sides[c] = partner < 0 || static_cast<size_t>(partner) > c
+                   ? connectivity_.s_halfedge_handle(TriMesh::EdgeHandle(edge_count++), 0)
+                   : connectivity_.opposite_halfedge_handle(sides[static_cast<size_t>(partner)]);
+  }
+  // Every element at once (new_edge and new_face resize every property per element).
+  connectivity_.resize(point_count_, static_cast<size_t>(edge_count), corner_count / 3);
+  std::vector<TriMesh::HalfedgeHandle> border_out(point_count_);  // invalid: an inner point
+  for (size_t c = 0; c < corner_count; c += 3) {
+    const auto face = connectivity_.face_handle(static_cast<int>(c / 3));
+    connectivity_.set_halfedge_handle(face, sides[c + 2]);
+    for (size_t k = c; k < c + 3; ++k) {
+      connectivity_.set_vertex_handle(sides[k], vertex(next_corner(k)));
+      connectivity_.set_face_handle(sides[k], face);
+      connectivity_.set_next_halfedge_handle(sides[k], sides[next_corner(k)]);
+      connectivity_.set_halfedge_handle(vertex(k), sides[k]);
+      if (partners[k] >= 0) continue;
+      const auto border = connectivity_.opposite_halfedge_handle(sides[k]);
+      connectivity_.set_vertex_handle(border, vertex(k));
+      border_out[static_cast<size_t>(corner_points_[next_corner(k)])] = border;
+    }
+  }
+  for (size_t c = 0; c < corner_count; ++c) {
+    if (partners[c] >= 0) continue;
+    // The border halfedge opposite side c runs into corner c's point.
+    connectivity_.set_next_halfedge_handle(connectivity_.opposite_halfedge_handle(sides[c]),
+                                           border_out[static_cast<size_t>(corner_points_[c])]);
+  }
+  for (size_t p = 0; p < point_count_; ++p)
+    if (border_out[p].is_valid())
+      connectivity_.set_halfedge_handle(connectivity_.vertex_handle(static_cast<int>(p)), border_out[p]);
 }
 
 void CollapseEngine::find_border_and_seam_sides() {

@@ -154,6 +154,7 @@ class CollapseEngine {
   using TriMesh = OpenMesh::TriConnectivity;
 
   void build_connectivity();
+  void link_paired_sides();
   void find_border_and_seam_sides();
   Candidate candidate_for(int32_t edge) const;
   Candidate evaluate(CollapsePolicy& policy, int32_t edge) const;

@@ -113,11 +113,20 @@ void bucket_by_point(size_t item_count, size_t point_count, PointOf point_of, st
       static_cast<int32_t>(i);
 }
 
-// Step 3: corner labels such that corners with one label form one fan. Across every undirected
-// edge, sides are paired first-come in face order, one forward with one backward; unpaired sides
-// are borders of their piece. Sides are visited in (edge, corner) order: bucketed by their lower
-// point, then sorted by (higher point, corner) inside the bucket.
-std::vector<int32_t> corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) {
+// Step 3's fans: `label` gives corners with one label one fan; `partner` the side paired with
+// each side (a side starts at its corner), -1 for a border; `simple` is set when every
+// undirected edge has at most one side each way and both are paired (then no directed edge
+// repeats, whatever the fans, and the pairing is the one OpenMesh's add_face would make).
+struct Fans {
+  std::vector<int32_t> label, partner;
+  bool simple = true;
+};
+
+// Step 3: across every undirected edge, sides are paired first-come in face order, one forward
+// with one backward; unpaired sides are borders of their piece, and paired sides join the
+// corners of their points into fans. Sides are visited in (edge, corner) order: bucketed by
+// their lower point, then sorted by (higher point, corner) inside the bucket.
+Fans corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) {
   const size_t corner_count = corner_points.size();
   std::vector<Side> sides(corner_count);
   for (size_t c = 0; c < corner_count; ++c) {
@@ -133,6 +142,8 @@ std::vector<int32_t> corner_fans(const std::vector<int32_t>& corner_points, size
     std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1],
               [](const Side& x, const Side& y) { return x.key != y.key ? x.key < y.key : x.corner < y.corner; });
   UnionFind fans(corner_count);
+  Fans out;
+  out.partner.assign(corner_count, -1);
   std::vector<int32_t> forward, backward;
   std::vector<uint8_t> taken;
   for (size_t i = 0; i < sorted.size();) {
@@ -141,6 +152,7 @@ std::vector<int32_t> corner_fans(const std::vector<int32_t>& corner_points, size
     forward.clear();
     backward.clear();
     for (size_t k = i; k < j; ++k) (sorted[k].forward ? forward : backward).push_back(sorted[k].corner);
+    out.simple &= forward.size() <= 1 && backward.size() <= 1;
     taken.assign(backward.size(), 0);
     for (const int32_t ca : forward) {
       // The first free opposite side, unless its face is the same triangle turned over (a
@@ -148,19 +160,24 @@ std::vector<int32_t> corner_fans(const std::vector<int32_t>& corner_points, size
       size_t match = 0;
       while (match < backward.size() && (taken[match] || same_triangle(corner_points, ca / 3, backward[match] / 3)))
         ++match;
-      if (match == backward.size()) continue;
+      if (match == backward.size()) {
+        out.simple &= backward.empty();
+        continue;
+      }
       taken[match] = 1;
       // Side a -> b starts at corner ca (point a) and ends at the next corner (point b); the
       // opposite side b -> a starts at point b. Join the corners of equal points.
       const int32_t cb = backward[match];
       fans.unite(ca, next_corner(cb));
       fans.unite(next_corner(ca), cb);
+      out.partner[static_cast<size_t>(ca)] = cb;
+      out.partner[static_cast<size_t>(cb)] = ca;
     }
     i = j;
   }
-  std::vector<int32_t> label(corner_count);
-  for (size_t c = 0; c < corner_count; ++c) label[c] = fans.find(static_cast<int32_t>(c));
-  return label;
+  out.label.resize(corner_count);
+  for (size_t c = 0; c < corner_count; ++c) out.label[c] = fans.find(static_cast<int32_t>(c));
+  return out;
 }
 
 // Faces that repeat a directed edge of a face before them (the lowest face keeps it): bucketed
@@ -256,7 +273,8 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   // (three new points), which ends the loop since its points are its own.
   out.point_split.assign(out.point_source.size(), 0);
   while (true) {
-    const std::vector<int32_t> label = corner_fans(corner_points, out.point_source.size());
+    Fans fans = corner_fans(corner_points, out.point_source.size());
+    const std::vector<int32_t>& label = fans.label;
     // One point per (point, fan); the fan of the lowest corner keeps the point's index.
     std::vector<int32_t> fan_point(corner_points.size(), -1);
     std::vector<int32_t> first_fan(out.point_source.size(), -1);
@@ -275,6 +293,10 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
       }
     }
     for (size_t c = 0; c < corner_points.size(); ++c) corner_points[c] = fan_point[label[c]];
+    if (fans.simple) {
+      out.side_partners = std::move(fans.partner);
+      break;
+    }
 
     std::vector<uint8_t> loose;
     const bool any = repeated_directed_edges(corner_points, out.point_source.size(), loose);

@@ -43,6 +43,11 @@ struct PreparedMesh {
   std::vector<int32_t> faces;          // (M', 3) point indices, manifold, consistently oriented
   std::vector<int32_t> corner_wedges;  // (M', 3) input vertex standing for each corner (after step 4)
   std::vector<int32_t> face_sources;   // (M',) input face index
+  // (M', 3) the corner whose side runs opposite corner c's (a corner's side runs from its point
+  // to the next corner's in the face), -1 on a border: the surface's edges, as OpenMesh's
+  // add_face pairs them. Empty when step 3 found an edge with several sides one way or an
+  // unpaired opposite pair (then only add_face's own search gives that pairing).
+  std::vector<int32_t> side_partners;
   std::vector<int32_t> wedge_point;    // (V,) a point of each input vertex, -1 when unreferenced
   std::vector<int32_t> wedge_representative;  // (V,) the wedge each input vertex merged into (step 4)
   // What was done, for reports.

@@ -78,12 +78,11 @@ std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, 
 
 int32_t next_corner(int32_t corner) { return corner - corner % 3 + (corner % 3 + 1) % 3; }
 
-bool same_triangle(const std::vector<int32_t>& corner_points, int32_t f, int32_t g) {
-  std::array<int32_t, 3> a{corner_points[3 * f], corner_points[3 * f + 1], corner_points[3 * f + 2]};
-  std::array<int32_t, 3> b{corner_points[3 * g], corner_points[3 * g + 1], corner_points[3 * g + 2]};
-  std::sort(a.begin(), a.end());
-  std::sort(b.begin(), b.end());
-  return a == b;
+// Whether the faces of two opposite sides (a -> b starting at corner `forward`, b -> a at
+// `backward`) are one triangle turned over: their third points agree.
+bool same_triangle(const std::vector<int32_t>& corner_points, int32_t forward, int32_t backward) {
+  return corner_points[static_cast<size_t>(next_corner(next_corner(forward)))] ==
+         corner_points[static_cast<size_t>(next_corner(next_corner(backward)))];
 }
 
 // Corners of one point are joined when their faces are paired across an edge at that point.
@@ -128,16 +127,16 @@ struct Fans {
 // their lower point, then sorted by (higher point, corner) inside the bucket.
 Fans corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) {
   const size_t corner_count = corner_points.size();
-  std::vector<Side> sides(corner_count);
-  for (size_t c = 0; c < corner_count; ++c) {
-    const int32_t a = corner_points[c], b = corner_points[next_corner(static_cast<int32_t>(c))];
-    sides[c] = {edge_key(a, b), static_cast<int32_t>(c), a < b ? 1 : 0};
-  }
+  auto end_point = [&](size_t c) { return corner_points[static_cast<size_t>(next_corner(static_cast<int32_t>(c)))]; };
   std::vector<int32_t> offsets, order;
-  bucket_by_point(corner_count, point_count, [&](size_t c) { return static_cast<int32_t>(sides[c].key >> 32); },
+  bucket_by_point(corner_count, point_count, [&](size_t c) { return std::min(corner_points[c], end_point(c)); },
                   offsets, order);
   std::vector<Side> sorted(corner_count);
-  for (size_t i = 0; i < corner_count; ++i) sorted[i] = sides[static_cast<size_t>(order[i])];
+  for (size_t i = 0; i < corner_count; ++i) {
+    const auto c = static_cast<size_t>(order[i]);
+    const int32_t a = corner_points[c], b = end_point(c);
+    sorted[i] = {edge_key(a, b), static_cast<int32_t>(c), a < b ? 1 : 0};
+  }
   for (size_t p = 0; p < point_count; ++p)
     std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1],
               [](const Side& x, const Side& y) { return x.key != y.key ? x.key < y.key : x.corner < y.corner; });
@@ -158,7 +157,7 @@ Fans corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) 
       // The first free opposite side, unless its face is the same triangle turned over (a
       // two-sided sheet): joining those would fold the surface onto itself.
       size_t match = 0;
-      while (match < backward.size() && (taken[match] || same_triangle(corner_points, ca / 3, backward[match] / 3)))
+      while (match < backward.size() && (taken[match] || same_triangle(corner_points, ca, backward[match])))
         ++match;
       if (match == backward.size()) {
         out.simple &= backward.empty();
@@ -228,8 +227,6 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   }
 
   // Step 2: faces in point terms; drop degenerate ones and repeats (same points, same turn).
-  std::vector<std::array<int32_t, 3>> kept_faces;
-  std::vector<int32_t> kept_sources;
   std::vector<std::pair<std::array<int32_t, 3>, int32_t>> rotated;  // canonical rotation, face
   for (size_t f = 0; f < mesh.face_count; ++f) {
     const int32_t* v = mesh.faces + 3 * f;

@@ -182,9 +182,16 @@ class AqemPolicy final : public detail::CollapsePolicy {
 
  private:
   void accumulate_quadrics();
-  void accumulate_frames(size_t begin, size_t end);
-  void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, size_t begin, size_t end);
-  void add_tip_points(size_t begin, size_t end);
+  // A worker's share of the quadrics: used frames [frame_begin, frame_end) of points
+  // [point_begin, point_end).
+  struct QuadricShare {
+    size_t frame_begin, frame_end;
+    int32_t point_begin, point_end;
+    bool has(int32_t point) const { return point >= point_begin && point < point_end; }
+  };
+  void accumulate_share(const QuadricShare& share);
+  void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, const QuadricShare& share);
+  void add_tip_points(const QuadricShare& share);
   // Placement of the candidate being evaluated, per worker; a cache line of its own, as every
   // evaluation writes it (sharing one, the two workers' evaluations took 1.5x as long).
   struct alignas(64) Scratch {
@@ -243,12 +250,21 @@ void AqemPolicy::accumulate_quadrics() {
       if (tips_.empty()) break;
     }
   }
-  // The frames are independent: two workers take half of them each, every quadric summing its
-  // planes in the same order as one worker would.
-  const size_t workers = used_count_ >= 2 && faces.size() * used_count_ >= 3 * 65536 ? 2 : 1;
+  // Two workers take half of the frames each, or with one frame half of the points (a face
+  // between the halves is planed by both); every quadric sums its planes in the same order as
+  // one worker would.
+  const size_t workers = faces.size() * used_count_ >= 3 * 65536 ? 2 : 1;
+  const auto points = static_cast<int32_t>(point_count);
   auto accumulate = [&](size_t worker) {
-    const size_t begin = used_count_ * worker / workers, end = used_count_ * (worker + 1) / workers;
-    accumulate_frames(begin, end);
+    QuadricShare share{0, used_count_, 0, points};
+    if (workers == 2 && used_count_ >= 2) {
+      share.frame_begin = used_count_ * worker / 2;
+      share.frame_end = used_count_ * (worker + 1) / 2;
+    } else if (workers == 2) {
+      share.point_begin = worker == 0 ? 0 : points / 2;
+      share.point_end = worker == 0 ? points / 2 : points;
+    }
+    accumulate_share(share);
   };
   std::thread second;
   if (workers == 2) second = std::thread(accumulate, 1);
@@ -256,12 +272,13 @@ void AqemPolicy::accumulate_quadrics() {
   if (second.joinable()) second.join();
 }
 
-// The quadrics of used frames [begin, end): every face's plane, then the border and seam sides'.
-void AqemPolicy::accumulate_frames(size_t begin, size_t end) {
+// A share of the quadrics: every face's plane, then the border and seam sides', then the tips'.
+void AqemPolicy::accumulate_share(const QuadricShare& share) {
   const std::vector<int32_t>& faces = engine_.prepared().faces;
   for (size_t f = 0; f < faces.size() / 3; ++f) {
     const int32_t* v = &faces[3 * f];
-    for (size_t k = begin; k < end; ++k) {
+    if (!share.has(v[0]) && !share.has(v[1]) && !share.has(v[2])) continue;
+    for (size_t k = share.frame_begin; k < share.frame_end; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d p0 = engine_.position(v[0], frame), p1 = engine_.position(v[1], frame),
                             p2 = engine_.position(v[2], frame);
@@ -269,29 +286,33 @@ void AqemPolicy::accumulate_frames(size_t begin, size_t end) {
       const double length = normal.norm();
       if (length == 0.0) continue;  // a face with no area in this frame has no plane
       const Quadric plane = Quadric::plane(normal / length, p0, 1.0);
-      for (int corner = 0; corner < 3; ++corner) quadrics_of(v[corner])[k] += plane;
+      for (int corner = 0; corner < 3; ++corner)
+        if (share.has(v[corner])) quadrics_of(v[corner])[k] += plane;
     }
   }
   if (options_.boundary_quadrics) {
-    add_side_planes(engine_.border_sides(), begin, end);
-    add_side_planes(engine_.seam_sides(), begin, end);
+    add_side_planes(engine_.border_sides(), share);
+    add_side_planes(engine_.seam_sides(), share);
   }
-  add_tip_points(begin, end);
+  add_tip_points(share);
 }
 
 // Every needle tip gets, in each used frame, the squared distance from where it is, once per
 // plane of the point (so it weighs like the planes do): moving a tip then costs at least its
 // displacement, which its nearly parallel planes do not charge.
-void AqemPolicy::add_tip_points(size_t begin, size_t end) {
-  for (size_t k = begin; k < end; ++k)
+void AqemPolicy::add_tip_points(const QuadricShare& share) {
+  for (size_t k = share.frame_begin; k < share.frame_end; ++k)
     for (int32_t tip : tips_)
-      quadrics_of(tip)[k] += Quadric::point(engine_.position(tip, static_cast<size_t>(frames_[k])), plane_counts_[tip]);
+      if (share.has(tip))
+        quadrics_of(tip)[k] +=
+            Quadric::point(engine_.position(tip, static_cast<size_t>(frames_[k])), plane_counts_[tip]);
 }
 
 // A plane through each side (a, b) perpendicular to the face (a, b, c) beside it.
-void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, size_t begin, size_t end) {
+void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, const QuadricShare& share) {
   for (const auto& [a, b, c] : sides) {
-    for (size_t k = begin; k < end; ++k) {
+    if (!share.has(a) && !share.has(b)) continue;
+    for (size_t k = share.frame_begin; k < share.frame_end; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d pa = engine_.position(a, frame), pb = engine_.position(b, frame),
                             pc = engine_.position(c, frame);
@@ -300,8 +321,8 @@ void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& side
       const double length = normal.norm();
       if (length == 0.0) continue;
       const Quadric plane = Quadric::plane(normal / length, pa, 1.0);
-      quadrics_of(a)[k] += plane;
-      quadrics_of(b)[k] += plane;
+      if (share.has(a)) quadrics_of(a)[k] += plane;
+      if (share.has(b)) quadrics_of(b)[k] += plane;
     }
   }
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <iterator>
 #include <limits>
 #include <thread>
@@ -292,6 +293,7 @@ int32_t CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candid
                        candidate.t);
   }
   merged_into_[candidate.removed] = candidate.kept;
+  if (!ranking_cache_.changed.empty()) ranking_cache_.changed[candidate.kept] = 1;
   for (const auto& [from, to] : workspace.wedge_moves) wedge_merged_into_[from] = to;
 
   // Corners of the removed point now belong to the kept point, with the mapped wedge.
@@ -441,8 +443,10 @@ EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
 bool CollapseEngine::release_guards(CollapsePolicy& policy) {
   if (released_) return false;
   released_ = true;
-  if (in_passes_)  // the next pass evaluates every edge anyway
+  if (in_passes_) {  // the next pass evaluates every edge, none from the cache (locked() changed)
+    std::fill(ranking_cache_.cost.begin(), ranking_cache_.cost.end(), std::numeric_limits<double>::quiet_NaN());
     return std::find(locked_.begin(), locked_.end(), kGuarded) != locked_.end();
+  }
   for (size_t p = 0; p < point_count_; ++p) {
     if (locked_[p] != kGuarded) continue;
     const auto vertex = connectivity_.vertex_handle(static_cast<int>(p));
@@ -539,11 +543,12 @@ CollapseEngine::Attempt CollapseEngine::try_collapse(CollapsePolicy& policy, Can
   return Attempt::collapsed;
 }
 
-// Every live edge that can collapse, with its cost, in edge order. The edges are split in
-// contiguous ranges over up to the policy's concurrency() threads (each candidate's values do
-// not depend on the thread that computed them), each writing its part of `ranked` from the
-// start of its range; the parts are then moved together.
-void CollapseEngine::rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) const {
+// Every live edge that can collapse, with its cost, in edge order (from ranking_cache_ where
+// that is kept). The edges are split in contiguous ranges over up to the policy's
+// concurrency() threads (each candidate's values do not depend on the thread that computed
+// them), each writing its part of `ranked` from the start of its range; the parts are then
+// moved together.
+void CollapseEngine::rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) {
   constexpr size_t kMinimumChunk = 8192;
   const size_t edge_count = connectivity_.n_edges();
   const size_t hardware = std::max<size_t>(std::thread::hardware_concurrency(), 1);
@@ -556,11 +561,20 @@ void CollapseEngine::rank_collapsible_edges(CollapsePolicy& policy, std::vector<
       if (connectivity_.status(connectivity_.edge_handle(static_cast<int>(e))).deleted()) continue;
       Candidate candidate = candidate_for(static_cast<int32_t>(e));
       if (locked(candidate.kept) && locked(candidate.removed)) continue;  // cannot collapse (yet)
-      policy.evaluate_concurrently(candidate, worker);
+      RankingCache& cache = ranking_cache_;
+      if (!cache.cost.empty() && !std::isnan(cache.cost[e]) && !cache.changed[candidate.kept] &&
+          !cache.changed[candidate.removed]) {
+        candidate.cost = cache.cost[e];
+        candidate.error = cache.error[e];
+      } else {
+        policy.evaluate_concurrently(candidate, worker);
+        if (!cache.cost.empty()) cache.cost[e] = candidate.cost, cache.error[e] = candidate.error;
+      }
       ranked[out++] = {candidate.cost, candidate.error, static_cast<int32_t>(e), candidate.kept, candidate.removed};
     }
     ends[worker] = out;
   });
+  std::fill(ranking_cache_.changed.begin(), ranking_cache_.changed.end(), 0);
   size_t size = ends[0];
   for (size_t worker = 1; worker < workers; ++worker) {
     const auto begin = ranked.begin() + static_cast<std::ptrdiff_t>(edge_count * worker / workers);
@@ -744,6 +758,9 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
   std::vector<int32_t> chosen_rank(connectivity_.n_edges(), -1);  // place in ranked of the pass's chosen edges
   std::vector<uint8_t> touched(point_count_, 0);
   in_passes_ = true;
+  ranking_cache_.cost.assign(connectivity_.n_edges(), std::numeric_limits<double>::quiet_NaN());
+  ranking_cache_.error.assign(connectivity_.n_edges(), 0.0);
+  ranking_cache_.changed.assign(point_count_, 0);
   while (next_level_ < targets.size()) {
     // Step 7: every collapsible edge, evaluated.
     rank_collapsible_edges(policy, ranked);
@@ -751,6 +768,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       // The last few edges in one greedy order: re-keying them costs little, and on small
       // meshes and coarse levels the order matters most.
       in_passes_ = false;
+      ranking_cache_ = {};
       run_greedy(policy, ranked, targets, levels, record);
       return;
     }
@@ -817,6 +835,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
     // cheapest legal collapse exceeds max_error), unless guarded points can be released.
     if (pass_collapses == 0 && (over_max_error || !release_guards(policy))) break;
   }
+  ranking_cache_ = {};
 }
 
 }  // namespace animlod::detail

@@ -187,7 +187,7 @@ class CollapseEngine {
                               EngineRecord& record, std::vector<RankedEdge>& deferred);
   void split_points_in_halves(const std::vector<RankedEdge>& chosen);
   bool stays_in_half(const RankedEdge& entry, uint8_t half) const;
-  void rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) const;
+  void rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked);
   void rekey_around(CollapsePolicy& policy, TriMesh::VertexHandle vertex, bool all_edges);
   void park(int32_t edge);
   EngineLevel snapshot(size_t target, bool reached);
@@ -219,6 +219,14 @@ class CollapseEngine {
   std::vector<uint8_t> parked_;             // (E,) popped while illegal; re-tried when the area changes
   std::vector<uint8_t> may_have_parked_;    // (P,) set when an edge of the point is parked
   std::array<Workspace, 2> workspaces_;     // per worker; the engine's own thread uses the first
+  // Collapse passes' costs carried from one ranking to the next: a candidate's values depend
+  // only on its two points (as the greedy order's re-keying around the kept point assumes too),
+  // so an edge whose points no collapse kept since, and no guard release, costs the same.
+  struct RankingCache {
+    std::vector<double> cost, error;  // (E,) NaN cost: not evaluated since the cache was reset
+    std::vector<uint8_t> changed;     // (P,) kept by a collapse since the last ranking
+  };
+  RankingCache ranking_cache_;              // empty outside collapse passes
   std::vector<uint8_t> half_;               // (P,) the half of the mesh each point is in (perform_in_halves)
   std::vector<std::array<int32_t, 3>> border_sides_, seam_sides_;
   TriMesh connectivity_;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
+#include <cstring>
 #include <numeric>
 
 #include "union_find.hpp"
@@ -34,44 +36,68 @@ std::vector<std::pair<int32_t, float>> skin_set(const WeldInput& input, size_t v
 
 // Step 1: vertices equal in every frame, in position attributes and in skin share a point.
 // Returns (V,) the lowest input vertex each referenced vertex welds with (itself if none), -1
-// for unreferenced vertices.
+// for unreferenced vertices. meshoptimizer's position remap: an open-addressing table keyed by
+// the frame-0 position (-0 as 0) holds the first vertex of each class met in input order, the
+// lowest; vertices alike in frame 0 but not elsewhere probe on.
 std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, const std::vector<uint8_t>& used) {
   const size_t vertex_count = mesh.vertex_count;
   const size_t frame_stride = vertex_count * 3;
-  std::vector<int32_t> order;
-  for (size_t v = 0; v < vertex_count; ++v)
-    if (used[v]) order.push_back(static_cast<int32_t>(v));
   std::vector<int32_t> welded_to(vertex_count, -1);
   if (!input.weld) {
-    for (int32_t v : order) welded_to[v] = v;
+    for (size_t v = 0; v < vertex_count; ++v)
+      if (used[v]) welded_to[v] = static_cast<int32_t>(v);
     return welded_to;
   }
-  auto compare = [&](int32_t a, int32_t b) {
-    // Frame 0 first: most vertices differ there, so the full rows are rarely read.
+  auto equal = [&](int32_t a, int32_t b) {
     for (size_t frame = 0; frame < mesh.frame_count; ++frame) {
       const float* pa = mesh.frames + frame * frame_stride + static_cast<size_t>(a) * 3;
       const float* pb = mesh.frames + frame * frame_stride + static_cast<size_t>(b) * 3;
-      if (int c = compare_rows(pa, pb, 3, 1, 1)) return c;
+      if (compare_rows(pa, pb, 3, 1, 1) != 0) return false;
     }
     const size_t width = input.position_attribute_count;
-    if (width) {
-      const float* pa = input.position_attributes + static_cast<size_t>(a) * width;
-      const float* pb = input.position_attributes + static_cast<size_t>(b) * width;
-      if (int c = compare_rows(pa, pb, width, 1, 1)) return c;
-    }
-    if (input.skin_joints) {
-      const auto sa = skin_set(input, a), sb = skin_set(input, b);
-      if (sa != sb) return sa < sb ? -1 : 1;
-    }
-    return 0;
+    if (width && compare_rows(input.position_attributes + static_cast<size_t>(a) * width,
+                              input.position_attributes + static_cast<size_t>(b) * width, width, 1, 1) != 0)
+      return false;
+    return !input.skin_joints || skin_set(input, static_cast<size_t>(a)) == skin_set(input, static_cast<size_t>(b));
   };
-  std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return compare(a, b) < 0; });
-  for (size_t i = 0; i < order.size();) {
-    size_t j = i + 1;
-    while (j < order.size() && compare(order[i], order[j]) == 0) ++j;
-    // stable_sort keeps equal vertices in input order: the first is the lowest index.
-    for (size_t k = i; k < j; ++k) welded_to[order[k]] = order[i];
-    i = j;
+  // Over everything `equal` compares, so that only equal vertices share a probe sequence (a
+  // mesh whose vertices all start at one spot must not chain them all).
+  auto mix = [](uint64_t h, float value) {
+    value += 0.0f;  // -0 + 0 is +0
+    uint32_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    h = (h ^ bits) * 0xff51afd7ed558ccdull;
+    return h ^ (h >> 32);
+  };
+  auto hash = [&](size_t v) {
+    uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (size_t frame = 0; frame < mesh.frame_count; ++frame)
+      for (size_t axis = 0; axis < 3; ++axis) h = mix(h, mesh.frames[frame * frame_stride + v * 3 + axis]);
+    for (size_t b = 0; b < input.position_attribute_count; ++b)
+      h = mix(h, input.position_attributes[v * input.position_attribute_count + b]);
+    uint64_t skin = 0;  // a sum: the influences' order does not count, zero weights do not count
+    for (size_t k = 0; input.skin_joints && k < input.influence_count; ++k) {
+      const float weight = input.skin_weights[v * input.influence_count + k];
+      if (weight > 0.0f) skin += mix(static_cast<uint64_t>(input.skin_joints[v * input.influence_count + k]), weight);
+    }
+    return h ^ skin;
+  };
+  size_t capacity = 16;
+  while (capacity < 2 * vertex_count) capacity *= 2;
+  std::vector<int32_t> table(capacity, -1);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    if (!used[v]) continue;
+    for (size_t slot = hash(v) & (capacity - 1);; slot = (slot + 1) & (capacity - 1)) {
+      if (table[slot] < 0) {
+        table[slot] = static_cast<int32_t>(v);
+        welded_to[v] = static_cast<int32_t>(v);
+        break;
+      }
+      if (equal(table[slot], static_cast<int32_t>(v))) {
+        welded_to[v] = table[slot];
+        break;
+      }
+    }
   }
   return welded_to;
 }

@@ -335,3 +335,27 @@ def test_int64_indices_are_range_checked_not_wrapped():
         )
     with pytest.raises(ValueError, match=r"^faces: expected an integer array \(int32 or int64\), got dtype float64$"):
         _core.simplify_animated(mesh.frames, mesh.faces.astype(np.float64))
+
+
+def test_welding_joins_exactly_the_copies_equal_everywhere():
+    # Four copies of every vertex of a tube: one equal to it in every frame (welds; -0 is 0), one
+    # equal in frame 0 only, one with another skin, one with the same skin listed in another
+    # order with a zero-weight influence (welds). Welding is keyed by a hash over all of these.
+    mesh = bending_tube(frames=2)
+    n = mesh.vertex_count
+    same = mesh.frames.copy()
+    same[same == 0.0] = -0.0
+    later = mesh.frames.copy()
+    later[1] += 0.25
+    frames = np.concatenate([mesh.frames, same, later, mesh.frames, mesh.frames], axis=1)
+    joints = np.tile(np.array([[0, 1, 2]], np.int32), (5 * n, 1))
+    weights = np.tile(np.array([[0.75, 0.25, 0.0]], np.float32), (5 * n, 1))
+    weights[3 * n : 4 * n] = [0.5, 0.5, 0.0]
+    joints[4 * n :] = [1, 0, 3]
+    weights[4 * n :] = [0.25, 0.75, 0.0]
+    faces = np.concatenate([mesh.faces + k * n for k in range(5)])
+    result = simplify_animated(AnimatedMesh(faces, frames), (0.5,), skin_joints=joints, skin_weights=weights)
+    assert result.preparation.welded_vertices == 2 * n
+    # The welded copies' faces repeat the tube's and are dropped; the other two copies stay.
+    assert result.preparation.duplicate_faces == 2 * mesh.face_count
+    assert result.preparation.face_count == 3 * mesh.face_count

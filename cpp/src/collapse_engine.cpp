@@ -152,6 +152,7 @@ void CollapseEngine::find_border_and_seam_sides() {
     const auto h = edge.h0();
     const auto left = h.face(), right = h.opp().face();
     const int32_t a = h.from().idx(), b = h.to().idx();
+    if (point_wedge_[a] >= 0 && point_wedge_[b] >= 0) continue;  // one wedge at each end
     if (corner_wedge(left, a) == corner_wedge(right, a) && corner_wedge(left, b) == corner_wedge(right, b)) continue;
     // A plane through the edge perpendicular to each face keeps the seam line in place.
     seam_sides_.push_back({a, b, h.next().to().idx()});

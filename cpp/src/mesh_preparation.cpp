@@ -254,6 +254,7 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
 
   // Step 2: faces in point terms; drop degenerate ones and repeats (same points, same turn).
   std::vector<std::pair<std::array<int32_t, 3>, int32_t>> rotated;  // canonical rotation, face
+  rotated.reserve(mesh.face_count);
   for (size_t f = 0; f < mesh.face_count; ++f) {
     const int32_t* v = mesh.faces + 3 * f;
     const std::array<int32_t, 3> p{point_of[v[0]], point_of[v[1]], point_of[v[2]]};
@@ -278,6 +279,9 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
       if (sorted[i].first == sorted[i - 1].first) repeated[sorted[i].second] = 1;
   }
   std::vector<int32_t> corner_points, corner_inputs;
+  corner_points.reserve(3 * rotated.size());
+  corner_inputs.reserve(3 * rotated.size());
+  out.face_sources.reserve(rotated.size());
   for (const auto& entry : rotated) {
     const int32_t f = entry.second;
     if (repeated[f]) {

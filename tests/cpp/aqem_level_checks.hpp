@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <set>
 #include <utility>
+#include <vector>
 
 #include <doctest/doctest.h>
 
@@ -20,6 +21,18 @@ inline AqemResult simplify(const OwnedAnimatedMesh& mesh, const AqemOptions& opt
   const animlod::Status status = simplify_animated(mesh.view(), data, options, result);
   REQUIRE_MESSAGE(status.ok, status.message);
   return result;
+}
+
+// Two attributes (UVs) and two skin influences per vertex, as the tests below give them.
+inline AqemVertexData uvs_and_two_influences(const std::vector<float>& uvs, const std::vector<int32_t>& joints,
+                                             const std::vector<float>& weights) {
+  AqemVertexData data;
+  data.attributes = uvs.data();
+  data.attribute_count = 2;
+  data.skin_joints = joints.data();
+  data.skin_weights = weights.data();
+  data.influence_count = 2;
+  return data;
 }
 
 // Every undirected edge of the level has one or two faces, each direction used once.

@@ -253,12 +253,7 @@ TEST_CASE("aqem merges skin weights and interpolates attributes") {
     uvs[2 * v] = mesh.frames[3 * v];
     uvs[2 * v + 1] = mesh.frames[3 * v + 1];
   }
-  AqemVertexData data;
-  data.skin_joints = joints.data();
-  data.skin_weights = weights.data();
-  data.influence_count = 2;
-  data.attributes = uvs.data();
-  data.attribute_count = 2;
+  const AqemVertexData data = animlod::testing::uvs_and_two_influences(uvs, joints, weights);
   AqemOptions options;
   options.target_ratios = {0.25};
   const AqemResult result = simplify(mesh, options, data);

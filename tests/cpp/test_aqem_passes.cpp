@@ -89,12 +89,7 @@ TEST_CASE("collapse passes on two workers keep seams and carry attributes and sk
     weights[2 * v] = 0.75f;
     weights[2 * v + 1] = 0.25f;
   }
-  AqemVertexData data;
-  data.attributes = uvs.data();
-  data.attribute_count = 2;
-  data.skin_joints = joints.data();
-  data.skin_weights = weights.data();
-  data.influence_count = 2;
+  const AqemVertexData data = animlod::testing::uvs_and_two_influences(uvs, joints, weights);
   AqemOptions options;
   options.target_ratios = {0.1};
   const AqemResult result = simplify(mesh, options, data);

@@ -14,8 +14,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <utility>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>

@@ -104,7 +104,6 @@ void CollapseEngine::build_connectivity() {
 void CollapseEngine::link_paired_sides() {
   const std::vector<int32_t>& partners = prepared_.side_partners;
   const size_t corner_count = corner_points_.size();
-  auto next_corner = [](size_t c) { return c - c % 3 + (c % 3 + 1) % 3; };
   auto vertex = [&](size_t c) { return connectivity_.vertex_handle(corner_points_[c]); };
   std::vector<TriMesh::HalfedgeHandle> sides(corner_count);  // the halfedge of each corner's side
   int edge_count = 0;

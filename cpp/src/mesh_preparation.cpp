@@ -36,9 +36,9 @@ std::vector<std::pair<int32_t, float>> skin_set(const WeldInput& input, size_t v
 
 // Step 1: vertices equal in every frame, in position attributes and in skin share a point.
 // Returns (V,) the lowest input vertex each referenced vertex welds with (itself if none), -1
-// for unreferenced vertices. meshoptimizer's position remap: an open-addressing table keyed by
-// the frame-0 position (-0 as 0) holds the first vertex of each class met in input order, the
-// lowest; vertices alike in frame 0 but not elsewhere probe on.
+// for unreferenced vertices. As meshoptimizer's position remap: an open-addressing table keyed
+// by a hash of everything compared holds the first vertex of each class met in input order, the
+// lowest.
 std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, const std::vector<uint8_t>& used) {
   const size_t vertex_count = mesh.vertex_count;
   const size_t frame_stride = vertex_count * 3;
@@ -102,8 +102,6 @@ std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, 
   return welded_to;
 }
 
-int32_t next_corner(int32_t corner) { return corner - corner % 3 + (corner % 3 + 1) % 3; }
-
 // Whether the faces of two opposite sides (a -> b starting at corner `forward`, b -> a at
 // `backward`) are one triangle turned over: their third points agree.
 bool same_triangle(const std::vector<int32_t>& corner_points, int32_t forward, int32_t backward) {
@@ -153,7 +151,7 @@ struct Fans {
 // their lower point, then sorted by (higher point, corner) inside the bucket.
 Fans corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) {
   const size_t corner_count = corner_points.size();
-  auto end_point = [&](size_t c) { return corner_points[static_cast<size_t>(next_corner(static_cast<int32_t>(c)))]; };
+  auto end_point = [&](size_t c) { return corner_points[next_corner(c)]; };
   std::vector<int32_t> offsets, order;
   bucket_by_point(corner_count, point_count, [&](size_t c) { return std::min(corner_points[c], end_point(c)); },
                   offsets, order);

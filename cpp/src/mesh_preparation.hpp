@@ -59,6 +59,13 @@ struct PreparedMesh {
   size_t unreferenced_vertices = 0;
 };
 
+// The corner after `corner` in its face (corners 3f, 3f + 1, 3f + 2 of face f); a corner's side
+// runs from its point to the next corner's.
+template <typename Index>
+constexpr Index next_corner(Index corner) {
+  return corner - corner % 3 + (corner % 3 + 1) % 3;
+}
+
 // `mesh` must have passed the size, finite and index-range checks. Deterministic.
 PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input);
 

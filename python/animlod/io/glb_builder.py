@@ -125,8 +125,8 @@ class GlbBuilder:
         js = self.json
         nodes = js.get("nodes", [])
         kept_meshes = sorted({node["mesh"] for node in nodes if "mesh" in node})
-        used = js.get("extensionsUsed", [])
-        if _animates_meshes(js) or any(not name.startswith(_NO_MESH_REFERENCES) for name in used):
+        may_name_meshes = any(not name.startswith(_NO_MESH_REFERENCES) for name in js.get("extensionsUsed", []))
+        if _animates_meshes(js) or may_name_meshes:
             kept_meshes = list(range(len(js.get("meshes", []))))
         new_mesh = {old: new for new, old in enumerate(kept_meshes)}
         for node in nodes:
@@ -137,8 +137,8 @@ class GlbBuilder:
         primitives = [p for mesh in js.get("meshes", []) for p in mesh.get("primitives", [])]
         if not any(DRACO_EXTENSION in p.get("extensions", {}) for p in primitives):
             _drop_extension(js, DRACO_EXTENSION)  # the compressed meshes were the input's, now replaced
-        if any(not name.startswith(_PRUNE_SAFE_EXTENSIONS) for name in used):
-            return
+        if any(not name.startswith(_PRUNE_SAFE_EXTENSIONS) for name in js.get("extensionsUsed", [])):
+            return  # read after the Draco drop: Draco no longer named is no reason to stop
         accessor_refs = list(_accessor_references(js))
         kept_accessors = sorted({holder[key] for holder, key in accessor_refs})
         new_accessor = {old: new for new, old in enumerate(kept_accessors)}

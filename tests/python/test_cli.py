@@ -75,6 +75,9 @@ def test_info_real_files(data_dir, capsys):
     assert "14 morph targets" in capsys.readouterr().out
     assert main(["info", str(data_dir / "meshseq" / "crane")]) == 0
     assert "vertices: 10002, triangles: 20000" in capsys.readouterr().out
+    # simplify reads a folder as frames: one holding a model names it instead of "no frame found"
+    assert main(["simplify", str(data_dir / "meshseq" / "Flamingo-morph-glTF"), "-o", "unused"]) == 2
+    assert "holds no .obj or .ply frame but Flamingo.glb: pass a file" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(

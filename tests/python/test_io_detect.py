@@ -40,3 +40,13 @@ def test_unknown_missing_or_unmatched_paths(tmp_path: Path) -> None:
         input_kind(tmp_path / "gone.bvh")
     with pytest.raises(FormatError, match="pattern: matches no file"):
         input_kind(str(tmp_path / "*.ply"))
+
+
+def test_a_folder_of_models_without_frames_names_them(tmp_path: Path) -> None:
+    # `animlod simplify FOLDER` on a folder holding one .glb said "no .obj or .ply frame found".
+    (tmp_path / "bird.glb").write_bytes(b"")
+    (tmp_path / "notes.txt").write_bytes(b"")
+    with pytest.raises(FormatError, match=r"folder: holds no .obj or .ply frame but bird.glb: pass a file"):
+        input_kind(tmp_path)
+    (tmp_path / "bird_0001.obj").write_bytes(b"")
+    assert input_kind(tmp_path) == "sequence"

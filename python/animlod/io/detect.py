@@ -27,6 +27,7 @@ def input_kind(path: str | os.PathLike) -> str:
             raise FormatError(text, "pattern", "matches no file")
         return "sequence"
     if candidate.is_dir():
+        _check_frame_folder(candidate)
         return "sequence"
     if not candidate.exists():
         raise FormatError(text, "file", "does not exist")
@@ -41,6 +42,23 @@ def input_kind(path: str | os.PathLike) -> str:
         return "sequence"
     expected = ".bvh, .glb, .gltf, .npz, .obj, .ply, .vrm or a folder"
     raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}")
+
+
+def _check_frame_folder(folder: Path) -> None:
+    """FormatError for a folder that holds models but no OBJ/PLY frame: a folder is read as one
+    frame sequence, and the models inside would otherwise meet "no frame found"."""
+    files = [path for path in sorted(folder.iterdir()) if path.is_file()]
+    if any(path.suffix.lower() in MESH_SUFFIXES for path in files):
+        return
+    models = [path.name for path in files if path.suffix.lower() in MODEL_SUFFIXES]
+    if models:
+        shown = ", ".join(models[:3]) + (f" and {len(models) - 3} more" if len(models) > 3 else "")
+        raise FormatError(
+            folder,
+            "folder",
+            f"holds no .obj or .ply frame but {shown}: pass a file (a folder is read as one frame sequence; "
+            "animlod batch takes a folder of models)",
+        )
 
 
 def input_stem(path: str | os.PathLike) -> str:

@@ -10,6 +10,7 @@
 #include <thread>
 #include <utility>
 
+#include "cost_order.hpp"
 #include "inversion_test.hpp"
 #include "skin_merge.hpp"
 #include "worker_threads.hpp"
@@ -585,55 +586,6 @@ void CollapseEngine::rank_collapsible_edges(CollapsePolicy& policy, std::vector<
   ranked.resize(size);
 }
 
-// Sorts [begin, end) by `less` (a total order), the two halves on two threads, then merges them.
-template <typename T, typename Less>
-void sort_in_halves(typename std::vector<T>::iterator begin, typename std::vector<T>::iterator end,
-                    std::vector<T>& scratch, Less less) {
-  constexpr std::ptrdiff_t kMinimumHalf = 65536;
-  if (end - begin < 2 * kMinimumHalf || std::thread::hardware_concurrency() < 2) {
-    std::sort(begin, end, less);
-    return;
-  }
-  const auto middle = begin + (end - begin) / 2;
-  std::thread first([&] { std::sort(begin, middle, less); });
-  std::sort(middle, end, less);
-  first.join();
-  scratch.resize(static_cast<size_t>(end - begin));
-  std::merge(begin, middle, middle, end, scratch.begin(), less);
-  std::copy(scratch.begin(), scratch.end(), begin);
-}
-
-// `items` read in the order of `less` (a total order), sorted only as far as it is read: a
-// collapse pass reads the cheapest third to half of its candidates. nth_element leaves every
-// item before the sorted prefix no greater than those after it, so the order read is the full
-// sort's.
-template <typename T, typename Less>
-class SortedOnDemand {
- public:
-  SortedOnDemand(std::vector<T>& items, std::vector<T>& scratch, Less less, size_t first_prefix)
-      : items_(items), scratch_(scratch), less_(less), first_prefix_(first_prefix) {}
-  size_t size() const { return items_.size(); }
-  const T& operator[](size_t i) {
-    if (i >= sorted_) sort_through(i);
-    return items_[i];
-  }
-
- private:
-  void sort_through(size_t i) {
-    const size_t end = std::min(items_.size(), std::max({i + 1, sorted_ + sorted_ / 2, first_prefix_}));
-    const auto begin = items_.begin() + static_cast<std::ptrdiff_t>(sorted_);
-    const auto last = items_.begin() + static_cast<std::ptrdiff_t>(end);
-    if (last != items_.end()) std::nth_element(begin, last, items_.end(), less_);
-    sort_in_halves(begin, last, scratch_, less_);
-    sorted_ = end;
-  }
-
-  std::vector<T>& items_;
-  std::vector<T>& scratch_;
-  Less less_;
-  size_t first_prefix_, sorted_ = 0;
-};
-
 namespace {
 
 void append(EngineRecord& to, const EngineRecord& from) {
@@ -754,7 +706,8 @@ CollapseEngine::Performed CollapseEngine::perform_in_halves(CollapsePolicy& poli
 void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t>& targets,
                                 std::vector<EngineLevel>& levels, EngineRecord& record) {
   constexpr size_t kMinimumHalves = 2048;  // fewer chosen collapses go one by one
-  std::vector<RankedEdge> ranked, scratch, chosen, deferred;
+  std::vector<RankedEdge> ranked, chosen, deferred;
+  CostOrder cost_order;  // ranked comes in edge order, so its (cost, index) order is (cost, edge)
   std::vector<int32_t> chosen_rank(connectivity_.n_edges(), -1);  // place in ranked of the pass's chosen edges
   std::vector<uint8_t> touched(point_count_, 0);
   in_passes_ = true;
@@ -772,15 +725,13 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       run_greedy(policy, ranked, targets, levels, record);
       return;
     }
-    auto less = [](const RankedEdge& a, const RankedEdge& b) {
-      return a.cost < b.cost || (a.cost == b.cost && a.edge < b.edge);
-    };
     const size_t face_goal = face_count_ - targets[next_level_];
     size_t edge_goal = face_goal / 2;  // an illegal collapse does not count towards the goal
-    SortedOnDemand order(ranked, scratch, less, edge_goal + edge_goal / 2);
+    cost_order.sort(ranked);
+    const std::vector<uint32_t>& order = cost_order.order();
     auto within_cost_goal = [&](double cost, size_t removed_faces) {
       return removed_faces <= face_goal / 6 || edge_goal >= order.size() ||
-             cost <= options_.pass_cost_growth * order[edge_goal].cost;
+             cost <= options_.pass_cost_growth * ranked[order[edge_goal]].cost;
     };
 
     // Steps 8-12: choose, then perform in edge order.
@@ -788,13 +739,13 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
     size_t next = 0;
     bool over_max_error = false;  // the pass stops at the first candidate whose error exceeds max_error
     for (size_t planned_faces = 0; next < order.size() && planned_faces < face_goal; ++next) {
-      const RankedEdge& entry = order[next];
+      const RankedEdge& entry = ranked[order[next]];
       if (!within_cost_goal(entry.cost, planned_faces)) break;
       if (touched[entry.kept] || touched[entry.removed]) continue;
       over_max_error = entry.error > options_.max_error;
       if (over_max_error) break;
       touched[entry.kept] = touched[entry.removed] = 1;
-      chosen_rank[entry.edge] = static_cast<int32_t>(next);
+      chosen_rank[entry.edge] = static_cast<int32_t>(order[next]);
       planned_faces += 2;
     }
     chosen.clear();
@@ -825,7 +776,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
     for (; !over_max_error && next < order.size(); ++next) {
       const size_t removed_faces = faces_before - face_count_;
       if (removed_faces >= face_goal) break;
-      const RankedEdge& entry = order[next];
+      const RankedEdge& entry = ranked[order[next]];
       if (!within_cost_goal(entry.cost, removed_faces)) break;
       if (touched[entry.kept] || touched[entry.removed]) continue;
       over_max_error = entry.error > options_.max_error;

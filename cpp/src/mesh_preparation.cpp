@@ -5,8 +5,10 @@
 #include <cstdint>
 #include <cstring>
 #include <numeric>
+#include <thread>
 
 #include "union_find.hpp"
+#include "worker_threads.hpp"
 
 namespace animlod::detail {
 
@@ -148,58 +150,72 @@ struct Fans {
 // Step 3: across every undirected edge, sides are paired first-come in face order, one forward
 // with one backward; unpaired sides are borders of their piece, and paired sides join the
 // corners of their points into fans. Sides are visited in (edge, corner) order: bucketed by
-// their lower point, then sorted by (higher point, corner) inside the bucket.
+// their lower point, then sorted by (higher point, corner) inside the bucket. Large meshes take
+// two workers: one for each half of the buckets (an edge's sides lie in one), then one for each
+// half of the points to join corners (a pairing joins only corners of one point). The fans are
+// the same sets either way, each labelled by its lowest corner.
 Fans corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) {
+  constexpr size_t kCornersPerWorker = 1 << 17;
   const size_t corner_count = corner_points.size();
+  const size_t workers = corner_count >= 2 * kCornersPerWorker && std::thread::hardware_concurrency() >= 2 ? 2 : 1;
   auto end_point = [&](size_t c) { return corner_points[next_corner(c)]; };
   std::vector<int32_t> offsets, order;
   bucket_by_point(corner_count, point_count, [&](size_t c) { return std::min(corner_points[c], end_point(c)); },
                   offsets, order);
-  std::vector<Side> sorted(corner_count);
-  for (size_t i = 0; i < corner_count; ++i) {
-    const auto c = static_cast<size_t>(order[i]);
-    const int32_t a = corner_points[c], b = end_point(c);
-    sorted[i] = {edge_key(a, b), static_cast<int32_t>(c), a < b ? 1 : 0};
-  }
-  for (size_t p = 0; p < point_count; ++p)
-    std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1],
-              [](const Side& x, const Side& y) { return x.key != y.key ? x.key < y.key : x.corner < y.corner; });
-  UnionFind fans(corner_count);
   Fans out;
   out.partner.assign(corner_count, -1);
-  std::vector<int32_t> forward, backward;
-  std::vector<uint8_t> taken;
-  for (size_t i = 0; i < sorted.size();) {
-    size_t j = i;
-    while (j < sorted.size() && sorted[j].key == sorted[i].key) ++j;
-    forward.clear();
-    backward.clear();
-    for (size_t k = i; k < j; ++k) (sorted[k].forward ? forward : backward).push_back(sorted[k].corner);
-    out.simple &= forward.size() <= 1 && backward.size() <= 1;
-    taken.assign(backward.size(), 0);
-    for (const int32_t ca : forward) {
-      // The first free opposite side, unless its face is the same triangle turned over (a
-      // two-sided sheet): joining those would fold the surface onto itself.
-      size_t match = 0;
-      while (match < backward.size() && (taken[match] || same_triangle(corner_points, ca, backward[match])))
-        ++match;
-      if (match == backward.size()) {
-        out.simple &= backward.empty();
-        continue;
-      }
-      taken[match] = 1;
-      // Side a -> b starts at corner ca (point a) and ends at the next corner (point b); the
-      // opposite side b -> a starts at point b. Join the corners of equal points.
-      const int32_t cb = backward[match];
-      fans.unite(ca, next_corner(cb));
-      fans.unite(next_corner(ca), cb);
-      out.partner[static_cast<size_t>(ca)] = cb;
-      out.partner[static_cast<size_t>(cb)] = ca;
+  std::vector<Side> sorted(corner_count);
+  std::vector<uint8_t> simple(workers, 1);
+  run_in_ranges(point_count, workers, [&](size_t first_point, size_t last_point, size_t worker) {
+    const auto begin = static_cast<size_t>(offsets[first_point]), end = static_cast<size_t>(offsets[last_point]);
+    for (size_t i = begin; i < end; ++i) {
+      const auto c = static_cast<size_t>(order[i]);
+      const int32_t a = corner_points[c], b = end_point(c);
+      sorted[i] = {edge_key(a, b), static_cast<int32_t>(c), a < b ? 1 : 0};
     }
-    i = j;
-  }
+    for (size_t p = first_point; p < last_point; ++p)
+      std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1],
+                [](const Side& x, const Side& y) { return x.key != y.key ? x.key < y.key : x.corner < y.corner; });
+    std::vector<int32_t> forward, backward;
+    std::vector<uint8_t> taken;
+    for (size_t i = begin; i < end;) {
+      size_t j = i;
+      while (j < end && sorted[j].key == sorted[i].key) ++j;
+      forward.clear();
+      backward.clear();
+      for (size_t k = i; k < j; ++k) (sorted[k].forward ? forward : backward).push_back(sorted[k].corner);
+      simple[worker] &= forward.size() <= 1 && backward.size() <= 1;
+      taken.assign(backward.size(), 0);
+      for (const int32_t ca : forward) {
+        // The first free opposite side, unless its face is the same triangle turned over (a
+        // two-sided sheet): joining those would fold the surface onto itself.
+        size_t match = 0;
+        while (match < backward.size() && (taken[match] || same_triangle(corner_points, ca, backward[match])))
+          ++match;
+        if (match == backward.size()) {
+          simple[worker] &= backward.empty();
+          continue;
+        }
+        taken[match] = 1;
+        out.partner[static_cast<size_t>(ca)] = backward[match];
+        out.partner[static_cast<size_t>(backward[match])] = ca;
+      }
+      i = j;
+    }
+  });
+  out.simple = std::all_of(simple.begin(), simple.end(), [](uint8_t flag) { return flag != 0; });
+  // Side a -> b starts at corner ca (point a) and ends at the next corner (point b); its partner
+  // b -> a starts at cb (point b): ca joins next(cb) at a, and cb joins next(ca) at b.
+  UnionFind fans(corner_count);
   out.label.resize(corner_count);
-  for (size_t c = 0; c < corner_count; ++c) out.label[c] = fans.find(static_cast<int32_t>(c));
+  const auto half_point = static_cast<int32_t>(point_count / 2);
+  run_in_ranges(workers, workers, [&](size_t, size_t, size_t worker) {
+    auto mine = [&](size_t c) { return workers == 1 || (corner_points[c] >= half_point) == (worker == 1); };
+    for (size_t c = 0; c < corner_count; ++c)
+      if (mine(c) && out.partner[c] >= 0) fans.unite(static_cast<int32_t>(c), next_corner(out.partner[c]));
+    for (size_t c = 0; c < corner_count; ++c)
+      if (mine(c)) out.label[c] = fans.find(static_cast<int32_t>(c));
+  });
   return out;
 }
 
@@ -364,9 +380,9 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   if (input.face_groups)
     for (size_t c = corner_inputs.size(); c-- > 0;)  // the first face using a vertex decides its group
       wedge_group[corner_inputs[c]] = input.face_groups[out.face_sources[c / 3]];
-  std::vector<int32_t> wedges;
+  std::vector<int32_t> used_vertices;
   for (size_t v = 0; v < vertex_count; ++v)
-    if (out.wedge_point[v] >= 0) wedges.push_back(static_cast<int32_t>(v));
+    if (out.wedge_point[v] >= 0) used_vertices.push_back(static_cast<int32_t>(v));
   const size_t width = input.attribute_count;
   auto wedge_less = [&](int32_t a, int32_t b) {
     if (out.wedge_point[a] != out.wedge_point[b]) return out.wedge_point[a] < out.wedge_point[b];
@@ -375,7 +391,15 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
     return compare_rows(input.attributes + static_cast<size_t>(a) * width,
                         input.attributes + static_cast<size_t>(b) * width, width, 1, 1) < 0;
   };
-  std::stable_sort(wedges.begin(), wedges.end(), wedge_less);
+  // Stably sorted by wedge_less: bucketed by point in vertex order, each bucket then sorted.
+  std::vector<int32_t> offsets, order;
+  bucket_by_point(used_vertices.size(), out.point_source.size(),
+                  [&](size_t i) { return out.wedge_point[used_vertices[i]]; }, offsets, order);
+  std::vector<int32_t> wedges(used_vertices.size());
+  for (size_t i = 0; i < wedges.size(); ++i) wedges[i] = used_vertices[static_cast<size_t>(order[i])];
+  for (size_t p = 0; p < out.point_source.size(); ++p)
+    if (offsets[p + 1] - offsets[p] > 1)
+      std::stable_sort(wedges.begin() + offsets[p], wedges.begin() + offsets[p + 1], wedge_less);
   out.wedge_representative.assign(vertex_count, -1);
   std::vector<int32_t> wedges_at_point(out.point_source.size(), 0);
   for (size_t i = 0; i < wedges.size();) {

@@ -204,7 +204,7 @@ def test_crane_sequence_at_ten_percent(data_dir):
     assert result.levels[-1].error < 0.02 * diagonal
 
 
-def test_a_bow_tie_vertex_and_a_three_face_edge_simplify_without_new_holes():
+def _tube_with_bow_tie_and_fin() -> AnimatedMesh:
     mesh = bending_tube(frames=2)
     # A closed tetrahedron that touches the tube at vertex 0 only (a bow tie), and a fin: one
     # more face on the tube's edge (0, 13).
@@ -213,7 +213,13 @@ def test_a_bow_tie_vertex_and_a_three_face_edge_simplify_without_new_holes():
     frames = np.concatenate([mesh.frames, apex, apex + [[[0, 0.3, 0]]], apex + [[[0, 0, 0.3]]], fin], axis=1)
     a, b, c, tip = 192, 193, 194, 195
     faces = np.concatenate([mesh.faces, [[0, b, a], [0, c, b], [0, a, c], [a, b, c], [0, 13, tip]]])
-    result = simplify_animated(AnimatedMesh(faces, frames), (0.5,))
+    return AnimatedMesh(faces, frames)
+
+
+def test_a_bow_tie_vertex_and_a_three_face_edge_simplify_without_new_holes():
+    mesh = _tube_with_bow_tie_and_fin()
+    faces, frames = mesh.faces, mesh.frames
+    result = simplify_animated(mesh, (0.5,))
     assert result.preparation.split_vertices >= 1
     level = result.levels[0]
     assert level.reached and level.mesh.face_count <= 183
@@ -224,6 +230,24 @@ def test_a_bow_tie_vertex_and_a_three_face_edge_simplify_without_new_holes():
     # The pieces stay stitched where they touched.
     for vertex in (0, 13):
         np.testing.assert_array_equal(level.mesh.frames[:, level.vertex_map[vertex]], frames[:, vertex])
+
+
+def test_many_non_manifold_pieces_are_prepared_as_each_piece_alone():
+    # Enough copies for the preparation's two workers (each takes half of the points), which
+    # must cut every bow tie and fin as the preparation of one piece does.
+    piece = _tube_with_bow_tie_and_fin()
+    copies = 240
+    offsets = (np.arange(copies) * piece.vertex_count)[:, None, None]
+    faces = (piece.faces[None] + offsets).reshape(-1, 3)
+    shifts = np.arange(copies, dtype=np.float32)[:, None] * np.float32([3.0, 0.0, 0.0])
+    frames = (piece.frames[:, None] + shifts[None, :, None]).reshape(piece.frame_count, -1, 3)
+    alone = simplify_animated(piece, (0.5,)).preparation
+    together = simplify_animated(AnimatedMesh(faces, frames), (0.5,))
+    prep = together.preparation
+    assert prep.face_count == copies * alone.face_count and prep.face_count * 3 >= 2 * 131072
+    assert prep.split_vertices == copies * alone.split_vertices > 0
+    assert (prep.welded_vertices, prep.seam_vertices) == (copies * alone.welded_vertices, 0)
+    assert together.levels[0].reached and _border_edge_count(together.levels[0].mesh.faces) <= _border_edge_count(faces)
 
 
 def test_an_unwelded_mesh_simplifies_like_the_welded_one():

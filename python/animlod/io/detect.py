@@ -47,10 +47,10 @@ def input_kind(path: str | os.PathLike) -> str:
 def _check_frame_folder(folder: Path) -> None:
     """FormatError for a folder that holds models but no OBJ/PLY frame: a folder is read as one
     frame sequence, and the models inside would otherwise meet "no frame found"."""
-    files = [path for path in sorted(folder.iterdir()) if path.is_file()]
-    if any(path.suffix.lower() in MESH_SUFFIXES for path in files):
-        return
-    models = [path.name for path in files if path.suffix.lower() in MODEL_SUFFIXES]
+    entries = sorted(folder.iterdir())
+    if any(path.suffix.lower() in MESH_SUFFIXES for path in entries):
+        return  # a frame sequence, whose reader checks each frame
+    models = [path.name for path in entries if path.suffix.lower() in MODEL_SUFFIXES and path.is_file()]
     if models:
         shown = ", ".join(models[:3]) + (f" and {len(models) - 3} more" if len(models) > 3 else "")
         raise FormatError(

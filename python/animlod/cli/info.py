@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.detect import MODEL_SUFFIXES, input_kind
+from ..io.detect import input_kind, models_in
 from ..model import AnimatedMesh, Motion
 
 
@@ -38,7 +38,7 @@ def _models(path: str) -> list[str]:
     folder = Path(path)
     if not folder.is_dir():
         return [path]
-    models = [str(p) for p in sorted(folder.iterdir()) if p.suffix.lower() in MODEL_SUFFIXES]
+    models = [str(model) for model in models_in(folder)]
     return models or [path]
 
 

@@ -44,13 +44,17 @@ def input_kind(path: str | os.PathLike) -> str:
     raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}")
 
 
+def models_in(folder: Path) -> list[Path]:
+    """The model files (glTF, VRM, BVH, NPZ) in ``folder``, in name order."""
+    return [path for path in sorted(folder.iterdir()) if path.suffix.lower() in MODEL_SUFFIXES]
+
+
 def _check_frame_folder(folder: Path) -> None:
     """FormatError for a folder that holds models but no OBJ/PLY frame: a folder is read as one
     frame sequence, and the models inside would otherwise meet "no frame found"."""
-    entries = sorted(folder.iterdir())
-    if any(path.suffix.lower() in MESH_SUFFIXES for path in entries):
+    if any(path.suffix.lower() in MESH_SUFFIXES for path in folder.iterdir()):
         return  # a frame sequence, whose reader checks each frame
-    models = [path.name for path in entries if path.suffix.lower() in MODEL_SUFFIXES and path.is_file()]
+    models = [path.name for path in models_in(folder)]
     if models:
         shown = ", ".join(models[:3]) + (f" and {len(models) - 3} more" if len(models) > 3 else "")
         raise FormatError(

@@ -708,7 +708,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
   constexpr size_t kMinimumHalves = 2048;  // fewer chosen collapses go one by one
   std::vector<RankedEdge> ranked, chosen, deferred;
   CostOrder cost_order;  // ranked comes in edge order, so its (cost, index) order is (cost, edge)
-  std::vector<int32_t> chosen_rank(connectivity_.n_edges(), -1);  // place in ranked of the pass's chosen edges
+  std::vector<int32_t> chosen_index(connectivity_.n_edges(), -1);  // place in ranked of the pass's chosen edges
   std::vector<uint8_t> touched(point_count_, 0);
   in_passes_ = true;
   ranking_cache_.cost.assign(connectivity_.n_edges(), std::numeric_limits<double>::quiet_NaN());
@@ -745,14 +745,14 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       over_max_error = entry.error > options_.max_error;
       if (over_max_error) break;
       touched[entry.kept] = touched[entry.removed] = 1;
-      chosen_rank[entry.edge] = static_cast<int32_t>(order[next]);
+      chosen_index[entry.edge] = static_cast<int32_t>(order[next]);
       planned_faces += 2;
     }
     chosen.clear();
-    for (int32_t& rank : chosen_rank) {
-      if (rank < 0) continue;
-      chosen.push_back(ranked[static_cast<size_t>(rank)]);
-      rank = -1;
+    for (int32_t& index : chosen_index) {
+      if (index < 0) continue;
+      chosen.push_back(ranked[static_cast<size_t>(index)]);
+      index = -1;
     }
     const size_t faces_before = face_count_;
     size_t pass_collapses = 0;

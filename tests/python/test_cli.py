@@ -49,6 +49,21 @@ def test_info_on_a_folder_of_models_describes_each(tmp_path, capsys):
     assert f"{tmp_path / 'a.bvh'}: bvh" in out and f"{tmp_path / 'b.npz'}: npz" in out
 
 
+def test_info_on_a_folder_of_frame_folders_describes_each_sequence(tmp_path, capsys):
+    # A library of sequences (../shared/data/meshseq) exited 2 with "no .obj or .ply frame found".
+    from animlod.io.meshseq import write_sequence
+
+    mesh = AnimatedMesh([[0, 1, 2]], np.tile(np.eye(3), (2, 1, 1)), fps=10.0)
+    for name in ("walk", "run"):
+        write_sequence(tmp_path / "library" / name, mesh)
+    write_bvh(tmp_path / "library" / "clips" / "a.bvh", _small_motion())
+    assert main(["info", str(tmp_path / "library")]) == 0
+    out = capsys.readouterr().out
+    for asset, kind in (("clips/a.bvh", "bvh"), ("run", "sequence"), ("walk", "sequence")):
+        assert f"{tmp_path / 'library' / asset}: {kind}" in out
+    assert out.count("vertices: 3, triangles: 1") == 2
+
+
 def test_info_into_a_pipe_closed_early_exits_quietly(tmp_path):
     # `animlod info DIR | head -1`: the reader leaves; not an error of the input.
     for index in range(200):
@@ -75,9 +90,15 @@ def test_info_real_files(data_dir, capsys):
     assert "14 morph targets" in capsys.readouterr().out
     assert main(["info", str(data_dir / "meshseq" / "crane")]) == 0
     assert "vertices: 10002, triangles: 20000" in capsys.readouterr().out
+    # a folder of sequence folders describes each sequence and model below it
+    assert main(["info", str(data_dir / "meshseq")]) == 0
+    out = capsys.readouterr().out
+    assert "crane: sequence" in out and "face-poses: sequence" in out and "Flamingo.glb: gltf" in out
     # simplify reads a folder as frames: one holding a model names it instead of "no frame found"
     assert main(["simplify", str(data_dir / "meshseq" / "Flamingo-morph-glTF"), "-o", "unused"]) == 2
-    assert "holds no .obj or .ply frame but Flamingo.glb: pass a file" in capsys.readouterr().err
+    assert "holds no .obj or .ply frame but Flamingo.glb: pass one of them" in capsys.readouterr().err
+    assert main(["simplify", str(data_dir / "meshseq"), "-o", "unused"]) == 2
+    assert "but crane, face-poses, Flamingo-morph-glTF/Flamingo.glb: pass one" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(

@@ -46,7 +46,15 @@ def test_a_folder_of_models_without_frames_names_them(tmp_path: Path) -> None:
     # `animlod simplify FOLDER` on a folder holding one .glb said "no .obj or .ply frame found".
     (tmp_path / "bird.glb").write_bytes(b"")
     (tmp_path / "notes.txt").write_bytes(b"")
-    with pytest.raises(FormatError, match=r"folder: holds no .obj or .ply frame but bird.glb: pass a file"):
+    with pytest.raises(FormatError, match=r"folder: holds no .obj or .ply frame but bird.glb: pass one of them"):
         input_kind(tmp_path)
     (tmp_path / "bird_0001.obj").write_bytes(b"")
     assert input_kind(tmp_path) == "sequence"
+
+
+def test_a_folder_of_frame_folders_names_them(tmp_path: Path) -> None:
+    for name in ("b_walk", "a_run", "c_jump", "d_idle"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "frame_0001.ply").write_bytes(b"")
+    with pytest.raises(FormatError, match=r"holds no .obj or .ply frame but a_run, b_walk, c_jump and more: pass one"):
+        input_kind(tmp_path)

@@ -28,11 +28,10 @@ from __future__ import annotations
 
 import glob
 import os
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
-from ..io.detect import MODEL_SUFFIXES, input_kind
+from ..io.detect import MODEL_SUFFIXES, assets_in, holds_frames, input_kind
 from ..io.errors import FormatError
 from ..io.meshseq import MESH_SUFFIXES
 from .jobs import DEFAULT_JOBS, check_options, find_job
@@ -88,33 +87,12 @@ def read_spec(spec: str | os.PathLike, job: str | None = None, options: dict | N
         raise SpecError(text, "file", "does not exist")
     if path.is_file() and path.suffix.lower() in MANIFEST_SUFFIXES:
         return _read_manifest(path, job, options)
-    if path.is_dir() and not _holds_frames(path):
-        found = [(os.fspath(item), _default_name(item, path)) for item in _scan(path)]
+    if path.is_dir() and not holds_frames(path):
+        found = [(os.fspath(item), _default_name(item, path)) for item in assets_in(path)]
         if not found:
             raise SpecError(text, "folder", f"holds no asset ({', '.join(MODEL_SUFFIXES)} files or folders of frames)")
         return _checked(text, "folder", found, job, options)
     return _checked(text, "input", [(text, _default_name(path, path.parent))], job, options)
-
-
-def _scan(folder: Path) -> Iterable[Path]:
-    """Asset files and frame folders below ``folder``, in a stable order."""
-    for root, folders, files in os.walk(folder):
-        folders.sort()
-        here = Path(root)
-        for name in sorted(files):
-            if Path(name).suffix.lower() in MODEL_SUFFIXES:
-                yield here / name
-        framed = [name for name in folders if _holds_frames(here / name)]
-        yield from (here / name for name in framed)
-        folders[:] = [name for name in folders if name not in framed and not name.startswith(".")]
-
-
-def _holds_frames(folder: Path) -> bool:
-    try:
-        with os.scandir(folder) as entries:
-            return any(entry.is_file() and Path(entry.name).suffix.lower() in MESH_SUFFIXES for entry in entries)
-    except OSError:
-        return False
 
 
 def _glob_base(pattern: str) -> Path:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.detect import input_kind, models_in
+from ..io.detect import assets_in, holds_frames, input_kind
 from ..model import AnimatedMesh, Motion
 
 
@@ -18,7 +18,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Print what a file holds: joints, frames, fps, vertices, faces, skins, animations, morph targets.",
     )
     parser.add_argument(
-        "path", help="a .bvh, .glb/.gltf/.vrm, .npz file, an OBJ/PLY file, a folder of frames or of models, or a glob"
+        "path", help="a .bvh, .glb/.gltf/.vrm, .npz file, an OBJ/PLY file, a folder of frames or of assets (models and frame folders, searched like batch does), or a glob"
     )
     parser.set_defaults(run=run)
 
@@ -33,13 +33,12 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _models(path: str) -> list[str]:
-    """``path`` itself, or for a folder holding model files (glTF, VRM, BVH, NPZ) each of them in
-    name order; a folder of OBJ/PLY frames alone is one sequence."""
+    """``path`` itself (a folder of OBJ/PLY frames is one sequence), or for another folder every
+    asset below it that ``animlod batch`` would take: model files and frame folders."""
     folder = Path(path)
-    if not folder.is_dir():
+    if not folder.is_dir() or holds_frames(folder):
         return [path]
-    models = [str(model) for model in models_in(folder)]
-    return models or [path]
+    return [str(asset) for asset in assets_in(folder)] or [path]
 
 
 def _describe(kind: str, path: str) -> list[str]:

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import glob
+import itertools
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 from .errors import FormatError
@@ -44,24 +46,44 @@ def input_kind(path: str | os.PathLike) -> str:
     raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}")
 
 
-def models_in(folder: Path) -> list[Path]:
-    """The model files (glTF, VRM, BVH, NPZ) in ``folder``, in name order."""
-    return [path for path in sorted(folder.iterdir()) if path.suffix.lower() in MODEL_SUFFIXES]
+def holds_frames(folder: Path) -> bool:
+    """Whether ``folder`` holds an OBJ/PLY frame, which makes it one frame sequence (decided by
+    names: a folder of thousands of frames costs no stat)."""
+    try:
+        with os.scandir(folder) as entries:
+            return any(entry.is_file() and Path(entry.name).suffix.lower() in MESH_SUFFIXES for entry in entries)
+    except OSError:
+        return False
+
+
+def assets_in(folder: Path) -> Iterator[Path]:
+    """The model files (glTF, VRM, BVH, NPZ) and frame folders below ``folder``, in a stable
+    order: each folder's files by name, then its frame folders, then the rest of its folders
+    (hidden ones skipped; a frame folder is not searched further)."""
+    for root, folders, files in os.walk(folder):
+        folders.sort()
+        here = Path(root)
+        for name in sorted(files):
+            if Path(name).suffix.lower() in MODEL_SUFFIXES:
+                yield here / name
+        framed = [name for name in folders if holds_frames(here / name)]
+        yield from (here / name for name in framed)
+        folders[:] = [name for name in folders if name not in framed and not name.startswith(".")]
 
 
 def _check_frame_folder(folder: Path) -> None:
-    """FormatError for a folder that holds models but no OBJ/PLY frame: a folder is read as one
-    frame sequence, and the models inside would otherwise meet "no frame found"."""
-    if any(path.suffix.lower() in MESH_SUFFIXES for path in folder.iterdir()):
+    """FormatError for a folder that holds no OBJ/PLY frame but models or frame folders: a folder
+    is read as one frame sequence, and the assets inside would otherwise meet "no frame found"."""
+    if holds_frames(folder):
         return  # a frame sequence, whose reader checks each frame
-    models = [path.name for path in models_in(folder)]
-    if models:
-        shown = ", ".join(models[:3]) + (f" and {len(models) - 3} more" if len(models) > 3 else "")
+    assets = [path.relative_to(folder).as_posix() for path in itertools.islice(assets_in(folder), 4)]
+    if assets:
+        shown = ", ".join(assets[:3]) + (" and more" if len(assets) > 3 else "")
         raise FormatError(
             folder,
             "folder",
-            f"holds no .obj or .ply frame but {shown}: pass a file (a folder is read as one frame sequence; "
-            "animlod batch takes a folder of models)",
+            f"holds no .obj or .ply frame but {shown}: pass one of them (a folder is read as one frame "
+            "sequence; animlod batch and animlod info take a folder of assets)",
         )
 
 

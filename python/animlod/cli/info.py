@@ -18,7 +18,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Print what a file holds: joints, frames, fps, vertices, faces, skins, animations, morph targets.",
     )
     parser.add_argument(
-        "path", help="a .bvh, .glb/.gltf/.vrm, .npz file, an OBJ/PLY file, a folder of frames or of assets (models and frame folders, searched like batch does), or a glob"
+        "path",
+        help="a .bvh, .glb/.gltf/.vrm, .npz file, an OBJ/PLY file, a folder of frames or of assets "
+        "(model files and frame folders, found as batch finds them), or a glob",
     )
     parser.set_defaults(run=run)
 

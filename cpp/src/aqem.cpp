@@ -157,7 +157,7 @@ class AqemPolicy final : public detail::CollapsePolicy {
         frames_(frames),
         used_count_(frames.size()),
         vertex_weights_(std::move(weights)),
-        scratch_(kWorkers, Scratch{std::vector<Eigen::Vector3d>(used_count_), {}}) {
+        scratch_(kWorkers) {
     accumulate_quadrics();
   }
 
@@ -168,10 +168,10 @@ class AqemPolicy final : public detail::CollapsePolicy {
   void evaluate_concurrently(Candidate& candidate, size_t worker) override {
     evaluate_with(candidate, scratch_[worker]);
   }
-  void place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) override {
+  void place(Candidate& candidate, std::vector<Eigen::Vector3d>& placed) override {
     place_concurrently(candidate, placed, 0);
   }
-  void place_concurrently(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed, size_t worker) override;
+  void place_concurrently(Candidate& candidate, std::vector<Eigen::Vector3d>& placed, size_t worker) override;
   void merge(const Candidate& candidate) override {
     Quadric* kept_quadrics = quadrics_of(candidate.kept);
     const Quadric* removed_quadrics = quadrics_of(candidate.removed);
@@ -192,15 +192,16 @@ class AqemPolicy final : public detail::CollapsePolicy {
   void accumulate_share(const QuadricShare& share);
   void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, const QuadricShare& share);
   void add_tip_points(const QuadricShare& share);
-  // Placement of the candidate being evaluated, per worker; a cache line of its own, as every
-  // evaluation writes it (sharing one, the two workers' evaluations took 1.5x as long).
+  // The last evaluation of a worker, which its placement reads; a cache line of its own, as
+  // every evaluation writes it (sharing one, the two workers' evaluations took 1.5x as long).
   struct alignas(64) Scratch {
-    std::vector<Eigen::Vector3d> new_positions;  // (K,) placement in the quadrics' frames
-    detail::MergedMinimizers minimizers;         // Eq. 5 in the quadrics' frames (unsolved: the fallback)
+    detail::MergedMinimizers minimizers;  // Eq. 5 in the quadrics' frames
+    int fallback = 0;  // kFallbacks index for the frames Eq. 5 leaves unsolved; -1: on the edge at t
   };
+  static constexpr double kFallbacks[3] = {0.0, 1.0, 0.5};  // kept, removed, midpoint along the edge
   static constexpr size_t kWorkers = 2;
   void evaluate_with(Candidate& candidate, Scratch& scratch) const;
-  void evaluate_on_edge(Candidate& candidate, bool pinned, Scratch& scratch) const;
+  void evaluate_on_edge(Candidate& candidate, bool pinned) const;
   double rms_plane_distance(const Candidate& candidate, double total) const;
   double weight(const Candidate& candidate) const {
     return 0.5 * (vertex_weights_[candidate.kept] + vertex_weights_[candidate.removed]);
@@ -330,20 +331,21 @@ void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& side
 // Steps 5-6: merged quadric, weight and optimal placement per used frame (Eq. 5); cost of
 // Eq. 6. Frames whose X is singular share one fallback, the best in sum over those frames of
 // the kept endpoint, the removed endpoint and the midpoint (ties in that order), so that the
-// point does not slide to a different spot of a flat region in every frame. Leaves the
-// placement in scratch.new_positions.
+// point does not slide to a different spot of a flat region in every frame. Leaves what the
+// placement needs in scratch (place_concurrently): most evaluations only key an edge.
 void AqemPolicy::evaluate_with(Candidate& candidate, Scratch& scratch) const {
   const bool pinned = engine_.locked(candidate.kept);
-  if (pinned || options_.placement == Placement::on_edge) return evaluate_on_edge(candidate, pinned, scratch);
+  if (pinned || options_.placement == Placement::on_edge) {
+    scratch.fallback = -1;
+    return evaluate_on_edge(candidate, pinned);
+  }
   const Quadric* kept_quadrics = quadrics_of(candidate.kept);
   const Quadric* removed_quadrics = quadrics_of(candidate.removed);
-  constexpr double kFallbacks[3] = {0.0, 1.0, 0.5};  // kept, removed, midpoint along the edge
   double fallback_cost[3] = {0.0, 0.0, 0.0};
   double total = 0.0;
   scratch.minimizers.solve(kept_quadrics, removed_quadrics, used_count_);
   for (size_t k = 0; k < used_count_; ++k) {
     if (scratch.minimizers.solved(k)) {
-      scratch.new_positions[k] = scratch.minimizers.position(k);
       total += scratch.minimizers.value(k);
       continue;
     }
@@ -358,18 +360,7 @@ void AqemPolicy::evaluate_with(Candidate& candidate, Scratch& scratch) const {
   for (int option = 1; option < 3; ++option)
     if (fallback_cost[option] < fallback_cost[fallback]) fallback = option;
   total += fallback_cost[fallback];
-
-  double along = 0.0, length2 = 0.0;
-  for (size_t k = 0; k < used_count_; ++k) {
-    const size_t frame = static_cast<size_t>(frames_[k]);
-    const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame),
-                          p_removed = engine_.position(candidate.removed, frame);
-    Eigen::Vector3d& v = scratch.new_positions[k];
-    if (!scratch.minimizers.solved(k)) v = p_kept + kFallbacks[fallback] * (p_removed - p_kept);
-    along += (v - p_kept).dot(p_removed - p_kept);
-    length2 += (p_removed - p_kept).squaredNorm();
-  }
-  candidate.t = length2 > 0.0 ? std::clamp(along / length2, 0.0, 1.0) : 0.0;
+  scratch.fallback = fallback;
   candidate.cost = weight(candidate) * total;
   candidate.error = rms_plane_distance(candidate, total);
 }
@@ -384,7 +375,7 @@ double AqemPolicy::rms_plane_distance(const Candidate& candidate, double total) 
 
 // Placement::on_edge (and a locked kept point, t = 0): the t in [0, 1] minimising
 // sum_f Q_f(kept_f + t (removed_f - kept_f)), a quadratic in t.
-void AqemPolicy::evaluate_on_edge(Candidate& candidate, bool pinned, Scratch& scratch) const {
+void AqemPolicy::evaluate_on_edge(Candidate& candidate, bool pinned) const {
   const Quadric* kept_quadrics = quadrics_of(candidate.kept);
   const Quadric* removed_quadrics = quadrics_of(candidate.removed);
   double curvature = 0.0, slope = 0.0;
@@ -401,21 +392,37 @@ void AqemPolicy::evaluate_on_edge(Candidate& candidate, bool pinned, Scratch& sc
   for (size_t k = 0; k < used_count_; ++k) {
     const size_t frame = static_cast<size_t>(frames_[k]);
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame);
-    scratch.new_positions[k] = p_kept + candidate.t * (engine_.position(candidate.removed, frame) - p_kept);
-    total += (kept_quadrics[k] + removed_quadrics[k]).evaluate(scratch.new_positions[k]);
+    total += (kept_quadrics[k] + removed_quadrics[k])
+                 .evaluate(p_kept + candidate.t * (engine_.position(candidate.removed, frame) - p_kept));
   }
   candidate.cost = weight(candidate) * total;
   candidate.error = rms_plane_distance(candidate, total);
 }
 
-// The candidate's point in every frame F: its Eq. 5 placement (the worker's last evaluation) in
-// the quadrics' frames, kept + t (removed - kept) in the others.
-void AqemPolicy::place_concurrently(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed,
-                                    size_t worker) {
+// The candidate's point in every frame F (the worker's last evaluation): its Eq. 5 placement in
+// the quadrics' frames, with t the mean projection of that placement onto the edge, and
+// kept + t (removed - kept) in the others. On the edge, that in every frame.
+void AqemPolicy::place_concurrently(Candidate& candidate, std::vector<Eigen::Vector3d>& placed, size_t worker) {
+  const Scratch& scratch = scratch_[worker];
+  const bool eq5 = scratch.fallback >= 0;
+  if (eq5) {
+    double along = 0.0, length2 = 0.0;
+    for (size_t k = 0; k < used_count_; ++k) {
+      const size_t frame = static_cast<size_t>(frames_[k]);
+      const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame),
+                            p_removed = engine_.position(candidate.removed, frame);
+      Eigen::Vector3d& v = placed[frame];
+      v = scratch.minimizers.solved(k) ? scratch.minimizers.position(k)
+                                       : Eigen::Vector3d(p_kept + kFallbacks[scratch.fallback] * (p_removed - p_kept));
+      along += (v - p_kept).dot(p_removed - p_kept);
+      length2 += (p_removed - p_kept).squaredNorm();
+    }
+    candidate.t = length2 > 0.0 ? std::clamp(along / length2, 0.0, 1.0) : 0.0;
+  }
   size_t used = 0;
   for (size_t frame = 0; frame < engine_.frame_count(); ++frame) {
-    if (used < used_count_ && static_cast<size_t>(frames_[used]) == frame) {
-      placed[frame] = scratch_[worker].new_positions[used++];
+    if (eq5 && used < used_count_ && static_cast<size_t>(frames_[used]) == frame) {
+      ++used;
       continue;
     }
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame);

@@ -46,16 +46,17 @@ struct RankedEdge {
 class CollapsePolicy {
  public:
   virtual ~CollapsePolicy() = default;
-  // Fills cost, error and t of `candidate` (kept and removed are set). Called to key every edge.
+  // Fills cost and error of `candidate` (kept and removed are set). Called to key every edge,
+  // so it leaves out what only a collapse needs: the placement.
   virtual void evaluate(Candidate& candidate) = 0;
-  // Writes the merged point's position in every frame F into `placed`; called right after
-  // evaluate() of the same candidate, only for the heap's top.
-  virtual void place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) = 0;
+  // Sets t and writes the merged point's position in every frame F into `placed`; called right
+  // after evaluate() of the same candidate, only for a collapse about to be tried.
+  virtual void place(Candidate& candidate, std::vector<Eigen::Vector3d>& placed) = 0;
   // The engine is applying `candidate`: merge the policy's per-point state into `kept`.
   virtual void merge(const Candidate& candidate) = 0;
   // Collapse passes evaluate every edge at once on up to concurrency() threads: worker w in
-  // [0, concurrency()) calls evaluate_concurrently, which fills cost, error and t like
-  // evaluate() and must not write state another worker reads (no merge() runs meanwhile).
+  // [0, concurrency()) calls evaluate_concurrently, which fills cost and error like evaluate()
+  // and must not write state another worker reads (no merge() runs meanwhile).
   // With two or more, they also perform collapses on workers 0 and 1 at once, in parts of the
   // mesh that share no point: then evaluate_concurrently, place_concurrently (the placement of
   // the worker's last evaluation) and merge run concurrently, and may only read and write the
@@ -63,8 +64,7 @@ class CollapsePolicy {
   // own thread, whose evaluations are those of evaluate() and place().
   virtual size_t concurrency() const { return 1; }
   virtual void evaluate_concurrently(Candidate& candidate, size_t /*worker*/) { evaluate(candidate); }
-  virtual void place_concurrently(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed,
-                                  size_t /*worker*/) {
+  virtual void place_concurrently(Candidate& candidate, std::vector<Eigen::Vector3d>& placed, size_t /*worker*/) {
     place(candidate, placed);
   }
 };

@@ -56,7 +56,7 @@ void TdagCollapsePolicy::evaluate(Candidate& candidate) {
   candidate.error = from_removed ? cost_removed : cost_kept;
 }
 
-void TdagCollapsePolicy::place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) {
+void TdagCollapsePolicy::place(Candidate& candidate, std::vector<Eigen::Vector3d>& placed) {
   placed[0] = engine_.position(candidate.t > 0.5 ? candidate.removed : candidate.kept, 0);
 }
 

@@ -48,7 +48,7 @@ class TdagCollapsePolicy final : public CollapsePolicy {
                      const HistoryTerm* history);
 
   void evaluate(Candidate& candidate) override;
-  void place(const Candidate& candidate, std::vector<Eigen::Vector3d>& placed) override;
+  void place(Candidate& candidate, std::vector<Eigen::Vector3d>& placed) override;
   void merge(const Candidate& candidate) override;
 
   const std::vector<VertexCollapse>& collapses() const { return collapses_; }

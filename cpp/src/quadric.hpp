@@ -71,6 +71,12 @@ class MergedMinimizers {
     frame_count_ = frame_count;
     if (columns_.size() < kColumns * frame_count) columns_.resize(kColumns * frame_count);
     double* merged = columns_.data();
+    if (frame_count == 1) {  // nothing to vectorise over: the columns' set-up cost more than the solve
+      const Quadric q = kept[0] + removed[0];
+      minimum(q.a00, q.a01, q.a02, q.a11, q.a12, q.a22, q.b0, q.b1, q.b2, q.c, merged[kX], merged[kY], merged[kZ],
+              merged[kValue], merged[kSolved]);
+      return;
+    }
     for (size_t k = 0; k < frame_count; ++k) {
       const Quadric q = kept[k] + removed[k];
       const double coefficients[10] = {q.a00, q.a01, q.a02, q.a11, q.a12, q.a22, q.b0, q.b1, q.b2, q.c};
@@ -91,27 +97,33 @@ class MergedMinimizers {
   // n frames: ten columns of coefficients in; x, y, z and Q out, and 1 or 0 into `solved`
   // (GCC 12 vectorised the loop with two output pointers, not with one).
   static void minimise(size_t n, const double* __restrict in, double* __restrict out, double* __restrict solved) {
-    for (size_t k = 0; k < n; ++k) {
-      const double a00 = in[k], a01 = in[n + k], a02 = in[2 * n + k], a11 = in[3 * n + k], a12 = in[4 * n + k],
-                   a22 = in[5 * n + k], b0 = in[6 * n + k], b1 = in[7 * n + k], b2 = in[8 * n + k], c = in[9 * n + k];
-      // The adjugate over the determinant. The products and sums are those of Eigen's 3x3
-      // inverse and product, which this replaced, in the same order: levels stay bit for bit.
-      const double c0 = a11 * a22 - a12 * a12, c1 = a12 * a02 - a22 * a01, c2 = a01 * a12 - a02 * a11;
-      const double determinant = (c0 * a00 + c1 * a01) + c2 * a02;
-      const double inverse = 1.0 / determinant;
-      const double x = (c0 * inverse * b0 + c1 * inverse * b1) + c2 * inverse * b2;
-      const double y = ((a12 * a02 - a01 * a22) * inverse * b0 + (a22 * a00 - a02 * a02) * inverse * b1) +
-                       (a02 * a01 - a00 * a12) * inverse * b2;
-      const double z = (a01 * a12 - a11 * a02) * inverse * b0 +
-                       ((a02 * a01 - a12 * a00) * inverse * b1 + (a00 * a11 - a01 * a01) * inverse * b2);
-      out[k] = x, out[n + k] = y, out[2 * n + k] = z;
-      out[3 * n + k] = Quadric{a00, a01, a02, a11, a12, a22, b0, b1, b2, c}.evaluate(Eigen::Vector3d(x, y, z));
-      // Selects, not && (a branch would stop the vectorisation); x - x is NaN for inf and NaN.
-      const double scale = a00 + a11 + a22;
-      double regular = scale > 0.0 ? 1.0 : 0.0;
-      regular = std::abs(determinant) > 1e-9 * scale * scale * scale ? regular : 0.0;
-      solved[k] = (x - x) + (y - y) + (z - z) == 0.0 ? regular : 0.0;
-    }
+    for (size_t k = 0; k < n; ++k)
+      minimum(in[k], in[n + k], in[2 * n + k], in[3 * n + k], in[4 * n + k], in[5 * n + k], in[6 * n + k],
+              in[7 * n + k], in[8 * n + k], in[9 * n + k], out[k], out[n + k], out[2 * n + k], out[3 * n + k], solved[k]);
+  }
+
+  // One merged quadric's minimiser (x, y, z), Q there, and 1 or 0 into `solved`. Inlined into
+  // minimise's loop, which GCC vectorises only with the whole body in view.
+  [[gnu::always_inline]] static inline void minimum(double a00, double a01, double a02, double a11, double a12,
+                                                    double a22, double b0, double b1, double b2, double c, double& out_x,
+                                                    double& out_y, double& out_z, double& value, double& solved) {
+    // The adjugate over the determinant. The products and sums are those of Eigen's 3x3
+    // inverse and product, which this replaced, in the same order: levels stay bit for bit.
+    const double c0 = a11 * a22 - a12 * a12, c1 = a12 * a02 - a22 * a01, c2 = a01 * a12 - a02 * a11;
+    const double determinant = (c0 * a00 + c1 * a01) + c2 * a02;
+    const double inverse = 1.0 / determinant;
+    const double x = (c0 * inverse * b0 + c1 * inverse * b1) + c2 * inverse * b2;
+    const double y = ((a12 * a02 - a01 * a22) * inverse * b0 + (a22 * a00 - a02 * a02) * inverse * b1) +
+                     (a02 * a01 - a00 * a12) * inverse * b2;
+    const double z = (a01 * a12 - a11 * a02) * inverse * b0 +
+                     ((a02 * a01 - a12 * a00) * inverse * b1 + (a00 * a11 - a01 * a01) * inverse * b2);
+    out_x = x, out_y = y, out_z = z;
+    value = Quadric{a00, a01, a02, a11, a12, a22, b0, b1, b2, c}.evaluate(Eigen::Vector3d(x, y, z));
+    // Selects, not && (a branch would stop the vectorisation); x - x is NaN for inf and NaN.
+    const double scale = a00 + a11 + a22;
+    double regular = scale > 0.0 ? 1.0 : 0.0;
+    regular = std::abs(determinant) > 1e-9 * scale * scale * scale ? regular : 0.0;
+    solved = (x - x) + (y - y) + (z - z) == 0.0 ? regular : 0.0;
   }
 
   size_t frame_count_ = 0;

@@ -216,7 +216,8 @@ bool CollapseEngine::map_wedges(const Candidate& candidate, TriMesh::HalfedgeHan
   return true;
 }
 
-bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse, Workspace& workspace) {
+bool CollapseEngine::is_legal_connectivity(const Candidate& candidate, TriMesh::HalfedgeHandle collapse,
+                                           Workspace& workspace) {
   if (locked(candidate.removed)) return false;  // both endpoints locked
   if (!connectivity_.is_collapse_ok(collapse)) return false;
   // A valence-3 interior vertex beside the edge would be left with two faces on the same three
@@ -228,7 +229,10 @@ bool CollapseEngine::is_legal(const Candidate& candidate, TriMesh::HalfedgeHandl
 
     if (valence_[opposite.idx()] <= 3 && !connectivity_.is_boundary(opposite)) return false;
   }
-  if (!map_wedges(candidate, collapse, workspace)) return false;
+  return map_wedges(candidate, collapse, workspace);
+}
+
+bool CollapseEngine::keeps_orientation(const Candidate& candidate, const Workspace& workspace) const {
   if (!options_.check_inversion) return true;
   // Eq. 7 for every face that survives around the collapse, in every frame F: the kept and the
   // removed point both move to workspace.placed.
@@ -513,17 +517,20 @@ void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<Ranked
   }
 }
 
-// Steps 8-9 for one candidate (kept and removed set) on `worker`: evaluate it again for its
-// placement, test legality and max_error, collapse into `record`. Leaves the collapse's values
-// in `candidate`; the caller counts the collapse and its removed faces.
+// Steps 8-9 for one candidate (kept and removed set) on `worker`: test the connectivity, evaluate
+// the candidate again for its placement, test Eq. 7 and max_error, collapse into `record`. Leaves
+// the collapse's values in `candidate`; the caller counts the collapse and its removed faces.
+// The connectivity comes first as it needs no placement: in the greedy order nearly every
+// illegal attempt fails there (21,648 of 21,650 on the 24-frame sphere of bench_aqem.py).
 CollapseEngine::Attempt CollapseEngine::attempt_collapse(CollapsePolicy& policy, Candidate& candidate, int32_t edge,
                                                          size_t worker, EngineRecord& record,
                                                          int32_t& faces_removed) {
   Workspace& workspace = workspaces_[worker];
+  const auto halfedge = removed_to_kept(candidate, edge);
+  if (!is_legal_connectivity(candidate, halfedge, workspace)) return Attempt::illegal;
   policy.evaluate_concurrently(candidate, worker);
   policy.place_concurrently(candidate, workspace.placed, worker);
-  const auto halfedge = removed_to_kept(candidate, edge);
-  if (!is_legal(candidate, halfedge, workspace)) return Attempt::illegal;
+  if (!keeps_orientation(candidate, workspace)) return Attempt::illegal;
   if (candidate.error > options_.max_error) return Attempt::over_max_error;
   faces_removed = collapse(policy, candidate, halfedge, workspace, record);
   return Attempt::collapsed;

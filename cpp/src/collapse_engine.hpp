@@ -166,7 +166,10 @@ class CollapseEngine {
     std::vector<std::pair<int32_t, int32_t>> wedge_moves;  // removed wedge -> kept wedge
   };
   bool map_wedges(const Candidate& candidate, TriMesh::HalfedgeHandle collapse, Workspace& workspace) const;
-  bool is_legal(const Candidate& candidate, TriMesh::HalfedgeHandle collapse, Workspace& workspace);
+  // Legality in two parts: the connectivity's (and the seams'), which needs no placement and is
+  // tested first, and Eq. 7's, which tests the placement.
+  bool is_legal_connectivity(const Candidate& candidate, TriMesh::HalfedgeHandle collapse, Workspace& workspace);
+  bool keeps_orientation(const Candidate& candidate, const Workspace& workspace) const;
   int32_t collapse(CollapsePolicy& policy, const Candidate& candidate, TriMesh::HalfedgeHandle halfedge,
                    const Workspace& workspace, EngineRecord& record);
   enum class Attempt { collapsed, illegal, over_max_error };

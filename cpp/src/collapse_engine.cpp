@@ -238,7 +238,14 @@ bool CollapseEngine::keeps_orientation(const Candidate& candidate, const Workspa
   // removed point both move to workspace.placed.
   for (const int32_t moved : {candidate.kept, candidate.removed}) {
     const int32_t other = moved == candidate.kept ? candidate.removed : candidate.kept;
-    for (const auto face : connectivity_.vf_range(connectivity_.vertex_handle(moved))) {
+    // The faces around `moved` by its outgoing halfedges, not by OpenMesh's face circulator,
+    // whose bookkeeping cost as much as the test (the test's outcome does not depend on order).
+    const auto first_out = connectivity_.halfedge_handle(connectivity_.vertex_handle(moved));
+    auto out = first_out;
+    do {
+      const auto face = connectivity_.face_handle(out);
+      out = connectivity_.cw_rotated_halfedge_handle(out);
+      if (!face.is_valid()) continue;
       std::array<const float*, 3> corners{};
       int moved_corner = -1;
       bool collapses = false;
@@ -248,7 +255,7 @@ bool CollapseEngine::keeps_orientation(const Candidate& candidate, const Workspa
       const int32_t first = connectivity_.to_vertex_handle(connectivity_.halfedge_handle(face)).idx();
       const int start = face_points[0] == first ? 0 : face_points[1] == first ? 1 : 2;
       for (int corner = 0; corner < 3; ++corner) {
-        const int32_t point = face_points[(start + corner) % 3];
+        const int32_t point = face_points[start + corner < 3 ? start + corner : start + corner - 3];
         if (point == moved) moved_corner = corner;
         collapses |= point == other;
         corners[corner] = &positions_[static_cast<size_t>(point) * frame_count_ * 3];
@@ -257,7 +264,7 @@ bool CollapseEngine::keeps_orientation(const Candidate& candidate, const Workspa
       if (!face_keeps_orientation(corners, moved_corner, workspace.placed.data(), frame_count_,
                                   options_.strict_inversion))
         return false;
-    }
+    } while (out != first_out);
   }
   return true;
 }

@@ -527,8 +527,9 @@ void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<Ranked
 // Steps 8-9 for one candidate (kept and removed set) on `worker`: test the connectivity, evaluate
 // the candidate again for its placement, test Eq. 7 and max_error, collapse into `record`. Leaves
 // the collapse's values in `candidate`; the caller counts the collapse and its removed faces.
-// The connectivity comes first as it needs no placement: in the greedy order nearly every
-// illegal attempt fails there (21,648 of 21,650 on the 24-frame sphere of bench_aqem.py).
+// The connectivity comes first as it needs no placement: in the greedy order most attempts are
+// illegal (an edge parked as illegal is keyed again whenever its neighbourhood changes), and
+// nearly all of those fail there.
 CollapseEngine::Attempt CollapseEngine::attempt_collapse(CollapsePolicy& policy, Candidate& candidate, int32_t edge,
                                                          size_t worker, EngineRecord& record,
                                                          int32_t& faces_removed) {

@@ -49,8 +49,9 @@ class CollapsePolicy {
   // Fills cost and error of `candidate` (kept and removed are set). Called to key every edge,
   // so it leaves out what only a collapse needs: the placement.
   virtual void evaluate(Candidate& candidate) = 0;
-  // Sets t and writes the merged point's position in every frame F into `placed`; called right
-  // after evaluate() of the same candidate, only for a collapse about to be tried.
+  // Writes the merged point's position in every frame F into `placed` and sets t where
+  // evaluate() did not; called right after evaluate() of the same candidate, only for a collapse
+  // about to be tried.
   virtual void place(Candidate& candidate, std::vector<Eigen::Vector3d>& placed) = 0;
   // The engine is applying `candidate`: merge the policy's per-point state into `kept`.
   virtual void merge(const Candidate& candidate) = 0;

@@ -195,6 +195,19 @@ TEST_CASE("merged minimisers solve A v = b frame by frame and refuse a singular 
   CHECK_FALSE(minimizers.solved(kRandom));
   CHECK_FALSE(minimizers.solved(kRandom + 1));
   CHECK_FALSE(minimizers.solved(kRandom + 2));
+  // One frame goes its own way (no columns): the same bits as the same frame among many.
+  std::vector<Eigen::Vector3d> positions(kFrames);
+  std::vector<double> values(kFrames);
+  std::vector<bool> solved(kFrames);
+  for (size_t k = 0; k < kFrames; ++k)
+    positions[k] = minimizers.position(k), values[k] = minimizers.value(k), solved[k] = minimizers.solved(k);
+  for (size_t k = 0; k < kFrames; ++k) {
+    minimizers.solve(kept.data() + k, removed.data() + k, 1);
+    CHECK(minimizers.solved(0) == solved[k]);
+    if (!solved[k]) continue;
+    CHECK(minimizers.position(0) == positions[k]);
+    CHECK(minimizers.value(0) == values[k]);
+  }
   // Fewer frames in the same object: the columns are laid out for the new count.
   minimizers.solve(kept.data() + kRandom, removed.data() + kRandom, 2);
   CHECK_FALSE(minimizers.solved(0));

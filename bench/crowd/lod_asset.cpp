@@ -19,6 +19,7 @@
 #include <glm/gtx/matrix_decompose.hpp>
 #include <tiny_gltf.h>
 
+#include "animation_pointers.hpp"
 #include "animlod/skinning.hpp"
 
 namespace crowd {
@@ -278,7 +279,8 @@ class Loader {
       const tinygltf::Animation& animation = model_.animations[static_cast<size_t>(a)];
       split_clip = split_clip && animation.name.empty();
       std::set<int> mine;
-      for (const tinygltf::AnimationChannel& channel : animation.channels) mine.insert(channel.target_node);
+      for (const tinygltf::AnimationChannel& channel : animation.channels)
+        if (channel.target_node >= 0) mine.insert(channel.target_node);  // -1: a pointer at no node
       for (int node : mine) split_clip = split_clip && targets.insert(node).second;
     }
     if (split_clip) {
@@ -716,11 +718,18 @@ bool read_model(const Model& model, const std::string& name, Asset& out, std::st
   return true;
 }
 
-// A GLB by its magic, whatever its name (a VRM avatar's is .vrm), as the Python reader decides.
-bool has_glb_magic(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  char magic[4] = {};
-  return file.read(magic, sizeof magic) && std::memcmp(magic, "glTF", sizeof magic) == 0;
+// tinygltf's model of a GLB (told by its magic, whatever its name: a VRM avatar's is .vrm, as
+// the Python reader decides) or glTF JSON, its pointer channels resolved first
+// (animation_pointers.hpp); external files are looked up in base_dir.
+bool parse_model(tinygltf::TinyGLTF& loader, const uint8_t* bytes, size_t size, const std::string& base_dir,
+                 Model& model, std::string& error) {
+  const std::vector<uint8_t> resolved = resolve_animation_pointers(bytes, size);
+  if (!resolved.empty()) bytes = resolved.data(), size = resolved.size();
+  std::string warnings;
+  const bool binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
+  return binary ? loader.LoadBinaryFromMemory(&model, &error, &warnings, bytes, static_cast<unsigned int>(size), base_dir)
+                : loader.LoadASCIIFromString(&model, &error, &warnings, reinterpret_cast<const char*>(bytes),
+                                             static_cast<unsigned int>(size), base_dir);
 }
 
 }  // namespace
@@ -731,12 +740,16 @@ bool load_asset(const std::string& path, Asset& out, std::string& error) {
     error = path + ": " + (std::filesystem::exists(path, status) ? "not a regular file" : "no such file");
     return false;
   }
+  std::ifstream file(path, std::ios::binary);
+  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (!file.good() && !file.eof()) {
+    error = path + ": could not be read";
+    return false;
+  }
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
-  std::string warnings;
-  const bool loaded = has_glb_magic(path) ? loader.LoadBinaryFromFile(&model, &error, &warnings, path)
-                             : loader.LoadASCIIFromFile(&model, &error, &warnings, path);
-  if (!loaded) return tinygltf_failure(path, error);
+  const std::string base_dir = std::filesystem::path(path).parent_path().string();
+  if (!parse_model(loader, bytes.data(), bytes.size(), base_dir, model, error)) return tinygltf_failure(path, error);
   return read_model(model, path, out, error);
 }
 
@@ -753,13 +766,7 @@ bool load_asset_from_memory(const uint8_t* bytes, size_t size, const std::string
   };
   no_files.WriteWholeFile = [](std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; };
   loader.SetFsCallbacks(no_files);
-  std::string warnings;
-  const bool binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
-  const bool loaded =
-      binary ? loader.LoadBinaryFromMemory(&model, &error, &warnings, bytes, static_cast<unsigned int>(size), "")
-             : loader.LoadASCIIFromString(&model, &error, &warnings, reinterpret_cast<const char*>(bytes),
-                                          static_cast<unsigned int>(size), "");
-  if (!loaded) return tinygltf_failure(name, error);
+  if (!parse_model(loader, bytes, size, "", model, error)) return tinygltf_failure(name, error);
   return read_model(model, name, out, error);
 }
 

@@ -16,6 +16,7 @@ import json
 import os
 import re
 import struct
+import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -272,7 +273,8 @@ def seeds_tdag(data_dir: Path | None) -> dict[str, bytes]:
 
 def seeds_crowd_glb(data_dir: Path | None) -> dict[str, bytes]:
     """GLBs split into JSON and BIN for fuzz_crowd_glb.cpp (which writes the container): the
-    skinned cylinder as a one-level chain and as a two-level MSFT_lod chain, and the small
+    skinned cylinder as a one-level chain, as a two-level MSFT_lod chain and as that chain with
+    KHR_animation_pointer channels, and the small
     skinned characters of the development data; plus a whole file (flag bit 0)."""
     import pygltflib
 
@@ -293,6 +295,13 @@ def seeds_crowd_glb(data_dir: Path | None) -> dict[str, bytes]:
     gltf.nodes[base].extras = {"MSFT_screencoverage": [0.5, 0.0], "animlod": {"level": 0, "error": 0.0}}
     gltf.extensionsUsed = [*(gltf.extensionsUsed or []), "MSFT_lod"]
     seeds["cylinder_lod"] = split(b"".join(gltf.save_to_bytes()))
+    # The same chain's joints moved through KHR_animation_pointer, plus a pointer at no node
+    # (animation_pointers.cpp rewrites them before tinygltf reads the file).
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))  # tests/python
+    from crowd_chain import channels_as_pointers
+
+    channels_as_pointers(gltf)
+    seeds["cylinder_pointers"] = split(b"".join(gltf.save_to_bytes()))
     for path in (data_dir / "gltf").glob("*.glb") if data_dir else ():
         if path.stat().st_size <= 60_000:
             seeds[path.stem] = split(path.read_bytes())

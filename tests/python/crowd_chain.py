@@ -139,3 +139,23 @@ def write_hand_built_chain(path: Path, seed: int = 0) -> Path:
     blob.finish()
     gltf.save_binary(str(path))
     return path
+
+
+def channels_as_pointers(gltf: pygltflib.GLTF2) -> None:
+    """Turn every animation channel of ``gltf`` into a KHR_animation_pointer one at the same node
+    property (as Blender 4 writes some), and add one that animates a material's colour from a
+    rotation sampler (four floats a key, as a colour has), which animates no node."""
+    gltf.extensionsUsed = [*(gltf.extensionsUsed or []), "KHR_animation_pointer"]
+    rotation = None
+    for animation in gltf.animations:
+        for channel in animation.channels:
+            if rotation is None and channel.target.path == "rotation":
+                rotation = (animation, channel.sampler)
+            pointer = f"/nodes/{channel.target.node}/{channel.target.path}"
+            channel.target = pygltflib.AnimationChannelTarget(
+                path="pointer", extensions={"KHR_animation_pointer": {"pointer": pointer}}
+            )
+    animation, sampler = rotation
+    colour = {"KHR_animation_pointer": {"pointer": "/materials/0/pbrMetallicRoughness/baseColorFactor"}}
+    target = pygltflib.AnimationChannelTarget(path="pointer", extensions=colour)
+    animation.channels.insert(0, pygltflib.AnimationChannel(sampler=sampler, target=target))

@@ -38,14 +38,13 @@ std::string string_member(const nlohmann::json* object, const char* key) {
   return value && value->is_string() ? value->get<std::string>() : std::string();
 }
 
-// Rewrites the pointer channels of `document`; false when it has none.
+// Rewrites the pointer channels of `document` (an object); false when it has none.
 bool resolve_in(nlohmann::json& document) {
   // At most 9 digits: no index overflows, and no real file has a billion nodes.
   static const std::regex node_pointer("/nodes/([0-9]{1,9})/(translation|rotation|scale|weights)");
   bool changed = false;
-  nlohmann::json* animations = document.is_object() && document.contains("animations") ? &document["animations"] : nullptr;
-  if (!animations || !animations->is_array()) return false;
-  for (nlohmann::json& animation : *animations) {
+  if (!document.contains("animations") || !document["animations"].is_array()) return false;
+  for (nlohmann::json& animation : document["animations"]) {
     if (!animation.is_object() || !animation.contains("channels") || !animation["channels"].is_array()) continue;
     for (nlohmann::json& channel : animation["channels"]) {
       if (!channel.is_object() || !channel.contains("target")) continue;

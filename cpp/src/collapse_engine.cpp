@@ -743,24 +743,24 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
     const size_t face_goal = face_count_ - targets[next_level_];
     size_t edge_goal = face_goal / 2;  // an illegal collapse does not count towards the goal
     cost_order.sort(ranked);
-    const std::vector<uint32_t>& order = cost_order.order();
     auto within_cost_goal = [&](double cost, size_t removed_faces) {
-      return removed_faces <= face_goal / 6 || edge_goal >= order.size() ||
-             cost <= options_.pass_cost_growth * ranked[order[edge_goal]].cost;
+      return removed_faces <= face_goal / 6 || edge_goal >= cost_order.size() ||
+             cost <= options_.pass_cost_growth * ranked[cost_order[edge_goal]].cost;
     };
 
     // Steps 8-12: choose, then perform in edge order.
     std::fill(touched.begin(), touched.end(), 0);
     size_t next = 0;
     bool over_max_error = false;  // the pass stops at the first candidate whose error exceeds max_error
-    for (size_t planned_faces = 0; next < order.size() && planned_faces < face_goal; ++next) {
-      const RankedEdge& entry = ranked[order[next]];
+    for (size_t planned_faces = 0; next < cost_order.size() && planned_faces < face_goal; ++next) {
+      const uint32_t index = cost_order[next];
+      const RankedEdge& entry = ranked[index];
       if (!within_cost_goal(entry.cost, planned_faces)) break;
       if (touched[entry.kept] || touched[entry.removed]) continue;
       over_max_error = entry.error > options_.max_error;
       if (over_max_error) break;
       touched[entry.kept] = touched[entry.removed] = 1;
-      chosen_index[entry.edge] = static_cast<int32_t>(order[next]);
+      chosen_index[entry.edge] = static_cast<int32_t>(index);
       planned_faces += 2;
     }
     chosen.clear();
@@ -788,10 +788,10 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       one_by_one = &deferred;
     }
     for (const RankedEdge& entry : *one_by_one) try_entry(entry);
-    for (; !over_max_error && next < order.size(); ++next) {
+    for (; !over_max_error && next < cost_order.size(); ++next) {
       const size_t removed_faces = faces_before - face_count_;
       if (removed_faces >= face_goal) break;
-      const RankedEdge& entry = ranked[order[next]];
+      const RankedEdge& entry = ranked[cost_order[next]];
       if (!within_cost_goal(entry.cost, removed_faces)) break;
       if (touched[entry.kept] || touched[entry.removed]) continue;
       over_max_error = entry.error > options_.max_error;

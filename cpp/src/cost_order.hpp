@@ -1,12 +1,16 @@
-// Collapse candidates ordered by cost without comparisons: a stable radix sort of the costs'
-// top 33 bits (meshoptimizer's sortEdgeCollapses counts the top 12 bits of its errors and
-// accepts that approximate order), then the short runs those bits leave tied ordered by the
-// whole cost. The result is the comparison sort's by (cost, index), from 3 counting passes over
-// 16-byte entries instead of O(n log n) comparisons and moves of the candidates themselves.
+// Collapse candidates ordered by cost without comparisons, and only as far as they are read. One
+// counting pass distributes the candidates by their costs' top 16 bits (sign, exponent and 4
+// mantissa bits: a few hundred buckets in practice); a bucket is ordered when the order is first
+// read inside it, by a stable radix sort of the next 22 bits in cache, then the short runs those
+// bits leave tied by the whole cost (meshoptimizer's sortEdgeCollapses counts the top 12 bits
+// and accepts that approximate order). A collapse pass reads the cheapest 20-60% of its
+// candidates, so the rest is never ordered. The result is the comparison sort's by
+// (cost, index).
 #pragma once
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -25,55 +29,90 @@ inline uint64_t cost_order_key(double value) {
 
 class CostOrder {
  public:
-  // Orders `items` (anything with a double `cost`) by (cost, index); order()[k] is the index of
-  // the k-th. The buffers are kept for the next call.
+  // Takes the costs of `items` (anything with a double `cost`) and distributes them by their top
+  // bits; (*this)[k] is then the index of the k-th item by (cost, index). The buffers are kept
+  // for the next call.
   template <typename T>
   void sort(const std::vector<T>& items) {
     const size_t count = items.size();
-    entries_.resize(count);
-    moved_.resize(count);
-    std::array<std::array<uint32_t, kBuckets>, kDigits> offsets{};
+    distributed_.resize(count);
+    bucket_ends_.clear();
+    next_bucket_ = ordered_ = 0;
+    std::vector<uint32_t>& offset = top_offsets_;
+    offset.assign(kTopBuckets, 0);
+    for (const T& item : items) ++offset[top_bucket(cost_order_key(item.cost))];
+    uint32_t sum = 0;
+    for (uint32_t& start : offset) {
+      if (start > 0) bucket_ends_.push_back(sum + start);
+      sum += std::exchange(start, sum);
+    }
     for (size_t i = 0; i < count; ++i) {
       const uint64_t key = cost_order_key(items[i].cost);
-      entries_[i] = {key, static_cast<uint32_t>(i)};
-      for (int digit = 0; digit < kDigits; ++digit) ++offsets[digit][bucket(key, digit)];
-    }
-    for (int digit = 0; digit < kDigits; ++digit) {
-      std::array<uint32_t, kBuckets>& offset = offsets[digit];
-      if (std::find(offset.begin(), offset.end(), count) != offset.end()) continue;  // one bucket: order kept
-      uint32_t sum = 0;
-      for (uint32_t& start : offset) sum += std::exchange(start, sum);
-      for (const Entry& entry : entries_) moved_[offset[bucket(entry.key, digit)]++] = entry;
-      entries_.swap(moved_);
-    }
-    order_.resize(count);
-    for (size_t begin = 0; begin < count;) {
-      size_t end = begin + 1;
-      while (end < count && (entries_[end].key ^ entries_[begin].key) >> kUnsortedBits == 0) ++end;
-      if (end - begin > 1)
-        std::sort(entries_.begin() + static_cast<std::ptrdiff_t>(begin),
-                  entries_.begin() + static_cast<std::ptrdiff_t>(end), [](const Entry& a, const Entry& b) {
-                    return a.key < b.key || (a.key == b.key && a.index < b.index);
-                  });
-      for (; begin < end; ++begin) order_[begin] = entries_[begin].index;
+      distributed_[offset[top_bucket(key)]++] = {key, static_cast<uint32_t>(i)};
     }
   }
 
-  const std::vector<uint32_t>& order() const { return order_; }
+  size_t size() const { return distributed_.size(); }
+
+  uint32_t operator[](size_t k) {
+    assert(k < size());
+    while (k >= ordered_) order_next_bucket();
+    return distributed_[k].index;
+  }
 
  private:
   struct Entry {
     uint64_t key;
     uint32_t index;
   };
-  static constexpr int kDigitBits = 11, kDigits = 3, kUnsortedBits = 64 - kDigitBits * kDigits;
-  static constexpr uint32_t kBuckets = 1u << kDigitBits;
+  static constexpr int kTopBits = 16, kDigitBits = 11, kDigits = 2;
+  static constexpr int kUnsortedBits = 64 - kTopBits - kDigitBits * kDigits;
+  static constexpr uint32_t kTopBuckets = 1u << kTopBits, kBuckets = 1u << kDigitBits;
+  static constexpr size_t kComparisonSortBelow = 256;  // fewer entries: a comparison sort is cheaper
+  static uint32_t top_bucket(uint64_t key) { return static_cast<uint32_t>(key >> (64 - kTopBits)); }
   static uint32_t bucket(uint64_t key, int digit) {
     return static_cast<uint32_t>(key >> (kUnsortedBits + kDigitBits * digit)) & (kBuckets - 1);
   }
+  static bool less(const Entry& a, const Entry& b) { return a.key < b.key || (a.key == b.key && a.index < b.index); }
 
-  std::vector<Entry> entries_, moved_;
-  std::vector<uint32_t> order_;
+  // Orders the next top-bits bucket in place; entries within it are in index order so far.
+  void order_next_bucket() {
+    const auto begin = distributed_.begin() + static_cast<std::ptrdiff_t>(ordered_);
+    const size_t count = bucket_ends_[next_bucket_++] - ordered_;
+    const auto end = begin + static_cast<std::ptrdiff_t>(count);
+    ordered_ += count;
+    if (count < kComparisonSortBelow) {
+      std::sort(begin, end, less);
+      return;
+    }
+    std::array<std::array<uint32_t, kBuckets>, kDigits> offsets{};
+    for (auto entry = begin; entry != end; ++entry)
+      for (int digit = 0; digit < kDigits; ++digit) ++offsets[digit][bucket(entry->key, digit)];
+    moved_.resize(count);
+    Entry *source = &*begin, *target = moved_.data();
+    for (int digit = 0; digit < kDigits; ++digit) {
+      std::array<uint32_t, kBuckets>& offset = offsets[digit];
+      if (std::find(offset.begin(), offset.end(), count) != offset.end()) continue;  // one bucket: order kept
+      uint32_t sum = 0;
+      for (uint32_t& start : offset) sum += std::exchange(start, sum);
+      for (const Entry* entry = source; entry != source + count; ++entry)
+        target[offset[bucket(entry->key, digit)]++] = *entry;
+      std::swap(source, target);
+    }
+    if (source != &*begin) std::copy(source, source + count, begin);
+    for (auto run = begin; run != end;) {
+      auto run_end = run + 1;
+      while (run_end != end && (run_end->key ^ run->key) >> kUnsortedBits == 0) ++run_end;
+      if (run_end - run > 1) std::sort(run, run_end, less);
+      run = run_end;
+    }
+  }
+
+  std::vector<Entry> distributed_, moved_;
+  std::vector<uint32_t> top_offsets_;
+  std::vector<uint32_t> bucket_ends_;  // exclusive end in distributed_ of each non-empty bucket
+  size_t next_bucket_ = 0;
+  size_t ordered_ = 0;  // distributed_[0, ordered_) is in order
 };
 
 }  // namespace animlod::detail

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import argparse
 import ctypes
+import dataclasses
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -50,7 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from devdata import DATA_DIR
 from table import print_table, stopwatch
 
-from animlod.aqem import simplify_animated
+from animlod.aqem import PhaseSeconds, simplify_animated
 from animlod.metrics import surface_error
 from animlod.model import AnimatedMesh
 
@@ -435,8 +436,13 @@ def character_table(quick: bool, max_triangles: int) -> None:
     )
 
 
+def _aqem_one_frame_phases(mesh: AnimatedMesh, target: int) -> tuple[int, PhaseSeconds]:
+    result = simplify_animated(mesh, target_face_counts=[target], use_motion_features=False)
+    return result.levels[0].mesh.face_count, result.seconds
+
+
 def _aqem_one_frame(mesh: AnimatedMesh, target: int) -> int:
-    return simplify_animated(mesh, target_face_counts=[target], use_motion_features=False).levels[0].mesh.face_count
+    return _aqem_one_frame_phases(mesh, target)[0]
 
 
 def _meshoptimizer_simplify(mesh: AnimatedMesh, target: int) -> int:
@@ -455,12 +461,13 @@ def _fast_simplification_simplify(mesh: AnimatedMesh, target: int) -> int:
 
 
 def speed_table(quick: bool) -> None:
+    aqem_method = "AQEM (animlod, OpenMesh connectivity)"
     methods = {
-        "AQEM (animlod, OpenMesh connectivity)": _aqem_one_frame,
-        "meshoptimizer simplify": _meshoptimizer_simplify,
-        "fast-simplification": _fast_simplification_simplify,
+        aqem_method: _aqem_one_frame_phases,
+        "meshoptimizer simplify": lambda mesh, target: (_meshoptimizer_simplify(mesh, target), None),
+        "fast-simplification": lambda mesh, target: (_fast_simplification_simplify(mesh, target), None),
     }
-    rows = []
+    rows, phase_rows = [], []
     inputs = [("bumpy sphere", bumpy_sphere(*((240, 240) if quick else (710, 705)), frames=1))]
     if not quick:
         inputs.append(("wobbly sphere", openmesh_bench_sphere()))
@@ -474,18 +481,26 @@ def speed_table(quick: bool) -> None:
     for name, mesh in inputs:
         target = mesh.face_count // 10
         best = dict.fromkeys(methods, float("inf"))
-        output_faces = {}
+        output_faces, best_phases = {}, None
         for _ in range(rounds):
             for method, simplify in methods.items():
                 with stopwatch() as elapsed:
-                    output_faces[method] = simplify(mesh, target)
-                best[method] = min(best[method], elapsed[0])
+                    output_faces[method], phases = simplify(mesh, target)
+                if elapsed[0] < best[method]:
+                    best[method] = elapsed[0]
+                    best_phases = phases or best_phases
         rows += [(method, name, mesh.face_count, output_faces[method], best[method]) for method in methods]
+        phase_rows.append((name, *(f"{1e3 * value:.0f}" for value in vars(best_phases).values())))
     rows = [(*row, f"{(row[2] - row[3]) / row[4] / 1e6:.2f}") for row in rows]
     print_table(
         f"Speed, one frame, to 10% of the faces (best of {rounds}, taking turns; the Decimater: one run)",
         ("method", "input", "input faces", "output faces", "time s", "M faces removed / s"),
         rows,
+    )
+    print_table(
+        "AQEM's phases in its best run above, ms (SimplifyResult.seconds)",
+        ("input", *(field.name for field in dataclasses.fields(PhaseSeconds))),
+        phase_rows,
     )
 
 

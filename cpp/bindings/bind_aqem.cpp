@@ -139,6 +139,17 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   preparation["unreferenced_vertices"] = report.unreferenced_vertices;
   preparation["face_count"] = report.face_count;
   out["preparation"] = preparation;
+  const AqemTimings& timings = result.seconds;
+  py::dict seconds;
+  seconds["preparation"] = timings.preparation;
+  seconds["motion_features"] = timings.motion_features;
+  seconds["connectivity"] = timings.connectivity;
+  seconds["quadrics"] = timings.quadrics;
+  seconds["ranking"] = timings.ranking;
+  seconds["choosing"] = timings.choosing;
+  seconds["collapsing"] = timings.collapsing;
+  seconds["levels"] = timings.levels;
+  out["seconds"] = seconds;
   return out;
 }
 }  // namespace
@@ -174,7 +185,9 @@ kept_vertices (V',), vertex_map (V,), positions (F, V', 3), attributes, position
 skin_joints, skin_weights, error, reached, target_face_count, collapse_count), "collapses"
 (removed, kept (C,), positions (C, F, 3), cost, error (C,)), "frames_used", "vertex_weights" (V,)
 and "preparation" (counts of degenerate_faces, duplicate_faces, welded_vertices, seam_vertices,
-split_vertices, unreferenced_vertices, and face_count simplified). Arrays own their memory (moved
+split_vertices, unreferenced_vertices, and face_count simplified), "seconds" (wall-clock seconds
+of the phases: preparation, motion_features, connectivity, quadrics, ranking, choosing,
+collapsing, levels; see AqemTimings in animlod/aqem.hpp). Arrays own their memory (moved
 from the core, no copy). The GIL is released while simplifying.
 
 Raises ValueError naming the element for bad meshes, targets or per-vertex inputs.)doc");

@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -30,6 +31,7 @@
 #include "mesh_preparation.hpp"
 #include "mesh_validation_detail.hpp"
 #include "needle_tips.hpp"
+#include "phase_timer.hpp"
 #include "quadric.hpp"
 
 namespace animlod {
@@ -456,6 +458,8 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   // (or an exception from the progress callback) leaves `out` empty, never half filled.
   out = AqemResult{};
   AqemResult result;
+  AqemTimings& seconds = result.seconds;
+  std::optional<detail::PhaseTimer> timer(std::in_place, seconds.preparation);
   if (Status status = detail::check_sizes_values_and_indices(mesh); !status) return status;
   if (Status status = validate_vertex_data(mesh, vertex_data); !status) return status;
 
@@ -490,6 +494,7 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   // importance multiplies them.
   const size_t point_count = prepared.point_source.size();
   std::vector<double> weights(point_count, 1.0);
+  timer.emplace(seconds.motion_features);
   if (options.use_motion_features) {
     MotionFeatures features;
     if (Status status = compute_motion_features(points.view(), options.motion_features, features); !status)
@@ -519,17 +524,26 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   engine_options.max_error = options.max_error;
   engine_options.progress = options.progress;
   engine_options.collapse_passes = true;
+  timer.emplace(seconds.connectivity);
   CollapseEngine engine(mesh, prepared, carried, engine_options);
+  timer.emplace(seconds.quadrics);
   AqemPolicy policy(engine, options, result.frames_used, std::move(weights));
+  timer.reset();
   std::vector<detail::EngineLevel> levels;
   detail::EngineRecord record;
   engine.run(policy, targets, levels, record);
+  seconds.ranking = engine.timings().ranking;
+  seconds.choosing = engine.timings().choosing;
+  seconds.collapsing = engine.timings().collapsing;
+  timer.emplace(seconds.levels);
   for (auto& level : levels) result.levels.push_back(to_level(std::move(level)));
   result.collapses.removed = std::move(record.removed);
   result.collapses.kept = std::move(record.kept);
   result.collapses.positions = std::move(record.positions);
   result.collapses.cost = std::move(record.cost);
   result.collapses.error = std::move(record.error);
+  timer.reset();
+  seconds.levels += engine.timings().levels;
   out = std::move(result);
   return Status::success();
 }

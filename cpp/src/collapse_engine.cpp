@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "cost_order.hpp"
+#include "phase_timer.hpp"
 #include "inversion_test.hpp"
 #include "skin_merge.hpp"
 #include "worker_threads.hpp"
@@ -370,6 +371,7 @@ void CollapseEngine::park(int32_t edge) {
 }
 
 EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
+  const PhaseTimer timer(timings_.levels);
   EngineLevel level;
   level.target_face_count = target;
   level.reached = reached;
@@ -474,6 +476,16 @@ void CollapseEngine::take_reached_levels(const std::vector<size_t>& targets, std
 
 void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
                          EngineRecord& record) {
+  double seconds = 0.0;
+  {
+    const PhaseTimer timer(seconds);
+    run_collapses(policy, targets, levels, record);
+  }
+  timings_.collapsing = seconds - timings_.ranking - timings_.choosing - timings_.levels;
+}
+
+void CollapseEngine::run_collapses(CollapsePolicy& policy, const std::vector<size_t>& targets,
+                                   std::vector<EngineLevel>& levels, EngineRecord& record) {
   planned_ = face_count_ > targets.back() ? (face_count_ - targets.back() + 1) / 2 : 0;
   next_level_ = 0;
   take_reached_levels(targets, levels);
@@ -565,6 +577,7 @@ CollapseEngine::Attempt CollapseEngine::try_collapse(CollapsePolicy& policy, Can
 // them), each writing its part of `ranked` from the start of its range; the parts are then
 // moved together.
 void CollapseEngine::rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) {
+  const PhaseTimer timer(timings_.ranking);
   constexpr size_t kMinimumChunk = 8192;
   const size_t edge_count = connectivity_.n_edges();
   const size_t hardware = std::max<size_t>(std::thread::hardware_concurrency(), 1);
@@ -742,32 +755,35 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
     }
     const size_t face_goal = face_count_ - targets[next_level_];
     size_t edge_goal = face_goal / 2;  // an illegal collapse does not count towards the goal
-    cost_order.sort(ranked);
     auto within_cost_goal = [&](double cost, size_t removed_faces) {
       return removed_faces <= face_goal / 6 || edge_goal >= cost_order.size() ||
              cost <= options_.pass_cost_growth * ranked[cost_order[edge_goal]].cost;
     };
 
     // Steps 8-12: choose, then perform in edge order.
-    std::fill(touched.begin(), touched.end(), 0);
     size_t next = 0;
     bool over_max_error = false;  // the pass stops at the first candidate whose error exceeds max_error
-    for (size_t planned_faces = 0; next < cost_order.size() && planned_faces < face_goal; ++next) {
-      const uint32_t index = cost_order[next];
-      const RankedEdge& entry = ranked[index];
-      if (!within_cost_goal(entry.cost, planned_faces)) break;
-      if (touched[entry.kept] || touched[entry.removed]) continue;
-      over_max_error = entry.error > options_.max_error;
-      if (over_max_error) break;
-      touched[entry.kept] = touched[entry.removed] = 1;
-      chosen_index[entry.edge] = static_cast<int32_t>(index);
-      planned_faces += 2;
-    }
-    chosen.clear();
-    for (int32_t& index : chosen_index) {
-      if (index < 0) continue;
-      chosen.push_back(ranked[static_cast<size_t>(index)]);
-      index = -1;
+    {
+      const PhaseTimer timer(timings_.choosing);
+      cost_order.sort(ranked);
+      std::fill(touched.begin(), touched.end(), 0);
+      for (size_t planned_faces = 0; next < cost_order.size() && planned_faces < face_goal; ++next) {
+        const uint32_t index = cost_order[next];
+        const RankedEdge& entry = ranked[index];
+        if (!within_cost_goal(entry.cost, planned_faces)) break;
+        if (touched[entry.kept] || touched[entry.removed]) continue;
+        over_max_error = entry.error > options_.max_error;
+        if (over_max_error) break;
+        touched[entry.kept] = touched[entry.removed] = 1;
+        chosen_index[entry.edge] = static_cast<int32_t>(index);
+        planned_faces += 2;
+      }
+      chosen.clear();
+      for (int32_t& index : chosen_index) {
+        if (index < 0) continue;
+        chosen.push_back(ranked[static_cast<size_t>(index)]);
+        index = -1;
+      }
     }
     const size_t faces_before = face_count_;
     size_t pass_collapses = 0;

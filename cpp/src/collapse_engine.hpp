@@ -121,6 +121,11 @@ struct EngineLevel {
   std::vector<float> skin_weights;      // (V', K)
 };
 
+// Wall-clock seconds of run()'s parts; collapsing is the rest of run().
+struct EngineTimings {
+  double ranking = 0.0, choosing = 0.0, collapsing = 0.0, levels = 0.0;
+};
+
 struct EngineRecord {
   std::vector<int32_t> removed, kept;  // (C,) input vertex standing for each point
   std::vector<float> positions;        // (C, F, 3)
@@ -150,10 +155,13 @@ class CollapseEngine {
   // Collapses until every target face count (descending) is reached or nothing legal remains.
   void run(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
            EngineRecord& record);
+  const EngineTimings& timings() const { return timings_; }
 
  private:
   using TriMesh = OpenMesh::TriConnectivity;
 
+  void run_collapses(CollapsePolicy& policy, const std::vector<size_t>& targets, std::vector<EngineLevel>& levels,
+                     EngineRecord& record);
   void build_connectivity();
   void link_paired_sides();
   void find_border_and_seam_sides();
@@ -239,6 +247,7 @@ class CollapseEngine {
   double error_so_far_ = 0.0;
   size_t collapse_count_ = 0;
   size_t next_level_ = 0;
+  EngineTimings timings_;
   size_t planned_ = 0;
   void take_reached_levels(const std::vector<size_t>& targets, std::vector<EngineLevel>& levels);
 };

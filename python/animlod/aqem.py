@@ -112,6 +112,33 @@ class Preparation:
 
 
 @dataclass
+class PhaseSeconds:
+    """Wall-clock seconds of one simplification's phases, in the order they run: where its time
+    goes. The core's own phases; converting the input and the result to numpy is not included.
+
+    preparation : checks, weld, dropped faces and cuts. motion_features : Eq. 6's features (0
+        when off). connectivity : the collapse engine's OpenMesh connectivity and per-point
+        state. quadrics : every point's quadrics. ranking : the costs of every collapsible edge
+        (each collapse pass's, or the greedy order's first). choosing : collapse passes ordering
+        their candidates by cost and choosing their collapses. collapsing : collapse attempts
+        (the greedy order's re-keying included). levels : the levels' meshes and arrays.
+    """
+
+    preparation: float
+    motion_features: float
+    connectivity: float
+    quadrics: float
+    ranking: float
+    choosing: float
+    collapsing: float
+    levels: float
+
+    @property
+    def total(self) -> float:
+        return sum(vars(self).values())
+
+
+@dataclass
 class CollapseRecord:
     """Every collapse in order: vertex ``removed[i]`` merged into ``kept[i]`` (input indices; for
     welded copies, the lowest input index at that position).
@@ -135,13 +162,14 @@ class CollapseRecord:
 @dataclass
 class SimplifyResult:
     """Levels (finest first), the collapse record, the frames whose quadrics were used, the
-    vertex weights (V,) of Eq. 6 and what preparing the input did."""
+    vertex weights (V,) of Eq. 6, what preparing the input did and the phases' seconds."""
 
     levels: list[SimplifiedLevel]
     collapses: CollapseRecord
     frames_used: np.ndarray
     vertex_weights: np.ndarray
     preparation: Preparation
+    seconds: PhaseSeconds
 
     def lod_chain(self, original: AnimatedMesh, name: str = "") -> LodChain:
         """The levels as a :class:`~animlod.model.LodChain`, ``original`` as level 0; each
@@ -418,4 +446,5 @@ def _result(raw: dict, fps: float | None) -> SimplifyResult:
         frames_used=raw["frames_used"],
         vertex_weights=raw["vertex_weights"],
         preparation=Preparation(**{name: int(count) for name, count in raw["preparation"].items()}),
+        seconds=PhaseSeconds(**raw["seconds"]),
     )

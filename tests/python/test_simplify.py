@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -383,3 +384,17 @@ def test_welding_joins_exactly_the_copies_equal_everywhere():
     # The welded copies' faces repeat the tube's and are dropped; the other two copies stay.
     assert result.preparation.duplicate_faces == 2 * mesh.face_count
     assert result.preparation.face_count == 3 * mesh.face_count
+
+
+def test_phase_seconds_account_for_the_call():
+    # Small meshes take the greedy order (no pass chooses anything); one above 100k edges takes
+    # collapse passes, which rank and choose.
+    for mesh, passes in ((bending_tube(), False), (ellipsoid(frames=1, rings=190, segments=190), True)):
+        start = time.perf_counter()
+        seconds = simplify_animated(mesh, (0.1,), use_motion_features=False).seconds
+        wall = time.perf_counter() - start
+        phases = vars(seconds)
+        assert all(value >= 0.0 for value in phases.values()), phases
+        assert seconds.total <= wall
+        assert seconds.ranking > 0.0 and seconds.collapsing > 0.0 and seconds.levels > 0.0
+        assert (seconds.choosing > 0.0) == passes

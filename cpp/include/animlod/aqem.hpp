@@ -159,6 +159,18 @@ struct CollapseRecord {
                                   //      used: sqrt(sum_k Q_k(v_k) / (K planes)), Eqs. 3-6 unweighted
 };
 
+// Wall-clock seconds of one call's phases: where its time goes (bench/bench_aqem.py prints them).
+struct AqemTimings {
+  double preparation = 0.0;      // checks, weld, dropped faces, cuts (before any collapse)
+  double motion_features = 0.0;  // Eq. 6's features (0 when off)
+  double connectivity = 0.0;     // the engine's OpenMesh connectivity and per-point state
+  double quadrics = 0.0;         // every point's quadrics
+  double ranking = 0.0;          // costs of every collapsible edge (each pass's, or the greedy heap's first)
+  double choosing = 0.0;         // collapse passes: ordering candidates by cost and choosing a pass's
+  double collapsing = 0.0;       // collapse attempts (the greedy order: its re-keying too)
+  double levels = 0.0;           // the levels' meshes and arrays
+};
+
 struct AqemResult {
   std::vector<AqemLevel> levels;     // one per target, finest first
   CollapseRecord collapses;
@@ -166,6 +178,7 @@ struct AqemResult {
   std::vector<float> vertex_weights; // (V,) weights of Eq. 6 (motion features x importance),
                                      //      1 for vertices no face uses
   AqemPreparation preparation;
+  AqemTimings seconds;
 };
 
 // Simplifies `mesh` to every target of `options`.

@@ -60,6 +60,10 @@ class CostOrder {
     return distributed_[k].index;
   }
 
+  // The index of the k-th item if its bucket is ordered already, without ordering any (to
+  // prefetch what the k-th will read); -1 otherwise.
+  int64_t ordered_index(size_t k) const { return k < ordered_ ? distributed_[k].index : -1; }
+
  private:
   struct Entry {
     uint64_t key;

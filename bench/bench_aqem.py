@@ -17,7 +17,8 @@ fast-simplification from the ``bench`` extra). Tables:
    baseline's (<= 1).
 2. Speed with one frame to 10%: a procedural mesh of about 1M triangles (AQEM, meshoptimizer,
    fast-simplification) and the 200k-triangle sphere of bench/openmesh_build, on which
-   OpenMesh's own Decimater with ModQuadric also runs.
+   OpenMesh's own Decimater with ModQuadric also runs; best of 3 rounds, the methods taking
+   turns; then AQEM's phases in its best run (``SimplifyResult.seconds``).
 3. Time against the frame count F = 1, 4, 16, 64 on one animated procedural mesh.
 
 4. Feature weightings in the whole-glTF pipeline (``animlod.pipelines.simplify_drawable``, as

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "cost_order.hpp"
+#include "interior_collapse.hpp"
 #include "phase_timer.hpp"
 #include "inversion_test.hpp"
 #include "skin_merge.hpp"
@@ -335,7 +336,7 @@ int32_t CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candid
   }
   valence_[candidate.kept] += valence_[candidate.removed] - 2 - faces_removed;
   if (point_wedge_[candidate.removed] < 0) point_wedge_[candidate.kept] = -1;
-  connectivity_.collapse(halfedge);
+  if (!collapse_away_from_borders(connectivity_, halfedge)) connectivity_.collapse(halfedge);
   return faces_removed;
 }
 

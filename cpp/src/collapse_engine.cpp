@@ -12,8 +12,8 @@
 
 #include "cost_order.hpp"
 #include "interior_collapse.hpp"
-#include "phase_timer.hpp"
 #include "inversion_test.hpp"
+#include "phase_timer.hpp"
 #include "skin_merge.hpp"
 #include "worker_threads.hpp"
 

@@ -1,11 +1,10 @@
 // Collapse candidates ordered by cost without comparisons, and only as far as they are read. One
 // counting pass distributes the candidates by their costs' top 16 bits (sign, exponent and 4
-// mantissa bits: a few hundred buckets in practice); a bucket is ordered when the order is first
-// read inside it, by a stable radix sort of the next 22 bits in cache, then the short runs those
-// bits leave tied by the whole cost (meshoptimizer's sortEdgeCollapses counts the top 12 bits
-// and accepts that approximate order). A collapse pass reads the cheapest 20-60% of its
-// candidates, so the rest is never ordered. The result is the comparison sort's by
-// (cost, index).
+// mantissa bits); a bucket is ordered when the order is first read inside it, by a stable radix
+// sort of the next 22 bits in cache, then the short runs those bits leave tied by the whole cost
+// (meshoptimizer's sortEdgeCollapses counts the top 12 bits and accepts that approximate order).
+// A collapse pass reads its candidates only up to its cost bound, so the dearer ones are never
+// ordered. The result is the comparison sort's by (cost, index).
 #pragma once
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Wall-clock time of a scope, added to a running total (AqemTimings' phases).
+// Wall-clock time of a scope, added to a running total (AqemTimings' and TdagBuildReport's phases).
 #pragma once
 
 #include <chrono>

@@ -11,7 +11,6 @@
 //                    the error bound, made monotone along dependencies and stored as time-
 //                    tagged runs (Section 2), so that a tolerance query always gives a valid cut.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -23,6 +22,7 @@
 #include "collapse_engine.hpp"
 #include "mesh_preparation.hpp"
 #include "mesh_validation_detail.hpp"
+#include "phase_timer.hpp"
 #include "tdag_data.hpp"
 #include "tdag_hierarchy.hpp"
 #include "tdag_policy.hpp"
@@ -34,10 +34,6 @@ namespace {
 using detail::CollapseTable;
 using detail::FrameHierarchy;
 using detail::Quadric;
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 Status check_options(const AnimatedMeshView& mesh, const TdagOptions& options) {
   if (options.governing == Governing::frame &&
@@ -303,12 +299,13 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
   data->scale = bounding_box_diagonal(view);
 
   // Section 3: the affine split.
-  auto start = std::chrono::steady_clock::now();
-  AffineSplit split;
-  if (Status status = affine_split(view, options.affine_base, split); !status) return status;
-  data->maps = std::move(split.maps);
-  data->residuals = std::move(split.residuals);
-  rep.seconds_affine = seconds_since(start);
+  {
+    const detail::PhaseTimer timer(rep.seconds_affine);
+    AffineSplit split;
+    if (Status status = affine_split(view, options.affine_base, split); !status) return status;
+    data->maps = std::move(split.maps);
+    data->residuals = std::move(split.residuals);
+  }
 
   // Section 4: the hierarchy (one order, or one per frame online) and the per-frame fields.
   CollapseTable table(data->vertex_count);
@@ -321,43 +318,45 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
   };
   std::vector<double> costs;
   if (options.governing != Governing::online) {
-    start = std::chrono::steady_clock::now();
     FrameHierarchy hierarchy;
-    if (options.governing == Governing::aqem) {
-      if (Status status = aqem_hierarchy(mesh, points, options, table, hierarchy); !status) return status;
-    } else {
-      const std::vector<float> positions = governing_positions(mesh, options);
-      if (Status status = decimate(mesh, points, positions.data(), options, boundary_or_null, nullptr, table,
-                                   hierarchy, costs);
-          !status)
-        return Status::error("internal: " + status.message);
+    {
+      const detail::PhaseTimer timer(rep.seconds_hierarchy);
+      if (options.governing == Governing::aqem) {
+        if (Status status = aqem_hierarchy(mesh, points, options, table, hierarchy); !status) return status;
+      } else {
+        const std::vector<float> positions = governing_positions(mesh, options);
+        if (Status status = decimate(mesh, points, positions.data(), options, boundary_or_null, nullptr, table,
+                                     hierarchy, costs);
+            !status)
+          return Status::error("internal: " + status.message);
+      }
     }
-    rep.seconds_hierarchy = seconds_since(start);
     progress(0);
-    start = std::chrono::steady_clock::now();
+    const detail::PhaseTimer timer(rep.seconds_fields);
     for (int32_t t = 0; t < frame_count; ++t) {
       fields.add_frame(t, table, hierarchy, rep);
       progress(static_cast<size_t>(t) + 1);
     }
-    rep.seconds_fields = seconds_since(start);
   } else {
     FrameHierarchy previous, current;
     std::vector<double> previous_costs;
     progress(0);
     for (int32_t t = 0; t < frame_count; ++t) {
-      start = std::chrono::steady_clock::now();
-      const float* positions = mesh.frames + static_cast<size_t>(t) * mesh.vertex_count * 3;
-      std::unique_ptr<detail::HistoryTerm> history;
-      if (t > 0 && options.history_weight > 0.0)
-        history = std::make_unique<detail::HistoryTerm>(table, previous, previous_costs, options.history_weight);
-      if (Status status = decimate(mesh, points, positions, options, boundary_or_null, history.get(), table, current,
-                                   costs);
-          !status)
-        return Status::error("internal: frame " + std::to_string(t) + ": " + status.message);
-      rep.seconds_hierarchy += seconds_since(start);
-      start = std::chrono::steady_clock::now();
-      fields.add_frame(t, table, current, rep);
-      rep.seconds_fields += seconds_since(start);
+      {
+        const detail::PhaseTimer timer(rep.seconds_hierarchy);
+        const float* positions = mesh.frames + static_cast<size_t>(t) * mesh.vertex_count * 3;
+        std::unique_ptr<detail::HistoryTerm> history;
+        if (t > 0 && options.history_weight > 0.0)
+          history = std::make_unique<detail::HistoryTerm>(table, previous, previous_costs, options.history_weight);
+        if (Status status = decimate(mesh, points, positions, options, boundary_or_null, history.get(), table,
+                                     current, costs);
+            !status)
+          return Status::error("internal: frame " + std::to_string(t) + ": " + status.message);
+      }
+      {
+        const detail::PhaseTimer timer(rep.seconds_fields);
+        fields.add_frame(t, table, current, rep);
+      }
       std::swap(previous, current);
       previous_costs = costs;
       progress(static_cast<size_t>(t) + 1);

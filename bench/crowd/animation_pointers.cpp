@@ -76,8 +76,7 @@ std::vector<uint8_t> resolve_json(const char* text, size_t size) {
 
 std::vector<uint8_t> resolve_animation_pointers(const uint8_t* bytes, size_t size) {
   const char* text = reinterpret_cast<const char*>(bytes);
-  const bool binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
-  if (!binary) {
+  if (!is_glb(bytes, size)) {
     if (std::string_view(text, size).find(kExtension) == std::string_view::npos) return {};
     return resolve_json(text, size);
   }

@@ -6,9 +6,14 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 namespace crowd {
+
+// Whether `bytes` are a GLB (its magic, whatever the file's name: a VRM avatar's is .vrm) rather
+// than glTF JSON.
+inline bool is_glb(const uint8_t* bytes, size_t size) { return size >= 4 && std::memcmp(bytes, "glTF", 4) == 0; }
 
 // `bytes` (a GLB or glTF JSON) with every KHR_animation_pointer channel that names a node's
 // translation, rotation, scale or weights made a channel of that node, and every other pointer

@@ -719,16 +719,14 @@ bool read_model(const Model& model, const std::string& name, Asset& out, std::st
   return true;
 }
 
-// tinygltf's model of a GLB (told by its magic, whatever its name: a VRM avatar's is .vrm, as
-// the Python reader decides) or glTF JSON, its pointer channels resolved first
+// tinygltf's model of a GLB (told by its magic, as the Python reader decides) or glTF JSON, its pointer channels resolved first
 // (animation_pointers.hpp); external files are looked up in base_dir.
 bool parse_model(tinygltf::TinyGLTF& loader, const uint8_t* bytes, size_t size, const std::string& base_dir,
                  Model& model, std::string& error) {
   const std::vector<uint8_t> resolved = resolve_animation_pointers(bytes, size);
   if (!resolved.empty()) bytes = resolved.data(), size = resolved.size();
   std::string warnings;
-  const bool binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
-  return binary ? loader.LoadBinaryFromMemory(&model, &error, &warnings, bytes, static_cast<unsigned int>(size), base_dir)
+  return is_glb(bytes, size) ? loader.LoadBinaryFromMemory(&model, &error, &warnings, bytes, static_cast<unsigned int>(size), base_dir)
                 : loader.LoadASCIIFromString(&model, &error, &warnings, reinterpret_cast<const char*>(bytes),
                                              static_cast<unsigned int>(size), base_dir);
 }

@@ -737,7 +737,9 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
   constexpr size_t kMinimumHalves = 2048;  // fewer chosen collapses go one by one
   std::vector<RankedEdge> ranked, chosen, deferred;
   CostOrder cost_order;  // ranked comes in edge order, so its (cost, index) order is (cost, edge)
-  std::vector<int32_t> chosen_index(connectivity_.n_edges(), -1);  // place in ranked of the pass's chosen edges
+  // The pass's chosen candidates, one bit per place in ranked: read in order of place, which is
+  // edge order, and small enough to stay in cache while the choice sets bits at random.
+  std::vector<uint64_t> chosen_places;
   std::vector<uint8_t> touched(point_count_, 0);
   in_passes_ = true;
   ranking_cache_.cost.assign(connectivity_.n_edges(), std::numeric_limits<double>::quiet_NaN());
@@ -768,6 +770,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       const PhaseTimer timer(timings_.choosing);
       cost_order.sort(ranked);
       std::fill(touched.begin(), touched.end(), 0);
+      chosen_places.assign((ranked.size() + 63) / 64, 0);
       for (size_t planned_faces = 0; next < cost_order.size() && planned_faces < face_goal; ++next) {
         // The candidates scatter over `ranked`: a load ahead overlaps its cache miss with the
         // choices before it.
@@ -781,15 +784,13 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
         over_max_error = entry.error > options_.max_error;
         if (over_max_error) break;
         touched[entry.kept] = touched[entry.removed] = 1;
-        chosen_index[entry.edge] = static_cast<int32_t>(index);
+        chosen_places[index / 64] |= uint64_t{1} << (index % 64);
         planned_faces += 2;
       }
       chosen.clear();
-      for (int32_t& index : chosen_index) {
-        if (index < 0) continue;
-        chosen.push_back(ranked[static_cast<size_t>(index)]);
-        index = -1;
-      }
+      for (size_t word = 0; word < chosen_places.size(); ++word)
+        for (uint64_t bits = chosen_places[word]; bits != 0; bits &= bits - 1)
+          chosen.push_back(ranked[64 * word + static_cast<size_t>(__builtin_ctzll(bits))]);
     }
     const size_t faces_before = face_count_;
     size_t pass_collapses = 0;

@@ -13,8 +13,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <thread>
 #include <utility>
 #include <vector>
+
+#include "worker_threads.hpp"
 
 namespace animlod::detail {
 
@@ -37,18 +40,27 @@ class CostOrder {
     distributed_.resize(count);
     bucket_ends_.clear();
     next_bucket_ = ordered_ = 0;
-    std::vector<uint32_t>& offset = top_offsets_;
-    offset.assign(kTopBuckets, 0);
-    for (const T& item : items) ++offset[top_bucket(cost_order_key(item.cost))];
+    // Two workers for many items, each counting and then placing its half of them (the first
+    // half's entries first in every bucket, as one worker places them).
+    const size_t workers = count >= kTwoWorkersFrom && std::thread::hardware_concurrency() >= 2 ? 2 : 1;
+    for (size_t worker = 0; worker < workers; ++worker) offsets_[worker].assign(kTopBuckets, 0);
+    run_in_ranges(count, workers, [&](size_t begin, size_t end, size_t worker) {
+      std::vector<uint32_t>& offset = offsets_[worker];
+      for (size_t i = begin; i < end; ++i) ++offset[top_bucket(cost_order_key(items[i].cost))];
+    });
     uint32_t sum = 0;
-    for (uint32_t& start : offset) {
-      if (start > 0) bucket_ends_.push_back(sum + start);
-      sum += std::exchange(start, sum);
+    for (uint32_t bucket = 0; bucket < kTopBuckets; ++bucket) {
+      const uint32_t start = sum;
+      for (size_t worker = 0; worker < workers; ++worker) sum += std::exchange(offsets_[worker][bucket], sum);
+      if (sum > start) bucket_ends_.push_back(sum);
     }
-    for (size_t i = 0; i < count; ++i) {
-      const uint64_t key = cost_order_key(items[i].cost);
-      distributed_[offset[top_bucket(key)]++] = {key, static_cast<uint32_t>(i)};
-    }
+    run_in_ranges(count, workers, [&](size_t begin, size_t end, size_t worker) {
+      std::vector<uint32_t>& offset = offsets_[worker];
+      for (size_t i = begin; i < end; ++i) {
+        const uint64_t key = cost_order_key(items[i].cost);
+        distributed_[offset[top_bucket(key)]++] = {key, static_cast<uint32_t>(i)};
+      }
+    });
   }
 
   size_t size() const { return distributed_.size(); }
@@ -72,6 +84,7 @@ class CostOrder {
   static constexpr int kUnsortedBits = 64 - kTopBits - kDigitBits * kDigits;
   static constexpr uint32_t kTopBuckets = 1u << kTopBits, kBuckets = 1u << kDigitBits;
   static constexpr size_t kComparisonSortBelow = 256;  // fewer entries: a comparison sort is cheaper
+  static constexpr size_t kTwoWorkersFrom = 1 << 18;    // fewer items are distributed on one thread
   static uint32_t top_bucket(uint64_t key) { return static_cast<uint32_t>(key >> (64 - kTopBits)); }
   static uint32_t bucket(uint64_t key, int digit) {
     return static_cast<uint32_t>(key >> (kUnsortedBits + kDigitBits * digit)) & (kBuckets - 1);
@@ -112,7 +125,7 @@ class CostOrder {
   }
 
   std::vector<Entry> distributed_, moved_;
-  std::vector<uint32_t> top_offsets_;
+  std::array<std::vector<uint32_t>, 2> offsets_;  // per worker: its count, then its next place, per top bucket
   std::vector<uint32_t> bucket_ends_;  // exclusive end in distributed_ of each non-empty bucket
   size_t next_bucket_ = 0;
   size_t ordered_ = 0;  // distributed_[0, ordered_) is in order

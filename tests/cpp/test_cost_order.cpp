@@ -35,7 +35,7 @@ std::vector<uint32_t> read_order(animlod::detail::CostOrder& order, size_t count
 TEST_CASE("cost order is the comparison sort's by (cost, index), ties in the top bits included") {
   std::mt19937 random(11);
   std::vector<Costed> items;
-  for (int i = 0; i < 20000; ++i) {
+  for (int i = 0; i < 300000; ++i) {  // above the two workers' threshold
     const double base = std::ldexp(1.0 + double(random() % 64) / 64.0, int(random() % 40) - 30);
     switch (random() % 7) {
       case 0: items.push_back({base}); break;  // exact ties among the 64 x 40 values

@@ -147,23 +147,58 @@ struct Fans {
   bool simple = true;
 };
 
-// Step 3: across every undirected edge, sides are paired first-come in face order, one forward
-// with one backward; unpaired sides are borders of their piece, and paired sides join the
-// corners of their points into fans. Sides are visited in (edge, corner) order: bucketed by
-// their lower point, then sorted by (higher point, corner) inside the bucket. Large meshes take
-// two workers: one for each half of the buckets (an edge's sides lie in one), then one for each
-// half of the points to join corners (a pairing joins only corners of one point). The fans are
-// the same sets either way, each labelled by its lowest corner.
-Fans corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) {
-  constexpr size_t kCornersPerWorker = 1 << 17;
+constexpr size_t kCornersPerWorker = 1 << 17;  // fewer corners per worker: one worker
+
+size_t workers_for(size_t corner_count) {
+  return corner_count >= 2 * kCornersPerWorker && std::thread::hardware_concurrency() >= 2 ? 2 : 1;
+}
+
+// The simple case of pair_sides without sorting any side: each side a -> b looks for its
+// directed edge among the few sides leaving a (it must be the only one) and for b -> a among
+// those leaving b (at most one, not its own triangle turned over). Fills `partner` as pair_sides
+// would and returns true when the mesh is simple; returns false as soon as it is not. A
+// repeated face repeats its directed edges, so a simple mesh has none.
+bool pair_unique_sides(const std::vector<int32_t>& corner_points, size_t point_count, std::vector<int32_t>& partner) {
   const size_t corner_count = corner_points.size();
-  const size_t workers = corner_count >= 2 * kCornersPerWorker && std::thread::hardware_concurrency() >= 2 ? 2 : 1;
+  std::vector<int32_t> offsets, order;
+  bucket_by_point(corner_count, point_count, [&](size_t c) { return corner_points[c]; }, offsets, order);
+  std::vector<int32_t> ends(corner_count);  // end point of each side leaving a point, in bucket order
+  for (size_t i = 0; i < corner_count; ++i) ends[i] = corner_points[next_corner(static_cast<size_t>(order[i]))];
+  partner.assign(corner_count, -1);
+  const size_t workers = workers_for(corner_count);
+  std::vector<uint8_t> simple(workers, 1);
+  run_in_ranges(corner_count, workers, [&](size_t begin, size_t end, size_t worker) {
+    for (size_t c = begin; c < end; ++c) {
+      const int32_t a = corner_points[c], b = corner_points[next_corner(c)];
+      int same_way = 0, other_way = 0;
+      int32_t opposite = -1;
+      for (int32_t i = offsets[a]; i < offsets[a + 1]; ++i) same_way += ends[i] == b;
+      for (int32_t i = offsets[b]; i < offsets[b + 1]; ++i)
+        if (ends[i] == a) ++other_way, opposite = order[i];
+      if (same_way > 1 || other_way > 1 ||
+          (opposite >= 0 && same_triangle(corner_points, static_cast<int32_t>(c), opposite))) {
+        simple[worker] = 0;
+        return;
+      }
+      partner[c] = opposite;
+    }
+  });
+  return std::all_of(simple.begin(), simple.end(), [](uint8_t flag) { return flag != 0; });
+}
+
+// Step 3's pairing: across every undirected edge, sides are paired first-come in face order,
+// one forward with one backward; unpaired sides are borders of their piece. Sides are visited
+// in (edge, corner) order: bucketed by their lower point, then sorted by (higher point, corner)
+// inside the bucket. Large meshes take two workers, one for each half of the buckets (an edge's
+// sides lie in one). Fills `partner`; returns whether the mesh is simple (Fans).
+bool pair_sides(const std::vector<int32_t>& corner_points, size_t point_count, std::vector<int32_t>& partner) {
+  const size_t corner_count = corner_points.size();
+  const size_t workers = workers_for(corner_count);
   auto end_point = [&](size_t c) { return corner_points[next_corner(c)]; };
   std::vector<int32_t> offsets, order;
   bucket_by_point(corner_count, point_count, [&](size_t c) { return std::min(corner_points[c], end_point(c)); },
                   offsets, order);
-  Fans out;
-  out.partner.assign(corner_count, -1);
+  partner.assign(corner_count, -1);
   std::vector<Side> sorted(corner_count);
   std::vector<uint8_t> simple(workers, 1);
   run_in_ranges(point_count, workers, [&](size_t first_point, size_t last_point, size_t worker) {
@@ -197,26 +232,71 @@ Fans corner_fans(const std::vector<int32_t>& corner_points, size_t point_count) 
           continue;
         }
         taken[match] = 1;
-        out.partner[static_cast<size_t>(ca)] = backward[match];
-        out.partner[static_cast<size_t>(backward[match])] = ca;
+        partner[static_cast<size_t>(ca)] = backward[match];
+        partner[static_cast<size_t>(backward[match])] = ca;
       }
       i = j;
     }
   });
-  out.simple = std::all_of(simple.begin(), simple.end(), [](uint8_t flag) { return flag != 0; });
-  // Side a -> b starts at corner ca (point a) and ends at the next corner (point b); its partner
-  // b -> a starts at cb (point b): ca joins next(cb) at a, and cb joins next(ca) at b.
+  return std::all_of(simple.begin(), simple.end(), [](uint8_t flag) { return flag != 0; });
+}
+
+// Paired sides join the corners of their points into fans, each labelled by its lowest corner.
+// Side a -> b starts at corner ca (point a) and ends at the next corner (point b); its partner
+// b -> a starts at cb (point b): ca joins next(cb) at a, and cb joins next(ca) at b. Large meshes
+// take two workers, one for each half of the points (a pairing joins corners of one point only,
+// and the labels do not depend on the order of the joins).
+std::vector<int32_t> join_fans(const std::vector<int32_t>& corner_points, size_t point_count,
+                               const std::vector<int32_t>& partner) {
+  const size_t corner_count = corner_points.size();
+  const size_t workers = workers_for(corner_count);
   UnionFind fans(corner_count);
-  out.label.resize(corner_count);
+  std::vector<int32_t> label(corner_count);
   const auto half_point = static_cast<int32_t>(point_count / 2);
   run_in_ranges(workers, workers, [&](size_t, size_t, size_t worker) {
     auto mine = [&](size_t c) { return workers == 1 || (corner_points[c] >= half_point) == (worker == 1); };
     for (size_t c = 0; c < corner_count; ++c)
-      if (mine(c) && out.partner[c] >= 0) fans.unite(static_cast<int32_t>(c), next_corner(out.partner[c]));
+      if (mine(c) && partner[c] >= 0) fans.unite(static_cast<int32_t>(c), next_corner(partner[c]));
     for (size_t c = 0; c < corner_count; ++c)
-      if (mine(c)) out.label[c] = fans.find(static_cast<int32_t>(c));
+      if (mine(c)) label[c] = fans.find(static_cast<int32_t>(c));
   });
-  return out;
+  return label;
+}
+
+// Step 2's repeats: faces with the points of a face before them in the same turn (sorted by
+// (rotated corners, face) inside buckets of their lowest point) leave the corner and face
+// lists. Returns how many left.
+size_t drop_repeated_faces(std::vector<int32_t>& corner_points, std::vector<int32_t>& corner_inputs,
+                           std::vector<int32_t>& face_sources, size_t point_count) {
+  const size_t face_count = face_sources.size();
+  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> rotated(face_count);  // canonical rotation, face
+  for (size_t f = 0; f < face_count; ++f) {
+    const int32_t* p = &corner_points[3 * f];
+    const auto first = static_cast<size_t>(std::min_element(p, p + 3) - p);
+    rotated[f] = {{p[first], p[(first + 1) % 3], p[(first + 2) % 3]}, static_cast<int32_t>(f)};
+  }
+  std::vector<int32_t> offsets, order;
+  bucket_by_point(face_count, point_count, [&](size_t f) { return rotated[f].first[0]; }, offsets, order);
+  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> sorted(face_count);
+  for (size_t i = 0; i < face_count; ++i) sorted[i] = rotated[static_cast<size_t>(order[i])];
+  for (size_t p = 0; p < point_count; ++p) std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1]);
+  std::vector<uint8_t> repeated(face_count, 0);
+  for (size_t i = 1; i < face_count; ++i)
+    if (sorted[i].first == sorted[i - 1].first) repeated[static_cast<size_t>(sorted[i].second)] = 1;
+  size_t kept = 0;
+  for (size_t f = 0; f < face_count; ++f) {
+    if (repeated[f]) continue;
+    face_sources[kept] = face_sources[f];
+    for (size_t k = 0; k < 3; ++k) {
+      corner_points[3 * kept + k] = corner_points[3 * f + k];
+      corner_inputs[3 * kept + k] = corner_inputs[3 * f + k];
+    }
+    ++kept;
+  }
+  face_sources.resize(kept);
+  corner_points.resize(3 * kept);
+  corner_inputs.resize(3 * kept);
+  return face_count - kept;
 }
 
 // Faces that repeat a directed edge of a face before them (the lowest face keeps it): bucketed
@@ -267,8 +347,10 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   }
 
   // Step 2: faces in point terms; drop degenerate ones and repeats (same points, same turn).
-  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> rotated;  // canonical rotation, face
-  rotated.reserve(mesh.face_count);
+  std::vector<int32_t> corner_points, corner_inputs;
+  corner_points.reserve(3 * mesh.face_count);
+  corner_inputs.reserve(3 * mesh.face_count);
+  out.face_sources.reserve(mesh.face_count);
   for (size_t f = 0; f < mesh.face_count; ++f) {
     const int32_t* v = mesh.faces + 3 * f;
     const std::array<int32_t, 3> p{point_of[v[0]], point_of[v[1]], point_of[v[2]]};
@@ -276,37 +358,17 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
       ++out.degenerate_faces;
       continue;
     }
-    const int first = static_cast<int>(std::min_element(p.begin(), p.end()) - p.begin());
-    rotated.push_back({{p[first], p[(first + 1) % 3], p[(first + 2) % 3]}, static_cast<int32_t>(f)});
+    out.face_sources.push_back(static_cast<int32_t>(f));
+    corner_inputs.insert(corner_inputs.end(), v, v + 3);
+    corner_points.insert(corner_points.end(), p.begin(), p.end());
   }
-  // Repeats: faces sorted by (rotated corners, face), bucketed by their lowest point.
-  std::vector<uint8_t> repeated(mesh.face_count, 0);
-  {
-    std::vector<int32_t> offsets, order;
-    bucket_by_point(rotated.size(), out.point_source.size(), [&](size_t i) { return rotated[i].first[0]; }, offsets,
-                    order);
-    std::vector<std::pair<std::array<int32_t, 3>, int32_t>> sorted(rotated.size());
-    for (size_t i = 0; i < rotated.size(); ++i) sorted[i] = rotated[static_cast<size_t>(order[i])];
-    for (size_t p = 0; p < out.point_source.size(); ++p)
-      std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1]);
-    for (size_t i = 1; i < sorted.size(); ++i)
-      if (sorted[i].first == sorted[i - 1].first) repeated[sorted[i].second] = 1;
-  }
-  std::vector<int32_t> corner_points, corner_inputs;
-  corner_points.reserve(3 * rotated.size());
-  corner_inputs.reserve(3 * rotated.size());
-  out.face_sources.reserve(rotated.size());
-  for (const auto& entry : rotated) {
-    const int32_t f = entry.second;
-    if (repeated[f]) {
-      ++out.duplicate_faces;
-      continue;
-    }
-    out.face_sources.push_back(f);
-    for (int k = 0; k < 3; ++k) {
-      corner_inputs.push_back(mesh.faces[3 * static_cast<size_t>(f) + k]);
-      corner_points.push_back(point_of[mesh.faces[3 * static_cast<size_t>(f) + k]]);
-    }
+  // A mesh with every directed edge once (the common case) repeats no face, and its sides pair
+  // without sorting (step 3).
+  Fans fans;
+  fans.simple = pair_unique_sides(corner_points, out.point_source.size(), fans.partner);
+  if (!fans.simple) {
+    out.duplicate_faces = drop_repeated_faces(corner_points, corner_inputs, out.face_sources, out.point_source.size());
+    fans.simple = pair_sides(corner_points, out.point_source.size(), fans.partner);
   }
 
   // Step 3: split points into fans until no directed edge is used twice. A fan that winds
@@ -314,7 +376,7 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   // (three new points), which ends the loop since its points are its own.
   out.point_split.assign(out.point_source.size(), 0);
   while (true) {
-    Fans fans = corner_fans(corner_points, out.point_source.size());
+    fans.label = join_fans(corner_points, out.point_source.size(), fans.partner);
     const std::vector<int32_t>& label = fans.label;
     // One point per (point, fan); the fan of the lowest corner keeps the point's index.
     std::vector<int32_t> fan_point(corner_points.size(), -1);
@@ -354,6 +416,7 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
         ++out.split_points;
       }
     }
+    fans.simple = pair_sides(corner_points, out.point_source.size(), fans.partner);
   }
   // A point whose only faces were cut loose is left without corners: renumber the points.
   std::vector<int32_t> renumber(out.point_source.size(), -1);

@@ -306,6 +306,36 @@ TEST_CASE("aqem drops degenerate and repeated faces and counts them") {
   CHECK(result.levels[0].faces.size() / 3 == 32);
 }
 
+TEST_CASE("aqem drops a repeat in another turn and keeps a two-sided sheet's sides apart") {
+  AqemOptions options;
+  options.target_ratios = {1.0};
+  OwnedAnimatedMesh mesh = animlod::testing::grid(4);  // 25 vertices, 32 faces
+  SUBCASE("a repeated face, rotated") {
+    mesh.faces.insert(mesh.faces.end(), {mesh.faces[7], mesh.faces[8], mesh.faces[6]});  // face 2
+    const AqemResult result = simplify(mesh, options);
+    CHECK(result.preparation.duplicate_faces == 1);
+    CHECK(result.preparation.face_count == 32);
+  }
+  // A face and its turned-over copy share their edges but must not be joined across them (the
+  // surface would fold onto itself): the back gets points of its own.
+  SUBCASE("every face also turned over") {
+    for (size_t f = 0; f < 32; ++f)
+      mesh.faces.insert(mesh.faces.end(), {mesh.faces[3 * f], mesh.faces[3 * f + 2], mesh.faces[3 * f + 1]});
+    const AqemResult result = simplify(mesh, options);
+    CHECK(result.preparation.duplicate_faces == 0);
+    CHECK(result.preparation.split_vertices == 25);
+    CHECK(result.preparation.face_count == 64);
+  }
+  SUBCASE("a lone two-sided triangle beside the grid") {  // every directed edge still used once
+    mesh.frames.insert(mesh.frames.end(), {2.0f, 0.0f, 0.0f, 3.0f, 0.0f, 0.0f, 2.0f, 1.0f, 0.0f});
+    mesh.faces.insert(mesh.faces.end(), {25, 26, 27, 25, 27, 26});
+    mesh.vertex_count += 3;
+    const AqemResult result = simplify(mesh, options);
+    CHECK(result.preparation.split_vertices == 3);
+    CHECK(result.preparation.face_count == 34);
+  }
+}
+
 TEST_CASE("aqem simplifies a bow tie and a three-face edge, keeping the spots stitched") {
   // Two grids sharing only their corner vertex 24 (a bow tie), plus a fin on edge (0, 1) of
   // the first grid (an edge of three faces).

@@ -156,12 +156,17 @@ size_t workers_for(size_t corner_count) {
 // The simple case of pair_sides without sorting any side: each side a -> b looks for its
 // directed edge among the few sides leaving a (it must be the only one) and for b -> a among
 // those leaving b (at most one, not its own triangle turned over). Fills `partner` as pair_sides
-// would and returns true when the mesh is simple; returns false as soon as it is not. A
-// repeated face repeats its directed edges, so a simple mesh has none.
+// would and returns true when the mesh is simple; returns false as soon as it is not, or when a
+// point has more than kMostLookedUpSides sides leaving it (the lookups grow with the square of
+// a point's sides: a fan of thousands of triangles takes pair_sides' sort). A repeated face
+// repeats its directed edges, so a simple mesh has none.
 bool pair_unique_sides(const std::vector<int32_t>& corner_points, size_t point_count, std::vector<int32_t>& partner) {
+  constexpr int32_t kMostLookedUpSides = 64;
   const size_t corner_count = corner_points.size();
   std::vector<int32_t> offsets, order;
   bucket_by_point(corner_count, point_count, [&](size_t c) { return corner_points[c]; }, offsets, order);
+  for (size_t p = 0; p < point_count; ++p)
+    if (offsets[p + 1] - offsets[p] > kMostLookedUpSides) return false;
   std::vector<int32_t> ends(corner_count);  // end point of each side leaving a point, in bucket order
   for (size_t i = 0; i < corner_count; ++i) ends[i] = corner_points[next_corner(static_cast<size_t>(order[i]))];
   partner.assign(corner_count, -1);

@@ -306,7 +306,7 @@ TEST_CASE("aqem drops degenerate and repeated faces and counts them") {
   CHECK(result.levels[0].faces.size() / 3 == 32);
 }
 
-TEST_CASE("aqem drops a repeat in another turn and keeps a two-sided sheet's sides apart") {
+TEST_CASE("aqem prepares a repeat in another turn, two-sided sheets and a fan of 100 triangles") {
   AqemOptions options;
   options.target_ratios = {1.0};
   OwnedAnimatedMesh mesh = animlod::testing::grid(4);  // 25 vertices, 32 faces
@@ -325,6 +325,22 @@ TEST_CASE("aqem drops a repeat in another turn and keeps a two-sided sheet's sid
     CHECK(result.preparation.duplicate_faces == 0);
     CHECK(result.preparation.split_vertices == 25);
     CHECK(result.preparation.face_count == 64);
+  }
+  SUBCASE("a disc of 100 triangles around one point, beside the grid") {  // sides sorted, not looked up
+    const auto center = static_cast<int32_t>(mesh.vertex_count);
+    mesh.frames.insert(mesh.frames.end(), {3.0f, 0.0f, 0.0f});
+    for (int k = 0; k < 100; ++k) {
+      const double angle = 2.0 * 3.14159265358979 * k / 100;
+      mesh.frames.insert(mesh.frames.end(), {3.0f + static_cast<float>(std::cos(angle)),
+                                             static_cast<float>(std::sin(angle)), 0.0f});
+      mesh.faces.insert(mesh.faces.end(), {center, center + 1 + k, center + 1 + (k + 1) % 100});
+    }
+    mesh.vertex_count += 101;
+    const AqemResult result = simplify(mesh, options);
+    CHECK(result.preparation.split_vertices == 0);
+    CHECK(result.preparation.face_count == 132);
+    options.target_ratios = {0.5};
+    CHECK(simplify(mesh, options).levels[0].faces.size() / 3 <= 66);
   }
   SUBCASE("a lone two-sided triangle beside the grid") {  // every directed edge still used once
     mesh.frames.insert(mesh.frames.end(), {2.0f, 0.0f, 0.0f, 3.0f, 0.0f, 0.0f, 2.0f, 1.0f, 0.0f});

@@ -489,7 +489,8 @@ def speed_table(quick: bool) -> None:
                     output_faces[method], phases = simplify(mesh, target)
                 if elapsed[0] < best[method]:
                     best[method] = elapsed[0]
-                    best_phases = phases or best_phases
+                    if phases is not None:  # AQEM's: the phases of its best run
+                        best_phases = phases
         rows += [(method, name, mesh.face_count, output_faces[method], best[method]) for method in methods]
         phase_rows.append((name, *(f"{1e3 * value:.0f}" for value in vars(best_phases).values())))
     rows = [(*row, f"{(row[2] - row[3]) / row[4] / 1e6:.2f}") for row in rows]

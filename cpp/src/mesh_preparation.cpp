@@ -153,33 +153,49 @@ size_t workers_for(size_t corner_count) {
   return corner_count >= 2 * kCornersPerWorker && std::thread::hardware_concurrency() >= 2 ? 2 : 1;
 }
 
-// The simple case of pair_sides without sorting any side: each side a -> b looks for its
-// directed edge among the few sides leaving a (it must be the only one) and for b -> a among
-// those leaving b (at most one, not its own triangle turned over). Fills `partner` as pair_sides
-// would and returns true when the mesh is simple; returns false as soon as it is not, or when a
-// point has more than kMostLookedUpSides sides leaving it (the lookups grow with the square of
-// a point's sides: a fan of thousands of triangles takes pair_sides' sort). A repeated face
-// repeats its directed edges, so a simple mesh has none.
+// The simple case of pair_sides without sorting every side: each side a -> b looks for its
+// directed edge among the sides leaving a (it must be the only one) and for b -> a among those
+// leaving b (at most one, not its own triangle turned over). A point's sides are few and
+// scanned; a point with more than kScannedSides (a sphere's pole, a disc fanned from its
+// centre) has its sides sorted by end point and searched, since scanning would grow with the
+// square of its sides. Fills `partner` as pair_sides would and returns true when the mesh is
+// simple; returns false as soon as it is not. A repeated face repeats its directed edges, so a
+// simple mesh has none.
 bool pair_unique_sides(const std::vector<int32_t>& corner_points, size_t point_count, std::vector<int32_t>& partner) {
-  constexpr int32_t kMostLookedUpSides = 64;
+  constexpr int32_t kScannedSides = 32;
   const size_t corner_count = corner_points.size();
   std::vector<int32_t> offsets, order;
   bucket_by_point(corner_count, point_count, [&](size_t c) { return corner_points[c]; }, offsets, order);
+  std::vector<std::pair<int32_t, int32_t>> leaving(corner_count);  // (end point, corner) by start point
+  for (size_t i = 0; i < corner_count; ++i) {
+    const auto c = static_cast<size_t>(order[i]);
+    leaving[i] = {corner_points[next_corner(c)], order[i]};
+  }
   for (size_t p = 0; p < point_count; ++p)
-    if (offsets[p + 1] - offsets[p] > kMostLookedUpSides) return false;
-  std::vector<int32_t> ends(corner_count);  // end point of each side leaving a point, in bucket order
-  for (size_t i = 0; i < corner_count; ++i) ends[i] = corner_points[next_corner(static_cast<size_t>(order[i]))];
+    if (offsets[p + 1] - offsets[p] > kScannedSides)
+      std::sort(leaving.begin() + offsets[p], leaving.begin() + offsets[p + 1]);
+  // How many sides run from a to b; `corner` is set to one of them.
+  auto sides_between = [&](int32_t a, int32_t b, int32_t& corner) {
+    const auto first = leaving.begin() + offsets[a], last = leaving.begin() + offsets[a + 1];
+    if (last - first > kScannedSides) {
+      const auto [from, to] = std::equal_range(first, last, std::pair<int32_t, int32_t>{b, 0},
+                                               [](const auto& x, const auto& y) { return x.first < y.first; });
+      if (from != to) corner = from->second;
+      return static_cast<int>(to - from);
+    }
+    int count = 0;
+    for (auto side = first; side != last; ++side)
+      if (side->first == b) ++count, corner = side->second;
+    return count;
+  };
   partner.assign(corner_count, -1);
   const size_t workers = workers_for(corner_count);
   std::vector<uint8_t> simple(workers, 1);
   run_in_ranges(corner_count, workers, [&](size_t begin, size_t end, size_t worker) {
     for (size_t c = begin; c < end; ++c) {
       const int32_t a = corner_points[c], b = corner_points[next_corner(c)];
-      int same_way = 0, other_way = 0;
-      int32_t opposite = -1;
-      for (int32_t i = offsets[a]; i < offsets[a + 1]; ++i) same_way += ends[i] == b;
-      for (int32_t i = offsets[b]; i < offsets[b + 1]; ++i)
-        if (ends[i] == a) ++other_way, opposite = order[i];
+      int32_t same = -1, opposite = -1;
+      const int same_way = sides_between(a, b, same), other_way = sides_between(b, a, opposite);
       if (same_way > 1 || other_way > 1 ||
           (opposite >= 0 && same_triangle(corner_points, static_cast<int32_t>(c), opposite))) {
         simple[worker] = 0;

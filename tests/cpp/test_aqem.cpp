@@ -326,7 +326,7 @@ TEST_CASE("aqem prepares a repeat in another turn, two-sided sheets and a fan of
     CHECK(result.preparation.split_vertices == 25);
     CHECK(result.preparation.face_count == 64);
   }
-  SUBCASE("a disc of 100 triangles around one point, beside the grid") {  // sides sorted, not looked up
+  SUBCASE("a disc of 100 triangles around one point, beside the grid") {  // its sides searched, not scanned
     const auto center = static_cast<int32_t>(mesh.vertex_count);
     mesh.frames.insert(mesh.frames.end(), {3.0f, 0.0f, 0.0f});
     for (int k = 0; k < 100; ++k) {

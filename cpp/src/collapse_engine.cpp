@@ -307,7 +307,7 @@ int32_t CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candid
                        candidate.t);
   }
   merged_into_[candidate.removed] = candidate.kept;
-  if (!ranking_cache_.changed.empty()) ranking_cache_.changed[candidate.kept] = 1;
+  if (!ranking_cache_.changed.empty()) ranking_cache_.changed[candidate.kept] = ranking_cache_.changed[candidate.removed] = 1;
   for (const auto& [from, to] : workspace.wedge_moves) wedge_merged_into_[from] = to;
 
   // Corners of the removed point now belong to the kept point, with the mapped wedge.
@@ -458,8 +458,8 @@ EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
 bool CollapseEngine::release_guards(CollapsePolicy& policy) {
   if (released_) return false;
   released_ = true;
-  if (in_passes_) {  // the next pass evaluates every edge, none from the cache (locked() changed)
-    std::fill(ranking_cache_.cost.begin(), ranking_cache_.cost.end(), std::numeric_limits<double>::quiet_NaN());
+  if (in_passes_) {  // the next pass evaluates every edge, none from the last ranking (locked() changed)
+    ranking_cache_.valid = false;
     return std::find(locked_.begin(), locked_.end(), kGuarded) != locked_.end();
   }
   for (size_t p = 0; p < point_count_; ++p) {
@@ -572,42 +572,51 @@ CollapseEngine::Attempt CollapseEngine::try_collapse(CollapsePolicy& policy, Can
   return Attempt::collapsed;
 }
 
-// Every live edge that can collapse, with its cost, in edge order (from ranking_cache_ where
-// that is kept). The edges are split in contiguous ranges over up to the policy's
-// concurrency() threads (each candidate's values do not depend on the thread that computed
-// them), each writing its part of `ranked` from the start of its range; the parts are then
-// moved together.
+// Every live edge that can collapse, with its cost, in edge order. The items are split in
+// contiguous ranges over up to the policy's concurrency() threads (each candidate's values do
+// not depend on the thread that computed them), each writing its part of `ranked` from the
+// start of its range; the parts are then moved together. The items are the edges, or with a
+// valid ranking_cache_ the entries of the last ranking (`ranked` itself, compacted in place: an
+// entry is written at or before where it was read), of which only those at changed points are
+// evaluated again: a pass deletes a fraction of the edges, and visiting all of them cost the
+// later passes more than their evaluations.
 void CollapseEngine::rank_collapsible_edges(CollapsePolicy& policy, std::vector<RankedEdge>& ranked) {
   const PhaseTimer timer(timings_.ranking);
   constexpr size_t kMinimumChunk = 8192;
-  const size_t edge_count = connectivity_.n_edges();
+  RankingCache& cache = ranking_cache_;
+  const bool from_last = cache.valid && options_.rank_from_last;
+  const size_t item_count = from_last ? ranked.size() : connectivity_.n_edges();
   const size_t hardware = std::max<size_t>(std::thread::hardware_concurrency(), 1);
-  const size_t workers = std::min({policy.concurrency(), hardware, std::max<size_t>(edge_count / kMinimumChunk, 1)});
-  ranked.resize(edge_count);
+  const size_t workers = std::min({policy.concurrency(), hardware, std::max<size_t>(item_count / kMinimumChunk, 1)});
+  if (!from_last) ranked.resize(item_count);
+  auto rank_edge = [&](int32_t edge, size_t worker, size_t& out) {
+    if (connectivity_.status(connectivity_.edge_handle(edge)).deleted()) return;
+    Candidate candidate = candidate_for(edge);
+    if (locked(candidate.kept) && locked(candidate.removed)) return;  // cannot collapse (yet)
+    policy.evaluate_concurrently(candidate, worker);
+    ranked[out++] = {candidate.cost, candidate.error, edge, candidate.kept, candidate.removed};
+  };
   std::vector<size_t> ends(workers);
-  run_in_ranges(edge_count, workers, [&](size_t begin, size_t end, size_t worker) {
+  run_in_ranges(item_count, workers, [&](size_t begin, size_t end, size_t worker) {
     size_t out = begin;
-    for (size_t e = begin; e < end; ++e) {
-      if (connectivity_.status(connectivity_.edge_handle(static_cast<int>(e))).deleted()) continue;
-      Candidate candidate = candidate_for(static_cast<int32_t>(e));
-      if (locked(candidate.kept) && locked(candidate.removed)) continue;  // cannot collapse (yet)
-      RankingCache& cache = ranking_cache_;
-      if (!cache.cost.empty() && !std::isnan(cache.cost[e]) && !cache.changed[candidate.kept] &&
-          !cache.changed[candidate.removed]) {
-        candidate.cost = cache.cost[e];
-        candidate.error = cache.error[e];
-      } else {
-        policy.evaluate_concurrently(candidate, worker);
-        if (!cache.cost.empty()) cache.cost[e] = candidate.cost, cache.error[e] = candidate.error;
+    if (!from_last) {
+      for (size_t e = begin; e < end; ++e) rank_edge(static_cast<int32_t>(e), worker, out);
+    } else {
+      for (size_t i = begin; i < end; ++i) {
+        const RankedEdge entry = ranked[i];
+        if (cache.changed[entry.kept] || cache.changed[entry.removed]) rank_edge(entry.edge, worker, out);
+        else ranked[out++] = entry;
       }
-      ranked[out++] = {candidate.cost, candidate.error, static_cast<int32_t>(e), candidate.kept, candidate.removed};
     }
     ends[worker] = out;
   });
-  std::fill(ranking_cache_.changed.begin(), ranking_cache_.changed.end(), 0);
+  if (!cache.changed.empty()) {
+    std::fill(cache.changed.begin(), cache.changed.end(), 0);
+    cache.valid = true;
+  }
   size_t size = ends[0];
   for (size_t worker = 1; worker < workers; ++worker) {
-    const auto begin = ranked.begin() + static_cast<std::ptrdiff_t>(edge_count * worker / workers);
+    const auto begin = ranked.begin() + static_cast<std::ptrdiff_t>(item_count * worker / workers);
     size = static_cast<size_t>(std::copy(begin, ranked.begin() + static_cast<std::ptrdiff_t>(ends[worker]),
                                          ranked.begin() + static_cast<std::ptrdiff_t>(size)) -
                                ranked.begin());
@@ -742,8 +751,6 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
   std::vector<uint64_t> chosen_places;
   std::vector<uint8_t> touched(point_count_, 0);
   in_passes_ = true;
-  ranking_cache_.cost.assign(connectivity_.n_edges(), std::numeric_limits<double>::quiet_NaN());
-  ranking_cache_.error.assign(connectivity_.n_edges(), 0.0);
   ranking_cache_.changed.assign(point_count_, 0);
   while (next_level_ < targets.size()) {
     // Step 7: every collapsible edge, evaluated.

@@ -102,6 +102,10 @@ struct EngineOptions {
   // order: see README's AQEM speed section).
   size_t greedy_tail_edges = 4096;
   size_t passes_above_edges = 100000;
+  // Collapse passes rank again from their last ranking, evaluating only the candidates at
+  // points a collapse changed; false evaluates every edge at every pass (the same result,
+  // slower: the reference the reuse is tested against).
+  bool rank_from_last = true;
 };
 
 // One level: the surviving faces over the surviving wedges (input vertex indices).
@@ -231,12 +235,13 @@ class CollapseEngine {
   std::vector<uint8_t> parked_;             // (E,) popped while illegal; re-tried when the area changes
   std::vector<uint8_t> may_have_parked_;    // (P,) set when an edge of the point is parked
   std::array<Workspace, 2> workspaces_;     // per worker; the engine's own thread uses the first
-  // Collapse passes' costs carried from one ranking to the next: a candidate's values depend
-  // only on its two points (as the greedy order's re-keying around the kept point assumes too),
-  // so an edge whose points no collapse kept since, and no guard release, costs the same.
+  // Collapse passes rank again from their last ranking: a candidate's values depend only on
+  // its two points (as the greedy order's re-keying around the kept point assumes too), and a
+  // collapse deletes and re-points only edges at its two points, so an entry whose points no
+  // collapse kept or removed since, and no guard release, is still live and costs the same.
   struct RankingCache {
-    std::vector<double> cost, error;  // (E,) NaN cost: not evaluated since the cache was reset
-    std::vector<uint8_t> changed;     // (P,) kept by a collapse since the last ranking
+    bool valid = false;            // `ranked` holds the last ranking of every collapsible edge
+    std::vector<uint8_t> changed;  // (P,) kept or removed by a collapse since the last ranking
   };
   RankingCache ranking_cache_;              // empty outside collapse passes
   std::vector<uint8_t> half_;               // (P,) the half of the mesh each point is in (perform_in_halves)

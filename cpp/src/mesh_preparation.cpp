@@ -138,15 +138,6 @@ void bucket_by_point(size_t item_count, size_t point_count, PointOf point_of, st
       static_cast<int32_t>(i);
 }
 
-// Step 3's fans: `label` gives corners with one label one fan; `partner` the side paired with
-// each side (a side starts at its corner), -1 for a border; `simple` is set when every
-// undirected edge has at most one side each way and both are paired (then no directed edge
-// repeats, whatever the fans, and the pairing is the one OpenMesh's add_face would make).
-struct Fans {
-  std::vector<int32_t> label, partner;
-  bool simple = true;
-};
-
 constexpr size_t kCornersPerWorker = 1 << 17;  // fewer corners per worker: one worker
 
 size_t workers_for(size_t corner_count) {
@@ -211,7 +202,10 @@ bool pair_unique_sides(const std::vector<int32_t>& corner_points, size_t point_c
 // one forward with one backward; unpaired sides are borders of their piece. Sides are visited
 // in (edge, corner) order: bucketed by their lower point, then sorted by (higher point, corner)
 // inside the bucket. Large meshes take two workers, one for each half of the buckets (an edge's
-// sides lie in one). Fills `partner`; returns whether the mesh is simple (Fans).
+// sides lie in one). Fills `partner`, the corner of the side paired with each side (a side
+// starts at its corner), -1 for a border. Returns whether the mesh is simple: every undirected
+// edge has at most one side each way and both are paired (then no directed edge repeats,
+// whatever the fans, and the pairing is the one OpenMesh's add_face would make).
 bool pair_sides(const std::vector<int32_t>& corner_points, size_t point_count, std::vector<int32_t>& partner) {
   const size_t corner_count = corner_points.size();
   const size_t workers = workers_for(corner_count);
@@ -385,11 +379,11 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   }
   // A mesh with every directed edge once (the common case) repeats no face, and its sides pair
   // without sorting (step 3).
-  Fans fans;
-  fans.simple = pair_unique_sides(corner_points, out.point_source.size(), fans.partner);
-  if (!fans.simple) {
+  std::vector<int32_t> partner;
+  bool simple = pair_unique_sides(corner_points, out.point_source.size(), partner);
+  if (!simple) {
     out.duplicate_faces = drop_repeated_faces(corner_points, corner_inputs, out.face_sources, out.point_source.size());
-    fans.simple = pair_sides(corner_points, out.point_source.size(), fans.partner);
+    simple = pair_sides(corner_points, out.point_source.size(), partner);
   }
 
   // Step 3: split points into fans until no directed edge is used twice. A fan that winds
@@ -397,8 +391,7 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   // (three new points), which ends the loop since its points are its own.
   out.point_split.assign(out.point_source.size(), 0);
   while (true) {
-    fans.label = join_fans(corner_points, out.point_source.size(), fans.partner);
-    const std::vector<int32_t>& label = fans.label;
+    const std::vector<int32_t> label = join_fans(corner_points, out.point_source.size(), partner);
     // One point per (point, fan); the fan of the lowest corner keeps the point's index.
     std::vector<int32_t> fan_point(corner_points.size(), -1);
     std::vector<int32_t> first_fan(out.point_source.size(), -1);
@@ -417,8 +410,8 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
       }
     }
     for (size_t c = 0; c < corner_points.size(); ++c) corner_points[c] = fan_point[label[c]];
-    if (fans.simple) {
-      out.side_partners = std::move(fans.partner);
+    if (simple) {
+      out.side_partners = std::move(partner);
       break;
     }
 
@@ -437,7 +430,7 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
         ++out.split_points;
       }
     }
-    fans.simple = pair_sides(corner_points, out.point_source.size(), fans.partner);
+    simple = pair_sides(corner_points, out.point_source.size(), partner);
   }
   // A point whose only faces were cut loose is left without corners: renumber the points.
   std::vector<int32_t> renumber(out.point_source.size(), -1);

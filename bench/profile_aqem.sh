@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Where AQEM's time goes: perf record of one simplification of the 1M-triangle bumpy sphere of
-# bench_aqem.py to 10% (one frame), reported per shared object and per named symbol. Needs
-# Debian's linux-perf; file-static functions of the core appear as addresses in the extension.
+# bench_aqem.py to 10% (one frame), reported per shared object, the heaviest symbols, and
+# OpenMesh's named symbols. Needs Debian's linux-perf; file-static functions of the core appear
+# as addresses in the extension.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 data=$(mktemp -d)
@@ -13,6 +14,7 @@ from bench_aqem import bumpy_sphere
 from animlod import simplify_animated
 simplify_animated(bumpy_sphere(708, 708, 1), (0.1,), use_motion_features=False)
 PY
-perf report -i "$data/perf.data" --no-children --sort dso --stdio 2>/dev/null | grep -E '^ +[0-9]' | head -n 5
-perf report -i "$data/perf.data" --no-children --sort symbol --stdio 2>/dev/null | grep -E '^ +[0-9]' | grep OpenMesh \
+perf report -i "$data/perf.data" --no-children -g none --sort dso --stdio 2>/dev/null | grep -E '^ +[0-9]' | head -n 5
+perf report -i "$data/perf.data" --no-children -g none --sort symbol --stdio 2>/dev/null | grep -E '^ +[0-9]' | head -n 12
+perf report -i "$data/perf.data" --no-children -g none --sort symbol --stdio 2>/dev/null | grep -E '^ +[0-9]' | grep OpenMesh \
   | awk 'NR <= 6 { print } { total += $1 } END { printf "OpenMesh connectivity, named symbols: %.1f%%\n", total }'

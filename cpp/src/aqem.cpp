@@ -33,6 +33,7 @@
 #include "needle_tips.hpp"
 #include "phase_timer.hpp"
 #include "quadric.hpp"
+#include "worker_threads.hpp"
 
 namespace animlod {
 
@@ -239,25 +240,33 @@ void AqemPolicy::accumulate_quadrics() {
         plane_counts_[side[0]] += 1.0;
         plane_counts_[side[1]] += 1.0;
       }
-  if (options_.tip_quadrics) {
-    // Tips in every used frame: a spike stays one, while a point that folds into a narrow cone
-    // in some poses only (a bent finger, a creased strip) is no needle. After the first frame
-    // only the tips so far are looked at.
-    std::vector<uint8_t> tip_so_far(point_count, 1);
-    for (size_t k = 0; k < used_count_; ++k) {
-      const size_t frame = static_cast<size_t>(frames_[k]);
-      auto position_of = [&](int32_t point) { return engine_.position(point, frame); };
-      tips_ = detail::find_needle_tips(faces, point_count, position_of, tip_so_far.data());
-      std::fill(tip_so_far.begin(), tip_so_far.end(), 0);
-      for (int32_t tip : tips_) tip_so_far[tip] = 1;
-      if (tips_.empty()) break;
-    }
-  }
   // Two workers take half of the frames each, or with one frame half of the points (a face
   // between the halves is planed by both); every quadric sums its planes in the same order as
   // one worker would.
   const size_t workers = faces.size() * used_count_ >= 3 * 65536 ? 2 : 1;
   const auto points = static_cast<int32_t>(point_count);
+  if (options_.tip_quadrics) {
+    // Tips in every used frame: a spike stays one, while a point that folds into a narrow cone
+    // in some poses only (a bent finger, a creased strip) is no needle. After the first frame
+    // only the tips so far are looked at. The search walks every face (at 1M triangles, half
+    // of the quadrics' time on one worker), so the workers take half of the points each.
+    const size_t tip_workers = faces.size() >= 3 * 65536 ? 2 : 1;
+    std::vector<uint8_t> tip_so_far(point_count, 1);
+    std::vector<std::vector<int32_t>> found(tip_workers);
+    for (size_t k = 0; k < used_count_; ++k) {
+      const size_t frame = static_cast<size_t>(frames_[k]);
+      auto position_of = [&](int32_t point) { return engine_.position(point, frame); };
+      detail::run_in_ranges(point_count, tip_workers, [&](size_t begin, size_t end, size_t worker) {
+        found[worker] = detail::find_needle_tips(faces, static_cast<int32_t>(begin), static_cast<int32_t>(end),
+                                                 position_of, tip_so_far.data());
+      });
+      tips_.clear();
+      for (const std::vector<int32_t>& part : found) tips_.insert(tips_.end(), part.begin(), part.end());
+      std::fill(tip_so_far.begin(), tip_so_far.end(), 0);
+      for (int32_t tip : tips_) tip_so_far[tip] = 1;
+      if (tips_.empty()) break;
+    }
+  }
   auto accumulate = [&](size_t worker) {
     QuadricShare share{0, used_count_, 0, points};
     if (workers == 2 && used_count_ >= 2) {

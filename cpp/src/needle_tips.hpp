@@ -20,14 +20,17 @@ namespace animlod::detail {
 // a right angle at its apex is.
 inline const double kNeedleTipCosine = std::sqrt(0.5);
 
-// The points of `faces` (M, 3) that are needle tips with the positions position_of(point)
-// (an Eigen::Vector3d), in increasing order; with `among` (P,), only points where it is nonzero
-// are looked at. Zero-length edges give no direction; a point whose edge directions cancel out
-// is no tip.
+// The points in [point_begin, point_end) of `faces` (M, 3) that are needle tips with the
+// positions position_of(point) (an Eigen::Vector3d), in increasing order; with `among` (P,),
+// only points where it is nonzero are looked at. Zero-length edges give no direction; a point
+// whose edge directions cancel out is no tip. A point's result does not depend on the range it
+// is looked at in, so workers can take ranges of their own.
 template <class PositionOf>
-std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, size_t point_count,
+std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, int32_t point_begin, int32_t point_end,
                                       const PositionOf& position_of, const uint8_t* among = nullptr) {
-  auto looked_at = [among](int32_t point) { return among == nullptr || among[point] != 0; };
+  auto looked_at = [=](int32_t point) {
+    return point >= point_begin && point < point_end && (among == nullptr || among[point] != 0);
+  };
   // Each edge of a point is seen once per face beside it, which changes neither the mean's
   // direction much nor the smallest cosine. Per face, its three sides' unit vectors serve both
   // of their points (the one they leave and, reversed, the one they reach).
@@ -46,30 +49,32 @@ std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, size_t 
       }
     }
   };
-  std::vector<Eigen::Vector3d> sum(point_count, Eigen::Vector3d::Zero());
-  std::vector<int32_t> count(point_count, 0);
+  const size_t range = static_cast<size_t>(point_end - point_begin);  // arrays below: (range,)
+  std::vector<Eigen::Vector3d> sum(range, Eigen::Vector3d::Zero());
+  std::vector<int32_t> count(range, 0);
   for_each_face_side(looked_at, [&](int32_t point, const Eigen::Vector3d& unit) {
-    sum[point] += unit;
-    ++count[point];
+    sum[point - point_begin] += unit;
+    ++count[point - point_begin];
   });
   // Every unit vector within the cone puts the sum's length above count * cos (so above 0):
   // the other points (all but a few on any surface, and those with no edge) need no second look.
-  std::vector<uint8_t> candidate(point_count, 0);
-  std::vector<double> least(point_count, 2.0);  // smallest cosine of an edge to the mean
-  for (size_t point = 0; point < point_count; ++point) {
-    const double length = sum[point].norm();
-    if (length > kNeedleTipCosine * count[point]) {
-      candidate[point] = 1;
-      sum[point] /= length;
+  std::vector<uint8_t> candidate(range, 0);
+  std::vector<double> least(range, 2.0);  // smallest cosine of an edge to the mean
+  for (size_t k = 0; k < range; ++k) {
+    const double length = sum[k].norm();
+    if (length > kNeedleTipCosine * count[k]) {
+      candidate[k] = 1;
+      sum[k] /= length;
     }
   }
-  for_each_face_side([&](int32_t point) { return candidate[point] != 0; },
-                     [&](int32_t point, const Eigen::Vector3d& unit) {
-                       least[point] = std::min(least[point], unit.dot(sum[point]));
-                     });
+  for_each_face_side(
+      [&](int32_t point) { return point >= point_begin && point < point_end && candidate[point - point_begin] != 0; },
+      [&](int32_t point, const Eigen::Vector3d& unit) {
+        least[point - point_begin] = std::min(least[point - point_begin], unit.dot(sum[point - point_begin]));
+      });
   std::vector<int32_t> tips;
-  for (size_t point = 0; point < point_count; ++point)
-    if (candidate[point] && least[point] > kNeedleTipCosine) tips.push_back(static_cast<int32_t>(point));
+  for (size_t k = 0; k < range; ++k)
+    if (candidate[k] && least[k] > kNeedleTipCosine) tips.push_back(point_begin + static_cast<int32_t>(k));
   return tips;
 }
 

@@ -19,7 +19,10 @@ struct PointMesh {
   std::vector<Eigen::Vector3d> points;
   std::vector<int32_t> faces;
   std::vector<int32_t> tips() const {
-    return find_needle_tips(faces, points.size(), [&](int32_t p) { return points[static_cast<size_t>(p)]; });
+    return tips_in(0, static_cast<int32_t>(points.size()));
+  }
+  std::vector<int32_t> tips_in(int32_t begin, int32_t end) const {
+    return find_needle_tips(faces, begin, end, [&](int32_t p) { return points[static_cast<size_t>(p)]; });
   }
 };
 
@@ -55,6 +58,27 @@ TEST_CASE("needle tips: zero-length edges give no direction and cancelling ones 
   // A degenerate face: point 0's edges cancel out; 1 and 2 each see the others in one direction.
   const PointMesh sliver{{{0, 0, 0}, {1, 0, 0}, {-1, 0, 0}}, {0, 1, 2}};
   CHECK(sliver.tips() == std::vector<int32_t>{1, 2});
+}
+
+TEST_CASE("needle tips: ranges of points searched apart give the whole mesh's tips") {
+  // Three spikes side by side (apexes 4, 9 and 14), the middle one blunt: split at every point,
+  // the two ranges' tips in order are the whole search's (the workers of aqem.cpp split so).
+  PointMesh spikes;
+  for (int s = 0; s < 3; ++s) {
+    PointMesh one = pyramid(s == 1 ? 1.0 : 10.0);
+    const auto offset = static_cast<int32_t>(spikes.points.size());
+    for (const Eigen::Vector3d& p : one.points) spikes.points.push_back(p + Eigen::Vector3d(3.0 * s, 0, 0));
+    for (int32_t corner : one.faces) spikes.faces.push_back(offset + corner);
+  }
+  const std::vector<int32_t> whole = spikes.tips();
+  REQUIRE(whole == std::vector<int32_t>{4, 14});
+  const auto points = static_cast<int32_t>(spikes.points.size());
+  for (int32_t split = 0; split <= points; ++split) {
+    std::vector<int32_t> parts = spikes.tips_in(0, split);
+    const std::vector<int32_t> rest = spikes.tips_in(split, points);
+    parts.insert(parts.end(), rest.begin(), rest.end());
+    CHECK(parts == whole);
+  }
 }
 
 TEST_CASE("tip quadrics change nothing on a mesh without needle tips") {

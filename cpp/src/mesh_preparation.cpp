@@ -362,10 +362,10 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   }
 
   // Step 2: faces in point terms; drop degenerate ones and repeats (same points, same turn).
-  std::vector<int32_t> corner_points, corner_inputs;
-  corner_points.reserve(3 * mesh.face_count);
-  corner_inputs.reserve(3 * mesh.face_count);
+  // Written in place (a range insert per face took most of this step's time at 1M faces).
+  std::vector<int32_t> corner_points(3 * mesh.face_count), corner_inputs(3 * mesh.face_count);
   out.face_sources.reserve(mesh.face_count);
+  size_t kept = 0;
   for (size_t f = 0; f < mesh.face_count; ++f) {
     const int32_t* v = mesh.faces + 3 * f;
     const std::array<int32_t, 3> p{point_of[v[0]], point_of[v[1]], point_of[v[2]]};
@@ -374,9 +374,14 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
       continue;
     }
     out.face_sources.push_back(static_cast<int32_t>(f));
-    corner_inputs.insert(corner_inputs.end(), v, v + 3);
-    corner_points.insert(corner_points.end(), p.begin(), p.end());
+    for (int k = 0; k < 3; ++k) {
+      corner_inputs[3 * kept + k] = v[k];
+      corner_points[3 * kept + k] = p[k];
+    }
+    ++kept;
   }
+  corner_inputs.resize(3 * kept);
+  corner_points.resize(3 * kept);
   // A mesh with every directed edge once (the common case) repeats no face, and its sides pair
   // without sorting (step 3).
   std::vector<int32_t> partner;

@@ -17,9 +17,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <optional>
 #include <string>
-#include <thread>
 #include <utility>
 
 #include <Eigen/Core>
@@ -150,18 +150,106 @@ class PointFrames {
   std::vector<float> copy_;
 };
 
+// Steps 1-2's part that needs no connectivity (Eqs. 1-4): every face's plane in every used
+// frame summed into its three points' quadrics of that frame, the planes counted per point (so
+// that the error can be a mean; a face with no area in a frame counts there as a plane at
+// distance 0), and the needle tips (option tip_quadrics). It reads only the prepared faces and
+// the points' frames, so simplify_animated sums it while the engine builds OpenMesh's
+// connectivity; AqemPolicy then adds the sides' planes and the tips' point quadrics.
+struct FaceQuadrics {
+  std::vector<Quadric> quadrics;     // (P, K) per-frame quadrics, contiguous per point
+  std::vector<double> plane_counts;  // (P,)
+  std::vector<int32_t> tips;         // needle tips in every used frame
+};
+
+Eigen::Vector3d point_position(const AnimatedMeshView& points, int32_t point, size_t frame) {
+  const float* p = points.frames + (frame * points.vertex_count + static_cast<size_t>(point)) * 3;
+  return {p[0], p[1], p[2]};
+}
+
+// Needle tips in every used frame: a spike stays one, while a point that folds into a narrow
+// cone in some poses only (a bent finger, a creased strip) is no needle. After the first frame
+// only the tips so far are looked at. The search walks every face, so two workers take half of
+// the points each.
+std::vector<int32_t> tips_in_every_frame(const std::vector<int32_t>& faces, const AnimatedMeshView& points,
+                                         const std::vector<int32_t>& frames) {
+  const size_t workers = faces.size() >= 3 * 65536 ? 2 : 1;
+  std::vector<uint8_t> tip_so_far(points.vertex_count, 1);
+  std::vector<std::vector<int32_t>> found(workers);
+  std::vector<int32_t> tips;
+  for (const int32_t frame : frames) {
+    auto position_of = [&](int32_t point) { return point_position(points, point, static_cast<size_t>(frame)); };
+    detail::run_in_ranges(points.vertex_count, workers, [&](size_t begin, size_t end, size_t worker) {
+      found[worker] = detail::find_needle_tips(faces, static_cast<int32_t>(begin), static_cast<int32_t>(end),
+                                               position_of, tip_so_far.data());
+    });
+    tips.clear();
+    for (const std::vector<int32_t>& part : found) tips.insert(tips.end(), part.begin(), part.end());
+    std::fill(tip_so_far.begin(), tip_so_far.end(), 0);
+    for (int32_t tip : tips) tip_so_far[tip] = 1;
+    if (tips.empty()) break;
+  }
+  return tips;
+}
+
+// faces: the prepared faces (M', 3); points: their points' frames (F, P, 3).
+FaceQuadrics face_quadrics(const std::vector<int32_t>& faces, const AnimatedMeshView& points,
+                           const std::vector<int32_t>& frames, bool tip_quadrics) {
+  const size_t point_count = points.vertex_count, used_count = frames.size();
+  auto position = [&](int32_t point, size_t frame) { return point_position(points, point, frame); };
+  FaceQuadrics out;
+  out.quadrics.assign(point_count * used_count, Quadric{});
+  out.plane_counts.assign(point_count, 0.0);
+  for (const int32_t point : faces) out.plane_counts[point] += 1.0;
+  if (tip_quadrics) out.tips = tips_in_every_frame(faces, points, frames);
+  // Two workers take half of the frames each, or with one frame half of the points (a face
+  // between the halves is planed by both); every quadric sums its planes in the same order as
+  // one worker would.
+  const size_t workers = faces.size() * used_count >= 3 * 65536 ? 2 : 1;
+  detail::run_in_ranges(workers, workers, [&](size_t, size_t, size_t worker) {
+    size_t frame_begin = 0, frame_end = used_count;
+    int32_t point_begin = 0, point_end = static_cast<int32_t>(point_count);
+    if (workers == 2 && used_count >= 2) {
+      frame_begin = used_count * worker / 2;
+      frame_end = used_count * (worker + 1) / 2;
+    } else if (workers == 2) {
+      (worker == 0 ? point_end : point_begin) = static_cast<int32_t>(point_count / 2);
+    }
+    auto has = [&](int32_t point) { return point >= point_begin && point < point_end; };
+    for (size_t f = 0; f < faces.size() / 3; ++f) {
+      const int32_t* v = &faces[3 * f];
+      if (!has(v[0]) && !has(v[1]) && !has(v[2])) continue;
+      for (size_t k = frame_begin; k < frame_end; ++k) {
+        const size_t frame = static_cast<size_t>(frames[k]);
+        const Eigen::Vector3d p0 = position(v[0], frame), p1 = position(v[1], frame), p2 = position(v[2], frame);
+        const Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0);
+        const double length = normal.norm();
+        if (length == 0.0) continue;  // a face with no area in this frame has no plane
+        const Quadric plane = Quadric::plane(normal / length, p0, 1.0);
+        for (int corner = 0; corner < 3; ++corner)
+          if (has(v[corner])) out.quadrics[static_cast<size_t>(v[corner]) * used_count + k] += plane;
+      }
+    }
+  });
+  return out;
+}
+
 // Steps 1-2 and 5-6 of the paper for the collapse engine.
 class AqemPolicy final : public detail::CollapsePolicy {
  public:
+  // Completes the face quadrics (FaceQuadrics) with the engine's border and seam sides.
   AqemPolicy(const CollapseEngine& engine, const AqemOptions& options, const std::vector<int32_t>& frames,
-             std::vector<double> weights)
+             std::vector<double> weights, FaceQuadrics face)
       : engine_(engine),
         options_(options),
         frames_(frames),
         used_count_(frames.size()),
         vertex_weights_(std::move(weights)),
+        quadrics_(std::move(face.quadrics)),
+        plane_counts_(std::move(face.plane_counts)),
+        tips_(std::move(face.tips)),
         scratch_(kWorkers) {
-    accumulate_quadrics();
+    add_side_quadrics();
   }
 
   void evaluate(Candidate& candidate) override { evaluate_with(candidate, scratch_[0]); }
@@ -184,17 +272,8 @@ class AqemPolicy final : public detail::CollapsePolicy {
   }
 
  private:
-  void accumulate_quadrics();
-  // A worker's share of the quadrics: used frames [frame_begin, frame_end) of points
-  // [point_begin, point_end).
-  struct QuadricShare {
-    size_t frame_begin, frame_end;
-    int32_t point_begin, point_end;
-    bool has(int32_t point) const { return point >= point_begin && point < point_end; }
-  };
-  void accumulate_share(const QuadricShare& share);
-  void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, const QuadricShare& share);
-  void add_tip_points(const QuadricShare& share);
+  void add_side_quadrics();
+  void add_side_planes(const std::vector<std::array<int32_t, 3>>& sides);
   // The last evaluation of a worker, which its placement reads; a cache line of its own, as
   // every evaluation writes it (sharing one, the two workers' evaluations took 1.5x as long).
   struct alignas(64) Scratch {
@@ -223,108 +302,30 @@ class AqemPolicy final : public detail::CollapsePolicy {
   std::vector<Scratch> scratch_;  // (kWorkers,) each holds its worker's last placement
 };
 
-// Steps 1-2 (Eqs. 1-4): every face's plane in every used frame goes into its three points'
-// quadrics of that frame; border and seam sides add a perpendicular plane (option
-// boundary_quadrics), needle tips a point quadric (option tip_quadrics). plane_counts_ counts
-// the planes of each point, so that the error can be a mean; a face with no area in a frame
-// counts there as a plane at distance 0.
-void AqemPolicy::accumulate_quadrics() {
-  const size_t point_count = engine_.point_count();
-  const std::vector<int32_t>& faces = engine_.prepared().faces;
-  quadrics_.assign(point_count * used_count_, Quadric{});
-  plane_counts_.assign(point_count, 0.0);
-  for (const int32_t point : faces) plane_counts_[point] += 1.0;
+// Border and seam sides add a plane through the side perpendicular to its face (option
+// boundary_quadrics), counted with the point's planes, and needle tips a point quadric (option
+// tip_quadrics): after the face planes, in the order one pass over everything would add them.
+void AqemPolicy::add_side_quadrics() {
   if (options_.boundary_quadrics)
-    for (const auto* sides : {&engine_.border_sides(), &engine_.seam_sides()})
+    for (const auto* sides : {&engine_.border_sides(), &engine_.seam_sides()}) {
       for (const auto& side : *sides) {
         plane_counts_[side[0]] += 1.0;
         plane_counts_[side[1]] += 1.0;
       }
-  // Two workers take half of the frames each, or with one frame half of the points (a face
-  // between the halves is planed by both); every quadric sums its planes in the same order as
-  // one worker would.
-  const size_t workers = faces.size() * used_count_ >= 3 * 65536 ? 2 : 1;
-  const auto points = static_cast<int32_t>(point_count);
-  if (options_.tip_quadrics) {
-    // Tips in every used frame: a spike stays one, while a point that folds into a narrow cone
-    // in some poses only (a bent finger, a creased strip) is no needle. After the first frame
-    // only the tips so far are looked at. The search walks every face (at 1M triangles, half
-    // of the quadrics' time on one worker), so the workers take half of the points each.
-    const size_t tip_workers = faces.size() >= 3 * 65536 ? 2 : 1;
-    std::vector<uint8_t> tip_so_far(point_count, 1);
-    std::vector<std::vector<int32_t>> found(tip_workers);
-    for (size_t k = 0; k < used_count_; ++k) {
-      const size_t frame = static_cast<size_t>(frames_[k]);
-      auto position_of = [&](int32_t point) { return engine_.position(point, frame); };
-      detail::run_in_ranges(point_count, tip_workers, [&](size_t begin, size_t end, size_t worker) {
-        found[worker] = detail::find_needle_tips(faces, static_cast<int32_t>(begin), static_cast<int32_t>(end),
-                                                 position_of, tip_so_far.data());
-      });
-      tips_.clear();
-      for (const std::vector<int32_t>& part : found) tips_.insert(tips_.end(), part.begin(), part.end());
-      std::fill(tip_so_far.begin(), tip_so_far.end(), 0);
-      for (int32_t tip : tips_) tip_so_far[tip] = 1;
-      if (tips_.empty()) break;
+      add_side_planes(*sides);
     }
-  }
-  auto accumulate = [&](size_t worker) {
-    QuadricShare share{0, used_count_, 0, points};
-    if (workers == 2 && used_count_ >= 2) {
-      share.frame_begin = used_count_ * worker / 2;
-      share.frame_end = used_count_ * (worker + 1) / 2;
-    } else if (workers == 2) {
-      share.point_begin = worker == 0 ? 0 : points / 2;
-      share.point_end = worker == 0 ? points / 2 : points;
-    }
-    accumulate_share(share);
-  };
-  std::thread second;
-  if (workers == 2) second = std::thread(accumulate, 1);
-  accumulate(0);
-  if (second.joinable()) second.join();
-}
-
-// A share of the quadrics: every face's plane, then the border and seam sides', then the tips'.
-void AqemPolicy::accumulate_share(const QuadricShare& share) {
-  const std::vector<int32_t>& faces = engine_.prepared().faces;
-  for (size_t f = 0; f < faces.size() / 3; ++f) {
-    const int32_t* v = &faces[3 * f];
-    if (!share.has(v[0]) && !share.has(v[1]) && !share.has(v[2])) continue;
-    for (size_t k = share.frame_begin; k < share.frame_end; ++k) {
-      const size_t frame = static_cast<size_t>(frames_[k]);
-      const Eigen::Vector3d p0 = engine_.position(v[0], frame), p1 = engine_.position(v[1], frame),
-                            p2 = engine_.position(v[2], frame);
-      const Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0);
-      const double length = normal.norm();
-      if (length == 0.0) continue;  // a face with no area in this frame has no plane
-      const Quadric plane = Quadric::plane(normal / length, p0, 1.0);
-      for (int corner = 0; corner < 3; ++corner)
-        if (share.has(v[corner])) quadrics_of(v[corner])[k] += plane;
-    }
-  }
-  if (options_.boundary_quadrics) {
-    add_side_planes(engine_.border_sides(), share);
-    add_side_planes(engine_.seam_sides(), share);
-  }
-  add_tip_points(share);
-}
-
-// Every needle tip gets, in each used frame, the squared distance from where it is, once per
-// plane of the point (so it weighs like the planes do): moving a tip then costs at least its
-// displacement, which its nearly parallel planes do not charge.
-void AqemPolicy::add_tip_points(const QuadricShare& share) {
-  for (size_t k = share.frame_begin; k < share.frame_end; ++k)
+  // Every needle tip gets, in each used frame, the squared distance from where it is, once per
+  // plane of the point (so it weighs like the planes do): moving a tip then costs at least its
+  // displacement, which its nearly parallel planes do not charge.
+  for (size_t k = 0; k < used_count_; ++k)
     for (int32_t tip : tips_)
-      if (share.has(tip))
-        quadrics_of(tip)[k] +=
-            Quadric::point(engine_.position(tip, static_cast<size_t>(frames_[k])), plane_counts_[tip]);
+      quadrics_of(tip)[k] += Quadric::point(engine_.position(tip, static_cast<size_t>(frames_[k])), plane_counts_[tip]);
 }
 
 // A plane through each side (a, b) perpendicular to the face (a, b, c) beside it.
-void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& sides, const QuadricShare& share) {
-  for (const auto& [a, b, c] : sides) {
-    if (!share.has(a) && !share.has(b)) continue;
-    for (size_t k = share.frame_begin; k < share.frame_end; ++k) {
+void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& sides) {
+  for (const auto& [a, b, c] : sides)
+    for (size_t k = 0; k < used_count_; ++k) {
       const size_t frame = static_cast<size_t>(frames_[k]);
       const Eigen::Vector3d pa = engine_.position(a, frame), pb = engine_.position(b, frame),
                             pc = engine_.position(c, frame);
@@ -333,10 +334,9 @@ void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& side
       const double length = normal.norm();
       if (length == 0.0) continue;
       const Quadric plane = Quadric::plane(normal / length, pa, 1.0);
-      if (share.has(a)) quadrics_of(a)[k] += plane;
-      if (share.has(b)) quadrics_of(b)[k] += plane;
+      quadrics_of(a)[k] += plane;
+      quadrics_of(b)[k] += plane;
     }
-  }
 }
 
 // Steps 5-6: merged quadric, weight and optimal placement per used frame (Eq. 5); cost of
@@ -533,10 +533,16 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   engine_options.max_error = options.max_error;
   engine_options.progress = options.progress;
   engine_options.collapse_passes = true;
+  // The face quadrics need no connectivity: they are summed while the engine builds it (a
+  // third thread on two cores; the phases then split the wall time: connectivity is the
+  // engine's build, quadrics what the face quadrics take beyond it and the sides' planes).
   timer.emplace(seconds.connectivity);
+  std::future<FaceQuadrics> face = std::async(std::launch::async, [&] {
+    return face_quadrics(prepared.faces, points.view(), result.frames_used, options.tip_quadrics);
+  });
   CollapseEngine engine(mesh, prepared, carried, engine_options);
   timer.emplace(seconds.quadrics);
-  AqemPolicy policy(engine, options, result.frames_used, std::move(weights));
+  AqemPolicy policy(engine, options, result.frames_used, std::move(weights), face.get());
   timer.reset();
   std::vector<detail::EngineLevel> levels;
   detail::EngineRecord record;

@@ -163,8 +163,10 @@ struct CollapseRecord {
 struct AqemTimings {
   double preparation = 0.0;      // checks, weld, dropped faces, cuts (before any collapse)
   double motion_features = 0.0;  // Eq. 6's features (0 when off)
-  double connectivity = 0.0;     // the engine's OpenMesh connectivity and per-point state
-  double quadrics = 0.0;         // every point's quadrics
+  double connectivity = 0.0;     // the engine's OpenMesh connectivity and per-point state (the
+                                 // faces' quadrics are summed meanwhile, on another thread)
+  double quadrics = 0.0;         // what the quadrics take beyond that: the rest of the faces',
+                                 // the border and seam sides'
   double ranking = 0.0;          // costs of every collapsible edge (each pass's, or the greedy heap's first)
   double choosing = 0.0;         // collapse passes: ordering candidates by cost and choosing a pass's
   double collapsing = 0.0;       // collapse attempts (the greedy order: its re-keying too)

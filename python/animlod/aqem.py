@@ -116,13 +116,14 @@ class PhaseSeconds:
     """Wall-clock seconds of one simplification's phases, in the order they run: where its time
     goes. The core's own phases; converting the input and the result to numpy is not included.
 
-    preparation : checks, weld, dropped faces and cuts. motion_features : Eq. 6's features (0
-        when off). connectivity : the collapse engine's OpenMesh connectivity and per-point
-        state, while the faces' quadrics are summed beside it. quadrics : what the points'
-        quadrics take beyond that (the rest of the faces', the border and seam sides'). ranking : the costs of every collapsible edge
-        (each collapse pass's, or the greedy order's first). choosing : collapse passes ordering
-        their candidates by cost and choosing their collapses. collapsing : collapse attempts
-        (the greedy order's re-keying included). levels : the levels' meshes and arrays.
+    preparation : checks, weld, dropped faces and cuts. motion_features : Eq. 6's features
+        (0 when off). connectivity : the collapse engine's OpenMesh connectivity and
+        per-point state, while the faces' quadrics are summed beside it. quadrics : what the
+        points' quadrics take beyond that (the rest of the faces', the border and seam
+        sides'). ranking : the costs of every collapsible edge (each collapse pass's, or the
+        greedy order's first). choosing : collapse passes ordering their candidates by cost
+        and choosing their collapses. collapsing : collapse attempts (the greedy order's
+        re-keying included). levels : the levels' meshes and arrays.
     """
 
     preparation: float

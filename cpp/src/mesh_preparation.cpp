@@ -6,6 +6,7 @@
 #include <cstring>
 #include <numeric>
 #include <thread>
+#include <utility>
 
 #include "union_find.hpp"
 #include "worker_threads.hpp"
@@ -453,11 +454,11 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
     out.point_split = std::move(split);
     for (int32_t& p : corner_points) p = renumber[p];
   }
-  out.faces = corner_points;
+  out.faces = std::move(corner_points);
 
   // Step 4: wedges of one point with equal attributes and face group merge into the lowest.
   out.wedge_point.assign(vertex_count, -1);
-  for (size_t c = 0; c < corner_inputs.size(); ++c) out.wedge_point[corner_inputs[c]] = corner_points[c];
+  for (size_t c = 0; c < corner_inputs.size(); ++c) out.wedge_point[corner_inputs[c]] = out.faces[c];
   std::vector<int32_t> wedge_group(vertex_count, 0);
   if (input.face_groups)
     for (size_t c = corner_inputs.size(); c-- > 0;)  // the first face using a vertex decides its group

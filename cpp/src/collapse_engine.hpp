@@ -144,7 +144,6 @@ class CollapseEngine {
 
   size_t frame_count() const { return frame_count_; }
   size_t point_count() const { return point_count_; }
-  const PreparedMesh& prepared() const { return prepared_; }
   Eigen::Vector3d position(int32_t point, size_t frame) const {
     const float* p = &positions_[(static_cast<size_t>(point) * frame_count_ + frame) * 3];
     return {p[0], p[1], p[2]};

@@ -36,7 +36,7 @@ from animlod import synth
 from animlod.io import write_glb
 from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_drawable import Drawable, read_drawables
-from animlod.metrics import surface_error
+from animlod.metrics import hausdorff_distance
 from animlod.model import AnimatedMesh, spread_frames
 from animlod.pipelines.drawable_levels import posed_frames, simplify_drawable
 
@@ -63,7 +63,10 @@ def measured_frames(drawable: Drawable) -> list[AnimatedMesh]:
 
 
 def worst_error(originals: list[AnimatedMesh], levels: list[AnimatedMesh]) -> float:
-    return max(float(surface_error(o, s, samples=SAMPLES).hausdorff.max()) for o, s in zip(originals, levels))
+    worst = 0.0
+    for original, level in zip(originals, levels):
+        worst = hausdorff_distance(original, level, samples=SAMPLES, at_least=worst)
+    return worst
 
 
 def meshopt_faces(drawable: Drawable, ratio: float) -> np.ndarray:

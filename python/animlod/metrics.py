@@ -5,7 +5,9 @@ closest points on the other), with the core's ``point_mesh_squared_distance`` (a
 hierarchy over the triangles, on every core, the GIL released; libigl's function of the same name
 is its reference in the tests). Each
 frame gives a symmetric Hausdorff distance and an RMS distance; both are reported in asset
-units and relative to the original frame's bounding-box diagonal.
+units and relative to the original frame's bounding-box diagonal. Where only the largest
+Hausdorff distance over the frames counts (the pipelines' level errors),
+:func:`hausdorff_distance` gives it, the same value for a fraction of the cost.
 """
 
 from __future__ import annotations
@@ -106,6 +108,43 @@ def surface_error(
     SurfaceError with (F,) arrays; ``summary()`` gives the mean/max over frames relative to the
     bounding-box diagonal.
     """
+    a, b, from_original, from_simplified = _measured_points(original, simplified, samples, seed)
+    squared = np.concatenate(
+        [
+            _core.point_mesh_squared_distance(from_original, b, simplified.faces),
+            _core.point_mesh_squared_distance(from_simplified, a, original.faces),
+        ],
+        axis=1,
+    )
+    diagonal = np.linalg.norm(np.ptp(a, axis=1), axis=-1)
+    return SurfaceError(np.sqrt(squared.max(axis=1)), np.sqrt(squared.mean(axis=1)), diagonal)
+
+
+def hausdorff_distance(
+    original: AnimatedMesh, simplified: AnimatedMesh, samples: int = 20000, seed: int = 0, at_least: float = 0.0
+) -> float:
+    """The largest symmetric Hausdorff distance over the frames, or ``at_least`` if larger.
+
+    Equal to ``max(at_least, surface_error(original, simplified, samples, seed).hausdorff.max())``
+    to the bit (the same points, measured both ways), without the distances that cannot raise
+    it: the core's ``point_mesh_max_squared_distance`` ends a point's search at the first
+    triangle no farther than the largest distance so far, which starts at ``at_least`` (a
+    running maximum the caller holds over clips or levels prunes from the start). ValueError for
+    an ``at_least`` that is not a number >= 0 or frame counts that differ.
+    """
+    if not at_least >= 0.0:
+        raise ValueError(f"at_least: {at_least!r}, expected a distance >= 0")
+    a, b, from_original, from_simplified = _measured_points(original, simplified, samples, seed)
+    squared = _core.point_mesh_max_squared_distance(from_original, b, simplified.faces, floor=at_least * at_least)
+    squared = _core.point_mesh_max_squared_distance(from_simplified, a, original.faces, floor=squared)
+    return max(at_least, float(np.sqrt(squared)))
+
+
+def _measured_points(
+    original: AnimatedMesh, simplified: AnimatedMesh, samples: int, seed: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Both meshes' (F, V, 3) float64 frames and the points measured against the other: each
+    mesh's vertices and ``samples`` points drawn on its surface, (F, V + samples, 3)."""
     if original.frame_count != simplified.frame_count:
         raise ValueError(f"simplified: {simplified.frame_count} frames, the original has {original.frame_count}")
     on_original = sample_surface(original, samples, seed)
@@ -116,15 +155,7 @@ def surface_error(
     # Every frame in one call each way: the core builds each mesh's tree once and refits it.
     from_original = np.concatenate([a, on_original.positions(original, every)], axis=1)
     from_simplified = np.concatenate([b, on_simplified.positions(simplified, every)], axis=1)
-    squared = np.concatenate(
-        [
-            _core.point_mesh_squared_distance(from_original, b, simplified.faces),
-            _core.point_mesh_squared_distance(from_simplified, a, original.faces),
-        ],
-        axis=1,
-    )
-    diagonal = np.linalg.norm(np.ptp(a, axis=1), axis=-1)
-    return SurfaceError(np.sqrt(squared.max(axis=1)), np.sqrt(squared.mean(axis=1)), diagonal)
+    return a, b, from_original, from_simplified
 
 
 def _relative(distance: np.ndarray, diagonal: np.ndarray) -> np.ndarray:

@@ -122,3 +122,36 @@ TEST_CASE("point_mesh_squared_distance refits the first frame's tree to the othe
   const auto status = animlod::point_mesh_squared_distance(mesh, points.data(), 3000, 0, out.data());
   CHECK(status.message.find("vertices[1, 1]") != std::string::npos);
 }
+
+TEST_CASE("point_mesh_max_squared_distance is the largest of every distance, to the bit") {
+  // A random soup in three frames, each moving every vertex; points near the surface and far.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const size_t vertex_count = 300, point_count = 6000, frames = 3;
+  std::vector<double> vertices;
+  for (size_t i = 0; i < 3 * vertex_count; ++i) vertices.push_back(uniform(rng));
+  for (size_t frame = 1; frame < frames; ++frame)
+    for (size_t i = 0; i < 3 * vertex_count; ++i) vertices.push_back(vertices[i] + 0.2 * frame * uniform(rng));
+  std::vector<int32_t> f;
+  std::uniform_int_distribution<int32_t> pick(0, static_cast<int32_t>(vertex_count) - 1);
+  for (int t = 0; t < 3 * 400; ++t) f.push_back(pick(rng));
+  std::vector<double> points;
+  for (size_t i = 0; i < 3 * point_count * frames; ++i) points.push_back((i % 7 == 0 ? 3.0 : 1.2) * uniform(rng));
+  const animlod::TriangleMeshView mesh{vertices.data(), f.data(), vertex_count, f.size() / 3, frames};
+  std::vector<double> every(point_count * frames);
+  REQUIRE(animlod::point_mesh_squared_distance(mesh, points.data(), point_count, 1, every.data()));
+  const double largest = *std::max_element(every.begin(), every.end());
+  for (const unsigned threads : {1u, 2u})
+    for (const double floor : {0.0, 0.25 * largest, 0.999 * largest, largest, 2.0 * largest}) {
+      double out = -1.0;
+      REQUIRE(animlod::point_mesh_max_squared_distance(mesh, points.data(), point_count, threads, floor, out));
+      CHECK(out == std::max(floor, largest));
+    }
+  double out = 0.0;
+  const std::vector<double> nan_point{0, std::nan(""), 0};
+  const auto status = animlod::point_mesh_max_squared_distance(view(vertices, {0, 1, 2}), nan_point.data(), 1, 0,
+                                                               0.0, out);
+  CHECK(status.message.find("points[0]") != std::string::npos);
+  CHECK(animlod::point_mesh_max_squared_distance(mesh, points.data(), point_count, 0, std::nan(""), out).message ==
+        "floor: not a number");
+}

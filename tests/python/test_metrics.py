@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from simplify_inputs import ellipsoid
 
-from animlod import _core
-from animlod.metrics import sample_surface, surface_error
+from animlod import _core, simplify_animated
+from animlod.metrics import hausdorff_distance, sample_surface, surface_error
 from animlod.model import AnimatedMesh
 
 
@@ -54,6 +54,19 @@ def test_frame_counts_must_match():
         surface_error(flat_square(np.zeros(3)), flat_square(np.zeros(2)))
 
 
+def test_hausdorff_distance_is_the_largest_of_surface_error_to_the_bit():
+    original = ellipsoid(frames=4)
+    level = simplify_animated(original, (0.1,)).levels[0].mesh
+    largest = surface_error(original, level, samples=2000, seed=4).hausdorff.max()
+    assert largest > 0.0
+    for at_least in (0.0, 0.5 * largest, 0.999 * largest, largest, 2.0 * largest):
+        assert hausdorff_distance(original, level, samples=2000, seed=4, at_least=at_least) == max(at_least, largest)
+    with pytest.raises(ValueError, match="simplified: 2 frames, the original has 3"):
+        hausdorff_distance(flat_square(np.zeros(3)), flat_square(np.zeros(2)))
+    with pytest.raises(ValueError, match="at_least: nan, expected a distance >= 0"):
+        hausdorff_distance(original, level, at_least=float("nan"))
+
+
 def test_point_mesh_distance_matches_libigl_on_a_deformed_surface():
     igl = pytest.importorskip("igl")  # the reference the metrics used before the core's
     mesh = ellipsoid(frames=3)
@@ -81,3 +94,7 @@ def test_point_mesh_distance_names_bad_input():
         _core.point_mesh_squared_distance(np.zeros((1, 3)), square, np.zeros((0, 3), np.int32))
     with pytest.raises(ValueError, match=r"points\[1\]: not a finite position"):
         _core.point_mesh_squared_distance([[0, 0, 0], [np.nan, 0, 0]], square, np.array([[0, 1, 2]]))
+    with pytest.raises(ValueError, match=r"points\[1\]: not a finite position"):
+        _core.point_mesh_max_squared_distance([[0, 0, 0], [np.nan, 0, 0]], square, np.array([[0, 1, 2]]))
+    with pytest.raises(ValueError, match=r"vertices: expected"):
+        _core.point_mesh_max_squared_distance(np.zeros((2, 1, 3)), square, np.array([[0, 1, 2]]))

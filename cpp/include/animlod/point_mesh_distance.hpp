@@ -1,5 +1,6 @@
 // Distance from points to the surface of a triangle mesh: the nearest-point query behind the
-// Hausdorff and RMS errors of python/animlod/metrics.py, run twice per measured frame and level.
+// Hausdorff and RMS errors of python/animlod/metrics.py, run twice per measured frame and level,
+// and its largest value alone (the Hausdorff distance of the pipelines' level errors).
 #pragma once
 
 #include <cstddef>
@@ -26,5 +27,14 @@ struct TriangleMeshView {
 // Errors: no triangle, a face index outside [0, V), a non-finite vertex or point (naming it).
 Status point_mesh_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
                                    unsigned threads, double* out);
+
+// Sets `out` to the largest of those squared distances over every point and frame when it
+// exceeds `floor`, to `floor` otherwise: a one-sided Hausdorff distance, squared, against a
+// running maximum the caller already holds. Equal to the largest element of what
+// point_mesh_squared_distance writes (or `floor`) to the bit, for any thread count; far
+// cheaper, as a point's search ends at the first triangle no farther than the largest so far.
+// The same errors, and a NaN floor.
+Status point_mesh_max_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
+                                       unsigned threads, double floor, double& out);
 
 }  // namespace animlod

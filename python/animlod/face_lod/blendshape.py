@@ -237,7 +237,7 @@ def prune_levels(face: BlendshapeFace, levels: list[BlendshapeLevel], options: B
     the input's) and keep, in ``kept_targets`` and ``targets``, the targets the rule of the module
     notes (or ``options.target_fractions``) keeps. ``levels[0]`` is the input and keeps them all;
     the others must still hold every target."""
-    from ..metrics import surface_error
+    from ..metrics import hausdorff_distance
 
     check_fractions(options.target_fractions, len(levels))
     everything = np.arange(face.target_count)
@@ -245,7 +245,7 @@ def prune_levels(face: BlendshapeFace, levels: list[BlendshapeLevel], options: B
     full = AnimatedMesh(face.faces, face.neutral[None])
     for index, level in enumerate(levels[1:], start=1):
         rest = AnimatedMesh(level.faces, level.neutral[None])
-        level.geometric_error = float(surface_error(full, rest, samples=5000).hausdorff[0])
+        level.geometric_error = hausdorff_distance(full, rest, samples=5000)
         if options.target_fractions is not None:
             kept = np.sort(order[: int(np.ceil(options.target_fractions[index] * face.target_count - 1e-9))])
         elif index == len(levels) - 1 and not options.animate_coarsest:

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aqem import simplify_animated
-from ..metrics import surface_error
+from ..metrics import hausdorff_distance
 from ..model import AnimatedMesh, spread_frames
 from .active_tree import ActiveTree
 from .mpa import MpaAnimation
@@ -177,7 +177,7 @@ def build_face_lod(
     reduction_error = _reduction_errors(rig)
     rest = AnimatedMesh(rig.faces, rig.positions[None])
     geometric = [0.0] + [
-        float(surface_error(rest, AnimatedMesh(level.mesh.faces, level.mesh.frames[:1]), samples=5000).hausdorff[0])
+        hausdorff_distance(rest, AnimatedMesh(level.mesh.faces, level.mesh.frames[:1]), samples=5000)
         for level in result.levels
     ]
     reduced_sets = _reduced(options.reduced_lattices, rig, reduction_error, geometric)

@@ -43,7 +43,7 @@ from ..io.gltf_lod import (
 )
 from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import add_animation, add_skeleton, add_skin
-from ..metrics import surface_error
+from ..metrics import hausdorff_distance
 from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
 from ..motion_lod.chain import MotionLevel
@@ -351,7 +351,7 @@ def _measure_chain(
             else:
                 weights = None if clip.morph_weights is None else clip.morph_weights[frames]
                 posed = reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
-            error = max(error, float(surface_error(original, posed, samples=4000).hausdorff.max()))
+            error = hausdorff_distance(original, posed, samples=4000, at_least=error)
         faces = level.simplified.mesh.face_count
         joints = motion.joint_count if motion_level is None else motion_level.report.joint_count
         report.append(CharacterLevel(i, i, m, faces, joints, error, 0.0, 0.0))

@@ -29,7 +29,7 @@ from ..aqem import Preparation, SimplifiedLevel, simplify_animated
 from ..io.gltf_drawable import Clip, Drawable
 from ..io.gltf_lod import PrimitiveArrays
 from ..io.gltf_mesh import PrimitiveGeometry, transform_points
-from ..metrics import surface_error
+from ..metrics import hausdorff_distance
 from ..model import AnimatedMesh, SkinnedMesh, spread_frames
 from ..options import AqemOptions
 
@@ -438,8 +438,7 @@ def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: i
         )
         for level in levels:
             posed = AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
-            distance = surface_error(original, posed, samples=_MEASURE_SAMPLES).hausdorff.max()
-            level.error = max(level.error, float(distance))
+            level.error = hausdorff_distance(original, posed, samples=_MEASURE_SAMPLES, at_least=level.error)
 
 
 def posed_frames(drawable: Drawable, level: DrawableLevel, clip: Clip | None, frames: np.ndarray) -> np.ndarray:

@@ -3,7 +3,8 @@
 // Invariants: the call fails exactly when there is no face, an index outside [0, V) or a
 // non-finite coordinate, with a message; on success every distance is finite, >= 0, no more
 // than the distance to the nearest vertex of a face in the same frame, and the same on one
-// thread as on two.
+// thread as on two; point_mesh_max_squared_distance gives their largest to the bit, from a
+// floor of 0 and of half of it, on one thread and on two.
 #include <cmath>
 #include <vector>
 
@@ -34,6 +35,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   ANIMLOD_FUZZ_REQUIRE(animlod::point_mesh_squared_distance(view, points.data(), point_count, 2, two.data()).ok);
   ANIMLOD_FUZZ_REQUIRE(one == two);
+  double largest = 0.0;
+  for (double d : one) largest = std::fmax(largest, d);
+  for (const unsigned threads : {1u, 2u})
+    for (const double floor : {0.0, 0.5 * largest}) {
+      double out = -1.0;
+      ANIMLOD_FUZZ_REQUIRE(
+          animlod::point_mesh_max_squared_distance(view, points.data(), point_count, threads, floor, out).ok);
+      ANIMLOD_FUZZ_REQUIRE(out == largest);
+    }
   for (size_t t = 0; t < frames; ++t)
     for (size_t i = 0; i < point_count; ++i) {
       const double* p = &points[3 * (t * point_count + i)];

@@ -249,7 +249,7 @@ Status check_inputs(const TriangleMeshView& mesh, const double* points, size_t p
     if (mesh.faces[i] < 0 || static_cast<size_t>(mesh.faces[i]) >= mesh.vertex_count)
       return Status::error("faces[" + std::to_string(i / 3) + "]: vertex index " + std::to_string(mesh.faces[i]) +
                            " is outside [0, " + std::to_string(mesh.vertex_count) + ")");
-  const size_t frames = std::max<size_t>(mesh.frame_count, 1);
+  const size_t frames = mesh.frame_count;
   const auto where = [](size_t row, size_t rows, size_t frame_count) {
     return frame_count > 1 ? std::to_string(row / rows) + ", " + std::to_string(row % rows) : std::to_string(row);
   };
@@ -275,10 +275,11 @@ template <typename Query>
 Status query_frames(const TriangleMeshView& mesh, const double* points, size_t point_count, size_t workers,
                     const Query& query) {
   if (Status status = check_inputs(mesh, points, point_count); !status) return status;
+  if (mesh.frame_count == 0) return Status::success();  // no frame, nothing to measure
   TriangleTree tree(mesh);
   const size_t chunk = (point_count + workers - 1) / workers;
   std::vector<int64_t> nearest(point_count, -1);
-  for (size_t frame = 0; frame < std::max<size_t>(mesh.frame_count, 1); ++frame) {
+  for (size_t frame = 0; frame < mesh.frame_count; ++frame) {
     if (frame > 0) tree.refit(mesh.vertices + 3 * mesh.vertex_count * frame);
     const double* frame_points = points + 3 * point_count * frame;
     auto run = [&](size_t worker) {

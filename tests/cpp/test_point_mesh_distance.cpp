@@ -155,3 +155,16 @@ TEST_CASE("point_mesh_max_squared_distance is the largest of every distance, to 
   CHECK(animlod::point_mesh_max_squared_distance(mesh, points.data(), point_count, 0, std::nan(""), out).message ==
         "floor: not a number");
 }
+
+TEST_CASE("point-to-mesh distances of no frame read nothing") {
+  // (0, N, 3) points against (0, V, 3) vertices: the faces are checked, no position is read.
+  const std::vector<int32_t> f{0, 1, 2};
+  const animlod::TriangleMeshView none{nullptr, f.data(), 3, 1, 0};
+  double out = -1.0;
+  CHECK(animlod::point_mesh_squared_distance(none, nullptr, 5, 0, nullptr));
+  CHECK(animlod::point_mesh_max_squared_distance(none, nullptr, 5, 0, 0.25, out));
+  CHECK(out == 0.25);
+  const std::vector<int32_t> bad{0, 1, 3};
+  CHECK(animlod::point_mesh_squared_distance({nullptr, bad.data(), 3, 1, 0}, nullptr, 5, 0, nullptr).message.find(
+            "faces[0]") != std::string::npos);
+}

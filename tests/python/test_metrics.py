@@ -86,6 +86,12 @@ def test_point_mesh_distance_matches_libigl_on_a_deformed_surface():
     np.testing.assert_allclose(_core.point_mesh_squared_distance(moved, frames, faces), each, rtol=1e-9, atol=1e-14)
 
 
+def test_point_mesh_distance_of_no_frame_is_empty():
+    triangle = np.array([[0, 1, 2]])
+    assert _core.point_mesh_squared_distance(np.zeros((0, 5, 3)), np.zeros((0, 3, 3)), triangle).shape == (0, 5)
+    assert _core.point_mesh_max_squared_distance(np.zeros((0, 5, 3)), np.zeros((0, 3, 3)), triangle, floor=0.5) == 0.5
+
+
 def test_point_mesh_distance_names_bad_input():
     square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0]], np.float64)
     with pytest.raises(ValueError, match=r"faces\[0\]: vertex index 3 is outside \[0, 3\)"):

@@ -16,7 +16,7 @@ struct TriangleMeshView {
   const int32_t* faces = nullptr;    // (F, 3) vertex indices
   size_t vertex_count = 0;           // V
   size_t face_count = 0;             // F
-  size_t frame_count = 1;            // T
+  size_t frame_count = 1;            // T (0: nothing to measure)
 };
 
 // Writes out (T, N): the squared distance from each point (T, N, 3) to the nearest point of any

@@ -7,11 +7,13 @@ is its reference in the tests). Each
 frame gives a symmetric Hausdorff distance and an RMS distance; both are reported in asset
 units and relative to the original frame's bounding-box diagonal. Where only the largest
 Hausdorff distance over the frames counts (the pipelines' level errors),
-:func:`hausdorff_distance` gives it, the same value for a fraction of the cost.
+:func:`hausdorff_distance` gives it, the same value for a fraction of the cost
+(:func:`hausdorff_distances` for several levels of one original).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -108,7 +110,9 @@ def surface_error(
     SurfaceError with (F,) arrays; ``summary()`` gives the mean/max over frames relative to the
     bounding-box diagonal.
     """
-    a, b, from_original, from_simplified = _measured_points(original, simplified, samples, seed)
+    _check_frames(original, simplified)
+    a, from_original = _measured_points(original, samples, seed)
+    b, from_simplified = _measured_points(simplified, samples, seed + 1)
     squared = np.concatenate(
         [
             _core.point_mesh_squared_distance(from_original, b, simplified.faces),
@@ -132,30 +136,48 @@ def hausdorff_distance(
     running maximum the caller holds over clips or levels prunes from the start). ValueError for
     an ``at_least`` that is not a number >= 0 or frame counts that differ.
     """
-    if not at_least >= 0.0:
-        raise ValueError(f"at_least: {at_least!r}, expected a distance >= 0")
-    a, b, from_original, from_simplified = _measured_points(original, simplified, samples, seed)
-    squared = _core.point_mesh_max_squared_distance(from_original, b, simplified.faces, floor=at_least * at_least)
-    squared = _core.point_mesh_max_squared_distance(from_simplified, a, original.faces, floor=squared)
-    return max(at_least, float(np.sqrt(squared)))
+    return hausdorff_distances(original, [simplified], samples, seed, [at_least])[0]
 
 
-def _measured_points(
-    original: AnimatedMesh, simplified: AnimatedMesh, samples: int, seed: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Both meshes' (F, V, 3) float64 frames and the points measured against the other: each
-    mesh's vertices and ``samples`` points drawn on its surface, (F, V + samples, 3)."""
+def hausdorff_distances(
+    original: AnimatedMesh,
+    simplified: Sequence[AnimatedMesh],
+    samples: int = 20000,
+    seed: int = 0,
+    at_least: Sequence[float] | None = None,
+) -> list[float]:
+    """:func:`hausdorff_distance` of each of several simplifications of one original (levels),
+    each from its own ``at_least`` (default 0); the original's points are drawn once."""
+    at_least = [0.0] * len(simplified) if at_least is None else list(at_least)
+    if len(at_least) != len(simplified):
+        raise ValueError(f"at_least: {len(at_least)} values for {len(simplified)} simplified meshes")
+    for value in at_least:
+        if not value >= 0.0:
+            raise ValueError(f"at_least: {value!r}, expected a distance >= 0")
+    for each in simplified:
+        _check_frames(original, each)
+    a, from_original = _measured_points(original, samples, seed)
+    distances = []
+    for each, floor in zip(simplified, at_least):
+        b, from_simplified = _measured_points(each, samples, seed + 1)
+        squared = _core.point_mesh_max_squared_distance(from_original, b, each.faces, floor=floor * floor)
+        squared = _core.point_mesh_max_squared_distance(from_simplified, a, original.faces, floor=squared)
+        distances.append(max(floor, float(np.sqrt(squared))))
+    return distances
+
+
+def _check_frames(original: AnimatedMesh, simplified: AnimatedMesh) -> None:
     if original.frame_count != simplified.frame_count:
         raise ValueError(f"simplified: {simplified.frame_count} frames, the original has {original.frame_count}")
-    on_original = sample_surface(original, samples, seed)
-    on_simplified = sample_surface(simplified, samples, seed + 1)
-    every = slice(None)
-    a = original.frames.astype(np.float64)  # (F, V, 3)
-    b = simplified.frames.astype(np.float64)
-    # Every frame in one call each way: the core builds each mesh's tree once and refits it.
-    from_original = np.concatenate([a, on_original.positions(original, every)], axis=1)
-    from_simplified = np.concatenate([b, on_simplified.positions(simplified, every)], axis=1)
-    return a, b, from_original, from_simplified
+
+
+def _measured_points(mesh: AnimatedMesh, samples: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh's (F, V, 3) float64 frames and the points measured against the other surface:
+    its vertices and ``samples`` points drawn on its surface, (F, V + samples, 3), every frame
+    in one array (the core builds each mesh's tree once and refits it from frame to frame)."""
+    frames = mesh.frames.astype(np.float64)
+    drawn = sample_surface(mesh, samples, seed).positions(mesh, slice(None))
+    return frames, np.concatenate([frames, drawn], axis=1)
 
 
 def _relative(distance: np.ndarray, diagonal: np.ndarray) -> np.ndarray:

@@ -7,7 +7,7 @@ import pytest
 from simplify_inputs import ellipsoid
 
 from animlod import _core, simplify_animated
-from animlod.metrics import hausdorff_distance, sample_surface, surface_error
+from animlod.metrics import hausdorff_distance, hausdorff_distances, sample_surface, surface_error
 from animlod.model import AnimatedMesh
 
 
@@ -65,6 +65,13 @@ def test_hausdorff_distance_is_the_largest_of_surface_error_to_the_bit():
         hausdorff_distance(flat_square(np.zeros(3)), flat_square(np.zeros(2)))
     with pytest.raises(ValueError, match="at_least: nan, expected a distance >= 0"):
         hausdorff_distance(original, level, at_least=float("nan"))
+    # Several levels of one original at once: each as alone, from its own floor.
+    levels = [result.mesh for result in simplify_animated(original, (0.5, 0.1)).levels]
+    floors = [0.0, 2.0 * largest]
+    alone = [hausdorff_distance(original, each, samples=2000, seed=4, at_least=f) for each, f in zip(levels, floors)]
+    assert hausdorff_distances(original, levels, samples=2000, seed=4, at_least=floors) == alone
+    with pytest.raises(ValueError, match="at_least: 1 values for 2 simplified meshes"):
+        hausdorff_distances(original, levels, at_least=[0.0])
 
 
 def test_point_mesh_distance_matches_libigl_on_a_deformed_surface():

@@ -43,7 +43,7 @@ from ..io.gltf_lod import (
 )
 from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import add_animation, add_skeleton, add_skin
-from ..metrics import hausdorff_distance
+from ..metrics import hausdorff_distances
 from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
 from ..motion_lod.chain import MotionLevel
@@ -336,25 +336,29 @@ def _measure_chain(
     there is), each measured as it is written: the level's skin played with its clips (the
     input's at motion level 0, the re-fitted ones on the reduced skin above) against the input's
     clips, max Hausdorff distance."""
-    report = [CharacterLevel(0, 0, 0, len(drawable.geometry.faces), motion.joint_count, 0.0, 0.0, 0.0)]
+    chain = []  # (geometry level, motion level index, motion level or None, reduced skin or None)
     for i in range(1, len(levels.levels) + 1):
         m = min(i, len(motion.reduced_levels))  # a small skeleton runs out of motion levels first
         level = levels.levels[i - 1]
         motion_level = motion.reduced_levels[m - 1] if m > 0 else None
         reduced = None if motion_level is None else transfer_skin(level.skinned, motion_level.frozen)
-        error = 0.0
-        for clip, span in motion.clips:
-            frames = spread_frames(clip.frame_count, measured_frames)
-            original = AnimatedMesh(drawable.geometry.faces, drawable.clip_frames(clip, frames))
-            if motion_level is None:
-                posed = AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
-            else:
-                weights = None if clip.morph_weights is None else clip.morph_weights[frames]
-                posed = reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
-            error = hausdorff_distance(original, posed, samples=4000, at_least=error)
-        faces = level.simplified.mesh.face_count
+        chain.append((level, m, motion_level, reduced))
+    errors = [0.0] * len(chain)
+    for clip, span in motion.clips:
+        frames = spread_frames(clip.frame_count, measured_frames)
+        original = AnimatedMesh(drawable.geometry.faces, drawable.clip_frames(clip, frames))
+        weights = None if clip.morph_weights is None else clip.morph_weights[frames]
+        posed = [
+            AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
+            if motion_level is None
+            else reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
+            for level, _, motion_level, reduced in chain
+        ]
+        errors = hausdorff_distances(original, posed, samples=4000, at_least=errors)
+    report = [CharacterLevel(0, 0, 0, len(drawable.geometry.faces), motion.joint_count, 0.0, 0.0, 0.0)]
+    for i, ((level, m, motion_level, _), error) in enumerate(zip(chain, errors), start=1):
         joints = motion.joint_count if motion_level is None else motion_level.report.joint_count
-        report.append(CharacterLevel(i, i, m, faces, joints, error, 0.0, 0.0))
+        report.append(CharacterLevel(i, i, m, level.simplified.mesh.face_count, joints, error, 0.0, 0.0))
     return report
 
 

@@ -29,7 +29,7 @@ from ..aqem import Preparation, SimplifiedLevel, simplify_animated
 from ..io.gltf_drawable import Clip, Drawable
 from ..io.gltf_lod import PrimitiveArrays
 from ..io.gltf_mesh import PrimitiveGeometry, transform_points
-from ..metrics import hausdorff_distance
+from ..metrics import hausdorff_distances
 from ..model import AnimatedMesh, SkinnedMesh, spread_frames
 from ..options import AqemOptions
 
@@ -436,9 +436,10 @@ def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: i
         original = AnimatedMesh(
             faces, drawable.rest_positions()[None] if clip is None else drawable.clip_frames(clip, frames)
         )
-        for level in levels:
-            posed = AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
-            level.error = hausdorff_distance(original, posed, samples=_MEASURE_SAMPLES, at_least=level.error)
+        posed = [AnimatedMesh(lv.simplified.mesh.faces, posed_frames(drawable, lv, clip, frames)) for lv in levels]
+        errors = hausdorff_distances(original, posed, _MEASURE_SAMPLES, at_least=[level.error for level in levels])
+        for level, error in zip(levels, errors):
+            level.error = error
 
 
 def posed_frames(drawable: Drawable, level: DrawableLevel, clip: Clip | None, frames: np.ndarray) -> np.ndarray:

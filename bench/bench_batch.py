@@ -18,7 +18,9 @@ vary from asset to asset. The small glTF files of the development data are added
 - Dask overhead per asset: (1-worker wall time - the sum of the jobs' own times measured on the
   worker) / assets, and over the mean job time: what scheduling, transfers, the records and the
   catalogue add; the jobs' time on the worker against the direct calls is printed beside it
-  (workers run one thread each, and the machine may be shared: the load average is printed);
+  (workers run one thread each, and the machine may be shared: the load average is printed),
+  and a no-op task's submit and result on the 1-worker cluster: the round trip the runner pays
+  before it hands out each next asset;
 - peak memory: the largest peak resident set of each worker process (``ru_maxrss``);
 - rerun: the same batch again, unchanged (every asset fingerprinted and skipped);
 - 16 workers: the measured 1-worker job times plus the measured overhead per asset, handed out
@@ -107,6 +109,19 @@ def warm_up(assets: list, folder: str) -> None:
             find_job(asset.job).function()(asset.input, Path(folder) / asset.name, **asset.options)
 
 
+def _nothing(value: int) -> int:
+    return value
+
+
+def round_trip_ms(client, repeats: int = 50) -> float:
+    """Mean milliseconds of a no-op task's submit and result on ``client``'s cluster."""
+    client.submit(_nothing, -1, pure=False).result()
+    with stopwatch() as elapsed:
+        for value in range(repeats):
+            client.submit(_nothing, value, pure=False).result()
+    return 1000 * elapsed[0] / repeats
+
+
 def simulate(times: list[float], workers: int) -> float:
     """Makespan of ``times`` handed in order to whichever of ``workers`` is free first."""
     free = [0.0] * workers
@@ -136,13 +151,15 @@ def main() -> None:
     direct_sum = sum(direct.values())
     loads = {0: os.getloadavg()[0]}  # 1-minute load average after each run: the machine may be shared
 
-    runs = {}
+    runs, round_trip = {}, 0.0
     for workers in (1, 2):
         with stopwatch() as started:
             client, cluster = connect(workers=workers)
             client.run(warm_up, assets, os.fspath(scratch / f"warm{workers}"))
         try:
             result = run_batch(assets, scratch / f"out{workers}", client=client, force=True)
+            if workers == 1:
+                round_trip = round_trip_ms(client)
         finally:
             client.close()
             cluster.close()
@@ -173,7 +190,9 @@ def main() -> None:
         f"\nDask overhead per asset: (1-worker wall - the jobs' own time on the worker) / assets. The jobs took "
         f"{worker_sum:.1f} s on the worker against {direct_sum:.1f} s called directly "
         f"({100 * (worker_sum - direct_sum) / direct_sum:+.1f} %: one thread per worker, and whatever else ran on "
-        f"the machine: 1-minute load average {load_before:.1f} at the start, then as in the table)."
+        f"the machine: 1-minute load average {load_before:.1f} at the start, then as in the table). A no-op "
+        f"task's submit and result on the 1-worker cluster: {round_trip:.1f} ms (the round trip the runner pays "
+        f"before it hands out each next asset)."
     )
 
     peaks: dict[str, float] = {}

@@ -126,6 +126,7 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
                 doc.item("skins", node.skin, doc.node_label(index))
             pairs.setdefault((node.mesh, node.skin), []).append(index)
     rigs: dict[int, SkinRig] = {}
+    motions: dict[tuple[int, int], Motion | None] = {}  # (skin, animation): sampled once per skin
     drawables = []
     for (mesh_index, skin_index), nodes in pairs.items():
         name = doc.gltf.meshes[mesh_index].name
@@ -144,7 +145,7 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
             drawable.skinned = skinned_mesh_of_node(doc, nodes[0], drawable.rig, geometry)
             sums = np.asarray(geometry.weights, np.float64).sum(axis=1)
             drawable.renormalised_weights = int(np.count_nonzero(np.abs(sums - 1.0) > _WEIGHT_SUM_TOLERANCE))
-        drawable.clips = _clips(doc, drawable, fps)
+        drawable.clips = _clips(doc, drawable, fps, motions)
         drawables.append(drawable)
     return drawables
 
@@ -164,13 +165,21 @@ def _alternate_nodes(node: dict) -> list[int]:
     return [index for index in ids if isinstance(index, int)]
 
 
-def _clips(doc: GltfDocument, drawable: Drawable, fps: float) -> list[Clip]:
-    """Clips of every animation that moves the drawable's skin or its first node's morph weights."""
+def _clips(
+    doc: GltfDocument, drawable: Drawable, fps: float, motions: dict[tuple[int, int], Motion | None]
+) -> list[Clip]:
+    """Clips of every animation that moves the drawable's skin or its first node's morph weights;
+    ``motions`` holds each (skin, animation) sampled so far, shared by the meshes of one skin."""
     targets = drawable.geometry.targets
     tracks = {} if targets is None else dict(morph_weight_tracks(doc, drawable.nodes[0], len(targets), fps))
     clips = []
     for index, animation in enumerate(doc.gltf.animations or []):
-        motion = drawable.rig.motion(doc, index, fps) if drawable.rig is not None else None
+        motion = None
+        if drawable.rig is not None:
+            key = (drawable.skin_index, index)
+            if key not in motions:
+                motions[key] = drawable.rig.motion(doc, index, fps)
+            motion = motions[key]
         weights = tracks.get(index)
         if motion is None and weights is None:
             continue

@@ -19,8 +19,9 @@ vary from asset to asset. The small glTF files of the development data are added
   worker) / assets, and over the mean job time: what scheduling, transfers, the records and the
   catalogue add; the jobs' time on the worker against the direct calls is printed beside it
   (workers run one thread each, and the machine may be shared: the load average is printed),
-  and a no-op task's submit and result on the 1-worker cluster: the round trip the runner pays
-  before it hands out each next asset;
+  and a no-op task's submit and result on the 1-worker cluster, for scale (the runner's path
+  from one asset to the next holds part of such a round trip: the finished task's notice and
+  the next submission);
 - peak memory: the largest peak resident set of each worker process (``ru_maxrss``);
 - rerun: the same batch again, unchanged (every asset fingerprinted and skipped);
 - 16 workers: the measured 1-worker job times plus the measured overhead per asset, handed out
@@ -191,8 +192,8 @@ def main() -> None:
         f"{worker_sum:.1f} s on the worker against {direct_sum:.1f} s called directly "
         f"({100 * (worker_sum - direct_sum) / direct_sum:+.1f} %: one thread per worker, and whatever else ran on "
         f"the machine: 1-minute load average {load_before:.1f} at the start, then as in the table). A no-op "
-        f"task's submit and result on the 1-worker cluster: {round_trip:.1f} ms (the round trip the runner pays "
-        f"before it hands out each next asset)."
+        f"task's submit and result on the 1-worker cluster: {round_trip:.1f} ms (for scale: the runner's path "
+        f"from one asset to the next holds part of such a round trip)."
     )
 
     peaks: dict[str, float] = {}

@@ -208,6 +208,9 @@ def _run_pending(client, pending, root: Path, records: dict, ran_flags: dict, pr
         submit_while_free()
         for future in running:
             asset, digest = futures.pop(future)
+            # The next asset goes out before this one's record is fetched: the worker is free
+            # now, and the fetch (a round trip to the worker) overlaps the next asset's run.
+            submit_while_free()
             try:
                 record = future.result()
             except Exception as error:
@@ -215,7 +218,6 @@ def _run_pending(client, pending, root: Path, records: dict, ran_flags: dict, pr
             # Released at once: a record held on a worker that dies later would be recomputed.
             future.release()
             records[asset.name], ran_flags[asset.name] = record, True
-            submit_while_free()
             progress.asset_done(record)
             if time.monotonic() - last_write >= CATALOGUE_INTERVAL:
                 _write(root, assets, records, ran_flags)

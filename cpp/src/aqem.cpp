@@ -237,7 +237,8 @@ FaceQuadrics face_quadrics(const std::vector<int32_t>& faces, const AnimatedMesh
 // Steps 1-2 and 5-6 of the paper for the collapse engine.
 class AqemPolicy final : public detail::CollapsePolicy {
  public:
-  // Completes the face quadrics (FaceQuadrics) with the engine's border and seam sides.
+  // Completes the face quadrics (FaceQuadrics) with the border and seam sides' planes and the
+  // needle tips' point quadrics.
   AqemPolicy(const CollapseEngine& engine, const AqemOptions& options, const std::vector<int32_t>& frames,
              std::vector<double> weights, FaceQuadrics face)
       : engine_(engine),

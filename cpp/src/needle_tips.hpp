@@ -28,9 +28,8 @@ inline const double kNeedleTipCosine = std::sqrt(0.5);
 template <class PositionOf>
 std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, int32_t point_begin, int32_t point_end,
                                       const PositionOf& position_of, const uint8_t* among = nullptr) {
-  auto looked_at = [=](int32_t point) {
-    return point >= point_begin && point < point_end && (among == nullptr || among[point] != 0);
-  };
+  auto in_range = [=](int32_t point) { return point >= point_begin && point < point_end; };
+  auto looked_at = [=](int32_t point) { return in_range(point) && (among == nullptr || among[point] != 0); };
   // Each edge of a point is seen once per face beside it, which changes neither the mean's
   // direction much nor the smallest cosine. Per face, its three sides' unit vectors serve both
   // of their points (the one they leave and, reversed, the one they reach).
@@ -68,7 +67,7 @@ std::vector<int32_t> find_needle_tips(const std::vector<int32_t>& faces, int32_t
     }
   }
   for_each_face_side(
-      [&](int32_t point) { return point >= point_begin && point < point_end && candidate[point - point_begin] != 0; },
+      [&](int32_t point) { return in_range(point) && candidate[point - point_begin] != 0; },
       [&](int32_t point, const Eigen::Vector3d& unit) {
         least[point - point_begin] = std::min(least[point - point_begin], unit.dot(sum[point - point_begin]));
       });

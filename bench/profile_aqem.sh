@@ -15,6 +15,8 @@ from animlod import simplify_animated
 simplify_animated(bumpy_sphere(708, 708, 1), (0.1,), use_motion_features=False)
 PY
 perf report -i "$data/perf.data" --no-children -g none --sort dso --stdio 2>/dev/null | grep -E '^ +[0-9]' | head -n 5
-perf report -i "$data/perf.data" --no-children -g none --sort symbol --stdio 2>/dev/null | grep -E '^ +[0-9]' | head -n 12
-perf report -i "$data/perf.data" --no-children -g none --sort symbol --stdio 2>/dev/null | grep -E '^ +[0-9]' | grep OpenMesh \
+perf report -i "$data/perf.data" --no-children -g none --sort symbol --stdio 2>/dev/null | grep -E '^ +[0-9]' \
+  > "$data/symbols.txt"
+head -n 12 "$data/symbols.txt"
+grep OpenMesh "$data/symbols.txt" \
   | awk 'NR <= 6 { print } { total += $1 } END { printf "OpenMesh connectivity, named symbols: %.1f%%\n", total }'

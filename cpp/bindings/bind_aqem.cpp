@@ -9,6 +9,7 @@
 #include "animlod/aqem.hpp"
 #include "array_checks.hpp"
 #include "numpy_from_vector.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -93,21 +94,10 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
     data.influence_count = static_cast<size_t>(skin_joints->shape(1));
   }
 
-  if (progress) {
-    const py::function callback = *progress;
-    options.progress = [callback](size_t done, size_t total) {
-      py::gil_scoped_acquire acquire;
-      callback(done, total);
-    };
-  }
+  options.progress = progress_callback(progress);
 
   AqemResult result;
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = simplify_animated(mesh, data, options, result);
-  }
-  raise_if_error(status);
+  call_released([&] { return simplify_animated(mesh, data, options, result); });
 
   const py::ssize_t frame_count = frames.shape(0);
   py::list levels;

@@ -4,6 +4,7 @@
 
 #include "animlod/cumulative_ranking.hpp"
 #include "array_checks.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -18,14 +19,11 @@ py::array_t<double> cumulative_freeze_steps_py(const DoubleArray& world, const D
   require_shape(parent_indices, "parents", {joints}, "(J,) like world");
   require_shape(candidates, "candidates", {joints}, "(J,) like world");
   py::array_t<double> out(joints);
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = cumulative_freeze_steps(world.data(), key_local.data(), parent_indices.data(), candidates.data(),
-                                     static_cast<size_t>(world.shape(0)), static_cast<size_t>(joints),
-                                     out.mutable_data());
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return cumulative_freeze_steps(world.data(), key_local.data(), parent_indices.data(), candidates.data(),
+                                   static_cast<size_t>(world.shape(0)), static_cast<size_t>(joints),
+                                   out.mutable_data());
+  });
   return out;
 }
 

@@ -8,6 +8,7 @@
 
 #include "animlod/ffd_lattice.hpp"
 #include "array_checks.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -37,12 +38,9 @@ py::array_t<float> ffd_local_coordinates_py(const FloatArray& points, const Doub
   const LatticeBox lattice_box = box_from(box);
   py::array_t<float> out({points.shape(0), py::ssize_t{3}});
   float* out_data = out.mutable_data();
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = ffd_local_coordinates(lattice_box, points.data(), static_cast<size_t>(points.shape(0)), out_data);
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return ffd_local_coordinates(lattice_box, points.data(), static_cast<size_t>(points.shape(0)), out_data);
+  });
   return out;
 }
 
@@ -56,12 +54,7 @@ py::array_t<float> ffd_evaluate_py(const FloatArray& local, const DoubleArray& c
   lattice.weights = weights_of(weights, control_points.size() / 3);
   py::array_t<float> out({local.shape(0), py::ssize_t{3}});
   float* out_data = out.mutable_data();
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = ffd_evaluate(lattice, local.data(), static_cast<size_t>(local.shape(0)), out_data);
-  }
-  raise_if_error(status);
+  call_released([&] { return ffd_evaluate(lattice, local.data(), static_cast<size_t>(local.shape(0)), out_data); });
   return out;
 }
 
@@ -95,13 +88,10 @@ py::array_t<float> ffd_displace_py(const FloatArray& rest, const FloatArray& loc
   py::array_t<float> out = single ? py::array_t<float>({vertex_count, py::ssize_t{3}})
                                   : py::array_t<float>({frames, vertex_count, py::ssize_t{3}});
   float* out_data = out.mutable_data();
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = ffd_displace(set, rest.data(), local.data(), vertex_lattice.data(), static_cast<size_t>(vertex_count),
-                          out_data);
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return ffd_displace(set, rest.data(), local.data(), vertex_lattice.data(), static_cast<size_t>(vertex_count),
+                        out_data);
+  });
   return out;
 }
 
@@ -121,13 +111,10 @@ py::array_t<double> ffd_fit_py(const FloatArray& local, const FloatArray& target
   py::array_t<double> out({static_cast<py::ssize_t>(size[0]), static_cast<py::ssize_t>(size[1]),
                            static_cast<py::ssize_t>(size[2]), py::ssize_t{3}});
   double* out_data = out.mutable_data();
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = ffd_fit(lattice_size, weight_data, local.data(), targets.data(), static_cast<size_t>(local.shape(0)),
-                     prior_data, out_data, options);
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return ffd_fit(lattice_size, weight_data, local.data(), targets.data(), static_cast<size_t>(local.shape(0)),
+                   prior_data, out_data, options);
+  });
   return out;
 }
 }  // namespace

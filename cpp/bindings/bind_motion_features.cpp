@@ -4,6 +4,7 @@
 #include "animlod/motion_features.hpp"
 #include "array_checks.hpp"
 #include "numpy_from_vector.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -17,12 +18,7 @@ py::dict motion_features_py(const FloatArray& frames, const py::array& face_indi
   const AnimatedMeshView mesh{frames.data(), faces.data(), static_cast<size_t>(frames.shape(0)),
                               static_cast<size_t>(frames.shape(1)), static_cast<size_t>(faces.shape(0))};
   MotionFeatures features;
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = compute_motion_features(mesh, options, features);
-  }
-  raise_if_error(status);
+  call_released([&] { return compute_motion_features(mesh, options, features); });
   const auto edge_count = static_cast<py::ssize_t>(features.angle_change.size());
   const auto vertex_count = static_cast<py::ssize_t>(features.vertex_weights.size());
   const auto feature_count = static_cast<py::ssize_t>(features.feature_sizes.size());

@@ -6,6 +6,7 @@
 
 #include "animlod/motion_recovery.hpp"
 #include "array_checks.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -35,13 +36,10 @@ std::tuple<py::array_t<double>, py::array_t<double>> recover_world_rotations_py(
   py::array_t<double> world({frames, k, py::ssize_t{4}});
   const AimedSkeleton skeleton{parent_indices.data(), translating.data(), offsets.data(), children.data(),
                                static_cast<size_t>(k)};
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = recover_world_rotations(skeleton, static_cast<size_t>(frames), original_world.data(), targets.data(),
-                                     recovered_translations.mutable_data(), world.mutable_data());
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return recover_world_rotations(skeleton, static_cast<size_t>(frames), original_world.data(), targets.data(),
+                                   recovered_translations.mutable_data(), world.mutable_data());
+  });
   return {world, recovered_translations};
 }
 

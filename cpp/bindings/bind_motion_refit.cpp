@@ -9,6 +9,7 @@
 #include "animlod/motion_refit.hpp"
 #include "array_checks.hpp"
 #include "numpy_from_vector.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -88,13 +89,10 @@ py::tuple objective_py(const ProblemHolder& h, const DoubleArray& x, const Doubl
   DoubleArray gradient({frames, static_cast<py::ssize_t>(h.view.point_count), py::ssize_t{3}});
   double* values_out = values.mutable_data();
   double* gradient_out = gradient.mutable_data();
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = motion_refit_objective(h.view, x.data(), original.data(), static_cast<size_t>(frames), values_out,
-                                    gradient_out);
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return motion_refit_objective(h.view, x.data(), original.data(), static_cast<size_t>(frames), values_out,
+                                  gradient_out);
+  });
   return py::make_tuple(values, gradient);
 }
 
@@ -107,12 +105,7 @@ py::tuple constraints_py(const ProblemHolder& h, const DoubleArray& x, size_t ro
   DoubleArray jacobian({frames, static_cast<py::ssize_t>(rows), points, py::ssize_t{3}});
   double* values_out = values.mutable_data();
   double* jacobian_out = jacobian.mutable_data();
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = function(h.view, x.data(), static_cast<size_t>(frames), values_out, jacobian_out);
-  }
-  raise_if_error(status);
+  call_released([&] { return function(h.view, x.data(), static_cast<size_t>(frames), values_out, jacobian_out); });
   return py::make_tuple(values, jacobian);
 }
 
@@ -129,13 +122,10 @@ py::dict solve_py(const ProblemHolder& h, const DoubleArray& original, const Dou
   }
   const double* cold = cold_starts ? cold_starts->data() : nullptr;
   MotionRefitResult result;
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = motion_refit_solve(h.view, original.data(), fallback.data(), cold,
-                                static_cast<size_t>(original.shape(0)), options, result);
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return motion_refit_solve(h.view, original.data(), fallback.data(), cold,
+                              static_cast<size_t>(original.shape(0)), options, result);
+  });
   const auto frames = original.shape(0);
   py::list failures;
   for (const auto& f : result.failures) failures.append(py::make_tuple(f.frame, f.reason, f.fell_back));

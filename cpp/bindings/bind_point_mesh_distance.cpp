@@ -3,6 +3,7 @@
 
 #include "animlod/point_mesh_distance.hpp"
 #include "array_checks.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -40,12 +41,9 @@ py::array_t<double> point_mesh_squared_distance_py(const DoubleArray& points, co
   py::array_t<double> out = points.ndim() == 3 ? py::array_t<double>({points.shape(0), points.shape(1)})
                                                : py::array_t<double>(points.shape(0));
   double* out_data = out.mutable_data();
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = point_mesh_squared_distance(mesh, points.data(), point_count_of(points), threads, out_data);
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return point_mesh_squared_distance(mesh, points.data(), point_count_of(points), threads, out_data);
+  });
   return out;
 }
 
@@ -54,12 +52,9 @@ double point_mesh_max_squared_distance_py(const DoubleArray& points, const Doubl
   const IndexArray faces = index_array(face_indices, "faces");
   const TriangleMeshView mesh = checked_mesh(points, vertices, faces);
   double out = floor;
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = point_mesh_max_squared_distance(mesh, points.data(), point_count_of(points), threads, floor, out);
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return point_mesh_max_squared_distance(mesh, points.data(), point_count_of(points), threads, floor, out);
+  });
   return out;
 }
 

@@ -12,6 +12,7 @@
 
 #include "animlod/pose.hpp"
 #include "array_checks.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -96,19 +97,17 @@ py::array_t<float> forward_kinematics_py(const py::object& parent_indices, const
   std::vector<float> s;
   if (scales) s.assign(scales->data(), scales->data() + scales->size());
   std::vector<float> world(static_cast<size_t>(joints) * 16);
-  Status status;
-  {
-    py::gil_scoped_release release;
-    for (py::ssize_t f = 0; f < frames && status.ok; ++f) {
+  call_released([&] {
+    for (py::ssize_t f = 0; f < frames; ++f) {
       const size_t offset = static_cast<size_t>(f * joints);
       LocalPose pose{t.data() + 3 * offset, r.data() + 4 * offset, s.empty() ? nullptr : s.data() + 3 * offset,
                      static_cast<size_t>(joints)};
-      status = forward_kinematics(parents.data(), pose, world.data());
-      if (!status.ok) status.message = "frame " + std::to_string(f) + ": " + status.message;
-      else transpose_matrices(world.data(), static_cast<size_t>(joints), data + 16 * offset);
+      const Status status = forward_kinematics(parents.data(), pose, world.data());
+      if (!status) return Status::error("frame " + std::to_string(f) + ": " + status.message);
+      transpose_matrices(world.data(), static_cast<size_t>(joints), data + 16 * offset);
     }
-  }
-  raise_if_error(status);
+    return Status::success();
+  });
   return out;
 }
 
@@ -117,13 +116,10 @@ py::array_t<double> clip_forward_kinematics_py(const py::object& parent_indices,
   const IndexArray parents = pose_parents(parent_indices, translations, rotations);
   const py::ssize_t joints = parents.shape(0), frames = translations.shape(0);
   py::array_t<double> out({frames, joints, py::ssize_t{4}, py::ssize_t{4}});
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = clip_forward_kinematics(parents.data(), static_cast<size_t>(joints), translations.data(),
-                                     rotations.data(), static_cast<size_t>(frames), out.mutable_data());
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return clip_forward_kinematics(parents.data(), static_cast<size_t>(joints), translations.data(),
+                                   rotations.data(), static_cast<size_t>(frames), out.mutable_data());
+  });
   return out;
 }
 

@@ -4,6 +4,7 @@
 
 #include "animlod/posture_error.hpp"
 #include "array_checks.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -16,12 +17,9 @@ py::array_t<double> posture_error_row_sums_py(const DoubleArray& directions, con
   const auto frames = static_cast<size_t>(directions.shape(0));
   const auto bones = static_cast<size_t>(directions.shape(1));
   py::array_t<double> out({directions.shape(1), directions.shape(0)});
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = posture_error_row_sums(directions.data(), radii.data(), frames, bones, threads, out.mutable_data());
-  }
-  raise_if_error(status);
+  call_released([&] {
+    return posture_error_row_sums(directions.data(), radii.data(), frames, bones, threads, out.mutable_data());
+  });
   return out;
 }
 

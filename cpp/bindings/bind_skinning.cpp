@@ -3,6 +3,7 @@
 
 #include "animlod/skinning.hpp"
 #include "array_checks.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -31,12 +32,7 @@ py::array_t<float> bake_lbs_py(const FloatArray& rest_positions, const py::array
 
   py::array_t<float> out({skin_matrices.shape(0), rest_positions.shape(0), py::ssize_t{3}});
   float* out_data = out.mutable_data();
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = bake_lbs(input, out_data);
-  }
-  raise_if_error(status);
+  call_released([&] { return bake_lbs(input, out_data); });
   return out;
 }
 }  // namespace

@@ -16,6 +16,7 @@
 #include "array_checks.hpp"
 #include "enum_names.hpp"
 #include "numpy_from_vector.hpp"
+#include "released_call.hpp"
 
 namespace animlod::bindings {
 
@@ -67,33 +68,16 @@ py::dict stats_to_dict(const PlayerLevelStats& s) {
   return out;
 }
 
-// Runs `call` with the GIL released and raises its Status as ValueError.
-template <typename Call>
-void released(Call&& call) {
-  Status status;
-  {
-    py::gil_scoped_release release;
-    status = call();
-  }
-  raise_if_error(status);
-}
-
 py::tuple build_py(const FloatArray& frames, const py::array& face_indices, const TdagOptions& options,
                    const std::optional<py::function>& progress) {
   require_shape(frames, "frames", {-1, -1, 3}, "(F, V, 3)");
   const IndexArray faces = index_array(face_indices, "faces");
   require_shape(faces, "faces", {-1, 3}, "(M, 3)");
   TdagOptions copy = options;
-  if (progress) {
-    const py::function callback = *progress;
-    copy.progress = [callback](size_t done, size_t total) {
-      py::gil_scoped_acquire acquire;
-      callback(done, total);
-    };
-  }
+  copy.progress = progress_callback(progress);
   TemporalDag dag;
   TdagBuildReport report;
-  released([&] { return build_temporal_dag(mesh_view(frames, faces), copy, dag, &report); });
+  call_released([&] { return build_temporal_dag(mesh_view(frames, faces), copy, dag, &report); });
   const auto frame_count = static_cast<py::ssize_t>(report.collapse_counts.size());
   const auto collapse_count = static_cast<py::ssize_t>(report.max_cost.size());
   py::dict out;
@@ -112,7 +96,7 @@ py::dict affine_split_py(const FloatArray& frames, const std::string& base) {
                               static_cast<size_t>(frames.shape(1)), 0};
   AffineSplit split;
   const AffineBase b = enum_from_name<AffineBase>(base, "base");
-  released([&] { return affine_split(mesh, b, split); });
+  call_released([&] { return affine_split(mesh, b, split); });
   const py::ssize_t f = frames.shape(0), v = frames.shape(1);
   py::dict out;
   out["maps"] = numpy_from_vector(std::move(split.maps), {f, 3, 4});
@@ -265,7 +249,7 @@ void bind_tdag(py::module_& m) {
           "to_bytes",
           [](const TemporalDag& d) {
             std::vector<uint8_t> bytes;
-            released([&] { return serialize_temporal_dag(d, bytes); });
+            call_released([&] { return serialize_temporal_dag(d, bytes); });
             return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
           },
           "the .tdag file contents (versioned, checksummed)")
@@ -274,7 +258,7 @@ void bind_tdag(py::module_& m) {
           [](const py::bytes& data) {
             const std::string_view view = data;
             TemporalDag dag;
-            released([&] {
+            call_released([&] {
               return deserialize_temporal_dag(reinterpret_cast<const uint8_t*>(view.data()), view.size(), dag);
             });
             return dag;
@@ -300,27 +284,28 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
       .def(py::init<const TemporalDag&>(), py::arg("dag"))
       .def("copy", [](const TdagCut& c) { return TdagCut(c); })
       .def(
-          "query", [](TdagCut& c, int32_t frame, double tolerance) { released([&] { return c.query(frame, tolerance); }); },
+          "query",
+          [](TdagCut& c, int32_t frame, double tolerance) { call_released([&] { return c.query(frame, tolerance); }); },
           py::arg("frame"), py::arg("tolerance"), "random query: the coarsest cut within `tolerance` (asset units)")
       .def(
           "query_view",
           [](TdagCut& c, int32_t frame, const std::vector<double>& camera, double pixels, double focal_pixels) {
             const ViewTolerance view = view_from(camera, pixels, focal_pixels);
-            released([&] { return c.query_view(frame, view); });
+            call_released([&] { return c.query_view(frame, view); });
           },
           py::arg("frame"), py::arg("camera"), py::arg("pixels") = 1.0, py::arg("focal_pixels") = 1000.0,
           "random query with a screen-space tolerance of `pixels` seen from `camera`")
       .def(
-          "advance", [](TdagCut& c, int32_t frame) { released([&] { return c.advance(frame); }); }, py::arg("frame"),
-          "incremental in time: the cut for `frame`, same tolerance")
+          "advance", [](TdagCut& c, int32_t frame) { call_released([&] { return c.advance(frame); }); },
+          py::arg("frame"), "incremental in time: the cut for `frame`, same tolerance")
       .def(
-          "refine", [](TdagCut& c, double tolerance) { released([&] { return c.refine(tolerance); }); },
+          "refine", [](TdagCut& c, double tolerance) { call_released([&] { return c.refine(tolerance); }); },
           py::arg("tolerance"), "incremental in resolution: a new tolerance at the same frame")
       .def(
           "refine_view",
           [](TdagCut& c, const std::vector<double>& camera, double pixels, double focal_pixels) {
             const ViewTolerance view = view_from(camera, pixels, focal_pixels);
-            released([&] { return c.refine_view(view); });
+            call_released([&] { return c.refine_view(view); });
           },
           py::arg("camera"), py::arg("pixels") = 1.0, py::arg("focal_pixels") = 1000.0)
       .def(
@@ -328,7 +313,7 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
           [](TdagCut& c, int32_t frame, int level) {
             TdagMesh mesh;
             const ApproximationLevel l = level_from(level);
-            released([&] { return c.approximate(frame, l, mesh); });
+            call_released([&] { return c.approximate(frame, l, mesh); });
             return mesh_to_dict(std::move(mesh));
           },
           py::arg("frame"), py::arg("level") = 3,
@@ -361,7 +346,7 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
       .def(
           "start",
           [](TdagPlayer& p, double tolerance, int32_t first_frame) {
-            released([&] { return p.start(tolerance, first_frame); });
+            call_released([&] { return p.start(tolerance, first_frame); });
           },
           py::arg("tolerance"), py::arg("first_frame") = 0)
       .def(
@@ -369,7 +354,7 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
           [](TdagPlayer& p, int level) {
             TdagMesh mesh;
             const ApproximationLevel l = level_from(level);
-            released([&] { return p.next(l, mesh); });
+            call_released([&] { return p.next(l, mesh); });
             return mesh_to_dict(std::move(mesh));
           },
           py::arg("level") = 3)
@@ -377,7 +362,7 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
            [](TdagPlayer& p) {
              TdagMesh mesh;
              ApproximationLevel used = ApproximationLevel::full;
-             released([&] { return p.next_available(mesh, used); });
+             call_released([&] { return p.next_available(mesh, used); });
              return py::make_tuple(mesh_to_dict(std::move(mesh)), static_cast<int>(used));
            })
       .def_property_readonly("frame", &TdagPlayer::frame)
@@ -387,7 +372,7 @@ bool (frames whose map was singular and use their centroid's translation).)doc")
       "play_temporal_dag",
       [](const TemporalDag& dag, const PlayerOptions& options) {
         PlayerReport report;
-        released([&] { return play_temporal_dag(dag, options, report); });
+        call_released([&] { return play_temporal_dag(dag, options, report); });
         py::dict out;
         out["frames"] = report.frames;
         py::list levels;

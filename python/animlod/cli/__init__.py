@@ -62,6 +62,13 @@ def positive_int(text: str) -> int:
     return value
 
 
+def print_rows(rows: list[tuple], indent: str = "") -> None:
+    """Print ``rows`` (the header first) as right-aligned columns two spaces apart."""
+    widths = [max(len(str(row[column])) for row in rows) for column in range(len(rows[0]))]
+    for row in rows:
+        print(indent + "  ".join(str(value).rjust(width) for value, width in zip(row, widths)))
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="animlod",

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind
-from . import UserError, positive_int
+from . import UserError, positive_int, print_rows
 from .simplify import feature_options
 
 
@@ -70,9 +70,7 @@ def run(args: argparse.Namespace) -> int:
         print(label)
         rows = [("level", "faces", "joints", "error", "coverage")]
         rows += [(lv.level, lv.faces, lv.joints, f"{lv.relative_error:.2e}", f"{lv.coverage:.3g}") for lv in levels]
-        widths = [max(len(str(row[c])) for row in rows) for c in range(len(rows[0]))]
-        for row in rows:
-            print("  " + "  ".join(str(value).rjust(width) for value, width in zip(row, widths)))
+        print_rows(rows, indent="  ")
     for note in report.notes:
         print(f"note: {note}")
     print(

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind, input_stem
 from ..model import AnimatedMesh
-from . import UserError, non_negative_int
+from . import UserError, non_negative_int, print_rows
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -121,7 +121,7 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
             (level.level, level.faces, level.target_faces, f"{level.relative_error:.2e}", f"{level.coverage:.3g}")
             for level in drawable.levels
         ]
-        _print_rows(rows, indent="  ")
+        print_rows(rows, indent="  ")
         for note in drawable.notes:
             print(f"  note: {note}")
     for path in report.outputs:
@@ -158,7 +158,7 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
         hausdorff = f"{surface['hausdorff_mean']:.2e} / {surface['hausdorff_max']:.2e}" if surface else "-"
         rms = f"{surface['rms_mean']:.2e} / {surface['rms_max']:.2e}" if surface else "-"
         rows.append((index, level.faces, f"{level.aqem_error:.3g}", hausdorff, rms, f"{report.seconds:.2f}"))
-    _print_rows(rows)
+    print_rows(rows)
     if args.plot:
         levels = [_read_level(level.path) for level in report.levels]
         features = not args.no_features
@@ -174,12 +174,6 @@ def _read_level(path: Path) -> AnimatedMesh:
     from ..io.meshseq import read_sequence
 
     return read_sequence(path)
-
-
-def _print_rows(rows: list[tuple], indent: str = "") -> None:
-    widths = [max(len(str(row[column])) for row in rows) for column in range(len(rows[0]))]
-    for row in rows:
-        print(indent + "  ".join(str(value).rjust(width) for value, width in zip(row, widths)))
 
 
 class _ProgressBar:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import UserError
+from . import UserError, print_rows
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -234,9 +234,7 @@ def run_play(args: argparse.Namespace) -> int:
                 f"{stats.mean_faces:.0f}",
             )
         )
-    widths = [max(len(row[column]) for row in rows) for column in range(len(header))]
-    for row in rows:
-        print("  ".join(value.rjust(width) for value, width in zip(row, widths)))
+    print_rows(rows)
     print(
         f"level 3: {report.mean_splits:.1f} splits and {report.mean_collapses:.1f} collapses per frame; "
         f"walk {report.sequential_seconds_per_frame * 1e3:.3f} ms per frame on one thread, "

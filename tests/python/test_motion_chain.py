@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -11,7 +12,9 @@ from test_motion_figures import figure_motion
 from animlod.cli import main
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, level_joint_counts
+from animlod.motion_lod.frozen import freeze
 from animlod.motion_lod.skeleton_reduce import expand_motion
+from animlod.motion_lod.skin_transfer import transfer_skin
 from animlod.synth import humanoid, humanoid_motion
 from animlod.synth.gait import STILL_FINGER_CHAIN
 
@@ -82,6 +85,22 @@ def test_skin_of_a_level_references_kept_joints_and_deforms_like_the_frozen_orig
         frozen_original = skin.bake(expand_motion(level.frozen, level.motion, motion)).frames
         difference = np.abs(level_skin.bake(level.motion).frames - frozen_original).max()
         assert difference < 1e-3 * chain.figure_size
+
+
+def test_an_eight_influence_skin_keeps_eight_influences_at_a_level_of_fewer_joints(walk_chain) -> None:
+    skin, motion, _ = walk_chain
+    wider = ((0, 0), (0, 4))
+    eight = dataclasses.replace(skin, joints=np.pad(skin.joints, wider), weights=np.pad(skin.weights, wider))
+    analysis = analyze_motion(motion)
+    level = freeze(motion, analysis, analysis.priority[:-5])
+    kept = level.kept_indices.size
+    assert kept < 8
+    reduced = transfer_skin(eight, level)
+    assert reduced.joints.shape == reduced.weights.shape == (skin.vertex_count, 8)
+    np.testing.assert_allclose(reduced.weights.sum(axis=1), 1.0, atol=1e-6)
+    assert np.all(reduced.weights[:, kept:] == 0.0) and reduced.joints.max() < kept
+    four = transfer_skin(skin, level)
+    np.testing.assert_array_equal(reduced.weights[:, :4], four.weights)
 
 
 def test_level_joint_counts_follow_the_paper_and_refuse_impossible_requests() -> None:

@@ -43,8 +43,9 @@ def transfer_skin(skin: SkinnedMesh, level: FrozenLevel) -> SkinnedMesh:
 
     Weights of a frozen joint move to its nearest kept ancestor and merge with the weight that
     ancestor already has on the vertex, so every vertex keeps K influences summing to one that
-    reference kept joints only. Normals follow the re-posing; morph targets are kept as they
-    are (their deltas stay in the original rest frame).
+    reference kept joints only (those beyond the level's joint count weigh 0). Normals follow
+    the re-posing; morph targets are kept as they are (their deltas stay in the original rest
+    frame).
     """
     skeleton = skin.skeleton
     if skeleton.names != level.skeleton.names:
@@ -71,6 +72,10 @@ def transfer_skin(skin: SkinnedMesh, level: FrozenLevel) -> SkinnedMesh:
     influences = skin.joints.shape[1]
     joints = np.argsort(-merged, axis=1, kind="stable")[:, :influences]
     weights = np.take_along_axis(merged, joints, axis=1)
+    # A level of fewer joints than K still has K influences (JOINTS_1 and WEIGHTS_1 of an
+    # 8-influence skin stay whole): the extra ones weigh 0.
+    unused = influences - joints.shape[1]
+    joints, weights = np.pad(joints, ((0, 0), (0, unused))), np.pad(weights, ((0, 0), (0, unused)))
     return SkinnedMesh(
         rest_positions=rest,
         faces=skin.faces,

@@ -21,16 +21,26 @@ def edit_glb(source: Path, target: Path, edit: Callable[[pygltflib.GLTF2, bytear
     return target
 
 
+def append_accessor(gltf: pygltflib.GLTF2, blob: bytearray, values: np.ndarray, accessor_type: str) -> int:
+    """``values`` (float32 or uint32 by dtype kind; one row per element) appended to the binary
+    chunk, 4-byte aligned, with a bufferView and an accessor; returns the accessor's index."""
+    floats = np.asarray(values).dtype.kind == "f"
+    data = np.ascontiguousarray(values, "<f4" if floats else "<u4").tobytes()
+    offset = len(blob) + (-len(blob)) % 4
+    blob.extend(bytes(offset - len(blob)) + data)
+    gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=offset, byteLength=len(data)))
+    component = pygltflib.FLOAT if floats else pygltflib.UNSIGNED_INT
+    view = len(gltf.bufferViews) - 1
+    accessor = pygltflib.Accessor(bufferView=view, componentType=component, count=len(values), type=accessor_type)
+    gltf.accessors.append(accessor)
+    return len(gltf.accessors) - 1
+
+
 def add_scale_channel(gltf: pygltflib.GLTF2, blob: bytearray, node: int, keys: np.ndarray) -> None:
     """A scale channel on ``node`` of the first animation, keyed at its first sampler's times."""
-    offset = len(blob) + (-len(blob)) % 4
-    blob.extend(bytes(offset - len(blob)) + keys.astype("<f4").tobytes())
-    gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=offset, byteLength=keys.size * 4))
-    view = len(gltf.bufferViews) - 1
-    accessor = pygltflib.Accessor(bufferView=view, componentType=pygltflib.FLOAT, count=len(keys), type="VEC3")
-    gltf.accessors.append(accessor)
+    output = append_accessor(gltf, blob, keys.astype(np.float32), "VEC3")
     animation = gltf.animations[0]
-    sampler = pygltflib.AnimationSampler(input=animation.samplers[0].input, output=len(gltf.accessors) - 1)
+    sampler = pygltflib.AnimationSampler(input=animation.samplers[0].input, output=output)
     animation.samplers.append(sampler)
     target = pygltflib.AnimationChannelTarget(node=node, path="scale")
     animation.channels.append(pygltflib.AnimationChannel(sampler=len(animation.samplers) - 1, target=target))
@@ -48,14 +58,8 @@ def share_one_vertex_buffer(gltf: pygltflib.GLTF2, blob: bytearray, parts: int =
         indices = np.frombuffer(bytes(blob), dtype[accessor.componentType], accessor.count, start).reshape(-1, 3)
         split = []
         for run in np.array_split(indices, parts):
-            offset = len(blob) + (-len(blob)) % 4
-            blob.extend(bytes(offset - len(blob)) + run.astype("<u4").tobytes())
-            gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=offset, byteLength=run.size * 4))
-            view = len(gltf.bufferViews) - 1
-            gltf.accessors.append(
-                pygltflib.Accessor(bufferView=view, componentType=pygltflib.UNSIGNED_INT, count=run.size, type="SCALAR")
-            )
-            split.append(pygltflib.Primitive(**{**vars(primitive), "indices": len(gltf.accessors) - 1}))
+            run_indices = append_accessor(gltf, blob, run.ravel().astype(np.uint32), "SCALAR")
+            split.append(pygltflib.Primitive(**{**vars(primitive), "indices": run_indices}))
         mesh.primitives[:1] = split
 
 

@@ -7,8 +7,9 @@ import os
 import subprocess
 
 import numpy as np
+import pygltflib
 import pytest
-from gltf_edits import draco_compressed, meshopt_compressed
+from gltf_edits import append_accessor, draco_compressed, edit_glb, meshopt_compressed
 
 from animlod import synth
 from animlod.cli import main
@@ -391,7 +392,9 @@ def test_character_refuses_a_file_without_a_skinned_animation(data_dir, tmp_path
     assert not (tmp_path / "x.glb").exists()
 
 
-def test_a_flat_shaded_mesh_simplifies_like_the_welded_one_and_stays_flat(tmp_path):
+def _write_flat_shaded(path):
+    """The procedural humanoid with a walk, flat shaded (every face its own three vertices with
+    its normal), written to ``path``; returns the welded humanoid and the walk."""
     from animlod.model import SkinnedMesh
 
     character = synth.humanoid()
@@ -409,8 +412,20 @@ def test_a_flat_shaded_mesh_simplifies_like_the_welded_one_and_stays_flat(tmp_pa
         character.skeleton,
         normals=normals,
     )
+    write_glb(path, flat, [walk])
+    return character, walk
+
+
+def _coarsest_primitive(doc, report):
+    base = report.drawables[0].nodes[0]
+    coarse = doc.json["nodes"][doc.json["nodes"][base]["extensions"]["MSFT_lod"]["ids"][-1]]
+    return doc.json["meshes"][coarse["mesh"]]["primitives"][0]
+
+
+def test_a_flat_shaded_mesh_simplifies_like_the_welded_one_and_stays_flat(tmp_path):
+    character, walk = _write_flat_shaded(tmp_path / "flat.glb")
+    corners = character.faces.ravel()
     write_glb(tmp_path / "welded.glb", character, [walk])
-    write_glb(tmp_path / "flat.glb", flat, [walk])
     welded = simplify_document(tmp_path / "welded.glb", tmp_path / "welded_lod.glb", [0.5, 0.1], **QUICK)
     report = simplify_document(tmp_path / "flat.glb", tmp_path / "flat_lod.glb", [0.5, 0.1], **QUICK)
     assert report.drawables[0].preparation.welded_vertices == corners.size - character.vertex_count
@@ -419,13 +434,47 @@ def test_a_flat_shaded_mesh_simplifies_like_the_welded_one_and_stays_flat(tmp_pa
     ]
     assert any("normals rebuilt" in note for note in report.drawables[0].notes)
     doc = GltfDocument(tmp_path / "flat_lod.glb")
-    base = report.drawables[0].nodes[0]
-    coarse = doc.json["nodes"][doc.json["nodes"][base]["extensions"]["MSFT_lod"]["ids"][-1]]
-    primitive = doc.json["meshes"][coarse["mesh"]]["primitives"][0]
+    primitive = _coarsest_primitive(doc, report)
     faces = doc.accessor(primitive["indices"], "i").reshape(-1, 3)
     level_normals = doc.accessor(primitive["attributes"]["NORMAL"], "n")[faces]
     np.testing.assert_allclose(level_normals[:, 0], level_normals[:, 1], atol=1e-6)  # flat again
     np.testing.assert_allclose(level_normals[:, 0], level_normals[:, 2], atol=1e-6)
+
+
+def test_hard_edges_keep_their_tangents_and_normal_deltas_make_no_seams(tmp_path):
+    # Exporters write a tangent per corner of a hard-edged mesh, and morph targets with NORMAL
+    # deltas, which differ between the copies of a position as the normals do.
+    _write_flat_shaded(tmp_path / "flat.glb")
+
+    def tangents_and_normal_target(gltf, blob):
+        primitive = gltf.meshes[0].primitives[0]
+        read = GltfDocument(tmp_path / "flat.glb")
+        normals = read.accessor(primitive.attributes.NORMAL, "n").astype(np.float64)
+        positions = read.accessor(primitive.attributes.POSITION, "p")
+        across = np.cross(normals, [0.0, 1.0, 0.0]) + np.cross(normals, [0.0, 0.0, 1.0]) * 1e-3
+        handedness = np.where(positions[:, 0] > 0.0, 1.0, -1.0)  # mirrored UVs on the left
+        tangent = np.c_[across / np.linalg.norm(across, axis=1, keepdims=True), handedness]
+        primitive.attributes.TANGENT = append_accessor(gltf, blob, tangent.astype(np.float32), "VEC4")
+        delta = 0.2 * np.roll(normals, 1, axis=1).astype(np.float32)
+        primitive.targets = [pygltflib.Attributes(NORMAL=append_accessor(gltf, blob, delta, "VEC3"))]
+        gltf.meshes[0].weights = [0.5]
+
+    source = edit_glb(tmp_path / "flat.glb", tmp_path / "tangents.glb", tangents_and_normal_target)
+    plain = simplify_document(tmp_path / "flat.glb", tmp_path / "flat_lod.glb", [0.5, 0.1], **QUICK)
+    report = simplify_document(source, tmp_path / "tangents_lod.glb", [0.5, 0.1], **QUICK)
+    assert report.drawables[0].preparation.seam_vertices == plain.drawables[0].preparation.seam_vertices
+    assert [level.faces for level in report.drawables[0].levels] == [level.faces for level in plain.drawables[0].levels]
+    doc = GltfDocument(tmp_path / "tangents_lod.glb")
+    primitive = _coarsest_primitive(doc, report)
+    tangent = doc.accessor(primitive["attributes"]["TANGENT"], "t")
+    normal = doc.accessor(primitive["attributes"]["NORMAL"], "n")
+    np.testing.assert_allclose(np.linalg.norm(tangent[:, :3], axis=1), 1.0, atol=1e-5)
+    np.testing.assert_allclose(np.einsum("vc,vc->v", tangent[:, :3], normal), 0.0, atol=1e-5)
+    side = doc.accessor(primitive["attributes"]["POSITION"], "p")[:, 0]
+    away = np.abs(side) > 0.05  # 5 cm from the middle, where a collapse may carry a vertex over
+    assert away.mean() > 0.8
+    np.testing.assert_array_equal(tangent[away, 3], np.where(side[away] > 0.0, 1.0, -1.0))
+    assert np.abs(doc.accessor(primitive["targets"][0]["NORMAL"], "d")).max() > 0.05
 
 
 def test_a_vertex_whose_weights_are_all_zero_is_named(humanoid_glb, tmp_path, capsys):

@@ -247,13 +247,17 @@ def _attribute_matrix(drawable: Drawable) -> tuple[np.ndarray, _Layout]:
     for k, primitive in enumerate(primitives):
         rows = slice(starts[k], starts[k + 1])
         crease.append(_crease_angle(primitive))
+        # Rebuilt normals: the copies of a position differ in normals, tangents and their morph
+        # deltas, which would make every hard edge a seam; the level takes them from its kept
+        # vertices instead (_level).
+        rebuilt = crease[k] is not None
         for name, values in primitive.attributes.items():
-            if name in columns and not (crease[k] is not None and name in _NORMAL_ATTRIBUTES):
+            if name in columns and not (rebuilt and name in _NORMAL_ATTRIBUTES):
                 first, size = columns[name]
                 matrix[rows, first : first + values.shape[1]] = values
         for t, target in enumerate(primitive.targets):
             for name, values in target.items():
-                if name != "POSITION":
+                if name != "POSITION" and not (rebuilt and name in _NORMAL_ATTRIBUTES):
                     first, size = target_columns[t][name]
                     matrix[rows, first : first + values.shape[1]] = values
     return matrix, _Layout(columns, target_columns, crease, width)
@@ -330,23 +334,23 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
             continue
         used, local_faces = np.unique(faces, return_inverse=True)
         local_faces = local_faces.reshape(-1, 3)
+        # With rebuilt normals, the input vertices kept (see _level_column).
+        wedges = level.kept_vertices[used] - geometry.vertex_starts[k] if layout.crease[k] is not None else None
         attributes = {"POSITION": transform_points(to_local, rest[used]).astype(np.float32)}
         for name, values in source.attributes.items():
             if name in layout.columns:
-                first, _ = layout.columns[name]
-                attributes[name] = level.attributes[used, first : first + values.shape[1]].copy()
+                attributes[name] = _level_column(level, used, layout.columns[name][0], values, name, wedges)
         _tidy_directions(attributes)
         if skinned is not None:
             attributes.update(_skin_columns(drawable, skinned.joints[used], skinned.weights[used]))
         targets = []
         for t, target in enumerate(source.targets):
             arrays = {}
-            for name in target:
+            for name, values in target.items():
                 if name == "POSITION":
                     arrays[name] = (deltas[t][used] @ to_local[:3, :3].T).astype(np.float32)
                 else:
-                    first, size = layout.target_columns[t][name]
-                    arrays[name] = level.attributes[used, first : first + size].copy()
+                    arrays[name] = _level_column(level, used, layout.target_columns[t][name][0], values, name, wedges)
             targets.append(arrays)
         primitive = PrimitiveArrays(source.index, attributes, local_faces, targets, used)
         if layout.crease[k] is not None:
@@ -355,17 +359,37 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
     return DrawableLevel(level, primitives, skinned, rest, deltas)
 
 
+def _level_column(
+    level: SimplifiedLevel, used: np.ndarray, first: int, values: np.ndarray, name: str, wedges: np.ndarray | None
+) -> np.ndarray:
+    """The values of the level's vertices ``used`` of an attribute or morph delta (the input's
+    ``values``) that starts at column ``first`` of the matrix. With rebuilt normals (``wedges``:
+    the input vertices kept), a normal, a tangent or a morph delta of either is the kept input
+    vertex's own: the matrix does not carry them (_attribute_matrix)."""
+    if wedges is not None and name in _NORMAL_ATTRIBUTES:
+        return values[wedges].astype(np.float32)
+    return level.attributes[used, first : first + values.shape[1]].copy()
+
+
 def _tidy_directions(attributes: dict[str, np.ndarray]) -> None:
-    """Interpolated normals back to unit length, tangents too with w = +-1, colours in [0, 1]."""
+    """Interpolated normals back to unit length, tangents too (perpendicular to the normals)
+    with w = +-1, colours in [0, 1]."""
     if "NORMAL" in attributes:
         attributes["NORMAL"] = _unit(attributes["NORMAL"])
     if "TANGENT" in attributes:
         tangent = attributes["TANGENT"]
-        tangent[:, :3] = _unit(tangent[:, :3])
+        tangent[:, :3] = _unit(_perpendicular(tangent[:, :3], attributes.get("NORMAL")))
         tangent[:, 3] = np.where(tangent[:, 3] < 0.0, -1.0, 1.0)
     for name in attributes:
         if name.startswith("COLOR_"):
             np.clip(attributes[name], 0.0, 1.0, out=attributes[name])
+
+
+def _perpendicular(vectors: np.ndarray, normals: np.ndarray | None) -> np.ndarray:
+    """``vectors`` less their part along the unit ``normals`` (Gram-Schmidt), if any."""
+    if normals is None:
+        return vectors
+    return vectors - np.einsum("vc,vc->v", vectors, normals)[:, None] * normals
 
 
 def _unit(vectors: np.ndarray) -> np.ndarray:
@@ -403,8 +427,7 @@ def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveA
     attributes["NORMAL"] = normal[first].astype(np.float32)
     if "TANGENT" in attributes:
         tangent = attributes["TANGENT"]
-        along = np.einsum("vc,vc->v", tangent[:, :3], attributes["NORMAL"])
-        tangent[:, :3] = _unit(tangent[:, :3] - along[:, None] * attributes["NORMAL"])
+        tangent[:, :3] = _unit(_perpendicular(tangent[:, :3], attributes["NORMAL"]))
     targets = [{name: values[source] for name, values in target.items()} for target in primitive.targets]
     return PrimitiveArrays(primitive.source, attributes, new_index.reshape(-1, 3), targets, primitive.vertices[source])
 

@@ -21,17 +21,29 @@ def edit_glb(source: Path, target: Path, edit: Callable[[pygltflib.GLTF2, bytear
     return target
 
 
-def append_accessor(gltf: pygltflib.GLTF2, blob: bytearray, values: np.ndarray, accessor_type: str) -> int:
-    """``values`` (float32 or uint32 by dtype kind; one row per element) appended to the binary
+_COMPONENTS = {
+    "f4": pygltflib.FLOAT,
+    "u1": pygltflib.UNSIGNED_BYTE,
+    "u2": pygltflib.UNSIGNED_SHORT,
+    "u4": pygltflib.UNSIGNED_INT,
+}
+
+
+def append_accessor(
+    gltf: pygltflib.GLTF2, blob: bytearray, values: np.ndarray, accessor_type: str, normalized: bool = False
+) -> int:
+    """``values`` (float32, uint8, uint16 or uint32; one row per element) appended to the binary
     chunk, 4-byte aligned, with a bufferView and an accessor; returns the accessor's index."""
-    floats = np.asarray(values).dtype.kind == "f"
-    data = np.ascontiguousarray(values, "<f4" if floats else "<u4").tobytes()
+    values = np.asarray(values)
+    code = f"{values.dtype.kind}{values.dtype.itemsize}"
+    data = np.ascontiguousarray(values, "<" + code).tobytes()
     offset = len(blob) + (-len(blob)) % 4
     blob.extend(bytes(offset - len(blob)) + data)
     gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=offset, byteLength=len(data)))
-    component = pygltflib.FLOAT if floats else pygltflib.UNSIGNED_INT
     view = len(gltf.bufferViews) - 1
-    accessor = pygltflib.Accessor(bufferView=view, componentType=component, count=len(values), type=accessor_type)
+    accessor = pygltflib.Accessor(
+        bufferView=view, componentType=_COMPONENTS[code], count=len(values), type=accessor_type, normalized=normalized
+    )
     gltf.accessors.append(accessor)
     return len(gltf.accessors) - 1
 

@@ -477,6 +477,34 @@ def test_hard_edges_keep_their_tangents_and_normal_deltas_make_no_seams(tmp_path
     assert np.abs(doc.accessor(primitive["targets"][0]["NORMAL"], "d")).max() > 0.05
 
 
+def test_levels_store_colours_texture_coordinates_and_feature_ids_as_the_input_does(humanoid_glb, tmp_path):
+    # Quantised exports store colours and texture coordinates as normalised integers, and
+    # application attributes such as feature IDs as plain integers.
+    def quantised(gltf, blob):
+        primitive = gltf.meshes[0].primitives[0]
+        positions = GltfDocument(humanoid_glb).accessor(primitive.attributes.POSITION, "p")
+        count = len(positions)
+        shade = np.clip(np.c_[positions[:, :3] - positions.min(axis=0), np.ones(count)], 0.0, 1.0)
+        primitive.attributes.COLOR_0 = append_accessor(gltf, blob, np.rint(255 * shade).astype(np.uint8), "VEC4", True)
+        uv = np.rint(65535 * shade[:, :2]).astype(np.uint16)
+        primitive.attributes.TEXCOORD_1 = append_accessor(gltf, blob, uv, "VEC2", True)
+        feature = (positions[:, 0] > 0.0).astype(np.uint16)[:, None]  # left and right
+        primitive.attributes._FEATURE_ID_0 = append_accessor(gltf, blob, feature, "SCALAR")
+
+    source = edit_glb(humanoid_glb, tmp_path / "quantised.glb", quantised)
+    report = simplify_document(source, tmp_path / "quantised_lod.glb", [0.5, 0.1], **QUICK)
+    doc = GltfDocument(tmp_path / "quantised_lod.glb")
+    base = report.drawables[0].nodes[0]
+    expected = {"COLOR_0": (5121, True), "TEXCOORD_1": (5123, True), "_FEATURE_ID_0": (5123, False)}
+    for node in [base, *doc.json["nodes"][base]["extensions"]["MSFT_lod"]["ids"]]:
+        attributes = doc.json["meshes"][doc.json["nodes"][node]["mesh"]]["primitives"][0]["attributes"]
+        for name, (component, normalized) in expected.items():
+            accessor = doc.json["accessors"][attributes[name]]
+            assert (accessor["componentType"], accessor.get("normalized", False)) == (component, normalized), name
+        assert set(np.unique(doc.accessor(attributes["_FEATURE_ID_0"], "f"))) <= {0, 1}
+        assert np.all(doc.accessor(attributes["COLOR_0"], "c")[:, 3] == 1.0)
+
+
 def test_a_vertex_whose_weights_are_all_zero_is_named(humanoid_glb, tmp_path, capsys):
     from animlod.io.glb_builder import GlbBuilder
 

@@ -26,11 +26,13 @@ from .gltf_document import GltfDocument
 from .gltf_draco import DRACO_EXTENSION
 from .gltf_meshopt import MESHOPT_EXTENSIONS
 
-FLOAT, UNSIGNED_BYTE, UNSIGNED_SHORT, UNSIGNED_INT = 5126, 5121, 5123, 5125
+BYTE, UNSIGNED_BYTE, SHORT, UNSIGNED_SHORT, UNSIGNED_INT, FLOAT = 5120, 5121, 5122, 5123, 5125, 5126
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 _COMPONENT_TYPES = {
     np.dtype("float32"): FLOAT,
+    np.dtype("int8"): BYTE,
     np.dtype("uint8"): UNSIGNED_BYTE,
+    np.dtype("int16"): SHORT,
     np.dtype("uint16"): UNSIGNED_SHORT,
     np.dtype("uint32"): UNSIGNED_INT,
 }
@@ -95,10 +97,11 @@ class GlbBuilder:
         items.append(item)
         return len(items) - 1
 
-    def add(self, values: np.ndarray, target: int | None = None, bounds: bool = False) -> int:
+    def add(self, values: np.ndarray, target: int | None = None, bounds: bool = False, normalized: bool = False) -> int:
         """Append ``values (count, width)`` as a tightly packed buffer view and accessor; its index.
 
-        ``bounds`` records min and max, which glTF requires for POSITION and animation inputs.
+        ``bounds`` records min and max, which glTF requires for POSITION and animation inputs;
+        ``normalized`` marks integer values that stand for [0, 1] or [-1, 1].
         """
         values = np.ascontiguousarray(values)
         count, width = values.shape
@@ -112,6 +115,8 @@ class GlbBuilder:
             "count": count,
             "type": _ACCESSOR_TYPES[width],
         }
+        if normalized:
+            accessor["normalized"] = True
         if bounds:
             accessor["min"] = values.min(axis=0).tolist()
             accessor["max"] = values.max(axis=0).tolist()

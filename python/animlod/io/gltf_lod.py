@@ -86,6 +86,13 @@ class LevelInfo:
         }
 
 
+# Attributes a level writes in the component type of the input's (normalised or plain integers,
+# as quantised exports store texture coordinates, colours and feature IDs); positions,
+# directions, morph deltas and skin weights are rebuilt by the levels and stay float.
+_INPUT_TYPED = ("TEXCOORD_", "COLOR_", "_")
+_INTEGER_COMPONENTS = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32}
+
+
 def add_level_mesh(
     builder: GlbBuilder, mesh_index: int, primitives: list[PrimitiveArrays], shared: list[int], name: str
 ) -> int:
@@ -107,16 +114,20 @@ def add_level_mesh(
         if extensions:
             primitive["extensions"] = extensions
         vertex_count = len(arrays.attributes["POSITION"])
-        primitive["attributes"] = {
-            attribute: builder.add(_storable(values), ARRAY_BUFFER, bounds=attribute == "POSITION")
-            for attribute, values in arrays.attributes.items()
-        }
+        inputs = source["primitives"][arrays.source].get("attributes", {})
+        primitive["attributes"] = {}
+        for attribute, values in arrays.attributes.items():
+            like = builder.json["accessors"][inputs[attribute]] if attribute in inputs else {}
+            stored, normalized = _storable(values, like if attribute.startswith(_INPUT_TYPED) else {})
+            primitive["attributes"][attribute] = builder.add(
+                stored, ARRAY_BUFFER, bounds=attribute == "POSITION", normalized=normalized
+            )
         primitive["indices"] = index_accessor(builder, arrays.faces, vertex_count)
         primitive["mode"] = 4
         if arrays.targets:
             primitive["targets"] = [
                 {
-                    name: builder.add(_storable(delta), ARRAY_BUFFER, bounds=name == "POSITION")
+                    name: builder.add(_storable(delta, {})[0], ARRAY_BUFFER, bounds=name == "POSITION")
                     for name, delta in t.items()
                 }
                 for t in arrays.targets
@@ -236,9 +247,21 @@ def _read_level(
     return LodLevel(mesh, rig.skeleton, motions, error, coverage, mesh_level, motion_level)
 
 
-def _storable(values: np.ndarray) -> np.ndarray:
-    """float32, or the smallest unsigned type for integer arrays (JOINTS_n)."""
+def _storable(values: np.ndarray, like: dict) -> tuple[np.ndarray, bool]:
+    """``values`` to write, and whether they are normalised: in the integer component type of
+    the input accessor ``like`` if it has one (rounded, normalised ones scaled), else float32;
+    integer arrays (JOINTS_n) in the smallest unsigned type."""
     values = np.asarray(values)
     if values.dtype.kind in "iu":
-        return values.astype(np.uint8 if values.max(initial=0) < 256 else np.uint16)
-    return values.astype(np.float32)
+        return values.astype(np.uint8 if values.max(initial=0) < 256 else np.uint16), False
+    dtype = _INTEGER_COMPONENTS.get(like.get("componentType"))
+    if dtype is None:
+        return values.astype(np.float32), False
+    normalized = bool(like.get("normalized", False))
+    limits = np.iinfo(dtype)
+    if normalized:  # [0, 1] or [-1, 1] to the type's range (glTF 2.0 section 3.11)
+        values = values * limits.max
+        lowest = -limits.max if limits.min < 0 else 0
+    else:
+        lowest = limits.min
+    return np.clip(np.rint(values), lowest, limits.max).astype(dtype), normalized

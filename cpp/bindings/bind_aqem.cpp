@@ -123,6 +123,7 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   py::dict preparation;
   preparation["degenerate_faces"] = report.degenerate_faces;
   preparation["duplicate_faces"] = report.duplicate_faces;
+  preparation["mirrored_faces"] = report.mirrored_faces;
   preparation["welded_vertices"] = report.welded_vertices;
   preparation["seam_vertices"] = report.seam_vertices;
   preparation["split_vertices"] = report.split_vertices;

@@ -484,10 +484,12 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   weld_input.influence_count = vertex_data.influence_count;
   weld_input.face_groups = vertex_data.face_groups;
   weld_input.weld = options.weld;
+  weld_input.mirror_two_sided = true;
   const detail::PreparedMesh prepared = detail::prepare_mesh(mesh, weld_input);
   AqemPreparation& report = result.preparation;
   report.degenerate_faces = prepared.degenerate_faces;
   report.duplicate_faces = prepared.duplicate_faces;
+  report.mirrored_faces = prepared.mirrored_faces;
   report.welded_vertices = prepared.welded_vertices;
   report.seam_vertices = prepared.seam_points;
   report.split_vertices = prepared.split_points;

@@ -413,6 +413,16 @@ EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
     level.face_sources.push_back(prepared_.face_sources[f]);
     for (size_t c = 0; c < 3; ++c) level.faces.push_back(new_index[corner_wedges_[3 * static_cast<size_t>(f) + c]]);
   }
+  // A two-sided sheet's faces come back in the reverse turn on the same vertices, after the
+  // others; the target counts them too.
+  if (!prepared_.mirror_sources.empty())
+    for (int32_t f : live_faces) {
+      const int32_t mirror = prepared_.mirror_sources[static_cast<size_t>(f)];
+      if (mirror < 0) continue;
+      level.face_sources.push_back(mirror);
+      for (size_t c : {0, 2, 1}) level.faces.push_back(new_index[corner_wedges_[3 * static_cast<size_t>(f) + c]]);
+      ++level.target_face_count;
+    }
   // An input vertex maps to the output vertex of the wedge it merged into; when no surviving
   // corner uses that wedge, to an output vertex of the point it merged into.
   level.vertex_map.assign(vertex_count, -1);

@@ -281,11 +281,15 @@ std::vector<int32_t> join_fans(const std::vector<int32_t>& corner_points, size_t
 
 // Step 2's repeats: faces with the points of a face before them in the same turn (sorted by
 // (rotated corners, face) inside buckets of their lowest point) leave the corner and face
-// lists. Returns how many left.
+// lists; with `mirror_sources` (not null), so do faces with the points of a face before them in
+// the reverse turn, each recorded there (aligned with the faces that stay) as its earlier face's
+// mirror. Returns how many left as repeats.
 size_t drop_repeated_faces(std::vector<int32_t>& corner_points, std::vector<int32_t>& corner_inputs,
-                           std::vector<int32_t>& face_sources, size_t point_count) {
+                           std::vector<int32_t>& face_sources, size_t point_count,
+                           std::vector<int32_t>* mirror_sources) {
+  using Rotated = std::pair<std::array<int32_t, 3>, int32_t>;  // canonical rotation, face
   const size_t face_count = face_sources.size();
-  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> rotated(face_count);  // canonical rotation, face
+  std::vector<Rotated> rotated(face_count);
   for (size_t f = 0; f < face_count; ++f) {
     const int32_t* p = &corner_points[3 * f];
     const auto first = static_cast<size_t>(std::min_element(p, p + 3) - p);
@@ -293,15 +297,36 @@ size_t drop_repeated_faces(std::vector<int32_t>& corner_points, std::vector<int3
   }
   std::vector<int32_t> offsets, order;
   bucket_by_point(face_count, point_count, [&](size_t f) { return rotated[f].first[0]; }, offsets, order);
-  std::vector<std::pair<std::array<int32_t, 3>, int32_t>> sorted(face_count);
+  std::vector<Rotated> sorted(face_count);
   for (size_t i = 0; i < face_count; ++i) sorted[i] = rotated[static_cast<size_t>(order[i])];
   for (size_t p = 0; p < point_count; ++p) std::sort(sorted.begin() + offsets[p], sorted.begin() + offsets[p + 1]);
   std::vector<uint8_t> repeated(face_count, 0);
   for (size_t i = 1; i < face_count; ++i)
     if (sorted[i].first == sorted[i - 1].first) repeated[static_cast<size_t>(sorted[i].second)] = 1;
+  // The first face of a rotation is no repeat; the first of the reversed rotation, if earlier,
+  // is the one a face mirrors (it mirrors no face itself: its own mirror would be earlier still
+  // and have this face's rotation, making this face a repeat).
+  std::vector<int32_t> mirror_of(mirror_sources ? face_count : 0, -1);
+  for (size_t f = 0; f < mirror_of.size(); ++f) {
+    if (repeated[f]) continue;
+    const std::array<int32_t, 3>& r = rotated[f].first;
+    const Rotated reversed{{r[0], r[2], r[1]}, -1};
+    const auto first = sorted.begin() + offsets[static_cast<size_t>(r[0])];
+    const auto last = sorted.begin() + offsets[static_cast<size_t>(r[0]) + 1];
+    const auto found = std::lower_bound(first, last, reversed);
+    if (found != last && found->first == reversed.first && static_cast<size_t>(found->second) < f)
+      mirror_of[f] = found->second;
+  }
+  // The input face of each face's mirror, by face (before the lists close up).
+  std::vector<int32_t> mirror_input(mirror_of.size(), -1);
+  bool any_mirror = false;
+  for (size_t f = 0; f < mirror_of.size(); ++f)
+    if (mirror_of[f] >= 0) mirror_input[static_cast<size_t>(mirror_of[f])] = face_sources[f], any_mirror = true;
+  if (any_mirror) mirror_sources->clear();
   size_t kept = 0;
   for (size_t f = 0; f < face_count; ++f) {
-    if (repeated[f]) continue;
+    if (repeated[f] || (!mirror_of.empty() && mirror_of[f] >= 0)) continue;
+    if (any_mirror) mirror_sources->push_back(mirror_input[f]);
     face_sources[kept] = face_sources[f];
     for (size_t k = 0; k < 3; ++k) {
       corner_points[3 * kept + k] = corner_points[3 * f + k];
@@ -309,10 +334,11 @@ size_t drop_repeated_faces(std::vector<int32_t>& corner_points, std::vector<int3
     }
     ++kept;
   }
+  const auto repeats = static_cast<size_t>(std::count(repeated.begin(), repeated.end(), 1));
   face_sources.resize(kept);
   corner_points.resize(3 * kept);
   corner_inputs.resize(3 * kept);
-  return face_count - kept;
+  return repeats;
 }
 
 // Faces that repeat a directed edge of a face before them (the lowest face keeps it): bucketed
@@ -362,7 +388,8 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
     }
   }
 
-  // Step 2: faces in point terms; drop degenerate ones and repeats (same points, same turn).
+  // Step 2: faces in point terms; drop degenerate ones and repeats (same points, same turn;
+  // with mirror_two_sided also the reverse turn, recorded as mirrors).
   // Written in place (a range insert per face took most of this step's time at 1M faces).
   std::vector<int32_t> corner_points(3 * mesh.face_count), corner_inputs(3 * mesh.face_count);
   out.face_sources.reserve(mesh.face_count);
@@ -388,7 +415,10 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   std::vector<int32_t> partner;
   bool simple = pair_unique_sides(corner_points, out.point_source.size(), partner);
   if (!simple) {
-    out.duplicate_faces = drop_repeated_faces(corner_points, corner_inputs, out.face_sources, out.point_source.size());
+    const size_t before = out.face_sources.size();
+    out.duplicate_faces = drop_repeated_faces(corner_points, corner_inputs, out.face_sources, out.point_source.size(),
+                                              input.mirror_two_sided ? &out.mirror_sources : nullptr);
+    out.mirrored_faces = before - out.duplicate_faces - out.face_sources.size();
     simple = pair_sides(corner_points, out.point_source.size(), partner);
   }
 

@@ -32,6 +32,10 @@ struct WeldInput {
   size_t influence_count = 0;                  // K
   const int32_t* face_groups = nullptr;        // (M,) material/primitive of each face
   bool weld = true;                            // false: every input vertex is its own point
+  // true: a face repeated in the reverse turn (a two-sided sheet, as exporters write double-
+  // sided cloth or leaves) leaves the surface and is recorded in mirror_sources; false: both
+  // stay, and the non-manifold cut separates and locks them.
+  bool mirror_two_sided = false;
 };
 
 struct PreparedMesh {
@@ -43,6 +47,9 @@ struct PreparedMesh {
   std::vector<int32_t> faces;          // (M', 3) point indices, manifold, consistently oriented
   std::vector<int32_t> corner_wedges;  // (M', 3) input vertex standing for each corner (after step 4)
   std::vector<int32_t> face_sources;   // (M',) input face index
+  // (M',) the input face that repeats each face in the reverse turn (WeldInput::mirror_two_sided),
+  // -1 for none; empty when no face has one.
+  std::vector<int32_t> mirror_sources;
   // (M', 3) the corner whose side runs opposite corner c's (a corner's side runs from its point
   // to the next corner's in the face), -1 on a border: the surface's edges, as OpenMesh's
   // add_face pairs them. Empty when step 3 found an edge with several sides one way or an
@@ -53,6 +60,7 @@ struct PreparedMesh {
   // What was done, for reports.
   size_t degenerate_faces = 0;   // faces dropped because two corners are one point
   size_t duplicate_faces = 0;    // faces dropped because an earlier face has the same corners
+  size_t mirrored_faces = 0;     // faces that left the surface as the reverse of an earlier one
   size_t welded_vertices = 0;    // referenced input vertices that share a point with a lower one
   size_t split_points = 0;       // extra points made by cutting non-manifold spots
   size_t seam_points = 0;        // points with more than one wedge

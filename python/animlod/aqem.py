@@ -95,6 +95,9 @@ class Preparation:
 
     degenerate_faces, duplicate_faces : dropped faces (two corners at one welded position; the
         same corners as an earlier face).
+    mirrored_faces : faces with the corners of an earlier face in the reverse turn (two-sided
+        sheets): simplified with that face and written on every level as its reverse, on the
+        same vertices (they count in the levels' faces and targets, not in ``face_count``).
     welded_vertices : vertices welded onto a lower-numbered copy (UV-seam or flat-shading copies).
     seam_vertices : welded positions whose copies keep different attributes (seams kept).
     split_vertices : copies made to cut non-manifold edges and vertices; they stay in place.
@@ -104,6 +107,7 @@ class Preparation:
 
     degenerate_faces: int
     duplicate_faces: int
+    mirrored_faces: int
     welded_vertices: int
     seam_vertices: int
     split_vertices: int

@@ -316,15 +316,17 @@ TEST_CASE("aqem prepares a repeat in another turn, two-sided sheets and a fan of
     CHECK(result.preparation.duplicate_faces == 1);
     CHECK(result.preparation.face_count == 32);
   }
-  // A face and its turned-over copy share their edges but must not be joined across them (the
-  // surface would fold onto itself): the back gets points of its own.
+  // A face and its turned-over copy (a two-sided sheet) share their edges: the copy leaves the
+  // surface and comes back reversed on every level.
   SUBCASE("every face also turned over") {
     for (size_t f = 0; f < 32; ++f)
       mesh.faces.insert(mesh.faces.end(), {mesh.faces[3 * f], mesh.faces[3 * f + 2], mesh.faces[3 * f + 1]});
     const AqemResult result = simplify(mesh, options);
     CHECK(result.preparation.duplicate_faces == 0);
-    CHECK(result.preparation.split_vertices == 25);
-    CHECK(result.preparation.face_count == 64);
+    CHECK(result.preparation.mirrored_faces == 32);
+    CHECK(result.preparation.split_vertices == 0);
+    CHECK(result.preparation.face_count == 32);
+    CHECK(result.levels[0].faces.size() / 3 == 64);
   }
   SUBCASE("a disc of 100 triangles around one point, beside the grid") {  // its sides searched, not scanned
     const auto center = static_cast<int32_t>(mesh.vertex_count);
@@ -347,8 +349,43 @@ TEST_CASE("aqem prepares a repeat in another turn, two-sided sheets and a fan of
     mesh.faces.insert(mesh.faces.end(), {25, 26, 27, 25, 27, 26});
     mesh.vertex_count += 3;
     const AqemResult result = simplify(mesh, options);
-    CHECK(result.preparation.split_vertices == 3);
-    CHECK(result.preparation.face_count == 34);
+    CHECK(result.preparation.mirrored_faces == 1);
+    CHECK(result.preparation.split_vertices == 0);
+    CHECK(result.preparation.face_count == 33);
+    CHECK(result.levels[0].faces.size() / 3 == 34);
+  }
+}
+
+// Exporters write double-sided cloth and leaves as every face again in the reverse turn, on
+// vertices of its own; cut apart and locked, such a sheet did not simplify at all.
+TEST_CASE("aqem simplifies a two-sided sheet as its front and writes each level's faces back reversed") {
+  const OwnedAnimatedMesh front = animlod::testing::grid(8);  // 81 vertices, 128 faces
+  OwnedAnimatedMesh sheet = front;
+  sheet.frames.insert(sheet.frames.end(), front.frames.begin(), front.frames.end());
+  sheet.vertex_count *= 2;
+  for (size_t f = 0; f < 128; ++f)
+    for (size_t c : {0, 2, 1}) sheet.faces.push_back(front.faces[3 * f + c] + 81);
+  AqemOptions options;
+  options.target_ratios = {0.5, 0.25, 0.1};
+  const AqemResult one = simplify(front, options), two = simplify(sheet, options);
+  CHECK(two.preparation.mirrored_faces == 128);
+  CHECK(two.preparation.split_vertices == 0);
+  REQUIRE(two.levels.size() == one.levels.size());
+  for (size_t l = 0; l < one.levels.size(); ++l) {
+    const AqemLevel &a = one.levels[l], &b = two.levels[l];
+    const size_t m = a.faces.size() / 3;
+    REQUIRE(b.faces.size() == 6 * m);
+    CHECK(b.target_face_count == a.target_face_count + m);  // the surface's target and the mirrors
+    CHECK(b.kept_vertices == a.kept_vertices);
+    CHECK(b.positions == a.positions);
+    for (size_t f = 0; f < m; ++f) {
+      CHECK(b.face_sources[f] == a.face_sources[f]);
+      CHECK(b.face_sources[m + f] == a.face_sources[f] + 128);  // the reversed copy's own input face
+      for (size_t c = 0; c < 3; ++c) {
+        CHECK(b.faces[3 * f + c] == a.faces[3 * f + c]);
+        CHECK(b.faces[3 * (m + f) + c] == a.faces[3 * f + (3 - c) % 3]);  // corners 0, 2, 1
+      }
+    }
   }
 }
 

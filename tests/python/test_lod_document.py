@@ -477,6 +477,41 @@ def test_hard_edges_keep_their_tangents_and_normal_deltas_make_no_seams(tmp_path
     assert np.abs(doc.accessor(primitive["targets"][0]["NORMAL"], "d")).max() > 0.05
 
 
+def test_a_double_sided_copy_simplifies_with_its_front_and_faces_away_from_it(humanoid_glb, tmp_path):
+    # How exporters write double-sided meshes: every face again in the reverse turn, on vertices
+    # of its own whose normals point the other way.
+    def double_sided(gltf, blob):
+        read = GltfDocument(humanoid_glb)
+        primitive = gltf.meshes[0].primitives[0]
+        count = read.accessor(primitive.attributes.POSITION, "p").shape[0]
+        for name in ("POSITION", "NORMAL", "TEXCOORD_0", "JOINTS_0", "WEIGHTS_0"):
+            values = read.accessor(getattr(primitive.attributes, name), name)
+            back = -values if name == "NORMAL" else values
+            both = np.concatenate([values, back]).astype(np.uint16 if name == "JOINTS_0" else np.float32)
+            index = append_accessor(gltf, blob, both, f"VEC{both.shape[1]}")
+            if name == "POSITION":
+                gltf.accessors[index].min, gltf.accessors[index].max = both.min(0).tolist(), both.max(0).tolist()
+            setattr(primitive.attributes, name, index)
+        faces = read.accessor(primitive.indices, "i").reshape(-1, 3)
+        reversed_copy = faces[:, ::-1] + count
+        primitive.indices = append_accessor(gltf, blob, np.r_[faces, reversed_copy].ravel().astype(np.uint32), "SCALAR")
+
+    source = edit_glb(humanoid_glb, tmp_path / "double.glb", double_sided)
+    single = simplify_document(humanoid_glb, tmp_path / "single_lod.glb", [0.5, 0.1], **QUICK)
+    report = simplify_document(source, tmp_path / "double_lod.glb", [0.5, 0.1], **QUICK)
+    assert report.drawables[0].preparation.mirrored_faces == single.drawables[0].faces
+    assert [level.faces for level in report.drawables[0].levels] == [
+        2 * level.faces for level in single.drawables[0].levels
+    ]
+    doc = GltfDocument(tmp_path / "double_lod.glb")
+    primitive = _coarsest_primitive(doc, report)
+    faces = doc.accessor(primitive["indices"], "i").reshape(-1, 3)
+    corners = doc.accessor(primitive["attributes"]["POSITION"], "p")[faces].astype(np.float64)
+    facing = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normals = doc.accessor(primitive["attributes"]["NORMAL"], "n")[faces]
+    assert np.all(np.einsum("fkc,fc->fk", normals, facing) > 0.0)  # the back's normals point back
+
+
 def test_levels_store_colours_texture_coordinates_and_feature_ids_as_the_input_does(humanoid_glb, tmp_path):
     # Quantised exports store colours and texture coordinates as normalised integers, and
     # application attributes such as feature IDs as plain integers.

@@ -115,12 +115,13 @@ struct AqemVertexData {
 };
 
 struct AqemLevel {
-  size_t target_face_count = 0;
+  size_t target_face_count = 0;      // with the mirrors of its faces (AqemPreparation::mirrored_faces)
   bool reached = false;              // false when max_error or legality stopped the run first
   size_t collapse_count = 0;         // the level is the first collapse_count records applied
   double error = 0.0;                // asset units: the largest collapse error so far (see
                                      // CollapseRecord::error)
-  std::vector<int32_t> faces;        // (M', 3) indices into the kept vertices, corners in input order
+  std::vector<int32_t> faces;        // (M', 3) indices into the kept vertices, corners in input order;
+                                     // the mirrors of two-sided faces last, on the same vertices
   std::vector<int32_t> face_sources; // (M',) input face each face comes from (its primitive)
   std::vector<int32_t> kept_vertices;  // (V',) original index of each kept vertex, ascending
   std::vector<int32_t> vertex_map;   // (V,) original vertex -> index of the kept vertex it merged
@@ -140,6 +141,9 @@ struct AqemLevel {
 struct AqemPreparation {
   size_t degenerate_faces = 0;       // dropped: two corners at one welded position
   size_t duplicate_faces = 0;        // dropped: the same corners as an earlier face, same turn
+  size_t mirrored_faces = 0;         // the same corners as an earlier face in the reverse turn (a
+                                     // two-sided sheet): simplified with it, and written on every
+                                     // level as its reverse, on the same vertices
   size_t welded_vertices = 0;        // vertices welded onto a lower-numbered copy
   size_t seam_vertices = 0;          // welded positions whose copies keep different attributes
   size_t split_vertices = 0;         // copies made to cut non-manifold edges and vertices (locked)

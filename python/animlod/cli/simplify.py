@@ -110,6 +110,7 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
             f"welded {prep.welded_vertices} vertices, {prep.seam_vertices} seam positions kept, "
             f"{prep.split_vertices} cut at non-manifold spots, {prep.degenerate_faces + prep.duplicate_faces} "
             f"degenerate or repeated faces dropped"
+            + (f", {prep.mirrored_faces} two-sided faces mirrored" if prep.mirrored_faces else "")
             + (
                 f", {drawable.renormalised_weights} skin weight rows renormalised"
                 if drawable.renormalised_weights

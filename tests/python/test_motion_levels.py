@@ -11,7 +11,7 @@ from animlod.cli import main
 from animlod.model import Motion, Skeleton
 from animlod.motion_lod import analyze_motion, joint_floor, level_joint_counts
 from animlod.motion_lod.analysis import translating_joints
-from animlod.motion_lod.chain import build_level
+from animlod.motion_lod.chain import build_level, build_motion_chain
 from animlod.motion_lod.frozen import freeze
 
 
@@ -84,6 +84,40 @@ def test_float_noise_and_constant_keys_are_not_translation() -> None:
     motion = Motion(motion.skeleton, motion.root_positions, motion.local_rotations, 30.0, joint_translations=noisy)
     assert not translating_joints(motion).any()
     assert joint_floor(motion, analyze_motion(motion)).fewest == 1
+
+
+def _with_a_zero_length_hand(motion: Motion) -> Motion:
+    """``motion`` with a turning LeftHand at LeftWrist's position, above LeftWrist_End (as CMU's
+    and Bandai's skeletons have zero-length joints)."""
+    skeleton = motion.skeleton
+    wrist = skeleton.index("LeftWrist")
+    order = [*range(wrist + 1), -1, *range(wrist + 1, skeleton.joint_count)]  # -1: the new joint
+    parents = [int(skeleton.parents[j]) if j >= 0 else wrist for j in order]
+    parents = [p + (p > wrist) for p in parents]
+    parents[order.index(wrist + 1)] = wrist + 1  # LeftWrist_End hangs from the hand
+    names = [skeleton.names[j] if j >= 0 else "LeftHand" for j in order]
+    offsets = [skeleton.offsets[j] if j >= 0 else np.zeros(3) for j in order]
+    ends = [bool(skeleton.end_sites[j]) if j >= 0 else False for j in order]
+    turn = rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), 0.3 * np.sin(np.arange(motion.frame_count) / 3))
+    local = np.insert(motion.local_rotations, wrist + 1, turn, axis=1)
+    return Motion(Skeleton(names, parents, offsets, end_sites=ends), motion.root_positions, local, fps=motion.fps)
+
+
+def test_noise_on_a_zero_length_bone_leaves_the_levels_of_the_clean_clip() -> None:
+    # Exporters write translation keys on every joint; on a zero-length bone their float noise
+    # (~1e-8 of the figure in 131_01 and Bandai's exports) is a bone in random directions, which
+    # is no bone to hold or turn.
+    clean = _with_a_zero_length_hand(figure_motion())
+    hand = clean.skeleton.index("LeftHand")
+    translations = np.broadcast_to(clean.skeleton.offsets, clean.local_rotations.shape[:2] + (3,)).copy()
+    translations[:, hand] = 3e-8 * np.random.default_rng(3).standard_normal((clean.frame_count, 3))  # 2e-8 of it
+    noisy = Motion(clean.skeleton, clean.root_positions, clean.local_rotations, 30.0, joint_translations=translations)
+    expected, got = (build_motion_chain(m, 6, ranking="importance") for m in (clean, noisy))
+    assert [level.report.joint_count for level in got.levels] == [level.report.joint_count for level in expected.levels]
+    size = expected.figure_size
+    for a, b in zip(expected.levels, got.levels):
+        assert abs(a.report.mean_error - b.report.mean_error) < 1e-5 * size
+        assert abs(a.report.max_error - b.report.max_error) < 1e-5 * size
 
 
 def test_a_small_real_translation_freezes_at_its_key_and_its_error_is_reported() -> None:

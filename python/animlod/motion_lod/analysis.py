@@ -86,6 +86,11 @@ class MotionAnalysis:
 
 # Default of translating_joints: a translation whose range stays under 1 % of its bone is held.
 TRANSLATION_TOLERANCE = 1e-2
+# A bone shorter than this fraction of the figure has no direction: a joint at its parent's
+# position. Float32 keys resolve ~1e-7 of a figure, and exporters write noise of that order on the
+# translation channels of such joints (a 1e-6 bone in random directions, held as a length, made
+# 131_01 with noise on its left hand's translation 18x slower to re-fit); real bones are over 1e-3.
+ZERO_LENGTH = 1e-6
 
 
 def translating_joints(motion: Motion, tolerance: float = TRANSLATION_TOLERANCE) -> np.ndarray:
@@ -130,7 +135,7 @@ def child_bones(
     if not look_through:
         return parents.astype(np.int64), vectors
     lengths = np.linalg.norm(offsets, axis=-1).max(axis=0)  # (J - 1,)
-    zero = np.concatenate([[False], lengths <= 1e-9 * max(float(lengths.max(initial=0.0)), 1e-300)])
+    zero = np.concatenate([[False], lengths <= ZERO_LENGTH * max(float(lengths.max(initial=0.0)), 1e-300)])
     # Nearest non-coincident points below each joint: walk down through zero-length children,
     # composing their rotations: v = R_j R_c1 ... R_ck offset_d (the zero-length offsets add 0).
     kids = skeleton.children()

@@ -26,10 +26,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import rotations
+from .analysis import ZERO_LENGTH
 from .frozen import FrozenLevel
 
 # Key lengths below this fraction of the length scale count as zero-length ("coincident") pairs.
-_COINCIDENT = 1e-9
+_COINCIDENT = ZERO_LENGTH
 # A rigid group's child whose height over its base plane is below this fraction of its distance
 # to the parent (about 3 degrees) is held by its height (a flat quad), not by distances alone.
 _FLAT = 0.05

@@ -24,10 +24,8 @@ import numpy as np
 
 from .. import _core, rotations
 from ..model import Motion, Skeleton
+from .analysis import ZERO_LENGTH
 from .frozen import FrozenLevel, held_translations
-
-# Child offsets shorter than this fraction of the level's extent give no direction.
-_SHORT = 1e-9
 
 
 def reduce_skeleton(level: FrozenLevel) -> Skeleton:
@@ -73,7 +71,7 @@ def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) ->
     # plane, else by the swing towards the longest.
     aims = []
     for children in skeleton.children():
-        useful = [c for c in children if static_offsets[c] > _SHORT * scale and not translating[c]]
+        useful = [c for c in children if static_offsets[c] > ZERO_LENGTH * scale and not translating[c]]
         if useful and not _spans_a_plane(skeleton.offsets[useful]):
             useful = [useful[int(np.argmax(static_offsets[useful]))]]
         aims.append(useful)

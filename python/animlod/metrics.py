@@ -120,7 +120,8 @@ def surface_error(
         ],
         axis=1,
     )
-    diagonal = np.linalg.norm(np.ptp(a, axis=1), axis=-1)
+    used_vertices = from_original[:, : from_original.shape[1] - samples]  # the drawn points follow them
+    diagonal = np.linalg.norm(np.ptp(used_vertices, axis=1), axis=-1)
     return SurfaceError(np.sqrt(squared.max(axis=1)), np.sqrt(squared.mean(axis=1)), diagonal)
 
 
@@ -173,11 +174,14 @@ def _check_frames(original: AnimatedMesh, simplified: AnimatedMesh) -> None:
 
 def _measured_points(mesh: AnimatedMesh, samples: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """The mesh's (F, V, 3) float64 frames and the points measured against the other surface:
-    its vertices and ``samples`` points drawn on its surface, (F, V + samples, 3), every frame
-    in one array (the core builds each mesh's tree once and refits it from frame to frame)."""
+    the vertices its faces use (one no face uses is no part of the surface) and ``samples``
+    points drawn on its surface, (F, U + samples, 3), every frame in one array (the core builds
+    each mesh's tree once and refits it from frame to frame)."""
     frames = mesh.frames.astype(np.float64)
+    used = np.unique(mesh.faces)
+    vertices = frames if used.size == mesh.vertex_count else frames[:, used]
     drawn = sample_surface(mesh, samples, seed).positions(mesh, slice(None))
-    return frames, np.concatenate([frames, drawn], axis=1)
+    return frames, np.concatenate([vertices, drawn], axis=1)
 
 
 def _relative(distance: np.ndarray, diagonal: np.ndarray) -> np.ndarray:

@@ -74,6 +74,18 @@ def test_hausdorff_distance_is_the_largest_of_surface_error_to_the_bit():
         hausdorff_distances(original, levels, at_least=[0.0])
 
 
+def test_vertices_no_face_uses_are_not_measured():
+    # OBJ files often keep vertices no face uses (left over from a deleted part): no surface.
+    original = ellipsoid(frames=3)
+    level = simplify_animated(original, (0.1,)).levels[0].mesh
+    far = np.full((original.frame_count, 5, 3), 50.0, np.float32)
+    extended = AnimatedMesh(original.faces, np.concatenate([original.frames, far], axis=1))
+    expected, got = surface_error(original, level, samples=2000), surface_error(extended, level, samples=2000)
+    for name in ("hausdorff", "rms", "diagonal"):
+        np.testing.assert_array_equal(getattr(got, name), getattr(expected, name))
+    assert hausdorff_distance(extended, level, samples=2000) == hausdorff_distance(original, level, samples=2000)
+
+
 def test_point_mesh_distance_matches_libigl_on_a_deformed_surface():
     igl = pytest.importorskip("igl")  # the reference the metrics used before the core's
     mesh = ellipsoid(frames=3)

@@ -151,7 +151,10 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
         )
     finally:
         progress.close()
-    print("errors relative to the bounding-box diagonal, over frames; time is the whole simplification")
+    print(
+        "AQEM error: the largest collapse error, asset units; Hausdorff and RMS: relative to the bounding-box"
+        " diagonal, over frames; time is the whole simplification"
+    )
     rows = [("level", "faces", "AQEM error", "Hausdorff mean / max", "RMS mean / max", "time s")]
     rows.append((0, report.original.face_count, "0", "-", "-", "-"))
     for index, level in enumerate(report.levels, start=1):

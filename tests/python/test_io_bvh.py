@@ -74,6 +74,13 @@ def test_a_file_converted_to_crlf_twice_reads_like_the_original(tmp_path: Path) 
     assert "line 27: expected 'Frames: N', found 'Frames: x'" in message  # as an editor counts
 
 
+def test_a_byte_order_mark_is_no_part_of_the_hierarchy(tmp_path: Path) -> None:
+    marked = tmp_path / "marked.bvh"
+    marked.write_bytes(b"\xef\xbb\xbf" + SMALL_BVH.encode())
+    once = read_bvh(_write(tmp_path, SMALL_BVH))
+    np.testing.assert_array_equal(read_bvh(marked).local_rotations, once.local_rotations)
+
+
 def test_euler_angles_follow_the_written_channel_order(tmp_path: Path) -> None:
     world = read_bvh(_write(tmp_path, SMALL_BVH)).world_positions()
     # Frame 0: no rotation.

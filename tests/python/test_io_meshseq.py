@@ -161,6 +161,13 @@ def test_obj_zero_or_too_negative_index(tmp_path: Path, index: str) -> None:
     assert _error(path) == f"{path}: face 1 (line 11): vertex index {index} is outside the 5 vertices"
 
 
+def test_comments_at_the_end_of_obj_statements_are_ignored(tmp_path: Path) -> None:
+    commented = "".join(line.rstrip("\r\n") + "  # note\n" for line in OBJ_TEXT.splitlines(True))
+    vertices, faces = read_obj(_write(tmp_path / "commented.obj", commented))
+    np.testing.assert_array_equal(vertices, EXPECTED_VERTICES)
+    np.testing.assert_array_equal(faces, EXPECTED_FACES)
+
+
 def test_obj_face_with_two_corners(tmp_path: Path) -> None:
     path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 3"))
     assert _error(path) == f"{path}: face 1 (line 11): needs at least 3 vertices, has 2"

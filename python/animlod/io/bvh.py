@@ -125,7 +125,8 @@ def read_bvh(path: str | os.PathLike) -> Motion:
         values, a value that is not a finite number.
     """
     path = Path(path)
-    text = path.read_bytes().decode("utf-8", errors="replace").replace("\r\n", "\n").replace("\r", "\n")
+    # utf-8-sig: a byte order mark (as some Windows tools write one) is no part of HIERARCHY.
+    text = path.read_bytes().decode("utf-8-sig", errors="replace").replace("\r\n", "\n").replace("\r", "\n")
     motion_match = _MOTION_LINE.search(text)
     hierarchy_lines = text[: motion_match.start() if motion_match else len(text)].split("\n")
     cursor = _TokenCursor(path, hierarchy_lines)

@@ -1,10 +1,10 @@
 """OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
 
 Only geometry is read: OBJ ``v`` and ``f`` lines (1-based or negative indices, ``a/b/c``
-corners, polygons fan-triangulated; other statements such as ``vt``, ``vn``, ``g``, ``usemtl``
-are ignored) and PLY ``vertex`` x, y, z with the ``face`` list ``vertex_indices`` (ascii,
-binary_little_endian, binary_big_endian; other elements and properties are skipped).
-Statements may be indented. Parsing works on the whole file's bytes with numpy: there is no
+corners, polygons fan-triangulated, ``#`` comments also at a line's end; other statements such
+as ``vt``, ``vn``, ``g``, ``usemtl`` are ignored) and PLY ``vertex`` x, y, z with the ``face``
+list ``vertex_indices`` (ascii, binary_little_endian, binary_big_endian; other elements and
+properties are skipped). Statements may be indented. Parsing works on the whole file's bytes with numpy: there is no
 Python loop over lines, vertices or faces.
 """
 
@@ -187,6 +187,8 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if nul >= 0:
         raise FormatError(path, f"byte {nul}", "NUL byte: an OBJ file is text, this looks like binary data")
     data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    if b"#" in data:  # a comment may also end a statement ("f 1 2 3 # cap"); line numbers stay
+        data = re.sub(rb"#[^\n]*", b"", data)
     if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
         data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
     (vertex_block, vertex_lines), (face_block, face_lines) = _obj_statements(data, (b"v", b"f"))

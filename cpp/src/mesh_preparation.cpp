@@ -320,8 +320,11 @@ size_t drop_repeated_faces(std::vector<int32_t>& corner_points, std::vector<int3
   // The input face of each face's mirror, by face (before the lists close up).
   std::vector<int32_t> mirror_input(mirror_of.size(), -1);
   bool any_mirror = false;
-  for (size_t f = 0; f < mirror_of.size(); ++f)
-    if (mirror_of[f] >= 0) mirror_input[static_cast<size_t>(mirror_of[f])] = face_sources[f], any_mirror = true;
+  for (size_t f = 0; f < mirror_of.size(); ++f) {
+    if (mirror_of[f] < 0) continue;
+    mirror_input[static_cast<size_t>(mirror_of[f])] = face_sources[f];
+    any_mirror = true;
+  }
   if (any_mirror) mirror_sources->clear();
   size_t kept = 0;
   for (size_t f = 0; f < face_count; ++f) {

@@ -357,9 +357,8 @@ def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     """Read the vertex positions and faces of a PLY file (ascii or binary).
 
     Returns ``vertices (V, 3) float32`` from vertex x, y, z and ``faces (M, 3) int32`` from the
-    face list ``vertex_indices`` (or ``vertex_index``), fan-triangulated; no face element gives
-    ``(0, 3)``. A binary file must use one polygon size per list element (all triangles, say);
-    ascii files may mix sizes.
+    face list ``vertex_indices`` (or ``vertex_index``), fan-triangulated (polygons of any sizes,
+    mixed); no face element gives ``(0, 3)``.
 
     Raises
     ------
@@ -485,7 +484,8 @@ def _single_list(path: Path, element: _PlyElement) -> int | None:
 def _read_ply_binary(
     path: Path, data: bytes, offset: int, elements: list[_PlyElement], byte_order: str
 ) -> dict[str, _ElementValues]:
-    """Read each element as one structured numpy array; a list property must have one length throughout."""
+    """Read each element as one structured numpy array, or, where a list property's length
+    varies from row to row, with :func:`_varying_list`."""
     values: dict[str, _ElementValues] = {}
     for element in elements:
         list_at = _single_list(path, element)
@@ -508,20 +508,70 @@ def _read_ply_binary(
                 (list_prop.name, byte_order + list_prop.type_code, (length,)),
             ]
         row = np.dtype(fields)
-        if offset + row.itemsize * element.count > len(data):
+        fits = offset + row.itemsize * element.count <= len(data)
+        table = np.frombuffer(data, row, element.count, offset) if fits else None
+        if list_at is not None and (table is None or np.any(table[_LIST_SIZE_FIELD] != length)):
+            values[element.name], offset = _varying_list(path, data, offset, element, byte_order, list_at)
+            continue
+        if table is None:
             raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
-        table = np.frombuffer(data, row, element.count, offset)
         offset += row.itemsize * element.count
         values[element.name] = {prop.name: table[prop.name] for prop in element.properties if prop.count_code is None}
         if list_at is not None:
-            other = np.flatnonzero(table[_LIST_SIZE_FIELD] != length)
-            if other.size:
-                size = table[_LIST_SIZE_FIELD][other[0]]
-                reason = f"list of {size} items after rows of {length} (mixed lengths need ascii PLY)"
-                raise FormatError(path, f"element {element.name} row {other[0]}", reason)
             name = element.properties[list_at].name
             values[element.name][name] = (np.full(element.count, length, dtype=np.int64), table[name].ravel())
     return values
+
+
+def _varying_list(
+    path: Path, data: bytes, offset: int, element: _PlyElement, byte_order: str, list_at: int
+) -> tuple[_ElementValues, int]:
+    """A binary element whose list property's length varies from row to row (triangles and
+    quads, as Blender writes them), and the offset after it. A row starts where the one before
+    it ends, so every byte a row could start at is given the start of the row after it, and the
+    rows' starts follow by pointer doubling: log2(rows) numpy passes, no loop over the rows."""
+    props = element.properties
+    before = np.dtype([(prop.name, byte_order + prop.type_code) for prop in props[:list_at]])
+    after = np.dtype([(prop.name, byte_order + prop.type_code) for prop in props[list_at + 1 :]])
+    size_type = np.dtype(byte_order + props[list_at].count_code)
+    item_type = np.dtype(byte_order + props[list_at].type_code)
+    fixed = before.itemsize + size_type.itemsize + after.itemsize
+    candidates = len(data) - offset - fixed + 1  # bytes at which a row could still start
+    if candidates <= 0:
+        raise FormatError(path, f"element {element.name}", "file ends inside the element")
+    raw = np.frombuffer(data, np.uint8, len(data) - offset, offset)
+
+    def read(at: np.ndarray, dtype: np.dtype) -> np.ndarray:  # a value of dtype at each byte offset
+        return raw[at[:, None] + np.arange(dtype.itemsize)].copy().view(dtype).ravel()
+
+    sizes_at = read(np.arange(candidates) + before.itemsize, size_type).astype(np.int64)
+    following = np.arange(candidates) + fixed + sizes_at * item_type.itemsize
+    # Past the last possible start, and a negative size, lead to a sink that leads to itself.
+    index = np.int32 if candidates < 2**31 - 1 else np.int64  # half the memory of the byte-sized arrays
+    jump = np.append(np.where((sizes_at >= 0) & (following < candidates), following, candidates), candidates)
+    jump = jump.astype(index)
+    starts = np.zeros(element.count, np.int64)
+    rows = np.arange(element.count)
+    step = 0
+    while (1 << step) < element.count:  # starts[i] = next^i(0): apply next^(2^k) for each bit k of i
+        odd = (rows >> step) & 1 == 1
+        starts[odd] = jump[starts[odd]]
+        jump = jump[jump]
+        step += 1
+    if np.any(starts == candidates):
+        raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
+    sizes = sizes_at[starts]
+    end = int(starts[-1] + fixed + sizes[-1] * item_type.itemsize)
+    if offset + end > len(data):
+        raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
+    first_item = starts + before.itemsize + size_type.itemsize
+    within = np.arange(int(sizes.sum())) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+    items = read(np.repeat(first_item, sizes) + within * item_type.itemsize, item_type)
+    element_values: _ElementValues = {props[list_at].name: (sizes, items)}
+    for row_start, layout in ((starts, before), (first_item + sizes * item_type.itemsize, after)):
+        for name in layout.names or ():
+            element_values[name] = read(row_start + layout.fields[name][1], layout.fields[name][0])
+    return element_values, offset + end
 
 
 def _read_ply_ascii(path: Path, body: bytes, elements: list[_PlyElement]) -> dict[str, _ElementValues]:

@@ -107,15 +107,16 @@ def from_axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
 
 
 def from_euler(angles: np.ndarray, order: str) -> np.ndarray:
-    """Quaternions from intrinsic Euler angles ``(..., 3)`` in radians.
+    """Quaternions from intrinsic Euler angles ``(..., n)`` in radians, n = len(order).
 
     ``order`` names the axes as they appear in a BVH CHANNELS line, e.g. ``"ZXY"``: the
-    rotation is ``R = R_Z(a0) @ R_X(a1) @ R_Y(a2)`` acting on column vectors.
+    rotation is ``R = R_Z(a0) @ R_X(a1) @ R_Y(a2)`` acting on column vectors. One or two
+    axes (a hinge's ``"X"``) turn about those only.
     """
     angles = np.asarray(angles, dtype=np.float64)
     order = order.upper()
-    if len(order) != 3 or set(order) - set(_AXIS_INDEX):
-        raise ValueError(f"Euler order: must be three of X, Y, Z, got {order!r}")
+    if not 1 <= len(order) <= 3 or len(set(order)) != len(order) or set(order) - set(_AXIS_INDEX):
+        raise ValueError(f"Euler order: must be one to three different axes of X, Y, Z, got {order!r}")
     q = identity(angles.shape[:-1])
     for k, axis_name in enumerate(order):
         axis = np.zeros(3)

@@ -81,6 +81,24 @@ def test_a_byte_order_mark_is_no_part_of_the_hierarchy(tmp_path: Path) -> None:
     np.testing.assert_array_equal(read_bvh(marked).local_rotations, once.local_rotations)
 
 
+def test_a_hinge_with_one_rotation_channel_reads_like_three_with_zeros(tmp_path: Path) -> None:
+    def clip(knee_channels: str, knee_values: list[str]) -> str:
+        rows = [f"0 1 0 0 0 0 {value}" for value in knee_values]
+        return (
+            "HIERARCHY\nROOT Hip\n{\n\tOFFSET 0 1 0\n"
+            "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+            f"\tJOINT Knee\n\t{{\n\t\tOFFSET 0 -0.5 0\n\t\tCHANNELS {knee_channels}\n"
+            "\t\tEnd Site\n\t\t{\n\t\t\tOFFSET 0 -0.5 0\n\t\t}\n\t}\n}\n"
+            f"MOTION\nFrames: {len(rows)}\nFrame Time: 0.1\n" + "\n".join(rows) + "\n"
+        )
+
+    hinge = read_bvh(_write(tmp_path, clip("1 Xrotation", ["10", "-35"]), "hinge.bvh"))
+    full = read_bvh(_write(tmp_path, clip("3 Zrotation Xrotation Yrotation", ["0 10 0", "0 -35 0"]), "full.bvh"))
+    np.testing.assert_allclose(hinge.local_rotations, full.local_rotations, atol=1e-15)
+    message = _read_error(tmp_path, clip("2 Xrotation Xrotation", ["1 2", "3 4"]))
+    assert "joint 'Knee': channels ['Xrotation', 'Xrotation'] must name each axis once" in message
+
+
 def test_euler_angles_follow_the_written_channel_order(tmp_path: Path) -> None:
     world = read_bvh(_write(tmp_path, SMALL_BVH)).world_positions()
     # Frame 0: no rotation.

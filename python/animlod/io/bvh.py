@@ -15,7 +15,9 @@ Conventions of this reader, in terms of :class:`animlod.model.Motion`:
   a static root) become ``Motion.joint_translations`` when they differ from the OFFSET in any
   frame, so forward kinematics matches the file exactly; otherwise it stays None.
 - Rotation channels are intrinsic Euler angles in degrees, in the order the channels are
-  written (``Zrotation Xrotation Yrotation`` means ``R = Rz @ Rx @ Ry``), per joint.
+  written (``Zrotation Xrotation Yrotation`` means ``R = Rz @ Rx @ Ry``), per joint. A joint
+  may have fewer than three (a hinge's ``CHANNELS 1 Xrotation``): it does not turn about the
+  others; position channels too may be any of the three.
 - ``Frame Time`` gives fps; when the written frame time is an integer rate rounded to the digits
   written (``.0083333`` for 120 fps), fps is that integer.
 """
@@ -203,10 +205,8 @@ def _parse_channels(cursor: _TokenCursor, joint_name: str, line: int) -> list[st
     if unknown:
         raise cursor.error(line, f"joint {joint_name!r}: unknown channel {unknown[0]!r}")
     lowered = [channel.lower() for channel in channels]
-    rotation_count = sum(_CHANNELS[channel][0] == "rotation" for channel in lowered)
-    if len(set(lowered)) != len(lowered) or rotation_count not in (0, 3):
-        reason = f"channels {channels} must name each axis once, with all three rotations or none"
-        raise cursor.error(line, f"joint {joint_name!r}: {reason}")
+    if len(set(lowered)) != len(lowered):
+        raise cursor.error(line, f"joint {joint_name!r}: channels {channels} must name each axis once")
     return channels
 
 

@@ -170,6 +170,21 @@ def test_round_trip_preserves_world_positions(tmp_path: Path, order: str, animat
     assert channel_lines == expected
 
 
+def test_a_tiny_skeleton_keeps_its_precision_through_a_round_trip(tmp_path: Path) -> None:
+    motion = _hand_made_motion(seed=3, animated_translation=False)
+    s = motion.skeleton
+    tiny = Motion(
+        Skeleton(s.names, s.parents, 1e-4 * s.offsets, end_sites=s.end_sites),
+        1e-4 * motion.root_positions,
+        motion.local_rotations,
+        motion.fps,
+    )
+    write_bvh(tmp_path / "tiny.bvh", tiny)
+    back = read_bvh(tmp_path / "tiny.bvh")
+    size = np.abs(s.offsets).max() * 1e-4
+    np.testing.assert_allclose(back.world_positions(), tiny.world_positions(), atol=1e-5 * size)
+
+
 def test_write_rejects_bad_rotation_order(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="rotation_order"):
         write_bvh(tmp_path / "x.bvh", _hand_made_motion(0, False), rotation_order="XXY")

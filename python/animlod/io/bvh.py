@@ -352,7 +352,9 @@ def _build_motion(path: Path, joints: list[_JointSpec], values: np.ndarray, fps:
     )
 
 
-def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZXY", precision: int = 6) -> None:
+def write_bvh(
+    path: str | os.PathLike, motion: Motion, rotation_order: str = "ZXY", precision: int | None = None
+) -> None:
     """Write ``motion`` as a BVH file, atomically.
 
     The root gets six channels (position, then rotation in ``rotation_order``), other joints
@@ -367,7 +369,8 @@ def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZX
     path : destination file.
     motion : the motion to write.
     rotation_order : Euler order of the rotation channels, three different axes, e.g. "ZXY".
-    precision : digits after the decimal point for offsets and channel values.
+    precision : digits after the decimal point for offsets and channel values; None: 6, and
+        more for a skeleton whose longest bone is under 1 unit (1e-6 of that bone at least).
 
     Raises
     ------
@@ -402,6 +405,9 @@ def write_bvh(path: str | os.PathLike, motion: Motion, rotation_order: str = "ZX
         if rotated[joint]:
             blocks.append(angles[:, angle_of_joint[joint]])
     table = np.concatenate(blocks, axis=1)
+    if precision is None:
+        longest = float(np.abs(skeleton.offsets[1:]).max(initial=0.0))
+        precision = max(6, 6 - int(np.floor(np.log10(longest)))) if longest > 0.0 else 6
     hierarchy = _hierarchy_text(skeleton, has_position, order, precision)
     with atomic_write(path, "w", encoding="utf-8", newline="\n") as handle:
         handle.write(hierarchy)

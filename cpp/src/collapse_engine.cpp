@@ -438,6 +438,12 @@ EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
     while (merged_into_[point] != point) point = merged_into_[point];
     level.vertex_map[v] = point_vertex[point];
   }
+  // A vertex that only a two-sided sheet's mirrors use maps where its front counterpart does.
+  for (size_t i = 0; i < prepared_.mirror_vertices.size(); i += 2) {
+    const auto mirror = static_cast<size_t>(prepared_.mirror_vertices[i]);
+    const auto front = static_cast<size_t>(prepared_.mirror_vertices[i + 1]);
+    if (level.vertex_map[mirror] < 0) level.vertex_map[mirror] = level.vertex_map[front];
+  }
   const size_t kept_count = level.kept_vertices.size();
   level.positions.resize(frame_count_ * kept_count * 3);
   for (size_t i = 0; i < kept_count; ++i) {

@@ -281,12 +281,13 @@ std::vector<int32_t> join_fans(const std::vector<int32_t>& corner_points, size_t
 
 // Step 2's repeats: faces with the points of a face before them in the same turn (sorted by
 // (rotated corners, face) inside buckets of their lowest point) leave the corner and face
-// lists; with `mirror_sources` (not null), so do faces with the points of a face before them in
-// the reverse turn, each recorded there (aligned with the faces that stay) as its earlier face's
-// mirror. Returns how many left as repeats.
+// lists; with `mirror_sources` and `mirror_vertices` (not null), so do faces with the points of
+// a face before them in the reverse turn, each recorded in the first (aligned with the faces
+// that stay) as its earlier face's mirror, and its corners' input vertices in the second, each
+// with the earlier face's at the same point. Returns how many left as repeats.
 size_t drop_repeated_faces(std::vector<int32_t>& corner_points, std::vector<int32_t>& corner_inputs,
                            std::vector<int32_t>& face_sources, size_t point_count,
-                           std::vector<int32_t>* mirror_sources) {
+                           std::vector<int32_t>* mirror_sources, std::vector<int32_t>* mirror_vertices) {
   using Rotated = std::pair<std::array<int32_t, 3>, int32_t>;  // canonical rotation, face
   const size_t face_count = face_sources.size();
   std::vector<Rotated> rotated(face_count);
@@ -322,8 +323,13 @@ size_t drop_repeated_faces(std::vector<int32_t>& corner_points, std::vector<int3
   bool any_mirror = false;
   for (size_t f = 0; f < mirror_of.size(); ++f) {
     if (mirror_of[f] < 0) continue;
-    mirror_input[static_cast<size_t>(mirror_of[f])] = face_sources[f];
+    const auto front = static_cast<size_t>(mirror_of[f]);
+    mirror_input[front] = face_sources[f];
     any_mirror = true;
+    for (size_t k = 0; k < 3; ++k)
+      for (size_t j = 0; j < 3; ++j)
+        if (corner_points[3 * f + k] == corner_points[3 * front + j])
+          mirror_vertices->insert(mirror_vertices->end(), {corner_inputs[3 * f + k], corner_inputs[3 * front + j]});
   }
   if (any_mirror) mirror_sources->clear();
   size_t kept = 0;
@@ -420,7 +426,8 @@ PreparedMesh prepare_mesh(const AnimatedMeshView& mesh, const WeldInput& input) 
   if (!simple) {
     const size_t before = out.face_sources.size();
     out.duplicate_faces = drop_repeated_faces(corner_points, corner_inputs, out.face_sources, out.point_source.size(),
-                                              input.mirror_two_sided ? &out.mirror_sources : nullptr);
+                                              input.mirror_two_sided ? &out.mirror_sources : nullptr,
+                                              input.mirror_two_sided ? &out.mirror_vertices : nullptr);
     out.mirrored_faces = before - out.duplicate_faces - out.face_sources.size();
     simple = pair_sides(corner_points, out.point_source.size(), partner);
   }

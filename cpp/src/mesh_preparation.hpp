@@ -50,6 +50,9 @@ struct PreparedMesh {
   // (M',) the input face that repeats each face in the reverse turn (WeldInput::mirror_two_sided),
   // -1 for none; empty when no face has one.
   std::vector<int32_t> mirror_sources;
+  // (K, 2) the mirrors' input vertices, each with the input vertex of its face's front at the
+  // same point: a vertex only mirrors use maps where its front counterpart maps.
+  std::vector<int32_t> mirror_vertices;
   // (M', 3) the corner whose side runs opposite corner c's (a corner's side runs from its point
   // to the next corner's in the face), -1 on a border: the surface's edges, as OpenMesh's
   // add_face pairs them. Empty when step 3 found an edge with several sides one way or an

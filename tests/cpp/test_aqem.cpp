@@ -378,6 +378,10 @@ TEST_CASE("aqem simplifies a two-sided sheet as its front and writes each level'
     CHECK(b.target_face_count == a.target_face_count + m);  // the surface's target and the mirrors
     CHECK(b.kept_vertices == a.kept_vertices);
     CHECK(b.positions == a.positions);
+    for (size_t v = 0; v < 81; ++v) {  // the back's own vertices map where the front's do
+      CHECK(b.vertex_map[v] == a.vertex_map[v]);
+      CHECK(b.vertex_map[v + 81] == a.vertex_map[v]);
+    }
     for (size_t f = 0; f < m; ++f) {
       CHECK(b.face_sources[f] == a.face_sources[f]);
       CHECK(b.face_sources[m + f] == a.face_sources[f] + 128);  // the reversed copy's own input face

@@ -55,6 +55,7 @@ Pieces engine_pieces(const animlod::fuzz::FuzzMesh& mesh, const animlod::AqemVer
   input.influence_count = data.influence_count;
   input.face_groups = data.face_groups;
   input.weld = weld;
+  input.mirror_two_sided = true;  // as simplify_animated prepares
   const animlod::detail::PreparedMesh prepared = animlod::detail::prepare_mesh(mesh.view(), input);
   // Faces joined across an edge of two points (the prepared faces are manifold): union-find.
   const size_t face_count = prepared.face_sources.size();
@@ -78,8 +79,13 @@ Pieces engine_pieces(const animlod::fuzz::FuzzMesh& mesh, const animlod::AqemVer
   for (size_t f = 0; f < face_count; ++f) {
     const auto [it, added] = number.emplace(find(f), static_cast<int32_t>(number.size()));
     const auto source = static_cast<size_t>(prepared.face_sources[f]);
-    pieces.of_face[source] = it->second;
-    for (size_t k = 0; k < 3; ++k) pieces.of_vertex[static_cast<size_t>(mesh.faces[3 * source + k])].push_back(it->second);
+    // A two-sided sheet's mirror lies in its front's piece.
+    const int32_t mirror = prepared.mirror_sources.empty() ? -1 : prepared.mirror_sources[f];
+    for (const size_t face : {source, static_cast<size_t>(mirror)}) {
+      if (face == static_cast<size_t>(-1)) continue;
+      pieces.of_face[face] = it->second;
+      for (size_t k = 0; k < 3; ++k) pieces.of_vertex[static_cast<size_t>(mesh.faces[3 * face + k])].push_back(it->second);
+    }
   }
   pieces.count = number.size();
   return pieces;

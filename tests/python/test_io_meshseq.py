@@ -85,32 +85,43 @@ def test_binary_big_endian_ply(tmp_path: Path) -> None:
     np.testing.assert_array_equal(read_faces, EXPECTED_FACES)
 
 
-def _polygon_ply(binary: bool, sizes: np.ndarray, corners: np.ndarray, vertices: np.ndarray) -> bytes:
+def _polygon_ply(binary: bool, sizes: np.ndarray, corners: np.ndarray, vertices: np.ndarray, uv: bool = False) -> bytes:
     """A PLY of polygons of the given sizes, each face with a uchar before its list and a float
-    after it, as exporters add flags and quality."""
+    after it, as exporters add flags and quality; with ``uv`` also a texcoord list (two floats a
+    corner, as MeshLab writes them) after the corners."""
     header = (
         f"ply\nformat {'binary_little_endian' if binary else 'ascii'} 1.0\nelement vertex {len(vertices)}\n"
         "property float x\nproperty float y\nproperty float z\n"
         f"element face {len(sizes)}\nproperty uchar flags\nproperty list uchar int vertex_indices\n"
-        "property float quality\nend_header\n"
+        + ("property list uchar float texcoord\n" if uv else "")
+        + "property float quality\nend_header\n"
     ).encode()
     rows = np.split(corners, np.cumsum(sizes)[:-1])
+    uvs = [np.linspace(0.0, 1.0, 2 * len(r), dtype=np.float32) for r in rows] if uv else [None] * len(rows)
     if not binary:
-        lines = [" ".join(map(str, v)) for v in vertices] + [f"7 {len(r)} {' '.join(map(str, r))} 0.5" for r in rows]
+        lines = [" ".join(map(str, v)) for v in vertices]
+        for r, w in zip(rows, uvs):
+            texcoord = f" {len(w)} {' '.join(map(str, w))}" if uv else ""
+            lines.append(f"7 {len(r)} {' '.join(map(str, r))}{texcoord} 0.5")
         return header + ("\n".join(lines) + "\n").encode()
-    faces = b"".join(b"\x07" + bytes([len(r)]) + r.astype("<i4").tobytes() + np.float32(0.5).tobytes() for r in rows)
+    faces = b"".join(
+        b"\x07" + bytes([len(r)]) + r.astype("<i4").tobytes()
+        + (bytes([len(w)]) + w.astype("<f4").tobytes() if uv else b"") + np.float32(0.5).tobytes()
+        for r, w in zip(rows, uvs)
+    )  # fmt: skip
     return header + vertices.astype("<f4").tobytes() + faces
 
 
-def test_binary_ply_with_mixed_polygons_reads_like_the_ascii_one(tmp_path: Path) -> None:
-    # Blender writes quads and triangles in one binary list; a row's place follows from the
-    # lengths of all rows before it.
+@pytest.mark.parametrize("uv", [False, True])
+def test_binary_ply_with_mixed_polygons_reads_like_the_ascii_one(tmp_path: Path, uv: bool) -> None:
+    # Blender writes quads and triangles in one binary list, MeshLab a texcoord list beside it;
+    # a row's place follows from the lengths of all rows before it.
     rng = np.random.default_rng(5)
     sizes = rng.integers(3, 6, 1000)
     vertices = rng.random((50, 3)).astype(np.float32)
     corners = rng.integers(0, 50, int(sizes.sum()))
-    ascii_ply = read_ply(_write(tmp_path / "a.ply", _polygon_ply(False, sizes, corners, vertices)))
-    binary = _write(tmp_path / "b.ply", _polygon_ply(True, sizes, corners, vertices))
+    ascii_ply = read_ply(_write(tmp_path / "a.ply", _polygon_ply(False, sizes, corners, vertices, uv)))
+    binary = _write(tmp_path / "b.ply", _polygon_ply(True, sizes, corners, vertices, uv))
     for got, expected in zip(read_ply(binary), ascii_ply):
         np.testing.assert_array_equal(got, expected)
     assert len(ascii_ply[1]) == int((sizes - 2).sum())

@@ -473,25 +473,23 @@ def _ply_property(path: Path, element: str, words: list[str]) -> _PlyProperty:
 _ElementValues = dict[str, "np.ndarray | tuple[np.ndarray, np.ndarray]"]
 
 
-def _single_list(path: Path, element: _PlyElement) -> int | None:
-    """Position of the element's list property (None if it has none); more than one is not supported."""
-    lists = [index for index, prop in enumerate(element.properties) if prop.count_code is not None]
-    if len(lists) > 1:
-        raise FormatError(path, f"element {element.name}", "more than one list property is not supported")
-    return lists[0] if lists else None
+def _list_positions(element: _PlyElement) -> list[int]:
+    """Positions of the element's list properties (MeshLab adds texcoord lists to faces)."""
+    return [index for index, prop in enumerate(element.properties) if prop.count_code is not None]
 
 
 def _read_ply_binary(
     path: Path, data: bytes, offset: int, elements: list[_PlyElement], byte_order: str
 ) -> dict[str, _ElementValues]:
-    """Read each element as one structured numpy array, or, where a list property's length
-    varies from row to row, with :func:`_varying_list`."""
+    """Read each element as one structured numpy array where its rows have one size (no list,
+    or one list of one length throughout); otherwise with :func:`_read_rows_of_lists`."""
     values: dict[str, _ElementValues] = {}
     for element in elements:
-        list_at = _single_list(path, element)
+        lists = _list_positions(element)
         fields = [(prop.name, byte_order + prop.type_code) for prop in element.properties]
         length = 0
-        if list_at is not None and element.count:
+        if len(lists) == 1 and element.count:
+            list_at = lists[0]
             prefix = np.dtype(fields[:list_at]).itemsize if list_at else 0
             count_type = np.dtype(byte_order + element.properties[list_at].count_code)
             if offset + prefix + count_type.itemsize > len(data):
@@ -501,55 +499,74 @@ def _read_ply_binary(
             if not 0 <= length <= len(data) - offset:
                 reason = f"list length {length} is negative or longer than the rest of the file"
                 raise FormatError(path, f"element {element.name} row 0", reason)
-        if list_at is not None:
-            list_prop = element.properties[list_at]
-            fields[list_at : list_at + 1] = [
+        if len(lists) == 1:
+            list_prop = element.properties[lists[0]]
+            fields[lists[0] : lists[0] + 1] = [
                 (_LIST_SIZE_FIELD, byte_order + list_prop.count_code),
                 (list_prop.name, byte_order + list_prop.type_code, (length,)),
             ]
         row = np.dtype(fields)
-        fits = offset + row.itemsize * element.count <= len(data)
+        fits = len(lists) <= 1 and offset + row.itemsize * element.count <= len(data)
         table = np.frombuffer(data, row, element.count, offset) if fits else None
-        if list_at is not None and (table is None or np.any(table[_LIST_SIZE_FIELD] != length)):
-            values[element.name], offset = _varying_list(path, data, offset, element, byte_order, list_at)
+        if lists and (table is None or np.any(table[_LIST_SIZE_FIELD] != length)):
+            values[element.name], offset = _read_rows_of_lists(path, data, offset, element, byte_order)
             continue
         if table is None:
             raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
         offset += row.itemsize * element.count
         values[element.name] = {prop.name: table[prop.name] for prop in element.properties if prop.count_code is None}
-        if list_at is not None:
+        for list_at in lists:
             name = element.properties[list_at].name
             values[element.name][name] = (np.full(element.count, length, dtype=np.int64), table[name].ravel())
     return values
 
 
-def _varying_list(
-    path: Path, data: bytes, offset: int, element: _PlyElement, byte_order: str, list_at: int
+def _read_rows_of_lists(
+    path: Path, data: bytes, offset: int, element: _PlyElement, byte_order: str
 ) -> tuple[_ElementValues, int]:
-    """A binary element whose list property's length varies from row to row (triangles and
-    quads, as Blender writes them), and the offset after it. A row starts where the one before
-    it ends, so every byte a row could start at is given the start of the row after it, and the
-    rows' starts follow by pointer doubling: log2(rows) numpy passes, no loop over the rows."""
+    """A binary element whose rows differ in size (lists of varying lengths: triangles and quads
+    as Blender writes them, MeshLab's texcoord lists), and the offset after it. A row starts
+    where the one before it ends, so every byte a row could start at is given the start of the
+    row after it, and the rows' starts follow by pointer doubling: log2(rows) numpy passes, no
+    loop over the rows."""
     props = element.properties
-    before = np.dtype([(prop.name, byte_order + prop.type_code) for prop in props[:list_at]])
-    after = np.dtype([(prop.name, byte_order + prop.type_code) for prop in props[list_at + 1 :]])
-    size_type = np.dtype(byte_order + props[list_at].count_code)
-    item_type = np.dtype(byte_order + props[list_at].type_code)
-    fixed = before.itemsize + size_type.itemsize + after.itemsize
-    candidates = len(data) - offset - fixed + 1  # bytes at which a row could still start
-    if candidates <= 0:
-        raise FormatError(path, f"element {element.name}", "file ends inside the element")
+    kinds = [(np.dtype(byte_order + p.count_code) if p.count_code else None, np.dtype(byte_order + p.type_code))
+             for p in props]  # fmt: skip
+    smallest = sum((count or item).itemsize for count, item in kinds)  # a row of empty lists
+    candidates = len(data) - offset - smallest + 1  # bytes at which a row could still start
+    if candidates <= 0 or not element.count:
+        if element.count:
+            raise FormatError(path, f"element {element.name}", "file ends inside the element")
+        return {p.name: (np.zeros(0, np.int64), np.zeros(0)) if p.count_code else np.zeros(0) for p in props}, offset
     raw = np.frombuffer(data, np.uint8, len(data) - offset, offset)
+    index = np.int32 if len(raw) < 2**31 - 1 else np.int64  # the byte-sized arrays in half the memory
 
     def read(at: np.ndarray, dtype: np.dtype) -> np.ndarray:  # a value of dtype at each byte offset
-        return raw[at[:, None] + np.arange(dtype.itemsize)].copy().view(dtype).ravel()
+        at = np.clip(at, 0, raw.size - dtype.itemsize)  # a start that is no row may point past the end
+        return raw[at[:, None] + np.arange(dtype.itemsize, dtype=index)].copy().view(dtype).ravel()
 
-    sizes_at = read(np.arange(candidates) + before.itemsize, size_type).astype(np.int64)
-    following = np.arange(candidates) + fixed + sizes_at * item_type.itemsize
+    Places = list[tuple[np.ndarray, "np.ndarray | None"]]
+
+    def walk(starts: np.ndarray, limit: int, record: bool) -> tuple[np.ndarray, Places]:
+        """Each row's end (``limit`` where it would end past it or has a negative length), and
+        with ``record`` per property where it starts and (lists) its length."""
+        cursor, places = starts.copy(), []
+        for count, item in kinds:
+            if count is None:
+                if record:
+                    places.append((cursor, None))
+                cursor = np.minimum(cursor + item.itemsize, limit).astype(starts.dtype)
+            else:
+                sizes = read(cursor, count).astype(np.int64)
+                if record:
+                    places.append((cursor + count.itemsize, sizes))
+                ahead = cursor + count.itemsize + np.maximum(sizes, 0) * item.itemsize
+                cursor = np.where(sizes < 0, limit, np.minimum(ahead, limit)).astype(starts.dtype)
+        return cursor, places
+
     # Past the last possible start, and a negative size, lead to a sink that leads to itself.
-    index = np.int32 if candidates < 2**31 - 1 else np.int64  # half the memory of the byte-sized arrays
-    jump = np.append(np.where((sizes_at >= 0) & (following < candidates), following, candidates), candidates)
-    jump = jump.astype(index)
+    following, _ = walk(np.arange(candidates, dtype=index), candidates, record=False)
+    jump = np.append(following, index(candidates))
     starts = np.zeros(element.count, np.int64)
     rows = np.arange(element.count)
     step = 0
@@ -558,20 +575,19 @@ def _varying_list(
         starts[odd] = jump[starts[odd]]
         jump = jump[jump]
         step += 1
-    if np.any(starts == candidates):
+    ends, places = walk(starts, len(raw) + 1, record=True)
+    if np.any(starts == candidates) or offset + int(ends[-1]) > len(data) or any(
+        sizes is not None and np.any(sizes < 0) for _, sizes in places
+    ):
         raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
-    sizes = sizes_at[starts]
-    end = int(starts[-1] + fixed + sizes[-1] * item_type.itemsize)
-    if offset + end > len(data):
-        raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
-    first_item = starts + before.itemsize + size_type.itemsize
-    within = np.arange(int(sizes.sum())) - np.repeat(np.cumsum(sizes) - sizes, sizes)
-    items = read(np.repeat(first_item, sizes) + within * item_type.itemsize, item_type)
-    element_values: _ElementValues = {props[list_at].name: (sizes, items)}
-    for row_start, layout in ((starts, before), (first_item + sizes * item_type.itemsize, after)):
-        for name in layout.names or ():
-            element_values[name] = read(row_start + layout.fields[name][1], layout.fields[name][0])
-    return element_values, offset + end
+    element_values: _ElementValues = {}
+    for prop, (_, item), (at, sizes) in zip(props, kinds, places):
+        if sizes is None:
+            element_values[prop.name] = read(at, item)
+            continue
+        within = np.arange(int(sizes.sum())) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+        element_values[prop.name] = (sizes, read(np.repeat(at, sizes) + within * item.itemsize, item))
+    return element_values, offset + int(ends[-1])
 
 
 def _read_ply_ascii(path: Path, body: bytes, elements: list[_PlyElement]) -> dict[str, _ElementValues]:
@@ -589,43 +605,47 @@ def _read_ply_ascii(path: Path, body: bytes, elements: list[_PlyElement]) -> dic
             raise FormatError(path, f"element {element.name}", reason)
         chosen = slice(first_row, first_row + element.count)
         starts, lengths = row_start[chosen], counts[rows[chosen]]
-        list_at = _single_list(path, element)
-        scalar_count = len(element.properties) - (list_at is not None)
         element_values: _ElementValues = {}
 
         def name_row(row: int, element: _PlyElement = element) -> str:
             return f"element {element.name} row {row}"
 
-        if list_at is None:
-            sizes = np.zeros(element.count, dtype=np.int64)
-        else:
-            # The list's length is read from the row, so the row must reach it first.
-            short = np.flatnonzero(lengths < scalar_count + 1)
+        # Property by property, each row's next token: a list's items push the rest right. A row
+        # must reach the next list's length (or its last scalar) before that length is known.
+        properties = element.properties
+        reach = [next((i - k + 1 for i in range(k, len(properties)) if properties[i].count_code), len(properties) - k)
+                 for k in range(len(properties))]  # fmt: skip
+        cursor, ends = starts.copy(), starts + lengths
+        for k, prop in enumerate(properties):
+            dtype = np.float64 if prop.type_code.startswith("f") else np.int64
+            short = np.flatnonzero(cursor + reach[k] > ends)
             if short.size:
                 row = short[0]
-                reason = f"has {lengths[row]} values, expected at least {scalar_count + 1}"
+                bound = "at least " if any(later.count_code for later in properties[k:]) else ""
+                reason = f"has {lengths[row]} values, expected {bound}{cursor[row] - starts[row] + reach[k]}"
                 raise FormatError(path, name_row(row), reason)
-            sizes = _parse_numbers(path, tokens[starts + list_at], np.int64, name_row)
-        negative = np.flatnonzero(sizes < 0)
-        if negative.size:
-            raise FormatError(path, name_row(negative[0]), f"list length {sizes[negative[0]]} is negative")
-        expected = scalar_count + sizes + (list_at is not None)
-        wrong = np.flatnonzero(lengths != expected)
+            if prop.count_code is None:
+                element_values[prop.name] = _parse_numbers(path, tokens[cursor], dtype, name_row)
+                cursor = cursor + 1
+                continue
+            sizes = _parse_numbers(path, tokens[cursor], np.int64, name_row)
+            negative = np.flatnonzero(sizes < 0)
+            if negative.size:
+                raise FormatError(path, name_row(negative[0]), f"list length {sizes[negative[0]]} is negative")
+            over = np.flatnonzero(cursor + 1 + sizes > ends)
+            if over.size:
+                row = over[0]
+                reason = f"has {lengths[row]} values, expected {cursor[row] + 1 + sizes[row] - starts[row]}"
+                raise FormatError(path, name_row(row), reason)
+            owner = np.repeat(np.arange(element.count), sizes)
+            items = tokens[np.repeat(cursor + 1 - (np.cumsum(sizes) - sizes), sizes) + np.arange(sizes.sum())]
+            parsed = _parse_numbers(path, items, dtype, lambda item, owner=owner: name_row(owner[item]))
+            element_values[prop.name] = (sizes, parsed)
+            cursor = cursor + 1 + sizes
+        wrong = np.flatnonzero(cursor != ends)
         if wrong.size:
             row = wrong[0]
-            raise FormatError(path, name_row(row), f"has {lengths[row]} values, expected {expected[row]}")
-        for index, prop in enumerate(element.properties):
-            dtype = np.float64 if prop.type_code.startswith("f") else np.int64
-            if prop.count_code is None:
-                # Scalars after the list are pushed right by the list's items.
-                column = starts + index + (sizes if list_at is not None and index > list_at else 0)
-                element_values[prop.name] = _parse_numbers(path, tokens[column], dtype, name_row)
-            else:
-                owner = np.repeat(np.arange(element.count), sizes)
-                item_start = np.repeat(starts + index + 1 - (np.cumsum(sizes) - sizes), sizes)
-                items = tokens[item_start + np.arange(sizes.sum())]
-                parsed = _parse_numbers(path, items, dtype, lambda item, owner=owner: name_row(owner[item]))
-                element_values[prop.name] = (sizes, parsed)
+            raise FormatError(path, name_row(row), f"has {lengths[row]} values, expected {cursor[row] - starts[row]}")
         values[element.name] = element_values
         first_row += element.count
     return values

@@ -4,8 +4,8 @@ Only geometry is read: OBJ ``v`` and ``f`` lines (1-based or negative indices, `
 corners, polygons fan-triangulated, ``#`` comments also at a line's end; other statements such
 as ``vt``, ``vn``, ``g``, ``usemtl`` are ignored) and PLY ``vertex`` x, y, z with the ``face``
 list ``vertex_indices`` (ascii, binary_little_endian, binary_big_endian; other elements and
-properties are skipped). Statements may be indented. Parsing works on the whole file's bytes with numpy: there is no
-Python loop over lines, vertices or faces.
+properties are skipped). Statements may be indented. Parsing works on the whole file's bytes
+with numpy: there is no Python loop over lines, vertices or faces.
 """
 
 from __future__ import annotations
@@ -322,6 +322,11 @@ def _check_face_indices(
         raise FormatError(path, element(int(owner[corner])), reason)
 
 
+def _within_runs(sizes: np.ndarray) -> np.ndarray:
+    """For runs of the given lengths back to back, each item's place in its run: 0, 1, .., n - 1."""
+    return np.arange(int(sizes.sum())) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+
+
 def _fan_triangulate(corners: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     """Triangles ``(sum(sizes - 2), 3) int32`` fanning each polygon from its first corner.
 
@@ -330,7 +335,7 @@ def _fan_triangulate(corners: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     first = np.cumsum(sizes) - sizes
     triangle_counts = sizes - 2
     polygon = np.repeat(np.arange(sizes.size), triangle_counts)
-    step = np.arange(triangle_counts.sum()) - np.repeat(np.cumsum(triangle_counts) - triangle_counts, triangle_counts)
+    step = _within_runs(triangle_counts)
     base = first[polygon]
     return np.stack([corners[base], corners[base + step + 1], corners[base + step + 2]], axis=1).astype(np.int32)
 
@@ -515,8 +520,8 @@ def _read_ply_binary(
             raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
         offset += row.itemsize * element.count
         values[element.name] = {prop.name: table[prop.name] for prop in element.properties if prop.count_code is None}
-        for list_at in lists:
-            name = element.properties[list_at].name
+        if lists:  # one, of one length
+            name = element.properties[lists[0]].name
             values[element.name][name] = (np.full(element.count, length, dtype=np.int64), table[name].ravel())
     return values
 
@@ -534,10 +539,10 @@ def _read_rows_of_lists(
              for p in props]  # fmt: skip
     smallest = sum((count or item).itemsize for count, item in kinds)  # a row of empty lists
     candidates = len(data) - offset - smallest + 1  # bytes at which a row could still start
-    if candidates <= 0 or not element.count:
-        if element.count:
-            raise FormatError(path, f"element {element.name}", "file ends inside the element")
+    if not element.count:
         return {p.name: (np.zeros(0, np.int64), np.zeros(0)) if p.count_code else np.zeros(0) for p in props}, offset
+    if candidates <= 0:
+        raise FormatError(path, f"element {element.name}", "file ends inside the element")
     raw = np.frombuffer(data, np.uint8, len(data) - offset, offset)
     index = np.int32 if len(raw) < 2**31 - 1 else np.int64  # the byte-sized arrays in half the memory
 
@@ -585,8 +590,8 @@ def _read_rows_of_lists(
         if sizes is None:
             element_values[prop.name] = read(at, item)
             continue
-        within = np.arange(int(sizes.sum())) - np.repeat(np.cumsum(sizes) - sizes, sizes)
-        element_values[prop.name] = (sizes, read(np.repeat(at, sizes) + within * item.itemsize, item))
+        items_at = np.repeat(at, sizes) + _within_runs(sizes) * item.itemsize
+        element_values[prop.name] = (sizes, read(items_at, item))
     return element_values, offset + int(ends[-1])
 
 
@@ -638,7 +643,7 @@ def _read_ply_ascii(path: Path, body: bytes, elements: list[_PlyElement]) -> dic
                 reason = f"has {lengths[row]} values, expected {cursor[row] + 1 + sizes[row] - starts[row]}"
                 raise FormatError(path, name_row(row), reason)
             owner = np.repeat(np.arange(element.count), sizes)
-            items = tokens[np.repeat(cursor + 1 - (np.cumsum(sizes) - sizes), sizes) + np.arange(sizes.sum())]
+            items = tokens[np.repeat(cursor + 1, sizes) + _within_runs(sizes)]
             parsed = _parse_numbers(path, items, dtype, lambda item, owner=owner: name_row(owner[item]))
             element_values[prop.name] = (sizes, parsed)
             cursor = cursor + 1 + sizes

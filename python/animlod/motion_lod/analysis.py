@@ -86,7 +86,8 @@ class MotionAnalysis:
 
 # Default of translating_joints: a translation whose range stays under 1 % of its bone is held.
 TRANSLATION_TOLERANCE = 1e-2
-# A bone shorter than this fraction of the figure has no direction: a joint at its parent's
+# A bone shorter than this fraction of the figure (its longest bone here, the key posture's
+# extent in the re-fit and the output skeleton) has no direction: a joint at its parent's
 # position. Float32 keys resolve ~1e-7 of a figure, and exporters write noise of that order on the
 # translation channels of such joints (a 1e-6 bone in random directions, held as a length, made
 # 131_01 with noise on its left hand's translation 18x slower to re-fit); real bones are over 1e-3.

@@ -29,8 +29,6 @@ from .. import rotations
 from .analysis import ZERO_LENGTH
 from .frozen import FrozenLevel
 
-# Key lengths below this fraction of the length scale count as zero-length ("coincident") pairs.
-_COINCIDENT = ZERO_LENGTH
 # A rigid group's child whose height over its base plane is below this fraction of its distance
 # to the parent (about 3 degrees) is held by its height (a flat quad), not by distances alone.
 _FLAT = 0.05
@@ -395,7 +393,7 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
     bones, siblings, quads, flat = [], [], [], []
     for parent in np.unique(level.kept_parent[kept]):
         group = [int(c) for c in kept if level.kept_parent[c] == parent and rigid[c]]
-        rigid_set = _rigid_set(int(parent), group, key, _COINCIDENT * scale)
+        rigid_set = _rigid_set(int(parent), group, key, ZERO_LENGTH * scale)
         bones += rigid_set[0]
         siblings += rigid_set[1]
         quads += [q for q in rigid_set[2] if abs(_volumes(key[None], np.array([q]))[0][0, 0]) > 1e-6 * scale**3]
@@ -403,7 +401,7 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
     pairs = np.array(bones + siblings, dtype=np.int64).reshape(-1, 2)
     is_bone = np.arange(pairs.shape[0]) < len(bones)
     lengths = np.linalg.norm(key[pairs[:, 0]] - key[pairs[:, 1]], axis=-1)
-    coincident = lengths <= _COINCIDENT * scale
+    coincident = lengths <= ZERO_LENGTH * scale
     quads_array = np.array(quads, dtype=np.int64).reshape(-1, 4)
     flat_array = np.array(flat, dtype=np.int64).reshape(-1, 4)
     base = np.cross(key[flat_array[:, 1]] - key[flat_array[:, 0]], key[flat_array[:, 2]] - key[flat_array[:, 0]])
@@ -412,12 +410,12 @@ def build_problem(level: FrozenLevel, weights: Weights | None = None) -> RefitPr
     children = skeleton.children()
     offset_length = np.linalg.norm(level.key_translations, axis=-1)
     for joint in np.flatnonzero(level.frozen):
-        if offset_length[joint] <= _COINCIDENT * scale:
+        if offset_length[joint] <= ZERO_LENGTH * scale:
             continue  # no parent bone, no angle
         triples += [
             (int(skeleton.parents[joint]), int(joint), child)
             for child in children[joint]
-            if rigid[child] and offset_length[child] > _COINCIDENT * scale
+            if rigid[child] and offset_length[child] > ZERO_LENGTH * scale
         ]
     triples_array = np.array(triples, dtype=np.int64).reshape(-1, 3)
     cosines, _ = _cosines(key[None], triples_array)

@@ -115,25 +115,34 @@ def add_animation(
     return builder.append("animations", animation)
 
 
+def influence_sets(joints: np.ndarray, weights: np.ndarray) -> dict[str, np.ndarray]:
+    """``joints, weights (V, K)`` as glTF's JOINTS_n (uint16) / WEIGHTS_n (float32) columns of 4,
+    K padded with zero weights to a whole number of sets, in the order a primitive lists them."""
+    sets = -(-joints.shape[1] // INFLUENCES_PER_SET)
+    pad = ((0, 0), (0, sets * INFLUENCES_PER_SET - joints.shape[1]))
+    joints = np.pad(joints, pad).astype(np.uint16)
+    weights = np.pad(weights, pad).astype(np.float32)
+    columns = {}
+    for k in range(sets):
+        taken = slice(k * INFLUENCES_PER_SET, (k + 1) * INFLUENCES_PER_SET)
+        columns[f"JOINTS_{k}"] = joints[:, taken]
+        columns[f"WEIGHTS_{k}"] = weights[:, taken]
+    return columns
+
+
 def skin_attributes(
     builder: GlbBuilder, joints: np.ndarray, weights: np.ndarray, joint_count: int, joint_dtype: type | None = None
 ) -> dict[str, int]:
-    """JOINTS_n / WEIGHTS_n accessors for ``joints, weights (V, K)``, K padded to sets of 4.
+    """JOINTS_n / WEIGHTS_n accessors for ``joints, weights (V, K)`` (:func:`influence_sets`).
 
     ``joint_dtype`` (uint8 or uint16) defaults to the smallest that holds ``joint_count`` joints.
     """
-    influence_sets = -(-joints.shape[1] // INFLUENCES_PER_SET)
-    pad = ((0, 0), (0, influence_sets * INFLUENCES_PER_SET - joints.shape[1]))
     if joint_dtype is None or (joint_dtype is np.uint8 and joint_count > 256):
         joint_dtype = np.uint8 if joint_count <= 256 else np.uint16
-    joints = np.pad(joints, pad).astype(joint_dtype)
-    weights = np.pad(weights, pad).astype(np.float32)
-    attributes = {}
-    for k in range(influence_sets):
-        columns = slice(k * INFLUENCES_PER_SET, (k + 1) * INFLUENCES_PER_SET)
-        attributes[f"JOINTS_{k}"] = builder.add(joints[:, columns], ARRAY_BUFFER)
-        attributes[f"WEIGHTS_{k}"] = builder.add(weights[:, columns], ARRAY_BUFFER)
-    return attributes
+    return {
+        name: builder.add(values.astype(joint_dtype) if name.startswith("JOINTS_") else values, ARRAY_BUFFER)
+        for name, values in influence_sets(joints, weights).items()
+    }
 
 
 def index_accessor(builder: GlbBuilder, faces: np.ndarray, vertex_count: int) -> int:

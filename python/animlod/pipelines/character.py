@@ -42,7 +42,7 @@ from ..io.gltf_lod import (
     screen_coverages,
 )
 from ..io.gltf_skin import SkinRig
-from ..io.gltf_write import add_animation, add_skeleton, add_skin
+from ..io.gltf_write import add_animation, add_skeleton, add_skin, influence_sets
 from ..metrics import hausdorff_distances
 from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
@@ -311,12 +311,7 @@ def _reposed(
                 values = attributes[name].copy()
                 values[:, :3] = turned / np.where(length > 0.0, length, 1.0)
                 attributes[name] = values.astype(np.float32)
-        sets = -(-reduced.joints.shape[1] // 4)
-        pad = ((0, 0), (0, 4 * sets - reduced.joints.shape[1]))
-        joints, weights = np.pad(reduced.joints[vertices], pad), np.pad(reduced.weights[vertices], pad)
-        for s in range(sets):
-            attributes[f"JOINTS_{s}"] = joints[:, 4 * s : 4 * s + 4].astype(np.uint16)
-            attributes[f"WEIGHTS_{s}"] = weights[:, 4 * s : 4 * s + 4].astype(np.float32)
+        attributes.update(influence_sets(reduced.joints[vertices], reduced.weights[vertices]))
         targets = [dict(target) for target in primitive.targets]
         if skinned.morph_targets is not None:  # world-space deltas, like the positions
             for t, target in enumerate(targets):

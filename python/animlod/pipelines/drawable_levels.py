@@ -29,6 +29,7 @@ from ..aqem import Preparation, SimplifiedLevel, simplify_animated
 from ..io.gltf_drawable import Clip, Drawable
 from ..io.gltf_lod import PrimitiveArrays
 from ..io.gltf_mesh import PrimitiveGeometry, transform_points
+from ..io.gltf_write import influence_sets
 from ..metrics import hausdorff_distances
 from ..model import AnimatedMesh, SkinnedMesh, spread_frames
 from ..options import AqemOptions
@@ -437,15 +438,7 @@ def _skin_columns(drawable: Drawable, joints: np.ndarray, weights: np.ndarray) -
     rig = drawable.rig
     slot_of_joint = np.empty(len(rig.remap), np.int64)
     slot_of_joint[rig.remap] = np.arange(len(rig.remap))
-    slots = np.where(weights > 0.0, slot_of_joint[joints], 0)
-    sets = -(-joints.shape[1] // 4)
-    pad = ((0, 0), (0, 4 * sets - joints.shape[1]))
-    slots, weights = np.pad(slots, pad), np.pad(weights, pad).astype(np.float32)
-    out = {}
-    for s in range(sets):
-        out[f"JOINTS_{s}"] = slots[:, 4 * s : 4 * s + 4].astype(np.uint16)
-        out[f"WEIGHTS_{s}"] = weights[:, 4 * s : 4 * s + 4]
-    return out
+    return influence_sets(np.where(weights > 0.0, slot_of_joint[joints], 0), weights)
 
 
 def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: int) -> None:

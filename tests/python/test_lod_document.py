@@ -523,8 +523,12 @@ def test_levels_store_colours_texture_coordinates_and_feature_ids_as_the_input_d
         primitive.attributes.COLOR_0 = append_accessor(gltf, blob, np.rint(255 * shade).astype(np.uint8), "VEC4", True)
         uv = np.rint(65535 * shade[:, :2]).astype(np.uint16)
         primitive.attributes.TEXCOORD_1 = append_accessor(gltf, blob, uv, "VEC2", True)
-        feature = (positions[:, 0] > 0.0).astype(np.uint16)[:, None]  # left and right
+        # Six bands across the figure, their IDs out of order: any blend of two makes an ID
+        # the input does not have.
+        bands = np.digitize(positions[:, 1], np.quantile(positions[:, 1], [0.2, 0.4, 0.5, 0.6, 0.8]))
+        feature = np.array([0, 7, 3, 12, 1, 9], np.uint16)[bands][:, None]
         primitive.attributes._FEATURE_ID_0 = append_accessor(gltf, blob, feature, "SCALAR")
+        primitive.attributes._BATCHID = append_accessor(gltf, blob, feature.astype(np.float32), "SCALAR")
 
     source = edit_glb(humanoid_glb, tmp_path / "quantised.glb", quantised)
     report = simplify_document(source, tmp_path / "quantised_lod.glb", [0.5, 0.1], **QUICK)
@@ -536,7 +540,8 @@ def test_levels_store_colours_texture_coordinates_and_feature_ids_as_the_input_d
         for name, (component, normalized) in expected.items():
             accessor = doc.json["accessors"][attributes[name]]
             assert (accessor["componentType"], accessor.get("normalized", False)) == (component, normalized), name
-        assert set(np.unique(doc.accessor(attributes["_FEATURE_ID_0"], "f"))) <= {0, 1}
+        for name in ("_FEATURE_ID_0", "_BATCHID"):  # each vertex keeps an ID of the input's
+            assert set(np.unique(doc.accessor(attributes[name], name))) <= {0, 7, 3, 12, 1, 9}, name
         assert np.all(doc.accessor(attributes["COLOR_0"], "c")[:, 3] == 1.0)
 
 

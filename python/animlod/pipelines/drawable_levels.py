@@ -335,12 +335,13 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
             continue
         used, local_faces = np.unique(faces, return_inverse=True)
         local_faces = local_faces.reshape(-1, 3)
-        # With rebuilt normals, the input vertices kept (see _level_column).
-        wedges = level.kept_vertices[used] - geometry.vertex_starts[k] if layout.crease[k] is not None else None
+        kept = level.kept_vertices[used] - geometry.vertex_starts[k]  # the input vertices kept
+        rebuilt = layout.crease[k] is not None
         attributes = {"POSITION": transform_points(to_local, rest[used]).astype(np.float32)}
         for name, values in source.attributes.items():
             if name in layout.columns:
-                attributes[name] = _level_column(level, used, layout.columns[name][0], values, name, wedges)
+                first = layout.columns[name][0]
+                attributes[name] = _level_column(level, used, first, values, kept if _carried(name, rebuilt) else None)
         _tidy_directions(attributes)
         if skinned is not None:
             attributes.update(_skin_columns(drawable, skinned.joints[used], skinned.weights[used]))
@@ -351,7 +352,8 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
                 if name == "POSITION":
                     arrays[name] = (deltas[t][used] @ to_local[:3, :3].T).astype(np.float32)
                 else:
-                    arrays[name] = _level_column(level, used, layout.target_columns[t][name][0], values, name, wedges)
+                    first = layout.target_columns[t][name][0]
+                    arrays[name] = _level_column(level, used, first, values, kept if _carried(name, rebuilt) else None)
             targets.append(arrays)
         primitive = PrimitiveArrays(source.index, attributes, local_faces, targets, used)
         if layout.crease[k] is not None:
@@ -360,15 +362,22 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
     return DrawableLevel(level, primitives, skinned, rest, deltas)
 
 
+def _carried(name: str, rebuilt: bool) -> bool:
+    """Whether a level's vertex takes attribute ``name`` from the input vertex it keeps rather
+    than the collapses' blend: application attributes (``_``-prefixed, such as feature IDs, whose
+    blend means nothing: IDs 0 and 7 would give 3.5) and, with rebuilt normals, normals, tangents
+    and their morph deltas, which the matrix does not carry (_attribute_matrix)."""
+    return name.startswith("_") or (rebuilt and name in _NORMAL_ATTRIBUTES)
+
+
 def _level_column(
-    level: SimplifiedLevel, used: np.ndarray, first: int, values: np.ndarray, name: str, wedges: np.ndarray | None
+    level: SimplifiedLevel, used: np.ndarray, first: int, values: np.ndarray, kept: np.ndarray | None
 ) -> np.ndarray:
     """The values of the level's vertices ``used`` of an attribute or morph delta (the input's
-    ``values``) that starts at column ``first`` of the matrix. With rebuilt normals (``wedges``:
-    the input vertices kept), a normal, a tangent or a morph delta of either is the kept input
-    vertex's own: the matrix does not carry them (_attribute_matrix)."""
-    if wedges is not None and name in _NORMAL_ATTRIBUTES:
-        return values[wedges].astype(np.float32)
+    ``values``) that starts at column ``first`` of the matrix: the kept input vertices' own
+    (``kept``, see :func:`_carried`) or the collapses' blend."""
+    if kept is not None:
+        return values[kept].astype(np.float32)
     return level.attributes[used, first : first + values.shape[1]].copy()
 
 

@@ -62,6 +62,7 @@ consumer-test: cpp-test
 
 lint: python-package
 	$(VENV)/bin/ruff check python tests bench
+	$(VENV)/bin/ruff format --check python tests bench
 
 # The crowd smoke test (tests/python/test_crowd.py) runs the binary under xvfb-run.
 CROWD_BIN := $(CURDIR)/$(CPP_BUILD)/bench/crowd/animlod_crowd

@@ -152,8 +152,17 @@ def selection(chain, animation, repeats: int, error_frames: int):
     print_table(
         "Runtime selection from the view distance (head radius "
         f"{radius:.3f} m; level errors {', '.join(f'{1000 * e:.2f}' for e in geometry_errors)} mm)",
-        ["distance (m)", "coverage", "pixels", "geometry level", "triangles", "animation level", "frame step",
-         "frames computed", "animation (us / shown frame)"],
+        [
+            "distance (m)",
+            "coverage",
+            "pixels",
+            "geometry level",
+            "triangles",
+            "animation level",
+            "frame step",
+            "frames computed",
+            "animation (us / shown frame)",
+        ],
         rows,
     )
 

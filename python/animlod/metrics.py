@@ -45,7 +45,6 @@ class SurfaceError:
     def relative_rms(self) -> np.ndarray:
         return _relative(self.rms, self.diagonal)
 
-
     def summary(self) -> dict[str, float]:
         """Mean and max over frames of both errors, relative to the bounding-box diagonal."""
         return {

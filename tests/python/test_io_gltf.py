@@ -733,6 +733,7 @@ def test_primitives_sharing_one_vertex_buffer_keep_only_the_vertices_they_use(ch
     assert len(geometry.primitives) == 3
     for primitive in geometry.primitives:
         assert np.unique(primitive.faces).size == primitive.vertex_count  # nothing unused
+
     # The same triangles at the same positions, with the same skin, as the one primitive had.
     def corners(g):
         rows = np.concatenate([g.positions[g.faces], g.weights[g.faces]], axis=2).reshape(len(g.faces), -1)

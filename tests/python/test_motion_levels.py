@@ -214,8 +214,10 @@ def test_cli_a_skeleton_of_zero_length_bones_writes_one_level(tmp_path, capsys) 
     out = tmp_path / "out"
     assert main(["motion", str(source), "-o", str(out)]) == 0
     captured = capsys.readouterr()
-    assert "nothing can freeze (2 joints, all kept: root, every bone of zero length (joint positions show no " \
+    assert (
+        "nothing can freeze (2 joints, all kept: root, every bone of zero length (joint positions show no "
         "rotation))" in captured.err
+    )
     assert sorted(p.name for p in out.iterdir()) == ["clip_lod0.bvh", "clip_motion_lod.json"]
 
 

@@ -25,8 +25,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("input", nargs="?", help="a .glb/.gltf with morph targets or a folder of poses "
                         "(default: the procedural face)")  # fmt: skip
     parser.add_argument("-o", "--output", required=True, help="folder to write the levels into (created if missing)")
-    parser.add_argument("--ratio", type=float, nargs="+", help="triangle fractions of the levels after the full face "
-                        "(default: the paper's 1533/2313 and 357/2313 for the procedural face; 0.5 0.25 0.1 else)")
+    parser.add_argument(
+        "--ratio",
+        type=float,
+        nargs="+",
+        help="triangle fractions of the levels after the full face "
+        "(default: the paper's 1533/2313 and 357/2313 for the procedural face; 0.5 0.25 0.1 else)",
+    )
     parser.add_argument("--faces", type=int, nargs="+", help="triangle counts of the levels instead of --ratio")
     parser.add_argument("--targets", type=float, nargs="+", metavar="FRACTION",
                         help="blendshape faces: fraction of morph targets kept at each level, the full face included "
@@ -36,8 +41,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--expression", help="expression (procedural face) or morph target to show with --plot")
     parser.add_argument("--plot", action="store_true", help="write a PNG of every level showing one expression")
     parser.add_argument("--repeats", type=int, default=3, help="timing runs per frame; the fastest is kept")
-    parser.add_argument("--error-frames", type=int, default=24,
-                        help="animation frames the surface error is measured on, evenly spaced (default 24)")
+    parser.add_argument(
+        "--error-frames",
+        type=int,
+        default=24,
+        help="animation frames the surface error is measured on, evenly spaced (default 24)",
+    )
     parser.set_defaults(run=run)
 
 

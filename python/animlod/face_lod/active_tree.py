@@ -24,7 +24,7 @@ class Transition:
 
     @property
     def kind(self) -> str:
-        """"shrink", "expand" or "none"."""
+        """ "shrink", "expand" or "none"."""
         if self.deactivated:
             return "shrink"
         return "expand" if self.activated else "none"

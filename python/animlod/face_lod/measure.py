@@ -83,7 +83,7 @@ def time_animators(animators: list[LevelAnimator], intensities: np.ndarray, repe
 
 
 def lattice_summary(animator: LevelAnimator) -> str:
-    """"9x27 + 8x8" for 9 lattices of 27 control points and 8 of 8; "-" when none."""
+    """ "9x27 + 8x8" for 9 lattices of 27 control points and 8 of 8; "-" when none."""
     if not animator.animates:
         return "-"
     counts = np.prod(animator.sizes, axis=1)
@@ -159,8 +159,17 @@ def measure_chain(
     levels = range(len(chain.geometry))
     times = time_animators([chain.animator(g) for g in levels], animation.intensities, repeats)
     return [
-        measure_level(chain, g, chain.geometry[g].animation_floor, animation, reference, repeats, samples,
-                      error_frames, times=times[g])  # fmt: skip
+        measure_level(
+            chain,
+            g,
+            chain.geometry[g].animation_floor,
+            animation,
+            reference,
+            repeats,
+            samples,
+            error_frames,
+            times=times[g],
+        )  # fmt: skip
         for g in levels
     ]
 

@@ -100,9 +100,7 @@ class FaceRegions:
         try:
             return self.names.index(name)
         except ValueError:
-            raise ValueError(
-                f"{element}: no region named {name!r}; the face has {', '.join(self.names)}"
-            ) from None
+            raise ValueError(f"{element}: no region named {name!r}; the face has {', '.join(self.names)}") from None
 
     def indices(self, names: Iterable[str], element: str = "face") -> np.ndarray:
         """(k,) int32 indices of ``names``, each checked."""

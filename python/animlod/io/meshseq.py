@@ -581,8 +581,10 @@ def _read_rows_of_lists(
         jump = jump[jump]
         step += 1
     ends, places = walk(starts, len(raw) + 1, record=True)
-    if np.any(starts == candidates) or offset + int(ends[-1]) > len(data) or any(
-        sizes is not None and np.any(sizes < 0) for _, sizes in places
+    if (
+        np.any(starts == candidates)
+        or offset + int(ends[-1]) > len(data)
+        or any(sizes is not None and np.any(sizes < 0) for _, sizes in places)
     ):
         raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
     element_values: _ElementValues = {}

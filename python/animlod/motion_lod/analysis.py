@@ -115,9 +115,7 @@ def translating_joints(motion: Motion, tolerance: float = TRANSLATION_TOLERANCE)
     return moving
 
 
-def child_bones(
-    motion: Motion, frames: np.ndarray, look_through: bool = False
-) -> tuple[np.ndarray, np.ndarray]:
+def child_bones(motion: Motion, frames: np.ndarray, look_through: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Every joint's bones as seen from its parent's frame.
 
     Returns ``owners (B,)`` (the joint ``j`` each bone hangs from) and ``vectors (n, B, 3)`` at

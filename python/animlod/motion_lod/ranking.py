@@ -64,9 +64,7 @@ def rotation_variance(motion: Motion, frames: np.ndarray) -> np.ndarray:
     return np.mean((2.0 * np.arccos(cosine)) ** 2, axis=0)
 
 
-def cumulative_scores(
-    motion: Motion, key_frames: np.ndarray, frames: np.ndarray, candidates: np.ndarray
-) -> np.ndarray:
+def cumulative_scores(motion: Motion, key_frames: np.ndarray, frames: np.ndarray, candidates: np.ndarray) -> np.ndarray:
     """Step at which the ``cumulative`` ranking freezes each candidate, ``(J,)`` (inf for others).
 
     Freezing joint j at its key frame's local transform moves j and every point below it by one

@@ -181,13 +181,13 @@ def mpa_fields(face: FaceModel) -> dict[str, tuple[list[str], Field]]:
         ),
         "open_jaw": (
             ["jaw", "lip_lower", "teeth_lower", "mouth", "cheek_left", "cheek_right"],
-            lambda p: _smoothstep((lip_line + 0.004 - p[:, 1]) / 0.012)[:, None]
-            * _rotation(p, hinge, side, 0.25),
+            lambda p: _smoothstep((lip_line + 0.004 - p[:, 1]) / 0.012)[:, None] * _rotation(p, hinge, side, 0.25),
         ),
         "smile": (
             mouth_regions,
-            lambda p: pair(p, corners, (0.016, 0.016, 0.05))[:, None]
-            * (0.004 * outward(p) + 0.004 * up - 0.001 * forward),
+            lambda p: (
+                pair(p, corners, (0.016, 0.016, 0.05))[:, None] * (0.004 * outward(p) + 0.004 * up - 0.001 * forward)
+            ),
         ),
         "frown": (mouth_regions, lambda p: -0.004 * pair(p, corners, (0.014, 0.014, 0.05))[:, None] * up),
         "stretch_lips": (
@@ -196,8 +196,10 @@ def mpa_fields(face: FaceModel) -> dict[str, tuple[list[str], Field]]:
         ),
         "pucker_lips": (
             ["mouth", "lip_upper", "lip_lower", "jaw", "cheek_left", "cheek_right"],
-            lambda p: _bump(p, mouth, (0.03, 0.018, 0.05))[:, None] * (0.005 * forward)
-            - 0.003 * pair(p, corners, (0.015, 0.015, 0.05))[:, None] * outward(p),
+            lambda p: (
+                _bump(p, mouth, (0.03, 0.018, 0.05))[:, None] * (0.005 * forward)
+                - 0.003 * pair(p, corners, (0.015, 0.015, 0.05))[:, None] * outward(p)
+            ),
         ),
         "raise_upper_lip": (
             ["lip_upper", "mouth", "nose"],
@@ -212,8 +214,15 @@ def mpa_fields(face: FaceModel) -> dict[str, tuple[list[str], Field]]:
             lambda p: 0.006 * pair(p, cheeks, (0.02, 0.02, 0.05))[:, None] * (0.7 * outward(p) + 0.7 * forward),
         ),
         "raise_cheeks": (
-            ["cheek_left", "cheek_right", "zygomatic_left", "zygomatic_right", "eyelid_lower_left",
-             "eyelid_lower_right", "mouth"],
+            [
+                "cheek_left",
+                "cheek_right",
+                "zygomatic_left",
+                "zygomatic_right",
+                "eyelid_lower_left",
+                "eyelid_lower_right",
+                "mouth",
+            ],
             lambda p: 0.003 * pair(p, zygos, (0.022, 0.02, 0.05))[:, None] * up,
         ),  # fmt: skip
         "wrinkle_nose": (

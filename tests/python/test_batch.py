@@ -287,7 +287,7 @@ def test_spec_forms_and_their_errors(library, tmp_path):
         path.write_text(text)
         return path
 
-    bar = library / "bar.npz"
+    bar, arm = library / "bar.npz", library / "motions" / "arm.bvh"
     cases = [
         (f'[[assets]]\ninput = "{bar}"\nname = "a"\n[[assets]]\ninput = "{bar}"\nname = "a"\n', "given to both"),
         (f'[[assets]]\ninput = "{bar}"\nname = "../a"\n', "relative path without '.' parts"),
@@ -297,6 +297,10 @@ def test_spec_forms_and_their_errors(library, tmp_path):
         (f'[defaults]\ninput = "{bar}"\n[[assets]]\ninput = "{bar}"\n', "defaults.input: belongs to an asset"),
         (f'[[assets]]\ninput = "{bar}"\nratios = [0.5, "x"]\n', "in the list: expected a number"),
         ("[[assets]\n", "not valid TOML"),
+        # Options whose default is None are checked against their annotation; callbacks are no options.
+        (f'[[assets]]\ninput = "{arm}"\nlevels = "eight"\n', "option 'levels': expected a whole number, got 'eight'"),
+        (f'[[assets]]\ninput = "{arm}"\nclip = 1.5\n', "option 'clip': expected a whole number or a string"),
+        (f'[[assets]]\ninput = "{arm}"\non_choice = "print"\n', "option 'on_choice': unknown for job motion"),
     ]
     for text, message in cases:
         with pytest.raises(SpecError, match=re.escape(message)):

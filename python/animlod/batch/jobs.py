@@ -13,18 +13,30 @@ step.
 
 from __future__ import annotations
 
+import collections.abc
 import importlib
 import inspect
 import math
+import types
+import typing
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 # The job an input gets when the spec names none, by input kind (animlod.io.detect.input_kind).
 DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "bvh": "motion"}
 # Keyword arguments a manifest never sets: the runner owns progress, and a batch spreads its
-# work over assets (one core each), not over the processes of one asset.
+# work over assets (one core each), not over the processes of one asset. Callbacks (parameters
+# annotated Callable) are left out too.
 # A pipeline's settings object is given by its fields (DrawableSettings, listed as a source).
-_RESERVED = frozenset({"source", "output", "progress", "workers", "on_level", "on_note", "settings", "aqem"})
+_RESERVED = frozenset({"source", "output", "progress", "workers", "settings", "aqem"})
+
+
+@dataclass(frozen=True)
+class _OneOf:
+    """An option whose default is None: a value of each plain type its annotation allows
+    (``int | str | None`` -> ``(0, "")``), to check values against as against a default."""
+
+    exemplars: tuple
 
 
 @dataclass(frozen=True)
@@ -126,6 +138,14 @@ def _type_problem(value: object, default: object) -> str | None:
     """What is wrong with ``value`` for an option whose default is ``default`` (None if nothing)."""
     if default is None or default is inspect.Parameter.empty:
         return None
+    if isinstance(default, _OneOf):
+        problems = [_type_problem(value, exemplar) for exemplar in default.exemplars]
+        if value is None or None in problems:
+            return None
+        if len(problems) == 1:
+            return problems[0]
+        expected = " or ".join(problem.removeprefix("expected ").split(", got ")[0] for problem in problems)
+        return f"expected {expected}, got {value!r}"
     if isinstance(default, bool):
         return None if isinstance(value, bool) else f"expected true or false, got {value!r}"
     if isinstance(default, int):
@@ -153,19 +173,43 @@ def _keywords(function: Callable) -> dict[str, object] | None:
     """Keyword parameters of ``function`` (name -> default) but the reserved ones; None when it
     takes ``**kwargs`` (anything goes)."""
     accepted = {}
-    for parameter in inspect.signature(function).parameters.values():
+    for parameter in inspect.signature(function, eval_str=True).parameters.values():
         if parameter.kind is inspect.Parameter.VAR_KEYWORD:
             if function.__module__.startswith("animlod."):
                 continue  # the pipeline's AQEM keywords: listed by the AqemOptions source
             return None
         if parameter.kind in (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.POSITIONAL_ONLY):
             continue
-        if parameter.name in _RESERVED or parameter.name.startswith("_"):
+        alternatives = _alternatives(parameter.annotation)
+        callback = any(typing.get_origin(kind) is collections.abc.Callable for kind in alternatives)
+        if parameter.name in _RESERVED or parameter.name.startswith("_") or callback:
             continue
         if parameter.default is inspect.Parameter.empty and parameter.kind is not inspect.Parameter.KEYWORD_ONLY:
             continue  # the positional inputs (source, output, mesh)
-        accepted[parameter.name] = parameter.default
+        default = parameter.default
+        if default is None:
+            exemplars = [_exemplar(kind) for kind in alternatives if kind is not type(None)]
+            default = _OneOf(tuple(exemplars)) if exemplars and None not in exemplars else None
+        accepted[parameter.name] = default
     return accepted
+
+
+def _alternatives(annotation: object) -> tuple:
+    """The types of a union annotation (``int | None`` -> ``(int, NoneType)``), else itself."""
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        return typing.get_args(annotation)
+    return (annotation,)
+
+
+def _exemplar(annotation: object) -> object:
+    """A value of the plain type ``annotation`` (a number, a string, a list of them) to check
+    values against; None for any other type, whose values are not checked."""
+    if annotation in (bool, int, float, str):
+        return annotation()
+    if typing.get_origin(annotation) in (list, tuple, collections.abc.Sequence):
+        items = [_exemplar(item) for item in typing.get_args(annotation) if item is not Ellipsis]
+        return [items[0]] if items and items[0] is not None else []
+    return None
 
 
 def _option_fields(options_type: type) -> dict[str, object]:

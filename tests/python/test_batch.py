@@ -17,9 +17,9 @@ pytest.importorskip("pyarrow")
 from animlod import Motion, Skeleton, rotations, synth
 from animlod.batch import BatchProgress, SpecError, connect, read_catalogue, read_spec, run_batch
 from animlod.batch.jobs import find_job
-from animlod.batch.outputs import STATE
 from animlod.cli import main
 from animlod.io import write_bvh, write_glb
+from animlod.io.detect import BATCH_STATE
 from animlod.io.meshseq import write_obj, write_sequence
 from animlod.io.npz import write_npz
 from animlod.pipelines import simplify_asset
@@ -108,7 +108,7 @@ def test_outputs_equal_the_direct_pipeline_and_broken_asset_is_reported(client, 
     assert broken["status"] == "failed"
     assert broken["error"]["file"].endswith("broken.glb") and broken["error"]["element"] and broken["error"]["reason"]
     assert not (tmp_path / "out" / "broken").exists()
-    assert list((tmp_path / "out" / STATE / "staging").iterdir()) == []
+    assert list((tmp_path / "out" / BATCH_STATE / "staging").iterdir()) == []
 
     rows = read_catalogue(result.catalogue).to_pylist()
     failed = [row for row in rows if row["status"] == "failed"]
@@ -305,3 +305,36 @@ def test_spec_forms_and_their_errors(library, tmp_path):
     for text, message in cases:
         with pytest.raises(SpecError, match=re.escape(message)):
             read_spec(manifest(text))
+
+
+def test_folder_scan_names_what_a_studio_library_holds(tmp_path):
+    # read_spec looks at names only, so placeholder bytes stand for the models.
+    lib = tmp_path / "lib"
+    for name in ("a.glb", "take[1].glb", "hero.glb", "hero/walk.bvh", "mixed/Stork.glb", "mixed/prop.obj"):
+        (lib / name).parent.mkdir(parents=True, exist_ok=True)
+        (lib / name).write_bytes(b"x")
+    (lib / "._a.glb").write_bytes(b"\x00\x05\x16\x07")  # a macOS resource fork
+    (lib / ".cache").mkdir()
+    (lib / ".cache" / "b.glb").write_bytes(b"x")
+    (lib / "props").mkdir()
+    (lib / "props" / "link.glb").symlink_to(lib / "a.glb")
+    (lib / "dangling.glb").symlink_to(lib / "nowhere.glb")
+    (lib / "loop1.glb").symlink_to(lib / "loop2.glb")
+    (lib / "loop2.glb").symlink_to(lib / "loop1.glb")
+    (lib / "_lod" / BATCH_STATE).mkdir(parents=True)  # an earlier batch's output inside the library
+    (lib / "_lod" / "a" / "a_lod.glb").parent.mkdir()
+    (lib / "_lod" / "a" / "a_lod.glb").write_bytes(b"x")
+
+    found = {asset.name: (Path(asset.input).relative_to(lib).as_posix(), asset.kind) for asset in read_spec(lib)}
+    assert found == {
+        "a": ("a.glb", "gltf"),
+        "hero_glb": ("hero.glb", "gltf"),  # beside a folder of clips: its own name would hold them
+        "take[1]": ("take[1].glb", "gltf"),  # a file name, not a pattern
+        "hero/walk": ("hero/walk.bvh", "bvh"),
+        "mixed_frames": ("mixed", "sequence"),  # a folder of frames that also holds a model
+        "mixed/Stork": ("mixed/Stork.glb", "gltf"),
+        "props/link": ("props/link.glb", "gltf"),  # a link is named after itself
+    }
+    # A folder that holds frames and models is a library, not one sequence.
+    assert sorted(asset.name for asset in read_spec(lib / "mixed")) == ["Stork", "mixed"]
+    assert [(asset.name, asset.kind) for asset in read_spec(lib / "mixed" / "prop.obj")] == [("prop", "sequence")]

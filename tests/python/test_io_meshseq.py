@@ -160,6 +160,12 @@ def test_folder_and_glob_use_natural_order_and_lists_keep_theirs(tmp_path: Path)
     listed = [tmp_path / "f10_0000.obj", tmp_path / "f1_0000.obj"]
     np.testing.assert_array_equal(read_sequence(listed).frames, mesh.frames[[2, 0]])
     np.testing.assert_array_equal(read_sequence(tmp_path / "f2_0000.obj").frames, mesh.frames[[1]])
+    # Hidden files are no frames (macOS leaves "._" resource forks beside every file it copies),
+    # and a frame whose name looks like a pattern is a file.
+    (tmp_path / "._f1_0000.obj").write_bytes(b"\x00\x05\x16\x07")
+    np.testing.assert_array_equal(read_sequence(tmp_path).frames, mesh.frames)
+    (tmp_path / "f2_0000.obj").rename(tmp_path / "take[2].obj")
+    np.testing.assert_array_equal(read_sequence(tmp_path / "take[2].obj").frames, mesh.frames[[1]])
 
 
 # --- real sequences (SOURCES.md) ------------------------------------------------------------

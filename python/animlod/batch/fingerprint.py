@@ -15,7 +15,8 @@ from pathlib import Path
 from urllib.parse import unquote
 
 from .. import __version__
-from ..io.meshseq import MESH_SUFFIXES
+from ..io.detect import is_pattern
+from ..io.meshseq import frame_files
 from .spec import AssetSpec
 
 _CHUNK = 1 << 20
@@ -26,12 +27,10 @@ def input_files(asset: AssetSpec) -> list[Path]:
     """Every file the job reads for ``asset``, in a stable order."""
     source = asset.input
     if asset.kind == "sequence":
-        if glob.has_magic(source):
+        if is_pattern(source):
             return sorted(Path(match) for match in glob.glob(source, recursive=True) if Path(match).is_file())
         path = Path(source)
-        if path.is_dir():
-            return sorted(item for item in path.iterdir() if item.is_file() and item.suffix.lower() in MESH_SUFFIXES)
-        return [path]
+        return frame_files(path) if path.is_dir() else [path]
     path = Path(source)
     if asset.kind == "gltf" and path.suffix.lower() == ".gltf":
         return [path, *_external_files(path)]

@@ -28,8 +28,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ..io.atomic import atomic_write
+from ..io.detect import BATCH_STATE
 
-STATE = ".animlod-batch"
 RECORD = ".animlod-asset.json"
 CATALOGUE = "catalogue.parquet"
 
@@ -43,14 +43,14 @@ def prepare_output(root: str | os.PathLike) -> Path:
     folder = Path(root)
     if folder.exists() and not folder.is_dir():
         raise FileExistsError(17, "is a file; a batch writes into a folder", os.fspath(folder))
-    (folder / STATE / "staging").mkdir(parents=True, exist_ok=True)
+    (folder / BATCH_STATE / "staging").mkdir(parents=True, exist_ok=True)
     return folder
 
 
 @contextlib.contextmanager
 def output_lock(root: Path) -> Iterator[None]:
     """Hold ``OUT/.animlod-batch/lock`` for the run; BatchBusy when another batch holds it."""
-    path = root / STATE / "lock"
+    path = root / BATCH_STATE / "lock"
     with open(path, "a+", encoding="utf-8") as handle:
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -70,7 +70,7 @@ def output_lock(root: Path) -> Iterator[None]:
 
 def clear_staging(root: Path) -> list[Path]:
     """Remove every staging folder (only while the lock is held and no task runs); returns them."""
-    staging = root / STATE / "staging"
+    staging = root / BATCH_STATE / "staging"
     removed = []
     for entry in sorted(staging.iterdir()) if staging.is_dir() else []:
         shutil.rmtree(entry, ignore_errors=True)
@@ -81,7 +81,7 @@ def clear_staging(root: Path) -> list[Path]:
 def staging_folder(root: Path, name: str) -> Path:
     """A new, empty folder for one attempt at asset ``name``."""
     flat = name.replace("/", "%")
-    folder = root / STATE / "staging" / f"{flat}.{socket.gethostname()}-{os.getpid()}-{secrets.token_hex(4)}"
+    folder = root / BATCH_STATE / "staging" / f"{flat}.{socket.gethostname()}-{os.getpid()}-{secrets.token_hex(4)}"
     folder.mkdir(parents=True)
     return folder
 

@@ -2,8 +2,11 @@
 
 SPEC forms (:func:`read_spec`):
 
-- a folder: every .glb/.gltf/.bvh/.npz file below it is an asset, and every folder holding
-  OBJ/PLY frames is one sequence asset; the output of ``a/b/hero.glb`` goes to ``OUT/a/b/hero``;
+- a folder: every .glb/.gltf/.vrm/.bvh/.npz file in and below it is an asset, and every folder
+  holding OBJ/PLY frames is one sequence asset (hidden files and folders, links to no file and
+  batch output folders are skipped); the output of ``a/b/hero.glb`` goes to ``OUT/a/b/hero``,
+  and where a name would repeat or hold another asset's folder (``hero.glb`` and ``hero.bvh``,
+  ``hero.glb`` beside ``hero/walk.bvh``) it takes its input's kind: ``hero_glb``, ``hero_frames``;
 - a glob (``"library/**/*.glb"``): every match is an asset (a file, or a folder of frames);
 - a manifest (``.toml`` or ``.json``), paths relative to the manifest's folder::
 
@@ -26,12 +29,14 @@ and the reason): unknown jobs and options, option types, missing inputs, clashin
 
 from __future__ import annotations
 
+import dataclasses
 import glob
 import os
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
-from ..io.detect import MODEL_SUFFIXES, assets_in, holds_frames, input_kind
+from ..io.detect import BATCH_STATE, MODEL_SUFFIXES, assets_in, input_kind, is_pattern
 from ..io.errors import FormatError
 from ..io.meshseq import MESH_SUFFIXES
 from .jobs import DEFAULT_JOBS, check_options, find_job
@@ -40,7 +45,7 @@ MANIFEST_SUFFIXES = (".toml", ".json")
 _ENTRY_KEYS = frozenset({"input", "glob", "name", "job"})
 _MANIFEST_KEYS = frozenset({"defaults", "assets"})
 # Names under OUT that belong to the runner, not to an asset.
-RESERVED_NAMES = frozenset({"catalogue.parquet", ".animlod-batch"})
+RESERVED_NAMES = frozenset({"catalogue.parquet", BATCH_STATE})
 
 
 class SpecError(FormatError):
@@ -76,7 +81,7 @@ def read_spec(spec: str | os.PathLike, job: str | None = None, options: dict | N
     text = os.fspath(spec)
     path = Path(text)
     options = dict(options or {})
-    if glob.has_magic(text) and not path.exists():
+    if is_pattern(text):
         matches = sorted(glob.glob(text, recursive=True))
         if not matches:
             raise SpecError(text, "pattern", "matches no file")
@@ -87,11 +92,12 @@ def read_spec(spec: str | os.PathLike, job: str | None = None, options: dict | N
         raise SpecError(text, "file", "does not exist")
     if path.is_file() and path.suffix.lower() in MANIFEST_SUFFIXES:
         return _read_manifest(path, job, options)
-    if path.is_dir() and not holds_frames(path):
+    if path.is_dir():
         found = [(os.fspath(item), _default_name(item, path)) for item in assets_in(path)]
         if not found:
             raise SpecError(text, "folder", f"holds no asset ({', '.join(MODEL_SUFFIXES)} files or folders of frames)")
-        return _checked(text, "folder", found, job, options)
+        if [source for source, _ in found] != [os.fspath(path)]:  # a library, not one folder of frames
+            return _checked(text, "folder", found, job, options)
     return _checked(text, "input", [(text, _default_name(path, path.parent))], job, options)
 
 
@@ -105,15 +111,14 @@ def _glob_base(pattern: str) -> Path:
 def _default_name(path: Path, base: Path) -> str:
     """The input's path below ``base`` without its suffix (a folder keeps its whole name; a frame
     glob is named after the folder it starts in)."""
-    if glob.has_magic(os.fspath(path)):
+    if is_pattern(path):
         path = _glob_base(os.fspath(path))
-    try:
-        relative = path.resolve().relative_to(base.resolve())
-    except ValueError:
-        relative = Path(path.name)
-    if path.is_file() and relative.suffix.lower() in MODEL_SUFFIXES + MESH_SUFFIXES:
+    # By the path as found, links not followed: a link is named after itself, not its target.
+    path, base = Path(os.path.abspath(path)), Path(os.path.abspath(base))
+    relative = path.relative_to(base) if path.is_relative_to(base) else Path(path.name)
+    if not path.is_dir() and relative.suffix.lower() in MODEL_SUFFIXES + MESH_SUFFIXES:
         relative = relative.with_suffix("")
-    return PurePosixPath(*relative.parts).as_posix() if relative.parts else path.resolve().name
+    return PurePosixPath(*relative.parts).as_posix() if relative.parts else path.name
 
 
 def _read_manifest(path: Path, job: str | None, options: dict) -> list[AssetSpec]:
@@ -143,7 +148,7 @@ def _read_manifest(path: Path, job: str | None, options: dict) -> list[AssetSpec
             raise SpecError(path, where, "needs exactly one of 'input' (one asset) or 'glob' (one asset per match)")
         if "input" in entry:
             source = _manifest_path(path, f"{where}.input", entry["input"], folder)
-            if not glob.has_magic(source) and not Path(source).exists():
+            if not is_pattern(source) and not Path(source).exists():
                 raise SpecError(path, f"{where}.input", f"{source} does not exist")
             name = entry.get("name", _default_name(Path(source), folder))
             if not isinstance(name, str):
@@ -237,16 +242,16 @@ def _asset(
 
 
 def _check_names(spec: str | Path, assets: list[AssetSpec], unique_suffixes: bool = False) -> None:
-    """Names must be relative, clean and distinct; where two inputs differ by suffix only
-    (``hero.glb`` and ``hero.bvh``), a folder or glob spec adds the suffix to each."""
+    """Names must be relative, clean and distinct, and no asset's folder may hold another's. A
+    folder or glob spec, which names assets itself, first tags each name that repeats or would
+    hold another asset's folder with its input's kind (see the module notes)."""
     if unique_suffixes:
-        counts: dict[str, int] = {}
-        for asset in assets:
-            counts[asset.name] = counts.get(asset.name, 0) + 1
+        counts = Counter(asset.name for asset in assets)
+        folders = {parent.as_posix() for asset in assets for parent in PurePosixPath(asset.name).parents}
         for index, asset in enumerate(assets):
-            suffix = Path(asset.input).suffix.lower().lstrip(".")
-            if counts[asset.name] > 1 and suffix:
-                assets[index] = AssetSpec(f"{asset.name}_{suffix}", asset.input, asset.kind, asset.job, asset.options)
+            if counts[asset.name] > 1 or asset.name in folders:
+                kind = "frames" if Path(asset.input).is_dir() else Path(asset.input).suffix.lstrip(".")
+                assets[index] = dataclasses.replace(asset, name=f"{asset.name}_{kind}" if kind else asset.name)
     seen: dict[str, str] = {}
     for asset in assets:
         parts = PurePosixPath(asset.name).parts

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.detect import assets_in, holds_frames, input_kind
+from ..io.detect import assets_in, input_kind
 from ..model import AnimatedMesh, Motion
 
 
@@ -35,12 +35,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _models(path: str) -> list[str]:
-    """``path`` itself (a folder of OBJ/PLY frames is one sequence), or for another folder every
-    asset below it that ``animlod batch`` would take: model files and frame folders."""
-    folder = Path(path)
-    if not folder.is_dir() or holds_frames(folder):
+    """``path`` itself, or for a folder every asset in and below it that ``animlod batch`` would
+    take: model files and frame folders (a folder of OBJ/PLY frames alone is one sequence)."""
+    if not Path(path).is_dir():
         return [path]
-    return [str(asset) for asset in assets_in(folder)] or [path]
+    return [str(asset) for asset in assets_in(Path(path))] or [path]
 
 
 def _describe(kind: str, path: str) -> list[str]:

@@ -16,16 +16,11 @@ from ..io.errors import FormatError
 from .blendshape import BlendshapeFace, one_at_a_time
 
 
-def _natural_key(path: Path) -> list[object]:
-    return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", path.name)]
-
-
 def pose_files(folder: str | os.PathLike, neutral: str | None = None) -> list[Path]:
     """The OBJ/PLY files of a pose folder, the neutral face first (see the module notes)."""
-    from ..io.meshseq import MESH_SUFFIXES
+    from ..io.meshseq import frame_files
 
-    folder = Path(folder)
-    files = sorted((p for p in folder.iterdir() if p.suffix.lower() in MESH_SUFFIXES), key=_natural_key)
+    files = frame_files(folder)
     if len(files) < 2:
         reason = f"holds {len(files)} OBJ/PLY file(s); a neutral face and at least one expression are needed"
         raise FormatError(str(folder), "folder", reason)

@@ -9,12 +9,21 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from .errors import FormatError
-from .meshseq import MESH_SUFFIXES
+from .meshseq import MESH_SUFFIXES, is_frame_name
 
 # A .vrm is a VRM avatar (VRoid, UniVRM): a binary glTF whose VRM extensions animlod carries.
 GLTF_SUFFIXES = (".glb", ".gltf", ".vrm")
 MODEL_SUFFIXES = (*GLTF_SUFFIXES, ".bvh", ".npz")
 GLB_OUTPUT_SUFFIXES = (".glb", ".vrm")
+# What marks a folder as a batch's output (animlod.batch.outputs.STATE): never an input.
+BATCH_STATE = ".animlod-batch"
+
+
+def is_pattern(path: str | os.PathLike) -> bool:
+    """Whether ``path`` is a glob pattern: it has ``*?[`` and names no file (``take[1].glb`` can
+    be a file's name)."""
+    text = os.fspath(path)
+    return glob.has_magic(text) and not os.path.lexists(text)
 
 
 def input_kind(path: str | os.PathLike) -> str:
@@ -24,7 +33,7 @@ def input_kind(path: str | os.PathLike) -> str:
     """
     text = os.fspath(path)
     candidate = Path(text)
-    if glob.has_magic(text):
+    if is_pattern(text):
         if not glob.glob(text):
             raise FormatError(text, "pattern", "matches no file")
         return "sequence"
@@ -51,24 +60,26 @@ def holds_frames(folder: Path) -> bool:
     names: a folder of thousands of frames costs no stat)."""
     try:
         with os.scandir(folder) as entries:
-            return any(entry.is_file() and Path(entry.name).suffix.lower() in MESH_SUFFIXES for entry in entries)
+            return any(is_frame_name(entry.name) and entry.is_file() for entry in entries)
     except OSError:
         return False
 
 
 def assets_in(folder: Path) -> Iterator[Path]:
-    """The model files (glTF, VRM, BVH, NPZ) and frame folders below ``folder``, in a stable
-    order: each folder's files by name, then its frame folders, then the rest of its folders
-    (hidden ones skipped; a frame folder is not searched further)."""
+    """The model files (glTF, VRM, BVH, NPZ) and frame folders in and below ``folder`` (itself
+    too when it holds frames), in a stable order: a folder's frames, then its files by name, then
+    its folders. Skipped: hidden files and folders, links to no file (dangling or looping) and
+    batch output folders (an output inside the library is not read back as input)."""
     for root, folders, files in os.walk(folder):
-        folders.sort()
         here = Path(root)
+        if holds_frames(here):
+            yield here
         for name in sorted(files):
-            if Path(name).suffix.lower() in MODEL_SUFFIXES:
+            if not name.startswith(".") and Path(name).suffix.lower() in MODEL_SUFFIXES and (here / name).is_file():
                 yield here / name
-        framed = [name for name in folders if holds_frames(here / name)]
-        yield from (here / name for name in framed)
-        folders[:] = [name for name in folders if name not in framed and not name.startswith(".")]
+        folders[:] = sorted(
+            name for name in folders if not name.startswith(".") and not (here / name / BATCH_STATE).exists()
+        )
 
 
 def _check_frame_folder(folder: Path) -> None:
@@ -91,7 +102,7 @@ def input_stem(path: str | os.PathLike) -> str:
     """A name for outputs derived from ``path``: a file's stem, a folder's name, or for a glob
     the name of the folder its pattern starts in (``frames/*.obj`` -> ``frames``)."""
     text = os.fspath(path)
-    if glob.has_magic(text):
+    if is_pattern(text):
         fixed = Path(text)
         while glob.has_magic(str(fixed)):
             fixed = fixed.parent

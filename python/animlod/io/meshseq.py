@@ -111,21 +111,34 @@ def _sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> 
         return paths
     location = Path(source)
     if location.is_dir():
-        paths = [path for path in location.iterdir() if path.suffix.lower() in MESH_SUFFIXES and path.is_file()]
-    elif glob.has_magic(os.fspath(source)):
-        paths = [Path(match) for match in glob.glob(os.fspath(source))]
-    elif location.is_file():
+        paths = frame_files(location)
+    elif location.is_file():  # before the pattern test: "take[1].obj" is a file name
         return [location]
+    elif glob.has_magic(os.fspath(source)):
+        paths = sorted((Path(match) for match in glob.glob(os.fspath(source))), key=natural_key)
     else:
         raise FormatError(source, "source", "is not a folder, a glob pattern or an existing file")
     if not paths:
         raise FormatError(source, "source", "no .obj or .ply frame found")
-    return sorted(paths, key=_natural_key)
+    return paths
 
 
-def _natural_key(path: Path) -> tuple[list[object], str]:
-    """Sort key that orders embedded numbers by value (frame2 < frame10), then by full path."""
-    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", path.name)], str(path)
+def is_frame_name(name: str) -> bool:
+    """Whether a file called ``name`` is an OBJ/PLY frame: hidden files (``._frame_0001.obj``,
+    the resource forks macOS copies leave beside every file) are not."""
+    return not name.startswith(".") and Path(name).suffix.lower() in MESH_SUFFIXES
+
+
+def frame_files(folder: str | os.PathLike) -> list[Path]:
+    """The OBJ/PLY frames of ``folder``, in natural order (see :func:`natural_key`)."""
+    found = (path for path in Path(folder).iterdir() if is_frame_name(path.name) and path.is_file())
+    return sorted(found, key=natural_key)
+
+
+def natural_key(path: Path) -> tuple[list[object], str]:
+    """Sort key that orders embedded numbers by value (frame2 < frame10) and letters regardless
+    of case, then by full path."""
+    return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", path.name)], str(path)
 
 
 def _check_same_connectivity(

@@ -165,6 +165,15 @@ def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, l
     assert (third.ran, third.skipped) == (1, 4)
     assert sorted(path.name for path in (tmp_path / "out" / "bar").iterdir()) == [".animlod-asset.json", "bar_lod1.npz"]
 
+    # A run that stops before running the changed asset keeps its earlier rows in the catalogue.
+    from animlod.batch import SchedulerUnreachable
+
+    listed = read_catalogue(third.catalogue).to_pylist()
+    changed[[asset.name for asset in changed].index("bar")].options["ratios"] = [0.4]
+    with pytest.raises(SchedulerUnreachable):
+        run_batch(changed, tmp_path / "out", scheduler="tcp://127.0.0.1:9", connect_timeout=1)
+    assert read_catalogue(third.catalogue).to_pylist() == [{**row, "ran": False} for row in listed]
+
 
 def test_killed_worker_leaves_no_partial_file_and_the_asset_is_redone(client, library, tmp_path):
     source = library / "characters" / "cyl0.glb"

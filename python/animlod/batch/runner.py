@@ -11,6 +11,8 @@
   the asset is tried once more on another worker, then marked failed (``allowed-failures`` 1).
 - Reruns: an asset whose fingerprint (inputs, job, options, version) matches the record in its
   output folder is not submitted; its rows are carried into the new catalogue.
+- A run that stops early (no scheduler, Ctrl-C) keeps in the catalogue the assets it did not
+  collect as their records on disk say (an earlier run's, or one a worker finished meanwhile).
 - Order: largest inputs first, so that a long asset does not start last.
 """
 
@@ -125,6 +127,7 @@ def run_batch(
         clear_staging(root)  # attempts of a killed earlier run
         records: dict[str, dict] = {}
         ran_flags: dict[str, bool] = {}
+        earlier: dict[str, dict] = {}  # records on disk of the assets still to run
         pending: list[tuple[AssetSpec, str, int]] = []
         for asset in assets:
             try:
@@ -133,11 +136,13 @@ def run_batch(
                 records[asset.name] = _failed(asset, "", describe_error(error, asset.input))
                 ran_flags[asset.name] = True
                 continue
-            previous = None if force else read_record(root, asset.name)
-            if previous is not None and _unchanged(previous, digest, root):
+            previous = read_record(root, asset.name)
+            if not force and previous is not None and _unchanged(previous, digest, root):
                 records[asset.name], ran_flags[asset.name] = previous, False
-            else:
-                pending.append((asset, digest, size))
+                continue
+            pending.append((asset, digest, size))
+            if previous is not None:
+                earlier[asset.name] = previous
         skipped = sum(1 for flag in ran_flags.values() if not flag)
         notes: list[str] = []
         worker_count = 0
@@ -150,14 +155,15 @@ def run_batch(
                 try:
                     _wait_for_a_worker(client, scheduler, connect_timeout)
                     worker_count, notes = _check_workers(client)
-                    _run_pending(client, pending, root, records, ran_flags, progress, assets)
+                    _run_pending(client, pending, root, records, ran_flags, progress, assets, earlier)
                 finally:
                     if owned is not None:
                         client.close()
                         owned.close()
         finally:
             progress.close()
-            _write(root, assets, records, ran_flags)
+            on_disk = {asset.name: read_record(root, asset.name) for asset in assets if asset.name not in records}
+            _write(root, assets, records, ran_flags, on_disk)
             clear_staging(root)
     ordered = [records[asset.name] for asset in assets if asset.name in records]
     failed = sum(1 for record in ordered if record["status"] != "ok")
@@ -167,8 +173,11 @@ def run_batch(
     )
 
 
-def _run_pending(client, pending, root: Path, records: dict, ran_flags: dict, progress: BatchProgress, assets) -> None:
-    """Run ``pending`` (largest first), collect records as they finish, keep the catalogue.
+def _run_pending(
+    client, pending, root: Path, records: dict, ran_flags: dict, progress: BatchProgress, assets, earlier: dict
+) -> None:
+    """Run ``pending`` (largest first), collect records as they finish, keep the catalogue (the
+    assets not collected yet as ``earlier`` records them).
 
     At most one asset per worker thread is in the cluster at a time: the next is submitted as one
     finishes. Handing a worker a second asset while it runs one would put both in memory, and
@@ -220,7 +229,7 @@ def _run_pending(client, pending, root: Path, records: dict, ran_flags: dict, pr
             records[asset.name], ran_flags[asset.name] = record, True
             progress.asset_done(record)
             if time.monotonic() - last_write >= CATALOGUE_INTERVAL:
-                _write(root, assets, records, ran_flags)
+                _write(root, assets, records, ran_flags, earlier)
                 last_write = time.monotonic()
     except BaseException:
         client.cancel(list(futures))
@@ -272,8 +281,16 @@ def _unchanged(record: dict, digest: str, root: Path) -> bool:
     """Whether an earlier record is for the same fingerprint and its outputs are all there."""
     if record.get("status") != "ok" or record.get("fingerprint") != digest or not record.get("result"):
         return False
-    folder = root / record["name"]
-    return all((folder / path).exists() for path in record["result"].get("outputs", []))
+    return _standing(record, root)
+
+
+def _standing(record: dict, root: Path) -> bool:
+    """Whether a record on disk still describes its folder: a whole record whose outputs are all
+    there (a failed one has none)."""
+    if not all(isinstance(record.get(key), str) for key in ("name", "job", "input", "status")):
+        return False
+    result = record.get("result") or {}
+    return all((root / record["name"] / path).exists() for path in result.get("outputs", []))
 
 
 def _wait_for_a_worker(client, scheduler: str | None, timeout: float) -> None:
@@ -305,9 +322,12 @@ def _takes_n_workers(client) -> bool:
     return "n_workers" in inspect.signature(client.scheduler_info).parameters
 
 
-def _write(root: Path, assets: Sequence[AssetSpec], records: dict, ran_flags: dict) -> None:
+def _write(root: Path, assets: Sequence[AssetSpec], records: dict, ran_flags: dict, on_disk: dict) -> None:
+    """The catalogue: each asset's record of this run, else its record ``on_disk`` if it stands."""
     rows = []
     for asset in assets:
         if asset.name in records:
             rows += record_rows(records[asset.name], ran_flags.get(asset.name, True))
+        elif (record := on_disk.get(asset.name)) is not None and _standing(record, root):
+            rows += record_rows(record, False)
     write_catalogue(root / CATALOGUE, rows)

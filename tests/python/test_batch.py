@@ -235,6 +235,9 @@ def test_cli_bad_inputs_are_one_line_exit_2(library, tmp_path, capsys):
     assert main(["batch", str(library), "-o", out, "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--scheduler: tcp://127.0.0.1:9: no Dask scheduler answered within 1 s" in err
+    assert main(["batch", str(library), "-o", out, "--scheduler", "farm:notaport"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--scheduler: farm:notaport: not a scheduler address like tcp://HOST:PORT" in err
 
     with pytest.raises(SpecError, match="no asset's job takes this option"):
         read_spec(library, options={"nonsense": 1})

@@ -77,6 +77,7 @@ def connect(
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
+        _check_address(scheduler)
         try:
             return Client(scheduler, timeout=timeout, set_as_default=False), None
         except (OSError, TimeoutError) as error:
@@ -93,6 +94,19 @@ def connect(
             silence_logs=logging.ERROR,
         )
     return Client(cluster, set_as_default=False), cluster
+
+
+def _check_address(scheduler: str) -> None:
+    """SchedulerUnreachable for an address no scheduler can have (checked before a Client is
+    made: one made from such an address fails late and leaves a closing traceback behind)."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(scheduler)
+        if scheme in ("tcp", "tls") and not 0 < parse_host_port(location)[1] < 65536:
+            raise ValueError("the port must be 1-65535")
+    except ValueError as error:
+        raise SchedulerUnreachable(f"{scheduler}: not a scheduler address like tcp://HOST:PORT ({error})") from None
 
 
 def run_batch(

@@ -350,3 +350,16 @@ def test_folder_scan_names_what_a_studio_library_holds(tmp_path):
     # A folder that holds frames and models is a library, not one sequence.
     assert sorted(asset.name for asset in read_spec(lib / "mixed")) == ["Stork", "mixed"]
     assert [(asset.name, asset.kind) for asset in read_spec(lib / "mixed" / "prop.obj")] == [("prop", "sequence")]
+
+
+def _interrupt_handler() -> object:
+    import signal
+
+    return signal.getsignal(signal.SIGINT)
+
+
+def test_local_workers_end_quietly_on_ctrl_c(client):
+    # Ctrl-C reaches the workers too: the default action ends them without a traceback each.
+    import signal
+
+    assert set(client.run(_interrupt_handler).values()) == {signal.SIG_DFL}

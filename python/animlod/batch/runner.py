@@ -41,6 +41,7 @@ if TYPE_CHECKING:
 CLUSTER_CONFIG = {
     "distributed.scheduler.allowed-failures": 1,
     "distributed.scheduler.worker-saturation": 1.0,
+    "distributed.worker.preload": ["animlod.batch.worker_setup"],
 }
 # Least time between two rewrites of the catalogue while assets finish (seconds).
 CATALOGUE_INTERVAL = 2.0

@@ -22,7 +22,9 @@ void on_glfw_error(int code, const char* description) {
 }
 
 // Skinning in the vertex shader: the palette holds 3 rows (RGBA32F texels) of each joint's
-// affine matrix; a vertex blends the rows of its 4 joints by weight (linear blend skinning).
+// affine matrix; a vertex blends the rows of its 4 or 8 joints by weight (linear blend
+// skinning). A mesh of 4 influences leaves the second set's arrays off: its weights read the
+// constant 0 (set in init).
 const char* kCharacterVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
@@ -31,6 +33,8 @@ layout(location = 3) in uvec4 a_joints;
 layout(location = 4) in vec4 a_weights;
 layout(location = 5) in vec4 a_placement;  // x, y, z, yaw
 layout(location = 6) in uvec2 a_instance;  // palette base, level
+layout(location = 7) in uvec4 a_joints_1;
+layout(location = 8) in vec4 a_weights_1;
 uniform samplerBuffer u_palette;
 uniform mat4 u_view_projection;
 uniform float u_tint_amount;
@@ -39,17 +43,21 @@ out vec3 v_color;
 const vec3 kTints[8] = vec3[8](vec3(0.10, 0.75, 0.20), vec3(0.95, 0.85, 0.10), vec3(0.95, 0.45, 0.05),
                                vec3(0.90, 0.10, 0.10), vec3(0.70, 0.15, 0.85), vec3(0.15, 0.35, 0.95),
                                vec3(0.10, 0.85, 0.90), vec3(0.95, 0.95, 0.95));
-void main() {
-  vec4 r0 = vec4(0.0), r1 = vec4(0.0), r2 = vec4(0.0);
+vec4 r0 = vec4(0.0), r1 = vec4(0.0), r2 = vec4(0.0);
+void blend(uvec4 joints, vec4 weights) {
   for (int k = 0; k < 4; ++k) {
-    float w = a_weights[k];
+    float w = weights[k];
     if (w > 0.0) {
-      int base = 3 * int(a_instance.x + a_joints[k]);
+      int base = 3 * int(a_instance.x + joints[k]);
       r0 += w * texelFetch(u_palette, base);
       r1 += w * texelFetch(u_palette, base + 1);
       r2 += w * texelFetch(u_palette, base + 2);
     }
   }
+}
+void main() {
+  blend(a_joints, a_weights);
+  blend(a_joints_1, a_weights_1);
   vec4 p = vec4(a_position, 1.0);
   vec3 skinned = vec3(dot(r0, p), dot(r1, p), dot(r2, p));
   vec3 n = vec3(dot(r0.xyz, a_normal), dot(r1.xyz, a_normal), dot(r2.xyz, a_normal));
@@ -257,6 +265,8 @@ bool GlRenderer::open(int width, int height, bool orphan_uploads, std::string& e
   u_ground_view_projection_ = glGetUniformLocation(ground_program_, "u_view_projection");
   glUseProgram(character_program_);
   glUniform1i(glGetUniformLocation(character_program_, "u_palette"), 0);
+  glVertexAttribI4ui(7, 0, 0, 0, 0);  // the second influence set of 4-influence meshes
+  glVertexAttrib4f(8, 0.0f, 0.0f, 0.0f, 0.0f);
   glGenTextures(1, &palette_texture_);
   glEnable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);  // exporters disagree on winding; skinned limbs show both sides
@@ -274,12 +284,26 @@ int GlRenderer::upload_meshes(const std::vector<MeshData>& meshes) {
     float_attribute(0, gpu.buffers[0], mesh.positions, 3);
     float_attribute(1, gpu.buffers[1], mesh.normals, 3);
     float_attribute(2, gpu.buffers[2], mesh.colors, 3);
+    // Influences in sets of 4: set s at attributes 3 + 4s (joints) and 4 + 4s (weights).
+    const GLsizei influences = mesh.influences;
     glBindBuffer(GL_ARRAY_BUFFER, gpu.buffers[3]);
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.joints.size() * sizeof(uint16_t)), mesh.joints.data(),
                  GL_STATIC_DRAW);
-    glEnableVertexAttribArray(3);
-    glVertexAttribIPointer(3, 4, GL_UNSIGNED_SHORT, 0, nullptr);
-    float_attribute(4, gpu.buffers[4], mesh.weights, 4);
+    for (GLsizei set = 0; 4 * set < influences; ++set) {
+      const GLuint location = 3 + 4 * static_cast<GLuint>(set);
+      glEnableVertexAttribArray(location);
+      glVertexAttribIPointer(location, 4, GL_UNSIGNED_SHORT, influences * static_cast<GLsizei>(sizeof(uint16_t)),
+                             reinterpret_cast<const void*>(4 * set * sizeof(uint16_t)));
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, gpu.buffers[4]);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.weights.size() * sizeof(float)), mesh.weights.data(),
+                 GL_STATIC_DRAW);
+    for (GLsizei set = 0; 4 * set < influences; ++set) {
+      const GLuint location = 4 + 4 * static_cast<GLuint>(set);
+      glEnableVertexAttribArray(location);
+      glVertexAttribPointer(location, 4, GL_FLOAT, GL_FALSE, influences * static_cast<GLsizei>(sizeof(float)),
+                            reinterpret_cast<const void*>(4 * set * sizeof(float)));
+    }
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.buffers[5]);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(uint32_t)),
                  mesh.indices.data(), GL_STATIC_DRAW);

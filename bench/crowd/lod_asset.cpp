@@ -553,6 +553,9 @@ class Loader {
   MeshData read_mesh(int mesh_index, size_t joint_count, const std::string& level) {
     const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(mesh_index)];
     MeshData out;
+    for (const tinygltf::Primitive& primitive : mesh.primitives)
+      if (primitive.attributes.count("JOINTS_1") || primitive.attributes.count("WEIGHTS_1")) out.influences = 8;
+    const size_t influences = static_cast<size_t>(out.influences);
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
       const tinygltf::Primitive& primitive = mesh.primitives[p];
       const std::string label = level + " mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p);
@@ -564,12 +567,25 @@ class Loader {
       if (attribute("POSITION") < 0) fail(label, "has no POSITION");
       if (attribute("JOINTS_0") < 0 || attribute("WEIGHTS_0") < 0)
         fail(label, "has no JOINTS_0 / WEIGHTS_0: a skinned mesh needs both");
+      if ((attribute("JOINTS_1") < 0) != (attribute("WEIGHTS_1") < 0)) fail(label, "has only one of JOINTS_1 / WEIGHTS_1");
       const std::vector<float> positions = to_floats(read_accessor(model_, attribute("POSITION"), 3, label + " POSITION"), label);
       const size_t count = positions.size() / 3, offset = out.vertex_count();
-      const std::vector<double> joints = read_accessor(model_, attribute("JOINTS_0"), 4, label + " JOINTS_0");
-      const std::vector<double> weights = read_accessor(model_, attribute("WEIGHTS_0"), 4, label + " WEIGHTS_0");
-      if (joints.size() != 4 * count || weights.size() != 4 * count)
-        fail(label, "JOINTS_0 / WEIGHTS_0 do not have one element per vertex");
+      // (count, influences): each vertex's sets of 4 one after the other, zeros for a set the
+      // primitive does not have.
+      std::vector<double> joints(influences * count, 0.0), weights(influences * count, 0.0);
+      for (size_t set = 0; set < influences / 4; ++set) {
+        const std::string suffix = "_" + std::to_string(set);
+        if (attribute(("JOINTS" + suffix).c_str()) < 0) continue;
+        const std::vector<double> set_joints = read_accessor(model_, attribute(("JOINTS" + suffix).c_str()), 4, label + " JOINTS" + suffix);
+        const std::vector<double> set_weights = read_accessor(model_, attribute(("WEIGHTS" + suffix).c_str()), 4, label + " WEIGHTS" + suffix);
+        if (set_joints.size() != 4 * count || set_weights.size() != 4 * count)
+          fail(label, "JOINTS" + suffix + " / WEIGHTS" + suffix + " do not have one element per vertex");
+        for (size_t v = 0; v < count; ++v)
+          for (size_t k = 0; k < 4; ++k) {
+            joints[influences * v + 4 * set + k] = set_joints[4 * v + k];
+            weights[influences * v + 4 * set + k] = set_weights[4 * v + k];
+          }
+      }
       std::vector<uint32_t> corners;
       if (primitive.indices >= 0) {
         for (double index : read_accessor(model_, primitive.indices, 1, label + " indices")) {
@@ -599,11 +615,11 @@ class Loader {
       for (size_t v = 0; v < count; ++v) {
         out.colors.insert(out.colors.end(), {color.r, color.g, color.b});
         double total = 0.0;
-        for (int k = 0; k < 4; ++k) total += std::max(weights[4 * v + static_cast<size_t>(k)], 0.0);
+        for (size_t k = 0; k < influences; ++k) total += std::max(weights[influences * v + k], 0.0);
         if (!(total > 0.0) || !std::isfinite(total)) fail(label, "vertex " + std::to_string(v) + " has no positive skin weight");
-        for (int k = 0; k < 4; ++k) {
-          const double w = std::max(weights[4 * v + static_cast<size_t>(k)], 0.0) / total;
-          const double j = joints[4 * v + static_cast<size_t>(k)];
+        for (size_t k = 0; k < influences; ++k) {
+          const double w = std::max(weights[influences * v + k], 0.0) / total;
+          const double j = joints[influences * v + k];
           if (w > 0.0 && (j < 0 || j >= static_cast<double>(joint_count)))
             fail(label, "vertex " + std::to_string(v) + " uses joint slot " + std::to_string(static_cast<long long>(j)) +
                             ", the skin has " + std::to_string(joint_count));
@@ -667,7 +683,7 @@ class Loader {
       input.weights = mesh.weights.data();
       input.skin_matrices = palette.data();
       input.vertex_count = mesh.vertex_count();
-      input.influence_count = 4;
+      input.influence_count = static_cast<size_t>(mesh.influences);
       input.joint_count = rig.joint_count();
       input.frame_count = 1;
       status = animlod::bake_lbs(input, skinned.data());

@@ -21,8 +21,9 @@ struct MeshData {
   std::vector<float> positions;   // (V, 3) bind-space positions
   std::vector<float> normals;     // (V, 3) (area-weighted face normals where the file has none)
   std::vector<float> colors;      // (V, 3) base colour of the vertex's material
-  std::vector<uint16_t> joints;   // (V, 4) skin joint slots
-  std::vector<float> weights;     // (V, 4) normalised to sum 1
+  std::vector<uint16_t> joints;   // (V, K) skin joint slots
+  std::vector<float> weights;     // (V, K) normalised to sum 1
+  int influences = 4;             // K: 8 where a primitive has JOINTS_1 / WEIGHTS_1, else 4
   std::vector<uint32_t> indices;  // (M * 3,)
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return indices.size() / 3; }

@@ -125,12 +125,13 @@ std::string markdown_report(const RunInfo& info, const std::vector<ModeResult>& 
           std::snprintf(range, sizeof range, "%.2f-%.2fx", *std::min_element(rounds.begin(), rounds.end()),
                         *std::max_element(rounds.begin(), rounds.end()));
       }
-      const std::string gpu = r.gpu_ms.empty() ? "-" : number(mean(r.gpu_ms));
+      char gpu[32] = "-";
+      if (!r.gpu_ms.empty()) std::snprintf(gpu, sizeof gpu, "%.2f", mean(r.gpu_ms));
       std::snprintf(line, sizeof line,
                     "| %s | %.2f | %s | %s | %.1f | %.1f | %.0f | %.0f | %.0f | %.0f | %.2f | %.2f | %.2f | %.1f | %s |\n",
                     r.name.c_str(), fps(r), speedup, range, percentile(r.frame_ms, 50), percentile(r.frame_ms, 95),
                     r.drawn / frames, r.triangles / frames, r.joints / frames, r.palette_joints / frames,
-                    mean(r.animation_ms), mean(r.upload_ms), mean(r.submit_ms), mean(r.swap_ms), gpu.c_str());
+                    mean(r.animation_ms), mean(r.upload_ms), mean(r.submit_ms), mean(r.swap_ms), gpu);
     }
     out << line;
   }

@@ -4,6 +4,7 @@
 #include "lod_asset.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -737,8 +738,24 @@ bool read_model(const Model& model, const std::string& name, Asset& out, std::st
 
 // tinygltf's model of a GLB (told by its magic, as the Python reader decides) or glTF JSON, its pointer channels resolved first
 // (animation_pointers.hpp); external files are looked up in base_dir.
+// Whether ``bytes`` open like a JSON object (a .gltf), after a byte order mark and white space.
+bool opens_like_json(const uint8_t* bytes, size_t size) {
+  size_t at = size >= 3 && std::memcmp(bytes, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
+  while (at < size && std::isspace(bytes[at])) ++at;
+  return at < size && bytes[at] == '{';
+}
+
 bool parse_model(tinygltf::TinyGLTF& loader, const uint8_t* bytes, size_t size, const std::string& base_dir,
                  Model& model, std::string& error) {
+  // Said in our words: the parsers' own (a JSON syntax error at line 1) do not say what the file is not.
+  if (size == 0) {
+    error = "empty file";
+    return false;
+  }
+  if (!is_glb(bytes, size) && !opens_like_json(bytes, size)) {
+    error = "not a glTF character: neither a GLB (it does not start with 'glTF') nor a .gltf JSON document";
+    return false;
+  }
   const std::vector<uint8_t> resolved = resolve_animation_pointers(bytes, size);
   if (!resolved.empty()) bytes = resolved.data(), size = resolved.size();
   std::string warnings;

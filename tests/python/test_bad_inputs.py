@@ -118,6 +118,10 @@ def _bvh(path: Path, offset: str) -> Path:
 
 # (class, name, make(tmp_path) -> argv, expected substring of the error line)
 CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
+    ("readers", "empty glb", lambda t: ["simplify", str(_write(t / "empty.glb", b"")), "-o", str(t / "o")],
+     "empty.glb: file: empty file"),
+    ("readers", "a BVH named .gltf", lambda t: ["info", str(_bvh(t / "walk.gltf", "0 -1 0"))],
+     "walk.gltf: file: not a glTF file: neither GLB (magic 'glTF') nor a JSON object"),
     ("readers", "gltf nesting 100,000 deep", lambda t: ["info", str(_write(t / "deep.gltf",
         b'{"asset": {"version": "2.0"}, "extras": ' + b"[" * 100_000 + b"]" * 100_000 + b"}"))],
      "deep.gltf: JSON: nests deeper than 100 levels"),

@@ -62,6 +62,7 @@ def test_smoke_run_reports_every_mode_and_shows_a_level_switch(binary, chain, tm
     for name, mode in report.modes.items():
         assert all(isinstance(mode[key], (int, float)) and mode[key] >= 0 for key in REQUIRED), name
         assert mode["fps"] > 0 and 0 < mode["drawn"] <= SMALL["count"]
+        assert mode["measured_frames"] == 12 - 2, name  # the screenshots' frames are out of every mode
     modes = report.modes
     original = modes["Original"]
     assert original["triangles"] == pytest.approx(original["drawn"] * 3664)  # every drawn character at level 0
@@ -210,8 +211,16 @@ def test_bad_arguments_exit_2_with_one_line(binary, chain, arguments, message) -
     assert completed.stderr.count("\n") == 1 and message in completed.stderr
 
 
-def test_a_folder_or_a_missing_file_is_one_line(binary, tmp_path) -> None:
-    for path, message in ((tmp_path, "not a regular file"), (tmp_path / "missing.glb", "no such file")):
+def test_a_folder_a_missing_file_or_no_gltf_is_one_line(binary, tmp_path) -> None:
+    (tmp_path / "empty.glb").write_bytes(b"")
+    (tmp_path / "walk.bvh").write_text("HIERARCHY\nROOT Hips\n{\n")
+    cases = [
+        (tmp_path, "not a regular file"),
+        (tmp_path / "missing.glb", "no such file"),
+        (tmp_path / "empty.glb", "empty file"),
+        (tmp_path / "walk.bvh", "not a glTF character: neither a GLB"),
+    ]
+    for path, message in cases:
         completed = subprocess.run([str(binary), str(path)], capture_output=True, text=True, check=False)
         assert completed.returncode == 2 and message in completed.stderr and completed.stderr.count("\n") == 1
 
@@ -227,6 +236,14 @@ def test_no_display_is_one_line_and_exit_3(binary, chain) -> None:
 def test_cli_refuses_an_unknown_mode_before_running(capsys) -> None:
     assert cli_main(["crowd", "--modes", "Original,Faster"]) == 2
     assert "mode 'Faster'" in capsys.readouterr().err
+
+
+def test_cli_refuses_a_json_it_could_not_write_before_running(tmp_path, capsys) -> None:
+    (tmp_path / "notes.txt").write_text("a file, not a folder")
+    assert cli_main(["crowd", "--json", str(tmp_path / "notes.txt" / "crowd.json")]) == 2
+    assert f"--json: {tmp_path / 'notes.txt' / 'crowd.json'}: {tmp_path / 'notes.txt'} is not a folder" in (
+        capsys.readouterr().err
+    )
 
 
 def test_mode_list() -> None:

@@ -104,10 +104,12 @@ def _check_address(scheduler: str) -> None:
 
     try:
         scheme, location = parse_address(scheduler)
-        if scheme in ("tcp", "tls") and not 0 < parse_host_port(location)[1] < 65536:
-            raise ValueError("the port must be 1-65535")
+        port = parse_host_port(location)[1] if scheme in ("tcp", "tls") else 1
+        reason = None if 0 < port < 65536 else "the port must be 1-65535"
     except ValueError as error:
-        raise SchedulerUnreachable(f"{scheduler}: not a scheduler address like tcp://HOST:PORT ({error})") from None
+        reason = str(error)
+    if reason:
+        raise SchedulerUnreachable(f"{scheduler}: not a scheduler address like tcp://HOST:PORT ({reason})")
 
 
 def run_batch(

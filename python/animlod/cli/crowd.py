@@ -52,10 +52,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..crowd import CrowdError, mode_list, procedural_chain, run_crowd, write_heat_map
-    from ..io.atomic import atomic_write
+    from ..io.atomic import atomic_write, unwritable
 
     if args.heat_map and not args.grid:
         raise UserError("--heat-map: needs --grid")
+    for option, target in (("--json", args.json), ("--heat-map", args.heat_map)):
+        if target and (reason := unwritable(target)):  # found before the run, not after it
+            raise UserError(f"{option}: {target}: {reason}")
     mode_list(args.modes)  # an unknown mode is refused before any chain is built
     try:
         screenshots = [(int(frame), png) for frame, png in args.screenshot]

@@ -29,6 +29,23 @@ def _prefix(target: Path) -> str:
     return f".{target.name}.animlod-{os.getpid()}-"
 
 
+def unwritable(path: str | os.PathLike) -> str | None:
+    """Why :func:`atomic_write` could not write ``path`` (its nearest existing folder is a file or
+    takes no new file), or None: for work that writes its result only at the end."""
+    folder = Path(os.path.abspath(path)).parent
+    while not folder.exists():
+        folder = folder.parent
+    if not folder.is_dir():
+        return f"{folder} is not a folder"
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".animlod-probe-", dir=folder)
+    except OSError as error:
+        return f"cannot write into {folder} ({error.strerror})"
+    os.close(fd)
+    os.unlink(probe)
+    return None
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> Iterator[IO]:
     """Open a temporary file beside ``path``; on success rename it to ``path``, on error remove it."""

@@ -504,6 +504,8 @@ def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
         data = Path(path).read_bytes()
     except OSError as error:
         raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
+    if not data:
+        raise FormatError(path, "file", "empty file")
     glb = data[:4] == _GLB_MAGIC
     json_chunk, binary_chunk = _glb_chunks(path, data) if glb else (data, None)
     if not glb:
@@ -511,6 +513,8 @@ def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
             data.decode("utf-8-sig")
         except UnicodeDecodeError:
             raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor JSON") from None
+        if not re.match(rb"(?:\xef\xbb\xbf)?\s*\{", data):  # a BVH or an OBJ, say: not a syntax error at line 1
+            raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor a JSON object")
     # Parsed with bounded nesting (json.loads recurses per level) and checked for the shape the
     # object model would otherwise bend ("nodes": {} is not a list). The object model shares
     # nothing with the raw JSON kept for the writers (decode_gltf copies what it keeps).

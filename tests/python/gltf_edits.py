@@ -23,6 +23,8 @@ def edit_glb(source: Path, target: Path, edit: Callable[[pygltflib.GLTF2, bytear
 
 _COMPONENTS = {
     "f4": pygltflib.FLOAT,
+    "i1": pygltflib.BYTE,
+    "i2": pygltflib.SHORT,
     "u1": pygltflib.UNSIGNED_BYTE,
     "u2": pygltflib.UNSIGNED_SHORT,
     "u4": pygltflib.UNSIGNED_INT,
@@ -32,7 +34,7 @@ _COMPONENTS = {
 def append_accessor(
     gltf: pygltflib.GLTF2, blob: bytearray, values: np.ndarray, accessor_type: str, normalized: bool = False
 ) -> int:
-    """``values`` (float32, uint8, uint16 or uint32; one row per element) appended to the binary
+    """``values`` (float32, int8, int16, uint8, uint16 or uint32; one row per element) appended to the binary
     chunk, 4-byte aligned, with a bufferView and an accessor; returns the accessor's index."""
     values = np.asarray(values)
     code = f"{values.dtype.kind}{values.dtype.itemsize}"

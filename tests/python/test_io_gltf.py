@@ -14,6 +14,7 @@ import pygltflib
 import pytest
 from gltf_edits import (
     add_scale_channel,
+    append_accessor,
     draco_compressed,
     edit_glb,
     meshopt_compressed,
@@ -568,6 +569,20 @@ def test_nan_in_positions(chain_glb, tmp_path):
 
     with pytest.raises(FormatError, match=r"accessor 1 \(mesh 0 primitive 0 POSITION\): non-finite value at element 3"):
         read_skinned(edit_glb(path, tmp_path / "nan.glb", poison))
+
+
+def test_quantized_morph_deltas_read_as_numbers(chain_glb, tmp_path):
+    # KHR_mesh_quantization lets morph deltas be plain SHORT (the node's scale makes them metres).
+    path, mesh, _ = chain_glb
+    stored = np.rint(mesh.morph_targets * 1000.0).astype(np.int16)
+
+    def quantize(gltf, blob) -> None:
+        for target, deltas in zip(gltf.meshes[0].primitives[0].targets, stored):
+            target["POSITION"] = append_accessor(gltf, blob, deltas, "VEC3")
+        gltf.extensionsUsed = [*(gltf.extensionsUsed or []), "KHR_mesh_quantization"]
+
+    read, _ = read_skinned(edit_glb(path, tmp_path / "quantized.glb", quantize))
+    np.testing.assert_array_equal(read.morph_targets, stored.astype(np.float32))
 
 
 def test_draco_compressed_primitives_read_as_the_uncompressed_ones(chain_glb, tmp_path):

@@ -223,11 +223,11 @@ def _morph_targets(doc: GltfDocument, primitive: pygltflib.Primitive, count: int
                 continue
             delta = doc.accessor(index, f"{element} target {t} {name}")
             width = 3 if name in ("POSITION", "NORMAL", "TANGENT") else delta.shape[1]
-            if delta.shape != (count, width) or delta.dtype.kind != "f":
-                raise doc.fail(
-                    f"{element} target {t} {name}", f"expected {count} float VEC{width}, got shape {delta.shape}"
-                )
-            deltas[name] = delta
+            if delta.shape != (count, width):
+                raise doc.fail(f"{element} target {t} {name}", f"expected {count} VEC{width}, got shape {delta.shape}")
+            # KHR_mesh_quantization stores deltas as plain BYTE or SHORT too, in the units the
+            # node's scale turns into positions, as its POSITION.
+            deltas[name] = delta.astype(np.float32, copy=False)
         targets.append(deltas)
     return targets
 

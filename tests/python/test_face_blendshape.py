@@ -7,7 +7,7 @@ import pygltflib
 import pytest
 
 from animlod.face_lod import BlendshapeFace, BlendshapeLodOptions, build_blendshape_lod, procedural_face, rank_targets
-from animlod.face_lod.blendshape import measure_blendshape_lod, target_contributions
+from animlod.face_lod.blendshape import measure_blendshape_lod, prune_levels, target_contributions
 from animlod.face_lod.lod_glb import gltf_face_levels, read_gltf_face, write_gltf_face_lod
 from animlod.face_lod.mpa import expression_sequence
 from animlod.face_lod.sources import pose_files, read_pose_face
@@ -39,14 +39,15 @@ def test_pruning_no_target_reproduces_the_blendshape_face_exactly(face):
 def test_targets_are_ranked_by_the_largest_displacement_they_cause():
     neutral = np.random.default_rng(0).normal(size=(6, 3)).astype(np.float32)
     faces = np.array([[0, 1, 2], [0, 2, 3], [3, 4, 5]])
-    targets = np.zeros((3, 6, 3), np.float32)
+    targets = np.zeros((4, 6, 3), np.float32)
     targets[0, 0] = [1.0, 0, 0]  # 1.0 at weight up to 0.5 -> 0.5
     targets[1, 1] = [0, 0.3, 0]  # 0.3 at weight 1 -> 0.3
     targets[2, 2] = [0, 0, 2.0]  # 2.0 at weight up to 0.4 -> 0.8
-    weights = np.array([[0.5, 1.0, 0.0], [0.0, 0.0, -0.4]])
-    face = BlendshapeFace(neutral, faces, targets, ["a", "b", "c"], weights)
-    np.testing.assert_allclose(target_contributions(face), [0.5, 0.3, 0.8])
-    np.testing.assert_array_equal(rank_targets(face), [2, 0, 1])
+    targets[3, 3] = [0, 0.6, 0]  # never driven: judged at weight 1 (driven at run time) -> 0.6
+    weights = np.array([[0.5, 1.0, 0.0, 0.0], [0.0, 0.0, -0.4, 0.0]])
+    face = BlendshapeFace(neutral, faces, targets, ["a", "b", "c", "d"], weights)
+    np.testing.assert_allclose(target_contributions(face), [0.5, 0.3, 0.8, 0.6])
+    np.testing.assert_array_equal(rank_targets(face), [2, 3, 0, 1])
 
 
 def test_levels_prune_what_moves_less_than_their_geometric_error(face):
@@ -65,6 +66,19 @@ def test_levels_prune_what_moves_less_than_their_geometric_error(face):
     rows = measure_blendshape_lod(face, levels, repeats=1, max_frames=8, samples=2000)
     assert rows[0].hausdorff < 1e-9 and rows[1].hausdorff < 0.05
     assert [row.targets for row in rows] == [len(level.kept_targets) for level in levels]
+
+
+def test_targets_that_only_turn_normals_are_kept(face):
+    # Such a target moves no vertex: its contribution is 0, and the error rule would drop it.
+    weakest = int(np.argmin(target_contributions(face)))
+    shading = np.arange(face.target_count) == weakest
+    options = BlendshapeLodOptions(ratios=(0.5, 0.15, 0.08))
+    assert not all(weakest in level.kept_targets for level in build_blendshape_lod(face, options)[1:-1])
+    every = BlendshapeLodOptions(ratios=options.ratios, target_fractions=[1.0] * 4)
+    levels = build_blendshape_lod(face, every)  # not pruned yet
+    prune_levels(face, levels, options, shading_only=shading)
+    assert all(weakest in level.kept_targets for level in levels[1:-1])
+    assert len(levels[-1].kept_targets) == 0  # the coarsest animates nothing still
 
 
 def test_bad_blendshape_input_is_named():

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import copy
 import json
 
 import numpy as np
 import pygltflib
+from gltf_edits import append_accessor, edit_glb
 
 from animlod.cli import main
 from animlod.io import write_obj
@@ -56,6 +58,25 @@ def test_face_pose_folder(tmp_path, capsys):
     assert "1 targets" in printed and "poses_lod.glb" in printed
     manifest = json.loads((tmp_path / "out" / "poses_face_lod.json").read_text())
     assert [level["targets"] for level in manifest["levels"]] == [["bulge"], []]
+    # A triangle count the face does not have is named as such, for poses and a glTF face alike
+    # (the glTF one said "target_ratios: 15.6 outside (0, 1]").
+    for source in (poses, tmp_path / "out" / "poses_lod.glb"):
+        assert main(["face", str(source), "-o", str(tmp_path / "again"), "--faces", "5000"]) == 2
+        assert "face counts: 5000 outside [1, 320] (the face has 320 triangles)" in capsys.readouterr().err
+
+    # A head of several meshes with targets (face, eyes, teeth): the face is the largest, not the first.
+    def eye_first(gltf, blob) -> None:
+        eye = copy.deepcopy(gltf.meshes[0])
+        eye.name = "eye"
+        eye.primitives[0].indices = append_accessor(gltf, blob, np.arange(60, dtype=np.uint32), "SCALAR")
+        gltf.meshes.append(eye)
+        gltf.nodes.append(pygltflib.Node(name="eye", mesh=len(gltf.meshes) - 1))
+        gltf.scenes[0].nodes.insert(0, len(gltf.nodes) - 1)
+
+    head = edit_glb(tmp_path / "out" / "poses_lod.glb", tmp_path / "head.glb", eye_first)
+    assert main(["face", str(head), "-o", str(tmp_path / "head"), "--ratio", "0.5", "--repeats", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert "the face is mesh 0 'face' (320 triangles" in printed and "written unchanged: mesh 2 'eye'" in printed
 
 
 def test_face_user_mistakes_exit_2_with_one_line(tmp_path, capsys):

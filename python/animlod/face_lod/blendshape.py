@@ -4,17 +4,21 @@ A blendshape face is ``neutral + sum_i w_i(t) delta_i``. Each target plays the p
 plays in seeds/004: a unit of animation that can be skipped when it matters little. Per level:
 
 - **ranking**: a target's contribution is the largest displacement it ever causes, the largest
-  weight the animation gives it times its largest vertex delta (asset units); targets are ranked
-  by it, ties by index;
-- **geometry**: one AQEM run over the neutral face and every target at its largest weight, with
+  weight the animation gives it times its largest vertex delta (asset units); a target the
+  animation never drives counts at weight 1, as when there is no animation (a rig's targets are
+  often driven at run time: live capture, a state machine); targets are ranked by it, ties by
+  index;
+- **geometry**: one AQEM run over the neutral face and every target at that weight, with
   region importance from regions grown from the targets' motion (moving 1, static lower), every
   target's deltas carried through the collapses as attributes; vertices are placed on the
   collapsed edge (``placement="on_edge"``) so that a vertex and its deltas describe one point;
 - **pruning**: a level drops the targets whose contribution is no more than its geometric error
   (the Hausdorff distance between its neutral mesh and the full one): what they add is below
   what the simplification already lost, as the lattice reduction of the region-animated face
-  (Figure 6). The coarsest level keeps no target ("when the model is far enough, no animation is
-  needed", Section 4.2.1). Explicit fractions of kept targets per level replace the rule.
+  (Figure 6). A target that moves no vertex but turns normals or tangents (a wrinkle's shading)
+  has no displacement to judge and is kept. The coarsest level keeps no target ("when the model
+  is far enough, no animation is needed", Section 4.2.1). Explicit fractions of kept targets per
+  level replace the rule.
 
 Shapes: ``V`` vertices, ``M`` faces, ``N`` targets, ``T`` animation frames.
 """
@@ -101,9 +105,11 @@ class BlendshapeFace:
     def vertex_count(self) -> int:
         return int(len(self.neutral))
 
-    def largest_weights(self) -> np.ndarray:
-        """(N,) the largest absolute weight the animation gives each target."""
-        return np.abs(self.weights).max(axis=0)
+    def reach_weights(self) -> np.ndarray:
+        """(N,) the weight each target is judged at: the largest absolute weight the animation
+        gives it, or 1 for a target the animation never drives (see the module notes)."""
+        largest = np.abs(self.weights).max(axis=0)
+        return np.where(largest > 0.0, largest, 1.0)
 
     def frames(self, weights: np.ndarray | None = None) -> AnimatedMesh:
         """The face blended with ``weights (T, N)`` (the animation when None)."""
@@ -178,10 +184,10 @@ class BlendshapeLodOptions:
 
 
 def target_contributions(face: BlendshapeFace) -> np.ndarray:
-    """(N,) the largest displacement (asset units) each target causes over the animation: its
-    largest absolute weight times its largest vertex delta."""
+    """(N,) the largest displacement (asset units) each target causes: its reach weight
+    (:meth:`BlendshapeFace.reach_weights`) times its largest vertex delta."""
     largest_delta = np.linalg.norm(face.targets, axis=2).max(axis=1, initial=0.0)
-    return face.largest_weights() * largest_delta
+    return face.reach_weights() * largest_delta
 
 
 def rank_targets(face: BlendshapeFace) -> np.ndarray:
@@ -192,7 +198,7 @@ def rank_targets(face: BlendshapeFace) -> np.ndarray:
 def target_regions(face: BlendshapeFace, options: GrowOptions | None = None) -> FaceRegions:
     """Regions grown from the targets' motion (each region a set of vertices that the same
     targets move alike), groups "moving" and "static"."""
-    return grow_regions(motion_of_targets(face.targets, face.largest_weights()), face.faces, options)
+    return grow_regions(motion_of_targets(face.targets, face.reach_weights()), face.faces, options)
 
 
 def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | None = None) -> list[BlendshapeLevel]:
@@ -203,7 +209,7 @@ def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | N
     """
     options = options or BlendshapeLodOptions()
     counts = (
-        [int(c) for c in options.face_counts]
+        checked_face_counts(options.face_counts, len(face.faces))
         if options.face_counts is not None
         else [max(4, round(r * len(face.faces))) for r in options.ratios]
     )
@@ -221,6 +227,15 @@ def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | N
     return levels
 
 
+def checked_face_counts(counts: Sequence[int], triangle_count: int) -> list[int]:
+    """``counts`` as ints; ValueError naming the first outside [1, ``triangle_count``]."""
+    for count in counts:
+        if not 1 <= count <= triangle_count:
+            bounds = f"[1, {triangle_count}] (the face has {triangle_count} triangles)"
+            raise ValueError(f"face counts: {count} outside {bounds}")
+    return [int(count) for count in counts]
+
+
 def check_fractions(fractions: Sequence[float] | None, level_count: int) -> None:
     """ValueError unless ``fractions`` is None or one value in [0, 1] per level."""
     if fractions is None:
@@ -232,16 +247,23 @@ def check_fractions(fractions: Sequence[float] | None, level_count: int) -> None
             raise ValueError(f"target fraction of level {index}: {fraction} is outside [0, 1]")
 
 
-def prune_levels(face: BlendshapeFace, levels: list[BlendshapeLevel], options: BlendshapeLodOptions) -> None:
+def prune_levels(
+    face: BlendshapeFace,
+    levels: list[BlendshapeLevel],
+    options: BlendshapeLodOptions,
+    shading_only: np.ndarray | None = None,
+) -> None:
     """Set every simplified level's ``geometric_error`` (Hausdorff distance of its neutral mesh to
     the input's) and keep, in ``kept_targets`` and ``targets``, the targets the rule of the module
-    notes (or ``options.target_fractions``) keeps. ``levels[0]`` is the input and keeps them all;
-    the others must still hold every target."""
+    notes (or ``options.target_fractions``) keeps; the rule keeps the ``shading_only`` ones (a
+    (N,) mask of targets that turn normals or tangents without moving a vertex). ``levels[0]`` is
+    the input and keeps them all; the others must still hold every target."""
     from ..metrics import hausdorff_distance
 
     check_fractions(options.target_fractions, len(levels))
     everything = np.arange(face.target_count)
     order, contributions = rank_targets(face), target_contributions(face)
+    always = np.zeros(face.target_count, bool) if shading_only is None else np.asarray(shading_only, bool)
     full = AnimatedMesh(face.faces, face.neutral[None])
     for index, level in enumerate(levels[1:], start=1):
         rest = AnimatedMesh(level.faces, level.neutral[None])
@@ -251,17 +273,17 @@ def prune_levels(face: BlendshapeFace, levels: list[BlendshapeLevel], options: B
         elif index == len(levels) - 1 and not options.animate_coarsest:
             kept = everything[:0]
         else:
-            kept = everything[contributions > level.geometric_error]
+            kept = everything[(contributions > level.geometric_error) | always]
         level.kept_targets = kept
         level.targets = np.ascontiguousarray(level.targets[kept])
 
 
 def _simplified_levels(face: BlendshapeFace, counts: list[int], importance: np.ndarray | None) -> list[BlendshapeLevel]:
-    """One AQEM run over the neutral face and every target at its largest weight, carrying UVs
+    """One AQEM run over the neutral face and every target at its reach weight, carrying UVs
     (attributes: copies with other UVs form seams) and every target's deltas (position
     attributes); one level per count, every target still attached."""
-    largest = face.largest_weights()
-    frames = np.concatenate([face.neutral[None], face.neutral[None] + largest[:, None, None] * face.targets])
+    reach = face.reach_weights()
+    frames = np.concatenate([face.neutral[None], face.neutral[None] + reach[:, None, None] * face.targets])
     result = simplify_animated(
         AnimatedMesh(face.faces, frames),
         target_face_counts=counts,

@@ -38,6 +38,7 @@ from .blendshape import (
     BlendshapeLevel,
     BlendshapeLodOptions,
     check_fractions,
+    checked_face_counts,
     one_at_a_time,
     prune_levels,
     target_regions,
@@ -51,36 +52,41 @@ class GltfFace:
     Attributes
     ----------
     doc : the parsed document.
-    drawable : the first drawable with morph targets.
+    drawable : the drawable with morph targets and the most triangles (a head exported as face,
+        eyes and teeth meshes: the face).
     face : its world-space neutral mesh, targets and the morph weights of every clip that drives
         them, played one after the other (each target in turn when no clip does).
+    others : labels of the other drawables with morph targets, written unchanged.
     """
 
     doc: GltfDocument
     drawable: Drawable
     face: BlendshapeFace
+    others: list[str]
 
 
 def read_gltf_face(path: str | os.PathLike, fps: float = 30.0, frames_each: int = 15) -> GltfFace:
-    """The first drawable with morph targets of a .glb/.gltf file. Raises FormatError naming the
-    file when none has morph targets, and the reader's errors for malformed files."""
+    """The face of a .glb/.gltf file: its drawable with morph targets and the most triangles.
+    Raises FormatError naming the file when none has morph targets, and the reader's errors for
+    malformed files."""
     doc = GltfDocument(path)
-    for drawable in read_drawables(doc, fps):
-        targets = drawable.morph_targets
-        if targets is None or len(targets) == 0:
-            continue
-        tracks = [clip.morph_weights for clip in drawable.clips if clip.morph_weights is not None]
-        weights = np.concatenate(tracks) if tracks else one_at_a_time(len(targets), frames_each)
-        names = drawable.geometry.target_names or [f"target_{index}" for index in range(len(targets))]
-        try:
-            face = BlendshapeFace(
-                neutral=drawable.bind_positions(), faces=drawable.geometry.faces, targets=targets, names=names,
-                weights=weights, fps=fps, uvs=drawable.geometry.uvs,
-            )  # fmt: skip
-        except ValueError as error:
-            raise doc.fail(drawable.label, str(error)) from None
-        return GltfFace(doc, drawable, face)
-    raise doc.fail("meshes", "no mesh has morph targets, so there is no blendshape face to simplify")
+    morphed = [drawable for drawable in read_drawables(doc, fps) if drawable.morph_targets is not None]
+    morphed = [drawable for drawable in morphed if len(drawable.morph_targets)]
+    if not morphed:
+        raise doc.fail("meshes", "no mesh has morph targets, so there is no blendshape face to simplify")
+    drawable = max(morphed, key=lambda item: len(item.geometry.faces))  # the first of the largest
+    targets = drawable.morph_targets
+    tracks = [clip.morph_weights for clip in drawable.clips if clip.morph_weights is not None]
+    weights = np.concatenate(tracks) if tracks else one_at_a_time(len(targets), frames_each)
+    names = drawable.geometry.target_names or [f"target_{index}" for index in range(len(targets))]
+    try:
+        face = BlendshapeFace(
+            neutral=drawable.bind_positions(), faces=drawable.geometry.faces, targets=targets, names=names,
+            weights=weights, fps=fps, uvs=drawable.geometry.uvs,
+        )  # fmt: skip
+    except ValueError as error:
+        raise doc.fail(drawable.label, str(error)) from None
+    return GltfFace(doc, drawable, face, [other.label for other in morphed if other is not drawable])
 
 
 @dataclass
@@ -100,7 +106,7 @@ def gltf_face_levels(source: GltfFace, options: BlendshapeLodOptions | None = No
     options = options or BlendshapeLodOptions()
     face = source.face
     ratios = (
-        [count / len(face.faces) for count in options.face_counts]
+        [count / len(face.faces) for count in checked_face_counts(options.face_counts, len(face.faces))]
         if options.face_counts is not None
         else list(options.ratios)
     )
@@ -121,7 +127,7 @@ def gltf_face_levels(source: GltfFace, options: BlendshapeLodOptions | None = No
                 aqem_error=level.simplified.error,
             )
         )  # fmt: skip
-    prune_levels(face, levels, options)
+    prune_levels(face, levels, options, _shading_only(source.drawable, face))
     primitives = []
     for level, drawn_level in zip(levels[1:], drawn.levels):
         pruned = np.setdiff1d(everything, level.kept_targets)
@@ -129,7 +135,22 @@ def gltf_face_levels(source: GltfFace, options: BlendshapeLodOptions | None = No
             for index in pruned:
                 primitive.targets[index] = {name: np.zeros_like(d) for name, d in primitive.targets[index].items()}
         primitives.append(drawn_level.primitives)
-    return GltfFaceLevels(levels, primitives, list(drawn.notes))
+    notes = list(drawn.notes)
+    if source.others:
+        notes.append(
+            f"the face is {source.drawable.label} ({len(face.faces)} triangles, the largest mesh with morph targets); "
+            f"written unchanged: {', '.join(source.others)}"
+        )
+    return GltfFaceLevels(levels, primitives, notes)
+
+
+def _shading_only(drawable: Drawable, face: BlendshapeFace) -> np.ndarray:
+    """(N,) the targets that move no vertex but carry NORMAL or TANGENT deltas."""
+    turns = np.zeros(face.target_count, bool)
+    for primitive in drawable.geometry.primitives:
+        for index, target in enumerate(primitive.targets):
+            turns[index] |= any(np.any(target[name]) for name in ("NORMAL", "TANGENT") if name in target)
+    return turns & ~np.any(face.targets, axis=(1, 2))
 
 
 def write_gltf_face_lod(

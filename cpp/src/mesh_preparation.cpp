@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <thread>
 #include <utility>
@@ -25,23 +27,64 @@ int compare_rows(const float* a, const float* b, size_t count, size_t stride_a, 
   return 0;
 }
 
-// Skin rows compare as (joint, weight) sets: influences with zero weight do not count, and the
-// order of the influences does not matter.
-std::vector<std::pair<int32_t, float>> skin_set(const WeldInput& input, size_t v) {
-  std::vector<std::pair<int32_t, float>> set;
+// Values closer than this fraction of the mesh's extent (positions and the values that move with
+// them), or than this weight, are one value to the weld: two copies of a seam that different
+// computations wrote (sin(2 pi) for sin(0), a delta one ulp off) are no seam. About 8 float ulps
+// at the extent; an absolute floor keeps a mesh of one point finite.
+constexpr double kWeldTolerance = 1e-6;
+
+// A value snapped to the weld's grid: values within one cell compare equal, -0 and 0 too.
+// Snapping keeps every exactly equal pair equal; a near pair that straddles a cell boundary stays
+// apart, as before the tolerance.
+int64_t snapped(float value, double inverse_cell) {
+  const double scaled = static_cast<double>(value) * inverse_cell;
+  if (std::fabs(scaled) < 4e18) return static_cast<int64_t>(std::llround(scaled));
+  // Far from the origin against the extent: the value itself, below every snapped one.
+  uint32_t bits;
+  value += 0.0f;  // -0 + 0 is +0
+  std::memcpy(&bits, &value, sizeof bits);
+  return std::numeric_limits<int64_t>::min() + static_cast<int64_t>(bits);
+}
+
+// Skin rows compare as snapped (joint, weight) sets: influences whose weight snaps to zero do
+// not count, and the order of the influences does not matter.
+std::vector<std::pair<int32_t, int64_t>> skin_set(const WeldInput& input, size_t v) {
+  std::vector<std::pair<int32_t, int64_t>> set;
   for (size_t k = 0; k < input.influence_count; ++k) {
-    const float weight = input.skin_weights[v * input.influence_count + k];
-    if (weight > 0.0f) set.emplace_back(input.skin_joints[v * input.influence_count + k], weight);
+    const int64_t weight = snapped(input.skin_weights[v * input.influence_count + k], 1.0 / kWeldTolerance);
+    if (weight > 0) set.emplace_back(input.skin_joints[v * input.influence_count + k], weight);
   }
   std::sort(set.begin(), set.end());
   return set;
 }
 
-// Step 1: vertices equal in every frame, in position attributes and in skin share a point.
-// Returns (V,) the lowest input vertex each referenced vertex welds with (itself if none), -1
-// for unreferenced vertices. As meshoptimizer's position remap: an open-addressing table keyed
-// by a hash of everything compared holds the first vertex of each class met in input order, the
-// lowest.
+// 1 / the weld's cell for positions and position attributes: kWeldTolerance of the largest
+// extent of the used vertices over the frames.
+double weld_inverse_cell(const AnimatedMeshView& mesh, const std::vector<uint8_t>& used) {
+  double extent = 0.0;
+  for (size_t frame = 0; frame < mesh.frame_count; ++frame) {
+    std::array<float, 3> low{}, high{};
+    bool first = true;
+    for (size_t v = 0; v < mesh.vertex_count; ++v) {
+      if (!used[v]) continue;
+      const float* p = mesh.frames + (frame * mesh.vertex_count + v) * 3;
+      for (size_t axis = 0; axis < 3; ++axis) {
+        low[axis] = first ? p[axis] : std::min(low[axis], p[axis]);
+        high[axis] = first ? p[axis] : std::max(high[axis], p[axis]);
+      }
+      first = false;
+    }
+    for (size_t axis = 0; axis < 3; ++axis)
+      extent = std::max(extent, static_cast<double>(high[axis]) - static_cast<double>(low[axis]));
+  }
+  return 1.0 / (kWeldTolerance * std::max(extent, 1e-30));
+}
+
+// Step 1: vertices equal in every frame, in position attributes and in skin (each snapped to the
+// weld's grid) share a point. Returns (V,) the lowest input vertex each referenced vertex welds
+// with (itself if none), -1 for unreferenced vertices. As meshoptimizer's position remap: an
+// open-addressing table keyed by a hash of everything compared holds the first vertex of each
+// class met in input order, the lowest.
 std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, const std::vector<uint8_t>& used) {
   const size_t vertex_count = mesh.vertex_count;
   const size_t frame_stride = vertex_count * 3;
@@ -51,38 +94,39 @@ std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, 
       if (used[v]) welded_to[v] = static_cast<int32_t>(v);
     return welded_to;
   }
+  const double inverse_cell = weld_inverse_cell(mesh, used);
+  auto same_rows = [&](const float* a, const float* b, size_t count) {
+    for (size_t i = 0; i < count; ++i)
+      if (snapped(a[i], inverse_cell) != snapped(b[i], inverse_cell)) return false;
+    return true;
+  };
   auto equal = [&](int32_t a, int32_t b) {
     for (size_t frame = 0; frame < mesh.frame_count; ++frame) {
       const float* pa = mesh.frames + frame * frame_stride + static_cast<size_t>(a) * 3;
       const float* pb = mesh.frames + frame * frame_stride + static_cast<size_t>(b) * 3;
-      if (compare_rows(pa, pb, 3, 1, 1) != 0) return false;
+      if (!same_rows(pa, pb, 3)) return false;
     }
     const size_t width = input.position_attribute_count;
-    if (width && compare_rows(input.position_attributes + static_cast<size_t>(a) * width,
-                              input.position_attributes + static_cast<size_t>(b) * width, width, 1, 1) != 0)
+    if (width && !same_rows(input.position_attributes + static_cast<size_t>(a) * width,
+                            input.position_attributes + static_cast<size_t>(b) * width, width))
       return false;
     return !input.skin_joints || skin_set(input, static_cast<size_t>(a)) == skin_set(input, static_cast<size_t>(b));
   };
   // Over everything `equal` compares, so that only equal vertices share a probe sequence (a
   // mesh whose vertices all start at one spot must not chain them all).
-  auto mix = [](uint64_t h, float value) {
-    value += 0.0f;  // -0 + 0 is +0
-    uint32_t bits;
-    std::memcpy(&bits, &value, sizeof bits);
-    h = (h ^ bits) * 0xff51afd7ed558ccdull;
+  auto mix = [](uint64_t h, int64_t value) {
+    h = (h ^ static_cast<uint64_t>(value)) * 0xff51afd7ed558ccdull;
     return h ^ (h >> 32);
   };
   auto hash = [&](size_t v) {
     uint64_t h = 0x9e3779b97f4a7c15ull;
     for (size_t frame = 0; frame < mesh.frame_count; ++frame)
-      for (size_t axis = 0; axis < 3; ++axis) h = mix(h, mesh.frames[frame * frame_stride + v * 3 + axis]);
+      for (size_t axis = 0; axis < 3; ++axis) h = mix(h, snapped(mesh.frames[frame * frame_stride + v * 3 + axis], inverse_cell));
     for (size_t b = 0; b < input.position_attribute_count; ++b)
-      h = mix(h, input.position_attributes[v * input.position_attribute_count + b]);
+      h = mix(h, snapped(input.position_attributes[v * input.position_attribute_count + b], inverse_cell));
     uint64_t skin = 0;  // a sum: the influences' order does not count, zero weights do not count
-    for (size_t k = 0; input.skin_joints && k < input.influence_count; ++k) {
-      const float weight = input.skin_weights[v * input.influence_count + k];
-      if (weight > 0.0f) skin += mix(static_cast<uint64_t>(input.skin_joints[v * input.influence_count + k]), weight);
-    }
+    if (input.skin_joints)
+      for (const auto& [joint, weight] : skin_set(input, v)) skin += mix(static_cast<uint64_t>(joint), weight);
     return h ^ skin;
   };
   size_t capacity = 16;

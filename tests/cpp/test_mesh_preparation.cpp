@@ -53,3 +53,27 @@ TEST_CASE("mesh preparation pairs every side with the side running the other way
     check_side_partners(prepared);
   }
 }
+
+TEST_CASE("the weld takes float noise for equality and nothing larger") {
+  // Two triangles meeting along an edge whose two points are written twice, the copies moved by
+  // `offset` (as a seam written by two computations: sin(2 pi) for sin(0)), in the second frame
+  // only when `late`.
+  auto points_of = [](float offset, bool late) {
+    animlod::testing::OwnedAnimatedMesh mesh;
+    const std::vector<float> rest = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    for (int frame = 0; frame < 2; ++frame) {
+      std::vector<float> positions = rest;
+      if (frame == 1 || !late) positions[11] += offset, positions[14] -= offset;  // copies 3 and 4, off the plane
+      mesh.frames.insert(mesh.frames.end(), positions.begin(), positions.end());
+    }
+    mesh.faces = {0, 1, 2, 4, 3, 5};
+    mesh.frame_count = 2;
+    mesh.vertex_count = 6;
+    return prepare(mesh).point_source.size();
+  };
+  CHECK(points_of(0.0f, false) == 4);
+  CHECK(points_of(2.4e-16f, false) == 4);  // the noise of sin(2 pi)
+  CHECK(points_of(1e-7f, true) == 4);      // a float ulp at the extent, in one frame
+  CHECK(points_of(1e-4f, false) == 6);     // a gap of 1e-4 of the extent is a gap
+  CHECK(points_of(1e-4f, true) == 6);
+}

@@ -233,6 +233,13 @@ def test_no_display_is_one_line_and_exit_3(binary, chain) -> None:
     assert "no display" in completed.stderr and completed.stderr.count("\n") == 1
 
 
+def test_cli_says_the_machine_has_no_display_with_exit_3(binary, chain, monkeypatch, capsys) -> None:
+    monkeypatch.setenv("DISPLAY", ":77")  # set, so no Xvfb is started, and no server behind it
+    assert cli_main(["crowd", str(chain), "--count", "2", "--frames", "2"]) == 3
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "animlod crowd: error:" in err
+
+
 def test_cli_refuses_an_unknown_mode_before_running(capsys) -> None:
     assert cli_main(["crowd", "--modes", "Original,Faster"]) == 2
     assert "mode 'Faster'" in capsys.readouterr().err

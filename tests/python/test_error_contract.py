@@ -16,7 +16,16 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[2] / "python" / "animlod"
 # Exception types a user can cause; others (AssertionError, NotImplementedError, ...) are bugs.
-USER_FACING = {"ValueError", "UserError", "FormatError", "LinAlgError", "OSError", "FileNotFoundError", "TypeError"}
+USER_FACING = {
+    "ValueError",
+    "UserError",
+    "MachineError",
+    "FormatError",
+    "LinAlgError",
+    "OSError",
+    "FileNotFoundError",
+    "TypeError",
+}
 # Helpers that build a FormatError from (element, reason) with the document's path.
 WHERE_BUILDERS = {"fail", "error", "value_error", "FormatError"}
 # "ELEMENT: WHAT" or "{path}: WHAT": a short head without a sentence's colon, then ": ".

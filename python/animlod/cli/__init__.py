@@ -37,6 +37,11 @@ class UserError(Exception):
     """
 
 
+class MachineError(Exception):
+    """What this machine cannot do for a well-formed request (no display or OpenGL context for
+    the crowd, its binary not built); printed as one line like a UserError, exit code 3."""
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with the one-line error contract: no usage block before the error line."""
 
@@ -191,9 +196,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with _sigterm_unwinds(), _guarded_stderr(args.command):
             return int(args.run(args) or 0)
-    except UserError as error:
+    except (UserError, MachineError) as error:
         print(f"animlod {args.command}: error: {' '.join(str(error).split())}", file=sys.stderr)
-        return 2
+        return 3 if isinstance(error, MachineError) else 2
     except BrokenPipeError as error:
         if not _stdout_gone():
             print(f"animlod {args.command}: error: {error_line(error, source)}", file=sys.stderr)

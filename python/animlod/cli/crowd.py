@@ -8,7 +8,7 @@ import json
 import tempfile
 from pathlib import Path
 
-from . import UserError
+from . import MachineError, UserError
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -83,6 +83,8 @@ def run(args: argparse.Namespace) -> int:
                     screenshots=screenshots if index == 0 else (),
                 )  # fmt: skip
             except CrowdError as error:
+                if not error.bad_input:
+                    raise MachineError(str(error)) from None
                 raise UserError(str(error)) from None
             if len(paths) > 1:
                 print(f"\npath {path}:")

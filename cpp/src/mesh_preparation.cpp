@@ -38,7 +38,7 @@ constexpr double kWeldTolerance = 1e-6;
 // apart, as before the tolerance.
 int64_t snapped(float value, double inverse_cell) {
   const double scaled = static_cast<double>(value) * inverse_cell;
-  if (std::fabs(scaled) < 4e18) return static_cast<int64_t>(std::llround(scaled));
+  if (std::fabs(scaled) < 4e18) return static_cast<int64_t>(scaled + std::copysign(0.5, scaled));  // llround, inlined
   // Far from the origin against the extent: the value itself, below every snapped one.
   uint32_t bits;
   value += 0.0f;  // -0 + 0 is +0

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <type_traits>
+#include <vector>
 
 #include <glm/gtc/type_ptr.hpp>
 #include <stb_image_write.h>
@@ -139,6 +141,24 @@ void float_attribute(unsigned index, unsigned buffer, const std::vector<float>& 
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
   glEnableVertexAttribArray(index);
   glVertexAttribPointer(index, size, GL_FLOAT, GL_FALSE, 0, nullptr);
+}
+
+// Skin influences, `per_vertex` values a vertex in sets of 4: set s at attribute `first` + 4 s
+// (joints 3 and 7, weights 4 and 8).
+template <typename T>
+void influence_attribute(unsigned first, unsigned buffer, const std::vector<T>& data, int per_vertex) {
+  glBindBuffer(GL_ARRAY_BUFFER, buffer);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.size() * sizeof(T)), data.data(), GL_STATIC_DRAW);
+  const GLsizei stride = per_vertex * static_cast<GLsizei>(sizeof(T));
+  for (int set = 0; 4 * set < per_vertex; ++set) {
+    const GLuint location = first + 4 * static_cast<GLuint>(set);
+    const void* offset = reinterpret_cast<const void*>(4 * static_cast<size_t>(set) * sizeof(T));
+    glEnableVertexAttribArray(location);
+    if constexpr (std::is_integral_v<T>)
+      glVertexAttribIPointer(location, 4, GL_UNSIGNED_SHORT, stride, offset);
+    else
+      glVertexAttribPointer(location, 4, GL_FLOAT, GL_FALSE, stride, offset);
+  }
 }
 
 bool has_extension(const char* name) {
@@ -284,26 +304,8 @@ int GlRenderer::upload_meshes(const std::vector<MeshData>& meshes) {
     float_attribute(0, gpu.buffers[0], mesh.positions, 3);
     float_attribute(1, gpu.buffers[1], mesh.normals, 3);
     float_attribute(2, gpu.buffers[2], mesh.colors, 3);
-    // Influences in sets of 4: set s at attributes 3 + 4s (joints) and 4 + 4s (weights).
-    const GLsizei influences = mesh.influences;
-    glBindBuffer(GL_ARRAY_BUFFER, gpu.buffers[3]);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.joints.size() * sizeof(uint16_t)), mesh.joints.data(),
-                 GL_STATIC_DRAW);
-    for (GLsizei set = 0; 4 * set < influences; ++set) {
-      const GLuint location = 3 + 4 * static_cast<GLuint>(set);
-      glEnableVertexAttribArray(location);
-      glVertexAttribIPointer(location, 4, GL_UNSIGNED_SHORT, influences * static_cast<GLsizei>(sizeof(uint16_t)),
-                             reinterpret_cast<const void*>(4 * set * sizeof(uint16_t)));
-    }
-    glBindBuffer(GL_ARRAY_BUFFER, gpu.buffers[4]);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.weights.size() * sizeof(float)), mesh.weights.data(),
-                 GL_STATIC_DRAW);
-    for (GLsizei set = 0; 4 * set < influences; ++set) {
-      const GLuint location = 4 + 4 * static_cast<GLuint>(set);
-      glEnableVertexAttribArray(location);
-      glVertexAttribPointer(location, 4, GL_FLOAT, GL_FALSE, influences * static_cast<GLsizei>(sizeof(float)),
-                            reinterpret_cast<const void*>(4 * set * sizeof(float)));
-    }
+    influence_attribute(3, gpu.buffers[3], mesh.joints, mesh.influences);
+    influence_attribute(4, gpu.buffers[4], mesh.weights, mesh.influences);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.buffers[5]);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(uint32_t)),
                  mesh.indices.data(), GL_STATIC_DRAW);

@@ -15,7 +15,7 @@ from .meshseq import MESH_SUFFIXES, is_frame_name
 GLTF_SUFFIXES = (".glb", ".gltf", ".vrm")
 MODEL_SUFFIXES = (*GLTF_SUFFIXES, ".bvh", ".npz")
 GLB_OUTPUT_SUFFIXES = (".glb", ".vrm")
-# What marks a folder as a batch's output (animlod.batch.outputs.STATE): never an input.
+# The folder where animlod batch keeps its state under OUT: it marks a batch output, never an input.
 BATCH_STATE = ".animlod-batch"
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from .model import AnimatedMesh, LodChain, LodLevel, Motion, SkinnedMesh
+from .model import AnimatedMesh, LodChain, LodLevel, Motion, SkinnedMesh, whole_indices
 from .options import AqemOptions, MotionFeatureOptions, resolve_options
 
 
@@ -406,15 +406,18 @@ def simplify_skinned(
 
 
 def _vertex_mask(name: str, indices: Sequence[int] | np.ndarray | None, vertex_count: int) -> np.ndarray | None:
-    """(V,) bool with the listed vertices set; ValueError naming an index outside [0, V)."""
+    """(V,) bool with the listed vertices set, or ``indices`` itself when it is a (V,) bool mask
+    (read as indices, True and False would be vertices 1 and 0); ValueError naming an index that
+    is not a whole number in [0, V)."""
     if indices is None:
         return None
-    indices = np.asarray(indices, dtype=np.int64).ravel()
-    outside = (indices < 0) | (indices >= vertex_count)
-    if np.any(outside):
-        raise ValueError(f"{name}: vertex {int(indices[np.argmax(outside)])} outside [0, {vertex_count})")
+    given = np.asarray(indices)
+    if given.dtype == np.bool_:
+        if given.shape != (vertex_count,):
+            raise ValueError(f"{name}: a mask must have one value per vertex ({vertex_count}), got shape {given.shape}")
+        return given.copy()
     mask = np.zeros(vertex_count, dtype=bool)
-    mask[indices] = True
+    mask[whole_indices(name, given.ravel(), "entry", 0, vertex_count)] = True
     return mask
 
 

@@ -30,30 +30,36 @@ def _check_finite(name: str, array: np.ndarray) -> None:
         raise ValueError(f"{name}: non-finite value at index {tuple(int(i) for i in bad)}")
 
 
+def whole_indices(name: str, values: object, item: str, low: int, high: int) -> np.ndarray:
+    """``values`` as int32 indices in [``low``, ``high``); ValueError naming ``name`` and the
+    ``item`` (row) holding one that is not a whole number or lies outside. Checked before the
+    cast to int32, which would wrap 2**32 + 2 to 2 and truncate 1.9 to 1 silently."""
+    given = np.asarray(values)
+    integral = given.dtype.kind in "iuf" or given.dtype == np.bool_
+    _require(integral, f"{name}: expected integer indices, got dtype {given.dtype}")
+    if not given.size:
+        return np.ascontiguousarray(given, dtype=np.int32)
+    rows = given.reshape(len(given), -1) if given.ndim else given.reshape(1, 1)
+
+    def fail(bad: np.ndarray, what: str) -> None:
+        row = int(np.argmax(bad.any(axis=1)))
+        shown = rows[row].tolist() if rows.shape[1] > 1 else rows[row, 0].item()
+        raise ValueError(f"{name}: {item} {row} {shown} has an index {what}")
+
+    if given.dtype.kind == "f":
+        wide = rows.astype(np.float64)
+        bad = ~np.isfinite(wide) | (wide != np.round(wide))
+        if bad.any():
+            fail(bad, "that is not a whole number")
+    if rows.min() < low or rows.max() >= high:
+        fail((rows < low) | (rows >= high), f"outside [{low}, {high})")
+    return np.ascontiguousarray(given, dtype=np.int32)
+
+
 def _check_faces(faces: np.ndarray, vertex_count: int) -> np.ndarray:
-    # Range and integrality are checked before the cast to int32, which would wrap 2**32 + 2 to 2
-    # and truncate 1.9 to 1 silently.
     given = np.asarray(faces)
     _require(given.ndim == 2 and given.shape[1] == 3, f"faces: expected shape (M, 3), got {given.shape}")
-    if given.size and given.dtype != np.int32:
-        _require(
-            given.dtype.kind in "iuf" or given.dtype == np.bool_,
-            f"faces: expected integer indices, got dtype {given.dtype}",
-        )
-        wide = given.astype(np.float64) if given.dtype.kind == "f" else given
-        bad = ~np.isfinite(wide) | (wide != np.round(wide)) if given.dtype.kind == "f" else np.zeros(given.shape, bool)
-        if bad.any():
-            row = int(np.argmax(bad.any(axis=1)))
-            raise ValueError(f"faces: face {row} {given[row].tolist()} has an index that is not a whole number")
-        outside = (wide < 0) | (wide >= vertex_count)
-        if outside.any():
-            row = int(np.argmax(outside.any(axis=1)))
-            raise ValueError(f"faces: face {row} {given[row].tolist()} has an index outside [0, {vertex_count})")
-    faces = np.ascontiguousarray(given, dtype=np.int32)
-    if faces.size and (faces.min() < 0 or faces.max() >= vertex_count):
-        row = int(np.argmax(np.any((faces < 0) | (faces >= vertex_count), axis=1)))
-        raise ValueError(f"faces: face {row} {faces[row].tolist()} has an index outside [0, {vertex_count})")
-    return faces
+    return whole_indices("faces", given, "face", 0, vertex_count)
 
 
 @dataclass
@@ -79,6 +85,7 @@ class AnimatedMesh:
         )
         _check_finite("frames", self.frames)
         self.faces = _check_faces(self.faces, self.frames.shape[1])
+        _require(self.fps is None or self.fps > 0.0 and np.isfinite(self.fps), f"fps: expected > 0, got {self.fps}")
 
     @property
     def frame_count(self) -> int:
@@ -116,9 +123,9 @@ class Skeleton:
 
     def __post_init__(self) -> None:
         self.names = [str(n) for n in self.names]
-        self.parents = np.asarray(self.parents, dtype=np.int32)
-        self.offsets = np.asarray(self.offsets, dtype=np.float64)
         joint_count = len(self.names)
+        self.parents = whole_indices("parents", self.parents, "joint", -1, max(joint_count, 1))
+        self.offsets = np.asarray(self.offsets, dtype=np.float64)
         _require(joint_count >= 1, "skeleton: needs at least one joint")
         _require(len(set(self.names)) == joint_count, "skeleton: joint names must be unique")
         _require(
@@ -368,7 +375,7 @@ class SkinnedMesh:
         )
         _check_finite("rest_positions", self.rest_positions)
         self.faces = _check_faces(self.faces, vertex_count)
-        self.joints = np.ascontiguousarray(self.joints, dtype=np.int32)
+        self.joints = np.asarray(self.joints)
         weights = np.asarray(self.weights, dtype=np.float64)
         _require(
             self.joints.ndim == 2 and self.joints.shape[0] == vertex_count,
@@ -381,9 +388,7 @@ class SkinnedMesh:
         )
         _check_finite("weights", weights)
         joint_count = self.skeleton.joint_count
-        if self.joints.size and (self.joints.min() < 0 or self.joints.max() >= joint_count):
-            vertex = int(np.argmax(np.any((self.joints < 0) | (self.joints >= joint_count), axis=1)))
-            raise ValueError(f"joints: vertex {vertex} references a joint outside [0, {joint_count})")
+        self.joints = whole_indices("joints", self.joints, "vertex", 0, joint_count)
         _require(bool(np.all(weights >= 0.0)), "weights: negative skin weight")
         self.joints, self.weights = normalize_skin_weights(self.joints, weights)
         self.inverse_bind = np.asarray(self.inverse_bind, dtype=np.float64)
@@ -395,18 +400,21 @@ class SkinnedMesh:
         if self.uvs is not None:
             self.uvs = np.ascontiguousarray(self.uvs, dtype=np.float32)
             _require(self.uvs.shape == (vertex_count, 2), f"uvs: expected ({vertex_count}, 2), got {self.uvs.shape}")
+            _check_finite("uvs", self.uvs)
         if self.normals is not None:
             self.normals = np.ascontiguousarray(self.normals, dtype=np.float32)
             _require(
                 self.normals.shape == (vertex_count, 3),
                 f"normals: expected ({vertex_count}, 3), got {self.normals.shape}",
             )
+            _check_finite("normals", self.normals)
         if self.morph_targets is not None:
             self.morph_targets = np.ascontiguousarray(self.morph_targets, dtype=np.float32)
             _require(
                 self.morph_targets.ndim == 3 and self.morph_targets.shape[1:] == (vertex_count, 3),
                 f"morph_targets: expected (N, {vertex_count}, 3), got {self.morph_targets.shape}",
             )
+            _check_finite("morph_targets", self.morph_targets)
 
     @property
     def vertex_count(self) -> int:

@@ -128,7 +128,13 @@ def test_bake_rejects_a_motion_for_another_skeleton():
 
 @pytest.mark.parametrize(
     "parents, message",
-    [([0, 0, 1], "joint 0 must be the root"), ([-1, 2, 0], "does not come before"), ([-1, 0, -1], "only joint 0")],
+    [
+        ([0, 0, 1], "joint 0 must be the root"),
+        ([-1, 2, 0], "does not come before"),
+        ([-1, 0, -1], "only joint 0"),
+        ([-1, 0, 2**32 + 1], r"joint 2 4294967297 has an index outside \[-1, 3\)"),  # wrapped to 1 before
+        ([-1, 0, 0.5], "joint 2 0.5 has an index that is not a whole number"),  # truncated to 0 before
+    ],
 )
 def test_skeleton_rejects_bad_hierarchies(parents, message):
     with pytest.raises(ValueError, match=message):
@@ -154,6 +160,26 @@ def test_motion_rejects_nan_rotation():
     local[1, 2, 0] = np.nan
     with pytest.raises(ValueError, match="local_rotations"):
         Motion(_chain(), np.zeros((2, 3)), local, fps=30.0)
+
+
+def test_skinned_mesh_and_animated_mesh_refuse_what_a_writer_could_not_write_back():
+    def skinned(**changes) -> SkinnedMesh:
+        arguments = {"rest_positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "faces": [[0, 1, 2]],
+                     "joints": [[0], [1], [2]], "weights": [[1], [1], [1]],
+                     "inverse_bind": np.tile(np.eye(4), (3, 1, 1)), "skeleton": _chain()}  # fmt: skip
+        return SkinnedMesh(**{**arguments, **changes})
+
+    with pytest.raises(ValueError, match="joints: vertex 2 4294967297 has an index outside"):
+        skinned(joints=[[0], [1], [2**32 + 1]])
+    with pytest.raises(ValueError, match="uvs: non-finite value"):
+        skinned(uvs=[[0, 0], [1, 0], [np.nan, 1]])
+    with pytest.raises(ValueError, match="normals: non-finite value"):
+        skinned(normals=[[0, 0, 1], [0, 0, 1], [0, 0, np.inf]])
+    with pytest.raises(ValueError, match="morph_targets: non-finite value"):
+        skinned(morph_targets=np.full((1, 3, 3), np.nan))
+    for fps in (-30.0, np.nan):
+        with pytest.raises(ValueError, match="fps: expected > 0"):
+            AnimatedMesh([[0, 1, 2]], np.zeros((1, 3, 3)), fps=fps)
 
 
 def test_skinned_mesh_rejects_vertex_without_weight():

@@ -148,8 +148,17 @@ def test_targets_out_of_range_are_named():
         simplify_animated(mesh, target_face_counts=[400])
     with pytest.raises(ValueError, match="placement"):
         simplify_animated(mesh, placement="middle")
-    with pytest.raises(ValueError, match=r"locked_vertices: vertex 9999 outside \[0, 192\)"):
+    with pytest.raises(ValueError, match=r"locked_vertices: entry 0 9999 has an index outside \[0, 192\)"):
         simplify_animated(mesh, locked_vertices=[9999])
+    with pytest.raises(ValueError, match="guarded_vertices: entry 1 10.9 has an index that is not a whole number"):
+        simplify_animated(mesh, guarded_vertices=[3, 10.9])  # was truncated to 10
+    # A (V,) bool mask is a mask: read as indices it locked vertices 0 and 1 alone.
+    mask = np.zeros(mesh.vertex_count, bool)
+    mask[::3] = True
+    by_mask = simplify_animated(mesh, target_ratios=[0.3], locked_vertices=mask).levels[0]
+    by_index = simplify_animated(mesh, target_ratios=[0.3], locked_vertices=np.flatnonzero(mask)).levels[0]
+    np.testing.assert_array_equal(by_mask.mesh.faces, by_index.mesh.faces)
+    assert np.isin(np.flatnonzero(mask), by_mask.kept_vertices).all()
 
 
 def test_a_tiny_ratio_stops_at_the_smallest_reachable_level():

@@ -117,6 +117,8 @@ def from_euler(angles: np.ndarray, order: str) -> np.ndarray:
     order = order.upper()
     if not 1 <= len(order) <= 3 or len(set(order)) != len(order) or set(order) - set(_AXIS_INDEX):
         raise ValueError(f"Euler order: must be one to three different axes of X, Y, Z, got {order!r}")
+    if angles.shape[-1:] != (len(order),):
+        raise ValueError(f"angles: expected (..., {len(order)}) for order {order!r}, got shape {angles.shape}")
     q = identity(angles.shape[:-1])
     for k, axis_name in enumerate(order):
         axis = np.zeros(3)
@@ -131,9 +133,9 @@ def to_euler(q: np.ndarray, order: str) -> np.ndarray:
     Works for the six Tait-Bryan orders; near gimbal lock the third angle is set to zero.
     """
     order = order.upper()
-    i, j, k = (_AXIS_INDEX[a] for a in order)
-    if len({i, j, k}) != 3:
+    if len(order) != 3 or len(set(order)) != 3 or set(order) - set(_AXIS_INDEX):
         raise ValueError(f"Euler order: only Tait-Bryan orders (three different axes) are supported, got {order!r}")
+    i, j, k = (_AXIS_INDEX[a] for a in order)
     m = to_matrix(q)
     # For R = R_i(a) R_j(b) R_k(c): m[i, k] = sign * sin(b), with sign +1 for cyclic (i, j, k).
     sign = 1.0 if (j - i) % 3 == 1 else -1.0

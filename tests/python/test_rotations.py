@@ -73,3 +73,11 @@ def test_slerp_endpoints_and_midpoint():
 def test_zero_quaternion_is_rejected():
     with pytest.raises(ValueError, match="zero"):
         rotations.normalize(np.zeros(4))
+
+
+def test_euler_refuses_an_order_or_a_count_of_angles_it_cannot_use():
+    q = rotations.identity((5,))
+    with pytest.raises(ValueError, match="Euler order: only Tait-Bryan orders .* got 'XYQ'"):
+        rotations.to_euler(q, "XYQ")  # a KeyError before
+    with pytest.raises(ValueError, match=r"angles: expected \(\.\.\., 3\) for order 'ZXY', got shape \(5, 2\)"):
+        rotations.from_euler(np.zeros((5, 2)), "ZXY")  # an IndexError before

@@ -23,6 +23,18 @@ def test_simplify_an_obj_sequence_writes_each_level_as_a_sequence(tmp_path, caps
     assert "AQEM error" in table and "180" in table
 
 
+def test_the_measurement_of_a_sequence_reports_its_progress(tmp_path):
+    # On long sequences it takes longer than the simplification, which it followed in silence.
+    from animlod.pipelines.lod_sequence import simplify_sequence
+
+    source = tmp_path / "tube"
+    write_sequence(source, bending_tube(frames=3))
+    (source / "._tube_0000.obj").write_bytes(b"\x00\x05\x16\x07")  # a macOS resource fork: no frame
+    calls = []
+    simplify_sequence(source, tmp_path / "out", [0.5, 0.2], measuring=lambda done, total: calls.append((done, total)))
+    assert calls == [(0, 2), (1, 2), (2, 2)]
+
+
 def test_simplify_npz_with_metrics_and_plot(tmp_path, capsys):
     write_npz(tmp_path / "tube.npz", bending_tube(frames=2))
     code = main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), "--ratio", "0.3", "--plot"])

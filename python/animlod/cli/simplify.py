@@ -138,7 +138,7 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
 def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
     from ..pipelines.lod_sequence import simplify_sequence
 
-    progress = _ProgressBar("AQEM")
+    progress, measuring = _ProgressBar("AQEM", "collapse"), _ProgressBar("measuring", "level")
     try:
         report = simplify_sequence(
             args.input,
@@ -146,11 +146,13 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
             args.ratio,
             measure=not args.no_metrics,
             progress=progress,
+            measuring=measuring,
             max_frames=args.max_frames,
             **options,
         )
     finally:
         progress.close()
+        measuring.close()
     print(
         "AQEM error: the largest collapse error, asset units; Hausdorff and RMS: relative to the bounding-box"
         " diagonal, over frames; time is the whole simplification"
@@ -181,17 +183,17 @@ def _read_level(path: Path) -> AnimatedMesh:
 
 
 class _ProgressBar:
-    """A tqdm bar fed by the simplifier's progress(done, total) callback; close() when done."""
+    """A tqdm bar of ``unit``s fed by a progress(done, total) callback; close() when done."""
 
-    def __init__(self, description: str) -> None:
-        self.description = description
+    def __init__(self, description: str, unit: str) -> None:
+        self.description, self.unit = description, unit
         self.bar = None
 
     def __call__(self, done: int, total: int) -> None:
         from tqdm import tqdm
 
         if self.bar is None:
-            self.bar = tqdm(total=total, desc=self.description, unit="collapse", leave=False)
+            self.bar = tqdm(total=total, desc=self.description, unit=self.unit, leave=False)
         self.bar.update(min(done, total) - self.bar.n)
 
     def close(self) -> None:

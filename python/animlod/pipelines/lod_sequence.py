@@ -51,13 +51,16 @@ def simplify_sequence(
     *,
     measure: bool = True,
     progress: Callable[[int, int], None] | None = None,
+    measuring: Callable[[int, int], None] | None = None,
     **aqem_options: object,
 ) -> SequenceReport:
     """Simplify the sequence at ``source`` (a folder, glob or file of OBJ/PLY frames, or an NPZ)
     and write its levels into the folder ``output``.
 
     ``aqem_options`` are keyword arguments of :func:`animlod.simplify_animated`; ``progress``
-    receives its (done, total) collapse counts. Raises FormatError for unreadable input.
+    receives its (done, total) collapse counts, ``measuring`` the (done, total) levels measured
+    (on long sequences the measurement takes longer than the simplification). Raises FormatError
+    for unreadable input.
     """
     kind = input_kind(source)
     if kind == "npz":
@@ -76,12 +79,16 @@ def simplify_sequence(
     folder, stem = Path(output), input_stem(source)
     levels = []
     for index, level in enumerate(result.levels, start=1):
+        if measure and measuring is not None:
+            measuring(index - 1, len(result.levels))
         path = _write_level(kind, source, folder / f"{stem}_lod{index}", level.mesh)
         measured = surface_error(original, level.mesh, samples=10000) if measure else None
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
         faces, target = level.mesh.face_count, level.target_face_count
         levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error))
+    if measure and measuring is not None:
+        measuring(len(result.levels), len(result.levels))
     return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds)
 
 
@@ -93,9 +100,9 @@ def _write_level(kind: str, source: str | os.PathLike, target: Path, mesh: Anima
         path = target.with_suffix(".npz")
         write_npz(path, mesh)
         return path
-    from ..io.meshseq import write_sequence
+    from ..io.meshseq import frame_files, write_sequence
 
-    files = sorted(Path(source).iterdir()) if Path(source).is_dir() else [Path(source)]
+    files = frame_files(source) if Path(source).is_dir() else [Path(source)]
     fmt = "ply" if any(path.suffix.lower() == ".ply" for path in files) else "obj"
     target.mkdir(parents=True, exist_ok=True)
     write_sequence(target, mesh, fmt)

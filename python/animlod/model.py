@@ -532,7 +532,10 @@ class LodChain:
         (``lod_selector.hpp``, ``level_for_error``), so Python and engines pick alike; a
         character that moves should keep a ``_core.LodSelector`` for its hysteresis.
         """
-        if distance <= 0.0:
-            raise ValueError(f"distance: must be positive, got {distance}")
+        for name, value in (("distance", distance), ("focal_length_px", focal_length_px)):
+            if not value > 0.0 or not np.isfinite(value):  # NaN compares false: every level would fit
+                raise ValueError(f"{name}: must be positive, got {value}")
+        if not screen_error_budget >= 0.0:
+            raise ValueError(f"screen_error_budget: must be a number >= 0, got {screen_error_budget}")
         errors = np.array([level.error for level in self.levels], dtype=np.float32)
         return int(_core.level_for_error(errors, distance, focal_length_px, screen_error_budget))

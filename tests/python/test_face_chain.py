@@ -141,3 +141,7 @@ def test_selection_lowers_the_animation_level_to_the_geometry(chain):
     far = select_face_levels(0.05, geometry_thresholds, animation_thresholds, floors)
     assert far.geometry_level == 2 and far.animation_level == floors[2]  # level 1 wanted, lowered by geometry 2
     assert far.frame_step > middle.frame_step >= near.frame_step
+    with pytest.raises(ValueError, match="coverage: must be a number >= 0, got nan"):
+        select_face_levels(float("nan"), geometry_thresholds, animation_thresholds, floors)
+    with pytest.raises(ValueError, match=r"animation floors: 7 outside \[0, 4\)"):
+        select_face_levels(0.3, geometry_thresholds, animation_thresholds, [0, 1, 7])

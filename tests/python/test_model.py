@@ -205,3 +205,8 @@ def test_lod_chain_picks_the_coarsest_level_within_the_pixel_budget():
     assert chain.level_for(1.0, 1000.0, 1000.0) == 3
     with pytest.raises(ValueError, match="distance"):
         chain.level_for(1.0, 0.0, 1000.0)
+    # NaN compares false and a negative focal length makes every error fit: both picked a level.
+    for arguments, name in (((1.0, np.nan, 1000.0), "distance"), ((1.0, 10.0, -1.0), "focal_length_px"),
+                            ((np.nan, 10.0, 1000.0), "screen_error_budget")):  # fmt: skip
+        with pytest.raises(ValueError, match=name):
+            chain.level_for(*arguments)

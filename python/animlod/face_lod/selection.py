@@ -116,6 +116,11 @@ def select_face_levels(
     allows (``animation_floors[g]``), and the frame step of frame skipping."""
     if len(animation_floors) != len(geometry_thresholds):
         raise ValueError(f"animation floors: {len(animation_floors)} for {len(geometry_thresholds)} geometry levels")
+    if not coverage >= 0.0:
+        raise ValueError(f"coverage: must be a number >= 0, got {coverage}")
+    outside = [floor for floor in animation_floors if not 0 <= floor < len(animation_thresholds)]
+    if outside:
+        raise ValueError(f"animation floors: {outside[0]} outside [0, {len(animation_thresholds)})")
     geometry = level_for_coverage(geometry_thresholds, coverage)
     animation = max(level_for_coverage(animation_thresholds, coverage), int(animation_floors[geometry]))
     return FaceSelection(geometry, animation, frame_step(coverage, full_rate_coverage, max_step), coverage)

@@ -145,8 +145,10 @@ class Skeleton:
         _check_finite("offsets", self.offsets)
         if self.rest_rotations is None:
             self.rest_rotations = rotations.identity((joint_count,))
-        self.rest_rotations = rotations.normalize(self.rest_rotations)
-        _require(self.rest_rotations.shape == (joint_count, 4), "rest_rotations: expected shape (J, 4)")
+        self.rest_rotations = np.asarray(self.rest_rotations, dtype=np.float64)
+        shape = self.rest_rotations.shape
+        _require(shape == (joint_count, 4), f"rest_rotations: expected shape ({joint_count}, 4), got {shape}")
+        self.rest_rotations = rotations.normalize(self.rest_rotations, "rest_rotations")
         self.end_sites = np.zeros(joint_count, bool) if self.end_sites is None else np.asarray(self.end_sites, bool)
         _require(self.end_sites.shape == (joint_count,), f"end_sites: expected shape ({joint_count},)")
         has_children = np.zeros(joint_count, bool)
@@ -229,7 +231,7 @@ class Motion:
         _require(local.shape == expected, f"local_rotations: expected shape {expected}, got {local.shape}")
         _check_finite("root_positions", self.root_positions)
         _check_finite("local_rotations", local)
-        self.local_rotations = rotations.normalize(local)
+        self.local_rotations = rotations.normalize(local, "local_rotations")
         _require(self.fps > 0 and np.isfinite(self.fps), f"fps: must be positive, got {self.fps}")
         if self.joint_translations is not None:
             self.joint_translations = np.asarray(self.joint_translations, dtype=np.float64)

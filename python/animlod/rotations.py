@@ -13,12 +13,15 @@ from . import _core
 _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
 
-def normalize(q: np.ndarray) -> np.ndarray:
-    """Unit quaternions ``(..., 4)``; a zero quaternion is an error, never silently identity."""
+def normalize(q: np.ndarray, name: str = "quaternion") -> np.ndarray:
+    """Unit quaternions ``(..., 4)``; a zero quaternion is an error naming ``name`` and its index,
+    never silently identity."""
     q = np.asarray(q, dtype=np.float64)
     norm = np.linalg.norm(q, axis=-1, keepdims=True)
-    if np.any(norm == 0.0) or not np.all(np.isfinite(norm)):
-        raise ValueError("quaternion: zero or non-finite norm")
+    bad = (norm[..., 0] == 0.0) | ~np.isfinite(norm[..., 0])
+    if np.any(bad):
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(f"{name}: index {index} has a zero or non-finite norm")
     return q / norm
 
 

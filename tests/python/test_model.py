@@ -210,3 +210,12 @@ def test_lod_chain_picks_the_coarsest_level_within_the_pixel_budget():
                             ((np.nan, 10.0, 1000.0), "screen_error_budget")):  # fmt: skip
         with pytest.raises(ValueError, match=name):
             chain.level_for(*arguments)
+
+
+def test_rotations_name_the_argument_and_the_quaternion_that_has_no_norm():
+    local = rotations.identity((4, 3))
+    local[2, 1] = 0.0
+    with pytest.raises(ValueError, match=r"local_rotations: index \(2, 1\) has a zero or non-finite norm"):
+        Motion(_chain(), np.zeros((4, 3)), local, fps=30.0)
+    with pytest.raises(ValueError, match=r"rest_rotations: expected shape \(3, 4\), got \(3, 3\)"):
+        Skeleton(["a", "b", "c"], [-1, 0, 1], np.zeros((3, 3)), rest_rotations=np.zeros((3, 3)))

@@ -289,6 +289,8 @@ def simplify_animated(
     an option cannot hold.
     """
     if target_ratios is not None:
+        if np.ndim(target_ratios) != 1:
+            raise ValueError(f"target_ratios: expected a list of fractions, one per level, got {target_ratios!r}")
         option_fields["target_ratios"] = list(target_ratios)
     resolved = resolve_options(AqemOptions, options, option_fields)
     raw = _core.simplify_animated(
@@ -352,6 +354,8 @@ def simplify_skinned(
     """
     if "attributes" in option_fields or "position_attributes" in option_fields:
         raise ValueError("simplify_skinned: attributes come from the SkinnedMesh (uvs, normals, morph targets)")
+    if isinstance(motions, Motion):
+        raise ValueError("motions: expected a list of clips, got one Motion (pass [motion])")
     baked = [skinned.bake(motion).frames for motion in motions]
     poses = AnimatedMesh(skinned.faces, np.concatenate([skinned.rest_positions[None], *baked], axis=0))
     uv_count = 0 if skinned.uvs is None else 2

@@ -64,6 +64,9 @@ def test_eight_levels_spread_down_to_the_floor(translating, locked, floor) -> No
             level_joint_counts(motion, analysis, 8)
     if floor == 5:  # above the paper's 8 %: the fractions are mapped onto 5..20
         assert counts[-1] == 5 and "2 locked (j2, j9), 2 translating (j1, j5)" in info.explain()
+    for levels in (4.5, [20, 10.7]):  # int() truncated 10.7 and iterated 4.5 ("not iterable")
+        with pytest.raises(ValueError, match="levels: expected a whole number of levels or a list of joint counts"):
+            level_joint_counts(motion, analysis, levels)
 
 
 def test_a_translating_non_root_joint_stays_and_the_rest_freeze() -> None:

@@ -148,6 +148,8 @@ def test_targets_out_of_range_are_named():
         simplify_animated(mesh, target_face_counts=[400])
     with pytest.raises(ValueError, match="placement"):
         simplify_animated(mesh, placement="middle")
+    with pytest.raises(ValueError, match="target_ratios: expected a list of fractions, one per level, got 0.5"):
+        simplify_animated(mesh, 0.5)  # "'float' object is not iterable" before
     with pytest.raises(ValueError, match=r"locked_vertices: entry 0 9999 has an index outside \[0, 192\)"):
         simplify_animated(mesh, locked_vertices=[9999])
     with pytest.raises(ValueError, match="guarded_vertices: entry 1 10.9 has an index that is not a whole number"):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from simplify_inputs import directed_edges_unique, two_bone_tube
 
 from animlod import synth
@@ -13,6 +14,8 @@ def test_skinned_levels_skin_with_valid_merged_weights():
     skinned, motion = two_bone_tube()  # an open tube with UVs
     levels = simplify_skinned(skinned, [motion], (0.5, 0.2))
     assert [level.target_face_count for level in levels] == [180, 72]
+    with pytest.raises(ValueError, match=r"motions: expected a list of clips, got one Motion \(pass \[motion\]\)"):
+        simplify_skinned(skinned, motion, (0.5, 0.2))
     for level in levels:
         mesh = level.mesh
         assert mesh.face_count <= level.target_face_count

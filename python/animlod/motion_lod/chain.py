@@ -166,7 +166,10 @@ def level_joint_counts(motion: Motion, analysis: MotionAnalysis, levels: int | S
         for k in range(1, levels):
             counts[k] = min(counts[k], counts[k - 1] - 1)
         return [int(c) for c in counts]
-    counts = sorted({int(c) for c in levels}, reverse=True)
+    given = np.asarray(levels)
+    if given.ndim != 1 or given.dtype.kind not in "iuf" or np.any(given != np.round(given)):
+        raise ValueError(f"levels: expected a whole number of levels or a list of joint counts, got {levels!r}")
+    counts = sorted({int(c) for c in given}, reverse=True)
     if not counts:
         raise ValueError("levels: empty list of joint counts")
     if counts[0] > total or counts[-1] < fewest:

@@ -79,6 +79,10 @@ def sample_surface(mesh: AnimatedMesh, count: int, seed: int = 0) -> SurfaceSamp
 
     The same face/barycentric pairs are used in every frame, so the samples move with the surface.
     """
+    if isinstance(count, bool) or not isinstance(count, int | np.integer) or count < 0:
+        raise ValueError(f"samples: expected a whole number >= 0, got {count!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ValueError(f"seed: expected a whole number >= 0, got {seed!r}")
     corners = mesh.frames[0][mesh.faces].astype(np.float64)
     areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
     rng = np.random.default_rng(seed)

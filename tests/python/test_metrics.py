@@ -123,3 +123,15 @@ def test_point_mesh_distance_names_bad_input():
         _core.point_mesh_max_squared_distance([[0, 0, 0], [np.nan, 0, 0]], square, np.array([[0, 1, 2]]))
     with pytest.raises(ValueError, match=r"vertices: expected"):
         _core.point_mesh_max_squared_distance(np.zeros((2, 1, 3)), square, np.array([[0, 1, 2]]))
+
+
+def test_sample_counts_and_seeds_are_checked_by_name():
+    from animlod import synth
+
+    mesh = synth.bending_cylinder(frames=2, rings=6, segments=6)
+    with pytest.raises(ValueError, match="samples: expected a whole number >= 0, got -5"):
+        surface_error(mesh, mesh, samples=-5)  # numpy's "negative dimensions are not allowed" before
+    with pytest.raises(ValueError, match="samples: expected a whole number >= 0, got 1.5"):
+        sample_surface(mesh, 1.5)
+    with pytest.raises(ValueError, match="seed: expected a whole number >= 0, got -1"):
+        surface_error(mesh, mesh, seed=-1)

@@ -46,7 +46,7 @@ _READABLE_EXTENSIONS = (
 )  # fmt: skip
 
 
-_COMPONENT_DTYPES = {
+COMPONENT_DTYPES = {
     5120: np.dtype("<i1"),
     5121: np.dtype("<u1"),
     5122: np.dtype("<i2"),
@@ -142,7 +142,7 @@ class GltfDocument:
 
     def _decode_accessor(self, index: int, accessor: pygltflib.Accessor, element: str) -> np.ndarray:
         component = accessor.componentType
-        if component not in _COMPONENT_DTYPES:
+        if component not in COMPONENT_DTYPES:
             raise self.fail(element, f"unknown componentType {component!r}")
         if accessor.type not in _TYPE_WIDTHS:
             raise self.fail(element, f"type {accessor.type!r} is not supported here")
@@ -151,7 +151,7 @@ class GltfDocument:
         if not isinstance(count, int) or isinstance(count, bool) or not 0 <= count <= _MAX_ACCESSOR_COUNT:
             raise self.fail(element, f"invalid count {count!r}")
         width = _TYPE_WIDTHS[accessor.type]
-        dtype = _COMPONENT_DTYPES[component]
+        dtype = COMPONENT_DTYPES[component]
         if accessor.bufferView is None and index in self._draco:
             values = self._draco_elements(index, count, width, dtype)
         elif accessor.bufferView is None:
@@ -251,7 +251,7 @@ class GltfDocument:
         if sparse.indices.componentType not in _SPARSE_INDEX_COMPONENTS:
             reason = f"componentType {sparse.indices.componentType!r} is not one of {_SPARSE_INDEX_COMPONENTS}"
             raise self.fail(index_element, reason)
-        index_dtype = _COMPONENT_DTYPES[sparse.indices.componentType]
+        index_dtype = COMPONENT_DTYPES[sparse.indices.componentType]
         indices = self._sparse_part(sparse.indices, substitutes, 1, index_dtype, index_element)
         new_values = self._sparse_part(sparse.values, substitutes, width, dtype, f"{element} sparse values")
         rows = indices[:, 0].astype(np.int64)  # unsigned, so only the upper bound can be crossed

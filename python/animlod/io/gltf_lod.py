@@ -27,7 +27,7 @@ import numpy as np
 
 from ..model import AnimatedMesh, LodChain, LodLevel
 from .glb_builder import ARRAY_BUFFER, GlbBuilder
-from .gltf_document import INSTANCING_EXTENSION, GltfDocument
+from .gltf_document import COMPONENT_DTYPES, INSTANCING_EXTENSION, GltfDocument
 from .gltf_draco import DRACO_EXTENSION
 from .gltf_mesh import read_mesh_geometry, transform_points
 from .gltf_read import skinned_mesh_of_node
@@ -90,7 +90,6 @@ class LevelInfo:
 # as quantised exports store texture coordinates, colours and feature IDs); positions,
 # directions, morph deltas and skin weights are rebuilt by the levels and stay float.
 _INPUT_TYPED = ("TEXCOORD_", "COLOR_", "_")
-_INTEGER_COMPONENTS = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32}
 
 
 def add_level_mesh(
@@ -254,8 +253,8 @@ def _storable(values: np.ndarray, like: dict) -> tuple[np.ndarray, bool]:
     values = np.asarray(values)
     if values.dtype.kind in "iu":
         return values.astype(np.uint8 if values.max(initial=0) < 256 else np.uint16), False
-    dtype = _INTEGER_COMPONENTS.get(like.get("componentType"))
-    if dtype is None:
+    dtype = COMPONENT_DTYPES.get(like.get("componentType"))
+    if dtype is None or dtype.kind == "f":
         return values.astype(np.float32), False
     normalized = bool(like.get("normalized", False))
     limits = np.iinfo(dtype)

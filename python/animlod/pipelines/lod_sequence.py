@@ -76,12 +76,12 @@ def simplify_sequence(
     started = time.perf_counter()
     result = simplify_animated(original, ratios, progress=progress, **aqem_options)
     seconds = time.perf_counter() - started
-    folder, stem = Path(output), input_stem(source)
+    folder, stem, fmt = Path(output), input_stem(source), _level_format(kind, source)
     levels = []
     for index, level in enumerate(result.levels, start=1):
         if measure and measuring is not None:
             measuring(index - 1, len(result.levels))
-        path = _write_level(kind, source, folder / f"{stem}_lod{index}", level.mesh)
+        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh)
         measured = surface_error(original, level.mesh, samples=10000) if measure else None
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
@@ -92,18 +92,26 @@ def simplify_sequence(
     return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds)
 
 
-def _write_level(kind: str, source: str | os.PathLike, target: Path, mesh: AnimatedMesh) -> Path:
-    """Write a level in the input's format; its path."""
+def _level_format(kind: str, source: str | os.PathLike) -> str:
+    """The levels' format, the input's: "npz", or "ply" when a frame is PLY, else "obj"."""
     if kind == "npz":
+        return "npz"
+    from ..io.meshseq import frame_files
+
+    files = frame_files(source) if Path(source).is_dir() else [Path(source)]
+    return "ply" if any(path.suffix.lower() == ".ply" for path in files) else "obj"
+
+
+def _write_level(fmt: str, target: Path, mesh: AnimatedMesh) -> Path:
+    """Write a level in ``fmt`` (see :func:`_level_format`); its path."""
+    if fmt == "npz":
         from ..io.npz import write_npz
 
         path = target.with_suffix(".npz")
         write_npz(path, mesh)
         return path
-    from ..io.meshseq import frame_files, write_sequence
+    from ..io.meshseq import write_sequence
 
-    files = frame_files(source) if Path(source).is_dir() else [Path(source)]
-    fmt = "ply" if any(path.suffix.lower() == ".ply" for path in files) else "obj"
     target.mkdir(parents=True, exist_ok=True)
     write_sequence(target, mesh, fmt)
     return target

@@ -124,10 +124,10 @@ class Skeleton:
     def __post_init__(self) -> None:
         self.names = [str(n) for n in self.names]
         joint_count = len(self.names)
-        self.parents = whole_indices("parents", self.parents, "joint", -1, max(joint_count, 1))
-        self.offsets = np.asarray(self.offsets, dtype=np.float64)
         _require(joint_count >= 1, "skeleton: needs at least one joint")
         _require(len(set(self.names)) == joint_count, "skeleton: joint names must be unique")
+        self.parents = whole_indices("parents", self.parents, "joint", -1, joint_count)
+        self.offsets = np.asarray(self.offsets, dtype=np.float64)
         _require(
             self.parents.shape == (joint_count,), f"parents: expected shape ({joint_count},), got {self.parents.shape}"
         )

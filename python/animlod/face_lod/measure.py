@@ -169,7 +169,7 @@ def measure_chain(
             samples,
             error_frames,
             times=times[g],
-        )  # fmt: skip
+        )
         for g in levels
     ]
 

@@ -224,7 +224,7 @@ def mpa_fields(face: FaceModel) -> dict[str, tuple[list[str], Field]]:
                 "mouth",
             ],
             lambda p: 0.003 * pair(p, zygos, (0.022, 0.02, 0.05))[:, None] * up,
-        ),  # fmt: skip
+        ),
         "wrinkle_nose": (
             ["nose", "lip_upper", "cheek_left", "cheek_right", "zygomatic_left", "zygomatic_right"],
             lambda p: 0.002 * _bump(p, nose, (0.015, 0.02, 0.05))[:, None] * (up - 0.5 * forward),

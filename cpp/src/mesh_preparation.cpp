@@ -46,12 +46,17 @@ int64_t snapped(float value, double inverse_cell) {
   return std::numeric_limits<int64_t>::min() + static_cast<int64_t>(bits);
 }
 
+// Influence k of vertex v's weight on the weld's grid.
+int64_t snapped_weight(const WeldInput& input, size_t v, size_t k) {
+  return snapped(input.skin_weights[v * input.influence_count + k], 1.0 / kWeldTolerance);
+}
+
 // Skin rows compare as snapped (joint, weight) sets: influences whose weight snaps to zero do
 // not count, and the order of the influences does not matter.
 std::vector<std::pair<int32_t, int64_t>> skin_set(const WeldInput& input, size_t v) {
   std::vector<std::pair<int32_t, int64_t>> set;
   for (size_t k = 0; k < input.influence_count; ++k) {
-    const int64_t weight = snapped(input.skin_weights[v * input.influence_count + k], 1.0 / kWeldTolerance);
+    const int64_t weight = snapped_weight(input, v, k);
     if (weight > 0) set.emplace_back(input.skin_joints[v * input.influence_count + k], weight);
   }
   std::sort(set.begin(), set.end());
@@ -125,8 +130,10 @@ std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, 
     for (size_t b = 0; b < input.position_attribute_count; ++b)
       h = mix(h, snapped(input.position_attributes[v * input.position_attribute_count + b], inverse_cell));
     uint64_t skin = 0;  // a sum: the influences' order does not count, zero weights do not count
-    if (input.skin_joints)
-      for (const auto& [joint, weight] : skin_set(input, v)) skin += mix(static_cast<uint64_t>(joint), weight);
+    for (size_t k = 0; input.skin_joints && k < input.influence_count; ++k) {
+      const int64_t weight = snapped_weight(input, v, k);
+      if (weight > 0) skin += mix(static_cast<uint64_t>(input.skin_joints[v * input.influence_count + k]), weight);
+    }
     return h ^ skin;
   };
   size_t capacity = 16;

@@ -72,7 +72,7 @@ def assets_in(folder: Path) -> Iterator[Path]:
     batch output folders (an output inside the library is not read back as input)."""
     for root, folders, files in os.walk(folder):
         here = Path(root)
-        if holds_frames(here):
+        if any(is_frame_name(name) and (here / name).is_file() for name in files):  # holds_frames, from the walk's list
             yield here
         for name in sorted(files):
             if not name.startswith(".") and Path(name).suffix.lower() in MODEL_SUFFIXES and (here / name).is_file():

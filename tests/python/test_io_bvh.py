@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -79,6 +81,31 @@ def test_a_byte_order_mark_is_no_part_of_the_hierarchy(tmp_path: Path) -> None:
     marked.write_bytes(b"\xef\xbb\xbf" + SMALL_BVH.encode())
     once = read_bvh(_write(tmp_path, SMALL_BVH))
     np.testing.assert_array_equal(read_bvh(marked).local_rotations, once.local_rotations)
+
+
+@pytest.mark.parametrize("case", [str.lower, str.title], ids=["lower", "title"])
+def test_keywords_in_any_case_read_like_upper_case(tmp_path: Path, case: Callable[[str], str]) -> None:
+    # Some exporters write "hierarchy", "root", "offset", "end site", "frames:"; Blender reads them.
+    # Joint names (Hips, A, B) stay as written; channel names were already read in any case.
+    keywords = r"HIERARCHY|ROOT|JOINT|OFFSET|CHANNELS|End Site|MOTION|Frames:|Frame Time:|[XYZ](?:position|rotation)"
+    text = re.sub(keywords, lambda match: case(match.group()), SMALL_BVH)
+    assert "root Hips" in text if case is str.lower else "Root Hips" in text
+    cased, upper = read_bvh(_write(tmp_path, text, "cased.bvh")), read_bvh(_write(tmp_path, SMALL_BVH))
+    assert cased.skeleton.names == upper.skeleton.names == ["Hips", "A", "A_End", "B"]
+    assert cased.fps == upper.fps
+    for name in ("root_positions", "local_rotations", "joint_translations"):
+        np.testing.assert_array_equal(getattr(cased, name), getattr(upper, name))
+    np.testing.assert_array_equal(cased.skeleton.offsets, upper.skeleton.offsets)
+    np.testing.assert_array_equal(cased.skeleton.parents, upper.skeleton.parents)
+    np.testing.assert_array_equal(cased.skeleton.end_sites, upper.skeleton.end_sites)
+
+
+def test_keywords_match_ascii_case_only(tmp_path: Path) -> None:
+    # U+017F LATIN SMALL LETTER LONG S upper-cases to "S"; it spells no keyword.
+    message = _read_error(tmp_path, SMALL_BVH.replace("End Site", "End \u017fite"))
+    assert message.endswith("line 10: expected 'Site', found '\u017fite'")
+    message = _read_error(tmp_path, SMALL_BVH.replace("Frames: 2", "Frame\u017f: 2"))
+    assert message.endswith("line 22: expected 'Frames: N', found 'Frame\u017f: 2'")
 
 
 def test_a_hinge_with_one_rotation_channel_reads_like_three_with_zeros(tmp_path: Path) -> None:

@@ -18,6 +18,10 @@ Conventions of this reader, in terms of :class:`animlod.model.Motion`:
   written (``Zrotation Xrotation Yrotation`` means ``R = Rz @ Rx @ Ry``), per joint. A joint
   may have fewer than three (a hinge's ``CHANNELS 1 Xrotation``): it does not turn about the
   others; position channels too may be any of the three.
+- Keywords (``HIERARCHY``, ``ROOT``, ``JOINT``, ``OFFSET``, ``CHANNELS``, ``End Site``,
+  ``MOTION``, ``Frames:``, ``Frame Time:``) are matched regardless of ASCII case, as Blender's
+  importer matches them (some exporters write ``hierarchy``, ``root``, ``offset``); channel
+  names too (``xrotation``). Joint names are kept as written, and stay case-sensitive.
 - ``Frame Time`` gives fps; when the written frame time is an integer rate rounded to the digits
   written (``.0083333`` for 120 fps), fps is that integer.
 """
@@ -41,7 +45,22 @@ from .tokens import parses, tokens_per_line
 _CHANNELS = {
     f"{axis.lower()}{kind}": (kind, index) for index, axis in enumerate("XYZ") for kind in ("position", "rotation")
 }
-_MOTION_LINE = re.compile(r"^[ \t]*MOTION\b", re.MULTILINE)
+
+
+def _any_case(keyword: str) -> str:
+    """A regular expression matching ``keyword`` in any ASCII case (re.IGNORECASE would also take
+    Unicode look-alikes: the long s for "s", the Kelvin sign for "k")."""
+    return "".join(f"[{char.upper()}{char.lower()}]" if char.isalpha() else re.escape(char) for char in keyword)
+
+
+def _is_keyword(token: str, keyword: str) -> bool:
+    """Whether ``token`` is the upper-case ``keyword`` written in any ASCII case."""
+    return token.isascii() and token.upper() == keyword
+
+
+_MOTION_LINE = re.compile(rf"^[ \t]*{_any_case('MOTION')}\b", re.MULTILINE)
+_FRAMES_LINE = re.compile(rf"\s*{_any_case('Frames:')}\s*(\d+)\s*")
+_FRAME_TIME_LINE = re.compile(rf"\s*{_any_case('Frame')}\s+{_any_case('Time:')}\s*(\S+)\s*")
 # Largest magnitude of an OFFSET or channel value. Beyond it, squared distances in forward
 # kinematics and error measures overflow (an OFFSET of 1e300 gave infinite errors and exit 0);
 # 1e12 is a million kilometres in millimetres, or 10^12 degrees.
@@ -82,8 +101,9 @@ class _TokenCursor:
         return token
 
     def expect(self, literal: str) -> None:
+        """Consume ``literal`` (a keyword in any ASCII case, or a brace)."""
         token, line = self.next(repr(literal))
-        if token != literal:
+        if not _is_keyword(token, literal.upper()):
             raise self.error(line, f"expected {literal!r}, found {token!r}")
 
     def number(self, what: str) -> float:
@@ -146,7 +166,7 @@ def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
     """Joints in file order. Iterative, with a stack of open blocks: chains of any depth parse."""
     cursor.expect("HIERARCHY")
     token, line = cursor.next("ROOT")
-    if token != "ROOT":
+    if not _is_keyword(token, "ROOT"):
         raise cursor.error(line, f"expected ROOT, found {token!r}")
     joints: list[_JointSpec] = []
     open_blocks = [_open_joint(cursor, joints, parent=-1, line=line, end_site=False)]  # (joint, line)
@@ -158,13 +178,13 @@ def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
             if joint.offset is None:
                 raise cursor.error(opened, f"joint {joint.name!r} has no OFFSET")
             open_blocks.pop()
-        elif token == "OFFSET":
+        elif _is_keyword(token, "OFFSET"):
             joint.offset = tuple(cursor.number(f"OFFSET of joint {joint.name!r}") for _ in range(3))
-        elif token == "CHANNELS" and not joint.end_site:
+        elif _is_keyword(token, "CHANNELS") and not joint.end_site:
             joint.channels = _parse_channels(cursor, joint.name, token_line)
-        elif token == "JOINT" and not joint.end_site:
+        elif _is_keyword(token, "JOINT") and not joint.end_site:
             open_blocks.append(_open_joint(cursor, joints, index, token_line, end_site=False))
-        elif token == "End" and not joint.end_site:
+        elif _is_keyword(token, "END") and not joint.end_site:
             cursor.expect("Site")
             open_blocks.append(_open_joint(cursor, joints, index, token_line, end_site=True))
         else:
@@ -172,7 +192,8 @@ def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
             raise cursor.error(token_line, f"unexpected {token!r} in {where}")
     extra = cursor.peek()
     if extra is not None:
-        reason = "a second ROOT is not supported" if extra[0] == "ROOT" else f"unexpected {extra[0]!r} after the root"
+        second_root = _is_keyword(extra[0], "ROOT")
+        reason = "a second ROOT is not supported" if second_root else f"unexpected {extra[0]!r} after the root"
         raise cursor.error(extra[1], reason)
     return joints
 
@@ -235,10 +256,10 @@ def _parse_motion_header(path: Path, text: str, motion_line: int) -> tuple[int, 
     if len(header) < 2:
         raise FormatError(path, f"line {motion_line}", "MOTION is not followed by Frames: and Frame Time: lines")
     (frames_line, frames_text), (time_line, time_text) = header
-    frames_match = re.fullmatch(r"\s*Frames:\s*(\d+)\s*", frames_text)
+    frames_match = _FRAMES_LINE.fullmatch(frames_text)
     if frames_match is None:
         raise FormatError(path, f"line {frames_line}", f"expected 'Frames: N', found {frames_text.strip()!r}")
-    time_match = re.fullmatch(r"\s*Frame\s+Time:\s*(\S+)\s*", time_text)
+    time_match = _FRAME_TIME_LINE.fullmatch(time_text)
     frame_time = float(time_match.group(1)) if time_match and parses(time_match.group(1), np.float64) else None
     # The rate 1 / Frame Time must be finite too: Frame Time: 1e-320 is positive but its inverse is not.
     if frame_time is None or not (frame_time > 0.0 and np.isfinite(frame_time) and np.isfinite(1.0 / frame_time)):

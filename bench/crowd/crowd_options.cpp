@@ -18,7 +18,8 @@ a path and reports frame times per LoD mode as a Markdown table (stdout) and JSO
 
   --count N              characters (default 1000)
   --frames K             measured frames per mode (default 300)
-  --warmup W             unmeasured frames before each mode in each round (default 10)
+  --warmup W             unmeasured frames before each mode in each round, and once more per
+                         mode before the first round (default 10)
   --rounds R             split the path into R rounds and let the modes take turns on each,
                          so that a change in machine load hits every mode alike (default 1)
   --modes LIST           all, or comma-separated of Original, GLoD, MLoD, G+MLoD, each

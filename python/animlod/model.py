@@ -332,11 +332,17 @@ class Motion:
 
     def skin_matrices(self, inverse_bind: np.ndarray) -> np.ndarray:
         """Skinning matrices ``world @ inverse_bind``, ``(T, J, 4, 4)``; ``world`` includes the
-        joint deformations."""
+        joint deformations. ``inverse_bind`` is ``(J, 4, 4)``, one finite matrix per joint of the
+        skeleton; any other shape (a lone ``(4, 4)``, which numpy would broadcast, too) or a
+        non-finite value is a ValueError naming ``inverse_bind``."""
+        inverse_bind = np.asarray(inverse_bind, dtype=np.float64)
+        expected = (self.skeleton.joint_count, 4, 4)
+        _require(inverse_bind.shape == expected, f"inverse_bind: expected shape {expected}, got {inverse_bind.shape}")
+        _check_finite("inverse_bind", inverse_bind)
         world = self.world_transforms()
         if self.joint_deformations is not None:
             world[..., :3, :3] = world[..., :3, :3] @ self.joint_deformations
-        return world @ np.asarray(inverse_bind, dtype=np.float64)
+        return world @ inverse_bind
 
 
 @dataclass
@@ -429,8 +435,10 @@ class SkinnedMesh:
     def bake(self, motion: Motion, morph_weights: np.ndarray | None = None) -> AnimatedMesh:
         """Linear blend skinning of every frame of ``motion`` in the C++ core.
 
-        ``morph_weights (T, N)`` blends the morph targets into the rest pose of each frame first,
-        as glTF does (morphing before skinning).
+        ``morph_weights (T, N)`` finite, one row per frame of ``motion`` and one column per morph
+        target (N = 0 for a skin without targets), blends the morph targets into the rest pose of
+        each frame first, as glTF does (morphing before skinning); None keeps the rest pose. Another
+        shape or a non-finite weight is a ValueError naming ``morph_weights``.
         """
         from ._core import bake_lbs
 
@@ -438,15 +446,18 @@ class SkinnedMesh:
             raise ValueError(
                 f"motion has {motion.skeleton.joint_count} joints, the skin's skeleton {self.skeleton.joint_count}"
             )
+        if morph_weights is not None:
+            morph_weights = np.asarray(morph_weights, np.float64)
+            target_count = 0 if self.morph_targets is None else len(self.morph_targets)
+            expected = (motion.frame_count, target_count)
+            _require(
+                morph_weights.shape == expected, f"morph_weights: expected shape {expected}, got {morph_weights.shape}"
+            )
+            _check_finite("morph_weights", morph_weights)
         matrices = motion.skin_matrices(self.inverse_bind).astype(np.float32)
         if morph_weights is None or self.morph_targets is None:
             frames = bake_lbs(self.rest_positions, self.joints, self.weights, matrices)
             return AnimatedMesh(self.faces, frames, fps=motion.fps)
-        morph_weights = np.asarray(morph_weights, np.float64)
-        expected = (motion.frame_count, len(self.morph_targets))
-        _require(
-            morph_weights.shape == expected, f"morph_weights: expected shape {expected}, got {morph_weights.shape}"
-        )
         frames = np.empty((motion.frame_count, self.vertex_count, 3), np.float32)
         for t in range(motion.frame_count):  # O(T) calls, each a whole frame in C++
             rest = self.rest_positions + np.einsum("n,nvc->vc", morph_weights[t], self.morph_targets)

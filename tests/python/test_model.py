@@ -126,6 +126,55 @@ def test_bake_rejects_a_motion_for_another_skeleton():
         _skinned_bar().bake(motion)
 
 
+def _nan_at(shape: tuple, index: tuple, base: np.ndarray | None = None) -> np.ndarray:
+    values = np.zeros(shape) if base is None else base.copy()
+    values[index] = np.nan
+    return values
+
+
+@pytest.mark.parametrize(
+    "inverse_bind, message",
+    [
+        (np.eye(4), r"inverse_bind: expected shape \(3, 4, 4\), got \(4, 4\)"),  # broadcast to every joint before
+        (np.zeros((1, 4, 4)), r"inverse_bind: expected shape \(3, 4, 4\), got \(1, 4, 4\)"),  # broadcast too
+        (np.zeros((2, 4, 4)), r"inverse_bind: expected shape \(3, 4, 4\), got \(2, 4, 4\)"),  # numpy's error
+        (np.zeros((3, 3, 3)), r"inverse_bind: expected shape \(3, 4, 4\), got \(3, 3, 3\)"),
+        (_nan_at((3, 4, 4), (1, 0, 0), np.eye(4)[None].repeat(3, 0)), r"inverse_bind: .* index \(1, 0, 0\)"),
+    ],
+)
+def test_skin_matrices_rejects_inverse_binds_of_another_shape_or_not_finite(inverse_bind, message):
+    with pytest.raises(ValueError, match=message):
+        _bend(np.zeros(2)).skin_matrices(inverse_bind)
+
+
+@pytest.mark.parametrize(
+    "targets, morph_weights, message",
+    [
+        (2, np.zeros((2, 5)), r"morph_weights: expected shape \(2, 2\), got \(2, 5\)"),
+        (2, np.zeros(2), r"morph_weights: expected shape \(2, 2\), got \(2,\)"),
+        (2, _nan_at((2, 2), (1, 0)), r"morph_weights: non-finite value at index \(1, 0\)"),  # "frames" before
+        (None, np.ones((2, 5)), r"morph_weights: expected shape \(2, 0\), got \(2, 5\)"),  # ignored before
+    ],
+)
+def test_bake_rejects_morph_weights_of_another_shape_or_not_finite(targets, morph_weights, message):
+    skinned = _skinned_bar()
+    if targets is not None:
+        skinned.morph_targets = np.ones((targets, skinned.vertex_count, 3), np.float32)
+    with pytest.raises(ValueError, match=message):
+        skinned.bake(_bend(np.zeros(2)), morph_weights)
+
+
+def test_bake_blends_morph_weights_of_the_right_shape():
+    skinned = _skinned_bar()
+    skinned.morph_targets = np.stack([np.tile([0.0, 1.0, 0.0], (3, 1)), np.tile([0.0, 0.0, 1.0], (3, 1))])
+    frames = skinned.bake(_bend(np.zeros(2)), [[0.0, 0.0], [0.5, 2.0]]).frames
+    np.testing.assert_allclose(frames[0], skinned.rest_positions, atol=1e-6)
+    np.testing.assert_allclose(frames[1] - skinned.rest_positions, np.tile([0.0, 0.5, 2.0], (3, 1)), atol=1e-6)
+    plain = _skinned_bar()
+    unmorphed = plain.bake(_bend(np.zeros(2)), np.zeros((2, 0))).frames  # N = 0: no targets, no weights
+    np.testing.assert_allclose(unmorphed, np.broadcast_to(plain.rest_positions, (2, 3, 3)), atol=1e-6)
+
+
 @pytest.mark.parametrize(
     "parents, message",
     [

@@ -74,3 +74,24 @@ def test_a_face_without_labels_is_offered_grown_ones(head):
     regions = grow_regions(motion_of_frames(animation.frames), model.faces)
     rig = FaceRig(model.positions, model.faces, regions)  # the grown labels make a rig
     assert set(rig.lattices) == set(regions.names)
+
+
+_SQUARE = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+@pytest.mark.parametrize(
+    "features, faces, message",
+    [
+        (None, [[0, 1, 2], [0, 2, 9]], r"faces: face 1 \[0, 2, 9\] has an index outside \[0, 4\)"),  # IndexError before
+        (None, [[0, 1, 2], [0, -1, 3]], r"faces: face 1 \[0, -1, 3\] has an index outside"),  # the last vertex before
+        (None, [[0, 1, 2], [0, 2.5, 3]], r"faces: face 1 \[0.0, 2.5, 3.0\] has an index that is not a whole number"),
+        (None, [[0, 1, 2, 3]], r"faces: expected shape \(M, 3\), got \(1, 4\)"),  # read as other triangles before
+        (np.ones((4, 4)), _SQUARE, r"features: expected shape \(V, D\) with D a multiple of 3, got \(4, 4\)"),
+        (np.full((4, 6), np.nan), _SQUARE, r"features: non-finite value at index \(0, 0\)"),  # "no vertex moves"
+    ],
+)
+def test_grow_regions_names_the_bad_face_or_feature(features, faces, message):
+    if features is None:
+        features = np.random.default_rng(0).normal(size=(4, 6))
+    with pytest.raises(ValueError, match=message):
+        grow_regions(features, faces)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model import _check_faces, _check_finite
 from .regions import FaceRegions, RegionGroup
 
 
@@ -60,13 +61,18 @@ def grow_regions(features: np.ndarray, faces: np.ndarray, options: GrowOptions |
 
     Returns regions named "static" (when any vertex is static) and "motion_<k>", numbered by
     decreasing size. ValueError when no vertex moves (every vertex would be static: there is
-    nothing to animate by region).
+    nothing to animate by region), and ValueError naming the argument and the element when
+    ``features`` is not ``(V, D)`` with D a multiple of 3 or holds a non-finite value, or when
+    ``faces`` is not ``(M, 3)`` whole indices in [0, V).
     """
     options = options or GrowOptions()
     features = np.asarray(features, dtype=np.float64)
-    faces = np.asarray(faces, dtype=np.int64)
-    vertex_count = len(features)
-    magnitude = np.linalg.norm(features.reshape(vertex_count, -1, 3), axis=2).max(axis=1, initial=0.0)
+    if features.ndim != 2 or features.shape[1] % 3:
+        raise ValueError(f"features: expected shape (V, D) with D a multiple of 3, got {features.shape}")
+    _check_finite("features", features)
+    vertex_count, dimensions = features.shape
+    faces = _check_faces(faces, vertex_count).astype(np.int64)
+    magnitude = np.linalg.norm(features.reshape(vertex_count, dimensions // 3, 3), axis=2).max(axis=1, initial=0.0)
     largest = float(magnitude.max(initial=0.0))
     if not largest > 0.0:
         raise ValueError("grow regions: no vertex moves in any frame or target, so there are no motion regions")

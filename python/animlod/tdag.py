@@ -20,6 +20,7 @@ is made by collapse ``c``), ``V'`` / ``M'`` vertices and faces of a queried mesh
 
 from __future__ import annotations
 
+import operator
 import os
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
@@ -165,6 +166,18 @@ def _mesh(raw: dict) -> TdagMesh:
         residual_frame=int(raw["residual_frame"]),
         error_bound=float(raw["error_bound"]),
     )
+
+
+def _first_frame(first_frame: int, frame_count: int) -> int:
+    """``first_frame`` as an int in [0, ``frame_count``); ValueError naming ``first_frame``, the
+    argument the caller passed (the core checks it too, but calls it ``frame``)."""
+    try:
+        frame = operator.index(first_frame)
+    except TypeError:
+        raise ValueError(f"first_frame: expected an integer, got {first_frame!r}") from None
+    if not 0 <= frame < frame_count:
+        raise ValueError(f"first_frame: {frame} outside [0, {frame_count})")
+    return frame
 
 
 def _level(level: int) -> int:
@@ -493,10 +506,11 @@ class TemporalDag:
         self, tolerance: float, first_frame: int = 0, frame_count: int | None = None, measure_error: bool = True
     ) -> PlayerReport:
         """Walk the frames from ``first_frame`` at ``tolerance`` and measure every approximation
-        level, a fresh query, and the level-3 walk single- and double-buffered (in C++)."""
+        level, a fresh query, and the level-3 walk single- and double-buffered (in C++).
+        ValueError naming ``first_frame`` when it is not a frame of the TDAG."""
         options = PlayerOptions(
             tolerance=tolerance,
-            first_frame=first_frame,
+            first_frame=_first_frame(first_frame, self.frame_count),
             frame_count=-1 if frame_count is None else frame_count,
             measure_error=measure_error,
         )
@@ -514,9 +528,10 @@ class TemporalDag:
         )
 
     def player(self, tolerance: float, first_frame: int = 0) -> Player:
-        """A double-buffered :class:`Player` from ``first_frame`` at ``tolerance``."""
+        """A double-buffered :class:`Player` from ``first_frame`` at ``tolerance``; ValueError
+        naming ``first_frame`` when it is not a frame of the TDAG."""
         core = _core.TdagPlayer(self._core)
-        core.start(tolerance, first_frame)
+        core.start(tolerance, _first_frame(first_frame, self.frame_count))
         return Player(core)
 
 

@@ -191,6 +191,25 @@ def test_bad_input_is_a_named_value_error(dag: TemporalDag, bending: AnimatedMes
         dag.cut(0, 0.1).advance(1, level=4)
 
 
+@pytest.mark.parametrize("first_frame", [8, -1, np.int64(99)])
+def test_play_and_player_name_the_first_frame_they_were_given(dag: TemporalDag, first_frame):
+    # The core's check reads "frame: 8 outside [0, 8)", a name neither method takes.
+    message = rf"^first_frame: {int(first_frame)} outside \[0, 8\)$"
+    with pytest.raises(ValueError, match=message):
+        dag.play(0.1, first_frame=first_frame, measure_error=False)
+    with pytest.raises(ValueError, match=message):
+        dag.player(0.1, first_frame)
+
+
+def test_player_takes_a_whole_first_frame_only(dag: TemporalDag):
+    with pytest.raises(ValueError, match=r"^first_frame: expected an integer, got 1.5$"):  # a pybind TypeError before
+        dag.player(0.1, 1.5)
+    with pytest.raises(ValueError, match=r"^first_frame: expected an integer, got 1.5$"):
+        dag.play(0.1, first_frame=1.5)
+    dag.play(0.1, first_frame=7, measure_error=False)  # the last frame is in range
+    dag.player(0.1, np.int64(7))
+
+
 def test_view_dependent_query_is_finer_near_the_camera(dag: TemporalDag):
     positions = dag.frame_positions(0)
     low, high = positions.min(axis=0), positions.max(axis=0)

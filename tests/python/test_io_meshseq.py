@@ -218,6 +218,28 @@ def test_comments_at_the_end_of_obj_statements_are_ignored(tmp_path: Path) -> No
     np.testing.assert_array_equal(faces, EXPECTED_FACES)
 
 
+def test_obj_lines_ending_in_a_backslash_continue_on_the_next(tmp_path: Path) -> None:
+    # The OBJ specification lets a backslash end a line to continue the statement (spaces may
+    # follow it); a comment ends at its line's end even after one, like this Windows path.
+    continued = (
+        OBJ_TEXT.replace("# square and roof", "# saved to C:\\models\\")
+        .replace("v 1 0 0", "v 1 \\\r\n  0 \\ \t\r\n0")
+        .replace("f 1/1/1 2/1/1", "f 1/1/1 \\\r\n2/1/1")
+        .replace("f 4//1 3//1 -1//1", "f 4//1 3//1 \\  # the roof\r\n-1//1")
+    )
+    vertices, faces = read_obj(_write(tmp_path / "continued.obj", continued))
+    np.testing.assert_array_equal(vertices, EXPECTED_VERTICES)
+    np.testing.assert_array_equal(faces, EXPECTED_FACES)
+    # Errors name the line a statement starts on; the lines after it keep their numbers.
+    path = _write(tmp_path / "bad.obj", continued.replace("-1//1", "6"))
+    assert _error(path) == f"{path}: face 1 (line 14): vertex index 6 is outside the 5 vertices"
+    path = _write(tmp_path / "bad.obj", continued.replace("v 1 1 0", "v 1 x1 0"))
+    assert _error(path) == f"{path}: vertex 2 (line 7): 'x1' is not a number or out of range"
+    # A backslash that ends the file continues onto nothing.
+    vertices, faces = read_obj(_write(tmp_path / "last.obj", OBJ_TEXT + "f 1 2 \\\n3 \\"))
+    np.testing.assert_array_equal(faces, np.concatenate([EXPECTED_FACES, [[0, 1, 2]]]))
+
+
 def test_obj_face_with_two_corners(tmp_path: Path) -> None:
     path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 3"))
     assert _error(path) == f"{path}: face 1 (line 11): needs at least 3 vertices, has 2"

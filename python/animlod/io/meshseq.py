@@ -1,8 +1,9 @@
 """OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
 
 Only geometry is read: OBJ ``v`` and ``f`` lines (1-based or negative indices, ``a/b/c``
-corners, polygons fan-triangulated, ``#`` comments also at a line's end; other statements such
-as ``vt``, ``vn``, ``g``, ``usemtl`` are ignored) and PLY ``vertex`` x, y, z with the ``face``
+corners, polygons fan-triangulated, ``#`` comments also at a line's end, a statement continued
+on the next line after a ``\\`` that ends its line; other statements such as ``vt``, ``vn``,
+``g``, ``usemtl`` are ignored) and PLY ``vertex`` x, y, z with the ``face``
 list ``vertex_indices`` (ascii, binary_little_endian, binary_big_endian; other elements and
 properties are skipped). Statements may be indented. Parsing works on the whole file's bytes
 with numpy: there is no Python loop over lines, vertices or faces.
@@ -188,6 +189,11 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     Returns ``vertices (V, 3) float32`` (extra values such as w or colours are dropped) and
     ``faces (M, 3) int32``, 0-based, polygons fan-triangulated in file order.
 
+    A backslash that ends a line (spaces or tabs may follow it) continues the statement on the
+    next line, as the OBJ specification allows; errors name the line the statement starts on. A
+    ``#`` comment ends at its line's end, even after a backslash (a Windows path such as
+    ``# saved to C:\\models\\`` does not swallow the next statement).
+
     Raises
     ------
     FormatError
@@ -202,6 +208,8 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
     if b"#" in data:  # a comment may also end a statement ("f 1 2 3 # cap"); line numbers stay
         data = re.sub(rb"#[^\n]*", b"", data)
+    if b"\\" in data:
+        data = _join_continued_lines(data)
     if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
         data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
     (vertex_block, vertex_lines), (face_block, face_lines) = _obj_statements(data, (b"v", b"f"))
@@ -238,6 +246,29 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
     _check_face_indices(path, resolved, written, owner, len(vertices), name_face)
     return vertices, _fan_triangulate(resolved, sizes)
+
+
+def _join_continued_lines(data: bytes) -> bytes:
+    """``data`` (LF line ends, no NUL byte) with every line that ends in a backslash joined to the
+    next one. The newlines taken out are put back after the joined statement, as empty lines, so
+    each statement keeps the number of the line it starts on and later lines keep theirs."""
+    # Mark each continuation with a NUL (the file has none, it was checked): the usual "\\\n" by
+    # bytes.replace, then those with spaces after the backslash, or ending the file, by a regex.
+    data = data.replace(b"\\\n", b"\0")
+    if b"\\" in data:
+        data = re.sub(rb"\\[ \t]*(?:\n|\Z)", b"\0", data)
+    codes = np.frombuffer(data, dtype=np.uint8)
+    marks = np.flatnonzero(codes == 0)
+    if not marks.size:
+        return data
+    newlines = np.flatnonzero(codes == ord("\n"))
+    marks_before = np.searchsorted(marks, newlines)
+    # A statement's end takes one newline more for each continuation since the newline before it.
+    at = np.repeat(newlines + 1, np.diff(marks_before, prepend=0))
+    joined = np.insert(codes, at, ord("\n"))
+    joined[joined == 0] = ord(" ")
+    tail = marks.size - (int(marks_before[-1]) if newlines.size else 0)  # continued into the file's end
+    return joined.tobytes() + b"\n" * tail
 
 
 def write_obj(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) -> None:

@@ -35,7 +35,7 @@ def test_every_field_carries_its_header_comment(cls):
 
 def test_defaults_are_the_structs():
     aqem = AqemOptions()
-    assert aqem.target_ratios == [0.5] and math.isinf(aqem.max_error) and aqem.placement == "optimal"
+    assert aqem.target_ratios == (0.5,) and math.isinf(aqem.max_error) and aqem.placement == "optimal"
     assert aqem.motion_features.min_angle_change == pytest.approx(math.radians(1.0))
     assert TdagOptions().governing == "first" and MotionRefitOptions().chunk_frames == 64
     mesh = bending_tube(frames=4)
@@ -67,14 +67,14 @@ def test_copies_are_deep_and_pickles_round_trip():
         other.motion_features.noise_mads = 1.0
         assert original.motion_features.noise_mads == MotionFeatureOptions().noise_mads
     assert AqemOptions() != original
-    assert repr(original).startswith("AqemOptions(target_ratios=[0.5], target_face_counts=[], max_error=0.25,")
+    assert repr(original).startswith("AqemOptions(target_ratios=(0.5,), target_face_counts=(), max_error=0.25,")
 
 
 def test_wrappers_take_an_object_and_keywords_without_changing_the_object():
     mesh = bending_tube(frames=4)
     coarse = AqemOptions(use_motion_features=False, target_ratios=[0.1])
     both = simplify_animated(mesh, None, coarse, placement="on_edge")
-    assert coarse.placement == "optimal" and coarse.target_ratios == [0.1]
+    assert coarse.placement == "optimal" and coarse.target_ratios == (0.1,)
     keywords = simplify_animated(mesh, (0.1,), use_motion_features=False, placement="on_edge")
     np.testing.assert_array_equal(both.levels[0].mesh.frames, keywords.levels[0].mesh.frames)
     with pytest.raises(ValueError, match=r"^options: expected AqemOptions, got dict$"):
@@ -89,3 +89,26 @@ def test_the_installed_stub_lists_what_the_module_binds():
     listed = re.search(r"^__all__: list\[str\] = \[(.*)\]$", text, re.M).group(1)
     assert set(listed.replace("'", "").split(", ")) == {name for name in dir(_core) if not name.startswith("_")}
     assert "def simplify_animated(" in text and "class AqemOptions:" in text
+
+
+LIST_FIELDS = [("target_ratios", [0.5, 0.25]), ("target_face_counts", [40, 20]), ("frame_subset", [0, 3])]
+
+
+@pytest.mark.parametrize("name, values", LIST_FIELDS)
+def test_list_fields_read_as_tuples_so_an_append_fails_instead_of_doing_nothing(name, values):
+    made = AqemOptions()
+    with pytest.raises(AttributeError, match="'tuple' object has no attribute 'append'"):
+        getattr(made, name).append(values[0])  # a list copy took it and the field stayed as it was
+    setattr(made, name, values)
+    assert getattr(made, name) == tuple(values)
+    setattr(made, name, getattr(made, name) + (values[-1],))
+    assert getattr(made, name) == tuple(values) + (values[-1],)
+    assert AqemOptions(**{name: values}) == pickle.loads(pickle.dumps(AqemOptions(**{name: tuple(values)})))
+    assert "Read as a tuple" in getattr(AqemOptions, name).__doc__
+
+
+def test_only_list_fields_read_as_tuples():
+    listed = {
+        (cls.__name__, name) for cls in OPTION_CLASSES for name in cls.fields if isinstance(getattr(cls(), name), tuple)
+    }
+    assert listed == {("AqemOptions", name) for name, _ in LIST_FIELDS}

@@ -1,7 +1,8 @@
 """Custom batch jobs for tests/python/test_batch.py (imported by name on the Dask workers).
 
 They stand for what goes wrong on a farm: a worker process that dies in the middle of an
-asset (a crash in native code, the kernel's out-of-memory killer), once or every time.
+asset (a crash in native code, the kernel's out-of-memory killer), once or every time; and for
+a studio's job whose options may each take values of several kinds.
 """
 
 from __future__ import annotations
@@ -27,3 +28,11 @@ def always_crash(source: str, output: str, *, progress=None, **options: object):
     """Every attempt writes half an output and kills its worker."""
     Path(output, "half_written_lod.glb").write_bytes(b"glTF\x02\x00\x00\x00")
     os.kill(os.getpid(), signal.SIGKILL)
+
+
+def several_kinds(
+    source: str, output: str, *, progress=None, frames: list[int] | str | None = None, rate: float | str | None = None
+):
+    """Options that take a value of either of two kinds (``frames``: a list of whole numbers or a
+    string such as "all"); runs the simplify job."""
+    return simplify_asset(source, output, progress=progress)

@@ -16,7 +16,7 @@ pytest.importorskip("pyarrow")
 
 from animlod import Motion, Skeleton, rotations, synth
 from animlod.batch import BatchProgress, SpecError, connect, read_catalogue, read_spec, run_batch
-from animlod.batch.jobs import find_job
+from animlod.batch.jobs import check_options, find_job
 from animlod.cli import main
 from animlod.io import write_bvh, write_glb
 from animlod.io.detect import BATCH_STATE
@@ -363,3 +363,20 @@ def test_local_workers_end_quietly_on_ctrl_c(client):
     import signal
 
     assert set(client.run(_interrupt_handler).values()) == {signal.SIG_DFL}
+
+
+@pytest.mark.parametrize(
+    "options, problem",
+    [
+        ({"frames": [1, 2], "rate": "fast"}, None),
+        ({"frames": "all", "rate": 24}, None),
+        ({"frames": 7}, "option 'frames': expected a list or a string, got 7"),
+        ({"rate": float("nan")}, "option 'rate': expected a number or a string, got nan"),
+        ({"rate": [1.0]}, "option 'rate': expected a number or a string, got [1.0]"),
+        # A list with an item of another kind: cutting the list's message apart gave "expected in
+        # the list: expected a whole number or a string, got [1.5]".
+        ({"frames": [1.5]}, "option 'frames': in the list: expected a whole number, got 1.5"),
+    ],
+)
+def test_an_option_of_several_kinds_names_them_or_the_bad_item(options, problem):
+    assert check_options(find_job("batch_jobs:several_kinds"), "npz", options) == problem

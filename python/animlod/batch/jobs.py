@@ -134,38 +134,58 @@ def check_options(job: Job, kind: str, options: dict[str, object]) -> str | None
     return None
 
 
+class _Kind(typing.NamedTuple):
+    """A plain type an option takes: its Python type, what the messages call a value of it, and
+    whether a value is one."""
+
+    type: type
+    name: str
+    fits: Callable[[object], bool]
+
+
+def _number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and not math.isnan(value)
+
+
+# The kinds of value an option's default can be, bool before int (a bool is an int), str before
+# the lists (a str is a Sequence). The one place that names them, for a default and a _OneOf alike.
+_KINDS = (
+    _Kind(bool, "true or false", lambda value: isinstance(value, bool)),
+    _Kind(int, "a whole number", lambda value: isinstance(value, int) and not isinstance(value, bool)),
+    _Kind(float, "a number", _number),
+    _Kind(str, "a string", lambda value: isinstance(value, str)),
+    _Kind(Sequence, "a list", lambda value: isinstance(value, (list, tuple))),
+)
+
+
+def _kind(default: object) -> _Kind | None:
+    """The kind of ``default``; None for another type, whose values are not checked."""
+    return next((kind for kind in _KINDS if isinstance(default, kind.type)), None)
+
+
 def _type_problem(value: object, default: object) -> str | None:
     """What is wrong with ``value`` for an option whose default is ``default`` (None if nothing)."""
     if default is None or default is inspect.Parameter.empty:
         return None
     if isinstance(default, _OneOf):
-        problems = [_type_problem(value, exemplar) for exemplar in default.exemplars]
-        if value is None or None in problems:
+        if value is None:
             return None
-        if len(problems) == 1:
-            return problems[0]
-        expected = " or ".join(problem.removeprefix("expected ").split(", got ")[0] for problem in problems)
-        return f"expected {expected}, got {value!r}"
-    if isinstance(default, bool):
-        return None if isinstance(value, bool) else f"expected true or false, got {value!r}"
-    if isinstance(default, int):
-        if isinstance(value, bool) or not isinstance(value, int):
-            return f"expected a whole number, got {value!r}"
+        kinds = [_kind(exemplar) for exemplar in default.exemplars]
+        fitting = [exemplar for exemplar, kind in zip(default.exemplars, kinds) if kind is None or kind.fits(value)]
+        if not fitting:
+            return f"expected {' or '.join(kind.name for kind in kinds)}, got {value!r}"
+        problems = [_type_problem(value, exemplar) for exemplar in fitting]
+        return None if None in problems else problems[0]  # a list of the right kind, but an item of another
+    kind = _kind(default)
+    if kind is None:
         return None
-    if isinstance(default, float):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            return f"expected a number, got {value!r}"
-        return None if not math.isnan(value) else "expected a number, got nan"
-    if isinstance(default, str):
-        return None if isinstance(value, str) else f"expected a string, got {value!r}"
-    if isinstance(default, Sequence):
-        if not isinstance(value, (list, tuple)):
-            return f"expected a list, got {value!r}"
-        if default:
-            for item in value:
-                problem = _type_problem(item, default[0])
-                if problem:
-                    return f"in the list: {problem}"
+    if not kind.fits(value):
+        return f"expected {kind.name}, got {value!r}"
+    if kind.type is Sequence and default:
+        for item in value:
+            problem = _type_problem(item, default[0])
+            if problem:
+                return f"in the list: {problem}"
     return None
 
 

@@ -42,8 +42,9 @@ _PLY_TYPES = {
 }
 _PLY_FORMATS = {"ascii": None, "binary_little_endian": "<", "binary_big_endian": ">"}
 _FACE_LIST_NAMES = ("vertex_indices", "vertex_index")
-# Field of a binary row holding a list's length; the space keeps it apart from any PLY property name.
-_LIST_SIZE_FIELD = "list size"
+# Prefix of the field of a binary row holding a list's length, followed by the list's name; the
+# spaces keep it apart from any PLY property name.
+_LIST_SIZE_FIELD = "list size of "
 
 
 # ---------------------------------------------------------------------------------------------
@@ -522,52 +523,58 @@ def _ply_property(path: Path, element: str, words: list[str]) -> _PlyProperty:
 _ElementValues = dict[str, "np.ndarray | tuple[np.ndarray, np.ndarray]"]
 
 
-def _list_positions(element: _PlyElement) -> list[int]:
-    """Positions of the element's list properties (MeshLab adds texcoord lists to faces)."""
-    return [index for index, prop in enumerate(element.properties) if prop.count_code is not None]
-
-
 def _read_ply_binary(
     path: Path, data: bytes, offset: int, elements: list[_PlyElement], byte_order: str
 ) -> dict[str, _ElementValues]:
-    """Read each element as one structured numpy array where its rows have one size (no list,
-    or one list of one length throughout); otherwise with :func:`_read_rows_of_lists`."""
+    """Read each element as one structured numpy array where its rows have one size (no list, or
+    lists each of one length throughout, as a mesh of triangles with MeshLab's texcoord lists);
+    otherwise with :func:`_read_rows_of_lists`."""
     values: dict[str, _ElementValues] = {}
     for element in elements:
-        lists = _list_positions(element)
-        fields = [(prop.name, byte_order + prop.type_code) for prop in element.properties]
-        length = 0
-        if len(lists) == 1 and element.count:
-            list_at = lists[0]
-            prefix = np.dtype(fields[:list_at]).itemsize if list_at else 0
-            count_type = np.dtype(byte_order + element.properties[list_at].count_code)
-            if offset + prefix + count_type.itemsize > len(data):
-                raise FormatError(path, f"element {element.name}", "file ends inside the element")
-            length = int(np.frombuffer(data, count_type, 1, offset + prefix)[0])
-            # Each item takes at least a byte, so a longer list cannot fit in the rest of the file.
-            if not 0 <= length <= len(data) - offset:
-                reason = f"list length {length} is negative or longer than the rest of the file"
-                raise FormatError(path, f"element {element.name} row 0", reason)
-        if len(lists) == 1:
-            list_prop = element.properties[lists[0]]
-            fields[lists[0] : lists[0] + 1] = [
-                (_LIST_SIZE_FIELD, byte_order + list_prop.count_code),
-                (list_prop.name, byte_order + list_prop.type_code, (length,)),
-            ]
+        fields, lengths = _first_row_fields(path, data, offset, element, byte_order)
         row = np.dtype(fields)
-        fits = len(lists) <= 1 and offset + row.itemsize * element.count <= len(data)
+        fits = offset + row.itemsize * element.count <= len(data)
         table = np.frombuffer(data, row, element.count, offset) if fits else None
-        if lists and (table is None or np.any(table[_LIST_SIZE_FIELD] != length)):
+        if lengths and (table is None or any(np.any(table[_LIST_SIZE_FIELD + name] != n) for name, n in lengths)):
             values[element.name], offset = _read_rows_of_lists(path, data, offset, element, byte_order)
             continue
         if table is None:
             raise FormatError(path, f"element {element.name}", f"file ends before its {element.count} rows")
         offset += row.itemsize * element.count
         values[element.name] = {prop.name: table[prop.name] for prop in element.properties if prop.count_code is None}
-        if lists:  # one, of one length
-            name = element.properties[lists[0]].name
+        for name, length in lengths:
             values[element.name][name] = (np.full(element.count, length, dtype=np.int64), table[name].ravel())
     return values
+
+
+def _first_row_fields(
+    path: Path, data: bytes, offset: int, element: _PlyElement, byte_order: str
+) -> tuple[list[tuple], list[tuple[str, int]]]:
+    """The numpy fields of the element's rows if each list has the length it has in the first row
+    (MeshLab adds texcoord lists to faces), and those lengths by list name (0 without rows)."""
+    fields: list[tuple] = []
+    lengths: list[tuple[str, int]] = []
+    position = offset
+    for prop in element.properties:
+        item = np.dtype(byte_order + prop.type_code)
+        if prop.count_code is None:
+            fields.append((prop.name, item))
+            position += item.itemsize
+            continue
+        count = np.dtype(byte_order + prop.count_code)
+        length = 0
+        if element.count:
+            if position + count.itemsize > len(data):
+                raise FormatError(path, f"element {element.name}", "file ends inside the element")
+            length = int(np.frombuffer(data, count, 1, position)[0])
+            # Each item takes at least a byte, so a longer list cannot fit in the rest of the file.
+            if not 0 <= length <= len(data) - offset:
+                reason = f"list length {length} is negative or longer than the rest of the file"
+                raise FormatError(path, f"element {element.name} row 0", reason)
+        fields += [(_LIST_SIZE_FIELD + prop.name, count), (prop.name, item, (length,))]
+        lengths.append((prop.name, length))
+        position += count.itemsize + length * item.itemsize
+    return fields, lengths
 
 
 def _read_rows_of_lists(

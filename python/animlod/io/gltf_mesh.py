@@ -267,9 +267,12 @@ def _influences(parts: list[PrimitiveGeometry], kind: str, sets: list[int]) -> n
     if not sets:
         return None
 
+    # Joint slots stay integers: float padding would turn the merged JOINTS into floats.
+    padding = np.uint8 if kind == "JOINTS" else np.float32
+
     def columns(part: PrimitiveGeometry, s: int) -> np.ndarray:
         values = part.attributes.get(f"{kind}_{s}")
-        return np.zeros((part.vertex_count, 4), np.float32) if values is None else values
+        return np.zeros((part.vertex_count, 4), padding) if values is None else values
 
     return np.concatenate([np.concatenate([columns(part, s) for s in sets], axis=1) for part in parts])
 

@@ -70,8 +70,8 @@ def read_gltf_face(path: str | os.PathLike, fps: float = 30.0, frames_each: int 
     Raises FormatError naming the file when none has morph targets, and the reader's errors for
     malformed files."""
     doc = GltfDocument(path)
-    morphed = [drawable for drawable in read_drawables(doc, fps) if drawable.morph_targets is not None]
-    morphed = [drawable for drawable in morphed if len(drawable.morph_targets)]
+    morphed = [drawable for drawable in read_drawables(doc, fps) if drawable.geometry.targets is not None]
+    morphed = [drawable for drawable in morphed if len(drawable.geometry.targets)]
     if not morphed:
         raise doc.fail("meshes", "no mesh has morph targets, so there is no blendshape face to simplify")
     drawable = max(morphed, key=lambda item: len(item.geometry.faces))  # the first of the largest

@@ -77,10 +77,12 @@ class Drawable:
 
     @property
     def morph_targets(self) -> np.ndarray | None:
-        """(N, V, 3) morph position deltas in the space of :meth:`bind_positions`, or None."""
-        if self.geometry.targets is None:
-            return None
-        return self.geometry.targets @ self.world[:3, :3].T
+        """(N, V, 3) float32 morph position deltas in the space of :meth:`bind_positions`, or None:
+        the stored deltas themselves (no copy) under a node without rotation or scale."""
+        targets = self.geometry.targets
+        if targets is None or np.array_equal(self.world[:3, :3], np.eye(3)):
+            return targets
+        return (targets @ self.world[:3, :3].T).astype(np.float32)
 
     def bind_positions(self) -> np.ndarray:
         """(V, 3) float32 bind shape: POSITION under the node's rest world transform (morph

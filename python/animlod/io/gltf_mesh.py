@@ -281,8 +281,13 @@ def _position_deltas(parts: list[PrimitiveGeometry], target_count: int) -> np.nd
     """(N, V, 3) POSITION deltas of every target (zeros where a target has none)."""
     if not target_count:
         return None
-    deltas = [
-        np.stack([target.get("POSITION", np.zeros((part.vertex_count, 3), np.float32)) for target in part.targets])
-        for part in parts
-    ]
-    return np.concatenate(deltas, axis=1).astype(np.float32)
+    # Filled in place: a face's targets are most of its memory, which stacking, joining and
+    # casting copied three times.
+    deltas = np.zeros((target_count, sum(part.vertex_count for part in parts), 3), np.float32)
+    start = 0
+    for part in parts:
+        for t, target in enumerate(part.targets):
+            if "POSITION" in target:
+                deltas[t, start : start + part.vertex_count] = target["POSITION"]
+        start += part.vertex_count
+    return deltas

@@ -201,15 +201,15 @@ def _drive_frames(drawable: Drawable, rest: np.ndarray, size: float, budget: int
     frames = [bind[None]]
     if np.abs(rest - bind).max() > _SAME_SHAPE * size:
         frames.append(rest[None])
-    if drawable.morph_targets is not None:
-        frames.append((rest[None] + drawable.rest_morph_targets()).astype(np.float32))
+    if drawable.geometry.targets is not None:
+        frames.append((rest[None] + drawable.rest_morph_targets()).astype(np.float32, copy=False))
     clips = drawable.clips
     remaining = max(budget - sum(len(f) for f in frames), 2 * len(clips))
     lengths = np.array([clip.frame_count for clip in clips], np.float64)
     for clip, share in zip(clips, lengths / max(lengths.sum(), 1.0)):
         count = int(np.clip(round(share * remaining), 2, clip.frame_count))
         frames.append(drawable.clip_frames(clip, spread_frames(clip.frame_count, count)))
-    return np.concatenate(frames).astype(np.float32)
+    return np.concatenate(frames).astype(np.float32, copy=False)
 
 
 def _attribute_matrix(drawable: Drawable) -> tuple[np.ndarray, _Layout]:

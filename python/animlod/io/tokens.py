@@ -12,6 +12,8 @@ import numpy as np
 
 _IS_SPACE = np.zeros(256, dtype=bool)
 _IS_SPACE[list(b" \t\r\n\v\f")] = True
+_IS_INTEGER_CHARACTER = np.zeros(256, dtype=bool)
+_IS_INTEGER_CHARACTER[list(b"0123456789+-")] = True
 
 
 def tokens_per_line(data: bytes) -> np.ndarray:
@@ -24,6 +26,18 @@ def tokens_per_line(data: bytes) -> np.ndarray:
     token_starts = np.flatnonzero(~space & np.concatenate(([True], space[:-1])))
     line_starts = np.concatenate(([0], np.flatnonzero(codes == ord("\n")) + 1, [codes.size + 1]))
     return np.diff(np.searchsorted(token_starts, line_starts)).astype(np.int64)
+
+
+def integer_tokens(data: bytes) -> np.ndarray:
+    """Whether each whitespace-separated token of ``data`` is written with ASCII digits and signs
+    only (``12``, ``-3``; not ``3.0`` or ``1e3``), as an integer table must be: ``(N,) bool``."""
+    codes = np.frombuffer(data, dtype=np.uint8)
+    space = _IS_SPACE[codes]
+    token_starts = np.flatnonzero(~space & np.concatenate(([True], space[:-1])))
+    if not token_starts.size:
+        return np.zeros(0, dtype=bool)
+    # A token's run reaches to the next token's start; the spaces after it are no other character.
+    return ~np.logical_or.reduceat(~(space | _IS_INTEGER_CHARACTER[codes]), token_starts)
 
 
 def parse_all(data: bytes, dtype: type) -> np.ndarray | None:

@@ -8,10 +8,29 @@ from pathlib import Path
 import numpy as np
 import pygltflib
 from gltf_edits import append_accessor, edit_glb
-from simplify_inputs import two_bone_tube
+from simplify_inputs import tube, two_bone_tube
 
+from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf import read_gltf, write_glb
+from animlod.io.gltf_document import GltfDocument
 from animlod.pipelines.lod_document import simplify_document
+
+
+def _morph_tube_glb(path: Path, node_weights: list[float] | None) -> Path:
+    """A tube with one morph target (doubling its height), mesh weights [0], drawn by one node
+    whose ``weights`` override the mesh's when given (glTF 2.0, 3.7.2.2)."""
+    positions, faces = tube()
+    builder = GlbBuilder()
+    position = builder.add(positions.astype(np.float32), bounds=True)
+    stretch = builder.add((positions * [0.0, 1.0, 0.0]).astype(np.float32), bounds=True)
+    indices = builder.add(faces.astype(np.uint32).reshape(-1, 1))
+    primitive = {"attributes": {"POSITION": position}, "indices": indices, "targets": [{"POSITION": stretch}]}
+    builder.append("meshes", {"primitives": [primitive], "weights": [0.0]})
+    node = {"mesh": 0, "name": "tall"} | ({} if node_weights is None else {"weights": node_weights})
+    builder.append("nodes", node)
+    builder.json["scenes"], builder.json["scene"] = [{"nodes": [0]}], 0
+    builder.save(path)
+    return path
 
 
 def _two_bone_glb(path: Path) -> Path:
@@ -43,3 +62,18 @@ def test_primitives_with_four_and_eight_influences_keep_integer_joints(tmp_path:
     np.testing.assert_allclose(skinned.rest_positions[vertices:], reference.rest_positions, atol=1e-6)
     report = simplify_document(source, tmp_path / "lod.glb")
     assert report.drawables and (tmp_path / "lod.glb").is_file()
+
+
+def test_level_nodes_keep_the_morph_weights_of_their_base_node(tmp_path: Path) -> None:
+    """A node's morph weights override its mesh's: the base node shows the tube stretched, and so must
+    every level that stands in for it. Level nodes copied the transform only, so an MSFT_lod viewer
+    switching levels showed the tube at half its height."""
+    source = _morph_tube_glb(tmp_path / "tall.glb", [1.0])
+    simplify_document(source, tmp_path / "lod.glb")
+    nodes = GltfDocument(tmp_path / "lod.glb").json["nodes"]
+    levels = nodes[0]["extensions"]["MSFT_lod"]["ids"]
+    assert levels and all(nodes[level].get("weights") == [1.0] for level in levels)
+    # Without node weights, levels show the mesh's own (and get none of their own).
+    simplify_document(_morph_tube_glb(tmp_path / "plain.glb", None), tmp_path / "plain_lod.glb")
+    plain = GltfDocument(tmp_path / "plain_lod.glb").json["nodes"]
+    assert all("weights" not in plain[level] for level in plain[0]["extensions"]["MSFT_lod"]["ids"])

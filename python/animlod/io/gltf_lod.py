@@ -145,6 +145,11 @@ def add_level_node(builder: GlbBuilder, base: int, mesh: int, skin: int | None, 
         node["extensions"] = {INSTANCING_EXTENSION: copy.deepcopy(instances)}
     node["name"] = f"{base_node.get('name', f'node{base}')}_LOD{info.level}"
     node["mesh"] = mesh
+    # A node's morph weights override its mesh's (glTF 2.0, 3.7.2.2): a level that kept every target
+    # shows the base node's shape only with them. A level with other targets keeps its mesh's.
+    primitives = builder.json["meshes"][mesh].get("primitives") or [{}]
+    if "weights" in base_node and len(primitives[0].get("targets", [])) == len(base_node["weights"]):
+        node["weights"] = copy.deepcopy(base_node["weights"])
     if skin is not None:
         node["skin"] = skin
     node["extras"] = {ANIMLOD_EXTRA: info.extras()}

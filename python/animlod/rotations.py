@@ -25,6 +25,13 @@ def normalize(q: np.ndarray, name: str = "quaternion") -> np.ndarray:
     return q / norm
 
 
+def _last_axis(name: str, array: np.ndarray, size: int) -> None:
+    """ValueError naming ``name`` unless ``array`` is ``(..., size)``: a longer last axis would
+    be read in part, silently. A look at the shape only, cheap enough for the hot helpers."""
+    if array.shape[-1:] != (size,):
+        raise ValueError(f"{name}: expected shape (..., {size}), got {array.shape}")
+
+
 def identity(shape: tuple[int, ...] = ()) -> np.ndarray:
     """Identity quaternions of the given leading ``shape``, ``shape + (4,)``."""
     q = np.zeros(shape + (4,))
@@ -33,9 +40,12 @@ def identity(shape: tuple[int, ...] = ()) -> np.ndarray:
 
 
 def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product ``a * b`` (apply ``b`` first, then ``a``), broadcasting ``(..., 4)``."""
+    """Hamilton product ``a * b`` (apply ``b`` first, then ``a``), broadcasting ``(..., 4)``;
+    ValueError naming ``a`` or ``b`` when its last axis is not 4."""
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
+    _last_axis("a", a, 4)
+    _last_axis("b", b, 4)
     ax, ay, az, aw = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
     bx, by, bz, bw = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
     return np.stack(
@@ -66,9 +76,12 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Rotate vectors ``v (..., 3)`` by unit quaternions ``q (..., 4)``."""
+    """Rotate vectors ``v (..., 3)`` by unit quaternions ``q (..., 4)``, broadcasting; ValueError
+    naming ``q`` or ``v`` when its last axis is not 4 or 3."""
     q = np.asarray(q, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)
+    _last_axis("q", q, 4)
+    _last_axis("v", v, 3)
     u = q[..., :3]
     w = q[..., 3:4]
     t = 2.0 * cross(u, v)
@@ -76,8 +89,11 @@ def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 def to_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrices ``(..., 3, 3)`` of unit quaternions ``(..., 4)``."""
-    x, y, z, w = np.moveaxis(np.asarray(q, dtype=np.float64), -1, 0)
+    """Rotation matrices ``(..., 3, 3)`` of unit quaternions ``q (..., 4)``; ValueError naming
+    ``q`` when its last axis is not 4."""
+    q = np.asarray(q, dtype=np.float64)
+    _last_axis("q", q, 4)
+    x, y, z, w = np.moveaxis(q, -1, 0)
     m = np.empty(x.shape + (3, 3))
     m[..., 0, 0] = 1 - 2 * (y * y + z * z)
     m[..., 0, 1] = 2 * (x * y - z * w)

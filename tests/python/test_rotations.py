@@ -81,3 +81,23 @@ def test_euler_refuses_an_order_or_a_count_of_angles_it_cannot_use():
         rotations.to_euler(q, "XYQ")  # a KeyError before
     with pytest.raises(ValueError, match=r"angles: expected \(\.\.\., 3\) for order 'ZXY', got shape \(5, 2\)"):
         rotations.from_euler(np.zeros((5, 2)), "ZXY")  # an IndexError before
+
+
+UNIT = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        # A last axis of 5 was read in part (a silent answer), one of 3 or 2 an IndexError or unpacking error.
+        (lambda: rotations.multiply(np.zeros(5), UNIT), r"^a: expected shape \(\.\.\., 4\), got \(5,\)$"),
+        (lambda: rotations.multiply(UNIT, np.zeros((2, 3))), r"^b: expected shape \(\.\.\., 4\), got \(2, 3\)$"),
+        (lambda: rotations.rotate(np.zeros(5), np.zeros(3)), r"^q: expected shape \(\.\.\., 4\), got \(5,\)$"),
+        (lambda: rotations.rotate(UNIT, np.zeros(4)), r"^v: expected shape \(\.\.\., 3\), got \(4,\)$"),
+        (lambda: rotations.rotate(UNIT, 1.0), r"^v: expected shape \(\.\.\., 3\), got \(\)$"),
+        (lambda: rotations.to_matrix(np.zeros((2, 5))), r"^q: expected shape \(\.\.\., 4\), got \(2, 5\)$"),
+    ],
+)
+def test_hot_helpers_name_the_argument_whose_last_axis_is_wrong(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()

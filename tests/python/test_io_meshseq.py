@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -323,11 +324,23 @@ def test_ply_face_index_out_of_range(tmp_path: Path) -> None:
     assert _error(path) == f"{path}: face 2: vertex index 7 is outside the 5 vertices"
 
 
-def test_writers_reject_bad_meshes(tmp_path: Path) -> None:
-    with pytest.raises(ValueError, match=r"face 0 \[0, 1, 5\] has an index outside \[0, 5\)"):
-        write_ply(tmp_path / "bad.ply", EXPECTED_VERTICES, [[0, 1, 5]])
-    with pytest.raises(ValueError, match="non-finite"):
-        write_obj(tmp_path / "bad.obj", np.full((3, 3), np.nan), [[0, 1, 2]])
+@pytest.mark.parametrize("write", [write_obj, write_ply, write_mesh])
+def test_writers_reject_bad_meshes_naming_the_file_and_argument(tmp_path: Path, write: Callable) -> None:
+    # The errors named "frames" (the AnimatedMesh the writers built), an argument they do not take.
+    path = tmp_path / ("bad.ply" if write is write_ply else "bad.obj")
+    not_finite = "is not finite as float32"
+    cases = [
+        (np.zeros((4, 2)), [[0, 1, 2]], "vertices: expected shape (V, 3), got (4, 2)"),
+        (np.full((3, 3), "x"), [[0, 1, 2]], "vertices: expected numbers, got dtype <U1"),
+        ([[0, 0, 0], [1, 0, 0], [np.nan, 0, 0]], [[0, 1, 2]], f"vertices: vertex 2 [nan, 0.0, 0.0] {not_finite}"),
+        ([[0, 0, 0], [1, 0, 0], [1e39, 0, 0]], [[0, 1, 2]], f"vertices: vertex 2 [1e+39, 0.0, 0.0] {not_finite}"),
+        (EXPECTED_VERTICES, [[0, 1, 5]], "faces: face 0 [0, 1, 5] has an index outside [0, 5)"),
+        (EXPECTED_VERTICES, [[0, 1]], "faces: expected shape (M, 3), got (1, 2)"),
+    ]
+    for vertices, faces, message in cases:
+        with pytest.raises(ValueError) as caught:
+            write(path, vertices, faces)
+        assert str(caught.value) == f"{path}: {message}"
     assert not list(tmp_path.iterdir())
 
 

@@ -275,9 +275,11 @@ def _join_continued_lines(data: bytes) -> bytes:
 def write_obj(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) -> None:
     """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically.
 
-    Coordinates are written with 9 significant digits, which round-trips float32 exactly.
+    Coordinates are written with 9 significant digits, which round-trips float32 exactly. A wrong
+    shape, a coordinate that is not finite as float32 or a face index outside the vertices is a
+    ValueError naming the file and the argument (``vertices`` or ``faces``); nothing is written.
     """
-    vertices, faces = _checked(vertices, faces)
+    vertices, faces = _checked(path, vertices, faces)
     vertices, faces = vertices.astype(np.float64), faces.astype(np.int64) + 1
     with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
         handle.write("# written by animlod\n")
@@ -285,10 +287,27 @@ def write_obj(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) 
         handle.write(("f %d %d %d\n" * len(faces)) % tuple(faces.ravel()))
 
 
-def _checked(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``vertices (V, 3) float32`` and ``faces (M, 3) int32`` checked as AnimatedMesh checks them
-    (shapes, finite values, indices in range); ValueError otherwise."""
-    mesh = AnimatedMesh(faces, np.asarray(vertices)[None])
+def _checked(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``vertices (V, 3) float32`` and ``faces (M, 3) int32`` checked as AnimatedMesh checks a
+    frame (shapes, finite values, indices in range); otherwise a ValueError that names the file
+    and the argument (``out.obj: vertices: vertex 2 [nan, 0.0, 0.0] is not finite``)."""
+    given = np.asarray(vertices)
+    if not (given.ndim == 2 and given.shape[1] == 3):
+        raise ValueError(f"{os.fspath(path)}: vertices: expected shape (V, 3), got {given.shape}")
+    try:
+        with np.errstate(over="ignore"):  # 1e39 becomes inf, refused below
+            positions = np.ascontiguousarray(given, dtype=np.float32)
+    except (TypeError, ValueError):
+        raise ValueError(f"{os.fspath(path)}: vertices: expected numbers, got dtype {given.dtype}") from None
+    finite = np.isfinite(positions).all(axis=1)
+    if not finite.all():
+        vertex = int(np.argmin(finite))
+        reason = f"vertex {vertex} {given[vertex].tolist()} is not finite as float32"
+        raise ValueError(f"{os.fspath(path)}: vertices: {reason}")
+    try:
+        mesh = AnimatedMesh(faces, positions[None])  # checks the faces against the vertex count
+    except ValueError as error:
+        raise ValueError(f"{os.fspath(path)}: {error}") from None
     return mesh.frames[0], mesh.faces
 
 
@@ -452,9 +471,9 @@ def write_ply(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, 
     """Write ``vertices (V, 3)`` as float x, y, z and ``faces (M, 3)`` as uchar/int lists, atomically.
 
     ``binary=True`` writes binary_little_endian (exact); ``binary=False`` ascii with 9
-    significant digits (exact for float32).
+    significant digits (exact for float32). Bad input is refused as :func:`write_obj` refuses it.
     """
-    vertices, faces = _checked(vertices, faces)
+    vertices, faces = _checked(path, vertices, faces)
     vertices, faces = vertices.astype("<f4"), faces.astype(np.int64)
     header = (
         f"ply\nformat {'binary_little_endian' if binary else 'ascii'} 1.0\ncomment written by animlod\n"

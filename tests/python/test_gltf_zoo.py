@@ -77,3 +77,13 @@ def test_level_nodes_keep_the_morph_weights_of_their_base_node(tmp_path: Path) -
     simplify_document(_morph_tube_glb(tmp_path / "plain.glb", None), tmp_path / "plain_lod.glb")
     plain = GltfDocument(tmp_path / "plain_lod.glb").json["nodes"]
     assert all("weights" not in plain[level] for level in plain[0]["extensions"]["MSFT_lod"]["ids"])
+
+
+def test_a_static_node_shows_its_own_morph_weights(tmp_path: Path) -> None:
+    """read_gltf places a static morphed mesh with its node's weights (they override the mesh's
+    [0]): the tube drawn stretched to twice its cross-section height. The mesh's weights were used."""
+    positions, _ = tube()
+    (stretched,) = read_gltf(_morph_tube_glb(tmp_path / "tall.glb", [1.0])).static_meshes
+    np.testing.assert_allclose(stretched.frames[0], positions * [1.0, 2.0, 1.0], atol=1e-6)
+    (plain,) = read_gltf(_morph_tube_glb(tmp_path / "plain.glb", None)).static_meshes
+    np.testing.assert_allclose(plain.frames[0], positions, atol=1e-6)

@@ -183,12 +183,24 @@ def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[Animated
         if not tracks:
             positions = geometry.positions.astype(np.float64)
             if geometry.targets is not None:
-                # pygltflib's Node has no ``weights`` field, so the mesh's default weights apply.
-                weights = geometry.default_weights
+                weights = _node_weights(doc, node_index, geometry.default_weights)
                 positions = positions + np.einsum("n,nvc->vc", weights, geometry.targets)
             frames = transform_points(world, positions)[None]
             statics.append(_animated_mesh(doc, doc.node_label(node_index), faces, frames, None))
     return morphs, statics
+
+
+def _node_weights(doc: GltfDocument, node: int, mesh_weights: np.ndarray) -> np.ndarray:
+    """(N,) morph weights node ``node`` shows without animation: its own ``weights``, which override
+    its mesh's (glTF 2.0, 3.7.2.2; pygltflib's Node drops them, the raw JSON keeps them)."""
+    weights = doc.json["nodes"][node].get("weights")
+    if weights is None:
+        return mesh_weights
+    values = np.asarray(weights, np.float64) if isinstance(weights, list) else np.empty(0)
+    if values.shape != mesh_weights.shape or not np.all(np.isfinite(values)):
+        reason = f"weights must be {mesh_weights.size} finite numbers, one per morph target of its mesh"
+        raise doc.fail(doc.node_label(node), reason)
+    return values
 
 
 def morph_weight_tracks(doc: GltfDocument, node: int, target_count: int, fps: float) -> list[tuple[int, np.ndarray]]:

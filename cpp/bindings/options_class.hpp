@@ -1,5 +1,5 @@
 // OptionsClass: the one way a core options struct becomes a Python class. Fields are
-// read-write, their defaults are the struct's, their docstrings the header comments
+// read-write (a vector field reads as a tuple), their defaults are the struct's, their docstrings the header comments
 // (header_docs.hpp); the class takes keyword arguments (also for the fields of nested options),
 // refuses an unknown name or a value of the wrong type with a ValueError naming the option,
 // and compares, prints, copies and pickles by its fields (Dask sends options to workers).
@@ -13,6 +13,7 @@
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/typing.h>
 
 #include "enum_names.hpp"
 #include "header_docs.hpp"
@@ -35,6 +36,23 @@ std::string value_kind(bool plural = false) {
   else if constexpr (std::is_floating_point_v<T>) return std::string(article) + "number" + s;
   else if constexpr (std::is_same_v<T, std::string>) return std::string(article) + "string" + s;
   else return std::string(article) + "list" + s + " of " + value_kind<typename T::value_type>(true);
+}
+
+template <class T>
+struct is_vector : std::false_type {};
+template <class T>
+struct is_vector<std::vector<T>> : std::true_type {};
+
+// What reading a field gives. Reading hands out a copy of the struct's value, so a vector reads
+// as a tuple: a list there took `opts.frame_subset.append(3)` and changed nothing.
+template <class T>
+auto readable(const T& value) {
+  if constexpr (is_vector<T>::value) {
+    using Item = std::conditional_t<std::is_floating_point_v<typename T::value_type>, py::float_, py::int_>;
+    return py::typing::Tuple<Item, py::ellipsis>(py::cast(value));
+  } else {
+    return value;
+  }
 }
 
 inline std::string repr_text(const py::handle& value) { return std::string(py::str(py::repr(value))); }
@@ -99,7 +117,9 @@ class OptionsClass {
   // A plain field.
   template <class T>
   OptionsClass& field(const char* name, T Options::*member) {
-    cls_.def_readwrite(name, member, doc(name).c_str());
+    cls_.def_property(
+        name, [member](const Options& o) { return detail::readable(o.*member); },
+        [member](Options& o, T value) { o.*member = std::move(value); }, field_doc<T>(name).c_str());
     layout_->fields.emplace_back(name, detail::value_kind<T>());
     return *this;
   }
@@ -110,13 +130,13 @@ class OptionsClass {
   OptionsClass& checked_field(const char* name, T Options::*member, Check check) {
     const std::string where = layout_->class_name + "." + name;
     cls_.def_property(
-        name, [member](const Options& o) { return o.*member; },
+        name, [member](const Options& o) { return detail::readable(o.*member); },
         [member, check, where](Options& o, T value) {
           const std::string problem = check(value);
           if (!problem.empty()) throw py::value_error(where + ": " + problem + ", got " + detail::repr_text(py::cast(value)));
           o.*member = value;
         },
-        doc(name).c_str());
+        field_doc<T>(name).c_str());
     layout_->fields.emplace_back(name, detail::value_kind<T>());
     return *this;
   }
@@ -186,6 +206,14 @@ class OptionsClass {
   }
 
  private:
+  template <class T>
+  std::string field_doc(const char* field) const {
+    if constexpr (detail::is_vector<T>::value)
+      return doc(field) + "\n\nRead as a tuple, a copy of the C++ vector; assign a sequence to change the field.";
+    else
+      return doc(field);
+  }
+
   std::string doc(const char* field) const {
     return std::string(header_docs::doc(layout_->class_name + "." + field));
   }

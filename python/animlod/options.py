@@ -6,9 +6,9 @@ docstrings from the header comments; see ``help(animlod.AqemOptions)``). A wrapp
 fields, or both (the keywords change a copy of the object).
 
 List fields (``AqemOptions.target_ratios``, ``target_face_counts``, ``frame_subset``) read as
-tuples. The object holds a C++ vector, so what reading such a field hands out is a copy: a list
-there took ``opts.frame_subset.append(3)`` and changed nothing; a tuple has no ``append`` and
-says so at once. Change the field by assigning a sequence (``opts.frame_subset = [0, 3]``,
+tuples (the binding's doing). The object holds a C++ vector, so what reading such a field hands
+out is a copy: a list there took ``opts.frame_subset.append(3)`` and changed nothing; a tuple has
+no ``append`` and says so at once. Change the field by assigning a sequence (``opts.frame_subset = [0, 3]``,
 ``opts.target_ratios += (0.25,)``), through ``update`` or by keyword, and compare it with a
 tuple (a list never equals one: ``opts.target_ratios == (0.5,)``).
 """
@@ -42,36 +42,6 @@ __all__ = [
 ]
 
 Options = TypeVar("Options")
-
-_TUPLE_NOTE = (
-    "\n\nRead as a tuple, a copy of the C++ vector (a list copy would take an append and change nothing); "
-    "assign a sequence to change the field."
-)
-
-
-def _read_lists_as_tuples(options_type: type) -> None:
-    """Make each list field of the bound ``options_type`` read as a tuple, keeping the binding's
-    setter (its checks and messages) and docstring. A list field is one the binding reads as a
-    list; a binding that returned tuples itself would leave nothing here to wrap."""
-    defaults = options_type()
-    for name in options_type.fields:
-        if isinstance(getattr(defaults, name), list):
-            bound = options_type.__dict__[name]
-            read = property(lambda self, get=bound.fget: tuple(get(self)), bound.fset, doc=bound.__doc__ + _TUPLE_NOTE)
-            setattr(options_type, name, read)
-
-
-for _options_type in (
-    AnimationRateOptions,
-    AqemOptions,
-    FfdFitOptions,
-    LodSelectorOptions,
-    MotionFeatureOptions,
-    MotionRefitOptions,
-    PlayerOptions,
-    TdagOptions,
-):
-    _read_lists_as_tuples(_options_type)
 
 
 def resolve_options(options_type: type[Options], options: Options | None, fields: dict[str, object]) -> Options:

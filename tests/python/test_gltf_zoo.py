@@ -10,6 +10,7 @@ import pygltflib
 from gltf_edits import append_accessor, edit_glb
 from simplify_inputs import tube, two_bone_tube
 
+from animlod import rotations
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf import read_gltf, write_glb
 from animlod.io.gltf_document import GltfDocument
@@ -87,3 +88,66 @@ def test_a_static_node_shows_its_own_morph_weights(tmp_path: Path) -> None:
     np.testing.assert_allclose(stretched.frames[0], positions * [1.0, 2.0, 1.0], atol=1e-6)
     (plain,) = read_gltf(_morph_tube_glb(tmp_path / "plain.glb", None)).static_meshes
     np.testing.assert_allclose(plain.frames[0], positions, atol=1e-6)
+
+
+def _trs_matrix(translation, rotation, scale) -> np.ndarray:
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotations.to_matrix(np.asarray(rotation, np.float64)) * np.asarray(scale, np.float64)
+    matrix[:3, 3] = translation
+    return matrix
+
+
+def test_a_mirrored_joint_is_posed_as_a_viewer_poses_it(tmp_path: Path) -> None:
+    """A joint with scale (-1, 1, 1), as 3ds Max and Maya write mirrored bones, between a turning root
+    and a turning child. The skin is baked exactly as glTF's node matrices pose it, and the motion stays
+    rigid (the mirroring is in the rest shape), so motion LoD takes it. Such files were refused."""
+    positions, faces = tube(rings=8, segments=6, length=1.0)
+    positions = positions[:, [1, 0, 2]] + [0.5, 0.5, 0.0]  # along y, over the mirrored joint and its child
+    weights = np.clip(positions[:, 1], 0.0, 1.0)
+    joints = np.tile(np.array([[2, 1, 0, 0]], np.uint16), (len(positions), 1))
+    weights = np.stack([weights, 1.0 - weights, np.zeros_like(weights), np.zeros_like(weights)], -1)
+    trs = [
+        ([0, 0, 0], [0, 0, 0, 1], [1, 1, 1]),
+        ([0.5, 0, 0], [0, 0, 0, 1], [-1, 1, 1]),
+        ([0, 1, 0], [0, 0, 0, 1], [1, 1, 1]),
+    ]
+    rest = [_trs_matrix(*trs[0])]
+    for node in (1, 2):
+        rest.append(rest[-1] @ _trs_matrix(*trs[node]))
+    keys = {0: rotations.from_axis_angle([0, 1, 0], [0.0, 0.7]), 2: rotations.from_axis_angle([0, 0, 1], [0.0, 0.9])}
+
+    builder = GlbBuilder()
+    primitive = {
+        "attributes": {
+            "POSITION": builder.add(positions.astype(np.float32), bounds=True),
+            "JOINTS_0": builder.add(joints),
+            "WEIGHTS_0": builder.add(weights.astype(np.float32)),
+        },
+        "indices": builder.add(faces.astype(np.uint32).reshape(-1, 1)),
+    }
+    builder.append("meshes", {"primitives": [primitive]})
+    inverse_bind = np.linalg.inv(np.stack(rest)).transpose(0, 2, 1).reshape(3, 16)
+    builder.append("skins", {"joints": [0, 1, 2], "inverseBindMatrices": builder.add(inverse_bind.astype(np.float32))})
+    for node, (translation, rotation, scale) in enumerate(trs):
+        node_json = {"name": f"joint{node}", "translation": translation, "rotation": rotation, "scale": scale}
+        builder.append("nodes", node_json | ({"children": [node + 1]} if node < 2 else {}))
+    builder.append("nodes", {"name": "body", "mesh": 0, "skin": 0})
+    times = builder.add(np.array([[0.0], [1.0]], np.float32), bounds=True)
+    samplers = [{"input": times, "output": builder.add(keys[node].astype(np.float32))} for node in keys]
+    channels = [{"sampler": k, "target": {"node": node, "path": "rotation"}} for k, node in enumerate(keys)]
+    builder.append("animations", {"name": "turn", "samplers": samplers, "channels": channels})
+    builder.json["scenes"], builder.json["scene"] = [{"nodes": [0, 3]}], 0
+    builder.save(tmp_path / "mirrored.glb")
+
+    scene = read_gltf(tmp_path / "mirrored.glb")
+    skinned, (motion,) = scene.skinned_meshes[0], scene.motions
+    assert motion.joint_deformations is None
+    baked = skinned.bake(motion).frames
+    for frame, key in ((0, 0), (-1, 1)):
+        world = [_trs_matrix(trs[0][0], keys[0][key], trs[0][2])]
+        world.append(world[0] @ _trs_matrix(*trs[1]))
+        world.append(world[1] @ _trs_matrix(trs[2][0], keys[2][key], trs[2][2]))
+        matrices = np.stack(world) @ np.linalg.inv(np.stack(rest))
+        blended = np.einsum("vk,vkij->vij", weights, matrices[joints])
+        expected = np.einsum("vij,vj->vi", blended[:, :3, :3], positions) + blended[:, :3, 3]
+        np.testing.assert_allclose(baked[frame], expected, atol=1e-5)

@@ -690,11 +690,22 @@ def test_a_stretched_leaf_leaves_the_motion_rigid(chain_glb, tmp_path):
     np.testing.assert_allclose(read.bake(read_motion).frames[4], _viewer_frame(stretched, 4), atol=1e-5)
 
 
-def test_a_mirrored_joint_is_refused(chain_glb, tmp_path):
-    path, _, _ = chain_glb
+def test_a_mirrored_joint_is_skinned_as_a_viewer_does(chain_glb, tmp_path):
+    # 3ds Max and Maya write mirrored bones with a negative scale: the rotations below stay rigid.
+    path, _, motion = chain_glb
     mirrored = edit_glb(path, tmp_path / "mirrored.glb", _rest_scale(1, [-1.0, 1.0, 1.0]))
-    with pytest.raises(FormatError, match=r"skin 0: scale \[-1.0, 1.0, 1.0\] of node 1 'mid' is not positive"):
-        read_skinned(mirrored)
+    read, (read_motion,) = read_skinned(mirrored, fps=motion.fps)
+    assert read_motion.joint_deformations is None
+    baked = read.bake(read_motion).frames
+    for frame in range(motion.frame_count):
+        np.testing.assert_allclose(baked[frame], _viewer_frame(mirrored, frame), atol=1e-5)
+
+
+def test_a_flattened_joint_is_refused(chain_glb, tmp_path):
+    path, _, _ = chain_glb
+    flattened = edit_glb(path, tmp_path / "flat.glb", _rest_scale(1, [0.0, 1.0, 1.0]))
+    with pytest.raises(FormatError, match=r"skin 0: scale \[0.0, 1.0, 1.0\] of node 1 'mid' has a zero component"):
+        read_skinned(flattened)
 
 
 def test_animated_scale_is_skinned_as_a_viewer_does(chain_glb, tmp_path):

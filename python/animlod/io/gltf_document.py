@@ -391,7 +391,8 @@ class GltfDocument:
     def rest_trs(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Rest ``translation (3,)``, ``rotation (4,)`` and ``scale (3,)`` of node ``index``.
 
-        A ``matrix`` is decomposed; shear and mirroring cannot be expressed as TRS and raise.
+        A ``matrix`` is decomposed (a mirroring one with a negative x scale); shear cannot be
+        expressed as TRS and raises.
         """
         node = self.gltf.nodes[index]
         if node.matrix is not None:
@@ -413,9 +414,11 @@ class GltfDocument:
         scale = np.linalg.norm(linear, axis=0)
         if np.any(scale == 0.0):
             raise self.fail(self.node_label(index), "matrix is singular")
+        if np.linalg.det(linear) < 0.0:  # mirrored: a negative x scale and a proper rotation
+            scale[0] = -scale[0]
         rotation = linear / scale
-        if np.linalg.det(rotation) < 0.0 or not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-4):
-            raise self.fail(self.node_label(index), "matrix has shear or mirroring, not translation-rotation-scale")
+        if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-4):
+            raise self.fail(self.node_label(index), "matrix has shear, not translation-rotation-scale")
         return matrix[:3, 3].copy(), rotations.from_matrix(rotation), scale
 
     def rest_matrix(self, index: int) -> np.ndarray:
@@ -437,11 +440,14 @@ class GltfDocument:
         return world
 
     def uniform_scale(self, index: int, scale: np.ndarray, element: str) -> float | None:
-        """The common value of a uniform ``scale (3,)``, None when it is not uniform; FormatError
-        when a component is not positive (a mirrored or flattened node)."""
-        if not np.all(scale > 0.0):
-            reason = f"scale {np.round(scale, 6).tolist()} of {self.node_label(index)} is not positive"
-            raise self.fail(element, f"{reason}; skeletons take no mirrored or flattened joint")
+        """The common value of a uniform ``scale (3,)``, None when it is not uniform or mirrors (a
+        negative component, as 3ds Max and Maya write mirrored bones); FormatError when a component
+        is zero (a flattened node)."""
+        if not np.all(scale != 0.0):
+            reason = f"scale {np.round(scale, 6).tolist()} of {self.node_label(index)} has a zero component"
+            raise self.fail(element, f"{reason}; skeletons take no flattened joint")
+        if np.any(scale < 0.0):
+            return None
         value = float(np.mean(scale))
         return value if np.max(np.abs(scale - value)) <= UNIFORM_SCALE_TOLERANCE * value else None
 

@@ -19,6 +19,9 @@ nothing), or turns a joint under a non-uniformly scaled one (a shear), poses the
 the joints' rigid frames move with the scaled offsets, and the rest of each joint's world
 transform becomes the motion's ``joint_deformations``
 (``W = W_rigid @ D @ rest_shape @ S(c)``), which skinning applies and motion LoD refuses.
+A mirrored node (a negative scale, as 3ds Max and Maya write mirrored bones) counts as
+non-uniform, and the rotations below it are mirrored too (``F @ R @ F``, :func:`_mirrored`), so
+that the mirroring stays in ``rest_shape`` and the motion stays rigid.
 """
 
 from __future__ import annotations
@@ -82,6 +85,7 @@ class SkinRig:
         self._node_parents = {n: int(doc.parents[n]) for n in self._nodes}
         self.rest_translation, self.rest_rotation, self._rest_scale = {}, {}, {}
         self._local_scale, self._world_scale = {}, {}
+        self._mirror: dict[int, np.ndarray] = {}  # (3,) signs of the scales down to each node at rest
         uniform = True
         for node in self._nodes:
             translation, rotation, scale = doc.rest_trs(node)
@@ -91,6 +95,7 @@ class SkinRig:
             uniform &= common is not None
             self._local_scale[node] = 1.0 if common is None else common
             self._world_scale[node] = self._local_scale[node] * self._world_scale.get(self._node_parents[node], 1.0)
+            self._mirror[node] = np.sign(scale) * self._mirror.get(self._node_parents[node], np.ones(3))
         self.scales = np.array([self._world_scale[n] for n in self.joint_nodes])
         self.inverse_bind = self._inverse_bind(doc, len(order))[order]
         positions, world_rotations, rest_shape = self._pose(
@@ -259,7 +264,8 @@ class SkinRig:
             else:
                 turned = (linear[parent] @ translations[node][..., None])[..., 0]
             position[node] = position[parent] + turned
-            rotation[node] = rotations.multiply(rotation[parent], local_rotations[node])
+            turned_rotation = _mirrored(local_rotations[node], self._mirror[parent])
+            rotation[node] = rotations.multiply(rotation[parent], turned_rotation)
         world_rotations = self._per_joint(rotation, frames)
         if scales is None:
             return self._per_joint(position, frames), world_rotations, None
@@ -291,7 +297,18 @@ class SkinRig:
         """Whether a scale channel's keys leave the node's rest scale by more than float noise."""
         keys = values[:, 1] if values.ndim == 3 else values  # CUBICSPLINE: the values between tangents
         rest = self._rest_scale[node]
-        return float(np.abs(keys - rest).max()) > UNIFORM_SCALE_TOLERANCE * float(rest.max())
+        return float(np.abs(keys - rest).max()) > UNIFORM_SCALE_TOLERANCE * float(np.abs(rest).max())
+
+
+def _mirrored(rotation: np.ndarray, signs: np.ndarray) -> np.ndarray:
+    """Quaternions ``(..., 4)`` of ``F @ R @ F``, F = diag(``signs``) the mirroring above a node: a
+    rotation again. Under a mirrored parent, ``L_parent @ R = Q_parent @ (F R F) @ F`` keeps the
+    mirroring F (with the scale) in the rest shape and the rigid frames turning."""
+    if np.all(signs > 0.0):
+        return rotation
+    # F R(a, t) F = R(det(F) F a, t): the axis mirrored, and reversed by an odd mirroring.
+    factors = np.append(np.prod(signs) * signs, 1.0)
+    return rotation * factors
 
 
 def _topological_order(parent_slots: list[int]) -> list[int]:

@@ -15,6 +15,7 @@ from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf import read_gltf, write_glb
 from animlod.io.gltf_document import GltfDocument
 from animlod.pipelines.lod_document import simplify_document
+from animlod.pipelines.motion import build_motion_levels
 
 
 def _morph_tube_glb(path: Path, node_weights: list[float] | None) -> Path:
@@ -151,3 +152,23 @@ def test_a_mirrored_joint_is_posed_as_a_viewer_poses_it(tmp_path: Path) -> None:
         blended = np.einsum("vk,vkij->vij", weights, matrices[joints])
         expected = np.einsum("vij,vj->vi", blended[:, :3, :3], positions) + blended[:, :3, 3]
         np.testing.assert_allclose(baked[frame], expected, atol=1e-5)
+
+
+def test_motion_levels_show_every_part_of_a_character_on_one_skin(tmp_path: Path) -> None:
+    """A character in parts (BrainStem's meshes, a body and its clothes) shares one skin; a part's
+    node has a transform of its own, which skinning ignores. Each motion level's GLB shows every
+    part, posed as the input poses it; it showed the first part alone."""
+
+    def second_part(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        gltf.meshes.append(pygltflib.Mesh(primitives=gltf.meshes[0].primitives, name="clothes"))
+        gltf.nodes.append(pygltflib.Node(name="clothes", mesh=1, skin=0, translation=[0.0, 3.0, 0.0], scale=[2.0] * 3))
+        gltf.scenes[gltf.scene or 0].nodes.append(len(gltf.nodes) - 1)
+
+    source = edit_glb(_two_bone_glb(tmp_path / "body.glb"), tmp_path / "parts.glb", second_part)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    scene = read_gltf(source)
+    expected = np.concatenate([mesh.bake(scene.motions[0]).frames for mesh in scene.skinned_meshes], axis=1)
+    written = read_gltf(tmp_path / "levels" / "parts_lod0.glb")
+    (skinned,), (motion,) = written.skinned_meshes, written.motions
+    np.testing.assert_allclose(skinned.bake(motion).frames, expected, atol=1e-4)
+    assert any("one mesh" in note for note in report.notes)

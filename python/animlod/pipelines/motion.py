@@ -13,6 +13,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
 from ..model import Motion, SkinnedMesh
@@ -169,9 +171,14 @@ def _read_input(
         return read_bvh(source), None
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or a skinned glTF")
-    from ..io.gltf import read_skinned
+    from ..io.gltf import read_gltf, read_skinned
 
-    skin, motions = read_skinned(source)
+    scene = read_gltf(source)
+    if not scene.skinned_meshes:
+        read_skinned(source)  # raises the error naming what the file has
+    skin, motions = _whole_skin(scene.skinned_meshes), scene.skinned_motions[0]
+    if skin.vertex_count > scene.skinned_meshes[0].vertex_count:
+        note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
     if not motions:
         raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
     if clip is None:
@@ -192,6 +199,54 @@ def _read_input(
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
     return _rigid(path, motions, range(clip, clip + 1), motions[clip]), skin
+
+
+def _whole_skin(meshes: list[SkinnedMesh]) -> SkinnedMesh:
+    """The first skinned mesh with every other one on its skeleton (a character in parts, as BrainStem
+    is) joined to it, so that a level's GLB shows the whole character. Each part keeps its skinning:
+    parts differ in inverse binds by their mesh node's transform ``T`` only (``IBM_part = IBM @ T``,
+    :func:`animlod.io.gltf_read.skinned_mesh_of_node`), which moves into its vertices. Parts with
+    other morph targets than the first stay out."""
+    first = meshes[0]
+    parts = [first]
+    for mesh in meshes[1:]:
+        same_targets = (mesh.morph_targets is None) == (first.morph_targets is None) and (
+            first.morph_targets is None or mesh.morph_target_names == first.morph_target_names
+        )
+        if mesh.skeleton is first.skeleton and same_targets:
+            parts.append(mesh)
+    if len(parts) == 1:
+        return first
+    influences = max(part.joints.shape[1] for part in parts)
+    moved = []
+    for part in parts:
+        to_first = np.linalg.inv(first.inverse_bind[0]) @ part.inverse_bind[0]  # T, the same for every joint
+        normals = None
+        if part.normals is not None:
+            normals = part.normals @ np.linalg.inv(to_first[:3, :3])  # the inverse transpose, row vectors
+            normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+        targets = None if part.morph_targets is None else part.morph_targets @ to_first[:3, :3].T
+        moved.append((part.rest_positions @ to_first[:3, :3].T + to_first[:3, 3], normals, targets))
+    starts = np.cumsum([0] + [part.vertex_count for part in parts])
+
+    def padded(values: np.ndarray) -> np.ndarray:
+        return np.pad(values, ((0, 0), (0, influences - values.shape[1])))
+
+    def joined(values: list[np.ndarray | None], axis: int = 0) -> np.ndarray | None:
+        return None if any(v is None for v in values) else np.concatenate(values, axis=axis)
+
+    return SkinnedMesh(
+        rest_positions=np.concatenate([positions for positions, _, _ in moved]).astype(np.float32),
+        faces=np.concatenate([part.faces + start for part, start in zip(parts, starts)]),
+        joints=np.concatenate([padded(part.joints) for part in parts]),
+        weights=np.concatenate([padded(part.weights) for part in parts]),
+        inverse_bind=first.inverse_bind,
+        skeleton=first.skeleton,
+        uvs=joined([part.uvs for part in parts]),
+        normals=joined([normals for _, normals, _ in moved]),
+        morph_targets=joined([targets for _, _, targets in moved], axis=1),
+        morph_target_names=first.morph_target_names,
+    )
 
 
 def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Motion:

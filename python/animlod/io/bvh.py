@@ -22,6 +22,9 @@ Conventions of this reader, in terms of :class:`animlod.model.Motion`:
   ``MOTION``, ``Frames:``, ``Frame Time:``) are matched regardless of ASCII case, as Blender's
   importer matches them (some exporters write ``hierarchy``, ``root``, ``offset``); channel
   names too (``xrotation``). Joint names are kept as written, and stay case-sensitive.
+- Text is UTF-8 (a byte order mark is skipped), or UTF-16 with a byte order mark; a file that is
+  neither has its joint names in a legacy code page, read as Shift-JIS or else Latin-1
+  (:func:`_decode`). Files are written in UTF-8.
 - ``Frame Time`` gives fps; when the written frame time is an integer rate rounded to the digits
   written (``.0083333`` for 120 fps), fps is that integer.
 """
@@ -147,8 +150,7 @@ def read_bvh(path: str | os.PathLike) -> Motion:
         values, a value that is not a finite number.
     """
     path = Path(path)
-    # utf-8-sig: a byte order mark (as some Windows tools write one) is no part of HIERARCHY.
-    text = path.read_bytes().decode("utf-8-sig", errors="replace").replace("\r\n", "\n").replace("\r", "\n")
+    text = _decode(path.read_bytes()).replace("\r\n", "\n").replace("\r", "\n")
     motion_match = _MOTION_LINE.search(text)
     hierarchy_lines = text[: motion_match.start() if motion_match else len(text)].split("\n")
     cursor = _TokenCursor(path, hierarchy_lines)
@@ -160,6 +162,26 @@ def read_bvh(path: str | os.PathLike) -> Motion:
     channel_count = sum(len(joint.channels) for joint in joints)
     values = _parse_motion_table(path, data_text, data_line, frame_count, channel_count, joints)
     return _build_motion(path, joints, values, fps)
+
+
+def _decode(data: bytes) -> str:
+    """The text of a BVH file: UTF-8 (a byte order mark dropped), UTF-16 after its byte order mark
+    (PowerShell's ``>`` and Notepad's "Unicode" write it), else the legacy code page the joint
+    names were written in: Shift-JIS (cp932, MikuMikuDance converters) when the bytes decode as
+    it into no half-width katakana, Latin-1 otherwise. Only names are outside ASCII, and a strict
+    decoding keeps different names different (replacing undecodable bytes made 左足 and 右足 one
+    name, "\ufffd\ufffd", written twice)."""
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return data.decode("utf-16", errors="replace")  # an odd byte at the end: a truncated file
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        pass
+    try:
+        text = data.decode("cp932")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+    return data.decode("latin-1") if re.search("[\uff61-\uff9f]", text) else text
 
 
 def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:

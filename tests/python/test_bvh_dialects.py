@@ -1,0 +1,87 @@
+"""BVH files as capture libraries and exporters write them, beyond test_io_bvh's hand-written ones.
+
+Each test builds its input in tmp_path in the dialect it names.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from animlod.io import read_bvh, write_bvh
+
+# Two joints whose names differ only outside ASCII (as MikuMikuDance-derived files name them).
+JAPANESE_BVH = (
+    "HIERARCHY\n"
+    "ROOT \u30bb\u30f3\u30bf\u30fc\n"  # センター
+    "{\n"
+    "\tOFFSET 0 0 0\n"
+    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+    "\tJOINT \u5de6\u8db3\n"  # 左足
+    "\t{\n"
+    "\t\tOFFSET 1 -1 0\n"
+    "\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n"
+    "\t\tEnd Site\n"
+    "\t\t{\n"
+    "\t\t\tOFFSET 0 -4 0\n"
+    "\t\t}\n"
+    "\t}\n"
+    "\tJOINT \u53f3\u8db3\n"  # 右足
+    "\t{\n"
+    "\t\tOFFSET -1 -1 0\n"
+    "\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n"
+    "\t\tEnd Site\n"
+    "\t\t{\n"
+    "\t\t\tOFFSET 0 -4 0\n"
+    "\t\t}\n"
+    "\t}\n"
+    "}\n"
+    "MOTION\n"
+    "Frames: 2\n"
+    "Frame Time: 0.033333\n"
+    "0 10 0 0 0 0 10 0 0 -10 0 0\n"
+    "0 10 1 0 5 0 20 0 0 -20 0 0\n"
+)
+NAMES = ["\u30bb\u30f3\u30bf\u30fc", "\u5de6\u8db3", "\u5de6\u8db3_End", "\u53f3\u8db3", "\u53f3\u8db3_End"]
+
+
+def test_shift_jis_joint_names_read_as_their_characters(tmp_path: Path) -> None:
+    # Japanese tools (MikuMikuDance converters) write Shift-JIS. Decoded as UTF-8 with
+    # replacement, 左足 and 右足 both became "\ufffd\ufffd" and the file was refused as naming a
+    # joint twice.
+    path = tmp_path / "mmd.bvh"
+    path.write_bytes(JAPANESE_BVH.encode("shift_jis"))
+    motion = read_bvh(path)
+    assert motion.skeleton.names == NAMES
+    reference = tmp_path / "utf8.bvh"
+    reference.write_bytes(JAPANESE_BVH.encode("utf-8"))
+    np.testing.assert_array_equal(motion.world_positions(), read_bvh(reference).world_positions())
+    # Written back (as UTF-8), the names survive a round trip.
+    write_bvh(tmp_path / "out.bvh", motion)
+    assert read_bvh(tmp_path / "out.bvh").skeleton.names == NAMES
+
+
+def test_names_in_a_single_byte_code_page_stay_distinct(tmp_path: Path) -> None:
+    # 3ds Max on a European Windows writes its code page: "Bip01 Épaule" and "Bip01 Èpaule"
+    # are two joints, not one name written twice.
+    text = JAPANESE_BVH.replace(NAMES[1], "Bip01 \u00c9paule").replace(NAMES[3], "Bip01 \u00c8paule")
+    path = tmp_path / "max.bvh"
+    path.write_bytes(text.replace(NAMES[0], "Bip01").encode("cp1252"))
+    names = read_bvh(path).skeleton.names
+    assert len(set(names)) == len(names) == 5
+    assert names[0] == "Bip01"
+
+
+def test_a_utf16_file_with_a_byte_order_mark_reads_like_utf8(tmp_path: Path) -> None:
+    # PowerShell's "> file.bvh" and Notepad's "Unicode" save write UTF-16 with a byte order mark.
+    reference = tmp_path / "utf8.bvh"
+    reference.write_bytes(JAPANESE_BVH.encode("utf-8"))
+    expected = read_bvh(reference)
+    for encoding in ("utf-16-le", "utf-16-be"):
+        path = tmp_path / f"{encoding}.bvh"
+        bom = b"\xff\xfe" if encoding.endswith("le") else b"\xfe\xff"
+        path.write_bytes(bom + JAPANESE_BVH.replace("\n", "\r\n").encode(encoding))
+        motion = read_bvh(path)
+        assert motion.skeleton.names == NAMES
+        np.testing.assert_array_equal(motion.local_rotations, expected.local_rotations)

@@ -135,6 +135,16 @@ void bind_tdag(py::module_& m) {
           },
           "(M, 3) int32 faces over the TDAG's vertices (a copy)")
       .def_property_readonly(
+          "two_sided",
+          [](const TemporalDag& d) {
+            py::array_t<bool> flags(static_cast<py::ssize_t>(d.face_count()));
+            auto out = flags.mutable_unchecked<1>();
+            for (py::ssize_t f = 0; f < out.shape(0); ++f) out(f) = d.two_sided(static_cast<size_t>(f));
+            return flags;
+          },
+          "(M,) bool: faces the input also held turned over (a two-sided sheet); cuts hand out their backs "
+          "beside them, after the other faces")
+      .def_property_readonly(
           "input_points",
           [](const TemporalDag& d) {
             std::vector<int32_t> p(d.input_points(), d.input_points() + d.input_vertex_count());

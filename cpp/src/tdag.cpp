@@ -52,6 +52,9 @@ Status derive_links(TdagData& data) {
     if (data.input_points[v] < -1 || data.input_points[v] >= vertex_count)
       return Status::error("input vertex " + std::to_string(v) + ": vertex " + std::to_string(data.input_points[v]) +
                            " outside [0, " + std::to_string(vertex_count) + ")");
+  if (!data.two_sided.empty() && data.two_sided.size() != data.face_count())
+    return Status::error("two-sided flags: " + std::to_string(data.two_sided.size()) + " for " +
+                         std::to_string(data.face_count()) + " faces");
   for (size_t i = 0; i < data.faces.size(); ++i)
     if (data.faces[i] < 0 || data.faces[i] >= vertex_count)
       return Status::error("face " + std::to_string(i / 3) + ": vertex index " + std::to_string(data.faces[i]) +
@@ -237,6 +240,7 @@ size_t TemporalDag::face_count() const { return data_ ? data_->face_count() : 0;
 size_t TemporalDag::collapse_count() const { return data_ ? data_->collapse_count() : 0; }
 size_t TemporalDag::node_count() const { return data_ ? data_->node_count() : 0; }
 const int32_t* TemporalDag::faces() const { return data_ ? data_->faces.data() : nullptr; }
+bool TemporalDag::two_sided(size_t face) const { return data_ && !data_->two_sided.empty() && data_->two_sided[face]; }
 size_t TemporalDag::input_vertex_count() const { return data_ ? data_->input_points.size() : 0; }
 const int32_t* TemporalDag::input_points() const { return data_ ? data_->input_points.data() : nullptr; }
 Governing TemporalDag::governing() const { return data_ ? data_->governing : Governing::first; }

@@ -45,7 +45,9 @@ Status check_options(const AnimatedMeshView& mesh, const TdagOptions& options) {
   return Status::success();
 }
 
-// The TDAG's vertices: the prepared points, with their frames (F, P, 3).
+// The TDAG's vertices: the prepared points, with their frames (F, P, 3). A face repeated in the
+// reverse turn (a two-sided sheet) leaves the surface as AQEM's does: kept, both sides were cut
+// apart at every edge and locked, and nothing collapsed.
 struct PointMesh {
   detail::PreparedMesh prepared;
   std::vector<float> frames;
@@ -55,6 +57,7 @@ struct PointMesh {
   PointMesh(const AnimatedMeshView& mesh, bool weld) {
     detail::WeldInput input;
     input.weld = weld;
+    input.mirror_two_sided = true;
     prepared = detail::prepare_mesh(mesh, input);
     const size_t point_count = prepared.point_source.size();
     frames.resize(mesh.frame_count * point_count * 3);
@@ -292,6 +295,13 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
   data->vertex_count = static_cast<int32_t>(view.vertex_count);
   data->faces = points.prepared.faces;
   data->input_points = points.prepared.wedge_point;
+  for (int32_t source : points.prepared.mirror_sources) data->two_sided.push_back(source >= 0 ? 1 : 0);
+  // A vertex only the turned-over copies use stands for its front counterpart's point.
+  const std::vector<int32_t>& mirrors = points.prepared.mirror_vertices;
+  for (size_t i = 0; i < mirrors.size(); i += 2) {
+    int32_t& point = data->input_points[static_cast<size_t>(mirrors[i])];
+    if (point < 0) point = data->input_points[static_cast<size_t>(mirrors[i + 1])];
+  }
   data->affine_base = options.affine_base;
   data->governing = options.governing;
   data->governing_frame = options.governing == Governing::frame ? options.governing_frame : 0;

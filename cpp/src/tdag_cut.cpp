@@ -480,6 +480,13 @@ struct CutState {
     for (size_t i = 0; i < face_ids.size(); ++i)
       for (size_t k = 0; k < 3; ++k)
         out.faces[3 * i + k] = slot_of[static_cast<size_t>(corner_nodes[3 * static_cast<size_t>(face_ids[i]) + k])];
+    // A two-sided face's back, turned over on the same vertices, after the others (as AQEM's levels).
+    if (!d->two_sided.empty())
+      for (int32_t face : face_ids) {
+        if (!d->two_sided[static_cast<size_t>(face)]) continue;
+        for (size_t k : {0, 2, 1})
+          out.faces.push_back(slot_of[static_cast<size_t>(corner_nodes[3 * static_cast<size_t>(face) + k])]);
+      }
     out.nodes = vertex_nodes;
     out.error_bound = error_bound();
   }

@@ -55,6 +55,9 @@ struct TdagData {
   int32_t frame_count = 0;   // F
   int32_t vertex_count = 0;  // V: nodes 0..V-1 are the input vertices (leaves)
   std::vector<int32_t> faces;  // (M, 3) over the TDAG's vertices
+  // (M,) 1 for a face also drawn turned over: the input held it twice, once in each turn (a
+  // two-sided sheet), and the TDAG simplifies one side and hands out both. Empty: none.
+  std::vector<uint8_t> two_sided;
   std::vector<int32_t> input_points;  // (input V,) TDAG vertex of each input vertex, -1: unused
   AffineBase affine_base = AffineBase::first;
   Governing governing = Governing::first;

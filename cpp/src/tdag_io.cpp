@@ -12,6 +12,8 @@
 //   faces        z delta of each index from the one before (3 M values)
 //   inputs       v input vertex count, u8 1 when input vertex v is TDAG vertex v, else each
 //                input vertex's TDAG vertex as z delta from the one before (from -1)
+//   two-sided    (version 2 on) v count, then each two-sided face as v (face - previous - 1),
+//                the previous starting at -1
 //   maps         F * 12 f64
 //   residuals    frame 0: V * 3 f32; frame t > 0: a bit per vertex (changed since t - 1), then
 //                the changed vertices' 3 f32 (a vertex that does not move is stored once)
@@ -355,6 +357,14 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
       last = point;
     }
   }
+  const auto two_sided = static_cast<size_t>(std::count(d.two_sided.begin(), d.two_sided.end(), 1));
+  w.varint(two_sided);
+  int64_t previous_face = -1;
+  for (size_t f = 0; f < d.two_sided.size(); ++f)
+    if (d.two_sided[f]) {
+      w.varint(static_cast<uint64_t>(static_cast<int64_t>(f) - previous_face - 1));
+      previous_face = static_cast<int64_t>(f);
+    }
   w.raw_array(d.maps.data(), d.maps.size());
   const size_t per_frame = vertex_count * 3;
   w.raw_array(d.residuals.data(), per_frame);
@@ -425,11 +435,11 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
   uint64_t body_size = 0;
   std::memcpy(&version, bytes + 8, 4);
   std::memcpy(&body_size, bytes + 12, 8);
-  if (version != kTdagFormatVersion)
+  if (version < kTdagOldestReadableVersion || version > kTdagFormatVersion)
     return Status::error("TDAG format version " + std::to_string(version) +
                          (version < kTdagFormatVersion ? " was written by an older animlod" : " was written by a newer animlod") +
-                         "; this build reads version " + std::to_string(kTdagFormatVersion) +
-                         " only (rebuild it with `animlod tdag build`)");
+                         "; this build reads versions " + std::to_string(kTdagOldestReadableVersion) + " to " +
+                         std::to_string(kTdagFormatVersion) + " (rebuild it with `animlod tdag build`)");
   if (size - kHeaderSize < 4 || body_size != size - kHeaderSize - 4)
     return Status::error("truncated or padded TDAG file: the header announces " + std::to_string(body_size) +
                          " bytes of data, the file holds " + std::to_string(size < kHeaderSize + 4 ? 0 : size - kHeaderSize - 4));
@@ -485,6 +495,16 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
       last = identity ? static_cast<int64_t>(v) : last + r.zigzag("input vertices");
       if (last < -1 || last >= static_cast<int64_t>(vertex_count)) r.fail("input vertices: a point outside [0, V)");
       d->input_points[v] = static_cast<int32_t>(last);
+    }
+  }
+  if (version >= 2) {  // version 1 had no two-sided faces
+    const uint64_t two_sided = r.count("two-sided face count", face_count);
+    if (two_sided > 0 && r.ok()) d->two_sided.assign(face_count, 0);
+    int64_t face = -1;
+    for (uint64_t i = 0; i < two_sided && r.ok(); ++i) {
+      face += static_cast<int64_t>(r.count("two-sided faces", face_count)) + 1;
+      if (face >= static_cast<int64_t>(face_count)) r.fail("two-sided faces: a face outside [0, M)");
+      else d->two_sided[static_cast<size_t>(face)] = 1;
     }
   }
   d->maps.resize(frame_count * 12);

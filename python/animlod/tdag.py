@@ -42,7 +42,8 @@ class TdagMesh:
     Attributes
     ----------
     positions : (V', 3) float32, asset units.
-    faces : (M', 3) int32 indices into ``positions``, counter-clockwise.
+    faces : (M', 3) int32 indices into ``positions``, counter-clockwise; the backs of two-sided
+        faces (:attr:`TemporalDag.two_sided`) follow the others, turned over.
     nodes : (V',) int32 hierarchy node of each vertex (``< V``: an input vertex).
     frame : frame of the affine map (and, at levels 2-3, of the residuals).
     cut_frame : frame the cut was computed for.
@@ -333,7 +334,9 @@ class TemporalDag:
             ``boundary_quadrics``, ``use_motion_features`` (``governing="aqem"`` only) and
             ``weld`` (weld vertices equal in every frame into one TDAG vertex, as AQEM does;
             either way degenerate and repeated faces are dropped and non-manifold spots cut
-            apart, so any indexed triangle mesh is taken, see :attr:`input_points`).
+            apart, so any indexed triangle mesh is taken, see :attr:`input_points`; a face
+            repeated in the reverse turn, as double-sided cloth is exported, is simplified as one
+            two-sided face, see :attr:`two_sided`).
         progress : ``progress(frames_done, F)`` called as the build goes.
 
         Raises
@@ -407,8 +410,14 @@ class TemporalDag:
 
     @property
     def faces(self) -> np.ndarray:
-        """(M, 3) int32 faces over the TDAG's vertices."""
+        """(M, 3) int32 faces over the TDAG's vertices (a two-sided face once: :attr:`two_sided`)."""
         return self._core.faces
+
+    @property
+    def two_sided(self) -> np.ndarray:
+        """(M,) bool: faces the input also held turned over (a sheet with a face per side). The TDAG
+        simplifies the front; queries hand out each live two-sided face's back after the other faces."""
+        return self._core.two_sided
 
     @property
     def input_points(self) -> np.ndarray:

@@ -354,7 +354,7 @@ TEST_CASE("tdag: every file the builder writes loads, a collapse ordered before 
   }
   crc ^= 0xFFFFFFFFu;
   std::vector<uint8_t> file = {'A', 'N', 'L', 'D', 'T', 'D', 'A', 'G'};
-  const uint32_t version = animlod::kTdagFormatVersion;
+  const uint32_t version = 1;  // the body was found with the format of version 1
   const uint64_t length = body.size();
   file.insert(file.end(), reinterpret_cast<const uint8_t*>(&version), reinterpret_cast<const uint8_t*>(&version) + 4);
   file.insert(file.end(), reinterpret_cast<const uint8_t*>(&length), reinterpret_cast<const uint8_t*>(&length) + 8);
@@ -368,6 +368,56 @@ TEST_CASE("tdag: every file the builder writes loads, a collapse ordered before 
   CHECK(refused.message.find("corrupted TDAG file: collapse ") == 0);
   CHECK(refused.message.find("child, node ") != std::string::npos);
   CHECK(refused.message.find("is not among the collapses it depends on") != std::string::npos);
+}
+
+// Double-sided cloth as exporters write it: every face again in the reverse turn, on vertices
+// of its own. Kept as faces, both sides were cut apart at every edge and locked: no collapse.
+TEST_CASE("tdag: a two-sided sheet simplifies as its front and cuts hand out both sides") {
+  OwnedAnimatedMesh front = animlod::testing::grid(8);  // 81 vertices, 128 faces
+  for (int f = 1; f < 3; ++f)
+    for (size_t v = 0; v < 81; ++v) {
+      const float x = front.frames[3 * v], y = front.frames[3 * v + 1];
+      front.frames.insert(front.frames.end(), {x, y, 0.1f * float(f) * std::sin(3.0f * x) * std::cos(2.0f * y)});
+    }
+  front.frame_count = 3;
+  OwnedAnimatedMesh sheet = front;
+  sheet.vertex_count = 162;
+  sheet.frames.clear();
+  for (size_t f = 0; f < 3; ++f)
+    for (int side = 0; side < 2; ++side)
+      sheet.frames.insert(sheet.frames.end(), front.frames.begin() + f * 243, front.frames.begin() + (f + 1) * 243);
+  for (size_t f = 0; f < 128; ++f)
+    for (size_t c : {0, 2, 1}) sheet.faces.push_back(front.faces[3 * f + c] + 81);
+  const TemporalDag one = build(front), two = build(sheet);
+  REQUIRE(one.collapse_count() > 0);
+  CHECK(two.collapse_count() == one.collapse_count());
+  REQUIRE(two.face_count() == 128);
+  for (size_t f = 0; f < 128; ++f) {
+    CHECK_FALSE(one.two_sided(f));
+    CHECK(two.two_sided(f));
+  }
+  for (size_t v = 0; v < 81; ++v) CHECK(two.input_points()[v + 81] == two.input_points()[v]);
+  for (double tolerance : {0.0, 0.02, 1e9}) {
+    TdagCut a(one), b(two);
+    REQUIRE(a.query(2, tolerance).ok);
+    REQUIRE(b.query(2, tolerance).ok);
+    TdagMesh front_mesh, both;
+    a.mesh(front_mesh);
+    b.mesh(both);
+    const size_t m = front_mesh.faces.size();
+    REQUIRE(both.faces.size() == 2 * m);
+    CHECK(both.positions == front_mesh.positions);
+    CHECK(std::equal(front_mesh.faces.begin(), front_mesh.faces.end(), both.faces.begin()));
+    for (size_t f = 0; f < m; f += 3)
+      for (size_t c = 0; c < 3; ++c) CHECK(both.faces[m + f + c] == front_mesh.faces[f + (3 - c) % 3]);  // 0, 2, 1
+  }
+  std::vector<uint8_t> bytes, again;
+  REQUIRE(animlod::serialize_temporal_dag(two, bytes).ok);
+  TemporalDag loaded;
+  REQUIRE(animlod::deserialize_temporal_dag(bytes.data(), bytes.size(), loaded).ok);
+  for (size_t f = 0; f < 128; ++f) CHECK(loaded.two_sided(f));
+  REQUIRE(animlod::serialize_temporal_dag(loaded, again).ok);
+  CHECK(again == bytes);
 }
 
 TEST_CASE("tdag: bad input is a named error") {

@@ -172,6 +172,31 @@ def test_save_load_round_trip_and_damaged_files(dag: TemporalDag, tmp_path):
         TemporalDag.load(tmp_path / "text.tdag")
 
 
+def test_a_two_sided_sheet_simplifies_like_its_front_and_queries_give_both_sides(tmp_path):
+    # Double-sided cloth exported as every face again in the reverse turn on vertices of its own:
+    # both sides were cut apart at every edge and locked, and the TDAG had no collapse at all.
+    x, y = np.meshgrid(np.linspace(0, 1, 12), np.linspace(0, 1, 12))
+    corner = np.arange(144).reshape(12, 12)[:-1, :-1].ravel()
+    front = np.concatenate(
+        [np.stack([corner, corner + 1, corner + 12], 1), np.stack([corner + 1, corner + 13, corner + 12], 1)]
+    )
+    frames = np.stack([np.stack([x, y, 0.1 * t * np.sin(3 * x) * np.cos(2 * y)], -1).reshape(-1, 3) for t in range(4)])
+    one = TemporalDag.build(AnimatedMesh(front, frames))
+    both = TemporalDag.build(
+        AnimatedMesh(np.concatenate([front, front[:, ::-1] + 144]), np.concatenate([frames, frames], 1))
+    )
+    assert one.collapse_count > 0 and both.collapse_count == one.collapse_count
+    assert both.two_sided.all() and not one.two_sided.any() and both.face_count == one.face_count
+    np.testing.assert_array_equal(both.input_points[144:], both.input_points[:144])
+    both.save(tmp_path / "sheet.tdag")
+    for dag in (both, TemporalDag.load(tmp_path / "sheet.tdag")):
+        single, double = one.query(3, 0.2), dag.query(3, 0.2)
+        m = len(single.faces)
+        assert m < len(front) and len(double.faces) == 2 * m
+        np.testing.assert_array_equal(double.faces[:m], single.faces)
+        np.testing.assert_array_equal(double.faces[m:], single.faces[:, [0, 2, 1]])
+
+
 def test_bad_input_is_a_named_value_error(dag: TemporalDag, bending: AnimatedMesh):
     frames = bending.frames.copy()
     frames[2, 7, 1] = np.nan

@@ -100,8 +100,12 @@ class TemporalDag {
   size_t face_count() const;      // M
   size_t collapse_count() const;  // C
   size_t node_count() const;      // V + C
-  // (M, 3) faces over the TDAG's vertices (the input's, less degenerate and repeated ones).
+  // (M, 3) faces over the TDAG's vertices (the input's, less degenerate and repeated ones, and
+  // less the second side of two-sided faces).
   const int32_t* faces() const;
+  // Whether face `face` is two-sided: the input also held it turned over (a sheet modelled with
+  // a face per side). Cuts hand out its turned-over copy beside it.
+  bool two_sided(size_t face) const;
   // Number of input vertices, and (input_vertex_count,) the TDAG vertex standing for each
   // (-1 for a vertex no face used).
   size_t input_vertex_count() const;
@@ -153,8 +157,10 @@ class TemporalDag {
 Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& options, TemporalDag& out,
                           TdagBuildReport* report = nullptr);
 
-// The current version of the .tdag format written by serialize_temporal_dag.
-constexpr uint32_t kTdagFormatVersion = 1;
+// The current version of the .tdag format written by serialize_temporal_dag (2: two-sided
+// faces), and the oldest deserialize_temporal_dag reads.
+constexpr uint32_t kTdagFormatVersion = 2;
+constexpr uint32_t kTdagOldestReadableVersion = 1;
 
 // The TDAG and its affine maps as bytes of the versioned .tdag format (little-endian, checksummed).
 Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out);
@@ -193,7 +199,8 @@ struct TdagMesh {
   int32_t cut_frame = 0;         // frame the cut was computed for
   int32_t residual_frame = 0;    // frame of the residual positions
   std::vector<float> positions;  // (V', 3) asset units
-  std::vector<int32_t> faces;    // (M', 3) indices into positions, counter-clockwise
+  std::vector<int32_t> faces;    // (M', 3) indices into positions, counter-clockwise; the
+                                 // turned-over copies of two-sided faces follow the others
   std::vector<int32_t> nodes;    // (V',) hierarchy node of each vertex (< V: an input vertex)
   double error_bound = 0.0;      // largest bound of the active nodes at cut_frame (asset units)
 };

@@ -10,10 +10,11 @@ import pygltflib
 from gltf_edits import append_accessor, edit_glb
 from simplify_inputs import tube, two_bone_tube
 
-from animlod import rotations
+from animlod import rotations, synth
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf import read_gltf, write_glb
 from animlod.io.gltf_document import GltfDocument
+from animlod.pipelines.character import build_character
 from animlod.pipelines.lod_document import simplify_document
 from animlod.pipelines.motion import build_motion_levels
 
@@ -172,3 +173,30 @@ def test_motion_levels_show_every_part_of_a_character_on_one_skin(tmp_path: Path
     (skinned,), (motion,) = written.skinned_meshes, written.motions
     np.testing.assert_allclose(skinned.bake(motion).frames, expected, atol=1e-4)
     assert any("one mesh" in note for note in report.notes)
+
+
+def test_character_level_nodes_are_named_by_their_place_in_the_grid(tmp_path: Path) -> None:
+    """Chain levels are ``<base>_LOD<i>`` and grid-only nodes ``<base>_G<g>M<m>``, each name once: every
+    level node was named ``<base>_LOD-1`` (the grid's placeholder level), which importers then told
+    apart as .001, .002, ..."""
+    character = synth.humanoid()
+    write_glb(tmp_path / "humanoid.glb", character, [synth.humanoid_motion(character.skeleton, "walk")])
+    build_character(
+        tmp_path / "humanoid.glb",
+        tmp_path / "lod.glb",
+        [0.5, 0.25],
+        solver="newton",
+        frame_budget=12,
+        measured_frames=2,
+    )
+    nodes = GltfDocument(tmp_path / "lod.glb").json["nodes"]
+    base = next(node for node in nodes if "MSFT_lod" in node.get("extensions", {}))
+    chain = [nodes[index]["name"] for index in base["extensions"]["MSFT_lod"]["ids"]]
+    assert chain == [f"{base['name']}_LOD1", f"{base['name']}_LOD2"]
+    grid = [nodes[index] for row in base["extras"]["animlod_grid"] for index in row]
+    for node in grid[1:]:
+        info = node["extras"]["animlod"]
+        if info["level"] < 0:
+            assert node["name"] == f"{base['name']}_G{info['mesh_level']}M{info['motion_level']}"
+    names = [node["name"] for node in grid]
+    assert len(set(names)) == len(names)

@@ -143,7 +143,7 @@ def add_level_node(builder: GlbBuilder, base: int, mesh: int, skin: int | None, 
     instances = base_node.get("extensions", {}).get(INSTANCING_EXTENSION)
     if instances is not None:  # every instance draws the level too
         node["extensions"] = {INSTANCING_EXTENSION: copy.deepcopy(instances)}
-    node["name"] = f"{base_node.get('name', f'node{base}')}_LOD{info.level}"
+    node["name"] = level_node_name(base_node.get("name", f"node{base}"), info)
     node["mesh"] = mesh
     # A node's morph weights override its mesh's (glTF 2.0, 3.7.2.2): a level that kept every target
     # shows the base node's shape only with them. A level with other targets keeps its mesh's.
@@ -154,6 +154,13 @@ def add_level_node(builder: GlbBuilder, base: int, mesh: int, skin: int | None, 
         node["skin"] = skin
     node["extras"] = {ANIMLOD_EXTRA: info.extras()}
     return builder.append("nodes", node)
+
+
+def level_node_name(base_name: str, info: LevelInfo) -> str:
+    """``<base>_LOD<i>`` for level i of a chain, ``<base>_G<g>M<m>`` for a grid-only node (level -1)."""
+    if info.level >= 0:
+        return f"{base_name}_LOD{info.level}"
+    return f"{base_name}_G{info.mesh_level}M{info.motion_level}"
 
 
 def attach_chain(

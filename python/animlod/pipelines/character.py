@@ -39,6 +39,7 @@ from ..io.gltf_lod import (
     add_level_mesh,
     add_level_node,
     attach_chain,
+    level_node_name,
     screen_coverages,
 )
 from ..io.gltf_skin import SkinRig
@@ -361,9 +362,11 @@ def _attach(builder: GlbBuilder, drawable: Drawable, report: list[CharacterLevel
     """The chain (diagonal of the grid) on every base node, with the grid beside it."""
     for index, base in enumerate(drawable.nodes):
         chain_nodes = [grid[level.mesh_level][level.motion_level][index] for level in report[1:]]
+        base_name = builder.json["nodes"][base].get("name", f"node{base}")
         for level, node in zip(report[1:], chain_nodes):
             info = builder.json["nodes"][node]["extras"]["animlod"]
             info.update(level=level.level, error=level.error)
+            builder.json["nodes"][node]["name"] = level_node_name(base_name, LevelInfo(**info))
         attach_chain(
             builder,
             base,

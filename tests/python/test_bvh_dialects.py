@@ -85,3 +85,14 @@ def test_a_utf16_file_with_a_byte_order_mark_reads_like_utf8(tmp_path: Path) -> 
         motion = read_bvh(path)
         assert motion.skeleton.names == NAMES
         np.testing.assert_array_equal(motion.local_rotations, expected.local_rotations)
+
+
+def test_a_frame_time_in_scientific_notation_gives_the_rate_it_was_rounded_from(tmp_path: Path) -> None:
+    # numpy.savetxt's "%e" and C's "%e" write 1/120 s as 8.333333e-03: nine digits after the
+    # point, as many as 0.008333333, which reads as 120 fps; the rate was 120.0000048.
+    for written in ("8.333333e-03", "8.333333E-03", "0.008333333"):
+        path = tmp_path / "clip.bvh"
+        path.write_text(JAPANESE_BVH.replace("0.033333", written), encoding="utf-8")
+        assert read_bvh(path).fps == 120.0, written
+    path.write_text(JAPANESE_BVH.replace("0.033333", "1.23456e-02"), encoding="utf-8")
+    assert read_bvh(path).fps == 1 / 0.0123456  # no integer rate rounds to it

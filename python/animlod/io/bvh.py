@@ -34,6 +34,7 @@ from __future__ import annotations
 import os
 import re
 from dataclasses import dataclass, field
+from decimal import Decimal
 from pathlib import Path
 
 import numpy as np
@@ -297,10 +298,11 @@ def _parse_motion_header(path: Path, text: str, motion_line: int) -> tuple[int, 
 def _frame_rate(frame_time: str) -> float:
     """Frames per second for a written frame time, snapped to the integer rate it was rounded from."""
     seconds = float(frame_time)
-    decimals = len(frame_time.split(".")[1]) if "." in frame_time and "e" not in frame_time.lower() else None
+    # Digits after the point as written, in scientific notation too: 8.333333e-03 has 9.
+    decimals = -int(Decimal(frame_time).as_tuple().exponent)
     rate = 1.0 / seconds
     whole = round(rate)
-    if decimals is not None and whole >= 1 and abs(seconds - 1.0 / whole) <= 0.5 * 10.0**-decimals:
+    if whole >= 1 and abs(seconds - 1.0 / whole) <= 0.5 * 10.0**-decimals:
         return float(whole)
     return rate
 

@@ -96,3 +96,21 @@ def test_a_frame_time_in_scientific_notation_gives_the_rate_it_was_rounded_from(
         assert read_bvh(path).fps == 120.0, written
     path.write_text(JAPANESE_BVH.replace("0.033333", "1.23456e-02"), encoding="utf-8")
     assert read_bvh(path).fps == 1 / 0.0123456  # no integer rate rounds to it
+
+
+def test_a_prop_of_one_joint_writes_its_motion_as_the_one_level(tmp_path: Path, capsys) -> None:
+    # A camera or prop clip: one ROOT with an End Site. Nothing can freeze; the note counts "1 joint".
+    from animlod.cli import main
+
+    path = tmp_path / "camera.bvh"
+    path.write_text(
+        "HIERARCHY\nROOT Camera\n{\n\tOFFSET 0 0 0\n\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+        "Yrotation\n\tEnd Site\n\t{\n\t\tOFFSET 0 0 -10\n\t}\n}\nMOTION\nFrames: 3\nFrame Time: 0.04\n"
+        "0 100 0 0 0 0\n5 100 0 0 10 0\n10 100 0 0 20 0\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "out"
+    assert main(["motion", str(path), "-o", str(out), "--levels", "8"]) == 0
+    assert "nothing can freeze (1 joint, all kept: root)" in capsys.readouterr().err
+    written = read_bvh(out / "camera_lod0.bvh")
+    np.testing.assert_allclose(written.world_positions(), read_bvh(path).world_positions(), atol=1e-6)

@@ -118,7 +118,8 @@ def build_motion_levels(
     )
     if floor.possible_levels == 1:
         note(
-            f"{os.fspath(source)}: nothing can freeze ({floor.total} joints, all kept: {floor.explain()}); "
+            f"{os.fspath(source)}: nothing can freeze ({floor.total} joint{'s' if floor.total != 1 else ''}, "
+            f"all kept: {floor.explain()}); "
             "writing one level, the input's motion"
         )
     chain = build_motion_chain(

@@ -62,6 +62,22 @@ int nearest_level(const Chain& chain, int g, int m) {
   return best;
 }
 
+// One motion level per skeleton: chains whose level 0 is skinned to the same rig (the meshes of
+// one character: a body and its eyes, BrainStem's parts) draw the finest motion level any of them
+// chose, each at its own mesh level, so that a character poses one skeleton and not one per
+// mesh (MLoD animated more joints than Original on such characters).
+void share_motion_levels(const Asset& asset, std::vector<int>& levels) {
+  for (size_t c = 0; c < asset.chains.size(); ++c) {
+    const Chain& chain = asset.chains[c];
+    int finest = chain.levels[static_cast<size_t>(levels[c])].motion_level;
+    for (size_t d = 0; d < asset.chains.size(); ++d)
+      if (asset.chains[d].levels.front().rig == chain.levels.front().rig)
+        finest = std::min(finest, asset.chains[d].levels[static_cast<size_t>(levels[d])].motion_level);
+    const Level& chosen = chain.levels[static_cast<size_t>(levels[c])];
+    if (finest < chosen.motion_level) levels[c] = nearest_level(chain, chosen.mesh_level, finest);
+  }
+}
+
 }  // namespace
 
 void CrowdAnimator::start(const Mode& mode, const int* forced) {
@@ -169,7 +185,10 @@ void CrowdAnimator::animate(const Camera& camera, const animlod::LodCamera& lod_
       const int level = subset.forced >= 0 ? subset.forced : subset.drawn[static_cast<size_t>(selected)];
       character.levels[c] = level;
       character.tints[c] = subset.forced >= 0 ? level : selected;
-      const Level& chosen = chain.levels[static_cast<size_t>(level)];
+    }
+    share_motion_levels(asset, character.levels);
+    for (size_t c = 0; c < asset.chains.size(); ++c) {
+      const Level& chosen = asset.chains[c].levels[static_cast<size_t>(character.levels[c])];
       counts.triangles += static_cast<int64_t>(asset.meshes[static_cast<size_t>(chosen.mesh)].triangle_count());
       ++counts.levels[static_cast<size_t>(std::min(character.tints[c], 15))];
     }

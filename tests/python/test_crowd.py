@@ -7,6 +7,7 @@ away), the Fig. 1 grid and its heat map, and bad input refused with one line.
 
 from __future__ import annotations
 
+import copy
 import os
 import shutil
 import subprocess
@@ -118,6 +119,27 @@ def test_modes_a_one_level_chain_leaves_alike_are_named_as_the_same_work(binary,
     alike = {name: mode["same_work_as_original"] for name, mode in report.modes.items()}
     assert alike == {"Original": False, "GLoD": True, "MLoD": True}
     assert "GLoD, MLoD: the same work per frame as Original" in report.markdown
+
+
+def test_the_meshes_of_one_character_pose_one_skeleton(binary, chain, tmp_path) -> None:
+    # A character in parts (a body and its eyes, BrainStem's meshes) has a chain per mesh on one
+    # skin. Each chain chose its own level, so a near part at motion level 0 and a far-off part's
+    # coarser level posed two skeletons: MLoD animated more joints than Original.
+    gltf = pygltflib.GLTF2().load(chain)
+    base = next(i for i, node in enumerate(gltf.nodes) if "MSFT_lod" in (node.extensions or {}))
+    (level,) = gltf.nodes[base].extensions["MSFT_lod"]["ids"]
+    coarse = copy.deepcopy(gltf.nodes[level])
+    coarse.extras["animlod"]["error"] = 1e-9  # this part always takes its coarser level
+    gltf.nodes.append(coarse)
+    part = copy.deepcopy(gltf.nodes[base])
+    part.name, part.extensions = "eyes", {"MSFT_lod": {"ids": [len(gltf.nodes) - 1]}}
+    gltf.nodes.append(part)
+    gltf.scenes[gltf.scene or 0].nodes.append(len(gltf.nodes) - 1)
+    gltf.save(tmp_path / "parts.glb")
+    report = run_crowd([tmp_path / "parts.glb"], frames=3, modes="Original,MLoD", pixel_error=1.0, **SMALL)
+    original, reduced = report.modes["Original"], report.modes["MLoD"]
+    assert reduced["drawn"] == original["drawn"] > 0
+    assert reduced["joints"] <= original["joints"] and reduced["palette_joints"] <= original["palette_joints"]
 
 
 def test_a_chain_named_vrm_loads_as_the_glb_it_is(binary, chain, tmp_path) -> None:

@@ -8,8 +8,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
-from animlod.io import read_bvh, write_bvh
+from animlod.io import FormatError, read_bvh, write_bvh
 
 # Two joints whose names differ only outside ASCII (as MikuMikuDance-derived files name them).
 JAPANESE_BVH = (
@@ -114,3 +115,25 @@ def test_a_prop_of_one_joint_writes_its_motion_as_the_one_level(tmp_path: Path, 
     assert "nothing can freeze (1 joint, all kept: root)" in capsys.readouterr().err
     written = read_bvh(out / "camera_lod0.bvh")
     np.testing.assert_allclose(written.world_positions(), read_bvh(path).world_positions(), atol=1e-6)
+
+
+def test_an_end_site_gives_way_to_a_joint_written_later_with_its_generated_name(tmp_path: Path) -> None:
+    # A joint "A" with an End Site and then a JOINT named "A_End" (as a rig with tip joints named
+    # <parent>_End writes them): the End Site, named A_End by the reader, was taken for a first
+    # use of that name and the file was refused as naming a joint twice.
+    text = (
+        "HIERARCHY\nROOT Hips\n{\n\tOFFSET 0 0 0\n\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+        "Yrotation\n\tJOINT A\n\t{\n\t\tOFFSET 0 1 0\n\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n"
+        "\t\tEnd Site\n\t\t{\n\t\t\tOFFSET 0 1 0\n\t\t}\n"
+        "\t\tJOINT A_End\n\t\t{\n\t\t\tOFFSET 1 0 0\n\t\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n\t\t}\n\t}\n}\n"
+        "MOTION\nFrames: 1\nFrame Time: 0.04\n0 0 0 0 0 0 0 0 0 0 0 0\n"
+    )
+    path = tmp_path / "tips.bvh"
+    path.write_text(text, encoding="utf-8")
+    skeleton = read_bvh(path).skeleton
+    assert skeleton.names == ["Hips", "A", "A_End1", "A_End"]
+    assert skeleton.end_sites.tolist() == [False, False, True, False]
+    # Two joints of one name are still refused.
+    path.write_text(text.replace("JOINT A_End", "JOINT A"), encoding="utf-8")
+    with pytest.raises(FormatError, match="line 14: joint name 'A' is used twice"):
+        read_bvh(path)

@@ -7,7 +7,8 @@ Conventions of this reader, in terms of :class:`animlod.model.Motion`:
 
 - Joints are kept in file order (depth first), so parents come before children. An
   ``End Site`` becomes a joint with ``skeleton.end_sites[j] = True``, named after the name
-  written beside it or else ``f"{parent}_End"``.
+  written beside it or else ``f"{parent}_End"``, with a number appended where a joint of the
+  file has that name (``A_End1`` beside a JOINT ``A_End``, wherever that joint is written).
 - ``skeleton.offsets`` are the OFFSET values; the root's offset is its rest position.
 - Position channels *replace* the offset of their joint. The root's become
   ``root_positions`` (the root's OFFSET when it has none). Position channels on other joints
@@ -233,8 +234,11 @@ def _open_joint(
         name = _unique_name(name or f"{joints[parent].name}_End", joints)
     elif not name:
         raise cursor.error(line, "joint without a name")
-    elif any(joint.name == name for joint in joints):
-        raise cursor.error(line, f"joint name {name!r} is used twice")
+    elif (taken := next((joint for joint in joints if joint.name == name), None)) is not None:
+        if not taken.end_site:
+            raise cursor.error(line, f"joint name {name!r} is used twice")
+        # An end site's name is the reader's (BVH writes none back); the joint keeps its own.
+        taken.name = _unique_name(name, joints)
     cursor.expect("{")
     joints.append(_JointSpec(name, parent, end_site))
     return len(joints) - 1, line

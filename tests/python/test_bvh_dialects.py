@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from animlod import rotations
 from animlod.io import FormatError, read_bvh, write_bvh
 
 # Two joints whose names differ only outside ASCII (as MikuMikuDance-derived files name them).
@@ -137,3 +138,99 @@ def test_an_end_site_gives_way_to_a_joint_written_later_with_its_generated_name(
     path.write_text(text.replace("JOINT A_End", "JOINT A"), encoding="utf-8")
     with pytest.raises(FormatError, match="line 14: joint name 'A' is used twice"):
         read_bvh(path)
+
+
+# A small figure: root, a spine chain ending in an End Site, and a two-joint leg; 4 frames.
+_PARENTS = [-1, 0, 1, 2, 0, 4]
+_OFFSETS = [[0.0, 90.0, 0.0], [0.0, 10.0, 1.0], [0.0, 30.0, 0.0], [0.0, 12.0, 0.0], [9.0, -5.0, 0.0], [0.0, -40.0, 2.0]]
+_END_SITES = [False, False, False, True, False, False]
+_LEGACY_NAMES = ["Hips", "Spine", "Head", "Head_End", "LeftUpLeg", "LeftLeg"]
+
+
+def _dialect_text(dialect: str) -> tuple[str, list[str]]:
+    """The figure's clip written as ``dialect`` writes it, and the joint names a reader should find."""
+    rng = np.random.default_rng(7)
+    frames = 4
+    angles = np.radians(rng.uniform(-80.0, 80.0, (frames, len(_PARENTS), 3)))
+    local = rotations.from_euler(angles, "ZXY")
+    root = np.array(_OFFSETS[0]) + rng.uniform(-5.0, 5.0, (frames, 3))
+    names = {
+        "biped": ["Bip01", "Bip01 Spine", "Bip01 Head", "Bip01 HeadNub", "Bip01 L Thigh", "Bip01 L Calf"],
+        "mixamo": [f"mixamorig:{name}" for name in _LEGACY_NAMES],
+    }.get(dialect, _LEGACY_NAMES)
+    order = {"lafan1": "XYZ", "neuron": "YXZ", "rotation_first": "ZYX"}.get(dialect, "ZXY")
+    fmt = "{:.6e}" if dialect == "scientific" else "{:.9f}"
+    indent = "  " if dialect == "mixamo" else "\t"
+    lines, columns = ["HIERARCHY"], []
+
+    def block(joint: int, depth: int) -> None:
+        pad, brace = indent * depth, " {" if dialect == "brace_same_line" else ""
+        offset = " ".join(fmt.format(v) for v in _OFFSETS[joint])
+        if _END_SITES[joint]:
+            label = "End Site" + (f" {names[joint]}" if dialect == "biped" else "")
+            lines.extend([pad + label + brace] + ([] if brace else [pad + "{"]) + [f"{pad}{indent}OFFSET {offset}"])
+            lines.append(pad + "}")
+            return
+        keyword = "ROOT" if joint == 0 else "JOINT"
+        lines.extend([f"{pad}{keyword} {names[joint]}{brace}"] + ([] if brace else [pad + "{"]))
+        lines.append(f"{pad}{indent}OFFSET {offset}")
+        position = [f"{axis}position" for axis in "XYZ"] if joint == 0 or dialect == "lafan1" else []
+        rotation = [f"{axis}rotation" for axis in order]
+        channels = rotation + position if dialect == "rotation_first" else position + rotation
+        lines.append(f"{pad}{indent}CHANNELS {len(channels)} {' '.join(channels)}")
+        euler = np.degrees(rotations.to_euler(local[:, joint], order))
+        translation = root if joint == 0 else np.broadcast_to(_OFFSETS[joint], (frames, 3))
+        for channel in channels:
+            axis = "XYZ".index(channel[0])
+            columns.append(translation[:, axis] if channel.endswith("position") else euler[:, order.index(channel[0])])
+        for child in (c for c, p in enumerate(_PARENTS) if p == joint):
+            block(child, depth + 1)
+        lines.append(pad + "}")
+
+    block(0, 0)
+    frame_time = "3.333333e-02" if dialect == "scientific" else "0.033333"
+    lines += ["MOTION", f"Frames: {frames}", f"Frame Time: {frame_time}"]
+    separator = "\t" if dialect == "tabs_and_trailing" else " "
+    lines += [separator.join(fmt.format(v) for v in row) for row in np.stack(columns, axis=1)]
+    if dialect == "tabs_and_trailing":
+        lines = [line + " \t" for line in lines] + ["", "", ""]
+    newline = "\r\n" if dialect == "biped" else "\n"
+    expected = [name if not end else f"{names[p]}_End" for name, end, p in zip(names, _END_SITES, _PARENTS)]
+    return newline.join(lines) + newline, expected
+
+
+DIALECTS = [
+    "biped",
+    "mixamo",
+    "lafan1",
+    "neuron",
+    "rotation_first",
+    "scientific",
+    "tabs_and_trailing",
+    "brace_same_line",
+]
+
+
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_exporter_dialects_read_as_the_same_motion(tmp_path: Path, dialect: str) -> None:
+    # 3ds Max Biped: names with spaces, named End Sites, CRLF. Mixamo: "mixamorig:" names, two-space
+    # indents. LAFAN1: six channels on every joint, XYZ. Perception Neuron: YXZ. Some exporters:
+    # rotation channels before position ones, %e numbers, tab-separated rows, trailing blanks,
+    # "JOINT Name {" on one line.
+    reference_text, _ = _dialect_text("legacy")
+    (tmp_path / "reference.bvh").write_text(reference_text, encoding="utf-8", newline="")
+    reference = read_bvh(tmp_path / "reference.bvh")
+    text, names = _dialect_text(dialect)
+    (tmp_path / "clip.bvh").write_text(text, encoding="utf-8", newline="")
+    motion = read_bvh(tmp_path / "clip.bvh")
+    expected_names = names if dialect != "biped" else names[:3] + ["Bip01 HeadNub"] + names[4:]
+    assert motion.skeleton.names == expected_names
+    assert motion.fps == 30.0
+    np.testing.assert_allclose(motion.world_positions(), reference.world_positions(), atol=1e-4)
+    # The levels' writer and reader keep the names as read.
+    write_bvh(tmp_path / "out.bvh", motion)
+    written = read_bvh(tmp_path / "out.bvh")
+    assert [n for n, e in zip(written.skeleton.names, _END_SITES) if not e] == [
+        n for n, e in zip(expected_names, _END_SITES) if not e
+    ]
+    np.testing.assert_allclose(written.world_positions(), motion.world_positions(), atol=1e-4)

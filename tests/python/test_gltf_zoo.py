@@ -200,3 +200,21 @@ def test_character_level_nodes_are_named_by_their_place_in_the_grid(tmp_path: Pa
             assert node["name"] == f"{base['name']}_G{info['mesh_level']}M{info['motion_level']}"
     names = [node["name"] for node in grid]
     assert len(set(names)) == len(names)
+
+
+def test_motion_levels_of_a_skin_without_inverse_bind_matrices_keep_the_frozen_bones(tmp_path: Path) -> None:
+    """Without inverseBindMatrices every bind is the identity (glTF 2.0, 3.7.3.1), so a frozen joint
+    re-posed from the bind pose had no bone: its vertices moved by the bone's length. In the frame
+    closest to the key posture a level shows its input as it is, matrices or none."""
+
+    def no_inverse_binds(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        gltf.skins[0].inverseBindMatrices = None
+
+    with_matrices = _two_bone_glb(tmp_path / "body.glb")
+    for source in (with_matrices, edit_glb(with_matrices, tmp_path / "no_ibm.glb", no_inverse_binds)):
+        build_motion_levels(source, tmp_path / source.stem, levels=2)
+        scene, level = read_gltf(source), read_gltf(tmp_path / source.stem / f"{source.stem}_lod1.glb")
+        assert level.skinned_meshes[0].skeleton.joint_count < scene.skinned_meshes[0].skeleton.joint_count
+        expected = scene.skinned_meshes[0].bake(scene.motions[0]).frames
+        distance = np.abs(level.skinned_meshes[0].bake(level.motions[0]).frames - expected).max(axis=(1, 2))
+        assert distance.min() < 1e-4, source.name

@@ -24,13 +24,17 @@ from .skeleton_reduce import reduce_skeleton
 
 
 def key_bind_pose(skin: SkinnedMesh, level: FrozenLevel) -> np.ndarray:
-    """World transforms ``(J, 4, 4)`` of the bind pose with frozen joints at their key rotations."""
+    """World transforms ``(J, 4, 4)`` of the bind pose with frozen joints at their key posture
+    (rotation and translation), as the level's motion holds them. A frozen joint's translation is
+    not read from the bind pose: without inverseBindMatrices every bind is the identity, and the
+    joint lost its bone."""
     bind = np.linalg.inv(skin.inverse_bind)
     parents = skin.skeleton.parents
     local = bind.copy()
     local[1:] = np.linalg.inv(bind[parents[1:]]) @ bind[1:]
     frozen = np.flatnonzero(level.frozen)
     local[frozen, :3, :3] = rotations.to_matrix(level.key_rotations[frozen])
+    local[frozen, :3, 3] = level.key_translations[frozen]
     world = np.empty_like(local)
     world[0] = local[0]
     for joint in range(1, parents.size):  # O(J) forward kinematics of one pose

@@ -206,6 +206,7 @@ def test_cli_a_clip_whose_every_joint_translates_writes_one_level(tmp_path, caps
     captured = capsys.readouterr()
     assert "nothing can freeze (8 joints, all kept: root, 7 translating" in captured.err
     assert sorted(p.name for p in out.iterdir()) == ["clip_lod0.bvh", "clip_motion_lod.json"]
+    assert f"wrote 2 files to {out} in " in captured.out.splitlines()[-1]  # where, and how long in all
 
 
 def test_cli_a_skeleton_of_zero_length_bones_writes_one_level(tmp_path, capsys) -> None:

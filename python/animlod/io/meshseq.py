@@ -194,6 +194,7 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     next line, as the OBJ specification allows; errors name the line the statement starts on. A
     ``#`` comment ends at its line's end, even after a backslash (a Windows path such as
     ``# saved to C:\\models\\`` does not swallow the next statement).
+    A UTF-8 byte order mark at the file's start is skipped.
 
     Raises
     ------
@@ -206,6 +207,8 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     nul = data.find(b"\0")
     if nul >= 0:
         raise FormatError(path, f"byte {nul}", "NUL byte: an OBJ file is text, this looks like binary data")
+    if data.startswith(b"\xef\xbb\xbf"):  # a UTF-8 byte order mark (.NET, Notepad) before the first statement
+        data = data[3:]
     data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
     if b"#" in data:  # a comment may also end a statement ("f 1 2 3 # cap"); line numbers stay
         data = re.sub(rb"#[^\n]*", b"", data)

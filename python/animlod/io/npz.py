@@ -1,7 +1,7 @@
 """Compressed NumPy archive (.npz) for an AnimatedMesh: the fastest way to store a baked sequence.
 
 Keys: ``format_version`` (int, currently 1), ``faces (M, 3) int32``, ``frames (F, V, 3)
-float32`` and ``fps`` (a float, NaN when the mesh has no frame rate).
+float32`` and ``fps`` (a float, NaN when the mesh has no frame rate; an integer is read too).
 """
 
 from __future__ import annotations
@@ -71,7 +71,8 @@ def read_npz(path: str | os.PathLike) -> AnimatedMesh:
         ("format_version", version.shape == () and _holds(version, np.integer), "an integer"),
         ("frames", frames.ndim == 3 and frames.shape[2] == 3 and _holds(frames, np.floating), "float (F, V, 3)"),
         ("faces", faces.ndim == 2 and faces.shape[1] == 3 and _holds(faces, np.integer), "integer (M, 3)"),
-        ("fps", fps.shape == () and _holds(fps, np.floating), "a float (NaN for none)"),
+        # np.savez(..., fps=30) stores an integer: as clear a rate as 30.0.
+        ("fps", fps.shape == () and (_holds(fps, np.floating) or _holds(fps, np.integer)), "a float (NaN for none)"),
     ]
     for key, valid, expected in checks:
         if not valid:
@@ -79,6 +80,7 @@ def read_npz(path: str | os.PathLike) -> AnimatedMesh:
     if not 1 <= int(version) <= FORMAT_VERSION:
         reason = f"unsupported version {int(version)}; this reader knows 1 to {FORMAT_VERSION}"
         raise FormatError(path, "key 'format_version'", reason)
+    fps = np.float64(fps)
     if not (np.isnan(fps) or (np.isfinite(fps) and fps > 0)):
         raise FormatError(path, "key 'fps'", f"must be positive or NaN, got {float(fps)}")
     try:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import UserError, print_rows
+from . import UserError, positive_int, print_rows
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -70,7 +70,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     play.add_argument("--tolerance", type=float, required=True, help="asset units (see --relative)")
     play.add_argument("--relative", action="store_true", help="tolerance as a fraction of the bounding-box diagonal")
     play.add_argument("--first-frame", type=int, default=0)
-    play.add_argument("--frames", type=int, default=None, help="frames to walk after the first (default: all)")
+    play.add_argument("--frames", type=positive_int, default=None, help="frames to walk after the first (default: all)")
     play.set_defaults(run=run_play)
 
 
@@ -219,6 +219,15 @@ def run_query(args: argparse.Namespace) -> int:
 def run_play(args: argparse.Namespace) -> int:
     dag = _load(args.tdag)
     tolerance = _tolerance(dag, args.tolerance, args.relative)
+    # The walk starts at --first-frame and measures the frames after it: none after it would print
+    # a table of zeros measured over nothing.
+    if not 0 <= args.first_frame < dag.frame_count:
+        raise UserError(f"{args.tdag}: --first-frame {args.first_frame} outside the frames 0 to {dag.frame_count - 1}")
+    if args.first_frame == dag.frame_count - 1:
+        raise UserError(
+            f"{args.tdag}: --first-frame {args.first_frame} leaves no frame to play after it "
+            f"(the TDAG holds {dag.frame_count} frame{'s' if dag.frame_count > 1 else ''}); use tdag query"
+        )
     report = dag.play(tolerance, args.first_frame, args.frames)
     print(f"{report.frames} frames from frame {args.first_frame}, tolerance {tolerance:.4g} (asset units)")
     header = ("level", "ms per frame (mean / max)", "error mean / max", "vertices", "faces")

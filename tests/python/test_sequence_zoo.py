@@ -7,7 +7,7 @@ import pytest
 
 from animlod import synth
 from animlod.cli import main
-from animlod.io.meshseq import read_obj, read_sequence
+from animlod.io.meshseq import read_obj, read_sequence, write_sequence
 from animlod.io.npz import read_npz, write_npz
 
 SQUARE = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\nf 1 3 2\nf 1 4 3\n"
@@ -65,3 +65,16 @@ def test_tdag_play_with_no_frame_to_walk_exits_2(single_frame_tdag, capsys, argu
     code = main(["tdag", "play", *[a.format(dir=single_frame_tdag) for a in arguments], "--tolerance", "0.01"])
     err = capsys.readouterr().err
     assert code == 2 and message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_simplify_says_which_sequence_levels_stopped_short_of_their_target(tmp_path, capsys):
+    # --max-error stops the collapses: levels 2 and 3 came out equal, and the table showed no target.
+    frames = tmp_path / "frames"
+    write_sequence(frames, synth.twisting_bar(frames=4, rings=12, segments=8))
+    args = ["simplify", str(frames), "-o", str(tmp_path / "out"), "--no-metrics", "--max-error", "1e-9"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "target" in out.splitlines()[1]
+    assert "note: level 1: stopped at" in out and "--max-error reached" in out
+    assert main(["simplify", str(frames), "-o", str(tmp_path / "out2"), "--no-metrics"]) == 0
+    assert "note:" not in capsys.readouterr().out

@@ -157,14 +157,22 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
         "AQEM error: the largest collapse error, asset units; Hausdorff and RMS: relative to the bounding-box"
         " diagonal, over frames; time is the whole simplification"
     )
-    rows = [("level", "faces", "AQEM error", "Hausdorff mean / max", "RMS mean / max", "time s")]
-    rows.append((0, report.original.face_count, "0", "-", "-", "-"))
+    rows = [("level", "faces", "target", "AQEM error", "Hausdorff mean / max", "RMS mean / max", "time s")]
+    faces = report.original.face_count
+    rows.append((0, faces, faces, "0", "-", "-", "-"))
     for index, level in enumerate(report.levels, start=1):
         surface = level.surface
         hausdorff = f"{surface['hausdorff_mean']:.2e} / {surface['hausdorff_max']:.2e}" if surface else "-"
         rms = f"{surface['rms_mean']:.2e} / {surface['rms_max']:.2e}" if surface else "-"
-        rows.append((index, level.faces, f"{level.aqem_error:.3g}", hausdorff, rms, f"{report.seconds:.2f}"))
+        error = f"{level.aqem_error:.3g}"
+        rows.append((index, level.faces, level.target_faces, error, hausdorff, rms, f"{report.seconds:.2f}"))
     print_rows(rows)
+    # A level short of its target (--max-error, or no legal collapse left) can equal the one before
+    # it; without a word the table read as two levels that happen to agree.
+    for index, level in enumerate(report.levels, start=1):
+        if not level.reached:
+            why = "--max-error reached" if math.isfinite(args.max_error) else "no legal collapse left"
+            print(f"note: level {index}: stopped at {level.faces} faces (target {level.target_faces}): {why}")
     if args.plot:
         levels = [_read_level(level.path) for level in report.levels]
         features = not args.no_features

@@ -78,3 +78,12 @@ def test_simplify_says_which_sequence_levels_stopped_short_of_their_target(tmp_p
     assert "note: level 1: stopped at" in out and "--max-error reached" in out
     assert main(["simplify", str(frames), "-o", str(tmp_path / "out2"), "--no-metrics"]) == 0
     assert "note:" not in capsys.readouterr().out
+
+
+def test_levels_of_ply_frames_given_by_a_glob_without_suffix_are_ply(tmp_path):
+    # 'frames/*' names PLY frames without saying so: the levels came out as OBJ.
+    from animlod.pipelines.lod_sequence import simplify_sequence
+
+    write_sequence(tmp_path / "frames", synth.twisting_bar(frames=3, rings=8, segments=6), fmt="ply")
+    report = simplify_sequence(str(tmp_path / "frames" / "*"), tmp_path / "out", (0.5,), measure=False)
+    assert [path.suffix for path in sorted(report.levels[0].path.iterdir())] == [".ply"] * 3

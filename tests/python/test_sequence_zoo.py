@@ -87,3 +87,26 @@ def test_levels_of_ply_frames_given_by_a_glob_without_suffix_are_ply(tmp_path):
     write_sequence(tmp_path / "frames", synth.twisting_bar(frames=3, rings=8, segments=6), fmt="ply")
     report = simplify_sequence(str(tmp_path / "frames" / "*"), tmp_path / "out", (0.5,), measure=False)
     assert [path.suffix for path in sorted(report.levels[0].path.iterdir())] == [".ply"] * 3
+
+
+def test_a_long_sequence_is_measured_in_chunks_of_frames_at_the_same_points(tmp_path, monkeypatch):
+    # Every frame's points in float64 at once: 1.4 GB to measure 1000 frames of a 441-vertex cloth.
+    from animlod import metrics
+    from animlod.pipelines import lod_sequence
+
+    mesh = synth.twisting_bar(frames=11, rings=8, segments=6)
+    write_npz(tmp_path / "bar.npz", mesh)
+    whole = lod_sequence.simplify_sequence(tmp_path / "bar.npz", tmp_path / "whole", (0.5, 0.2))
+    measured_frames = []
+
+    def spy(original, simplified, samples, seed=0):
+        measured_frames.append(original.frame_count)
+        return metrics.surface_error(original, simplified, samples, seed)
+
+    per_frame = mesh.vertex_count * 2 + 2 * 10000  # at most: a level has fewer vertices
+    monkeypatch.setattr(lod_sequence, "_MEASURED_POINTS_PER_CHUNK", 3 * per_frame)
+    monkeypatch.setattr(lod_sequence, "surface_error", spy)
+    chunked = lod_sequence.simplify_sequence(tmp_path / "bar.npz", tmp_path / "chunked", (0.5, 0.2))
+    assert measured_frames and max(measured_frames) <= 5
+    for a, b in zip(whole.levels, chunked.levels):
+        assert a.surface == b.surface and a.error == b.error

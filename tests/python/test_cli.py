@@ -49,6 +49,20 @@ def test_info_on_a_folder_of_models_describes_each(tmp_path, capsys):
     assert f"{tmp_path / 'a.bvh'}: bvh" in out and f"{tmp_path / 'b.npz'}: npz" in out
 
 
+def test_info_on_a_library_names_an_unreadable_asset_and_lists_the_rest(tmp_path, capsys):
+    # It stopped at the first unreadable asset with its error, so the assets after it were never listed.
+    (tmp_path / "a_broken.bvh").write_text("HIERARCHY\nROOT hips\n")
+    write_bvh(tmp_path / "b.bvh", _small_motion())
+    assert main(["info", str(tmp_path)]) == 2
+    captured = capsys.readouterr()
+    assert f"{tmp_path / 'a_broken.bvh'}: bvh\n  error: {tmp_path / 'a_broken.bvh'}" in captured.out
+    assert f"{tmp_path / 'b.bvh'}: bvh\n  joints: 2" in captured.out
+    assert captured.err.strip() == "animlod info: 1 of 2 assets could not be read"
+    assert main(["info", str(tmp_path / "a_broken.bvh")]) == 2  # one file: its error alone, as before
+    captured = capsys.readouterr()
+    assert captured.out == "" and len(captured.err.strip().splitlines()) == 1
+
+
 def test_info_on_a_folder_of_frame_folders_describes_each_sequence(tmp_path, capsys):
     # A library of sequences (../shared/data/meshseq) exited 2 with "no .obj or .ply frame found".
     from animlod.io.meshseq import write_sequence

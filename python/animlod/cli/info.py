@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -26,11 +27,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    for path in _models(args.path):
+    """Describe each asset; in a library an unreadable one is named with its reason and the rest
+    still listed (exit code 2 if any was unreadable)."""
+    paths = _models(args.path)
+    unreadable = 0
+    for path in paths:
         kind = input_kind(path)
+        try:
+            lines = _describe(kind, path)
+        except (ValueError, OSError) as error:
+            if len(paths) == 1:
+                raise
+            lines, unreadable = [f"error: {error}"], unreadable + 1
         print(f"{path}: {kind}")
-        for line in _describe(kind, path):
+        for line in lines:
             print(f"  {line}")
+    if unreadable:
+        print(f"animlod info: {unreadable} of {len(paths)} assets could not be read", file=sys.stderr)
+        return 2
     return 0
 
 

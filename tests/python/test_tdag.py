@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from animlod import AnimatedMesh, TemporalDag, _core, synth
+from animlod.cli import main
 from animlod.tdag import affine_split
 
 
@@ -172,7 +173,7 @@ def test_save_load_round_trip_and_damaged_files(dag: TemporalDag, tmp_path):
         TemporalDag.load(tmp_path / "text.tdag")
 
 
-def test_a_two_sided_sheet_simplifies_like_its_front_and_queries_give_both_sides(tmp_path):
+def test_a_two_sided_sheet_simplifies_like_its_front_and_queries_give_both_sides(tmp_path, capsys):
     # Double-sided cloth exported as every face again in the reverse turn on vertices of its own:
     # both sides were cut apart at every edge and locked, and the TDAG had no collapse at all.
     x, y = np.meshgrid(np.linspace(0, 1, 12), np.linspace(0, 1, 12))
@@ -195,6 +196,10 @@ def test_a_two_sided_sheet_simplifies_like_its_front_and_queries_give_both_sides
         assert m < len(front) and len(double.faces) == 2 * m
         np.testing.assert_array_equal(double.faces[:m], single.faces)
         np.testing.assert_array_equal(double.faces[m:], single.faces[:, [0, 2, 1]])
+    # The CLI counts the input's faces with both sides, as the query's.
+    query = ["tdag", "query", str(tmp_path / "sheet.tdag"), "--frame", "3", "--tolerance", "0"]
+    assert main([*query, "-o", str(tmp_path / "q.obj")]) == 0
+    assert f"{2 * len(front)} faces (input 144, {2 * len(front)})" in capsys.readouterr().out
 
 
 def test_bad_input_is_a_named_value_error(dag: TemporalDag, bending: AnimatedMesh):

@@ -201,9 +201,10 @@ def run_query(args: argparse.Namespace) -> int:
         mesh = dag.advance(args.frame, args.level)
         what = f"tolerance {tolerance:.4g}, level {args.level} from the cut of frame {start}"
     write_mesh(output, mesh.positions, mesh.faces)
+    backs = int(np.count_nonzero(dag.two_sided))  # a two-sided face is one face of the TDAG, two of the mesh
     print(
         f"wrote {output}: frame {args.frame}, {what}: {mesh.vertex_count} vertices, {mesh.face_count} faces "
-        f"(input {dag.vertex_count}, {dag.face_count}), error bound {mesh.error_bound:.4g}"
+        f"(input {dag.vertex_count}, {dag.face_count + backs}), error bound {mesh.error_bound:.4g}"
     )
     if args.plot:
         from ..tdag import plot_tolerances

@@ -29,7 +29,10 @@ def error_line(error: BaseException, source: str | None = None) -> str:
       file): ``source: message``, ``source`` being the input file the command was reading.
     Newlines inside the message become spaces.
     """
-    if isinstance(error, OSError):
+    blocking = _file_in_the_way(error)
+    if blocking is not None:
+        message = f"{blocking}: is a file where the output needs a folder"
+    elif isinstance(error, OSError):
         reason = error.strerror or str(error)
         files = [os.fspath(name) for name in (error.filename, error.filename2) if name is not None]
         message = f"{' -> '.join(files)}: {reason}" if files else f"{source or 'output'}: {reason}"
@@ -38,6 +41,17 @@ def error_line(error: BaseException, source: str | None = None) -> str:
         if source and not isinstance(error, FormatError) and not _names_a_path(message, source):
             message = f"{source}: {message}"
     return " ".join(message.split())
+
+
+def _file_in_the_way(error: BaseException) -> str | None:
+    """The file standing where a folder was to be made (``-o out.glb`` for a command that writes
+    folders), for the system's "File exists" and "Not a directory"; None for any other error."""
+    if not isinstance(error, (FileExistsError, NotADirectoryError)) or error.filename is None:
+        return None
+    path = os.fspath(error.filename)
+    while path and not os.path.lexists(path):
+        path = os.path.dirname(path)
+    return path if path and os.path.lexists(path) and not os.path.isdir(path) else None
 
 
 def _names_a_path(message: str, source: str) -> bool:

@@ -16,14 +16,20 @@ _IS_INTEGER_CHARACTER = np.zeros(256, dtype=bool)
 _IS_INTEGER_CHARACTER[list(b"0123456789+-")] = True
 
 
+def _token_layout(data: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``data``'s bytes, whether each is white space, and the offset of every whitespace-separated
+    token (a byte that is not space after one that is, or at the start)."""
+    codes = np.frombuffer(data, dtype=np.uint8)
+    space = _IS_SPACE[codes]
+    return codes, space, np.flatnonzero(~space & np.concatenate(([True], space[:-1])))
+
+
 def tokens_per_line(data: bytes) -> np.ndarray:
     """Number of whitespace-separated tokens on each ``\\n``-separated line of ``data``.
 
     Returns ``(L,) int64`` where ``L = data.count(b"\\n") + 1``; entry ``i`` is for line ``i``.
     """
-    codes = np.frombuffer(data, dtype=np.uint8)
-    space = _IS_SPACE[codes]
-    token_starts = np.flatnonzero(~space & np.concatenate(([True], space[:-1])))
+    codes, _, token_starts = _token_layout(data)
     line_starts = np.concatenate(([0], np.flatnonzero(codes == ord("\n")) + 1, [codes.size + 1]))
     return np.diff(np.searchsorted(token_starts, line_starts)).astype(np.int64)
 
@@ -31,9 +37,7 @@ def tokens_per_line(data: bytes) -> np.ndarray:
 def integer_tokens(data: bytes) -> np.ndarray:
     """Whether each whitespace-separated token of ``data`` is written with ASCII digits and signs
     only (``12``, ``-3``; not ``3.0`` or ``1e3``), as an integer table must be: ``(N,) bool``."""
-    codes = np.frombuffer(data, dtype=np.uint8)
-    space = _IS_SPACE[codes]
-    token_starts = np.flatnonzero(~space & np.concatenate(([True], space[:-1])))
+    codes, space, token_starts = _token_layout(data)
     if not token_starts.size:
         return np.zeros(0, dtype=bool)
     # A token's run reaches to the next token's start; the spaces after it are no other character.

@@ -71,7 +71,7 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
         When no frame is found, a file cannot be read, or a frame's vertex count or faces
         differ from the first frame's (naming the file and the first differing face).
     """
-    paths = _sequence_paths(source)
+    paths = sequence_paths(source)
     first_vertices, faces = read_mesh(paths[0])
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
     if not len(faces):
@@ -105,7 +105,9 @@ def write_sequence(folder: str | os.PathLike, mesh: AnimatedMesh, fmt: str = "ob
     return [Path(folder) / name for name in names]
 
 
-def _sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> list[Path]:
+def sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> list[Path]:
+    """The frame files :func:`read_sequence` reads for ``source``, in its order; FormatError when
+    there is none."""
     if not isinstance(source, (str, os.PathLike)):
         paths = [Path(path) for path in source]
         if not paths:

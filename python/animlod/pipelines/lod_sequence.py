@@ -7,7 +7,6 @@ Hausdorff and RMS distance relative to the bounding-box diagonal).
 
 from __future__ import annotations
 
-import glob
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -125,16 +124,10 @@ def _level_format(kind: str, source: str | os.PathLike) -> str:
     """The levels' format, the input's: "npz", or "ply" when a frame is PLY, else "obj"."""
     if kind == "npz":
         return "npz"
-    from ..io.detect import is_pattern
-    from ..io.meshseq import frame_files
+    from ..io.meshseq import sequence_paths
 
-    if Path(source).is_dir():
-        files = frame_files(source)
-    elif is_pattern(source):  # the files it matches: "frames/*" holds PLY frames without saying so
-        files = [Path(match) for match in glob.glob(os.fspath(source))]
-    else:
-        files = [Path(source)]
-    return "ply" if any(path.suffix.lower() == ".ply" for path in files) else "obj"
+    # The frames read, not the source's name: "frames/*" holds PLY frames without saying so.
+    return "ply" if any(path.suffix.lower() == ".ply" for path in sequence_paths(source)) else "obj"
 
 
 def _write_level(fmt: str, target: Path, mesh: AnimatedMesh) -> Path:

@@ -736,15 +736,15 @@ bool read_model(const Model& model, const std::string& name, Asset& out, std::st
   return true;
 }
 
-// tinygltf's model of a GLB (told by its magic, as the Python reader decides) or glTF JSON, its pointer channels resolved first
-// (animation_pointers.hpp); external files are looked up in base_dir.
-// Whether ``bytes`` open like a JSON object (a .gltf), after a byte order mark and white space.
+// Whether `bytes` open like a JSON object (a .gltf), after a byte order mark and white space.
 bool opens_like_json(const uint8_t* bytes, size_t size) {
   size_t at = size >= 3 && std::memcmp(bytes, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
   while (at < size && std::isspace(bytes[at])) ++at;
   return at < size && bytes[at] == '{';
 }
 
+// tinygltf's model of a GLB (told by its magic, as the Python reader decides) or glTF JSON, its pointer channels resolved first
+// (animation_pointers.hpp); external files are looked up in base_dir.
 bool parse_model(tinygltf::TinyGLTF& loader, const uint8_t* bytes, size_t size, const std::string& base_dir,
                  Model& model, std::string& error) {
   // Said in our words: the parsers' own (a JSON syntax error at line 1) do not say what the file is not.

@@ -1,8 +1,9 @@
 // OptionsClass: the one way a core options struct becomes a Python class. Fields are
-// read-write (a vector field reads as a tuple), their defaults are the struct's, their docstrings the header comments
-// (header_docs.hpp); the class takes keyword arguments (also for the fields of nested options),
-// refuses an unknown name or a value of the wrong type with a ValueError naming the option,
-// and compares, prints, copies and pickles by its fields (Dask sends options to workers).
+// read-write (a vector field reads as a tuple), their defaults are the struct's, their
+// docstrings the header comments (header_docs.hpp); the class takes keyword arguments (also for
+// the fields of nested options), refuses an unknown name or a value of the wrong type with a
+// ValueError naming the option, and compares, prints, copies and pickles by its fields (Dask
+// sends options to workers).
 #pragma once
 
 #include <memory>

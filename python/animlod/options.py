@@ -8,9 +8,9 @@ fields, or both (the keywords change a copy of the object).
 List fields (``AqemOptions.target_ratios``, ``target_face_counts``, ``frame_subset``) read as
 tuples (the binding's doing). The object holds a C++ vector, so what reading such a field hands
 out is a copy: a list there took ``opts.frame_subset.append(3)`` and changed nothing; a tuple has
-no ``append`` and says so at once. Change the field by assigning a sequence (``opts.frame_subset = [0, 3]``,
-``opts.target_ratios += (0.25,)``), through ``update`` or by keyword, and compare it with a
-tuple (a list never equals one: ``opts.target_ratios == (0.5,)``).
+no ``append`` and says so at once. Change the field by assigning a sequence
+(``opts.frame_subset = [0, 3]``, ``opts.target_ratios += (0.25,)``), through ``update`` or by
+keyword, and compare it with a tuple (a list never equals one: ``opts.target_ratios == (0.5,)``).
 """
 
 from __future__ import annotations

@@ -173,6 +173,7 @@ def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(ch
     (colour,) = [channel for channel in clip.channels if channel.target.path == "pointer"]
     levels = [animation for animation in doc_out.gltf.animations if "@motion" in (animation.name or "")]
     assert levels
+    level_nodes = set(_level_nodes(doc_out))  # drive_morph_weights's, tested below
     for animation in levels:
         m = animation.name.rsplit("@motion", 1)[1]
         carried = {
@@ -180,6 +181,7 @@ def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(ch
             for channel in animation.channels
             for path in [channel.target.path]
             if path != "pointer"
+            and channel.target.node not in level_nodes
             and (path == "weights" or "socket" in (doc_out.gltf.nodes[channel.target.node].name or ""))
         }
         (carried_colour,) = [channel for channel in animation.channels if channel.target.path == "pointer"]
@@ -191,3 +193,23 @@ def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(ch
             (base_name, "weights"): outputs[(base_name, "weights")],
             (f"Head@motion{m}", "weights"): outputs[("Head", "weights")],  # the hat's, on its copy
         }
+
+
+def _level_nodes(doc: GltfDocument) -> list[int]:
+    """Every node of the skinned mesh's (geometry x motion) grid but its base node."""
+    (base,) = [index for index, node in enumerate(doc.gltf.nodes) if node.extras and "animlod_grid" in node.extras]
+    return [node for row in doc.gltf.nodes[base].extras["animlod_grid"] for node in row if node != base]
+
+
+def test_every_level_node_of_the_skinned_mesh_plays_its_morph_weights(character_with_sockets):
+    """Each clip's channel of the base node's morph weights drives every node of the grid with the
+    same keys: a level is a node of its own, and it held its rest weights (no channel)."""
+    _, output, _ = character_with_sockets
+    doc = GltfDocument(output)
+    (base,) = [index for index, node in enumerate(doc.gltf.nodes) if node.extras and "animlod_grid" in node.extras]
+    level_nodes = _level_nodes(doc)
+    assert len(level_nodes) >= 3
+    for animation in doc.gltf.animations:
+        (sampler,) = [c.sampler for c in animation.channels if (c.target.node, c.target.path) == (base, "weights")]
+        driven = [c.target.node for c in animation.channels if c.target.path == "weights" and c.sampler == sampler]
+        assert sorted(driven) == sorted([base, *level_nodes])

@@ -158,6 +158,10 @@ def test_every_morph_target_file_as_one_lod_glb(data_dir, tmp_path, name):
         # Every level keeps every target slot, so the base node's morph-weight clip drives it.
         assert [len(p.targets) for p in mesh.primitives] == [len(p.targets) for p in base_mesh.primitives]
         assert glb.nodes[node].extras["animlod"]["targets"] == level.kept_targets.tolist()
+    for animation in glb.animations:  # each level plays the base node's morph weights
+        driven = {c.target.node: c.sampler for c in animation.channels if c.target.path == "weights"}
+        if base in driven:
+            assert all(driven.get(node) == driven[base] for node in ids)
         assert glb.nodes[node].extras["animlod"]["triangles"] == level.triangle_count
     assert len(glb.animations) == len(source.doc.gltf.animations)  # the input's clips are kept
 

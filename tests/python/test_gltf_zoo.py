@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pygltflib
+import pytest
 from gltf_edits import append_accessor, edit_glb
 from simplify_inputs import tube, two_bone_tube
 
@@ -19,9 +20,10 @@ from animlod.pipelines.lod_document import simplify_document
 from animlod.pipelines.motion import build_motion_levels
 
 
-def _morph_tube_glb(path: Path, node_weights: list[float] | None) -> Path:
+def _morph_tube_glb(path: Path, node_weights: list[float] | None, clip: str | None = None) -> Path:
     """A tube with one morph target (doubling its height), mesh weights [0], drawn by one node
-    whose ``weights`` override the mesh's when given (glTF 2.0, 3.7.2.2)."""
+    whose ``weights`` override the mesh's when given (glTF 2.0, 3.7.2.2); with ``clip``, a clip
+    stretching it over one second, by a "weights" channel or a KHR_animation_pointer ("pointer")."""
     positions, faces = tube()
     builder = GlbBuilder()
     position = builder.add(positions.astype(np.float32), bounds=True)
@@ -32,6 +34,14 @@ def _morph_tube_glb(path: Path, node_weights: list[float] | None) -> Path:
     node = {"mesh": 0, "name": "tall"} | ({} if node_weights is None else {"weights": node_weights})
     builder.append("nodes", node)
     builder.json["scenes"], builder.json["scene"] = [{"nodes": [0]}], 0
+    if clip is not None:
+        times = builder.add(np.array([[0.0], [1.0]], np.float32), bounds=True)
+        sampler = {"input": times, "output": builder.add(np.array([[0.0], [1.0]], np.float32))}
+        target = {"node": 0, "path": "weights"}
+        if clip == "pointer":
+            target = {"path": "pointer", "extensions": {"KHR_animation_pointer": {"pointer": "/nodes/0/weights"}}}
+            builder.add_extension_used("KHR_animation_pointer")
+        builder.append("animations", {"samplers": [sampler], "channels": [{"sampler": 0, "target": target}]})
     builder.save(path)
     return path
 
@@ -80,6 +90,18 @@ def test_level_nodes_keep_the_morph_weights_of_their_base_node(tmp_path: Path) -
     simplify_document(_morph_tube_glb(tmp_path / "plain.glb", None), tmp_path / "plain_lod.glb")
     plain = GltfDocument(tmp_path / "plain_lod.glb").json["nodes"]
     assert all("weights" not in plain[level] for level in plain[0]["extensions"]["MSFT_lod"]["ids"])
+
+
+@pytest.mark.parametrize("clip", ["weights", "pointer"])
+def test_every_level_node_plays_the_morph_weight_clip_of_its_base_node(tmp_path: Path, clip: str) -> None:
+    """A clip's morph-weight channel animates one node, and each MSFT_lod level is a node of its own:
+    the levels had no channel, so a viewer switching to one showed the tube at its rest weights."""
+    simplify_document(_morph_tube_glb(tmp_path / "tall.glb", None, clip), tmp_path / "lod.glb")
+    doc = GltfDocument(tmp_path / "lod.glb")
+    levels = doc.json["nodes"][0]["extensions"]["MSFT_lod"]["ids"]
+    (channels,) = doc.channel_targets
+    assert levels and channels == [(0, "weights"), *[(level, "weights") for level in levels]]
+    assert {channel.sampler for channel in doc.gltf.animations[0].channels} == {0}
 
 
 def test_a_static_node_shows_its_own_morph_weights(tmp_path: Path) -> None:

@@ -63,8 +63,14 @@ def _without_chain(node: dict) -> dict:
 def _assert_document_kept(source, output) -> None:
     """Every object of ``source`` is in ``output`` at the same index with the same content."""
     before, after = GltfDocument(source), GltfDocument(output)
-    for kind in ("materials", "textures", "samplers", "skins", "animations", "scenes", "cameras", "meshes"):
+    for kind in ("materials", "textures", "samplers", "skins", "scenes", "cameras", "meshes"):
         assert after.json.get(kind, [])[: len(before.json.get(kind, []))] == before.json.get(kind, []), kind
+    nodes = len(before.json.get("nodes", []))
+    for index, animation in enumerate(before.json.get("animations", [])):
+        # The input's channels first, then its morph-weight channels again for the new level nodes.
+        kept, count = after.json["animations"][index], len(animation["channels"])
+        assert {**kept, "channels": kept["channels"][:count]} == animation
+        assert all(c["target"]["path"] == "weights" and c["target"]["node"] >= nodes for c in kept["channels"][count:])
     for index, node in enumerate(before.json.get("nodes", [])):
         assert _without_chain(after.json["nodes"][index]) == _without_chain(node), f"node {index}"
     for index in range(len(before.json.get("accessors", []))):

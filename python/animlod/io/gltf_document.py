@@ -80,7 +80,7 @@ _CHANNEL_PATHS = ("translation", "rotation", "scale", "weights")
 # KHR_animation_pointer: a channel of path "pointer" animates the property its JSON pointer
 # names; those of a node's TRS or weights are read as that node's channels.
 POINTER_EXTENSION = "KHR_animation_pointer"
-_NODE_POINTER = re.compile(r"/nodes/(\d+)/(translation|rotation|scale|weights)")
+NODE_POINTER = re.compile(r"/nodes/(\d+)/(translation|rotation|scale|weights)")
 # Top-level arrays whose singular is not the name without its last letter.
 _IRREGULAR_SINGULARS = {"meshes": "mesh"}
 
@@ -361,7 +361,7 @@ class GltfDocument:
             pointer = extension.get("pointer") if isinstance(extension, dict) else None
             if not isinstance(pointer, str):
                 raise self.fail(element, f"path 'pointer' needs a {POINTER_EXTENSION} pointer string")
-            match = _NODE_POINTER.fullmatch(pointer)
+            match = NODE_POINTER.fullmatch(pointer)
             if match is None:
                 return None, "pointer"
             node = int(match.group(1))

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..model import AnimatedMesh, LodChain, LodLevel
 from .glb_builder import ARRAY_BUFFER, GlbBuilder
-from .gltf_document import COMPONENT_DTYPES, INSTANCING_EXTENSION, GltfDocument
+from .gltf_document import COMPONENT_DTYPES, INSTANCING_EXTENSION, NODE_POINTER, POINTER_EXTENSION, GltfDocument
 from .gltf_draco import DRACO_EXTENSION
 from .gltf_mesh import read_mesh_geometry, transform_points
 from .gltf_read import skinned_mesh_of_node
@@ -167,7 +167,8 @@ def attach_chain(
     builder: GlbBuilder, base: int, level_nodes: list[int], coverages: list[float], base_info: LevelInfo
 ) -> None:
     """Makes node ``base`` the top of a chain: MSFT_lod ids, screen coverages (one per level,
-    ``len(level_nodes) + 1`` decreasing values ending at 0) and its own animlod extras."""
+    ``len(level_nodes) + 1`` decreasing values ending at 0), its own animlod extras, and the
+    level nodes driven by its morph-weight clips (:func:`drive_morph_weights`)."""
     if len(coverages) != len(level_nodes) + 1:
         raise ValueError(f"coverages: {len(coverages)} values for {len(level_nodes) + 1} levels")
     node = builder.json["nodes"][base]
@@ -179,6 +180,37 @@ def attach_chain(
     extras[ANIMLOD_EXTRA] = base_info.extras()
     node["extras"] = extras
     builder.add_extension_used(LOD_EXTENSION)
+    drive_morph_weights(builder, base, level_nodes)
+
+
+def drive_morph_weights(builder: GlbBuilder, base: int, level_nodes: list[int]) -> None:
+    """Every clip's morph-weight channel of node ``base`` also drives those of ``level_nodes``
+    whose meshes have as many targets, through the same sampler. A channel animates one node and a
+    level is a node of its own: without this, a viewer that switches to a coarser level shows it
+    at its rest weights (a flamingo that stops flapping at a distance)."""
+    targets = _morph_target_count(builder, base)
+    driven = [node for node in level_nodes if targets and _morph_target_count(builder, node) == targets]
+    for animation in builder.json.get("animations", []) if driven else []:
+        channels = animation.get("channels", [])
+        for channel in [c for c in channels if _weights_node(c.get("target", {})) == base]:
+            channels.extend({"sampler": channel["sampler"], "target": {"node": n, "path": "weights"}} for n in driven)
+
+
+def _morph_target_count(builder: GlbBuilder, node: int) -> int:
+    """Morph targets of the mesh node ``node`` draws (every primitive of a mesh has as many)."""
+    mesh = builder.json["nodes"][node].get("mesh")
+    primitives = builder.json["meshes"][mesh].get("primitives") if mesh is not None else None
+    return len(primitives[0].get("targets", [])) if primitives else 0
+
+
+def _weights_node(target: dict) -> int | None:
+    """The node whose morph weights a channel target animates, by node and path or by a
+    KHR_animation_pointer at ``/nodes/<n>/weights``; None for anything else."""
+    if target.get("path") == "weights":
+        return target.get("node")
+    pointer = (target.get("extensions") or {}).get(POINTER_EXTENSION, {}).get("pointer", "")
+    match = NODE_POINTER.fullmatch(pointer) if target.get("path") == "pointer" and isinstance(pointer, str) else None
+    return int(match.group(1)) if match and match.group(2) == "weights" else None
 
 
 def screen_coverages(

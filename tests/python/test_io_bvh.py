@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from animlod import rotations
-from animlod.io import FormatError, read_bvh, write_bvh
+from animlod.io import FormatError, read_bvh, read_bvh_rotation_orders, write_bvh
 from animlod.model import Motion, Skeleton
 
 # Root with 6 channels, a 3-channel joint A (Z-X-Y intrinsic), an End Site, and a 6-channel
@@ -210,6 +210,35 @@ def test_a_tiny_skeleton_keeps_its_precision_through_a_round_trip(tmp_path: Path
     back = read_bvh(tmp_path / "tiny.bvh")
     size = np.abs(s.offsets).max() * 1e-4
     np.testing.assert_allclose(back.world_positions(), tiny.world_positions(), atol=1e-5 * size)
+
+
+MIXED_ORDERS_BVH = (
+    "HIERARCHY\nROOT Hips\n{\n\tOFFSET 0 0 0\n"
+    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation\n"
+    "\tJOINT Spine\n\t{\n\t\tOFFSET 0 1 0\n\t\tCHANNELS 3 Yrotation Xrotation Zrotation\n"
+    "\t\tJOINT Hinge\n\t\t{\n\t\t\tOFFSET 0 1 0\n\t\t\tCHANNELS 1 Xrotation\n"
+    "\t\t\tEnd Site\n\t\t\t{\n\t\t\t\tOFFSET 0 0.5 0\n\t\t\t}\n\t\t}\n\t}\n}\n"
+    "MOTION\nFrames: 2\nFrame Time: 0.5\n"
+    "1.5 2 3 10 -20 30 40 50 -60 70\n"
+    "1 2 3 -170 80 -120 -35 -5 175 -10\n"
+)
+
+
+def test_a_motion_written_in_its_files_rotation_orders_keeps_its_channel_values(tmp_path: Path) -> None:
+    """read_bvh_rotation_orders gives each joint's order as written (the one-channel hinge has none:
+    written in the default ZXY), and write_bvh writes them back: the same channels and, for angles
+    in Euler's principal range, the same values."""
+    source = _write(tmp_path, MIXED_ORDERS_BVH)
+    orders = read_bvh_rotation_orders(source)
+    assert orders == {"Hips": "ZYX", "Spine": "YXZ"}
+    write_bvh(tmp_path / "back.bvh", read_bvh(source), rotation_order=orders)
+    text = (tmp_path / "back.bvh").read_text()
+    channels = [line.split()[2:] for line in text.splitlines() if "CHANNELS" in line]
+    assert channels[:2] == [["Xposition", "Yposition", "Zposition", "Zrotation", "Yrotation", "Xrotation"],
+                            ["Yrotation", "Xrotation", "Zrotation"]]  # fmt: skip
+    rows = np.loadtxt(text.split("Frame Time: 0.5\n")[1].splitlines())
+    expected = np.loadtxt(MIXED_ORDERS_BVH.split("Frame Time: 0.5\n")[1].splitlines())
+    np.testing.assert_allclose(rows[:, :9], expected[:, :9], atol=1e-6)
 
 
 def test_write_rejects_bad_rotation_order(tmp_path: Path) -> None:

@@ -8,6 +8,7 @@ from test_motion_figures import figure_motion
 
 from animlod import rotations
 from animlod.cli import main
+from animlod.io.bvh import write_bvh
 from animlod.model import Motion, Skeleton
 from animlod.motion_lod import analyze_motion, joint_floor, level_joint_counts
 from animlod.motion_lod.analysis import translating_joints
@@ -174,8 +175,6 @@ def test_the_bandai_clip_spreads_to_two_joints(data_dir) -> None:
 
 
 def _write(tmp_path, motion: Motion, name: str = "clip.bvh"):
-    from animlod.io.bvh import write_bvh
-
     path = tmp_path / name
     write_bvh(path, motion)
     return path
@@ -230,3 +229,17 @@ def test_cli_summary_says_why_the_floor_is_above_the_paper(tmp_path, capsys) -> 
     assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--levels", "3"]) == 0
     out = capsys.readouterr().out
     assert "fewest joints: 4 of 20, above the paper's 8% (2): root, 3 translating (j1, j5, j9) never freeze" in out
+
+
+def test_levels_of_a_bvh_keep_its_rotation_channel_orders(tmp_path) -> None:
+    """Each joint of every level is written in the rotation order its input channels have (here
+    XYZ, ZYX on the root): the levels were all written ZXY, whatever the input's layout."""
+    motion = tree_motion(8)
+    orders = {name: "XYZ" for name in motion.skeleton.names} | {"j0": "ZYX"}
+    source = tmp_path / "clip.bvh"
+    write_bvh(source, motion, rotation_order=orders)
+    assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--levels", "3"]) == 0
+    for level in sorted((tmp_path / "out").glob("clip_lod*.bvh")):
+        channels = [line.split()[2:] for line in level.read_text().splitlines() if "CHANNELS" in line]
+        assert channels[0][3:] == ["Zrotation", "Yrotation", "Xrotation"]
+        assert all(joint[-3:] == ["Xrotation", "Yrotation", "Zrotation"] for joint in channels[1:]), level.name

@@ -1,6 +1,6 @@
 """File formats: BVH, glTF 2.0 / GLB, OBJ and PLY frame sequences, NPZ."""
 
-from .bvh import read_bvh, write_bvh
+from .bvh import read_bvh, read_bvh_rotation_orders, write_bvh
 from .errors import FormatError
 from .gltf import GltfScene, read_gltf, read_lod_chains, read_skinned, write_glb
 from .meshseq import read_mesh, read_obj, read_ply, read_sequence, write_mesh, write_obj, write_ply, write_sequence
@@ -10,6 +10,7 @@ __all__ = [
     "FormatError",
     "GltfScene",
     "read_bvh",
+    "read_bvh_rotation_orders",
     "read_gltf",
     "read_lod_chains",
     "read_mesh",

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
@@ -152,18 +153,35 @@ def read_bvh(path: str | os.PathLike) -> Motion:
         values, a value that is not a finite number.
     """
     path = Path(path)
-    text = _decode(path.read_bytes()).replace("\r\n", "\n").replace("\r", "\n")
-    motion_match = _MOTION_LINE.search(text)
-    hierarchy_lines = text[: motion_match.start() if motion_match else len(text)].split("\n")
-    cursor = _TokenCursor(path, hierarchy_lines)
-    joints = _parse_hierarchy(cursor)
+    text, joints, motion_match, motion_line = _read_hierarchy(path)
     if motion_match is None:
-        raise FormatError(path, f"line {len(hierarchy_lines)}", "no MOTION section after the hierarchy")
-    motion_line = len(hierarchy_lines)
+        raise FormatError(path, f"line {motion_line}", "no MOTION section after the hierarchy")
     frame_count, fps, data_line, data_text = _parse_motion_header(path, text[motion_match.end() :], motion_line)
     channel_count = sum(len(joint.channels) for joint in joints)
     values = _parse_motion_table(path, data_text, data_line, frame_count, channel_count, joints)
     return _build_motion(path, joints, values, fps)
+
+
+def read_bvh_rotation_orders(path: str | os.PathLike) -> dict[str, str]:
+    """Each joint's Euler order as its rotation channels are written (``"ZYX"`` for ``Zrotation
+    Yrotation Xrotation``), by joint name, for joints with all three: what :func:`write_bvh` takes
+    to write a file's levels in its own channel layout. Reads the hierarchy only; raises
+    FormatError as :func:`read_bvh` does for it."""
+    orders = {}
+    for joint in _read_hierarchy(Path(path))[1]:
+        order = "".join(channel[0].upper() for channel in joint.channels if channel.lower().endswith("rotation"))
+        if sorted(order) == ["X", "Y", "Z"]:
+            orders[joint.name] = order
+    return orders
+
+
+def _read_hierarchy(path: Path) -> tuple[str, list[_JointSpec], re.Match | None, int]:
+    """The file's text (line ends made LF), its parsed joints, the match of its MOTION line (None
+    when it has none) and the number of lines before it."""
+    text = _decode(path.read_bytes()).replace("\r\n", "\n").replace("\r", "\n")
+    motion_match = _MOTION_LINE.search(text)
+    hierarchy_lines = text[: motion_match.start() if motion_match else len(text)].split("\n")
+    return text, _parse_hierarchy(_TokenCursor(path, hierarchy_lines)), motion_match, len(hierarchy_lines)
 
 
 def _decode(data: bytes) -> str:
@@ -402,13 +420,16 @@ def _build_motion(path: Path, joints: list[_JointSpec], values: np.ndarray, fps:
 
 
 def write_bvh(
-    path: str | os.PathLike, motion: Motion, rotation_order: str = "ZXY", precision: int | None = None
+    path: str | os.PathLike,
+    motion: Motion,
+    rotation_order: str | Mapping[str, str] = "ZXY",
+    precision: int | None = None,
 ) -> None:
     """Write ``motion`` as a BVH file, atomically.
 
-    The root gets six channels (position, then rotation in ``rotation_order``), other joints
-    three rotation channels, plus three position channels where ``motion.joint_translations``
-    moves them away from their offsets. End-site joints are written as ``End Site`` blocks
+    The root gets six channels (position, then rotation), other joints three rotation channels,
+    plus three position channels where ``motion.joint_translations`` moves them away from their
+    offsets. End-site joints are written as ``End Site`` blocks
     (their names are not stored; :func:`read_bvh` names them ``f"{parent}_End"``). A leaf that
     is not an end site is written as a JOINT without children. ``skeleton.rest_rotations`` are
     not written: Motion's forward kinematics does not use them.
@@ -417,7 +438,9 @@ def write_bvh(
     ----------
     path : destination file.
     motion : the motion to write.
-    rotation_order : Euler order of the rotation channels, three different axes, e.g. "ZXY".
+    rotation_order : Euler order of the rotation channels, three different axes, e.g. "ZXY"; or
+        one per joint name (:func:`read_bvh_rotation_orders` of the file the motion came from),
+        "ZXY" for joints it does not name.
     precision : digits after the decimal point for offsets and channel values; None: 6, and
         more for a skeleton whose longest bone is under 1 unit (1e-6 of that bone at least).
 
@@ -427,14 +450,17 @@ def write_bvh(
         For an unsupported ``rotation_order``, an end site whose translation is animated, or a
         motion whose joints scale (BVH has no scale channels).
     """
-    order = rotation_order.upper()
-    if len(order) != 3 or set(order) != set("XYZ"):
-        raise ValueError(f"{os.fspath(path)}: rotation_order: must be a permutation of XYZ, got {rotation_order!r}")
+    skeleton = motion.skeleton
+    named = rotation_order if isinstance(rotation_order, Mapping) else {}
+    default = "ZXY" if isinstance(rotation_order, Mapping) else rotation_order
+    orders = [named.get(name, default).upper() for name in skeleton.names]
+    for order in {*orders, default.upper()}:
+        if len(order) != 3 or set(order) != set("XYZ"):
+            raise ValueError(f"{os.fspath(path)}: rotation_order: must be a permutation of XYZ, got {order!r}")
     try:
         motion.require_rigid("BVH")
     except ValueError as error:
         raise ValueError(f"{os.fspath(path)}: {error}") from None
-    skeleton = motion.skeleton
     translations = motion.local_translations()
     has_position = np.zeros(skeleton.joint_count, dtype=bool)
     has_position[0] = True
@@ -445,26 +471,28 @@ def write_bvh(
         reason = "is an end site with animated translation; BVH cannot store it"
         raise ValueError(f"{os.fspath(path)}: joint {name!r}: {reason}")
     rotated = ~skeleton.end_sites
-    angles = np.degrees(rotations.to_euler(motion.local_rotations[:, rotated], order))
-    angle_of_joint = np.cumsum(rotated) - 1
+    angles = np.zeros(motion.local_rotations.shape[:2] + (3,))
+    for order in set(orders):  # one vectorised conversion per order, as the reader does
+        joints = rotated & (np.array(orders) == order)
+        angles[:, joints] = np.degrees(rotations.to_euler(motion.local_rotations[:, joints], order))
     blocks = []
     for joint in range(skeleton.joint_count):
         if has_position[joint]:
             blocks.append(translations[:, joint])
         if rotated[joint]:
-            blocks.append(angles[:, angle_of_joint[joint]])
+            blocks.append(angles[:, joint])
     table = np.concatenate(blocks, axis=1)
     if precision is None:
         longest = float(np.abs(skeleton.offsets[1:]).max(initial=0.0))
         precision = max(6, 6 - int(np.floor(np.log10(longest)))) if longest > 0.0 else 6
-    hierarchy = _hierarchy_text(skeleton, has_position, order, precision)
+    hierarchy = _hierarchy_text(skeleton, has_position, orders, precision)
     with atomic_write(path, "w", encoding="utf-8", newline="\n") as handle:
         handle.write(hierarchy)
         handle.write(f"MOTION\nFrames: {motion.frame_count}\nFrame Time: {1.0 / motion.fps:.10g}\n")
         np.savetxt(handle, table, fmt=f"%.{precision}f", delimiter=" ")
 
 
-def _hierarchy_text(skeleton: Skeleton, has_position: np.ndarray, order: str, precision: int) -> str:
+def _hierarchy_text(skeleton: Skeleton, has_position: np.ndarray, orders: list[str], precision: int) -> str:
     """The HIERARCHY section, depth first. Iterative, so chains of any depth are written."""
     children = skeleton.children()
     lines = ["HIERARCHY"]
@@ -480,7 +508,7 @@ def _hierarchy_text(skeleton: Skeleton, has_position: np.ndarray, order: str, pr
             lines.extend([f"{indent}End Site", f"{indent}{{", f"{indent}\tOFFSET {offset}", f"{indent}}}"])
             continue
         channels = [f"{axis}position" for axis in "XYZ"] if has_position[joint] else []
-        channels += [f"{axis}rotation" for axis in order]
+        channels += [f"{axis}rotation" for axis in orders[joint]]
         keyword = "ROOT" if joint == 0 else "JOINT"
         lines.extend(
             [

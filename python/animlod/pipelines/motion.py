@@ -135,16 +135,18 @@ def build_motion_levels(
         on_choice=on_choice,
     )
 
-    from ..io.bvh import write_bvh
+    from ..io.bvh import read_bvh_rotation_orders, write_bvh
     from ..io.manifest import write_lod_manifest
 
     folder = Path(output)
     folder.mkdir(parents=True, exist_ok=True)
     stem = input_stem(source)
+    # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
+    orders = read_bvh_rotation_orders(source) if input_kind(source) == "bvh" else "ZXY"
     files, rows = [], []
     for index, level in enumerate(chain.levels):
         names = [Path(f"{stem}_lod{index}.bvh")]
-        write_bvh(folder / names[0], level.motion)
+        write_bvh(folder / names[0], level.motion, rotation_order=orders)
         if level.skin is not None:
             from ..io.gltf import write_glb
 

@@ -24,7 +24,8 @@ def _require(condition: bool, what: str) -> None:
         raise ValueError(what)
 
 
-def _check_finite(name: str, array: np.ndarray) -> None:
+def check_finite(name: str, array: np.ndarray) -> None:
+    """ValueError naming ``name`` and the index of the first non-finite value of ``array``."""
     if not np.all(np.isfinite(array)):
         bad = np.argwhere(~np.isfinite(array))[0]
         raise ValueError(f"{name}: non-finite value at index {tuple(int(i) for i in bad)}")
@@ -56,7 +57,8 @@ def whole_indices(name: str, values: object, item: str, low: int, high: int) -> 
     return np.ascontiguousarray(given, dtype=np.int32)
 
 
-def _check_faces(faces: np.ndarray, vertex_count: int) -> np.ndarray:
+def checked_faces(faces: np.ndarray, vertex_count: int) -> np.ndarray:
+    """``faces`` as (M, 3) int32 indices below ``vertex_count`` (:func:`whole_indices`)."""
     given = np.asarray(faces)
     _require(given.ndim == 2 and given.shape[1] == 3, f"faces: expected shape (M, 3), got {given.shape}")
     return whole_indices("faces", given, "face", 0, vertex_count)
@@ -83,8 +85,8 @@ class AnimatedMesh:
             self.frames.ndim == 3 and self.frames.shape[2] == 3 and self.frames.shape[0] >= 1,
             f"frames: expected shape (F, V, 3) with F >= 1, got {self.frames.shape}",
         )
-        _check_finite("frames", self.frames)
-        self.faces = _check_faces(self.faces, self.frames.shape[1])
+        check_finite("frames", self.frames)
+        self.faces = checked_faces(self.faces, self.frames.shape[1])
         _require(self.fps is None or self.fps > 0.0 and np.isfinite(self.fps), f"fps: expected > 0, got {self.fps}")
 
     @property
@@ -142,7 +144,7 @@ class Skeleton:
             f"parents: joint {later[0] + 1 if later.size else 0} has a parent that does not come before it",
         )
         _require(bool(np.all(self.parents[1:] >= 0)), "parents: only joint 0 may have no parent")
-        _check_finite("offsets", self.offsets)
+        check_finite("offsets", self.offsets)
         if self.rest_rotations is None:
             self.rest_rotations = rotations.identity((joint_count,))
         self.rest_rotations = np.asarray(self.rest_rotations, dtype=np.float64)
@@ -229,8 +231,8 @@ class Motion:
         )
         expected = (frame_count, self.skeleton.joint_count, 4)
         _require(local.shape == expected, f"local_rotations: expected shape {expected}, got {local.shape}")
-        _check_finite("root_positions", self.root_positions)
-        _check_finite("local_rotations", local)
+        check_finite("root_positions", self.root_positions)
+        check_finite("local_rotations", local)
         self.local_rotations = rotations.normalize(local, "local_rotations")
         _require(self.fps > 0 and np.isfinite(self.fps), f"fps: must be positive, got {self.fps}")
         if self.joint_translations is not None:
@@ -239,14 +241,14 @@ class Motion:
                 self.joint_translations.shape == expected[:2] + (3,),
                 f"joint_translations: expected shape {expected[:2] + (3,)}, got {self.joint_translations.shape}",
             )
-            _check_finite("joint_translations", self.joint_translations)
+            check_finite("joint_translations", self.joint_translations)
         if self.joint_deformations is not None:
             self.joint_deformations = np.asarray(self.joint_deformations, dtype=np.float64)
             _require(
                 self.joint_deformations.shape == expected[:2] + (3, 3),
                 f"joint_deformations: expected shape {expected[:2] + (3, 3)}, got {self.joint_deformations.shape}",
             )
-            _check_finite("joint_deformations", self.joint_deformations)
+            check_finite("joint_deformations", self.joint_deformations)
 
     @property
     def frame_count(self) -> int:
@@ -338,7 +340,7 @@ class Motion:
         inverse_bind = np.asarray(inverse_bind, dtype=np.float64)
         expected = (self.skeleton.joint_count, 4, 4)
         _require(inverse_bind.shape == expected, f"inverse_bind: expected shape {expected}, got {inverse_bind.shape}")
-        _check_finite("inverse_bind", inverse_bind)
+        check_finite("inverse_bind", inverse_bind)
         world = self.world_transforms()
         if self.joint_deformations is not None:
             world[..., :3, :3] = world[..., :3, :3] @ self.joint_deformations
@@ -381,8 +383,8 @@ class SkinnedMesh:
             self.rest_positions.shape == (vertex_count, 3),
             f"rest_positions: expected (V, 3), got {self.rest_positions.shape}",
         )
-        _check_finite("rest_positions", self.rest_positions)
-        self.faces = _check_faces(self.faces, vertex_count)
+        check_finite("rest_positions", self.rest_positions)
+        self.faces = checked_faces(self.faces, vertex_count)
         self.joints = np.asarray(self.joints)
         weights = np.asarray(self.weights, dtype=np.float64)
         _require(
@@ -394,7 +396,7 @@ class SkinnedMesh:
             self.joints.shape[1] in (1, 2, 3, 4, 8),
             f"joints: K must be 1-4 or 8 influences, got {self.joints.shape[1]}",
         )
-        _check_finite("weights", weights)
+        check_finite("weights", weights)
         joint_count = self.skeleton.joint_count
         self.joints = whole_indices("joints", self.joints, "vertex", 0, joint_count)
         _require(bool(np.all(weights >= 0.0)), "weights: negative skin weight")
@@ -404,25 +406,25 @@ class SkinnedMesh:
             self.inverse_bind.shape == (joint_count, 4, 4),
             f"inverse_bind: expected ({joint_count}, 4, 4), got {self.inverse_bind.shape}",
         )
-        _check_finite("inverse_bind", self.inverse_bind)
+        check_finite("inverse_bind", self.inverse_bind)
         if self.uvs is not None:
             self.uvs = np.ascontiguousarray(self.uvs, dtype=np.float32)
             _require(self.uvs.shape == (vertex_count, 2), f"uvs: expected ({vertex_count}, 2), got {self.uvs.shape}")
-            _check_finite("uvs", self.uvs)
+            check_finite("uvs", self.uvs)
         if self.normals is not None:
             self.normals = np.ascontiguousarray(self.normals, dtype=np.float32)
             _require(
                 self.normals.shape == (vertex_count, 3),
                 f"normals: expected ({vertex_count}, 3), got {self.normals.shape}",
             )
-            _check_finite("normals", self.normals)
+            check_finite("normals", self.normals)
         if self.morph_targets is not None:
             self.morph_targets = np.ascontiguousarray(self.morph_targets, dtype=np.float32)
             _require(
                 self.morph_targets.ndim == 3 and self.morph_targets.shape[1:] == (vertex_count, 3),
                 f"morph_targets: expected (N, {vertex_count}, 3), got {self.morph_targets.shape}",
             )
-            _check_finite("morph_targets", self.morph_targets)
+            check_finite("morph_targets", self.morph_targets)
 
     @property
     def vertex_count(self) -> int:
@@ -453,7 +455,7 @@ class SkinnedMesh:
             _require(
                 morph_weights.shape == expected, f"morph_weights: expected shape {expected}, got {morph_weights.shape}"
             )
-            _check_finite("morph_weights", morph_weights)
+            check_finite("morph_weights", morph_weights)
         matrices = motion.skin_matrices(self.inverse_bind).astype(np.float32)
         if morph_weights is None or self.morph_targets is None:
             frames = bake_lbs(self.rest_positions, self.joints, self.weights, matrices)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import _check_faces, _check_finite
+from ..model import check_finite, checked_faces
 from .regions import FaceRegions, RegionGroup
 
 
@@ -69,9 +69,9 @@ def grow_regions(features: np.ndarray, faces: np.ndarray, options: GrowOptions |
     features = np.asarray(features, dtype=np.float64)
     if features.ndim != 2 or features.shape[1] % 3:
         raise ValueError(f"features: expected shape (V, D) with D a multiple of 3, got {features.shape}")
-    _check_finite("features", features)
+    check_finite("features", features)
     vertex_count, dimensions = features.shape
-    faces = _check_faces(faces, vertex_count).astype(np.int64)
+    faces = checked_faces(faces, vertex_count).astype(np.int64)
     magnitude = np.linalg.norm(features.reshape(vertex_count, dimensions // 3, 3), axis=2).max(axis=1, initial=0.0)
     largest = float(magnitude.max(initial=0.0))
     if not largest > 0.0:

@@ -29,12 +29,19 @@ def _prefix(target: Path) -> str:
     return f".{target.name}.animlod-{os.getpid()}-"
 
 
+def nearest_existing(path: str | os.PathLike) -> Path:
+    """``path`` or its nearest ancestor that exists (a file or a folder; a dangling link counts),
+    as relative as ``path`` is: "." when none of a relative path's folders exists."""
+    found = os.fspath(path)
+    while found and not os.path.lexists(found) and os.path.dirname(found) != found:
+        found = os.path.dirname(found)
+    return Path(found or ".")
+
+
 def unwritable(path: str | os.PathLike) -> str | None:
     """Why :func:`atomic_write` could not write ``path`` (its nearest existing folder is a file or
     takes no new file), or None: for work that writes its result only at the end."""
-    folder = Path(os.path.abspath(path)).parent
-    while not folder.exists():
-        folder = folder.parent
+    folder = nearest_existing(Path(os.path.abspath(path)).parent)
     if not folder.is_dir():
         return f"{folder} is not a folder"
     try:

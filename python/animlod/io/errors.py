@@ -46,12 +46,12 @@ def error_line(error: BaseException, source: str | None = None) -> str:
 def _file_in_the_way(error: BaseException) -> str | None:
     """The file standing where a folder was to be made (``-o out.glb`` for a command that writes
     folders), for the system's "File exists" and "Not a directory"; None for any other error."""
+    from .atomic import nearest_existing
+
     if not isinstance(error, (FileExistsError, NotADirectoryError)) or error.filename is None:
         return None
-    path = os.fspath(error.filename)
-    while path and not os.path.lexists(path):
-        path = os.path.dirname(path)
-    return path if path and os.path.lexists(path) and not os.path.isdir(path) else None
+    found = nearest_existing(error.filename)
+    return os.fspath(found) if os.path.lexists(found) and not found.is_dir() else None
 
 
 def _names_a_path(message: str, source: str) -> bool:

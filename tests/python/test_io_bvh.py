@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from animlod import rotations
-from animlod.io import FormatError, read_bvh, read_bvh_rotation_orders, write_bvh
+from animlod.io import FormatError, read_bvh, read_bvh_layout, write_bvh
 from animlod.model import Motion, Skeleton
 
 # Root with 6 channels, a 3-channel joint A (Z-X-Y intrinsic), an End Site, and a 6-channel
@@ -225,11 +225,11 @@ MIXED_ORDERS_BVH = (
 
 
 def test_a_motion_written_in_its_files_rotation_orders_keeps_its_channel_values(tmp_path: Path) -> None:
-    """read_bvh_rotation_orders gives each joint's order as written (the one-channel hinge has none:
+    """read_bvh_layout gives each joint's rotation order as written (the one-channel hinge has none:
     written in the default ZXY), and write_bvh writes them back: the same channels and, for angles
     in Euler's principal range, the same values."""
     source = _write(tmp_path, MIXED_ORDERS_BVH)
-    orders = read_bvh_rotation_orders(source)
+    orders = read_bvh_layout(source).rotation_orders
     assert orders == {"Hips": "ZYX", "Spine": "YXZ"}
     write_bvh(tmp_path / "back.bvh", read_bvh(source), rotation_order=orders)
     text = (tmp_path / "back.bvh").read_text()
@@ -239,6 +239,39 @@ def test_a_motion_written_in_its_files_rotation_orders_keeps_its_channel_values(
     rows = np.loadtxt(text.split("Frame Time: 0.5\n")[1].splitlines())
     expected = np.loadtxt(MIXED_ORDERS_BVH.split("Frame Time: 0.5\n")[1].splitlines())
     np.testing.assert_allclose(rows[:, :9], expected[:, :9], atol=1e-6)
+
+
+def _root_block(name: str, child: str, offset: str) -> str:
+    """A ROOT block with six channels, one child of three and its end site."""
+    return (
+        f"ROOT {name}\n{{\n\tOFFSET {offset}\n"
+        "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+        f"\tJOINT {child}\n\t{{\n\t\tOFFSET 0 1 0\n\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n"
+        "\t\tEnd Site\n\t\t{\n\t\t\tOFFSET 0 1 0\n\t\t}\n\t}\n}\n"
+    )
+
+
+def _bvh_text(blocks: list[str], rows: list[str]) -> str:
+    return "HIERARCHY\n" + "".join(blocks) + f"MOTION\nFrames: {len(rows)}\nFrame Time: 0.5\n" + "\n".join(rows) + "\n"
+
+
+def test_several_roots_read_as_one_skeleton_below_a_joint_of_their_own(tmp_path: Path) -> None:
+    """Two ROOTs (a performer and a prop, or two performers): each moves as its file alone would,
+    below a joint at the origin named Roots (Roots1 here, as the file has a joint Roots). Such
+    files were refused."""
+    actor, prop = _root_block("Actor", "Roots", "0 0 0"), _root_block("Prop", "Tip", "5 0 0")
+    actor_rows = ["1 2 3 10 20 30 40 0 0", "2 2 3 15 25 35 45 5 0"]
+    prop_rows = ["-1 0 0 0 90 0 0 0 30", "-2 0 1 0 80 0 0 0 20"]
+    both = _write(tmp_path, _bvh_text([actor, prop], [f"{a} {p}" for a, p in zip(actor_rows, prop_rows)]), "both.bvh")
+    motion = read_bvh(both)
+    assert motion.skeleton.names[:2] == ["Roots1", "Actor"] and motion.skeleton.parents[[1, 4]].tolist() == [0, 0]
+    assert read_bvh_layout(both).roots == ["Actor", "Prop"]
+    np.testing.assert_array_equal(motion.root_positions, 0.0)
+    for block, rows, joints in ((actor, actor_rows, slice(1, 4)), (prop, prop_rows, slice(4, 7))):
+        alone = read_bvh(_write(tmp_path, _bvh_text([block], rows), "alone.bvh"))
+        np.testing.assert_allclose(motion.world_positions()[:, joints], alone.world_positions(), atol=1e-12)
+    write_bvh(tmp_path / "back.bvh", motion)
+    np.testing.assert_allclose(read_bvh(tmp_path / "back.bvh").world_positions(), motion.world_positions(), atol=1e-5)
 
 
 def test_write_rejects_bad_rotation_order(tmp_path: Path) -> None:

@@ -243,3 +243,19 @@ def test_levels_of_a_bvh_keep_its_rotation_channel_orders(tmp_path) -> None:
         channels = [line.split()[2:] for line in level.read_text().splitlines() if "CHANNELS" in line]
         assert channels[0][3:] == ["Zrotation", "Yrotation", "Xrotation"]
         assert all(joint[-3:] == ["Xrotation", "Yrotation", "Zrotation"] for joint in channels[1:]), level.name
+
+
+def test_cli_a_bvh_of_two_roots_is_simplified_below_one_and_says_so(tmp_path, capsys) -> None:
+    """Two ROOTs, each a copy of the tree clip's skeleton: one motion, a note naming them."""
+    motion = tree_motion(8)
+    write_bvh(tmp_path / "one.bvh", motion)
+    hierarchy, table = (tmp_path / "one.bvh").read_text().split("MOTION\n")
+    lines = table.splitlines()
+    header, rows = lines[:2], lines[2:]
+    second = hierarchy.split("HIERARCHY\n", 1)[1].replace("ROOT j0", "ROOT k0").replace("JOINT j", "JOINT k")
+    source = tmp_path / "two.bvh"
+    source.write_text(hierarchy + second + "MOTION\n" + "\n".join(header) + "\n" + "".join(f"{r} {r}\n" for r in rows))
+    assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--levels", "3"]) == 0
+    printed = capsys.readouterr()
+    assert "its 2 ROOTs (j0, k0) are joints below one ROOT of its own, 'Roots'" in printed.out + printed.err
+    assert len(list((tmp_path / "out").glob("two_lod*.bvh"))) == 3

@@ -1,16 +1,17 @@
 """File formats: BVH, glTF 2.0 / GLB, OBJ and PLY frame sequences, NPZ."""
 
-from .bvh import read_bvh, read_bvh_rotation_orders, write_bvh
+from .bvh import BvhLayout, read_bvh, read_bvh_layout, write_bvh
 from .errors import FormatError
 from .gltf import GltfScene, read_gltf, read_lod_chains, read_skinned, write_glb
 from .meshseq import read_mesh, read_obj, read_ply, read_sequence, write_mesh, write_obj, write_ply, write_sequence
 from .npz import read_npz, write_npz
 
 __all__ = [
+    "BvhLayout",
     "FormatError",
     "GltfScene",
     "read_bvh",
-    "read_bvh_rotation_orders",
+    "read_bvh_layout",
     "read_gltf",
     "read_lod_chains",
     "read_mesh",

@@ -10,6 +10,9 @@ Conventions of this reader, in terms of :class:`animlod.model.Motion`:
   written beside it or else ``f"{parent}_End"``, with a number appended where a joint of the
   file has that name (``A_End1`` beside a JOINT ``A_End``, wherever that joint is written).
 - ``skeleton.offsets`` are the OFFSET values; the root's offset is its rest position.
+- A file with several ROOTs (two performers, a tracked prop) is one skeleton: a joint named
+  ``Roots`` at the origin, without channels, holds each ROOT as a child, whose position channels
+  become its ``joint_translations`` (:func:`write_bvh` writes it back with one ROOT).
 - Position channels *replace* the offset of their joint. The root's become
   ``root_positions`` (the root's OFFSET when it has none). Position channels on other joints
   (Bandai Namco files put six channels on every joint, and animate the hips' translation under
@@ -47,6 +50,8 @@ from .atomic import atomic_write
 from .errors import FormatError
 from .tokens import parses, tokens_per_line
 
+# The joint a file with several ROOTs gets above them (a number appended if the file uses the name).
+ROOTS_JOINT = "Roots"
 # Lower-case channel name -> (kind, axis index).
 _CHANNELS = {
     f"{axis.lower()}{kind}": (kind, index) for index, axis in enumerate("XYZ") for kind in ("position", "rotation")
@@ -153,7 +158,7 @@ def read_bvh(path: str | os.PathLike) -> Motion:
         values, a value that is not a finite number.
     """
     path = Path(path)
-    text, joints, motion_match, motion_line = _read_hierarchy(path)
+    text, joints, _, motion_match, motion_line = _read_hierarchy(path)
     if motion_match is None:
         raise FormatError(path, f"line {motion_line}", "no MOTION section after the hierarchy")
     frame_count, fps, data_line, data_text = _parse_motion_header(path, text[motion_match.end() :], motion_line)
@@ -162,26 +167,42 @@ def read_bvh(path: str | os.PathLike) -> Motion:
     return _build_motion(path, joints, values, fps)
 
 
-def read_bvh_rotation_orders(path: str | os.PathLike) -> dict[str, str]:
-    """Each joint's Euler order as its rotation channels are written (``"ZYX"`` for ``Zrotation
-    Yrotation Xrotation``), by joint name, for joints with all three: what :func:`write_bvh` takes
-    to write a file's levels in its own channel layout. Reads the hierarchy only; raises
-    FormatError as :func:`read_bvh` does for it."""
+@dataclass(frozen=True)
+class BvhLayout:
+    """What a BVH file's hierarchy says besides the motion :func:`read_bvh` makes of it.
+
+    roots : names of its ROOT joints in file order (several: :func:`read_bvh` puts them under one
+        joint of its own, :data:`ROOTS_JOINT`).
+    rotation_orders : joint name -> Euler order of its rotation channels as written (``"ZYX"``
+        for ``Zrotation Yrotation Xrotation``), for the joints with all three: what
+        :func:`write_bvh` takes to write a motion in the file's own channel layout.
+    """
+
+    roots: list[str]
+    rotation_orders: dict[str, str]
+
+
+def read_bvh_layout(path: str | os.PathLike) -> BvhLayout:
+    """The layout of a BVH file's hierarchy (reads the hierarchy only; raises FormatError as
+    :func:`read_bvh` does for it)."""
+    _, joints, roots, _, _ = _read_hierarchy(Path(path))
     orders = {}
-    for joint in _read_hierarchy(Path(path))[1]:
+    for joint in joints:
         order = "".join(channel[0].upper() for channel in joint.channels if channel.lower().endswith("rotation"))
         if sorted(order) == ["X", "Y", "Z"]:
             orders[joint.name] = order
-    return orders
+    return BvhLayout([joints[root].name for root in roots], orders)
 
 
-def _read_hierarchy(path: Path) -> tuple[str, list[_JointSpec], re.Match | None, int]:
-    """The file's text (line ends made LF), its parsed joints, the match of its MOTION line (None
-    when it has none) and the number of lines before it."""
+def _read_hierarchy(path: Path) -> tuple[str, list[_JointSpec], list[int], re.Match | None, int]:
+    """The file's text (line ends made LF), its parsed joints and the indices of its ROOTs among
+    them (:func:`_parse_hierarchy`), the match of its MOTION line (None when it has none) and the
+    number of lines before it."""
     text = _decode(path.read_bytes()).replace("\r\n", "\n").replace("\r", "\n")
     motion_match = _MOTION_LINE.search(text)
     hierarchy_lines = text[: motion_match.start() if motion_match else len(text)].split("\n")
-    return text, _parse_hierarchy(_TokenCursor(path, hierarchy_lines)), motion_match, len(hierarchy_lines)
+    joints, roots = _parse_hierarchy(_TokenCursor(path, hierarchy_lines))
+    return text, joints, roots, motion_match, len(hierarchy_lines)
 
 
 def _decode(data: bytes) -> str:
@@ -204,13 +225,39 @@ def _decode(data: bytes) -> str:
     return data.decode("latin-1") if re.search("[\uff61-\uff9f]", text) else text
 
 
-def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
-    """Joints in file order. Iterative, with a stack of open blocks: chains of any depth parse."""
+def _parse_hierarchy(cursor: _TokenCursor) -> tuple[list[_JointSpec], list[int]]:
+    """Joints in file order, under a joint of their own (:data:`ROOTS_JOINT`) when the file has
+    several ROOTs, and the indices of the file's ROOTs among them."""
     cursor.expect("HIERARCHY")
     token, line = cursor.next("ROOT")
     if not _is_keyword(token, "ROOT"):
         raise cursor.error(line, f"expected ROOT, found {token!r}")
     joints: list[_JointSpec] = []
+    roots = []
+    while True:
+        roots.append(len(joints))
+        _parse_root(cursor, joints, line)
+        extra = cursor.peek()
+        if extra is None:
+            break
+        if not _is_keyword(extra[0], "ROOT"):
+            raise cursor.error(extra[1], f"unexpected {extra[0]!r} after the root")
+        line = cursor.next("ROOT")[1]
+    if len(roots) == 1:
+        return joints, roots
+    # Several ROOTs (performers, props): one skeleton, each root a translating joint below a
+    # joint at the origin, which has no channels.
+    for joint in joints:
+        joint.parent += 1
+    for root in roots:
+        joints[root].parent = 0
+    above = _JointSpec(_unique_name(ROOTS_JOINT, joints), -1, False, (0.0, 0.0, 0.0))
+    return [above, *joints], [root + 1 for root in roots]
+
+
+def _parse_root(cursor: _TokenCursor, joints: list[_JointSpec], line: int) -> None:
+    """One ROOT block (keyword consumed), its joints appended in file order. Iterative, with a
+    stack of open blocks: chains of any depth parse."""
     open_blocks = [_open_joint(cursor, joints, parent=-1, line=line, end_site=False)]  # (joint, line)
     while open_blocks:
         index, opened = open_blocks[-1]
@@ -232,12 +279,6 @@ def _parse_hierarchy(cursor: _TokenCursor) -> list[_JointSpec]:
         else:
             where = f"End Site of {joints[joint.parent].name!r}" if joint.end_site else f"joint {joint.name!r}"
             raise cursor.error(token_line, f"unexpected {token!r} in {where}")
-    extra = cursor.peek()
-    if extra is not None:
-        second_root = _is_keyword(extra[0], "ROOT")
-        reason = "a second ROOT is not supported" if second_root else f"unexpected {extra[0]!r} after the root"
-        raise cursor.error(extra[1], reason)
-    return joints
 
 
 def _open_joint(
@@ -439,7 +480,7 @@ def write_bvh(
     path : destination file.
     motion : the motion to write.
     rotation_order : Euler order of the rotation channels, three different axes, e.g. "ZXY"; or
-        one per joint name (:func:`read_bvh_rotation_orders` of the file the motion came from),
+        one per joint name (:func:`read_bvh_layout`'s of the file the motion came from),
         "ZXY" for joints it does not name.
     precision : digits after the decimal point for offsets and channel values; None: 6, and
         more for a skeleton whose longest bone is under 1 unit (1e-6 of that bone at least).

@@ -113,6 +113,14 @@ def build_motion_levels(
             on_note(text)
 
     motion, skin = _read_input(source, clip, note)
+    layout = None
+    if input_kind(source) == "bvh":
+        from ..io.bvh import read_bvh_layout
+
+        layout = read_bvh_layout(source)
+        if len(layout.roots) > 1:
+            note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
+                 f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
     analysis, counts, floor = _plan_levels(
         motion, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
@@ -135,14 +143,14 @@ def build_motion_levels(
         on_choice=on_choice,
     )
 
-    from ..io.bvh import read_bvh_rotation_orders, write_bvh
+    from ..io.bvh import write_bvh
     from ..io.manifest import write_lod_manifest
 
     folder = Path(output)
     folder.mkdir(parents=True, exist_ok=True)
     stem = input_stem(source)
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
-    orders = read_bvh_rotation_orders(source) if input_kind(source) == "bvh" else "ZXY"
+    orders = layout.rotation_orders if layout is not None else "ZXY"
     files, rows = [], []
     for index, level in enumerate(chain.levels):
         names = [Path(f"{stem}_lod{index}.bvh")]

@@ -347,7 +347,9 @@ Status motion_refit_solve(const MotionRefitProblem& problem, const double* origi
   out.values.assign(frame_count, 0.0);
   out.evaluations.assign(frame_count, 0);
   out.failures.clear();
-  const auto chunk_frames = static_cast<size_t>(options.chunk_frames);
+  // Without warm starts every frame starts cold and is a task of its own: the threads share
+  // short solves (a trial re-fit's 16 frames) and uneven frames evenly, with the same results.
+  const auto chunk_frames = options.warm_start ? static_cast<size_t>(options.chunk_frames) : size_t{1};
   const size_t chunk_count = (frame_count + chunk_frames - 1) / chunk_frames;
   std::vector<std::vector<MotionRefitFailure>> chunk_failures(chunk_count);
   std::atomic<size_t> next_chunk{0};

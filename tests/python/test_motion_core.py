@@ -78,12 +78,18 @@ def test_core_solve_matches_the_python_reference(level, hard) -> None:
         assert np.abs(violation).max() <= 1e-6
 
 
-def test_core_solve_is_the_same_on_one_and_two_threads(level) -> None:
+@pytest.mark.parametrize("warm_start", [False, True])
+def test_core_solve_is_the_same_on_one_and_two_threads(level, warm_start) -> None:
+    """Warm starts run within chunks of frames; without them each frame is a task of its own,
+    and the chunk size changes nothing either."""
     _, _, problem, original, fallback = level
-    one = refit_core(problem, original, fallback, threads=1, chunk_frames=5)
-    two = refit_core(problem, original, fallback, threads=2, chunk_frames=5)
+    one = refit_core(problem, original, fallback, threads=1, chunk_frames=5, warm_start=warm_start)
+    two = refit_core(problem, original, fallback, threads=2, chunk_frames=5, warm_start=warm_start)
     np.testing.assert_array_equal(one.positions, two.positions)
     np.testing.assert_array_equal(one.evaluations, two.evaluations)
+    if not warm_start:
+        whole = refit_core(problem, original, fallback, threads=2, chunk_frames=len(original))
+        np.testing.assert_array_equal(whole.positions, two.positions)
 
 
 def test_core_refuses_bad_shapes_and_problems_by_name(level) -> None:

@@ -119,7 +119,8 @@ struct MotionRefitOptions {
   // three per child, and their group's lengths, heights and handedness leave SLSQP (they hold by
   // construction). A hand with its finger bases, the hips, the chest. The minima are the same.
   bool rigid_bodies = true;
-  int chunk_frames = 64;        // consecutive frames per task (warm starts run inside a chunk)
+  int chunk_frames = 64;        // with warm_start, consecutive frames per task (warm starts run
+                                // inside a chunk); without, each frame is a task
   int threads = 0;              // worker threads; 0 uses every hardware thread
 };
 

@@ -63,8 +63,9 @@ def refit_core(
     fallback : (T, P, 3) positions kept where a frame's solves fail (feasible by construction).
     options, **option_fields : a :class:`~animlod.options.MotionRefitOptions` and/or its fields
         by name: stopping rules, hard constraints, preconditioning, ``threads`` (0: every
-        hardware thread; the result does not depend on it) and ``chunk_frames`` (consecutive
-        frames per task; warm starts run inside a chunk).
+        hardware thread; the result does not depend on it) and ``chunk_frames`` (with
+        ``warm_start``, consecutive frames per task, the warm starts running inside a chunk;
+        without, each frame is a task).
     progress : called with the (fractional) number of frames finished after each group.
     cold_starts : (T, P, 3) where frames start and failed frames restart (feasible with hard
         constraints), or None: the original positions, or the fallback with hard constraints.

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -31,6 +32,8 @@ constexpr size_t kLeafSize = 4;
 constexpr size_t kStackSize = 96;
 // Points per thread below which another thread costs more than it saves.
 constexpr size_t kPointsPerThread = 2048;
+// Points a thread takes at a time.
+constexpr size_t kBlockPoints = 256;
 
 Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -269,22 +272,26 @@ size_t worker_count(size_t point_count, unsigned threads) {
 }
 
 // Checks the input, then runs query(tree, frame_points, nearest, frame, begin, end, worker) for
-// each frame in turn over `workers` fixed ranges of the points, the tree refitted to the frame.
-// nearest (N,) holds each point's nearest triangle so far (-1 before the first).
+// each frame in turn over blocks of kBlockPoints points that `workers` threads take as they
+// finish, the tree refitted to the frame. Points cost unequally (a vertex of the measured mesh
+// is found at once, a sample between its vertices is not; the metrics pass vertices first), so
+// fixed halves left one thread idle: 0.23 s on one thread and 0.21 s on two for face-poses'
+// vertices and samples against itself. nearest (N,) holds each point's nearest triangle so far
+// (-1 before the first).
 template <typename Query>
 Status query_frames(const TriangleMeshView& mesh, const double* points, size_t point_count, size_t workers,
                     const Query& query) {
   if (Status status = check_inputs(mesh, points, point_count); !status) return status;
   if (mesh.frame_count == 0) return Status::success();  // no frame, nothing to measure
   TriangleTree tree(mesh);
-  const size_t chunk = (point_count + workers - 1) / workers;
   std::vector<int64_t> nearest(point_count, -1);
   for (size_t frame = 0; frame < mesh.frame_count; ++frame) {
     if (frame > 0) tree.refit(mesh.vertices + 3 * mesh.vertex_count * frame);
     const double* frame_points = points + 3 * point_count * frame;
+    std::atomic<size_t> next{0};
     auto run = [&](size_t worker) {
-      query(tree, frame_points, nearest.data(), frame, std::min(point_count, worker * chunk),
-            std::min(point_count, (worker + 1) * chunk), worker);
+      for (size_t begin = next.fetch_add(kBlockPoints); begin < point_count; begin = next.fetch_add(kBlockPoints))
+        query(tree, frame_points, nearest.data(), frame, begin, std::min(point_count, begin + kBlockPoints), worker);
     };
     std::vector<std::thread> pool;
     for (size_t w = 1; w < workers; ++w) pool.emplace_back(run, w);

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pygltflib
 import pytest
@@ -66,6 +68,27 @@ def test_levels_prune_what_moves_less_than_their_geometric_error(face):
     rows = measure_blendshape_lod(face, levels, repeats=1, max_frames=8, samples=2000)
     assert rows[0].hausdorff < 1e-9 and rows[1].hausdorff < 0.05
     assert [row.targets for row in rows] == [len(level.kept_targets) for level in levels]
+
+
+def test_the_input_level_is_not_measured(face, monkeypatch):
+    """Level 0 draws the face itself: error 0 without measuring it (it gave float rounding for a
+    quarter of the time of face-poses' measurement); a copy of it is measured."""
+    import animlod.metrics
+
+    levels = build_blendshape_lod(face, BlendshapeLodOptions(ratios=(0.5,)))
+    measured = []
+    surface_error = animlod.metrics.surface_error
+
+    def counted(*args, **kwargs):
+        measured.append(args[1])
+        return surface_error(*args, **kwargs)
+
+    monkeypatch.setattr(animlod.metrics, "surface_error", counted)
+    rows = measure_blendshape_lod(face, levels, repeats=1, max_frames=4, samples=500)
+    assert len(measured) == 1 and rows[0].hausdorff == rows[0].hausdorff_units == 0.0
+    copy = dataclasses.replace(levels[0], neutral=levels[0].neutral.copy())
+    measure_blendshape_lod(face, [copy], repeats=1, max_frames=4, samples=500)
+    assert len(measured) == 2
 
 
 def test_targets_that_only_turn_normals_are_kept(face):

@@ -118,6 +118,9 @@ def test_projected_coverage_and_thresholds():
     assert [level_for_coverage(thresholds, c) for c in (10.0, thresholds[0], 0.5 * thresholds[0], 0.0)] == [0, 0, 1, 2]
     assert coverage_thresholds([0.0, 0.01, 0.005], 0.12, camera, 1.0)[1] == coverage_thresholds(
         [0.0, 0.01, 0.01], 0.12, camera, 1.0)[1]  # fmt: skip
+    # MSFT_lod's range: a level without error, or within rounding of the face, takes over at 1 (it
+    # gave an infinity, which JSON cannot hold, or 4e10).
+    assert coverage_thresholds([0.0, 0.0, 1e-12, 0.01], 0.12, camera, 1.0)[:2] == [1.0, 1.0]
 
 
 def test_frame_skipping_grows_with_distance_and_keeps_the_duration():

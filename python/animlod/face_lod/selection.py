@@ -66,18 +66,15 @@ def coverage_thresholds(errors: Sequence[float], radius: float, camera: Camera, 
 
     Level i+1 may replace level i once its error projects to at most ``pixel_tolerance`` pixels:
     an error e on a face of coverage c spans ``e c H / (2 radius)`` pixels, so
-    ``c_i = 2 radius tolerance / (e_{i+1} H)``. Errors are made non-decreasing first (a coarser
-    level is never assumed better than a finer one); the last threshold is 0.
+    ``c_i = 2 radius tolerance / (e_{i+1} H)``: the LoD GLB's rule
+    (:func:`animlod.io.gltf_lod.screen_coverages`, the face's diameter as its size), clamped to
+    MSFT_lod's range [0, 1], non-increasing (a coarser level is never assumed better than a finer
+    one), the last 0. Unclamped, a level 1 within float rounding of the face put a threshold of
+    4e10 in the GLB (and one of error 0 an infinity, which JSON cannot hold).
     """
-    errors = np.maximum.accumulate(np.asarray(errors, dtype=np.float64))
-    thresholds = []
-    for error in errors[1:]:
-        pixels_per_coverage = error * camera.viewport_height_px / (2.0 * radius)
-        thresholds.append(math.inf if error <= 0.0 else pixel_tolerance / pixels_per_coverage)
-    thresholds.append(0.0)
-    # A level whose error is 0 is never worse: let it take over at once (threshold inf), and keep
-    # the thresholds decreasing.
-    return list(np.minimum.accumulate(np.asarray(thresholds)))
+    from ..io.gltf_lod import screen_coverages
+
+    return screen_coverages(list(errors), 2.0 * radius, pixel_tolerance, camera.viewport_height_px)
 
 
 def level_for_coverage(thresholds: Sequence[float], coverage: float) -> int:

@@ -154,3 +154,17 @@ def test_sigterm_during_a_cli_write_removes_the_temporary(tmp_path: Path) -> Non
     done = subprocess.run([sys.executable, "-c", script, str(tmp_path)], capture_output=True, text=True)
     assert done.returncode == 143 and done.stderr == "animlod info: terminated\n"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_non_finite_number_is_named_and_nothing_is_written(tmp_path: Path) -> None:
+    """JSON has no NaN or infinity: Python's json wrote them as NaN and Infinity, which every strict
+    glTF or JSON reader refuses. The writers name where the number is and write nothing."""
+    from animlod.io.glb_builder import GlbBuilder
+
+    with pytest.raises(ValueError, match=r"levels\.json: JSON /levels/1/error: not a finite number"):
+        write_lod_manifest(tmp_path / "levels.json", "mesh", [{"error": 0.0}, {"error": float("inf")}])
+    builder = GlbBuilder()
+    builder.append("nodes", {"extras": {"animlod": {"error": float("nan")}}})
+    with pytest.raises(ValueError, match=r"JSON /nodes/0/extras/animlod/error: not a finite number"):
+        builder.save(tmp_path / "level.glb")
+    assert list(tmp_path.iterdir()) == []

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import base64
 import copy
-import json
 import mimetypes
 import os
 import struct
@@ -25,6 +24,7 @@ from .atomic import atomic_write
 from .gltf_document import GltfDocument
 from .gltf_draco import DRACO_EXTENSION
 from .gltf_meshopt import MESHOPT_EXTENSIONS
+from .json_limits import finite_json_text
 
 BYTE, UNSIGNED_BYTE, SHORT, UNSIGNED_SHORT, UNSIGNED_INT, FLOAT = 5120, 5121, 5122, 5123, 5125, 5126
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
@@ -181,7 +181,7 @@ class GlbBuilder:
             self.json["buffers"] = [{"byteLength": len(self.blob)}]
         else:
             self.json.pop("buffers", None)
-        text = json.dumps(self.json, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
+        text = finite_json_text(self.json, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
         text += b" " * (-len(text) % 4)
         chunks = struct.pack("<II", len(text), _JSON_CHUNK) + text
         if self.blob:

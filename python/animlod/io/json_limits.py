@@ -1,9 +1,13 @@
-"""JSON from untrusted files with bounded nesting.
+"""JSON from untrusted files with bounded nesting, and JSON written only with finite numbers.
 
 ``json.loads`` recurses once per nesting level; a file of 100,000 ``[`` raises RecursionError
 (or, in a deeper call stack, exhausts it). animlod's JSON documents (glTF, LoD manifests) need a
 handful of levels, so anything nested deeper than :data:`MAX_JSON_DEPTH` is refused before it is
 parsed, with a FormatError naming the file and the byte where the limit is crossed.
+
+Python's ``json`` writes NaN and infinities as ``NaN`` and ``Infinity``, which JSON does not
+have: a glTF or manifest holding one is refused by every strict reader. :func:`finite_json_text`
+refuses them instead, naming where the first one is.
 """
 
 from __future__ import annotations
@@ -61,3 +65,27 @@ def load_json(path: str | os.PathLike, data: bytes, element: str = "JSON") -> An
         raise FormatError(path, element, reason) from None
     except RecursionError:  # a deep stack of callers; the depth check above makes this rare
         raise FormatError(path, element, "nests too deeply to parse") from None
+
+
+def finite_json_text(document: Any, **dumps_options: Any) -> str:
+    """``json.dumps(document, **dumps_options)``; ValueError naming the JSON pointer of the first
+    number that is not finite (``/nodes/3/extras/animlod/error``) instead of writing it."""
+    try:
+        return json.dumps(document, allow_nan=False, **dumps_options)
+    except ValueError:
+        pointer = _non_finite_pointer(document, "")
+        if pointer is None:
+            raise
+        raise ValueError(f"JSON {pointer or '/'}: not a finite number (JSON has no NaN or infinity)") from None
+
+
+def _non_finite_pointer(value: Any, pointer: str) -> str | None:
+    """The JSON pointer of the first non-finite float within ``value``, or None."""
+    if isinstance(value, float):
+        return None if np.isfinite(value) else pointer
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list | tuple) else ()
+    for key, item in items:
+        found = _non_finite_pointer(item, f"{pointer}/{key}")
+        if found is not None:
+            return found
+    return None

@@ -7,7 +7,6 @@ draws the coarsest level under its pixel budget (see :meth:`animlod.model.LodCha
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Sequence
@@ -16,7 +15,7 @@ from typing import Any
 
 from .atomic import atomic_write
 from .errors import FormatError
-from .json_limits import load_json
+from .json_limits import finite_json_text, load_json
 
 MANIFEST_FORMAT = "animlod-lod"
 MANIFEST_VERSION = 1
@@ -34,9 +33,12 @@ def write_lod_manifest(path: str | os.PathLike, kind: str, levels: Sequence[dict
         if "error" not in level:
             raise ValueError(f"{os.fspath(path)}: level {index}: no 'error'")
     document = {"format": MANIFEST_FORMAT, "version": MANIFEST_VERSION, "kind": kind, "levels": list(levels)}
+    try:
+        text = finite_json_text(document, indent=2)
+    except ValueError as error:
+        raise ValueError(f"{os.fspath(path)}: {error}") from None
     with atomic_write(path, "w", encoding="utf-8") as handle:
-        json.dump(document, handle, indent=2)
-        handle.write("\n")
+        handle.write(text + "\n")
 
 
 def read_lod_manifest(path: str | os.PathLike) -> dict[str, Any]:

@@ -196,6 +196,22 @@ def test_folder_and_glob_use_natural_order_and_lists_keep_theirs(tmp_path: Path)
     np.testing.assert_array_equal(read_sequence(tmp_path / "take[2].obj").frames, mesh.frames[[1]])
 
 
+@pytest.mark.parametrize(
+    ("names", "order"),
+    [
+        (["frame.0001.obj", "frame.-001.obj", "frame.0000.obj", "frame.-002.obj"], [3, 1, 2, 0]),  # Houdini
+        (["cloth_1.obj", "cloth_-1.obj", "cloth_0.obj"], [1, 2, 0]),
+        (["mesh-002.obj", "mesh-001.obj", "mesh-010.obj"], [1, 0, 2]),  # a dash after a letter separates
+    ],
+)
+def test_frames_numbered_below_zero_come_first(tmp_path: Path, names: list[str], order: list[int]) -> None:
+    """Negative frame numbers sorted after every other frame: a sequence started before frame 0
+    was read with its first frames last."""
+    for name in names:
+        (tmp_path / name).write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    assert [path.name for path in meshseq.frame_files(tmp_path)] == [names[index] for index in order]
+
+
 # --- real sequences (SOURCES.md) ------------------------------------------------------------
 
 

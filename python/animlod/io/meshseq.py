@@ -105,6 +105,10 @@ def write_sequence(folder: str | os.PathLike, mesh: AnimatedMesh, fmt: str = "ob
     return [Path(folder) / name for name in names]
 
 
+# A number in a frame name, with its sign where a minus follows a separator.
+_NUMBER = re.compile(r"((?:(?<=[._ ])-)?\d+)")
+
+
 def sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> list[Path]:
     """The frame files :func:`read_sequence` reads for ``source``, in its order; FormatError when
     there is none."""
@@ -141,8 +145,11 @@ def frame_files(folder: str | os.PathLike) -> list[Path]:
 
 def natural_key(path: Path) -> tuple[list[object], str]:
     """Sort key that orders embedded numbers by value (frame2 < frame10) and letters regardless
-    of case, then by full path."""
-    return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", path.name)], str(path)
+    of case, then by full path. A minus sign after a separator is the number's
+    (``frame.-001.obj``, before frame 0, as Houdini numbers frames before the first); after
+    anything else it separates (``mesh-001`` is frame 1)."""
+    parts = _NUMBER.split(path.name)  # text, number, text, ...: the numbers at odd places
+    return [int(part) if index % 2 else part.lower() for index, part in enumerate(parts)], str(path)
 
 
 def _check_same_connectivity(

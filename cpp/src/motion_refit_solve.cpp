@@ -1,9 +1,10 @@
 // Motion LoD re-fit, the solve (seeds/000, Section 5.2: "SQP is applied to solve this
 // problem"): one small SLSQP problem per frame (nlopt's LD_SLSQP through its C library), since
-// E (Eq. 5) does not couple frames. Phases per chunk of consecutive frames: pick the start (the
-// chunk's cold start, then the previous frame's result), precondition, solve, check, and retry
-// from the cold start or fall back when the check fails. Chunks run on std::threads; a chunk's
-// result depends only on its own frames, so the output does not depend on the thread count.
+// E (Eq. 5) does not couple frames. Phases per frame: pick the start (the cold start, or with
+// warm starts the previous frame's result within a chunk of consecutive frames), precondition,
+// solve, check, and retry from the cold start or fall back when the check fails. Chunks (single
+// frames without warm starts) run on std::threads; a chunk's result depends only on its own
+// frames, so the output does not depend on the thread count.
 //
 // The Python reference of the same loop is python/animlod/motion_lod/refit.py.
 #include <algorithm>

@@ -1,3 +1,6 @@
+#include <string>
+#include <vector>
+
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -58,6 +61,28 @@ double point_mesh_max_squared_distance_py(const DoubleArray& points, const Doubl
   return out;
 }
 
+py::array_t<double> point_mesh_max_squared_distances_py(const DoubleArray& points, const DoubleArray& vertices,
+                                                        const py::array& face_indices, const py::array& segment_ends,
+                                                        const DoubleArray& floors, unsigned threads) {
+  const IndexArray faces = index_array(face_indices, "faces");
+  const IndexArray ends = index_array(segment_ends, "segment_ends");
+  require_shape(ends, "segment_ends", {-1}, "(S,)");
+  require_shape(floors, "floors", {ends.shape(0)}, "(S,) like segment_ends");
+  const TriangleMeshView mesh = checked_mesh(points, vertices, faces);
+  std::vector<size_t> checked_ends;
+  for (py::ssize_t s = 0; s < ends.shape(0); ++s) {
+    if (ends.data()[s] < 0) throw py::value_error("segment_ends[" + std::to_string(s) + "]: negative");
+    checked_ends.push_back(static_cast<size_t>(ends.data()[s]));
+  }
+  py::array_t<double> out(ends.shape(0));
+  double* out_data = out.mutable_data();
+  call_released([&] {
+    return point_mesh_max_squared_distances(mesh, points.data(), point_count_of(points), checked_ends.data(),
+                                            checked_ends.size(), threads, floors.data(), out_data);
+  });
+  return out;
+}
+
 }  // namespace
 
 void bind_point_mesh_distance(py::module_& m) {
@@ -90,6 +115,15 @@ to the bit, for any thread count, at a fraction of the cost: a point's search en
 triangle no farther than the largest distance found so far (or ``floor``), since such a point
 cannot raise it (a one-sided Hausdorff distance with an early break). The same errors, and a
 NaN floor.)doc");
+  m.def("point_mesh_max_squared_distances", &point_mesh_max_squared_distances_py, py::arg("points"),
+        py::arg("vertices"), py::arg("faces"), py::arg("segment_ends"), py::arg("floors"), py::arg("threads") = 0,
+        R"doc(:func:`point_mesh_max_squared_distance` of each segment of the points alone, with one tree.
+
+Segment s is each frame's points ``[segment_ends[s - 1], segment_ends[s])`` (from 0; the last
+end is N) with its own ``floors[s]``: several levels' points measured against one mesh, whose
+tree is built once and refitted once per frame. Returns (S,) float64, each equal to the
+single-segment call on its points to the bit. The same errors, and segment ends that decrease or
+do not end at N.)doc");
 }
 
 }  // namespace animlod::bindings

@@ -316,27 +316,52 @@ Status point_mesh_squared_distance(const TriangleMeshView& mesh, const double* p
                       });
 }
 
-Status point_mesh_max_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
-                                       unsigned threads, double floor, double& out) {
-  if (std::isnan(floor)) return Status::error("floor: not a number");
-  // Each worker's largest so far (its own slot, a cache line apart), carried from frame to frame.
+Status point_mesh_max_squared_distances(const TriangleMeshView& mesh, const double* points, size_t point_count,
+                                        const size_t* segment_ends, size_t segment_count, unsigned threads,
+                                        const double* floors, double* out) {
+  for (size_t s = 0; s < segment_count; ++s) {
+    if (std::isnan(floors[s])) return Status::error("floors[" + std::to_string(s) + "]: not a number");
+    if (segment_ends[s] > point_count || (s > 0 && segment_ends[s] < segment_ends[s - 1]))
+      return Status::error("segment_ends[" + std::to_string(s) + "]: " + std::to_string(segment_ends[s]) +
+                           " is not within the points (" + std::to_string(point_count) + ") and increasing");
+  }
+  if (segment_count == 0 || segment_ends[segment_count - 1] != point_count)
+    return Status::error("segment_ends: the last end is not the point count, " + std::to_string(point_count));
+  // Each worker's largest so far per segment (a worker's slots a cache line apart from the next
+  // worker's), carried from frame to frame.
   struct alignas(64) Largest {
     double value;
   };
-  std::vector<Largest> largest(worker_count(point_count, threads), Largest{floor});
+  const size_t workers = worker_count(point_count, threads);
+  std::vector<Largest> largest(workers * segment_count);
+  for (size_t w = 0; w < workers; ++w)
+    for (size_t s = 0; s < segment_count; ++s) largest[w * segment_count + s].value = floors[s];
   const Status status = query_frames(
-      mesh, points, point_count, largest.size(),
+      mesh, points, point_count, workers,
       [&](const TriangleTree& tree, const double* frame_points, int64_t* nearest, size_t, size_t begin, size_t end,
           size_t worker) {
-        double value = largest[worker].value;
-        for (size_t i = begin; i < end; ++i)
-          value = std::max(value, tree.squared_distance(point_at(frame_points, i), nearest[i], value));
-        largest[worker].value = value;
+        size_t segment = static_cast<size_t>(std::upper_bound(segment_ends, segment_ends + segment_count, begin) -
+                                             segment_ends);
+        for (size_t i = begin; i < end; ++segment) {
+          const size_t stop = std::min(end, segment_ends[segment]);
+          double value = largest[worker * segment_count + segment].value;
+          for (; i < stop; ++i)
+            value = std::max(value, tree.squared_distance(point_at(frame_points, i), nearest[i], value));
+          largest[worker * segment_count + segment].value = value;
+        }
       });
   if (!status) return status;
-  out = floor;
-  for (const Largest& each : largest) out = std::max(out, each.value);
+  for (size_t s = 0; s < segment_count; ++s) {
+    out[s] = floors[s];
+    for (size_t w = 0; w < workers; ++w) out[s] = std::max(out[s], largest[w * segment_count + s].value);
+  }
   return Status::success();
+}
+
+Status point_mesh_max_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
+                                       unsigned threads, double floor, double& out) {
+  if (std::isnan(floor)) return Status::error("floor: not a number");
+  return point_mesh_max_squared_distances(mesh, points, point_count, &point_count, 1, threads, &floor, &out);
 }
 
 }  // namespace animlod

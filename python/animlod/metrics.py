@@ -161,13 +161,17 @@ def hausdorff_distances(
     for each in simplified:
         _check_frames(original, each)
     a, from_original = _measured_points(original, samples, seed)
-    distances = []
+    squared, from_simplified = [], []
     for each, floor in zip(simplified, at_least):
-        b, from_simplified = _measured_points(each, samples, seed + 1)
-        squared = _core.point_mesh_max_squared_distance(from_original, b, each.faces, floor=floor * floor)
-        squared = _core.point_mesh_max_squared_distance(from_simplified, a, original.faces, floor=squared)
-        distances.append(max(floor, float(np.sqrt(squared))))
-    return distances
+        b, points = _measured_points(each, samples, seed + 1)
+        squared.append(_core.point_mesh_max_squared_distance(from_original, b, each.faces, floor=floor * floor))
+        from_simplified.append(points)
+    # Every level's points against the original at once: its tree is built once for them all.
+    ends = np.cumsum([points.shape[1] for points in from_simplified])
+    squared = _core.point_mesh_max_squared_distances(
+        np.concatenate(from_simplified, axis=1), a, original.faces, ends, np.array(squared)
+    )
+    return [max(floor, float(np.sqrt(value))) for floor, value in zip(at_least, squared)]
 
 
 def _check_frames(original: AnimatedMesh, simplified: AnimatedMesh) -> None:

@@ -154,6 +154,31 @@ TEST_CASE("point_mesh_max_squared_distance is the largest of every distance, to 
   CHECK(status.message.find("points[0]") != std::string::npos);
   CHECK(animlod::point_mesh_max_squared_distance(mesh, points.data(), point_count, 0, std::nan(""), out).message ==
         "floor: not a number");
+
+  // Segments (an empty one among them, ends inside the threads' blocks of points): each the
+  // largest of its own points' distances or its floor, to the bit.
+  const std::vector<size_t> ends{1000, 1000, 3333, 3334, point_count};
+  const std::vector<double> floors{0.0, 0.5, 0.1 * largest, 0.0, 0.9 * largest};
+  for (const unsigned threads : {1u, 2u}) {
+    std::vector<double> per_segment(ends.size(), -1.0);
+    REQUIRE(animlod::point_mesh_max_squared_distances(mesh, points.data(), point_count, ends.data(), ends.size(),
+                                                      threads, floors.data(), per_segment.data()));
+    for (size_t s = 0; s < ends.size(); ++s) {
+      double expected = floors[s];
+      for (size_t frame = 0; frame < frames; ++frame)
+        for (size_t i = s ? ends[s - 1] : 0; i < ends[s]; ++i)
+          expected = std::max(expected, every[frame * point_count + i]);
+      CHECK(per_segment[s] == expected);
+    }
+  }
+  const std::vector<size_t> short_ends{1000, point_count - 1}, falling{1000, 999, point_count};
+  std::vector<double> scratch(ends.size());
+  CHECK(animlod::point_mesh_max_squared_distances(mesh, points.data(), point_count, short_ends.data(), 2, 0,
+                                                  floors.data(), scratch.data())
+            .message.find("the last end is not the point count") != std::string::npos);
+  CHECK(animlod::point_mesh_max_squared_distances(mesh, points.data(), point_count, falling.data(), 3, 0,
+                                                  floors.data(), scratch.data())
+            .message.find("segment_ends[1]") != std::string::npos);
 }
 
 TEST_CASE("point-to-mesh distances of no frame read nothing") {

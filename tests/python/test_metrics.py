@@ -123,6 +123,16 @@ def test_point_mesh_distance_names_bad_input():
         _core.point_mesh_max_squared_distance([[0, 0, 0], [np.nan, 0, 0]], square, np.array([[0, 1, 2]]))
     with pytest.raises(ValueError, match=r"vertices: expected"):
         _core.point_mesh_max_squared_distance(np.zeros((2, 1, 3)), square, np.array([[0, 1, 2]]))
+    points, triangle = np.zeros((3, 3)), np.array([[0, 1, 2]])
+    for ends, floors, message in (
+        ([1, 2], [0.0, 0.0], "the last end is not the point count, 3"),
+        ([2, 1, 3], [0.0] * 3, r"segment_ends\[1\]: 1 is not within the points \(3\) and increasing"),
+        ([-1, 3], [0.0, 0.0], r"segment_ends\[0\]: negative"),
+        ([1, 3], [0.0], r"floors: expected shape \(S,\) like segment_ends"),
+        ([1, 3], [0.0, np.nan], r"floors\[1\]: not a number"),
+    ):
+        with pytest.raises(ValueError, match=message):
+            _core.point_mesh_max_squared_distances(points, square, triangle, np.array(ends), np.array(floors))
 
 
 def test_sample_counts_and_seeds_are_checked_by_name():

@@ -37,4 +37,13 @@ Status point_mesh_squared_distance(const TriangleMeshView& mesh, const double* p
 Status point_mesh_max_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
                                        unsigned threads, double floor, double& out);
 
+// point_mesh_max_squared_distance of each segment of the points alone (segment s: each frame's
+// points [segment_ends[s - 1], segment_ends[s]), from 0; the last end is point_count), against
+// its own floors[s], into out[s], to the bit: several levels' points measured against one mesh
+// with one tree, refitted once per frame. Errors: those of point_mesh_max_squared_distance, and
+// segment ends that decrease or do not end at point_count.
+Status point_mesh_max_squared_distances(const TriangleMeshView& mesh, const double* points, size_t point_count,
+                                        const size_t* segment_ends, size_t segment_count, unsigned threads,
+                                        const double* floors, double* out);
+
 }  // namespace animlod

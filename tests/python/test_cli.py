@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 import pytest
+from bvh_edits import with_a_second_root
 
 from animlod import AnimatedMesh, Motion, Skeleton, rotations
 from animlod.cli import main
@@ -30,6 +31,11 @@ def test_info_bvh(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "joints: 2 (+1 end sites), root 'hips'" in out
     assert "frames: 4 at 24 fps" in out
+    assert "ROOTs" not in out
+    # Two ROOTs: the file's own are named beside the joint read above them.
+    two = with_a_second_root(path, tmp_path / "two.bvh", {"ROOT hips": "ROOT prop", "JOINT leg": "JOINT tip"})
+    assert main(["info", str(two)]) == 0
+    assert "ROOTs: hips, prop, below 'Roots' at the origin" in capsys.readouterr().out
 
 
 def test_info_npz(tmp_path, capsys):

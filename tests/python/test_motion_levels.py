@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from bvh_edits import with_a_second_root
 from test_motion_figures import figure_motion
 
 from animlod import rotations
@@ -247,14 +248,8 @@ def test_levels_of_a_bvh_keep_its_rotation_channel_orders(tmp_path) -> None:
 
 def test_cli_a_bvh_of_two_roots_is_simplified_below_one_and_says_so(tmp_path, capsys) -> None:
     """Two ROOTs, each a copy of the tree clip's skeleton: one motion, a note naming them."""
-    motion = tree_motion(8)
-    write_bvh(tmp_path / "one.bvh", motion)
-    hierarchy, table = (tmp_path / "one.bvh").read_text().split("MOTION\n")
-    lines = table.splitlines()
-    header, rows = lines[:2], lines[2:]
-    second = hierarchy.split("HIERARCHY\n", 1)[1].replace("ROOT j0", "ROOT k0").replace("JOINT j", "JOINT k")
-    source = tmp_path / "two.bvh"
-    source.write_text(hierarchy + second + "MOTION\n" + "\n".join(header) + "\n" + "".join(f"{r} {r}\n" for r in rows))
+    source = with_a_second_root(_write(tmp_path, tree_motion(8), "one.bvh"), tmp_path / "two.bvh",
+                                {"ROOT j0": "ROOT k0", "JOINT j": "JOINT k"})  # fmt: skip
     assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--levels", "3"]) == 0
     printed = capsys.readouterr()
     assert "its 2 ROOTs (j0, k0) are joints below one ROOT of its own, 'Roots'" in printed.out + printed.err

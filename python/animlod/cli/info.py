@@ -58,9 +58,13 @@ def _models(path: str) -> list[str]:
 
 def _describe(kind: str, path: str) -> list[str]:
     if kind == "bvh":
-        from ..io.bvh import read_bvh
+        from ..io.bvh import read_bvh, read_bvh_layout
 
-        return _motion_lines(read_bvh(path))
+        motion, roots = read_bvh(path), read_bvh_layout(path).roots
+        lines = _motion_lines(motion)
+        if len(roots) > 1:  # read below a joint of their own, which the file does not have
+            lines.insert(1, f"ROOTs: {', '.join(roots)}, below {motion.skeleton.names[0]!r} at the origin")
+        return lines
     if kind == "npz":
         from ..io.npz import read_npz
 

@@ -160,6 +160,8 @@ def hausdorff_distances(
             raise ValueError(f"at_least: {value!r}, expected a distance >= 0")
     for each in simplified:
         _check_frames(original, each)
+    if not simplified:
+        return []
     a, from_original = _measured_points(original, samples, seed)
     squared, from_simplified = [], []
     for each, floor in zip(simplified, at_least):

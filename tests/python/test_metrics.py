@@ -70,6 +70,7 @@ def test_hausdorff_distance_is_the_largest_of_surface_error_to_the_bit():
     floors = [0.0, 2.0 * largest]
     alone = [hausdorff_distance(original, each, samples=2000, seed=4, at_least=f) for each, f in zip(levels, floors)]
     assert hausdorff_distances(original, levels, samples=2000, seed=4, at_least=floors) == alone
+    assert hausdorff_distances(original, []) == []
     with pytest.raises(ValueError, match="at_least: 1 values for 2 simplified meshes"):
         hausdorff_distances(original, levels, at_least=[0.0])
 

@@ -482,6 +482,26 @@ class TemporalDag:
         self._cursor = cursor
         return cursor.mesh()
 
+    def tolerance_for_faces(self, frame: int, faces: int) -> float:
+        """The smallest tolerance (asset units) at which ``frame``'s mesh has at most ``faces``
+        faces (the coarsest mesh's tolerance when none has so few): a query by size. The face
+        count changes only where a collapse's error bound is passed, so the search bisects those
+        bounds (a few hundred distinct values: ~10 queries). ValueError naming ``faces`` or
+        ``frame``."""
+        if isinstance(faces, bool) or not isinstance(faces, int | np.integer) or faces < 1:
+            raise ValueError(f"faces: expected a whole number >= 1, got {faces!r}")
+        bounds = self.error_bounds(frame)
+        candidates = np.unique(np.concatenate([[0.0], bounds[np.isfinite(bounds)]]))
+        cut = Cut(_core.TdagCut(self._core), self.frame_count)
+        low, high = 0, len(candidates) - 1  # the answer's index, if the coarsest mesh is small enough
+        while low < high:
+            middle = (low + high) // 2
+            if cut.query(frame, float(candidates[middle])).face_count <= faces:
+                high = middle
+            else:
+                low = middle + 1
+        return float(candidates[low])
+
     def query_view(
         self, frame: int, camera: Sequence[float], pixels: float = 1.0, focal_pixels: float = 1000.0
     ) -> TdagMesh:

@@ -8,6 +8,7 @@ from animlod import synth
 from animlod.cli import main
 from animlod.io.meshseq import read_mesh
 from animlod.io.npz import write_npz
+from animlod.tdag import TemporalDag
 
 
 @pytest.fixture(scope="module")
@@ -40,6 +41,26 @@ def test_query_writes_the_mesh_and_the_plot(built, capsys):
     assert "level 1 from the cut of frame 3" in capsys.readouterr().out
 
 
+def test_query_by_face_count_writes_the_finest_mesh_within_it(built, capsys):
+    """--faces N: the smallest tolerance whose mesh has at most N faces (a budget instead of an
+    error); at levels 1-2, that of the earlier frame's cut, which they keep."""
+    dag = TemporalDag.load(built / "bar.tdag")
+    for level, budget in ((3, 60), (2, 100), (3, 1)):
+        cut_frame = 4 if level == 3 else 3
+        target = built / f"budget{level}_{budget}.obj"
+        assert main(["tdag", "query", str(built / "bar.tdag"), "--frame", "4", "--faces", str(budget), "--level",
+                     str(level), "-o", str(target)]) == 0  # fmt: skip
+        tolerance = dag.tolerance_for_faces(cut_frame, budget)
+        assert f"tolerance {tolerance:.4g} (for at most {budget} faces)" in capsys.readouterr().out
+        bounds = dag.error_bounds(cut_frame)
+        coarsest = dag.query(cut_frame, float(bounds.max())).face_count
+        assert len(read_mesh(target)[1]) <= max(budget, coarsest)
+        below = bounds[bounds < tolerance]
+        if below.size:  # the next bound down gives a mesh over the budget
+            assert dag.query(cut_frame, float(below.max())).face_count > budget
+    assert coarsest > 1  # the last budget is below the coarsest mesh: its tolerance is the largest bound
+
+
 def test_play_prints_every_level(built, capsys):
     assert main(["tdag", "play", str(built / "bar.tdag"), "--tolerance", "0.02", "--relative"]) == 0
     out = capsys.readouterr().out
@@ -54,6 +75,8 @@ def test_play_prints_every_level(built, capsys):
         (["query", "{dir}/bar.tdag", "--frame", "0", "--tolerance", "-1", "-o", "{dir}/x.obj"], "--tolerance"),
         (["query", "{dir}/bar.npz", "--frame", "0", "--tolerance", "1", "-o", "{dir}/x.obj"], "not a TDAG file"),
         (["query", "{dir}/bar.tdag", "--frame", "0", "--tolerance", "1", "-o", "{dir}/x.stl"], "expected an .obj"),
+        (["query", "{dir}/bar.tdag", "--frame", "0", "--faces", "0", "-o", "{dir}/x.obj"], "faces: expected a whole"),
+        (["query", "{dir}/bar.tdag", "--frame", "0", "--faces", "9", "--relative", "-o", "{dir}/x.obj"], "--relative"),
         (["build", "{dir}/missing.obj", "-o", "{dir}/x.tdag"], "does not exist"),
         (["build", "{dir}/bar.npz", "-o", "{dir}/x.tdag", "--governing", "best"], "--governing"),
         (["play", "{dir}/missing.tdag", "--tolerance", "1"], "missing.tdag"),

@@ -46,7 +46,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     query = commands.add_parser("query", help="write one frame at a tolerance as OBJ/PLY")
     query.add_argument("tdag", help="a .tdag file")
     query.add_argument("--frame", type=int, required=True, help="frame to extract")
-    query.add_argument("--tolerance", type=float, required=True, help="asset units (see --relative)")
+    size = query.add_mutually_exclusive_group(required=True)
+    size.add_argument("--tolerance", type=float, help="asset units (see --relative)")
+    size.add_argument(
+        "--faces", type=int, help="instead of a tolerance: the finest mesh of at most this many faces (at --frame)"
+    )
     query.add_argument("--relative", action="store_true", help="tolerance as a fraction of the bounding-box diagonal")
     query.add_argument("-o", "--output", required=True, help="the .obj or .ply file to write")
     query.add_argument(
@@ -185,21 +189,28 @@ def run_query(args: argparse.Namespace) -> int:
     from ..io.meshseq import write_mesh
 
     dag = _load(args.tdag)
-    tolerance = _tolerance(dag, args.tolerance, args.relative)
     output = Path(args.output)
     if output.suffix.lower() not in (".obj", ".ply"):
         raise UserError(f"{output}: expected an .obj or .ply output")
+    # Levels 1-2 keep the cut of an earlier frame (and its face count).
+    start = args.from_frame if args.from_frame is not None else max(args.frame - 1, 0)
+    cut_frame = args.frame if args.level == 3 else start
+    if args.faces is None:
+        tolerance = _tolerance(dag, args.tolerance, args.relative)
+    elif args.camera is not None or args.relative:
+        raise UserError("--faces: sets the tolerance itself; drop " + ("--camera" if args.camera else "--relative"))
+    else:
+        tolerance = dag.tolerance_for_faces(cut_frame, args.faces)
+    what = f"tolerance {tolerance:.4g}" + (f" (for at most {args.faces} faces)" if args.faces else "")
     if args.camera is not None:
         mesh = dag.query_view(args.frame, args.camera, args.pixels, args.focal)
         what = f"view from {tuple(args.camera)}, {args.pixels:g} px at focal {args.focal:g}"
     elif args.level == 3:
         mesh = dag.query(args.frame, tolerance)
-        what = f"tolerance {tolerance:.4g}"
     else:
-        start = args.from_frame if args.from_frame is not None else max(args.frame - 1, 0)
         dag.query(start, tolerance)
         mesh = dag.advance(args.frame, args.level)
-        what = f"tolerance {tolerance:.4g}, level {args.level} from the cut of frame {start}"
+        what += f", level {args.level} from the cut of frame {start}"
     write_mesh(output, mesh.positions, mesh.faces)
     backs = int(np.count_nonzero(dag.two_sided))  # a two-sided face is one face of the TDAG, two of the mesh
     print(

@@ -6,7 +6,7 @@ import numpy as np
 from simplify_inputs import bending_tube
 
 from animlod.cli import main
-from animlod.io.meshseq import read_sequence, write_sequence
+from animlod.io.meshseq import read_mesh, read_sequence, write_mesh, write_sequence
 from animlod.io.npz import read_npz, write_npz
 
 
@@ -21,6 +21,21 @@ def test_simplify_an_obj_sequence_writes_each_level_as_a_sequence(tmp_path, caps
         assert mesh.frame_count == 3 and mesh.face_count <= faces
     table = capsys.readouterr().out
     assert "AQEM error" in table and "180" in table
+
+
+def test_one_mesh_file_gives_one_file_per_level_and_dotted_names_keep_their_levels_apart(tmp_path):
+    """A single OBJ/PLY gave a folder per level holding frame_0000; NPZ levels of walk.v2.npz were
+    all written to walk.npz (the suffix swapped instead of appended), each over the last."""
+    tube = bending_tube(frames=1)
+    write_mesh(tmp_path / "tube.v2.ply", tube.frames[0], tube.faces)
+    write_npz(tmp_path / "walk.v2.npz", bending_tube(frames=2))
+    for source in ("tube.v2.ply", "walk.v2.npz"):
+        assert main(["simplify", str(tmp_path / source), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    suffix = {"tube.v2": "ply", "walk.v2": "npz"}
+    expected = [f"{stem}_lod{level}.{ext}" for stem, ext in suffix.items() for level in (1, 2, 3)]
+    assert sorted(path.name for path in (tmp_path / "out").iterdir()) == expected
+    faces = [read_mesh(tmp_path / "out" / f"tube.v2_lod{level}.ply")[1].shape[0] for level in (1, 2, 3)]
+    assert faces == sorted(faces, reverse=True) and faces[0] < tube.face_count
 
 
 def test_the_measurement_of_a_sequence_reports_its_progress(tmp_path):

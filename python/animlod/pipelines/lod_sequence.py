@@ -1,8 +1,9 @@
 """A deforming mesh sequence in (OBJ/PLY frames or NPZ), its AQEM levels out in the same format.
 
-Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OBJ/PLY input,
-``<stem>_lod<i>.npz`` for NPZ input, and measured against the input frame by frame (symmetric
-Hausdorff and RMS distance relative to the bounding-box diagonal).
+Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OBJ/PLY frames,
+``<stem>_lod<i>.obj`` (or ``.ply``) for one mesh file, ``<stem>_lod<i>.npz`` for NPZ input, and
+measured against the input frame by frame (symmetric Hausdorff and RMS distance relative to the
+bounding-box diagonal).
 """
 
 from __future__ import annotations
@@ -121,22 +122,33 @@ def _surface_error(original: AnimatedMesh, level: AnimatedMesh) -> SurfaceError:
 
 
 def _level_format(kind: str, source: str | os.PathLike) -> str:
-    """The levels' format, the input's: "npz", or "ply" when a frame is PLY, else "obj"."""
+    """The levels' format, the input's: "npz"; "obj file" or "ply file" for one mesh file; else
+    "ply" when a frame is PLY, "obj" otherwise (frame folders)."""
     if kind == "npz":
         return "npz"
     from ..io.meshseq import sequence_paths
 
     # The frames read, not the source's name: "frames/*" holds PLY frames without saying so.
-    return "ply" if any(path.suffix.lower() == ".ply" for path in sequence_paths(source)) else "obj"
+    paths = sequence_paths(source)
+    fmt = "ply" if any(path.suffix.lower() == ".ply" for path in paths) else "obj"
+    return f"{fmt} file" if isinstance(source, str | os.PathLike) and Path(source).is_file() else fmt
 
 
 def _write_level(fmt: str, target: Path, mesh: AnimatedMesh) -> Path:
-    """Write a level in ``fmt`` (see :func:`_level_format`); its path."""
+    """Write a level in ``fmt`` (see :func:`_level_format`); its path. A file's suffix is
+    appended, not swapped: ``walk.v2_lod1`` has the suffix ``.v2_lod1`` (every level of
+    walk.v2.npz was written to walk.npz)."""
     if fmt == "npz":
         from ..io.npz import write_npz
 
-        path = target.with_suffix(".npz")
+        path = target.with_name(f"{target.name}.npz")
         write_npz(path, mesh)
+        return path
+    if fmt.endswith(" file"):  # one mesh in, one mesh out
+        from ..io.meshseq import write_mesh
+
+        path = target.with_name(f"{target.name}.{fmt.split()[0]}")
+        write_mesh(path, mesh.frames[0], mesh.faces)
         return path
     from ..io.meshseq import write_sequence
 

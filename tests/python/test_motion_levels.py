@@ -253,4 +253,5 @@ def test_cli_a_bvh_of_two_roots_is_simplified_below_one_and_says_so(tmp_path, ca
     assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--levels", "3"]) == 0
     printed = capsys.readouterr()
     assert "its 2 ROOTs (j0, k0) are joints below one ROOT of its own, 'Roots'" in printed.out + printed.err
+    assert "\r" not in printed.err  # progress bars are for a terminal: in a log, \r and cursor moves
     assert len(list((tmp_path / "out").glob("two_lod*.bvh"))) == 3

@@ -87,9 +87,11 @@ class _Progress:
     each level."""
 
     def __init__(self) -> None:
+        from functools import partial
+
         from tqdm import tqdm
 
-        self._tqdm = tqdm
+        self._tqdm = partial(tqdm, disable=None)  # on a terminal only: in a log, its cursor moves are noise
         self.choice = None
         self.levels = None
         self.frames = None

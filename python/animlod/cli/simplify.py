@@ -201,7 +201,7 @@ class _ProgressBar:
         from tqdm import tqdm
 
         if self.bar is None:
-            self.bar = tqdm(total=total, desc=self.description, unit=self.unit, leave=False)
+            self.bar = tqdm(total=total, desc=self.description, unit=self.unit, leave=False, disable=None)
         self.bar.update(min(done, total) - self.bar.n)
 
     def close(self) -> None:

@@ -124,7 +124,7 @@ def run_build(args: argparse.Namespace) -> int:
 
     governing = _governing(args.governing)
     mesh = read_animation(args.input)
-    bar = tqdm(total=mesh.frame_count, desc="TDAG", unit="frame", leave=False)
+    bar = tqdm(total=mesh.frame_count, desc="TDAG", unit="frame", leave=False, disable=None)
 
     def progress(done: int, total: int) -> None:
         bar.update(done - bar.n)

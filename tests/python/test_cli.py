@@ -38,6 +38,12 @@ def test_info_bvh(tmp_path, capsys):
     assert "ROOTs: hips, prop, below 'Roots' at the origin" in capsys.readouterr().out
 
 
+def test_version(capsys):
+    import animlod
+
+    assert main(["--version"]) == 0 and capsys.readouterr().out == f"animlod {animlod.__version__}\n"
+
+
 def test_info_npz(tmp_path, capsys):
     path = tmp_path / "mesh.npz"
     frames = np.random.default_rng(0).normal(size=(3, 4, 3))

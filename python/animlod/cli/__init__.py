@@ -79,6 +79,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="animlod",
         description="Level of detail for animated content: meshes, skinned characters, motion and faces.",
     )
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"animlod {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in COMMAND_MODULES:
         importlib.import_module(f"{__name__}.{name}").register(subparsers)

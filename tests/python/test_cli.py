@@ -44,6 +44,24 @@ def test_version(capsys):
     assert main(["--version"]) == 0 and capsys.readouterr().out == f"animlod {animlod.__version__}\n"
 
 
+def test_info_on_what_animlod_writes(tmp_path, capsys):
+    """A .tdag file and a LoD manifest: `info` refused them as unknown types."""
+    from animlod.io.manifest import write_lod_manifest
+
+    frames = np.random.default_rng(1).normal(size=(2, 4, 3))
+    write_npz(tmp_path / "quad.npz", AnimatedMesh([[0, 1, 2], [0, 2, 3]], frames, fps=10.0))
+    assert main(["tdag", "build", str(tmp_path / "quad.npz"), "-o", str(tmp_path / "quad.tdag")]) == 0
+    write_lod_manifest(tmp_path / "clip_motion_lod.json", "motion",
+                       [{"files": ["clip_lod0.bvh"], "joints": 20, "error": 0.0},
+                        {"files": ["clip_lod1.bvh"], "joints": 9, "error": 0.25}])  # fmt: skip
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "quad.tdag")]) == 0
+    assert "frames: 2, vertices: 4, faces: 2" in capsys.readouterr().out
+    assert main(["info", str(tmp_path / "clip_motion_lod.json")]) == 0
+    out = capsys.readouterr().out
+    assert "2 levels of a motion chain" in out and "level 1: 9 joints; error 0.25: clip_lod1.bvh" in out
+
+
 def test_info_npz(tmp_path, capsys):
     path = tmp_path / "mesh.npz"
     frames = np.random.default_rng(0).normal(size=(3, 4, 3))

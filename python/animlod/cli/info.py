@@ -15,13 +15,14 @@ from ..model import AnimatedMesh, Motion
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "info",
-        help="describe a BVH, glTF/GLB, OBJ/PLY sequence or NPZ file",
+        help="describe a BVH, glTF/GLB, OBJ/PLY sequence or NPZ file, or a .tdag or LoD manifest animlod wrote",
         description="Print what a file holds: joints, frames, fps, vertices, faces, skins, animations, morph targets.",
     )
     parser.add_argument(
         "path",
         help="a .bvh, .glb/.gltf/.vrm, .npz file, an OBJ/PLY file, a folder of frames or of assets "
-        "(model files and frame folders, found as batch finds them), or a glob",
+        "(model files and frame folders, found as batch finds them), a glob, or animlod's own .tdag "
+        "file or <name>_*lod.json manifest",
     )
     parser.set_defaults(run=run)
 
@@ -29,6 +30,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Describe each asset; in a library an unreadable one is named with its reason and the rest
     still listed (exit code 2 if any was unreadable)."""
+    written = _own_output(args.path)
+    if written is not None:
+        kind, lines = written
+        print(f"{args.path}: {kind}")
+        for line in lines:
+            print(f"  {line}")
+        return 0
     paths = _models(args.path)
     unreadable = 0
     for path in paths:
@@ -46,6 +54,34 @@ def run(args: argparse.Namespace) -> int:
         print(f"animlod info: {unreadable} of {len(paths)} assets could not be read", file=sys.stderr)
         return 2
     return 0
+
+
+def _own_output(path: str) -> tuple[str, list[str]] | None:
+    """(kind, lines) for a file animlod writes that is no input of its commands: a .tdag file
+    or a LoD manifest; None for anything else. FormatError naming the file and element."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".tdag":
+        from ..tdag import TemporalDag
+
+        dag = TemporalDag.load(path)
+        backs = int(dag.two_sided.sum())
+        stored = ", ".join(f"{count} {name.replace('_', ' ')}" for name, count in dag.stored_counts.items())
+        return "tdag", [
+            f"frames: {dag.frame_count}, vertices: {dag.vertex_count}, faces: {dag.face_count}"
+            + (f" ({backs} of them two-sided)" if backs else ""),
+            f"collapses: {dag.collapse_count}; stored {stored}; {Path(path).stat().st_size} bytes",
+        ]
+    if suffix == ".json":
+        from ..io.manifest import read_lod_manifest
+
+        manifest = read_lod_manifest(path)
+        lines = [f"{len(manifest['levels'])} levels of a {manifest['kind'].replace('_', ' ')} chain"]
+        for index, level in enumerate(manifest["levels"]):
+            sizes = ", ".join(f"{level[key]} {key}" for key in ("faces", "triangles", "joints") if key in level)
+            files = ", ".join(level.get("files", []))
+            lines.append(f"level {index}: {sizes + '; ' if sizes else ''}error {level['error']:.4g}: {files}")
+        return "LoD manifest", lines
+    return None
 
 
 def _models(path: str) -> list[str]:

@@ -85,9 +85,21 @@ def test_subsampling_analyses_evenly_spaced_frames() -> None:
     np.testing.assert_allclose(analysis.importance[moving], full.importance[moving], rtol=0.25)
 
 
+def test_a_single_pose_analyses_to_no_motion_and_freezes_exactly() -> None:
+    """One frame (a pose; a glTF clip of one key): no joint moves, so every importance is 0 and
+    every key posture is that frame, and the fewest joints reproduce it to rounding. It was
+    refused ("at least 2 frames"), and with it `animlod character` on a posed character."""
+    from animlod.motion_lod import build_motion_chain
+
+    motion = figure_motion().take_frames(np.array([5]))
+    analysis = analyze_motion(motion)
+    assert np.all(analysis.importance == 0.0) and np.all(analysis.key_frames == 0)
+    chain = build_motion_chain(motion, 3)
+    assert chain.levels[-1].report.joint_count < chain.levels[0].report.joint_count
+    assert max(level.report.max_error for level in chain.levels) < 1e-9
+
+
 def test_bad_input_is_refused_with_a_reason() -> None:
-    with pytest.raises(ValueError, match="at least 2 frames"):
-        analyze_motion(chain_motion([0.3]))
     with pytest.raises(ValueError, match="no joint named 'Elbow'"):
         analyze_motion(chain_motion([0.0, 1.0]), locked=["Elbow"])
     with pytest.raises(ValueError, match="end site"):

@@ -215,8 +215,6 @@ def analyze_motion(
     skeleton = motion.skeleton
     if ranking not in RANKINGS:
         raise ValueError(f"ranking: expected one of {', '.join(RANKINGS)}, got {ranking!r}")
-    if motion.frame_count < 2:
-        raise ValueError(f"motion: needs at least 2 frames for motion analysis, got {motion.frame_count}")
     if max_frames < 2:
         raise ValueError(f"max_frames: must be at least 2, got {max_frames}")
     if workers < 0:

@@ -378,7 +378,7 @@ def build_motion_chain(
 
     Parameters
     ----------
-    motion : the clip (at least 2 frames).
+    motion : the clip (one frame, a pose, freezes exactly).
     levels : number of levels, or the joint counts (end sites not counted) of each level.
     locked : joint names never frozen.
     weights : alpha, beta, gamma of Eq. 5.

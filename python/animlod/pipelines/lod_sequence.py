@@ -121,37 +121,43 @@ def _surface_error(original: AnimatedMesh, level: AnimatedMesh) -> SurfaceError:
     return SurfaceError(*(np.concatenate(arrays) for arrays in zip(*parts)))
 
 
-def _level_format(kind: str, source: str | os.PathLike) -> str:
-    """The levels' format, the input's: "npz"; "obj file" or "ply file" for one mesh file; else
-    "ply" when a frame is PLY, "obj" otherwise (frame folders)."""
+@dataclass(frozen=True)
+class _LevelFormat:
+    """How the levels are written: ``suffix`` "npz", "obj" or "ply"; ``one_file`` for a single
+    mesh or an NPZ, else a folder of frames per level."""
+
+    suffix: str
+    one_file: bool
+
+
+def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
+    """The input's format: NPZ, one OBJ/PLY file, or frames (PLY when a frame is PLY)."""
     if kind == "npz":
-        return "npz"
+        return _LevelFormat("npz", True)
     from ..io.meshseq import sequence_paths
 
     # The frames read, not the source's name: "frames/*" holds PLY frames without saying so.
-    paths = sequence_paths(source)
-    fmt = "ply" if any(path.suffix.lower() == ".ply" for path in paths) else "obj"
-    return f"{fmt} file" if isinstance(source, str | os.PathLike) and Path(source).is_file() else fmt
+    suffix = "ply" if any(path.suffix.lower() == ".ply" for path in sequence_paths(source)) else "obj"
+    return _LevelFormat(suffix, isinstance(source, str | os.PathLike) and Path(source).is_file())
 
 
-def _write_level(fmt: str, target: Path, mesh: AnimatedMesh) -> Path:
-    """Write a level in ``fmt`` (see :func:`_level_format`); its path. A file's suffix is
-    appended, not swapped: ``walk.v2_lod1`` has the suffix ``.v2_lod1`` (every level of
-    walk.v2.npz was written to walk.npz)."""
-    if fmt == "npz":
+def _write_level(fmt: _LevelFormat, target: Path, mesh: AnimatedMesh) -> Path:
+    """Write a level as ``fmt`` says; its path. A file's suffix is appended, not swapped:
+    ``walk.v2_lod1`` has the suffix ``.v2_lod1`` (every level of walk.v2.npz was written to
+    walk.npz)."""
+    if not fmt.one_file:
+        from ..io.meshseq import write_sequence
+
+        target.mkdir(parents=True, exist_ok=True)
+        write_sequence(target, mesh, fmt.suffix)
+        return target
+    path = target.with_name(f"{target.name}.{fmt.suffix}")
+    if fmt.suffix == "npz":
         from ..io.npz import write_npz
 
-        path = target.with_name(f"{target.name}.npz")
         write_npz(path, mesh)
-        return path
-    if fmt.endswith(" file"):  # one mesh in, one mesh out
+    else:  # one mesh in, one mesh out
         from ..io.meshseq import write_mesh
 
-        path = target.with_name(f"{target.name}.{fmt.split()[0]}")
         write_mesh(path, mesh.frames[0], mesh.faces)
-        return path
-    from ..io.meshseq import write_sequence
-
-    target.mkdir(parents=True, exist_ok=True)
-    write_sequence(target, mesh, fmt)
-    return target
+    return path

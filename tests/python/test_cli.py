@@ -106,6 +106,8 @@ def test_info_on_a_folder_of_frame_folders_describes_each_sequence(tmp_path, cap
     for asset, kind in (("clips/a.bvh", "bvh"), ("run", "sequence"), ("walk", "sequence")):
         assert f"{tmp_path / 'library' / asset}: {kind}" in out
     assert out.count("vertices: 3, triangles: 1") == 2
+    # The first and last file in reading order: a stray file beside the frames shows at an end.
+    assert out.count("frames: 2, frame_0000.obj .. frame_0001.obj") == 2
 
 
 def test_info_into_a_pipe_closed_early_exits_quietly(tmp_path):

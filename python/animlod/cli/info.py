@@ -106,9 +106,13 @@ def _describe(kind: str, path: str) -> list[str]:
 
         return _animated_lines(read_npz(path))
     if kind == "sequence":
-        from ..io.meshseq import read_sequence
+        from ..io.meshseq import read_sequence, sequence_paths
 
-        return _animated_lines(read_sequence(path))
+        lines = _animated_lines(read_sequence(path))
+        names = [frame.name for frame in sequence_paths(path)]
+        if len(names) > 1:  # the order the frames are read in: a stray file shows at an end
+            lines[-1] += f", {names[0]} .. {names[-1]}"
+        return lines
     return _document_lines(path)
 
 

@@ -898,7 +898,7 @@ def test_flamingo_morph_animation(data_dir):
     np.testing.assert_allclose(flight.frames[9], rest + np.einsum("n,nvc->vc", weights[3], deltas), atol=1e-4)
     between = weights[3] + (weights[4] - weights[3]) / 3
     np.testing.assert_allclose(flight.frames[10], rest + np.einsum("n,nvc->vc", between, deltas), atol=1e-4)
-    with pytest.raises(FormatError, match="Flamingo.glb: skin a skinned mesh: not in the file"):
+    with pytest.raises(FormatError, match="Flamingo.glb: skins: no node draws a skinned mesh"):
         read_skinned(path)
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from animlod import rotations
-from animlod.io import FormatError, read_bvh, read_bvh_layout, write_bvh
+from animlod.io import FormatError, read_bvh, read_bvh_with_layout, write_bvh
 from animlod.model import Motion, Skeleton
 
 # Root with 6 channels, a 3-channel joint A (Z-X-Y intrinsic), an End Site, and a 6-channel
@@ -225,11 +225,11 @@ MIXED_ORDERS_BVH = (
 
 
 def test_a_motion_written_in_its_files_rotation_orders_keeps_its_channel_values(tmp_path: Path) -> None:
-    """read_bvh_layout gives each joint's rotation order as written (the one-channel hinge has none:
+    """read_bvh_with_layout gives each joint's rotation order as written (the one-channel hinge has none:
     written in the default ZXY), and write_bvh writes them back: the same channels and, for angles
     in Euler's principal range, the same values."""
     source = _write(tmp_path, MIXED_ORDERS_BVH)
-    orders = read_bvh_layout(source).rotation_orders
+    orders = read_bvh_with_layout(source)[1].rotation_orders
     assert orders == {"Hips": "ZYX", "Spine": "YXZ"}
     write_bvh(tmp_path / "back.bvh", read_bvh(source), rotation_order=orders)
     text = (tmp_path / "back.bvh").read_text()
@@ -265,7 +265,7 @@ def test_several_roots_read_as_one_skeleton_below_a_joint_of_their_own(tmp_path:
     both = _write(tmp_path, _bvh_text([actor, prop], [f"{a} {p}" for a, p in zip(actor_rows, prop_rows)]), "both.bvh")
     motion = read_bvh(both)
     assert motion.skeleton.names[:2] == ["Roots1", "Actor"] and motion.skeleton.parents[[1, 4]].tolist() == [0, 0]
-    assert read_bvh_layout(both).roots == ["Actor", "Prop"]
+    assert read_bvh_with_layout(both)[1].roots == ["Actor", "Prop"]
     np.testing.assert_array_equal(motion.root_positions, 0.0)
     for block, rows, joints in ((actor, actor_rows, slice(1, 4)), (prop, prop_rows, slice(4, 7))):
         alone = read_bvh(_write(tmp_path, _bvh_text([block], rows), "alone.bvh"))

@@ -94,12 +94,12 @@ def _models(path: str) -> list[str]:
 
 def _describe(kind: str, path: str) -> list[str]:
     if kind == "bvh":
-        from ..io.bvh import read_bvh, read_bvh_layout
+        from ..io.bvh import read_bvh_with_layout
 
-        motion, roots = read_bvh(path), read_bvh_layout(path).roots
+        motion, layout = read_bvh_with_layout(path)
         lines = _motion_lines(motion)
-        if len(roots) > 1:  # read below a joint of their own, which the file does not have
-            lines.insert(1, f"ROOTs: {', '.join(roots)}, below {motion.skeleton.names[0]!r} at the origin")
+        if len(layout.roots) > 1:  # read below a joint of their own, which the file does not have
+            lines.insert(1, f"ROOTs: {', '.join(layout.roots)}, below {motion.skeleton.names[0]!r} at the origin")
         return lines
     if kind == "npz":
         from ..io.npz import read_npz

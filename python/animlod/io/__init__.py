@@ -1,6 +1,6 @@
 """File formats: BVH, glTF 2.0 / GLB, OBJ and PLY frame sequences, NPZ."""
 
-from .bvh import BvhLayout, read_bvh, read_bvh_layout, write_bvh
+from .bvh import BvhLayout, read_bvh, read_bvh_with_layout, write_bvh
 from .errors import FormatError
 from .gltf import GltfScene, read_gltf, read_lod_chains, read_skinned, write_glb
 from .meshseq import read_mesh, read_obj, read_ply, read_sequence, write_mesh, write_obj, write_ply, write_sequence
@@ -11,7 +11,7 @@ __all__ = [
     "FormatError",
     "GltfScene",
     "read_bvh",
-    "read_bvh_layout",
+    "read_bvh_with_layout",
     "read_gltf",
     "read_lod_chains",
     "read_mesh",

@@ -157,14 +157,7 @@ def read_bvh(path: str | os.PathLike) -> Motion:
         MOTION table with fewer or more rows than ``Frames:``, a row with the wrong number of
         values, a value that is not a finite number.
     """
-    path = Path(path)
-    text, joints, _, motion_match, motion_line = _read_hierarchy(path)
-    if motion_match is None:
-        raise FormatError(path, f"line {motion_line}", "no MOTION section after the hierarchy")
-    frame_count, fps, data_line, data_text = _parse_motion_header(path, text[motion_match.end() :], motion_line)
-    channel_count = sum(len(joint.channels) for joint in joints)
-    values = _parse_motion_table(path, data_text, data_line, frame_count, channel_count, joints)
-    return _build_motion(path, joints, values, fps)
+    return read_bvh_with_layout(path)[0]
 
 
 @dataclass(frozen=True)
@@ -182,16 +175,23 @@ class BvhLayout:
     rotation_orders: dict[str, str]
 
 
-def read_bvh_layout(path: str | os.PathLike) -> BvhLayout:
-    """The layout of a BVH file's hierarchy (reads the hierarchy only; raises FormatError as
-    :func:`read_bvh` does for it)."""
-    _, joints, roots, _, _ = _read_hierarchy(Path(path))
-    orders = {}
-    for joint in joints:
-        order = "".join(channel[0].upper() for channel in joint.channels if channel.lower().endswith("rotation"))
-        if sorted(order) == ["X", "Y", "Z"]:
-            orders[joint.name] = order
-    return BvhLayout([joints[root].name for root in roots], orders)
+def read_bvh_with_layout(path: str | os.PathLike) -> tuple[Motion, BvhLayout]:
+    """:func:`read_bvh` and the file's :class:`BvhLayout`, from one read of the file."""
+    path = Path(path)
+    text, joints, roots, motion_match, motion_line = _read_hierarchy(path)
+    if motion_match is None:
+        raise FormatError(path, f"line {motion_line}", "no MOTION section after the hierarchy")
+    frame_count, fps, data_line, data_text = _parse_motion_header(path, text[motion_match.end() :], motion_line)
+    channel_count = sum(len(joint.channels) for joint in joints)
+    values = _parse_motion_table(path, data_text, data_line, frame_count, channel_count, joints)
+    orders = {joint.name: order for joint in joints if sorted(order := _rotation_order(joint)) == ["X", "Y", "Z"]}
+    return _build_motion(path, joints, values, fps), BvhLayout([joints[root].name for root in roots], orders)
+
+
+def _rotation_order(joint: _JointSpec) -> str:
+    """The axes of ``joint``'s rotation channels in the order they are written (``"ZXY"``)."""
+    return "".join("XYZ"[axis] for kind, axis in (_CHANNELS[channel.lower()] for channel in joint.channels)
+                   if kind == "rotation")  # fmt: skip
 
 
 def _read_hierarchy(path: Path) -> tuple[str, list[_JointSpec], list[int], re.Match | None, int]:
@@ -425,16 +425,16 @@ def _build_motion(path: Path, joints: list[_JointSpec], values: np.ndarray, fps:
     rotation_columns: dict[str, list[tuple[int, list[int]]]] = {}  # Euler order -> [(joint, columns)]
     column = 0
     for index, joint in enumerate(joints):
-        order, columns = "", []
+        columns = []
         for channel in joint.channels:
             kind, axis = _CHANNELS[channel.lower()]
             if kind == "position":
                 position_columns.append((index, axis, column))
             else:
-                order, columns = order + "XYZ"[axis], columns + [column]
+                columns.append(column)
             column += 1
-        if order:
-            rotation_columns.setdefault(order, []).append((index, columns))
+        if columns:
+            rotation_columns.setdefault(_rotation_order(joint), []).append((index, columns))
     if position_columns:
         joint_index, axis, source = np.array(position_columns).T
         translations[:, joint_index, axis] = values[:, source]
@@ -480,7 +480,7 @@ def write_bvh(
     path : destination file.
     motion : the motion to write.
     rotation_order : Euler order of the rotation channels, three different axes, e.g. "ZXY"; or
-        one per joint name (:func:`read_bvh_layout`'s of the file the motion came from),
+        one per joint name (the :class:`BvhLayout` of the file the motion came from),
         "ZXY" for joints it does not name.
     precision : digits after the decimal point for offsets and channel values; None: 6, and
         more for a skeleton whose longest bone is under 1 unit (1e-6 of that bone at least).

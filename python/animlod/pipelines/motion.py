@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.bvh import BvhLayout
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
 from ..model import Motion, SkinnedMesh
@@ -112,15 +113,10 @@ def build_motion_levels(
         if on_note is not None:
             on_note(text)
 
-    motion, skin = _read_input(source, clip, note)
-    layout = None
-    if input_kind(source) == "bvh":
-        from ..io.bvh import read_bvh_layout
-
-        layout = read_bvh_layout(source)
-        if len(layout.roots) > 1:
-            note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
-                 f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
+    motion, skin, layout = _read_input(source, clip, note)
+    if layout is not None and len(layout.roots) > 1:
+        note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
+             f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
     analysis, counts, floor = _plan_levels(
         motion, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
@@ -172,14 +168,15 @@ def build_motion_levels(
 
 def _read_input(
     source: str | os.PathLike, clip: int | str | None, note: Callable[[str], None]
-) -> tuple[Motion, SkinnedMesh | None]:
-    """The motion to simplify and, for a skinned glTF, its skin."""
+) -> tuple[Motion, SkinnedMesh | None, BvhLayout | None]:
+    """The motion to simplify and, for a skinned glTF, its skin; for a BVH, its layout."""
     path = os.fspath(source)
     kind = input_kind(source)
     if kind == "bvh":
-        from ..io.bvh import read_bvh
+        from ..io.bvh import read_bvh_with_layout
 
-        return read_bvh(source), None
+        motion, layout = read_bvh_with_layout(source)
+        return motion, None, layout
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or a skinned glTF")
     from ..io.gltf import read_gltf, read_skinned
@@ -199,8 +196,8 @@ def _read_input(
         if merged is not None:
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
-            return _rigid(path, motions, range(len(motions)), merged), skin
-        return _rigid(path, motions, range(1), motions[0]), skin
+            return _rigid(path, motions, range(len(motions)), merged), skin, None
+        return _rigid(path, motions, range(1), motions[0]), skin, None
     if isinstance(clip, str):
         names = [m.name for m in motions]
         if clip not in names:
@@ -209,7 +206,7 @@ def _read_input(
         clip = names.index(clip)
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
-    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), skin
+    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), skin, None
 
 
 def _whole_skin(meshes: list[SkinnedMesh]) -> SkinnedMesh:

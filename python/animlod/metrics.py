@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
-from .model import AnimatedMesh
+from .model import AnimatedMesh, whole_number
 
 
 @dataclass
@@ -79,10 +79,7 @@ def sample_surface(mesh: AnimatedMesh, count: int, seed: int = 0) -> SurfaceSamp
 
     The same face/barycentric pairs are used in every frame, so the samples move with the surface.
     """
-    if isinstance(count, bool) or not isinstance(count, int | np.integer) or count < 0:
-        raise ValueError(f"samples: expected a whole number >= 0, got {count!r}")
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ValueError(f"seed: expected a whole number >= 0, got {seed!r}")
+    count, seed = whole_number("samples", count, 0), whole_number("seed", seed, 0)
     corners = mesh.frames[0][mesh.faces].astype(np.float64)
     areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
     rng = np.random.default_rng(seed)

@@ -31,6 +31,14 @@ def check_finite(name: str, array: np.ndarray) -> None:
         raise ValueError(f"{name}: non-finite value at index {tuple(int(i) for i in bad)}")
 
 
+def whole_number(name: str, value: object, minimum: int) -> int:
+    """``value`` as an int when it is a whole number (Python's or numpy's, not a bool) of at
+    least ``minimum``; otherwise a ValueError naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
+        raise ValueError(f"{name}: expected a whole number >= {minimum}, got {value!r}")
+    return int(value)
+
+
 def whole_indices(name: str, values: object, item: str, low: int, high: int) -> np.ndarray:
     """``values`` as int32 indices in [``low``, ``high``); ValueError naming ``name`` and the
     ``item`` (row) holding one that is not a whole number or lies outside. Checked before the

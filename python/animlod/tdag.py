@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from . import _core
-from .model import AnimatedMesh
+from .model import AnimatedMesh, whole_number
 from .options import PlayerOptions, TdagOptions, resolve_options
 
 GOVERNING_CHOICES = ("first", "average", "aqem", "online")
@@ -488,8 +488,7 @@ class TemporalDag:
         count changes only where a collapse's error bound is passed, so the search bisects those
         bounds (a few hundred distinct values: ~10 queries). ValueError naming ``faces`` or
         ``frame``."""
-        if isinstance(faces, bool) or not isinstance(faces, int | np.integer) or faces < 1:
-            raise ValueError(f"faces: expected a whole number >= 1, got {faces!r}")
+        faces = whole_number("faces", faces, 1)
         bounds = self.error_bounds(frame)
         candidates = np.unique(np.concatenate([[0.0], bounds[np.isfinite(bounds)]]))
         cut = Cut(_core.TdagCut(self._core), self.frame_count)

@@ -87,9 +87,9 @@ def read_skinned(
     """
     doc = GltfDocument(path)
     nodes = _skinned_mesh_nodes(doc)
-    chosen = [node for node in nodes if skin is None or _uses_skin(doc, node, skin)]
     if not nodes:
         raise doc.fail("skins", "no node draws a skinned mesh (a skin names the skeleton's joints)")
+    chosen = [node for node in nodes if skin is None or _uses_skin(doc, node, skin)]
     if not chosen:
         available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes}))
         raise doc.fail(f"skin {skin!r}", f"not in the file (skinned meshes use skins: {available})")

@@ -12,6 +12,7 @@ from gltf_edits import append_accessor, edit_glb
 from simplify_inputs import tube, two_bone_tube
 
 from animlod import rotations, synth
+from animlod.io.errors import FormatError
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf import read_gltf, write_glb
 from animlod.io.gltf_document import GltfDocument
@@ -240,3 +241,59 @@ def test_motion_levels_of_a_skin_without_inverse_bind_matrices_keep_the_frozen_b
         expected = scene.skinned_meshes[0].bake(scene.motions[0]).frames
         distance = np.abs(level.skinned_meshes[0].bake(level.motions[0]).frames - expected).max(axis=(1, 2))
         assert distance.min() < 1e-4, source.name
+
+
+def _animation_library(source: Path, target: Path) -> Path:
+    """``source`` (animlod's GLB of one skinned mesh) as animation libraries are exported: no skin,
+    the mesh drawn by a prop node held in a hand, and a keyless fingertip."""
+
+    def strip(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        mesh_node = len(gltf.nodes) - 1  # write_glb appends the skinned mesh's node last
+        gltf.scenes[0].nodes.remove(mesh_node)
+        gltf.nodes[mesh_node] = pygltflib.Node(name="prop", mesh=0)
+        gltf.skins = []
+        names = [node.name for node in gltf.nodes]
+        hand, finger = names.index("RightHand"), names.index("LeftHandIndex2")
+        gltf.nodes[hand].children = [*(gltf.nodes[hand].children or []), mesh_node]
+        gltf.nodes.append(pygltflib.Node(name="LeftHandIndex3", translation=[0.02, 0.0, 0.0]))
+        gltf.nodes[finger].children = [*(gltf.nodes[finger].children or []), len(gltf.nodes) - 1]
+
+    return edit_glb(source, target, strip)
+
+
+def test_motion_levels_of_an_animation_library_without_skins(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """A glTF of clips on a node tree and no skin was refused ("no node draws a skinned mesh"); its
+    animated nodes and the keyless nodes below them that draw nothing are the skeleton, and each level's
+    GLB holds the level's skeleton and clip. ``info`` names that skeleton."""
+    from animlod.cli import main
+    from animlod.io.gltf_read import read_node_motions
+
+    character = synth.humanoid()
+    skinned = tmp_path / "humanoid.glb"
+    write_glb(skinned, character, [synth.humanoid_motion(character.skeleton, "walk")])
+    source = _animation_library(skinned, tmp_path / "clips.glb")
+    (motion,) = read_node_motions(source)
+    assert motion.skeleton.names == [*character.skeleton.names, "LeftHandIndex3"]
+    expected = read_gltf(skinned).motions[0].world_positions()
+    np.testing.assert_allclose(motion.world_positions()[:, :-1], expected, atol=1e-5)
+
+    report = build_motion_levels(source, tmp_path / "levels", levels=3)
+    assert any("no skinned mesh; the skeleton is its animated node tree (42 joints" in note for note in report.notes)
+    for index, level in enumerate(report.chain.levels):
+        assert report.files[index][1].name == f"clips_lod{index}.glb"
+        (written,) = read_node_motions(tmp_path / "levels" / report.files[index][1])
+        assert written.skeleton.names == level.motion.skeleton.names
+        np.testing.assert_allclose(written.world_positions(), level.motion.world_positions(), atol=1e-4)
+    assert report.chain.levels[-1].report.joint_count < 42
+    capsys.readouterr()
+    assert main(["info", str(source)]) == 0
+    assert "no skin; animated node tree: 42 joints, root 'Hips'" in capsys.readouterr().out
+    with pytest.raises(ValueError, match="motions: a GLB without a skinned mesh needs a motion"):
+        write_glb(tmp_path / "empty.glb", None, [])
+    assert not (tmp_path / "empty.glb").exists()
+
+
+def test_a_gltf_without_skins_or_moving_nodes_has_no_skeleton_for_motion(tmp_path: Path) -> None:
+    source = _morph_tube_glb(tmp_path / "tube.glb", None, clip="weights")
+    with pytest.raises(FormatError, match="tube.glb: animations: no skin, and no animation translates, turns or"):
+        build_motion_levels(source, tmp_path / "levels", levels=2)

@@ -5,11 +5,15 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..io.detect import assets_in, input_kind
 from ..model import AnimatedMesh, Motion
+
+if TYPE_CHECKING:
+    from ..io.gltf_document import GltfDocument
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -156,6 +160,8 @@ def _document_lines(path: str) -> list[str]:
                 lines.append(
                     f"  skin weights of {drawable.renormalised_weights} vertices did not sum to 1 (normalised)"
                 )
+    if doc.gltf.animations and not doc.gltf.skins:
+        lines += _node_tree_lines(doc)
     for index, animation in enumerate(doc.gltf.animations or []):
         frames = doc.animation_frame_times(index, 30.0)
         extras = animation.extras.get("animlod") if isinstance(animation.extras, dict) else None
@@ -173,6 +179,19 @@ def _document_lines(path: str) -> list[str]:
             )
             lines.append(f"LoD chain on {doc.node_label(index)}: levels at nodes {[index, *ids]}, coverage {coverage}")
     return lines
+
+
+def _node_tree_lines(doc: GltfDocument) -> list[str]:
+    """The skeleton ``motion`` reads from a file without skins, its animated node tree, if any
+    (``motion`` says why there is none)."""
+    from ..io.errors import FormatError
+    from ..io.gltf_skin import SkinRig
+
+    try:
+        skeleton = SkinRig(doc, None).skeleton
+    except FormatError:
+        return []
+    return [f"no skin; animated node tree: {skeleton.joint_count} joints, root {skeleton.names[0]!r}"]
 
 
 def _motion_lines(motion: Motion) -> list[str]:

@@ -22,10 +22,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "Motion LoD (Sections 4-6 of the motion LoD paper): joint importance from posture error picks the "
             "joints to freeze at their key frames; every frame is re-fitted (E = 0.2 Ed + 0.4 Es + 0.4 Ea) so "
             "that the kept joints stay close to the original with rigid bones. Writes one BVH per level and, "
-            "for a skinned glTF, one GLB per level with the skin moved onto the kept joints."
+            "for a glTF, one GLB per level with the skin moved onto the kept joints (a glTF without skins: its "
+            "animated node tree is the skeleton, and each GLB holds the skeleton and its clip)."
         ),
     )
-    parser.add_argument("input", help="a .bvh motion, or a .glb/.gltf/.vrm with a skinned mesh and an animation")
+    parser.add_argument(
+        "input", help="a .bvh motion, or a .glb/.gltf/.vrm with an animation (of a skinned mesh or of nodes)"
+    )
     parser.add_argument("-o", "--output", required=True, help="folder to write the levels into (created if missing)")
     parser.add_argument(
         "--levels", type=int, default=None,

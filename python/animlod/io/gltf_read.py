@@ -120,10 +120,24 @@ def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:
     return wanted in (doc.gltf.skins[skin].name, doc.gltf.meshes[doc.gltf.nodes[node].mesh].name)
 
 
+def read_node_motions(path: str | os.PathLike, fps: float = 30.0) -> list[Motion]:
+    """The animations of a glTF file, sampled at ``fps``, as motions of its animated node tree: the
+    skeleton of a file without skins, as animation libraries are exported without their mesh
+    (:class:`~animlod.io.gltf_skin.SkinRig` without a skin). Raises FormatError naming the file
+    when no animation translates, turns or scales a node."""
+    doc = GltfDocument(path)
+    return _rig_motions(doc, SkinRig(doc, None), fps)
+
+
+def _rig_motions(doc: GltfDocument, rig: SkinRig, fps: float) -> list[Motion]:
+    """Every animation that moves one of ``rig``'s nodes, as a motion of its skeleton."""
+    motions = [rig.motion(doc, animation, fps) for animation in range(len(doc.gltf.animations or []))]
+    return [motion for motion in motions if motion is not None]
+
+
 def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -> tuple[SkinnedMesh, list[Motion]]:
     mesh = skinned_mesh_of_node(doc, node, rig, read_mesh_geometry(doc, doc.gltf.nodes[node].mesh, skinned=True))
-    motions = [rig.motion(doc, animation, fps) for animation in range(len(doc.gltf.animations or []))]
-    return mesh, [motion for motion in motions if motion is not None]
+    return mesh, _rig_motions(doc, rig, fps)
 
 
 def skinned_mesh_of_node(

@@ -1,5 +1,9 @@
 """A glTF skin as an animlod skeleton, and its animations as motions.
 
+A file without skins (an animation library exported without its mesh) gives its animated node
+tree instead: the nodes its animations move and every node below one that draws nothing (end
+sites, helper bones), with an identity inverse bind.
+
 The skin's joints are put in topological order (parents first; an order that already is
 topological is kept, so JOINTS_0 of such files need no remapping). Every joint and every
 ancestor of one takes part in posing: the armature above the root joint (glTF viewers apply
@@ -51,7 +55,8 @@ END_SITE_EXTRA = "animlod_end_site"
 
 
 class SkinRig:
-    """Skin ``skin`` of a document as a skeleton, with what is needed to pose it.
+    """Skin ``skin`` of a document (None: its animated node tree) as a skeleton, with what is
+    needed to pose it.
 
     Attributes
     ----------
@@ -66,9 +71,9 @@ class SkinRig:
     inverse_bind : (J, 4, 4) the skin's inverse bind matrices in skeleton order, as stored.
     """
 
-    def __init__(self, doc: GltfDocument, skin: int) -> None:
+    def __init__(self, doc: GltfDocument, skin: int | None) -> None:
         self.skin = skin
-        self.element = f"skin {skin}"
+        self.element = "animated nodes" if skin is None else f"skin {skin}"
         joint_nodes = self._joint_nodes(doc)
         self.skin_slots = len(joint_nodes)
         joint_nodes += self._common_root(doc, joint_nodes)
@@ -184,6 +189,8 @@ class SkinRig:
         return np.array([isinstance(e, dict) and e.get(END_SITE_EXTRA) is True for e in extras])
 
     def _joint_nodes(self, doc: GltfDocument) -> list[int]:
+        if self.skin is None:
+            return _animated_tree(doc)
         joints = list(doc.gltf.skins[self.skin].joints or [])
         if not joints:
             raise doc.fail(self.element, "has no joints")
@@ -213,11 +220,11 @@ class SkinRig:
 
     def _inverse_bind(self, doc: GltfDocument, joint_count: int) -> np.ndarray:
         """Inverse bind matrices ``(J, 4, 4)`` in slot order: the skin's (identity when absent),
-        then identity for an added common root."""
-        skin = doc.gltf.skins[self.skin]
+        then identity for an added common root (and for an animated node tree, which has no skin)."""
         matrices = np.broadcast_to(np.eye(4), (joint_count, 4, 4)).copy()
-        if skin.inverseBindMatrices is None:
+        if self.skin is None or doc.gltf.skins[self.skin].inverseBindMatrices is None:
             return matrices
+        skin = doc.gltf.skins[self.skin]
         stored = doc.accessor(skin.inverseBindMatrices, f"{self.element} inverseBindMatrices")
         count = self.skin_slots
         if stored.shape != (count, 16) or stored.dtype.kind != "f":
@@ -298,6 +305,22 @@ class SkinRig:
         keys = values[:, 1] if values.ndim == 3 else values  # CUBICSPLINE: the values between tangents
         rest = self._rest_scale[node]
         return float(np.abs(keys - rest).max()) > UNIFORM_SCALE_TOLERANCE * float(np.abs(rest).max())
+
+
+def _animated_tree(doc: GltfDocument) -> list[int]:
+    """The nodes an animation translates, turns or scales, and every node below one that draws
+    nothing (no mesh, no camera: an end site or a bone without keys), in node order."""
+    moved = {node for targets in doc.channel_targets for node, path in targets if path in _NODE_PATHS}
+    if not moved:
+        raise doc.fail(
+            "animations", "no skin, and no animation translates, turns or scales a node: no skeleton to read"
+        )
+    nodes = doc.gltf.nodes
+    return [
+        index
+        for index, node in enumerate(nodes)
+        if index in moved or (node.mesh is None and node.camera is None and not moved.isdisjoint(doc.ancestors(index)))
+    ]
 
 
 def _mirrored(rotation: np.ndarray, signs: np.ndarray) -> np.ndarray:

@@ -1,6 +1,7 @@
 """Write skinned meshes, skeletons and motions as glTF 2.0 (GLB).
 
-``write_glb`` writes one skinned mesh and its motions to a new file: one node per joint (rest
+``write_glb`` writes one skinned mesh (or none: a skeleton's clips) and its motions to a new
+file: one node per joint (rest
 translation and rotation, parents before children, end sites marked with
 ``extras.animlod_end_site``), a mesh node with the skin, one mesh primitive (POSITION, NORMAL and
 TEXCOORD_0 when present, JOINTS_0/WEIGHTS_0 and, for 8 influences, JOINTS_1/WEIGHTS_1,
@@ -29,7 +30,7 @@ _TRIANGLES, _LINEAR = 4, "LINEAR"
 
 def write_glb(
     path: str | os.PathLike,
-    skinned: SkinnedMesh,
+    skinned: SkinnedMesh | None,
     motions: Sequence[Motion] = (),
     names: Sequence[str] | None = None,
 ) -> None:
@@ -38,25 +39,32 @@ def write_glb(
     Parameters
     ----------
     path : output file, replaced only once the whole file is written.
-    skinned : the mesh; K < 4 influences are padded with zero weights to glTF's 4.
+    skinned : the mesh; K < 4 influences are padded with zero weights to glTF's 4. None writes
+        the skeleton of ``motions[0]`` and the motions only (an animation library's file).
     motions : animations on ``skinned.skeleton`` (same joint names, parents and offsets).
     names : animation names, one per motion; defaults to each motion's name, or "motion<i>".
 
     Raises
     ------
-    ValueError if a motion is on another skeleton or ``names`` has the wrong length.
+    ValueError if a motion is on another skeleton, ``names`` has the wrong length, or there is
+    neither a mesh nor a motion.
     """
     names = _animation_names(motions, names)
+    if skinned is None and not motions:
+        raise ValueError("motions: a GLB without a skinned mesh needs a motion to give its skeleton")
+    skeleton = motions[0].skeleton if skinned is None else skinned.skeleton
     for index, motion in enumerate(motions):
-        _check_same_skeleton(skinned, motion, index)
+        _check_same_skeleton(skeleton, motion, index)
     builder = GlbBuilder()
-    joint_nodes = add_skeleton(builder, skinned.skeleton)
-    skin = add_skin(builder, joint_nodes, skinned.inverse_bind)
-    mesh = builder.append("meshes", _mesh(builder, skinned))
-    mesh_node = builder.append("nodes", {"name": "skinned mesh", "mesh": mesh, "skin": skin})
+    joint_nodes = add_skeleton(builder, skeleton)
+    scene_nodes = [joint_nodes[0]]
+    if skinned is not None:
+        skin = add_skin(builder, joint_nodes, skinned.inverse_bind)
+        mesh = builder.append("meshes", _mesh(builder, skinned))
+        scene_nodes.append(builder.append("nodes", {"name": "skinned mesh", "mesh": mesh, "skin": skin}))
     for motion, name in zip(motions, names):
         add_animation(builder, motion, joint_nodes, name)
-    builder.json["scenes"] = [{"nodes": [joint_nodes[0], mesh_node]}]
+    builder.json["scenes"] = [{"nodes": scene_nodes}]
     builder.json["scene"] = 0
     builder.save(path)
 
@@ -159,17 +167,17 @@ def _animation_names(motions: Sequence[Motion], names: Sequence[str] | None) -> 
     return [str(name) for name in names]
 
 
-def _check_same_skeleton(skinned: SkinnedMesh, motion: Motion, index: int) -> None:
-    mesh_skeleton, skeleton = skinned.skeleton, motion.skeleton
+def _check_same_skeleton(written: Skeleton, motion: Motion, index: int) -> None:
+    skeleton = motion.skeleton
     same = (
-        skeleton.names == mesh_skeleton.names
-        and np.array_equal(skeleton.parents, mesh_skeleton.parents)
-        and np.allclose(skeleton.offsets[1:], mesh_skeleton.offsets[1:], rtol=1e-6, atol=1e-9)
+        skeleton.names == written.names
+        and np.array_equal(skeleton.parents, written.parents)
+        and np.allclose(skeleton.offsets[1:], written.offsets[1:], rtol=1e-6, atol=1e-9)
     )
     if not same:
         raise ValueError(
-            f"motion {index} ({motion.name!r}): its skeleton differs from the skinned mesh's "
-            "(joint names, parents or bone offsets); a GLB animation can only drive the mesh's own joints"
+            f"motion {index} ({motion.name!r}): its skeleton differs from the written one "
+            "(joint names, parents or bone offsets); a GLB animation can only drive the file's own joints"
         )
 
 

@@ -1,4 +1,4 @@
-"""The motion LoD pipeline: a BVH or a skinned glTF clip in, one BVH (and GLB) per level out.
+"""The motion LoD pipeline: a BVH or a glTF clip in, one BVH (and GLB) per level out.
 
 Joint elimination and re-fit (the motion LoD paper, Sections 4-6) through
 :func:`animlod.build_motion_chain`; ``animlod motion`` and the batch runner's ``motion`` job
@@ -30,8 +30,8 @@ class MotionReport:
     """What :func:`build_motion_levels` did.
 
     chain : the analysis and the levels, finest first (level 0 keeps every joint).
-    files : per level, the files written (relative to the output folder): a BVH, and a GLB for a
-        skinned glTF input.
+    files : per level, the files written (relative to the output folder): a BVH, and for a glTF
+        input a GLB (the skinned mesh on the level's joints, or the skeleton alone without a skin).
     manifest : the level chooser's manifest (``<stem>_motion_lod.json``).
     faces : triangles of the skinned mesh (None for a BVH).
     motion : the clip simplified (several split clips merged into one, see ``notes``).
@@ -67,9 +67,10 @@ def build_motion_levels(
     on_choice: Callable[[int, int], None] | None = None,
     on_note: Callable[[str], None] | None = None,
 ) -> MotionReport:
-    """Motion levels of ``source`` (a .bvh, or a .glb/.gltf with a skinned mesh and animations)
-    written into the folder ``output`` as ``<stem>_lod<i>.bvh`` (and ``.glb`` with the skin moved
-    onto the kept joints), plus ``<stem>_motion_lod.json``, each file atomically.
+    """Motion levels of ``source`` (a .bvh, or a .glb/.gltf with animations: of a skinned mesh, or
+    of a node tree without skins) written into the folder ``output`` as ``<stem>_lod<i>.bvh`` (and
+    ``.glb`` with the skin moved onto the kept joints, or the skeleton alone), plus
+    ``<stem>_motion_lod.json``, each file atomically.
 
     Parameters
     ----------
@@ -93,7 +94,7 @@ def build_motion_levels(
         re-fits choose the joints, before the first level.
     on_note : called with each note as it arises (also kept in the report).
 
-    Raises FormatError for unreadable input or a glTF without a skinned, animated mesh;
+    Raises FormatError for unreadable input or a glTF without animations of a skeleton;
     ValueError naming the option for bad options and impossible level requests.
     """
     from ..motion_lod.chain import build_motion_chain
@@ -151,7 +152,7 @@ def build_motion_levels(
     for index, level in enumerate(chain.levels):
         names = [Path(f"{stem}_lod{index}.bvh")]
         write_bvh(folder / names[0], level.motion, rotation_order=orders)
-        if level.skin is not None:
+        if input_kind(source) == "gltf":
             from ..io.gltf import write_glb
 
             names.append(Path(f"{stem}_lod{index}.glb"))
@@ -169,7 +170,8 @@ def build_motion_levels(
 def _read_input(
     source: str | os.PathLike, clip: int | str | None, note: Callable[[str], None]
 ) -> tuple[Motion, SkinnedMesh | None, BvhLayout | None]:
-    """The motion to simplify and, for a skinned glTF, its skin; for a BVH, its layout."""
+    """The motion to simplify and, for a skinned glTF, its skin (None for a glTF without skins:
+    the animated node tree is the skeleton); for a BVH, its layout."""
     path = os.fspath(source)
     kind = input_kind(source)
     if kind == "bvh":
@@ -178,17 +180,22 @@ def _read_input(
         motion, layout = read_bvh_with_layout(source)
         return motion, None, layout
     if kind != "gltf":
-        raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or a skinned glTF")
-    from ..io.gltf import read_gltf, read_skinned
+        raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
+    from ..io.gltf import read_gltf
+    from ..io.gltf_read import read_node_motions
 
     scene = read_gltf(source)
-    if not scene.skinned_meshes:
-        read_skinned(source)  # raises the error naming what the file has
-    skin, motions = _whole_skin(scene.skinned_meshes), scene.skinned_motions[0]
-    if skin.vertex_count > scene.skinned_meshes[0].vertex_count:
-        note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
-    if not motions:
-        raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
+    if scene.skinned_meshes:
+        skin, motions = _whole_skin(scene.skinned_meshes), scene.skinned_motions[0]
+        if skin.vertex_count > scene.skinned_meshes[0].vertex_count:
+            note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
+        if not motions:
+            raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
+    else:  # an animation library exported without its mesh
+        skin, motions = None, read_node_motions(source)
+        skeleton = motions[0].skeleton
+        note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
+             f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clip")  # fmt: skip
     if clip is None:
         from ..motion_lod.clips import merge_split_clips
 

@@ -173,7 +173,7 @@ def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(ch
     (colour,) = [channel for channel in clip.channels if channel.target.path == "pointer"]
     levels = [animation for animation in doc_out.gltf.animations if "@motion" in (animation.name or "")]
     assert levels
-    level_nodes = set(_level_nodes(doc_out))  # drive_morph_weights's, tested below
+    level_nodes = set(_level_nodes(doc_out))  # drive_level_nodes's, tested below
     for animation in levels:
         m = animation.name.rsplit("@motion", 1)[1]
         carried = {

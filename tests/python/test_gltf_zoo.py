@@ -24,7 +24,8 @@ from animlod.pipelines.motion import build_motion_levels
 def _morph_tube_glb(path: Path, node_weights: list[float] | None, clip: str | None = None) -> Path:
     """A tube with one morph target (doubling its height), mesh weights [0], drawn by one node
     whose ``weights`` override the mesh's when given (glTF 2.0, 3.7.2.2); with ``clip``, a clip
-    stretching it over one second, by a "weights" channel or a KHR_animation_pointer ("pointer")."""
+    stretching it over one second, by a "weights" channel or a KHR_animation_pointer ("pointer"), or
+    turning it a quarter turn ("rotation", as a truck's wheels turn)."""
     positions, faces = tube()
     builder = GlbBuilder()
     position = builder.add(positions.astype(np.float32), bounds=True)
@@ -39,6 +40,9 @@ def _morph_tube_glb(path: Path, node_weights: list[float] | None, clip: str | No
         times = builder.add(np.array([[0.0], [1.0]], np.float32), bounds=True)
         sampler = {"input": times, "output": builder.add(np.array([[0.0], [1.0]], np.float32))}
         target = {"node": 0, "path": "weights"}
+        if clip == "rotation":
+            turn = np.array([[0.0, 0.0, 0.0, 1.0], [0.0, 0.5**0.5, 0.0, 0.5**0.5]], np.float32)
+            sampler, target = {"input": times, "output": builder.add(turn)}, {"node": 0, "path": "rotation"}
         if clip == "pointer":
             target = {"path": "pointer", "extensions": {"KHR_animation_pointer": {"pointer": "/nodes/0/weights"}}}
             builder.add_extension_used("KHR_animation_pointer")
@@ -93,15 +97,16 @@ def test_level_nodes_keep_the_morph_weights_of_their_base_node(tmp_path: Path) -
     assert all("weights" not in plain[level] for level in plain[0]["extensions"]["MSFT_lod"]["ids"])
 
 
-@pytest.mark.parametrize("clip", ["weights", "pointer"])
-def test_every_level_node_plays_the_morph_weight_clip_of_its_base_node(tmp_path: Path, clip: str) -> None:
-    """A clip's morph-weight channel animates one node, and each MSFT_lod level is a node of its own:
-    the levels had no channel, so a viewer switching to one showed the tube at its rest weights."""
+@pytest.mark.parametrize("clip", ["weights", "pointer", "rotation"])
+def test_every_level_node_plays_the_clip_of_its_base_node(tmp_path: Path, clip: str) -> None:
+    """A clip's channel animates one node, and each MSFT_lod level is a node of its own: the levels had
+    no channel, so a viewer switching to one showed the tube at its rest weights, or not turning."""
     simplify_document(_morph_tube_glb(tmp_path / "tall.glb", None, clip), tmp_path / "lod.glb")
     doc = GltfDocument(tmp_path / "lod.glb")
     levels = doc.json["nodes"][0]["extensions"]["MSFT_lod"]["ids"]
     (channels,) = doc.channel_targets
-    assert levels and channels == [(0, "weights"), *[(level, "weights") for level in levels]]
+    path = "rotation" if clip == "rotation" else "weights"
+    assert levels and channels == [(0, path), *[(level, path) for level in levels]]
     assert {channel.sampler for channel in doc.gltf.animations[0].channels} == {0}
 
 

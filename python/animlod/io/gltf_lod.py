@@ -168,7 +168,7 @@ def attach_chain(
 ) -> None:
     """Makes node ``base`` the top of a chain: MSFT_lod ids, screen coverages (one per level,
     ``len(level_nodes) + 1`` decreasing values ending at 0), its own animlod extras, and the
-    level nodes driven by its morph-weight clips (:func:`drive_morph_weights`)."""
+    level nodes driven by its clips (:func:`drive_level_nodes`)."""
     if len(coverages) != len(level_nodes) + 1:
         raise ValueError(f"coverages: {len(coverages)} values for {len(level_nodes) + 1} levels")
     node = builder.json["nodes"][base]
@@ -180,20 +180,25 @@ def attach_chain(
     extras[ANIMLOD_EXTRA] = base_info.extras()
     node["extras"] = extras
     builder.add_extension_used(LOD_EXTENSION)
-    drive_morph_weights(builder, base, level_nodes)
+    drive_level_nodes(builder, base, level_nodes)
 
 
-def drive_morph_weights(builder: GlbBuilder, base: int, level_nodes: list[int]) -> None:
-    """Every clip's morph-weight channel of node ``base`` also drives those of ``level_nodes``
-    whose meshes have as many targets, through the same sampler. A channel animates one node and a
-    level is a node of its own: without this, a viewer that switches to a coarser level shows it
-    at its rest weights (a flamingo that stops flapping at a distance)."""
+def drive_level_nodes(builder: GlbBuilder, base: int, level_nodes: list[int]) -> None:
+    """Every clip's channel that moves node ``base`` (its translation, rotation or scale) or sets its
+    morph weights also drives ``level_nodes`` through the same sampler; morph weights only those
+    whose meshes have as many targets. A channel animates one node and a level is a node of its own:
+    without this, a viewer that switches to a coarser level shows it at rest (a flamingo that stops
+    flapping, a truck whose wheels stop turning at a distance)."""
     targets = _morph_target_count(builder, base)
-    driven = [node for node in level_nodes if targets and _morph_target_count(builder, node) == targets]
-    for animation in builder.json.get("animations", []) if driven else []:
+    weighted = [node for node in level_nodes if targets and _morph_target_count(builder, node) == targets]
+    for animation in builder.json.get("animations", []) if level_nodes else []:
         channels = animation.get("channels", [])
-        for channel in [c for c in channels if _weights_node(c.get("target", {})) == base]:
-            channels.extend({"sampler": channel["sampler"], "target": {"node": n, "path": "weights"}} for n in driven)
+        for channel in list(channels):
+            target = _node_target(channel.get("target", {}))
+            if target is None or target[0] != base:
+                continue
+            driven = weighted if target[1] == "weights" else level_nodes
+            channels.extend({"sampler": channel["sampler"], "target": {"node": n, "path": target[1]}} for n in driven)
 
 
 def _morph_target_count(builder: GlbBuilder, node: int) -> int:
@@ -203,14 +208,15 @@ def _morph_target_count(builder: GlbBuilder, node: int) -> int:
     return len(primitives[0].get("targets", [])) if primitives else 0
 
 
-def _weights_node(target: dict) -> int | None:
-    """The node whose morph weights a channel target animates, by node and path or by a
-    KHR_animation_pointer at ``/nodes/<n>/weights``; None for anything else."""
-    if target.get("path") == "weights":
-        return target.get("node")
+def _node_target(target: dict) -> tuple[int, str] | None:
+    """The (node, path) a channel target animates, by node and path or by a KHR_animation_pointer
+    at ``/nodes/<n>/<path>``; None for anything else (a material's colour, a light)."""
+    path = target.get("path")
+    if path != "pointer":
+        return (target["node"], path) if target.get("node") is not None else None
     pointer = (target.get("extensions") or {}).get(POINTER_EXTENSION, {}).get("pointer", "")
-    match = NODE_POINTER.fullmatch(pointer) if target.get("path") == "pointer" and isinstance(pointer, str) else None
-    return int(match.group(1)) if match and match.group(2) == "weights" else None
+    match = NODE_POINTER.fullmatch(pointer) if isinstance(pointer, str) else None
+    return (int(match.group(1)), match.group(2)) if match else None
 
 
 def screen_coverages(

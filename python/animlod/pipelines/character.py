@@ -39,7 +39,7 @@ from ..io.gltf_lod import (
     add_level_mesh,
     add_level_node,
     attach_chain,
-    drive_morph_weights,
+    drive_level_nodes,
     level_node_name,
     screen_coverages,
 )
@@ -378,4 +378,4 @@ def _attach(builder: GlbBuilder, drawable: Drawable, report: list[CharacterLevel
         extras = builder.json["nodes"][base]["extras"]
         extras[GRID_EXTRA] = [[cells[index] for cells in row] for row in grid]
         grid_only = [cells[index] for row in grid for cells in row if cells[index] not in (base, *chain_nodes)]
-        drive_morph_weights(builder, base, grid_only)
+        drive_level_nodes(builder, base, grid_only)

@@ -250,7 +250,7 @@ def test_motion_levels_of_a_skin_without_inverse_bind_matrices_keep_the_frozen_b
 
 def _animation_library(source: Path, target: Path) -> Path:
     """``source`` (animlod's GLB of one skinned mesh) as animation libraries are exported: no skin,
-    the mesh drawn by a prop node held in a hand, and a keyless fingertip."""
+    the mesh drawn by a prop node held in a hand, a keyless fingertip, and a camera moving beside."""
 
     def strip(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
         mesh_node = len(gltf.nodes) - 1  # write_glb appends the skinned mesh's node last
@@ -262,6 +262,16 @@ def _animation_library(source: Path, target: Path) -> Path:
         gltf.nodes[hand].children = [*(gltf.nodes[hand].children or []), mesh_node]
         gltf.nodes.append(pygltflib.Node(name="LeftHandIndex3", translation=[0.02, 0.0, 0.0]))
         gltf.nodes[finger].children = [*(gltf.nodes[finger].children or []), len(gltf.nodes) - 1]
+        gltf.cameras = [pygltflib.Camera(type="perspective", perspective=pygltflib.Perspective(yfov=0.8, znear=0.1))]
+        gltf.nodes.append(pygltflib.Node(name="camera", camera=0))
+        gltf.scenes[0].nodes.append(len(gltf.nodes) - 1)
+        animation = gltf.animations[0]
+        animation.channels.append(
+            pygltflib.AnimationChannel(
+                sampler=animation.channels[0].sampler,  # the root's translation keys
+                target=pygltflib.AnimationChannelTarget(node=len(gltf.nodes) - 1, path="translation"),
+            )
+        )
 
     return edit_glb(source, target, strip)
 

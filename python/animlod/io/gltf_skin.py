@@ -43,6 +43,7 @@ from .gltf_keyframes import sample_keyframes
 # rest value count as held, so the motion needs no per-frame joint translations.
 _HELD_TRANSLATION_TOLERANCE = 1e-4
 _NODE_PATHS = ("translation", "rotation", "scale")
+_LIGHTS_EXTENSION = "KHR_lights_punctual"
 # Below this relative volume (|det| over the product of the column lengths) a 3x3 part counts as
 # singular: its inverse would amplify float32 noise by more than a million.
 _SINGULAR_VOLUME = 1e-6
@@ -308,18 +309,24 @@ class SkinRig:
 
 
 def _animated_tree(doc: GltfDocument) -> list[int]:
-    """The nodes an animation translates, turns or scales, and every node below one that draws
-    nothing (no mesh, no camera: an end site or a bone without keys), in node order."""
-    moved = {node for targets in doc.channel_targets for node, path in targets if path in _NODE_PATHS}
+    """The nodes an animation translates, turns or scales, but cameras and lights (the scene's, not
+    the skeleton's), and every node below one that draws nothing (an end site or a bone without
+    keys), in node order."""
+    nodes = doc.gltf.nodes or []
+    staging = {
+        index
+        for index, node in enumerate(nodes)
+        if node.camera is not None or _LIGHTS_EXTENSION in (node.extensions or {})
+    }
+    moved = {node for targets in doc.channel_targets for node, path in targets if path in _NODE_PATHS} - staging
     if not moved:
         raise doc.fail(
             "animations", "no skin, and no animation translates, turns or scales a node: no skeleton to read"
         )
-    nodes = doc.gltf.nodes
     return [
         index
         for index, node in enumerate(nodes)
-        if index in moved or (node.mesh is None and node.camera is None and not moved.isdisjoint(doc.ancestors(index)))
+        if index in moved or (node.mesh is None and index not in staging and not moved.isdisjoint(doc.ancestors(index)))
     ]
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pygltflib
 import pytest
 from gltf_edits import append_accessor, edit_glb
-from simplify_inputs import tube, two_bone_tube
+from simplify_inputs import ellipsoid, tube, two_bone_tube
 
 from animlod import rotations, synth
 from animlod.io.errors import FormatError
@@ -312,3 +312,37 @@ def test_a_gltf_without_skins_or_moving_nodes_has_no_skeleton_for_motion(tmp_pat
     source = _morph_tube_glb(tmp_path / "tube.glb", None, clip="weights")
     with pytest.raises(FormatError, match="tube.glb: animations: no skin, and no animation translates, turns or"):
         build_motion_levels(source, tmp_path / "levels", levels=2)
+
+
+def _placed_glb(path: Path, translation: list[float]) -> Path:
+    """A bumpy sphere of 2 units across drawn by one node at ``translation``."""
+    sphere = ellipsoid(frames=1, rings=24, segments=32)
+    positions = sphere.frames[0] * (1.0 + 0.05 * np.sin(7.0 * sphere.frames[0][:, :1]))
+    builder = GlbBuilder()
+    attributes = {"POSITION": builder.add(positions.astype(np.float32), bounds=True)}
+    indices = builder.add(sphere.faces.astype(np.uint32).reshape(-1, 1))
+    builder.append("meshes", {"primitives": [{"attributes": attributes, "indices": indices}]})
+    builder.append("nodes", {"mesh": 0, "translation": translation})
+    builder.json["scenes"], builder.json["scene"] = [{"nodes": [0]}], 0
+    builder.save(path)
+    return path
+
+
+def test_a_mesh_placed_far_from_the_origin_simplifies_as_at_the_origin(tmp_path: Path) -> None:
+    """Georeferenced scenes place meshes a million units out, where float32 steps by 0.0625: the
+    levels were computed and written back from world positions on that grid (at half the faces, 14
+    times the error at the origin: a tenth of the radius). The node's placement stays out of the
+    float32 positions."""
+    reports, positions = [], []
+    for name, translation in (("origin", [0.0, 0.0, 0.0]), ("far", [1e6, -2e6, 5e5])):
+        reports.append(
+            simplify_document(_placed_glb(tmp_path / f"{name}.glb", translation), tmp_path / f"{name}_lod.glb")
+        )
+        doc = GltfDocument(tmp_path / f"{name}_lod.glb")
+        positions.append(
+            [doc.accessor(mesh["primitives"][0]["attributes"]["POSITION"], "") for mesh in doc.json["meshes"]]
+        )
+    errors = [[level.error for level in report.drawables[0].levels] for report in reports]
+    assert len(errors[0]) > 1 and errors[0] == errors[1]
+    for near, far in zip(*positions):
+        np.testing.assert_array_equal(near, far)

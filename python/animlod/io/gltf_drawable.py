@@ -57,7 +57,12 @@ class Drawable:
     nodes : the nodes that draw this pair (instances).
     label : "mesh 0 'Body' with skin 0" for messages.
     geometry : the triangle primitives, node-local.
-    world : (4, 4) rest world transform of the first node; positions below are in world space.
+    world : (4, 4) rest world transform of the first node, less ``placement``; positions below are
+        in world space shifted by ``-placement``.
+    placement : (3,) the first node's world position for an unskinned mesh (zero when skinned:
+        a skin places it). Taken out of ``world`` so that float32 positions keep the precision of
+        the stored ones: a mesh placed a million units out had its world positions, and the levels
+        written back from them, on float32's 0.0625-unit grid there.
     skinned : the world-space skinned mesh (joints in skeleton order), or None.
     rig : the skin as a skeleton, or None.
     clips : the animations that move this drawable.
@@ -70,6 +75,7 @@ class Drawable:
     label: str
     geometry: MeshGeometry
     world: np.ndarray
+    placement: np.ndarray = field(default_factory=lambda: np.zeros(3))
     skinned: SkinnedMesh | None = None
     rig: SkinRig | None = None
     clips: list[Clip] = field(default_factory=list)
@@ -139,7 +145,10 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
         world = doc.rest_world_matrix(nodes[0])
         if abs(np.linalg.det(world[:3, :3])) < 1e-30:
             raise doc.fail(doc.node_label(nodes[0]), "its world transform is singular (a zero scale)")
-        drawable = Drawable(mesh_index, skin_index, nodes, label, geometry, world)
+        placement = np.zeros(3)
+        if skin_index is None:
+            placement, world[:3, 3] = world[:3, 3].copy(), 0.0
+        drawable = Drawable(mesh_index, skin_index, nodes, label, geometry, world, placement)
         if skin_index is not None:
             if skin_index not in rigs:
                 rigs[skin_index] = SkinRig(doc, skin_index)

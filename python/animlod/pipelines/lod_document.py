@@ -53,7 +53,7 @@ class DrawableReport:
     renormalised_weights: int
     levels: list[LevelReport] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
-    rest_meshes: list[AnimatedMesh] = field(default_factory=list)  # level 0, 1, ... in the rest pose, world
+    rest_meshes: list[AnimatedMesh] = field(default_factory=list)  # level 0, 1, ... at rest, world less the placement
 
 
 @dataclass

@@ -203,6 +203,38 @@ def test_motion_levels_show_every_part_of_a_character_on_one_skin(tmp_path: Path
     assert any("one mesh" in note for note in report.notes)
 
 
+def test_motion_levels_show_a_part_on_a_skin_of_its_own_over_the_same_joints(tmp_path: Path) -> None:
+    """Exporters may give each mesh a skin of its own over the joints it uses (Soldier's visor): such
+    a part was left out of every motion level's GLB. It joins the character where its skin was bound
+    in the same pose; a part bound in another pose stays out, and a note says so."""
+
+    def part_on_own_skin(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        joints = list(reversed(gltf.skins[0].joints))  # the same joints, listed in another order
+        stored = gltf.skins[0].inverseBindMatrices
+        view = gltf.bufferViews[gltf.accessors[stored].bufferView]
+        start = (view.byteOffset or 0) + (gltf.accessors[stored].byteOffset or 0)
+        matrices = np.frombuffer(bytes(blob[start : start + 64 * len(joints)]), np.float32).reshape(-1, 16)
+        elsewhere = matrices[::-1].copy()
+        elsewhere[0, 12:15] += 1.0  # one joint bound a unit away (column-major: the translation)
+        for name, rows in (("visor", matrices[::-1].copy()), ("posed elsewhere", elsewhere)):
+            skin = pygltflib.Skin(joints=joints, inverseBindMatrices=append_accessor(gltf, blob, rows, "MAT4"))
+            gltf.skins.append(skin)
+            gltf.meshes.append(pygltflib.Mesh(primitives=gltf.meshes[0].primitives, name=name))
+            gltf.nodes.append(pygltflib.Node(name=name, mesh=len(gltf.meshes) - 1, skin=len(gltf.skins) - 1))
+            gltf.scenes[gltf.scene or 0].nodes.append(len(gltf.nodes) - 1)
+
+    source = edit_glb(_two_bone_glb(tmp_path / "body.glb"), tmp_path / "parts.glb", part_on_own_skin)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    scene = read_gltf(source)
+    expected = np.concatenate(
+        [mesh.bake(motions[0]).frames for mesh, motions in zip(scene.skinned_meshes[:2], scene.skinned_motions)], axis=1
+    )
+    written = read_gltf(tmp_path / "levels" / "parts_lod0.glb")
+    (skinned,), (motion,) = written.skinned_meshes, written.motions
+    np.testing.assert_allclose(skinned.bake(motion).frames, expected, atol=1e-4)
+    assert any("1 skinned mesh on other joints, bound in another pose" in note for note in report.notes)
+
+
 def test_character_level_nodes_are_named_by_their_place_in_the_grid(tmp_path: Path) -> None:
     """Chain levels are ``<base>_LOD<i>`` and grid-only nodes ``<base>_G<g>M<m>``, each name once: every
     level node was named ``<base>_LOD-1`` (the grid's placeholder level), which importers then told

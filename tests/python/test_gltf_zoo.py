@@ -378,3 +378,20 @@ def test_a_mesh_placed_far_from_the_origin_simplifies_as_at_the_origin(tmp_path:
     assert len(errors[0]) > 1 and errors[0] == errors[1]
     for near, far in zip(*positions):
         np.testing.assert_array_equal(near, far)
+
+
+def test_simplify_points_an_animation_library_to_motion(tmp_path: Path) -> None:
+    character = synth.humanoid()
+    write_glb(tmp_path / "humanoid.glb", character, [synth.humanoid_motion(character.skeleton, "walk")])
+
+    def no_prop(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        gltf.nodes[next(i for i, node in enumerate(gltf.nodes) if node.name == "prop")].mesh = None
+
+    source = edit_glb(
+        _animation_library(tmp_path / "humanoid.glb", tmp_path / "with_prop.glb"), tmp_path / "clips.glb", no_prop
+    )
+    with pytest.raises(
+        FormatError,
+        match="no node draws a triangle mesh, nothing to simplify .its animations are `animlod motion`'s input",
+    ):
+        simplify_document(source, tmp_path / "lod.glb")

@@ -101,7 +101,10 @@ def simplify_document(
     doc = GltfDocument(source)
     drawables = read_drawables(doc, settings.fps)
     if not drawables:
-        raise FormatError(doc.path, "meshes", "no node draws a triangle mesh, nothing to simplify")
+        reason = "no node draws a triangle mesh, nothing to simplify"
+        if doc.gltf.animations:  # an animation library: its clips are motion LoD's input
+            reason += " (its animations are `animlod motion`'s input)"
+        raise FormatError(doc.path, "meshes", reason)
     simplified = []
     for drawable in drawables:
         if progress:

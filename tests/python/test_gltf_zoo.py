@@ -395,3 +395,27 @@ def test_simplify_points_an_animation_library_to_motion(tmp_path: Path) -> None:
         match="no node draws a triangle mesh, nothing to simplify .its animations are `animlod motion`'s input",
     ):
         simplify_document(source, tmp_path / "lod.glb")
+
+
+def test_motion_levels_of_every_clip_share_one_skeleton_per_level(tmp_path: Path) -> None:
+    """A glTF's clips (a character's walk, run, idle) need one skeleton per level at run time; its
+    first clip alone was simplified and the others dropped without a word. They are simplified
+    together now, one after another: each level writes a BVH per clip and one GLB with every clip."""
+    from animlod.io.bvh import read_bvh
+
+    skinned, motion = two_bone_tube()
+    back = motion.take_frames(np.arange(motion.frame_count)[::-1])
+    write_glb(tmp_path / "clips.glb", skinned, [motion, back], names=["Armature|Bend", "Armature|Bend"])
+    report = build_motion_levels(tmp_path / "clips.glb", tmp_path / "levels", levels=2)
+    assert any("its 2 animations simplified together" in note for note in report.notes)
+    frames = motion.frame_count
+    for index, level in enumerate(report.chain.levels):
+        clip_files = [f"clips_lod{index}_Armature_Bend_{k}.bvh" for k in range(2)]
+        assert [path.name for path in report.files[index]] == [*clip_files, f"clips_lod{index}.glb"]
+        written = read_gltf(tmp_path / "levels" / f"clips_lod{index}.glb").motions
+        assert [clip.name for clip in written] == ["Armature|Bend"] * 2
+        for k, span in enumerate((slice(0, frames), slice(frames, 2 * frames))):
+            expected = level.motion.take_frames(span).world_positions()
+            np.testing.assert_allclose(written[k].world_positions(), expected, atol=1e-5)
+            from_bvh = read_bvh(tmp_path / "levels" / clip_files[k]).world_positions()
+            np.testing.assert_allclose(from_bvh, expected, atol=1e-4)

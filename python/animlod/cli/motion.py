@@ -78,8 +78,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--max-frames", type=int, default=600, help="frames motion analysis looks at, at most")
     parser.add_argument(
         "--clip", type=_clip, default=None,
-        help="which animation of a glTF file, by index or name; default the first, or all of them as one motion "
-        "when each moves other joints (one animation per joint node)",
+        help="which animation of a glTF file, by index or name; default all of them: as one motion when each "
+        "moves other joints (one animation per joint node), else one after another with one skeleton per level "
+        "(a BVH per clip and level, every clip in each level's GLB)",
     )  # fmt: skip
     parser.add_argument("--plot", action="store_true", help="write importance, key posture and error charts (PNG)")
     parser.set_defaults(run=run)

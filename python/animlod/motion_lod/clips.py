@@ -1,4 +1,5 @@
-"""One motion from animations that each move different joints.
+"""One motion from several clips: animations that each move different joints
+(:func:`merge_split_clips`), or clips played one after another (:func:`join_clips`).
 
 Some exporters store one motion as many glTF animations, one per joint node (Monster.glb of the
 development data: 32 animations of 101 keys, each moving one node). Read one by one they are 32
@@ -73,3 +74,12 @@ def merge_split_clips(motions: Sequence[Motion]) -> Motion | None:
         "merged",
         translations if moved_translation else None,
     )
+
+
+def join_clips(motions: Sequence[Motion]) -> tuple[Motion, list[slice]]:
+    """The clips one after another as one motion (one analysis, one reduced skeleton for all; the
+    caller's to check they share a skeleton and rate), named by their names joined with ``+``, and
+    each clip's frames in it."""
+    starts = np.cumsum([0] + [motion.frame_count for motion in motions])
+    spans = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
+    return Motion.concatenate(list(motions), "+".join(motion.name for motion in motions)), spans

@@ -49,6 +49,7 @@ from ..metrics import hausdorff_distances
 from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
 from ..motion_lod.chain import MotionLevel
+from ..motion_lod.clips import join_clips
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
@@ -130,7 +131,7 @@ def build_character(
         if skin in motion_chains:
             continue
         clips = [clip for clip in drawable.clips if clip.motion is not None]
-        joined, spans = _joined_motion([clip.motion for clip in clips])
+        joined, spans = join_clips([clip.motion for clip in clips])
         scaling = joined.deforming_joint()
         if scaling is not None:
             notes.append(
@@ -187,14 +188,6 @@ def build_character(
         notes.append(f"not simplified (no skin or no animation): {', '.join(skipped)}")
     builder.save(output)
     return CharacterReport(Path(source), Path(output), chains, motion_seconds, geometry_seconds, notes)
-
-
-def _joined_motion(motions: list[Motion]) -> tuple[Motion, list[slice]]:
-    """The clips one after another as one motion (one analysis, one reduced skeleton for all),
-    and each clip's frames in it."""
-    starts = np.cumsum([0] + [motion.frame_count for motion in motions])
-    spans = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
-    return Motion.concatenate(motions, "+".join(motion.name for motion in motions)), spans
 
 
 @dataclass

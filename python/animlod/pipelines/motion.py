@@ -8,6 +8,7 @@ call :func:`build_motion_levels`.
 from __future__ import annotations
 
 import os
+import re
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -34,11 +35,12 @@ class MotionReport:
     """What :func:`build_motion_levels` did.
 
     chain : the analysis and the levels, finest first (level 0 keeps every joint).
-    files : per level, the files written (relative to the output folder): a BVH, and for a glTF
-        input a GLB (the skinned mesh on the level's joints, or the skeleton alone without a skin).
+    files : per level, the files written (relative to the output folder): a BVH per clip, and for
+        a glTF input a GLB with every clip (the skinned mesh on the level's joints, or the skeleton
+        alone without a skin).
     manifest : the level chooser's manifest (``<stem>_motion_lod.json``).
     faces : triangles of the skinned mesh (None for a BVH).
-    motion : the clip simplified (several split clips merged into one, see ``notes``).
+    motion : the clip simplified (several clips merged into one, or one after another: see ``notes``).
     floor : the fewest joints the skeleton allows and why (:func:`animlod.motion_lod.chain.joint_floor`).
     notes : what the user should know (clips merged, nothing could freeze).
     """
@@ -72,9 +74,10 @@ def build_motion_levels(
     on_note: Callable[[str], None] | None = None,
 ) -> MotionReport:
     """Motion levels of ``source`` (a .bvh, or a .glb/.gltf with animations: of a skinned mesh, or
-    of a node tree without skins) written into the folder ``output`` as ``<stem>_lod<i>.bvh`` (and
-    ``.glb`` with the skin moved onto the kept joints, or the skeleton alone), plus
-    ``<stem>_motion_lod.json``, each file atomically.
+    of a node tree without skins) written into the folder ``output`` as ``<stem>_lod<i>.bvh``
+    (``<stem>_lod<i>_<clip>.bvh`` for each of several clips) and ``.glb`` with every clip, the skin
+    moved onto the kept joints or the skeleton alone, plus ``<stem>_motion_lod.json``, each file
+    atomically.
 
     Parameters
     ----------
@@ -90,8 +93,9 @@ def build_motion_levels(
     translation_tolerance : fraction of a bone's length above which a translating joint never freezes.
     weights : (alpha, beta, gamma) of the distance, string and angle errors (Eq. 5).
     max_frames : frames the motion analysis looks at, at most.
-    clip : which animation of a glTF input, by index or name; None: the first, or all of them as
-        one motion when each moves other joints (one animation per joint node).
+    clip : which animation of a glTF input, by index or name; None: all of them, as one motion when
+        each moves other joints (one animation per joint node), else one after another, so that
+        each level has one skeleton for every clip.
     on_level : called with (level index, joint count, frame count, number of levels) as each
         level starts; may return a callback taking the frames done.
     on_choice : called with (levels chosen, levels to choose) while the "refit" ranking's trial
@@ -118,7 +122,7 @@ def build_motion_levels(
         if on_note is not None:
             on_note(text)
 
-    motion, skin, layout = _read_input(source, clip, note)
+    motion, clips, skin, layout = _read_input(source, clip, note)
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
@@ -152,15 +156,19 @@ def build_motion_levels(
     stem = input_stem(source)
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
     orders = layout.rotation_orders if layout is not None else "ZXY"
+    suffixes = _clip_suffixes([name for name, _ in clips])
     files, rows = [], []
     for index, level in enumerate(chain.levels):
-        names = [Path(f"{stem}_lod{index}.bvh")]
-        write_bvh(folder / names[0], level.motion, rotation_order=orders)
-        if input_kind(source) == "gltf":
+        names = []
+        level_clips = [level.motion.take_frames(frames) for _, frames in clips]
+        for clip_motion, suffix in zip(level_clips, suffixes):
+            names.append(Path(f"{stem}_lod{index}{suffix}.bvh"))
+            write_bvh(folder / names[-1], clip_motion, rotation_order=orders)
+        if input_kind(source) == "gltf":  # every clip in one GLB per level
             from ..io.gltf import write_glb
 
             names.append(Path(f"{stem}_lod{index}.glb"))
-            write_glb(folder / names[1], level.skin, [level.motion])
+            write_glb(folder / names[-1], level.skin, level_clips, names=[name for name, _ in clips])
         files.append(names)
         rows.append({"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
                      "error": level.report.max_error})  # fmt: skip
@@ -173,16 +181,17 @@ def build_motion_levels(
 
 def _read_input(
     source: str | os.PathLike, clip: int | str | None, note: Callable[[str], None]
-) -> tuple[Motion, SkinnedMesh | None, BvhLayout | None]:
-    """The motion to simplify and, for a skinned glTF, its skin (None for a glTF without skins:
-    the animated node tree is the skeleton); for a BVH, its layout."""
+) -> tuple[Motion, list[tuple[str, slice]], SkinnedMesh | None, BvhLayout | None]:
+    """The motion to simplify, the clips it is made of (each one's name and frames in it), for a
+    skinned glTF its skin (None for a glTF without skins: the animated node tree is the skeleton)
+    and for a BVH its layout."""
     path = os.fspath(source)
     kind = input_kind(source)
     if kind == "bvh":
         from ..io.bvh import read_bvh_with_layout
 
         motion, layout = read_bvh_with_layout(source)
-        return motion, None, layout
+        return motion, [(motion.name, slice(None))], None, layout
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
     from ..io.gltf import read_gltf
@@ -203,25 +212,41 @@ def _read_input(
         skin, motions = None, read_node_motions(source)
         skeleton = motions[0].skeleton
         note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
-             f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clip")  # fmt: skip
+             f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clips")  # fmt: skip
+    names = [motion.name or f"animation{index}" for index, motion in enumerate(motions)]
     if clip is None:
-        from ..motion_lod.clips import merge_split_clips
+        from ..motion_lod.clips import join_clips, merge_split_clips
 
         merged = merge_split_clips(motions)
         if merged is not None:
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
-            return _rigid(path, motions, range(len(motions)), merged), skin, None
-        return _rigid(path, motions, range(1), motions[0]), skin, None
+            return _rigid(path, motions, range(len(motions)), merged), [(merged.name, slice(None))], skin, None
+        if len(motions) > 1:
+            note(f"{path}: its {len(motions)} animations simplified together, one skeleton per level for all of "
+                 "them (use --clip to take one)")  # fmt: skip
+            joined, spans = join_clips(motions)
+            return _rigid(path, motions, range(len(motions)), joined), list(zip(names, spans)), skin, None
+        clip = 0
     if isinstance(clip, str):
-        names = [m.name for m in motions]
         if clip not in names:
             listed = ", ".join(f"{i}: {name!r}" for i, name in enumerate(names))
             raise FormatError(path, "clip", f"no animation named {clip!r}; the file has {listed}")
         clip = names.index(clip)
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
-    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), skin, None
+    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), [(names[clip], slice(None))], skin, None
+
+
+def _clip_suffixes(names: list[str]) -> list[str]:
+    """File name suffixes of the clips' BVH files: none for one clip, else ``_<name>`` with what a
+    file name should not hold as ``_`` (``Armature|Walk`` -> ``_Armature_Walk``), ``_<name>_<index>``
+    where names repeat."""
+    if len(names) == 1:
+        return [""]
+    safe = [re.sub(r"[^\w.-]+", "_", name).strip("_.") or "animation" for name in names]
+    repeated = {name for name in safe if safe.count(name) > 1}
+    return [f"_{name}_{index}" if name in repeated else f"_{name}" for index, name in enumerate(safe)]
 
 
 def _whole_skin(meshes: list[SkinnedMesh]) -> tuple[SkinnedMesh, int]:

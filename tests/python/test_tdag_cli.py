@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import pytest
+from simplify_inputs import two_bone_tube
 
 from animlod import synth
 from animlod.cli import main
+from animlod.io.gltf import write_glb
 from animlod.io.meshseq import read_mesh
 from animlod.io.npz import write_npz
 from animlod.tdag import TemporalDag
@@ -86,3 +88,12 @@ def test_user_mistakes_exit_2_with_one_line(built, capsys, arguments, message):
     assert main(["tdag", *[a.format(dir=built) for a in arguments]]) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_build_from_a_gltf_of_several_clips_says_which_one_it_took(tmp_path, capsys):
+    """A TDAG is one mesh over one run of frames; the other clips were left out without a word."""
+    skinned, motion = two_bone_tube()
+    write_glb(tmp_path / "clips.glb", skinned, [motion, motion], names=["bend", "again"])
+    assert main(["tdag", "build", str(tmp_path / "clips.glb"), "-o", str(tmp_path / "clips.tdag")]) == 0
+    error = capsys.readouterr().err
+    assert "the TDAG is of the first skinned mesh baked with its first clip, 'bend'; 1 other (mesh, clip) pair" in error

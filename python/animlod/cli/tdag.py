@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
 from pathlib import Path
 
@@ -111,10 +112,18 @@ def read_animation(path: str):
 
     scene = read_gltf(path)
     if scene.morph_animations:
-        return scene.morph_animations[0]
-    if scene.skinned_meshes and scene.motions:
-        return scene.skinned_meshes[0].bake(scene.motions[0])
-    raise UserError(f"{path}: no morph-animated mesh and no animated skinned mesh to build a TDAG of")
+        mesh, others = scene.morph_animations[0], len(scene.morph_animations) - 1
+        taken = "the first morph-animated mesh and clip"
+    elif scene.skinned_meshes and scene.motions:
+        mesh = scene.skinned_meshes[0].bake(scene.motions[0])
+        others = len(scene.skinned_meshes) * len(scene.motions) - 1
+        taken = f"the first skinned mesh baked with its first clip, {scene.motions[0].name or 'unnamed'!r}"
+    else:
+        raise UserError(f"{path}: no morph-animated mesh and no animated skinned mesh to build a TDAG of")
+    if others:  # a TDAG is one mesh over one run of frames
+        print(f"note: {path}: the TDAG is of {taken}; {others} other (mesh, clip) pair{'s' if others > 1 else ''} "
+              "left out", file=sys.stderr)  # fmt: skip
+    return mesh
 
 
 def run_build(args: argparse.Namespace) -> int:

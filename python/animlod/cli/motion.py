@@ -21,9 +21,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=(
             "Motion LoD (Sections 4-6 of the motion LoD paper): joint importance from posture error picks the "
             "joints to freeze at their key frames; every frame is re-fitted (E = 0.2 Ed + 0.4 Es + 0.4 Ea) so "
-            "that the kept joints stay close to the original with rigid bones. Writes one BVH per level and, "
-            "for a glTF, one GLB per level with the skin moved onto the kept joints (a glTF without skins: its "
-            "animated node tree is the skeleton, and each GLB holds the skeleton and its clip)."
+            "that the kept joints stay close to the original with rigid bones. Writes one BVH per level (per clip "
+            "and level for a glTF of several) and, for a glTF, one GLB per level with every clip and the skin "
+            "moved onto the kept joints (a glTF without skins: its animated node tree is the skeleton, and each "
+            "GLB holds the skeleton and the clips)."
         ),
     )
     parser.add_argument(

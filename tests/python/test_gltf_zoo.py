@@ -380,7 +380,7 @@ def test_a_mesh_placed_far_from_the_origin_simplifies_as_at_the_origin(tmp_path:
         np.testing.assert_array_equal(near, far)
 
 
-def test_simplify_points_an_animation_library_to_motion(tmp_path: Path) -> None:
+def test_simplify_and_character_point_an_animation_library_to_motion(tmp_path: Path) -> None:
     character = synth.humanoid()
     write_glb(tmp_path / "humanoid.glb", character, [synth.humanoid_motion(character.skeleton, "walk")])
 
@@ -395,6 +395,8 @@ def test_simplify_points_an_animation_library_to_motion(tmp_path: Path) -> None:
         match="no node draws a triangle mesh, nothing to simplify .its animations are `animlod motion`'s input",
     ):
         simplify_document(source, tmp_path / "lod.glb")
+    with pytest.raises(FormatError, match="a character chain needs both .it draws no mesh: `animlod motion` takes its"):
+        build_character(source, tmp_path / "lod.glb")
 
 
 def test_motion_levels_of_every_clip_share_one_skeleton_per_level(tmp_path: Path) -> None:

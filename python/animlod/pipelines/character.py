@@ -118,7 +118,9 @@ def build_character(
     animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]
     if not animated:
         reason = "no skinned mesh with an animation: a character chain needs both"
-        raise FormatError(doc.path, "skins", f"{reason} (`animlod simplify` gives mesh levels alone)")
+        if all_drawables or not doc.gltf.animations:
+            raise FormatError(doc.path, "skins", f"{reason} (`animlod simplify` gives mesh levels alone)")
+        raise FormatError(doc.path, "skins", f"{reason} (it draws no mesh: `animlod motion` takes its clips)")
     levels_wanted = len(ratios) + 1
     started = time.perf_counter()
     motion_chains: dict[int, _SkinMotion] = {}

@@ -282,7 +282,8 @@ def test_motion_levels_of_a_skin_without_inverse_bind_matrices_keep_the_frozen_b
 
 def _animation_library(source: Path, target: Path) -> Path:
     """``source`` (animlod's GLB of one skinned mesh) as animation libraries are exported: no skin,
-    the mesh drawn by a prop node held in a hand, a keyless fingertip, and a camera moving beside."""
+    the mesh drawn by a prop node held in a hand, a keyless fingertip, and a camera and a sword moving
+    beside."""
 
     def strip(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
         mesh_node = len(gltf.nodes) - 1  # write_glb appends the skinned mesh's node last
@@ -295,15 +296,16 @@ def _animation_library(source: Path, target: Path) -> Path:
         gltf.nodes.append(pygltflib.Node(name="LeftHandIndex3", translation=[0.02, 0.0, 0.0]))
         gltf.nodes[finger].children = [*(gltf.nodes[finger].children or []), len(gltf.nodes) - 1]
         gltf.cameras = [pygltflib.Camera(type="perspective", perspective=pygltflib.Perspective(yfov=0.8, znear=0.1))]
-        gltf.nodes.append(pygltflib.Node(name="camera", camera=0))
-        gltf.scenes[0].nodes.append(len(gltf.nodes) - 1)
         animation = gltf.animations[0]
-        animation.channels.append(
-            pygltflib.AnimationChannel(
-                sampler=animation.channels[0].sampler,  # the root's translation keys
-                target=pygltflib.AnimationChannelTarget(node=len(gltf.nodes) - 1, path="translation"),
+        for node in (pygltflib.Node(name="camera", camera=0), pygltflib.Node(name="sword")):
+            gltf.nodes.append(node)
+            gltf.scenes[0].nodes.append(len(gltf.nodes) - 1)
+            animation.channels.append(
+                pygltflib.AnimationChannel(
+                    sampler=animation.channels[0].sampler,  # the root's translation keys
+                    target=pygltflib.AnimationChannelTarget(node=len(gltf.nodes) - 1, path="translation"),
+                )
             )
-        )
 
     return edit_glb(source, target, strip)
 
@@ -319,22 +321,26 @@ def test_motion_levels_of_an_animation_library_without_skins(tmp_path: Path, cap
     skinned = tmp_path / "humanoid.glb"
     write_glb(skinned, character, [synth.humanoid_motion(character.skeleton, "walk")])
     source = _animation_library(skinned, tmp_path / "clips.glb")
-    (motion,) = read_node_motions(source)
+    (motion,), left_out = read_node_motions(source)
     assert motion.skeleton.names == [*character.skeleton.names, "LeftHandIndex3"]
+    assert left_out == ["node 44 'sword'"]
     expected = read_gltf(skinned).motions[0].world_positions()
     np.testing.assert_allclose(motion.world_positions()[:, :-1], expected, atol=1e-5)
 
     report = build_motion_levels(source, tmp_path / "levels", levels=3)
     assert any("no skinned mesh; the skeleton is its animated node tree (42 joints" in note for note in report.notes)
+    assert any("under no node in common with the skeleton's left out: node 44 'sword'" in n for n in report.notes)
     for index, level in enumerate(report.chain.levels):
         assert report.files[index][1].name == f"clips_lod{index}.glb"
-        (written,) = read_node_motions(tmp_path / "levels" / report.files[index][1])
+        (written,), _ = read_node_motions(tmp_path / "levels" / report.files[index][1])
         assert written.skeleton.names == level.motion.skeleton.names
         np.testing.assert_allclose(written.world_positions(), level.motion.world_positions(), atol=1e-4)
     assert report.chain.levels[-1].report.joint_count < 42
     capsys.readouterr()
     assert main(["info", str(source)]) == 0
-    assert "no skin; animated node tree: 42 joints, root 'Hips'" in capsys.readouterr().out
+    assert "no skin; animated node tree: 42 joints, root 'Hips'; other animated trees: node 44 'sword'" in (
+        capsys.readouterr().out
+    )
     with pytest.raises(ValueError, match="motions: a GLB without a skinned mesh needs a motion"):
         write_glb(tmp_path / "empty.glb", None, [])
     assert not (tmp_path / "empty.glb").exists()

@@ -188,10 +188,12 @@ def _node_tree_lines(doc: GltfDocument) -> list[str]:
     from ..io.gltf_skin import SkinRig
 
     try:
-        skeleton = SkinRig(doc, None).skeleton
+        rig = SkinRig(doc, None)
     except FormatError:
         return []
-    return [f"no skin; animated node tree: {skeleton.joint_count} joints, root {skeleton.names[0]!r}"]
+    skeleton = rig.skeleton
+    line = f"no skin; animated node tree: {skeleton.joint_count} joints, root {skeleton.names[0]!r}"
+    return [line + (f"; other animated trees: {', '.join(rig.trees_left_out)}" if rig.trees_left_out else "")]
 
 
 def _motion_lines(motion: Motion) -> list[str]:

@@ -120,13 +120,15 @@ def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:
     return wanted in (doc.gltf.skins[skin].name, doc.gltf.meshes[doc.gltf.nodes[node].mesh].name)
 
 
-def read_node_motions(path: str | os.PathLike, fps: float = 30.0) -> list[Motion]:
+def read_node_motions(path: str | os.PathLike, fps: float = 30.0) -> tuple[list[Motion], list[str]]:
     """The animations of a glTF file, sampled at ``fps``, as motions of its animated node tree: the
     skeleton of a file without skins, as animation libraries are exported without their mesh
-    (:class:`~animlod.io.gltf_skin.SkinRig` without a skin). Raises FormatError naming the file
-    when no animation translates, turns or scales a node."""
+    (:class:`~animlod.io.gltf_skin.SkinRig` without a skin); and the labels of animated trees left
+    out (under no node in common with the skeleton's). Raises FormatError naming the file when no
+    animation translates, turns or scales a node."""
     doc = GltfDocument(path)
-    return _rig_motions(doc, SkinRig(doc, None), fps)
+    rig = SkinRig(doc, None)
+    return _rig_motions(doc, rig, fps), rig.trees_left_out
 
 
 def _rig_motions(doc: GltfDocument, rig: SkinRig, fps: float) -> list[Motion]:

@@ -70,11 +70,14 @@ class SkinRig:
     rest_shape : (J, 3, 3) what each joint's rest world transform does beyond its rotation and
         ``scales`` (a non-uniform rest scale), in the joint's frame; None when every node is uniform.
     inverse_bind : (J, 4, 4) the skin's inverse bind matrices in skeleton order, as stored.
+    trees_left_out : without a skin, the first node of each animated tree under no node in common
+        with the skeleton's (a weapon animated beside the character), for messages.
     """
 
     def __init__(self, doc: GltfDocument, skin: int | None) -> None:
         self.skin = skin
         self.element = "animated nodes" if skin is None else f"skin {skin}"
+        self.trees_left_out: list[str] = []
         joint_nodes = self._joint_nodes(doc)
         self.skin_slots = len(joint_nodes)
         joint_nodes += self._common_root(doc, joint_nodes)
@@ -191,7 +194,8 @@ class SkinRig:
 
     def _joint_nodes(self, doc: GltfDocument) -> list[int]:
         if self.skin is None:
-            return _animated_tree(doc)
+            nodes, self.trees_left_out = _animated_tree(doc)
+            return nodes
         joints = list(doc.gltf.skins[self.skin].joints or [])
         if not joints:
             raise doc.fail(self.element, "has no joints")
@@ -308,10 +312,12 @@ class SkinRig:
         return float(np.abs(keys - rest).max()) > UNIFORM_SCALE_TOLERANCE * float(np.abs(rest).max())
 
 
-def _animated_tree(doc: GltfDocument) -> list[int]:
+def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
     """The nodes an animation translates, turns or scales, but cameras and lights (the scene's, not
     the skeleton's), and every node below one that draws nothing (an end site or a bone without
-    keys), in node order."""
+    keys), in node order; and the labels of the top nodes of trees left out. Animated nodes under
+    no common node (a weapon animated beside the character, a second character) are several
+    trees: the one of the most nodes is the skeleton."""
     nodes = doc.gltf.nodes or []
     staging = {
         index
@@ -323,11 +329,17 @@ def _animated_tree(doc: GltfDocument) -> list[int]:
         raise doc.fail(
             "animations", "no skin, and no animation translates, turns or scales a node: no skeleton to read"
         )
-    return [
+    tree = [
         index
         for index, node in enumerate(nodes)
         if index in moved or (node.mesh is None and index not in staging and not moved.isdisjoint(doc.ancestors(index)))
     ]
+    trees: dict[int, list[int]] = {}  # by the top node of the scene tree each lies in
+    for index in tree:
+        trees.setdefault(([index, *doc.ancestors(index)])[-1], []).append(index)
+    kept = max(trees.values(), key=len)  # the first of the largest
+    left_out = [members[0] for members in trees.values() if members is not kept]
+    return kept, [doc.node_label(node) for node in left_out]
 
 
 def _mirrored(rotation: np.ndarray, signs: np.ndarray) -> np.ndarray:

@@ -209,10 +209,12 @@ def _read_input(
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
     else:  # an animation library exported without its mesh
-        skin, motions = None, read_node_motions(source)
+        (motions, left_out), skin = read_node_motions(source), None
         skeleton = motions[0].skeleton
         note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
              f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clips")  # fmt: skip
+        if left_out:
+            note(f"{path}: animated nodes under no node in common with the skeleton's left out: {', '.join(left_out)}")
     names = [motion.name or f"animation{index}" for index, motion in enumerate(motions)]
     if clip is None:
         from ..motion_lod.clips import join_clips, merge_split_clips

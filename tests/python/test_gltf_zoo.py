@@ -427,3 +427,34 @@ def test_motion_levels_of_every_clip_share_one_skeleton_per_level(tmp_path: Path
             np.testing.assert_allclose(written[k].world_positions(), expected, atol=1e-5)
             from_bvh = read_bvh(tmp_path / "levels" / clip_files[k]).world_positions()
             np.testing.assert_allclose(from_bvh, expected, atol=1e-4)
+
+
+def test_meshes_on_skins_of_the_same_joints_share_one_skeleton_per_motion_level(tmp_path: Path) -> None:
+    """Exporters may give every mesh a skin of its own over the same joints: each skin got a chain
+    of its own, so the LoD GLB held a reduced skeleton and re-fitted clips per mesh, each animated
+    at run time. One skeleton per motion level now serves every such mesh."""
+    character = synth.humanoid()
+    write_glb(tmp_path / "humanoid.glb", character, [synth.humanoid_motion(character.skeleton, "walk")])
+
+    def hair_on_own_skin(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        skin = pygltflib.Skin(joints=list(gltf.skins[0].joints), inverseBindMatrices=gltf.skins[0].inverseBindMatrices)
+        gltf.skins.append(skin)
+        gltf.meshes.append(pygltflib.Mesh(primitives=gltf.meshes[0].primitives, name="hair"))
+        gltf.nodes.append(pygltflib.Node(name="hair", mesh=1, skin=1))
+        gltf.scenes[0].nodes.append(len(gltf.nodes) - 1)
+
+    source = edit_glb(tmp_path / "humanoid.glb", tmp_path / "two_skins.glb", hair_on_own_skin)
+    report = build_character(
+        source, tmp_path / "lod.glb", [0.5, 0.25], solver="newton", frame_budget=12, measured_frames=2
+    )
+    assert "skin 1: the joints of skin 0; it plays the same motion levels" in report.notes
+    doc = GltfDocument(tmp_path / "lod.glb")
+    assert len(doc.gltf.animations) == 3  # the input's clip and one per reduced motion level
+    joints_by_level: dict[int, set] = {}
+    for node in doc.json["nodes"]:
+        info = (node.get("extras") or {}).get("animlod")
+        if info and info["motion_level"] > 0 and "skin" in node:
+            joints_by_level.setdefault(info["motion_level"], set()).add(
+                tuple(doc.json["skins"][node["skin"]]["joints"])
+            )
+    assert sorted(joints_by_level) == [1, 2] and all(len(joints) == 1 for joints in joints_by_level.values())

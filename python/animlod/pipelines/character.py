@@ -124,14 +124,25 @@ def build_character(
     levels_wanted = len(ratios) + 1
     started = time.perf_counter()
     motion_chains: dict[int, _SkinMotion] = {}
+    chain_of: dict[int, int] = {}  # skin -> the skin whose motion levels it plays
     notes = []
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
     # Larger skeletons first: a skin whose joints all belong to a larger skin (a helmet bound to
     # the head) keeps its joints, as freezing them on their own would tear it from the body.
     for drawable in sorted(animated, key=lambda d: -len(joints_of[d.skin_index])):
         skin = drawable.skin_index
-        if skin in motion_chains:
+        if skin in chain_of:
             continue
+        # Exporters may give every mesh a skin of its own over the same joints: one skeleton
+        # per level serves them all (a copy each would animate the skeleton once per mesh).
+        twin = next(
+            (other for other in motion_chains if motion_chains[other].rig.joint_nodes == drawable.rig.joint_nodes), None
+        )
+        if twin is not None:
+            chain_of[skin] = twin
+            notes.append(f"skin {skin}: the joints of skin {twin}; it plays the same motion levels")
+            continue
+        chain_of[skin] = skin
         clips = [clip for clip in drawable.clips if clip.motion is not None]
         joined, spans = join_clips([clip.motion for clip in clips])
         scaling = joined.deforming_joint()
@@ -169,6 +180,8 @@ def build_character(
 
     builder = GlbBuilder.from_document(doc)
     motion_nodes = {skin: _add_motion_levels(builder, doc, motion) for skin, motion in motion_chains.items()}
+    motion_nodes = {skin: motion_nodes[owner] for skin, owner in chain_of.items()}
+    motion_chains = {skin: motion_chains[owner] for skin, owner in chain_of.items()}
     chains = {}
     for drawable in animated:
         motion = motion_chains[drawable.skin_index]

@@ -14,7 +14,7 @@ from simplify_inputs import ellipsoid, tube, two_bone_tube
 from animlod import rotations, synth
 from animlod.io.errors import FormatError
 from animlod.io.glb_builder import GlbBuilder
-from animlod.io.gltf import read_gltf, write_glb
+from animlod.io.gltf import read_gltf, read_node_motions, write_glb
 from animlod.io.gltf_document import GltfDocument
 from animlod.pipelines.character import build_character
 from animlod.pipelines.lod_document import simplify_document
@@ -315,7 +315,6 @@ def test_motion_levels_of_an_animation_library_without_skins(tmp_path: Path, cap
     animated nodes and the keyless nodes below them that draw nothing are the skeleton, and each level's
     GLB holds the level's skeleton and clip. ``info`` names that skeleton."""
     from animlod.cli import main
-    from animlod.io.gltf_read import read_node_motions
 
     character = synth.humanoid()
     skinned = tmp_path / "humanoid.glb"

@@ -2,7 +2,7 @@
 
 from .bvh import BvhLayout, read_bvh, read_bvh_with_layout, write_bvh
 from .errors import FormatError
-from .gltf import GltfScene, read_gltf, read_lod_chains, read_skinned, write_glb
+from .gltf import GltfScene, read_gltf, read_lod_chains, read_node_motions, read_skinned, write_glb
 from .meshseq import read_mesh, read_obj, read_ply, read_sequence, write_mesh, write_obj, write_ply, write_sequence
 from .npz import read_npz, write_npz
 
@@ -15,6 +15,7 @@ __all__ = [
     "read_gltf",
     "read_lod_chains",
     "read_mesh",
+    "read_node_motions",
     "read_npz",
     "read_obj",
     "read_ply",

@@ -8,7 +8,7 @@ with their levels (the LoD GLB) in :mod:`.gltf_lod` and :mod:`animlod.pipelines`
 """
 
 from .gltf_lod import read_lod_chains
-from .gltf_read import GltfScene, read_gltf, read_skinned
+from .gltf_read import GltfScene, read_gltf, read_node_motions, read_skinned
 from .gltf_write import write_glb
 
-__all__ = ["GltfScene", "read_gltf", "read_lod_chains", "read_skinned", "write_glb"]
+__all__ = ["GltfScene", "read_gltf", "read_lod_chains", "read_node_motions", "read_skinned", "write_glb"]

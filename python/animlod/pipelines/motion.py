@@ -194,8 +194,7 @@ def _read_input(
         return motion, [(motion.name, slice(None))], None, layout
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
-    from ..io.gltf import read_gltf
-    from ..io.gltf_read import read_node_motions
+    from ..io.gltf import read_gltf, read_node_motions
 
     scene = read_gltf(source)
     if scene.skinned_meshes:

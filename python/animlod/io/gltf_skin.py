@@ -336,7 +336,7 @@ def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
     ]
     trees: dict[int, list[int]] = {}  # by the top node of the scene tree each lies in
     for index in tree:
-        trees.setdefault(([index, *doc.ancestors(index)])[-1], []).append(index)
+        trees.setdefault([index, *doc.ancestors(index)][-1], []).append(index)
     kept = max(trees.values(), key=len)  # the first of the largest
     left_out = [members[0] for members in trees.values() if members is not kept]
     return kept, [doc.node_label(node) for node in left_out]

@@ -319,6 +319,16 @@ def test_spec_forms_and_their_errors(library, tmp_path):
             read_spec(manifest(text))
 
 
+def test_a_gltf_of_clips_alone_defaults_to_the_motion_job(tmp_path):
+    """An animation library's GLBs draw no mesh: the default job, simplify, failed on each."""
+    skin, motion = synth.bending_cylinder_skinned(frames=6, rings=10, segments=10)
+    write_glb(tmp_path / "cyl.glb", skin, [motion])
+    write_glb(tmp_path / "clips.glb", None, [motion])
+    (tmp_path / "broken.glb").write_bytes(b"glTF\x02\x00\x00\x00 not a glb")
+    jobs = {asset.name: asset.job for asset in read_spec(tmp_path)}
+    assert jobs == {"cyl": "simplify", "clips": "motion", "broken": "simplify"}
+
+
 def test_folder_scan_names_what_a_studio_library_holds(tmp_path):
     # read_spec looks at names only, so placeholder bytes stand for the models.
     lib = tmp_path / "lib"

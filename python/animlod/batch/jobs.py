@@ -22,13 +22,32 @@ import typing
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-# The job an input gets when the spec names none, by input kind (animlod.io.detect.input_kind).
+# The job an input gets when the spec names none, by input kind (animlod.io.detect.input_kind);
+# see default_job for a glTF of clips alone.
 DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "bvh": "motion"}
 # Keyword arguments a manifest never sets: the runner owns progress, and a batch spreads its
 # work over assets (one core each), not over the processes of one asset. Callbacks (parameters
 # annotated Callable) are left out too.
 # A pipeline's settings object is given by its fields (DrawableSettings, listed as a source).
 _RESERVED = frozenset({"source", "output", "progress", "workers", "settings", "aqem"})
+
+
+def default_job(source: str, kind: str) -> str | None:
+    """The job of an asset whose spec names none: ``DEFAULT_JOBS`` by kind, but ``motion`` for a
+    glTF that draws no mesh and has animations (an animation library exported without its mesh,
+    which ``simplify`` refuses). A file that cannot be read gets its kind's job, which says why."""
+    if kind == "gltf":
+        from ..io.errors import FormatError
+        from ..io.gltf_document import document_json
+
+        try:
+            document = document_json(source)
+        except FormatError:
+            return DEFAULT_JOBS[kind]
+        nodes = document.get("nodes", [])
+        if document.get("animations") and not any(isinstance(node, dict) and "mesh" in node for node in nodes):
+            return "motion"
+    return DEFAULT_JOBS.get(kind)
 
 
 @dataclass(frozen=True)

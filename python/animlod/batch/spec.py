@@ -15,7 +15,7 @@ SPEC forms (:func:`read_spec`):
 
       [[assets]]
       input = "characters/hero.glb"
-      job = "character"          # optional; by default simplify for meshes, motion for BVH
+      job = "character"          # optional; by default simplify for meshes, motion for BVH and glTF clips alone
       name = "hero"              # optional: its folder under OUT
       solver = "newton"          # any option of the job
 
@@ -39,7 +39,7 @@ from pathlib import Path, PurePosixPath
 from ..io.detect import BATCH_STATE, MODEL_SUFFIXES, assets_in, input_kind, is_pattern
 from ..io.errors import FormatError
 from ..io.meshseq import MESH_SUFFIXES
-from .jobs import DEFAULT_JOBS, check_options, find_job
+from .jobs import check_options, default_job, find_job
 
 MANIFEST_SUFFIXES = (".toml", ".json")
 _ENTRY_KEYS = frozenset({"input", "glob", "name", "job"})
@@ -219,7 +219,7 @@ def _asset(
         kind = input_kind(source)
     except FormatError as error:
         raise SpecError(spec, where, f"{source}: {error.reason}") from None
-    job_name = job if job is not None else DEFAULT_JOBS.get(kind)
+    job_name = job if job is not None else default_job(source, kind)
     if not isinstance(job_name, str):
         raise SpecError(spec, f"{where}.job", f"expected a job name, got {job_name!r}")
     try:

@@ -538,6 +538,31 @@ def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
     return gltf, raw
 
 
+def document_json(path: str | os.PathLike) -> dict:
+    """The JSON of a .glb or .gltf file, read without a GLB's binary chunk (what an asset holds,
+    told cheaply); FormatError naming the file for what is not a glTF document."""
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(_GLB_HEADER_BYTES + 8)
+            if head[:4] != _GLB_MAGIC:
+                data, element = head + handle.read(), "JSON"
+            else:
+                if len(head) < _GLB_HEADER_BYTES + 8:
+                    raise FormatError(path, "GLB header", f"file is truncated ({len(head)} bytes)")
+                length, kind = struct.unpack_from("<II", head, _GLB_HEADER_BYTES)
+                if kind != _GLB_JSON_CHUNK:
+                    raise FormatError(
+                        path, f"GLB chunk at byte {_GLB_HEADER_BYTES}", "the first chunk must be the JSON chunk"
+                    )
+                data, element = handle.read(length), "GLB JSON chunk"
+    except OSError as error:
+        raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
+    document = load_json(path, data, element)
+    _check_top_level(path, document)
+    return document
+
+
 def _frame_limit(limit: int | None) -> int:
     """The sampling limit: ``limit``, else ANIMLOD_MAX_ANIMATION_FRAMES, else MAX_ANIMATION_FRAMES."""
     if limit is None:

@@ -119,3 +119,17 @@ def test_real_clip_analysis(data_dir) -> None:
     assert np.all(analysis.importance[skeleton.end_sites] == 0.0)
     ordered = analysis.importance[analysis.priority]
     assert np.all(np.diff(ordered) >= 0.0)
+
+
+def test_a_long_run_of_clips_is_analysed_clip_by_clip() -> None:
+    """Above max_frames the analysis took evenly spaced frames over the whole joined motion, and a
+    short clip among long ones (a three-frame pose) fell between them: its bend was never seen."""
+    from animlod.motion_lod.clips import join_clips
+
+    walk = figure_motion(frames=400)
+    pose = figure_motion(frames=3)
+    joined, spans = join_clips([walk, pose, walk])
+    evenly = analyze_motion(joined, max_frames=50)
+    by_clip = analyze_motion(joined, max_frames=50, clips=spans)
+    assert not np.isin(np.arange(400, 403), evenly.frames).any()
+    assert np.isin([400, 402], by_clip.frames).all() and len(by_clip.frames) <= 50 + 2 * len(spans)

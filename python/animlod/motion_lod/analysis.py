@@ -29,18 +29,21 @@ Conventions this implementation fixes where the paper is silent:
   Above ``max_frames`` frames, Eqs. 1-3 run on ``max_frames`` evenly spaced frames: key frames
   are then chosen among those frames and eps_j becomes the same mean over a uniform subsample
   (a Riemann sum of the full-rate mean), which changes it by at most the motion between two
-  sampled frames. ``MotionAnalysis.frames`` records which frames were used.
+  sampled frames. Clips played one after another are sampled clip by clip, in proportion to
+  their lengths (clips.spread_over_clips), so that no short clip is skipped.
+  ``MotionAnalysis.frames`` records which frames were used.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import _core, rotations
 from ..model import Motion, spread_frames
+from .clips import spread_over_clips
 from .ranking import DEFAULT_RANKING, PAPER_RANKING, RANKINGS, elimination_order, rank_scores
 
 
@@ -191,6 +194,7 @@ def analyze_motion(
     translation_tolerance: float = TRANSLATION_TOLERANCE,
     ranking: str = DEFAULT_RANKING,
     workers: int = 0,
+    clips: Sequence[slice] | None = None,
 ) -> MotionAnalysis:
     """Key frames, joint importance and elimination priority of a motion (Eqs. 1-3).
 
@@ -204,6 +208,8 @@ def analyze_motion(
         length translates and is never frozen (translating_joints).
     ranking : how joints are ordered for elimination, one of ranking.RANKINGS.
     workers : threads of Eq. 1's table (0: every core); the result does not depend on it.
+    clips : the frames of each clip when the motion is several played one after another
+        (clips.join_clips); above ``max_frames``, the subsample spreads over each clip.
 
     Returns
     -------
@@ -225,7 +231,9 @@ def analyze_motion(
         raise ValueError(f"locked: {end_site_locks[0]!r} is an end site, not a joint")
 
     if motion.frame_count > max_frames:
-        frames = spread_frames(motion.frame_count, max_frames)
+        frames = (
+            spread_frames(motion.frame_count, max_frames) if clips is None else spread_over_clips(clips, max_frames)
+        )
     else:
         frames = np.arange(motion.frame_count, dtype=np.int64)
     r_max = _r_max(motion)

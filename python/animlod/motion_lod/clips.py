@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .. import rotations
-from ..model import Motion
+from ..model import Motion, spread_frames
 
 # A channel moves when it leaves its rest value by more than this (radians, or this fraction of
 # the skeleton's longest offset): exporters' float noise stays below.
@@ -83,3 +83,13 @@ def join_clips(motions: Sequence[Motion]) -> tuple[Motion, list[slice]]:
     starts = np.cumsum([0] + [motion.frame_count for motion in motions])
     spans = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
     return Motion.concatenate(list(motions), "+".join(motion.name for motion in motions)), spans
+
+
+def spread_over_clips(spans: Sequence[slice], count: int) -> np.ndarray:
+    """Frame indices of a joined motion (:func:`join_clips`' spans) spread over each clip in
+    proportion to its length, both ends of each included, and at least two of each clip's frames
+    where it has them: ``count`` evenly spaced frames over the whole would skip a short clip (a
+    pose of three frames among thousands), whose joints then seem still."""
+    lengths = np.array([span.stop - span.start for span in spans])
+    shares = np.maximum(np.minimum(lengths, 2), count * lengths // max(int(lengths.sum()), 1))
+    return np.concatenate([span.start + spread_frames(n, k) for span, n, k in zip(spans, lengths, shares)])

@@ -153,7 +153,7 @@ def build_character(
             )
             motion_chains[skin] = _SkinMotion(None, list(zip(clips, spans)), drawable.rig, joined)
             continue
-        analysis = analyze_motion(joined, workers=workers)
+        analysis = analyze_motion(joined, workers=workers, clips=spans)
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
         floor = joint_floor(joined, analysis)
         levels = min(levels_wanted, floor.possible_levels)

@@ -126,8 +126,9 @@ def build_motion_levels(
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
+    spans = [frames for _, frames in clips] if len(clips) > 1 else None
     analysis, counts, floor = _plan_levels(
-        motion, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
+        motion, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
     if floor.possible_levels == 1:
         note(
@@ -336,6 +337,7 @@ def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Mot
 
 def _plan_levels(
     motion: Motion,
+    spans: list[slice] | None,
     levels: int | None,
     joints: Sequence[int] | None,
     lock: Sequence[str],
@@ -344,8 +346,8 @@ def _plan_levels(
     ranking: str,
     workers: int,
 ) -> tuple[MotionAnalysis, list[int], JointFloor]:
-    """The motion analysis, the joint counts of the levels and the joint floor (ValueError on a
-    bad request)."""
+    """The motion analysis (over each clip's frames, ``spans``, of several), the joint counts of
+    the levels and the joint floor (ValueError on a bad request)."""
     from ..motion_lod.analysis import analyze_motion
     from ..motion_lod.chain import joint_floor, level_joint_counts
 
@@ -356,6 +358,7 @@ def _plan_levels(
         translation_tolerance=translation_tolerance,
         ranking=ranking,
         workers=workers,
+        clips=spans,
     )
     floor = joint_floor(motion, analysis)
     if joints:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import signal
+from collections.abc import Sequence
 from pathlib import Path
 
 from animlod.pipelines import simplify_asset
@@ -31,8 +32,14 @@ def always_crash(source: str, output: str, *, progress=None, **options: object):
 
 
 def several_kinds(
-    source: str, output: str, *, progress=None, frames: list[int] | str | None = None, rate: float | str | None = None
+    source: str,
+    output: str,
+    *,
+    progress=None,
+    frames: list[int] | str | None = None,
+    rate: float | str | None = None,
+    tags: Sequence[str] = (),
 ):
     """Options that take a value of either of two kinds (``frames``: a list of whole numbers or a
-    string such as "all"); runs the simplify job."""
+    string such as "all"), and a list whose default is empty (``tags``); runs the simplify job."""
     return simplify_asset(source, output, progress=progress)

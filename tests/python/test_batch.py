@@ -386,6 +386,9 @@ def test_local_workers_end_quietly_on_ctrl_c(client):
         # A list with an item of another kind: cutting the list's message apart gave "expected in
         # the list: expected a whole number or a string, got [1.5]".
         ({"frames": [1.5]}, "option 'frames': in the list: expected a whole number, got 1.5"),
+        # An empty default list has no item to check against: its annotation gives the kind.
+        ({"tags": ["hero"]}, None),
+        ({"tags": [1]}, "option 'tags': in the list: expected a string, got 1"),
     ],
 )
 def test_an_option_of_several_kinds_names_them_or_the_bad_item(options, problem):

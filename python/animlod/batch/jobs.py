@@ -29,7 +29,9 @@ DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "
 # work over assets (one core each), not over the processes of one asset. Callbacks (parameters
 # annotated Callable) are left out too.
 # A pipeline's settings object is given by its fields (DrawableSettings, listed as a source).
-_RESERVED = frozenset({"source", "output", "progress", "workers", "settings", "aqem"})
+# Files besides the asset (character clips) would escape its fingerprint, so reruns would miss
+# their changes.
+_RESERVED = frozenset({"source", "output", "progress", "workers", "settings", "aqem", "clips"})
 
 
 def default_job(source: str, kind: str) -> str | None:
@@ -229,6 +231,8 @@ def _keywords(function: Callable) -> dict[str, object] | None:
         if default is None:
             exemplars = [_exemplar(kind) for kind in alternatives if kind is not type(None)]
             default = _OneOf(tuple(exemplars)) if exemplars and None not in exemplars else None
+        elif isinstance(default, (list, tuple)) and not default:  # no item to check others against
+            default = _exemplar(parameter.annotation) or default
         accepted[parameter.name] = default
     return accepted
 

@@ -22,7 +22,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "input document stays whole; a viewer without MSFT_lod shows level 0."
         ),
     )
-    parser.add_argument("input", help="a .glb/.gltf/.vrm with a skinned mesh and at least one animation")
+    parser.add_argument(
+        "input", help="a .glb/.gltf/.vrm with a skinned mesh and at least one animation (its own or --clips')"
+    )
     parser.add_argument(
         "-o", "--output", required=True, help="the LoD .glb (or .vrm) to write, or a folder for <name>_character.glb"
     )
@@ -41,6 +43,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--max-frames", type=positive_int, default=48, help="frames of all clips that drive AQEM (default 48)"
     )
+    parser.add_argument(
+        "--clips", nargs="+", default=(), metavar="FILE",
+        help="glTF files of clips on the same rig (an animation library without the mesh, such as Mixamo's "
+        "'without skin' downloads), added to the character's own by node name",
+    )  # fmt: skip
     parser.set_defaults(run=run)
 
 
@@ -60,6 +67,7 @@ def run(args: argparse.Namespace) -> int:
         args.ratio,
         solver=args.solver,
         workers=args.workers,
+        clips=args.clips,
         frame_budget=args.max_frames,
         **feature_options(args),
         progress=print,

@@ -103,10 +103,15 @@ class GltfDocument:
         KHR_animation_pointer channel resolved; ``(None, "pointer")`` when it animates no node).
     """
 
-    def __init__(self, path: str | os.PathLike, max_animation_frames: int | None = None) -> None:
+    def __init__(
+        self, path: str | os.PathLike, max_animation_frames: int | None = None, data: bytes | None = None
+    ) -> None:
+        """``data``: the file's bytes, given instead of read from ``path`` (a document assembled in
+        memory, whose messages still name ``path``)."""
         self.path = os.fspath(path)
         self.max_animation_frames = _frame_limit(max_animation_frames)
-        self.gltf, self.json = _parse(self.path)
+        self._size = None if data is None else len(data)
+        self.gltf, self.json = _parse(self.path, data)
         self._buffers: dict[int, bytes] = {}
         self._accessors: dict[int, np.ndarray] = {}
         self._draco_meshes: dict[int, Any] = {}  # decoded per compressed buffer view
@@ -271,7 +276,7 @@ class GltfDocument:
     def _file_bytes(self) -> int:
         """Size of the file and of the external buffer files it names: what bounds its accessors
         (declared byteLengths are not trusted)."""
-        total = os.path.getsize(self.path)
+        total = os.path.getsize(self.path) if self._size is None else self._size
         for buffer in self.gltf.buffers or []:
             if isinstance(buffer.uri, str) and not buffer.uri.startswith("data:"):
                 external = Path(self.path).parent / unquote(buffer.uri)
@@ -504,12 +509,14 @@ class GltfDocument:
         return times, output.reshape((count, 3, width) if per_key == 3 else (count, width)), interpolation
 
 
-def _parse(path: str) -> tuple[pygltflib.GLTF2, dict]:
-    """pygltflib's document for a .glb or .gltf file and its raw JSON; FormatError for anything else."""
-    try:
-        data = Path(path).read_bytes()
-    except OSError as error:
-        raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
+def _parse(path: str, data: bytes | None = None) -> tuple[pygltflib.GLTF2, dict]:
+    """pygltflib's document for a .glb or .gltf file (or its bytes, ``data``) and its raw JSON;
+    FormatError for anything else."""
+    if data is None:
+        try:
+            data = Path(path).read_bytes()
+        except OSError as error:
+            raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
     if not data:
         raise FormatError(path, "file", "empty file")
     glb = data[:4] == _GLB_MAGIC

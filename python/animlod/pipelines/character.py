@@ -53,6 +53,7 @@ from ..motion_lod.clips import join_clips
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
+from .clip_import import with_clips
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, posed_frames, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
 
@@ -90,6 +91,7 @@ def build_character(
     *,
     solver: str = "slsqp",
     workers: int = 1,
+    clips: Sequence[str] = (),
     settings: DrawableSettings | None = None,
     progress: Callable[[str], None] | None = None,
     **keywords: object,
@@ -103,6 +105,8 @@ def build_character(
         spread down to the fewest the skeleton allows, see :func:`animlod.build_motion_chain`).
     solver, workers : the motion re-fit (``"slsqp"``, the paper's SQP, or ``"newton"``) and the
         processes it uses.
+    clips : glTF files of clips on the same rig (an animation library without the mesh), added to
+        the character's own by node name (:mod:`.clip_import`).
     settings, **keywords : a :class:`~animlod.pipelines.DrawableSettings` and/or its fields and
         AQEM options by name, as for :func:`animlod.pipelines.simplify_document`.
 
@@ -112,7 +116,10 @@ def build_character(
     """
     say = progress or (lambda _line: None)
     settings = DrawableSettings.resolve(settings, keywords)
+    notes: list[str] = []
     doc = GltfDocument(source)
+    if clips:
+        doc = with_clips(doc, clips, notes.append)
     all_drawables = read_drawables(doc, settings.fps)
     drawables = [d for d in all_drawables if d.skinned is not None]
     animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]
@@ -125,7 +132,6 @@ def build_character(
     started = time.perf_counter()
     motion_chains: dict[int, _SkinMotion] = {}
     chain_of: dict[int, int] = {}  # skin -> the skin whose motion levels it plays
-    notes = []
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
     # Larger skeletons first: a skin whose joints all belong to a larger skin (a helmet bound to
     # the head) keeps its joints, as freezing them on their own would tear it from the body.

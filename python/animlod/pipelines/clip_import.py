@@ -1,0 +1,102 @@
+"""Clips from other glTF files of the same rig, added to a character's document by node name.
+
+Animation libraries come apart from their characters: Mixamo's "without skin" downloads, one
+file per clip, hold the rig's nodes and a clip each, no mesh. Each translation, rotation or
+scale channel of such a file moves the character's node of the same name, its keys copied as
+they are (times, values, interpolation); the result is the character's document with more
+animations, which the pipelines then treat as its own (every level plays them).
+
+Only the same rig in the same proportions is taken as it is: a node whose translation a clip
+animates must rest where the character's node of that name rests (within ``REST_TOLERANCE`` of
+the rig's size), or the clip would stretch the character's bones to another figure's
+(retargeting is not done here). Rotations and scales move any node of the name. Channels on
+nodes the character lacks, or whose name it uses twice, are left out and counted in a note.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import Counter
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from ..io.glb_builder import GlbBuilder
+from ..io.gltf_document import GltfDocument
+
+# A node whose translation a clip animates rests within this fraction of the rig's size (the
+# character's largest rest translation among those nodes) of the character's node.
+REST_TOLERANCE = 0.01
+_NODE_PATHS = {"translation": 3, "rotation": 4, "scale": 3}
+
+
+def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note: Callable[[str], None]) -> GltfDocument:
+    """``doc`` with every animation of each of ``clip_files`` added (see the module notes);
+    FormatError naming the clip file for one that cannot be read, has no animation, or moves the
+    translation of a node of the same name resting elsewhere."""
+    builder = GlbBuilder.from_document(doc)
+    targets = _named_nodes(doc)
+    for clip_file in clip_files:
+        source = GltfDocument(clip_file)
+        if not source.gltf.animations:
+            raise source.fail("animations", "no animation to add to the character")
+        mapping = {node: targets[name] for name, node in _named_nodes(source).items() if name in targets}
+        _check_rests(source, doc, mapping)
+        left_out = 0
+        for index, animation in enumerate(source.gltf.animations):
+            samplers: list[dict] = []
+            placed: dict[int, int] = {}  # the clip's sampler -> the added animation's
+            channels = []
+            for (node, path), channel in zip(source.channel_targets[index], animation.channels or []):
+                if path not in _NODE_PATHS or node not in mapping:
+                    left_out += 1
+                    continue
+                if channel.sampler not in placed:
+                    placed[channel.sampler] = len(samplers)
+                    samplers.append(_copied_sampler(builder, source, index, channel.sampler, _NODE_PATHS[path]))
+                channels.append({"sampler": placed[channel.sampler], "target": {"node": mapping[node], "path": path}})
+            if channels:
+                name = animation.name or f"{Path(clip_file).stem} {index}"
+                builder.append("animations", {"name": name, "samplers": samplers, "channels": channels})
+        dropped = f"; {left_out} channel(s) on nodes the character has not, or of weights, left out" if left_out else ""
+        note(f"{os.fspath(clip_file)}: {len(source.gltf.animations)} clip(s) added to the character{dropped}")
+    return GltfDocument(doc.path, doc.max_animation_frames, data=builder.to_bytes())
+
+
+def _named_nodes(doc: GltfDocument) -> dict[str, int]:
+    """Node index by name, for the names one node alone has."""
+    names = [node.name for node in doc.gltf.nodes or []]
+    counts = Counter(names)
+    return {name: index for index, name in enumerate(names) if name and counts[name] == 1}
+
+
+def _check_rests(source: GltfDocument, doc: GltfDocument, mapping: dict[int, int]) -> None:
+    """FormatError for a node whose translation the clips animate, resting away from the
+    character's node of its name (another figure's proportions)."""
+    moved = sorted({node for targets in source.channel_targets for node, path in targets if path == "translation"})
+    moved = [node for node in moved if node in mapping]
+    if not moved:
+        return
+    rests = {node: (source.rest_trs(node)[0], doc.rest_trs(mapping[node])[0]) for node in moved}
+    size = max(float(np.linalg.norm(own)) for _, own in rests.values())
+    for node, (theirs, own) in rests.items():
+        if np.linalg.norm(theirs - own) > REST_TOLERANCE * max(size, 1e-12):
+            reason = (
+                f"its translation is animated and it rests at {np.round(theirs, 4).tolist()}, the character's "
+                f"{source.gltf.nodes[node].name!r} at {np.round(own, 4).tolist()}: another figure's proportions "
+                "(retarget the clip to this character first)"
+            )
+            raise source.fail(source.node_label(node), reason)
+
+
+def _copied_sampler(builder: GlbBuilder, source: GltfDocument, animation: int, sampler: int, width: int) -> dict:
+    """Sampler ``sampler`` of the clip file's animation ``animation``, its keys added to ``builder``."""
+    times, values, interpolation = source.sampler_keys(
+        animation, sampler, width, f"animation {animation} sampler {sampler}"
+    )
+    return {
+        "input": builder.add(times.astype(np.float32)[:, None], bounds=True),
+        "output": builder.add(np.ascontiguousarray(values.reshape(-1, width), dtype=np.float32)),
+        "interpolation": interpolation,
+    }

@@ -1,0 +1,59 @@
+"""Clips from an animation library without the mesh, added to a character by node name
+(``animlod character --clips``): a character exported in its rest pose and its clips exported apart,
+as Mixamo's downloads come, gave no chain at all ("no skinned mesh with an animation")."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from animlod import synth
+from animlod.cli import main
+from animlod.io.errors import FormatError
+from animlod.io.gltf import read_gltf, write_glb
+from animlod.model import Skeleton
+from animlod.pipelines.character import build_character
+
+QUICK = {"solver": "newton", "frame_budget": 12, "measured_frames": 2}
+
+
+@pytest.fixture(scope="module")
+def split_character(tmp_path_factory) -> tuple[Path, Path, Path]:
+    """The humanoid with its walk, the humanoid alone, and the walk alone (no mesh)."""
+    folder = tmp_path_factory.mktemp("split")
+    character = synth.humanoid()
+    walk = synth.humanoid_motion(character.skeleton, "walk")
+    write_glb(folder / "whole.glb", character, [walk])
+    write_glb(folder / "rest.glb", character, [])
+    write_glb(folder / "walk.glb", None, [walk])
+    return folder / "whole.glb", folder / "rest.glb", folder / "walk.glb"
+
+
+def test_a_character_plays_the_clips_of_an_animation_library(split_character, tmp_path):
+    whole, rest, walk = split_character
+    with pytest.raises(FormatError, match="no skinned mesh with an animation"):
+        build_character(rest, tmp_path / "none.glb", [0.5], **QUICK)
+    split = build_character(rest, tmp_path / "split.glb", [0.5], clips=[walk], **QUICK)
+    joined = build_character(whole, tmp_path / "whole.glb", [0.5], **QUICK)
+    assert any("walk.glb: 1 clip(s) added to the character" in note for note in split.notes)
+    for ours, theirs in zip(split.chains.values(), joined.chains.values()):
+        assert [(level.faces, level.joints) for level in ours] == [(level.faces, level.joints) for level in theirs]
+        np.testing.assert_allclose([level.error for level in ours], [level.error for level in theirs], rtol=1e-6)
+    played = read_gltf(tmp_path / "split.glb").motions[0].world_positions()  # level 0 plays the clip
+    np.testing.assert_allclose(played, read_gltf(whole).motions[0].world_positions(), atol=1e-5)
+
+
+def test_a_clip_of_other_proportions_is_refused_naming_the_joint(split_character, tmp_path, capsys):
+    _, rest, _ = split_character
+    skeleton = synth.humanoid().skeleton
+    taller = Skeleton(
+        skeleton.names, skeleton.parents, skeleton.offsets * 1.2, skeleton.rest_rotations, skeleton.end_sites
+    )
+    write_glb(tmp_path / "tall_walk.glb", None, [synth.humanoid_motion(taller, "walk")])
+    code = main(["character", str(rest), "-o", str(tmp_path / "out.glb"), "--clips", str(tmp_path / "tall_walk.glb")])
+    assert code == 2
+    error = capsys.readouterr().err
+    assert "tall_walk.glb: node 0 'Hips': its translation is animated and it rests at" in error
+    assert "another figure's proportions" in error and not (tmp_path / "out.glb").exists()

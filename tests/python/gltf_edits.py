@@ -50,10 +50,12 @@ def append_accessor(
     return len(gltf.accessors) - 1
 
 
-def add_scale_channel(gltf: pygltflib.GLTF2, blob: bytearray, node: int, keys: np.ndarray) -> None:
-    """A scale channel on ``node`` of the first animation, keyed at its first sampler's times."""
+def add_scale_channel(
+    gltf: pygltflib.GLTF2, blob: bytearray, node: int, keys: np.ndarray, animation_index: int = 0
+) -> None:
+    """A scale channel on ``node`` of animation ``animation_index``, keyed at its first sampler's times."""
     output = append_accessor(gltf, blob, keys.astype(np.float32), "VEC3")
-    animation = gltf.animations[0]
+    animation = gltf.animations[animation_index]
     sampler = pygltflib.AnimationSampler(input=animation.samplers[0].input, output=output)
     animation.samplers.append(sampler)
     target = pygltflib.AnimationChannelTarget(node=node, path="scale")

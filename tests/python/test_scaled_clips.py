@@ -62,3 +62,26 @@ def test_motion_refuses_the_clip_in_one_line_and_simplify_takes_it(squashing_hum
     assert f"{squashing_humanoid}: animation 'walk': joint 'Spine' scales; motion LoD re-fits rigid motions" in error
     assert not any((tmp_path / "motion").glob("*"))
     assert main(["simplify", str(squashing_humanoid), "-o", str(tmp_path / "levels.glb"), "--ratio", "0.5"]) == 0
+
+
+def test_motion_leaves_a_scaling_clip_out_of_the_others_levels(tmp_path, capsys):
+    """Every clip of a glTF is simplified now: one clip that scales a joint refused the whole file,
+    where the first clip alone used to make levels. It is left out, in a note."""
+    character = synth.humanoid()
+    clips = [synth.humanoid_motion(character.skeleton, kind) for kind in ("walk", "run")]
+    write_glb(tmp_path / "two.glb", character, clips)
+
+    def squash_the_run(gltf, blob):
+        keys = np.linspace(0.0, 1.0, gltf.accessors[gltf.animations[1].samplers[0].input].count)[:, None]
+        spine = next(index for index, node in enumerate(gltf.nodes) if node.name == "Spine")
+        add_scale_channel(gltf, blob, spine, np.c_[1.0 - 0.2 * keys, 1.0 + 0.4 * keys, 1.0 - 0.2 * keys], 1)
+
+    source = edit_glb(tmp_path / "two.glb", tmp_path / "squash_run.glb", squash_the_run)
+    assert main(["motion", str(source), "-o", str(tmp_path / "motion"), "--levels", "3", "--solver", "newton"]) == 0
+    assert "'run' scales joints and motion LoD re-fits rigid motions only: left out of the levels" in (
+        capsys.readouterr().err
+    )
+    (walk,) = read_skinned(tmp_path / "motion" / "squash_run_lod0.glb")[1]
+    assert (
+        walk.name == "walk" and sorted(p.name for p in (tmp_path / "motion").glob("*.bvh"))[0] == "squash_run_lod0.bvh"
+    )

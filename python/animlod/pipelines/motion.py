@@ -224,12 +224,18 @@ def _read_input(
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
             return _rigid(path, motions, range(len(motions)), merged), [(merged.name, slice(None))], skin, None
-        if len(motions) > 1:
-            note(f"{path}: its {len(motions)} animations simplified together, one skeleton per level for all of "
+        # A clip that scales a joint cannot be re-fitted; the others still make levels.
+        rigid = [index for index, motion in enumerate(motions) if motion.deforming_joint() is None]
+        scaling = [names[index] for index in range(len(motions)) if index not in rigid]
+        if scaling and rigid:
+            note(f"{path}: {', '.join(map(repr, scaling))} scale{'s' if len(scaling) == 1 else ''} joints and "
+                 "motion LoD re-fits rigid motions only: left out of the levels")  # fmt: skip
+        if len(rigid) > 1:
+            note(f"{path}: its {len(rigid)} animations simplified together, one skeleton per level for all of "
                  "them (use --clip to take one)")  # fmt: skip
-            joined, spans = join_clips(motions)
-            return _rigid(path, motions, range(len(motions)), joined), list(zip(names, spans)), skin, None
-        clip = 0
+            joined, spans = join_clips([motions[index] for index in rigid])
+            return joined, [(names[index], span) for index, span in zip(rigid, spans)], skin, None
+        clip = rigid[0] if rigid else 0
     if isinstance(clip, str):
         if clip not in names:
             listed = ", ".join(f"{i}: {name!r}" for i, name in enumerate(names))

@@ -43,7 +43,7 @@ def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note:
             raise source.fail("animations", "no animation to add to the character")
         mapping = {node: targets[name] for name, node in _named_nodes(source).items() if name in targets}
         _check_rests(source, doc, mapping)
-        left_out = 0
+        left_out = added = 0
         for index, animation in enumerate(source.gltf.animations):
             samplers: list[dict] = []
             placed: dict[int, int] = {}  # the clip's sampler -> the added animation's
@@ -59,8 +59,10 @@ def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note:
             if channels:
                 name = animation.name or f"{Path(clip_file).stem} {index}"
                 builder.append("animations", {"name": name, "samplers": samplers, "channels": channels})
+                added += 1
         dropped = f"; {left_out} channel(s) on nodes the character has not, or of weights, left out" if left_out else ""
-        note(f"{os.fspath(clip_file)}: {len(source.gltf.animations)} clip(s) added to the character{dropped}")
+        total = len(source.gltf.animations)
+        note(f"{os.fspath(clip_file)}: {added} of its {total} clip(s) added to the character{dropped}")
     return GltfDocument(doc.path, doc.max_animation_frames, data=builder.to_bytes())
 
 

@@ -26,7 +26,7 @@ from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 
 # A node whose translation a clip animates rests within this fraction of the rig's size (the
-# character's largest rest translation among those nodes) of the character's node.
+# largest rest translation among the character's nodes the clip names) of the character's node.
 REST_TOLERANCE = 0.01
 _NODE_PATHS = {"translation": 3, "rotation": 4, "scale": 3}
 
@@ -81,7 +81,7 @@ def _check_rests(source: GltfDocument, doc: GltfDocument, mapping: dict[int, int
     if not moved:
         return
     rests = {node: (source.rest_trs(node)[0], doc.rest_trs(mapping[node])[0]) for node in moved}
-    size = max(float(np.linalg.norm(own)) for _, own in rests.values())
+    size = max(float(np.linalg.norm(doc.rest_trs(node)[0])) for node in mapping.values())
     for node, (theirs, own) in rests.items():
         if np.linalg.norm(theirs - own) > REST_TOLERANCE * max(size, 1e-12):
             reason = (

@@ -409,6 +409,7 @@ def test_motion_levels_of_every_clip_share_one_skeleton_per_level(tmp_path: Path
     first clip alone was simplified and the others dropped without a word. They are simplified
     together now, one after another: each level writes a BVH per clip and one GLB with every clip."""
     from animlod.io.bvh import read_bvh
+    from animlod.io.manifest import read_lod_manifest
 
     skinned, motion = two_bone_tube()
     back = motion.take_frames(np.arange(motion.frame_count)[::-1])
@@ -426,6 +427,13 @@ def test_motion_levels_of_every_clip_share_one_skeleton_per_level(tmp_path: Path
             np.testing.assert_allclose(written[k].world_positions(), expected, atol=1e-5)
             from_bvh = read_bvh(tmp_path / "levels" / clip_files[k]).world_positions()
             np.testing.assert_allclose(from_bvh, expected, atol=1e-4)
+    # Each clip's largest error at each level, for a runtime that picks a level per clip.
+    manifest = read_lod_manifest(tmp_path / "levels" / "clips_motion_lod.json")
+    for level, row in zip(report.chain.levels, manifest["levels"]):
+        errors = [clip["error"] for clip in row["clips"]]
+        assert [clip["name"] for clip in row["clips"]] == ["Armature|Bend"] * 2
+        assert max(errors) == pytest.approx(level.report.max_error, rel=1e-12, abs=1e-15)
+    assert len(set(manifest["levels"][-1]["clips"][k]["error"] for k in range(2))) == 1  # a clip and its reverse
 
 
 def test_meshes_on_skins_of_the_same_joints_share_one_skeleton_per_motion_level(tmp_path: Path) -> None:

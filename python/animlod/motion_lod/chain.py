@@ -45,6 +45,7 @@ class LevelReport:
     largest standard deviation over frames of a re-fitted bone's length, relative to its key
     length. fk_residual: largest distance between the output's forward kinematics and the
     re-fitted positions (0 up to round-off with hard constraints). energy: mean E per frame.
+    frame_errors: (T,) each frame's largest joint position error (a clip's share of max_error).
     """
 
     joint_count: int
@@ -58,6 +59,7 @@ class LevelReport:
     evaluations: float
     seconds: float
     failures: list[FrameFailure] = field(default_factory=list)
+    frame_errors: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass
@@ -354,6 +356,7 @@ def build_level(
         evaluations=float(result.evaluations.mean()),
         seconds=time.perf_counter() - start,
         failures=result.failures,
+        frame_errors=error.max(axis=1),
     )
     level_skin = transfer_skin(skin, level) if skin is not None else None
     return MotionLevel(level, result.positions, solved.output, report, level_skin)

@@ -171,8 +171,13 @@ def build_motion_levels(
             names.append(Path(f"{stem}_lod{index}.glb"))
             write_glb(folder / names[-1], level.skin, level_clips, names=[name for name, _ in clips])
         files.append(names)
-        rows.append({"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
-                     "error": level.report.max_error})  # fmt: skip
+        row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
+               "error": level.report.max_error}  # fmt: skip
+        if len(clips) > 1:  # a runtime may pick each clip's level by its own error
+            row["clips"] = [
+                {"name": name, "error": float(level.report.frame_errors[span].max())} for name, span in clips
+            ]
+        rows.append(row)
     # The runtime's level chooser: each level's largest joint position error in asset units.
     manifest = Path(f"{stem}_motion_lod.json")
     write_lod_manifest(folder / manifest, "motion", rows)

@@ -13,7 +13,7 @@ from animlod import synth
 from animlod.cli import main
 from animlod.io.errors import FormatError
 from animlod.io.gltf import read_gltf, write_glb
-from animlod.model import Skeleton
+from animlod.model import Motion, Skeleton
 from animlod.pipelines.character import build_character
 
 QUICK = {"solver": "newton", "frame_budget": 12, "measured_frames": 2}
@@ -57,3 +57,14 @@ def test_a_clip_of_other_proportions_is_refused_naming_the_joint(split_character
     error = capsys.readouterr().err
     assert "tall_walk.glb: node 0 'Hips': its translation is animated and it rests at" in error
     assert "another figure's proportions" in error and not (tmp_path / "out.glb").exists()
+
+
+def test_a_clip_of_another_rig_is_refused(split_character, tmp_path):
+    _, rest, _ = split_character
+    skeleton = synth.humanoid().skeleton
+    renamed = Skeleton([f"other:{name}" for name in skeleton.names], skeleton.parents, skeleton.offsets,
+                       skeleton.rest_rotations, skeleton.end_sites)  # fmt: skip
+    walk = synth.humanoid_motion(skeleton, "walk")
+    write_glb(tmp_path / "other_rig.glb", None, [Motion(renamed, walk.root_positions, walk.local_rotations, walk.fps)])
+    with pytest.raises(FormatError, match="other_rig.glb: animations: none moves a node of the character's by name"):
+        build_character(rest, tmp_path / "out.glb", [0.5], clips=[tmp_path / "other_rig.glb"], **QUICK)

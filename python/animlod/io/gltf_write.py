@@ -5,8 +5,9 @@ file: one node per joint (rest translation and rotation, parents before children
 marked with ``extras.animlod_end_site``), a mesh node with the skin, one mesh primitive
 (POSITION, NORMAL and TEXCOORD_0 when present, JOINTS_0/WEIGHTS_0 and, for 8 influences,
 JOINTS_1/WEIGHTS_1, uint16/uint32 indices, morph targets with their names in
-``extras.targetNames``), and one LINEAR animation per motion: the root's translation and every joint's rotation at every frame (and
-every joint's translation when the motion has per-frame ``joint_translations``).
+``extras.targetNames``), and one LINEAR animation per motion: the root's translation and every
+joint's rotation at every frame (and every joint's translation when the motion has per-frame
+``joint_translations``).
 
 The pieces (``add_skeleton``, ``add_skin``, ``add_animation``, ``skin_attributes``) also serve
 the LoD GLB writer, which adds reduced skeletons and their clips to a whole input document.

@@ -33,8 +33,9 @@ _NODE_PATHS = {"translation": 3, "rotation": 4, "scale": 3}
 
 def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note: Callable[[str], None]) -> GltfDocument:
     """``doc`` with every animation of each of ``clip_files`` added (see the module notes);
-    FormatError naming the clip file for one that cannot be read, has no animation, or moves the
-    translation of a node of the same name resting elsewhere."""
+    FormatError naming the clip file for one that cannot be read, has no animation moving a node
+    of the character's by name, or moves the translation of a node of the same name resting
+    elsewhere."""
     builder = GlbBuilder.from_document(doc)
     targets = _named_nodes(doc)
     for clip_file in clip_files:
@@ -60,6 +61,8 @@ def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note:
                 name = animation.name or f"{Path(clip_file).stem} {index}"
                 builder.append("animations", {"name": name, "samplers": samplers, "channels": channels})
                 added += 1
+        if not added:
+            raise source.fail("animations", "none moves a node of the character's by name (another rig?)")
         dropped = f"; {left_out} channel(s) on nodes the character has not, or of weights, left out" if left_out else ""
         total = len(source.gltf.animations)
         note(f"{os.fspath(clip_file)}: {added} of its {total} clip(s) added to the character{dropped}")

@@ -13,6 +13,7 @@ from animlod import synth
 from animlod.cli import main
 from animlod.io.errors import FormatError
 from animlod.io.gltf import read_gltf, write_glb
+from animlod.io.npz import write_npz
 from animlod.model import Motion, Skeleton
 from animlod.pipelines.character import build_character
 
@@ -37,7 +38,7 @@ def test_a_character_plays_the_clips_of_an_animation_library(split_character, tm
         build_character(rest, tmp_path / "none.glb", [0.5], **QUICK)
     split = build_character(rest, tmp_path / "split.glb", [0.5], clips=[walk], **QUICK)
     joined = build_character(whole, tmp_path / "whole.glb", [0.5], **QUICK)
-    assert any("walk.glb: 1 of its 1 clip(s) added to the character" in note for note in split.notes)
+    assert any("walk.glb: 1 of its 1 clip(s) added to rest.glb" in note for note in split.notes)
     for ours, theirs in zip(split.chains.values(), joined.chains.values()):
         assert [(level.faces, level.joints) for level in ours] == [(level.faces, level.joints) for level in theirs]
         np.testing.assert_allclose([level.error for level in ours], [level.error for level in theirs], rtol=1e-6)
@@ -66,5 +67,19 @@ def test_a_clip_of_another_rig_is_refused(split_character, tmp_path):
                        skeleton.rest_rotations, skeleton.end_sites)  # fmt: skip
     walk = synth.humanoid_motion(skeleton, "walk")
     write_glb(tmp_path / "other_rig.glb", None, [Motion(renamed, walk.root_positions, walk.local_rotations, walk.fps)])
-    with pytest.raises(FormatError, match="other_rig.glb: animations: none moves a node of the character's by name"):
+    with pytest.raises(FormatError, match="other_rig.glb: animations: none moves a node of rest.glb's by name"):
         build_character(rest, tmp_path / "out.glb", [0.5], clips=[tmp_path / "other_rig.glb"], **QUICK)
+
+
+def test_simplify_drives_the_skinned_levels_with_added_clips(split_character, tmp_path, capsys):
+    from animlod.pipelines.lod_document import simplify_document
+
+    whole, rest, walk = split_character
+    split = simplify_document(rest, tmp_path / "split.glb", [0.5, 0.25], clips=[walk], frame_budget=12)
+    joined = simplify_document(whole, tmp_path / "whole.glb", [0.5, 0.25], frame_budget=12)
+    assert [level.error for level in split.drawables[0].levels] == [level.error for level in joined.drawables[0].levels]
+    assert split.drawables[0].clips == 1 and split.notes == [f"{walk}: 1 of its 1 clip(s) added to rest.glb"]
+    assert len(read_gltf(tmp_path / "split.glb").motions) == 1
+    write_npz(tmp_path / "bar.npz", synth.twisting_bar(frames=3, rings=6, segments=6))
+    assert main(["simplify", str(tmp_path / "bar.npz"), "-o", str(tmp_path / "out"), "--clips", str(walk)]) == 2
+    assert "--clips: adds glTF clips to a glTF input, not to a npz input" in capsys.readouterr().err

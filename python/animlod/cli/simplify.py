@@ -68,6 +68,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "faces lie nearly parallel to them, then collapse first)",
     )
     parser.add_argument("--separate", action="store_true", help="glTF: one whole GLB per level instead of one LoD GLB")
+    parser.add_argument(
+        "--clips", nargs="+", default=(), metavar="FILE",
+        help="glTF: files of clips on the same rig (an animation library without the mesh), added to the input's "
+        "own by node name: they drive the skinned meshes' levels, and the output plays them",
+    )  # fmt: skip
     parser.add_argument("--no-metrics", action="store_true", help="sequences: skip the Hausdorff/RMS measurement")
     parser.add_argument(
         "--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side"
@@ -88,6 +93,8 @@ def run(args: argparse.Namespace) -> int:
         options["tip_quadrics"] = False
     if kind == "gltf":
         return _simplify_document(args, options)
+    if args.clips:
+        raise UserError(f"--clips: adds glTF clips to a glTF input, not to a {kind} input ({args.input})")
     return _simplify_sequence(args, options)
 
 
@@ -99,8 +106,9 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
         output = output / glb_name(args.input, "_lod")
     frame_budget = {"frame_budget": args.max_frames} if args.max_frames else {}
     report = simplify_document(
-        args.input, output, args.ratio, separate=args.separate, progress=print, **frame_budget, **options
-    )
+        args.input, output, args.ratio, separate=args.separate, clips=args.clips, progress=print, **frame_budget,
+        **options,
+    )  # fmt: skip
     print("errors: max over the rest pose and frames of every clip of the Hausdorff distance, relative to the")
     print("bounding-box diagonal; coverage: the MSFT_screencoverage below which the next level takes over")
     for drawable in report.drawables:
@@ -125,6 +133,8 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
         print_rows(rows, indent="  ")
         for note in drawable.notes:
             print(f"  note: {note}")
+    for note in report.notes:
+        print(f"note: {note}")
     for path in report.outputs:
         print(f"wrote {path}")
     print(f"{report.seconds:.2f} s")

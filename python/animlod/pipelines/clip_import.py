@@ -41,7 +41,7 @@ def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note:
     for clip_file in clip_files:
         source = GltfDocument(clip_file)
         if not source.gltf.animations:
-            raise source.fail("animations", "no animation to add to the character")
+            raise source.fail("animations", f"no animation to add to {Path(doc.path).name}")
         mapping = {node: targets[name] for name, node in _named_nodes(source).items() if name in targets}
         _check_rests(source, doc, mapping)
         left_out = added = 0
@@ -61,11 +61,12 @@ def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note:
                 name = animation.name or f"{Path(clip_file).stem} {index}"
                 builder.append("animations", {"name": name, "samplers": samplers, "channels": channels})
                 added += 1
+        into = Path(doc.path).name
         if not added:
-            raise source.fail("animations", "none moves a node of the character's by name (another rig?)")
-        dropped = f"; {left_out} channel(s) on nodes the character has not, or of weights, left out" if left_out else ""
+            raise source.fail("animations", f"none moves a node of {into}'s by name (another rig?)")
+        dropped = f"; {left_out} channel(s) on nodes {into} has not, or of weights, left out" if left_out else ""
         total = len(source.gltf.animations)
-        note(f"{os.fspath(clip_file)}: {added} of its {total} clip(s) added to the character{dropped}")
+        note(f"{os.fspath(clip_file)}: {added} of its {total} clip(s) added to {into}{dropped}")
     return GltfDocument(doc.path, doc.max_animation_frames, data=builder.to_bytes())
 
 

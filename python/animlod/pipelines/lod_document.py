@@ -23,6 +23,7 @@ from ..io.gltf_document import GltfDocument
 from ..io.gltf_drawable import Drawable, read_drawables
 from ..io.gltf_lod import LevelInfo, add_level_mesh, add_level_node, attach_chain, screen_coverages
 from ..model import AnimatedMesh
+from .clip_import import with_clips
 from .drawable_levels import DrawableLevels, DrawableSettings, simplify_drawable
 
 DEFAULT_RATIOS = (0.5, 0.25, 0.1)
@@ -64,6 +65,7 @@ class DocumentReport:
     outputs: list[Path]
     drawables: list[DrawableReport]
     seconds: float
+    notes: list[str] = field(default_factory=list)  # about the document (clips added from other files)
 
 
 def simplify_document(
@@ -72,6 +74,7 @@ def simplify_document(
     ratios: Sequence[float] = DEFAULT_RATIOS,
     *,
     separate: bool = False,
+    clips: Sequence[str] = (),
     settings: DrawableSettings | None = None,
     progress: Callable[[str], None] | None = None,
     **keywords: object,
@@ -84,6 +87,8 @@ def simplify_document(
     output : the LoD GLB to write (atomically); with ``separate``, a folder that receives one
         ``<stem>_lod<i>.glb`` per level instead, each the whole document at that level.
     ratios : face ratios of the levels below level 0, in (0, 1].
+    clips : glTF files of clips on the same rig, added to the document's own by node name
+        (:mod:`.clip_import`): they drive the skinned meshes' levels, and the output plays them.
     settings, **keywords : a :class:`~animlod.pipelines.DrawableSettings` and/or its fields by
         name (``fps``, ``frame_budget``, ``measured_frames``, ``pixel_error``, ``viewport_px``)
         and AQEM options (``use_motion_features``, ``max_error``, ``placement`` ..., see
@@ -98,7 +103,10 @@ def simplify_document(
     if not ratios or any(not 0.0 < ratio <= 1.0 for ratio in ratios):
         raise ValueError(f"ratios: each must be in (0, 1], got {list(ratios)}")
     settings = DrawableSettings.resolve(settings, keywords)
+    notes: list[str] = []
     doc = GltfDocument(source)
+    if clips:
+        doc = with_clips(doc, clips, notes.append)
     drawables = read_drawables(doc, settings.fps)
     if not drawables:
         reason = "no node draws a triangle mesh, nothing to simplify"
@@ -116,7 +124,7 @@ def simplify_document(
     else:
         outputs = [Path(output)]
         _write_chain(doc, drawables, simplified, reports).save(output)
-    return DocumentReport(Path(source), outputs, reports, time.perf_counter() - started)
+    return DocumentReport(Path(source), outputs, reports, time.perf_counter() - started, notes)
 
 
 def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettings) -> DrawableReport:

@@ -11,6 +11,7 @@ import pytest
 
 from animlod import synth
 from animlod.cli import main
+from animlod.io.bvh import write_bvh
 from animlod.io.errors import FormatError
 from animlod.io.gltf import read_gltf, write_glb
 from animlod.io.npz import write_npz
@@ -83,3 +84,19 @@ def test_simplify_drives_the_skinned_levels_with_added_clips(split_character, tm
     write_npz(tmp_path / "bar.npz", synth.twisting_bar(frames=3, rings=6, segments=6))
     assert main(["simplify", str(tmp_path / "bar.npz"), "-o", str(tmp_path / "out"), "--clips", str(walk)]) == 2
     assert "--clips: adds glTF clips to a glTF input, not to a npz input" in capsys.readouterr().err
+
+
+def test_motion_levels_of_a_character_with_added_clips(split_character, tmp_path):
+    from animlod.pipelines.motion import build_motion_levels
+
+    whole, rest, walk = split_character
+    split = build_motion_levels(rest, tmp_path / "split", levels=3, clips=[walk], solver="newton")
+    joined = build_motion_levels(whole, tmp_path / "whole", levels=3, solver="newton")
+    assert [level.report.max_error for level in split.chain.levels] == [
+        level.report.max_error for level in joined.chain.levels
+    ]
+    assert f"{walk}: 1 of its 1 clip(s) added to rest.glb" in split.notes
+    assert (tmp_path / "split" / "rest_lod2.glb").is_file()
+    write_bvh(tmp_path / "walk.bvh", read_gltf(whole).motions[0])
+    with pytest.raises(ValueError, match="clips: adds glTF clips to a glTF input, not to a bvh input"):
+        build_motion_levels(tmp_path / "walk.bvh", tmp_path / "bvh", levels=2, clips=[walk])

@@ -83,6 +83,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "moves other joints (one animation per joint node), else one after another with one skeleton per level "
         "(a BVH per clip and level, every clip in each level's GLB)",
     )  # fmt: skip
+    parser.add_argument(
+        "--clips", nargs="+", default=(), metavar="FILE",
+        help="glTF files of clips on the same rig (an animation library without the mesh), added to a glTF "
+        "input's own by node name",
+    )  # fmt: skip
     parser.add_argument("--plot", action="store_true", help="write importance, key posture and error charts (PNG)")
     parser.set_defaults(run=run)
 
@@ -172,6 +177,7 @@ def run(args: argparse.Namespace) -> int:
             weights=args.weights,
             max_frames=args.max_frames,
             clip=args.clip,
+            clips=args.clips,
             on_level=on_level,
             on_choice=lambda chosen, to_choose: progress().chose(chosen, to_choose),
             on_note=lambda text: print(text, file=sys.stderr),

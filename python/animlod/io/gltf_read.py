@@ -50,14 +50,15 @@ class GltfScene:
     skinned_motions: list[list[Motion]] = field(default_factory=list)
 
 
-def read_gltf(path: str | os.PathLike, fps: float = 30.0) -> GltfScene:
-    """Read every skinned mesh, motion, morph animation and static mesh of a .glb / .gltf file.
+def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> GltfScene:
+    """Read every skinned mesh, motion, morph animation and static mesh of a .glb / .gltf file
+    (or of a document already parsed).
 
     Animations are sampled at ``fps`` from time 0 to their last key. Raises
     :class:`~animlod.io.FormatError` naming the file, the element and the reason for input it
     cannot read.
     """
-    doc = GltfDocument(path)
+    doc = path if isinstance(path, GltfDocument) else GltfDocument(path)
     rigs: dict[int, SkinRig] = {}
     skinned, skinned_motions = [], []
     for node in _skinned_mesh_nodes(doc):
@@ -120,13 +121,13 @@ def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:
     return wanted in (doc.gltf.skins[skin].name, doc.gltf.meshes[doc.gltf.nodes[node].mesh].name)
 
 
-def read_node_motions(path: str | os.PathLike, fps: float = 30.0) -> tuple[list[Motion], list[str]]:
-    """The animations of a glTF file, sampled at ``fps``, as motions of its animated node tree: the
-    skeleton of a file without skins, as animation libraries are exported without their mesh
-    (:class:`~animlod.io.gltf_skin.SkinRig` without a skin); and the labels of animated trees left
-    out (under no node in common with the skeleton's). Raises FormatError naming the file when no
-    animation translates, turns or scales a node."""
-    doc = GltfDocument(path)
+def read_node_motions(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> tuple[list[Motion], list[str]]:
+    """The animations of a glTF file (or parsed document), sampled at ``fps``, as motions of its
+    animated node tree: the skeleton of a file without skins, as animation libraries are exported
+    without their mesh (:class:`~animlod.io.gltf_skin.SkinRig` without a skin); and the labels of
+    animated trees left out (under no node in common with the skeleton's). Raises FormatError
+    naming the file when no animation translates, turns or scales a node."""
+    doc = path if isinstance(path, GltfDocument) else GltfDocument(path)
     rig = SkinRig(doc, None)
     return _rig_motions(doc, rig, fps), rig.trees_left_out
 

@@ -69,6 +69,7 @@ def build_motion_levels(
     weights: Sequence[float] = (0.2, 0.4, 0.4),
     max_frames: int = 600,
     clip: int | str | None = None,
+    clips: Sequence[str] = (),
     on_level: Callable[[int, int, int, int], Callable[[float], None] | None] | None = None,
     on_choice: Callable[[int, int], None] | None = None,
     on_note: Callable[[str], None] | None = None,
@@ -96,6 +97,8 @@ def build_motion_levels(
     clip : which animation of a glTF input, by index or name; None: all of them, as one motion when
         each moves other joints (one animation per joint node), else one after another, so that
         each level has one skeleton for every clip.
+    clips : glTF files of clips on the same rig, added to a glTF input's own by node name
+        (:mod:`.clip_import`).
     on_level : called with (level index, joint count, frame count, number of levels) as each
         level starts; may return a callback taking the frames done.
     on_choice : called with (levels chosen, levels to choose) while the "refit" ranking's trial
@@ -122,11 +125,11 @@ def build_motion_levels(
         if on_note is not None:
             on_note(text)
 
-    motion, clips, skin, layout = _read_input(source, clip, note)
+    motion, played, skin, layout = _read_input(source, clip, clips, note)
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
-    spans = [frames for _, frames in clips] if len(clips) > 1 else None
+    spans = [frames for _, frames in played] if len(played) > 1 else None
     analysis, counts, floor = _plan_levels(
         motion, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
@@ -157,11 +160,11 @@ def build_motion_levels(
     stem = input_stem(source)
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
     orders = layout.rotation_orders if layout is not None else "ZXY"
-    suffixes = _clip_suffixes([name for name, _ in clips])
+    suffixes = _clip_suffixes([name for name, _ in played])
     files, rows = [], []
     for index, level in enumerate(chain.levels):
         names = []
-        level_clips = [level.motion.take_frames(frames) for _, frames in clips]
+        level_clips = [level.motion.take_frames(frames) for _, frames in played]
         for clip_motion, suffix in zip(level_clips, suffixes):
             names.append(Path(f"{stem}_lod{index}{suffix}.bvh"))
             write_bvh(folder / names[-1], clip_motion, rotation_order=orders)
@@ -169,13 +172,13 @@ def build_motion_levels(
             from ..io.gltf import write_glb
 
             names.append(Path(f"{stem}_lod{index}.glb"))
-            write_glb(folder / names[-1], level.skin, level_clips, names=[name for name, _ in clips])
+            write_glb(folder / names[-1], level.skin, level_clips, names=[name for name, _ in played])
         files.append(names)
         row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
                "error": level.report.max_error}  # fmt: skip
-        if len(clips) > 1:  # a runtime may pick each clip's level by its own error
+        if len(played) > 1:  # a runtime may pick each clip's level by its own error
             row["clips"] = [
-                {"name": name, "error": float(level.report.frame_errors[span].max())} for name, span in clips
+                {"name": name, "error": float(level.report.frame_errors[span].max())} for name, span in played
             ]
         rows.append(row)
     # The runtime's level chooser: each level's largest joint position error in asset units.
@@ -186,13 +189,15 @@ def build_motion_levels(
 
 
 def _read_input(
-    source: str | os.PathLike, clip: int | str | None, note: Callable[[str], None]
+    source: str | os.PathLike, clip: int | str | None, clip_files: Sequence[str], note: Callable[[str], None]
 ) -> tuple[Motion, list[tuple[str, slice]], SkinnedMesh | None, BvhLayout | None]:
     """The motion to simplify, the clips it is made of (each one's name and frames in it), for a
     skinned glTF its skin (None for a glTF without skins: the animated node tree is the skeleton)
-    and for a BVH its layout."""
+    and for a BVH its layout. ``clip_files`` add to a glTF's clips."""
     path = os.fspath(source)
     kind = input_kind(source)
+    if clip_files and kind != "gltf":
+        raise ValueError(f"clips: adds glTF clips to a glTF input, not to a {kind} input")
     if kind == "bvh":
         from ..io.bvh import read_bvh_with_layout
 
@@ -201,8 +206,13 @@ def _read_input(
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
     from ..io.gltf import read_gltf, read_node_motions
+    from ..io.gltf_document import GltfDocument
+    from .clip_import import with_clips
 
-    scene = read_gltf(source)
+    document = GltfDocument(source)
+    if clip_files:
+        document = with_clips(document, clip_files, note)
+    scene = read_gltf(document)
     if scene.skinned_meshes:
         (skin, left_out), motions = _whole_skin(scene.skinned_meshes), scene.skinned_motions[0]
         if skin.vertex_count > scene.skinned_meshes[0].vertex_count:
@@ -214,7 +224,7 @@ def _read_input(
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
     else:  # an animation library exported without its mesh
-        (motions, left_out), skin = read_node_motions(source), None
+        (motions, left_out), skin = read_node_motions(document), None
         skeleton = motions[0].skeleton
         note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
              f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clips")  # fmt: skip

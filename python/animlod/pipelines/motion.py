@@ -161,6 +161,7 @@ def build_motion_levels(
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
     orders = layout.rotation_orders if layout is not None else "ZXY"
     suffixes = _clip_suffixes([name for name, _ in played])
+    gltf_input = input_kind(source) == "gltf"
     files, rows = [], []
     for index, level in enumerate(chain.levels):
         names = []
@@ -168,7 +169,7 @@ def build_motion_levels(
         for clip_motion, suffix in zip(level_clips, suffixes):
             names.append(Path(f"{stem}_lod{index}{suffix}.bvh"))
             write_bvh(folder / names[-1], clip_motion, rotation_order=orders)
-        if input_kind(source) == "gltf":  # every clip in one GLB per level
+        if gltf_input:  # every clip in one GLB per level
             from ..io.gltf import write_glb
 
             names.append(Path(f"{stem}_lod{index}.glb"))
@@ -224,12 +225,13 @@ def _read_input(
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
     else:  # an animation library exported without its mesh
-        (motions, left_out), skin = read_node_motions(document), None
+        (motions, other_trees), skin = read_node_motions(document), None
         skeleton = motions[0].skeleton
         note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
              f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clips")  # fmt: skip
-        if left_out:
-            note(f"{path}: animated nodes under no node in common with the skeleton's left out: {', '.join(left_out)}")
+        if other_trees:
+            note(f"{path}: animated nodes under no node in common with the skeleton's left out: "
+                 f"{', '.join(other_trees)}")  # fmt: skip
     names = [motion.name or f"animation{index}" for index, motion in enumerate(motions)]
     if clip is None:
         from ..motion_lod.clips import join_clips, merge_split_clips

@@ -116,7 +116,7 @@ def read_animation(path: str):
         taken = "the first morph-animated mesh and clip"
     elif scene.skinned_meshes and scene.motions:
         mesh = scene.skinned_meshes[0].bake(scene.motions[0])
-        others = len(scene.skinned_meshes) * len(scene.motions) - 1
+        others = sum(len(motions) for motions in scene.skinned_motions) - 1
         taken = f"the first skinned mesh baked with its first clip, {scene.motions[0].name or 'unnamed'!r}"
     else:
         raise UserError(f"{path}: no morph-animated mesh and no animated skinned mesh to build a TDAG of")

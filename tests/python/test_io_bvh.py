@@ -402,9 +402,12 @@ def test_truncated_motion_table(tmp_path: Path) -> None:
     assert "line 26 (frame 2): Frames: says 3 but the MOTION table has 2 rows" in message
 
 
-def test_more_rows_than_frames(tmp_path: Path) -> None:
-    message = _read_error(tmp_path, SMALL_BVH.replace("Frames: 2", "Frames: 1"))
-    assert "Frames: says 1 but the MOTION table has 2 rows" in message
+def test_more_rows_than_frames_are_all_read_with_a_warning(tmp_path: Path) -> None:
+    expected = read_bvh(_write(tmp_path, SMALL_BVH))
+    with pytest.warns(UserWarning, match=r"clip.bvh: Frames: says 1 but the MOTION table has 2 rows; read all 2"):
+        motion = read_bvh(_write(tmp_path, SMALL_BVH.replace("Frames: 2", "Frames: 1")))
+    np.testing.assert_array_equal(motion.local_rotations, expected.local_rotations)
+    np.testing.assert_array_equal(motion.root_positions, expected.root_positions)
 
 
 def test_row_with_wrong_channel_count(tmp_path: Path) -> None:

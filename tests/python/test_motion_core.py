@@ -3,16 +3,20 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from test_motion_figures import figure_motion
 
 from animlod import _core
+from animlod.model import Motion, Skeleton
 from animlod.motion_lod import analyze_motion, build_motion_chain
-from animlod.motion_lod.chain import _cold_starts
+from animlod.motion_lod.chain import _cold_starts, build_level
 from animlod.motion_lod.core_refit import core_problem, refit_core
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.objective import (
+    _rigid_set,
     build_problem,
     handedness_constraints,
     objective,
@@ -185,3 +189,32 @@ def test_core_and_reference_agree_on_a_real_clip_sample(data_dir) -> None:
     same = np.abs(core.objective - reference.objective) <= 1e-6 * reference.objective
     assert same.mean() >= 0.9
     assert abs(core.objective.mean() / reference.objective.mean() - 1.0) < 0.001
+
+
+@pytest.mark.parametrize("side", [-1.0, 0.5])
+def test_children_on_one_line_through_their_joint_move_as_one_body(side) -> None:
+    # Hips exactly at +-x of the root (assimp's Boxing_Toes.bvh), or a second child halfway along
+    # the first (a twist joint beside the next bone): bones alone let each child swing on its
+    # own, and forward kinematics, which turns them as one, put the second 13 units (8%
+    # of the figure) away from its re-fit at the boxer's 4-joint level.
+    motion = figure_motion()
+    offsets = motion.skeleton.offsets.copy()
+    offsets[1] = (0.1, 0.0, 0.0)
+    offsets[4] = (0.1 * side, 0.0, 0.0)
+    skeleton = Skeleton(motion.skeleton.names, motion.skeleton.parents, offsets, end_sites=motion.skeleton.end_sites)
+    motion = Motion(skeleton, motion.root_positions, motion.local_rotations, motion.fps, motion.name)
+    analysis = analyze_motion(motion)
+    names = skeleton.names
+    order = [names.index(n) for n in ("LeftKnee", "RightKnee", "Spine", "Chest", "LeftShoulder", "LeftElbow",
+                                      "LeftWrist", "RightShoulder", "RightElbow")]  # fmt: skip
+    analysis = dataclasses.replace(analysis, priority=order + [names.index("LeftHip"), names.index("RightHip")])
+    level = build_level(motion, analysis, 3)
+    assert level.report.fk_residual < 1e-6 and level.report.failures == []
+    assert [4, 1] in build_problem(level.frozen).length_pairs.tolist()  # RightHip tied to LeftHip
+
+
+def test_three_children_on_one_line_make_a_minimal_rigid_set() -> None:
+    key = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    bones, siblings, handed, flat = _rigid_set(0, [1, 2, 3], key, 1e-9)
+    assert len(bones) + len(siblings) == 3 * 3 - 3 and handed == flat == []
+    assert siblings == [(2, 1), (3, 1), (3, 2)]

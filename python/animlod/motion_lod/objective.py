@@ -342,7 +342,9 @@ def _rigid_set(
     distances to both base children, plus a handedness quad (distances fix c only up to its
     mirror image); within _FLAT of that plane, where distances pin it out of the plane only to
     second order, its distance to one base child (the one making the larger triangle with c and
-    the parent) and a flat quad holding its height over the plane.
+    the parent) and a flat quad holding its height over the plane. Children all on one line
+    through the parent are tied the same way, without quads: their distances hold the line only
+    to second order, but they make the set a rigid body, which the core's solve moves as one.
 
     Returns bone pairs, sibling pairs, handed quads and flat quads (parent, base a, base b, child).
     """
@@ -363,7 +365,10 @@ def _rigid_set(
     areas = np.linalg.norm(np.cross(arms[:, None], arms[None]), axis=-1)
     i, j = np.unravel_index(int(np.argmax(areas)), areas.shape)
     if areas[i, j] <= tolerance * float(np.linalg.norm(arms, axis=-1).max()):
-        return bones, siblings, [], []  # all on one line through the parent: the bones hold it
+        # All on one line through the parent (hips at +-x, a twist joint beside the next bone):
+        # the bones alone let each child swing on its own.
+        a, b = distinct[:2]
+        return bones, siblings + [(b, a)] + [(c, d) for c in distinct[2:] for d in (a, b)], [], []
     ia, ib = min(i, j), max(i, j)
     a, b = distinct[ia], distinct[ib]
     normal = np.cross(key[a] - key[parent], key[b] - key[parent]) / areas[i, j]

@@ -325,6 +325,19 @@ def test_unreadable_ply_header(tmp_path: Path, content: bytes, element: str) -> 
     assert _error(path).startswith(f"{path}: {element}")
 
 
+def test_ply_header_line_without_a_keyword_is_skipped_with_a_warning(tmp_path: Path) -> None:
+    # Blender 2.4 wrote its "comment" line without the keyword (assimp's test set, Wuson.ply).
+    mesh = _moving_mesh()
+    write_ply(tmp_path / "clean.ply", mesh.frames[0], mesh.faces, binary=False)
+    text = (tmp_path / "clean.ply").read_bytes().replace(b"format ascii 1.0\n", b"format ascii 1.0\nCreated by X\n", 1)
+    path = _write(tmp_path / "blender24.ply", text)
+    with pytest.warns(UserWarning, match=r"blender24.ply: header line 3: skipped 'Created by X', which starts with no"):
+        vertices, faces = read_ply(path)
+    clean_vertices, clean_faces = read_ply(tmp_path / "clean.ply")
+    np.testing.assert_array_equal(vertices, clean_vertices)
+    np.testing.assert_array_equal(faces, clean_faces)
+
+
 def test_truncated_binary_ply(tmp_path: Path) -> None:
     mesh = _moving_mesh()
     write_ply(tmp_path / "whole.ply", mesh.frames[0], mesh.faces)

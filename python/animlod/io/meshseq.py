@@ -14,6 +14,7 @@ from __future__ import annotations
 import glob
 import os
 import re
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -535,8 +536,13 @@ def _read_ply_header(path: Path, data: bytes) -> tuple[str | None, list[_PlyElem
             if any(other.name == prop.name for other in elements[-1].properties):
                 raise FormatError(path, element, f"property {prop.name!r} is declared twice in {elements[-1].name!r}")
             elements[-1].properties.append(prop)
-        else:
+        elif words[0] in ("format", "element", "property"):
             raise FormatError(path, element, f"cannot read {line.strip()!r}")
+        else:
+            # Not a PLY keyword: Blender 2.4's exporter wrote its comment without one (assimp's
+            # Wuson.ply); readers such as assimp skip such lines, and so does this one, aloud.
+            reason = f"skipped {line.strip()!r}, which starts with no PLY keyword"
+            warnings.warn(f"{path}: {element}: {reason}", stacklevel=4)
     if not format_seen:
         raise FormatError(path, "header", "no 'format ascii|binary_little_endian|binary_big_endian 1.0' line")
     return byte_order, elements, body

@@ -536,9 +536,6 @@ def _parse(path: str, data: bytes | None = None) -> tuple[pygltflib.GLTF2, dict]
     gltf = decode_gltf(path, raw)
     if binary_chunk is not None:
         gltf.set_binary_blob(binary_chunk)
-    version = str(getattr(gltf.asset, "version", "") or "")
-    if not version.startswith("2."):
-        raise FormatError(path, "asset", f"glTF version {version!r} is not 2.x")
     unsupported = [name for name in gltf.extensionsRequired or [] if not name.startswith(_READABLE_EXTENSIONS)]
     if unsupported:
         raise FormatError(path, "extensionsRequired", f"needs {', '.join(unsupported)}, which animlod cannot read")
@@ -584,10 +581,22 @@ def _frame_limit(limit: int | None) -> int:
     return limit
 
 
+_GLTF1_ADVICE = "convert it to glTF 2.0 first: gltf-pipeline, for one, upgrades glTF 1.0 files"
+
+
 def _check_top_level(path: str, document: Any) -> None:
     """The JSON is an object whose arrays of objects are arrays, and whose scene is an index."""
     if not isinstance(document, dict):
         raise FormatError(path, "JSON", f"the document is a {type(document).__name__}, not an object")
+    # Checked first: a glTF 1.0 document has objects where 2.0 has arrays, which would be named
+    # as the fault otherwise.
+    asset = document.get("asset")
+    version = asset.get("version") if isinstance(asset, dict) else None
+    if not (isinstance(version, str) and version.startswith("2.")):
+        reason = "has no version (glTF 2.0 requires one)" if version is None else f"glTF version {version!r} is not 2.x"
+        if isinstance(version, str) and version.startswith("1."):
+            reason += f"; {_GLTF1_ADVICE}"
+        raise FormatError(path, "asset", reason)
     for key in _TOP_LEVEL_ARRAYS:
         if key in document and not isinstance(document[key], list):
             raise FormatError(path, key, f"must be an array, got {type(document[key]).__name__}")
@@ -603,7 +612,8 @@ def _glb_chunks(path: str, data: bytes) -> tuple[bytes, bytes | None]:
         raise FormatError(path, "GLB header", f"file is truncated ({len(data)} bytes)")
     version, length = struct.unpack_from("<II", data, 4)
     if version != 2:
-        raise FormatError(path, "GLB header", f"container version {version} is not 2")
+        advice = f": a glTF 1.0 binary file; {_GLTF1_ADVICE}" if version == 1 else ""
+        raise FormatError(path, "GLB header", f"container version {version} is not 2{advice}")
     if length > len(data):
         raise FormatError(path, "GLB header", f"file is truncated: header says {length} bytes, file has {len(data)}")
     offset = _GLB_HEADER_BYTES

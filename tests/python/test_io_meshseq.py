@@ -318,6 +318,10 @@ def test_frames_with_different_faces(tmp_path: Path) -> None:
         (b"ply\nformat ascii 1.0\nelement vertex three\nend_header\n", "header line 3: cannot read 'element"),
         (b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float3 x\nend_header\n", "header line 4: cannot read"),
         (b"ply\nelement vertex 0\nend_header\n", "header: no 'format"),
+        (
+            b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nprope\xffty float y\nend_header\n",
+            "header line 5: cannot",
+        ),
     ],
 )
 def test_unreadable_ply_header(tmp_path: Path, content: bytes, element: str) -> None:

@@ -536,11 +536,13 @@ def _read_ply_header(path: Path, data: bytes) -> tuple[str | None, list[_PlyElem
             if any(other.name == prop.name for other in elements[-1].properties):
                 raise FormatError(path, element, f"property {prop.name!r} is declared twice in {elements[-1].name!r}")
             elements[-1].properties.append(prop)
-        elif words[0] in ("format", "element", "property"):
+        elif words[0] in ("format", "element", "property") or elements:
             raise FormatError(path, element, f"cannot read {line.strip()!r}")
         else:
             # Not a PLY keyword: Blender 2.4's exporter wrote its comment without one (assimp's
-            # Wuson.ply); readers such as assimp skip such lines, and so does this one, aloud.
+            # Wuson.ply); assimp skips such lines, and so does this one, aloud, before the first
+            # element only: among the elements it may be a damaged property, and the rows would
+            # be read with the wrong layout.
             reason = f"skipped {line.strip()!r}, which starts with no PLY keyword"
             warnings.warn(f"{path}: {element}: {reason}", stacklevel=4)
     if not format_seen:

@@ -552,14 +552,7 @@ def document_json(path: str | os.PathLike) -> dict:
             if head[:4] != _GLB_MAGIC:
                 data, element = head + handle.read(), "JSON"
             else:
-                if len(head) < _GLB_HEADER_BYTES + 8:
-                    raise FormatError(path, "GLB header", f"file is truncated ({len(head)} bytes)")
-                length, kind = struct.unpack_from("<II", head, _GLB_HEADER_BYTES)
-                if kind != _GLB_JSON_CHUNK:
-                    raise FormatError(
-                        path, f"GLB chunk at byte {_GLB_HEADER_BYTES}", "the first chunk must be the JSON chunk"
-                    )
-                data, element = handle.read(length), "GLB JSON chunk"
+                data, element = handle.read(_glb_json_chunk_length(path, head)), "GLB JSON chunk"
     except OSError as error:
         raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
     document = load_json(path, data, element)
@@ -605,15 +598,26 @@ def _check_top_level(path: str, document: Any) -> None:
         raise FormatError(path, "scene", f"must be an index, got {scene!r}")
 
 
-def _glb_chunks(path: str, data: bytes) -> tuple[bytes, bytes | None]:
-    """Check the GLB header and chunk table; return the JSON chunk's bytes and the first BIN
-    chunk's (None without one). Chunks of other types are skipped (glTF 2.0 section 4.4.3)."""
-    if len(data) < _GLB_HEADER_BYTES + 8:
-        raise FormatError(path, "GLB header", f"file is truncated ({len(data)} bytes)")
-    version, length = struct.unpack_from("<II", data, 4)
+def _glb_json_chunk_length(path: str, head: bytes) -> int:
+    """Check a GLB's header and that its first chunk is the JSON chunk, from the file's first 20
+    bytes (``head``); return that chunk's declared length."""
+    if len(head) < _GLB_HEADER_BYTES + 8:
+        raise FormatError(path, "GLB header", f"file is truncated ({len(head)} bytes)")
+    version = struct.unpack_from("<I", head, 4)[0]
     if version != 2:
         advice = f": a glTF 1.0 binary file; {_GLTF1_ADVICE}" if version == 1 else ""
         raise FormatError(path, "GLB header", f"container version {version} is not 2{advice}")
+    chunk_length, chunk_type = struct.unpack_from("<II", head, _GLB_HEADER_BYTES)
+    if chunk_type != _GLB_JSON_CHUNK:
+        raise FormatError(path, f"GLB chunk at byte {_GLB_HEADER_BYTES}", "the first chunk must be the JSON chunk")
+    return chunk_length
+
+
+def _glb_chunks(path: str, data: bytes) -> tuple[bytes, bytes | None]:
+    """Check the GLB header and chunk table; return the JSON chunk's bytes and the first BIN
+    chunk's (None without one). Chunks of other types are skipped (glTF 2.0 section 4.4.3)."""
+    _glb_json_chunk_length(path, data[: _GLB_HEADER_BYTES + 8])
+    length = struct.unpack_from("<I", data, 8)[0]
     if length > len(data):
         raise FormatError(path, "GLB header", f"file is truncated: header says {length} bytes, file has {len(data)}")
     offset = _GLB_HEADER_BYTES
@@ -627,9 +631,7 @@ def _glb_chunks(path: str, data: bytes) -> tuple[bytes, bytes | None]:
                 path, f"GLB chunk at byte {offset}", f"declares {chunk_length} bytes, only {length - offset - 8} remain"
             )
         chunk = data[offset + 8 : offset + 8 + chunk_length]
-        if json_chunk is None:
-            if chunk_type != _GLB_JSON_CHUNK:
-                raise FormatError(path, f"GLB chunk at byte {offset}", "the first chunk must be the JSON chunk")
+        if json_chunk is None:  # the first chunk, JSON as _glb_json_chunk_length checked
             json_chunk = chunk
         elif chunk_type == _GLB_BIN_CHUNK and binary_chunk is None:
             binary_chunk = chunk

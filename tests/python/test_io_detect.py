@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from animlod.io import FormatError
-from animlod.io.detect import input_kind
+from animlod.io.detect import assets_in, input_kind
 
 
 @pytest.mark.parametrize(
@@ -58,3 +58,39 @@ def test_a_folder_of_frame_folders_names_them(tmp_path: Path) -> None:
         (tmp_path / name / "frame_0001.ply").write_bytes(b"")
     with pytest.raises(FormatError, match=r"holds no .obj or .ply frame but a_run, b_walk, c_jump and more: pass one"):
         input_kind(tmp_path)
+
+
+_TRIANGLE = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+_QUAD = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n"
+
+
+def test_a_folder_of_separate_meshes_is_a_library_not_a_sequence(tmp_path: Path) -> None:
+    # Props as loose OBJ/PLY files (an asset pack; assimp's OBJ test folder): each an asset of
+    # batch and info, where the whole folder was one sequence that failed at its second file.
+    props = tmp_path / "props"
+    props.mkdir()
+    (props / "rock_2.obj").write_bytes(_QUAD)
+    (props / "rock_10.obj").write_bytes(_TRIANGLE)
+    (props / "tree.obj").write_bytes(_QUAD)
+    assert list(assets_in(tmp_path)) == [props / "rock_2.obj", props / "rock_10.obj", props / "tree.obj"]
+    with pytest.raises(
+        FormatError, match=r"props: folder: holds 3 separate meshes \(rock_2.obj, rock_10.obj, tree.obj"
+    ):
+        input_kind(props)
+
+
+def test_numbered_frames_stay_one_sequence_when_one_of_them_differs(tmp_path: Path) -> None:
+    # A broken frame of a numbered sequence (beside its rest mesh) is the sequence's error, not a
+    # library of one-frame assets; unnumbered poses with one connectivity are one sequence too.
+    frames = tmp_path / "gallop"
+    frames.mkdir()
+    for index in range(3):
+        (frames / f"horse-{index:02d}.obj").write_bytes(_QUAD)
+    (frames / "horse-03.obj").write_bytes(_TRIANGLE)
+    (frames / "horse-reference.obj").write_bytes(_QUAD)
+    poses = tmp_path / "poses"
+    poses.mkdir()
+    for name in ("neutral", "smile", "frown"):
+        (poses / f"{name}.obj").write_bytes(_QUAD)
+    assert list(assets_in(tmp_path)) == [frames, poses]
+    assert input_kind(frames) == input_kind(poses) == "sequence"

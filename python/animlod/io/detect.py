@@ -5,11 +5,13 @@ from __future__ import annotations
 import glob
 import itertools
 import os
+import re
+from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
 
 from .errors import FormatError
-from .meshseq import MESH_SUFFIXES, is_frame_name
+from .meshseq import MESH_SUFFIXES, frame_files, is_frame_name, natural_key
 
 # A .vrm is a VRM avatar (VRoid, UniVRM): a binary glTF whose VRM extensions animlod carries.
 GLTF_SUFFIXES = (".glb", ".gltf", ".vrm")
@@ -56,8 +58,8 @@ def input_kind(path: str | os.PathLike) -> str:
 
 
 def holds_frames(folder: Path) -> bool:
-    """Whether ``folder`` holds an OBJ/PLY frame, which makes it one frame sequence (decided by
-    names: a folder of thousands of frames costs no stat)."""
+    """Whether ``folder`` holds an OBJ/PLY file: one frame sequence, or separate meshes (see
+    :func:`separate_meshes`); decided by names, so a folder of thousands of frames costs no stat."""
     try:
         with os.scandir(folder) as entries:
             return any(is_frame_name(entry.name) and entry.is_file() for entry in entries)
@@ -68,11 +70,15 @@ def holds_frames(folder: Path) -> bool:
 def assets_in(folder: Path) -> Iterator[Path]:
     """The model files (glTF, VRM, BVH, NPZ) and frame folders in and below ``folder`` (itself
     too when it holds frames), in a stable order: a folder's frames, then its files by name, then
-    its folders. Skipped: hidden files and folders, links to no file (dangling or looping) and
-    batch output folders (an output inside the library is not read back as input)."""
+    its folders. A folder whose OBJ/PLY files are separate meshes (:func:`separate_meshes`) gives
+    each of them instead. Skipped: hidden files and folders, links to no file (dangling or
+    looping) and batch output folders (an output inside the library is not read back as input)."""
     for root, folders, files in os.walk(folder):
         here = Path(root)
-        if any(is_frame_name(name) and (here / name).is_file() for name in files):  # holds_frames, from the walk's list
+        frames = [here / name for name in files if is_frame_name(name) and (here / name).is_file()]
+        if frames and separate_meshes(frames):
+            yield from sorted(frames, key=natural_key)
+        elif frames:
             yield here
         for name in sorted(files):
             if not name.startswith(".") and Path(name).suffix.lower() in MODEL_SUFFIXES and (here / name).is_file():
@@ -82,10 +88,58 @@ def assets_in(folder: Path) -> Iterator[Path]:
         )
 
 
+# A file stem that ends in a number, and the text before it: "mesh_0048" -> "mesh_".
+_NUMBERED = re.compile(r"(.*?)\d+")
+# Statement lines of an OBJ that make vertices and faces ("v 1 2 3", "f 1 2 3").
+_OBJ_VERTEX, _OBJ_FACE = re.compile(rb"(?m)^[ \t]*v[ \t]"), re.compile(rb"(?m)^[ \t]*f[ \t]")
+_PLY_COUNT = re.compile(rb"element[ \t]+(vertex|face)[ \t]+(\d+)")
+
+
+def separate_meshes(paths: list[Path]) -> bool:
+    """Whether the OBJ/PLY files of one folder are separate meshes (a library of props) rather than
+    the frames of one sequence: their vertex or face counts differ (a PLY's header, an OBJ's
+    ``v`` and ``f`` lines: counted, not parsed), and their names are not numbered frames of one
+    name (all of them ending in a number after the same text, as ``mesh_0001.obj``,
+    ``mesh_0002.obj``, or all but one and at least three, beside a rest mesh), which stay one
+    sequence so that a broken frame is reported as such. Two numbered files beside a third
+    (``rock_1``, ``rock_2``, ``tree``) are told apart by their counts."""
+    if len(paths) < 2:
+        return False
+    prefixes = Counter(match.group(1) for path in paths if (match := _NUMBERED.fullmatch(path.stem)))
+    numbered = prefixes.most_common(1)[0][1] if prefixes else 0
+    if numbered == len(paths) or numbered >= max(3, len(paths) - 1):
+        return False
+    return len({_element_counts(path) for path in paths}) > 1
+
+
+def _element_counts(path: Path) -> tuple[int, int] | None:
+    """(vertices, faces) of an OBJ/PLY file as its lines or header give them; None if unreadable."""
+    try:
+        if path.suffix.lower() == ".ply":
+            with open(path, "rb") as handle:
+                header = handle.read(1 << 16).split(b"end_header", 1)[0]
+            counts = dict(_PLY_COUNT.findall(header))
+            return int(counts.get(b"vertex", -1)), int(counts.get(b"face", -1))
+        data = path.read_bytes()
+    except OSError:
+        return None
+    return len(_OBJ_VERTEX.findall(data)), len(_OBJ_FACE.findall(data))
+
+
 def _check_frame_folder(folder: Path) -> None:
-    """FormatError for a folder that holds no OBJ/PLY frame but models or frame folders: a folder
-    is read as one frame sequence, and the assets inside would otherwise meet "no frame found"."""
+    """FormatError for a folder that holds no OBJ/PLY frame but models or frame folders, or whose
+    OBJ/PLY files are separate meshes: a folder is read as one frame sequence, and the assets
+    inside would otherwise meet "no frame found" or a frame whose faces differ from the first's."""
     if holds_frames(folder):
+        frames = frame_files(folder)
+        if separate_meshes(frames):
+            shown = ", ".join(path.name for path in frames[:3]) + (" and more" if len(frames) > 3 else "")
+            raise FormatError(
+                folder,
+                "folder",
+                f"holds {len(frames)} separate meshes ({shown}: their vertex or face counts differ), not the "
+                "frames of one sequence: pass one of them, or the folder to animlod batch (each an asset)",
+            )
         return  # a frame sequence, whose reader checks each frame
     assets = [path.relative_to(folder).as_posix() for path in itertools.islice(assets_in(folder), 4)]
     if assets:

@@ -15,8 +15,10 @@ import numpy as np
 import pytest
 
 from animlod.cli import main
+from animlod.io.detect import assets_in
 from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_drawable import read_drawables
+from animlod.io.meshseq import read_obj
 
 MODELS = Path("/usr/share/assimp/models")
 SUFFIXES = (".glb", ".gltf", ".bvh", ".obj", ".ply")
@@ -130,3 +132,15 @@ def _corners(path: Path) -> list[np.ndarray]:
             faces = geometry.faces
         corners.append(np.sort(positions[faces].reshape(-1, 3), axis=0))
     return corners
+
+
+def test_utf16_obj_reads_as_its_utf8_twin() -> None:
+    wide, plain = read_obj(_model("OBJ/box_UTF16BE.obj")), read_obj(_model("OBJ/box.obj"))
+    np.testing.assert_array_equal(wide[0], plain[0])
+    np.testing.assert_array_equal(wide[1], plain[1])
+
+
+def test_a_folder_of_assimp_meshes_is_a_library_of_them(tmp_path: Path) -> None:
+    folder = _model("OBJ")
+    assets = list(assets_in(folder))
+    assert folder not in assets and _model("OBJ/spider.obj") in assets

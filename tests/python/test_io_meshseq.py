@@ -512,3 +512,16 @@ def test_binary_ply_scalar_named_like_an_internal_field(tmp_path: Path) -> None:
     vertices, faces = read_ply(path)
     np.testing.assert_array_equal(vertices, np.eye(3))
     np.testing.assert_array_equal(faces, [[2, 0, 1]])
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])
+def test_utf16_obj_after_its_byte_order_mark_reads_as_utf8(tmp_path: Path, encoding: str) -> None:
+    mesh = _moving_mesh(1)
+    write_obj(tmp_path / "plain.obj", mesh.frames[0], mesh.faces)
+    text = (tmp_path / "plain.obj").read_text()
+    wide = ("\ufeff" + text).encode("utf-16-be") if encoding == "utf-16-be" else text.encode("utf-16")
+    vertices, faces = read_obj(_write(tmp_path / "wide.obj", wide))
+    np.testing.assert_array_equal(vertices, read_obj(tmp_path / "plain.obj")[0])
+    np.testing.assert_array_equal(faces, mesh.faces)
+    with pytest.raises(FormatError, match=r"cut.obj: byte \d+: not UTF-16 text after its byte order mark"):
+        read_obj(_write(tmp_path / "cut.obj", wide[:-1]))

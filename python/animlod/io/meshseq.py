@@ -204,7 +204,8 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     next line, as the OBJ specification allows; errors name the line the statement starts on. A
     ``#`` comment ends at its line's end, even after a backslash (a Windows path such as
     ``# saved to C:\\models\\`` does not swallow the next statement).
-    A UTF-8 byte order mark at the file's start is skipped.
+    A UTF-8 byte order mark at the file's start is skipped; after a UTF-16 one the file is read as
+    UTF-16.
 
     Raises
     ------
@@ -214,6 +215,11 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     """
     path = Path(path)
     data = path.read_bytes()
+    if data.startswith((b"\xfe\xff", b"\xff\xfe")):  # UTF-16 after its byte order mark (assimp's box_UTF16BE.obj)
+        try:
+            data = data.decode("utf-16").encode("utf-8")
+        except UnicodeDecodeError as error:
+            raise FormatError(path, f"byte {error.start}", "not UTF-16 text after its byte order mark") from None
     nul = data.find(b"\0")
     if nul >= 0:
         raise FormatError(path, f"byte {nul}", "NUL byte: an OBJ file is text, this looks like binary data")

@@ -3,8 +3,9 @@
 SPEC forms (:func:`read_spec`):
 
 - a folder: every .glb/.gltf/.vrm/.bvh/.npz file in and below it is an asset, and every folder
-  holding OBJ/PLY frames is one sequence asset (hidden files and folders, links to no file and
-  batch output folders are skipped); the output of ``a/b/hero.glb`` goes to ``OUT/a/b/hero``,
+  holding OBJ/PLY frames is one sequence asset, or each of its files one when they are separate
+  meshes (:func:`animlod.io.detect.separate_meshes`); hidden files and folders, links to no file
+  and batch output folders are skipped; the output of ``a/b/hero.glb`` goes to ``OUT/a/b/hero``,
   and where a name would repeat or hold another asset's folder (``hero.glb`` and ``hero.bvh``,
   ``hero.glb`` beside ``hero/walk.bvh``) it takes its input's kind: ``hero_glb``, ``hero_frames``;
 - a glob (``"library/**/*.glb"``): every match is an asset (a file, or a folder of frames);

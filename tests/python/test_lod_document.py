@@ -568,3 +568,32 @@ def test_a_vertex_whose_weights_are_all_zero_is_named(humanoid_glb, tmp_path, ca
     err = capsys.readouterr().err
     assert "vertex 7 has no positive skin weight" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "out.glb").exists()
+
+
+def test_an_image_written_with_backslashes_is_embedded_and_a_missing_one_keeps_its_uri(humanoid_glb, tmp_path, capsys):
+    # assimp's glTF exports of its test models name textures as their sources did: Windows paths
+    # ('.\\test.png'), files on the author's machine or never shipped. They failed the whole run.
+    (tmp_path / "tex").mkdir()
+    (tmp_path / "tex" / "wood.png").write_bytes(b"\x89PNG wood")
+    images = [{"uri": ".\\tex\\wood.png"}, {"uri": "C:\\Users\\me\\gone.png"}]
+    source = _edited(humanoid_glb, tmp_path, lambda js: js.__setitem__("images", images))
+    output = tmp_path / "out.glb"
+    assert main(["simplify", source, "-o", str(output), "--ratio", "0.5", "--max-frames", "8"]) == 0
+    err = capsys.readouterr().err
+    assert f"image 1: {tmp_path / 'C:/Users/me/gone.png'} not found; the output refers to" in err
+    written = GltfDocument(output)
+    embedded, kept = written.json["images"]
+    assert _image_bytes(written, embedded) == b"\x89PNG wood" and "uri" not in embedded
+    assert kept == {"uri": "C:\\Users\\me\\gone.png"}
+
+
+def test_a_document_in_latin_1_is_read_with_a_warning_and_written_as_utf_8(humanoid_glb, tmp_path, capsys):
+    # assimp's glTF exporter writes names in Latin-1 ("Terraind\xe6k" of its OBJ test set).
+    data = humanoid_glb.read_bytes()
+    assert data.count(b'"generator":"animlod"') == 1
+    source = tmp_path / "latin1.glb"
+    source.write_bytes(data.replace(b'"generator":"animlod"', b'"generator":"anim\xe6od"'))
+    output = tmp_path / "out.glb"
+    assert main(["simplify", str(source), "-o", str(output), "--ratio", "0.5", "--max-frames", "8"]) == 0
+    assert "GLB JSON chunk: not UTF-8 text (byte" in capsys.readouterr().err
+    assert GltfDocument(output).json["asset"]["generator"] == "anim\u00e6od"

@@ -15,6 +15,7 @@ import copy
 import mimetypes
 import os
 import struct
+import warnings
 from pathlib import Path
 from urllib.parse import unquote
 
@@ -75,8 +76,10 @@ class GlbBuilder:
         for name in MESHOPT_EXTENSIONS:
             _drop_extension(builder.json, name)
         for index, image in enumerate(builder.json.get("images", [])):
-            if "uri" in image:
-                data, mime = _image_bytes(doc, index, image.pop("uri"))
+            found = _image_bytes(doc, index, image["uri"]) if "uri" in image else None
+            if found is not None:
+                data, mime = found
+                del image["uri"]
                 image["bufferView"] = len(views)
                 views.append({"buffer": 0, "byteOffset": builder._append(data), "byteLength": len(data)})
                 image.setdefault("mimeType", mime)
@@ -230,17 +233,25 @@ def _animates_meshes(js: dict) -> bool:
     return any(isinstance(p, dict) and str(p.get("pointer", "")).startswith("/meshes/") for p in pointers)
 
 
-def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | None]:
-    """The bytes and MIME type of an image given by a data URI or a file next to the document."""
+def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | None] | None:
+    """The bytes and MIME type of an image given by a data URI or a file next to the document;
+    None, with a warning, for a file that is not there. Textures left behind are common (a path
+    on the author's machine, ``C:\\Users\\...\\wood.jpg``, or a file not shipped) and play no
+    part in the levels: the image keeps its URI, as the input had it, instead of failing the run."""
     if uri.startswith("data:"):
         header, _, payload = uri.partition(",")
         try:
             return base64.b64decode(payload, validate=True), header[5:].split(";")[0] or None
         except ValueError as error:
             raise doc.fail(f"image {index}", f"malformed data URI ({error})") from None
-    path = Path(doc.path).parent / unquote(uri)
-    try:
-        data = path.read_bytes()
-    except OSError as error:
-        raise doc.fail(f"image {index}", f"cannot read {path} ({error.strerror})") from None
-    return data, _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0]
+    # A URI's separator is '/', but Windows exporters write backslashes (.\textures\wood.png).
+    candidates = [Path(doc.path).parent / unquote(text) for text in dict.fromkeys((uri, uri.replace("\\", "/")))]
+    for path in candidates:
+        try:
+            data = path.read_bytes()
+        except OSError:
+            continue
+        return data, _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0]
+    reason = f"{candidates[-1]} not found; the output refers to {uri!r} as the input did"
+    warnings.warn(f"{doc.path}: image {index}: {reason}", stacklevel=3)
+    return None

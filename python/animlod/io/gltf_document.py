@@ -13,6 +13,7 @@ import base64
 import os
 import re
 import struct
+import warnings
 from pathlib import Path
 from typing import Any
 from urllib.parse import unquote
@@ -521,17 +522,13 @@ def _parse(path: str, data: bytes | None = None) -> tuple[pygltflib.GLTF2, dict]
         raise FormatError(path, "file", "empty file")
     glb = data[:4] == _GLB_MAGIC
     json_chunk, binary_chunk = _glb_chunks(path, data) if glb else (data, None)
-    if not glb:
-        try:
-            data.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor JSON") from None
-        if not re.match(rb"(?:\xef\xbb\xbf)?\s*\{", data):  # a BVH or an OBJ, say: not a syntax error at line 1
-            raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor a JSON object")
+    if not glb and not re.match(rb"(?:\xef\xbb\xbf)?\s*\{", data):  # a BVH or an OBJ, say: not a syntax error at line 1
+        raise FormatError(path, "file", "not a glTF file: neither GLB (magic 'glTF') nor a JSON object")
     # Parsed with bounded nesting (json.loads recurses per level) and checked for the shape the
     # object model would otherwise bend ("nodes": {} is not a list). The object model shares
     # nothing with the raw JSON kept for the writers (decode_gltf copies what it keeps).
-    raw = load_json(path, json_chunk, "GLB JSON chunk" if glb else "JSON")
+    element = "GLB JSON chunk" if glb else "JSON"
+    raw = load_json(path, _utf8(path, json_chunk, element), element)
     _check_top_level(path, raw)
     gltf = decode_gltf(path, raw)
     if binary_chunk is not None:
@@ -555,9 +552,21 @@ def document_json(path: str | os.PathLike) -> dict:
                 data, element = handle.read(_glb_json_chunk_length(path, head)), "GLB JSON chunk"
     except OSError as error:
         raise FormatError(path, "file", f"cannot read ({error.strerror})") from None
-    document = load_json(path, data, element)
+    document = load_json(path, _utf8(path, data, element), element)
     _check_top_level(path, document)
     return document
+
+
+def _utf8(path: str, data: bytes, element: str) -> bytes:
+    """``data`` as UTF-8: JSON that is not UTF-8 is read as Latin-1, with a warning. assimp's glTF
+    exporter writes names in Latin-1 ("Terraind\xe6k" of its OBJ test set); every byte is a
+    Latin-1 character, so such a document parses with its names as they were most likely meant."""
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        warnings.warn(f"{path}: {element}: not UTF-8 text (byte {error.start}); read as Latin-1", stacklevel=4)
+        return data.decode("latin-1").encode("utf-8")
+    return data
 
 
 def _frame_limit(limit: int | None) -> int:

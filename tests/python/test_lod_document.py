@@ -597,3 +597,26 @@ def test_a_document_in_latin_1_is_read_with_a_warning_and_written_as_utf_8(human
     assert main(["simplify", str(source), "-o", str(output), "--ratio", "0.5", "--max-frames", "8"]) == 0
     assert "GLB JSON chunk: not UTF-8 text (byte" in capsys.readouterr().err
     assert GltfDocument(output).json["asset"]["generator"] == "anim\u00e6od"
+
+
+def test_three_component_texture_coordinates_give_levels_their_u_and_v(humanoid_glb, tmp_path, capsys):
+    # assimp's exporter writes a source's (u, v, w) as a VEC3 TEXCOORD_0, which glTF does not allow.
+    def widen(gltf, blob):
+        primitive = gltf.meshes[0].primitives[0]
+        uv = np.asarray(GltfDocument(humanoid_glb).accessor(primitive.attributes.TEXCOORD_0, "uv"))
+        primitive.attributes.TEXCOORD_0 = append_accessor(
+            gltf, blob, np.c_[uv, np.full(len(uv), 0.5)].astype("f4"), "VEC3"
+        )
+
+    source = edit_glb(humanoid_glb, tmp_path / "uvw.glb", widen)
+    output = tmp_path / "out.glb"
+    assert main(["simplify", str(source), "-o", str(output), "--ratio", "0.5", "--max-frames", "8"]) == 0
+    assert "TEXCOORD_0: VEC3, which glTF does not allow; the levels keep u and v" in capsys.readouterr().err
+    plain = tmp_path / "plain.glb"
+    assert main(["simplify", str(humanoid_glb), "-o", str(plain), "--ratio", "0.5", "--max-frames", "8"]) == 0
+    written, expected = GltfDocument(output), GltfDocument(plain)
+    level, expected_level = written.json["meshes"][-1]["primitives"][0], expected.json["meshes"][-1]["primitives"][0]
+    np.testing.assert_array_equal(
+        written.accessor(level["attributes"]["TEXCOORD_0"], "uv"),
+        expected.accessor(expected_level["attributes"]["TEXCOORD_0"], "uv"),
+    )

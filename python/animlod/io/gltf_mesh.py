@@ -11,6 +11,7 @@ a skinned mesh.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -199,6 +200,11 @@ def _attribute(doc: GltfDocument, attributes, name: str, vertex_count: int, elem
     values = doc.accessor(getattr(attributes, name), f"{element} {name}")
     where = f"{element} {name}"
     width = _ATTRIBUTE_WIDTHS.get(name)
+    if name.startswith("TEXCOORD_") and values.shape[1] == 3:
+        # glTF's texture coordinates are VEC2, but assimp's exporter writes a source's (u, v, w)
+        # as they were (its Collada and OBJ test models): u and v are what a renderer samples.
+        warnings.warn(f"{doc.path}: {where}: VEC3, which glTF does not allow; the levels keep u and v", stacklevel=5)
+        values = values[:, :2]
     if name.startswith("TEXCOORD_"):
         width = 2
     elif name.startswith(("JOINTS_", "WEIGHTS_", "COLOR_")):

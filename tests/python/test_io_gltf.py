@@ -682,6 +682,17 @@ def test_a_non_uniform_rest_scale_is_skinned_as_a_viewer_does(chain_glb, tmp_pat
     np.testing.assert_allclose(read.rest_pose(), _viewer_frame(stretched, 0, animated=False), atol=1e-5)
 
 
+def test_float_noise_in_a_rest_scale_leaves_the_motion_rigid(chain_glb, tmp_path):
+    # 3ds Max's Biped writes scales off 1 by up to 1.5e-4 on each axis, which chains of them add up:
+    # a shear of a few 1e-4 under the turning tip is float noise, and the viewer's skin is still met.
+    path, _, motion = chain_glb
+    noisy = edit_glb(path, tmp_path / "noisy.glb", _rest_scale(1, [1.0, 1.0003, 0.9997]))
+    read, (read_motion,) = read_skinned(noisy, fps=motion.fps)
+    assert read_motion.joint_deformations is None
+    extent = float(np.ptp(read.rest_positions, axis=0).max())
+    np.testing.assert_allclose(read.bake(read_motion).frames[4], _viewer_frame(noisy, 4), atol=1e-3 * extent)
+
+
 def test_a_stretched_leaf_leaves_the_motion_rigid(chain_glb, tmp_path):
     path, _, motion = chain_glb
     stretched = edit_glb(path, tmp_path / "leaf.glb", _rest_scale(2, [1.0, 3.0, 1.0]))

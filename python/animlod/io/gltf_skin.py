@@ -22,7 +22,9 @@ inverse bind too. An animation that scales nodes of the tree (squash and stretch
 nothing), or turns a joint under a non-uniformly scaled one (a shear), poses the full transforms:
 the joints' rigid frames move with the scaled offsets, and the rest of each joint's world
 transform becomes the motion's ``joint_deformations``
-(``W = W_rigid @ D @ rest_shape @ S(c)``), which skinning applies and motion LoD refuses.
+(``W = W_rigid @ D @ rest_shape @ S(c)``), which skinning applies and motion LoD refuses;
+``D`` within 1e-3 of the identity in every frame is float noise (3ds Max's Biped scales) and
+leaves the motion rigid.
 A mirrored node (a negative scale, as 3ds Max and Maya write mirrored bones) counts as
 non-uniform, and the rotations below it are mirrored too (``F @ R @ F``, :func:`_mirrored`), so
 that the mirroring stays in ``rest_shape`` and the motion stays rigid.
@@ -49,7 +51,10 @@ _LIGHTS_EXTENSION = "KHR_lights_punctual"
 _SINGULAR_VOLUME = 1e-6
 # A joint whose deformation relative to its rest shape stays this close to the identity in every
 # frame (a stretched leaf, a stretched joint whose children do not turn) leaves the motion rigid.
-_RIGID_DEFORMATION_TOLERANCE = 1e-6
+# 3ds Max's Biped writes every node's scale off 1 by up to ~1.5e-4 on each axis, and glTF turns
+# that into shears of ~2e-4 under turning joints (assimp's MotionCaptureROM.ase, exported to
+# glTF): float noise, which refused the file's motion LoD at 1e-6; a real stretch is far above.
+_RIGID_DEFORMATION_TOLERANCE = 1e-3
 # Node extras key marking a joint as an end site (a BVH "End Site": a leaf without rotation);
 # animlod writes it and reads it back, other tools ignore it.
 END_SITE_EXTRA = "animlod_end_site"

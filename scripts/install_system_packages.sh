@@ -3,8 +3,8 @@
 # venv for building the extension, doctest for the C++ tests, dpkg-dev for unpacking the
 # OpenMesh source package, libnlopt-dev for the core's motion LoD SLSQP, libstb-dev for the
 # crowd benchmark's PNG screenshots, nlohmann-json3-dev for its KHR_animation_pointer channels,
-# assimp-testmodels, assimp-utils and gltfpack for the tests on other tools' files). Installs only what is
-# missing, so a second run is quick.
+# assimp-testmodels, assimp-utils and gltfpack for the tests on other tools' files). Installs
+# only what is missing, so a second run is quick.
 # Extra package names given as arguments are installed too (`make fuzz` adds clang's).
 set -euo pipefail
 

@@ -525,3 +525,13 @@ def test_utf16_obj_after_its_byte_order_mark_reads_as_utf8(tmp_path: Path, encod
     np.testing.assert_array_equal(faces, mesh.faces)
     with pytest.raises(FormatError, match=r"cut.obj: byte \d+: not UTF-16 text after its byte order mark"):
         read_obj(_write(tmp_path / "cut.obj", wide[:-1]))
+
+
+def test_points_and_lines_in_a_ply_face_element_are_left_out_with_a_warning(tmp_path: Path) -> None:
+    # assimp's PLY exporter writes a mesh's points and lines as faces of one or two vertices.
+    mixed = _write(tmp_path / "mixed.ply", _ascii_ply("property list uchar int vertex_indices", "2 0 1\n3 0 1 2\n"))
+    with pytest.warns(UserWarning, match=r"mixed.ply: element face: 1 of 2 faces have fewer than 3 vertices"):
+        vertices, faces = read_ply(mixed)
+    np.testing.assert_array_equal(faces, [[0, 1, 2]])
+    lines = _write(tmp_path / "lines.ply", _ascii_ply("property list uchar int vertex_indices", "2 0 1\n1 2\n"))
+    assert _error(lines) == f"{lines}: element face: all 2 faces have fewer than 3 vertices (points or lines)"

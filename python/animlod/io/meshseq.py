@@ -477,10 +477,19 @@ def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if corners.dtype.kind == "f":
         raise FormatError(path, "element face", "vertex index list has float items; indices must be integers")
 
-    def name_face(face_index: int) -> str:
-        return f"face {face_index}"
+    # Points and lines in the face element (assimp writes a mesh's that way): no surface, left out.
+    kept = np.flatnonzero(sizes >= 3)
+    if sizes.size and not kept.size:
+        raise FormatError(path, "element face", f"all {sizes.size} faces have fewer than 3 vertices (points or lines)")
+    if kept.size < sizes.size:
+        short = sizes.size - kept.size
+        warnings.warn(f"{path}: element face: {short} of {sizes.size} faces have fewer than 3 vertices (points "
+                      "or lines); left out", stacklevel=4)  # fmt: skip
+        corners, sizes = corners[np.repeat(sizes >= 3, sizes)], sizes[kept]
 
-    _require_sizes(path, sizes, 3, name_face, "vertices")
+    def name_face(face_index: int) -> str:
+        return f"face {kept[face_index]}"
+
     corners = corners.astype(np.int64)
     _check_face_indices(path, corners, corners, np.repeat(np.arange(sizes.size), sizes), len(vertices), name_face)
     return vertices, _fan_triangulate(corners, sizes)

@@ -289,6 +289,10 @@ def test_spec_forms_and_their_errors(library, tmp_path):
     assert [asset.name for asset in read_spec(library / "characters", job="character")] == ["cyl0", "cyl1"]
     with pytest.raises(SpecError, match="pattern: matches no file"):
         read_spec(f"{library}/*.nothing")
+    (tmp_path / "fbx").mkdir()
+    (tmp_path / "fbx" / "hero.fbx").write_bytes(b"")
+    with pytest.raises(SpecError, match=r"holds no asset \(.*\), but 1 model files of formats animlod does not read"):
+        read_spec(tmp_path / "fbx")
     with pytest.raises(SpecError, match="does not take bvh input"):
         read_spec(library / "motions", job="simplify")
     with pytest.raises(SpecError, match="job 'nosuchjob': unknown"):

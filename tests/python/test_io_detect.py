@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
 
 from animlod.io import FormatError
-from animlod.io.detect import assets_in, input_kind
+from animlod.io.detect import assets_in, input_kind, unread_models_note
 
 
 @pytest.mark.parametrize(
@@ -94,3 +95,23 @@ def test_numbered_frames_stay_one_sequence_when_one_of_them_differs(tmp_path: Pa
         (poses / f"{name}.obj").write_bytes(_QUAD)
     assert list(assets_in(tmp_path)) == [frames, poses]
     assert input_kind(frames) == input_kind(poses) == "sequence"
+
+
+def test_model_formats_animlod_does_not_read_are_named_not_passed_over(tmp_path: Path, capsys) -> None:
+    from animlod.cli import main
+
+    library = tmp_path / "library"
+    (library / "props").mkdir(parents=True)
+    (library / "hero.fbx").write_bytes(b"")
+    (library / "props" / "crate.dae").write_bytes(b"")
+    (library / "props" / ".hidden.fbx").write_bytes(b"")
+    note = "2 model files of formats animlod does not read (1 .dae, 1 .fbx); convert them to glTF first"
+    assert note in unread_models_note(library)
+    with pytest.raises(FormatError, match=re.escape(f"folder: holds no .obj or .ply frame, but {note}")):
+        input_kind(library)
+    (library / "props" / "box.obj").write_bytes(_QUAD)
+    assert main(["info", str(library)]) == 0
+    assert f"note: {library}: left out {note}" in capsys.readouterr().out
+    (library / "hero.fbx").unlink()
+    (library / "props" / "crate.dae").unlink()
+    assert unread_models_note(library) is None

@@ -37,7 +37,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
-from ..io.detect import BATCH_STATE, MODEL_SUFFIXES, assets_in, input_kind, is_pattern
+from ..io.detect import BATCH_STATE, MODEL_SUFFIXES, assets_in, input_kind, is_pattern, unread_models_note
 from ..io.errors import FormatError
 from ..io.meshseq import MESH_SUFFIXES
 from .jobs import check_options, default_job, find_job
@@ -96,7 +96,9 @@ def read_spec(spec: str | os.PathLike, job: str | None = None, options: dict | N
     if path.is_dir():
         found = [(os.fspath(item), _default_name(item, path)) for item in assets_in(path)]
         if not found:
-            raise SpecError(text, "folder", f"holds no asset ({', '.join(MODEL_SUFFIXES)} files or folders of frames)")
+            unread = unread_models_note(path)
+            reason = f"holds no asset ({', '.join(MODEL_SUFFIXES)} files or folders of frames)"
+            raise SpecError(text, "folder", reason + (f", but {unread}" if unread else ""))
         if [source for source, _ in found] != [os.fspath(path)]:  # a library, not one folder of frames
             return _checked(text, "folder", found, job, options)
     return _checked(text, "input", [(text, _default_name(path, path.parent))], job, options)

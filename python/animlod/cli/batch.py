@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
+from ..io.detect import unread_models_note
 from . import UserError, positive_int
 
 
@@ -70,6 +72,7 @@ def run(args: argparse.Namespace) -> int:
     if args.connect_timeout <= 0:
         raise UserError(f"--connect-timeout: must be > 0, got {args.connect_timeout}")
     assets = read_spec(args.spec, job=args.job, options=_options(args.options))
+    unread = unread_models_note(Path(args.spec)) if Path(args.spec).is_dir() else None
     try:
         import distributed  # noqa: F401
         import pyarrow  # noqa: F401
@@ -89,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
         )
     except SchedulerUnreachable as error:
         raise UserError(f"--scheduler: {error}") from None
-    for note in result.notes:
+    for note in [*result.notes, *([f"{args.spec}: left out {unread}"] if unread else [])]:
         print(f"note: {note}")
     failures = [record for record in result.records if record["status"] != "ok"]
     for record in failures[:20]:

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..io.detect import assets_in, input_kind
+from ..io.detect import assets_in, input_kind, unread_models_note
 from ..model import AnimatedMesh, Motion
 
 if TYPE_CHECKING:
@@ -54,6 +54,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"{path}: {kind}")
         for line in lines:
             print(f"  {line}")
+    unread = unread_models_note(Path(args.path)) if Path(args.path).is_dir() else None
+    if unread:
+        print(f"note: {args.path}: left out {unread}")
     if unreadable:
         print(f"animlod info: {unreadable} of {len(paths)} assets could not be read", file=sys.stderr)
         return 2

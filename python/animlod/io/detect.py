@@ -73,16 +73,46 @@ def assets_in(folder: Path) -> Iterator[Path]:
     its folders. A folder whose OBJ/PLY files are separate meshes (:func:`separate_meshes`) gives
     each of them instead. Skipped: hidden files and folders, links to no file (dangling or
     looping) and batch output folders (an output inside the library is not read back as input)."""
-    for root, folders, files in os.walk(folder):
-        here = Path(root)
-        frames = [here / name for name in files if is_frame_name(name) and (here / name).is_file()]
+    for here, files in _library_folders(folder):
+        frames = [here / name for name in files if is_frame_name(name)]
         if frames and separate_meshes(frames):
             yield from sorted(frames, key=natural_key)
         elif frames:
             yield here
-        for name in sorted(files):
-            if not name.startswith(".") and Path(name).suffix.lower() in MODEL_SUFFIXES and (here / name).is_file():
-                yield here / name
+        yield from (here / name for name in files if Path(name).suffix.lower() in MODEL_SUFFIXES)
+
+
+# Model formats animlod does not read, which a library folder may hold beside its glTF files.
+_OTHER_MODEL_SUFFIXES = (
+    ".fbx", ".dae", ".blend", ".usd", ".usda", ".usdc", ".usdz", ".abc", ".3ds", ".max", ".ma", ".mb", ".c4d",
+    ".stl", ".x", ".md5mesh", ".md5anim", ".lwo", ".ase", ".off", ".3mf",
+)  # fmt: skip
+
+
+def unread_models_note(folder: Path) -> str | None:
+    """What ``folder`` holds in and below it of model formats animlod does not read (FBX,
+    Collada, Blender, USD...), which :func:`assets_in` leaves out, and what to do; None if nothing."""
+    counts = Counter(
+        suffix
+        for _, files in _library_folders(folder)
+        for name in files
+        if (suffix := Path(name).suffix.lower()) in _OTHER_MODEL_SUFFIXES
+    )
+    if not counts:
+        return None
+    kinds = ", ".join(f"{count} {suffix}" for suffix, count in sorted(counts.items()))
+    return (
+        f"{sum(counts.values())} model files of formats animlod does not read ({kinds}); convert them to glTF "
+        "first (with Blender, or assimp export FILE OUT.glb)"
+    )
+
+
+def _library_folders(folder: Path) -> Iterator[tuple[Path, list[str]]]:
+    """Each folder in and below ``folder`` with its files (by name, hidden ones left out), skipping
+    hidden folders and batch output folders."""
+    for root, folders, files in os.walk(folder):
+        here = Path(root)
+        yield here, [name for name in sorted(files) if not name.startswith(".") and (here / name).is_file()]
         folders[:] = sorted(
             name for name in folders if not name.startswith(".") and not (here / name / BATCH_STATE).exists()
         )
@@ -150,6 +180,9 @@ def _check_frame_folder(folder: Path) -> None:
             f"holds no .obj or .ply frame but {shown}: pass one of them (a folder is read as one frame "
             "sequence; animlod batch and animlod info take a folder of assets)",
         )
+    unread = unread_models_note(folder)
+    if unread:
+        raise FormatError(folder, "folder", f"holds no .obj or .ply frame, but {unread}")
 
 
 def input_stem(path: str | os.PathLike) -> str:

@@ -397,3 +397,22 @@ def test_local_workers_end_quietly_on_ctrl_c(client):
 )
 def test_an_option_of_several_kinds_names_them_or_the_bad_item(options, problem):
     assert check_options(find_job("batch_jobs:several_kinds"), "npz", options) == problem
+
+
+def test_an_assets_warnings_go_with_its_notes_and_the_summary(tmp_path, capsys):
+    # A BVH whose Frames: line counts one short reads whole with a warning; in a batch that
+    # warning went to the worker's stderr, out of the asset's record and the summary.
+    from animlod.batch.task import run_asset
+    from animlod.cli import main
+
+    library = tmp_path / "library"
+    library.mkdir()
+    write_bvh(library / "arm.bvh", _arm_motion())
+    text = (library / "arm.bvh").read_text()
+    (library / "arm.bvh").write_text(text.replace("Frames: 8", "Frames: 7"))
+    (asset,) = read_spec(library, options={"levels": 2})
+    record = run_asset(asset, str(tmp_path / "out"), fingerprint="f")
+    warning = "Frames: says 7 but the MOTION table has 8 rows; read all 8"
+    assert record["status"] == "ok" and any(warning in note for note in record["result"]["notes"])
+    assert main(["batch", str(library), "-o", str(tmp_path / "cli"), "--set", "levels=2", "--workers", "1"]) == 0
+    assert f"warning arm: {library / 'arm.bvh'}: {warning}" in capsys.readouterr().out

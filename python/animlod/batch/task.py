@@ -13,6 +13,7 @@ import resource
 import socket
 import time
 import traceback
+import warnings
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -52,7 +53,13 @@ def run_asset(asset: AssetSpec, root: str, fingerprint: str, topic: str | None =
         folder = Path(root)
         staging = staging_folder(folder, asset.name)
         job = find_job(asset.job).function()
-        result = job(asset.input, staging, progress=_progress(topic, asset.name), **asset.options)
+        # The readers' warnings (a texture not found, a BVH's frame count one short) go with the
+        # asset's notes, not to the worker's stderr. Exact on single-threaded workers, as the
+        # local cluster's are: catch_warnings is process-wide.
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("default")
+            result = job(asset.input, staging, progress=_progress(topic, asset.name), **asset.options)
+        result.notes += [f"warning: {' '.join(str(warning.message).split())}" for warning in caught]
         record.update(status="ok", result=result.to_dict(relative_to=staging), error=None)
         _finish(record, started)
         publish(staging, folder, asset.name, record)

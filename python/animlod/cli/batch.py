@@ -94,6 +94,12 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--scheduler: {error}") from None
     for note in [*result.notes, *([f"{args.spec}: left out {unread}"] if unread else [])]:
         print(f"note: {note}")
+    warned = [(record["name"], note) for record in result.records if record["status"] == "ok"
+              for note in record["result"]["notes"] if note.startswith("warning: ")]  # fmt: skip
+    for name, note in warned[:20]:
+        print(f"{note.split(': ', 1)[0]} {name}: {note.split(': ', 1)[1]}")
+    if len(warned) > 20:
+        print(f"... and {len(warned) - 20} more warnings (see each asset's record)")
     failures = [record for record in result.records if record["status"] != "ok"]
     for record in failures[:20]:
         error = record["error"]

@@ -139,7 +139,8 @@ def separate_meshes(paths: list[Path]) -> bool:
     numbered = prefixes.most_common(1)[0][1] if prefixes else 0
     if numbered == len(paths) or numbered >= max(3, len(paths) - 1):
         return False
-    return len({_element_counts(path) for path in paths}) > 1
+    first = _element_counts(paths[0])
+    return any(_element_counts(path) != first for path in paths[1:])  # props differ at once: two reads
 
 
 def _element_counts(path: Path) -> tuple[int, int] | None:

@@ -105,10 +105,12 @@ def test_model_formats_animlod_does_not_read_are_named_not_passed_over(tmp_path:
     (library / "hero.fbx").write_bytes(b"")
     (library / "props" / "crate.dae").write_bytes(b"")
     (library / "props" / ".hidden.fbx").write_bytes(b"")
-    note = "2 model files of formats animlod does not read (1 .dae, 1 .fbx); convert them to glTF first"
+    note = "2 model files of formats animlod does not read (1 .dae, 1 .fbx); convert to glTF first"
     assert note in unread_models_note(library)
     with pytest.raises(FormatError, match=re.escape(f"folder: holds no .obj or .ply frame, but {note}")):
         input_kind(library)
+    with pytest.raises(FormatError, match=r"hero.fbx: file: unknown type .fbx; expected .*; convert to glTF first"):
+        input_kind(library / "hero.fbx")
     (library / "props" / "box.obj").write_bytes(_QUAD)
     assert main(["info", str(library)]) == 0
     assert f"note: {library}: left out {note}" in capsys.readouterr().out

@@ -54,7 +54,8 @@ def input_kind(path: str | os.PathLike) -> str:
     if suffix in MESH_SUFFIXES:
         return "sequence"
     expected = ".bvh, .glb, .gltf, .npz, .obj, .ply, .vrm or a folder"
-    raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}")
+    advice = f"; {_CONVERT_ADVICE}" if suffix in _OTHER_MODEL_SUFFIXES else ""
+    raise FormatError(text, "file", f"unknown type {suffix or '(no suffix)'}; expected {expected}{advice}")
 
 
 def holds_frames(folder: Path) -> bool:
@@ -89,6 +90,9 @@ _OTHER_MODEL_SUFFIXES = (
 )  # fmt: skip
 
 
+_CONVERT_ADVICE = "convert to glTF first (with Blender, or assimp export FILE OUT.glb)"
+
+
 def unread_models_note(folder: Path) -> str | None:
     """What ``folder`` holds in and below it of model formats animlod does not read (FBX,
     Collada, Blender, USD...), which :func:`assets_in` leaves out, and what to do; None if nothing."""
@@ -101,10 +105,7 @@ def unread_models_note(folder: Path) -> str | None:
     if not counts:
         return None
     kinds = ", ".join(f"{count} {suffix}" for suffix, count in sorted(counts.items()))
-    return (
-        f"{sum(counts.values())} model files of formats animlod does not read ({kinds}); convert them to glTF "
-        "first (with Blender, or assimp export FILE OUT.glb)"
-    )
+    return f"{sum(counts.values())} model files of formats animlod does not read ({kinds}); {_CONVERT_ADVICE}"
 
 
 def _library_folders(folder: Path) -> Iterator[tuple[Path, list[str]]]:

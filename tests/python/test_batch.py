@@ -20,6 +20,7 @@ from animlod.batch.jobs import check_options, find_job
 from animlod.cli import main
 from animlod.io import write_bvh, write_glb
 from animlod.io.detect import BATCH_STATE
+from animlod.io.glb_builder import GlbBuilder
 from animlod.io.meshseq import write_obj, write_sequence
 from animlod.io.npz import write_npz
 from animlod.pipelines import simplify_asset
@@ -416,3 +417,22 @@ def test_an_assets_warnings_go_with_its_notes_and_the_summary(tmp_path, capsys):
     assert record["status"] == "ok" and any(warning in note for note in record["result"]["notes"])
     assert main(["batch", str(library), "-o", str(tmp_path / "cli"), "--set", "levels=2", "--workers", "1"]) == 0
     assert f"warning arm: {library / 'arm.bvh'}: {warning}" in capsys.readouterr().out
+
+
+def test_the_fingerprint_covers_the_images_the_job_reads(tmp_path):
+    # The job finds an image written with backslashes ('.\\tex\\wood.png', as Windows exporters
+    # write) and a GLB's external one: a rerun must see them change.
+    from animlod.batch.fingerprint import fingerprint, input_files
+
+    (tmp_path / "tex").mkdir()
+    (tmp_path / "tex" / "wood.png").write_bytes(b"\x89PNG wood")
+    gltf = tmp_path / "a.gltf"
+    gltf.write_text('{"asset": {"version": "2.0"}, "images": [{"uri": ".\\\\tex\\\\wood.png"}, {"uri": "gone.png"}]}')
+    builder = GlbBuilder(document={"asset": {"version": "2.0"}, "images": [{"uri": "tex/wood.png"}]})
+    builder.save(tmp_path / "b.glb")
+    for name in ("a.gltf", "b.glb"):
+        (asset,) = read_spec(tmp_path / name)
+        assert input_files(asset) == [tmp_path / name, tmp_path / "tex" / "wood.png"]
+        before = fingerprint(asset)
+        (tmp_path / "tex" / "wood.png").write_bytes(b"\x89PNG oak " + name.encode())
+        assert fingerprint(asset) != before

@@ -11,11 +11,13 @@ import glob
 import hashlib
 import json
 import os
+import warnings
 from pathlib import Path
-from urllib.parse import unquote
 
 from .. import __version__
 from ..io.detect import is_pattern
+from ..io.errors import FormatError
+from ..io.gltf_document import document_json, image_file, uri_path
 from ..io.meshseq import frame_files
 from .spec import AssetSpec
 
@@ -32,27 +34,28 @@ def input_files(asset: AssetSpec) -> list[Path]:
         path = Path(source)
         return frame_files(path) if path.is_dir() else [path]
     path = Path(source)
-    if asset.kind == "gltf" and path.suffix.lower() == ".gltf":
+    if asset.kind == "gltf":  # a .glb may name external files too (assimp's name their textures)
         return [path, *_external_files(path)]
     return [path]
 
 
 def _external_files(path: Path) -> list[Path]:
-    """Buffers and images a .gltf names by relative URI (data: URIs are inside the file)."""
+    """Buffers and images a glTF names by relative URI (data: URIs are inside the file), found
+    as the job finds them (an image URI with backslashes, a document in Latin-1)."""
     try:
-        document = json.loads(path.read_bytes().decode("utf-8-sig"))
-    except (OSError, ValueError):
+        with warnings.catch_warnings():  # the job gives the reader's warnings
+            warnings.simplefilter("ignore")
+            document = document_json(path)
+    except FormatError:
         return []  # the job will say what is wrong with the file
-    if not isinstance(document, dict):
-        return []
     found = []
-    for key in ("buffers", "images"):
+    for key, resolve in (("buffers", uri_path), ("images", image_file)):
         items = document.get(key)
         for item in items if isinstance(items, list) else []:
             uri = item.get("uri") if isinstance(item, dict) else None
             if isinstance(uri, str) and uri and not uri.startswith("data:") and "://" not in uri:
-                candidate = path.parent / unquote(uri)
-                if candidate.is_file():
+                candidate = resolve(path, uri)
+                if candidate is not None and candidate.is_file():
                     found.append(candidate)
     return sorted(set(found))
 

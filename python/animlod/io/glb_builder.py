@@ -11,18 +11,17 @@ so the output stands alone wherever it is written. New data is appended as tight
 from __future__ import annotations
 
 import base64
+import contextlib
 import copy
 import mimetypes
 import os
 import struct
 import warnings
-from pathlib import Path
-from urllib.parse import unquote
 
 import numpy as np
 
 from .atomic import atomic_write
-from .gltf_document import GltfDocument
+from .gltf_document import GltfDocument, image_file, uri_path
 from .gltf_draco import DRACO_EXTENSION
 from .gltf_meshopt import MESHOPT_EXTENSIONS
 from .json_limits import finite_json_text
@@ -244,14 +243,10 @@ def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | 
             return base64.b64decode(payload, validate=True), header[5:].split(";")[0] or None
         except ValueError as error:
             raise doc.fail(f"image {index}", f"malformed data URI ({error})") from None
-    # A URI's separator is '/', but Windows exporters write backslashes (.\textures\wood.png).
-    candidates = [Path(doc.path).parent / unquote(text) for text in dict.fromkeys((uri, uri.replace("\\", "/")))]
-    for path in candidates:
-        try:
-            data = path.read_bytes()
-        except OSError:
-            continue
-        return data, _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0]
-    reason = f"{candidates[-1]} not found; the output refers to {uri!r} as the input did"
-    warnings.warn(f"{doc.path}: image {index}: {reason}", stacklevel=3)
+    if (path := image_file(doc.path, uri)) is not None:
+        with contextlib.suppress(OSError):  # there but unreadable: kept by its URI as a missing one is
+            return path.read_bytes(), _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0]
+    missing = uri_path(doc.path, uri.replace("\\", "/"))
+    warnings.warn(f"{doc.path}: image {index}: {missing} not found; the output refers to {uri!r} as the input did",
+                  stacklevel=3)  # fmt: skip
     return None

@@ -280,7 +280,7 @@ class GltfDocument:
         total = os.path.getsize(self.path) if self._size is None else self._size
         for buffer in self.gltf.buffers or []:
             if isinstance(buffer.uri, str) and not buffer.uri.startswith("data:"):
-                external = Path(self.path).parent / unquote(buffer.uri)
+                external = uri_path(self.path, buffer.uri)
                 total += external.stat().st_size if external.is_file() else 0
         return total
 
@@ -312,7 +312,7 @@ class GltfDocument:
             except (IndexError, ValueError) as error:  # binascii.Error, or non-ASCII text
                 raise self.fail(element, f"malformed base64 data URI ({error})") from None
         else:
-            external = Path(self.path).parent / unquote(buffer.uri)  # a relative URI, percent-encoded
+            external = uri_path(self.path, buffer.uri)
             try:
                 data = external.read_bytes()
             except OSError as error:
@@ -555,6 +555,20 @@ def document_json(path: str | os.PathLike) -> dict:
     document = load_json(path, _utf8(path, data, element), element)
     _check_top_level(path, document)
     return document
+
+
+def uri_path(document: str | os.PathLike, uri: str) -> Path:
+    """The file a buffer's URI names: relative to the document, percent-encoded."""
+    return Path(document).parent / unquote(uri)
+
+
+def image_file(document: str | os.PathLike, uri: str) -> Path | None:
+    """The file an image's URI names (see :func:`uri_path`), None if there is none. A URI's
+    separator is '/', but Windows exporters write backslashes (``.\\textures\\wood.png``)."""
+    for text in dict.fromkeys((uri, uri.replace("\\", "/"))):
+        if (path := uri_path(document, text)).is_file():
+            return path
+    return None
 
 
 def _utf8(path: str, data: bytes, element: str) -> bytes:

@@ -29,6 +29,8 @@ if TYPE_CHECKING:
 # Least time between two progress events of one asset (seconds): enough for a live bar, few
 # enough messages that the scheduler does not notice them.
 PROGRESS_INTERVAL = 0.25
+# How an asset's notes begin for a warning a reader gave while its job ran.
+WARNING_NOTE = "warning: "
 
 
 def run_asset(asset: AssetSpec, root: str, fingerprint: str, topic: str | None = None) -> dict:
@@ -59,7 +61,7 @@ def run_asset(asset: AssetSpec, root: str, fingerprint: str, topic: str | None =
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("default")
             result = job(asset.input, staging, progress=_progress(topic, asset.name), **asset.options)
-        result.notes += [f"warning: {' '.join(str(warning.message).split())}" for warning in caught]
+        result.notes += [WARNING_NOTE + " ".join(str(warning.message).split()) for warning in caught]
         record.update(status="ok", result=result.to_dict(relative_to=staging), error=None)
         _finish(record, started)
         publish(staging, folder, asset.name, record)

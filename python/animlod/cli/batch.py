@@ -66,6 +66,7 @@ def _options(pairs: list[str]) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     from ..batch.spec import read_spec
+    from ..batch.task import WARNING_NOTE
 
     if args.workers is not None and args.scheduler:
         raise UserError("--workers: sizes the local cluster; a --scheduler cluster has its own workers")
@@ -95,9 +96,9 @@ def run(args: argparse.Namespace) -> int:
     for note in [*result.notes, *([f"{args.spec}: left out {unread}"] if unread else [])]:
         print(f"note: {note}")
     warned = [(record["name"], note) for record in result.records if record["status"] == "ok"
-              for note in record["result"]["notes"] if note.startswith("warning: ")]  # fmt: skip
+              for note in record["result"]["notes"] if note.startswith(WARNING_NOTE)]  # fmt: skip
     for name, note in warned[:20]:
-        print(f"{note.split(': ', 1)[0]} {name}: {note.split(': ', 1)[1]}")
+        print(f"warning {name}: {note.removeprefix(WARNING_NOTE)}")
     if len(warned) > 20:
         print(f"... and {len(warned) - 20} more warnings (see each asset's record)")
     failures = [record for record in result.records if record["status"] != "ok"]

@@ -478,14 +478,15 @@ def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         raise FormatError(path, "element face", "vertex index list has float items; indices must be integers")
 
     # Points and lines in the face element (assimp writes a mesh's that way): no surface, left out.
-    kept = np.flatnonzero(sizes >= 3)
+    polygons = sizes >= 3
+    kept = np.flatnonzero(polygons)
     if sizes.size and not kept.size:
         raise FormatError(path, "element face", f"all {sizes.size} faces have fewer than 3 vertices (points or lines)")
     if kept.size < sizes.size:
         short = sizes.size - kept.size
         warnings.warn(f"{path}: element face: {short} of {sizes.size} faces have fewer than 3 vertices (points "
                       "or lines); left out", stacklevel=4)  # fmt: skip
-        corners, sizes = corners[np.repeat(sizes >= 3, sizes)], sizes[kept]
+        corners, sizes = corners[np.repeat(polygons, sizes)], sizes[kept]
 
     def name_face(face_index: int) -> str:
         return f"face {kept[face_index]}"

@@ -66,7 +66,8 @@ class Drawable:
     skinned : the world-space skinned mesh (joints in skeleton order), or None.
     rig : the skin as a skeleton, or None.
     clips : the animations that move this drawable.
-    renormalised_weights : vertices whose stored skin weights did not sum to 1.
+    renormalised_weights : vertices whose stored skin weights did not sum to 1 (not counting those
+        with no weight at all, which get a warning of their own).
     """
 
     mesh_index: int
@@ -155,7 +156,9 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
             drawable.rig = rigs[skin_index]
             drawable.skinned = skinned_mesh_of_node(doc, nodes[0], drawable.rig, geometry)
             sums = np.asarray(geometry.weights, np.float64).sum(axis=1)
-            drawable.renormalised_weights = int(np.count_nonzero(np.abs(sums - 1.0) > _WEIGHT_SUM_TOLERANCE))
+            # Vertices with no weight at all are a warning of their own (skinned_mesh_of_node).
+            off = (sums > 0.0) & (np.abs(sums - 1.0) > _WEIGHT_SUM_TOLERANCE)
+            drawable.renormalised_weights = int(np.count_nonzero(off))
         drawable.clips = _clips(doc, drawable, fps, motions)
         drawables.append(drawable)
     return drawables

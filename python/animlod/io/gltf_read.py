@@ -18,6 +18,7 @@ viewer shows. Meshes without a skin are placed by their node's world transform.
 from __future__ import annotations
 
 import os
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -151,8 +152,9 @@ def skinned_mesh_of_node(
     the node's rest world transform (for a LoD node standing in for another node)."""
     mesh_index = doc.gltf.nodes[node].mesh
     slots = rig.skin_slots
+    weights = _weights_of_unweighted_vertices(doc, mesh_index, geometry.weights)
     # Unused influences may carry any index (some exporters leave garbage there).
-    joints = np.where(geometry.weights > 0.0, geometry.joints, 0)
+    joints = np.where(weights > 0.0, geometry.joints, 0)
     if joints.size and joints.max() >= slots:
         vertex = int(np.argmax((joints >= slots).any(axis=1)))
         reason = f"vertex {vertex} uses joint slot {int(joints[vertex].max())}, skin {rig.skin} has {slots}"
@@ -168,7 +170,7 @@ def skinned_mesh_of_node(
             rest_positions=transform_points(mesh_world, geometry.positions),
             faces=geometry.faces,
             joints=rig.remap[joints],
-            weights=geometry.weights,
+            weights=weights,
             inverse_bind=inverse_bind,
             skeleton=rig.skeleton,
             uvs=geometry.uvs,
@@ -178,6 +180,24 @@ def skinned_mesh_of_node(
         )
     except ValueError as error:
         raise doc.fail(f"mesh {mesh_index} with skin {rig.skin}", str(error)) from None
+
+
+def _weights_of_unweighted_vertices(doc: GltfDocument, mesh_index: int, weights: np.ndarray) -> np.ndarray:
+    """``weights`` with full weight on the first listed joint of every vertex whose weights are all
+    zero. glTF forbids such vertices, but Blender (before 2.90) and Maya2glTF write the vertices
+    no bone deforms that way; three.js and Blender's importer move them with that joint."""
+    unweighted = ~(weights > 0.0).any(axis=1)
+    if not unweighted.any():
+        return weights
+    vertex = int(np.argmax(unweighted))
+    warnings.warn(
+        f"{doc.path}: mesh {mesh_index} WEIGHTS: {int(unweighted.sum())} of {len(weights)} vertices (first: {vertex}) "
+        "have no positive skin weight; they follow their first listed joint, as three.js and Blender do",
+        stacklevel=5,
+    )
+    weights = weights.copy()
+    weights[unweighted, 0] = 1.0
+    return weights
 
 
 def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[AnimatedMesh], list[AnimatedMesh]]:

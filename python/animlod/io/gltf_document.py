@@ -597,7 +597,7 @@ def _frame_limit(limit: int | None) -> int:
     return limit
 
 
-_GLTF1_ADVICE = "convert it to glTF 2.0 first: gltf-pipeline, for one, upgrades glTF 1.0 files"
+_UPGRADE_ADVICE = "convert it to glTF 2.0 first: gltf-pipeline, for one, upgrades glTF 0.8 and 1.0 files"
 
 
 def _check_top_level(path: str, document: Any) -> None:
@@ -610,8 +610,9 @@ def _check_top_level(path: str, document: Any) -> None:
     version = asset.get("version") if isinstance(asset, dict) else None
     if not (isinstance(version, str) and version.startswith("2.")):
         reason = "has no version (glTF 2.0 requires one)" if version is None else f"glTF version {version!r} is not 2.x"
-        if isinstance(version, str) and version.startswith("1."):
-            reason += f"; {_GLTF1_ADVICE}"
+        # Before 1.0 the version was a number (collada2gltf's 0.8, Qt 3D's examples).
+        if isinstance(version, (str, float)) and str(version).startswith(("0.", "1.")):
+            reason += f"; {_UPGRADE_ADVICE}"
         raise FormatError(path, "asset", reason)
     for key in _TOP_LEVEL_ARRAYS:
         if key in document and not isinstance(document[key], list):
@@ -628,7 +629,7 @@ def _glb_json_chunk_length(path: str, head: bytes) -> int:
         raise FormatError(path, "GLB header", f"file is truncated ({len(head)} bytes)")
     version = struct.unpack_from("<I", head, 4)[0]
     if version != 2:
-        advice = f": a glTF 1.0 binary file; {_GLTF1_ADVICE}" if version == 1 else ""
+        advice = f": a glTF 1.0 binary file; {_UPGRADE_ADVICE}" if version == 1 else ""
         raise FormatError(path, "GLB header", f"container version {version} is not 2{advice}")
     chunk_length, chunk_type = struct.unpack_from("<II", head, _GLB_HEADER_BYTES)
     if chunk_type != _GLB_JSON_CHUNK:

@@ -433,7 +433,10 @@ def test_motion_levels_of_every_clip_share_one_skeleton_per_level(tmp_path: Path
         errors = [clip["error"] for clip in row["clips"]]
         assert [clip["name"] for clip in row["clips"]] == ["Armature|Bend"] * 2
         assert max(errors) == pytest.approx(level.report.max_error, rel=1e-12, abs=1e-15)
-    assert len(set(manifest["levels"][-1]["clips"][k]["error"] for k in range(2))) == 1  # a clip and its reverse
+    # A clip and its reverse: the same error, up to the solver's tolerance (each frame's solve
+    # starts from the frame before, and the tube's skinned tip is re-fitted, skin_tips.py).
+    first, reverse = (clip["error"] for clip in manifest["levels"][-1]["clips"])
+    assert first == pytest.approx(reverse, rel=1e-6)
 
 
 def test_meshes_on_skins_of_the_same_joints_share_one_skeleton_per_motion_level(tmp_path: Path) -> None:

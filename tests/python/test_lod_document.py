@@ -376,19 +376,37 @@ def test_character_chain_combines_geometry_and_motion_levels(data_dir, tmp_path)
 
 
 def test_character_keeps_the_motion_whole_where_no_joint_can_freeze(data_dir, tmp_path):
-    # SimpleSkin's two joints coincide: joint positions cannot show its rotations, so nothing
-    # freezes; the geometry levels are still written, each with the input's motion.
+    # SimpleSkin's two joints coincide; with the skin on the root alone, neither joint positions
+    # nor skin points show joint 1's rotation, so nothing freezes; the geometry levels are still
+    # written, each with the input's motion.
+    import dataclasses
+
     from animlod.io import read_lod_chains
     from animlod.pipelines.character import build_character
 
+    scene = read_gltf(data_dir / "gltf" / "SimpleSkin.gltf")
+    (skin,) = scene.skinned_meshes
+    weights = np.broadcast_to(np.eye(1, skin.joints.shape[1]), skin.weights.shape)
+    on_root = dataclasses.replace(skin, joints=np.zeros_like(skin.joints), weights=weights)
+    write_glb(tmp_path / "still.glb", on_root, scene.motions)
     output = tmp_path / "character.glb"
-    report = build_character(data_dir / "gltf" / "SimpleSkin.gltf", output, [0.5], **QUICK)
+    report = build_character(tmp_path / "still.glb", output, [0.5], **QUICK)
     assert any("1 motion level(s) for 2 geometry levels" in note and "every bone of zero length" in note
                for note in report.notes)  # fmt: skip
     (levels,) = report.chains.values()
     assert [level.faces for level in levels] == [8, 4] and levels[0].joints == levels[1].joints == 2
     (chain,) = read_lod_chains(output)
     assert [level.motion_level for level in chain.levels] == [0, 0]
+
+
+def test_character_freezes_a_skinned_leaf_on_its_parent_and_measures_it_on_the_skin(data_dir, tmp_path):
+    # The same joints, SimpleSkin's own skin: joint 1's rotation bends the upper half, which its
+    # skin's points show (skin_tips.py), so it can freeze, at the error it costs.
+    from animlod.pipelines.character import build_character
+
+    report = build_character(data_dir / "gltf" / "SimpleSkin.gltf", tmp_path / "character.glb", [0.5], **QUICK)
+    (levels,) = report.chains.values()
+    assert [level.joints for level in levels] == [2, 1] and levels[1].relative_error > 0.01
 
 
 def test_character_refuses_a_file_without_a_skinned_animation(data_dir, tmp_path, capsys):

@@ -185,7 +185,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         for bar in bars:
             bar.close()
-    _print_summary(report.chain, report.floor)
+    _print_summary(report.chain, report.floor, skinned=report.faces is not None)
     written = sum(len(files) for files in report.files) + 1  # the levels and the manifest
     if args.plot:
         from ..motion_lod.plots import plot_chain
@@ -202,9 +202,10 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_summary(chain, floor) -> None:
+def _print_summary(chain, floor, skinned: bool) -> None:
     size = chain.figure_size
-    print(f"\nfigure size {size:.4g} (asset units); errors over every original joint and frame")
+    leaves = ", leaf joints measured by points of their skin" if skinned else ""
+    print(f"\nfigure size {size:.4g} (asset units); errors over every original joint and frame{leaves}")
     if floor.fewest > floor.paper_fewest:
         print(
             f"fewest joints: {floor.fewest} of {floor.total}, above the paper's 8% ({floor.paper_fewest}): "

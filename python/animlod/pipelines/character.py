@@ -51,6 +51,7 @@ from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joi
 from ..motion_lod.chain import MotionLevel
 from ..motion_lod.clips import join_clips
 from ..motion_lod.frozen import FrozenLevel
+from ..motion_lod.skin_tips import with_skin_tips, without_skin_tips
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
 from .clip_import import with_clips
@@ -159,9 +160,12 @@ def build_character(
             )
             motion_chains[skin] = _SkinMotion(None, list(zip(clips, spans)), drawable.rig, joined)
             continue
-        analysis = analyze_motion(joined, workers=workers, clips=spans)
+        # Leaf joints are measured by their skin's points (skin_tips.py); the levels drop them.
+        same_joints = [d.skinned for d in animated if d.rig.joint_nodes == drawable.rig.joint_nodes]
+        tipped = with_skin_tips(joined, same_joints)
+        analysis = analyze_motion(tipped, workers=workers, clips=spans)
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
-        floor = joint_floor(joined, analysis)
+        floor = joint_floor(tipped, analysis)
         levels = min(levels_wanted, floor.possible_levels)
         covering = [other for other in motion_chains if joints_of[skin] < joints_of[other]]
         if covering:
@@ -173,7 +177,8 @@ def build_character(
                 f"at least {floor.fewest} kept: {floor.explain()})"
             )
         say(f"skin {skin}: {levels} motion levels over {len(clips)} clips")
-        chain = build_motion_chain(joined, levels=levels, solver=solver, workers=workers, analysis=analysis)
+        chain = build_motion_chain(tipped, levels=levels, solver=solver, workers=workers, analysis=analysis)
+        chain = without_skin_tips(chain, joined)
         motion_chains[skin] = _SkinMotion(chain, list(zip(clips, spans)), drawable.rig, joined)
     motion_seconds = time.perf_counter() - started
     started = time.perf_counter()

@@ -110,6 +110,7 @@ def build_motion_levels(
     """
     from ..motion_lod.chain import build_motion_chain
     from ..motion_lod.objective import Weights
+    from ..motion_lod.skin_tips import with_skin_tips, without_skin_tips
     from ..options import MotionRefitOptions
 
     if workers < 0:
@@ -130,8 +131,10 @@ def build_motion_levels(
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
     spans = [frames for _, frames in played] if len(played) > 1 else None
+    # Leaf joints are measured by their skin's points (skin_tips.py); the levels drop them.
+    tipped = motion if skin is None else with_skin_tips(motion, [skin])
     analysis, counts, floor = _plan_levels(
-        motion, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
+        tipped, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
     if floor.possible_levels == 1:
         note(
@@ -140,17 +143,17 @@ def build_motion_levels(
             "writing one level, the input's motion"
         )
     chain = build_motion_chain(
-        motion,
+        tipped,
         counts,
         weights=Weights(*weights),
         solver=solver,
         slsqp_options=MotionRefitOptions(hard_constraints=solver != "newton" and not penalty),
         workers=workers,
-        skin=skin,
         on_level=(lambda index, count: on_level(index, count, motion.frame_count, len(counts))) if on_level else None,
         analysis=analysis,
         on_choice=on_choice,
     )
+    chain = without_skin_tips(chain, motion, skin)
 
     from ..io.bvh import write_bvh
     from ..io.manifest import write_lod_manifest

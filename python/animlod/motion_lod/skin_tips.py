@@ -1,0 +1,158 @@
+"""Points of the skin that a leaf joint turns, so that its rotation counts (Eqs. 1-5).
+
+The paper measures a joint by the points below it: Eq. 1's bones to its children, the re-fit's
+joint positions (Eq. 5) and the levels' errors. A BVH leaf ends in an End Site; a glTF skeleton's
+leaf joints have nothing below them (Blender's head, toes and weapon bones), so turning one moves
+no point. Eq. 1 gave such a joint importance 0 and the re-fit saw no error in freezing it, so it
+froze first whatever skin it carried: Castle Game Engine's knight lost its head's motion at the
+first level (36 of 50 joints), 8 % of its size on the skin for a joint error of 1e-6.
+
+:func:`with_skin_tips` gives every leaf joint that carries skin two end sites where its skin is:
+its weighted centroid moved one standard deviation along each of the two main axes of the skin
+around it (weighted principal axes, in the joint's bind frame). Two points off one line fix the
+joint's rotation, swing and twist, and their displacement is the skin's. The chain is built on
+that motion; :func:`without_skin_tips` then takes the points out of every level, so the levels
+have the input's joints and the errors measured on the skin's points.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .. import rotations
+from ..model import Motion, Skeleton, SkinnedMesh
+from .chain import MotionLodChain
+from .frozen import FrozenLevel
+from .skin_transfer import transfer_skin
+
+TIPS_PER_JOINT = 2
+
+
+def with_skin_tips(motion: Motion, skins: list[SkinnedMesh]) -> Motion:
+    """``motion`` with end sites on the skin of every leaf joint that ``skins`` weigh (after its
+    joints, in joint order; names ``<joint>_tip0``, ``<joint>_tip1`` made unique); ``motion``
+    itself where no leaf joint carries skin."""
+    skeleton = motion.skeleton
+    tips = _tip_offsets(skeleton, skins)
+    if not tips:
+        return motion
+    owners = np.repeat(sorted(tips), TIPS_PER_JOINT)
+    offsets = np.concatenate([tips[j] for j in sorted(tips)])
+    taken = set(skeleton.names)
+    names = []
+    for joint, k in zip(owners, np.tile(np.arange(TIPS_PER_JOINT), len(tips))):
+        name = f"{skeleton.names[joint]}_tip{k}"
+        while name in taken:
+            name += "_"
+        taken.add(name)
+        names.append(name)
+    added = len(names)
+    tipped = Skeleton(
+        skeleton.names + names,
+        np.concatenate([skeleton.parents, owners]),
+        np.concatenate([skeleton.offsets, offsets]),
+        np.concatenate([skeleton.rest_rotations, rotations.identity((added,))]),
+        np.concatenate([skeleton.end_sites, np.ones(added, bool)]),
+    )
+    frames = motion.frame_count
+    local = np.concatenate([motion.local_rotations, rotations.identity((frames, added))], axis=1)
+    translations = None
+    if motion.joint_translations is not None:
+        held = np.broadcast_to(offsets, (frames, added, 3))
+        translations = np.concatenate([motion.joint_translations, held], axis=1)
+    deformations = None
+    if motion.joint_deformations is not None:
+        identity = np.broadcast_to(np.eye(3), (frames, added, 3, 3))
+        deformations = np.concatenate([motion.joint_deformations, identity], axis=1)
+    return Motion(tipped, motion.root_positions, local, motion.fps, motion.name, translations, deformations)
+
+
+def _tip_offsets(skeleton: Skeleton, skins: list[SkinnedMesh]) -> dict[int, np.ndarray]:
+    """``{leaf joint: (2, 3) tip offsets in its frame}`` for the leaf joints the skins weigh."""
+    leaves = np.ones(skeleton.joint_count, bool)
+    leaves[skeleton.parents[1:]] = False
+    leaves &= ~skeleton.end_sites
+    leaves[0] = False
+    total = np.zeros(skeleton.joint_count)
+    first = np.zeros((skeleton.joint_count, 3))
+    second = np.zeros((skeleton.joint_count, 3, 3))
+    for skin in skins:
+        if skin.skeleton.names != skeleton.names:
+            raise ValueError("skin: its skeleton's joint names differ from the motion's")
+        weights = skin.weights.astype(np.float64)
+        used = weights > 0.0
+        vertices, slots = np.nonzero(used & leaves[skin.joints])
+        joints = skin.joints[vertices, slots]
+        # Each vertex in the bind frame of each leaf joint it follows: inverse_bind @ v.
+        rest = np.c_[skin.rest_positions[vertices].astype(np.float64), np.ones(vertices.size)]
+        local = np.einsum("nij,nj->ni", skin.inverse_bind[joints], rest)[:, :3]
+        w = weights[vertices, slots]
+        np.add.at(total, joints, w)
+        np.add.at(first, joints, w[:, None] * local)
+        np.add.at(second, joints, w[:, None, None] * local[:, :, None] * local[:, None, :])
+    tips = {}
+    for joint in np.flatnonzero(total > 0.0):  # O(leaf joints) 3x3 eigenproblems
+        centroid = first[joint] / total[joint]
+        covariance = second[joint] / total[joint] - np.outer(centroid, centroid)
+        variances, axes = np.linalg.eigh(covariance)  # ascending
+        spread = np.sqrt(np.maximum(variances[::-1][:TIPS_PER_JOINT], 0.0))
+        tips[int(joint)] = centroid + (axes[:, ::-1][:, :TIPS_PER_JOINT] * spread).T
+    return tips
+
+
+def without_skin_tips(chain: MotionLodChain, motion: Motion, skin: SkinnedMesh | None = None) -> MotionLodChain:
+    """``chain``, built on :func:`with_skin_tips` of ``motion``, with the tips taken out of every
+    level: the levels' skeletons, motions and frozen splits on ``motion``'s joints, their reports
+    (errors measured on the tips too) as they are, and each level's skin ``skin`` moved onto its
+    kept joints (:func:`transfer_skin`) when given."""
+    count = motion.skeleton.joint_count
+    levels = []
+    for level in chain.levels:
+        frozen = _first_points(level.frozen, motion.skeleton, count)
+        kept = int(np.count_nonzero(frozen.kept))
+        levels.append(
+            dataclasses.replace(
+                level,
+                frozen=frozen,
+                positions=level.positions[:, :count],
+                motion=_first_joints(level.motion, kept),
+                skin=None if skin is None else transfer_skin(skin, frozen),
+            )
+        )
+    analysis = chain.analysis
+    analysis = dataclasses.replace(
+        analysis, key_frames=analysis.key_frames[:count], importance=analysis.importance[:count]
+    )
+    return MotionLodChain(analysis, levels)
+
+
+def _first_points(level: FrozenLevel, skeleton: Skeleton, count: int) -> FrozenLevel:
+    """``level`` on its first ``count`` points (the tips come after them and hang from them)."""
+    arrays = {
+        field.name: getattr(level, field.name)[:count]
+        for field in dataclasses.fields(level)
+        if isinstance(getattr(level, field.name), np.ndarray)
+    }
+    return dataclasses.replace(level, skeleton=skeleton, **arrays)
+
+
+def _first_joints(motion: Motion, count: int) -> Motion:
+    """``motion`` on the first ``count`` joints of its skeleton (those below them come after)."""
+    skeleton = motion.skeleton
+    return Motion(
+        Skeleton(
+            skeleton.names[:count],
+            skeleton.parents[:count],
+            skeleton.offsets[:count],
+            skeleton.rest_rotations[:count],
+            skeleton.end_sites[:count],
+        ),
+        motion.root_positions,
+        motion.local_rotations[:, :count],
+        motion.fps,
+        motion.name,
+        None if motion.joint_translations is None else motion.joint_translations[:, :count],
+        None if motion.joint_deformations is None else motion.joint_deformations[:, :count],
+    )

@@ -1,0 +1,110 @@
+"""Leaf joints measured by their skin's points (motion_lod/skin_tips.py).
+
+A glTF leaf joint has no point below it, so its rotation moved no joint: the paper's measures
+gave it nothing to lose, and Blender characters lost their heads' motion at the first level.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from animlod import rotations
+from animlod.cli import main
+from animlod.io import read_gltf, write_glb
+from animlod.model import Motion, Skeleton, SkinnedMesh
+from animlod.motion_lod.chain import build_motion_chain
+from animlod.motion_lod.skin_tips import with_skin_tips, without_skin_tips
+from animlod.motion_lod.skin_transfer import transfer_skin
+
+NAMES = ["root", "spine", "head", "control"]
+
+
+def _box(centre, size, n=4) -> np.ndarray:
+    axes = [np.linspace(c - s / 2, c + s / 2, n) for c, s in zip(centre, size)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+@pytest.fixture(scope="module")
+def rig():
+    """A body on the spine, a wide head on the leaf joint 'head' that turns about the neck's
+    own axis (which moves no joint), and a leaf 'control' with no skin that swings widely."""
+    skeleton = Skeleton(NAMES, [-1, 0, 1, 0], [[0, 0, 0], [0, 1, 0], [0, 1, 0], [0.5, 0, 0]])
+    body, head = _box([0, 1.0, 0], [0.6, 1.0, 0.3]), _box([0, 2.3, 0], [0.6, 0.4, 0.5])
+    positions = np.concatenate([body, head]).astype(np.float32)
+    joints = np.zeros((len(positions), 4), np.int32)
+    joints[:, 0] = np.r_[np.full(len(body), 1), np.full(len(head), 2)]
+    weights = np.zeros((len(positions), 4), np.float32)
+    weights[:, 0] = 1.0
+    bind = skeleton.rest_world_transforms()
+    faces = np.array([[0, 1, 2], [len(body), len(body) + 1, len(body) + 2]])
+    skin = SkinnedMesh(positions, faces, joints, weights, np.linalg.inv(bind), skeleton)
+    frames = 24
+    angle = np.linspace(0.0, 1.2, frames)
+    local = rotations.identity((frames, 4))
+    local[:, 1] = rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), 0.05 * angle)  # a slight bend
+    local[:, 2] = rotations.from_axis_angle(np.array([0.0, 1.0, 0.0]), angle)  # the head turns
+    local[:, 3] = rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), 2.0 * angle)
+    motion = Motion(skeleton, np.zeros((frames, 3)), local, fps=24.0, name="turn")
+    return skin, motion
+
+
+def _skin_error(skin, motion, level) -> float:
+    reduced = transfer_skin(skin, level.frozen)
+    return float(np.abs(reduced.bake(level.motion).frames - skin.bake(motion).frames).max())
+
+
+def test_the_points_of_a_skinned_leaf_keep_its_joint_where_the_bare_skeleton_froze_it(rig) -> None:
+    skin, motion = rig
+    bare = build_motion_chain(motion, [3])
+    assert bare.levels[1].report.frozen == ["head"]  # nothing measured its turn: the failure
+    assert _skin_error(skin, motion, bare.levels[1]) > 0.2
+
+    chain = without_skin_tips(build_motion_chain(with_skin_tips(motion, [skin]), [3]), motion, skin)
+    level = chain.levels[1]
+    assert level.report.frozen == ["control"]  # it carries no skin: freezing it costs nothing seen
+    assert _skin_error(skin, motion, level) < 1e-5
+
+
+def test_tips_sit_on_the_main_axes_of_the_skin_and_leave_the_levels_on_the_input_joints(rig) -> None:
+    skin, motion = rig
+    tipped = with_skin_tips(motion, [skin])
+    assert tipped.skeleton.names == NAMES + ["head_tip0", "head_tip1"]  # 'control' has no skin
+    assert tipped.skeleton.end_sites.tolist() == [False] * 4 + [True, True]
+    tips = tipped.skeleton.offsets[4:]
+    # The head's skin in its frame: centred 0.3 above the joint, widest along x, then z (the
+    # axes' signs are the eigensolver's).
+    head = skin.rest_positions[skin.joints[:, 0] == 2] - [0, 2, 0]
+    spread = head.std(axis=0)
+    np.testing.assert_allclose(np.abs(tips), [[spread[0], 0.3, 0.0], [0.0, 0.3, spread[2]]], atol=1e-6)
+
+    chain = without_skin_tips(build_motion_chain(tipped, [4, 3, 2]), motion, skin)
+    for level in chain.levels:
+        names = level.motion.skeleton.names
+        assert set(names) <= set(NAMES) and level.skin.skeleton.names == names
+        assert level.frozen.skeleton is motion.skeleton and level.positions.shape[1] == 4
+    assert chain.levels[2].report.frozen == ["control", "spine"]  # the slight bend goes before the head
+
+    # The errors are measured on the tips: with the spine locked, the head must go, and it shows.
+    bare, tipped_level = (build_motion_chain(m, [2], locked=["spine"]).levels[1] for m in (motion, tipped))
+    assert set(bare.report.frozen) == set(tipped_level.report.frozen) == {"head", "control"}
+    assert bare.report.max_error < 1e-9 and tipped_level.report.max_error > 0.1
+
+
+def test_a_skin_on_no_leaf_joint_leaves_the_motion_as_it_is(rig) -> None:
+    skin, motion = rig
+    on_spine = SkinnedMesh(skin.rest_positions, skin.faces, np.where(skin.joints == 2, 1, skin.joints),
+                           skin.weights, skin.inverse_bind, skin.skeleton)  # fmt: skip
+    assert with_skin_tips(motion, [on_spine]) is motion
+
+
+def test_motion_on_a_gltf_character_keeps_its_skinned_leaf(rig, tmp_path) -> None:
+    skin, motion = rig
+    write_glb(tmp_path / "turn.glb", skin, [motion])
+    assert main(["motion", str(tmp_path / "turn.glb"), "-o", str(tmp_path / "levels"), "--joints", "4", "3"]) == 0
+    levels = json.loads((tmp_path / "levels" / "turn_motion_lod.json").read_text())["levels"]
+    assert levels[1]["joints"] == 3 and levels[1]["error"] < 1e-6
+    kept = read_gltf(tmp_path / "levels" / levels[1]["files"][-1]).skinned_meshes[0].skeleton.names
+    assert kept == ["root", "spine", "head"]  # 'control' froze, the head turns

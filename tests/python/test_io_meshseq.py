@@ -284,9 +284,16 @@ def test_obj_lines_ending_in_a_backslash_continue_on_the_next(tmp_path: Path) ->
     np.testing.assert_array_equal(faces, np.concatenate([EXPECTED_FACES, [[0, 1, 2]]]))
 
 
-def test_obj_face_with_two_corners(tmp_path: Path) -> None:
-    path = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 3"))
-    assert _error(path) == f"{path}: face 1 (line 11): needs at least 3 vertices, has 2"
+def test_obj_faces_with_two_corners_are_left_out_with_a_warning(tmp_path: Path) -> None:
+    # pybullet's samurai_monastry.obj has 201 two-vertex faces among its 125k.
+    path = _write(tmp_path / "lines.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 3"))
+    with pytest.warns(UserWarning, match=r"lines.obj: face 1 \(line 11\): 1 of 2 faces have fewer than 3 vertices"):
+        vertices, faces = read_obj(path)
+    np.testing.assert_array_equal(faces, EXPECTED_FACES[:2])  # the square fanned, the roof line left out
+    only = _write(tmp_path / "only.obj", "v 0 0 0\nv 1 0 0\nf 1 2\nf 2 1\n")
+    assert _error(only) == f"{only}: face 0 (line 3): needs at least 3 vertices, has 2; so does every face"
+    bad = _write(tmp_path / "bad.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 9"))
+    assert _error(bad) == f"{bad}: face 1 (line 11): vertex index 9 is outside the 5 vertices"  # still checked
 
 
 @pytest.mark.parametrize(

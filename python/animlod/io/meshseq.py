@@ -211,7 +211,8 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     ------
     FormatError
         Naming the line and vertex or face for a malformed or non-finite coordinate, a face
-        with fewer than three corners, or a face index outside the vertices defined so far.
+        index outside the vertices defined so far, or faces that all have fewer than three
+        corners (some such faces among polygons are left out with a warning).
     """
     path = Path(path)
     data = path.read_bytes()
@@ -255,7 +256,15 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if b"/" in face_block:
         face_block = re.sub(rb"/\S*", b"", face_block)  # v of v/vt/vn
     sizes = _row_sizes(face_block, len(face_lines))
-    _require_sizes(path, sizes, 3, name_face, "vertices")
+    # Faces of one or two vertices have no surface (pybullet's samurai_monastry.obj has 201 among
+    # its 125k): left out, as in a PLY file.
+    polygons = sizes >= 3
+    if sizes.size and not polygons.any():
+        raise FormatError(path, name_face(0), f"needs at least 3 vertices, has {sizes[0]}; so does every face")
+    if not polygons.all():
+        first = int(np.argmin(polygons))
+        warnings.warn(f"{path}: {name_face(first)}: {sizes.size - int(polygons.sum())} of {sizes.size} faces have "
+                      "fewer than 3 vertices (points or lines); left out", stacklevel=3)  # fmt: skip
     owner = np.repeat(np.arange(sizes.size), sizes)
     written = _untagged_values(face_block, np.int64, sizes)
     if written is None:
@@ -265,7 +274,7 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     defined = np.searchsorted(vertex_lines, face_lines)[owner]
     resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
     _check_face_indices(path, resolved, written, owner, len(vertices), name_face)
-    return vertices, _fan_triangulate(resolved, sizes)
+    return vertices, _fan_triangulate(resolved[polygons[owner]], sizes[polygons])
 
 
 def _join_continued_lines(data: bytes) -> bytes:

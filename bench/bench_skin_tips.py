@@ -7,13 +7,15 @@ the largest mesh's motion levels as ``animlod character`` builds them (every cli
 4 levels, the default ranking and solver), once on the bare skeleton and once with the leaf
 joints' skin tips. Per level: joints, and the skin's distance to the input over every frame of
 every clip (the level's reduced skin played with its re-fitted clips, geometry untouched), max
-and mean over vertices and frames, relative to the rest pose's diagonal.
+and mean over vertices and frames, relative to the rest pose's diagonal; and the CPU seconds of the
+analysis and the chain on one thread (on the file's first row).
 """
 
 from __future__ import annotations
 
 import hashlib
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -23,9 +25,9 @@ from devdata import DATA_DIR
 from table import print_table
 
 from animlod.io.gltf_drawable import read_document_drawables
-from animlod.motion_lod import build_motion_chain
+from animlod.motion_lod import analyze_motion, build_motion_chain
 from animlod.motion_lod.clips import join_clips
-from animlod.motion_lod.skin_tips import with_skin_tips, without_skin_tips
+from animlod.motion_lod.skin_tips import measured_by_tips, with_skin_tips, without_skin_tips
 from animlod.motion_lod.skin_transfer import transfer_skin
 
 CASTLE = Path("/usr/share/doc/castle-game-engine-doc/examples")
@@ -59,14 +61,21 @@ def skin_errors(path: Path) -> list[list[object]]:
     diagonal = float(np.linalg.norm(np.ptp(skin.rest_pose(), axis=0)))
     originals = [skin.bake(clip.motion).frames for clip in clips]
     measured = {}  # tips -> [(joints, max %, mean %) per level]
+    seconds = {}  # tips -> CPU seconds of the analysis and the chain, on one thread
     for tips in (False, True):
+        started = time.process_time()
         motion = with_skin_tips(joined, [skin]) if tips else joined
+        analysis = analyze_motion(motion, clips=spans, workers=1)
         try:
-            chain = build_motion_chain(motion, LEVELS)
+            if tips:
+                chain = without_skin_tips(
+                    build_motion_chain(motion, LEVELS, analysis=measured_by_tips(analysis, joined), workers=1), joined
+                )
+            else:
+                chain = build_motion_chain(motion, LEVELS, analysis=analysis, workers=1)
         except ValueError:  # fewer joints can freeze than LEVELS levels need
             return []
-        if tips:
-            chain = without_skin_tips(chain, joined)
+        seconds[tips] = time.process_time() - started
         measured[tips] = []
         for level in chain.levels[1:]:
             reduced = transfer_skin(skin, level.frozen)
@@ -76,18 +85,20 @@ def skin_errors(path: Path) -> list[list[object]]:
             ]) * (100 / diagonal)  # fmt: skip
             measured[tips].append((level.report.joint_count, float(distances.max()), float(distances.mean())))
     label = path.name if path.is_relative_to(DATA_DIR) else str(path.relative_to(CASTLE))
-    return [
-        [label, index, joints, bare[1], tipped[1], bare[2], tipped[2]]
+    rows = [
+        [label, index, tipped[0], bare[1], tipped[1], bare[2], tipped[2], "", ""]
         for index, (bare, tipped) in enumerate(zip(measured[False], measured[True]), start=1)
-        for joints in [tipped[0]]
     ]
+    rows[0][-2:] = [seconds[False], seconds[True]]
+    return rows
 
 
 def main() -> None:
     rows = []
     for path in characters():
         rows += skin_errors(path)
-    columns = ["file", "level", "joints", "max %, bare", "max %, tips", "mean %, bare", "mean %, tips"]
+    columns = ["file", "level", "joints", "max %, bare", "max %, tips", "mean %, bare", "mean %, tips",
+               "CPU s, bare", "CPU s, tips"]  # fmt: skip
     print_table("Motion levels: skin distance with and without skin tips", columns, rows)
 
 

@@ -66,6 +66,8 @@ class MotionAnalysis:
     r_max : the normaliser of Eq. 1, in the asset's units; 0 where every bone has zero length.
     translating : joint indices whose translation moves (see translating_joints), never frozen.
     ranking : the name of the ranking that ordered ``priority`` (ranking.RANKINGS).
+    markers : end sites that measure their joint's rotation but belong to no level (a skinned
+        leaf joint's skin tips, skin_tips.py): never re-fitted, placed from their joint.
     """
 
     key_frames: np.ndarray
@@ -76,6 +78,7 @@ class MotionAnalysis:
     r_max: float
     translating: list[int] = field(default_factory=list)
     ranking: str = "importance"
+    markers: list[int] = field(default_factory=list)
 
     def key_rotations(self, motion: Motion) -> np.ndarray:
         """Key posture (Section 4.2): every joint's local rotation at its key frame, ``(J, 4)``."""

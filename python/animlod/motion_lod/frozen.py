@@ -6,7 +6,8 @@ whose key transforms fold into one constant transform: the kept point's new offs
 ``fold_translation + fold_rotation @ offset`` and its rotation is preceded by ``fold_rotation``.
 
 End sites (see analysis.py) are never counted as joints of a level; an end site is kept when its
-joint is kept and dropped with it when that joint is frozen.
+joint is kept and dropped with it when that joint is frozen. Markers (MotionAnalysis.markers) are
+never kept: placed from their joint, they are measured and not re-fitted.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ class FrozenLevel:
     ----------
     skeleton : the original skeleton.
     frozen : (J,) bool joints frozen at this level.
-    kept : (J,) bool points in the level's skeleton (not frozen, not an end site of a frozen joint).
+    kept : (J,) bool points in the level's skeleton (not frozen, not an end site of a frozen joint,
+        not a marker).
     kept_parent : (J,) int64 nearest kept ancestor of each kept point, -1 for the root and for
         points that are not kept.
     key_rotations : (J, 4) local rotations of the key posture (Section 4.2).
@@ -90,6 +92,7 @@ def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | 
     kept = ~frozen
     end_site_parents = skeleton.parents[skeleton.end_sites]
     kept[np.flatnonzero(skeleton.end_sites)[frozen[end_site_parents]]] = False
+    kept[analysis.markers] = False
 
     key_rotations = analysis.key_rotations(motion)
     key_translations = analysis.key_translations(motion)

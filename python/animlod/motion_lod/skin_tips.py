@@ -11,8 +11,12 @@ first level (36 of 50 joints), 8 % of its size on the skin for a joint error of 
 its weighted centroid moved one standard deviation along each of the two main axes of the skin
 around it (weighted principal axes, in the joint's bind frame). Two points off one line fix the
 joint's rotation, swing and twist, and their displacement is the skin's. The chain is built on
-that motion; :func:`without_skin_tips` then takes the points out of every level, so the levels
-have the input's joints and the errors measured on the skin's points.
+that motion with the tips as markers (:func:`measured_by_tips`): they count in Eq. 1 and in every
+error, but they belong to no level and are not re-fitted (a kept leaf keeps its own rotation, which
+places them; as SLSQP variables they took 1.7x the CPU time of Soldier.glb's 4 levels for about
+the same errors). Then
+:func:`without_skin_tips` takes them out of the chain, whose levels have the input's joints and
+errors measured on the skin's points.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton, SkinnedMesh
+from .analysis import MotionAnalysis
 from .chain import MotionLodChain
 from .frozen import FrozenLevel
 from .skin_transfer import transfer_skin
@@ -102,28 +107,31 @@ def _tip_offsets(skeleton: Skeleton, skins: list[SkinnedMesh]) -> dict[int, np.n
     return tips
 
 
+def measured_by_tips(analysis: MotionAnalysis, motion: Motion) -> MotionAnalysis:
+    """``analysis`` of :func:`with_skin_tips` of ``motion``, its tips made markers."""
+    tipped = analysis.key_frames.size
+    return dataclasses.replace(analysis, markers=list(range(motion.skeleton.joint_count, tipped)))
+
+
 def without_skin_tips(chain: MotionLodChain, motion: Motion, skin: SkinnedMesh | None = None) -> MotionLodChain:
-    """``chain``, built on :func:`with_skin_tips` of ``motion``, with the tips taken out of every
-    level: the levels' skeletons, motions and frozen splits on ``motion``'s joints, their reports
-    (errors measured on the tips too) as they are, and each level's skin ``skin`` moved onto its
-    kept joints (:func:`transfer_skin`) when given."""
+    """``chain``, built on :func:`with_skin_tips` of ``motion`` with :func:`measured_by_tips`,
+    on ``motion``'s joints: the frozen splits, the re-fitted positions and the analysis without
+    the tips (the levels' skeletons never had them), the reports (errors measured on the tips
+    too) as they are, and each level's skin ``skin`` moved onto its kept joints
+    (:func:`transfer_skin`) when given."""
     count = motion.skeleton.joint_count
     levels = []
     for level in chain.levels:
         frozen = _first_points(level.frozen, motion.skeleton, count)
-        kept = int(np.count_nonzero(frozen.kept))
+        skin_of_level = None if skin is None else transfer_skin(skin, frozen)
         levels.append(
-            dataclasses.replace(
-                level,
-                frozen=frozen,
-                positions=level.positions[:, :count],
-                motion=_first_joints(level.motion, kept),
-                skin=None if skin is None else transfer_skin(skin, frozen),
-            )
+            dataclasses.replace(level, frozen=frozen, positions=level.positions[:, :count], skin=skin_of_level)
         )
-    analysis = chain.analysis
     analysis = dataclasses.replace(
-        analysis, key_frames=analysis.key_frames[:count], importance=analysis.importance[:count]
+        chain.analysis,
+        key_frames=chain.analysis.key_frames[:count],
+        importance=chain.analysis.importance[:count],
+        markers=[],
     )
     return MotionLodChain(analysis, levels)
 
@@ -136,23 +144,3 @@ def _first_points(level: FrozenLevel, skeleton: Skeleton, count: int) -> FrozenL
         if isinstance(getattr(level, field.name), np.ndarray)
     }
     return dataclasses.replace(level, skeleton=skeleton, **arrays)
-
-
-def _first_joints(motion: Motion, count: int) -> Motion:
-    """``motion`` on the first ``count`` joints of its skeleton (those below them come after)."""
-    skeleton = motion.skeleton
-    return Motion(
-        Skeleton(
-            skeleton.names[:count],
-            skeleton.parents[:count],
-            skeleton.offsets[:count],
-            skeleton.rest_rotations[:count],
-            skeleton.end_sites[:count],
-        ),
-        motion.root_positions,
-        motion.local_rotations[:, :count],
-        motion.fps,
-        motion.name,
-        None if motion.joint_translations is None else motion.joint_translations[:, :count],
-        None if motion.joint_deformations is None else motion.joint_deformations[:, :count],
-    )

@@ -110,7 +110,7 @@ def build_motion_levels(
     """
     from ..motion_lod.chain import build_motion_chain
     from ..motion_lod.objective import Weights
-    from ..motion_lod.skin_tips import with_skin_tips, without_skin_tips
+    from ..motion_lod.skin_tips import measured_by_tips, with_skin_tips, without_skin_tips
     from ..options import MotionRefitOptions
 
     if workers < 0:
@@ -136,6 +136,7 @@ def build_motion_levels(
     analysis, counts, floor = _plan_levels(
         tipped, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
+    analysis = measured_by_tips(analysis, motion)
     if floor.possible_levels == 1:
         note(
             f"{os.fspath(source)}: nothing can freeze ({floor.total} joint{'s' if floor.total != 1 else ''}, "

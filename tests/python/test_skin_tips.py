@@ -6,6 +6,7 @@ gave it nothing to lose, and Blender characters lost their heads' motion at the 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -16,8 +17,8 @@ from animlod.cli import main
 from animlod.io import read_gltf, write_glb
 from animlod.model import Motion, Skeleton, SkinnedMesh
 from animlod.motion_lod import analyze_motion
-from animlod.motion_lod.chain import build_motion_chain
-from animlod.motion_lod.skin_tips import measured_by_tips, with_skin_tips, without_skin_tips
+from animlod.motion_lod.chain import build_motion_chain, joint_floor
+from animlod.motion_lod.skin_tips import measured_by_skin, with_skin_tips, without_skin_tips
 from animlod.motion_lod.skin_transfer import transfer_skin
 
 NAMES = ["root", "spine", "head", "control"]
@@ -55,7 +56,7 @@ def rig():
 def _tipped_chain(motion, skin, counts, **options):
     """The chain as the pipelines build it: on the tipped motion, the tips as markers."""
     tipped = with_skin_tips(motion, [skin])
-    analysis = measured_by_tips(analyze_motion(tipped, **options), motion)
+    analysis = measured_by_skin(analyze_motion(tipped, **options), motion, [skin])
     return without_skin_tips(build_motion_chain(tipped, counts, analysis=analysis), motion, skin)
 
 
@@ -88,7 +89,7 @@ def test_tips_sit_on_the_main_axes_of_the_skin_and_leave_the_levels_on_the_input
     np.testing.assert_allclose(np.abs(tips), [[spread[0], 0.3, 0.0], [0.0, 0.3, spread[2]]], atol=1e-6)
 
     # Markers: measured, never in a level (a kept leaf's own rotation places them).
-    markers = measured_by_tips(analyze_motion(tipped), motion)
+    markers = measured_by_skin(analyze_motion(tipped), motion, [skin])
     assert markers.markers == [4, 5]
     for level in build_motion_chain(tipped, [4, 3, 2], analysis=markers).levels:
         assert not level.frozen.kept[4:].any() and level.motion.skeleton.names[-1] in NAMES
@@ -122,3 +123,23 @@ def test_motion_on_a_gltf_character_keeps_its_skinned_leaf(rig, tmp_path) -> Non
     assert levels[1]["joints"] == 3 and levels[1]["error"] < 1e-6
     kept = read_gltf(tmp_path / "levels" / levels[1]["files"][-1]).skinned_meshes[0].skeleton.names
     assert kept == ["root", "spine", "head"]  # 'control' froze, the head turns
+
+
+def test_a_joint_that_moves_no_skin_freezes_first_even_translating_and_counts_in_no_error(rig) -> None:
+    # 'control' carries no skin, nor does its parent: a rig's IK target. Let it translate too.
+    skin, motion = rig
+    translations = np.broadcast_to(motion.skeleton.offsets, (motion.frame_count, 4, 3)).copy()
+    translations[:, 3, 1] = np.linspace(0.0, 0.5, motion.frame_count)
+    moving = dataclasses.replace(motion, joint_translations=translations)
+    bare = analyze_motion(moving)
+    assert bare.translating == [3] and joint_floor(moving, bare).fewest == 2  # it could never freeze
+
+    tipped = with_skin_tips(moving, [skin])
+    measured = measured_by_skin(analyze_motion(tipped), moving, [skin])
+    assert measured.hidden == [3] and measured.translating == [3] and measured.priority[0] == 3
+    assert joint_floor(tipped, measured).fewest == 1
+    level = without_skin_tips(build_motion_chain(tipped, [3], analysis=measured), moving, skin).levels[1]
+    assert level.report.frozen == ["control"] and level.report.max_error < 1e-9  # held, unmeasured
+    # Something hung from it (a prop under an IK target) shows: then it is measured as before.
+    attached = measured_by_skin(analyze_motion(tipped), moving, [skin], attached=[3])
+    assert attached.hidden == [] and 3 not in attached.priority

@@ -204,7 +204,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _print_summary(chain, floor, skinned: bool) -> None:
     size = chain.figure_size
-    leaves = ", leaf joints measured by points of their skin" if skinned else ""
+    leaves = ", as the skin sees them (leaf joints by points of their skin, joints that move none left out)"
+    leaves = leaves if skinned else ""
     print(f"\nfigure size {size:.4g} (asset units); errors over every original joint and frame{leaves}")
     if floor.fewest > floor.paper_fewest:
         print(

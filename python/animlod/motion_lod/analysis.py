@@ -64,10 +64,14 @@ class MotionAnalysis:
     locked : joint indices the caller locked (never frozen).
     frames : (n,) int64 frames the analysis used (all frames unless subsampled).
     r_max : the normaliser of Eq. 1, in the asset's units; 0 where every bone has zero length.
-    translating : joint indices whose translation moves (see translating_joints), never frozen.
+    translating : joint indices whose translation moves (see translating_joints), never frozen
+        unless hidden.
     ranking : the name of the ranking that ordered ``priority`` (ranking.RANKINGS).
     markers : end sites that measure their joint's rotation but belong to no level (a skinned
         leaf joint's skin tips, skin_tips.py): never re-fitted, placed from their joint.
+    hidden : joints that move nothing measured (no skin on or below them, nor on their parent:
+        a rig's IK targets and controls, skin_tips.py): first in ``priority``, translating or
+        not, and left out of every error.
     """
 
     key_frames: np.ndarray
@@ -79,6 +83,7 @@ class MotionAnalysis:
     translating: list[int] = field(default_factory=list)
     ranking: str = "importance"
     markers: list[int] = field(default_factory=list)
+    hidden: list[int] = field(default_factory=list)
 
     def key_rotations(self, motion: Motion) -> np.ndarray:
         """Key posture (Section 4.2): every joint's local rotation at its key frame, ``(J, 4)``."""

@@ -40,7 +40,8 @@ class LevelReport:
     """Errors and cost of one level, lengths in the asset's units.
 
     mean_error / max_error: joint position error of the level (frozen parts placed by their key
-    posture) against the original, over every original point and frame. bone_error: Fig. 7's
+    posture) against the original, over every original point (but MotionAnalysis.hidden's) and
+    frame. bone_error: Fig. 7's
     mean over frames of the summed |b(t) - b(0)| of the re-fitted bones; bone_variation: the
     largest standard deviation over frames of a re-fitted bone's length, relative to its key
     length. fk_residual: largest distance between the output's forward kinematics and the
@@ -126,7 +127,7 @@ def joint_floor(motion: Motion, analysis: MotionAnalysis) -> JointFloor:
     names = motion.skeleton.names
     total = int(np.count_nonzero(~motion.skeleton.end_sites))
     locked = [j for j in analysis.locked if j != 0]
-    translating = [j for j in analysis.translating if j != 0 and j not in locked]
+    translating = [j for j in analysis.translating if j != 0 and j not in locked and j not in analysis.hidden]
     return JointFloor(
         total=total,
         fewest=total - len(analysis.priority),
@@ -267,17 +268,19 @@ def _trial_key(level: FrozenLevel) -> bytes:
 @dataclass
 class _Solved:
     """A level re-fitted on a motion's frames: the problem, the solve, the level's output motion,
-    every original point placed by it (frozen parts by their key posture) and the original."""
+    every original point placed by it (frozen parts by their key posture), the original, and
+    which points the errors count (FrozenLevel.measured)."""
 
     problem: RefitProblem
     result: RefitResult
     output: Motion
     placed: np.ndarray
     original: np.ndarray
+    measured: np.ndarray
 
     def errors(self) -> np.ndarray:
-        """(T, J) distance of every original point from its original position."""
-        return np.linalg.norm(self.placed - self.original, axis=-1)
+        """(T, M) distance of every measured original point from its original position."""
+        return np.linalg.norm(self.placed[:, self.measured] - self.original[:, self.measured], axis=-1)
 
 
 def _solve_level(
@@ -316,7 +319,7 @@ def _solve_level(
             progress(motion.frame_count)
     output = recover_motion(level, result.positions, motion)
     placed = expand_motion(level, output, motion).world_positions()
-    return _Solved(problem, result, output, placed, original)
+    return _Solved(problem, result, output, placed, original, level.measured)
 
 
 def build_level(

@@ -40,6 +40,7 @@ class FrozenLevel:
         point and its kept parent (identity when there are none).
     fold_translations : (J, 3) their combined translation, in the kept parent's frame.
     animated : (J,) bool translating joints (analysis.translating_joints): their bone is not rigid.
+    measured : (J,) bool points the level's errors count (all but MotionAnalysis.hidden).
     """
 
     skeleton: Skeleton
@@ -52,6 +53,7 @@ class FrozenLevel:
     fold_rotations: np.ndarray
     fold_translations: np.ndarray
     animated: np.ndarray
+    measured: np.ndarray
 
     @property
     def kept_indices(self) -> np.ndarray:
@@ -74,7 +76,8 @@ class FrozenLevel:
 def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | np.ndarray) -> FrozenLevel:
     """Freeze ``frozen_joints`` (original indices) of ``motion`` at their key frames.
 
-    Raises ValueError for the root, an end site, a locked joint or a translating one.
+    Raises ValueError for the root, an end site, a locked joint or a translating one that is not
+    hidden (MotionAnalysis.hidden; its translation is then held at the key posture).
     """
     skeleton = motion.skeleton
     count = skeleton.joint_count
@@ -82,7 +85,9 @@ def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | 
     frozen[np.asarray(frozen_joints, dtype=np.int64)] = True
     animated = np.zeros(count, bool)
     animated[analysis.translating] = True
-    forbidden = frozen & (skeleton.end_sites | animated)
+    hidden = np.zeros(count, bool)
+    hidden[analysis.hidden] = True
+    forbidden = frozen & (skeleton.end_sites | (animated & ~hidden))
     forbidden[0] |= frozen[0]
     forbidden[analysis.locked] |= frozen[analysis.locked]
     if forbidden.any():
@@ -93,6 +98,7 @@ def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | 
     end_site_parents = skeleton.parents[skeleton.end_sites]
     kept[np.flatnonzero(skeleton.end_sites)[frozen[end_site_parents]]] = False
     kept[analysis.markers] = False
+    measured = ~hidden
 
     key_rotations = analysis.key_rotations(motion)
     key_translations = analysis.key_translations(motion)
@@ -126,6 +132,7 @@ def freeze(motion: Motion, analysis: MotionAnalysis, frozen_joints: list[int] | 
         fold_rotations,
         fold_translations,
         animated,
+        measured,
     )
 
 

@@ -11,7 +11,8 @@ ranking.PROPOSING_RANKINGS proposes its next joints after those already frozen; 
 proposal is frozen and re-fitted on TRIAL_FRAMES evenly spaced frames of the clip, and the one
 with the lowest mean joint position error over every original point is kept (ties: the earlier
 ranking, importance first). A joint frozen at one level stays frozen at every coarser one. The
-kept proposal's trial is the level's own re-fit of those frames (chain.py reuses it).
+kept proposal's trial is the level's own re-fit of those frames (chain.py reuses it). Hidden
+joints (MotionAnalysis.hidden: they move nothing measured) freeze first, without a trial.
 
 Proposals are tried in ranking order, and one whose error is at the resolution of the float32 keys
 the levels are written with (NEGLIGIBLE_ERROR) is kept without trying the rest: below it the
@@ -79,6 +80,8 @@ def choose_by_refit(
     frames = spread_frames(motion.frame_count, TRIAL_FRAMES)
     frozen: list[int] = []
     for chosen, count in enumerate(counts[1:], start=1):
+        # Hidden joints move nothing measured: they go first, without a trial.
+        frozen += [j for j in analysis.hidden if j not in frozen][: counts[0] - count - len(frozen)]
         need = counts[0] - count - len(frozen)
         proposals: list[list[int]] = []
         for order in orders:

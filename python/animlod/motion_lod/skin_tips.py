@@ -11,7 +11,7 @@ first level (36 of 50 joints), 8 % of its size on the skin for a joint error of 
 its weighted centroid moved one standard deviation along each of the two main axes of the skin
 around it (weighted principal axes, in the joint's bind frame). Two points off one line fix the
 joint's rotation, swing and twist, and their displacement is the skin's. The chain is built on
-that motion with the tips as markers (:func:`measured_by_tips`): they count in Eq. 1 and in every
+that motion with the tips as markers (:func:`measured_by_skin`): they count in Eq. 1 and in every
 error, but they belong to no level and are not re-fitted (a kept leaf keeps its own rotation, which
 places them; as SLSQP variables they took 1.7x the CPU time of Soldier.glb's 4 levels for about
 the same errors). Then
@@ -22,6 +22,7 @@ errors measured on the skin's points.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -76,7 +77,7 @@ def with_skin_tips(motion: Motion, skins: list[SkinnedMesh]) -> Motion:
 
 def _tip_offsets(skeleton: Skeleton, skins: list[SkinnedMesh]) -> dict[int, np.ndarray]:
     """``{leaf joint: (2, 3) tip offsets in its frame}`` for the leaf joints the skins weigh."""
-    leaves = np.ones(skeleton.joint_count, bool)
+    leaves = _joint_weights(skeleton, skins) > 0.0  # checks the skins' skeletons too
     leaves[skeleton.parents[1:]] = False
     leaves &= ~skeleton.end_sites
     leaves[0] = False
@@ -84,8 +85,6 @@ def _tip_offsets(skeleton: Skeleton, skins: list[SkinnedMesh]) -> dict[int, np.n
     first = np.zeros((skeleton.joint_count, 3))
     second = np.zeros((skeleton.joint_count, 3, 3))
     for skin in skins:
-        if skin.skeleton.names != skeleton.names:
-            raise ValueError("skin: its skeleton's joint names differ from the motion's")
         weights = skin.weights.astype(np.float64)
         used = weights > 0.0
         vertices, slots = np.nonzero(used & leaves[skin.joints])
@@ -107,14 +106,46 @@ def _tip_offsets(skeleton: Skeleton, skins: list[SkinnedMesh]) -> dict[int, np.n
     return tips
 
 
-def measured_by_tips(analysis: MotionAnalysis, motion: Motion) -> MotionAnalysis:
-    """``analysis`` of :func:`with_skin_tips` of ``motion``, its tips made markers."""
-    tipped = analysis.key_frames.size
-    return dataclasses.replace(analysis, markers=list(range(motion.skeleton.joint_count, tipped)))
+def measured_by_skin(
+    analysis: MotionAnalysis, motion: Motion, skins: list[SkinnedMesh], attached: Sequence[int] = ()
+) -> MotionAnalysis:
+    """``analysis`` of :func:`with_skin_tips` of ``motion``, measured as the skins see it: the tips
+    are markers, and the joints that move no skin are hidden: no skin on them or below them, nor
+    on their parent (whose end bone such a joint would be), and no node hung from them or below
+    them (``attached``: joint indices, a character's props). Those are a rig's IK targets and
+    controls (Castle Game Engine's knight: 18 of 50 joints, 6 of them translating); they freeze
+    first, translating or not, and count in no error. A locked joint is never hidden."""
+    skeleton = motion.skeleton
+    carries = _joint_weights(skeleton, skins) > 0.0
+    carries[list(attached)] = True
+    below = carries.copy()
+    for joint in range(skeleton.joint_count - 1, 0, -1):  # O(J): children before parents
+        below[skeleton.parents[joint]] |= below[joint]
+    hidden = [
+        j
+        for j in range(1, skeleton.joint_count)
+        if not below[j] and not carries[skeleton.parents[j]] and j not in analysis.locked
+    ]
+    return dataclasses.replace(
+        analysis,
+        markers=list(range(skeleton.joint_count, analysis.key_frames.size)),
+        hidden=hidden,
+        priority=hidden + [j for j in analysis.priority if j not in hidden],
+    )
+
+
+def _joint_weights(skeleton: Skeleton, skins: list[SkinnedMesh]) -> np.ndarray:
+    """(J,) the summed skin weight of every joint over ``skins``."""
+    total = np.zeros(skeleton.joint_count)
+    for skin in skins:
+        if skin.skeleton.names != skeleton.names:
+            raise ValueError("skin: its skeleton's joint names differ from the motion's")
+        np.add.at(total, skin.joints.ravel(), skin.weights.ravel().astype(np.float64))
+    return total
 
 
 def without_skin_tips(chain: MotionLodChain, motion: Motion, skin: SkinnedMesh | None = None) -> MotionLodChain:
-    """``chain``, built on :func:`with_skin_tips` of ``motion`` with :func:`measured_by_tips`,
+    """``chain``, built on :func:`with_skin_tips` of ``motion`` with :func:`measured_by_skin`,
     on ``motion``'s joints: the frozen splits, the re-fitted positions and the analysis without
     the tips (the levels' skeletons never had them), the reports (errors measured on the tips
     too) as they are, and each level's skin ``skin`` moved onto its kept joints

@@ -110,7 +110,7 @@ def build_motion_levels(
     """
     from ..motion_lod.chain import build_motion_chain
     from ..motion_lod.objective import Weights
-    from ..motion_lod.skin_tips import measured_by_tips, with_skin_tips, without_skin_tips
+    from ..motion_lod.skin_tips import without_skin_tips
     from ..options import MotionRefitOptions
 
     if workers < 0:
@@ -131,12 +131,9 @@ def build_motion_levels(
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
     spans = [frames for _, frames in played] if len(played) > 1 else None
-    # Leaf joints are measured by their skin's points (skin_tips.py); the levels drop them.
-    tipped = motion if skin is None else with_skin_tips(motion, [skin])
-    analysis, counts, floor = _plan_levels(
-        tipped, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
+    tipped, analysis, counts, floor = _plan_levels(
+        motion, skin, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
-    analysis = measured_by_tips(analysis, motion)
     if floor.possible_levels == 1:
         note(
             f"{os.fspath(source)}: nothing can freeze ({floor.total} joint{'s' if floor.total != 1 else ''}, "
@@ -364,6 +361,7 @@ def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Mot
 
 def _plan_levels(
     motion: Motion,
+    skin: SkinnedMesh | None,
     spans: list[slice] | None,
     levels: int | None,
     joints: Sequence[int] | None,
@@ -372,14 +370,17 @@ def _plan_levels(
     translation_tolerance: float,
     ranking: str,
     workers: int,
-) -> tuple[MotionAnalysis, list[int], JointFloor]:
-    """The motion analysis (over each clip's frames, ``spans``, of several), the joint counts of
-    the levels and the joint floor (ValueError on a bad request)."""
+) -> tuple[Motion, MotionAnalysis, list[int], JointFloor]:
+    """The motion the chain is built on (with the skin's tips, skin_tips.py, for a skinned input),
+    its analysis (over each clip's frames, ``spans``, of several; measured as the skin sees it),
+    the joint counts of the levels and the joint floor (ValueError on a bad request)."""
     from ..motion_lod.analysis import analyze_motion
     from ..motion_lod.chain import joint_floor, level_joint_counts
+    from ..motion_lod.skin_tips import measured_by_skin, with_skin_tips
 
+    tipped = motion if skin is None else with_skin_tips(motion, [skin])
     analysis = analyze_motion(
-        motion,
+        tipped,
         locked=lock,
         max_frames=max_frames,
         translation_tolerance=translation_tolerance,
@@ -387,13 +388,15 @@ def _plan_levels(
         workers=workers,
         clips=spans,
     )
-    floor = joint_floor(motion, analysis)
+    if skin is not None:
+        analysis = measured_by_skin(analysis, motion, [skin])
+    floor = joint_floor(tipped, analysis)
     if joints:
-        return analysis, level_joint_counts(motion, analysis, list(joints)), floor
+        return tipped, analysis, level_joint_counts(tipped, analysis, list(joints)), floor
     if floor.possible_levels == 1:  # every joint stays: one level, in a note
-        return analysis, [floor.total], floor
+        return tipped, analysis, [floor.total], floor
     count = levels if levels is not None else min(8, floor.possible_levels)
-    return analysis, level_joint_counts(motion, analysis, count), floor
+    return tipped, analysis, level_joint_counts(tipped, analysis, count), floor
 
 
 def motion_asset(

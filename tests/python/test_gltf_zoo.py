@@ -434,7 +434,7 @@ def test_motion_levels_of_every_clip_share_one_skeleton_per_level(tmp_path: Path
         assert [clip["name"] for clip in row["clips"]] == ["Armature|Bend"] * 2
         assert max(errors) == pytest.approx(level.report.max_error, rel=1e-12, abs=1e-15)
     # A clip and its reverse: the same error, up to the solver's tolerance (each frame's solve
-    # starts from the frame before, and the tube's skinned tip is re-fitted, skin_tips.py).
+    # starts from the frame before, and the tube's skinned tip is re-fitted, skin_measure.py).
     first, reverse = (clip["error"] for clip in manifest["levels"][-1]["clips"])
     assert first == pytest.approx(reverse, rel=1e-6)
 

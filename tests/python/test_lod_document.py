@@ -401,7 +401,7 @@ def test_character_keeps_the_motion_whole_where_no_joint_can_freeze(data_dir, tm
 
 def test_character_freezes_a_skinned_leaf_on_its_parent_and_measures_it_on_the_skin(data_dir, tmp_path):
     # The same joints, SimpleSkin's own skin: joint 1's rotation bends the upper half, which its
-    # skin's points show (skin_tips.py), so it can freeze, at the error it costs.
+    # skin's points show (skin_measure.py), so it can freeze, at the error it costs.
     from animlod.pipelines.character import build_character
 
     report = build_character(data_dir / "gltf" / "SimpleSkin.gltf", tmp_path / "character.glb", [0.5], **QUICK)

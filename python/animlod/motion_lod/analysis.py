@@ -68,9 +68,9 @@ class MotionAnalysis:
         unless hidden.
     ranking : the name of the ranking that ordered ``priority`` (ranking.RANKINGS).
     markers : end sites that measure their joint's rotation but belong to no level (a skinned
-        leaf joint's skin tips, skin_tips.py): never re-fitted, placed from their joint.
+        leaf joint's skin tips, skin_measure.py): never re-fitted, placed from their joint.
     hidden : joints that move nothing measured (no skin on or below them, nor on their parent:
-        a rig's IK targets and controls, skin_tips.py): first in ``priority``, translating or
+        a rig's IK targets and controls, skin_measure.py): first in ``priority``, translating or
         not, and left out of every error.
     """
 

@@ -51,7 +51,7 @@ from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joi
 from ..motion_lod.chain import MotionLevel
 from ..motion_lod.clips import join_clips
 from ..motion_lod.frozen import FrozenLevel
-from ..motion_lod.skin_tips import measured_by_skin, with_skin_tips, without_skin_tips
+from ..motion_lod.skin_measure import measured_by_skin, with_skin_tips, without_skin_tips
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
 from .clip_import import with_clips
@@ -160,7 +160,7 @@ def build_character(
             )
             motion_chains[skin] = _SkinMotion(None, list(zip(clips, spans)), drawable.rig, joined)
             continue
-        # Measured as the skin sees it (skin_tips.py): leaf joints by their skin's points, joints
+        # Measured as the skin sees it (skin_measure.py): leaf joints by their skin's points, joints
         # that move no skin and hold no attachment not at all. The levels drop the points.
         same_joints = [d.skinned for d in animated if d.rig.joint_nodes == drawable.rig.joint_nodes]
         tipped = with_skin_tips(joined, same_joints)

@@ -110,7 +110,7 @@ def build_motion_levels(
     """
     from ..motion_lod.chain import build_motion_chain
     from ..motion_lod.objective import Weights
-    from ..motion_lod.skin_tips import without_skin_tips
+    from ..motion_lod.skin_measure import without_skin_tips
     from ..options import MotionRefitOptions
 
     if workers < 0:
@@ -371,12 +371,12 @@ def _plan_levels(
     ranking: str,
     workers: int,
 ) -> tuple[Motion, MotionAnalysis, list[int], JointFloor]:
-    """The motion the chain is built on (with the skin's tips, skin_tips.py, for a skinned input),
+    """The motion the chain is built on (with the skin's tips, skin_measure.py, for a skinned input),
     its analysis (over each clip's frames, ``spans``, of several; measured as the skin sees it),
     the joint counts of the levels and the joint floor (ValueError on a bad request)."""
     from ..motion_lod.analysis import analyze_motion
     from ..motion_lod.chain import joint_floor, level_joint_counts
-    from ..motion_lod.skin_tips import measured_by_skin, with_skin_tips
+    from ..motion_lod.skin_measure import measured_by_skin, with_skin_tips
 
     tipped = motion if skin is None else with_skin_tips(motion, [skin])
     analysis = analyze_motion(

@@ -1,22 +1,27 @@
-"""Points of the skin that a leaf joint turns, so that its rotation counts (Eqs. 1-5).
+"""A skinned rig's motion measured as its skin sees it (Eqs. 1-5 on the points that matter).
 
 The paper measures a joint by the points below it: Eq. 1's bones to its children, the re-fit's
-joint positions (Eq. 5) and the levels' errors. A BVH leaf ends in an End Site; a glTF skeleton's
-leaf joints have nothing below them (Blender's head, toes and weapon bones), so turning one moves
-no point. Eq. 1 gave such a joint importance 0 and the re-fit saw no error in freezing it, so it
-froze first whatever skin it carried: Castle Game Engine's knight lost its head's motion at the
-first level (36 of 50 joints), 8 % of its size on the skin for a joint error of 1e-6.
+joint positions (Eq. 5) and the levels' errors. On a skinned rig that misjudges two kinds of joint.
 
-:func:`with_skin_tips` gives every leaf joint that carries skin two end sites where its skin is:
-its weighted centroid moved one standard deviation along each of the two main axes of the skin
-around it (weighted principal axes, in the joint's bind frame). Two points off one line fix the
-joint's rotation, swing and twist, and their displacement is the skin's. The chain is built on
-that motion with the tips as markers (:func:`measured_by_skin`): they count in Eq. 1 and in every
-error, but they belong to no level and are not re-fitted (a kept leaf keeps its own rotation, which
-places them; as SLSQP variables they took 1.7x the CPU time of Soldier.glb's 4 levels for about
-the same errors). Then
-:func:`without_skin_tips` takes them out of the chain, whose levels have the input's joints and
-errors measured on the skin's points.
+- A leaf joint that carries skin. A BVH leaf ends in an End Site; a glTF skeleton's leaf joints
+  have nothing below them (Blender's head, toes and weapon bones), so turning one moved no point:
+  Eq. 1 gave it importance 0 and the re-fit saw no error in freezing it, so it froze first
+  whatever skin it carried (Castle Game Engine's knight lost its head's motion at the first
+  level, 8 % of its size on the skin for a joint error of 1e-6). :func:`with_skin_tips` gives it
+  two end sites where its skin is: the weighted centroid moved one standard deviation along each
+  of the two main axes of the skin around the joint (weighted principal axes, in its bind
+  frame). Two points off one line fix the joint's rotation, swing and twist, and their
+  displacement is the skin's. They are markers (MotionAnalysis.markers): they count in Eq. 1 and
+  in every error, belong to no level and are not re-fitted (a kept leaf keeps its own rotation,
+  which places them; as SLSQP variables they took 1.7x the CPU time of Soldier.glb's 4 levels
+  for about the same errors).
+- A joint that moves no skin: a rig's IK targets and controls. Its position cost as much as any
+  joint's, and a translating one could never freeze (the knight: 18 of 50 joints, 6 translating).
+  :func:`measured_by_skin` hides it (MotionAnalysis.hidden): it freezes first, translating or
+  not, and counts in no error.
+
+:func:`without_skin_tips` then takes the tips out of the chain, whose levels have the input's
+joints and errors measured as the skin sees them.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Leaf joints measured by their skin's points (motion_lod/skin_tips.py).
+"""Leaf joints measured by their skin's points (motion_lod/skin_measure.py).
 
 A glTF leaf joint has no point below it, so its rotation moved no joint: the paper's measures
 gave it nothing to lose, and Blender characters lost their heads' motion at the first level.
@@ -18,7 +18,7 @@ from animlod.io import read_gltf, write_glb
 from animlod.model import Motion, Skeleton, SkinnedMesh
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, joint_floor
-from animlod.motion_lod.skin_tips import measured_by_skin, with_skin_tips, without_skin_tips
+from animlod.motion_lod.skin_measure import measured_by_skin, with_skin_tips, without_skin_tips
 from animlod.motion_lod.skin_transfer import transfer_skin
 
 NAMES = ["root", "spine", "head", "control"]

@@ -1,8 +1,8 @@
 """Motion levels of skinned glTF characters measured on the bare skeleton and as the skin sees it
-(motion_lod/skin_tips.py: skinned leaf joints by points of their skin, joints that move no skin
+(motion_lod/skin_measure.py: skinned leaf joints by points of their skin, joints that move no skin
 not at all).
 
-Run: ``.venv/bin/python bench/bench_skin_tips.py`` (part of ``make bench``). For every skinned,
+Run: ``.venv/bin/python bench/bench_skin_measure.py`` (part of ``make bench``). For every skinned,
 animated glTF of ../shared/data/gltf and of Castle Game Engine's examples (Debian's
 castle-game-engine-doc, Blender exports whose leaf joints carry skin; each distinct file once),
 the largest mesh's motion levels as ``animlod character`` builds them (every clip as one motion,
@@ -29,7 +29,7 @@ from table import print_table
 from animlod.io.gltf_drawable import read_document_drawables
 from animlod.motion_lod import analyze_motion, build_motion_chain
 from animlod.motion_lod.clips import join_clips
-from animlod.motion_lod.skin_tips import measured_by_skin, with_skin_tips, without_skin_tips
+from animlod.motion_lod.skin_measure import measured_by_skin, with_skin_tips, without_skin_tips
 from animlod.motion_lod.skin_transfer import transfer_skin
 from animlod.pipelines.attachments import find_attachments
 

@@ -67,3 +67,4 @@ def test_the_knight_keeps_its_head_and_drops_its_ik_controls_first(tmp_path: Pat
     assert {"knee_pole_l", "foot_ctrl_l", "hand_ik_l", "arm_pole_r"} <= set(first.frozen)
     assert first.max_error < 1e-3 * report.chain.figure_size
     assert report.floor.fewest == 7 and report.chain.levels[-1].report.joint_count == 7
+    assert any("18 joints move no skin (knee_pole_l, knee_pole_r, " in note for note in report.notes)

@@ -18,7 +18,7 @@ from animlod.io import read_gltf, write_glb
 from animlod.model import Motion, Skeleton, SkinnedMesh
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, joint_floor
-from animlod.motion_lod.skin_measure import measured_by_skin, with_skin_tips, without_skin_tips
+from animlod.motion_lod.skin_measure import hidden_note, measured_by_skin, with_skin_tips, without_skin_tips
 from animlod.motion_lod.skin_transfer import transfer_skin
 
 NAMES = ["root", "spine", "head", "control"]
@@ -137,6 +137,8 @@ def test_a_joint_that_moves_no_skin_freezes_first_even_translating_and_counts_in
     tipped = with_skin_tips(moving, [skin])
     measured = measured_by_skin(analyze_motion(tipped), moving, [skin])
     assert measured.hidden == [3] and measured.translating == [3] and measured.priority[0] == 3
+    assert hidden_note(measured, moving) == "1 joint moves no skin (control): they freeze first and count in no error"
+    assert hidden_note(bare, moving) is None
     assert joint_floor(tipped, measured).fewest == 1
     level = without_skin_tips(build_motion_chain(tipped, [3], analysis=measured), moving, skin).levels[1]
     assert level.report.frozen == ["control"] and level.report.max_error < 1e-9  # held, unmeasured

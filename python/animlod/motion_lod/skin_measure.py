@@ -139,6 +139,16 @@ def measured_by_skin(
     )
 
 
+def hidden_note(analysis: MotionAnalysis, motion: Motion) -> str | None:
+    """What the summary says of the hidden joints (``measured_by_skin``), or None without any."""
+    if not analysis.hidden:
+        return None
+    names = [motion.skeleton.names[j] for j in analysis.hidden]
+    shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
+    count = "1 joint moves" if len(names) == 1 else f"{len(names)} joints move"
+    return f"{count} no skin ({shown}): they freeze first and count in no error"
+
+
 def _joint_weights(skeleton: Skeleton, skins: list[SkinnedMesh]) -> np.ndarray:
     """(J,) the summed skin weight of every joint over ``skins``."""
     total = np.zeros(skeleton.joint_count)

@@ -51,7 +51,7 @@ from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joi
 from ..motion_lod.chain import MotionLevel
 from ..motion_lod.clips import join_clips
 from ..motion_lod.frozen import FrozenLevel
-from ..motion_lod.skin_measure import measured_by_skin, with_skin_tips, without_skin_tips
+from ..motion_lod.skin_measure import hidden_note, measured_by_skin, with_skin_tips, without_skin_tips
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
 from .clip_import import with_clips
@@ -167,6 +167,9 @@ def build_character(
         attached = [attachment.joint for attachment in find_attachments(doc, drawable.rig)]
         analysis = analyze_motion(tipped, workers=workers, clips=spans)
         analysis = measured_by_skin(analysis, joined, same_joints, attached)
+        hidden = hidden_note(analysis, joined)
+        if hidden:
+            notes.append(f"skin {skin}: {hidden}")
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
         floor = joint_floor(tipped, analysis)
         levels = min(levels_wanted, floor.possible_levels)

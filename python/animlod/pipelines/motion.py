@@ -110,7 +110,7 @@ def build_motion_levels(
     """
     from ..motion_lod.chain import build_motion_chain
     from ..motion_lod.objective import Weights
-    from ..motion_lod.skin_measure import without_skin_tips
+    from ..motion_lod.skin_measure import hidden_note, without_skin_tips
     from ..options import MotionRefitOptions
 
     if workers < 0:
@@ -134,6 +134,9 @@ def build_motion_levels(
     tipped, analysis, counts, floor = _plan_levels(
         motion, skin, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
+    hidden = hidden_note(analysis, motion)
+    if hidden:
+        note(f"{os.fspath(source)}: {hidden}")
     if floor.possible_levels == 1:
         note(
             f"{os.fspath(source)}: nothing can freeze ({floor.total} joint{'s' if floor.total != 1 else ''}, "

@@ -137,7 +137,7 @@ def test_a_joint_that_moves_no_skin_freezes_first_even_translating_and_counts_in
     tipped = with_skin_tips(moving, [skin])
     measured = measured_by_skin(analyze_motion(tipped), moving, [skin])
     assert measured.hidden == [3] and measured.translating == [3] and measured.priority[0] == 3
-    assert hidden_note(measured, moving) == "1 joint moves no skin (control): they freeze first and count in no error"
+    assert hidden_note(measured, moving) == "1 joint moves no skin (control): frozen first, counted in no error"
     assert hidden_note(bare, moving) is None
     assert joint_floor(tipped, measured).fewest == 1
     level = without_skin_tips(build_motion_chain(tipped, [3], analysis=measured), moving, skin).levels[1]

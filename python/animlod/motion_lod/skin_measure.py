@@ -146,7 +146,7 @@ def hidden_note(analysis: MotionAnalysis, motion: Motion) -> str | None:
     names = [motion.skeleton.names[j] for j in analysis.hidden]
     shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
     count = "1 joint moves" if len(names) == 1 else f"{len(names)} joints move"
-    return f"{count} no skin ({shown}): they freeze first and count in no error"
+    return f"{count} no skin ({shown}): frozen first, counted in no error"
 
 
 def _joint_weights(skeleton: Skeleton, skins: list[SkinnedMesh]) -> np.ndarray:

@@ -18,7 +18,13 @@ from animlod.io import read_gltf, write_glb
 from animlod.model import Motion, Skeleton, SkinnedMesh
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, joint_floor
-from animlod.motion_lod.skin_measure import hidden_note, measured_by_skin, with_skin_tips, without_skin_tips
+from animlod.motion_lod.skin_measure import (
+    build_skinned_motion_chain,
+    hidden_note,
+    measured_by_skin,
+    with_skin_tips,
+    without_skin_tips,
+)
 from animlod.motion_lod.skin_transfer import transfer_skin
 
 NAMES = ["root", "spine", "head", "control"]
@@ -53,13 +59,6 @@ def rig():
     return skin, motion
 
 
-def _tipped_chain(motion, skin, counts, **options):
-    """The chain as the pipelines build it: on the tipped motion, the tips as markers."""
-    tipped = with_skin_tips(motion, [skin])
-    analysis = measured_by_skin(analyze_motion(tipped, **options), motion, [skin])
-    return without_skin_tips(build_motion_chain(tipped, counts, analysis=analysis), motion, skin)
-
-
 def _skin_error(skin, motion, level) -> float:
     reduced = transfer_skin(skin, level.frozen)
     return float(np.abs(reduced.bake(level.motion).frames - skin.bake(motion).frames).max())
@@ -71,7 +70,7 @@ def test_the_points_of_a_skinned_leaf_keep_its_joint_where_the_bare_skeleton_fro
     assert bare.levels[1].report.frozen == ["head"]  # nothing measured its turn: the failure
     assert _skin_error(skin, motion, bare.levels[1]) > 0.2
 
-    level = _tipped_chain(motion, skin, [3]).levels[1]
+    level = build_skinned_motion_chain(motion, skin, [3]).levels[1]
     assert level.report.frozen == ["control"]  # it carries no skin: freezing it costs nothing seen
     assert _skin_error(skin, motion, level) < 1e-5
 
@@ -94,7 +93,7 @@ def test_tips_sit_on_the_main_axes_of_the_skin_and_leave_the_levels_on_the_input
     for level in build_motion_chain(tipped, [4, 3, 2], analysis=markers).levels:
         assert not level.frozen.kept[4:].any() and level.motion.skeleton.names[-1] in NAMES
 
-    chain = _tipped_chain(motion, skin, [4, 3, 2])
+    chain = build_skinned_motion_chain(motion, skin, [4, 3, 2])
     for level in chain.levels:
         names = level.motion.skeleton.names
         assert set(names) <= set(NAMES) and level.skin.skeleton.names == names
@@ -103,7 +102,7 @@ def test_tips_sit_on_the_main_axes_of_the_skin_and_leave_the_levels_on_the_input
 
     # The errors are measured on the tips: with the spine locked, the head must go, and it shows.
     bare = build_motion_chain(motion, [2], locked=["spine"]).levels[1]
-    tipped_level = _tipped_chain(motion, skin, [2], locked=["spine"]).levels[1]
+    tipped_level = build_skinned_motion_chain(motion, skin, [2], locked=["spine"]).levels[1]
     assert set(bare.report.frozen) == set(tipped_level.report.frozen) == {"head", "control"}
     assert bare.report.max_error < 1e-9 and tipped_level.report.max_error > 0.1
 

@@ -1,6 +1,8 @@
 """Motion level of detail (seeds/000): analysis, frozen joints, re-fit and level chains.
 
-Start with :func:`build_motion_chain` (or ``animlod motion`` on the command line); the pieces:
+Start with :func:`build_motion_chain` (or ``animlod motion`` on the command line), or for a
+skinned character :func:`build_skinned_motion_chain` (skin_measure.py: measured as the skin sees
+it, as ``animlod character`` does); the pieces:
 analysis.py (Eqs. 1-3), ranking.py (elimination orders), refit_choice.py (the default order,
 chosen level by level by a trial re-fit), frozen.py (Section 5.1), objective.py
 (Eqs. 4-8), core_refit.py (SLSQP in the C++ core, the default), refit.py (the same SLSQP in
@@ -22,6 +24,7 @@ from .chain import (
 from .grouped_solve import FrameFailure
 from .objective import Weights
 from .ranking import RANKINGS
+from .skin_measure import build_skinned_motion_chain
 
 __all__ = [
     "RANKINGS",
@@ -35,6 +38,7 @@ __all__ = [
     "Weights",
     "analyze_motion",
     "build_motion_chain",
+    "build_skinned_motion_chain",
     "joint_floor",
     "level_joint_counts",
 ]

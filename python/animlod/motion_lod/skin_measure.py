@@ -33,8 +33,8 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton, SkinnedMesh
-from .analysis import MotionAnalysis
-from .chain import MotionLodChain
+from .analysis import MotionAnalysis, analyze_motion
+from .chain import MotionLodChain, build_motion_chain
 from .frozen import FrozenLevel
 from .skin_transfer import transfer_skin
 
@@ -157,6 +157,22 @@ def _joint_weights(skeleton: Skeleton, skins: list[SkinnedMesh]) -> np.ndarray:
             raise ValueError("skin: its skeleton's joint names differ from the motion's")
         np.add.at(total, skin.joints.ravel(), skin.weights.ravel().astype(np.float64))
     return total
+
+
+def build_skinned_motion_chain(
+    motion: Motion,
+    skin: SkinnedMesh,
+    levels: int | Sequence[int] = 8,
+    attached: Sequence[int] = (),
+    locked: Sequence[str] = (),
+    **options: object,
+) -> MotionLodChain:
+    """:func:`~animlod.motion_lod.chain.build_motion_chain` of ``motion`` measured as ``skin``
+    sees it, as ``animlod character`` and ``animlod motion`` build it: the levels on ``motion``'s
+    joints, each with its skin. ``options`` go to ``build_motion_chain`` (not ``analysis``)."""
+    tipped = with_skin_tips(motion, [skin])
+    analysis = measured_by_skin(analyze_motion(tipped, locked=locked), motion, [skin], attached)
+    return without_skin_tips(build_motion_chain(tipped, levels, analysis=analysis, **options), motion, skin)
 
 
 def without_skin_tips(chain: MotionLodChain, motion: Motion, skin: SkinnedMesh | None = None) -> MotionLodChain:

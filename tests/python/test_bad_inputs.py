@@ -140,6 +140,9 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
         _last_key_at(30_000.0), t / "long.glb"))], "long.glb: animation 'bend': lasts 30000 s: 900001 frames"),
     ("readers", "random bytes named .obj", lambda t: ["info", str(_write(t / "noise.obj",
         np.random.default_rng(0).bytes(4096)))], "noise.obj: byte"),
+    ("readers", "another format's text named .obj", lambda t: ["info", str(_write(t / "map.obj",
+        b"# gravitywars' levels\n****--0\n**..*--1\n"))],  # fmt: skip
+     "map.obj: line 2: '****--0' is not an OBJ statement: not a Wavefront OBJ file?"),
     ("readers", "empty obj frame", lambda t: ["info", str(_write(t / "empty.obj", b"# nothing\n"))],
      "empty.obj: mesh: no vertices and no faces"),
     ("readers", "obj without faces", lambda t: ["info", str(_write(t / "points.obj", b"v 0 0 0\nv 1 0 0\n"))],

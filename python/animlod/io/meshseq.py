@@ -234,6 +234,8 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
         data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
     (vertex_block, vertex_lines), (face_block, face_lines) = _obj_statements(data, (b"v", b"f"))
+    if not len(vertex_lines):
+        _require_obj_statement(path, data)
 
     def name_vertex(vertex: int) -> str:
         return f"vertex {vertex} (line {vertex_lines[vertex]})"
@@ -275,6 +277,25 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
     _check_face_indices(path, resolved, written, owner, len(vertices), name_face)
     return vertices, _fan_triangulate(resolved[polygons[owner]], sizes[polygons])
+
+
+# The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.
+_OBJ_KEYWORDS = frozenset(
+    b"v vt vn vp f l p o g s mg usemtl mtllib maplib usemap cstype deg bmat step curv curv2 surf parm "
+    b"trim hole scrv sp end con bevel c_interp d_interp lod shadow_obj trace_obj ctech stech".split()
+)
+
+
+def _require_obj_statement(path: Path, data: bytes) -> None:
+    """A file with no vertex whose first statement is no OBJ keyword is another format's text (a
+    game's level map named .obj): say so, rather than that the mesh is empty."""
+    for number, line in enumerate(data.split(b"\n"), start=1):
+        words = line.split()
+        if words and words[0] not in _OBJ_KEYWORDS:
+            shown = words[0][:20].decode("utf-8", "replace")
+            raise FormatError(path, f"line {number}", f"{shown!r} is not an OBJ statement: not a Wavefront OBJ file?")
+        if words:
+            return
 
 
 def _join_continued_lines(data: bytes) -> bytes:

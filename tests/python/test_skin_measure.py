@@ -144,3 +144,23 @@ def test_a_joint_that_moves_no_skin_freezes_first_even_translating_and_counts_in
     # Something hung from it (a prop under an IK target) shows: then it is measured as before.
     attached = measured_by_skin(analyze_motion(tipped), moving, [skin], attached=[3])
     assert attached.hidden == [] and 3 not in attached.priority
+
+
+def test_a_hidden_joint_takes_its_end_site_along(rig) -> None:
+    # A skeleton from a BVH (animlod's glTF of one) ends its leaves in end sites: the control's
+    # goes with it, unmeasured, and never into the elimination order (freeze() refuses one).
+    skin, motion = rig
+    skeleton = motion.skeleton
+    ended = Skeleton([*skeleton.names, "control_end"], [*skeleton.parents, 3], [*skeleton.offsets, [0.3, 0, 0]],
+                     end_sites=[False] * 4 + [True])  # fmt: skip
+    local = np.concatenate([motion.local_rotations, rotations.identity((motion.frame_count, 1))], axis=1)
+    moving = Motion(ended, motion.root_positions, local, motion.fps)
+    on_ended = dataclasses.replace(
+        skin, skeleton=ended, inverse_bind=np.concatenate([skin.inverse_bind, np.eye(4)[None]])
+    )
+    tipped = with_skin_tips(moving, [on_ended])
+    measured = measured_by_skin(analyze_motion(tipped), moving, [on_ended])
+    assert measured.hidden == [3, 4] and 4 not in measured.priority
+    assert hidden_note(measured, moving) == "1 joint moves no skin (control): frozen first, counted in no error"
+    level = without_skin_tips(build_motion_chain(tipped, [3], analysis=measured), moving).levels[1]
+    assert level.report.frozen == ["control"] and level.report.max_error < 1e-9  # its end site swung, unmeasured

@@ -69,9 +69,9 @@ class MotionAnalysis:
     ranking : the name of the ranking that ordered ``priority`` (ranking.RANKINGS).
     markers : end sites that measure their joint's rotation but belong to no level (a skinned
         leaf joint's skin tips, skin_measure.py): never re-fitted, placed from their joint.
-    hidden : joints that move nothing measured (no skin on or below them, nor on their parent:
-        a rig's IK targets and controls, skin_measure.py): first in ``priority``, translating or
-        not, and left out of every error.
+    hidden : points that move nothing measured (no skin on or below them, nor on their parent:
+        a rig's IK targets and controls and their end sites, skin_measure.py): the joints first
+        in ``priority``, translating or not, and every one left out of every error.
     """
 
     key_frames: np.ndarray

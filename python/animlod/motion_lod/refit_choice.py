@@ -79,9 +79,10 @@ def choose_by_refit(
     orders = proposal_orders(motion, analysis)
     frames = spread_frames(motion.frame_count, TRIAL_FRAMES)
     frozen: list[int] = []
+    hidden = [j for j in analysis.hidden if not motion.skeleton.end_sites[j]]
     for chosen, count in enumerate(counts[1:], start=1):
         # Hidden joints move nothing measured: they go first, without a trial.
-        frozen += [j for j in analysis.hidden if j not in frozen][: counts[0] - count - len(frozen)]
+        frozen += [j for j in hidden if j not in frozen][: counts[0] - count - len(frozen)]
         need = counts[0] - count - len(frozen)
         proposals: list[list[int]] = []
         for order in orders:

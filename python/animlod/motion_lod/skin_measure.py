@@ -134,19 +134,21 @@ def measured_by_skin(
         for j in range(1, skeleton.joint_count)
         if not below[j] and not carries[skeleton.parents[j]] and j not in analysis.locked
     ]
+    joints = [j for j in hidden if not skeleton.end_sites[j]]  # an end site goes with its joint
     return dataclasses.replace(
         analysis,
         markers=list(range(skeleton.joint_count, analysis.key_frames.size)),
         hidden=hidden,
-        priority=hidden + [j for j in analysis.priority if j not in hidden],
+        priority=joints + [j for j in analysis.priority if j not in hidden],
     )
 
 
 def hidden_note(analysis: MotionAnalysis, motion: Motion) -> str | None:
     """What the summary says of the hidden joints (``measured_by_skin``), or None without any."""
-    if not analysis.hidden:
+    skeleton = motion.skeleton
+    names = [skeleton.names[j] for j in analysis.hidden if not skeleton.end_sites[j]]
+    if not names:
         return None
-    names = [motion.skeleton.names[j] for j in analysis.hidden]
     shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
     count = "1 joint moves" if len(names) == 1 else f"{len(names)} joints move"
     return f"{count} no skin ({shown}): frozen first, counted in no error"

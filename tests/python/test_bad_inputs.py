@@ -145,6 +145,9 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
      "map.obj: line 2: '****--0' is not an OBJ statement: not a Wavefront OBJ file?"),
     ("readers", "empty obj frame", lambda t: ["info", str(_write(t / "empty.obj", b"# nothing\n"))],
      "empty.obj: mesh: no vertices and no faces"),
+    ("readers", "obj of polylines only", lambda t: ["info", str(_write(t / "axes.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 1 3\n"))],  # fmt: skip
+     "axes.obj: line 4: 2 polylines ('l') and no face: animlod simplifies surfaces"),
     ("readers", "obj without faces", lambda t: ["info", str(_write(t / "points.obj", b"v 0 0 0\nv 1 0 0\n"))],
      "points.obj: mesh: 2 vertices but no faces"),
     ("readers", "glTF channel on node 9999", lambda t: ["info", str(_edit_gltf(_small_glb(t / "a.glb"),

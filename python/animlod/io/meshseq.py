@@ -233,9 +233,12 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         data = _join_continued_lines(data)
     if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
         data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
-    (vertex_block, vertex_lines), (face_block, face_lines) = _obj_statements(data, (b"v", b"f"))
+    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines) = _obj_statements(data, (b"v", b"f", b"l"))
     if not len(vertex_lines):
         _require_obj_statement(path, data)
+    if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
+        reason = f"{len(polylines)} polylines ('l') and no face: animlod simplifies surfaces"
+        raise FormatError(path, f"line {polylines[0]}", reason)
 
     def name_vertex(vertex: int) -> str:
         return f"vertex {vertex} (line {vertex_lines[vertex]})"

@@ -261,15 +261,11 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if b"/" in face_block:
         face_block = re.sub(rb"/\S*", b"", face_block)  # v of v/vt/vn
     sizes = _row_sizes(face_block, len(face_lines))
-    # Faces of one or two vertices have no surface (pybullet's samurai_monastry.obj has 201 among
-    # its 125k): left out, as in a PLY file.
-    polygons = sizes >= 3
-    if sizes.size and not polygons.any():
-        raise FormatError(path, name_face(0), f"needs at least 3 vertices, has {sizes[0]}; so does every face")
-    if not polygons.all():
-        first = int(np.argmin(polygons))
-        warnings.warn(f"{path}: {name_face(first)}: {sizes.size - int(polygons.sum())} of {sizes.size} faces have "
-                      "fewer than 3 vertices (points or lines); left out", stacklevel=3)  # fmt: skip
+    polygons = sizes >= 3  # pybullet's samurai_monastry.obj has 201 faces of two vertices among its 125k
+    if sizes.size:
+        first = int(np.argmin(polygons))  # the first face of fewer than 3 vertices, named in the warning
+        refusal = f"needs at least 3 vertices, has {sizes[first]}; so does every face"
+        polygons = _polygons(path, sizes, name_face(first), refusal)
     owner = np.repeat(np.arange(sizes.size), sizes)
     written = _untagged_values(face_block, np.int64, sizes)
     if written is None:
@@ -280,6 +276,20 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
     _check_face_indices(path, resolved, written, owner, len(vertices), name_face)
     return vertices, _fan_triangulate(resolved[polygons[owner]], sizes[polygons])
+
+
+def _polygons(path: Path, sizes: np.ndarray, element: str, refusal: str) -> np.ndarray:
+    """(M,) bool: the faces of three vertices or more. Points and lines written among the faces
+    have no surface: they are left out with a warning naming ``element``, and a file of nothing
+    else is refused there with ``refusal``."""
+    polygons = sizes >= 3
+    if sizes.size and not polygons.any():
+        raise FormatError(path, element, refusal)
+    if not polygons.all():
+        short = sizes.size - int(polygons.sum())
+        warnings.warn(f"{path}: {element}: {short} of {sizes.size} faces have fewer than 3 vertices (points or "
+                      "lines); left out", stacklevel=4)  # fmt: skip
+    return polygons
 
 
 # The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.
@@ -510,16 +520,11 @@ def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if corners.dtype.kind == "f":
         raise FormatError(path, "element face", "vertex index list has float items; indices must be integers")
 
-    # Points and lines in the face element (assimp writes a mesh's that way): no surface, left out.
-    polygons = sizes >= 3
+    # assimp writes a mesh's points and lines into the face element.
+    refusal = f"all {sizes.size} faces have fewer than 3 vertices (points or lines)"
+    polygons = _polygons(path, sizes, "element face", refusal)
     kept = np.flatnonzero(polygons)
-    if sizes.size and not kept.size:
-        raise FormatError(path, "element face", f"all {sizes.size} faces have fewer than 3 vertices (points or lines)")
-    if kept.size < sizes.size:
-        short = sizes.size - kept.size
-        warnings.warn(f"{path}: element face: {short} of {sizes.size} faces have fewer than 3 vertices (points "
-                      "or lines); left out", stacklevel=4)  # fmt: skip
-        corners, sizes = corners[np.repeat(polygons, sizes)], sizes[kept]
+    corners, sizes = corners[np.repeat(polygons, sizes)], sizes[kept]
 
     def name_face(face_index: int) -> str:
         return f"face {kept[face_index]}"

@@ -29,7 +29,7 @@ from table import print_table
 from animlod.io.gltf_drawable import read_document_drawables
 from animlod.motion_lod import analyze_motion, build_motion_chain
 from animlod.motion_lod.clips import join_clips
-from animlod.motion_lod.skin_measure import measured_by_skin, with_skin_tips, without_skin_tips
+from animlod.motion_lod.skin_measure import analyze_skinned_motion, without_skin_tips
 from animlod.motion_lod.skin_transfer import transfer_skin
 from animlod.pipelines.attachments import find_attachments
 
@@ -67,11 +67,11 @@ def skin_errors(path: Path) -> list[list[object]]:
     seconds = {}  # skin-measured -> CPU seconds of the analysis and the chain, on one thread
     for by_skin in (False, True):
         started = time.process_time()
-        motion = with_skin_tips(joined, [skin]) if by_skin else joined
-        analysis = analyze_motion(motion, clips=spans, workers=1)
         if by_skin:
             attached = [attachment.joint for attachment in find_attachments(doc, drawable.rig)]
-            analysis = measured_by_skin(analysis, joined, [skin], attached)
+            motion, analysis = analyze_skinned_motion(joined, [skin], attached, clips=spans, workers=1)
+        else:
+            motion, analysis = joined, analyze_motion(joined, clips=spans, workers=1)
         try:
             chain = build_motion_chain(motion, LEVELS, analysis=analysis, workers=1)
             if by_skin:

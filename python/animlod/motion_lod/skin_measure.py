@@ -164,6 +164,15 @@ def _joint_weights(skeleton: Skeleton, skins: list[SkinnedMesh]) -> np.ndarray:
     return total
 
 
+def analyze_skinned_motion(
+    motion: Motion, skins: list[SkinnedMesh], attached: Sequence[int] = (), **options: object
+) -> tuple[Motion, MotionAnalysis]:
+    """The motion a skinned rig's chain is built on (``motion`` with :func:`with_skin_tips`) and
+    its :func:`analyze_motion` (``options``) measured as ``skins`` see it (:func:`measured_by_skin`)."""
+    tipped = with_skin_tips(motion, skins)
+    return tipped, measured_by_skin(analyze_motion(tipped, **options), motion, skins, attached)  # type: ignore[arg-type]
+
+
 def build_skinned_motion_chain(
     motion: Motion,
     skin: SkinnedMesh,
@@ -175,8 +184,7 @@ def build_skinned_motion_chain(
     """:func:`~animlod.motion_lod.chain.build_motion_chain` of ``motion`` measured as ``skin``
     sees it, as ``animlod character`` and ``animlod motion`` build it: the levels on ``motion``'s
     joints, each with its skin. ``options`` go to ``build_motion_chain`` (not ``analysis``)."""
-    tipped = with_skin_tips(motion, [skin])
-    analysis = measured_by_skin(analyze_motion(tipped, locked=locked), motion, [skin], attached)
+    tipped, analysis = analyze_skinned_motion(motion, [skin], attached, locked=locked)
     return without_skin_tips(build_motion_chain(tipped, levels, analysis=analysis, **options), motion, skin)
 
 

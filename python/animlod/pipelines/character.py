@@ -47,11 +47,11 @@ from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import add_animation, add_skeleton, add_skin, influence_sets
 from ..metrics import hausdorff_distances
 from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
-from ..motion_lod import MotionLodChain, analyze_motion, build_motion_chain, joint_floor
+from ..motion_lod import MotionLodChain, build_motion_chain, joint_floor
 from ..motion_lod.chain import MotionLevel
 from ..motion_lod.clips import join_clips
 from ..motion_lod.frozen import FrozenLevel
-from ..motion_lod.skin_measure import hidden_note, measured_by_skin, with_skin_tips, without_skin_tips
+from ..motion_lod.skin_measure import analyze_skinned_motion, hidden_note, without_skin_tips
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
 from .clip_import import with_clips
@@ -163,10 +163,8 @@ def build_character(
         # Measured as the skin sees it (skin_measure.py): leaf joints by their skin's points, joints
         # that move no skin and hold no attachment not at all. The levels drop the points.
         same_joints = [d.skinned for d in animated if d.rig.joint_nodes == drawable.rig.joint_nodes]
-        tipped = with_skin_tips(joined, same_joints)
         attached = [attachment.joint for attachment in find_attachments(doc, drawable.rig)]
-        analysis = analyze_motion(tipped, workers=workers, clips=spans)
-        analysis = measured_by_skin(analysis, joined, same_joints, attached)
+        tipped, analysis = analyze_skinned_motion(joined, same_joints, attached, workers=workers, clips=spans)
         hidden = hidden_note(analysis, joined)
         if hidden:
             notes.append(f"skin {skin}: {hidden}")

@@ -379,11 +379,9 @@ def _plan_levels(
     the joint counts of the levels and the joint floor (ValueError on a bad request)."""
     from ..motion_lod.analysis import analyze_motion
     from ..motion_lod.chain import joint_floor, level_joint_counts
-    from ..motion_lod.skin_measure import measured_by_skin, with_skin_tips
+    from ..motion_lod.skin_measure import analyze_skinned_motion
 
-    tipped = motion if skin is None else with_skin_tips(motion, [skin])
-    analysis = analyze_motion(
-        tipped,
+    options = dict(
         locked=lock,
         max_frames=max_frames,
         translation_tolerance=translation_tolerance,
@@ -391,8 +389,10 @@ def _plan_levels(
         workers=workers,
         clips=spans,
     )
-    if skin is not None:
-        analysis = measured_by_skin(analysis, motion, [skin])
+    if skin is None:
+        tipped, analysis = motion, analyze_motion(motion, **options)
+    else:
+        tipped, analysis = analyze_skinned_motion(motion, [skin], **options)
     floor = joint_floor(tipped, analysis)
     if joints:
         return tipped, analysis, level_joint_counts(tipped, analysis, list(joints)), floor

@@ -19,9 +19,11 @@ from animlod.model import Motion, Skeleton, SkinnedMesh
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, joint_floor
 from animlod.motion_lod.skin_measure import (
+    analyze_skinned_motion,
     build_skinned_motion_chain,
     hidden_note,
     measured_by_skin,
+    skin_trial_measure,
     with_skin_tips,
     without_skin_tips,
 )
@@ -112,6 +114,72 @@ def test_a_skin_on_no_leaf_joint_leaves_the_motion_as_it_is(rig) -> None:
     on_spine = SkinnedMesh(skin.rest_positions, skin.faces, np.where(skin.joints == 2, 1, skin.joints),
                            skin.weights, skin.inverse_bind, skin.skeleton)  # fmt: skip
     assert with_skin_tips(motion, [on_spine]) is motion
+
+
+@pytest.fixture(scope="module")
+def twisting_arm():
+    """A slab on 'arm' that turns about the arm's own bone, towards 'hand', a leaf without skin
+    (so the turn moves no point the joints' error sees), and a spine that bends slightly."""
+    names = ["root", "spine", "arm", "hand"]
+    skeleton = Skeleton(names, [-1, 0, 1, 2], [[0, 0, 0], [0, 1, 0], [0, 1, 0], [0, 1, 0]])
+    body, slab = _box([0, 1.5, 0], [0.3, 1.0, 0.3]), _box([0, 2.5, 0], [1.0, 0.8, 0.1])
+    positions = np.concatenate([body, slab]).astype(np.float32)
+    joints = np.zeros((len(positions), 4), np.int32)
+    joints[:, 0] = np.r_[np.full(len(body), 1), np.full(len(slab), 2)]
+    weights = np.zeros((len(positions), 4), np.float32)
+    weights[:, 0] = 1.0
+    inverse_bind = np.linalg.inv(skeleton.rest_world_transforms())
+    faces = np.arange(len(positions) - 2)[:, None] + [0, 1, 2]  # every vertex in a face: a GLB keeps it
+    skin = SkinnedMesh(positions, faces, joints, weights, inverse_bind, skeleton)
+    frames = 24
+    angle = np.linspace(0.0, 1.2, frames)
+    local = rotations.identity((frames, 4))
+    local[:, 1] = rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), 0.1 * np.sin(4.0 * angle))
+    local[:, 2] = rotations.from_axis_angle(np.array([0.0, 1.0, 0.0]), angle)
+    return skin, Motion(skeleton, np.zeros((frames, 3)), local, fps=24.0, name="twist")
+
+
+def _mean_skin_distance(skin, motion, level) -> float:
+    reduced = transfer_skin(skin, level.frozen)
+    return float(np.linalg.norm(reduced.bake(level.motion).frames - skin.bake(motion).frames, axis=-1).mean())
+
+
+def test_the_joints_each_level_freezes_are_chosen_by_the_skin(twisting_arm, tmp_path) -> None:
+    skin, motion = twisting_arm
+    # By the joints' error, freezing the arm's turn costs nothing: the failure.
+    bare = build_motion_chain(motion, [4, 2]).levels[1]
+    assert bare.report.frozen == ["arm", "hand"]
+    assert _mean_skin_distance(skin, motion, bare) > 0.05
+
+    level = build_skinned_motion_chain(motion, skin, [4, 2]).levels[1]
+    assert level.report.frozen == ["hand", "spine"]  # the bend, of which the re-fit repairs most
+    assert _mean_skin_distance(skin, motion, level) < 0.2 * _mean_skin_distance(skin, motion, bare)
+
+    write_glb(tmp_path / "twist.glb", skin, [motion])
+    assert main(["motion", str(tmp_path / "twist.glb"), "-o", str(tmp_path / "levels"), "--joints", "4", "2"]) == 0
+    levels = json.loads((tmp_path / "levels" / "twist_motion_lod.json").read_text())["levels"]
+    kept = read_gltf(tmp_path / "levels" / levels[1]["files"][-1]).skinned_meshes[0].skeleton.names
+    assert kept == ["root", "arm"]
+
+
+def test_the_skin_trial_measure_is_the_mean_distance_of_the_skin_on_the_input_joints(rig) -> None:
+    skin, motion = rig
+    tipped, analysis, measure = analyze_skinned_motion(motion, [skin])
+    assert tipped.skeleton.joint_count == 6  # the head's tips: the levels scored carry them
+    frames = np.array([0, 11, 23])
+    original = skin.bake(motion.take_frames(frames)).frames
+    chain = build_motion_chain(tipped, [4, 3, 2], analysis=analysis)
+    on_input = without_skin_tips(chain, motion).levels
+    for level, untipped in zip(chain.levels, on_input):
+        played = level.motion.take_frames(frames)
+        distances = np.linalg.norm(transfer_skin(skin, untipped.frozen).bake(played).frames - original, axis=-1)
+        assert measure(level.frozen, played, frames) == pytest.approx(float(distances.mean()), rel=1e-6, abs=1e-9)
+    assert measure(chain.levels[0].frozen, chain.levels[0].motion.take_frames(frames), frames) < 1e-6
+    assert measure(chain.levels[2].frozen, chain.levels[2].motion.take_frames(frames), frames) > 1e-3
+    # Several skins: the mean over all their vertices.
+    level = chain.levels[2]
+    both = skin_trial_measure(motion, [skin, skin])(level.frozen, level.motion.take_frames(frames), frames)
+    assert both == pytest.approx(measure(level.frozen, level.motion.take_frames(frames), frames), rel=1e-6)
 
 
 def test_motion_on_a_gltf_character_keeps_its_skinned_leaf(rig, tmp_path) -> None:

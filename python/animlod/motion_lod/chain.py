@@ -33,6 +33,8 @@ from .skin_transfer import transfer_skin
 SOLVERS = ("slsqp", "slsqp-python", "newton")
 # Joint counts of the paper's 8 levels as fractions of the full skeleton (Fig. 1).
 _PAPER_FRACTIONS = np.array([1.0, 0.82, 0.70, 0.58, 0.45, 0.33, 0.20, 0.08])
+# Scores a trial re-fit of the "refit" ranking: (frozen level, re-fitted motion, trial frames) -> error.
+TrialMeasure = Callable[[FrozenLevel, Motion, np.ndarray], float]
 
 
 @dataclass
@@ -379,6 +381,7 @@ def build_motion_chain(
     analysis: MotionAnalysis | None = None,
     ranking: str = DEFAULT_RANKING,
     on_choice: Callable[[int, int], None] | None = None,
+    trial_measure: TrialMeasure | None = None,
 ) -> MotionLodChain:
     """Analyse ``motion`` and build its levels.
 
@@ -405,6 +408,10 @@ def build_motion_chain(
         joints chosen by their error after a trial re-fit, refit_choice.py).
     on_choice : with the "refit" ranking, called with (levels chosen, levels to choose) as its
         trial re-fits, which run before the first level, finish each level.
+    trial_measure : with the "refit" ranking, how a trial re-fit is scored (lower is better): called
+        with the frozen level, its re-fitted motion on the trial frames and those frames. None: the
+        mean distance of every measured point from its original position; a skinned rig's chain
+        measures its skin (skin_measure.skin_trial_measure).
 
     Returns
     -------
@@ -427,6 +434,8 @@ def build_motion_chain(
             solved = _solve_level(level, motion.take_frames(frames), weights, solver, slsqp_options, workers, None)
             if not slsqp_options.warm_start:
                 trials[_trial_key(level)] = _KnownFrames(frames, solved.result)
+            if trial_measure is not None:
+                return trial_measure(level, solved.output, frames)
             return float(solved.errors().mean())
 
         analysis = choose_by_refit(motion, analysis, counts, trial_error, on_choice)

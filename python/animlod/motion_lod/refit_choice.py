@@ -10,8 +10,9 @@ the others do not share. So at every level, going from fine to coarse, each rank
 ranking.PROPOSING_RANKINGS proposes its next joints after those already frozen; each distinct
 proposal is frozen and re-fitted on TRIAL_FRAMES evenly spaced frames of the clip, and the one
 with the lowest mean joint position error over every original point is kept (ties: the earlier
-ranking, importance first). A joint frozen at one level stays frozen at every coarser one. The
-kept proposal's trial is the level's own re-fit of those frames (chain.py reuses it). Hidden
+ranking, importance first); a skinned rig scores the trials by its skin's mean distance instead
+(skin_measure.skin_trial_measure). A joint frozen at one level stays frozen at every coarser one.
+The kept proposal's trial is the level's own re-fit of those frames (chain.py reuses it). Hidden
 joints (MotionAnalysis.hidden: they move nothing measured) freeze first, without a trial.
 
 Proposals are tried in ranking order, and one whose error is at the resolution of the float32 keys
@@ -68,8 +69,9 @@ def choose_by_refit(
     motion : the clip.
     analysis : its analysis (key frames, importance, candidates in ``priority``).
     counts : joint counts of the levels, strictly decreasing, the first every joint.
-    trial_error : mean joint position error of a frozen level re-fitted on the given frames of
-        ``motion`` (TRIAL_FRAMES evenly spaced ones, the same for every call).
+    trial_error : the error (mean joint position error, or the skin's mean distance) of a frozen
+        level re-fitted on the given frames of ``motion`` (TRIAL_FRAMES evenly spaced ones, the
+        same for every call).
     progress : called with (levels chosen, levels to choose) after each level.
 
     Returns

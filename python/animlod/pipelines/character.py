@@ -164,7 +164,9 @@ def build_character(
         # that move no skin and hold no attachment not at all. The levels drop the points.
         same_joints = [d.skinned for d in animated if d.rig.joint_nodes == drawable.rig.joint_nodes]
         attached = [attachment.joint for attachment in find_attachments(doc, drawable.rig)]
-        tipped, analysis = analyze_skinned_motion(joined, same_joints, attached, workers=workers, clips=spans)
+        tipped, analysis, trial_measure = analyze_skinned_motion(
+            joined, same_joints, attached, workers=workers, clips=spans
+        )
         hidden = hidden_note(analysis, joined)
         if hidden:
             notes.append(f"skin {skin}: {hidden}")
@@ -181,7 +183,9 @@ def build_character(
                 f"at least {floor.fewest} kept: {floor.explain()})"
             )
         say(f"skin {skin}: {levels} motion levels over {len(clips)} clips")
-        chain = build_motion_chain(tipped, levels=levels, solver=solver, workers=workers, analysis=analysis)
+        chain = build_motion_chain(
+            tipped, levels=levels, solver=solver, workers=workers, analysis=analysis, trial_measure=trial_measure
+        )
         chain = without_skin_tips(chain, joined)
         motion_chains[skin] = _SkinMotion(chain, list(zip(clips, spans)), drawable.rig, joined)
     motion_seconds = time.perf_counter() - started

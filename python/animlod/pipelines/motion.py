@@ -21,7 +21,7 @@ from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
 from ..model import Motion, SkinnedMesh
 from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis
-from ..motion_lod.chain import SOLVERS, JointFloor, MotionLodChain
+from ..motion_lod.chain import SOLVERS, JointFloor, MotionLodChain, TrialMeasure
 from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from .result import AssetResult, LevelRow, Progress
 
@@ -131,7 +131,7 @@ def build_motion_levels(
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
     spans = [frames for _, frames in played] if len(played) > 1 else None
-    tipped, analysis, counts, floor = _plan_levels(
+    tipped, analysis, trial_measure, counts, floor = _plan_levels(
         motion, skin, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
     hidden = hidden_note(analysis, motion)
@@ -153,6 +153,7 @@ def build_motion_levels(
         on_level=(lambda index, count: on_level(index, count, motion.frame_count, len(counts))) if on_level else None,
         analysis=analysis,
         on_choice=on_choice,
+        trial_measure=trial_measure,
     )
     chain = without_skin_tips(chain, motion, skin)
 
@@ -373,10 +374,11 @@ def _plan_levels(
     translation_tolerance: float,
     ranking: str,
     workers: int,
-) -> tuple[Motion, MotionAnalysis, list[int], JointFloor]:
+) -> tuple[Motion, MotionAnalysis, TrialMeasure | None, list[int], JointFloor]:
     """The motion the chain is built on (with the skin's tips, skin_measure.py, for a skinned input),
     its analysis (over each clip's frames, ``spans``, of several; measured as the skin sees it),
-    the joint counts of the levels and the joint floor (ValueError on a bad request)."""
+    the refit ranking's trial measure (the skin's, or None: the joints'), the joint counts of the
+    levels and the joint floor (ValueError on a bad request)."""
     from ..motion_lod.analysis import analyze_motion
     from ..motion_lod.chain import joint_floor, level_joint_counts
     from ..motion_lod.skin_measure import analyze_skinned_motion
@@ -390,16 +392,17 @@ def _plan_levels(
         clips=spans,
     )
     if skin is None:
-        tipped, analysis = motion, analyze_motion(motion, **options)
+        tipped, analysis, measure = motion, analyze_motion(motion, **options), None
     else:
-        tipped, analysis = analyze_skinned_motion(motion, [skin], **options)
+        tipped, analysis, measure = analyze_skinned_motion(motion, [skin], **options)
     floor = joint_floor(tipped, analysis)
     if joints:
-        return tipped, analysis, level_joint_counts(tipped, analysis, list(joints)), floor
-    if floor.possible_levels == 1:  # every joint stays: one level, in a note
-        return tipped, analysis, [floor.total], floor
-    count = levels if levels is not None else min(8, floor.possible_levels)
-    return tipped, analysis, level_joint_counts(tipped, analysis, count), floor
+        counts = level_joint_counts(tipped, analysis, list(joints))
+    elif floor.possible_levels == 1:  # every joint stays: one level, in a note
+        counts = [floor.total]
+    else:
+        counts = level_joint_counts(tipped, analysis, levels if levels is not None else min(8, floor.possible_levels))
+    return tipped, analysis, measure, counts, floor
 
 
 def motion_asset(

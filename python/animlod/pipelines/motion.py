@@ -24,10 +24,7 @@ from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis
 from ..motion_lod.chain import SOLVERS, JointFloor, MotionLodChain, TrialMeasure
 from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from .result import AssetResult, LevelRow, Progress
-
-# Inverse binds stored as float32 agree to about 1e-7 of their largest entry where two skins were
-# bound in one pose; a part whose binds differ by more than this was bound in another.
-_SAME_BIND_TOLERANCE = 1e-5
+from .skin_parts import moved_onto, placement_on
 
 
 @dataclass
@@ -282,33 +279,22 @@ def _clip_suffixes(names: list[str]) -> list[str]:
 def _whole_skin(meshes: list[SkinnedMesh]) -> tuple[SkinnedMesh, int]:
     """The first skinned mesh with every other one on its skeleton (a character in parts, as BrainStem
     is) joined to it, so that a level's GLB shows the whole character, and how many stay out. A part
-    may have a skin of its own over some of the first one's joints (as Soldier's visor has): its
-    joints map to the first skeleton's by name. Each part keeps its skinning: where both skins were
-    bound in one pose, a part's inverse binds differ from the first's by one transform ``T`` for
-    every joint its weights use (its mesh node's, :func:`animlod.io.gltf_read.skinned_mesh_of_node`),
-    which moves into its vertices. Parts on other joints, bound in another pose, or with other morph
-    targets than the first stay out."""
+    may have a skin of its own over some of the first one's joints (as Soldier's visor has; see
+    skin_parts.py). Parts on other joints, bound in another pose, or with other morph targets than
+    the first stay out."""
     first = meshes[0]
-    parts = [(first, np.arange(first.skeleton.joint_count), np.eye(4))]
+    parts = [first]
     for mesh in meshes[1:]:
         same_targets = (mesh.morph_targets is None) == (first.morph_targets is None) and (
             first.morph_targets is None or mesh.morph_target_names == first.morph_target_names
         )
-        placement = _onto_skeleton(first, mesh)
+        placement = placement_on(first, mesh)
         if same_targets and placement is not None:
-            parts.append((mesh, *placement))
+            parts.append(moved_onto(mesh, first, placement))
     if len(parts) == 1:
         return first, len(meshes) - 1
-    influences = max(part.joints.shape[1] for part, _, _ in parts)
-    moved = []
-    for part, _, to_first in parts:
-        normals = None
-        if part.normals is not None:
-            normals = part.normals @ np.linalg.inv(to_first[:3, :3])  # the inverse transpose, row vectors
-            normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
-        targets = None if part.morph_targets is None else part.morph_targets @ to_first[:3, :3].T
-        moved.append((part.rest_positions @ to_first[:3, :3].T + to_first[:3, 3], normals, targets))
-    starts = np.cumsum([0] + [part.vertex_count for part, _, _ in parts])
+    influences = max(part.joints.shape[1] for part in parts)
+    starts = np.cumsum([0] + [part.vertex_count for part in parts])
 
     def padded(values: np.ndarray) -> np.ndarray:
         return np.pad(values, ((0, 0), (0, influences - values.shape[1])))
@@ -317,39 +303,18 @@ def _whole_skin(meshes: list[SkinnedMesh]) -> tuple[SkinnedMesh, int]:
         return None if any(v is None for v in values) else np.concatenate(values, axis=axis)
 
     whole = SkinnedMesh(
-        rest_positions=np.concatenate([positions for positions, _, _ in moved]).astype(np.float32),
-        faces=np.concatenate([part.faces + start for (part, _, _), start in zip(parts, starts)]),
-        joints=np.concatenate([padded(joint_map[part.joints]) for part, joint_map, _ in parts]),
-        weights=np.concatenate([padded(part.weights) for part, _, _ in parts]),
+        rest_positions=np.concatenate([part.rest_positions for part in parts]).astype(np.float32),
+        faces=np.concatenate([part.faces + start for part, start in zip(parts, starts)]),
+        joints=np.concatenate([padded(part.joints) for part in parts]),
+        weights=np.concatenate([padded(part.weights) for part in parts]),
         inverse_bind=first.inverse_bind,
         skeleton=first.skeleton,
-        uvs=joined([part.uvs for part, _, _ in parts]),
-        normals=joined([normals for _, normals, _ in moved]),
-        morph_targets=joined([targets for _, _, targets in moved], axis=1),
+        uvs=joined([part.uvs for part in parts]),
+        normals=joined([part.normals for part in parts]),
+        morph_targets=joined([part.morph_targets for part in parts], axis=1),
         morph_target_names=first.morph_target_names,
     )
     return whole, len(meshes) - len(parts)
-
-
-def _onto_skeleton(first: SkinnedMesh, part: SkinnedMesh) -> tuple[np.ndarray, np.ndarray] | None:
-    """(the first skeleton's joint for each of ``part``'s joints, ``T`` (4, 4)) that put ``part`` on
-    ``first``'s skeleton and bind (``IBM_part = IBM_first @ T`` for every joint its weights use), or
-    None where its joints are not all the first's or were bound in another pose."""
-    index = {name: joint for joint, name in enumerate(first.skeleton.names)}
-    if part.skeleton is first.skeleton:
-        joint_map = np.arange(first.skeleton.joint_count)
-    elif all(name in index for name in part.skeleton.names):
-        joint_map = np.array([index[name] for name in part.skeleton.names])
-    else:
-        return None
-    used = np.unique(part.joints[part.weights > 0.0])
-    if not used.size:
-        return None
-    transforms = np.linalg.inv(first.inverse_bind[joint_map[used]]) @ part.inverse_bind[used]
-    scale = max(1.0, float(np.abs(transforms).max()))
-    if not np.allclose(transforms, transforms[0], rtol=0.0, atol=_SAME_BIND_TOLERANCE * scale):
-        return None
-    return joint_map, transforms[0]
 
 
 def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Motion:

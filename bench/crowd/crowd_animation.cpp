@@ -62,16 +62,17 @@ int nearest_level(const Chain& chain, int g, int m) {
   return best;
 }
 
-// One motion level per skeleton: chains whose level 0 is skinned to the same rig (the meshes of
-// one character: a body and its eyes, BrainStem's parts) draw the finest motion level any of them
+// One motion level per skeleton: the chains of one skeleton (Chain::skeleton: the meshes of one
+// character, a body and its eyes, BrainStem's parts) draw the finest motion level any of them
 // chose, each at its own mesh level, so that a character poses one skeleton and not one per
-// mesh (MLoD animated more joints than Original on such characters).
+// mesh (MLoD animated more joints than Original on such characters), and a part skinned to the
+// body's head never follows another level's head.
 void share_motion_levels(const Asset& asset, std::vector<int>& levels) {
   for (size_t c = 0; c < asset.chains.size(); ++c) {
     const Chain& chain = asset.chains[c];
     int finest = chain.levels[static_cast<size_t>(levels[c])].motion_level;
     for (size_t d = 0; d < asset.chains.size(); ++d)
-      if (asset.chains[d].levels.front().rig == chain.levels.front().rig)
+      if (asset.chains[d].skeleton == chain.skeleton)
         finest = std::min(finest, asset.chains[d].levels[static_cast<size_t>(levels[d])].motion_level);
     const Level& chosen = chain.levels[static_cast<size_t>(levels[c])];
     if (finest < chosen.motion_level) levels[c] = nearest_level(chain, chosen.mesh_level, finest);

@@ -183,10 +183,39 @@ class Loader {
       fail("scene", "no skinned mesh (a node with a mesh and a skin) in the default scene; the crowd needs a skin");
     find_original_clips(mesh_nodes.front());
     for (int node : mesh_nodes) asset_.chains.push_back(read_chain(node));
+    group_skeletons();
     compute_bounds();
   }
 
  private:
+  // Chain::skeleton: chains whose level-0 rigs move a joint node in common, transitively, share
+  // the lowest chain index among them.
+  void group_skeletons() {
+    std::vector<std::set<int>> moved;
+    for (const Chain& chain : asset_.chains) {
+      const Rig& rig = asset_.rigs[static_cast<size_t>(chain.levels.front().rig)];
+      std::set<int> nodes;
+      for (int32_t joint : rig.joint_nodes) nodes.insert(rig.nodes[static_cast<size_t>(joint)]);
+      moved.push_back(std::move(nodes));
+    }
+    for (size_t c = 0; c < asset_.chains.size(); ++c) asset_.chains[c].skeleton = static_cast<int>(c);
+    for (size_t c = 0; c < asset_.chains.size(); ++c)
+      for (size_t d = 0; d < c; ++d) {
+        const bool shared = std::any_of(moved[c].begin(), moved[c].end(), [&](int n) { return moved[d].count(n) > 0; });
+        const int from = asset_.chains[c].skeleton, to = asset_.chains[d].skeleton;
+        if (!shared || from == to) continue;
+        for (Chain& chain : asset_.chains)
+          if (chain.skeleton == std::max(from, to)) chain.skeleton = std::min(from, to);
+      }
+  }
+
+  // A joint node's name; unnamed: "node<i>", the name animlod gives an unnamed joint
+  // (gltf_skin.py), which a character chain's reduced skeletons carry: their roots then match.
+  std::string joint_name(int node) const {
+    const std::string& name = model_.nodes[static_cast<size_t>(node)].name;
+    return name.empty() ? "node" + std::to_string(node) : name;
+  }
+
   void find_parents() {
     parents_.assign(model_.nodes.size(), -1);
     for (size_t n = 0; n < model_.nodes.size(); ++n)
@@ -352,13 +381,22 @@ class Loader {
         }
       }
     }
-    const std::string& root = asset_.rigs[static_cast<size_t>(chain.levels[0].rig)].root_name;
+    // A level's skeleton root is level 0's, or an ancestor of it where level 0 is a part skinned
+    // to some of the body's joints (a helmet on the head plays the body's reduced skeletons).
+    const Rig& finest = asset_.rigs[static_cast<size_t>(chain.levels[0].rig)];
+    std::set<std::string> roots{finest.root_name};
+    for (int32_t joint : finest.joint_nodes) {
+      const int top = finest.nodes[static_cast<size_t>(joint)];
+      if (joint_name(top) != finest.root_name) continue;
+      for (int ancestor : ancestors(top)) roots.insert(joint_name(ancestor));
+      break;
+    }
     for (size_t i = 1; i < chain.levels.size(); ++i) {
       const std::string& other = asset_.rigs[static_cast<size_t>(chain.levels[i].rig)].root_name;
-      if (other != root)
+      if (!roots.count(other))
         fail(node_label(model_, node), "level node " + std::to_string(i) + " (" + node_label(model_, chain.levels[i].node) +
-                                           ") has skeleton root '" + other + "', level 0 has '" + root +
-                                           "': the levels of a chain must share a skeleton root");
+                                           ") has skeleton root '" + other + "', level 0 has '" + finest.root_name +
+                                           "': the levels of a chain must share a skeleton root (or hang below it)");
     }
     return chain;
   }
@@ -461,10 +499,7 @@ class Loader {
         bool top = true;
         for (int a : ancestors(joint)) top = top && !joints.count(a);
         if (top) {
-          const std::string& name = model_.nodes[static_cast<size_t>(joint)].name;
-          // Unnamed: "node<i>", the name animlod gives an unnamed joint (gltf_skin.py), which a
-          // character chain's reduced skeletons carry: their roots then match this one's.
-          rig.root_name = name.empty() ? "node" + std::to_string(joint) : name;
+          rig.root_name = joint_name(joint);
         }
       }
     }

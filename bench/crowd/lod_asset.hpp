@@ -85,6 +85,9 @@ struct Chain {
   size_t selection_count = 0;
   bool has_errors = false;     // every chain level records extras.animlod.error
   bool has_coverages = false;  // the node has MSFT_screencoverage
+  // The same for the chains of one skeleton: their level-0 skins move a joint node in common (the
+  // meshes of one character: a body, the visor or eyes skinned to its head, BrainStem's parts).
+  int skeleton = 0;
 
   // The level drawing (mesh level g, motion level m), or -1.
   int find(int mesh_level, int motion_level) const {

@@ -1,8 +1,9 @@
-"""Shared fixtures: the real development data (skipped cleanly when absent)."""
+"""Shared fixtures: the real development data and the crowd binary (skipped cleanly when absent)."""
 
 from __future__ import annotations
 
 import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -16,3 +17,16 @@ def data_dir() -> Path:
     if not DATA_DIR.is_dir():
         pytest.skip(f"development data not found at {DATA_DIR}")
     return DATA_DIR
+
+
+@pytest.fixture(scope="session")
+def binary() -> Path:
+    """The crowd benchmark's binary (skipped cleanly where it is not built or no display can run)."""
+    from animlod.crowd import find_crowd_binary
+
+    found = find_crowd_binary()
+    if found is None:
+        pytest.skip("animlod_crowd is not built (make test builds it and sets ANIMLOD_CROWD_BIN)")
+    if not os.environ.get("DISPLAY") and not shutil.which("xvfb-run"):
+        pytest.skip("no display and no xvfb-run")
+    return found

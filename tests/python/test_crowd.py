@@ -20,20 +20,10 @@ import pytest
 from crowd_chain import channels_as_pointers, write_hand_built_chain
 
 from animlod.cli import main as cli_main
-from animlod.crowd import CrowdError, find_crowd_binary, mode_list, run_crowd, write_heat_map
+from animlod.crowd import CrowdError, mode_list, run_crowd, write_heat_map
 
 REQUIRED = ("fps", "frame_ms_p50", "frame_ms_p95", "triangles", "joints", "drawn")
 SMALL = {"count": 24, "warmup": 2, "width": 640, "height": 360}
-
-
-@pytest.fixture(scope="module")
-def binary() -> Path:
-    found = find_crowd_binary()
-    if found is None:
-        pytest.skip("animlod_crowd is not built (make test builds it and sets ANIMLOD_CROWD_BIN)")
-    if not os.environ.get("DISPLAY") and not shutil.which("xvfb-run"):
-        pytest.skip("no display and no xvfb-run")
-    return found
 
 
 @pytest.fixture(scope="module")

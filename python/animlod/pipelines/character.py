@@ -11,9 +11,11 @@ motion level i (or the coarsest one a small skeleton has); every other combinati
 too (``extras.animlod_grid`` on the base node lists them by geometry level, then motion level)
 so that a benchmark can walk the whole grid.
 
-Motion level m >= 1 adds, per skin, a reduced skeleton as joint nodes of its own, a skin over
-them and one animation per input clip (``extras.animlod = {"clip", "motion_level"}``); a level
-node at motion level m uses that skin, so any glTF engine can play it. Nodes hung from the
+A skin whose joints all belong to a larger skin's (a helmet or visor on the head, bound in the
+same pose) is a part (:mod:`.skin_parts`): it plays that skin's motion levels, on its reduced
+skeletons. Motion level m >= 1 adds, per skin, a reduced skeleton as joint nodes of its own, a
+skin over them and one animation per input clip (``extras.animlod = {"clip", "motion_level"}``);
+a level node at motion level m uses that skin, so any glTF engine can play it. Nodes hung from the
 input's joints (props, sockets) are copied onto each level's skeleton, and each level clip also
 plays what its input clip moves besides the skeleton (morph weights; :mod:`.attachments`).
 """
@@ -57,6 +59,7 @@ from .attachments import add_level_attachments, carry_other_channels, find_attac
 from .clip_import import with_clips
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, posed_frames, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
+from .skin_parts import Placement, moved_onto, placement_on
 
 
 @dataclass
@@ -133,9 +136,12 @@ def build_character(
     started = time.perf_counter()
     motion_chains: dict[int, _SkinMotion] = {}
     chain_of: dict[int, int] = {}  # skin -> the skin whose motion levels it plays
+    parts: dict[int, _Part] = {}  # skin -> its place on the skeleton of the skin it plays
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
+    skinned_of = {d.skin_index: d.skinned for d in animated}
     # Larger skeletons first: a skin whose joints all belong to a larger skin (a helmet bound to
-    # the head) keeps its joints, as freezing them on their own would tear it from the body.
+    # the head) plays that skin's motion levels, as freezing its joints on their own, or keeping
+    # them while the body freezes them, would tear it from the body.
     for drawable in sorted(animated, key=lambda d: -len(joints_of[d.skin_index])):
         skin = drawable.skin_index
         if skin in chain_of:
@@ -148,6 +154,13 @@ def build_character(
         if twin is not None:
             chain_of[skin] = twin
             notes.append(f"skin {skin}: the joints of skin {twin}; it plays the same motion levels")
+            continue
+        owner = next((other for other in motion_chains if joints_of[skin] < joints_of[other]), None)
+        placement = None if owner is None else placement_on(skinned_of[owner], drawable.skinned)
+        if placement is not None:
+            chain_of[skin] = owner
+            parts[skin] = _Part(skinned_of[owner], placement, {clip.index: clip for clip in drawable.clips})
+            notes.append(f"skin {skin}: its joints belong to skin {owner}; it plays that skin's motion levels")
             continue
         chain_of[skin] = skin
         clips = [clip for clip in drawable.clips if clip.motion is not None]
@@ -173,10 +186,11 @@ def build_character(
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
         floor = joint_floor(tipped, analysis)
         levels = min(levels_wanted, floor.possible_levels)
-        covering = [other for other in motion_chains if joints_of[skin] < joints_of[other]]
-        if covering:
+        if owner is not None:  # bound in another pose than its owner's skin: its joints stay
             levels = 1
-            notes.append(f"skin {skin}: its joints belong to skin {covering[0]}; it keeps them at every level")
+            notes.append(
+                f"skin {skin}: its joints belong to skin {owner}, bound in another pose; it keeps them at every level"
+            )
         elif levels < levels_wanted:
             notes.append(
                 f"skin {skin}: {levels} motion level(s) for {levels_wanted} geometry levels ({floor.total} joints, "
@@ -202,12 +216,14 @@ def build_character(
     motion_nodes = {skin: motion_nodes[owner] for skin, owner in chain_of.items()}
     motion_chains = {skin: motion_chains[owner] for skin, owner in chain_of.items()}
     chains = {}
+    level_skins: dict[tuple[tuple[int, ...], bytes], int] = {}
     for drawable in animated:
         motion = motion_chains[drawable.skin_index]
         levels = geometry[drawable.label]
         say(f"{drawable.label}: writing the grid, measuring the chain")
-        grid = _write_grid(builder, doc, drawable, levels, motion, motion_nodes[drawable.skin_index])
-        report = _measure_chain(drawable, levels, motion, settings.measured_frames)
+        part = parts.get(drawable.skin_index)
+        grid = _write_grid(builder, doc, drawable, levels, motion, motion_nodes[drawable.skin_index], part, level_skins)
+        report = _measure_chain(drawable, levels, motion, settings.measured_frames, part)
         coverages = screen_coverages(
             [level.error for level in report], levels.size, settings.pixel_error, settings.viewport_px
         )
@@ -247,6 +263,22 @@ class _SkinMotion:
 
 
 @dataclass
+class _Part:
+    """A skinned drawable that plays the motion levels of a skin over more of its joints (a visor
+    on the head): that skin's mesh, where the drawable lies on its skeleton (skin_parts.py), and
+    the drawable's own clips by animation index (its morph weights)."""
+
+    first: SkinnedMesh
+    placement: Placement
+    clips: dict[int, Clip]
+
+
+def _played(skinned: SkinnedMesh, part: _Part | None) -> SkinnedMesh:
+    """``skinned`` on the skeleton whose motion levels it plays."""
+    return skinned if part is None else moved_onto(skinned, part.first, part.placement)
+
+
+@dataclass
 class _MotionLevelNodes:
     """What one motion level adds to the document for one skin: the joint nodes of its reduced
     skeleton (None at level 0, which keeps the input's joints) and its joint count."""
@@ -280,16 +312,25 @@ def _write_grid(
     levels: DrawableLevels,
     motion: _SkinMotion,
     motion_nodes: list[_MotionLevelNodes],
+    part: _Part | None,
+    level_skins: dict[tuple[tuple[int, ...], bytes], int],
 ) -> list[list[list[int]]]:
     """Every (geometry g, motion m) combination of ``drawable`` as level nodes, one per base
-    node; returns ``grid[g][m]`` -> those nodes ((0, 0) is the base nodes themselves)."""
+    node; returns ``grid[g][m]`` -> those nodes ((0, 0) is the base nodes themselves). A ``part``
+    is bound to its owner's reduced skeletons at motion levels m >= 1. ``level_skins``: the reduced
+    skins written so far, by joint nodes and inverse binds (shared across drawables)."""
     geometry: list[DrawableLevel | None] = [None, *levels.levels]  # geometry level 0 is the input
     input_joints = len(doc.gltf.skins[drawable.skin_index].joints)
     frozen = [None] + [level.frozen for level in motion.reduced_levels]  # motion level 0 freezes nothing
     skins = [drawable.skin_index]
     for m in range(1, len(frozen)):  # a reduced skin's inverse binds do not depend on the geometry
-        reduced = transfer_skin(drawable.skinned, frozen[m])
-        skins.append(add_skin(builder, motion_nodes[m].joint_nodes, reduced.inverse_bind))
+        reduced = transfer_skin(_played(drawable.skinned, part), frozen[m])
+        # One skin per reduced skeleton and binds: a part shares its owner's, so that a runtime
+        # poses that skeleton once for both.
+        key = (tuple(motion_nodes[m].joint_nodes), reduced.inverse_bind.astype(np.float32).tobytes())
+        if key not in level_skins:
+            level_skins[key] = add_skin(builder, motion_nodes[m].joint_nodes, reduced.inverse_bind)
+        skins.append(level_skins[key])
     mesh_name = doc.gltf.meshes[drawable.mesh_index].name or f"mesh{drawable.mesh_index}"
     grid = [[list(drawable.nodes) for _ in frozen] for _ in geometry]
     for g, level in enumerate(geometry):
@@ -299,7 +340,8 @@ def _write_grid(
             primitives = _input_primitives(drawable) if level is None else level.primitives
             skinned = drawable.skinned if level is None else level.skinned
             if frozen_level is not None:
-                primitives = _reposed(drawable, skinned, frozen_level, primitives)
+                to_bind = drawable.world if part is None else part.placement.transform @ drawable.world
+                primitives = _reposed(_played(skinned, part), to_bind, frozen_level, primitives)
             mesh = add_level_mesh(
                 builder, drawable.mesh_index, primitives, drawable.geometry.other_primitives, f"{mesh_name}_G{g}M{m}"
             )
@@ -319,15 +361,16 @@ def _input_primitives(drawable: Drawable) -> list[PrimitiveArrays]:
 
 
 def _reposed(
-    drawable: Drawable, skinned: SkinnedMesh, frozen: FrozenLevel, primitives: list[PrimitiveArrays]
+    skinned: SkinnedMesh, to_bind: np.ndarray, frozen: FrozenLevel, primitives: list[PrimitiveArrays]
 ) -> list[PrimitiveArrays]:
     """``primitives`` bound to a motion level's reduced skin: positions and directions re-posed
-    into the key posture of the frozen joints (world space, as the reduced skin's inverse binds
-    are), skin weights moved to the kept joints (:func:`transfer_skin`)."""
+    into the key posture of the frozen joints (in the space of ``skinned``'s rest pose and inverse
+    binds, which ``to_bind`` (4, 4) maps the primitives' node-local space to), skin weights moved to
+    the kept joints (:func:`transfer_skin`)."""
     reduced = transfer_skin(skinned, frozen)
     matrices = key_bind_pose(skinned, frozen) @ skinned.inverse_bind  # (J, 4, 4) rest -> key posture
     blended = np.einsum("vk,vkij->vij", skinned.weights, matrices[skinned.joints])[:, :3, :3]
-    to_world = np.linalg.inv(drawable.world[:3, :3]).T  # directions: the inverse transpose
+    to_bind_directions = np.linalg.inv(to_bind[:3, :3]).T  # the inverse transpose
     out = []
     for primitive in primitives:
         vertices = primitive.vertices
@@ -335,7 +378,7 @@ def _reposed(
         attributes["POSITION"] = reduced.rest_positions[vertices]
         for name in ("NORMAL", "TANGENT"):
             if name in attributes:
-                turned = np.einsum("vij,vj->vi", blended[vertices], attributes[name][:, :3] @ to_world.T)
+                turned = np.einsum("vij,vj->vi", blended[vertices], attributes[name][:, :3] @ to_bind_directions.T)
                 length = np.linalg.norm(turned, axis=1, keepdims=True)
                 values = attributes[name].copy()
                 values[:, :3] = turned / np.where(length > 0.0, length, 1.0)
@@ -355,25 +398,33 @@ def _measure_chain(
     levels: DrawableLevels,
     motion: _SkinMotion,
     measured_frames: int,
+    part: _Part | None,
 ) -> list[CharacterLevel]:
     """The chain's levels (geometry level i with motion level i, or the coarsest motion level
     there is), each measured as it is written: the level's skin played with its clips (the
     input's at motion level 0, the re-fitted ones on the reduced skin above) against the input's
-    clips, max Hausdorff distance."""
+    clips, max Hausdorff distance. A ``part`` plays its owner's clips on its owner's skeleton."""
     chain = []  # (geometry level, motion level index, motion level or None, reduced skin or None)
     for i in range(1, len(levels.levels) + 1):
         m = min(i, len(motion.reduced_levels))  # a small skeleton runs out of motion levels first
         level = levels.levels[i - 1]
         motion_level = motion.reduced_levels[m - 1] if m > 0 else None
-        reduced = None if motion_level is None else transfer_skin(level.skinned, motion_level.frozen)
+        reduced = None if motion_level is None else transfer_skin(_played(level.skinned, part), motion_level.frozen)
         chain.append((level, m, motion_level, reduced))
     errors = [0.0] * len(chain)
     for clip, span in motion.clips:
         frames = spread_frames(clip.frame_count, measured_frames)
-        original = AnimatedMesh(drawable.geometry.faces, drawable.clip_frames(clip, frames))
-        weights = None if clip.morph_weights is None else clip.morph_weights[frames]
+        weights = _morph_weights(clip, part, frames)
+        if part is None:
+            original = AnimatedMesh(drawable.geometry.faces, drawable.clip_frames(clip, frames))
+        else:
+            original = _played(drawable.skinned, part).bake(clip.motion.take_frames(frames), weights)
         posed = [
-            AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
+            (
+                AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
+                if part is None
+                else _played(level.skinned, part).bake(clip.motion.take_frames(frames), weights)
+            )
             if motion_level is None
             else reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
             for level, _, motion_level, reduced in chain
@@ -384,6 +435,15 @@ def _measure_chain(
         joints = motion.joint_count if motion_level is None else motion_level.report.joint_count
         report.append(CharacterLevel(i, i, m, level.simplified.mesh.face_count, joints, error, 0.0, 0.0))
     return report
+
+
+def _morph_weights(clip: Clip, part: _Part | None, frames: np.ndarray) -> np.ndarray | None:
+    """The morph weights of the measured drawable at ``frames`` of ``clip`` (its owner's clip for
+    a ``part``, whose own clip of that animation holds them), or None."""
+    if part is not None:
+        own = part.clips.get(clip.index)
+        clip = own if own is not None and own.frame_count == clip.frame_count else None
+    return None if clip is None or clip.morph_weights is None else clip.morph_weights[frames]
 
 
 def _attach(builder: GlbBuilder, drawable: Drawable, report: list[CharacterLevel], grid: list) -> None:

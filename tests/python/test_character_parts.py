@@ -8,15 +8,18 @@ visor: 7.8 % of the figure's diagonal apart at its 4-joint level).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pygltflib
 import pytest
 
 from animlod import synth
-from animlod.io import read_lod_chains, write_glb
+from animlod.io import read_gltf, read_lod_chains, write_glb
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
 from animlod.pipelines.character import build_character
+from animlod.pipelines.motion import build_motion_levels
 
 QUICK = {"frame_budget": 12, "measured_frames": 2}
 
@@ -28,11 +31,11 @@ def _box(centre: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
     return (centre + half * corners).astype(np.float32), np.array(faces, np.uint16)
 
 
-@pytest.fixture(scope="module")
-def helmeted(tmp_path_factory):
-    """The procedural humanoid walking, with a helmet whose own skin lists Neck and Head (bound
-    in the body's pose) and weighs every vertex to Head; its LoD GLB and the build's report."""
-    folder = tmp_path_factory.mktemp("parts")
+def _with_part(folder, name: str, hair: str | None = None) -> Path:
+    """The procedural humanoid walking, with a box over its head skinned by a skin of its own
+    (bound in the body's pose): over Neck and Head, every vertex on Head; or with ``hair``
+    ("still" or "swinging") over Head and a bone "Hair" of its own below it, every vertex on
+    Hair."""
     plain = folder / "humanoid.glb"
     character = synth.humanoid()
     write_glb(plain, character, [synth.humanoid_motion(character.skeleton, "walk")])
@@ -41,45 +44,104 @@ def helmeted(tmp_path_factory):
     nodes = builder.json["nodes"]
     by_name = {node.get("name"): index for index, node in enumerate(nodes)}
     body_skin = builder.json["skins"][0]
-    binds = np.asarray(doc.accessor(body_skin["inverseBindMatrices"], "test"), np.float32).reshape(-1, 16)
-    slots = [body_skin["joints"].index(by_name[name]) for name in ("Neck", "Head")]
-    skin = builder.append(
-        "skins", {"joints": [by_name["Neck"], by_name["Head"]], "inverseBindMatrices": builder.add(binds[slots])}
-    )
+    stored = np.asarray(doc.accessor(body_skin["inverseBindMatrices"], "test"), np.float32).reshape(-1, 4, 4)
+    head_bind = stored[body_skin["joints"].index(by_name["Head"])].T  # column-major storage
+    if hair is None:
+        joint_nodes = [by_name["Neck"], by_name["Head"]]
+        binds = [stored[body_skin["joints"].index(node)].T for node in joint_nodes]
+    else:
+        lift = np.eye(4)
+        lift[1, 3] = 0.15
+        bone = builder.append("nodes", {"name": "Hair", "translation": lift[:3, 3].tolist()})
+        nodes[by_name["Head"]].setdefault("children", []).append(bone)
+        joint_nodes, binds = [by_name["Head"], bone], [head_bind, np.linalg.inv(lift) @ head_bind]
+        if hair == "swinging":
+            animation = builder.json["animations"][0]
+            keys = builder.json["accessors"][animation["samplers"][0]["input"]]["count"]
+            angles = np.linspace(0.0, 0.6, keys)
+            turns = np.stack([np.sin(angles / 2), 0 * angles, 0 * angles, np.cos(angles / 2)], axis=1)
+            animation["samplers"].append({"input": animation["samplers"][0]["input"],
+                                          "output": builder.add(turns.astype(np.float32))})  # fmt: skip
+            target = {"node": bone, "path": "rotation"}
+            animation["channels"].append({"sampler": len(animation["samplers"]) - 1, "target": target})
+    matrices = np.stack([bind.T for bind in binds]).reshape(-1, 16).astype(np.float32)
+    skin = builder.append("skins", {"joints": joint_nodes, "inverseBindMatrices": builder.add(matrices)})
     positions, faces = _box(doc.rest_world_matrix(by_name["Head"])[:3, 3] + [0.0, 0.1, 0.0], 0.12)
     joints = np.zeros((len(positions), 4), np.uint16)
-    joints[:, 0] = 1  # Head
+    joints[:, 0] = 1  # Head, or Hair
     weights = np.zeros((len(positions), 4), np.float32)
     weights[:, 0] = 1.0
     attributes = {"POSITION": builder.add(positions, bounds=True), "JOINTS_0": builder.add(joints),
                   "WEIGHTS_0": builder.add(weights)}  # fmt: skip
     primitive = {"attributes": attributes, "indices": builder.add(faces.reshape(-1, 1))}
-    mesh = builder.append("meshes", {"name": "helmet", "primitives": [primitive]})
-    helmet = builder.append("nodes", {"name": "helmet", "mesh": mesh, "skin": skin})
-    builder.json["scenes"][0]["nodes"].append(helmet)
-    source = folder / "helmeted.glb"
+    mesh = builder.append("meshes", {"name": name, "primitives": [primitive]})
+    builder.json["scenes"][0]["nodes"].append(builder.append("nodes", {"name": name, "mesh": mesh, "skin": skin}))
+    source = folder / f"{name}.glb"
     builder.save(source)
-    output = folder / "helmeted_lod.glb"
-    report = build_character(source, output, [0.5, 0.25, 0.1], solver="newton", **QUICK)
-    return output, report
+    return source
+
+
+def _character_with_part(folder, name: str, ratios: list[float], hair: str | None = None) -> tuple:
+    """:func:`_with_part`'s LoD GLB and the build's report."""
+    output = folder / f"{name}_lod.glb"
+    return output, build_character(_with_part(folder, name, hair), output, ratios, solver="newton", **QUICK)
+
+
+@pytest.fixture(scope="module")
+def helmeted(tmp_path_factory):
+    return _character_with_part(tmp_path_factory.mktemp("parts"), "helmet", [0.5, 0.25, 0.1])
+
+
+def _plays_the_bodys_levels(output, part: str) -> int:
+    """Asserts that every reduced level of ``part`` is posed by the body's level's joint matrices;
+    returns at how many of them the body froze its head."""
+    chains = {chain.name: chain for chain in read_lod_chains(output)}
+    body, levels = chains["skinned mesh"].levels, chains[part].levels
+    frozen_heads = 0
+    for body_level, part_level in zip(body[1:], levels[1:]):
+        # One skeleton, bound alike and played by the same clips: posed by the same joint matrices.
+        assert part_level.skeleton.names == body_level.skeleton.names
+        np.testing.assert_allclose(part_level.mesh.inverse_bind, body_level.mesh.inverse_bind, atol=1e-6)
+        for mine, theirs in zip(part_level.motions, body_level.motions):
+            np.testing.assert_allclose(mine.local_rotations, theirs.local_rotations, atol=1e-6)
+            np.testing.assert_allclose(mine.root_positions, theirs.root_positions, atol=1e-6)
+        frozen_heads += "Head" not in body_level.skeleton.names
+    return frozen_heads
 
 
 def test_a_helmet_on_the_head_plays_the_bodys_motion_levels(helmeted) -> None:
     output, report = helmeted
     assert "skin 1: its joints belong to skin 0; it plays that skin's motion levels" in report.notes
-    chains = {chain.name: chain for chain in read_lod_chains(output)}
-    body, helmet = chains["skinned mesh"].levels, chains["helmet"].levels
-    assert helmet[0].skeleton.names == ["Neck", "Head"]  # the input, as it was
-    frozen_heads = 0
-    for body_level, helmet_level in zip(body[1:], helmet[1:]):
-        # One skeleton, bound alike and played by the same clips: posed by the same joint matrices.
-        assert helmet_level.skeleton.names == body_level.skeleton.names
-        np.testing.assert_allclose(helmet_level.mesh.inverse_bind, body_level.mesh.inverse_bind, atol=1e-6)
-        for mine, theirs in zip(helmet_level.motions, body_level.motions):
-            np.testing.assert_allclose(mine.local_rotations, theirs.local_rotations, atol=1e-6)
-            np.testing.assert_allclose(mine.root_positions, theirs.root_positions, atol=1e-6)
-        frozen_heads += "Head" not in body_level.skeleton.names
-    assert frozen_heads >= 1  # the case that tore the helmet off
+    helmet = {chain.name: chain for chain in read_lod_chains(output)}["helmet"]
+    assert helmet.levels[0].skeleton.names == ["Neck", "Head"]  # the input, as it was
+    assert _plays_the_bodys_levels(output, "helmet") >= 1  # the case that tore the helmet off
+
+
+def test_hair_on_a_bone_of_its_own_plays_the_bodys_levels_while_that_bone_holds_still(tmp_path) -> None:
+    # VRoid's hair: a skin over the head and hair bones the body's skin does not list. Bones that
+    # hold their bind pose on the head move their vertices with it; a swinging one keeps the
+    # hair on levels of its own, and a note says they may part.
+    output, report = _character_with_part(tmp_path, "hair", [0.25], hair="still")
+    assert "skin 1: its joints hang from those of skin 0; it plays that skin's motion levels" in report.notes
+    _plays_the_bodys_levels(output, "hair")
+    output, report = _character_with_part(tmp_path, "swinging", [0.25], hair="swinging")
+    assert any(note.startswith("skin 1: shares joints with skin 0 but cannot play") for note in report.notes)
+    swinging = {chain.name: chain for chain in read_lod_chains(output)}["swinging"]
+    assert swinging.levels[1].skeleton.names[0] == "Head"  # a skeleton of its own, not the body's
+
+
+def test_motion_levels_show_hair_whose_bone_holds_still(tmp_path) -> None:
+    # `motion` joins the parts on the body's skeleton into one mesh per level GLB; hair on a bone
+    # of its own was left out of them.
+    source = _with_part(tmp_path, "hair", hair="still")
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    assert not any("not in the levels' GLBs" in note for note in report.notes)
+    scene = read_gltf(source)
+    expected = np.concatenate([mesh.bake(motions[0]).frames for mesh, motions in
+                               zip(scene.skinned_meshes, scene.skinned_motions)], axis=1)  # fmt: skip
+    written = read_gltf(tmp_path / "levels" / "hair_lod0.glb")
+    (skinned,), (motion,) = written.skinned_meshes, written.motions
+    np.testing.assert_allclose(skinned.bake(motion).frames, expected, atol=1e-4)
 
 
 def test_the_helmets_levels_share_the_bodys_skins(helmeted) -> None:

@@ -139,9 +139,10 @@ def build_character(
     parts: dict[int, _Part] = {}  # skin -> its place on the skeleton of the skin it plays
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
     skinned_of = {d.skin_index: d.skinned for d in animated}
-    # Larger skeletons first: a skin whose joints all belong to a larger skin (a helmet bound to
-    # the head) plays that skin's motion levels, as freezing its joints on their own, or keeping
-    # them while the body freezes them, would tear it from the body.
+    # Larger skeletons first: a skin whose joints belong to a larger skin (a helmet bound to the
+    # head), or hang from them holding their bind pose (VRoid's hair bones below the head), plays
+    # that skin's motion levels, as freezing its joints on their own, or keeping them while the
+    # body freezes them, would tear it from the body.
     for drawable in sorted(animated, key=lambda d: -len(joints_of[d.skin_index])):
         skin = drawable.skin_index
         if skin in chain_of:
@@ -155,16 +156,18 @@ def build_character(
             chain_of[skin] = twin
             notes.append(f"skin {skin}: the joints of skin {twin}; it plays the same motion levels")
             continue
-        owner = next((other for other in motion_chains if joints_of[skin] < joints_of[other]), None)
-        placement = None if owner is None else placement_on(skinned_of[owner], drawable.skinned)
+        clips = [clip for clip in drawable.clips if clip.motion is not None]
+        joined, spans = join_clips([clip.motion for clip in clips])
+        owner = next((other for other in motion_chains if joints_of[skin] & joints_of[other]), None)
+        covered = owner is not None and joints_of[skin] < joints_of[owner]
+        placement = None if owner is None else placement_on(skinned_of[owner], drawable.skinned, joined)
         if placement is not None:
             chain_of[skin] = owner
             parts[skin] = _Part(skinned_of[owner], placement, {clip.index: clip for clip in drawable.clips})
-            notes.append(f"skin {skin}: its joints belong to skin {owner}; it plays that skin's motion levels")
+            relation = "its joints belong to" if covered else "its joints hang from those of"
+            notes.append(f"skin {skin}: {relation} skin {owner}; it plays that skin's motion levels")
             continue
         chain_of[skin] = skin
-        clips = [clip for clip in drawable.clips if clip.motion is not None]
-        joined, spans = join_clips([clip.motion for clip in clips])
         scaling = joined.deforming_joint()
         if scaling is not None:
             notes.append(
@@ -186,10 +189,15 @@ def build_character(
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
         floor = joint_floor(tipped, analysis)
         levels = min(levels_wanted, floor.possible_levels)
-        if owner is not None:  # bound in another pose than its owner's skin: its joints stay
+        if covered:  # bound in another pose than its owner's skin: its joints stay
             levels = 1
             notes.append(
                 f"skin {skin}: its joints belong to skin {owner}, bound in another pose; it keeps them at every level"
+            )
+        elif owner is not None:
+            notes.append(
+                f"skin {skin}: shares joints with skin {owner} but cannot play its motion levels (bound in another "
+                f"pose, or its joints that skin {owner} lacks move in its clips); its own levels may part from them"
             )
         elif levels < levels_wanted:
             notes.append(

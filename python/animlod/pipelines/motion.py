@@ -217,7 +217,7 @@ def _read_input(
         document = with_clips(document, clip_files, note)
     scene = read_gltf(document)
     if scene.skinned_meshes:
-        (skin, left_out), motions = _whole_skin(scene.skinned_meshes), scene.skinned_motions[0]
+        (skin, left_out), motions = _whole_skin(scene.skinned_meshes, scene.skinned_motions), scene.skinned_motions[0]
         if skin.vertex_count > scene.skinned_meshes[0].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
@@ -276,19 +276,21 @@ def _clip_suffixes(names: list[str]) -> list[str]:
     return [f"_{name}_{index}" if name in repeated else f"_{name}" for index, name in enumerate(safe)]
 
 
-def _whole_skin(meshes: list[SkinnedMesh]) -> tuple[SkinnedMesh, int]:
+def _whole_skin(meshes: list[SkinnedMesh], motions: list[list[Motion]]) -> tuple[SkinnedMesh, int]:
     """The first skinned mesh with every other one on its skeleton (a character in parts, as BrainStem
     is) joined to it, so that a level's GLB shows the whole character, and how many stay out. A part
-    may have a skin of its own over some of the first one's joints (as Soldier's visor has; see
-    skin_parts.py). Parts on other joints, bound in another pose, or with other morph targets than
-    the first stay out."""
+    may have a skin of its own over some of the first one's joints (as Soldier's visor has), or over
+    bones of its own below them that hold still in its clips, ``motions`` (see skin_parts.py). Parts
+    on other joints, bound in another pose, or with other morph targets than the first stay out."""
+    from ..motion_lod.clips import join_clips
+
     first = meshes[0]
     parts = [first]
-    for mesh in meshes[1:]:
+    for mesh, clips in zip(meshes[1:], motions[1:]):
         same_targets = (mesh.morph_targets is None) == (first.morph_targets is None) and (
             first.morph_targets is None or mesh.morph_target_names == first.morph_target_names
         )
-        placement = placement_on(first, mesh)
+        placement = placement_on(first, mesh, join_clips(clips)[0] if clips else None)
         if same_targets and placement is not None:
             parts.append(moved_onto(mesh, first, placement))
     if len(parts) == 1:

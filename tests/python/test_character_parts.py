@@ -171,3 +171,17 @@ def test_a_crowd_poses_the_helmet_at_the_bodys_motion_level(binary, helmeted, tm
     original, reduced = report.modes["Original"], report.modes["MLoD"]
     assert reduced["drawn"] == original["drawn"] > 0
     assert reduced["joints"] == original["joints"]
+
+
+def test_the_chains_of_one_skeleton_switch_at_the_same_distance(helmeted) -> None:
+    # An engine compares each node's own projected size with its MSFT_screencoverage values: the
+    # helmet, a tenth of the body's size, took its 4-joint level at another distance than the body,
+    # which drew the other skeleton's head meanwhile. Each level now ends where the later of the two
+    # chains asks (a coverage in proportion to each one's size).
+    _, report = helmeted
+    body, helmet = report.chains["mesh 0 'skinned mesh' with skin 0"], report.chains["mesh 1 'helmet' with skin 1"]
+    sizes = [chain[-1].error / chain[-1].relative_error for chain in (body, helmet)]
+    assert sizes[1] < 0.2 * sizes[0]
+    for mine, theirs in zip(helmet[:-1], body[:-1]):
+        assert mine.coverage > 0.0 and sizes[0] / theirs.coverage == pytest.approx(sizes[1] / mine.coverage)
+    assert helmet[-1].coverage == body[-1].coverage == 0.0

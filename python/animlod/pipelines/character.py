@@ -223,7 +223,7 @@ def build_character(
     motion_nodes = {skin: _add_motion_levels(builder, doc, motion) for skin, motion in motion_chains.items()}
     motion_nodes = {skin: motion_nodes[owner] for skin, owner in chain_of.items()}
     motion_chains = {skin: motion_chains[owner] for skin, owner in chain_of.items()}
-    chains = {}
+    chains, grids = {}, {}
     level_skins: dict[tuple[tuple[int, ...], bytes], int] = {}
     for drawable in animated:
         motion = motion_chains[drawable.skin_index]
@@ -238,9 +238,13 @@ def build_character(
         for level, coverage in zip(report, coverages):
             level.coverage = coverage
             level.relative_error = level.error / levels.size if levels.size > 0 else 0.0
-        _attach(builder, drawable, report, grid)
-        chains[drawable.label] = report
+        chains[drawable.label], grids[drawable.label] = report, grid
         notes += [f"{drawable.label}: {note}" for note in levels.notes]
+    for skin in set(chain_of.values()):
+        members = [d for d in animated if chain_of[d.skin_index] == skin]
+        _switch_together([chains[d.label] for d in members], [geometry[d.label].size for d in members])
+    for drawable in animated:
+        _attach(builder, drawable, chains[drawable.label], grids[drawable.label])
     skipped = [d.label for d in all_drawables if d.label not in chains]
     if skipped:
         notes.append(f"not simplified (no skin or no animation): {', '.join(skipped)}")
@@ -443,6 +447,21 @@ def _measure_chain(
         joints = motion.joint_count if motion_level is None else motion_level.report.joint_count
         report.append(CharacterLevel(i, i, m, level.simplified.mesh.face_count, joints, error, 0.0, 0.0))
     return report
+
+
+def _switch_together(reports: list[list[CharacterLevel]], sizes: list[float]) -> None:
+    """Coverages that switch the chains of one skeleton (a body, its clothes and visor) at the same
+    distances, the farthest any of them asks for, so that a glTF engine never draws two of them
+    at different motion levels. An engine compares a node's own projected size with its
+    coverages, and a mesh of size s covers s / d at distance d (in some unit of the viewport):
+    level i of every chain ends at distance D_i = max over chains of s / c_i, at coverage s / D_i."""
+    if len(reports) < 2 or min(sizes) <= 0.0 or len({len(report) for report in reports}) != 1:
+        return
+    for i in range(len(reports[0]) - 1):  # the last coverage is 0: the coarsest level never ends
+        ends = [size / report[i].coverage if report[i].coverage > 0.0 else np.inf
+                for report, size in zip(reports, sizes)]  # fmt: skip
+        for report, size in zip(reports, sizes):
+            report[i].coverage = min(1.0, size / max(ends))
 
 
 def _morph_weights(clip: Clip, part: _Part | None, frames: np.ndarray) -> np.ndarray | None:

@@ -11,13 +11,15 @@ motion level i (or the coarsest one a small skeleton has); every other combinati
 too (``extras.animlod_grid`` on the base node lists them by geometry level, then motion level)
 so that a benchmark can walk the whole grid.
 
-A skin whose joints all belong to a larger skin's (a helmet or visor on the head, bound in the
-same pose) is a part (:mod:`.skin_parts`): it plays that skin's motion levels, on its reduced
-skeletons. Motion level m >= 1 adds, per skin, a reduced skeleton as joint nodes of its own, a
-skin over them and one animation per input clip (``extras.animlod = {"clip", "motion_level"}``);
-a level node at motion level m uses that skin, so any glTF engine can play it. Nodes hung from the
-input's joints (props, sockets) are copied onto each level's skeleton, and each level clip also
-plays what its input clip moves besides the skeleton (morph weights; :mod:`.attachments`).
+A skin whose joints belong to a larger skin's (a helmet or visor on the head), or hang from
+them holding their bind pose (hair bones), bound in the same pose, is a part
+(:mod:`.skin_parts`): it plays that skin's motion levels, on its reduced skeletons, and the
+chains of one skeleton switch at one distance. Motion level m >= 1 adds, per skin, a reduced
+skeleton as joint nodes of its own, a skin over them and one animation per input clip
+(``extras.animlod = {"clip", "motion_level"}``); a level node at motion level m uses that skin,
+so any glTF engine can play it. Nodes hung from the input's joints (props, sockets) are copied
+onto each level's skeleton, and each level clip also plays what its input clip moves besides the
+skeleton (morph weights; :mod:`.attachments`).
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ import pytest
 
 from animlod import rotations
 from animlod.cli import main
-from animlod.io import read_gltf, write_glb
+from animlod.io import read_gltf, write_bvh, write_glb
 from animlod.model import Motion, Skeleton, SkinnedMesh
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, joint_floor
@@ -28,6 +28,7 @@ from animlod.motion_lod.skin_measure import (
     without_skin_tips,
 )
 from animlod.motion_lod.skin_transfer import transfer_skin
+from animlod.pipelines.motion import build_motion_levels
 
 NAMES = ["root", "spine", "head", "control"]
 
@@ -181,6 +182,22 @@ def test_the_skin_trial_measure_is_the_mean_distance_of_the_skin_on_the_input_jo
     level = chain.levels[2]
     both = skin_trial_measure(motion, [skin, skin])(level.frozen, level.motion.take_frames(frames), frames)
     assert both == pytest.approx(measure(level.frozen, level.motion.take_frames(frames), frames), rel=1e-6)
+
+
+def test_motion_reports_the_skins_largest_distance_for_a_skinned_gltf(twisting_arm, tmp_path) -> None:
+    skin, motion = twisting_arm
+    write_glb(tmp_path / "twist.glb", skin, [motion])
+    report = build_motion_levels(tmp_path / "twist.glb", tmp_path / "levels", joints=[4, 2])
+    levels = json.loads((tmp_path / "levels" / "twist_motion_lod.json").read_text())["levels"]
+    assert levels[0]["skin_error"] < 1e-5
+    level = report.chain.levels[1]  # the level's skin, moved onto its joints, with its clip
+    input_skin = report.chain.levels[0].skin  # the skin as the GLB read it
+    expected = np.linalg.norm(level.skin.bake(level.motion).frames - input_skin.bake(report.motion).frames, axis=-1)
+    assert expected.max() > 0.01 and levels[1]["skin_error"] == pytest.approx(float(expected.max()), rel=1e-6)
+    write_bvh(tmp_path / "twist.bvh", motion)  # no skin, no skin error
+    build_motion_levels(tmp_path / "twist.bvh", tmp_path / "bvh_levels", joints=[4, 2])
+    levels = json.loads((tmp_path / "bvh_levels" / "twist_motion_lod.json").read_text())["levels"]
+    assert all("skin_error" not in level for level in levels)
 
 
 def test_motion_on_a_gltf_character_keeps_its_skinned_leaf(rig, tmp_path) -> None:

@@ -186,7 +186,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         for bar in bars:
             bar.close()
-    _print_summary(report.chain, report.floor, skinned=report.faces is not None)
+    _print_summary(report.chain, report.floor, report.skin_errors)
     written = sum(len(files) for files in report.files) + 1  # the levels and the manifest
     if args.plot:
         from ..motion_lod.plots import plot_chain
@@ -203,17 +203,20 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_summary(chain, floor, skinned: bool) -> None:
+def _print_summary(chain, floor, skin_errors) -> None:
     size = chain.figure_size
     leaves = ", as the skin sees them (leaf joints by points of their skin, joints that move none left out)"
-    leaves = leaves if skinned else ""
+    leaves = leaves if skin_errors is not None else ""
     print(f"\nfigure size {size:.4g} (asset units); errors over every original joint and frame{leaves}")
+    if skin_errors is not None:
+        print("skin max: the largest distance of a skin vertex from the input's, over every frame")
     if floor.fewest > floor.paper_fewest:
         print(
             f"fewest joints: {floor.fewest} of {floor.total}, above the paper's 8% ({floor.paper_fewest}): "
             f"{floor.explain()} never freeze"
         )
     header = ("level", "joints", "mean err", "max err", "max/size", "bone err", "bone var", "FK resid", "failed", "s")
+    header += ("skin max",) if skin_errors is not None else ()
     print(" | ".join(f"{h:>9}" for h in header))
     for index, level in enumerate(chain.levels):
         r = level.report
@@ -223,6 +226,7 @@ def _print_summary(chain, floor, skinned: bool) -> None:
             f"{r.bone_error:.3g}", f"{100 * r.bone_variation:.3f}%", f"{r.fk_residual:.2g}", len(r.failures),
             f"{r.seconds:.1f}",
         )  # fmt: skip
+        cells += (f"{skin_errors[index].max():.4g}",) if skin_errors is not None else ()
         print(" | ".join(f"{c!s:>9}" for c in cells))
     failures = [f for level in chain.levels for f in level.report.failures]
     for failure in failures[:10]:

@@ -21,7 +21,7 @@ from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
 from ..model import Motion, SkinnedMesh
 from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis
-from ..motion_lod.chain import SOLVERS, JointFloor, MotionLodChain, TrialMeasure
+from ..motion_lod.chain import SOLVERS, JointFloor, MotionLevel, MotionLodChain, TrialMeasure
 from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from .result import AssetResult, LevelRow, Progress
 from .skin_parts import moved_onto, placement_on
@@ -40,6 +40,8 @@ class MotionReport:
     motion : the clip simplified (several clips merged into one, or one after another: see ``notes``).
     floor : the fewest joints the skeleton allows and why (:func:`animlod.motion_lod.chain.joint_floor`).
     notes : what the user should know (clips merged, nothing could freeze).
+    skin_errors : for a skinned glTF, per level, the skin's largest distance from the input's in
+        each frame (asset units; :func:`skin_distances`); None otherwise.
     """
 
     chain: MotionLodChain
@@ -49,6 +51,7 @@ class MotionReport:
     motion: Motion
     floor: JointFloor
     notes: list[str]
+    skin_errors: list[np.ndarray] | None = None
 
 
 def build_motion_levels(
@@ -164,6 +167,7 @@ def build_motion_levels(
     orders = layout.rotation_orders if layout is not None else "ZXY"
     suffixes = _clip_suffixes([name for name, _ in played])
     gltf_input = input_kind(source) == "gltf"
+    skin_errors = None if skin is None else [skin_distances(skin, motion, level) for level in chain.levels]
     files, rows = [], []
     for index, level in enumerate(chain.levels):
         names = []
@@ -179,16 +183,38 @@ def build_motion_levels(
         files.append(names)
         row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
                "error": level.report.max_error}  # fmt: skip
+        if skin_errors is not None:  # what a runtime drawing the skin sees
+            row["skin_error"] = float(skin_errors[index].max())
         if len(played) > 1:  # a runtime may pick each clip's level by its own error
-            row["clips"] = [
-                {"name": name, "error": float(level.report.frame_errors[span].max())} for name, span in played
-            ]
+            row["clips"] = []
+            for name, span in played:
+                row["clips"].append({"name": name, "error": float(level.report.frame_errors[span].max())})
+                if skin_errors is not None:
+                    row["clips"][-1]["skin_error"] = float(skin_errors[index][span].max())
         rows.append(row)
-    # The runtime's level chooser: each level's largest joint position error in asset units.
+    # The runtime's level chooser: each level's largest joint position error in asset units (and
+    # the skin's largest distance, for a skinned glTF).
     manifest = Path(f"{stem}_motion_lod.json")
     write_lod_manifest(folder / manifest, "motion", rows)
     faces = None if skin is None else int(skin.faces.shape[0])
-    return MotionReport(chain, files, manifest, faces, motion, floor, notes)
+    return MotionReport(chain, files, manifest, faces, motion, floor, notes, skin_errors)
+
+
+# Vertex positions baked at a time by skin_distances: a chunk of frames holds two copies of each.
+_BAKED_POSITIONS_PER_CHUNK = 4_000_000
+
+
+def skin_distances(skin: SkinnedMesh, motion: Motion, level: MotionLevel) -> np.ndarray:
+    """(T,) the largest distance, in each frame of ``motion``, of a vertex of ``level``'s skin
+    played with the level's motion from where ``motion`` puts it on the input ``skin``."""
+    chunk = max(1, _BAKED_POSITIONS_PER_CHUNK // max(1, skin.vertex_count))
+    out = np.empty(motion.frame_count)
+    for start in range(0, motion.frame_count, chunk):
+        frames = slice(start, min(start + chunk, motion.frame_count))
+        original = skin.bake(motion.take_frames(frames)).frames
+        posed = level.skin.bake(level.motion.take_frames(frames)).frames
+        out[frames] = np.linalg.norm(posed - original, axis=-1).max(axis=1)
+    return out
 
 
 def _read_input(

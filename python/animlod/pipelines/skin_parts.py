@@ -80,7 +80,7 @@ def moved_onto(part: SkinnedMesh, first: SkinnedMesh, placement: Placement) -> S
     return SkinnedMesh(
         rest_positions=(part.rest_positions @ to_first[:3, :3].T + to_first[:3, 3]).astype(np.float32),
         faces=part.faces,
-        joints=placement.joint_map[part.joints],
+        joints=np.where(part.weights > 0.0, placement.joint_map[part.joints], 0),  # unused slots: joint 0
         weights=part.weights,
         inverse_bind=first.inverse_bind,
         skeleton=first.skeleton,

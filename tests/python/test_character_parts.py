@@ -14,10 +14,11 @@ import numpy as np
 import pygltflib
 import pytest
 
-from animlod import synth
+from animlod import rotations, synth
 from animlod.io import read_gltf, read_lod_chains, write_glb
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
+from animlod.model import Motion, Skeleton, SkinnedMesh
 from animlod.pipelines.character import build_character
 from animlod.pipelines.motion import build_motion_levels
 
@@ -31,14 +32,15 @@ def _box(centre: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
     return (centre + half * corners).astype(np.float32), np.array(faces, np.uint16)
 
 
-def _with_part(folder, name: str, hair: str | None = None) -> Path:
-    """The procedural humanoid walking, with a box over its head skinned by a skin of its own
-    (bound in the body's pose): over Neck and Head, every vertex on Head; or with ``hair``
-    ("still" or "swinging") over Head and a bone "Hair" of its own below it, every vertex on
-    Hair."""
-    plain = folder / "humanoid.glb"
-    character = synth.humanoid()
-    write_glb(plain, character, [synth.humanoid_motion(character.skeleton, "walk")])
+def _with_part(folder, name: str, hair: str | None = None, plain: Path | None = None) -> Path:
+    """The procedural humanoid walking (or the character of ``plain``), with a box over its head
+    skinned by a skin of its own (bound in the body's pose): over Neck and Head, every vertex on
+    Head; or with ``hair`` ("still" or "swinging") over Head and a bone "Hair" of its own below
+    it, every vertex on Hair."""
+    if plain is None:
+        plain = folder / "humanoid.glb"
+        character = synth.humanoid()
+        write_glb(plain, character, [synth.humanoid_motion(character.skeleton, "walk")])
     doc = GltfDocument(plain)
     builder = GlbBuilder.from_document(doc)
     nodes = builder.json["nodes"]
@@ -128,6 +130,36 @@ def test_hair_on_a_bone_of_its_own_plays_the_bodys_levels_while_that_bone_holds_
     assert any(note.startswith("skin 1: shares joints with skin 0 but cannot play") for note in report.notes)
     swinging = {chain.name: chain for chain in read_lod_chains(output)}["swinging"]
     assert swinging.levels[1].skeleton.names[0] == "Head"  # a skeleton of its own, not the body's
+
+
+def test_a_head_of_its_own_counts_in_the_choice_of_the_bodys_joints(tmp_path) -> None:
+    # A modular character: the body's skin weighs nothing to Head, a leaf joint, and the head is a
+    # mesh of its own on Neck and Head. Measured by the body's skin alone, Head moved nothing and
+    # froze first, and the head, playing the body's levels, lost its nod at the first level.
+    names = ["Hips", "Spine", "Neck", "Head", "LeftLeg", "RightLeg"]
+    offsets = [[0, 1, 0], [0, 0.3, 0], [0, 0.3, 0], [0, 0.1, 0], [0.1, -0.1, 0], [-0.1, -0.1, 0]]
+    skeleton = Skeleton(names, [-1, 0, 1, 2, 0, 0], offsets)
+    frames = 30
+    phase = np.linspace(0.0, 2.0 * np.pi, frames)
+    local = rotations.identity((frames, len(names)))
+    for joint, axis, amplitude in ((1, 2, 0.05), (2, 2, 0.05), (3, 0, 0.8), (4, 0, 0.4), (5, 0, -0.4)):
+        local[:, joint] = rotations.from_axis_angle(np.eye(3)[axis], amplitude * np.sin(phase))
+    motion = Motion(skeleton, np.tile([0.0, 1.0, 0.0], (frames, 1)), local, fps=30.0, name="nod")
+    rest = skeleton.rest_world_transforms()[:, :3, 3]
+    parts = [(joint, _box(rest[joint] + [0.0, 0.1, 0.0], 0.08)[0]) for joint in (0, 1, 2)]
+    parts += [(joint, _box(rest[joint] + [0.0, -0.25, 0.0], 0.08)[0]) for joint in (4, 5)]
+    positions = np.concatenate([points for _, points in parts])
+    joints = np.zeros((len(positions), 4), np.int32)
+    joints[:, 0] = np.concatenate([np.full(len(points), joint) for joint, points in parts])
+    weights = np.zeros((len(positions), 4), np.float32)
+    weights[:, 0] = 1.0
+    faces = np.arange(len(positions) - 2)[:, None] + [0, 1, 2]
+    body = SkinnedMesh(positions, faces, joints, weights, np.linalg.inv(skeleton.rest_world_transforms()), skeleton)
+    write_glb(tmp_path / "body.glb", body, [motion])
+    source = _with_part(tmp_path, "head", plain=tmp_path / "body.glb")
+    build_character(source, tmp_path / "lod.glb", [0.5, 0.25], solver="newton", **QUICK)
+    level = {chain.name: chain for chain in read_lod_chains(tmp_path / "lod.glb")}["skinned mesh"].levels[1]
+    assert "Head" in level.skeleton.names and len(level.skeleton.names) < len(names)
 
 
 def test_motion_levels_show_hair_whose_bone_holds_still(tmp_path) -> None:

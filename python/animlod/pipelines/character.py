@@ -136,11 +136,12 @@ def build_character(
         raise FormatError(doc.path, "skins", f"{reason} (it draws no mesh: `animlod motion` takes its clips)")
     levels_wanted = len(ratios) + 1
     started = time.perf_counter()
-    motion_chains: dict[int, _SkinMotion] = {}
     chain_of: dict[int, int] = {}  # skin -> the skin whose motion levels it plays
     parts: dict[int, _Part] = {}  # skin -> its place on the skeleton of the skin it plays
+    owners: dict[int, Drawable] = {}  # skin -> its drawable, for the skins with motion levels of their own
+    sharing: dict[int, int] = {}  # an owner -> the owner it shares joints with but cannot play
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
-    skinned_of = {d.skin_index: d.skinned for d in animated}
+    played_clips = {d.skin_index: _joined_clips(d) for d in animated}
     # Larger skeletons first: a skin whose joints belong to a larger skin (a helmet bound to the
     # head), or hang from them holding their bind pose (VRoid's hair bones below the head), plays
     # that skin's motion levels, as freezing its joints on their own, or keeping them while the
@@ -151,25 +152,26 @@ def build_character(
             continue
         # Exporters may give every mesh a skin of its own over the same joints: one skeleton
         # per level serves them all (a copy each would animate the skeleton once per mesh).
-        twin = next(
-            (other for other in motion_chains if motion_chains[other].rig.joint_nodes == drawable.rig.joint_nodes), None
-        )
+        twin = next((other for other, d in owners.items() if d.rig.joint_nodes == drawable.rig.joint_nodes), None)
         if twin is not None:
             chain_of[skin] = twin
             notes.append(f"skin {skin}: the joints of skin {twin}; it plays the same motion levels")
             continue
-        clips = [clip for clip in drawable.clips if clip.motion is not None]
-        joined, spans = join_clips([clip.motion for clip in clips])
-        owner = next((other for other in motion_chains if joints_of[skin] & joints_of[other]), None)
-        covered = owner is not None and joints_of[skin] < joints_of[owner]
-        placement = None if owner is None else placement_on(skinned_of[owner], drawable.skinned, joined)
+        owner = next((other for other in owners if joints_of[skin] & joints_of[other]), None)
+        joined = played_clips[skin][1]
+        placement = None if owner is None else placement_on(owners[owner].skinned, drawable.skinned, joined)
         if placement is not None:
             chain_of[skin] = owner
-            parts[skin] = _Part(skinned_of[owner], placement, {clip.index: clip for clip in drawable.clips})
-            relation = "its joints belong to" if covered else "its joints hang from those of"
+            parts[skin] = _Part(owners[owner].skinned, placement, {clip.index: clip for clip in drawable.clips})
+            relation = "its joints belong to" if joints_of[skin] < joints_of[owner] else "its joints hang from those of"
             notes.append(f"skin {skin}: {relation} skin {owner}; it plays that skin's motion levels")
             continue
-        chain_of[skin] = skin
+        chain_of[skin], owners[skin] = skin, drawable
+        if owner is not None:
+            sharing[skin] = owner
+    motion_chains: dict[int, _SkinMotion] = {}
+    for skin, drawable in owners.items():
+        clips, joined, spans = played_clips[skin]
         scaling = joined.deforming_joint()
         if scaling is not None:
             notes.append(
@@ -178,20 +180,21 @@ def build_character(
             )
             motion_chains[skin] = _SkinMotion(None, list(zip(clips, spans)), drawable.rig, joined)
             continue
-        # Measured as the skin sees it (skin_measure.py): leaf joints by their skin's points, joints
-        # that move no skin and hold no attachment not at all. The levels drop the points.
-        same_joints = [d.skinned for d in animated if d.rig.joint_nodes == drawable.rig.joint_nodes]
+        # Measured as every skin that plays these levels sees it (skin_measure.py; a visor or a
+        # head of its own too): leaf joints by their skin's points, joints that move no skin and
+        # hold no attachment not at all. The levels drop the points.
+        players = [d for d in animated if chain_of[d.skin_index] == skin]
+        skins = [_played(d.skinned, parts.get(d.skin_index)) for d in players]
         attached = [attachment.joint for attachment in find_attachments(doc, drawable.rig)]
-        tipped, analysis, trial_measure = analyze_skinned_motion(
-            joined, same_joints, attached, workers=workers, clips=spans
-        )
+        tipped, analysis, trial_measure = analyze_skinned_motion(joined, skins, attached, workers=workers, clips=spans)
         hidden = hidden_note(analysis, joined)
         if hidden:
             notes.append(f"skin {skin}: {hidden}")
         # As many motion levels as geometry levels, or as the skeleton has joints that can freeze.
         floor = joint_floor(tipped, analysis)
         levels = min(levels_wanted, floor.possible_levels)
-        if covered:  # bound in another pose than its owner's skin: its joints stay
+        owner = sharing.get(skin)
+        if owner is not None and joints_of[skin] < joints_of[owner]:  # bound in another pose: its joints stay
             levels = 1
             notes.append(
                 f"skin {skin}: its joints belong to skin {owner}, bound in another pose; it keeps them at every level"
@@ -285,6 +288,14 @@ class _Part:
     first: SkinnedMesh
     placement: Placement
     clips: dict[int, Clip]
+
+
+def _joined_clips(drawable: Drawable) -> tuple[list[Clip], Motion, list[slice]]:
+    """The drawable's clips that move its skeleton, and their motions one after another (with
+    each one's frames in it)."""
+    clips = [clip for clip in drawable.clips if clip.motion is not None]
+    joined, spans = join_clips([clip.motion for clip in clips])
+    return clips, joined, spans
 
 
 def _played(skinned: SkinnedMesh, part: _Part | None) -> SkinnedMesh:

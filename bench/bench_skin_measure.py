@@ -6,7 +6,8 @@ Run: ``.venv/bin/python bench/bench_skin_measure.py`` (part of ``make bench``). 
 animated glTF of ../shared/data/gltf and of Castle Game Engine's examples (Debian's
 castle-game-engine-doc, Blender exports whose leaf joints carry skin; each distinct file once),
 the largest mesh's motion levels as ``animlod character`` builds them (every clip as one motion,
-4 levels, the default ranking and solver), on the bare skeleton, as the skin sees it with the
+4 levels, the default ranking and solver; on that mesh's skin alone, where ``character`` also
+counts the parts that play the same levels, Soldier's visor), on the bare skeleton, as the skin sees it with the
 ranking's trial re-fits scored by the joints' mean error, and as the skin sees it with the trials
 scored by the skin's mean distance (the default; VARIANTS). Per level: joints, and the skin's
 distance to the input over every frame of every clip (the level's reduced skin played with its

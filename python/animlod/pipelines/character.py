@@ -136,39 +136,10 @@ def build_character(
         raise FormatError(doc.path, "skins", f"{reason} (it draws no mesh: `animlod motion` takes its clips)")
     levels_wanted = len(ratios) + 1
     started = time.perf_counter()
-    chain_of: dict[int, int] = {}  # skin -> the skin whose motion levels it plays
-    parts: dict[int, _Part] = {}  # skin -> its place on the skeleton of the skin it plays
-    owners: dict[int, Drawable] = {}  # skin -> its drawable, for the skins with motion levels of their own
-    sharing: dict[int, int] = {}  # an owner -> the owner it shares joints with but cannot play
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
     played_clips = {d.skin_index: _joined_clips(d) for d in animated}
-    # Larger skeletons first: a skin whose joints belong to a larger skin (a helmet bound to the
-    # head), or hang from them holding their bind pose (VRoid's hair bones below the head), plays
-    # that skin's motion levels, as freezing its joints on their own, or keeping them while the
-    # body freezes them, would tear it from the body.
-    for drawable in sorted(animated, key=lambda d: -len(joints_of[d.skin_index])):
-        skin = drawable.skin_index
-        if skin in chain_of:
-            continue
-        # Exporters may give every mesh a skin of its own over the same joints: one skeleton
-        # per level serves them all (a copy each would animate the skeleton once per mesh).
-        twin = next((other for other, d in owners.items() if d.rig.joint_nodes == drawable.rig.joint_nodes), None)
-        if twin is not None:
-            chain_of[skin] = twin
-            notes.append(f"skin {skin}: the joints of skin {twin}; it plays the same motion levels")
-            continue
-        owner = next((other for other in owners if joints_of[skin] & joints_of[other]), None)
-        joined = played_clips[skin][1]
-        placement = None if owner is None else placement_on(owners[owner].skinned, drawable.skinned, joined)
-        if placement is not None:
-            chain_of[skin] = owner
-            parts[skin] = _Part(owners[owner].skinned, placement, {clip.index: clip for clip in drawable.clips})
-            relation = "its joints belong to" if joints_of[skin] < joints_of[owner] else "its joints hang from those of"
-            notes.append(f"skin {skin}: {relation} skin {owner}; it plays that skin's motion levels")
-            continue
-        chain_of[skin], owners[skin] = skin, drawable
-        if owner is not None:
-            sharing[skin] = owner
+    roles = _assign_skeletons(animated, joints_of, played_clips, notes)
+    chain_of, parts, owners, sharing = roles.chain_of, roles.parts, roles.owners, roles.sharing
     motion_chains: dict[int, _SkinMotion] = {}
     for skin, drawable in owners.items():
         clips, joined, spans = played_clips[skin]
@@ -277,6 +248,55 @@ class _SkinMotion:
     def joint_count(self) -> int:
         """Joints of motion level 0 (end sites not counted)."""
         return int(np.count_nonzero(~self.joined.skeleton.end_sites))
+
+
+@dataclass
+class _Roles:
+    """Which skin plays which skin's motion levels (:func:`_assign_skeletons`)."""
+
+    chain_of: dict[int, int] = field(default_factory=dict)  # skin -> the skin whose levels it plays
+    parts: dict[int, _Part] = field(default_factory=dict)  # skin -> its place on that skin's skeleton
+    owners: dict[int, Drawable] = field(default_factory=dict)  # the skins with levels of their own
+    sharing: dict[int, int] = field(default_factory=dict)  # owner -> an owner it shares joints with
+
+
+def _assign_skeletons(
+    animated: list[Drawable],
+    joints_of: dict[int, set[int]],
+    played_clips: dict[int, tuple[list[Clip], Motion, list[slice]]],
+    notes: list[str],
+) -> _Roles:
+    """Larger skeletons first: a skin over the joints of one before it (exporters may give every
+    mesh a skin of its own over the same joints) plays its motion levels, and so does a skin whose
+    joints belong to a larger skin's (a helmet bound to the head) or hang from them holding their
+    bind pose (VRoid's hair bones below the head): freezing its joints on their own, or keeping
+    them while the body freezes them, would tear it from the body. Every other skin has levels of
+    its own. Notes say which is which."""
+    roles = _Roles()
+    for drawable in sorted(animated, key=lambda d: -len(joints_of[d.skin_index])):
+        skin = drawable.skin_index
+        if skin in roles.chain_of:
+            continue
+        # One skeleton per level serves twins (a copy each would animate the skeleton once per mesh).
+        twin = next((o for o, d in roles.owners.items() if d.rig.joint_nodes == drawable.rig.joint_nodes), None)
+        if twin is not None:
+            roles.chain_of[skin] = twin
+            notes.append(f"skin {skin}: the joints of skin {twin}; it plays the same motion levels")
+            continue
+        owner = next((other for other in roles.owners if joints_of[skin] & joints_of[other]), None)
+        joined = played_clips[skin][1]
+        placement = None if owner is None else placement_on(roles.owners[owner].skinned, drawable.skinned, joined)
+        if placement is not None:
+            roles.chain_of[skin] = owner
+            own_clips = {clip.index: clip for clip in drawable.clips}
+            roles.parts[skin] = _Part(roles.owners[owner].skinned, placement, own_clips)
+            relation = "its joints belong to" if joints_of[skin] < joints_of[owner] else "its joints hang from those of"
+            notes.append(f"skin {skin}: {relation} skin {owner}; it plays that skin's motion levels")
+            continue
+        roles.chain_of[skin], roles.owners[skin] = skin, drawable
+        if owner is not None:
+            roles.sharing[skin] = owner
+    return roles
 
 
 @dataclass

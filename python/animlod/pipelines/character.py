@@ -50,7 +50,7 @@ from ..io.gltf_lod import (
 from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import add_animation, add_skeleton, add_skin, influence_sets
 from ..metrics import hausdorff_distances
-from ..model import AnimatedMesh, Motion, SkinnedMesh, spread_frames
+from ..model import Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, build_motion_chain, joint_floor
 from ..motion_lod.chain import MotionLevel
 from ..motion_lod.clips import join_clips
@@ -59,7 +59,7 @@ from ..motion_lod.skin_measure import analyze_skinned_motion, hidden_note, witho
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
 from .clip_import import with_clips
-from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, posed_frames, simplify_drawable
+from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
 from .skin_parts import Placement, moved_onto, placement_on
 
@@ -367,9 +367,11 @@ def _write_grid(
     geometry: list[DrawableLevel | None] = [None, *levels.levels]  # geometry level 0 is the input
     input_joints = len(doc.gltf.skins[drawable.skin_index].joints)
     frozen = [None] + [level.frozen for level in motion.reduced_levels]  # motion level 0 freezes nothing
+    played = [_played(drawable.skinned if level is None else level.skinned, part) for level in geometry]
+    to_bind = drawable.world if part is None else part.placement.transform @ drawable.world
     skins = [drawable.skin_index]
     for m in range(1, len(frozen)):  # a reduced skin's inverse binds do not depend on the geometry
-        reduced = transfer_skin(_played(drawable.skinned, part), frozen[m])
+        reduced = transfer_skin(played[0], frozen[m])
         # One skin per reduced skeleton and binds: a part shares its owner's, so that a runtime
         # poses that skeleton once for both.
         key = (tuple(motion_nodes[m].joint_nodes), reduced.inverse_bind.astype(np.float32).tobytes())
@@ -385,8 +387,7 @@ def _write_grid(
             primitives = _input_primitives(drawable) if level is None else level.primitives
             skinned = drawable.skinned if level is None else level.skinned
             if frozen_level is not None:
-                to_bind = drawable.world if part is None else part.placement.transform @ drawable.world
-                primitives = _reposed(_played(skinned, part), to_bind, frozen_level, primitives)
+                primitives = _reposed(played[g], to_bind, frozen_level, primitives)
             mesh = add_level_mesh(
                 builder, drawable.mesh_index, primitives, drawable.geometry.other_primitives, f"{mesh_name}_G{g}M{m}"
             )
@@ -449,30 +450,27 @@ def _measure_chain(
     there is), each measured as it is written: the level's skin played with its clips (the
     input's at motion level 0, the re-fitted ones on the reduced skin above) against the input's
     clips, max Hausdorff distance. A ``part`` plays its owner's clips on its owner's skeleton."""
-    chain = []  # (geometry level, motion level index, motion level or None, reduced skin or None)
+    chain = []  # (geometry level, motion level index, motion level or None, the skin it plays)
     for i in range(1, len(levels.levels) + 1):
         m = min(i, len(motion.reduced_levels))  # a small skeleton runs out of motion levels first
         level = levels.levels[i - 1]
         motion_level = motion.reduced_levels[m - 1] if m > 0 else None
-        reduced = None if motion_level is None else transfer_skin(_played(level.skinned, part), motion_level.frozen)
-        chain.append((level, m, motion_level, reduced))
+        played = _played(level.skinned, part)
+        chain.append(
+            (level, m, motion_level, played if motion_level is None else transfer_skin(played, motion_level.frozen))
+        )
     errors = [0.0] * len(chain)
+    input_skin = _played(drawable.skinned, part)
     for clip, span in motion.clips:
         frames = spread_frames(clip.frame_count, measured_frames)
         weights = _morph_weights(clip, part, frames)
-        if part is None:
-            original = AnimatedMesh(drawable.geometry.faces, drawable.clip_frames(clip, frames))
-        else:
-            original = _played(drawable.skinned, part).bake(clip.motion.take_frames(frames), weights)
+        clip_frames = clip.motion.take_frames(frames)
+        original = input_skin.bake(clip_frames, weights)
         posed = [
-            (
-                AnimatedMesh(level.simplified.mesh.faces, posed_frames(drawable, level, clip, frames))
-                if part is None
-                else _played(level.skinned, part).bake(clip.motion.take_frames(frames), weights)
+            skin.bake(
+                clip_frames if motion_level is None else motion_level.motion.take_frames(span.start + frames), weights
             )
-            if motion_level is None
-            else reduced.bake(motion_level.motion.take_frames(span.start + frames), weights)
-            for level, _, motion_level, reduced in chain
+            for _, _, motion_level, skin in chain
         ]
         errors = hausdorff_distances(original, posed, samples=4000, at_least=errors)
     report = [CharacterLevel(0, 0, 0, len(drawable.geometry.faces), motion.joint_count, 0.0, 0.0, 0.0)]

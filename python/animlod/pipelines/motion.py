@@ -167,7 +167,7 @@ def build_motion_levels(
     orders = layout.rotation_orders if layout is not None else "ZXY"
     suffixes = _clip_suffixes([name for name, _ in played])
     gltf_input = input_kind(source) == "gltf"
-    skin_errors = None if skin is None else [skin_distances(skin, motion, level) for level in chain.levels]
+    skin_errors = None if skin is None else skin_distances(skin, motion, chain.levels)
     files, rows = [], []
     for index, level in enumerate(chain.levels):
         names = []
@@ -204,16 +204,18 @@ def build_motion_levels(
 _BAKED_POSITIONS_PER_CHUNK = 4_000_000
 
 
-def skin_distances(skin: SkinnedMesh, motion: Motion, level: MotionLevel) -> np.ndarray:
-    """(T,) the largest distance, in each frame of ``motion``, of a vertex of ``level``'s skin
-    played with the level's motion from where ``motion`` puts it on the input ``skin``."""
+def skin_distances(skin: SkinnedMesh, motion: Motion, levels: Sequence[MotionLevel]) -> list[np.ndarray]:
+    """Per level, (T,) the largest distance, in each frame of ``motion``, of a vertex of the
+    level's skin played with the level's motion from where ``motion`` puts it on the input ``skin``
+    (the input baked once per chunk of frames for every level)."""
     chunk = max(1, _BAKED_POSITIONS_PER_CHUNK // max(1, skin.vertex_count))
-    out = np.empty(motion.frame_count)
+    out = [np.empty(motion.frame_count) for _ in levels]
     for start in range(0, motion.frame_count, chunk):
         frames = slice(start, min(start + chunk, motion.frame_count))
         original = skin.bake(motion.take_frames(frames)).frames
-        posed = level.skin.bake(level.motion.take_frames(frames)).frames
-        out[frames] = np.linalg.norm(posed - original, axis=-1).max(axis=1)
+        for level, distances in zip(levels, out):
+            posed = level.skin.bake(level.motion.take_frames(frames)).frames
+            distances[frames] = np.linalg.norm(posed - original, axis=-1).max(axis=1)
     return out
 
 

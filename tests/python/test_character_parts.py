@@ -13,12 +13,13 @@ from pathlib import Path
 import numpy as np
 import pygltflib
 import pytest
+from rigid_skin import rigid_skin
 
 from animlod import rotations, synth
 from animlod.io import read_gltf, read_lod_chains, write_glb
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
-from animlod.model import Motion, Skeleton, SkinnedMesh
+from animlod.model import Motion, Skeleton
 from animlod.pipelines.character import build_character
 from animlod.pipelines.motion import build_motion_levels
 
@@ -148,14 +149,7 @@ def test_a_head_of_its_own_counts_in_the_choice_of_the_bodys_joints(tmp_path) ->
     rest = skeleton.rest_world_transforms()[:, :3, 3]
     parts = [(joint, _box(rest[joint] + [0.0, 0.1, 0.0], 0.08)[0]) for joint in (0, 1, 2)]
     parts += [(joint, _box(rest[joint] + [0.0, -0.25, 0.0], 0.08)[0]) for joint in (4, 5)]
-    positions = np.concatenate([points for _, points in parts])
-    joints = np.zeros((len(positions), 4), np.int32)
-    joints[:, 0] = np.concatenate([np.full(len(points), joint) for joint, points in parts])
-    weights = np.zeros((len(positions), 4), np.float32)
-    weights[:, 0] = 1.0
-    faces = np.arange(len(positions) - 2)[:, None] + [0, 1, 2]
-    body = SkinnedMesh(positions, faces, joints, weights, np.linalg.inv(skeleton.rest_world_transforms()), skeleton)
-    write_glb(tmp_path / "body.glb", body, [motion])
+    write_glb(tmp_path / "body.glb", rigid_skin(skeleton, parts), [motion])
     source = _with_part(tmp_path, "head", plain=tmp_path / "body.glb")
     build_character(source, tmp_path / "lod.glb", [0.5, 0.25], solver="newton", **QUICK)
     level = {chain.name: chain for chain in read_lod_chains(tmp_path / "lod.glb")}["skinned mesh"].levels[1]

@@ -11,6 +11,7 @@ import json
 
 import numpy as np
 import pytest
+from rigid_skin import rigid_skin
 
 from animlod import rotations
 from animlod.cli import main
@@ -38,20 +39,6 @@ def _box(centre, size, n=4) -> np.ndarray:
     return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
 
 
-def _rigid_skin(
-    skeleton: Skeleton, parts: list[tuple[int, np.ndarray]], faces: np.ndarray | None = None
-) -> SkinnedMesh:
-    """A skin of ``parts`` (joint, points), each following its joint alone, bound in the rest
-    pose; ``faces`` None: a strip through every vertex (a GLB keeps only vertices in faces)."""
-    positions = np.concatenate([points for _, points in parts]).astype(np.float32)
-    joints = np.zeros((len(positions), 4), np.int32)
-    joints[:, 0] = np.concatenate([np.full(len(points), joint) for joint, points in parts])
-    weights = np.zeros((len(positions), 4), np.float32)
-    weights[:, 0] = 1.0
-    faces = np.arange(len(positions) - 2)[:, None] + [0, 1, 2] if faces is None else faces
-    return SkinnedMesh(positions, faces, joints, weights, np.linalg.inv(skeleton.rest_world_transforms()), skeleton)
-
-
 @pytest.fixture(scope="module")
 def rig():
     """A body on the spine, a wide head on the leaf joint 'head' that turns about the neck's
@@ -59,7 +46,7 @@ def rig():
     skeleton = Skeleton(NAMES, [-1, 0, 1, 0], [[0, 0, 0], [0, 1, 0], [0, 1, 0], [0.5, 0, 0]])
     body, head = _box([0, 1.0, 0], [0.6, 1.0, 0.3]), _box([0, 2.3, 0], [0.6, 0.4, 0.5])
     faces = np.array([[0, 1, 2], [len(body), len(body) + 1, len(body) + 2]])
-    skin = _rigid_skin(skeleton, [(1, body), (2, head)], faces)
+    skin = rigid_skin(skeleton, [(1, body), (2, head)], faces)
     frames = 24
     angle = np.linspace(0.0, 1.2, frames)
     local = rotations.identity((frames, 4))
@@ -132,7 +119,7 @@ def twisting_arm():
     names = ["root", "spine", "arm", "hand"]
     skeleton = Skeleton(names, [-1, 0, 1, 2], [[0, 0, 0], [0, 1, 0], [0, 1, 0], [0, 1, 0]])
     body, slab = _box([0, 1.5, 0], [0.3, 1.0, 0.3]), _box([0, 2.5, 0], [1.0, 0.8, 0.1])
-    skin = _rigid_skin(skeleton, [(1, body), (2, slab)])
+    skin = rigid_skin(skeleton, [(1, body), (2, slab)])
     frames = 24
     angle = np.linspace(0.0, 1.2, frames)
     local = rotations.identity((frames, 4))

@@ -120,17 +120,41 @@ def test_a_helmet_on_the_head_plays_the_bodys_motion_levels(helmeted) -> None:
     assert _plays_the_bodys_levels(output, "helmet") >= 1  # the case that tore the helmet off
 
 
-def test_hair_on_a_bone_of_its_own_plays_the_bodys_levels_while_that_bone_holds_still(tmp_path) -> None:
+def test_hair_on_a_bone_of_its_own_that_holds_still_plays_the_bodys_levels(tmp_path) -> None:
     # VRoid's hair: a skin over the head and hair bones the body's skin does not list. Bones that
-    # hold their bind pose on the head move their vertices with it; a swinging one keeps the
-    # hair on levels of its own, and a note says they may part.
+    # hold their bind pose on the head move their vertices with it.
     output, report = _character_with_part(tmp_path, "hair", [0.25], hair="still")
     assert "skin 1: its joints hang from those of skin 0; it plays that skin's motion levels" in report.notes
     _plays_the_bodys_levels(output, "hair")
-    output, report = _character_with_part(tmp_path, "swinging", [0.25], hair="swinging")
-    assert any(note.startswith("skin 1: shares joints with skin 0 but cannot play") for note in report.notes)
-    swinging = {chain.name: chain for chain in read_lod_chains(output)}["swinging"]
-    assert swinging.levels[1].skeleton.names[0] == "Head"  # a skeleton of its own, not the body's
+
+
+def test_swinging_hair_joins_the_bodys_skeleton(tmp_path) -> None:
+    # Hair whose own bone swings kept a skeleton of its own (Head, Hair) with levels of its own:
+    # where the body froze the head, the hair went on nodding without it. Its bone now joins the
+    # body's skeleton, in every mesh drawn with the body's skin (a second body mesh here), and the
+    # hair plays the body's levels: the swing where the level keeps the bone, none where it freezes.
+    source = _with_part(tmp_path, "swinging", hair="swinging")
+    builder = GlbBuilder.from_document(GltfDocument(source))
+    body_node = next(node for node in builder.json["nodes"] if node.get("skin") == 0)
+    second = dict(builder.json["meshes"][body_node["mesh"]], name="second body")
+    node = builder.append("nodes", {"name": "second body", "mesh": builder.append("meshes", second), "skin": 0})
+    builder.json["scenes"][0]["nodes"].append(node)
+    builder.save(source)
+    output = tmp_path / "swinging_lod.glb"
+    report = build_character(source, output, [0.5, 0.25], solver="newton", **QUICK)
+    assert "skin 1: its own joints (node 42 'Hair') move in its clips and join skin 0; it plays that skin's " \
+        "motion levels" in report.notes  # fmt: skip
+    assert _plays_the_bodys_levels(output, "swinging") >= 1
+    chains = {chain.name: chain for chain in read_lod_chains(output)}
+    assert [level.skeleton.names for level in chains["second body"].levels[1:]] == [
+        level.skeleton.names for level in chains["skinned mesh"].levels[1:]
+    ]
+    swings = []
+    for level in chains["swinging"].levels[1:]:
+        if "Hair" in level.skeleton.names:
+            turns = level.motions[0].local_rotations[:, level.skeleton.names.index("Hair")]
+            swings.append(float(2.0 * np.arccos(np.clip(np.abs(turns @ turns[0]), 0.0, 1.0)).max()))
+    assert swings and min(swings) > 0.5  # the input swings by 0.6 radians
 
 
 def test_a_head_of_its_own_counts_in_the_choice_of_the_bodys_joints(tmp_path) -> None:

@@ -10,7 +10,9 @@ the drawable's posed frames can be produced for any clip: skinning after morphin
 
 from __future__ import annotations
 
+import dataclasses
 import os
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -168,6 +170,17 @@ def read_document_drawables(path: str | os.PathLike, fps: float = 30.0) -> tuple
     """The parsed document at ``path`` and its drawables."""
     doc = GltfDocument(path)
     return doc, read_drawables(doc, fps)
+
+
+def on_rig(doc: GltfDocument, drawable: Drawable, rig: SkinRig, fps: float = 30.0) -> Drawable:
+    """``drawable`` (skinned) read again on ``rig``, a rig of its skin with extra joints
+    (SkinRig): its skinned mesh over that skeleton and its clips sampled on it."""
+    with warnings.catch_warnings():  # its weights warned when it was first read
+        warnings.simplefilter("ignore")
+        skinned = skinned_mesh_of_node(doc, drawable.nodes[0], rig, drawable.geometry)
+    moved = dataclasses.replace(drawable, rig=rig, skinned=skinned)
+    moved.clips = _clips(doc, moved, fps, {})
+    return moved
 
 
 def _alternate_nodes(node: dict) -> list[int]:

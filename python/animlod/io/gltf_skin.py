@@ -33,6 +33,7 @@ that the mirroring stays in ``rest_shape`` and the motion stays rigid.
 from __future__ import annotations
 
 import heapq
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -69,8 +70,12 @@ class SkinRig:
     skeleton : the joints in topological order, rest offsets and rotations from the nodes.
         When the skin's joints form several trees, their lowest common ancestor node joins
         the skeleton as its root (no vertex is bound to it, its inverse bind is identity).
+        ``extra_joints`` (nodes below the skin's joints, with ``extra_binds`` (E, 4, 4) in the
+        skin's bind space) join it too: the bones of another skin that plays this one's skeleton
+        (pipelines/skin_parts.py); no vertex of this skin is bound to them.
     skin_slots : S, the number of joints the skin lists (JOINTS_0 indexes them).
-    remap : (J,) skeleton joint of each skin slot, then of the added common root if any.
+    remap : (J,) skeleton joint of each skin slot, then of the extra joints and the added common
+        root if any.
     scales : (J,) accumulated uniform scale of each joint's node at rest (non-uniform nodes count 1).
     rest_shape : (J, 3, 3) what each joint's rest world transform does beyond its rotation and
         ``scales`` (a non-uniform rest scale), in the joint's frame; None when every node is uniform.
@@ -79,12 +84,21 @@ class SkinRig:
         with the skeleton's (a weapon animated beside the character), for messages.
     """
 
-    def __init__(self, doc: GltfDocument, skin: int | None) -> None:
+    def __init__(
+        self,
+        doc: GltfDocument,
+        skin: int | None,
+        extra_joints: Sequence[int] = (),
+        extra_binds: np.ndarray | None = None,
+    ) -> None:
         self.skin = skin
         self.element = "animated nodes" if skin is None else f"skin {skin}"
         self.trees_left_out: list[str] = []
         joint_nodes = self._joint_nodes(doc)
         self.skin_slots = len(joint_nodes)
+        self.extra_joints = list(extra_joints)
+        self.extra_binds = np.zeros((0, 4, 4)) if extra_binds is None else np.asarray(extra_binds, np.float64)
+        joint_nodes += self.extra_joints
         joint_nodes += self._common_root(doc, joint_nodes)
         parent_slots = self._parent_slots(doc, joint_nodes)
         order = _topological_order(parent_slots)
@@ -229,9 +243,11 @@ class SkinRig:
         return [next((slot_of[a] for a in doc.ancestors(node) if a in slot_of), -1) for node in joint_nodes]
 
     def _inverse_bind(self, doc: GltfDocument, joint_count: int) -> np.ndarray:
-        """Inverse bind matrices ``(J, 4, 4)`` in slot order: the skin's (identity when absent),
-        then identity for an added common root (and for an animated node tree, which has no skin)."""
+        """Inverse bind matrices ``(J, 4, 4)`` in slot order: the skin's (identity when absent), the
+        extra joints', then identity for an added common root (and for an animated node tree, which
+        has no skin)."""
         matrices = np.broadcast_to(np.eye(4), (joint_count, 4, 4)).copy()
+        matrices[self.skin_slots : self.skin_slots + len(self.extra_binds)] = self.extra_binds
         if self.skin is None or doc.gltf.skins[self.skin].inverseBindMatrices is None:
             return matrices
         skin = doc.gltf.skins[self.skin]

@@ -12,9 +12,9 @@ too (``extras.animlod_grid`` on the base node lists them by geometry level, then
 so that a benchmark can walk the whole grid.
 
 A skin whose joints belong to a larger skin's (a helmet or visor on the head), or hang from
-them holding their bind pose (hair bones), bound in the same pose, is a part
-(:mod:`.skin_parts`): it plays that skin's motion levels, on its reduced skeletons, and the
-chains of one skeleton switch at one distance. Motion level m >= 1 adds, per skin, a reduced
+them (hair bones), bound in the same pose, is a part (:mod:`.skin_parts`): it plays that skin's
+motion levels, on its reduced skeletons, and the chains of one skeleton switch at one distance.
+Its own bones that move in its clips join that skin's skeleton first. Motion level m >= 1 adds, per skin, a reduced
 skeleton as joint nodes of its own, a skin over them and one animation per input clip
 (``extras.animlod = {"clip", "motion_level"}``); a level node at motion level m uses that skin,
 so any glTF engine can play it. Nodes hung from the input's joints (props, sockets) are copied
@@ -35,7 +35,7 @@ import numpy as np
 from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
-from ..io.gltf_drawable import Clip, Drawable, read_drawables
+from ..io.gltf_drawable import Clip, Drawable, on_rig, read_drawables
 from ..io.gltf_lod import (
     GRID_EXTRA,
     LevelInfo,
@@ -61,7 +61,7 @@ from .attachments import add_level_attachments, carry_other_channels, find_attac
 from .clip_import import with_clips
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
-from .skin_parts import Placement, moved_onto, placement_on
+from .skin_parts import Placement, joined_rig, moved_onto, placement_on
 
 
 @dataclass
@@ -138,8 +138,9 @@ def build_character(
     started = time.perf_counter()
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
     played_clips = {d.skin_index: _joined_clips(d) for d in animated}
-    roles = _assign_skeletons(animated, joints_of, played_clips, notes)
+    roles = _assign_skeletons(doc, animated, joints_of, played_clips, notes, settings.fps)
     chain_of, parts, owners, sharing = roles.chain_of, roles.parts, roles.owners, roles.sharing
+    animated = [roles.current(d) for d in animated]
     motion_chains: dict[int, _SkinMotion] = {}
     for skin, drawable in owners.items():
         clips, joined, spans = played_clips[skin]
@@ -173,7 +174,7 @@ def build_character(
         elif owner is not None:
             notes.append(
                 f"skin {skin}: shares joints with skin {owner} but cannot play its motion levels (bound in another "
-                f"pose, or its joints that skin {owner} lacks move in its clips); its own levels may part from them"
+                f"pose, or weighted to joints below none of skin {owner}'s); its own levels may part from them"
             )
         elif levels < levels_wanted:
             notes.append(
@@ -258,20 +259,30 @@ class _Roles:
     parts: dict[int, _Part] = field(default_factory=dict)  # skin -> its place on that skin's skeleton
     owners: dict[int, Drawable] = field(default_factory=dict)  # the skins with levels of their own
     sharing: dict[int, int] = field(default_factory=dict)  # owner -> an owner it shares joints with
+    # Drawables read again on their skin's rig joined with a part's own bones, by label.
+    rejoined: dict[str, Drawable] = field(default_factory=dict)
+
+    def current(self, drawable: Drawable) -> Drawable:
+        """``drawable`` as its chain plays it: on a joined rig where a part's bones joined it."""
+        return self.rejoined.get(drawable.label, drawable)
 
 
 def _assign_skeletons(
+    doc: GltfDocument,
     animated: list[Drawable],
     joints_of: dict[int, set[int]],
     played_clips: dict[int, tuple[list[Clip], Motion, list[slice]]],
     notes: list[str],
+    fps: float,
 ) -> _Roles:
     """Larger skeletons first: a skin over the joints of one before it (exporters may give every
     mesh a skin of its own over the same joints) plays its motion levels, and so does a skin whose
-    joints belong to a larger skin's (a helmet bound to the head) or hang from them holding their
-    bind pose (VRoid's hair bones below the head): freezing its joints on their own, or keeping
-    them while the body freezes them, would tear it from the body. Every other skin has levels of
-    its own. Notes say which is which."""
+    joints belong to a larger skin's (a helmet bound to the head) or hang from them (VRoid's hair
+    bones below the head): freezing its joints on their own, or keeping them while the body
+    freezes them, would tear it from the body. Bones of its own that hold their bind pose move its
+    vertices with the body's joint above them; bones that move (a cape's, swinging hair) join the
+    body's skeleton (:func:`_join`). Every other skin has levels of its own. Notes say which is
+    which; ``joints_of`` and ``played_clips`` follow the joined skeletons."""
     roles = _Roles()
     for drawable in sorted(animated, key=lambda d: -len(joints_of[d.skin_index])):
         skin = drawable.skin_index
@@ -286,17 +297,54 @@ def _assign_skeletons(
         owner = next((other for other in roles.owners if joints_of[skin] & joints_of[other]), None)
         joined = played_clips[skin][1]
         placement = None if owner is None else placement_on(roles.owners[owner].skinned, drawable.skinned, joined)
+        relation = None
+        if placement is None and owner is not None and _join(doc, roles, owner, drawable, animated, fps):
+            own = sorted(set(drawable.rig.joint_nodes) - joints_of[owner])
+            relation = f"its own joints ({', '.join(doc.node_label(node) for node in own)}) move in its clips and join"
+            joints_of[owner] = set(roles.owners[owner].rig.joint_nodes)
+            played_clips[owner] = _joined_clips(roles.owners[owner])
+            placement = placement_on(roles.owners[owner].skinned, drawable.skinned)
         if placement is not None:
             roles.chain_of[skin] = owner
             own_clips = {clip.index: clip for clip in drawable.clips}
             roles.parts[skin] = _Part(roles.owners[owner].skinned, placement, own_clips)
-            relation = "its joints belong to" if joints_of[skin] < joints_of[owner] else "its joints hang from those of"
+            if relation is None:
+                relation = (
+                    "its joints belong to" if joints_of[skin] < joints_of[owner] else "its joints hang from those of"
+                )
             notes.append(f"skin {skin}: {relation} skin {owner}; it plays that skin's motion levels")
             continue
         roles.chain_of[skin], roles.owners[skin] = skin, drawable
         if owner is not None:
             roles.sharing[skin] = owner
     return roles
+
+
+def _join(doc: GltfDocument, roles: _Roles, owner: int, part: Drawable, animated: list[Drawable], fps: float) -> bool:
+    """Adds ``part``'s own bones, those ``owner``'s skin lacks, to the skeleton of every drawable
+    that plays ``owner``'s levels on a skin of its own kind (the owner's meshes and twins: read
+    again, ``roles.rejoined``; parts placed on it move onto the joined skeleton), so that the part
+    plays them too. False, and nothing changed, where some of them cannot take those bones (bound
+    in another pose than the part; skin_parts.joined_rig)."""
+    members = [
+        roles.current(d)
+        for d in animated
+        if roles.chain_of.get(d.skin_index) == owner and d.skin_index not in roles.parts
+    ]
+    rigs = {}
+    for member in members:
+        if member.skin_index not in rigs:
+            rig = joined_rig(doc, member.rig, member.skinned, part.rig, part.skinned)
+            if rig is None:
+                return False
+            rigs[member.skin_index] = rig
+    for member in members:
+        roles.rejoined[member.label] = on_rig(doc, member, rigs[member.skin_index], fps)
+    roles.owners[owner] = roles.rejoined[roles.owners[owner].label]
+    for skin, placed in roles.parts.items():
+        if roles.chain_of[skin] == owner:  # the joined skeleton keeps every joint's index
+            placed.first = roles.owners[owner].skinned
+    return True
 
 
 @dataclass

@@ -5,15 +5,20 @@ clips.
 
 Where both skins were bound in one pose, a part's inverse binds differ from the first skin's by
 one transform ``T`` for every joint its weights use (its mesh node's,
-:func:`animlod.io.gltf_read.skinned_mesh_of_node`); ``T`` moves into its vertices.
+:func:`animlod.io.gltf_read.skinned_mesh_of_node`); ``T`` moves into its vertices. Bones of the
+part's own that hold their bind pose fold into the joint above them (:func:`placement_on`);
+bones that move join the first skin's skeleton (:func:`joined_rig`), bound as the part binds them.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from typing import NamedTuple
 
 import numpy as np
 
+from ..io.gltf_document import GltfDocument
+from ..io.gltf_skin import SkinRig
 from ..model import Motion, SkinnedMesh
 
 # Inverse binds stored as float32 agree to about 1e-7 of their largest entry where two skins were
@@ -38,28 +43,76 @@ def placement_on(first: SkinnedMesh, part: SkinnedMesh, motion: Motion | None = 
     A joint ``first`` lacks (VRoid hair and skirt bones under the head and hips) moves its
     vertices with its nearest ancestor that ``first`` lists. That is exact only where it holds
     its bind pose on that ancestor in every frame of ``motion``, the part's clips (checked on
-    its skin matrices); without ``motion``, such a part has no placement.
+    its skin matrices); without ``motion``, such a part has no placement (:func:`joined_rig`
+    adds such bones to ``first``'s skeleton instead).
     """
+    lying = _lying_on(first, part)
+    if lying is None:
+        return None
+    folded = lying.used[~lying.listed[lying.used]]
+    if folded.size:
+        if motion is None:
+            return None
+        matrices = motion.skin_matrices(part.inverse_bind)
+        if not _alike(matrices[:, folded], matrices[:, lying.anchor[folded]]):
+            return None
+    return Placement(lying.joint_map, lying.transform)
+
+
+def joined_rig(
+    doc: GltfDocument, first_rig: SkinRig, first: SkinnedMesh, part_rig: SkinRig, part: SkinnedMesh
+) -> SkinRig | None:
+    """``first``'s rig with the joints of ``part`` it lacks (a cape's or hair's own bones, below
+    joints it lists), bound as ``part`` binds them, so that a part whose own bones move in its
+    clips plays one skeleton with ``first``; None where ``part`` has no such joint, or has no
+    placement but for them (:func:`placement_on`: its weights reach a joint with no ancestor
+    ``first`` lists, or it was bound in another pose)."""
+    lying = _lying_on(first, part)
+    if lying is None:
+        return None
+    extra = np.flatnonzero(~lying.listed & (lying.anchor >= 0))
+    if not extra.size:
+        return None
+    # In the stored binds (SkinRig.inverse_bind), IBM_part = IBM_first @ T at every joint both
+    # list, T a rigid change of bind space (the same T as Placement's, before each mesh's node).
+    shared = part_rig.joint_nodes[int(lying.anchor[lying.used[0]])]
+    to_part = (
+        np.linalg.inv(first_rig.inverse_bind[first_rig.joint_nodes.index(shared)])
+        @ part_rig.inverse_bind[part_rig.joint_nodes.index(shared)]
+    )
+    nodes = first_rig.extra_joints + [part_rig.joint_nodes[j] for j in extra]
+    binds = np.concatenate([first_rig.extra_binds, part_rig.inverse_bind[extra] @ np.linalg.inv(to_part)])
+    return SkinRig(doc, first_rig.skin, nodes, binds)
+
+
+class _Lying(NamedTuple):
+    """Where a part's joints (its skeleton's) meet another skin's (:func:`_lying_on`)."""
+
+    listed: np.ndarray  # (J,) bool: the other skin lists the joint (by name)
+    anchor: np.ndarray  # (J,) the nearest listed joint at or above each, -1 for none
+    used: np.ndarray  # the joints the part's weights use
+    joint_map: np.ndarray  # (J,) the other skin's joint for each anchor, -1 for none
+    transform: np.ndarray  # (4, 4) T of Placement
+
+
+def _lying_on(first: SkinnedMesh, part: SkinnedMesh) -> _Lying | None:
+    """How ``part``'s joints meet ``first``'s; None where a joint its weights use has no ancestor
+    ``first`` lists, it uses none, or it was bound in another pose."""
     index = {name: joint for joint, name in enumerate(first.skeleton.names)}
     parents = part.skeleton.parents
     listed = np.array([name in index for name in part.skeleton.names])
-    anchor = np.full(part.skeleton.joint_count, -1)  # the nearest listed joint at or above each joint
+    anchor = np.full(part.skeleton.joint_count, -1)
     for joint in range(part.skeleton.joint_count):  # parents before children
         anchor[joint] = joint if listed[joint] else (anchor[parents[joint]] if parents[joint] >= 0 else -1)
     used = np.unique(part.joints[part.weights > 0.0])
     if not used.size or (anchor[used] < 0).any():
         return None
     joint_map = np.array([index[part.skeleton.names[a]] if a >= 0 else -1 for a in anchor])
-    folded = used[~listed[used]]
-    if folded.size:
-        if motion is None:
-            return None
-        matrices = motion.skin_matrices(part.inverse_bind)
-        if not _alike(matrices[:, folded], matrices[:, anchor[folded]]):
-            return None
     anchors = np.unique(anchor[used])
     transforms = np.linalg.inv(first.inverse_bind[joint_map[anchors]]) @ part.inverse_bind[anchors]
-    return Placement(joint_map, transforms[0]) if _alike(transforms, transforms[0]) else None
+    if not _alike(transforms, transforms[0]):
+        return None
+    return _Lying(listed, anchor, used, joint_map, transforms[0])
 
 
 def _alike(matrices: np.ndarray, reference: np.ndarray) -> bool:

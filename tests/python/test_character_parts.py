@@ -133,7 +133,9 @@ def test_swinging_hair_joins_the_bodys_skeleton(tmp_path) -> None:
     # where the body froze the head, the hair went on nodding without it. Its bone now joins the
     # body's skeleton, in every mesh drawn with the body's skin (a second body mesh here), and the
     # hair plays the body's levels: the swing where the level keeps the bone, none where it freezes.
-    source = _with_part(tmp_path, "swinging", hair="swinging")
+    # A second lock of hair on a bone of the same name joins it too, as a bone of its own.
+    first = _with_part(tmp_path, "swinging", hair="swinging")
+    source = _with_part(tmp_path, "second lock", hair="swinging", plain=first)
     builder = GlbBuilder.from_document(GltfDocument(source))
     body_node = next(node for node in builder.json["nodes"] if node.get("skin") == 0)
     second = dict(builder.json["meshes"][body_node["mesh"]], name="second body")
@@ -142,19 +144,20 @@ def test_swinging_hair_joins_the_bodys_skeleton(tmp_path) -> None:
     builder.save(source)
     output = tmp_path / "swinging_lod.glb"
     report = build_character(source, output, [0.5, 0.25], solver="newton", **QUICK)
-    assert "skin 1: its own joints (node 42 'Hair') move in its clips and join skin 0; it plays that skin's " \
-        "motion levels" in report.notes  # fmt: skip
-    assert _plays_the_bodys_levels(output, "swinging") >= 1
+    for skin, node in ((1, 42), (2, 44)):
+        assert f"skin {skin}: its own joints (node {node} 'Hair') move in its clips and join skin 0; it plays that " \
+            "skin's motion levels" in report.notes  # fmt: skip
+        assert _plays_the_bodys_levels(output, "swinging" if skin == 1 else "second lock") >= 1
     chains = {chain.name: chain for chain in read_lod_chains(output)}
     assert [level.skeleton.names for level in chains["second body"].levels[1:]] == [
         level.skeleton.names for level in chains["skinned mesh"].levels[1:]
     ]
     swings = []
     for level in chains["swinging"].levels[1:]:
-        if "Hair" in level.skeleton.names:
-            turns = level.motions[0].local_rotations[:, level.skeleton.names.index("Hair")]
+        for bone in {"Hair#42", "Hair#44"} & set(level.skeleton.names):
+            turns = level.motions[0].local_rotations[:, level.skeleton.names.index(bone)]
             swings.append(float(2.0 * np.arccos(np.clip(np.abs(turns @ turns[0]), 0.0, 1.0)).max()))
-    assert swings and min(swings) > 0.5  # the input swings by 0.6 radians
+    assert len(swings) >= 2 and min(swings) > 0.5  # the input swings by 0.6 radians
 
 
 def test_a_head_of_its_own_counts_in_the_choice_of_the_bodys_joints(tmp_path) -> None:

@@ -61,7 +61,7 @@ from .attachments import add_level_attachments, carry_other_channels, find_attac
 from .clip_import import with_clips
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
-from .skin_parts import Placement, joined_rig, moved_onto, placement_on
+from .skin_parts import JointKeys, Placement, joined_rig, moved_onto, placement_on
 
 
 @dataclass
@@ -296,14 +296,14 @@ def _assign_skeletons(
             continue
         owner = next((other for other in roles.owners if joints_of[skin] & joints_of[other]), None)
         joined = played_clips[skin][1]
-        placement = None if owner is None else placement_on(roles.owners[owner].skinned, drawable.skinned, joined)
+        placement = None if owner is None else _placement(roles.owners[owner], drawable, joined)
         relation = None
         if placement is None and owner is not None and _join(doc, roles, owner, drawable, animated, fps):
             own = sorted(set(drawable.rig.joint_nodes) - joints_of[owner])
             relation = f"its own joints ({', '.join(doc.node_label(node) for node in own)}) move in its clips and join"
             joints_of[owner] = set(roles.owners[owner].rig.joint_nodes)
             played_clips[owner] = _joined_clips(roles.owners[owner])
-            placement = placement_on(roles.owners[owner].skinned, drawable.skinned)
+            placement = _placement(roles.owners[owner], drawable)
         if placement is not None:
             roles.chain_of[skin] = owner
             own_clips = {clip.index: clip for clip in drawable.clips}
@@ -318,6 +318,12 @@ def _assign_skeletons(
         if owner is not None:
             roles.sharing[skin] = owner
     return roles
+
+
+def _placement(owner: Drawable, part: Drawable, motion: Motion | None = None) -> Placement | None:
+    """Where ``part`` lies on ``owner``'s skeleton (skin_parts.placement_on), joints matched by node."""
+    keys = JointKeys(owner.rig.joint_nodes, part.rig.joint_nodes)
+    return placement_on(owner.skinned, part.skinned, motion, keys)
 
 
 def _join(doc: GltfDocument, roles: _Roles, owner: int, part: Drawable, animated: list[Drawable], fps: float) -> bool:

@@ -13,6 +13,7 @@ bones that move join the first skin's skeleton (:func:`joined_rig`), bound as th
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -36,9 +37,12 @@ class Placement:
     transform: np.ndarray
 
 
-def placement_on(first: SkinnedMesh, part: SkinnedMesh, motion: Motion | None = None) -> Placement | None:
+def placement_on(
+    first: SkinnedMesh, part: SkinnedMesh, motion: Motion | None = None, keys: JointKeys | None = None
+) -> Placement | None:
     """How ``part`` lies on ``first``'s skeleton and binds, or None: where its weights reach a joint
-    with no ancestor ``first`` lists (by name), reach none, or it was bound in another pose.
+    with no ancestor ``first`` lists, reach none, or it was bound in another pose. ``keys`` tell
+    which joints of the two skeletons are one (the joints' names by default).
 
     A joint ``first`` lacks (VRoid hair and skirt bones under the head and hips) moves its
     vertices with its nearest ancestor that ``first`` lists. That is exact only where it holds
@@ -46,7 +50,7 @@ def placement_on(first: SkinnedMesh, part: SkinnedMesh, motion: Motion | None = 
     its skin matrices); without ``motion``, such a part has no placement (:func:`joined_rig`
     adds such bones to ``first``'s skeleton instead).
     """
-    lying = _lying_on(first, part)
+    lying = _lying_on(first, part, keys)
     if lying is None:
         return None
     folded = lying.used[~lying.listed[lying.used]]
@@ -66,8 +70,8 @@ def joined_rig(
     joints it lists), bound as ``part`` binds them, so that a part whose own bones move in its
     clips plays one skeleton with ``first``; None where ``part`` has no such joint, or has no
     placement but for them (:func:`placement_on`: its weights reach a joint with no ancestor
-    ``first`` lists, or it was bound in another pose)."""
-    lying = _lying_on(first, part)
+    ``first`` lists, or it was bound in another pose). Joints are one where they are one node."""
+    lying = _lying_on(first, part, JointKeys(first_rig.joint_nodes, part_rig.joint_nodes))
     if lying is None:
         return None
     extra = np.flatnonzero(~lying.listed & (lying.anchor >= 0))
@@ -85,29 +89,38 @@ def joined_rig(
     return SkinRig(doc, first_rig.skin, nodes, binds)
 
 
+class JointKeys(NamedTuple):
+    """What identifies each joint of two skeletons, in skeleton order: their nodes where both come
+    from one document (names may repeat there: two bones named "Hair"), else their names."""
+
+    first: Sequence[object]
+    part: Sequence[object]
+
+
 class _Lying(NamedTuple):
     """Where a part's joints (its skeleton's) meet another skin's (:func:`_lying_on`)."""
 
-    listed: np.ndarray  # (J,) bool: the other skin lists the joint (by name)
+    listed: np.ndarray  # (J,) bool: the other skin lists the joint
     anchor: np.ndarray  # (J,) the nearest listed joint at or above each, -1 for none
     used: np.ndarray  # the joints the part's weights use
     joint_map: np.ndarray  # (J,) the other skin's joint for each anchor, -1 for none
     transform: np.ndarray  # (4, 4) T of Placement
 
 
-def _lying_on(first: SkinnedMesh, part: SkinnedMesh) -> _Lying | None:
+def _lying_on(first: SkinnedMesh, part: SkinnedMesh, keys: JointKeys | None) -> _Lying | None:
     """How ``part``'s joints meet ``first``'s; None where a joint its weights use has no ancestor
     ``first`` lists, it uses none, or it was bound in another pose."""
-    index = {name: joint for joint, name in enumerate(first.skeleton.names)}
+    keys = keys or JointKeys(first.skeleton.names, part.skeleton.names)
+    index = {key: joint for joint, key in enumerate(keys.first)}
     parents = part.skeleton.parents
-    listed = np.array([name in index for name in part.skeleton.names])
+    listed = np.array([key in index for key in keys.part])
     anchor = np.full(part.skeleton.joint_count, -1)
     for joint in range(part.skeleton.joint_count):  # parents before children
         anchor[joint] = joint if listed[joint] else (anchor[parents[joint]] if parents[joint] >= 0 else -1)
     used = np.unique(part.joints[part.weights > 0.0])
     if not used.size or (anchor[used] < 0).any():
         return None
-    joint_map = np.array([index[part.skeleton.names[a]] if a >= 0 else -1 for a in anchor])
+    joint_map = np.array([index[keys.part[a]] if a >= 0 else -1 for a in anchor])
     anchors = np.unique(anchor[used])
     transforms = np.linalg.inv(first.inverse_bind[joint_map[anchors]]) @ part.inverse_bind[anchors]
     if not _alike(transforms, transforms[0]):

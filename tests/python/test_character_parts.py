@@ -183,18 +183,46 @@ def test_a_head_of_its_own_counts_in_the_choice_of_the_bodys_joints(tmp_path) ->
     assert "Head" in level.skeleton.names and len(level.skeleton.names) < len(names)
 
 
-def test_motion_levels_show_hair_whose_bone_holds_still(tmp_path) -> None:
-    # `motion` joins the parts on the body's skeleton into one mesh per level GLB; hair on a bone
-    # of its own was left out of them.
-    source = _with_part(tmp_path, "hair", hair="still")
-    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+def _motion_levels_show_every_skin(source: Path, folder: Path) -> list[str]:
+    """Asserts that `motion`'s first level GLB of ``source`` draws all of its skinned meshes as the
+    input does; returns the build's notes."""
+    report = build_motion_levels(source, folder, levels=2)
     assert not any("not in the levels' GLBs" in note for note in report.notes)
     scene = read_gltf(source)
     expected = np.concatenate([mesh.bake(motions[0]).frames for mesh, motions in
                                zip(scene.skinned_meshes, scene.skinned_motions)], axis=1)  # fmt: skip
-    written = read_gltf(tmp_path / "levels" / "hair_lod0.glb")
+    written = read_gltf(folder / f"{source.stem}_lod0.glb")
     (skinned,), (motion,) = written.skinned_meshes, written.motions
     np.testing.assert_allclose(skinned.bake(motion).frames, expected, atol=1e-4)
+    return report.notes
+
+
+def test_motion_levels_show_hair_whose_bone_holds_still(tmp_path) -> None:
+    # `motion` joins the parts on the body's skeleton into one mesh per level GLB; hair on a bone
+    # of its own was left out of them.
+    _motion_levels_show_every_skin(_with_part(tmp_path, "hair", hair="still"), tmp_path / "levels")
+
+
+def test_motion_levels_show_swinging_hair_on_the_bodys_skeleton(tmp_path) -> None:
+    # `motion` left hair whose own bone moves in its clips out of the levels' GLBs; its bone now
+    # joins the body's skeleton, as in `character`.
+    source = _with_part(tmp_path, "hair", hair="swinging")
+    notes = _motion_levels_show_every_skin(source, tmp_path / "levels")
+    assert f"{source}: node 43 'hair' has joints of its own that move in its clips (node 42 'Hair'); they join the " \
+        "skeleton of node 41 'skinned mesh'" in notes  # fmt: skip
+    assert "Hair" in read_gltf(tmp_path / "levels" / "hair_lod0.glb").skinned_meshes[0].skeleton.names
+
+
+def test_motion_levels_tell_the_hair_bone_from_a_body_bone_of_the_same_name(tmp_path) -> None:
+    # `motion` matched a part's joints to the body's by name: hair on a bone of its own named like
+    # one of the body's (the left hand, here) was put on that bone and swung with the hand.
+    plain = tmp_path / "humanoid.glb"
+    character = synth.humanoid()
+    write_glb(plain, character, [synth.humanoid_motion(character.skeleton, "walk")])
+    builder = GlbBuilder.from_document(GltfDocument(plain))
+    next(node for node in builder.json["nodes"] if node.get("name") == "LeftHand")["name"] = "Hair"
+    builder.save(plain)
+    _motion_levels_show_every_skin(_with_part(tmp_path, "hair", hair="still", plain=plain), tmp_path / "levels")
 
 
 def test_the_helmets_levels_share_the_bodys_skins(helmeted) -> None:

@@ -42,6 +42,9 @@ class GltfScene:
         at ``fps``, one per (node, animation).
     static_meshes : the other meshes without a skin, one frame each, in world space.
     skinned_motions : the animations of every skinned mesh, parallel to ``skinned_meshes``.
+    skinned_nodes : the node that draws each skinned mesh, parallel to ``skinned_meshes``.
+    skinned_rigs : the skin of each skinned mesh as a skeleton, parallel to ``skinned_meshes``;
+        their ``joint_nodes`` tell which joints of two skins are one (names may repeat in a file).
     """
 
     skinned_meshes: list[SkinnedMesh]
@@ -49,6 +52,8 @@ class GltfScene:
     morph_animations: list[AnimatedMesh]
     static_meshes: list[AnimatedMesh]
     skinned_motions: list[list[Motion]] = field(default_factory=list)
+    skinned_nodes: list[int] = field(default_factory=list)
+    skinned_rigs: list[SkinRig] = field(default_factory=list)
 
 
 def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> GltfScene:
@@ -62,11 +67,12 @@ def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> Gltf
     doc = path if isinstance(path, GltfDocument) else GltfDocument(path)
     rigs: dict[int, SkinRig] = {}
     skinned, skinned_motions = [], []
-    for node in _skinned_mesh_nodes(doc):
+    nodes = _skinned_mesh_nodes(doc)
+    for node in nodes:
         skin = doc.gltf.nodes[node].skin
         if skin not in rigs:
             rigs[skin] = SkinRig(doc, skin)
-        mesh, motions = _read_skinned_node(doc, node, rigs[skin], fps)
+        mesh, motions = read_skinned_node(doc, node, rigs[skin], fps)
         skinned.append(mesh)
         skinned_motions.append(motions)
     morph_animations, static_meshes = _read_unskinned_meshes(doc, fps)
@@ -76,6 +82,8 @@ def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> Gltf
         morph_animations=morph_animations,
         static_meshes=static_meshes,
         skinned_motions=skinned_motions,
+        skinned_nodes=nodes,
+        skinned_rigs=[rigs[doc.gltf.nodes[node].skin] for node in nodes],
     )
 
 
@@ -95,7 +103,7 @@ def read_skinned(
     if not chosen:
         available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes}))
         raise doc.fail(f"skin {skin!r}", f"not in the file (skinned meshes use skins: {available})")
-    return _read_skinned_node(doc, chosen[0], SkinRig(doc, doc.gltf.nodes[chosen[0]].skin), fps)
+    return read_skinned_node(doc, chosen[0], SkinRig(doc, doc.gltf.nodes[chosen[0]].skin), fps)
 
 
 def _skinned_mesh_nodes(doc: GltfDocument) -> list[int]:
@@ -139,7 +147,8 @@ def _rig_motions(doc: GltfDocument, rig: SkinRig, fps: float) -> list[Motion]:
     return [motion for motion in motions if motion is not None]
 
 
-def _read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -> tuple[SkinnedMesh, list[Motion]]:
+def read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -> tuple[SkinnedMesh, list[Motion]]:
+    """The skinned mesh node ``node`` draws with ``rig`` and every animation that moves the rig."""
     mesh = skinned_mesh_of_node(doc, node, rig, read_mesh_geometry(doc, doc.gltf.nodes[node].mesh, skinned=True))
     return mesh, _rig_motions(doc, rig, fps)
 

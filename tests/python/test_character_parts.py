@@ -8,6 +8,7 @@ visor: 7.8 % of the figure's diagonal apart at its 4-joint level).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -33,11 +34,13 @@ def _box(centre: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
     return (centre + half * corners).astype(np.float32), np.array(faces, np.uint16)
 
 
-def _with_part(folder, name: str, hair: str | None = None, plain: Path | None = None) -> Path:
+def _with_part(
+    folder, name: str, hair: str | None = None, plain: Path | None = None, targets: Sequence[str] = ()
+) -> Path:
     """The procedural humanoid walking (or the character of ``plain``), with a box over its head
     skinned by a skin of its own (bound in the body's pose): over Neck and Head, every vertex on
     Head; or with ``hair`` ("still" or "swinging") over Head and a bone "Hair" of its own below
-    it, every vertex on Hair."""
+    it, every vertex on Hair. The box has a morph target of each name in ``targets``."""
     if plain is None:
         plain = folder / "humanoid.glb"
         character = synth.humanoid()
@@ -77,7 +80,12 @@ def _with_part(folder, name: str, hair: str | None = None, plain: Path | None = 
     attributes = {"POSITION": builder.add(positions, bounds=True), "JOINTS_0": builder.add(joints),
                   "WEIGHTS_0": builder.add(weights)}  # fmt: skip
     primitive = {"attributes": attributes, "indices": builder.add(faces.reshape(-1, 1))}
-    mesh = builder.append("meshes", {"name": name, "primitives": [primitive]})
+    mesh = {"name": name, "primitives": [primitive]}
+    if targets:
+        deltas = np.random.default_rng(len(name)).normal(0.0, 0.02, (len(targets),) + positions.shape)
+        primitive["targets"] = [{"POSITION": builder.add(d.astype(np.float32), bounds=True)} for d in deltas]
+        mesh["extras"] = {"targetNames": list(targets)}
+    mesh = builder.append("meshes", mesh)
     builder.json["scenes"][0]["nodes"].append(builder.append("nodes", {"name": name, "mesh": mesh, "skin": skin}))
     source = folder / f"{name}.glb"
     builder.save(source)
@@ -211,6 +219,25 @@ def test_motion_levels_show_swinging_hair_on_the_bodys_skeleton(tmp_path) -> Non
     assert f"{source}: node 43 'hair' has joints of its own that move in its clips (node 42 'Hair'); they join the " \
         "skeleton of node 41 'skinned mesh'" in notes  # fmt: skip
     assert "Hair" in read_gltf(tmp_path / "levels" / "hair_lod0.glb").skinned_meshes[0].skeleton.names
+
+
+def test_motion_levels_show_parts_with_morph_targets_the_body_lacks(tmp_path) -> None:
+    # `motion` left out every part whose morph targets were not the first mesh's: a head with
+    # blendshapes beside a body without (ReadyPlayerMe, VRoid). Targets join by name: "jaw"
+    # moves both parts that have it.
+    head = _with_part(tmp_path, "head", targets=["jaw", "blink"])
+    teeth = _with_part(tmp_path, "teeth", targets=["jaw"], plain=head)
+    _motion_levels_show_every_skin(teeth, tmp_path / "levels")
+    scene, written = read_gltf(teeth), read_gltf(tmp_path / "levels" / "teeth_lod0.glb")
+    (skinned,), (motion,) = written.skinned_meshes, written.motions
+    assert skinned.morph_target_names == ["jaw", "blink"]
+    weights = {"jaw": 1.0, "blink": 0.5}
+    expected = [
+        mesh.bake(motions[0], np.tile([weights[n] for n in mesh.morph_target_names or []], (motion.frame_count, 1)))
+        for mesh, motions in zip(scene.skinned_meshes, scene.skinned_motions)
+    ]
+    posed = skinned.bake(motion, np.tile([1.0, 0.5], (motion.frame_count, 1))).frames
+    np.testing.assert_allclose(posed, np.concatenate([each.frames for each in expected], axis=1), atol=1e-4)
 
 
 def test_motion_levels_tell_the_hair_bone_from_a_body_bone_of_the_same_name(tmp_path) -> None:

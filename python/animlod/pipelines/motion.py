@@ -13,7 +13,6 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,11 +24,6 @@ from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis
 from ..motion_lod.chain import SOLVERS, JointFloor, MotionLevel, MotionLodChain, TrialMeasure
 from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from .result import AssetResult, LevelRow, Progress
-from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
-
-if TYPE_CHECKING:
-    from ..io.gltf import GltfScene
-    from ..io.gltf_document import GltfDocument
 
 
 @dataclass
@@ -247,18 +241,19 @@ def _read_input(
     from ..io.gltf import read_gltf, read_node_motions
     from ..io.gltf_document import GltfDocument
     from .clip_import import with_clips
+    from .whole_skin import whole_skin
 
     document = GltfDocument(source)
     if clip_files:
         document = with_clips(document, clip_files, note)
     scene = read_gltf(document, _GLTF_FPS)
     if scene.skinned_meshes:
-        skin, motions, left_out = _whole_skin(document, scene, note)
+        skin, motions, left_out = whole_skin(document, scene, note, _GLTF_FPS)
         if skin.vertex_count > scene.skinned_meshes[0].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
             note(f"{path}: {left_out} skinned mesh{'es' if left_out > 1 else ''} on other joints, bound in another "
-                 "pose or with other morph targets than the first, not in the levels' GLBs (`animlod character` "
+                 "pose or with unnamed morph targets beside named ones, not in the levels' GLBs (`animlod character` "
                  "takes every skin)")  # fmt: skip
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
@@ -310,68 +305,6 @@ def _clip_suffixes(names: list[str]) -> list[str]:
     safe = [re.sub(r"[^\w.-]+", "_", name).strip("_.") or "animation" for name in names]
     repeated = {name for name in safe if safe.count(name) > 1}
     return [f"_{name}_{index}" if name in repeated else f"_{name}" for index, name in enumerate(safe)]
-
-
-def _whole_skin(
-    doc: GltfDocument, scene: GltfScene, note: Callable[[str], None]
-) -> tuple[SkinnedMesh, list[Motion], int]:
-    """The first skinned mesh of ``scene`` with every other one on its skeleton (a character in
-    parts, as BrainStem is) joined to it, so that a level's GLB shows the whole character, its
-    motions, and how many meshes stay out. A part may have a skin of its own over some of the first
-    one's joints (as Soldier's visor has), or over bones of its own below them (VRoid's hair): bones
-    that hold still in the part's clips fold into the joint above them, bones that move join the
-    first mesh's skeleton, read again with them (skin_parts.py). Joints match by node. Parts on
-    other joints, bound in another pose, or with other morph targets than the first stay out."""
-    from ..io.gltf_read import read_skinned_node
-    from ..motion_lod.clips import join_clips
-
-    meshes = scene.skinned_meshes
-    first, motions, rig = meshes[0], scene.skinned_motions[0], scene.skinned_rigs[0]
-    parts = [first]
-    for mesh, clips, node, part_rig in zip(meshes[1:], scene.skinned_motions[1:], scene.skinned_nodes[1:],
-                                           scene.skinned_rigs[1:]):  # fmt: skip
-        if (mesh.morph_targets is None) != (first.morph_targets is None) or (
-            first.morph_targets is not None and mesh.morph_target_names != first.morph_target_names
-        ):
-            continue
-        keys = JointKeys(rig.joint_nodes, part_rig.joint_nodes)
-        placement = placement_on(first, mesh, join_clips(clips)[0] if clips else None, keys)
-        with_bones = joined_rig(doc, rig, first, part_rig, mesh) if placement is None else None
-        if with_bones is not None:  # the joined skeleton keeps every joint's index: placed parts stay valid
-            own = with_bones.extra_joints[len(rig.extra_joints) :]
-            note(f"{doc.path}: {doc.node_label(node)} has joints of its own that move in its clips "
-                 f"({', '.join(map(doc.node_label, own))}); they join the skeleton of "
-                 f"{doc.node_label(scene.skinned_nodes[0])}")  # fmt: skip
-            rig = with_bones
-            first, motions = read_skinned_node(doc, scene.skinned_nodes[0], rig, _GLTF_FPS)
-            placement = placement_on(first, mesh, keys=JointKeys(rig.joint_nodes, part_rig.joint_nodes))
-        if placement is not None:
-            parts.append(moved_onto(mesh, first, placement))
-    parts[0] = first
-    if len(parts) == 1:
-        return first, motions, len(meshes) - 1
-    influences = max(part.joints.shape[1] for part in parts)
-    starts = np.cumsum([0] + [part.vertex_count for part in parts])
-
-    def padded(values: np.ndarray) -> np.ndarray:
-        return np.pad(values, ((0, 0), (0, influences - values.shape[1])))
-
-    def joined(values: list[np.ndarray | None], axis: int = 0) -> np.ndarray | None:
-        return None if any(v is None for v in values) else np.concatenate(values, axis=axis)
-
-    whole = SkinnedMesh(
-        rest_positions=np.concatenate([part.rest_positions for part in parts]).astype(np.float32),
-        faces=np.concatenate([part.faces + start for part, start in zip(parts, starts)]),
-        joints=np.concatenate([padded(part.joints) for part in parts]),
-        weights=np.concatenate([padded(part.weights) for part in parts]),
-        inverse_bind=first.inverse_bind,
-        skeleton=first.skeleton,
-        uvs=joined([part.uvs for part in parts]),
-        normals=joined([part.normals for part in parts]),
-        morph_targets=joined([part.morph_targets for part in parts], axis=1),
-        morph_target_names=first.morph_target_names,
-    )
-    return whole, motions, len(meshes) - len(parts)
 
 
 def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Motion:

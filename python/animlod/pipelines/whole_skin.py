@@ -1,0 +1,116 @@
+"""The skinned meshes of a glTF on one skeleton as one mesh: a character in parts (BrainStem's
+pieces, Soldier's visor, VRoid's hair, a head with its own blendshapes beside a body without),
+for writers that take one skinned mesh per file (`animlod motion`'s level GLBs).
+
+Each part lies on the first mesh's skeleton as :mod:`.skin_parts` places it; bones of a part's own
+that move in its clips join that skeleton. Morph targets join by name: a target some parts name
+moves those parts' vertices and leaves the others', so one weight drives it everywhere, as
+engines drive a face's and its teeth's "jawOpen" together.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..io.gltf_document import GltfDocument
+from ..io.gltf_read import GltfScene, read_skinned_node
+from ..model import Motion, SkinnedMesh
+from ..motion_lod.clips import join_clips
+from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
+
+
+def whole_skin(
+    doc: GltfDocument, scene: GltfScene, note: Callable[[str], None], fps: float
+) -> tuple[SkinnedMesh, list[Motion], int]:
+    """The first skinned mesh of ``scene`` with every other one on its skeleton joined to it, its
+    motions (sampled at ``fps``), and how many meshes stay out: those on other joints, bound in
+    another pose, or whose morph targets lack names where the others' have them. A part's joints
+    match the first mesh's by node; bones of its own that move in its clips join the skeleton, the
+    first mesh read again with them, and ``note`` names them."""
+    meshes = scene.skinned_meshes
+    first, motions, rig = meshes[0], scene.skinned_motions[0], scene.skinned_rigs[0]
+    parts = [first]
+    for mesh, clips, node, part_rig in zip(meshes[1:], scene.skinned_motions[1:], scene.skinned_nodes[1:],
+                                           scene.skinned_rigs[1:]):  # fmt: skip
+        if not _targets_join(parts, mesh):
+            continue
+        keys = JointKeys(rig.joint_nodes, part_rig.joint_nodes)
+        placement = placement_on(first, mesh, join_clips(clips)[0] if clips else None, keys)
+        with_bones = joined_rig(doc, rig, first, part_rig, mesh) if placement is None else None
+        if with_bones is not None:  # the joined skeleton keeps every joint's index: placed parts stay valid
+            own = with_bones.extra_joints[len(rig.extra_joints) :]
+            note(f"{doc.path}: {doc.node_label(node)} has joints of its own that move in its clips "
+                 f"({', '.join(map(doc.node_label, own))}); they join the skeleton of "
+                 f"{doc.node_label(scene.skinned_nodes[0])}")  # fmt: skip
+            rig = with_bones
+            first, motions = read_skinned_node(doc, scene.skinned_nodes[0], rig, fps)
+            placement = placement_on(first, mesh, keys=JointKeys(rig.joint_nodes, part_rig.joint_nodes))
+        if placement is not None:
+            parts.append(moved_onto(mesh, first, placement))
+    parts[0] = first
+    if len(parts) == 1:
+        return first, motions, len(meshes) - 1
+    influences = max(part.joints.shape[1] for part in parts)
+    starts = np.cumsum([0] + [part.vertex_count for part in parts])
+
+    def padded(values: np.ndarray) -> np.ndarray:
+        return np.pad(values, ((0, 0), (0, influences - values.shape[1])))
+
+    def joined(values: list[np.ndarray | None]) -> np.ndarray | None:
+        return None if any(v is None for v in values) else np.concatenate(values)
+
+    targets, target_names = _joined_targets(parts)
+    whole = SkinnedMesh(
+        rest_positions=np.concatenate([part.rest_positions for part in parts]).astype(np.float32),
+        faces=np.concatenate([part.faces + start for part, start in zip(parts, starts)]),
+        joints=np.concatenate([padded(part.joints) for part in parts]),
+        weights=np.concatenate([padded(part.weights) for part in parts]),
+        inverse_bind=first.inverse_bind,
+        skeleton=first.skeleton,
+        uvs=joined([part.uvs for part in parts]),
+        normals=joined([part.normals for part in parts]),
+        morph_targets=targets,
+        morph_target_names=target_names,
+    )
+    return whole, motions, len(meshes) - len(parts)
+
+
+def _target_keys(mesh: SkinnedMesh) -> list[tuple[str | None, int]]:
+    """What identifies each morph target of ``mesh`` across meshes: its name and how many before it
+    bear that name (names may repeat), or no name and its index where the mesh names none."""
+    if mesh.morph_targets is None:
+        return []
+    if mesh.morph_target_names is None:
+        return [(None, index) for index in range(len(mesh.morph_targets))]
+    seen: dict[str, int] = {}
+    keys = []
+    for name in mesh.morph_target_names:
+        keys.append((name, seen.get(name, 0)))
+        seen[name] = keys[-1][1] + 1
+    return keys
+
+
+def _targets_join(parts: list[SkinnedMesh], mesh: SkinnedMesh) -> bool:
+    """Whether ``mesh``'s morph targets can join those of ``parts``: all named or all unnamed."""
+    named = {part.morph_target_names is not None for part in parts + [mesh] if part.morph_targets is not None}
+    return len(named) <= 1
+
+
+def _joined_targets(parts: list[SkinnedMesh]) -> tuple[np.ndarray | None, list[str] | None]:
+    """The parts' morph targets as one mesh's, (N, V, 3) with their names (None where unnamed): one
+    target per key (:func:`_target_keys`) of any part, no offset on the parts without it."""
+    keys = [_target_keys(part) for part in parts]
+    union = list(dict.fromkeys(key for part_keys in keys for key in part_keys))
+    if not union:
+        return None, None
+    place = {key: index for index, key in enumerate(union)}
+    targets = np.zeros((len(union), sum(part.vertex_count for part in parts), 3), np.float32)
+    start = 0
+    for part, part_keys in zip(parts, keys):
+        if part_keys:
+            targets[[place[key] for key in part_keys], start : start + part.vertex_count] = part.morph_targets
+        start += part.vertex_count
+    names = None if union[0][0] is None else [name for name, _ in union]
+    return targets, names

@@ -202,6 +202,10 @@ def _motion_levels_show_every_skin(source: Path, folder: Path) -> list[str]:
     written = read_gltf(folder / f"{source.stem}_lod0.glb")
     (skinned,), (motion,) = written.skinned_meshes, written.motions
     np.testing.assert_allclose(skinned.bake(motion).frames, expected, atol=1e-4)
+    # The boxes have neither normals nor texture coordinates; the body's are kept all the same.
+    body = scene.skinned_meshes[0]
+    np.testing.assert_allclose(skinned.normals[: body.vertex_count], body.normals, atol=1e-6)
+    np.testing.assert_array_equal(skinned.uvs[: body.vertex_count], body.uvs)
     return report.notes
 
 

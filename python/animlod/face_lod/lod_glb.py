@@ -33,6 +33,7 @@ from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_drawable import Drawable, read_drawables
 from ..io.gltf_lod import ANIMLOD_EXTRA, LevelInfo, PrimitiveArrays, add_level_mesh, add_level_node, attach_chain
+from ..normals import vertex_normals
 from .blendshape import (
     BlendshapeFace,
     BlendshapeLevel,
@@ -222,20 +223,9 @@ def _attach(builder: GlbBuilder, base: int, meshes: list[int], skin: int | None,
 
 def _primitive(level: BlendshapeLevel, target_count: int) -> PrimitiveArrays:
     """One primitive of a level: positions, smooth normals, UVs, every target (zeros when pruned)."""
-    attributes = {"POSITION": level.neutral.astype(np.float32), "NORMAL": smooth_normals(level.neutral, level.faces)}
+    attributes = {"POSITION": level.neutral.astype(np.float32), "NORMAL": vertex_normals(level.neutral, level.faces)}
     if level.uvs is not None:
         attributes["TEXCOORD_0"] = level.uvs.astype(np.float32)
     deltas = np.zeros((target_count,) + level.neutral.shape, np.float32)
     deltas[level.kept_targets] = level.targets
     return PrimitiveArrays(0, attributes, level.faces, [{"POSITION": delta} for delta in deltas])
-
-
-def smooth_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(V, 3) float32 area-weighted vertex normals (unit; zero for unreferenced vertices)."""
-    corners = np.asarray(positions, np.float64)[faces]
-    area_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    normals = np.zeros((len(positions), 3))
-    for k in range(3):  # the three corners of every face, vectorised over faces
-        np.add.at(normals, faces[:, k], area_normal)
-    length = np.linalg.norm(normals, axis=1, keepdims=True)
-    return (normals / np.where(length > 0.0, length, 1.0)).astype(np.float32)

@@ -5,7 +5,8 @@ for writers that take one skinned mesh per file (`animlod motion`'s level GLBs).
 Each part lies on the first mesh's skeleton as :mod:`.skin_parts` places it; bones of a part's own
 that move in its clips join that skeleton. Morph targets join by name: a target some parts name
 moves those parts' vertices and leaves the others', so one weight drives it everywhere, as
-engines drive a face's and its teeth's "jawOpen" together.
+engines drive a face's and its teeth's "jawOpen" together. A part without normals gets smooth
+ones, and one without texture coordinates (0, 0), where other parts have them.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from ..io.gltf_document import GltfDocument
 from ..io.gltf_read import GltfScene, read_skinned_node
 from ..model import Motion, SkinnedMesh
 from ..motion_lod.clips import join_clips
+from ..normals import vertex_normals
 from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
 
 
@@ -58,8 +60,13 @@ def whole_skin(
     def padded(values: np.ndarray) -> np.ndarray:
         return np.pad(values, ((0, 0), (0, influences - values.shape[1])))
 
-    def joined(values: list[np.ndarray | None]) -> np.ndarray | None:
-        return None if any(v is None for v in values) else np.concatenate(values)
+    def joined(attribute: str, missing: Callable[[SkinnedMesh], np.ndarray]) -> np.ndarray | None:
+        """An attribute of the parts as one mesh's, ``missing(part)`` for a part without it; None
+        where no part has it."""
+        values = [getattr(part, attribute) for part in parts]
+        if all(value is None for value in values):
+            return None
+        return np.concatenate([missing(part) if value is None else value for part, value in zip(parts, values)])
 
     targets, target_names = _joined_targets(parts)
     whole = SkinnedMesh(
@@ -69,8 +76,8 @@ def whole_skin(
         weights=np.concatenate([padded(part.weights) for part in parts]),
         inverse_bind=first.inverse_bind,
         skeleton=first.skeleton,
-        uvs=joined([part.uvs for part in parts]),
-        normals=joined([part.normals for part in parts]),
+        uvs=joined("uvs", lambda part: np.zeros((part.vertex_count, 2), np.float32)),  # an untextured part
+        normals=joined("normals", lambda part: vertex_normals(part.rest_positions, part.faces)),
         morph_targets=targets,
         morph_target_names=target_names,
     )

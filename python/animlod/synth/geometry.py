@@ -204,14 +204,3 @@ def merge(parts: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.nd
     faces = np.concatenate([f + o for (_, f), o in zip(parts, offsets)]).astype(np.int32)
     part_of_vertex = np.repeat(np.arange(len(parts), dtype=np.int32), counts)
     return positions, faces, part_of_vertex
-
-
-def vertex_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Area-weighted unit vertex normals ``(V, 3) float32`` of a counter-clockwise mesh."""
-    positions = np.asarray(positions, dtype=np.float64)
-    corners = positions[faces]
-    face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])  # length = 2 * area
-    normals = np.zeros_like(positions)
-    np.add.at(normals, faces.ravel(), np.repeat(face_normals, 3, axis=0))
-    length = np.linalg.norm(normals, axis=1, keepdims=True)
-    return (normals / np.where(length > 0.0, length, 1.0)).astype(np.float32)

@@ -13,7 +13,8 @@ from typing import Optional
 import numpy as np
 
 from ..model import Skeleton, SkinnedMesh
-from .geometry import Tube, capsule, merge, vertex_normals
+from ..normals import vertex_normals
+from .geometry import Tube, capsule, merge
 
 _JointRow = tuple[str, Optional[str], tuple[float, float, float]]
 

@@ -167,6 +167,25 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
     ("readers", "glTF scene past the list", lambda t: ["info", str(_write(t / "s.gltf",
         b'{"asset": {"version": "2.0"}, "scene": 3, "scenes": [{"nodes": []}]}'))],
      "s.gltf: scene: refers to scene 3, but the file has 1 scenes"),
+    ("readers", "glTF texture -1 (assimp's badUint.gltf)", lambda t: ["info", str(_write(t / "t.gltf",
+        b'{"asset": {"version": "2.0"}, "textures": [{}], "materials": '
+        b'[{"pbrMetallicRoughness": {"baseColorTexture": {"index": -1}}}]}'))],
+     "t.gltf: material 0 pbrMetallicRoughness.baseColorTexture: refers to texture -1, but the file has 1 textures"),
+    ("readers", "glTF extension's texture past the list", lambda t: ["info", str(_write(t / "c.gltf",
+        b'{"asset": {"version": "2.0"}, "materials": '
+        b'[{"extensions": {"KHR_materials_clearcoat": {"clearcoatTexture": {"index": 3}}}}]}'))],
+     "c.gltf: material 0 extensions.KHR_materials_clearcoat.clearcoatTexture: refers to texture 3, but the file "
+     "has 0 textures"),
+    ("readers", "glTF texture's image past the list", lambda t: ["info", str(_write(t / "i.gltf",
+        b'{"asset": {"version": "2.0"}, "textures": [{"extensions": {"EXT_texture_webp": {"source": 2}}}]}'))],
+     "i.gltf: texture 0 extensions.EXT_texture_webp.source: refers to image 2, but the file has 0 images"),
+    ("readers", "glTF primitive's material past the list", lambda t: ["info", str(_write(t / "m.gltf",
+        b'{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, '
+        b'"material": 5}]}]}'))],
+     "m.gltf: mesh 0 primitive 0 material: refers to material 5, but the file has 0 materials"),
+    ("readers", "glTF extension that is no object", lambda t: ["info", str(_write(t / "e.gltf",
+        b'{"asset": {"version": "2.0"}, "textures": [{"extensions": {"KHR_texture_basisu": 7}}]}'))],
+     "e.gltf: textures[0].extensions.KHR_texture_basisu: expected an object, got 7"),
     ("readers", "BVH OFFSET 1e300", lambda t: ["info", str(_bvh(t / "far.bvh", "0 1e300 0"))],
      "far.bvh: line 8: OFFSET of joint 'leg': value 1e300 is beyond"),
     ("readers", "singular inverse bind matrix", lambda t: ["info", str(_edit_gltf(_small_glb(t / "a.glb"),

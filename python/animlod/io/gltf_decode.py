@@ -137,7 +137,11 @@ def _copy_json(value: Any) -> Any:
 
 
 def _extensions(value: Any, where: str) -> dict:
-    return _copy_json(_json_object(value, where))
+    """``extensions``: an object of objects (glTF 2.0's extension.schema.json), kept as it is."""
+    extensions = _json_object(value, where)
+    for name, extension in extensions.items():
+        _json_object(extension, f"{where}.{name}")
+    return _copy_json(extensions)
 
 
 def _decoder_for_hint(hint: Any, owner: str) -> _Decode:

@@ -235,3 +235,13 @@ def test_a_primitive_without_attributes_is_refused_by_the_reader(tmp_path):
     path.write_text(json.dumps(document))
     with pytest.raises(FormatError, match="has no POSITION attribute"):
         read_gltf(path)
+
+
+def test_a_number_given_as_a_label_is_written_as_its_text(tmp_path):
+    # assimp's badString.gltf names its scene 42: read as "42", it was copied into outputs as 42,
+    # which glTF's schema refuses.
+    path = tmp_path / "numbered.gltf"
+    path.write_text(json.dumps({"asset": {"version": "2.0", "generator": 3}, "scenes": [{"name": 42}]}))
+    document = GltfDocument(path)
+    assert document.json["scenes"][0]["name"] == "42" and document.json["asset"]["generator"] == "3"
+    assert document.gltf.scenes[0].name == "42"

@@ -80,9 +80,27 @@ def _string(value: Any, where: str) -> str:
 def _label(value: Any, where: str) -> str:
     """A descriptive string (a name, the generator): a number is taken as its text, as pygltflib
     does, rather than refusing a whole file over a label nothing reads."""
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
+    if _is_number(value):
         return str(value)
     return _string(value, where)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def labels_as_text(document: dict) -> None:
+    """Numbers given as labels in a glTF JSON object (a scene named 42) become their text in place,
+    as :func:`decode_gltf` takes them, so that writers copying the JSON write valid labels. Only
+    the asset and the top-level objects have labels in glTF 2.0."""
+    holders = [document.get("asset")] + [
+        item for items in document.values() if isinstance(items, list) for item in items
+    ]
+    for holder in holders:
+        if isinstance(holder, dict):
+            for key in _LABELS:
+                if _is_number(holder.get(key)):
+                    holder[key] = str(holder[key])
 
 
 def _boolean(value: Any, where: str) -> bool:

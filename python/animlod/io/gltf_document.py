@@ -24,7 +24,7 @@ import pygltflib
 
 from .. import rotations
 from .errors import FormatError
-from .gltf_decode import decode_gltf, is_whole_number
+from .gltf_decode import decode_gltf, is_whole_number, labels_as_text
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
 from .gltf_keyframes import INTERPOLATIONS, frame_times
 from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
@@ -553,6 +553,7 @@ def _parse(path: str, data: bytes | None = None) -> tuple[pygltflib.GLTF2, dict]
     raw = load_json(path, _utf8(path, json_chunk, element), element)
     _check_top_level(path, raw)
     gltf = decode_gltf(path, raw)
+    labels_as_text(raw)
     if binary_chunk is not None:
         gltf.set_binary_blob(binary_chunk)
     unsupported = [name for name in gltf.extensionsRequired or [] if not name.startswith(_READABLE_EXTENSIONS)]

@@ -180,9 +180,15 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
         b'{"asset": {"version": "2.0"}, "textures": [{"extensions": {"EXT_texture_webp": {"source": 2}}}]}'))],
      "i.gltf: texture 0 extensions.EXT_texture_webp.source: refers to image 2, but the file has 0 images"),
     ("readers", "glTF primitive's material past the list", lambda t: ["info", str(_write(t / "m.gltf",
-        b'{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, '
-        b'"material": 5}]}]}'))],
+        b'{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {}, "material": 5}]}]}'))],
      "m.gltf: mesh 0 primitive 0 material: refers to material 5, but the file has 0 materials"),
+    ("readers", "glTF unused accessor's bufferView past the list", lambda t: ["info", str(_write(t / "a.gltf",
+        b'{"asset": {"version": "2.0"}, "accessors": [{"bufferView": 99, "componentType": 5126, "count": 1, '
+        b'"type": "SCALAR"}]}'))],
+     "a.gltf: accessor 0 bufferView: refers to bufferView 99, but the file has 0 bufferViews"),
+    ("readers", "glTF skin's skeleton past the list", lambda t: ["info", str(_write(t / "k.gltf",
+        b'{"asset": {"version": "2.0"}, "nodes": [{}], "skins": [{"joints": [0], "skeleton": 4}]}'))],
+     "k.gltf: skin 0 skeleton: refers to node 4, but the file has 1 nodes"),
     ("readers", "glTF extension that is no object", lambda t: ["info", str(_write(t / "e.gltf",
         b'{"asset": {"version": "2.0"}, "textures": [{"extensions": {"KHR_texture_basisu": 7}}]}'))],
      "e.gltf: textures[0].extensions.KHR_texture_basisu: expected an object, got 7"),

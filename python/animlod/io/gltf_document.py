@@ -14,7 +14,6 @@ import os
 import re
 import struct
 import warnings
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 from urllib.parse import unquote
@@ -28,6 +27,7 @@ from .gltf_decode import decode_gltf, is_whole_number, labels_as_text
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
 from .gltf_keyframes import INTERPOLATIONS, frame_times
 from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
+from .gltf_references import index_references
 from .json_limits import load_json
 
 _GLB_MAGIC = b"glTF"
@@ -121,7 +121,7 @@ class GltfDocument:
         self._draco = draco_sources(self.gltf, self.fail)
         self.parents = self._node_parents()
         self._check_scenes_and_channels()
-        self._check_copied_references()
+        self._check_references()
 
     def fail(self, element: str, reason: str) -> FormatError:
         """The error to raise for ``element`` of this file."""
@@ -357,25 +357,10 @@ class GltfDocument:
             for a, animation in enumerate(gltf.animations or [])
         ]
 
-    def _check_copied_references(self) -> None:
-        """The references whole-document writers copy as they are (a primitive's material, a
-        material's textures, a texture's images and sampler, a node's camera) refer to things the
-        file has: a texture -1 would otherwise go on into every output."""
-        for m, mesh in enumerate(self.gltf.meshes or []):
-            for p, primitive in enumerate(mesh.primitives or []):
-                if primitive.material is not None:
-                    self.item("materials", primitive.material, f"mesh {m} primitive {p} material")
-        for index, material in enumerate(self.json.get("materials", [])):
-            for where, info in _texture_infos(material):
-                self.item("textures", info.get("index"), f"material {index} {where}")
-        for index, texture in enumerate(self.json.get("textures", [])):
-            for where, image in _texture_sources(texture):
-                self.item("images", image, f"texture {index} {where}")
-            if "sampler" in texture:
-                self.item("samplers", texture["sampler"], f"texture {index} sampler")
-        for index, node in enumerate(self.gltf.nodes or []):
-            if node.camera is not None:
-                self.item("cameras", node.camera, f"{self.node_label(index)} camera")
+    def _check_references(self) -> None:
+        """Every other index of the file refers to something it has (gltf_references.py)."""
+        for kind, index, referrer in index_references(self):
+            self.item(kind, index, referrer)
 
     def _channel_target(self, a: int, c: int, channel: pygltflib.AnimationChannel) -> tuple[int | None, str]:
         """The (node, path) channel ``c`` of animation ``a`` animates: its target's, or for a
@@ -621,28 +606,6 @@ def _frame_limit(limit: int | None) -> int:
 
 
 _UPGRADE_ADVICE = "convert it to glTF 2.0 first: gltf-pipeline, for one, upgrades glTF 0.8 and 1.0 files"
-
-
-def _texture_infos(properties: dict, where: str = "") -> Iterator[tuple[str, dict]]:
-    """Every textureInfo of a material's JSON, its own and its extensions' (``clearcoatTexture``),
-    with its path in the material: the objects under a key ending in "Texture"."""
-    for key, value in properties.items():
-        if isinstance(value, dict):
-            path = f"{where}.{key}" if where else key
-            if key.endswith("Texture"):
-                yield path, value
-            else:
-                yield from _texture_infos(value, path)
-
-
-def _texture_sources(texture: dict) -> Iterator[tuple[str, Any]]:
-    """The images a texture's JSON refers to: its ``source`` and its extensions' (KHR_texture_basisu,
-    EXT_texture_webp), with their paths in the texture."""
-    if "source" in texture:
-        yield "source", texture["source"]
-    for name, extension in texture.get("extensions", {}).items():
-        if "source" in extension:
-            yield f"extensions.{name}.source", extension["source"]
 
 
 def _check_top_level(path: str, document: Any) -> None:

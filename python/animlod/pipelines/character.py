@@ -323,7 +323,7 @@ def _assign_skeletons(
 def _placement(owner: Drawable, part: Drawable, motion: Motion | None = None) -> Placement | None:
     """Where ``part`` lies on ``owner``'s skeleton (skin_parts.placement_on), joints matched by node."""
     keys = JointKeys(owner.rig.joint_nodes, part.rig.joint_nodes)
-    return placement_on(owner.skinned, part.skinned, motion, keys)
+    return placement_on(owner.skinned, part.skinned, keys, motion)
 
 
 def _join(doc: GltfDocument, roles: _Roles, owner: int, part: Drawable, animated: list[Drawable], fps: float) -> bool:

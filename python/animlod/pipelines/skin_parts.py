@@ -38,11 +38,11 @@ class Placement:
 
 
 def placement_on(
-    first: SkinnedMesh, part: SkinnedMesh, motion: Motion | None = None, keys: JointKeys | None = None
+    first: SkinnedMesh, part: SkinnedMesh, keys: JointKeys, motion: Motion | None = None
 ) -> Placement | None:
     """How ``part`` lies on ``first``'s skeleton and binds, or None: where its weights reach a joint
     with no ancestor ``first`` lists, reach none, or it was bound in another pose. ``keys`` tell
-    which joints of the two skeletons are one (the joints' names by default).
+    which joints of the two skeletons are one.
 
     A joint ``first`` lacks (VRoid hair and skirt bones under the head and hips) moves its
     vertices with its nearest ancestor that ``first`` lists. That is exact only where it holds
@@ -90,11 +90,11 @@ def joined_rig(
 
 
 class JointKeys(NamedTuple):
-    """What identifies each joint of two skeletons, in skeleton order: their nodes where both come
-    from one document (names may repeat there: two bones named "Hair"), else their names."""
+    """The node of each joint of two skeletons of one document, in skeleton order: what tells which
+    joints are one (names may repeat: two bones named "Hair")."""
 
-    first: Sequence[object]
-    part: Sequence[object]
+    first: Sequence[int]
+    part: Sequence[int]
 
 
 class _Lying(NamedTuple):
@@ -107,10 +107,9 @@ class _Lying(NamedTuple):
     transform: np.ndarray  # (4, 4) T of Placement
 
 
-def _lying_on(first: SkinnedMesh, part: SkinnedMesh, keys: JointKeys | None) -> _Lying | None:
+def _lying_on(first: SkinnedMesh, part: SkinnedMesh, keys: JointKeys) -> _Lying | None:
     """How ``part``'s joints meet ``first``'s; None where a joint its weights use has no ancestor
     ``first`` lists, it uses none, or it was bound in another pose."""
-    keys = keys or JointKeys(first.skeleton.names, part.skeleton.names)
     index = {key: joint for joint, key in enumerate(keys.first)}
     parents = part.skeleton.parents
     listed = np.array([key in index for key in keys.part])

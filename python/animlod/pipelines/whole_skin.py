@@ -39,7 +39,7 @@ def whole_skin(
         if not _targets_join(parts, mesh):
             continue
         keys = JointKeys(rig.joint_nodes, part_rig.joint_nodes)
-        placement = placement_on(first, mesh, join_clips(clips)[0] if clips else None, keys)
+        placement = placement_on(first, mesh, keys, join_clips(clips)[0] if clips else None)
         with_bones = joined_rig(doc, rig, first, part_rig, mesh) if placement is None else None
         if with_bones is not None:  # the joined skeleton keeps every joint's index: placed parts stay valid
             own = with_bones.extra_joints[len(rig.extra_joints) :]
@@ -48,7 +48,7 @@ def whole_skin(
                  f"{doc.node_label(scene.skinned_nodes[0])}")  # fmt: skip
             rig = with_bones
             first, motions = read_skinned_node(doc, scene.skinned_nodes[0], rig, fps)
-            placement = placement_on(first, mesh, keys=JointKeys(rig.joint_nodes, part_rig.joint_nodes))
+            placement = placement_on(first, mesh, JointKeys(rig.joint_nodes, part_rig.joint_nodes))
         if placement is not None:
             parts.append(moved_onto(mesh, first, placement))
     parts[0] = first

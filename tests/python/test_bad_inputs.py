@@ -153,8 +153,8 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
     ("readers", "glTF channel on node 9999", lambda t: ["info", str(_edit_gltf(_small_glb(t / "a.glb"),
         _json_edit(lambda d: d["animations"][0]["channels"][0]["target"].update(node=9999)), t / "n.gltf"))],
      "n.gltf: animation 0 channel 0 target: refers to node 9999"),
-    ("readers", "glTF nodes is an object", lambda t: ["info", str(_write(t / "o.gltf",
-        b'{"asset": {"version": "2.0"}, "nodes": {}}'))], "o.gltf: nodes: must be an array, got dict"),
+    ("readers", "glTF nodes is an object", lambda t: ["info", str(_gltf(t / "o.gltf",
+        b'{"nodes": {}}'))], "o.gltf: nodes: must be an array, got dict"),
     ("readers", "glTF 1.0 document", lambda t: ["info", str(_write(t / "v1.gltf",
         b'{"asset": {"version": "1.0"}, "accessors": {"a": {}}}'))],
      "v1.gltf: asset: glTF version '1.0' is not 2.x; convert it to glTF 2.0 first"),
@@ -164,33 +164,30 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
     ("readers", "glTF 1.0 binary file", lambda t: ["info", str(_write(t / "v1.glb",
         b"glTF" + struct.pack("<IIII", 1, 28, 8, 0) + b'{"a": 1}'))],
      "v1.glb: GLB header: container version 1 is not 2: a glTF 1.0 binary file; convert it to glTF 2.0"),
-    ("readers", "glTF scene past the list", lambda t: ["info", str(_write(t / "s.gltf",
-        b'{"asset": {"version": "2.0"}, "scene": 3, "scenes": [{"nodes": []}]}'))],
+    ("readers", "glTF scene past the list", lambda t: ["info", str(_gltf(t / "s.gltf",
+        b'{"scene": 3, "scenes": [{"nodes": []}]}'))],
      "s.gltf: scene: refers to scene 3, but the file has 1 scenes"),
-    ("readers", "glTF texture -1 (assimp's badUint.gltf)", lambda t: ["info", str(_write(t / "t.gltf",
-        b'{"asset": {"version": "2.0"}, "textures": [{}], "materials": '
-        b'[{"pbrMetallicRoughness": {"baseColorTexture": {"index": -1}}}]}'))],
+    ("readers", "glTF texture -1 (assimp's badUint.gltf)", lambda t: ["info", str(_gltf(t / "t.gltf",
+        b'{"textures": [{}], "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": -1}}}]}'))],
      "t.gltf: material 0 pbrMetallicRoughness.baseColorTexture: refers to texture -1, but the file has 1 textures"),
-    ("readers", "glTF extension's texture past the list", lambda t: ["info", str(_write(t / "c.gltf",
-        b'{"asset": {"version": "2.0"}, "materials": '
-        b'[{"extensions": {"KHR_materials_clearcoat": {"clearcoatTexture": {"index": 3}}}}]}'))],
+    ("readers", "glTF extension's texture past the list", lambda t: ["info", str(_gltf(t / "c.gltf",
+        b'{"materials": [{"extensions": {"KHR_materials_clearcoat": {"clearcoatTexture": {"index": 3}}}}]}'))],
      "c.gltf: material 0 extensions.KHR_materials_clearcoat.clearcoatTexture: refers to texture 3, but the file "
      "has 0 textures"),
-    ("readers", "glTF texture's image past the list", lambda t: ["info", str(_write(t / "i.gltf",
-        b'{"asset": {"version": "2.0"}, "textures": [{"extensions": {"EXT_texture_webp": {"source": 2}}}]}'))],
+    ("readers", "glTF texture's image past the list", lambda t: ["info", str(_gltf(t / "i.gltf",
+        b'{"textures": [{"extensions": {"EXT_texture_webp": {"source": 2}}}]}'))],
      "i.gltf: texture 0 extensions.EXT_texture_webp.source: refers to image 2, but the file has 0 images"),
-    ("readers", "glTF primitive's material past the list", lambda t: ["info", str(_write(t / "m.gltf",
-        b'{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {}, "material": 5}]}]}'))],
+    ("readers", "glTF primitive's material past the list", lambda t: ["info", str(_gltf(t / "m.gltf",
+        b'{"meshes": [{"primitives": [{"attributes": {}, "material": 5}]}]}'))],
      "m.gltf: mesh 0 primitive 0 material: refers to material 5, but the file has 0 materials"),
-    ("readers", "glTF unused accessor's bufferView past the list", lambda t: ["info", str(_write(t / "a.gltf",
-        b'{"asset": {"version": "2.0"}, "accessors": [{"bufferView": 99, "componentType": 5126, "count": 1, '
-        b'"type": "SCALAR"}]}'))],
+    ("readers", "glTF unused accessor's bufferView past the list", lambda t: ["info", str(_gltf(t / "a.gltf",
+        b'{"accessors": [{"bufferView": 99, "componentType": 5126, "count": 1, "type": "SCALAR"}]}'))],
      "a.gltf: accessor 0 bufferView: refers to bufferView 99, but the file has 0 bufferViews"),
-    ("readers", "glTF skin's skeleton past the list", lambda t: ["info", str(_write(t / "k.gltf",
-        b'{"asset": {"version": "2.0"}, "nodes": [{}], "skins": [{"joints": [0], "skeleton": 4}]}'))],
+    ("readers", "glTF skin's skeleton past the list", lambda t: ["info", str(_gltf(t / "k.gltf",
+        b'{"nodes": [{}], "skins": [{"joints": [0], "skeleton": 4}]}'))],
      "k.gltf: skin 0 skeleton: refers to node 4, but the file has 1 nodes"),
-    ("readers", "glTF extension that is no object", lambda t: ["info", str(_write(t / "e.gltf",
-        b'{"asset": {"version": "2.0"}, "textures": [{"extensions": {"KHR_texture_basisu": 7}}]}'))],
+    ("readers", "glTF extension that is no object", lambda t: ["info", str(_gltf(t / "e.gltf",
+        b'{"textures": [{"extensions": {"KHR_texture_basisu": 7}}]}'))],
      "e.gltf: textures[0].extensions.KHR_texture_basisu: expected an object, got 7"),
     ("readers", "BVH OFFSET 1e300", lambda t: ["info", str(_bvh(t / "far.bvh", "0 1e300 0"))],
      "far.bvh: line 8: OFFSET of joint 'leg': value 1e300 is beyond"),
@@ -218,6 +215,11 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
 def _write(path: Path, data: bytes) -> Path:
     path.write_bytes(data)
     return path
+
+
+def _gltf(path: Path, properties: bytes) -> Path:
+    """A glTF 2.0 document at ``path``: ``properties`` (a JSON object's text) beside its asset."""
+    return _write(path, b'{"asset": {"version": "2.0"}, ' + properties[1:])
 
 
 def _glb_bytes(json_chunk: bytes) -> bytes:

@@ -389,6 +389,7 @@ def simplify_skinned(
             uvs=carried[:, :uv_count] if uv_count else None,
             morph_targets=carried[:, uv_count:].reshape(-1, morph_count, 3).transpose(1, 0, 2) if morph_count else None,
             morph_target_names=skinned.morph_target_names if morph_count else None,
+            default_morph_weights=skinned.default_morph_weights if morph_count else None,
         )
         skinning_error = 0.0
         for motion, start in zip(motions, starts):

@@ -371,6 +371,8 @@ class SkinnedMesh:
     normals : (V, 3) float32 or None.
     morph_targets : (N, V, 3) float32 position deltas or None.
     morph_target_names : N names, or None.
+    default_morph_weights : (N,) float64 weights the morph targets show where no animation drives
+        them (glTF's mesh or node ``weights``), or None: all 0.
     """
 
     rest_positions: np.ndarray
@@ -383,6 +385,7 @@ class SkinnedMesh:
     normals: np.ndarray | None = None
     morph_targets: np.ndarray | None = None
     morph_target_names: list[str] | None = field(default=None)
+    default_morph_weights: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.rest_positions = np.ascontiguousarray(self.rest_positions, dtype=np.float32)
@@ -433,6 +436,14 @@ class SkinnedMesh:
                 f"morph_targets: expected (N, {vertex_count}, 3), got {self.morph_targets.shape}",
             )
             check_finite("morph_targets", self.morph_targets)
+        if self.default_morph_weights is not None:
+            self.default_morph_weights = np.asarray(self.default_morph_weights, np.float64)
+            target_count = 0 if self.morph_targets is None else len(self.morph_targets)
+            _require(
+                self.default_morph_weights.shape == (target_count,),
+                f"default_morph_weights: expected ({target_count},), got {self.default_morph_weights.shape}",
+            )
+            check_finite("default_morph_weights", self.default_morph_weights)
 
     @property
     def vertex_count(self) -> int:
@@ -447,8 +458,9 @@ class SkinnedMesh:
 
         ``morph_weights (T, N)`` finite, one row per frame of ``motion`` and one column per morph
         target (N = 0 for a skin without targets), blends the morph targets into the rest pose of
-        each frame first, as glTF does (morphing before skinning); None keeps the rest pose. Another
-        shape or a non-finite weight is a ValueError naming ``morph_weights``.
+        each frame first, as glTF does (morphing before skinning); None keeps the rest pose with
+        ``default_morph_weights``. Another shape or a non-finite weight is a ValueError naming
+        ``morph_weights``.
         """
         from ._core import bake_lbs
 
@@ -466,13 +478,21 @@ class SkinnedMesh:
             check_finite("morph_weights", morph_weights)
         matrices = motion.skin_matrices(self.inverse_bind).astype(np.float32)
         if morph_weights is None or self.morph_targets is None:
-            frames = bake_lbs(self.rest_positions, self.joints, self.weights, matrices)
+            frames = bake_lbs(self.default_shape(), self.joints, self.weights, matrices)
             return AnimatedMesh(self.faces, frames, fps=motion.fps)
         frames = np.empty((motion.frame_count, self.vertex_count, 3), np.float32)
         for t in range(motion.frame_count):  # O(T) calls, each a whole frame in C++
             rest = self.rest_positions + np.einsum("n,nvc->vc", morph_weights[t], self.morph_targets)
             frames[t] = bake_lbs(rest.astype(np.float32), self.joints, self.weights, matrices[t : t + 1])[0]
         return AnimatedMesh(self.faces, frames, fps=motion.fps)
+
+    def default_shape(self) -> np.ndarray:
+        """(V, 3) float32 bind shape with the morph targets at their default weights: what the
+        skeleton poses where no animation drives the weights."""
+        if self.default_morph_weights is None or not self.default_morph_weights.any():
+            return self.rest_positions
+        shape = self.rest_positions + np.einsum("n,nvc->vc", self.default_morph_weights, self.morph_targets)
+        return shape.astype(np.float32)
 
     def rest_pose(self) -> np.ndarray:
         """(V, 3) float32 positions skinned by the skeleton's rest pose: what a viewer shows with no

@@ -35,12 +35,18 @@ def _box(centre: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _with_part(
-    folder, name: str, hair: str | None = None, plain: Path | None = None, targets: Sequence[str] = ()
+    folder,
+    name: str,
+    hair: str | None = None,
+    plain: Path | None = None,
+    targets: Sequence[str] = (),
+    defaults: Sequence[float] | None = None,
 ) -> Path:
     """The procedural humanoid walking (or the character of ``plain``), with a box over its head
     skinned by a skin of its own (bound in the body's pose): over Neck and Head, every vertex on
     Head; or with ``hair`` ("still" or "swinging") over Head and a bone "Hair" of its own below
-    it, every vertex on Hair. The box has a morph target of each name in ``targets``."""
+    it, every vertex on Hair. The box has a morph target of each name in ``targets``, with the
+    mesh's default weights ``defaults``."""
     if plain is None:
         plain = folder / "humanoid.glb"
         character = synth.humanoid()
@@ -85,6 +91,8 @@ def _with_part(
         deltas = np.random.default_rng(len(name)).normal(0.0, 0.02, (len(targets),) + positions.shape)
         primitive["targets"] = [{"POSITION": builder.add(d.astype(np.float32), bounds=True)} for d in deltas]
         mesh["extras"] = {"targetNames": list(targets)}
+        if defaults is not None:
+            mesh["weights"] = list(defaults)
     mesh = builder.append("meshes", mesh)
     builder.json["scenes"][0]["nodes"].append(builder.append("nodes", {"name": name, "mesh": mesh, "skin": skin}))
     source = folder / f"{name}.glb"
@@ -242,6 +250,27 @@ def test_motion_levels_show_parts_with_morph_targets_the_body_lacks(tmp_path) ->
     ]
     posed = skinned.bake(motion, np.tile([1.0, 0.5], (motion.frame_count, 1))).frames
     np.testing.assert_allclose(posed, np.concatenate([each.frames for each in expected], axis=1), atol=1e-4)
+
+
+def test_motion_levels_show_each_parts_default_morph_weights(tmp_path) -> None:
+    # A skinned mesh's default morph weights (glTF's mesh or node `weights`, what a viewer shows
+    # where no animation drives them) were read as 0 and written as 0: `motion` drew a Blender
+    # shape key left at 1 as if it were off. Parts joined on one mesh keep their own defaults,
+    # the head's "jaw" at 1 beside the teeth's at 0.25, the teeth's node overriding its mesh.
+    head = _with_part(tmp_path, "head", targets=["jaw", "blink"], defaults=[1.0, 0.5])
+    teeth = _with_part(tmp_path, "teeth", targets=["jaw"], plain=head, defaults=[0.0])
+    builder = GlbBuilder.from_document(GltfDocument(teeth))
+    next(node for node in builder.json["nodes"] if node.get("name") == "teeth")["weights"] = [0.25]
+    builder.save(teeth)
+    scene = read_gltf(teeth)
+    head_mesh, teeth_mesh = scene.skinned_meshes[1:]
+    np.testing.assert_array_equal(head_mesh.default_morph_weights, [1.0, 0.5])
+    np.testing.assert_array_equal(teeth_mesh.default_morph_weights, [0.25])
+    motion = scene.skinned_motions[1][0]
+    np.testing.assert_allclose(
+        head_mesh.bake(motion).frames, head_mesh.bake(motion, np.tile([1.0, 0.5], (motion.frame_count, 1))).frames
+    )
+    _motion_levels_show_every_skin(teeth, tmp_path / "levels")
 
 
 def test_motion_levels_tell_the_hair_bone_from_a_body_bone_of_the_same_name(tmp_path) -> None:

@@ -14,6 +14,7 @@ from gltf_edits import append_accessor, draco_compressed, edit_glb, meshopt_comp
 from animlod import synth
 from animlod.cli import main
 from animlod.io import read_gltf, write_glb
+from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_drawable import read_drawables
 from animlod.pipelines import DrawableSettings, simplify_document
@@ -444,6 +445,38 @@ def _coarsest_primitive(doc, report):
     base = report.drawables[0].nodes[0]
     coarse = doc.json["nodes"][doc.json["nodes"][base]["extensions"]["MSFT_lod"]["ids"][-1]]
     return doc.json["meshes"][coarse["mesh"]]["primitives"][0]
+
+
+@pytest.mark.parametrize("skinned", [True, False])
+def test_morph_targets_are_shown_and_measured_at_their_default_weights(humanoid_glb, tmp_path, skinned):
+    # A mesh's default morph weights (glTF's mesh `weights`, which a node's own override: a
+    # Blender shape key left on) are what a viewer shows where no animation drives them. The
+    # drawables showed and measured the targets at 0, unskinned ones unless read as static.
+    def drawable(name, mesh_weights, node_weights=None):
+        builder = GlbBuilder.from_document(GltfDocument(humanoid_glb))
+        primitive = builder.json["meshes"][0]["primitives"][0]
+        lift = np.zeros((builder.json["accessors"][primitive["attributes"]["POSITION"]]["count"], 3), np.float32)
+        lift[:, 1] = 0.1
+        primitive["targets"] = [{"POSITION": builder.add(lift, bounds=True)}]
+        builder.json["meshes"][0]["weights"] = mesh_weights
+        node = next(node for node in builder.json["nodes"] if node.get("mesh") == 0)
+        if not skinned:
+            del node["skin"]
+        if node_weights is not None:
+            node["weights"] = node_weights
+        builder.save(tmp_path / name)
+        return read_drawables(GltfDocument(tmp_path / name))[0]
+
+    off, half, node_full = drawable("off.glb", [0.0]), drawable("half.glb", [0.5]), drawable("node.glb", [0.5], [1.0])
+    np.testing.assert_array_equal(half.default_weights, [0.5])
+    rest = off.rest_positions()
+    np.testing.assert_allclose(half.rest_positions() - rest, np.tile([0.0, 0.05, 0.0], (len(rest), 1)), atol=1e-5)
+    np.testing.assert_allclose(node_full.rest_positions() - rest, np.tile([0.0, 0.1, 0.0], (len(rest), 1)), atol=1e-5)
+    if skinned:  # the walk drives the joints only: its frames show the default weights too
+        clip, frames = half.clips[0], np.array([0, 5])
+        expected = half.skinned.bake(clip.motion.take_frames(frames), np.full((2, 1), 0.5)).frames
+        np.testing.assert_allclose(half.clip_frames(clip, frames), expected, atol=1e-6)
+        assert np.abs(half.clip_frames(clip, frames) - off.clip_frames(clip, frames)).max() > 0.04
 
 
 def test_a_flat_shaded_mesh_simplifies_like_the_welded_one_and_stays_flat(tmp_path):

@@ -21,7 +21,7 @@ from ..model import Motion, SkinnedMesh
 from .gltf_document import GltfDocument
 from .gltf_lod import GRID_EXTRA
 from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_points
-from .gltf_read import morph_weight_tracks, skinned_mesh_of_node
+from .gltf_read import morph_weight_tracks, node_weights, skinned_mesh_of_node
 from .gltf_skin import SkinRig
 
 # Weight sums further than this from 1 count as "normalised on load" in the report.
@@ -68,6 +68,8 @@ class Drawable:
     skinned : the world-space skinned mesh (joints in skeleton order), or None.
     rig : the skin as a skeleton, or None.
     clips : the animations that move this drawable.
+    default_weights : (N,) morph weights the first node shows where no animation drives them
+        (glTF's node or mesh ``weights``), or None without morph targets.
     renormalised_weights : vertices whose stored skin weights did not sum to 1 (not counting those
         with no weight at all, which get a warning of their own).
     """
@@ -82,6 +84,7 @@ class Drawable:
     skinned: SkinnedMesh | None = None
     rig: SkinRig | None = None
     clips: list[Clip] = field(default_factory=list)
+    default_weights: np.ndarray | None = None
     renormalised_weights: int = 0
 
     @property
@@ -99,11 +102,13 @@ class Drawable:
         return transform_points(self.world, self.geometry.positions).astype(np.float32)
 
     def rest_positions(self) -> np.ndarray:
-        """(V, 3) float32 world positions a viewer shows with no animation playing (morph weights
-        0): a skinned mesh posed by its skeleton's rest pose (SkinnedMesh.rest_pose, which can
-        differ from the bind shape in pose and scale: Xbot.glb's is 100x), the bind shape
-        otherwise. Sizes and errors are taken on this one."""
-        return self.bind_positions() if self.skinned is None else self.skinned.rest_pose()
+        """(V, 3) float32 world positions a viewer shows with no animation playing (morph targets
+        at ``default_weights``): a skinned mesh posed by its skeleton's rest pose
+        (SkinnedMesh.rest_pose, which can differ from the bind shape in pose and scale: Xbot.glb's
+        is 100x), the bind shape otherwise. Sizes and errors are taken on this one."""
+        if self.skinned is not None:
+            return self.skinned.rest_pose()
+        return morphed(self.bind_positions(), self.morph_targets, self.default_weights, 1)[0]
 
     def rest_morph_targets(self) -> np.ndarray | None:
         """(N, V, 3) morph deltas as they move :meth:`rest_positions`, or None."""
@@ -116,10 +121,17 @@ class Drawable:
         if self.skinned is not None:
             motion = clip.motion.take_frames(frames)
             return self.skinned.bake(motion, weights).frames
-        rest = self.bind_positions().astype(np.float64)
-        if weights is None:
-            return np.broadcast_to(rest, (len(frames),) + rest.shape).astype(np.float32)
-        return (rest + np.einsum("tn,nvc->tvc", weights, self.morph_targets)).astype(np.float32)
+        weights = self.default_weights if weights is None else weights
+        return morphed(self.bind_positions(), self.morph_targets, weights, len(frames))
+
+
+def morphed(bind: np.ndarray, targets: np.ndarray | None, weights: np.ndarray | None, count: int) -> np.ndarray:
+    """(count, V, 3) float32 frames of an unskinned mesh: ``bind`` (V, 3) with its morph ``targets``
+    (N, V, 3) at ``weights``, (count, N) or (N,) for every frame (None: all 0)."""
+    if weights is None or not np.any(weights):
+        return np.broadcast_to(bind, (count,) + bind.shape).astype(np.float32)
+    shapes = bind.astype(np.float64) + np.einsum("...n,nvc->...vc", weights, targets)
+    return np.broadcast_to(shapes, (count,) + bind.shape).astype(np.float32)
 
 
 def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
@@ -152,6 +164,8 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
         if skin_index is None:
             placement, world[:3, 3] = world[:3, 3].copy(), 0.0
         drawable = Drawable(mesh_index, skin_index, nodes, label, geometry, world, placement)
+        if geometry.targets is not None:
+            drawable.default_weights = node_weights(doc, nodes[0], geometry.default_weights)
         if skin_index is not None:
             if skin_index not in rigs:
                 rigs[skin_index] = SkinRig(doc, skin_index)

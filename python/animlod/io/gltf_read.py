@@ -174,6 +174,7 @@ def skinned_mesh_of_node(
     inverse_bind = rig.inverse_bind.copy()
     inverse_bind[:, :3] = rig.rest_linear @ inverse_bind[:, :3]
     inverse_bind = inverse_bind @ np.linalg.inv(mesh_world)
+    defaults = None if geometry.targets is None else node_weights(doc, node, geometry.default_weights)
     try:
         return SkinnedMesh(
             rest_positions=transform_points(mesh_world, geometry.positions),
@@ -186,6 +187,7 @@ def skinned_mesh_of_node(
             normals=None if geometry.normals is None else transform_normals(mesh_world, geometry.normals),
             morph_targets=None if geometry.targets is None else geometry.targets @ mesh_world[:3, :3].T,
             morph_target_names=geometry.target_names,
+            default_morph_weights=defaults,
         )
     except ValueError as error:
         raise doc.fail(f"mesh {mesh_index} with skin {rig.skin}", str(error)) from None
@@ -230,14 +232,14 @@ def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[Animated
         if not tracks:
             positions = geometry.positions.astype(np.float64)
             if geometry.targets is not None:
-                weights = _node_weights(doc, node_index, geometry.default_weights)
+                weights = node_weights(doc, node_index, geometry.default_weights)
                 positions = positions + np.einsum("n,nvc->vc", weights, geometry.targets)
             frames = transform_points(world, positions)[None]
             statics.append(_animated_mesh(doc, doc.node_label(node_index), faces, frames, None))
     return morphs, statics
 
 
-def _node_weights(doc: GltfDocument, node: int, mesh_weights: np.ndarray) -> np.ndarray:
+def node_weights(doc: GltfDocument, node: int, mesh_weights: np.ndarray) -> np.ndarray:
     """(N,) morph weights node ``node`` shows without animation: its own ``weights``, which override
     its mesh's (glTF 2.0, 3.7.2.2; pygltflib's Node drops them, the raw JSON keeps them)."""
     weights = doc.json["nodes"][node].get("weights")

@@ -198,7 +198,8 @@ def _mesh(builder: GlbBuilder, skinned: SkinnedMesh) -> dict:
         primitive["targets"] = [
             {"POSITION": builder.add(delta, ARRAY_BUFFER, bounds=True)} for delta in skinned.morph_targets
         ]
-        mesh["weights"] = [0.0] * len(skinned.morph_targets)
+        defaults = skinned.default_morph_weights
+        mesh["weights"] = [0.0] * len(skinned.morph_targets) if defaults is None else defaults.tolist()
         if skinned.morph_target_names is not None:
             mesh["extras"] = {"targetNames": list(skinned.morph_target_names)}
     return mesh

@@ -91,4 +91,5 @@ def transfer_skin(skin: SkinnedMesh, level: FrozenLevel) -> SkinnedMesh:
         normals=normals,
         morph_targets=skin.morph_targets,
         morph_target_names=skin.morph_target_names,
+        default_morph_weights=skin.default_morph_weights,
     )

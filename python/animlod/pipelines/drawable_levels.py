@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aqem import Preparation, SimplifiedLevel, simplify_animated
-from ..io.gltf_drawable import Clip, Drawable
+from ..io.gltf_drawable import Clip, Drawable, morphed
 from ..io.gltf_lod import PrimitiveArrays
 from ..io.gltf_mesh import PrimitiveGeometry, transform_points
 from ..io.gltf_write import influence_sets
@@ -97,6 +97,7 @@ class DrawableLevel:
     skinned : the level as a world-space skinned mesh (skinned drawables), else None.
     bind : (V', 3) the level's bind shape (the space of the drawable's ``bind_positions``).
     morph_targets : (N, V', 3) its morph deltas in that space, or None.
+    default_weights : (N,) the weights its targets show where no animation drives them, or None.
     error : asset units, max over measured frames of the Hausdorff distance to the input (0 when
         simplify_drawable was asked not to measure).
     """
@@ -106,11 +107,14 @@ class DrawableLevel:
     skinned: SkinnedMesh | None
     bind: np.ndarray
     morph_targets: np.ndarray | None
+    default_weights: np.ndarray | None = None
     error: float = 0.0
 
     def rest_positions(self) -> np.ndarray:
         """(V', 3) what a viewer shows of the level with no animation (see Drawable.rest_positions)."""
-        return self.bind if self.skinned is None else self.skinned.rest_pose()
+        if self.skinned is not None:
+            return self.skinned.rest_pose()
+        return morphed(self.bind, self.morph_targets, self.default_weights, 1)[0]
 
 
 @dataclass
@@ -195,14 +199,17 @@ def simplify_drawable(
 def _drive_frames(drawable: Drawable, rest: np.ndarray, size: float, budget: int) -> np.ndarray:
     """(F, V, 3) world positions AQEM works over: the bind shape (frame 0, from which _level reads
     the levels' stored positions), the rest pose ``rest`` (diagonal ``size``) where a viewer shows
-    something else, each morph target at full weight on the rest pose, then frames spread evenly
-    over every clip (at least two per clip), F <= ``budget`` where the clips allow."""
+    something else, each morph target at full weight on the rest pose (the others at 0), then
+    frames spread evenly over every clip (at least two per clip), F <= ``budget`` where the clips
+    allow."""
     bind = drawable.bind_positions()
     frames = [bind[None]]
     if np.abs(rest - bind).max() > _SAME_SHAPE * size:
         frames.append(rest[None])
     if drawable.geometry.targets is not None:
-        frames.append((rest[None] + drawable.rest_morph_targets()).astype(np.float32, copy=False))
+        deltas = drawable.rest_morph_targets()
+        undriven = rest - np.einsum("n,nvc->vc", drawable.default_weights, deltas).astype(np.float32)
+        frames.append(undriven[None] + deltas)
     clips = drawable.clips
     remaining = max(budget - sum(len(f) for f in frames), 2 * len(clips))
     lengths = np.array([clip.frame_count for clip in clips], np.float64)
@@ -325,6 +332,7 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
             inverse_bind=drawable.skinned.inverse_bind,
             skeleton=drawable.skinned.skeleton,
             morph_targets=deltas,
+            default_morph_weights=drawable.skinned.default_morph_weights,
         )
     to_local = np.linalg.inv(drawable.world)
     groups = geometry.face_groups[level.face_sources]
@@ -359,7 +367,7 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
         if layout.crease[k] is not None:
             primitive = with_crease_normals(primitive, layout.crease[k])
         primitives.append(primitive)
-    return DrawableLevel(level, primitives, skinned, rest, deltas)
+    return DrawableLevel(level, primitives, skinned, rest, deltas, drawable.default_weights)
 
 
 def _carried(name: str, rebuilt: bool) -> bool:
@@ -474,6 +482,5 @@ def posed_frames(drawable: Drawable, level: DrawableLevel, clip: Clip | None, fr
     weights = None if clip.morph_weights is None else clip.morph_weights[frames]
     if level.skinned is not None:
         return level.skinned.bake(clip.motion.take_frames(frames), weights).frames
-    if weights is None:
-        return np.broadcast_to(level.bind, (len(frames),) + level.bind.shape)
-    return (level.bind + np.einsum("tn,nvc->tvc", weights, level.morph_targets)).astype(np.float32)
+    weights = level.default_weights if weights is None else weights
+    return morphed(level.bind, level.morph_targets, weights, len(frames))

@@ -153,4 +153,5 @@ def moved_onto(part: SkinnedMesh, first: SkinnedMesh, placement: Placement) -> S
         normals=normals,
         morph_targets=targets,
         morph_target_names=part.morph_target_names,
+        default_morph_weights=part.default_morph_weights,
     )

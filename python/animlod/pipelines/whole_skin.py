@@ -30,7 +30,8 @@ def whole_skin(
     motions (sampled at ``fps``), and how many meshes stay out: those on other joints, bound in
     another pose, or whose morph targets lack names where the others' have them. A part's joints
     match the first mesh's by node; bones of its own that move in its clips join the skeleton, the
-    first mesh read again with them, and ``note`` names them."""
+    first mesh read again with them, and ``note`` names them. Morph targets join by name
+    (:func:`_joined_targets`), each part keeping the shape of its default weights."""
     meshes = scene.skinned_meshes
     first, motions, rig = meshes[0], scene.skinned_motions[0], scene.skinned_rigs[0]
     parts = [first]
@@ -68,9 +69,9 @@ def whole_skin(
             return None
         return np.concatenate([missing(part) if value is None else value for part, value in zip(parts, values)])
 
-    targets, target_names = _joined_targets(parts)
+    targets, target_names, defaults, shapes = _joined_targets(parts)
     whole = SkinnedMesh(
-        rest_positions=np.concatenate([part.rest_positions for part in parts]).astype(np.float32),
+        rest_positions=np.concatenate(shapes).astype(np.float32),
         faces=np.concatenate([part.faces + start for part, start in zip(parts, starts)]),
         joints=np.concatenate([padded(part.joints) for part in parts]),
         weights=np.concatenate([padded(part.weights) for part in parts]),
@@ -80,6 +81,7 @@ def whole_skin(
         normals=joined("normals", lambda part: vertex_normals(part.rest_positions, part.faces)),
         morph_targets=targets,
         morph_target_names=target_names,
+        default_morph_weights=defaults,
     )
     return whole, motions, len(meshes) - len(parts)
 
@@ -105,19 +107,32 @@ def _targets_join(parts: list[SkinnedMesh], mesh: SkinnedMesh) -> bool:
     return len(named) <= 1
 
 
-def _joined_targets(parts: list[SkinnedMesh]) -> tuple[np.ndarray | None, list[str] | None]:
-    """The parts' morph targets as one mesh's, (N, V, 3) with their names (None where unnamed): one
-    target per key (:func:`_target_keys`) of any part, no offset on the parts without it."""
+def _joined_targets(
+    parts: list[SkinnedMesh],
+) -> tuple[np.ndarray | None, list[str] | None, np.ndarray | None, list[np.ndarray]]:
+    """The parts' morph targets as one mesh's, (N, V, 3) with their names (None where unnamed) and
+    default weights: one target per key (:func:`_target_keys`) of any part, no offset on the parts
+    without it, at the default weight of the first part that has it. Last, each part's bind shape
+    with the difference of its own defaults from those folded in, so that every part shows its own
+    default shape."""
     keys = [_target_keys(part) for part in parts]
     union = list(dict.fromkeys(key for part_keys in keys for key in part_keys))
+    shapes = [part.rest_positions for part in parts]
     if not union:
-        return None, None
+        return None, None, None, shapes
     place = {key: index for index, key in enumerate(union)}
     targets = np.zeros((len(union), sum(part.vertex_count for part in parts), 3), np.float32)
+    defaults = np.full(len(union), np.nan)
     start = 0
-    for part, part_keys in zip(parts, keys):
+    for k, (part, part_keys) in enumerate(zip(parts, keys)):
         if part_keys:
-            targets[[place[key] for key in part_keys], start : start + part.vertex_count] = part.morph_targets
+            places = [place[key] for key in part_keys]
+            targets[places, start : start + part.vertex_count] = part.morph_targets
+            own = np.zeros(len(places)) if part.default_morph_weights is None else part.default_morph_weights
+            unset = np.isnan(defaults[places])
+            defaults[np.asarray(places)[unset]] = own[unset]
+            if np.any(own != defaults[places]):
+                shapes[k] = part.rest_positions + np.einsum("n,nvc->vc", own - defaults[places], part.morph_targets)
         start += part.vertex_count
     names = None if union[0][0] is None else [name for name, _ in union]
-    return targets, names
+    return targets, names, defaults, shapes

@@ -59,7 +59,7 @@ from ..motion_lod.skin_measure import analyze_skinned_motion, hidden_note, witho
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
 from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
 from .clip_import import with_clips
-from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, simplify_drawable
+from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, measure_samples, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
 from .skin_parts import JointKeys, Placement, joined_rig, moved_onto, placement_on
 
@@ -526,7 +526,7 @@ def _measure_chain(
             )
             for _, _, motion_level, skin in chain
         ]
-        errors = hausdorff_distances(original, posed, samples=4000, at_least=errors)
+        errors = hausdorff_distances(original, posed, measure_samples(drawable), at_least=errors)
     report = [CharacterLevel(0, 0, 0, len(drawable.geometry.faces), motion.joint_count, 0.0, 0.0, 0.0)]
     for i, ((level, m, motion_level, _), error) in enumerate(zip(chain, errors), start=1):
         joints = motion.joint_count if motion_level is None else motion_level.report.joint_count

@@ -20,6 +20,7 @@ from .. import rotations
 from .._core import bake_lbs
 from ..model import SkinnedMesh
 from .frozen import FrozenLevel
+from .ranking import joint_depths
 from .skeleton_reduce import reduce_skeleton
 
 
@@ -35,10 +36,11 @@ def key_bind_pose(skin: SkinnedMesh, level: FrozenLevel) -> np.ndarray:
     frozen = np.flatnonzero(level.frozen)
     local[frozen, :3, :3] = rotations.to_matrix(level.key_rotations[frozen])
     local[frozen, :3, 3] = level.key_translations[frozen]
-    world = np.empty_like(local)
-    world[0] = local[0]
-    for joint in range(1, parents.size):  # O(J) forward kinematics of one pose
-        world[joint] = world[parents[joint]] @ local[joint]
+    world = local.copy()
+    depths = joint_depths(parents)
+    for depth in range(1, int(depths.max(initial=0)) + 1):  # forward kinematics, one layer of joints at a time
+        layer = np.flatnonzero(depths == depth)
+        world[layer] = world[parents[layer]] @ local[layer]
     return world
 
 

@@ -341,10 +341,11 @@ void AqemPolicy::add_side_planes(const std::vector<std::array<int32_t, 3>>& side
 }
 
 // Steps 5-6: merged quadric, weight and optimal placement per used frame (Eq. 5); cost of
-// Eq. 6. Frames whose X is singular share one fallback, the best in sum over those frames of
-// the kept endpoint, the removed endpoint and the midpoint (ties in that order), so that the
-// point does not slide to a different spot of a flat region in every frame. Leaves what the
-// placement needs in scratch (place_concurrently): most evaluations only key an edge.
+// Eq. 6. Frames whose X is singular or whose minimiser is out of the edge's reach share one
+// fallback, the best in sum over those frames of the kept endpoint, the removed endpoint and the
+// midpoint (ties in that order), so that the point does not slide to a different spot of a flat
+// region in every frame. Leaves what the placement needs in scratch (place_concurrently): most
+// evaluations only key an edge.
 void AqemPolicy::evaluate_with(Candidate& candidate, Scratch& scratch) const {
   const bool pinned = engine_.locked(candidate.kept);
   if (pinned || options_.placement == Placement::on_edge) {
@@ -357,14 +358,23 @@ void AqemPolicy::evaluate_with(Candidate& candidate, Scratch& scratch) const {
   double total = 0.0;
   scratch.minimizers.solve(kept_quadrics, removed_quadrics, used_count_);
   for (size_t k = 0; k < used_count_; ++k) {
-    if (scratch.minimizers.solved(k)) {
-      total += scratch.minimizers.value(k);
-      continue;
-    }
     const size_t frame = static_cast<size_t>(frames_[k]);
-    const Quadric merged = kept_quadrics[k] + removed_quadrics[k];
     const Eigen::Vector3d p_kept = engine_.position(candidate.kept, frame),
                           p_removed = engine_.position(candidate.removed, frame);
+    if (scratch.minimizers.solved(k)) {
+      // A minimiser farther from the edge's midpoint than the edge is long comes from a nearly
+      // flat direction of the quadric (a strip of a cylinder barely bent in a frame near rest
+      // put it 2.7 diagonals away): its plane distances are small, but it is no point of the
+      // surface there, so the frame takes the fallback (meshoptimizer rejects an optimal
+      // position outside the vertex's neighbourhood for the same reason).
+      const Eigen::Vector3d from_middle = scratch.minimizers.position(k) - 0.5 * (p_kept + p_removed);
+      if (from_middle.squaredNorm() <= (p_removed - p_kept).squaredNorm()) {
+        total += scratch.minimizers.value(k);
+        continue;
+      }
+      scratch.minimizers.reject(k);
+    }
+    const Quadric merged = kept_quadrics[k] + removed_quadrics[k];
     for (int option = 0; option < 3; ++option)
       fallback_cost[option] += merged.evaluate(p_kept + kFallbacks[option] * (p_removed - p_kept));
   }

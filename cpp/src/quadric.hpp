@@ -86,6 +86,8 @@ class MergedMinimizers {
   }
 
   bool solved(size_t k) const { return column(kSolved)[k] != 0.0; }
+  // Frame k counts as unsolved after all (its minimiser is out of reach: AqemPolicy).
+  void reject(size_t k) { columns_[kSolved * frame_count_ + k] = 0.0; }
   Eigen::Vector3d position(size_t k) const { return {column(kX)[k], column(kY)[k], column(kZ)[k]}; }
   double value(size_t k) const { return column(kValue)[k]; }
 

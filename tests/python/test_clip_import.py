@@ -4,19 +4,24 @@ as Mixamo's downloads come, gave no chain at all ("no skinned mesh with an anima
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from animlod import synth
+from animlod import rotations, synth
 from animlod.cli import main
 from animlod.io.bvh import write_bvh
 from animlod.io.errors import FormatError
+from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf import read_gltf, write_glb
+from animlod.io.gltf_document import GltfDocument
+from animlod.io.gltf_drawable import read_drawables
 from animlod.io.npz import write_npz
 from animlod.model import Motion, Skeleton
 from animlod.pipelines.character import build_character
+from animlod.pipelines.clip_import import with_clips
 
 QUICK = {"solver": "newton", "frame_budget": 12, "measured_frames": 2}
 
@@ -100,3 +105,91 @@ def test_motion_levels_of_a_character_with_added_clips(split_character, tmp_path
     write_bvh(tmp_path / "walk.bvh", read_gltf(whole).motions[0])
     with pytest.raises(ValueError, match="clips: adds glTF clips to a glTF input, not to a bvh input"):
         build_motion_levels(tmp_path / "walk.bvh", tmp_path / "bvh", levels=2, clips=[walk])
+
+
+def _bvh_in(folder: Path, name: str, motion: Motion, turn: np.ndarray | None = None, scale: float = 1.0) -> Path:
+    """``motion`` as a BVH file, its world turned by ``turn`` (3, 3) and its lengths scaled, as an
+    exporter of other axes or units writes the same clip."""
+    turn = np.eye(3) if turn is None else turn
+    skeleton = motion.skeleton
+    q = rotations.from_matrix(turn)
+    turned = Skeleton(skeleton.names, skeleton.parents, scale * skeleton.offsets @ turn.T,
+                      skeleton.rest_rotations, skeleton.end_sites)  # fmt: skip
+    local = rotations.multiply(rotations.multiply(q, motion.local_rotations), rotations.conjugate(q))
+    path = folder / f"{name}.bvh"
+    write_bvh(path, Motion(turned, scale * motion.root_positions @ turn.T, local, motion.fps, name))
+    return path
+
+
+def _played_frames(document: GltfDocument) -> np.ndarray:
+    (drawable,) = read_drawables(document)
+    return drawable.clip_frames(drawable.clips[0])
+
+
+def _rolled(source: Path, target: Path, names: Sequence[str]) -> Path:
+    """``source`` with the nodes ``names`` given rest rotations of their own (bone roll, as Blender
+    exports), their children's translations and rotations and the skin's inverse binds made up
+    for it: the same rest shape and skinning on other joint axes."""
+    doc = GltfDocument(source)
+    builder = GlbBuilder.from_document(doc)
+    nodes = builder.json["nodes"]
+    skin = builder.json["skins"][0]
+    binds = np.asarray(doc.accessor(skin["inverseBindMatrices"], "test"), np.float64).reshape(-1, 4, 4)
+    binds = np.swapaxes(binds, 1, 2)  # stored column-major
+    for k, name in enumerate(names):
+        index = next(i for i, node in enumerate(nodes) if node.get("name") == name)
+        roll = rotations.from_axis_angle(np.array([0.3, 1.0, -0.5]) / np.linalg.norm([0.3, 1.0, -0.5]), 0.7 + k)
+        node = nodes[index]
+        node["rotation"] = rotations.multiply(node.get("rotation", [0, 0, 0, 1.0]), roll).tolist()
+        unroll = rotations.conjugate(roll)
+        for child in node.get("children", []):
+            nodes[child]["translation"] = rotations.rotate(
+                unroll, np.array(nodes[child].get("translation", [0, 0, 0.0]))
+            ).tolist()
+            nodes[child]["rotation"] = rotations.multiply(unroll, nodes[child].get("rotation", [0, 0, 0, 1.0])).tolist()
+        if index in skin["joints"]:
+            slot = skin["joints"].index(index)
+            undo = np.eye(4)
+            undo[:3, :3] = rotations.to_matrix(unroll)
+            binds[slot] = undo @ binds[slot]
+    skin["inverseBindMatrices"] = builder.add(np.swapaxes(binds, 1, 2).reshape(-1, 16).astype(np.float32))
+    builder.save(target)
+    return target
+
+
+def test_a_bvh_clip_of_the_same_skeleton_plays_as_the_gltf_clip_does(split_character, tmp_path):
+    # A clip captured on the character's own skeleton often comes as BVH; --clips took glTF
+    # files only. Its joints' world rotations carry over relative to the rests, whatever the
+    # BVH's axes and units (a Z-up file in centimetres here) and the nodes' own rest rotations.
+    whole, rest, _ = split_character
+    walk = read_gltf(whole).motions[0]
+    expected = _played_frames(GltfDocument(whole))
+    z_up = rotations.to_matrix(rotations.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.pi / 2))
+    notes = []
+    for bvh in (_bvh_in(tmp_path, "walk", walk), _bvh_in(tmp_path, "walk_z_up_cm", walk, z_up, 100.0)):
+        for character in (rest, _rolled(rest, tmp_path / "rolled.glb", ["Spine", "LeftUpLeg", "LeftLeg", "Head"])):
+            played = _played_frames(with_clips(GltfDocument(character), [bvh], notes.append))
+            np.testing.assert_allclose(played, expected, atol=2e-5)
+    assert f"{tmp_path / 'walk.bvh'}: its clip added to rest.glb (38 joints)" in notes
+    report = build_character(rest, tmp_path / "out.glb", [0.5], clips=[tmp_path / "walk.bvh"], **QUICK)
+    assert len(read_gltf(tmp_path / "out.glb").motions) == 1 and report.chains
+
+
+def test_a_bvh_clip_of_another_rest_pose_is_refused_naming_the_joint(split_character, tmp_path, capsys):
+    _, rest, _ = split_character
+    walk = synth.humanoid_motion(synth.humanoid().skeleton, "walk")
+    skeleton = walk.skeleton
+    offsets = skeleton.offsets.copy()
+    arm = skeleton.names.index("LeftForeArm")
+    offsets[arm] = rotations.rotate(rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), 0.8), offsets[arm])
+    a_pose = Skeleton(skeleton.names, skeleton.parents, offsets, skeleton.rest_rotations, skeleton.end_sites)
+    write_bvh(tmp_path / "a_pose.bvh", Motion(a_pose, walk.root_positions, walk.local_rotations, walk.fps))
+    code = main(["character", str(rest), "-o", str(tmp_path / "out.glb"), "--clips", str(tmp_path / "a_pose.bvh")])
+    assert code == 2 and not (tmp_path / "out.glb").exists()
+    error = capsys.readouterr().err
+    assert "a_pose.bvh: joint 'LeftForeArm': its rest bone points 43 degrees away from the character's " in error
+    renamed = Skeleton([f"other:{n}" for n in skeleton.names], skeleton.parents, skeleton.offsets,
+                       skeleton.rest_rotations, skeleton.end_sites)  # fmt: skip
+    write_bvh(tmp_path / "other.bvh", Motion(renamed, walk.root_positions, walk.local_rotations, walk.fps))
+    with pytest.raises(FormatError, match="other.bvh: ROOT: its root 'other:Hips' is no node of rest.glb's by name"):
+        with_clips(GltfDocument(rest), [tmp_path / "other.bvh"], print)

@@ -70,8 +70,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--separate", action="store_true", help="glTF: one whole GLB per level instead of one LoD GLB")
     parser.add_argument(
         "--clips", nargs="+", default=(), metavar="FILE",
-        help="glTF: files of clips on the same rig (an animation library without the mesh), added to the input's "
-        "own by node name: they drive the skinned meshes' levels, and the output plays them",
+        help="glTF: glTF or BVH files of clips on the same rig (an animation library without the mesh), added to the "
+        "input's own by node name: they drive the skinned meshes' levels, and the output plays them",
     )  # fmt: skip
     parser.add_argument("--no-metrics", action="store_true", help="sequences: skip the Hausdorff/RMS measurement")
     parser.add_argument(

@@ -110,7 +110,7 @@ def add_animation(
     tracks = [(0, "translation", motion.root_positions)]
     if motion.joint_translations is not None:  # bones that stretch or slide get their own tracks
         tracks += [(j, "translation", motion.joint_translations[:, j]) for j in range(1, joint_count)]
-    local_rotations = _sign_continuous(motion.local_rotations)
+    local_rotations = sign_continuous(motion.local_rotations)
     tracks += [(j, "rotation", local_rotations[:, j]) for j in range(joint_count)]
     samplers, channels = [], []
     for joint, path, values in tracks:
@@ -205,7 +205,7 @@ def _mesh(builder: GlbBuilder, skinned: SkinnedMesh) -> dict:
     return mesh
 
 
-def _sign_continuous(quaternions: np.ndarray) -> np.ndarray:
+def sign_continuous(quaternions: np.ndarray) -> np.ndarray:
     """``(T, J, 4)`` with signs flipped so consecutive keys have a non-negative dot product.
 
     q and -q are the same rotation, but a viewer interpolating from q to -q' may take the long

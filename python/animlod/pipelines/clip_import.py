@@ -1,4 +1,4 @@
-"""Clips from other glTF files of the same rig, added to a character's document by node name.
+"""Clips from other glTF or BVH files of the same rig, added to a character's document by node name.
 
 Animation libraries come apart from their characters: Mixamo's "without skin" downloads, one
 file per clip, hold the rig's nodes and a clip each, no mesh. Each translation, rotation or
@@ -11,6 +11,7 @@ animates must rest where the character's node of that name rests (within ``REST_
 the rig's size), or the clip would stretch the character's bones to another figure's
 (retargeting is not done here). Rotations and scales move any node of the name. Channels on
 nodes the character lacks, or whose name it uses twice, are left out and counted in a note.
+A BVH file of the same skeleton is carried over relative to the rest poses (:mod:`.bvh_clips`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import numpy as np
 
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
+from .bvh_clips import add_bvh_clip
 
 # A node whose translation a clip animates rests within this fraction of the rig's size (the
 # largest rest translation among the character's nodes the clip names) of the character's node.
@@ -35,10 +37,13 @@ def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note:
     """``doc`` with every animation of each of ``clip_files`` added (see the module notes);
     FormatError naming the clip file for one that cannot be read, has no animation moving a node
     of the character's by name, or moves the translation of a node of the same name resting
-    elsewhere."""
+    elsewhere (a ``.bvh`` file: :func:`.bvh_clips.add_bvh_clip`)."""
     builder = GlbBuilder.from_document(doc)
     targets = _named_nodes(doc)
     for clip_file in clip_files:
+        if Path(clip_file).suffix.lower() == ".bvh":
+            note(add_bvh_clip(builder, doc, clip_file, targets))
+            continue
         source = GltfDocument(clip_file)
         if not source.gltf.animations:
             raise source.fail("animations", f"no animation to add to {Path(doc.path).name}")

@@ -175,21 +175,69 @@ def test_a_bvh_clip_of_the_same_skeleton_plays_as_the_gltf_clip_does(split_chara
     assert len(read_gltf(tmp_path / "out.glb").motions) == 1 and report.chains
 
 
-def test_a_bvh_clip_of_another_rest_pose_is_refused_naming_the_joint(split_character, tmp_path, capsys):
+def test_a_bvh_clip_of_another_rest_pose_and_proportions_moves_every_bone_as_the_clip_does(split_character, tmp_path):
+    # A clip captured on another figure of the same skeleton (an A-pose rest, longer legs) turns
+    # each bone from the character's rest onto the clip's: every bone points where the clip's does.
     _, rest, _ = split_character
     walk = synth.humanoid_motion(synth.humanoid().skeleton, "walk")
     skeleton = walk.skeleton
     offsets = skeleton.offsets.copy()
-    arm = skeleton.names.index("LeftForeArm")
-    offsets[arm] = rotations.rotate(rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), 0.8), offsets[arm])
-    a_pose = Skeleton(skeleton.names, skeleton.parents, offsets, skeleton.rest_rotations, skeleton.end_sites)
-    write_bvh(tmp_path / "a_pose.bvh", Motion(a_pose, walk.root_positions, walk.local_rotations, walk.fps))
-    code = main(["character", str(rest), "-o", str(tmp_path / "out.glb"), "--clips", str(tmp_path / "a_pose.bvh")])
-    assert code == 2 and not (tmp_path / "out.glb").exists()
-    error = capsys.readouterr().err
-    assert "a_pose.bvh: joint 'LeftForeArm': its rest bone points 43 degrees away from the character's " in error
+    offsets[skeleton.names.index("LeftForeArm")] = rotations.rotate(
+        rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), 0.8), offsets[skeleton.names.index("LeftForeArm")]
+    )
+    offsets[[skeleton.names.index(name) for name in ("LeftLeg", "RightLeg")]] *= 1.3
+    other = Skeleton(skeleton.names, skeleton.parents, offsets, skeleton.rest_rotations, skeleton.end_sites)
+    clip = Motion(other, walk.root_positions, walk.local_rotations, walk.fps, "a_pose")
+    notes = []
+    document = with_clips(GltfDocument(rest), [_bvh_in(tmp_path, "a_pose", clip)], notes.append)
+    assert "its rest pose differs from the character's by up to 4" in notes[0]
+    (drawable,) = read_drawables(document)
+    motion = drawable.clips[0].motion
+    ours, theirs = motion.world_positions(), clip.world_positions()
+    names = motion.skeleton.names
+    for joint, name in enumerate(other.names[1:], start=1):
+        if other.end_sites is not None and other.end_sites[joint]:
+            continue
+        parent = other.parents[joint]
+        ours_bone = ours[:, names.index(name)] - ours[:, names.index(other.names[parent])]
+        theirs_bone = theirs[:, joint] - theirs[:, parent]
+        cosine = np.einsum("tc,tc->t", ours_bone, theirs_bone) / (
+            np.linalg.norm(ours_bone, axis=1) * np.linalg.norm(theirs_bone, axis=1)
+        )
+        assert cosine.min() > 1.0 - 1e-9, name
+
+
+def test_a_bvh_clip_without_a_rest_position_stands_on_the_floor(split_character, tmp_path):
+    # CMU's files give the root an OFFSET of zero and channels that are heights above the floor:
+    # moved from a zero rest position, the character floated a hip height above it.
+    whole, rest, _ = split_character
+    walk = read_gltf(whole).motions[0]
+    skeleton = walk.skeleton
+    offsets = skeleton.offsets.copy()
+    offsets[0] = 0.0
+    cmu = Skeleton(skeleton.names, skeleton.parents, offsets, skeleton.rest_rotations, skeleton.end_sites)
+    bvh = _bvh_in(tmp_path, "cmu_walk", Motion(cmu, walk.root_positions, walk.local_rotations, walk.fps))
+    played = _played_frames(with_clips(GltfDocument(rest), [bvh], print))
+    expected = _played_frames(GltfDocument(whole))
+    height = np.ptp(expected[..., 1])
+    assert abs(played[..., 1].min() - expected[..., 1].min()) < 0.01 * height
+
+
+def test_a_bvh_clip_of_another_rig_is_refused_naming_the_joint(split_character, tmp_path):
+    _, rest, _ = split_character
+    walk = synth.humanoid_motion(synth.humanoid().skeleton, "walk")
+    skeleton = walk.skeleton
     renamed = Skeleton([f"other:{n}" for n in skeleton.names], skeleton.parents, skeleton.offsets,
                        skeleton.rest_rotations, skeleton.end_sites)  # fmt: skip
     write_bvh(tmp_path / "other.bvh", Motion(renamed, walk.root_positions, walk.local_rotations, walk.fps))
     with pytest.raises(FormatError, match="other.bvh: ROOT: its root 'other:Hips' is no node of rest.glb's by name"):
         with_clips(GltfDocument(rest), [tmp_path / "other.bvh"], print)
+    swapped = list(skeleton.names)
+    arm, leg = swapped.index("LeftArm"), swapped.index("LeftUpLeg")
+    swapped[arm], swapped[leg] = swapped[leg], swapped[arm]
+    swapped_skeleton = Skeleton(
+        swapped, skeleton.parents, skeleton.offsets, skeleton.rest_rotations, skeleton.end_sites
+    )
+    write_bvh(tmp_path / "swapped.bvh", Motion(swapped_skeleton, walk.root_positions, walk.local_rotations, walk.fps))
+    with pytest.raises(FormatError, match="swapped.bvh: joint 'LeftUpLeg': hangs from 'LeftShoulder', which is no anc"):
+        with_clips(GltfDocument(rest), [tmp_path / "swapped.bvh"], print)

@@ -1,24 +1,29 @@
-"""A BVH clip of a character's own skeleton, added to its glTF document by joint name.
+"""A BVH clip of a character's skeleton, added to its glTF document by joint name.
 
 Clips captured or edited on a character's skeleton often come as BVH (Blender's and
 MotionBuilder's exports). A BVH joint's rotation is relative to the file's rest pose (every
 rotation zero, each bone along its OFFSET), a glTF node's to its parent's axes with any rest
 rotation of its own (bone roll), so each joint's world rotation is carried over relative to the
-rest: ``W(t) = G B(t) G^T W_rest``, with ``B(t)`` the joint's world rotation in the BVH,
-``W_rest`` the node's in the character's rest pose, and ``G`` the rotation that best lays the
-BVH's rest bones onto the character's (a BVH may be Z-up). The root moves by its displacement
-from its OFFSET (its rest position, as Blender's importer reads it), scaled by the ratio of the
-two skeletons' bone lengths. The character's nodes the BVH lacks keep their rest rotation; BVH
-joints the character lacks, and position channels below the root, are left out and counted.
+rests: ``W(t) = G B(t) G^T S W_rest``, with ``B(t)`` the joint's world rotation in the BVH,
+``W_rest`` the node's in the character's rest pose, ``G`` the turn between coordinate axes that
+best lays the BVH's rest bones onto the character's (a BVH may be Z-up), and ``S`` the joint's swing that lays the
+character's rest bones below it onto the BVH's (identity for the same rest pose; an A-pose clip
+on a T-pose rig turns the arms): every bone then points where the clip's does, whatever the two
+figures' proportions. The root moves by its displacement from its rest position (its OFFSET, as
+Blender's importer reads it, or where the OFFSET is zero, as in CMU's files, the height that
+stands the rest pose on the clip's lowest point), scaled by the ratio of the two roots' heights
+above their feet. The
+character's nodes the BVH lacks keep their rest rotation; BVH joints the character lacks, and
+position channels below the root, are left out and counted in the note, which also says how far
+the rest poses differ.
 
-Only the same skeleton in the same rest pose is taken: every bone between two joints of the
-character must lie along its rest direction within ``REST_ANGLE`` once ``G`` turns it, and a
-joint's nearest named ancestor must be the same in both, or the file is refused naming the joint
-(retargeting between figures or poses is not done here).
+Joints correspond by name only: a joint whose nearest named ancestor differs from the
+character's, or a root the character lacks, is refused naming the joint.
 """
 
 from __future__ import annotations
 
+import itertools
 import os
 from pathlib import Path
 
@@ -32,8 +37,12 @@ from ..io.gltf_document import GltfDocument
 from ..io.gltf_write import sign_continuous
 from ..model import Motion, Skeleton
 
-# Largest angle between a bone's BVH rest direction (turned by G) and the character's.
-REST_ANGLE = np.radians(10.0)
+# The 24 rotations between coordinate axes: signed permutation matrices of determinant 1.
+_AXIS_TURNS = np.array([
+    np.diag(signs) @ np.eye(3)[list(order)]
+    for order in itertools.permutations(range(3)) for signs in itertools.product((1.0, -1.0), repeat=3)
+    if np.linalg.det(np.diag(signs) @ np.eye(3)[list(order)]) > 0.0
+])  # fmt: skip
 
 
 def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike, nodes_by_name: dict[str, int]) -> str:
@@ -55,7 +64,7 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
             raise FormatError(os.fspath(path), f"joint {skeleton.names[j]!r}", f"{doc.node_label(node)} of {into} "
                               "has a matrix, which glTF does not animate")  # fmt: skip
 
-    turn, scale = _rest_alignment(doc, motion, joints, node_of, os.fspath(path))
+    turn, swings, pose_note = _rest_alignment(doc, motion, joints, node_of, os.fspath(path))
     # (T, J, 3, 3) world rotations of the BVH's joints, in the character's axes.
     bvh_world = motion.world_transforms()[..., :3, :3]
     bvh_world = np.einsum("ab,tjbc,dc->tjad", turn, bvh_world, turn)
@@ -67,7 +76,7 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
         if node not in world:
             rest = _rotation(doc.rest_world_matrix(node))
             if node in joint_of:
-                world[node] = bvh_world[:, joint_of[node]] @ rest
+                world[node] = bvh_world[:, joint_of[node]] @ swings[joint_of[node]] @ rest
             elif any(ancestor in joint_of for ancestor in doc.ancestors(node)):  # its rest rotation under its parent's
                 world[node] = world_rotation(doc.parents[node]) @ _rotation(doc.rest_matrix(node))
             else:
@@ -86,12 +95,7 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
         parent_world = world_rotation(parent) if parent != -1 else np.eye(3)
         local = np.swapaxes(parent_world, -1, -2) @ world_rotation(node)
         animate(node, "rotation", sign_continuous(rotations.from_matrix(local)[:, None])[:, 0])
-    root = node_of[0]
-    rest_position = doc.rest_world_matrix(root)[:3, 3]
-    moved = rest_position + scale * (motion.root_positions - skeleton.offsets[0]) @ turn.T
-    parent_matrix = doc.rest_world_matrix(doc.parents[root]) if doc.parents[root] != -1 else np.eye(4)
-    local_positions = (np.c_[moved, np.ones(frame_count)] @ np.linalg.inv(parent_matrix).T)[:, :3]
-    animate(root, "translation", local_positions)
+    animate(node_of[0], "translation", _root_translations(doc, motion, turn, node_of))
     builder.append("animations", {"name": motion.name or Path(path).stem, "samplers": samplers, "channels": channels})
 
     left_out = [name for j, name in enumerate(skeleton.names) if not end_sites[j] and j not in node_of]
@@ -99,6 +103,8 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
     if left_out:
         notes.append(f"{len(left_out)} joint(s) {into} has not left out ({', '.join(left_out[:5])}"
                      f"{', ...' if len(left_out) > 5 else ''})")  # fmt: skip
+    if pose_note:
+        notes.append(pose_note)
     if motion.joint_translations is not None:
         notes.append("position channels below the root left out")
     return "; ".join(notes)
@@ -106,14 +112,16 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
 
 def _rest_alignment(
     doc: GltfDocument, motion: Motion, joints: list[int], node_of: dict[int, int], path: str
-) -> tuple[np.ndarray, float]:
-    """``G`` (3, 3), the rotation that best turns the BVH's rest bones onto the character's
-    (Kabsch), and the ratio of their lengths; FormatError naming the first joint whose bone
-    points elsewhere or hangs from another named joint."""
+) -> tuple[np.ndarray, dict[int, np.ndarray], str | None]:
+    """``G`` (3, 3), the turn between axes that best lays the BVH's rest bones onto the
+    character's, each joint's swing ``S`` (3, 3) that lays the character's rest bones below it
+    onto the BVH's turned by ``G``, and a note naming the bone whose rest directions differ most
+    where that is over a degree. FormatError naming the first joint that hangs from another
+    named joint than in the character."""
     skeleton = motion.skeleton
     bvh_rest = _rest_positions(skeleton)
     named = set(joints)
-    pairs = []
+    bones = []  # (joint, its nearest named ancestor, BVH rest bone, the character's)
     for j in joints[1:]:
         ancestor = int(skeleton.parents[j])
         while ancestor not in named:
@@ -123,25 +131,88 @@ def _rest_alignment(
             reason = f"hangs from {skeleton.names[ancestor]!r}, which is no ancestor of {doc.node_label(node)}"
             raise FormatError(path, f"joint {skeleton.names[j]!r}", reason)
         ours = doc.rest_world_matrix(node)[:3, 3] - doc.rest_world_matrix(above)[:3, 3]
-        pairs.append((j, bvh_rest[j] - bvh_rest[ancestor], ours))
-    theirs = np.array([pair[1] for pair in pairs]).reshape(-1, 3)
-    ours = np.array([pair[2] for pair in pairs]).reshape(-1, 3)
-    lengths = np.linalg.norm(theirs, axis=1), np.linalg.norm(ours, axis=1)
-    if not len(pairs) or lengths[0].sum() <= 0.0 or lengths[1].sum() <= 0.0:
+        bones.append((j, ancestor, bvh_rest[j] - bvh_rest[ancestor], ours))
+    theirs = np.array([bone[2] for bone in bones]).reshape(-1, 3)
+    ours = np.array([bone[3] for bone in bones]).reshape(-1, 3)
+    if not (np.linalg.norm(theirs, axis=1).sum() > 0.0 and np.linalg.norm(ours, axis=1).sum() > 0.0):
         raise FormatError(path, "HIERARCHY", f"no bone between two joints of {Path(doc.path).name}'s by name")
-    u, _, vt = np.linalg.svd(ours.T @ theirs)
-    turn = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
-    for (j, their_bone, our_bone), their_length, our_length in zip(pairs, *lengths):
-        if their_length <= 0.0 or our_length <= 0.0:
-            continue
-        cosine = float(np.dot(turn @ their_bone, our_bone) / (their_length * our_length))
-        if cosine < np.cos(REST_ANGLE):
-            angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
-            label = doc.node_label(node_of[j])
-            reason = (f"its rest bone points {angle:.0f} degrees away from the character's ({label}): another rest "
-                      "pose or figure (retarget the clip to this character first)")  # fmt: skip
-            raise FormatError(path, f"joint {skeleton.names[j]!r}", reason)
-    return turn, float(lengths[1].sum() / lengths[0].sum())
+    turn = _axis_turn(_best_rotation(theirs, ours))
+    swings = {}
+    for j in joints:
+        below = [(our, turn @ their) for _, ancestor, their, our in bones if ancestor == j]
+        swings[j] = _best_rotation(*map(np.array, zip(*below))) if below else np.eye(3)
+    angles = [_angle(turn @ their, our) for _, _, their, our in bones]
+    worst = int(np.argmax(angles)) if angles else 0
+    note = None
+    if angles and angles[worst] > 1.0:
+        name = skeleton.names[bones[worst][0]]
+        note = (f"its rest pose differs from the character's by up to {angles[worst]:.0f} degrees (the bone to "
+                f"{name!r}): each bone follows the clip's direction")  # fmt: skip
+    return turn, swings, note
+
+
+def _axis_turn(rotation: np.ndarray) -> np.ndarray:
+    """The turn between coordinate axes nearest ``rotation`` (one of the 24 signed permutations
+    of determinant 1): exporters write Y-up or Z-up axes, and what the best fit adds to such a turn
+    is a difference of the two rest poses, which each joint's swing takes."""
+    turns = _AXIS_TURNS
+    return turns[int(np.argmax(np.einsum("kij,ij->k", turns, rotation)))]
+
+
+def _best_rotation(source: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The rotation that best turns the vectors ``source`` (n, 3) onto ``target`` (n, 3): Kabsch,
+    or for one vector the smallest rotation between the two directions (no twist of its own)."""
+    if len(source) == 1:
+        a, b = (v / max(np.linalg.norm(v), 1e-300) for v in (source[0], target[0]))
+        axis, cosine = np.cross(a, b), float(np.dot(a, b))
+        if cosine < -1.0 + 1e-12:  # opposite: half a turn about any perpendicular axis
+            perpendicular = np.cross(a, np.eye(3)[int(np.argmin(np.abs(a)))])
+            perpendicular /= np.linalg.norm(perpendicular)
+            return 2.0 * np.outer(perpendicular, perpendicular) - np.eye(3)
+        cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+        return np.eye(3) + cross + cross @ cross / (1.0 + cosine)
+    u, _, vt = np.linalg.svd(target.T @ source)
+    return u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    """Degrees between two vectors (0 where one is zero)."""
+    lengths = np.linalg.norm(a) * np.linalg.norm(b)
+    return float(np.degrees(np.arccos(np.clip(np.dot(a, b) / lengths, -1.0, 1.0)))) if lengths > 0.0 else 0.0
+
+
+def _root_translations(doc: GltfDocument, motion: Motion, turn: np.ndarray, node_of: dict[int, int]) -> np.ndarray:
+    """(T, 3) translations of the root's node: its rest position moved by the BVH root's
+    displacement from its rest (:func:`_root_rest`), in the frame of the node's parent."""
+    root = node_of[0]
+    root_rest, scale = _root_rest(doc, motion, turn, node_of)
+    moved = doc.rest_world_matrix(root)[:3, 3] + scale * (motion.root_positions - root_rest) @ turn.T
+    parent = doc.parents[root]
+    to_parent = np.linalg.inv(doc.rest_world_matrix(parent)) if parent != -1 else np.eye(4)
+    return (np.c_[moved, np.ones(len(moved))] @ to_parent.T)[:, :3]
+
+
+def _root_rest(
+    doc: GltfDocument, motion: Motion, turn: np.ndarray, node_of: dict[int, int]
+) -> tuple[np.ndarray, float]:
+    """(3,) where the BVH's root stands in its rest pose, and the scale of its moves: the ratio of
+    the two roots' rest heights above their lowest named joint (the legs' lengths, so that feet
+    that touch the floor in the clip touch it on the character). The rest position is the root's
+    OFFSET, or where that is zero (CMU's files give none: their root channels are heights above
+    the floor) the height that stands the rest pose's lowest named joint on the clip's lowest
+    (``turn`` maps the file's axes onto the character's, whose up is +Y)."""
+    joints = list(node_of)
+    up = turn[1]  # the file's up direction
+    rest_heights = _rest_positions(motion.skeleton)[joints] @ up
+    their_height = rest_heights[0] - rest_heights.min()
+    our_heights = np.array([doc.rest_world_matrix(node)[1, 3] for node in node_of.values()])
+    our_height = our_heights[0] - our_heights.min()
+    scale = our_height / their_height if their_height > 0.0 and our_height > 0.0 else 1.0
+    offset = motion.skeleton.offsets[0]
+    if np.any(offset != 0.0):
+        return offset, scale
+    floor = float((motion.world_positions()[:, joints] @ up).min())
+    return up * (floor + their_height), scale
 
 
 def _rest_positions(skeleton: Skeleton) -> np.ndarray:

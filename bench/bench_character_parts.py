@@ -98,7 +98,7 @@ def main() -> None:
             "geometry s",
             "writing and measuring s",
             "coarsest level's largest error (asset units)",
-        ),  # fmt: skip
+        ),
         rows,
     )
 

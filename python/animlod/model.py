@@ -489,10 +489,7 @@ class SkinnedMesh:
     def default_shape(self) -> np.ndarray:
         """(V, 3) float32 bind shape with the morph targets at their default weights: what the
         skeleton poses where no animation drives the weights."""
-        if self.default_morph_weights is None or not self.default_morph_weights.any():
-            return self.rest_positions
-        shape = self.rest_positions + np.einsum("n,nvc->vc", self.default_morph_weights, self.morph_targets)
-        return shape.astype(np.float32)
+        return morphed(self.rest_positions, self.morph_targets, self.default_morph_weights, 1)[0]
 
     def rest_pose(self) -> np.ndarray:
         """(V, 3) float32 positions skinned by the skeleton's rest pose: what a viewer shows with no
@@ -509,6 +506,15 @@ class SkinnedMesh:
         matrices = self.skeleton.rest_motion(1).skin_matrices(self.inverse_bind)[0, :, :3, :3]  # (J, 3, 3)
         blended = np.einsum("vk,vkij->vij", self.weights, matrices[self.joints])
         return np.einsum("vij,nvj->nvi", blended, self.morph_targets).astype(np.float32)
+
+
+def morphed(bind: np.ndarray, targets: np.ndarray | None, weights: np.ndarray | None, count: int) -> np.ndarray:
+    """(count, V, 3) float32: the shape ``bind`` (V, 3) with its morph ``targets``
+    (N, V, 3) at ``weights``, (count, N) or (N,) for every frame (None: all 0)."""
+    if weights is None or not np.any(weights):
+        return np.broadcast_to(bind, (count,) + bind.shape).astype(np.float32)
+    shapes = bind.astype(np.float64) + np.einsum("...n,nvc->...vc", weights, targets)
+    return np.broadcast_to(shapes, (count,) + bind.shape).astype(np.float32)
 
 
 def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -191,7 +191,8 @@ struct AqemResult {
 //
 // Placement (Eq. 5, Placement::optimal): per frame, v = X^-1 Y of the merged quadric; where a
 // frame's X is singular, or v lies farther from the edge's midpoint than the edge is long, the
-// best of the two endpoints and the midpoint (one choice shared by those frames). Placement::on_edge puts the vertex at one point of the edge. In frames outside frames_used the
+// best of the two endpoints and the midpoint (one choice shared by those frames).
+// Placement::on_edge puts the vertex at one point of the edge. In frames outside frames_used the
 // new vertex sits on the collapsed edge at the parameter that best matches the optimal
 // positions of the used frames. Attributes and skin weights are interpolated with that same
 // parameter. Ties in cost are broken by edge index, so the output is deterministic.

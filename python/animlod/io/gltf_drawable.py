@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import Motion, SkinnedMesh
+from ..model import Motion, SkinnedMesh, morphed
 from .gltf_document import GltfDocument
 from .gltf_lod import GRID_EXTRA
 from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_points
@@ -123,15 +123,6 @@ class Drawable:
             return self.skinned.bake(motion, weights).frames
         weights = self.default_weights if weights is None else weights
         return morphed(self.bind_positions(), self.morph_targets, weights, len(frames))
-
-
-def morphed(bind: np.ndarray, targets: np.ndarray | None, weights: np.ndarray | None, count: int) -> np.ndarray:
-    """(count, V, 3) float32 frames of an unskinned mesh: ``bind`` (V, 3) with its morph ``targets``
-    (N, V, 3) at ``weights``, (count, N) or (N,) for every frame (None: all 0)."""
-    if weights is None or not np.any(weights):
-        return np.broadcast_to(bind, (count,) + bind.shape).astype(np.float32)
-    shapes = bind.astype(np.float64) + np.einsum("...n,nvc->...vc", weights, targets)
-    return np.broadcast_to(shapes, (count,) + bind.shape).astype(np.float32)
 
 
 def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:

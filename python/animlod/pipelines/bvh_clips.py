@@ -35,7 +35,7 @@ from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_write import sign_continuous
-from ..model import Motion, Skeleton
+from ..model import Motion
 
 # The 24 rotations between coordinate axes: signed permutation matrices of determinant 1.
 _AXIS_TURNS = np.array([
@@ -65,9 +65,9 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
                               "has a matrix, which glTF does not animate")  # fmt: skip
 
     turn, swings, pose_note = _rest_alignment(doc, motion, joints, node_of, os.fspath(path))
+    clip_world = motion.world_transforms()
     # (T, J, 3, 3) world rotations of the BVH's joints, in the character's axes.
-    bvh_world = motion.world_transforms()[..., :3, :3]
-    bvh_world = np.einsum("ab,tjbc,dc->tjad", turn, bvh_world, turn)
+    bvh_world = np.einsum("ab,tjbc,dc->tjad", turn, clip_world[..., :3, :3], turn)
     frame_count = motion.frame_count
     joint_of = {node: j for j, node in node_of.items()}
     world: dict[int, np.ndarray] = {}  # node -> (T, 3, 3) world rotation while the clip plays
@@ -95,7 +95,7 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
         parent_world = world_rotation(parent) if parent != -1 else np.eye(3)
         local = np.swapaxes(parent_world, -1, -2) @ world_rotation(node)
         animate(node, "rotation", sign_continuous(rotations.from_matrix(local)[:, None])[:, 0])
-    animate(node_of[0], "translation", _root_translations(doc, motion, turn, node_of))
+    animate(node_of[0], "translation", _root_translations(doc, motion, clip_world[..., :3, 3], turn, node_of))
     builder.append("animations", {"name": motion.name or Path(path).stem, "samplers": samplers, "channels": channels})
 
     left_out = [name for j, name in enumerate(skeleton.names) if not end_sites[j] and j not in node_of]
@@ -119,7 +119,7 @@ def _rest_alignment(
     where that is over a degree. FormatError naming the first joint that hangs from another
     named joint than in the character."""
     skeleton = motion.skeleton
-    bvh_rest = _rest_positions(skeleton)
+    bvh_rest = skeleton.rest_world_transforms()[:, :3, 3]  # every rotation zero: a BVH's rest pose
     named = set(joints)
     bones = []  # (joint, its nearest named ancestor, BVH rest bone, the character's)
     for j in joints[1:]:
@@ -181,11 +181,14 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.degrees(np.arccos(np.clip(np.dot(a, b) / lengths, -1.0, 1.0)))) if lengths > 0.0 else 0.0
 
 
-def _root_translations(doc: GltfDocument, motion: Motion, turn: np.ndarray, node_of: dict[int, int]) -> np.ndarray:
+def _root_translations(
+    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, turn: np.ndarray, node_of: dict[int, int]
+) -> np.ndarray:
     """(T, 3) translations of the root's node: its rest position moved by the BVH root's
-    displacement from its rest (:func:`_root_rest`), in the frame of the node's parent."""
+    displacement from its rest (:func:`_root_rest`; ``clip_positions`` (T, J, 3) are the BVH's
+    joints in every frame), in the frame of the node's parent."""
     root = node_of[0]
-    root_rest, scale = _root_rest(doc, motion, turn, node_of)
+    root_rest, scale = _root_rest(doc, motion, clip_positions, turn, node_of)
     moved = doc.rest_world_matrix(root)[:3, 3] + scale * (motion.root_positions - root_rest) @ turn.T
     parent = doc.parents[root]
     to_parent = np.linalg.inv(doc.rest_world_matrix(parent)) if parent != -1 else np.eye(4)
@@ -193,7 +196,7 @@ def _root_translations(doc: GltfDocument, motion: Motion, turn: np.ndarray, node
 
 
 def _root_rest(
-    doc: GltfDocument, motion: Motion, turn: np.ndarray, node_of: dict[int, int]
+    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, turn: np.ndarray, node_of: dict[int, int]
 ) -> tuple[np.ndarray, float]:
     """(3,) where the BVH's root stands in its rest pose, and the scale of its moves: the ratio of
     the two roots' rest heights above their lowest named joint (the legs' lengths, so that feet
@@ -203,7 +206,7 @@ def _root_rest(
     (``turn`` maps the file's axes onto the character's, whose up is +Y)."""
     joints = list(node_of)
     up = turn[1]  # the file's up direction
-    rest_heights = _rest_positions(motion.skeleton)[joints] @ up
+    rest_heights = motion.skeleton.rest_world_transforms()[joints, :3, 3] @ up
     their_height = rest_heights[0] - rest_heights.min()
     our_heights = np.array([doc.rest_world_matrix(node)[1, 3] for node in node_of.values()])
     our_height = our_heights[0] - our_heights.min()
@@ -211,17 +214,8 @@ def _root_rest(
     offset = motion.skeleton.offsets[0]
     if np.any(offset != 0.0):
         return offset, scale
-    floor = float((motion.world_positions()[:, joints] @ up).min())
+    floor = float((clip_positions[:, joints] @ up).min())
     return up * (floor + their_height), scale
-
-
-def _rest_positions(skeleton: Skeleton) -> np.ndarray:
-    """(J, 3) world positions of the joints with every rotation zero (a BVH's rest pose)."""
-    positions = np.zeros((skeleton.joint_count, 3))
-    positions[0] = skeleton.offsets[0]
-    for joint in range(1, skeleton.joint_count):
-        positions[joint] = positions[skeleton.parents[joint]] + skeleton.offsets[joint]
-    return positions
 
 
 def _rotation(matrix: np.ndarray) -> np.ndarray:

@@ -26,12 +26,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aqem import Preparation, SimplifiedLevel, simplify_animated
-from ..io.gltf_drawable import Clip, Drawable, morphed
+from ..io.gltf_drawable import Clip, Drawable
 from ..io.gltf_lod import PrimitiveArrays
 from ..io.gltf_mesh import PrimitiveGeometry, transform_points
 from ..io.gltf_write import influence_sets
 from ..metrics import hausdorff_distances
-from ..model import AnimatedMesh, SkinnedMesh, spread_frames
+from ..model import AnimatedMesh, SkinnedMesh, morphed, spread_frames
 from ..options import AqemOptions
 
 _SKIN_PREFIXES = ("JOINTS_", "WEIGHTS_")

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_read import GltfScene, read_skinned_node
-from ..model import Motion, SkinnedMesh
+from ..model import Motion, SkinnedMesh, morphed
 from ..motion_lod.clips import join_clips
 from ..normals import vertex_normals
 from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
@@ -132,7 +132,7 @@ def _joined_targets(
             unset = np.isnan(defaults[places])
             defaults[np.asarray(places)[unset]] = own[unset]
             if np.any(own != defaults[places]):
-                shapes[k] = part.rest_positions + np.einsum("n,nvc->vc", own - defaults[places], part.morph_targets)
+                shapes[k] = morphed(part.rest_positions, part.morph_targets, own - defaults[places], 1)[0]
         start += part.vertex_count
     names = None if union[0][0] is None else [name for name, _ in union]
     return targets, names, defaults, shapes

@@ -4,6 +4,7 @@ as Mixamo's downloads come, gave no chain at all ("no skinned mesh with an anima
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -12,7 +13,7 @@ import pytest
 
 from animlod import rotations, synth
 from animlod.cli import main
-from animlod.io.bvh import write_bvh
+from animlod.io.bvh import read_bvh, write_bvh
 from animlod.io.errors import FormatError
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf import read_gltf, write_glb
@@ -22,6 +23,7 @@ from animlod.io.npz import write_npz
 from animlod.model import Motion, Skeleton
 from animlod.pipelines.character import build_character
 from animlod.pipelines.clip_import import with_clips
+from animlod.pipelines.joint_matching import match_joints, side
 
 QUICK = {"solver": "newton", "frame_budget": 12, "measured_frames": 2}
 
@@ -223,21 +225,129 @@ def test_a_bvh_clip_without_a_rest_position_stands_on_the_floor(split_character,
     assert abs(played[..., 1].min() - expected[..., 1].min()) < 0.01 * height
 
 
+def _edited(motion: Motion, order: Sequence[str], renamed: dict[str, str] | None = None) -> Motion:
+    """``motion`` with its joints in ``order`` (names, parents first; the joints not named are
+    left out, each with every joint below it) and ``renamed``: the same clip as another
+    exporter writes it."""
+    skeleton, renamed = motion.skeleton, renamed or {}
+    index = [skeleton.names.index(name) for name in order]
+    place = {joint: k for k, joint in enumerate(index)}
+    parents = [place.get(int(skeleton.parents[joint]), -1) for joint in index]
+    edited = Skeleton([renamed.get(name, name) for name in order], parents, skeleton.offsets[index],
+                      skeleton.rest_rotations[index], skeleton.end_sites[index])  # fmt: skip
+    return Motion(edited, motion.root_positions, motion.local_rotations[:, index], motion.fps, motion.name)
+
+
+def _depth_first(skeleton: Skeleton, last_child_first: bool) -> list[str]:
+    children = skeleton.children()
+    order, pending = [], [0]
+    while pending:
+        joint = pending.pop()
+        order.append(skeleton.names[joint])
+        pending.extend(children[joint] if last_child_first else reversed(children[joint]))
+    return order
+
+
+def _played_positions(document: GltfDocument, names: Sequence[str]) -> np.ndarray:
+    (drawable,) = read_drawables(document)
+    motion = drawable.clips[0].motion
+    return motion.world_positions()[:, [motion.skeleton.names.index(name) for name in names]]
+
+
+def test_a_bvh_clip_of_the_same_skeleton_under_other_names_plays_by_the_skeletons_shape(split_character, tmp_path):
+    # CMU's ASF conversions name the joints of the cgspeed rigs otherwise, and some names mean
+    # other joints: CMU's 'LeftShoulder' is the rig's upper arm, its 'Neck' the rig's head. By
+    # name, such a clip turned the collar with the upper arm's rotation and left most joints out.
+    whole, rest, _ = split_character
+    walk = read_gltf(whole).motions[0]
+    cmu = {"Spine": "lowerback", "Spine1": "Chest", "Spine2": "Chest2", "Neck": "lowerneck", "Head": "Neck",
+           "HeadTop_End": "Head"}  # fmt: skip
+    limbs = {"Shoulder": "Collar", "Arm": "Shoulder", "ForeArm": "Elbow", "Hand": "Wrist",
+             "UpLeg": "Hip", "Leg": "Knee", "Foot": "Ankle", "ToeBase": "Toe"}  # fmt: skip
+    cmu |= {side + ours: side + theirs for side in ("Left", "Right") for ours, theirs in limbs.items()}
+    # The right side first in the file, as the character's left comes first: only the names' sides pair them.
+    clip = _edited(walk, _depth_first(walk.skeleton, last_child_first=True), cmu)
+    notes = []
+    played = _played_frames(with_clips(GltfDocument(rest), [_bvh_in(tmp_path, "cmu", clip)], notes.append))
+    np.testing.assert_allclose(played, _played_frames(GltfDocument(whole)), atol=2e-5)
+    assert (
+        "(38 joints); joints matched by the two skeletons' shape: 21 to nodes of other names ('RightHip' -> "
+        in notes[0]
+    )
+
+
+def test_a_bvh_clip_of_another_shape_plays_by_name_up_to_namespace(split_character, tmp_path):
+    # A clip without the character's ring fingers, its joints in Mixamo's namespace: the
+    # skeletons differ in shape, and the names match without the namespace.
+    whole, rest, _ = split_character
+    walk = read_gltf(whole).motions[0]
+    names = walk.skeleton.names
+    order = [name for name in names if "Ring" not in name]
+    clip = _edited(walk, order, {name: f"mixamorig:{name}" for name in names})
+    notes = []
+    document = with_clips(GltfDocument(rest), [_bvh_in(tmp_path, "mixamo", clip)], notes.append)
+    assert (
+        "(34 joints); 34 joint(s) matched by name up to case, separators and namespace ('mixamorig:Hips' -> 'Hips'"
+        in notes[0]
+    )
+    kept = [name for name in order if name in names and not name.endswith("_End")]
+    np.testing.assert_allclose(
+        _played_positions(document, kept), _played_positions(GltfDocument(whole), kept), atol=2e-5
+    )
+
+
 def test_a_bvh_clip_of_another_rig_is_refused_naming_the_joint(split_character, tmp_path):
     _, rest, _ = split_character
     walk = synth.humanoid_motion(synth.humanoid().skeleton, "walk")
-    skeleton = walk.skeleton
-    renamed = Skeleton([f"other:{n}" for n in skeleton.names], skeleton.parents, skeleton.offsets,
-                       skeleton.rest_rotations, skeleton.end_sites)  # fmt: skip
-    write_bvh(tmp_path / "other.bvh", Motion(renamed, walk.root_positions, walk.local_rotations, walk.fps))
-    with pytest.raises(FormatError, match="other.bvh: ROOT: its root 'other:Hips' is no node of rest.glb's by name"):
+    write_bvh(tmp_path / "other.bvh", _edited(walk, ["Hips", "Spine"], {"Hips": "a", "Spine": "b"}))
+    with pytest.raises(
+        FormatError, match="other.bvh: ROOT: its root 'a' matches no node of rest.glb's, by shape or by n"
+    ):
         with_clips(GltfDocument(rest), [tmp_path / "other.bvh"], print)
-    swapped = list(skeleton.names)
-    arm, leg = swapped.index("LeftArm"), swapped.index("LeftUpLeg")
-    swapped[arm], swapped[leg] = swapped[leg], swapped[arm]
-    swapped_skeleton = Skeleton(
-        swapped, skeleton.parents, skeleton.offsets, skeleton.rest_rotations, skeleton.end_sites
-    )
-    write_bvh(tmp_path / "swapped.bvh", Motion(swapped_skeleton, walk.root_positions, walk.local_rotations, walk.fps))
+    # Another shape, and names that match only here and there: a few joints would move.
+    ringless = [name for name in walk.skeleton.names if "Ring" not in name]
+    renamed = {name: f"joint{k}" for k, name in enumerate(ringless) if name not in ("Hips", "Neck", "Head")}
+    write_bvh(tmp_path / "few.bvh", _edited(walk, ringless, renamed))
+    reason = "HIERARCHY: only 3 of its 34 joints match a node of rest.glb's by name (Hips, Neck, Head), and the sk"
+    with pytest.raises(FormatError, match=re.escape(f"few.bvh: {reason}")):
+        with_clips(GltfDocument(rest), [tmp_path / "few.bvh"], print)
+    # Another shape (no ring fingers) and an arm and a leg named like each other: by name, the
+    # arm's joint would drive the leg.
+    swapped = {"LeftArm": "LeftUpLeg", "LeftUpLeg": "LeftArm"}
+    clip = _edited(walk, ringless, swapped)
+    write_bvh(tmp_path / "swapped.bvh", clip)
     with pytest.raises(FormatError, match="swapped.bvh: joint 'LeftUpLeg': hangs from 'LeftShoulder', which is no anc"):
         with_clips(GltfDocument(rest), [tmp_path / "swapped.bvh"], print)
+
+
+@pytest.mark.parametrize(
+    ("name", "expected"),
+    [("LeftArm", "left"), ("mixamorig:RightHand", "right"), ("LThumb", "left"), ("hand_l", "left"), ("Arm.R", "right"),
+     ("Bip01 R Calf", "right"), ("UpperArmL", "left"), ("lowerback", None), ("lhand", None), ("Root", None)],
+)  # fmt: skip
+def test_a_joint_names_its_side_as_exporters_write_it(name, expected):
+    assert side(name) == expected
+
+
+def test_a_cmu_clip_drives_the_rig_made_from_its_skeleton(data_dir, tmp_path):
+    # delfem2's rig carries the cgspeed names of CMU's skeleton, 131_01 CMU's own: 9 of its 31
+    # joint names are the rig's, two of them for other joints (the upper arms).
+    rig, clip = data_dir / "gltf" / "rig_transfer_from_bvh.glb", data_dir / "bvh" / "131_01.bvh"
+    document, motion = GltfDocument(rig), read_bvh(clip)
+    match = match_joints(motion.skeleton, document, str(clip))
+    pairs = {motion.skeleton.names[j]: document.gltf.nodes[n].name for j, n in match.node_of.items()}
+    assert len(pairs) == 31
+    expected = {"LeftShoulder": "LeftArm", "LeftCollar": "LeftShoulder", "Neck": "Neck1", "Head": "Head",
+                "RightHip": "RightUpLeg", "Chest2": "Spine1", "RFingers": "RightHandIndex1"}  # fmt: skip
+    assert {name: pairs[name] for name in expected} == expected
+    # Each matched bone is about as long on the rig as in the clip (the same figure).
+    theirs = motion.skeleton.rest_world_transforms()[:, :3, 3]
+    ratios = []
+    for joint, node in match.node_of.items():
+        parent = int(motion.skeleton.parents[joint])
+        if parent >= 0 and np.linalg.norm(theirs[joint] - theirs[parent]) > 0.1:
+            ours = document.rest_world_matrix(node)[:3, 3] - document.rest_world_matrix(match.node_of[parent])[:3, 3]
+            ratios.append(np.linalg.norm(ours) / np.linalg.norm(theirs[joint] - theirs[parent]))
+    assert len(ratios) >= 20 and min(ratios) > 0.75 and max(ratios) < 1.35
+    build_character(rig, tmp_path / "out.glb", [0.5], clips=[clip], **QUICK)
+    assert len(read_gltf(tmp_path / "out.glb").motions) == 1

@@ -17,8 +17,9 @@ character's nodes the BVH lacks keep their rest rotation; BVH joints the charact
 position channels below the root, are left out and counted in the note, which also says how far
 the rest poses differ.
 
-Joints correspond by name only: a joint whose nearest named ancestor differs from the
-character's, or a root the character lacks, is refused naming the joint.
+Joints correspond by the skeletons' shape where the two are alike, else by name
+(:mod:`.joint_matching`, which refuses another rig); a joint whose nearest matched ancestor
+differs from the character's is refused naming the joint.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_write import sign_continuous
 from ..model import Motion
+from .joint_matching import match_joints
 
 # The 24 rotations between coordinate axes: signed permutation matrices of determinant 1.
 _AXIS_TURNS = np.array([
@@ -45,20 +47,17 @@ _AXIS_TURNS = np.array([
 ])  # fmt: skip
 
 
-def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike, nodes_by_name: dict[str, int]) -> str:
+def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike) -> str:
     """Adds the clip of the BVH file at ``path`` to ``builder`` (the document ``doc``) as an
-    animation of the nodes named like its joints (``nodes_by_name``: names one node alone has);
-    returns the note saying what was added. FormatError naming the file and the joint where the
-    skeletons differ (see the module notes)."""
+    animation of the nodes that match its joints; returns the note saying what was added.
+    FormatError naming the file and the joint where the skeletons differ (see the module notes)."""
     motion = read_bvh(path)
     skeleton = motion.skeleton
     end_sites = np.zeros(skeleton.joint_count, bool) if skeleton.end_sites is None else skeleton.end_sites
-    joints = [j for j, name in enumerate(skeleton.names) if name in nodes_by_name and not end_sites[j]]
+    match = match_joints(skeleton, doc, os.fspath(path))
+    node_of = match.node_of
+    joints = sorted(node_of)
     into = Path(doc.path).name
-    if 0 not in joints:
-        reason = f"its root {skeleton.names[0]!r} is no node of {into}'s by name (another rig?)"
-        raise FormatError(os.fspath(path), "ROOT", reason)
-    node_of = {j: nodes_by_name[skeleton.names[j]] for j in joints}
     for j, node in node_of.items():
         if doc.gltf.nodes[node].matrix is not None:
             raise FormatError(os.fspath(path), f"joint {skeleton.names[j]!r}", f"{doc.node_label(node)} of {into} "
@@ -100,6 +99,8 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
 
     left_out = [name for j, name in enumerate(skeleton.names) if not end_sites[j] and j not in node_of]
     notes = [f"{os.fspath(path)}: its clip added to {into} ({len(node_of)} joints)"]
+    if match.note:
+        notes.append(match.note)
     if left_out:
         notes.append(f"{len(left_out)} joint(s) {into} has not left out ({', '.join(left_out[:5])}"
                      f"{', ...' if len(left_out) > 5 else ''})")  # fmt: skip

@@ -42,7 +42,7 @@ def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note:
     targets = _named_nodes(doc)
     for clip_file in clip_files:
         if Path(clip_file).suffix.lower() == ".bvh":
-            note(add_bvh_clip(builder, doc, clip_file, targets))
+            note(add_bvh_clip(builder, doc, clip_file))
             continue
         source = GltfDocument(clip_file)
         if not source.gltf.animations:

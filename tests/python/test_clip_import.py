@@ -23,7 +23,8 @@ from animlod.io.npz import write_npz
 from animlod.model import Motion, Skeleton
 from animlod.pipelines.character import build_character
 from animlod.pipelines.clip_import import with_clips
-from animlod.pipelines.joint_matching import match_joints, side
+from animlod.pipelines.joint_matching import match_joints
+from animlod.pipelines.joint_names import side
 
 QUICK = {"solver": "newton", "frame_budget": 12, "measured_frames": 2}
 
@@ -351,3 +352,94 @@ def test_a_cmu_clip_drives_the_rig_made_from_its_skeleton(data_dir, tmp_path):
     assert len(ratios) >= 20 and min(ratios) > 0.75 and max(ratios) < 1.35
     build_character(rig, tmp_path / "out.glb", [0.5], clips=[clip], **QUICK)
     assert len(read_gltf(tmp_path / "out.glb").motions) == 1
+
+
+_CMU_LIMBS = {"Shoulder": "Collar", "Arm": "Shoulder", "ForeArm": "Elbow", "Hand": "Wrist",
+              "UpLeg": "Hip", "Leg": "Knee", "Foot": "Ankle", "ToeBase": "Toe"}  # fmt: skip
+_BODY = ["Hips", "Spine", "Spine1", "Spine2", "Neck", "Head"] + [
+    side + limb for side in ("Left", "Right") for limb in _CMU_LIMBS
+]
+
+
+def test_a_cmu_named_clip_plays_on_a_mixamo_named_rig_by_body_part(split_character, tmp_path):
+    # Another naming and another shape (no fingers): CMU's 'LeftShoulder' is Mixamo's 'LeftArm';
+    # by name, a few joints matched, two of them the wrong ones, and the clip was refused.
+    whole, rest, _ = split_character
+    walk = read_gltf(whole).motions[0]
+    cmu = {"Spine": "lowerback", "Spine1": "Chest", "Spine2": "Chest2", "Neck": "lowerneck"}
+    cmu |= {side + ours: side + theirs for side in ("Left", "Right") for ours, theirs in _CMU_LIMBS.items()}
+    order = [name for name in walk.skeleton.names if "Hand" not in name or name.endswith("Hand")]
+    notes = []
+    document = with_clips(GltfDocument(rest), [_bvh_in(tmp_path, "cmu", _edited(walk, order, cmu))], notes.append)
+    assert (
+        "joints matched by body part, CMU's naming onto Mixamo's ('Hips' -> 'Hips', 'lowerback' -> 'Spine'" in notes[0]
+    )
+    expected = _played_positions(GltfDocument(whole), _BODY)
+    np.testing.assert_allclose(_played_positions(document, _BODY), expected, atol=2e-5)
+
+
+def _bandai_like(motion: Motion) -> Motion:
+    """``motion`` as Bandai-Namco's files write a clip: Unity's joint names, a ``joint_Root``
+    above the hips (turned here, the hips turned back), and each joint's axes laying its first
+    child's bone along x (the joint orients baked into the rotations), so that the rest pose, every
+    rotation zero, is no pose of the figure. Every joint's world position is the same."""
+    skeleton = motion.skeleton
+    children = skeleton.children()
+    orient = np.array([rotations.identity(()) if not children[j] or not skeleton.offsets[children[j][0]].any()
+                       else _turn_onto(np.array([1.0, 0.0, 0.0]), skeleton.offsets[children[j][0]])
+                       for j in range(skeleton.joint_count)])  # fmt: skip
+    root_turn = rotations.from_axis_angle(np.array([0.0, 1.0, 0.0]), 0.6)
+    above = np.concatenate([[root_turn], orient[skeleton.parents[1:]]])  # each joint's parent's axes
+    offsets = rotations.rotate(rotations.conjugate(above), skeleton.offsets)
+    offsets[0] = 0.0
+    local = rotations.multiply(rotations.multiply(rotations.conjugate(above), motion.local_rotations), orient)
+    names = {"Spine1": "Chest", "Spine2": "UpperChest"}
+    limbs = {"Shoulder": "Shoulder", "Arm": "UpperArm", "ForeArm": "LowerArm", "Hand": "Hand",
+             "UpLeg": "UpperLeg", "Leg": "LowerLeg", "Foot": "Foot", "ToeBase": "Toes"}  # fmt: skip
+    names |= {side + ours: f"{theirs}_{side[0]}" for side in ("Left", "Right") for ours, theirs in limbs.items()}
+    bandai = Skeleton(["joint_Root"] + [names.get(name, name) for name in skeleton.names],
+                      np.concatenate([[-1], skeleton.parents + 1]), np.concatenate([[skeleton.offsets[0]], offsets]),
+                      end_sites=np.concatenate([[False], skeleton.end_sites]))  # fmt: skip
+    frames = motion.frame_count
+    local = np.concatenate([np.broadcast_to(root_turn, (frames, 1, 4)), local], axis=1)
+    return Motion(bandai, motion.root_positions, local, motion.fps, "bandai")
+
+
+def _turn_onto(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The quaternion of the smallest turn of direction ``a`` onto direction ``b``."""
+    a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
+    axis = np.cross(a, b)
+    if np.linalg.norm(axis) < 1e-12:
+        axis = np.cross(a, np.eye(3)[int(np.argmin(np.abs(a)))]) if np.dot(a, b) < 0.0 else np.array([1.0, 0.0, 0.0])
+    return rotations.from_axis_angle(axis / np.linalg.norm(axis), float(np.arccos(np.clip(np.dot(a, b), -1.0, 1.0))))
+
+
+def test_a_bandai_like_clip_plays_by_body_part(split_character, tmp_path):
+    # Bandai-Namco's motion dataset names the joints as Unity does, puts a joint_Root above the
+    # hips and bakes its joint orients into the rotations: by name it was refused; the rest pose
+    # laid every bone along x, so that the turn between the files' axes, fitted to it, laid the
+    # figure on its side.
+    whole, rest, _ = split_character
+    walk = read_gltf(whole).motions[0]
+    handless = _edited(walk, [name for name in walk.skeleton.names if "Hand" not in name or name.endswith("Hand")])
+    clip = _bandai_like(handless)
+    np.testing.assert_allclose(clip.world_positions()[:, 1:], handless.world_positions(), atol=1e-9)
+    notes = []
+    document = with_clips(GltfDocument(rest), [_bvh_in(tmp_path, "bandai", clip)], notes.append)
+    assert "joints matched by body part, Unity's naming onto Mixamo's ('Hips' -> 'Hips'" in notes[0]
+    assert "its rest pose is no pose of the figure" in notes[0]
+    expected = _played_positions(GltfDocument(whole), _BODY)
+    np.testing.assert_allclose(_played_positions(document, _BODY), expected, atol=2e-5)
+
+
+@pytest.mark.parametrize("character", ["Xbot.glb", "Soldier.glb", "rig_transfer_from_bvh.glb"])
+@pytest.mark.parametrize("clip", ["131_01.bvh", "dataset-1_run_proud_001.bvh"])
+def test_capture_clips_play_on_the_dev_humanoids_with_their_feet_near_the_floor(data_dir, character, clip):
+    notes = []
+    document = with_clips(GltfDocument(data_dir / "gltf" / character), [data_dir / "bvh" / clip], notes.append)
+    assert "by body part" in notes[0] or "by the two skeletons' shape" in notes[0]
+    drawables = [drawable for drawable in read_drawables(document) if drawable.clips]
+    rest = np.concatenate([drawable.rest_positions()[:, 1] for drawable in drawables])
+    played = np.concatenate([drawable.clip_frames(drawable.clips[-1])[..., 1] for drawable in drawables], axis=1)
+    lowest = (played.min(axis=1) - rest.min()) / np.ptp(rest)  # the skin's lowest point per frame
+    assert lowest.min() > -0.08 and lowest.max() < 0.08

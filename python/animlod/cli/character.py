@@ -45,8 +45,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--clips", nargs="+", default=(), metavar="FILE",
-        help="glTF or BVH files of clips on the same rig (an animation library without the mesh, such as "
-        "Mixamo's 'without skin' downloads; a BVH of the same skeleton), added to the character's own by node name",
+        help="glTF files of clips on the same rig (an animation library without the mesh, such as Mixamo's "
+        "'without skin' downloads), added to the character's own by node name; BVH files of its skeleton or of "
+        "another humanoid's (CMU, Bandai-Namco), matched by shape or body part",
     )  # fmt: skip
     parser.set_defaults(run=run)
 

@@ -86,8 +86,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )  # fmt: skip
     parser.add_argument(
         "--clips", nargs="+", default=(), metavar="FILE",
-        help="glTF or BVH files of clips on the same rig (an animation library without the mesh), added to a "
-        "glTF input's own by node name",
+        help="glTF files of clips on the same rig (an animation library without the mesh), added to a glTF "
+        "input's own by node name; BVH files of its skeleton or of another humanoid's, matched by shape or body part",
     )  # fmt: skip
     parser.add_argument("--plot", action="store_true", help="write importance, key posture and error charts (PNG)")
     parser.set_defaults(run=run)

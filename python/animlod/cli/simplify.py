@@ -70,8 +70,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--separate", action="store_true", help="glTF: one whole GLB per level instead of one LoD GLB")
     parser.add_argument(
         "--clips", nargs="+", default=(), metavar="FILE",
-        help="glTF: glTF or BVH files of clips on the same rig (an animation library without the mesh), added to the "
-        "input's own by node name: they drive the skinned meshes' levels, and the output plays them",
+        help="glTF: glTF files of clips on the same rig (an animation library without the mesh), added to the "
+        "input's own by node name, and BVH files of its skeleton or of another humanoid's, matched by shape or body "
+        "part: they drive the skinned meshes' levels, and the output plays them",
     )  # fmt: skip
     parser.add_argument("--no-metrics", action="store_true", help="sequences: skip the Hausdorff/RMS measurement")
     parser.add_argument(

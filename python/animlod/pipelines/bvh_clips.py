@@ -1,25 +1,28 @@
-"""A BVH clip of a character's skeleton, added to its glTF document by joint name.
+"""A BVH clip of a character's skeleton, or of another humanoid's, added to its glTF document.
 
 Clips captured or edited on a character's skeleton often come as BVH (Blender's and
-MotionBuilder's exports). A BVH joint's rotation is relative to the file's rest pose (every
-rotation zero, each bone along its OFFSET), a glTF node's to its parent's axes with any rest
-rotation of its own (bone roll), so each joint's world rotation is carried over relative to the
-rests: ``W(t) = G B(t) G^T S W_rest``, with ``B(t)`` the joint's world rotation in the BVH,
-``W_rest`` the node's in the character's rest pose, ``G`` the turn between coordinate axes that
-best lays the BVH's rest bones onto the character's (a BVH may be Z-up), and ``S`` the joint's swing that lays the
+MotionBuilder's exports), and capture libraries (CMU's, Bandai-Namco's) as BVH of their own
+skeletons. A BVH joint's rotation is relative to the file's rest pose (every rotation zero,
+each bone along its OFFSET), a glTF node's to its parent's axes with any rest rotation of its
+own (bone roll), so each joint's world rotation is carried over relative to the rests:
+``W(t) = G B(t) G^T S W_rest``, with ``B(t)`` the joint's world rotation in the BVH, ``W_rest``
+the node's in the character's rest pose, ``G`` the turn between coordinate axes that best lays
+the BVH's rest bones onto the character's (a BVH may be Z-up; where its rest pose is no pose of
+the figure, its bones in the clip's frames), and ``S`` the joint's swing that lays the
 character's rest bones below it onto the BVH's (identity for the same rest pose; an A-pose clip
 on a T-pose rig turns the arms): every bone then points where the clip's does, whatever the two
-figures' proportions. The root moves by its displacement from its rest position (its OFFSET, as
-Blender's importer reads it, or where the OFFSET is zero, as in CMU's files, the height that
-stands the rest pose on the clip's lowest point), scaled by the ratio of the two roots' heights
-above their feet. The
-character's nodes the BVH lacks keep their rest rotation; BVH joints the character lacks, and
-position channels below the root, are left out and counted in the note, which also says how far
-the rest poses differ.
+figures' proportions. The joint above every matched one (the file's root, or the hips below a
+root of the file's own) moves by its displacement from its rest position (its place in the rest
+pose, the file's root on its OFFSET as Blender's importer reads it, or where that OFFSET is
+zero, as in CMU's files, at the height that stands the figure on the clip's lowest point),
+scaled by the ratio of the two figures' leg lengths. The character's nodes the BVH lacks keep
+their rest rotation; BVH joints the character lacks, and position channels below the moving
+joint, are left out and counted in the note, which also says how far the rest poses differ.
 
-Joints correspond by the skeletons' shape where the two are alike, else by name
-(:mod:`.joint_matching`, which refuses another rig); a joint whose nearest matched ancestor
-differs from the character's is refused naming the joint.
+Joints correspond by the skeletons' shape where the two are alike, else by body part where
+they are humanoids of two namings, else by name (:mod:`.joint_matching`, which refuses another
+rig); a joint whose nearest matched ancestor differs from the character's is refused naming
+the joint.
 """
 
 from __future__ import annotations
@@ -36,9 +39,12 @@ from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_write import sign_continuous
-from ..model import Motion
+from ..model import Motion, spread_frames
 from .joint_matching import match_joints
 
+# A rest pose whose bones lie farther from the character's on average, after the best turn,
+# is no pose of the figure (joint orients baked into the rotations): the axes come from the clip.
+NO_POSE_DEGREES = 45.0
 # The 24 rotations between coordinate axes: signed permutation matrices of determinant 1.
 _AXIS_TURNS = np.array([
     np.diag(signs) @ np.eye(3)[list(order)]
@@ -56,15 +62,14 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
     end_sites = np.zeros(skeleton.joint_count, bool) if skeleton.end_sites is None else skeleton.end_sites
     match = match_joints(skeleton, doc, os.fspath(path))
     node_of = match.node_of
-    joints = sorted(node_of)
     into = Path(doc.path).name
     for j, node in node_of.items():
         if doc.gltf.nodes[node].matrix is not None:
             raise FormatError(os.fspath(path), f"joint {skeleton.names[j]!r}", f"{doc.node_label(node)} of {into} "
                               "has a matrix, which glTF does not animate")  # fmt: skip
 
-    turn, swings, pose_note = _rest_alignment(doc, motion, joints, node_of, os.fspath(path))
     clip_world = motion.world_transforms()
+    turn, swings, pose_note = _rest_alignment(doc, motion, clip_world[..., :3, 3], node_of, match.root, os.fspath(path))
     # (T, J, 3, 3) world rotations of the BVH's joints, in the character's axes.
     bvh_world = np.einsum("ab,tjbc,dc->tjad", turn, clip_world[..., :3, :3], turn)
     frame_count = motion.frame_count
@@ -94,7 +99,8 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
         parent_world = world_rotation(parent) if parent != -1 else np.eye(3)
         local = np.swapaxes(parent_world, -1, -2) @ world_rotation(node)
         animate(node, "rotation", sign_continuous(rotations.from_matrix(local)[:, None])[:, 0])
-    animate(node_of[0], "translation", _root_translations(doc, motion, clip_world[..., :3, 3], turn, node_of))
+    translations = _root_translations(doc, motion, clip_world[..., :3, 3], turn, node_of, match.root)
+    animate(node_of[match.root], "translation", translations)
     builder.append("animations", {"name": motion.name or Path(path).stem, "samplers": samplers, "channels": channels})
 
     left_out = [name for j, name in enumerate(skeleton.names) if not end_sites[j] and j not in node_of]
@@ -107,25 +113,37 @@ def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike
     if pose_note:
         notes.append(pose_note)
     if motion.joint_translations is not None:
-        notes.append("position channels below the root left out")
+        notes.append(f"position channels below {skeleton.names[match.root]!r} left out")
     return "; ".join(notes)
 
 
 def _rest_alignment(
-    doc: GltfDocument, motion: Motion, joints: list[int], node_of: dict[int, int], path: str
+    doc: GltfDocument,
+    motion: Motion,
+    clip_positions: np.ndarray,
+    node_of: dict[int, int],
+    root: int,
+    path: str,
 ) -> tuple[np.ndarray, dict[int, np.ndarray], str | None]:
     """``G`` (3, 3), the turn between axes that best lays the BVH's rest bones onto the
-    character's, each joint's swing ``S`` (3, 3) that lays the character's rest bones below it
-    onto the BVH's turned by ``G``, and a note naming the bone whose rest directions differ most
-    where that is over a degree. FormatError naming the first joint that hangs from another
-    named joint than in the character."""
+    character's (or, where the rest pose is no pose of the figure, its bones in the clip's frames
+    ``clip_positions`` (T, J, 3)), each joint's swing ``S`` (3, 3) that lays the character's rest
+    bones below it onto the BVH's turned by ``G``, and a note on how the rest poses differ.
+    FormatError naming the first joint that hangs from another matched joint than in the
+    character, or from none below ``root``."""
     skeleton = motion.skeleton
     bvh_rest = skeleton.rest_world_transforms()[:, :3, 3]  # every rotation zero: a BVH's rest pose
+    joints = sorted(node_of)
     named = set(joints)
     bones = []  # (joint, its nearest named ancestor, BVH rest bone, the character's)
-    for j in joints[1:]:
+    for j in joints:
+        if j == root:
+            continue
         ancestor = int(skeleton.parents[j])
         while ancestor not in named:
+            if ancestor == -1:
+                raise FormatError(path, f"joint {skeleton.names[j]!r}", f"lies below none of the matched joints' root "
+                                  f"{skeleton.names[root]!r}")  # fmt: skip
             ancestor = int(skeleton.parents[ancestor])
         node, above = node_of[j], node_of[ancestor]
         if above not in doc.ancestors(node):
@@ -137,7 +155,14 @@ def _rest_alignment(
     ours = np.array([bone[3] for bone in bones]).reshape(-1, 3)
     if not (np.linalg.norm(theirs, axis=1).sum() > 0.0 and np.linalg.norm(ours, axis=1).sum() > 0.0):
         raise FormatError(path, "HIERARCHY", f"no bone between two joints of {Path(doc.path).name}'s by name")
-    turn = _axis_turn(_best_rotation(theirs, ours))
+    fit = _best_rotation(theirs, ours)
+    lengths = np.linalg.norm(ours, axis=1)
+    spread = np.average([_angle(fit @ their, our) for their, our in zip(theirs, ours)], weights=lengths)
+    if spread > NO_POSE_DEGREES:
+        frames = clip_positions[spread_frames(motion.frame_count, min(motion.frame_count, 64))]
+        posed = frames[:, [bone[0] for bone in bones]] - frames[:, [bone[1] for bone in bones]]
+        fit = _best_rotation(posed.reshape(-1, 3), np.tile(ours, (len(frames), 1)))
+    turn = _axis_turn(fit)
     swings = {}
     for j in joints:
         below = [(our, turn @ their) for _, ancestor, their, our in bones if ancestor == j]
@@ -145,7 +170,10 @@ def _rest_alignment(
     angles = [_angle(turn @ their, our) for _, _, their, our in bones]
     worst = int(np.argmax(angles)) if angles else 0
     note = None
-    if angles and angles[worst] > 1.0:
+    if spread > NO_POSE_DEGREES:
+        note = (f"its rest pose is no pose of the figure (its bones {spread:.0f} degrees from the character's on "
+                "average): the axes are taken from its frames; each bone follows the clip's direction")  # fmt: skip
+    elif angles and angles[worst] > 1.0:
         name = skeleton.names[bones[worst][0]]
         note = (f"its rest pose differs from the character's by up to {angles[worst]:.0f} degrees (the bone to "
                 f"{name!r}): each bone follows the clip's direction")  # fmt: skip
@@ -183,40 +211,53 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _root_translations(
-    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, turn: np.ndarray, node_of: dict[int, int]
+    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, turn: np.ndarray, node_of: dict[int, int], root: int
 ) -> np.ndarray:
-    """(T, 3) translations of the root's node: its rest position moved by the BVH root's
-    displacement from its rest (:func:`_root_rest`; ``clip_positions`` (T, J, 3) are the BVH's
-    joints in every frame), in the frame of the node's parent."""
-    root = node_of[0]
-    root_rest, scale = _root_rest(doc, motion, clip_positions, turn, node_of)
-    moved = doc.rest_world_matrix(root)[:3, 3] + scale * (motion.root_positions - root_rest) @ turn.T
-    parent = doc.parents[root]
+    """(T, 3) translations of the node of the BVH joint ``root`` (the one above every matched
+    joint): its rest position moved by the joint's displacement from its rest (:func:`_root_rest`;
+    ``clip_positions`` (T, J, 3) are the BVH's joints in every frame), in the frame of the node's
+    parent."""
+    node = node_of[root]
+    root_rest, scale = _root_rest(doc, motion, clip_positions, turn, node_of, root)
+    moved = doc.rest_world_matrix(node)[:3, 3] + scale * (clip_positions[:, root] - root_rest) @ turn.T
+    parent = doc.parents[node]
     to_parent = np.linalg.inv(doc.rest_world_matrix(parent)) if parent != -1 else np.eye(4)
     return (np.c_[moved, np.ones(len(moved))] @ to_parent.T)[:, :3]
 
 
 def _root_rest(
-    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, turn: np.ndarray, node_of: dict[int, int]
+    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, turn: np.ndarray, node_of: dict[int, int], root: int
 ) -> tuple[np.ndarray, float]:
-    """(3,) where the BVH's root stands in its rest pose, and the scale of its moves: the ratio of
-    the two roots' rest heights above their lowest named joint (the legs' lengths, so that feet
-    that touch the floor in the clip touch it on the character). The rest position is the root's
-    OFFSET, or where that is zero (CMU's files give none: their root channels are heights above
-    the floor) the height that stands the rest pose's lowest named joint on the clip's lowest
-    (``turn`` maps the file's axes onto the character's, whose up is +Y)."""
+    """(3,) where the BVH joint ``root`` stands in the rest pose, and the scale of its moves: the
+    ratio of the two legs' lengths (the matched bones from the root down to the joint lowest in
+    the clip), so that feet that touch the floor in the clip touch it on the character. The rest
+    pose stands the file's root on its OFFSET, or where that is zero (CMU's files give none: their
+    root channels are heights above the floor) at the height that makes the root's height above
+    the clip's lowest point the scaled height of its node above the character's lowest matched
+    joint (``turn`` maps the file's axes onto the character's, whose up is +Y). Lengths, not the
+    rest pose's heights: some files' rest pose is no pose of the figure (Bandai-Namco's lays
+    every bone along its joint's x axis)."""
     joints = list(node_of)
     up = turn[1]  # the file's up direction
-    rest_heights = motion.skeleton.rest_world_transforms()[joints, :3, 3] @ up
-    their_height = rest_heights[0] - rest_heights.min()
+    rest = motion.skeleton.rest_world_transforms()[:, :3, 3]
+    heights = clip_positions[:, joints] @ up
+    theirs = ours = 0.0
+    joint = joints[int(np.argmin(heights.mean(axis=0)))]
+    while joint != root:
+        above = int(motion.skeleton.parents[joint])
+        while above not in node_of:
+            above = int(motion.skeleton.parents[above])
+        theirs += float(np.linalg.norm(rest[joint] - rest[above]))
+        ours += float(
+            np.linalg.norm(doc.rest_world_matrix(node_of[joint])[:3, 3] - doc.rest_world_matrix(node_of[above])[:3, 3])
+        )
+        joint = above
+    scale = ours / theirs if theirs > 0.0 and ours > 0.0 else 1.0
+    if np.any(motion.skeleton.offsets[0] != 0.0):
+        return rest[root], scale
     our_heights = np.array([doc.rest_world_matrix(node)[1, 3] for node in node_of.values()])
-    our_height = our_heights[0] - our_heights.min()
-    scale = our_height / their_height if their_height > 0.0 and our_height > 0.0 else 1.0
-    offset = motion.skeleton.offsets[0]
-    if np.any(offset != 0.0):
-        return offset, scale
-    floor = float((clip_positions[:, joints] @ up).min())
-    return up * (floor + their_height), scale
+    our_height = doc.rest_world_matrix(node_of[root])[1, 3] - our_heights.min()
+    return rest[root] - up * (rest[root] @ up) + up * (float(heights.min()) + our_height / scale), scale
 
 
 def _rotation(matrix: np.ndarray) -> np.ndarray:

@@ -11,7 +11,8 @@ animates must rest where the character's node of that name rests (within ``REST_
 the rig's size), or the clip would stretch the character's bones to another figure's
 (retargeting is not done here). Rotations and scales move any node of the name. Channels on
 nodes the character lacks, or whose name it uses twice, are left out and counted in a note.
-A BVH file of the same skeleton is carried over relative to the rest poses (:mod:`.bvh_clips`).
+A BVH file of the same skeleton or of another humanoid is carried over relative to the rest
+poses, its joints matched by shape or body part (:mod:`.bvh_clips`).
 """
 
 from __future__ import annotations

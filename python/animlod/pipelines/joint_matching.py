@@ -7,13 +7,13 @@ Exporters name one skeleton's joints differently (CMU's ASF conversions say ``Le
 have the same shape (the rooted tree of the BVH's joints, with or without its end sites, and
 that of the skins' joints), joints correspond by their place in it: children of one shape are
 told apart by name, then by side (left or right in the name), then by their order in the files,
-which the note then says. Skeletons of different shapes correspond by name, exactly or up to
-case, separators and namespace.
+which the note then says. Humanoids of two namings correspond by body part
+(:mod:`.humanoid_roles`: CMU's ``LeftShoulder`` onto Mixamo's ``LeftArm``). Other skeletons
+correspond by name, exactly or up to case, separators and namespace.
 """
 
 from __future__ import annotations
 
-import re
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,15 +23,19 @@ import numpy as np
 from ..io.errors import FormatError
 from ..io.gltf_document import GltfDocument
 from ..model import Skeleton
+from .humanoid_roles import MIN_ROLES, roles_of
+from .joint_names import normalized_name, side
 
 
 @dataclass(frozen=True)
 class JointMatch:
-    """``node_of``: the character's node each BVH joint drives (end sites left out); ``note``:
-    how they were matched where names alone would not say it, else None."""
+    """``node_of``: the character's node each BVH joint drives (end sites left out), ``root``:
+    the BVH joint above all of them, whose node takes the clip's translation; ``note``: how they
+    were matched where names alone would not say it, else None."""
 
     node_of: dict[int, int]
     note: str | None
+    root: int = 0
 
 
 @dataclass(frozen=True)
@@ -68,8 +72,11 @@ def match_joints(skeleton: Skeleton, doc: GltfDocument, path: str) -> JointMatch
                 pairs, in_file_order = paired
                 return JointMatch({j: n for j, n in pairs.items() if not end_sites[j]},
                                   _shape_note(skeleton, doc, pairs, end_sites, in_file_order))  # fmt: skip
-    match = _match_by_name(skeleton, doc, end_sites)
     into = Path(doc.path).name
+    by_role = _match_by_role(skeleton, doc, end_sites, skin_joints)
+    if by_role is not None:
+        return by_role
+    match = _match_by_name(skeleton, doc, end_sites)
     if 0 not in match.node_of:
         reason = f"its root {skeleton.names[0]!r} matches no node of {into}'s, by shape or by name (another rig?)"
         raise FormatError(path, "ROOT", reason)
@@ -82,22 +89,6 @@ def match_joints(skeleton: Skeleton, doc: GltfDocument, path: str) -> JointMatch
                   "another rig (retarget the clip to this character first)")  # fmt: skip
         raise FormatError(path, "HIERARCHY", reason)
     return match
-
-
-def normalized_name(name: str) -> str:
-    """``name`` without namespace (``mixamorig:``, ``Armature|``), case and separators."""
-    return re.sub(r"[^0-9a-z]", "", re.split(r"[:|]", name)[-1].lower())
-
-
-def side(name: str) -> str | None:
-    """'left' or 'right' where ``name`` says it ("LeftArm", "LThumb", "hand_l", "Bip01 R Thigh"), else None."""
-    base = re.split(r"[:|]", name)[-1]
-    for word, upper in (("left", "L"), ("right", "R")):
-        lower = upper.lower()
-        pattern = rf"^{upper}(?=[A-Z0-9_.\- ])|^{lower}(?=[_.\- ])|[_.\- ][{upper}{lower}](?![A-Za-z0-9])|[a-z]{upper}$"
-        if word in base.lower() or re.search(pattern, base):
-            return word
-    return None
 
 
 def _tree_of(doc: GltfDocument, joints: set[int]) -> _Tree | None:
@@ -181,6 +172,25 @@ def _shape_note(
     if in_file_order:
         parts.append(f"{in_file_order} alike in shape, name and side paired in the files' order")
     return ": ".join(parts[:2]) + ("; " + parts[2] if len(parts) > 2 else "")
+
+
+def _match_by_role(
+    skeleton: Skeleton, doc: GltfDocument, end_sites: np.ndarray, skin_joints: set[int]
+) -> JointMatch | None:
+    """Joints matched by the body part their two namings give them (:mod:`.humanoid_roles`),
+    where the skeletons are humanoids of two namings that share ``MIN_ROLES`` parts, hips among them."""
+    theirs = roles_of(["" if end else name for name, end in zip(skeleton.names, end_sites)])
+    nodes = doc.gltf.nodes or []
+    ours = roles_of([(node.name or "") if not skin_joints or n in skin_joints else "" for n, node in enumerate(nodes)])
+    if theirs is None or ours is None or theirs[0] == ours[0]:
+        return None
+    shared = [role for role in theirs[1] if role in ours[1]]
+    if len(shared) < MIN_ROLES or "hips" not in shared:
+        return None
+    node_of = {theirs[1][role]: ours[1][role] for role in shared}
+    pairs = ", ".join(f"{skeleton.names[j]!r} -> {nodes[n].name!r}" for j, n in list(node_of.items())[:3])
+    note = f"joints matched by body part, {theirs[0]}'s naming onto {ours[0]}'s ({pairs}, ...)"
+    return JointMatch(dict(sorted(node_of.items())), note, root=theirs[1]["hips"])
 
 
 def _match_by_name(skeleton: Skeleton, doc: GltfDocument, end_sites: np.ndarray) -> JointMatch:

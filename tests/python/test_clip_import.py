@@ -4,6 +4,7 @@ as Mixamo's downloads come, gave no chain at all ("no skinned mesh with an anima
 
 from __future__ import annotations
 
+import json
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -443,3 +444,54 @@ def test_capture_clips_play_on_the_dev_humanoids_with_their_feet_near_the_floor(
     played = np.concatenate([drawable.clip_frames(drawable.clips[-1])[..., 1] for drawable in drawables], axis=1)
     lowest = (played.min(axis=1) - rest.min()) / np.ptp(rest)  # the skin's lowest point per frame
     assert lowest.min() > -0.08 and lowest.max() < 0.08
+
+
+def test_a_joint_map_matches_a_clip_that_no_rule_can(split_character, tmp_path, capsys):
+    # Joints named j0, j1, ... on another shape (no fingers): neither shape, body part nor name
+    # tells; a table does, by node name or index (a rig of unnamed joints).
+    whole, rest, walk_glb = split_character
+    walk = read_gltf(whole).motions[0]
+    order = [name for name in walk.skeleton.names if "Hand" not in name or name.endswith("Hand")]
+    numbered = {name: f"j{k}" for k, name in enumerate(order)}
+    bvh = _bvh_in(tmp_path, "numbered", _edited(walk, order, numbered))
+    with pytest.raises(FormatError, match="numbered.bvh: ROOT: its root 'j0' matches no node"):
+        with_clips(GltfDocument(rest), [bvh], print)
+    nodes = [node.name for node in GltfDocument(rest).gltf.nodes]
+    table = {numbered[name]: name for name in _BODY} | {numbered["Hips"]: nodes.index("Hips")}
+    (tmp_path / "map.json").write_text(json.dumps(table))
+    notes = []
+    document = with_clips(GltfDocument(rest), [bvh], notes.append, tmp_path / "map.json")
+    assert "(22 joints); joints matched by the joint map map.json" in notes[0]
+    expected = _played_positions(GltfDocument(whole), _BODY)
+    np.testing.assert_allclose(_played_positions(document, _BODY), expected, atol=2e-5)
+    out = tmp_path / "out.glb"
+    argv = ["character", str(rest), "-o", str(out), "--clips", str(bvh), "--joint-map", str(tmp_path / "map.json")]
+    assert main([*argv, "--ratio", "0.5", "--max-frames", "4"]) == 0 and out.is_file()
+
+
+@pytest.mark.parametrize(
+    ("table", "reason"),
+    [
+        ("{", "map.json: JSON: no joint map: Expecting property name"),
+        ('["j0"]', 'map.json: JSON: a joint map is an object {"BVH joint": "node name" or node index, ...}'),
+        ('{"j0": 1.5}', "map.json: 'j0': maps to 1.5: a node's name or index is expected"),
+        ('{"Hips": "Hips"}', "map.json: 'Hips': is no joint of numbered.bvh (end sites take none)"),
+        ('{"j0": "Pelvis"}', "map.json: 'j0': maps to 'Pelvis', no node of rest.glb's (or one of several)"),
+        ('{"j0": 999}', "map.json: 'j0': maps to 999, no node of rest.glb's (or one of several)"),
+        ('{"j0": "Hips", "j1": "Hips"}', "map.json: 'j1': maps to node 0 'Hips', which another joint drives"),
+        ('{"j1": "Spine", "j0": "Hips", "j2": "LeftUpLeg"}', "numbered.bvh: joint 'j2': hangs from 'j1', which is no"),
+    ],
+)
+def test_a_joint_map_that_does_not_fit_is_refused_naming_the_entry(split_character, tmp_path, capsys, table, reason):
+    _, rest, walk_glb = split_character
+    walk = synth.humanoid_motion(synth.humanoid().skeleton, "walk")
+    numbered = {name: f"j{k}" for k, name in enumerate(walk.skeleton.names)}
+    bvh = tmp_path / "numbered.bvh"
+    write_bvh(bvh, _edited(walk, walk.skeleton.names, numbered))
+    (tmp_path / "map.json").write_text(table)
+    argv = ["character", str(rest), "-o", str(tmp_path / "out.glb"), "--clips", str(bvh), "--joint-map"]
+    assert main([*argv, str(tmp_path / "map.json")]) == 2
+    assert reason in capsys.readouterr().err and not (tmp_path / "out.glb").exists()
+    assert main(["character", str(rest), "-o", str(tmp_path / "out.glb"), "--clips", str(walk_glb), "--joint-map",
+                 str(tmp_path / "map.json")]) == 2  # fmt: skip
+    assert "map.json: maps the joints of BVH clips, and no BVH clip is given" in capsys.readouterr().err

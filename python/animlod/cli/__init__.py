@@ -67,6 +67,15 @@ def positive_int(text: str) -> int:
     return value
 
 
+def add_joint_map_argument(parser: argparse.ArgumentParser) -> None:
+    """``--joint-map FILE``, the table of nodes that BVH clips' joints drive (with ``--clips``)."""
+    parser.add_argument(
+        "--joint-map", metavar="MAP.json",
+        help='with BVH --clips: {"BVH joint": "node name" or node index, ...}, the node each joint drives, where '
+        "the skeletons' shape, body parts and names do not tell (only its entries are matched)",
+    )  # fmt: skip
+
+
 def print_rows(rows: list[tuple], indent: str = "") -> None:
     """Print ``rows`` (the header first) as right-aligned columns two spaces apart."""
     widths = [max(len(str(row[column])) for row in rows) for column in range(len(rows[0]))]

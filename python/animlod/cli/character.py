@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind
-from . import UserError, positive_int, print_rows
+from . import UserError, add_joint_map_argument, positive_int, print_rows
 from .simplify import feature_options
 
 
@@ -49,6 +49,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "'without skin' downloads), added to the character's own by node name; BVH files of its skeleton or of "
         "another humanoid's (CMU, Bandai-Namco), matched by shape or body part",
     )  # fmt: skip
+    add_joint_map_argument(parser)
     parser.set_defaults(run=run)
 
 
@@ -69,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
         solver=args.solver,
         workers=args.workers,
         clips=args.clips,
+        joint_map=args.joint_map,
         frame_budget=args.max_frames,
         **feature_options(args),
         progress=print,

@@ -11,7 +11,7 @@ from ..io.detect import input_kind, input_stem
 from ..motion_lod.analysis import TRANSLATION_TOLERANCE
 from ..motion_lod.chain import SOLVERS
 from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
-from . import UserError
+from . import UserError, add_joint_map_argument
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -89,6 +89,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="glTF files of clips on the same rig (an animation library without the mesh), added to a glTF "
         "input's own by node name; BVH files of its skeleton or of another humanoid's, matched by shape or body part",
     )  # fmt: skip
+    add_joint_map_argument(parser)
     parser.add_argument("--plot", action="store_true", help="write importance, key posture and error charts (PNG)")
     parser.set_defaults(run=run)
 
@@ -179,6 +180,7 @@ def run(args: argparse.Namespace) -> int:
             max_frames=args.max_frames,
             clip=args.clip,
             clips=args.clips,
+            joint_map=args.joint_map,
             on_level=on_level,
             on_choice=lambda chosen, to_choose: progress().chose(chosen, to_choose),
             on_note=lambda text: print(text, file=sys.stderr),

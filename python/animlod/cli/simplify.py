@@ -10,7 +10,7 @@ import numpy as np
 
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind, input_stem
 from ..model import AnimatedMesh
-from . import UserError, non_negative_int, print_rows
+from . import UserError, add_joint_map_argument, non_negative_int, print_rows
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -74,6 +74,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "input's own by node name, and BVH files of its skeleton or of another humanoid's, matched by shape or body "
         "part: they drive the skinned meshes' levels, and the output plays them",
     )  # fmt: skip
+    add_joint_map_argument(parser)
     parser.add_argument("--no-metrics", action="store_true", help="sequences: skip the Hausdorff/RMS measurement")
     parser.add_argument(
         "--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side"
@@ -94,8 +95,9 @@ def run(args: argparse.Namespace) -> int:
         options["tip_quadrics"] = False
     if kind == "gltf":
         return _simplify_document(args, options)
-    if args.clips:
-        raise UserError(f"--clips: adds glTF clips to a glTF input, not to a {kind} input ({args.input})")
+    if args.clips or args.joint_map:
+        option = "--clips" if args.clips else "--joint-map"
+        raise UserError(f"{option}: adds glTF clips to a glTF input, not to a {kind} input ({args.input})")
     return _simplify_sequence(args, options)
 
 
@@ -107,7 +109,8 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
         output = output / glb_name(args.input, "_lod")
     frame_budget = {"frame_budget": args.max_frames} if args.max_frames else {}
     report = simplify_document(
-        args.input, output, args.ratio, separate=args.separate, clips=args.clips, progress=print, **frame_budget,
+        args.input, output, args.ratio, separate=args.separate, clips=args.clips,
+        joint_map=args.joint_map, progress=print, **frame_budget,
         **options,
     )  # fmt: skip
     print("errors: max over the rest pose and frames of every clip of the Hausdorff distance, relative to the")

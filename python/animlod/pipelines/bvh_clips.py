@@ -40,7 +40,7 @@ from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_write import sign_continuous
 from ..model import Motion, spread_frames
-from .joint_matching import match_joints
+from .joint_matching import JointMap, match_joints
 
 # A rest pose whose bones lie farther from the character's on average, after the best turn,
 # is no pose of the figure (joint orients baked into the rotations): the axes come from the clip.
@@ -53,14 +53,17 @@ _AXIS_TURNS = np.array([
 ])  # fmt: skip
 
 
-def add_bvh_clip(builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike) -> str:
+def add_bvh_clip(
+    builder: GlbBuilder, doc: GltfDocument, path: str | os.PathLike, joint_map: JointMap | None = None
+) -> str:
     """Adds the clip of the BVH file at ``path`` to ``builder`` (the document ``doc``) as an
-    animation of the nodes that match its joints; returns the note saying what was added.
+    animation of the nodes that match its joints (or that ``joint_map`` gives them); returns the
+    note saying what was added.
     FormatError naming the file and the joint where the skeletons differ (see the module notes)."""
     motion = read_bvh(path)
     skeleton = motion.skeleton
     end_sites = np.zeros(skeleton.joint_count, bool) if skeleton.end_sites is None else skeleton.end_sites
-    match = match_joints(skeleton, doc, os.fspath(path))
+    match = match_joints(skeleton, doc, os.fspath(path), joint_map)
     node_of = match.node_of
     into = Path(doc.path).name
     for j, node in node_of.items():

@@ -98,6 +98,7 @@ def build_character(
     solver: str = "slsqp",
     workers: int = 1,
     clips: Sequence[str] = (),
+    joint_map: str | os.PathLike | None = None,
     settings: DrawableSettings | None = None,
     progress: Callable[[str], None] | None = None,
     **keywords: object,
@@ -113,6 +114,8 @@ def build_character(
         processes it uses.
     clips : glTF files of clips on the same rig (an animation library without the mesh), added to
         the character's own by node name (:mod:`.clip_import`).
+    joint_map : a JSON table of the character's node each BVH clip's joint drives, where the
+        skeletons' shape, body parts and names do not tell (:func:`.joint_matching.read_joint_map`).
     settings, **keywords : a :class:`~animlod.pipelines.DrawableSettings` and/or its fields and
         AQEM options by name, as for :func:`animlod.pipelines.simplify_document`.
 
@@ -124,8 +127,8 @@ def build_character(
     settings = DrawableSettings.resolve(settings, keywords)
     notes: list[str] = []
     doc = GltfDocument(source)
-    if clips:
-        doc = with_clips(doc, clips, notes.append)
+    if clips or joint_map is not None:
+        doc = with_clips(doc, clips, notes.append, joint_map)
     all_drawables = read_drawables(doc, settings.fps)
     drawables = [d for d in all_drawables if d.skinned is not None]
     animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]

@@ -27,6 +27,7 @@ import numpy as np
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from .bvh_clips import add_bvh_clip
+from .joint_matching import read_joint_map
 
 # A node whose translation a clip animates rests within this fraction of the rig's size (the
 # largest rest translation among the character's nodes the clip names) of the character's node.
@@ -34,16 +35,27 @@ REST_TOLERANCE = 0.01
 _NODE_PATHS = {"translation": 3, "rotation": 4, "scale": 3}
 
 
-def with_clips(doc: GltfDocument, clip_files: Sequence[str | os.PathLike], note: Callable[[str], None]) -> GltfDocument:
-    """``doc`` with every animation of each of ``clip_files`` added (see the module notes);
-    FormatError naming the clip file for one that cannot be read, has no animation moving a node
-    of the character's by name, or moves the translation of a node of the same name resting
-    elsewhere (a ``.bvh`` file: :func:`.bvh_clips.add_bvh_clip`)."""
+def with_clips(
+    doc: GltfDocument,
+    clip_files: Sequence[str | os.PathLike],
+    note: Callable[[str], None],
+    joint_map: str | os.PathLike | None = None,
+) -> GltfDocument:
+    """``doc`` with every animation of each of ``clip_files`` added (see the module notes), the
+    joints of BVH files matched by the JSON table ``joint_map`` where given
+    (:func:`.joint_matching.read_joint_map`); FormatError naming the clip file for one that
+    cannot be read, has no animation moving a node of the character's by name, or moves the
+    translation of a node of the same name resting elsewhere (a ``.bvh`` file:
+    :func:`.bvh_clips.add_bvh_clip`); ValueError for a joint map without a BVH file."""
     builder = GlbBuilder.from_document(doc)
     targets = _named_nodes(doc)
+    bvh_files = [clip_file for clip_file in clip_files if Path(clip_file).suffix.lower() == ".bvh"]
+    if joint_map is not None and not bvh_files:
+        raise ValueError(f"joint map {os.fspath(joint_map)}: maps the joints of BVH clips, and no BVH clip is given")
+    table = read_joint_map(joint_map) if joint_map is not None else None
     for clip_file in clip_files:
-        if Path(clip_file).suffix.lower() == ".bvh":
-            note(add_bvh_clip(builder, doc, clip_file))
+        if clip_file in bvh_files:
+            note(add_bvh_clip(builder, doc, clip_file, table))
             continue
         source = GltfDocument(clip_file)
         if not source.gltf.animations:

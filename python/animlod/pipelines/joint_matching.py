@@ -9,11 +9,14 @@ that of the skins' joints), joints correspond by their place in it: children of 
 told apart by name, then by side (left or right in the name), then by their order in the files,
 which the note then says. Humanoids of two namings correspond by body part
 (:mod:`.humanoid_roles`: CMU's ``LeftShoulder`` onto Mixamo's ``LeftArm``). Other skeletons
-correspond by name, exactly or up to case, separators and namespace.
+correspond by name, exactly or up to case, separators and namespace. Where none of these tells,
+the user's table does (:class:`JointMap`), and only its entries are matched.
 """
 
 from __future__ import annotations
 
+import json
+import os
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,6 +42,32 @@ class JointMatch:
 
 
 @dataclass(frozen=True)
+class JointMap:
+    """A table of the node each BVH joint drives, where no rule finds it (a rig of unnamed or
+    unusual joints): ``nodes`` maps a joint's name to a node's name or index; ``path`` is the
+    table's file, named in messages."""
+
+    path: str
+    nodes: dict[str, str | int]
+
+
+def read_joint_map(path: str | os.PathLike) -> JointMap:
+    """The JSON object of ``path`` ({"BVH joint": "node name" or node index, ...}); FormatError
+    naming the file and the entry that is not one."""
+    where = os.fspath(path)
+    try:
+        table = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise FormatError(where, "JSON", f"no joint map: {error}") from None
+    if not isinstance(table, dict) or not table:
+        raise FormatError(where, "JSON", 'a joint map is an object {"BVH joint": "node name" or node index, ...}')
+    for joint, node in table.items():
+        if isinstance(node, bool) or not isinstance(node, str | int) or (isinstance(node, int) and node < 0):
+            raise FormatError(where, repr(joint), f"maps to {node!r}: a node's name or index is expected")
+    return JointMap(where, table)
+
+
+@dataclass(frozen=True)
 class _Tree:
     """A rooted tree of ids (BVH joints or glTF nodes): ``order`` parents first, ``parent`` of
     each id (-1 for the root), ``names`` of each."""
@@ -54,13 +83,16 @@ class _Tree:
         return result
 
 
-def match_joints(skeleton: Skeleton, doc: GltfDocument, path: str) -> JointMatch:
+def match_joints(skeleton: Skeleton, doc: GltfDocument, path: str, joint_map: JointMap | None = None) -> JointMatch:
     """The character's node of each joint of ``skeleton`` (the BVH file ``path``'s) in ``doc``
-    (see the module notes); joints that match no node are left out of ``node_of``. FormatError
-    naming the file where the root matches no node, or where names alone match fewer than half
-    of the smaller skeleton's joints (another rig: what little matched would move a few joints
-    of another figure, some of them named alike for other places)."""
+    (see the module notes, or ``joint_map``'s entries alone where given); joints that match no
+    node are left out of ``node_of``. FormatError naming the file where the root matches no node,
+    or where names alone match fewer than half of the smaller skeleton's joints (another rig:
+    what little matched would move a few joints of another figure, some of them named alike for
+    other places), or naming the joint map's entry that names no joint or node."""
     end_sites = np.zeros(skeleton.joint_count, bool) if skeleton.end_sites is None else skeleton.end_sites
+    if joint_map is not None:
+        return _match_by_map(skeleton, doc, end_sites, joint_map, path)
     skin_joints = {int(j) for skin in doc.gltf.skins or [] for j in skin.joints or []}
     ours = _tree_of(doc, skin_joints)
     if ours is not None:
@@ -172,6 +204,30 @@ def _shape_note(
     if in_file_order:
         parts.append(f"{in_file_order} alike in shape, name and side paired in the files' order")
     return ": ".join(parts[:2]) + ("; " + parts[2] if len(parts) > 2 else "")
+
+
+def _match_by_map(
+    skeleton: Skeleton, doc: GltfDocument, end_sites: np.ndarray, joint_map: JointMap, path: str
+) -> JointMatch:
+    """The joint map's pairs, each checked; the topmost mapped joint takes the translation."""
+    joints = {name: j for j, name in enumerate(skeleton.names) if not end_sites[j]}
+    nodes = doc.gltf.nodes or []
+    by_name = _unique({node.name: n for n, node in enumerate(nodes) if node.name}, [node.name for node in nodes])
+    into = Path(doc.path).name
+    node_of: dict[int, int] = {}
+    for joint, node in joint_map.nodes.items():
+        if joint not in joints:
+            raise FormatError(joint_map.path, repr(joint), f"is no joint of {Path(path).name} (end sites take none)")
+        index = node if isinstance(node, int) else by_name.get(node, -1)
+        if not 0 <= index < len(nodes):
+            raise FormatError(joint_map.path, repr(joint), f"maps to {node!r}, no node of {into}'s (or one of several)")
+        if index in node_of.values():
+            raise FormatError(
+                joint_map.path, repr(joint), f"maps to {doc.node_label(index)}, which another joint drives"
+            )
+        node_of[joints[joint]] = index
+    note = f"joints matched by the joint map {Path(joint_map.path).name}"
+    return JointMatch(dict(sorted(node_of.items())), note, root=min(node_of))
 
 
 def _match_by_role(

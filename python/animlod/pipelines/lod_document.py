@@ -75,6 +75,7 @@ def simplify_document(
     *,
     separate: bool = False,
     clips: Sequence[str] = (),
+    joint_map: str | os.PathLike | None = None,
     settings: DrawableSettings | None = None,
     progress: Callable[[str], None] | None = None,
     **keywords: object,
@@ -89,6 +90,8 @@ def simplify_document(
     ratios : face ratios of the levels below level 0, in (0, 1].
     clips : glTF files of clips on the same rig, added to the document's own by node name
         (:mod:`.clip_import`): they drive the skinned meshes' levels, and the output plays them.
+    joint_map : a JSON table of the character's node each BVH clip's joint drives, where the
+        skeletons' shape, body parts and names do not tell (:func:`.joint_matching.read_joint_map`).
     settings, **keywords : a :class:`~animlod.pipelines.DrawableSettings` and/or its fields by
         name (``fps``, ``frame_budget``, ``measured_frames``, ``pixel_error``, ``viewport_px``)
         and AQEM options (``use_motion_features``, ``max_error``, ``placement`` ..., see
@@ -105,8 +108,8 @@ def simplify_document(
     settings = DrawableSettings.resolve(settings, keywords)
     notes: list[str] = []
     doc = GltfDocument(source)
-    if clips:
-        doc = with_clips(doc, clips, notes.append)
+    if clips or joint_map is not None:
+        doc = with_clips(doc, clips, notes.append, joint_map)
     drawables = read_drawables(doc, settings.fps)
     if not drawables:
         reason = "no node draws a triangle mesh, nothing to simplify"

@@ -69,6 +69,7 @@ def build_motion_levels(
     max_frames: int = 600,
     clip: int | str | None = None,
     clips: Sequence[str] = (),
+    joint_map: str | os.PathLike | None = None,
     on_level: Callable[[int, int, int, int], Callable[[float], None] | None] | None = None,
     on_choice: Callable[[int, int], None] | None = None,
     on_note: Callable[[str], None] | None = None,
@@ -98,6 +99,8 @@ def build_motion_levels(
         each level has one skeleton for every clip.
     clips : glTF files of clips on the same rig, added to a glTF input's own by node name
         (:mod:`.clip_import`).
+    joint_map : a JSON table of the character's node each BVH clip's joint drives, where the
+        skeletons' shape, body parts and names do not tell (:func:`.joint_matching.read_joint_map`).
     on_level : called with (level index, joint count, frame count, number of levels) as each
         level starts; may return a callback taking the frames done.
     on_choice : called with (levels chosen, levels to choose) while the "refit" ranking's trial
@@ -125,7 +128,7 @@ def build_motion_levels(
         if on_note is not None:
             on_note(text)
 
-    motion, played, skin, layout = _read_input(source, clip, clips, note)
+    motion, played, skin, layout = _read_input(source, clip, clips, joint_map, note)
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
@@ -222,14 +225,18 @@ def skin_distances(skin: SkinnedMesh, motion: Motion, levels: Sequence[MotionLev
 
 
 def _read_input(
-    source: str | os.PathLike, clip: int | str | None, clip_files: Sequence[str], note: Callable[[str], None]
+    source: str | os.PathLike,
+    clip: int | str | None,
+    clip_files: Sequence[str],
+    joint_map: str | os.PathLike | None,
+    note: Callable[[str], None],
 ) -> tuple[Motion, list[tuple[str, slice]], SkinnedMesh | None, BvhLayout | None]:
     """The motion to simplify, the clips it is made of (each one's name and frames in it), for a
     skinned glTF its skin (None for a glTF without skins: the animated node tree is the skeleton)
-    and for a BVH its layout. ``clip_files`` add to a glTF's clips."""
+    and for a BVH its layout. ``clip_files`` add to a glTF's clips (BVH ones matched by ``joint_map``)."""
     path = os.fspath(source)
     kind = input_kind(source)
-    if clip_files and kind != "gltf":
+    if (clip_files or joint_map is not None) and kind != "gltf":
         raise ValueError(f"clips: adds glTF clips to a glTF input, not to a {kind} input")
     if kind == "bvh":
         from ..io.bvh import read_bvh_with_layout
@@ -244,8 +251,8 @@ def _read_input(
     from .whole_skin import whole_skin
 
     document = GltfDocument(source)
-    if clip_files:
-        document = with_clips(document, clip_files, note)
+    if clip_files or joint_map is not None:
+        document = with_clips(document, clip_files, note, joint_map)
     scene = read_gltf(document, _GLTF_FPS)
     if scene.skinned_meshes:
         skin, motions, left_out = whole_skin(document, scene, note, _GLTF_FPS)

@@ -303,7 +303,7 @@ def test_a_bvh_clip_of_another_rig_is_refused_naming_the_joint(split_character, 
     walk = synth.humanoid_motion(synth.humanoid().skeleton, "walk")
     write_bvh(tmp_path / "other.bvh", _edited(walk, ["Hips", "Spine"], {"Hips": "a", "Spine": "b"}))
     with pytest.raises(
-        FormatError, match="other.bvh: ROOT: its root 'a' matches no node of rest.glb's, by shape or by n"
+        FormatError, match="other.bvh: ROOT: its root 'a' matches no node of rest.glb's, by shape, body part or name"
     ):
         with_clips(GltfDocument(rest), [tmp_path / "other.bvh"], print)
     # Another shape, and names that match only here and there: a few joints would move.

@@ -110,7 +110,8 @@ def match_joints(skeleton: Skeleton, doc: GltfDocument, path: str, joint_map: Jo
         return by_role
     match = _match_by_name(skeleton, doc, end_sites)
     if 0 not in match.node_of:
-        reason = f"its root {skeleton.names[0]!r} matches no node of {into}'s, by shape or by name (another rig?)"
+        reason = (f"its root {skeleton.names[0]!r} matches no node of {into}'s, by shape, body part or name "
+                  "(another rig? a joint map, --joint-map, pairs the joints)")  # fmt: skip
         raise FormatError(path, "ROOT", reason)
     joint_count = int(np.count_nonzero(~end_sites))
     node_count = len(skin_joints or doc.gltf.nodes or [])
@@ -118,7 +119,7 @@ def match_joints(skeleton: Skeleton, doc: GltfDocument, path: str, joint_map: Jo
         names = ", ".join(skeleton.names[j] for j in list(match.node_of)[:5])
         reason = (f"only {len(match.node_of)} of its {joint_count} joints match a node of {into}'s by name "
                   f"({names}{', ...' if len(match.node_of) > 5 else ''}), and the skeletons differ in shape: "
-                  "another rig (retarget the clip to this character first)")  # fmt: skip
+                  "another rig (a joint map, --joint-map, pairs the joints)")  # fmt: skip
         raise FormatError(path, "HIERARCHY", reason)
     return match
 

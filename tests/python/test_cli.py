@@ -124,13 +124,17 @@ def test_info_into_a_pipe_closed_early_exits_quietly(tmp_path):
 
 def test_info_real_files(data_dir, capsys):
     assert main(["info", str(data_dir / "bvh" / "131_01.bvh")]) == 0
-    assert "joints: 31 (+7 end sites)" in capsys.readouterr().out
+    # The naming that BVH clips of other humanoids are matched through, body part by body part.
+    assert "joints: 31 (+7 end sites), root 'Hips', CMU naming (23 of 23 body parts)" in capsys.readouterr().out
+    assert main(["info", str(data_dir / "bvh" / "dataset-1_run_proud_001.bvh")]) == 0
+    assert "root 'joint_Root', Unity naming (21 of 23 body parts)" in capsys.readouterr().out
     assert main(["info", str(data_dir / "gltf" / "Soldier.glb")]) == 0
     out = capsys.readouterr().out
     assert out.count(" with skin ") == 2 and "'Walk'" in out and "2 materials, 2 textures" in out
     assert main(["info", str(data_dir / "gltf" / "Xbot.glb")]) == 0
     out = capsys.readouterr().out
     assert "'Mesh' with skin 0" in out and "'Mesh.001' with skin 0" in out and "Beta_Joints_MAT" in out
+    assert "skin: 67 joints, 4 influences per vertex, Mixamo naming (22 of 23 body parts)" in out
     # a folder holding one model file describes that file
     assert main(["info", str(data_dir / "meshseq" / "Flamingo-morph-glTF")]) == 0
     assert "14 morph targets" in capsys.readouterr().out

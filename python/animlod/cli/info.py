@@ -11,6 +11,7 @@ import numpy as np
 
 from ..io.detect import assets_in, input_kind, unread_models_note
 from ..model import AnimatedMesh, Motion
+from ..pipelines.humanoid_roles import naming_label
 
 if TYPE_CHECKING:
     from ..io.gltf_document import GltfDocument
@@ -156,8 +157,10 @@ def _document_lines(path: str) -> list[str]:
             lines.append(f"  primitives {geometry.other_primitives}: points or lines")
         if drawable.skinned is not None:
             skeleton = drawable.skinned.skeleton
+            naming = naming_label(skeleton.names)
             lines.append(
                 f"  skin: {skeleton.joint_count} joints, {drawable.skinned.joints.shape[1]} influences per vertex"
+                + (f", {naming}" if naming else "")
             )
             if drawable.renormalised_weights:
                 lines.append(
@@ -202,8 +205,10 @@ def _node_tree_lines(doc: GltfDocument) -> list[str]:
 def _motion_lines(motion: Motion) -> list[str]:
     skeleton = motion.skeleton
     end_sites = int(np.count_nonzero(skeleton.end_sites))
+    naming = naming_label([name for name, end in zip(skeleton.names, skeleton.end_sites) if not end])
     return [
-        f"joints: {skeleton.joint_count - end_sites} (+{end_sites} end sites), root {skeleton.names[0]!r}",
+        f"joints: {skeleton.joint_count - end_sites} (+{end_sites} end sites), root {skeleton.names[0]!r}"
+        + (f", {naming}" if naming else ""),
         f"frames: {motion.frame_count} at {motion.fps:g} fps ({motion.duration:.2f} s)",
     ]
 

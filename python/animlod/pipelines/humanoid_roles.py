@@ -44,6 +44,7 @@ _NAMINGS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
 
 # A skeleton is taken for a naming only where it holds at least this many of its roles.
 MIN_ROLES = 12
+ROLE_COUNT = len(_MIDDLE) + 2 * len(_SIDED)
 
 
 def roles_of(names: list[str]) -> tuple[str, dict[str, int]] | None:
@@ -61,6 +62,13 @@ def roles_of(names: list[str]) -> tuple[str, dict[str, int]] | None:
         if len(found) >= MIN_ROLES and (best is None or len(found) > len(best[1])):
             best = (naming, found)
     return best
+
+
+def naming_label(names: list[str]) -> str:
+    """What :func:`roles_of` makes of a skeleton's joint ``names``, for reports: "Mixamo naming
+    (22 of 23 body parts)", or "" where it holds no naming."""
+    found = roles_of(names)
+    return "" if found is None else f"{found[0]} naming ({len(found[1])} of {ROLE_COUNT} body parts)"
 
 
 def _role_key(name: str) -> tuple[str | None, str]:

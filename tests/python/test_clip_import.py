@@ -306,6 +306,12 @@ def test_a_bvh_clip_of_another_rig_is_refused_naming_the_joint(split_character, 
         FormatError, match="other.bvh: ROOT: its root 'a' matches no node of rest.glb's, by shape, body part or name"
     ):
         with_clips(GltfDocument(rest), [tmp_path / "other.bvh"], print)
+    # One joint: nothing to lay a bone of the character's along.
+    write_bvh(tmp_path / "hips.bvh", _edited(walk, ["Hips"]))
+    with pytest.raises(
+        FormatError, match="hips.bvh: HIERARCHY: no bone between two of its joints matched to rest.glb's"
+    ):
+        with_clips(GltfDocument(rest), [tmp_path / "hips.bvh"], print)
     # Another shape, and names that match only here and there: a few joints would move.
     ringless = [name for name in walk.skeleton.names if "Ring" not in name]
     renamed = {name: f"joint{k}" for k, name in enumerate(ringless) if name not in ("Hips", "Neck", "Head")}

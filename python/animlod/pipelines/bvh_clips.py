@@ -157,7 +157,7 @@ def _rest_alignment(
     theirs = np.array([bone[2] for bone in bones]).reshape(-1, 3)
     ours = np.array([bone[3] for bone in bones]).reshape(-1, 3)
     if not (np.linalg.norm(theirs, axis=1).sum() > 0.0 and np.linalg.norm(ours, axis=1).sum() > 0.0):
-        raise FormatError(path, "HIERARCHY", f"no bone between two joints of {Path(doc.path).name}'s by name")
+        raise FormatError(path, "HIERARCHY", f"no bone between two of its joints matched to {Path(doc.path).name}'s")
     fit = _best_rotation(theirs, ours)
     lengths = np.linalg.norm(ours, axis=1)
     spread = np.average([_angle(fit @ their, our) for their, our in zip(theirs, ours)], weights=lengths)

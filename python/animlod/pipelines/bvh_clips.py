@@ -30,6 +30,7 @@ from __future__ import annotations
 import itertools
 import os
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -39,7 +40,7 @@ from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_write import sign_continuous
-from ..model import Motion, spread_frames
+from ..model import Motion, Skeleton, spread_frames
 from .joint_matching import JointMap, match_joints
 
 # A rest pose whose bones lie farther from the character's on average, after the best turn,
@@ -72,7 +73,9 @@ def add_bvh_clip(
                               "has a matrix, which glTF does not animate")  # fmt: skip
 
     clip_world = motion.world_transforms()
-    turn, swings, pose_note = _rest_alignment(doc, motion, clip_world[..., :3, 3], node_of, match.root, os.fspath(path))
+    rest = skeleton.rest_world_transforms()[:, :3, 3]  # every rotation zero: a BVH's rest pose
+    bones = _matched_bones(doc, skeleton, rest, node_of, match.root, os.fspath(path))
+    turn, swings, pose_note = _rest_alignment(doc, motion, clip_world[..., :3, 3], bones, os.fspath(path))
     # (T, J, 3, 3) world rotations of the BVH's joints, in the character's axes.
     bvh_world = np.einsum("ab,tjbc,dc->tjad", turn, clip_world[..., :3, :3], turn)
     frame_count = motion.frame_count
@@ -102,7 +105,7 @@ def add_bvh_clip(
         parent_world = world_rotation(parent) if parent != -1 else np.eye(3)
         local = np.swapaxes(parent_world, -1, -2) @ world_rotation(node)
         animate(node, "rotation", sign_continuous(rotations.from_matrix(local)[:, None])[:, 0])
-    translations = _root_translations(doc, motion, clip_world[..., :3, 3], turn, node_of, match.root)
+    translations = _root_translations(doc, motion, rest, clip_world[..., :3, 3], turn, node_of, match.root, bones)
     animate(node_of[match.root], "translation", translations)
     builder.append("animations", {"name": motion.name or Path(path).stem, "samplers": samplers, "channels": channels})
 
@@ -120,30 +123,27 @@ def add_bvh_clip(
     return "; ".join(notes)
 
 
-def _rest_alignment(
-    doc: GltfDocument,
-    motion: Motion,
-    clip_positions: np.ndarray,
-    node_of: dict[int, int],
-    root: int,
-    path: str,
-) -> tuple[np.ndarray, dict[int, np.ndarray], str | None]:
-    """``G`` (3, 3), the turn between axes that best lays the BVH's rest bones onto the
-    character's (or, where the rest pose is no pose of the figure, its bones in the clip's frames
-    ``clip_positions`` (T, J, 3)), each joint's swing ``S`` (3, 3) that lays the character's rest
-    bones below it onto the BVH's turned by ``G``, and a note on how the rest poses differ.
-    FormatError naming the first joint that hangs from another matched joint than in the
-    character, or from none below ``root``."""
-    skeleton = motion.skeleton
-    bvh_rest = skeleton.rest_world_transforms()[:, :3, 3]  # every rotation zero: a BVH's rest pose
-    joints = sorted(node_of)
-    named = set(joints)
-    bones = []  # (joint, its nearest named ancestor, BVH rest bone, the character's)
-    for j in joints:
+class _Bone(NamedTuple):
+    """A matched joint's bone: its nearest matched ancestor, and the bone from it in the BVH's rest
+    pose and in the character's."""
+
+    above: int
+    theirs: np.ndarray
+    ours: np.ndarray
+
+
+def _matched_bones(
+    doc: GltfDocument, skeleton: Skeleton, rest: np.ndarray, node_of: dict[int, int], root: int, path: str
+) -> dict[int, _Bone]:
+    """Each matched joint but ``root``, in joint order, with its :class:`_Bone` (``rest`` (J, 3):
+    the BVH's rest pose). FormatError naming the first joint that hangs from another matched joint
+    than in the character, or from none below ``root``."""
+    bones = {}
+    for j in sorted(node_of):
         if j == root:
             continue
         ancestor = int(skeleton.parents[j])
-        while ancestor not in named:
+        while ancestor not in node_of:
             if ancestor == -1:
                 raise FormatError(path, f"joint {skeleton.names[j]!r}", f"lies below none of the matched joints' root "
                                   f"{skeleton.names[root]!r}")  # fmt: skip
@@ -153,9 +153,20 @@ def _rest_alignment(
             reason = f"hangs from {skeleton.names[ancestor]!r}, which is no ancestor of {doc.node_label(node)}"
             raise FormatError(path, f"joint {skeleton.names[j]!r}", reason)
         ours = doc.rest_world_matrix(node)[:3, 3] - doc.rest_world_matrix(above)[:3, 3]
-        bones.append((j, ancestor, bvh_rest[j] - bvh_rest[ancestor], ours))
-    theirs = np.array([bone[2] for bone in bones]).reshape(-1, 3)
-    ours = np.array([bone[3] for bone in bones]).reshape(-1, 3)
+        bones[j] = _Bone(ancestor, rest[j] - rest[ancestor], ours)
+    return bones
+
+
+def _rest_alignment(
+    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, bones: dict[int, _Bone], path: str
+) -> tuple[np.ndarray, dict[int, np.ndarray], str | None]:
+    """``G`` (3, 3), the turn between axes that best lays the BVH's rest ``bones`` onto the
+    character's (or, where the rest pose is no pose of the figure, its bones in the clip's frames
+    ``clip_positions`` (T, J, 3)), each matched joint's swing ``S`` (3, 3) that lays the
+    character's rest bones below it onto the BVH's turned by ``G``, and a note on how the rest
+    poses differ. FormatError where no bone has a length."""
+    theirs = np.array([bone.theirs for bone in bones.values()]).reshape(-1, 3)
+    ours = np.array([bone.ours for bone in bones.values()]).reshape(-1, 3)
     if not (np.linalg.norm(theirs, axis=1).sum() > 0.0 and np.linalg.norm(ours, axis=1).sum() > 0.0):
         raise FormatError(path, "HIERARCHY", f"no bone between two of its joints matched to {Path(doc.path).name}'s")
     fit = _best_rotation(theirs, ours)
@@ -163,21 +174,21 @@ def _rest_alignment(
     spread = np.average([_angle(fit @ their, our) for their, our in zip(theirs, ours)], weights=lengths)
     if spread > NO_POSE_DEGREES:
         frames = clip_positions[spread_frames(motion.frame_count, min(motion.frame_count, 64))]
-        posed = frames[:, [bone[0] for bone in bones]] - frames[:, [bone[1] for bone in bones]]
+        posed = frames[:, list(bones)] - frames[:, [bone.above for bone in bones.values()]]
         fit = _best_rotation(posed.reshape(-1, 3), np.tile(ours, (len(frames), 1)))
     turn = _axis_turn(fit)
     swings = {}
-    for j in joints:
-        below = [(our, turn @ their) for _, ancestor, their, our in bones if ancestor == j]
+    for j in sorted({*bones, *(bone.above for bone in bones.values())}):  # every matched joint
+        below = [(bone.ours, turn @ bone.theirs) for bone in bones.values() if bone.above == j]
         swings[j] = _best_rotation(*map(np.array, zip(*below))) if below else np.eye(3)
-    angles = [_angle(turn @ their, our) for _, _, their, our in bones]
+    angles = [_angle(turn @ bone.theirs, bone.ours) for bone in bones.values()]
     worst = int(np.argmax(angles)) if angles else 0
     note = None
     if spread > NO_POSE_DEGREES:
         note = (f"its rest pose is no pose of the figure (its bones {spread:.0f} degrees from the character's on "
                 "average): the axes are taken from its frames; each bone follows the clip's direction")  # fmt: skip
     elif angles and angles[worst] > 1.0:
-        name = skeleton.names[bones[worst][0]]
+        name = motion.skeleton.names[list(bones)[worst]]
         note = (f"its rest pose differs from the character's by up to {angles[worst]:.0f} degrees (the bone to "
                 f"{name!r}): each bone follows the clip's direction")  # fmt: skip
     return turn, swings, note
@@ -214,14 +225,21 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _root_translations(
-    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, turn: np.ndarray, node_of: dict[int, int], root: int
+    doc: GltfDocument,
+    motion: Motion,
+    rest: np.ndarray,
+    clip_positions: np.ndarray,
+    turn: np.ndarray,
+    node_of: dict[int, int],
+    root: int,
+    bones: dict[int, _Bone],
 ) -> np.ndarray:
     """(T, 3) translations of the node of the BVH joint ``root`` (the one above every matched
     joint): its rest position moved by the joint's displacement from its rest (:func:`_root_rest`;
     ``clip_positions`` (T, J, 3) are the BVH's joints in every frame), in the frame of the node's
     parent."""
     node = node_of[root]
-    root_rest, scale = _root_rest(doc, motion, clip_positions, turn, node_of, root)
+    root_rest, scale = _root_rest(doc, motion, rest, clip_positions, turn, node_of, root, bones)
     moved = doc.rest_world_matrix(node)[:3, 3] + scale * (clip_positions[:, root] - root_rest) @ turn.T
     parent = doc.parents[node]
     to_parent = np.linalg.inv(doc.rest_world_matrix(parent)) if parent != -1 else np.eye(4)
@@ -229,7 +247,14 @@ def _root_translations(
 
 
 def _root_rest(
-    doc: GltfDocument, motion: Motion, clip_positions: np.ndarray, turn: np.ndarray, node_of: dict[int, int], root: int
+    doc: GltfDocument,
+    motion: Motion,
+    rest: np.ndarray,
+    clip_positions: np.ndarray,
+    turn: np.ndarray,
+    node_of: dict[int, int],
+    root: int,
+    bones: dict[int, _Bone],
 ) -> tuple[np.ndarray, float]:
     """(3,) where the BVH joint ``root`` stands in the rest pose, and the scale of its moves: the
     ratio of the two legs' lengths (the matched bones from the root down to the joint lowest in
@@ -242,19 +267,13 @@ def _root_rest(
     every bone along its joint's x axis)."""
     joints = list(node_of)
     up = turn[1]  # the file's up direction
-    rest = motion.skeleton.rest_world_transforms()[:, :3, 3]
     heights = clip_positions[:, joints] @ up
     theirs = ours = 0.0
     joint = joints[int(np.argmin(heights.mean(axis=0)))]
     while joint != root:
-        above = int(motion.skeleton.parents[joint])
-        while above not in node_of:
-            above = int(motion.skeleton.parents[above])
-        theirs += float(np.linalg.norm(rest[joint] - rest[above]))
-        ours += float(
-            np.linalg.norm(doc.rest_world_matrix(node_of[joint])[:3, 3] - doc.rest_world_matrix(node_of[above])[:3, 3])
-        )
-        joint = above
+        theirs += float(np.linalg.norm(bones[joint].theirs))
+        ours += float(np.linalg.norm(bones[joint].ours))
+        joint = bones[joint].above
     scale = ours / theirs if theirs > 0.0 and ours > 0.0 else 1.0
     if np.any(motion.skeleton.offsets[0] != 0.0):
         return rest[root], scale

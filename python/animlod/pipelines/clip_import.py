@@ -18,7 +18,6 @@ poses, its joints matched by shape or body part (:mod:`.bvh_clips`).
 from __future__ import annotations
 
 import os
-from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -27,7 +26,7 @@ import numpy as np
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from .bvh_clips import add_bvh_clip
-from .joint_matching import read_joint_map
+from .joint_matching import named_nodes, read_joint_map
 
 # A node whose translation a clip animates rests within this fraction of the rig's size (the
 # largest rest translation among the character's nodes the clip names) of the character's node.
@@ -48,7 +47,7 @@ def with_clips(
     translation of a node of the same name resting elsewhere (a ``.bvh`` file:
     :func:`.bvh_clips.add_bvh_clip`); ValueError for a joint map without a BVH file."""
     builder = GlbBuilder.from_document(doc)
-    targets = _named_nodes(doc)
+    targets = named_nodes(doc)
     bvh_files = [clip_file for clip_file in clip_files if Path(clip_file).suffix.lower() == ".bvh"]
     if joint_map is not None and not bvh_files:
         raise ValueError(f"joint map {os.fspath(joint_map)}: maps the joints of BVH clips, and no BVH clip is given")
@@ -60,7 +59,7 @@ def with_clips(
         source = GltfDocument(clip_file)
         if not source.gltf.animations:
             raise source.fail("animations", f"no animation to add to {Path(doc.path).name}")
-        mapping = {node: targets[name] for name, node in _named_nodes(source).items() if name in targets}
+        mapping = {node: targets[name] for name, node in named_nodes(source).items() if name in targets}
         _check_rests(source, doc, mapping)
         left_out = added = 0
         for index, animation in enumerate(source.gltf.animations):
@@ -86,13 +85,6 @@ def with_clips(
         total = len(source.gltf.animations)
         note(f"{os.fspath(clip_file)}: {added} of its {total} clip(s) added to {into}{dropped}")
     return GltfDocument(doc.path, doc.max_animation_frames, data=builder.to_bytes())
-
-
-def _named_nodes(doc: GltfDocument) -> dict[str, int]:
-    """Node index by name, for the names one node alone has."""
-    names = [node.name for node in doc.gltf.nodes or []]
-    counts = Counter(names)
-    return {name: index for index, name in enumerate(names) if name and counts[name] == 1}
 
 
 def _check_rests(source: GltfDocument, doc: GltfDocument, mapping: dict[int, int]) -> None:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 
-from .joint_names import normalized_name, split_side
+from .joint_names import normalized_name, split_side, unique_index
 
 # Roles along the body's middle, then on each side (each side's roles are prefixed by it).
 _MIDDLE = ("hips", "spine", "chest", "upper chest", "neck", "upper neck", "head")
@@ -51,14 +51,12 @@ def roles_of(names: list[str]) -> tuple[str, dict[str, int]] | None:
     """The naming that ``names`` (a skeleton's joint names) holds most roles of, and the joint
     index of each of those roles; None where no naming has ``MIN_ROLES`` of them."""
     keys = [_role_key(name) for name in names]
+    once = unique_index(keys)
     best: tuple[str, dict[str, int]] | None = None
     for naming, (middle, sided) in _NAMINGS.items():
         wanted = {(None, _plain(name)): role for role, name in zip(_MIDDLE, middle) if name}
         wanted |= {(s, _plain(name)): f"{s} {role}" for role, name in zip(_SIDED, sided) for s in ("left", "right")}
-        found = {}
-        for joint, key in enumerate(keys):
-            if key in wanted and keys.count(key) == 1:
-                found[wanted[key]] = joint
+        found = {wanted[key]: joint for key, joint in once.items() if key in wanted}
         if len(found) >= MIN_ROLES and (best is None or len(found) > len(best[1])):
             best = (naming, found)
     return best

@@ -27,7 +27,7 @@ from ..io.errors import FormatError
 from ..io.gltf_document import GltfDocument
 from ..model import Skeleton
 from .humanoid_roles import MIN_ROLES, roles_of
-from .joint_names import normalized_name, side
+from .joint_names import normalized_name, side, unique_index
 
 
 @dataclass(frozen=True)
@@ -124,6 +124,11 @@ def match_joints(skeleton: Skeleton, doc: GltfDocument, path: str, joint_map: Jo
     return match
 
 
+def named_nodes(doc: GltfDocument) -> dict[str, int]:
+    """Node index by name, for the names one node alone has."""
+    return unique_index([node.name or "" for node in doc.gltf.nodes or []])
+
+
 def _tree_of(doc: GltfDocument, joints: set[int]) -> _Tree | None:
     """The nodes ``joints`` as a tree (each under its nearest ancestor among them), or None
     where they form several trees or none."""
@@ -178,12 +183,11 @@ def _pair_siblings(
     """Siblings of one shape paired by name, then by side, then in order; also how many of the
     pairs the order alone made (0 where one pair is left)."""
     pairs: dict[int, int] = {}
-    for key in (lambda i, names: normalized_name(names[i]), lambda i, names: side(names[i])):
-        their_keys = [key(i, their_names) for i in theirs]
-        our_keys = [key(i, our_names) for i in ours]
-        for i, k in zip(theirs, their_keys):
-            if k and their_keys.count(k) == 1 and our_keys.count(k) == 1:
-                pairs[i] = ours[our_keys.index(k)]
+    for key in (normalized_name, side):
+        our_once = unique_index([key(our_names[i]) for i in ours])
+        for k, t in unique_index([key(their_names[i]) for i in theirs]).items():
+            if k in our_once:
+                pairs[theirs[t]] = ours[our_once[k]]
         theirs = [i for i in theirs if i not in pairs]
         taken = set(pairs.values())
         ours = [i for i in ours if i not in taken]
@@ -213,7 +217,7 @@ def _match_by_map(
     """The joint map's pairs, each checked; the topmost mapped joint takes the translation."""
     joints = {name: j for j, name in enumerate(skeleton.names) if not end_sites[j]}
     nodes = doc.gltf.nodes or []
-    by_name = _unique({node.name: n for n, node in enumerate(nodes) if node.name}, [node.name for node in nodes])
+    by_name = named_nodes(doc)
     into = Path(doc.path).name
     node_of: dict[int, int] = {}
     for joint, node in joint_map.nodes.items():
@@ -254,16 +258,16 @@ def _match_by_name(skeleton: Skeleton, doc: GltfDocument, end_sites: np.ndarray)
     """Joints matched to the nodes of their name, else of their normalized name (each name one
     node's and one joint's alone)."""
     nodes = doc.gltf.nodes or []
-    exact = _unique({node.name: n for n, node in enumerate(nodes) if node.name}, [node.name for node in nodes])
-    loose_names = [normalized_name(node.name) if node.name else "" for node in nodes]
-    loose = _unique({name: n for n, name in enumerate(loose_names) if name}, loose_names)
+    exact = named_nodes(doc)
+    loose = unique_index([normalized_name(node.name) if node.name else "" for node in nodes])
     joints = [j for j in range(skeleton.joint_count) if not end_sites[j]]
     their_loose = [normalized_name(skeleton.names[j]) for j in joints]
+    once = unique_index(their_loose)
     node_of = {j: exact[skeleton.names[j]] for j in joints if skeleton.names[j] in exact}
     taken = set(node_of.values())
     loosely = []
     for j, name in zip(joints, their_loose):
-        if j not in node_of and name in loose and their_loose.count(name) == 1 and loose[name] not in taken:
+        if j not in node_of and name in loose and name in once and loose[name] not in taken:
             node_of[j] = loose[name]
             loosely.append(f"{skeleton.names[j]!r} -> {nodes[loose[name]].name!r}")
     note = None
@@ -271,11 +275,3 @@ def _match_by_name(skeleton: Skeleton, doc: GltfDocument, end_sites: np.ndarray)
         note = (f"{len(loosely)} joint(s) matched by name up to case, separators and namespace "
                 f"({', '.join(loosely[:3])}{', ...' if len(loosely) > 3 else ''})")  # fmt: skip
     return JointMatch(dict(sorted(node_of.items())), note)
-
-
-def _unique(index: dict[str, int], names: list[str]) -> dict[str, int]:
-    """``index`` without the names that ``names`` holds more than once."""
-    counts: dict[str, int] = defaultdict(int)
-    for name in names:
-        counts[name] += 1
-    return {name: n for name, n in index.items() if counts[name] == 1}

@@ -4,6 +4,8 @@ and the body side it names."""
 from __future__ import annotations
 
 import re
+from collections import Counter
+from collections.abc import Hashable, Sequence
 
 # A side letter standing alone: "LThumb", "l_arm", "hand_l", "Bip01 L Thigh", "UpperArmL".
 _SIDE_LETTER = r"^{0}(?=[A-Z0-9_.\- ])|^{1}(?=[_.\- ])|(?<=[_.\- ])[{0}{1}](?![A-Za-z0-9])|(?<=[a-z]){0}$"
@@ -31,6 +33,13 @@ def split_side(name: str) -> tuple[str | None, str]:
 def side(name: str) -> str | None:
     """'left' or 'right' where ``name`` says it ("LeftArm", "LThumb", "hand_l", "Bip01 R Thigh"), else None."""
     return split_side(name)[0]
+
+
+def unique_index(names: Sequence[Hashable]) -> dict[Hashable, int]:
+    """Each name that ``names`` holds once (empty ones aside), with its index: a name several
+    joints or nodes share tells none of them apart."""
+    counts = Counter(names)
+    return {name: index for index, name in enumerate(names) if name and counts[name] == 1}
 
 
 def _without_namespace(name: str) -> str:

@@ -127,8 +127,7 @@ def build_character(
     settings = DrawableSettings.resolve(settings, keywords)
     notes: list[str] = []
     doc = GltfDocument(source)
-    if clips or joint_map is not None:
-        doc = with_clips(doc, clips, notes.append, joint_map)
+    doc = with_clips(doc, clips, notes.append, joint_map)
     all_drawables = read_drawables(doc, settings.fps)
     drawables = [d for d in all_drawables if d.skinned is not None]
     animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]

@@ -45,7 +45,10 @@ def with_clips(
     (:func:`.joint_matching.read_joint_map`); FormatError naming the clip file for one that
     cannot be read, has no animation moving a node of the character's by name, or moves the
     translation of a node of the same name resting elsewhere (a ``.bvh`` file:
-    :func:`.bvh_clips.add_bvh_clip`); ValueError for a joint map without a BVH file."""
+    :func:`.bvh_clips.add_bvh_clip`); ValueError for a joint map without a BVH file. ``doc``
+    itself where there is nothing to add."""
+    if not clip_files and joint_map is None:
+        return doc
     builder = GlbBuilder.from_document(doc)
     targets = named_nodes(doc)
     bvh_files = [clip_file for clip_file in clip_files if Path(clip_file).suffix.lower() == ".bvh"]

@@ -108,8 +108,7 @@ def simplify_document(
     settings = DrawableSettings.resolve(settings, keywords)
     notes: list[str] = []
     doc = GltfDocument(source)
-    if clips or joint_map is not None:
-        doc = with_clips(doc, clips, notes.append, joint_map)
+    doc = with_clips(doc, clips, notes.append, joint_map)
     drawables = read_drawables(doc, settings.fps)
     if not drawables:
         reason = "no node draws a triangle mesh, nothing to simplify"

@@ -251,8 +251,7 @@ def _read_input(
     from .whole_skin import whole_skin
 
     document = GltfDocument(source)
-    if clip_files or joint_map is not None:
-        document = with_clips(document, clip_files, note, joint_map)
+    document = with_clips(document, clip_files, note, joint_map)
     scene = read_gltf(document, _GLTF_FPS)
     if scene.skinned_meshes:
         skin, motions, left_out = whole_skin(document, scene, note, _GLTF_FPS)

@@ -109,6 +109,8 @@ def test_motion_levels_of_a_character_with_added_clips(split_character, tmp_path
     write_bvh(tmp_path / "walk.bvh", read_gltf(whole).motions[0])
     with pytest.raises(ValueError, match="clips: adds glTF clips to a glTF input, not to a bvh input"):
         build_motion_levels(tmp_path / "walk.bvh", tmp_path / "bvh", levels=2, clips=[walk])
+    with pytest.raises(ValueError, match="^joint_map: adds glTF clips to a glTF input, not to a bvh input"):
+        build_motion_levels(tmp_path / "walk.bvh", tmp_path / "bvh", levels=2, joint_map=tmp_path / "map.json")
 
 
 def _bvh_in(folder: Path, name: str, motion: Motion, turn: np.ndarray | None = None, scale: float = 1.0) -> Path:

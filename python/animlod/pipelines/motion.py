@@ -237,7 +237,8 @@ def _read_input(
     path = os.fspath(source)
     kind = input_kind(source)
     if (clip_files or joint_map is not None) and kind != "gltf":
-        raise ValueError(f"clips: adds glTF clips to a glTF input, not to a {kind} input")
+        option = "clips" if clip_files else "joint_map"
+        raise ValueError(f"{option}: adds glTF clips to a glTF input, not to a {kind} input")
     if kind == "bvh":
         from ..io.bvh import read_bvh_with_layout
 

@@ -202,13 +202,13 @@ def _shape_note(
     renamed = [(a, b) for a, b in renamed if normalized_name(a) != normalized_name(b)]
     if not renamed and not in_file_order:
         return None
-    parts = ["joints matched by the two skeletons' shape"]
+    details = []
     if renamed:
         examples = ", ".join(f"{a!r} -> {b!r}" for a, b in renamed[:3])
-        parts.append(f"{len(renamed)} to nodes of other names ({examples}{', ...' if len(renamed) > 3 else ''})")
+        details.append(f"{len(renamed)} to nodes of other names ({examples}{', ...' if len(renamed) > 3 else ''})")
     if in_file_order:
-        parts.append(f"{in_file_order} alike in shape, name and side paired in the files' order")
-    return ": ".join(parts[:2]) + ("; " + parts[2] if len(parts) > 2 else "")
+        details.append(f"{in_file_order} alike in shape, name and side paired in the files' order")
+    return "joints matched by the two skeletons' shape: " + "; ".join(details)
 
 
 def _match_by_map(

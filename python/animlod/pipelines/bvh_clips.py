@@ -105,7 +105,9 @@ def add_bvh_clip(
         parent_world = world_rotation(parent) if parent != -1 else np.eye(3)
         local = np.swapaxes(parent_world, -1, -2) @ world_rotation(node)
         animate(node, "rotation", sign_continuous(rotations.from_matrix(local)[:, None])[:, 0])
-    translations = _root_translations(doc, motion, rest, clip_world[..., :3, 3], turn, node_of, match.root, bones)
+    root_rest, scale = _root_rest(doc, motion, rest, clip_world[..., :3, 3], turn, node_of, match.root, bones)
+    root_positions = clip_world[:, match.root, :3, 3]
+    translations = _root_translations(doc, node_of[match.root], root_positions, root_rest, scale, turn)
     animate(node_of[match.root], "translation", translations)
     builder.append("animations", {"name": motion.name or Path(path).stem, "samplers": samplers, "channels": channels})
 
@@ -225,22 +227,13 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _root_translations(
-    doc: GltfDocument,
-    motion: Motion,
-    rest: np.ndarray,
-    clip_positions: np.ndarray,
-    turn: np.ndarray,
-    node_of: dict[int, int],
-    root: int,
-    bones: dict[int, _Bone],
+    doc: GltfDocument, node: int, root_positions: np.ndarray, root_rest: np.ndarray, scale: float, turn: np.ndarray
 ) -> np.ndarray:
-    """(T, 3) translations of the node of the BVH joint ``root`` (the one above every matched
-    joint): its rest position moved by the joint's displacement from its rest (:func:`_root_rest`;
-    ``clip_positions`` (T, J, 3) are the BVH's joints in every frame), in the frame of the node's
-    parent."""
-    node = node_of[root]
-    root_rest, scale = _root_rest(doc, motion, rest, clip_positions, turn, node_of, root, bones)
-    moved = doc.rest_world_matrix(node)[:3, 3] + scale * (clip_positions[:, root] - root_rest) @ turn.T
+    """(T, 3) translations of ``node``, the node of the BVH joint above every matched joint, in the
+    frame of the node's parent: its rest position moved by the joint's displacement from its rest,
+    ``root_positions`` (T, 3) - ``root_rest``, scaled and turned into the character's axes
+    (:func:`_root_rest`)."""
+    moved = doc.rest_world_matrix(node)[:3, 3] + scale * (root_positions - root_rest) @ turn.T
     parent = doc.parents[node]
     to_parent = np.linalg.inv(doc.rest_world_matrix(parent)) if parent != -1 else np.eye(4)
     return (np.c_[moved, np.ones(len(moved))] @ to_parent.T)[:, :3]

@@ -482,8 +482,8 @@ class SkinnedMesh:
             return AnimatedMesh(self.faces, frames, fps=motion.fps)
         frames = np.empty((motion.frame_count, self.vertex_count, 3), np.float32)
         for t in range(motion.frame_count):  # O(T) calls, each a whole frame in C++
-            rest = self.rest_positions + np.einsum("n,nvc->vc", morph_weights[t], self.morph_targets)
-            frames[t] = bake_lbs(rest.astype(np.float32), self.joints, self.weights, matrices[t : t + 1])[0]
+            rest = morphed(self.rest_positions, self.morph_targets, morph_weights[t], 1)[0]
+            frames[t] = bake_lbs(rest, self.joints, self.weights, matrices[t : t + 1])[0]
         return AnimatedMesh(self.faces, frames, fps=motion.fps)
 
     def default_shape(self) -> np.ndarray:

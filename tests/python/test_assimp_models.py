@@ -19,7 +19,7 @@ from animlod.cli import main
 from animlod.io.detect import assets_in
 from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_drawable import read_drawables
-from animlod.io.meshseq import read_obj
+from animlod.io.obj import read_obj
 
 MODELS = Path("/usr/share/assimp/models")
 SUFFIXES = (".glb", ".gltf", ".bvh", ".obj", ".ply")

@@ -21,8 +21,9 @@ from animlod.cli import main
 from animlod.io import write_bvh, write_glb
 from animlod.io.detect import BATCH_STATE
 from animlod.io.glb_builder import GlbBuilder
-from animlod.io.meshseq import write_obj, write_sequence
+from animlod.io.meshseq import write_sequence
 from animlod.io.npz import write_npz
+from animlod.io.obj import write_obj
 from animlod.pipelines import simplify_asset
 
 # Small enough for a quick suite: few drive and measured frames per clip.

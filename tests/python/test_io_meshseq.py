@@ -11,6 +11,7 @@ import pytest
 from animlod.io import (
     FormatError,
     meshseq,
+    ply,
     read_mesh,
     read_obj,
     read_ply,
@@ -147,7 +148,7 @@ def test_binary_ply_with_lists_of_one_length_is_one_table(tmp_path: Path, monkey
     def row_by_row(*args: object) -> None:
         raise AssertionError("read row by row")
 
-    monkeypatch.setattr(meshseq, "_read_rows_of_lists", row_by_row)
+    monkeypatch.setattr(ply, "_read_rows_of_lists", row_by_row)
     for got, wanted in zip(read_ply(tmp_path / "triangles.ply"), expected["triangles"]):
         np.testing.assert_array_equal(got, wanted)
     with pytest.raises(AssertionError, match="read row by row"):  # control: rows of several sizes
@@ -440,7 +441,7 @@ def test_ascii_ply_numbers_are_parsed_in_bulk(tmp_path: Path, monkeypatch: pytes
     def token_by_token(*args: object) -> None:
         raise AssertionError("parsed token by token")
 
-    monkeypatch.setattr(meshseq, "_parse_numbers", token_by_token)
+    monkeypatch.setattr(ply, "parse_numbers", token_by_token)
     for got, expected in zip(read_ply(_write(tmp_path / "a.ply", text)), binary):
         np.testing.assert_array_equal(got, expected)
     monkeypatch.undo()

@@ -7,8 +7,9 @@ import pytest
 
 from animlod import synth
 from animlod.cli import main
-from animlod.io.meshseq import read_obj, read_sequence, write_sequence
+from animlod.io.meshseq import read_sequence, write_sequence
 from animlod.io.npz import read_npz, write_npz
+from animlod.io.obj import read_obj
 
 SQUARE = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\nf 1 3 2\nf 1 4 3\n"
 

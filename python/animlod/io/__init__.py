@@ -3,8 +3,10 @@
 from .bvh import BvhLayout, read_bvh, read_bvh_with_layout, write_bvh
 from .errors import FormatError
 from .gltf import GltfScene, read_gltf, read_lod_chains, read_node_motions, read_skinned, write_glb
-from .meshseq import read_mesh, read_obj, read_ply, read_sequence, write_mesh, write_obj, write_ply, write_sequence
+from .meshseq import read_mesh, read_sequence, write_mesh, write_sequence
 from .npz import read_npz, write_npz
+from .obj import read_obj, write_obj
+from .ply import read_ply, write_ply
 
 __all__ = [
     "BvhLayout",

@@ -1,0 +1,208 @@
+"""Wavefront OBJ geometry: ``v`` and ``f`` lines read (1-based or negative indices, ``a/b/c``
+corners, polygons fan-triangulated, ``#`` comments also at a line's end, a statement continued
+on the next line after a ``\\`` that ends its line; other statements such as ``vt``, ``vn``,
+``g``, ``usemtl`` are ignored; statements may be indented) and written. Parsing works on the
+whole file's bytes with numpy: there is no Python loop over lines, vertices or faces."""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from .atomic import atomic_write
+from .errors import FormatError
+from .polygon_mesh import (
+    check_face_indices,
+    check_finite_vertices,
+    checked_for_writing,
+    fan_triangulate,
+    parse_numbers,
+    polygon_mask,
+)
+from .tokens import parse_all, tokens_per_line
+
+
+def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
+    """Read the ``v`` and ``f`` lines of a Wavefront OBJ file.
+
+    Returns ``vertices (V, 3) float32`` (extra values such as w or colours are dropped) and
+    ``faces (M, 3) int32``, 0-based, polygons fan-triangulated in file order.
+
+    A backslash that ends a line (spaces or tabs may follow it) continues the statement on the
+    next line, as the OBJ specification allows; errors name the line the statement starts on. A
+    ``#`` comment ends at its line's end, even after a backslash (a Windows path such as
+    ``# saved to C:\\models\\`` does not swallow the next statement).
+    A UTF-8 byte order mark at the file's start is skipped; after a UTF-16 one the file is read as
+    UTF-16.
+
+    Raises
+    ------
+    FormatError
+        Naming the line and vertex or face for a malformed or non-finite coordinate, a face
+        index outside the vertices defined so far, or faces that all have fewer than three
+        corners (some such faces among polygons are left out with a warning).
+    """
+    path = Path(path)
+    data = path.read_bytes()
+    if data.startswith((b"\xfe\xff", b"\xff\xfe")):  # UTF-16 after its byte order mark (assimp's box_UTF16BE.obj)
+        try:
+            data = data.decode("utf-16").encode("utf-8")
+        except UnicodeDecodeError as error:
+            raise FormatError(path, f"byte {error.start}", "not UTF-16 text after its byte order mark") from None
+    nul = data.find(b"\0")
+    if nul >= 0:
+        raise FormatError(path, f"byte {nul}", "NUL byte: an OBJ file is text, this looks like binary data")
+    if data.startswith(b"\xef\xbb\xbf"):  # a UTF-8 byte order mark (.NET, Notepad) before the first statement
+        data = data[3:]
+    data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    if b"#" in data:  # a comment may also end a statement ("f 1 2 3 # cap"); line numbers stay
+        data = re.sub(rb"#[^\n]*", b"", data)
+    if b"\\" in data:
+        data = _join_continued_lines(data)
+    if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
+        data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
+    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines) = _obj_statements(data, (b"v", b"f", b"l"))
+    if not len(vertex_lines):
+        _require_obj_statement(path, data)
+    if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
+        reason = f"{len(polylines)} polylines ('l') and no face: animlod simplifies surfaces"
+        raise FormatError(path, f"line {polylines[0]}", reason)
+
+    def name_vertex(vertex: int) -> str:
+        return f"vertex {vertex} (line {vertex_lines[vertex]})"
+
+    sizes = _row_sizes(vertex_block, len(vertex_lines))
+    _require_sizes(path, sizes, 3, name_vertex, "coordinates")
+    values = _untagged_values(vertex_block, np.float64, sizes)
+    if values is not None:
+        vertices = values[(np.cumsum(sizes) - sizes)[:, None] + np.arange(3)]
+    else:  # find the bad one among x, y, z (extra values are dropped unread)
+        tokens, starts = _row_tokens(vertex_block, sizes)
+        columns = tokens[starts[:, None] + np.arange(1, 4)]
+        vertices = parse_numbers(path, columns, np.float64, lambda token: name_vertex(token // 3))
+    vertices = vertices.astype(np.float32)
+    check_finite_vertices(path, vertices, name_vertex)
+
+    def name_face(face: int) -> str:
+        return f"face {face} (line {face_lines[face]})"
+
+    if b"/" in face_block:
+        face_block = re.sub(rb"/\S*", b"", face_block)  # v of v/vt/vn
+    sizes = _row_sizes(face_block, len(face_lines))
+    polygons = sizes >= 3  # pybullet's samurai_monastry.obj has 201 faces of two vertices among its 125k
+    if sizes.size:
+        first = int(np.argmin(polygons))  # the first face of fewer than 3 vertices, named in the warning
+        refusal = f"needs at least 3 vertices, has {sizes[first]}; so does every face"
+        polygons = polygon_mask(path, sizes, name_face(first), refusal)
+    owner = np.repeat(np.arange(sizes.size), sizes)
+    written = _untagged_values(face_block, np.int64, sizes)
+    if written is None:
+        tokens, starts = _row_tokens(face_block, sizes)
+        written = parse_numbers(path, np.delete(tokens, starts), np.int64, lambda corner: name_face(owner[corner]))
+    # Negative indices count back from the last vertex defined above the face's line.
+    defined = np.searchsorted(vertex_lines, face_lines)[owner]
+    resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
+    check_face_indices(path, resolved, written, owner, len(vertices), name_face)
+    return vertices, fan_triangulate(resolved[polygons[owner]], sizes[polygons])
+
+
+def write_obj(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) -> None:
+    """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically.
+
+    Coordinates are written with 9 significant digits, which round-trips float32 exactly. A wrong
+    shape, a coordinate that is not finite as float32 or a face index outside the vertices is a
+    ValueError naming the file and the argument (``vertices`` or ``faces``); nothing is written.
+    """
+    vertices, faces = checked_for_writing(path, vertices, faces)
+    vertices, faces = vertices.astype(np.float64), faces.astype(np.int64) + 1
+    with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
+        handle.write("# written by animlod\n")
+        handle.write(("v %.9g %.9g %.9g\n" * len(vertices)) % tuple(vertices.ravel()))
+        handle.write(("f %d %d %d\n" * len(faces)) % tuple(faces.ravel()))
+
+
+# The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.
+_OBJ_KEYWORDS = frozenset(
+    b"v vt vn vp f l p o g s mg usemtl mtllib maplib usemap cstype deg bmat step curv curv2 surf parm "
+    b"trim hole scrv sp end con bevel c_interp d_interp lod shadow_obj trace_obj ctech stech".split()
+)
+
+
+def _require_obj_statement(path: Path, data: bytes) -> None:
+    """A file with no vertex whose first statement is no OBJ keyword is another format's text (a
+    game's level map named .obj): say so, rather than that the mesh is empty."""
+    for number, line in enumerate(data.split(b"\n"), start=1):
+        words = line.split()
+        if words and words[0] not in _OBJ_KEYWORDS:
+            shown = words[0][:20].decode("utf-8", "replace")
+            raise FormatError(path, f"line {number}", f"{shown!r} is not an OBJ statement: not a Wavefront OBJ file?")
+        if words:
+            return
+
+
+def _join_continued_lines(data: bytes) -> bytes:
+    """``data`` (LF line ends, no NUL byte) with every line that ends in a backslash joined to the
+    next one. The newlines taken out are put back after the joined statement, as empty lines, so
+    each statement keeps the number of the line it starts on and later lines keep theirs."""
+    # Mark each continuation with a NUL (the file has none, it was checked): the usual "\\\n" by
+    # bytes.replace, then those with spaces after the backslash, or ending the file, by a regex.
+    data = data.replace(b"\\\n", b"\0")
+    if b"\\" in data:
+        data = re.sub(rb"\\[ \t]*(?:\n|\Z)", b"\0", data)
+    codes = np.frombuffer(data, dtype=np.uint8)
+    marks = np.flatnonzero(codes == 0)
+    if not marks.size:
+        return data
+    newlines = np.flatnonzero(codes == ord("\n"))
+    marks_before = np.searchsorted(marks, newlines)
+    # A statement's end takes one newline more for each continuation since the newline before it.
+    at = np.repeat(newlines + 1, np.diff(marks_before, prepend=0))
+    joined = np.insert(codes, at, ord("\n"))
+    joined[joined == 0] = ord(" ")
+    tail = marks.size - (int(marks_before[-1]) if newlines.size else 0)  # continued into the file's end
+    return joined.tobytes() + b"\n" * tail
+
+
+def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:
+    """For each one-letter tag: the bytes of all lines starting with it, and their 1-based line numbers."""
+    codes = np.frombuffer(data + b"\n\n", dtype=np.uint8)  # padding: every line start has two bytes
+    line_starts = np.concatenate(([0], np.flatnonzero(codes[: len(data)] == ord("\n")) + 1))
+    line_lengths = np.diff(line_starts, append=len(data))
+    separated = np.isin(codes[line_starts + 1], np.frombuffer(b" \t", dtype=np.uint8))
+    result = []
+    for tag in tags:
+        selected = (codes[line_starts] == tag[0]) & separated
+        result.append((codes[: len(data)][np.repeat(selected, line_lengths)].tobytes(), np.flatnonzero(selected) + 1))
+    return result
+
+
+def _row_sizes(block: bytes, line_count: int) -> np.ndarray:
+    """The number of values after the tag on each of the ``line_count`` tag-led lines of ``block``.
+    Rows are counted by line, not by tag token: ``v v 1 2`` is one row (whose "v" then fails to
+    parse), not two."""
+    return tokens_per_line(block)[:line_count] - 1
+
+
+def _untagged_values(block: bytes, dtype: type, sizes: np.ndarray) -> np.ndarray | None:
+    """Every value after the tags of ``block``'s lines, in order, as ``dtype``; None when one does
+    not parse (then :func:`_row_tokens` and :func:`parse_numbers` name it)."""
+    codes = np.frombuffer(block, dtype=np.uint8).copy()
+    codes[np.concatenate(([0], np.flatnonzero(codes[:-1] == ord("\n")) + 1))[: sizes.size]] = ord(" ")
+    values = parse_all(codes.tobytes(), dtype)
+    return values if values is not None and values.size == sizes.sum() else None
+
+
+def _row_tokens(block: bytes, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The tokens of ``block`` and the index of each row's tag among them (rows of ``sizes`` values)."""
+    counts = sizes + 1
+    return np.array(block.split(), dtype=np.bytes_), np.cumsum(counts) - counts
+
+
+def _require_sizes(path: Path, sizes: np.ndarray, minimum: int, element: Callable[[int], str], what: str) -> None:
+    short = np.flatnonzero(sizes < minimum)
+    if short.size:
+        raise FormatError(path, element(short[0]), f"needs at least {minimum} {what}, has {sizes[short[0]]}")

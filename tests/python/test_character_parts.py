@@ -285,6 +285,49 @@ def test_motion_levels_tell_the_hair_bone_from_a_body_bone_of_the_same_name(tmp_
     _motion_levels_show_every_skin(_with_part(tmp_path, "hair", hair="still", plain=plain), tmp_path / "levels")
 
 
+def _nodes_reversed(source: Path) -> Path:
+    """``source`` with its nodes listed in reverse order, every reference to them renumbered."""
+    builder = GlbBuilder.from_document(GltfDocument(source))
+    gltf = builder.json
+    last = len(gltf["nodes"]) - 1
+    gltf["nodes"].reverse()
+    for node in gltf["nodes"]:
+        if "children" in node:
+            node["children"] = [last - child for child in node["children"]]
+    for scene in gltf["scenes"]:
+        scene["nodes"] = [last - node for node in scene["nodes"]]
+    for skin in gltf["skins"]:
+        skin["joints"] = [last - joint for joint in skin["joints"]]
+        if "skeleton" in skin:
+            skin["skeleton"] = last - skin["skeleton"]
+    for animation in gltf["animations"]:
+        for channel in animation["channels"]:
+            channel["target"]["node"] = last - channel["target"]["node"]
+    reversed_source = source.with_name(f"{source.stem}_reversed.glb")
+    builder.save(reversed_source)
+    return reversed_source
+
+
+def test_motion_levels_of_the_body_when_a_part_comes_first_in_the_file(tmp_path) -> None:
+    # Files list a visor or a helmet before the body as often as after. `motion` took the first
+    # skinned mesh in node order as the skeleton: the helmet's two joints, the body left out
+    # (Soldier with its nodes reversed: "the skeleton allows 2 (2 joints ...)"). So did `tdag`.
+    from animlod.cli.tdag import read_animation
+    from animlod.io import read_skinned
+
+    source = _nodes_reversed(_with_part(tmp_path, "helmet"))
+    scene = read_gltf(source)
+    helmet, body = scene.skinned_meshes
+    assert helmet.skeleton.joint_count < body.skeleton.joint_count and scene.body == 1
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    assert not any("not in the levels' GLBs" in note for note in report.notes)
+    (written,) = read_gltf(tmp_path / "levels" / f"{source.stem}_lod0.glb").skinned_meshes
+    assert written.skeleton.names == body.skeleton.names
+    assert written.vertex_count == body.vertex_count + helmet.vertex_count
+    assert read_animation(str(source)).vertex_count == body.vertex_count
+    assert read_skinned(source)[0].vertex_count == body.vertex_count
+
+
 def test_the_helmets_levels_share_the_bodys_skins(helmeted) -> None:
     output, _ = helmeted
     nodes = GltfDocument(output).json["nodes"]

@@ -96,4 +96,5 @@ def test_build_from_a_gltf_of_several_clips_says_which_one_it_took(tmp_path, cap
     write_glb(tmp_path / "clips.glb", skinned, [motion, motion], names=["bend", "again"])
     assert main(["tdag", "build", str(tmp_path / "clips.glb"), "-o", str(tmp_path / "clips.tdag")]) == 0
     error = capsys.readouterr().err
-    assert "the TDAG is of the first skinned mesh baked with its first clip, 'bend'; 1 other (mesh, clip) pair" in error
+    taken = "the TDAG is of the body's skinned mesh baked with its first clip, 'bend'"
+    assert f"{taken}; 1 other (mesh, clip) pair" in error

@@ -94,7 +94,8 @@ def _governing(text: str) -> str | int:
 
 def read_animation(path: str):
     """The deforming mesh of ``path``: OBJ/PLY frames, an NPZ, or a glTF's first morph-animated
-    mesh (baked frames) or first skinned mesh baked with its first animation."""
+    mesh (baked frames) or its body's skinned mesh (``GltfScene.body``) baked with its first
+    animation."""
     from ..io.detect import input_kind
 
     kind = input_kind(path)
@@ -115,9 +116,9 @@ def read_animation(path: str):
         mesh, others = scene.morph_animations[0], len(scene.morph_animations) - 1
         taken = "the first morph-animated mesh and clip"
     elif scene.skinned_meshes and scene.motions:
-        mesh = scene.skinned_meshes[0].bake(scene.motions[0])
+        mesh = scene.skinned_meshes[scene.body].bake(scene.motions[0])
         others = sum(len(motions) for motions in scene.skinned_motions) - 1
-        taken = f"the first skinned mesh baked with its first clip, {scene.motions[0].name or 'unnamed'!r}"
+        taken = f"the body's skinned mesh baked with its first clip, {scene.motions[0].name or 'unnamed'!r}"
     else:
         raise UserError(f"{path}: no morph-animated mesh and no animated skinned mesh to build a TDAG of")
     if others:  # a TDAG is one mesh over one run of frames

@@ -37,7 +37,8 @@ class GltfScene:
     Attributes
     ----------
     skinned_meshes : one per (mesh, skin) pair used by a node, in node order.
-    motions : the animations on the skeleton of ``skinned_meshes[0]`` (empty without skins).
+    motions : the animations on the skeleton of the body, ``skinned_meshes[body]`` (empty
+        without skins).
     morph_animations : meshes without a skin whose morph weights an animation drives, baked
         at ``fps``, one per (node, animation).
     static_meshes : the other meshes without a skin, one frame each, in world space.
@@ -45,6 +46,7 @@ class GltfScene:
     skinned_nodes : the node that draws each skinned mesh, parallel to ``skinned_meshes``.
     skinned_rigs : the skin of each skinned mesh as a skeleton, parallel to ``skinned_meshes``;
         their ``joint_nodes`` tell which joints of two skins are one (names may repeat in a file).
+    body : the index in ``skinned_meshes`` of the character's body (:func:`_body_node`).
     """
 
     skinned_meshes: list[SkinnedMesh]
@@ -54,6 +56,7 @@ class GltfScene:
     skinned_motions: list[list[Motion]] = field(default_factory=list)
     skinned_nodes: list[int] = field(default_factory=list)
     skinned_rigs: list[SkinRig] = field(default_factory=list)
+    body: int = 0
 
 
 def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> GltfScene:
@@ -76,14 +79,16 @@ def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> Gltf
         skinned.append(mesh)
         skinned_motions.append(motions)
     morph_animations, static_meshes = _read_unskinned_meshes(doc, fps)
+    body = nodes.index(_body_node(doc, nodes)) if nodes else 0
     return GltfScene(
         skinned_meshes=skinned,
-        motions=skinned_motions[0] if skinned_motions else [],
+        motions=skinned_motions[body] if skinned_motions else [],
         morph_animations=morph_animations,
         static_meshes=static_meshes,
         skinned_motions=skinned_motions,
         skinned_nodes=nodes,
         skinned_rigs=[rigs[doc.gltf.nodes[node].skin] for node in nodes],
+        body=body,
     )
 
 
@@ -92,8 +97,9 @@ def read_skinned(
 ) -> tuple[SkinnedMesh, list[Motion]]:
     """One skinned mesh of a glTF file and its motions sampled at ``fps``.
 
-    ``skin`` picks the skin by index, or by skin or mesh name; None takes the first skinned
-    mesh. A file without that skin raises FormatError naming the file and the skin asked for.
+    ``skin`` picks the skin by index, or by skin or mesh name; None takes the body
+    (:func:`_body_node`). A file without that skin raises FormatError naming the file and the
+    skin asked for.
     """
     doc = GltfDocument(path)
     nodes = _skinned_mesh_nodes(doc)
@@ -103,7 +109,8 @@ def read_skinned(
     if not chosen:
         available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes}))
         raise doc.fail(f"skin {skin!r}", f"not in the file (skinned meshes use skins: {available})")
-    return read_skinned_node(doc, chosen[0], SkinRig(doc, doc.gltf.nodes[chosen[0]].skin), fps)
+    node = _body_node(doc, chosen)
+    return read_skinned_node(doc, node, SkinRig(doc, doc.gltf.nodes[node].skin), fps)
 
 
 def _skinned_mesh_nodes(doc: GltfDocument) -> list[int]:
@@ -116,6 +123,14 @@ def _skinned_mesh_nodes(doc: GltfDocument) -> list[int]:
             seen.add((node.mesh, node.skin))
             nodes.append(index)
     return nodes
+
+
+def _body_node(doc: GltfDocument, nodes: list[int]) -> int:
+    """The node of ``nodes`` that draws the character's body: the one whose skin lists the most
+    joints, the first in node order among equals. A visor or hair skinned to a few head joints
+    comes before the body in some files; its skeleton would leave the body out."""
+    joint_counts = [len(doc.gltf.skins[doc.gltf.nodes[node].skin].joints) for node in nodes]
+    return nodes[joint_counts.index(max(joint_counts))]
 
 
 def _skin_label(doc: GltfDocument, skin: int) -> str:

@@ -256,7 +256,7 @@ def _read_input(
     scene = read_gltf(document, _GLTF_FPS)
     if scene.skinned_meshes:
         skin, motions, left_out = whole_skin(document, scene, note, _GLTF_FPS)
-        if skin.vertex_count > scene.skinned_meshes[0].vertex_count:
+        if skin.vertex_count > scene.skinned_meshes[scene.body].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
             note(f"{path}: {left_out} skinned mesh{'es' if left_out > 1 else ''} on other joints, bound in another "

@@ -2,7 +2,7 @@
 pieces, Soldier's visor, VRoid's hair, a head with its own blendshapes beside a body without),
 for writers that take one skinned mesh per file (`animlod motion`'s level GLBs).
 
-Each part lies on the first mesh's skeleton as :mod:`.skin_parts` places it; bones of a part's own
+Each part lies on the body's skeleton as :mod:`.skin_parts` places it; bones of a part's own
 that move in its clips join that skeleton. Morph targets join by name: a target some parts name
 moves those parts' vertices and leaves the others', so one weight drives it everywhere, as
 engines drive a face's and its teeth's "jawOpen" together. A part without normals gets smooth
@@ -26,35 +26,36 @@ from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
 def whole_skin(
     doc: GltfDocument, scene: GltfScene, note: Callable[[str], None], fps: float
 ) -> tuple[SkinnedMesh, list[Motion], int]:
-    """The first skinned mesh of ``scene`` with every other one on its skeleton joined to it, its
-    motions (sampled at ``fps``), and how many meshes stay out: those on other joints, bound in
-    another pose, or whose morph targets lack names where the others' have them. A part's joints
-    match the first mesh's by node; bones of its own that move in its clips join the skeleton, the
-    first mesh read again with them, and ``note`` names them. Morph targets join by name
+    """The body of ``scene`` (``scene.body``) with every other skinned mesh on its skeleton joined
+    to it, its motions (sampled at ``fps``), and how many meshes stay out: those on other joints,
+    bound in another pose, or whose morph targets lack names where the others' have them. A part's
+    joints match the body's by node; bones of its own that move in its clips join the skeleton,
+    the body read again with them, and ``note`` names them. Morph targets join by name
     (:func:`_joined_targets`), each part keeping the shape of its default weights."""
-    meshes = scene.skinned_meshes
-    first, motions, rig = meshes[0], scene.skinned_motions[0], scene.skinned_rigs[0]
-    parts = [first]
-    for mesh, clips, node, part_rig in zip(meshes[1:], scene.skinned_motions[1:], scene.skinned_nodes[1:],
-                                           scene.skinned_rigs[1:]):  # fmt: skip
+    body, motions, rig, body_node = (scene.skinned_meshes[scene.body], scene.skinned_motions[scene.body],
+                                     scene.skinned_rigs[scene.body], scene.skinned_nodes[scene.body])  # fmt: skip
+    parts = [body]
+    for index in (index for index in range(len(scene.skinned_meshes)) if index != scene.body):
+        mesh, node, part_rig = scene.skinned_meshes[index], scene.skinned_nodes[index], scene.skinned_rigs[index]
         if not _targets_join(parts, mesh):
             continue
+        clips = scene.skinned_motions[index]
         keys = JointKeys(rig.joint_nodes, part_rig.joint_nodes)
-        placement = placement_on(first, mesh, keys, join_clips(clips)[0] if clips else None)
-        with_bones = joined_rig(doc, rig, first, part_rig, mesh) if placement is None else None
+        placement = placement_on(body, mesh, keys, join_clips(clips)[0] if clips else None)
+        with_bones = joined_rig(doc, rig, body, part_rig, mesh) if placement is None else None
         if with_bones is not None:  # the joined skeleton keeps every joint's index: placed parts stay valid
             own = with_bones.extra_joints[len(rig.extra_joints) :]
             note(f"{doc.path}: {doc.node_label(node)} has joints of its own that move in its clips "
                  f"({', '.join(map(doc.node_label, own))}); they join the skeleton of "
-                 f"{doc.node_label(scene.skinned_nodes[0])}")  # fmt: skip
+                 f"{doc.node_label(body_node)}")  # fmt: skip
             rig = with_bones
-            first, motions = read_skinned_node(doc, scene.skinned_nodes[0], rig, fps)
-            placement = placement_on(first, mesh, JointKeys(rig.joint_nodes, part_rig.joint_nodes))
+            body, motions = read_skinned_node(doc, body_node, rig, fps)
+            placement = placement_on(body, mesh, JointKeys(rig.joint_nodes, part_rig.joint_nodes))
         if placement is not None:
-            parts.append(moved_onto(mesh, first, placement))
-    parts[0] = first
+            parts.append(moved_onto(mesh, body, placement))
+    parts[0] = body
     if len(parts) == 1:
-        return first, motions, len(meshes) - 1
+        return body, motions, len(scene.skinned_meshes) - 1
     influences = max(part.joints.shape[1] for part in parts)
     starts = np.cumsum([0] + [part.vertex_count for part in parts])
 
@@ -75,15 +76,15 @@ def whole_skin(
         faces=np.concatenate([part.faces + start for part, start in zip(parts, starts)]),
         joints=np.concatenate([padded(part.joints) for part in parts]),
         weights=np.concatenate([padded(part.weights) for part in parts]),
-        inverse_bind=first.inverse_bind,
-        skeleton=first.skeleton,
+        inverse_bind=body.inverse_bind,
+        skeleton=body.skeleton,
         uvs=joined("uvs", lambda part: np.zeros((part.vertex_count, 2), np.float32)),  # an untextured part
         normals=joined("normals", lambda part: vertex_normals(part.rest_positions, part.faces)),
         morph_targets=targets,
         morph_target_names=target_names,
         default_morph_weights=defaults,
     )
-    return whole, motions, len(meshes) - len(parts)
+    return whole, motions, len(scene.skinned_meshes) - len(parts)
 
 
 def _target_keys(mesh: SkinnedMesh) -> list[tuple[str | None, int]]:

@@ -385,6 +385,41 @@ def test_a_mesh_placed_far_from_the_origin_simplifies_as_at_the_origin(tmp_path:
         np.testing.assert_array_equal(near, far)
 
 
+def _triangle_soup(source: Path, target: Path) -> Path:
+    """``source`` with every primitive's attributes spread to its corners and its indices dropped:
+    three vertices per triangle, as Khronos's Fox and many exporters' flat-shaded meshes are."""
+    doc = GltfDocument(source)
+    builder = GlbBuilder.from_document(doc)
+
+    def spread(index: int, corners: np.ndarray) -> int:
+        accessor = builder.json["accessors"][index]
+        values = np.asarray(doc.accessor(index, "attribute"))[corners]
+        return builder.add(values, bounds="min" in accessor, normalized=accessor.get("normalized", False))
+
+    for mesh in builder.json["meshes"]:
+        for primitive in mesh["primitives"]:
+            corners = np.asarray(doc.accessor(primitive.pop("indices"), "indices"))[:, 0]
+            primitive["attributes"] = {name: spread(index, corners) for name, index in primitive["attributes"].items()}
+    builder.prune()
+    builder.save(target)
+    return target
+
+
+def test_a_character_without_indices_simplifies_as_the_indexed_one(tmp_path: Path) -> None:
+    # glTF allows triangles without an index buffer (glTF 2.0, 3.7.2.1); the weld joins the
+    # corners that share a position and attributes back into the indexed mesh's vertices.
+    character = synth.humanoid()
+    write_glb(tmp_path / "indexed.glb", character, [synth.humanoid_motion(character.skeleton, "walk")])
+    soup = _triangle_soup(tmp_path / "indexed.glb", tmp_path / "soup.glb")
+    (read,) = read_gltf(soup).skinned_meshes
+    assert read.vertex_count == 3 * character.face_count
+    reports = [
+        simplify_document(source, tmp_path / f"{source.stem}_lod.glb") for source in (tmp_path / "indexed.glb", soup)
+    ]
+    levels = [[(level.faces, level.error) for level in report.drawables[0].levels] for report in reports]
+    assert len(levels[0]) > 2 and levels[0] == levels[1]
+
+
 def test_simplify_and_character_point_an_animation_library_to_motion(tmp_path: Path) -> None:
     character = synth.humanoid()
     write_glb(tmp_path / "humanoid.glb", character, [synth.humanoid_motion(character.skeleton, "walk")])

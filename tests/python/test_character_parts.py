@@ -328,6 +328,32 @@ def test_motion_levels_of_the_body_when_a_part_comes_first_in_the_file(tmp_path)
     assert read_skinned(source)[0].vertex_count == body.vertex_count
 
 
+def test_motion_levels_of_the_body_when_hair_of_more_bones_comes_first(tmp_path) -> None:
+    # VRoid's hair is skinned to more bones than its body, bones its clips leave alone (a runtime's
+    # spring simulation moves them). Chosen by its joint count, its skeleton would be the levels'.
+    builder = GlbBuilder.from_document(GltfDocument(_with_part(tmp_path, "hair", hair="still")))
+    gltf, doc = builder.json, GltfDocument(tmp_path / "hair.glb")
+    hair_skin = gltf["skins"][1]
+    binds = np.asarray(doc.accessor(hair_skin["inverseBindMatrices"], "test"), np.float32).reshape(-1, 4, 4)
+    lift = np.eye(4, dtype=np.float32)
+    lift[3, :3] = -0.01  # column-major storage: the inverse of a 0.01 lift above the Hair bone
+    strands = [builder.append("nodes", {"name": f"Strand{index}", "translation": [0.0, 0.01, 0.0]})
+               for index in range(len(gltf["skins"][0]["joints"]))]  # fmt: skip
+    gltf["nodes"][hair_skin["joints"][1]]["children"] = strands
+    hair_skin["joints"] += strands
+    strand_binds = np.repeat((binds[1] @ lift)[None], len(strands), axis=0)
+    hair_skin["inverseBindMatrices"] = builder.add(np.concatenate([binds, strand_binds]).reshape(-1, 16))
+    builder.save(tmp_path / "long_hair.glb")
+    source = _nodes_reversed(tmp_path / "long_hair.glb")
+    scene = read_gltf(source)
+    hair, body = scene.skinned_meshes
+    assert hair.skeleton.joint_count > body.skeleton.joint_count and scene.body == 1
+    build_motion_levels(source, tmp_path / "levels", levels=2)
+    (written,) = read_gltf(tmp_path / "levels" / f"{source.stem}_lod0.glb").skinned_meshes
+    assert written.vertex_count == body.vertex_count + hair.vertex_count
+    assert set(body.skeleton.names) <= set(written.skeleton.names)
+
+
 def test_the_helmets_levels_share_the_bodys_skins(helmeted) -> None:
     output, _ = helmeted
     nodes = GltfDocument(output).json["nodes"]

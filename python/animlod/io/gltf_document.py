@@ -78,7 +78,8 @@ _TOP_LEVEL_ARRAYS = (
     "accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials", "meshes", "nodes",
     "samplers", "scenes", "skins", "textures", "extensionsUsed", "extensionsRequired",
 )  # fmt: skip
-_CHANNEL_PATHS = ("translation", "rotation", "scale", "weights")
+NODE_PATHS = ("translation", "rotation", "scale")  # the channel paths that move a node
+_CHANNEL_PATHS = (*NODE_PATHS, "weights")
 # KHR_animation_pointer: a channel of path "pointer" animates the property its JSON pointer
 # names; those of a node's TRS or weights are read as that node's channels.
 POINTER_EXTENSION = "KHR_animation_pointer"
@@ -386,6 +387,11 @@ class GltfDocument:
             reason = f"path {channel.target.path!r} is not one of {', '.join(_CHANNEL_PATHS)}, or 'pointer'"
             raise self.fail(element, reason)
         return channel.target.node, channel.target.path
+
+    def moved_nodes(self) -> set[int]:
+        """The nodes an animation channel translates, turns or scales (a "weights" channel morphs a
+        mesh and moves no node)."""
+        return {node for targets in self.channel_targets for node, path in targets if path in NODE_PATHS}
 
     def node_label(self, index: int) -> str:
         """``node 5 'Hips'`` for messages."""

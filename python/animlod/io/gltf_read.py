@@ -127,10 +127,18 @@ def _skinned_mesh_nodes(doc: GltfDocument) -> list[int]:
 
 def _body_node(doc: GltfDocument, nodes: list[int]) -> int:
     """The node of ``nodes`` that draws the character's body: the one whose skin lists the most
-    joints, the first in node order among equals. A visor or hair skinned to a few head joints
-    comes before the body in some files; its skeleton would leave the body out."""
-    joint_counts = [len(doc.gltf.skins[doc.gltf.nodes[node].skin].joints) for node in nodes]
-    return nodes[joint_counts.index(max(joint_counts))]
+    joints the animations move, then the most joints, the first in node order among equals. A
+    visor skinned to a few head joints, or hair to a hundred hair bones that only a runtime's
+    spring simulation moves, comes before the body in some files; its skeleton would leave the
+    body out."""
+    moved = doc.moved_nodes()
+
+    def size(node: int) -> tuple[int, int]:
+        joints = doc.gltf.skins[doc.gltf.nodes[node].skin].joints
+        return sum(joint in moved for joint in joints), len(joints)
+
+    sizes = [size(node) for node in nodes]
+    return nodes[sizes.index(max(sizes))]
 
 
 def _skin_label(doc: GltfDocument, skin: int) -> str:

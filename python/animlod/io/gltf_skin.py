@@ -39,13 +39,12 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton
-from .gltf_document import UNIFORM_SCALE_TOLERANCE, GltfDocument
+from .gltf_document import NODE_PATHS, UNIFORM_SCALE_TOLERANCE, GltfDocument
 from .gltf_keyframes import sample_keyframes
 
 # Animated bone offsets within this fraction of the skeleton's largest rest offset of their
 # rest value count as held, so the motion needs no per-frame joint translations.
 _HELD_TRANSLATION_TOLERANCE = 1e-4
-_NODE_PATHS = ("translation", "rotation", "scale")
 _LIGHTS_EXTENSION = "KHR_lights_punctual"
 # Below this relative volume (|det| over the product of the column lengths) a 3x3 part counts as
 # singular: its inverse would amplify float32 noise by more than a million.
@@ -161,7 +160,7 @@ class SkinRig:
             for index, (channel, (node, path)) in enumerate(
                 zip(animation.channels or [], doc.channel_targets[animation_index])
             )
-            if node in self.rest_translation and path in _NODE_PATHS
+            if node in self.rest_translation and path in NODE_PATHS
         ]
         if not channels:
             return None
@@ -345,7 +344,7 @@ def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
         for index, node in enumerate(nodes)
         if node.camera is not None or _LIGHTS_EXTENSION in (node.extensions or {})
     }
-    moved = {node for targets in doc.channel_targets for node, path in targets if path in _NODE_PATHS} - staging
+    moved = doc.moved_nodes() - staging
     if not moved:
         raise doc.fail(
             "animations", "no skin, and no animation translates, turns or scales a node: no skeleton to read"

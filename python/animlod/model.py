@@ -482,14 +482,14 @@ class SkinnedMesh:
             return AnimatedMesh(self.faces, frames, fps=motion.fps)
         frames = np.empty((motion.frame_count, self.vertex_count, 3), np.float32)
         for t in range(motion.frame_count):  # O(T) calls, each a whole frame in C++
-            rest = morphed(self.rest_positions, self.morph_targets, morph_weights[t], 1)[0]
+            rest = morphed(self.rest_positions, self.morph_targets, morph_weights[t])
             frames[t] = bake_lbs(rest, self.joints, self.weights, matrices[t : t + 1])[0]
         return AnimatedMesh(self.faces, frames, fps=motion.fps)
 
     def default_shape(self) -> np.ndarray:
         """(V, 3) float32 bind shape with the morph targets at their default weights: what the
         skeleton poses where no animation drives the weights."""
-        return morphed(self.rest_positions, self.morph_targets, self.default_morph_weights, 1)[0]
+        return morphed(self.rest_positions, self.morph_targets, self.default_morph_weights)
 
     def rest_pose(self) -> np.ndarray:
         """(V, 3) float32 positions skinned by the skeleton's rest pose: what a viewer shows with no
@@ -508,13 +508,19 @@ class SkinnedMesh:
         return np.einsum("vij,nvj->nvi", blended, self.morph_targets).astype(np.float32)
 
 
-def morphed(bind: np.ndarray, targets: np.ndarray | None, weights: np.ndarray | None, count: int) -> np.ndarray:
-    """(count, V, 3) float32: the shape ``bind`` (V, 3) with its morph ``targets``
-    (N, V, 3) at ``weights``, (count, N) or (N,) for every frame (None: all 0)."""
+def morphed(
+    bind: np.ndarray, targets: np.ndarray | None, weights: np.ndarray | None, count: int | None = None
+) -> np.ndarray:
+    """float32: the shape ``bind`` (V, 3) with its morph ``targets`` (N, V, 3) at ``weights`` (N,)
+    (None: all 0), (V, 3); with ``count``, (count, V, 3), one shape per frame for ``weights``
+    (count, N) or (N,)."""
+    shape = (1 if count is None else count,) + bind.shape
     if weights is None or not np.any(weights):
-        return np.broadcast_to(bind, (count,) + bind.shape).astype(np.float32)
-    shapes = bind.astype(np.float64) + np.einsum("...n,nvc->...vc", weights, targets)
-    return np.broadcast_to(shapes, (count,) + bind.shape).astype(np.float32)
+        shapes = np.broadcast_to(bind, shape).astype(np.float32)
+    else:
+        blended = bind.astype(np.float64) + np.einsum("...n,nvc->...vc", weights, targets)
+        shapes = np.broadcast_to(blended, shape).astype(np.float32)
+    return shapes[0] if count is None else shapes
 
 
 def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

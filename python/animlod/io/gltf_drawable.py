@@ -108,7 +108,7 @@ class Drawable:
         is 100x), the bind shape otherwise. Sizes and errors are taken on this one."""
         if self.skinned is not None:
             return self.skinned.rest_pose()
-        return morphed(self.bind_positions(), self.morph_targets, self.default_weights, 1)[0]
+        return morphed(self.bind_positions(), self.morph_targets, self.default_weights)
 
     def rest_morph_targets(self) -> np.ndarray | None:
         """(N, V, 3) morph deltas as they move :meth:`rest_positions`, or None."""

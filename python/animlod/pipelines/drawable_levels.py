@@ -114,7 +114,7 @@ class DrawableLevel:
         """(V', 3) what a viewer shows of the level with no animation (see Drawable.rest_positions)."""
         if self.skinned is not None:
             return self.skinned.rest_pose()
-        return morphed(self.bind, self.morph_targets, self.default_weights, 1)[0]
+        return morphed(self.bind, self.morph_targets, self.default_weights)
 
 
 @dataclass

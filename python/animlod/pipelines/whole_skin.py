@@ -133,7 +133,7 @@ def _joined_targets(
             unset = np.isnan(defaults[places])
             defaults[np.asarray(places)[unset]] = own[unset]
             if np.any(own != defaults[places]):
-                shapes[k] = morphed(part.rest_positions, part.morph_targets, own - defaults[places], 1)[0]
+                shapes[k] = morphed(part.rest_positions, part.morph_targets, own - defaults[places])
         start += part.vertex_count
     names = None if union[0][0] is None else [name for name, _ in union]
     return targets, names, defaults, shapes

@@ -46,7 +46,9 @@ class GltfScene:
     skinned_nodes : the node that draws each skinned mesh, parallel to ``skinned_meshes``.
     skinned_rigs : the skin of each skinned mesh as a skeleton, parallel to ``skinned_meshes``;
         their ``joint_nodes`` tell which joints of two skins are one (names may repeat in a file).
-    body : the index in ``skinned_meshes`` of the character's body (:func:`_body_node`).
+    body : the index in ``skinned_meshes`` of the character's body: the mesh whose skin lists the
+        most joints the animations move, then the most joints, the first in node order among
+        equals (a visor or hair may come first in the file).
     """
 
     skinned_meshes: list[SkinnedMesh]
@@ -97,9 +99,9 @@ def read_skinned(
 ) -> tuple[SkinnedMesh, list[Motion]]:
     """One skinned mesh of a glTF file and its motions sampled at ``fps``.
 
-    ``skin`` picks the skin by index, or by skin or mesh name; None takes the body
-    (:func:`_body_node`). A file without that skin raises FormatError naming the file and the
-    skin asked for.
+    ``skin`` picks the skin by index, or by skin or mesh name; None takes the body (as
+    :attr:`GltfScene.body` picks it). A file without that skin raises FormatError naming the file
+    and the skin asked for.
     """
     doc = GltfDocument(path)
     nodes = _skinned_mesh_nodes(doc)

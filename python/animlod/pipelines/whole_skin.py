@@ -35,10 +35,10 @@ def whole_skin(
     body, motions, rig, body_node = (scene.skinned_meshes[scene.body], scene.skinned_motions[scene.body],
                                      scene.skinned_rigs[scene.body], scene.skinned_nodes[scene.body])  # fmt: skip
     parts = [body]
-    for index in (index for index in range(len(scene.skinned_meshes)) if index != scene.body):
-        mesh, node, part_rig = scene.skinned_meshes[index], scene.skinned_nodes[index], scene.skinned_rigs[index]
-        if not _targets_join(parts, mesh):
+    for index, mesh in enumerate(scene.skinned_meshes):
+        if index == scene.body or not _targets_join(parts, mesh):
             continue
+        node, part_rig = scene.skinned_nodes[index], scene.skinned_rigs[index]
         clips = scene.skinned_motions[index]
         keys = JointKeys(rig.joint_nodes, part_rig.joint_nodes)
         placement = placement_on(body, mesh, keys, join_clips(clips)[0] if clips else None)

@@ -363,6 +363,18 @@ def test_the_helmets_levels_share_the_bodys_skins(helmeted) -> None:
     assert by_name["helmet"]["skin"] != by_name["skinned mesh"]["skin"]
 
 
+def test_every_node_of_a_motion_level_records_its_skeletons_joints(helmeted) -> None:
+    # The helmet's geometry levels at motion level 0 recorded its own skin's 2 joints, while its
+    # base node and the body's nodes recorded the skeleton's.
+    output, _ = helmeted
+    joints: dict[int, set[int]] = {}
+    for node in GltfDocument(output).json["nodes"]:
+        info = node.get("extras", {}).get("animlod", {})
+        if "joints" in info:
+            joints.setdefault(info["motion_level"], set()).add(info["joints"])
+    assert len(joints) == 4 and all(len(counts) == 1 for counts in joints.values()), joints
+
+
 def test_a_crowd_poses_the_helmet_at_the_bodys_motion_level(binary, helmeted, tmp_path) -> None:
     # The body's chain and the helmet's choose their levels apart; a crowd draws the finest motion
     # level either chose for both, as for the meshes of one skin: here the body stays at level 0

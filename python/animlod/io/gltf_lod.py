@@ -9,7 +9,8 @@ primitives keep the input primitives' materials and attribute sets:
 - ``base.extras.MSFT_screencoverage = [c0, ..., cL]``: level i is used while the object covers
   at least ``c_i`` of the viewport height; ``cL = 0``;
 - ``extras.animlod = {"level", "error", "triangles", "mesh_level", "motion_level", "joints"}`` on
-  every node of the chain (``error`` in asset units).
+  every node of the chain (``error`` in asset units; ``joints``: the skeleton's joints at that
+  motion level, alike on every skin that plays it).
 
 Motion levels (fewer joints, see :mod:`animlod.pipelines.character`) add a reduced skeleton as
 its own joint nodes, a skin over them, and one animation per input clip with

@@ -421,7 +421,6 @@ def _write_grid(
     is bound to its owner's reduced skeletons at motion levels m >= 1. ``level_skins``: the reduced
     skins written so far, by joint nodes and inverse binds (shared across drawables)."""
     geometry: list[DrawableLevel | None] = [None, *levels.levels]  # geometry level 0 is the input
-    input_joints = len(doc.gltf.skins[drawable.skin_index].joints)
     frozen = [None] + [level.frozen for level in motion.reduced_levels]  # motion level 0 freezes nothing
     played = [_played(drawable.skinned if level is None else level.skinned, part) for level in geometry]
     to_bind = drawable.world if part is None else part.placement.transform @ drawable.world
@@ -447,8 +446,7 @@ def _write_grid(
             mesh = add_level_mesh(
                 builder, drawable.mesh_index, primitives, drawable.geometry.other_primitives, f"{mesh_name}_G{g}M{m}"
             )
-            joints = input_joints if m == 0 else motion_nodes[m].joints
-            info = LevelInfo(-1, 0.0, skinned.face_count, g, m, joints)
+            info = LevelInfo(-1, 0.0, skinned.face_count, g, m, motion_nodes[m].joints)
             grid[g][m] = [add_level_node(builder, base, mesh, skins[m], info) for base in drawable.nodes]
     return grid
 

@@ -22,7 +22,9 @@ fast-simplification from the ``bench`` extra). Tables:
 2. Speed with one frame to 10%: a procedural mesh of about 1M triangles (AQEM, meshoptimizer,
    fast-simplification) and the 200k-triangle sphere of bench/openmesh_build, on which
    OpenMesh's own Decimater with ModQuadric also runs; best of 3 rounds, the methods taking
-   turns; then AQEM's phases in its best run (``SimplifyResult.seconds``).
+   turns; then AQEM's phases in its best run (``SimplifyResult.seconds``). Then each method's
+   first call in a fresh process (best of 3) beside its best later call in this one, with the
+   fresh pages each faults in: fast-simplification keeps its arrays between calls.
 3. Time against the frame count F = 1, 4, 16, 64 on one animated procedural mesh.
 
 4. Feature weightings in the whole-glTF pipeline (``animlod.pipelines.simplify_drawable``, as
@@ -38,7 +40,7 @@ fast-simplification from the ``bench`` extra). Tables:
    about 17k triangles (and crane) against fast-simplification's frame-0 collapses replayed on
    every frame (issue 8's second speed goal); best of 5 rounds, the methods taking turns.
 
-``--tables quality,baked,characters,speed,frames,allframes`` picks tables (default: all).
+``--tables quality,baked,characters,speed,firstcall,frames,allframes`` picks tables (default: all).
 """
 
 from __future__ import annotations
@@ -46,6 +48,8 @@ from __future__ import annotations
 import argparse
 import ctypes
 import dataclasses
+import resource
+import subprocess
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -129,8 +133,6 @@ def openmesh_bench_sphere() -> AnimatedMesh:
 def openmesh_decimater_row() -> tuple | None:
     """Runs OpenMesh's own Decimater + ModQuadric (bench/openmesh_build, release OpenMesh) on its
     200k-triangle sphere; None when it cannot be built."""
-    import subprocess
-
     root = Path(__file__).resolve().parents[1]
     build = root / "build" / "openmesh_bench_release"
     binary = build / "openmesh_decimater_bench"
@@ -566,6 +568,62 @@ def speed_table(quick: bool) -> None:
     )
 
 
+# One call in a process of its own, timed with the fresh pages it faults in: the peers' modules
+# are imported before the clock starts, the mesh is built first, nothing runs before the call.
+_FIRST_CALL = """
+import resource, sys, time
+sys.path.insert(0, {bench!r})
+import bench_aqem, fast_simplification, meshoptimizer
+mesh = bench_aqem.bumpy_sphere({rings}, {segments}, 1)
+pages = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+start = time.perf_counter()
+getattr(bench_aqem, {function!r})(mesh, mesh.face_count // 10)
+print(time.perf_counter() - start, resource.getrusage(resource.RUSAGE_SELF).ru_minflt - pages)
+"""
+
+
+def first_call_table(quick: bool) -> None:
+    """Each method's first call in a fresh process against its best later call in one process:
+    fast-simplification keeps its arrays for the process's life (none faulted in after its first
+    call), while AQEM and meshoptimizer return theirs, so the speed table's best-of-rounds
+    compares AQEM's fresh memory with fast-simplification's reused memory."""
+    rings, segments = (240, 240) if quick else (710, 705)
+    functions = {
+        "AQEM": _aqem_one_frame,
+        "meshoptimizer simplify": _meshoptimizer_simplify,
+        "fast-simplification": _fast_simplification_simplify,
+    }
+    mesh = bumpy_sphere(rings, segments, frames=1)
+    rounds = 1 if quick else 3
+    first, later = dict.fromkeys(functions, (float("inf"), 0)), dict.fromkeys(functions, (float("inf"), 0))
+    for _ in range(rounds):  # taking turns, as the speed table does
+        for method, function in functions.items():
+            code = _FIRST_CALL.format(bench=str(Path(__file__).parent), rings=rings, segments=segments,
+                                      function=function.__name__)  # fmt: skip
+            seconds, pages = subprocess.run(
+                [sys.executable, "-c", code], check=True, capture_output=True, text=True
+            ).stdout.split()
+            first[method] = min(first[method], (float(seconds), int(pages)))
+            function(mesh, mesh.face_count // 10)  # this process's first call of it is not counted
+            pages = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+            with stopwatch() as elapsed:
+                function(mesh, mesh.face_count // 10)
+            later[method] = min(later[method], (elapsed[0], resource.getrusage(resource.RUSAGE_SELF).ru_minflt - pages))
+    baseline = "fast-simplification"
+    rows = [
+        (method, f"{mesh.face_count:,}", first[method][0], f"{first[method][1] / 1e3:.0f}k",
+         f"{first[method][0] / first[baseline][0]:.2f}", later[method][0], f"{later[method][1] / 1e3:.0f}k",
+         f"{later[method][0] / later[baseline][0]:.2f}")
+        for method in functions
+    ]  # fmt: skip
+    print_table(
+        f"First call in a fresh process against a later call in one process, one frame to 10% (best of {rounds})",
+        ("method", "input faces", "first call s", "fresh pages", "/ fast-simplification", "later call s",
+         "fresh pages", "/ fast-simplification"),
+        rows,
+    )  # fmt: skip
+
+
 def frame_count_table(quick: bool) -> None:
     rings, segments = (60, 60) if quick else (160, 160)
     rows = []
@@ -623,7 +681,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller inputs, for a smoke test")
     parser.add_argument(
-        "--tables", default="quality,baked,characters,speed,frames,allframes", help="comma-separated tables to print"
+        "--tables",
+        default="quality,baked,characters,speed,firstcall,frames,allframes",
+        help="comma-separated tables to print",
     )
     parser.add_argument("--max-triangles", type=int, default=12000, help="characters: skip larger drawables")
     args = parser.parse_args()
@@ -632,6 +692,7 @@ def main() -> None:
         "baked": baked_table,
         "characters": lambda quick: character_table(quick, args.max_triangles),
         "speed": speed_table,
+        "firstcall": first_call_table,
         "frames": frame_count_table,
         "allframes": all_frames_table,
     }

@@ -293,7 +293,7 @@ def test_spec_forms_and_their_errors(library, tmp_path):
         read_spec(f"{library}/*.nothing")
     (tmp_path / "fbx").mkdir()
     (tmp_path / "fbx" / "hero.fbx").write_bytes(b"")
-    with pytest.raises(SpecError, match=r"holds no asset \(.*\), but 1 model files of formats animlod does not read"):
+    with pytest.raises(SpecError, match=r"holds no asset \(.*\), but 1 model file in a format animlod does not read"):
         read_spec(tmp_path / "fbx")
     with pytest.raises(SpecError, match="does not take bvh input"):
         read_spec(library / "motions", job="simplify")

@@ -105,7 +105,7 @@ def test_model_formats_animlod_does_not_read_are_named_not_passed_over(tmp_path:
     (library / "hero.fbx").write_bytes(b"")
     (library / "props" / "crate.dae").write_bytes(b"")
     (library / "props" / ".hidden.fbx").write_bytes(b"")
-    note = "2 model files of formats animlod does not read (1 .dae, 1 .fbx); convert to glTF first"
+    note = "2 model files in formats animlod does not read (1 .dae, 1 .fbx); convert to glTF first"
     assert note in unread_models_note(library)
     with pytest.raises(FormatError, match=re.escape(f"folder: holds no .obj or .ply frame, but {note}")):
         input_kind(library)
@@ -115,5 +115,6 @@ def test_model_formats_animlod_does_not_read_are_named_not_passed_over(tmp_path:
     assert main(["info", str(library)]) == 0
     assert f"note: {library}: left out {note}" in capsys.readouterr().out
     (library / "hero.fbx").unlink()
+    assert "1 model file in a format animlod does not read (.dae); convert" in unread_models_note(library)
     (library / "props" / "crate.dae").unlink()
     assert unread_models_note(library) is None

@@ -104,8 +104,11 @@ def unread_models_note(folder: Path) -> str | None:
     )
     if not counts:
         return None
+    total = sum(counts.values())
+    if total == 1:
+        return f"1 model file in a format animlod does not read ({next(iter(counts))}); {_CONVERT_ADVICE}"
     kinds = ", ".join(f"{count} {suffix}" for suffix, count in sorted(counts.items()))
-    return f"{sum(counts.values())} model files of formats animlod does not read ({kinds}); {_CONVERT_ADVICE}"
+    return f"{total} model files in formats animlod does not read ({kinds}); {_CONVERT_ADVICE}"
 
 
 def _library_folders(folder: Path) -> Iterator[tuple[Path, list[str]]]:

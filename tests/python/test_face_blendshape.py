@@ -128,6 +128,11 @@ def test_pose_folders_pick_the_neutral_face(tmp_path, face):
     np.testing.assert_allclose(posed.targets[2], 0.1, atol=1e-6)
     with pytest.raises(FormatError, match="no file named 'absent.obj'"):
         pose_files(tmp_path, neutral="absent.obj")
+    scans = tmp_path / "scans"  # a scanned pose set's rest mesh, named after its folder
+    scans.mkdir()
+    for name in ("1.obj", "4.obj", "scans.obj"):
+        write_obj(scans / name, face.neutral, face.faces)
+    assert [p.name for p in pose_files(scans)] == ["scans.obj", "1.obj", "4.obj"]
     single = tmp_path / "single"
     single.mkdir()
     write_obj(single / "only.obj", face.neutral, face.faces)
@@ -190,7 +195,8 @@ def test_every_morph_target_file_as_one_lod_glb(data_dir, tmp_path, name):
 
 
 def test_the_face_pose_scans_as_a_blendshape_face(data_dir):
-    face = read_pose_face(data_dir / "meshseq" / "face-poses", neutral="face-poses.obj")
+    face = read_pose_face(data_dir / "meshseq" / "face-poses")  # its rest mesh, face-poses.obj, is the neutral
+    assert face.names == ["1", "4", "9"]
     assert face.target_count == 3 and face.vertex_count == 29299
     levels = build_blendshape_lod(face, BlendshapeLodOptions(ratios=(0.5,), animate_coarsest=True))
     assert levels[1].triangle_count <= len(face.faces) // 2 + 1

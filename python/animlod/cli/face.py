@@ -16,10 +16,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "lattices per region, simplified by AQEM with region-group importance over its expressions; each "
             "level animates only the regions of its active-tree level and uses 2x2x2 lattices where the geometry "
             "already lost as much. With a .glb/.gltf with morph targets, or a folder of OBJ/PLY poses (the "
-            "neutral face first, or named *neutral*/*reference*, then the expressions): targets ranked by the "
-            "largest displacement they cause, the least important pruned per level, the mesh simplified with the "
-            "kept targets carried. Writes one GLB per level (morph targets), a JSON manifest and a table of "
-            "sizes, time per frame and surface error against the full face."
+            "neutral face named *neutral*/*reference*, else after its folder, else the first; then the "
+            "expressions): targets ranked by the largest displacement they cause, the least important pruned per "
+            "level, the mesh simplified with the kept targets carried. Writes one GLB per level (morph targets), a "
+            "JSON manifest and a table of sizes, time per frame and surface error against the full face."
         ),
     )
     parser.add_argument("input", nargs="?", help="a .glb/.gltf with morph targets or a folder of poses "

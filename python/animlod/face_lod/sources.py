@@ -2,8 +2,10 @@
 read with their document, :func:`animlod.face_lod.lod_glb.read_gltf_face`).
 
 A pose folder's neutral face is the file named ``neutral``, else the one named
-``*reference*`` or ``*neutral*``, else the first in natural order; every other file is one
-expression target, and the animation raises and lowers each in turn.
+``*reference*`` or ``*neutral*``, else the one named after the folder (``face-poses/face-poses.obj``
+beside ``1.obj``, ``4.obj``..., as scanned pose sets ship their rest mesh), else the first in
+natural order; every other file is one expression target, and the animation raises and lowers
+each in turn.
 """
 
 from __future__ import annotations
@@ -29,7 +31,11 @@ def pose_files(folder: str | os.PathLike, neutral: str | None = None) -> list[Pa
         if not chosen:
             raise FormatError(str(folder), "neutral", f"no file named {neutral!r} in the folder")
     else:
-        chosen = [p for p in files if re.search("reference|neutral", p.name, re.IGNORECASE)] or files[:1]
+        chosen = (
+            [p for p in files if re.search("reference|neutral", p.name, re.IGNORECASE)]
+            or [p for p in files if p.stem.lower() == Path(folder).resolve().name.lower()]
+            or files[:1]
+        )
     return [chosen[0]] + [p for p in files if p != chosen[0]]
 
 

@@ -355,7 +355,8 @@ class Loader {
     }
     chain.has_errors = true;
     for (size_t i = 0; i < level_nodes.size(); ++i) {
-      chain.levels.push_back(read_level(level_nodes[i], "level " + std::to_string(i), static_cast<int>(i), 0));
+      const int finest_rig = i == 0 ? -1 : chain.levels[0].rig;
+      chain.levels.push_back(read_level(level_nodes[i], "level " + std::to_string(i), static_cast<int>(i), 0, finest_rig));
       Level& level = chain.levels.back();
       if (chain.has_coverages) level.coverage = coverages[i];
       const Value* extras = animlod_extras(model_.nodes[static_cast<size_t>(level.node)].extras);
@@ -375,7 +376,7 @@ class Loader {
           bool listed = false;
           for (const Level& level : chain.levels) listed = listed || level.node == cell;
           if (listed) continue;
-          chain.levels.push_back(read_level(cell, label, static_cast<int>(g), static_cast<int>(m)));
+          chain.levels.push_back(read_level(cell, label, static_cast<int>(g), static_cast<int>(m), chain.levels[0].rig));
           chain.levels.back().mesh_level = static_cast<int>(g);  // the grid's place wins over extras
           chain.levels.back().motion_level = static_cast<int>(m);
         }
@@ -402,7 +403,8 @@ class Loader {
   }
 
   // A level node; (mesh_level, motion_level) hold where its extras.animlod does not say.
-  Level read_level(int node, const std::string& name, int mesh_level, int motion_level) {
+  // `finest_rig`: the rig of the chain's level 0 (-1 when reading level 0 itself).
+  Level read_level(int node, const std::string& name, int mesh_level, int motion_level, int finest_rig) {
     const tinygltf::Node& n = model_.nodes[static_cast<size_t>(node)];
     const std::string label = name + " (" + node_label(model_, node) + ")";
     if (n.mesh < 0 || static_cast<size_t>(n.mesh) >= model_.meshes.size()) fail(label, "has no mesh");
@@ -426,14 +428,15 @@ class Loader {
     asset_.meshes.push_back(read_mesh(n.mesh, asset_.rigs[static_cast<size_t>(level.rig)].joint_count(), label));
     for (size_t k = 0; k < original_clips_.size(); ++k) {
       std::vector<int> animations;
-      for (int original : original_clips_[k]) animations.push_back(animation_for(level, original, label, k));
+      for (int original : original_clips_[k])
+        animations.push_back(animation_for(level, original, finest_rig, label, k));
       level.clips.push_back(clip_for(level.rig, animations));
     }
     return level;
   }
 
   // The animation playing original clip `original` at the level's motion level.
-  int animation_for(const Level& level, int original, const std::string& label, size_t k) {
+  int animation_for(const Level& level, int original, int finest_rig, const std::string& label, size_t k) {
     if (level.motion_level == 0) return original;
     const std::set<int> nodes(asset_.rigs[static_cast<size_t>(level.rig)].nodes.begin(),
                               asset_.rigs[static_cast<size_t>(level.rig)].nodes.end());
@@ -446,9 +449,19 @@ class Loader {
       for (const tinygltf::AnimationChannel& channel : animation.channels)
         if (nodes.count(channel.target_node)) return static_cast<int>(a);
     }
+    // A clip of another character in the same file moves none of this chain's joints, so the
+    // character writes no motion level of it: the level stands still, as level 0 does.
+    if (finest_rig >= 0 && !moves_rig(finest_rig, original)) return original;
     fail(label, "motion level " + std::to_string(level.motion_level) + " has no animation for clip '" +
                     asset_.clip_names[k] + "' (" + animation_label(model_, original) +
                     ") targeting its skeleton (expected extras.animlod {clip, motion_level})");
+  }
+
+  bool moves_rig(int rig, int animation) const {
+    const std::vector<int>& nodes = asset_.rigs[static_cast<size_t>(rig)].nodes;
+    for (const tinygltf::AnimationChannel& channel : model_.animations[static_cast<size_t>(animation)].channels)
+      if (std::find(nodes.begin(), nodes.end(), channel.target_node) != nodes.end()) return true;
+    return false;
   }
 
   int rig_for_skin(int skin) {

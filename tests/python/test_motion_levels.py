@@ -82,6 +82,29 @@ def test_a_translating_non_root_joint_stays_and_the_rest_freeze() -> None:
     assert level.report.joint_count == 2 and level.report.failures == []
 
 
+def test_noisy_keys_beside_a_translating_joint_leave_the_level_rigid() -> None:
+    # Exporters key every joint's translation with float noise, and a clip with one translating
+    # joint (hips under a static root joint, as game rigs have) keeps all those keys. The re-fit
+    # holds the other bones at their key lengths, but forward kinematics ran through the noisy
+    # keys: it missed the re-fitted positions by the noise (3e-7 of the figure on Soldier given a
+    # root joint, where the frozen motion, the re-fit's fallback, broke its lengths too and
+    # frames fell back to it).
+    from animlod.motion_lod.frozen import frozen_motion
+
+    motion = tree_motion(12, translating=(1,))
+    noisy = motion.joint_translations.copy()
+    noisy[:, 2:] *= 1.0 + 1e-6 * np.random.default_rng(1).normal(size=noisy[:, 2:].shape)
+    motion = Motion(motion.skeleton, motion.root_positions, motion.local_rotations, 30.0, joint_translations=noisy)
+    analysis = analyze_motion(motion)
+    assert analysis.translating == [1]
+    size = np.ptp(motion.world_positions().reshape(-1, 3), axis=0).max()
+    level = build_level(motion, analysis, 6)
+    assert level.report.fk_residual < 1e-8 * size and level.report.failures == []  # 8e-8 through the noisy keys
+    held = frozen_motion(freeze(motion, analysis, analysis.priority[:6]), motion).joint_translations
+    np.testing.assert_array_equal(held[:, 2:], np.broadcast_to(held[0, 2:], held[:, 2:].shape))
+    np.testing.assert_array_equal(held[:, 1], noisy[:, 1])  # the translating joint keeps its path
+
+
 def test_float_noise_and_constant_keys_are_not_translation() -> None:
     motion = tree_motion(12)
     noisy = np.broadcast_to(motion.skeleton.offsets, motion.local_rotations.shape[:2] + (3,)).copy()

@@ -151,11 +151,26 @@ def frozen_motion(level: FrozenLevel, motion: Motion) -> Motion:
 
 
 def held_translations(level: FrozenLevel, motion: Motion) -> np.ndarray | None:
-    """``motion.joint_translations`` with each frozen joint's translation held at its key frame
-    (a joint with a small real translation can freeze), or None when the motion has none."""
+    """``motion.joint_translations`` with every joint that does not translate held at its key
+    frame's translation, or None when the motion has none: a frozen joint (one with a small real
+    translation can freeze) and a kept joint whose bone the level holds rigid. Exporters key
+    every joint's translation, with float noise (or a motion under the translation tolerance);
+    the re-fit holds those bones at their key lengths, and forward kinematics through the
+    per-frame keys missed its positions by that noise, as did the frozen motion, the re-fit's
+    fallback, whose lengths must hold exactly."""
     if motion.joint_translations is None:
         return None
-    translations = motion.joint_translations.copy()
-    frozen = np.flatnonzero(level.frozen)
-    translations[:, frozen] = level.key_translations[frozen]
+    return held_local_translations(level, motion)
+
+
+def held_local_translations(level: FrozenLevel, motion: Motion) -> np.ndarray:
+    """``motion.local_translations()`` (root positions in column 0) with the translations of
+    :func:`held_translations`; the input's own where nothing is frozen (no re-fit: the level is
+    the input)."""
+    translations = motion.local_translations()
+    if not level.frozen.any():
+        return translations
+    held = ~level.animated
+    held[0] = False  # the root's column is its path
+    translations[:, held] = level.key_translations[held]
     return translations

@@ -25,7 +25,7 @@ import numpy as np
 from .. import _core, rotations
 from ..model import Motion, Skeleton
 from .analysis import ZERO_LENGTH
-from .frozen import FrozenLevel, held_translations
+from .frozen import FrozenLevel, held_local_translations, held_translations
 
 
 def reduce_skeleton(level: FrozenLevel) -> Skeleton:
@@ -82,7 +82,7 @@ def recover_motion(level: FrozenLevel, positions: np.ndarray, motion: Motion) ->
         np.array([c for a in aims for c in a], dtype=np.int64),
         rotations.from_matrix(motion.world_transforms()[:, kept, :3, :3]),
         positions[:, kept],
-        _folded_offsets(level, motion.local_translations()),
+        _folded_offsets(level, held_local_translations(level, motion)),
     )
     local = world.copy()
     local[:, 1:] = rotations.multiply(rotations.conjugate(world[:, skeleton.parents[1:]]), world[:, 1:])

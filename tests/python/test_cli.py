@@ -168,6 +168,22 @@ def test_user_mistakes_exit_2_with_one_line(tmp_path, capsys, name, content, mes
     assert message in err and err.count("\n") == 1 and "Traceback" not in err
 
 
+def test_an_output_that_is_the_input_file_is_refused_before_anything_is_written(tmp_path, capsys):
+    # `animlod simplify hero.glb -o hero.glb` replaced the file it read with its LoD GLB.
+    from animlod import synth
+    from animlod.io import write_glb
+
+    character = synth.humanoid()
+    source = tmp_path / "hero.glb"
+    write_glb(source, character, [synth.humanoid_motion(character.skeleton, "walk", cycles=1)])
+    before = source.read_bytes()
+    for command in ("simplify", "character"):
+        assert main([command, str(source), "-o", str(tmp_path / "." / "hero.glb")]) == 2
+        err = capsys.readouterr().err
+        assert "hero.glb: is the input file; write the levels to another file" in err and err.count("\n") == 1
+    assert source.read_bytes() == before
+
+
 def test_demo_writes_the_character_and_its_lod_glb(tmp_path, capsys):
     from animlod.io import read_lod_chains
     from animlod.io.gltf import read_skinned

@@ -194,6 +194,15 @@ def _stdout_gone() -> bool:
     return gone
 
 
+def _check_output_is_not_input(source: str | os.PathLike | None, output: object) -> None:
+    """UserError when ``-o`` names the input file itself: the levels would replace the file
+    they are built from (a LoD GLB holds the input, but not byte for byte)."""
+    if source is None or not isinstance(output, (str, os.PathLike)) or not os.path.isfile(source):
+        return
+    if os.path.exists(output) and os.path.samefile(source, output):
+        raise UserError(f"-o {os.fspath(output)}: is the input file; write the levels to another file")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     try:
@@ -206,6 +215,7 @@ def main(argv: list[str] | None = None) -> int:
     if os.environ.get("ANIMLOD_DEBUG"):
         return int(args.run(args) or 0)  # tracebacks and live output, for telling a bug from a mistake
     try:
+        _check_output_is_not_input(source, getattr(args, "output", None))
         with _sigterm_unwinds(), _guarded_stderr(args.command):
             return int(args.run(args) or 0)
     except (UserError, MachineError) as error:

@@ -212,10 +212,12 @@ def main(argv: list[str] | None = None) -> int:
     source = getattr(args, "input", None) or getattr(args, "path", None)
     if not isinstance(source, (str, os.PathLike)):
         source = None  # e.g. crowd's --path, a list of navigation paths, names no input file
-    if os.environ.get("ANIMLOD_DEBUG"):
-        return int(args.run(args) or 0)  # tracebacks and live output, for telling a bug from a mistake
+    output = getattr(args, "output", None)
+    if os.environ.get("ANIMLOD_DEBUG"):  # tracebacks and live output, for telling a bug from a mistake
+        _check_output_is_not_input(source, output)
+        return int(args.run(args) or 0)
     try:
-        _check_output_is_not_input(source, getattr(args, "output", None))
+        _check_output_is_not_input(source, output)
         with _sigterm_unwinds(), _guarded_stderr(args.command):
             return int(args.run(args) or 0)
     except (UserError, MachineError) as error:

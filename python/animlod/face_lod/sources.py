@@ -31,9 +31,10 @@ def pose_files(folder: str | os.PathLike, neutral: str | None = None) -> list[Pa
         if not chosen:
             raise FormatError(str(folder), "neutral", f"no file named {neutral!r} in the folder")
     else:
+        folder_name = Path(folder).resolve().name.lower()
         chosen = (
             [p for p in files if re.search("reference|neutral", p.name, re.IGNORECASE)]
-            or [p for p in files if p.stem.lower() == Path(folder).resolve().name.lower()]
+            or [p for p in files if p.stem.lower() == folder_name]
             or files[:1]
         )
     return [chosen[0]] + [p for p in files if p != chosen[0]]

@@ -396,18 +396,23 @@ def _tidy_directions(attributes: dict[str, np.ndarray]) -> None:
         attributes["NORMAL"] = _unit(attributes["NORMAL"])
     if "TANGENT" in attributes:
         tangent = attributes["TANGENT"]
-        tangent[:, :3] = _unit(_perpendicular(tangent[:, :3], attributes.get("NORMAL")))
+        tangent[:, :3] = _tangent_directions(tangent[:, :3], attributes.get("NORMAL"))
         tangent[:, 3] = np.where(tangent[:, 3] < 0.0, -1.0, 1.0)
     for name in attributes:
         if name.startswith("COLOR_"):
             np.clip(attributes[name], 0.0, 1.0, out=attributes[name])
 
 
-def _perpendicular(vectors: np.ndarray, normals: np.ndarray | None) -> np.ndarray:
-    """``vectors`` less their part along the unit ``normals`` (Gram-Schmidt), if any."""
+def _tangent_directions(tangents: np.ndarray, normals: np.ndarray | None) -> np.ndarray:
+    """Unit ``tangents`` made perpendicular to the unit ``normals`` (Gram-Schmidt), if any. A
+    tangent along its normal (a hard edge's corner that kept another face's vertex) has nothing
+    across it and takes any perpendicular direction: a zero vector is no tangent."""
     if normals is None:
-        return vectors
-    return vectors - np.einsum("vc,vc->v", vectors, normals)[:, None] * normals
+        return _unit(tangents)
+    across = tangents - np.einsum("vc,vc->v", tangents, normals)[:, None] * normals
+    lost = ~across.any(axis=1)
+    across[lost] = np.cross(normals[lost], np.eye(3)[np.argmin(np.abs(normals[lost]), axis=1)])
+    return _unit(across)
 
 
 def _unit(vectors: np.ndarray) -> np.ndarray:
@@ -423,7 +428,8 @@ def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveA
     faces = primitive.faces
     corners = positions[faces]
     area_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    unit = _unit(area_normal).astype(np.float64)
+    length = np.linalg.norm(area_normal, axis=1, keepdims=True)
+    unit = area_normal / np.where(length > 0.0, length, 1.0)
     corner_vertex, corner_face = faces.ravel(), np.repeat(np.arange(len(faces)), 3)
     # Every pair of corners at one vertex: (a, b) with b running over a's vertex group.
     order = np.argsort(corner_vertex, kind="stable")
@@ -433,10 +439,20 @@ def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveA
     a = np.repeat(order, group_size)
     offsets = np.arange(a.size) - np.repeat(np.cumsum(group_size) - group_size, group_size)
     b = order[np.repeat(group_start, group_size) + offsets]
-    close = np.einsum("pc,pc->p", unit[corner_face[a]], unit[corner_face[b]]) >= np.cos(crease) - 1e-9
+    # A corner always takes its own face (at crease 0, rounding can put a unit vector's dot with
+    # itself below cos 0 = 1, which left flat-shaded levels with zero normals).
+    close = (a == b) | (np.einsum("pc,pc->p", unit[corner_face[a]], unit[corner_face[b]]) >= np.cos(crease) - 1e-9)
     normal = np.zeros((corner_vertex.size, 3))
     np.add.at(normal, a[close], area_normal[corner_face[b[close]]])
     normal = _unit(normal)
+    # A degenerate face's corner gets nothing (its face has no normal): it takes its vertex's
+    # smooth normal, or +Z where every face at the vertex is degenerate.
+    lost = ~normal.any(axis=1)
+    if lost.any():
+        smooth = np.zeros((len(positions), 3))
+        np.add.at(smooth, corner_vertex, area_normal[corner_face])
+        normal[lost] = _unit(smooth[corner_vertex[lost]])
+        normal[~normal.any(axis=1)] = (0.0, 0.0, 1.0)
     # One output vertex per (vertex, normal).
     keys = np.concatenate([corner_vertex[:, None].astype(np.float32), normal], axis=1)
     _, first, new_index = np.unique(keys, axis=0, return_index=True, return_inverse=True)
@@ -445,7 +461,7 @@ def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveA
     attributes["NORMAL"] = normal[first].astype(np.float32)
     if "TANGENT" in attributes:
         tangent = attributes["TANGENT"]
-        tangent[:, :3] = _unit(_perpendicular(tangent[:, :3], attributes["NORMAL"]))
+        tangent[:, :3] = _tangent_directions(tangent[:, :3], attributes["NORMAL"])
     targets = [{name: values[source] for name, values in target.items()} for target in primitive.targets]
     return PrimitiveArrays(primitive.source, attributes, new_index.reshape(-1, 3), targets, primitive.vertices[source])
 

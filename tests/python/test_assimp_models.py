@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from gltf_conformance import added_problems
 
 from animlod.cli import main
 from animlod.io.detect import assets_in
@@ -64,6 +65,9 @@ def test_every_command_ends_in_data_or_one_error_line(path: Path, tmp_path: Path
             assert len(lines) == 1, err
             match = ERROR_LINE.match(lines[0])
             assert match and match.group(1) == argv[0] and match.group(2) == str(path), lines[0]
+    levels = tmp_path / "levels.glb"
+    if levels.exists():  # what it wrote breaks no rule of glTF's that the input kept
+        assert added_problems(path, levels) == []
 
 
 def _model(relative: str) -> Path:
@@ -118,6 +122,7 @@ def test_gltfpack_output_reads_as_its_input(relative: str, flags: list[str], tmp
         assert np.abs(before - after).max() <= grid
     code, _, err = _run(["simplify", str(packed), "-o", str(tmp_path / "levels.glb")], capfd)
     assert code == 0, err
+    assert added_problems(packed, tmp_path / "levels.glb") == []
 
 
 def _corners(path: Path) -> list[np.ndarray]:
@@ -172,3 +177,5 @@ def test_assimp_gltf_exports_go_through(
     code, _, err = _run([command, str(exported), "-o", str(out)], capfd)
     assert code == 0, err
     assert warning is None or warning in err, err
+    if out.suffix == ".glb":
+        assert added_problems(exported, out) == []

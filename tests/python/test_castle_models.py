@@ -9,6 +9,7 @@ import hashlib
 from pathlib import Path
 
 import pytest
+from gltf_conformance import added_problems
 
 from animlod.cli import main
 from animlod.pipelines.motion import build_motion_levels
@@ -38,6 +39,7 @@ def test_every_model_is_described_and_simplified(path: Path, tmp_path: Path, cap
     assert main(["info", str(path)]) == 0
     assert main(["simplify", str(path), "-o", str(tmp_path / "levels.glb")]) == 0
     assert "Traceback" not in capfd.readouterr().err
+    assert added_problems(path, tmp_path / "levels.glb") == []
 
 
 @needs_examples
@@ -45,6 +47,7 @@ def test_every_model_is_described_and_simplified(path: Path, tmp_path: Path, cap
 def test_every_skinned_model_builds_its_character_chain(path: Path, tmp_path: Path, capfd) -> None:
     assert main(["character", str(path), "-o", str(tmp_path / "character.glb")]) == 0
     assert "Traceback" not in capfd.readouterr().err
+    assert added_problems(path, tmp_path / "character.glb") == []
 
 
 @needs_examples

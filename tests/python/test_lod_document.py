@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import json
 import os
 import subprocess
@@ -9,6 +10,7 @@ import subprocess
 import numpy as np
 import pygltflib
 import pytest
+from gltf_conformance import added_problems, problems
 from gltf_edits import append_accessor, draco_compressed, edit_glb, meshopt_compressed
 
 from animlod import synth
@@ -61,11 +63,43 @@ def _without_chain(node: dict) -> dict:
     return node
 
 
+def _without_weights(meshes: list[dict]) -> list[dict]:
+    """``meshes`` without their primitives' WEIGHTS_n (which a LoD GLB may rewrite)."""
+    meshes = copy.deepcopy(meshes)
+    for primitive in (p for mesh in meshes for p in mesh.get("primitives", [])):
+        primitive["attributes"] = {
+            k: v for k, v in primitive.get("attributes", {}).items() if not k.startswith("WEIGHTS_")
+        }
+    return meshes
+
+
+def _assert_weights_kept_or_normalised(before: GltfDocument, after: GltfDocument) -> None:
+    """Each vertex's stored skin weights as they were, or scaled to sum 1 (all-zero rows: weight 1
+    on the first joint): the one change to level 0 (animlod.io.stored_weights)."""
+    for mesh_index, mesh in enumerate(before.json.get("meshes", [])):
+        for index, primitive in enumerate(mesh.get("primitives", [])):
+            names = [k for k in primitive.get("attributes", {}) if k.startswith("WEIGHTS_")]
+            if not names:
+                continue
+            written = after.json["meshes"][mesh_index]["primitives"][index]["attributes"]
+            stored = np.hstack([before.accessor(primitive["attributes"][k], "t") for k in names]).astype(np.float64)
+            kept = np.hstack([after.accessor(written[k], "t") for k in names]).astype(np.float64)
+            changed = np.any(kept != stored, axis=1)
+            totals = stored[changed].sum(axis=1, keepdims=True)
+            first_joint = np.eye(stored.shape[1])[np.zeros(int(changed.sum()), int)]
+            expected = np.where(totals > 0.0, stored[changed] / np.where(totals > 0.0, totals, 1.0), first_joint)
+            np.testing.assert_allclose(kept[changed], expected, rtol=1e-6, atol=1e-7)
+
+
 def _assert_document_kept(source, output) -> None:
-    """Every object of ``source`` is in ``output`` at the same index with the same content."""
+    """Every object of ``source`` is in ``output`` at the same index with the same content, but
+    for level 0's skin weights made to sum to 1 where they did not."""
     before, after = GltfDocument(source), GltfDocument(output)
-    for kind in ("materials", "textures", "samplers", "skins", "scenes", "cameras", "meshes"):
+    for kind in ("materials", "textures", "samplers", "skins", "scenes", "cameras"):
         assert after.json.get(kind, [])[: len(before.json.get(kind, []))] == before.json.get(kind, []), kind
+    meshes = before.json.get("meshes", [])
+    assert _without_weights(after.json.get("meshes", [])[: len(meshes)]) == _without_weights(meshes)
+    _assert_weights_kept_or_normalised(before, after)
     nodes = len(before.json.get("nodes", []))
     for index, animation in enumerate(before.json.get("animations", [])):
         # The input's channels first, then its morph-weight channels again for the new level nodes.
@@ -94,6 +128,7 @@ def test_dev_files_keep_every_object_and_get_a_valid_chain(data_dir, tmp_path, n
     output = tmp_path / "out.glb"
     report = simplify_document(source, output, [0.5, 0.1], **QUICK)
     _assert_document_kept(source, output)
+    assert added_problems(source, output) == []
     doc = GltfDocument(output)
     drawables = read_drawables(GltfDocument(source))
     for drawable, drawn in zip(drawables, report.drawables):
@@ -496,6 +531,8 @@ def test_a_flat_shaded_mesh_simplifies_like_the_welded_one_and_stays_flat(tmp_pa
     level_normals = doc.accessor(primitive["attributes"]["NORMAL"], "n")[faces]
     np.testing.assert_allclose(level_normals[:, 0], level_normals[:, 1], atol=1e-6)  # flat again
     np.testing.assert_allclose(level_normals[:, 0], level_normals[:, 2], atol=1e-6)
+    np.testing.assert_allclose(np.linalg.norm(level_normals, axis=2), 1.0, atol=1e-6)  # none is zero
+    assert problems(tmp_path / "flat_lod.glb") == []
 
 
 def test_hard_edges_keep_their_tangents_and_normal_deltas_make_no_seams(tmp_path):
@@ -527,6 +564,7 @@ def test_hard_edges_keep_their_tangents_and_normal_deltas_make_no_seams(tmp_path
     normal = doc.accessor(primitive["attributes"]["NORMAL"], "n")
     np.testing.assert_allclose(np.linalg.norm(tangent[:, :3], axis=1), 1.0, atol=1e-5)
     np.testing.assert_allclose(np.einsum("vc,vc->v", tangent[:, :3], normal), 0.0, atol=1e-5)
+    assert problems(tmp_path / "tangents_lod.glb") == []  # unit normals too
     side = doc.accessor(primitive["attributes"]["POSITION"], "p")[:, 0]
     away = np.abs(side) > 0.05  # 5 cm from the middle, where a collapse may carry a vertex over
     assert away.mean() > 0.8

@@ -33,6 +33,7 @@ from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_drawable import Drawable, read_drawables
 from ..io.gltf_lod import ANIMLOD_EXTRA, LevelInfo, PrimitiveArrays, add_level_mesh, add_level_node, attach_chain
+from ..io.stored_weights import normalise_stored_weights
 from ..normals import vertex_normals
 from .blendshape import (
     BlendshapeFace,
@@ -157,10 +158,12 @@ def _shading_only(drawable: Drawable, face: BlendshapeFace) -> np.ndarray:
 def write_gltf_face_lod(
     path: str | os.PathLike, source: GltfFace, levels: GltfFaceLevels, errors: Sequence[float],
     coverages: Sequence[float],
-) -> None:  # fmt: skip
-    """The input document whole with the face's levels attached to each node that draws it."""
+) -> str | None:  # fmt: skip
+    """The input document whole with the face's levels attached to each node that draws it.
+    Returns a note when level 0's skin weights were rewritten (:mod:`animlod.io.stored_weights`)."""
     builder = GlbBuilder.from_document(source.doc)
     drawable = source.drawable
+    weights_note = normalise_stored_weights(builder, source.doc, drawable)
     name = source.doc.gltf.meshes[drawable.mesh_index].name or f"mesh{drawable.mesh_index}"
     meshes = [
         add_level_mesh(builder, drawable.mesh_index, primitives, drawable.geometry.other_primitives, f"{name}_LOD{i}")
@@ -169,6 +172,7 @@ def write_gltf_face_lod(
     for base in drawable.nodes:
         _attach(builder, base, meshes, drawable.skin_index, levels.levels, errors, coverages)
     builder.save(path)
+    return weights_note
 
 
 def write_new_face_lod(

@@ -205,8 +205,8 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
     )  # fmt: skip
     glb = output / glb_name(source, "_lod")
     if gltf is not None:
-        write_gltf_face_lod(glb, gltf, gltf_levels, errors, thresholds)
-        run.notes += gltf_levels.notes
+        weights_note = write_gltf_face_lod(glb, gltf, gltf_levels, errors, thresholds)
+        run.notes += gltf_levels.notes + ([weights_note] if weights_note else [])
     else:
         write_new_face_lod(glb, levels, face.names, face.weights, face.fps, errors, thresholds, "expressions")
     manifest = []

@@ -1,6 +1,7 @@
 """LoD chains in glTF 2.0: the LoD GLB.
 
-The input document stays whole and level 0 is its own mesh node, untouched. Lower levels are
+The input document stays whole and level 0 is its own mesh node, untouched but for skin weights
+that break glTF's unit sum (:mod:`.stored_weights`, which the pipelines apply). Lower levels are
 nodes listed by the base node's MSFT_lod extension (in no scene and no children list, so that
 any viewer shows level 0), with the base node's transform and skin, and their own meshes whose
 primitives keep the input primitives' materials and attribute sets:

@@ -49,6 +49,7 @@ from ..io.gltf_lod import (
 )
 from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import add_animation, add_skeleton, add_skin, influence_sets
+from ..io.stored_weights import normalise_stored_weights
 from ..metrics import hausdorff_distances
 from ..model import Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, build_motion_chain, joint_floor
@@ -219,6 +220,9 @@ def build_character(
             level.relative_error = level.error / levels.size if levels.size > 0 else 0.0
         chains[drawable.label], grids[drawable.label] = report, grid
         notes += [f"{drawable.label}: {note}" for note in levels.notes]
+        weights_note = normalise_stored_weights(builder, doc, drawable)
+        if weights_note:
+            notes.append(f"{drawable.label}: {weights_note}")
     for skin in set(chain_of.values()):
         members = [d for d in animated if chain_of[d.skin_index] == skin]
         _switch_together([chains[d.label] for d in members], [geometry[d.label].size for d in members])

@@ -22,6 +22,7 @@ from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_drawable import Drawable, read_drawables
 from ..io.gltf_lod import LevelInfo, add_level_mesh, add_level_node, attach_chain, screen_coverages
+from ..io.stored_weights import normalise_stored_weights
 from ..model import AnimatedMesh
 from .clip_import import with_clips
 from .drawable_levels import DrawableLevels, DrawableSettings, simplify_drawable
@@ -172,6 +173,9 @@ def _write_chain(
     """The input document with every drawable's levels attached to its nodes by MSFT_lod."""
     builder = GlbBuilder.from_document(doc)
     for drawable, levels, report in zip(drawables, simplified, reports):
+        note = normalise_stored_weights(builder, doc, drawable)
+        if note:
+            report.notes.append(note)
         meshes = [
             add_level_mesh(builder, drawable.mesh_index, level.primitives, drawable.geometry.other_primitives, name)
             for level, name in zip(levels.levels, _level_names(doc, drawable, len(levels.levels)))

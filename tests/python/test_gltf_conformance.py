@@ -1,0 +1,138 @@
+"""What animlod writes breaks none of glTF 2.0's rules that the Khronos validator reports as
+errors (tests/python/gltf_conformance.py), on procedural characters and on every dev file and
+command; the checker itself finds what it is for."""
+
+from __future__ import annotations
+
+import numpy as np
+import pygltflib
+import pytest
+from gltf_conformance import added_problems, problems
+from gltf_edits import append_accessor, edit_glb
+
+from animlod import synth
+from animlod.cli import main
+from animlod.io import write_glb
+from animlod.io.gltf_document import GltfDocument
+from animlod.pipelines import simplify_document
+from animlod.pipelines.character import build_character
+
+QUICK = {"frame_budget": 12, "measured_frames": 2}
+SKINNED = ["gltf/Monster.glb", "gltf/RiggedFigure.glb", "gltf/Soldier.glb", "gltf/Xbot.glb", "gltf/SimpleSkin.gltf"]
+MORPHED = ["morph/MorphStressTest.gltf", "morph/Parrot.glb", "morph/Stork.glb"]
+
+
+@pytest.fixture(scope="module")
+def humanoid_glb(tmp_path_factory):
+    path = tmp_path_factory.mktemp("humanoid") / "humanoid.glb"
+    character = synth.humanoid()
+    write_glb(path, character, [synth.humanoid_motion(character.skeleton, "walk")])
+    return path
+
+
+def _edited(source, target, edit):
+    def apply(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        primitive = gltf.meshes[0].primitives[0]
+        edit(gltf, blob, primitive, GltfDocument(source))
+
+    return edit_glb(source, target, apply)
+
+
+@pytest.mark.parametrize(
+    ("edit", "code"),
+    [
+        ("zero normal", "ACCESSOR_VECTOR3_NON_UNIT"),
+        ("weights of 0.9", "ACCESSOR_WEIGHTS_NON_NORMALIZED"),
+        ("weights a float step off", "ACCESSOR_WEIGHTS_NON_NORMALIZED"),
+        ("stale bounds", "ACCESSOR_MAX_MISMATCH"),
+        ("index past the vertices", "ACCESSOR_INDEX_OOB"),
+        ("rotation key of length 2", "ACCESSOR_ANIMATION_SAMPLER_OUTPUT_NON_NORMALIZED_QUATERNION"),
+    ],
+)
+def test_the_checker_finds_each_kind_of_error(humanoid_glb, tmp_path, edit, code):
+    def apply(gltf, blob, primitive, doc):
+        attributes = primitive.attributes
+        if edit == "zero normal":
+            normals = np.array(doc.accessor(attributes.NORMAL, "t"))
+            normals[5] = 0.0
+            attributes.NORMAL = append_accessor(gltf, blob, normals, "VEC3")
+        elif edit.startswith("weights"):
+            weights = np.array(doc.accessor(attributes.WEIGHTS_0, "t"), np.float32)
+            if edit == "weights of 0.9":
+                weights[3] *= 0.9
+            else:  # two weights whose float32 sum is the float below 1
+                weights[3] = [0.5, np.float32(0.5) - np.float32(2.0**-24), 0.0, 0.0]
+            attributes.WEIGHTS_0 = append_accessor(gltf, blob, weights, "VEC4")
+        elif edit == "stale bounds":
+            gltf.accessors[attributes.POSITION].max = [v + 1.0 for v in gltf.accessors[attributes.POSITION].max]
+        elif edit == "index past the vertices":
+            faces = np.array(doc.accessor(primitive.indices, "t")).astype(np.uint32)
+            faces[0] = gltf.accessors[attributes.POSITION].count
+            primitive.indices = append_accessor(gltf, blob, faces, "SCALAR")
+        else:
+            sampler = next(s for c, s in zip(gltf.animations[0].channels, gltf.animations[0].samplers)
+                           if c.target.path == "rotation")  # fmt: skip
+            rotations = 2.0 * np.array(doc.accessor(sampler.output, "t"))
+            sampler.output = append_accessor(gltf, blob, rotations.astype(np.float32), "VEC4")
+
+    assert problems(humanoid_glb) == []
+    edited = _edited(humanoid_glb, tmp_path / "edited.glb", apply)
+    assert [found[0] for found in problems(edited)] == [code]
+
+
+def test_level_zero_weights_that_break_the_unit_sum_are_written_normalised(humanoid_glb, tmp_path):
+    # Exporters write weights off 1 (Khronos' Monster: vertices at 0.24) or all zero (Blender):
+    # level 0 is written as the levels were built, from the weights normalised.
+    def apply(gltf, blob, primitive, doc):
+        weights = np.array(doc.accessor(primitive.attributes.WEIGHTS_0, "t"), np.float32)
+        weights[:40] *= 0.5
+        weights[40:45] = 0.0
+        primitive.attributes.WEIGHTS_0 = append_accessor(gltf, blob, weights, "VEC4")
+
+    source = _edited(humanoid_glb, tmp_path / "off.glb", apply)
+    assert {found[0] for found in problems(source)} == {"ACCESSOR_WEIGHTS_NON_NORMALIZED"}
+    output = tmp_path / "out.glb"
+    with pytest.warns(UserWarning, match="5 of 1862 vertices .* have no positive skin weight"):
+        report = simplify_document(source, output, [0.5], **QUICK)
+    assert problems(output) == []
+    assert any("skin weights of 45 vertices rewritten to sum to 1" in note for note in report.drawables[0].notes)
+    before, after = GltfDocument(source), GltfDocument(output)
+    stored = np.asarray(before.accessor(before.json["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"], "t"))
+    written = np.asarray(after.accessor(after.json["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"], "t"))
+    np.testing.assert_allclose(written[:40], 2.0 * stored[:40], rtol=1e-6)
+    np.testing.assert_array_equal(written[40:45], [[1.0, 0.0, 0.0, 0.0]] * 5)
+    np.testing.assert_array_equal(written[45:], stored[45:])
+
+
+def test_a_procedural_character_chain_is_conformant(humanoid_glb, tmp_path):
+    output = tmp_path / "character.glb"
+    build_character(humanoid_glb, output, [0.5, 0.25], solver="newton", **QUICK)
+    assert problems(output) == []
+
+
+@pytest.mark.parametrize("name", SKINNED + MORPHED)
+def test_simplify_adds_no_error_to_a_dev_file(data_dir, tmp_path, name):
+    output = tmp_path / "levels.glb"
+    assert main(["simplify", str(data_dir / name), "-o", str(output), "--max-frames", "12"]) == 0
+    assert added_problems(data_dir / name, output) == []
+
+
+@pytest.mark.parametrize("name", SKINNED)
+def test_character_chains_of_the_dev_characters_are_conformant(data_dir, tmp_path, name):
+    # Their inputs' one kind of error, weights that do not sum to 1, is mended at level 0.
+    output = tmp_path / "character.glb"
+    assert main(["character", str(data_dir / name), "-o", str(output), "--max-frames", "12"]) == 0
+    assert problems(output) == []
+
+
+@pytest.mark.parametrize("name", MORPHED)
+def test_face_levels_add_no_error_to_a_dev_file(data_dir, tmp_path, name):
+    assert main(["face", str(data_dir / name), "-o", str(tmp_path / "face")]) == 0
+    (written,) = (tmp_path / "face").glob("*.glb")
+    assert added_problems(data_dir / name, written) == []
+
+
+def test_motion_levels_of_a_dev_character_are_conformant(data_dir, tmp_path):
+    assert main(["motion", str(data_dir / "gltf/Soldier.glb"), "-o", str(tmp_path), "--levels", "3"]) == 0
+    written = sorted(tmp_path.glob("*.glb"))
+    assert len(written) == 3 and all(problems(path) == [] for path in written)

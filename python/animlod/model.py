@@ -524,16 +524,25 @@ def morphed(
 
 
 def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Sort influences by decreasing weight and normalise them to sum 1 per vertex.
+    """Merge a vertex's influences of one joint, sort them by decreasing weight and normalise them
+    to sum 1 per vertex.
 
-    A vertex with all-zero weights is an error (it would not move with any joint).
-    Returns ``joints (V, K) int32`` and ``weights (V, K) float32``.
+    Influences of one joint add up, as a skinning shader adds them; glTF forbids a joint twice in
+    a vertex's influences, and exporters write it. A vertex with all-zero weights is an error (it
+    would not move with any joint). Returns ``joints (V, K) int32`` and ``weights (V, K) float32``.
     """
     weights = np.asarray(weights, dtype=np.float64)
     totals = weights.sum(axis=1)
     if np.any(totals <= 0.0):
         vertex = int(np.argmax(totals <= 0.0))
         raise ValueError(f"weights: vertex {vertex} has no positive skin weight")
+    joints = np.asarray(joints)
+    weights = weights.copy()
+    for later in range(1, weights.shape[1]):  # into the joint's first slot; the slots' order stays
+        for first in range(later):
+            repeat = joints[:, later] == joints[:, first]
+            weights[repeat, first] += weights[repeat, later]
+            weights[repeat, later] = 0.0
     order = np.argsort(-weights, axis=1, kind="stable")
     weights = np.take_along_axis(weights, order, axis=1) / totals[:, None]
     joints = np.take_along_axis(np.asarray(joints), order, axis=1)

@@ -104,6 +104,19 @@ def test_level_zero_weights_that_break_the_unit_sum_are_written_normalised(human
     np.testing.assert_array_equal(written[45:], stored[45:])
 
 
+def test_levels_of_a_skin_that_lists_a_joint_twice_list_it_once(humanoid_glb, tmp_path):
+    def apply(gltf, blob, primitive, doc):
+        halves = 0.5 * np.array(doc.accessor(primitive.attributes.WEIGHTS_0, "t"), np.float32)
+        primitive.attributes.WEIGHTS_0 = append_accessor(gltf, blob, halves, "VEC4")
+        primitive.attributes.WEIGHTS_1 = append_accessor(gltf, blob, halves, "VEC4")
+        primitive.attributes.JOINTS_1 = primitive.attributes.JOINTS_0
+
+    source = _edited(humanoid_glb, tmp_path / "twice.glb", apply)
+    assert {found[0] for found in problems(source)} == {"ACCESSOR_JOINTS_INDEX_DUPLICATE"}
+    simplify_document(source, tmp_path / "out.glb", [0.5], **QUICK)
+    assert added_problems(source, tmp_path / "out.glb") == []
+
+
 def test_a_procedural_character_chain_is_conformant(humanoid_glb, tmp_path):
     output = tmp_path / "character.glb"
     build_character(humanoid_glb, output, [0.5, 0.25], solver="newton", **QUICK)

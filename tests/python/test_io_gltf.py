@@ -59,20 +59,17 @@ def _box_along_y(rings: int = 5) -> tuple[np.ndarray, np.ndarray]:
     return positions.astype(np.float32), np.array(faces, np.int32)
 
 
-def _chain_mesh(influences: int = 4, extras: bool = True) -> SkinnedMesh:
+def _chain_mesh(extras: bool = True) -> SkinnedMesh:
     skeleton = _chain_skeleton()
     positions, faces = _box_along_y()
     vertex_count = len(positions)
     # Weights fall off with the distance along the chain from each joint (rest heights 0, 1, 2).
     height = positions[:, 1:2]
     raw = np.maximum(1.0 - np.abs(height - np.array([[0.0, 1.0, 2.0]])), 0.0) + 0.05
-    joints = np.zeros((vertex_count, influences), np.int32)
-    weights = np.zeros((vertex_count, influences))
+    joints = np.zeros((vertex_count, 4), np.int32)
+    weights = np.zeros((vertex_count, 4))
     joints[:, :3] = [0, 1, 2]
     weights[:, :3] = raw
-    if influences == 8:  # spread some weight to further slots so the second set is used
-        joints[:, 4:7] = [2, 1, 0]
-        weights[:, 4:7] = raw[:, ::-1] * 0.25
     # Bound in a straight pose that differs from the skeleton's rest pose, as in real files.
     bind_pose = Skeleton(skeleton.names, skeleton.parents, [[0, 0, 0], [0, 1, 0], [0, 1, 0]])
     inverse_bind = np.linalg.inv(bind_pose.rest_world_transforms())
@@ -266,9 +263,43 @@ def test_written_rotation_keys_have_no_sign_flips(tmp_path):
     np.testing.assert_allclose(read.world_transforms(), motion.world_transforms(), atol=1e-6)
 
 
+def _eight_influences() -> SkinnedMesh:
+    """The procedural humanoid with four more influences per vertex, each on a joint the vertex
+    does not use yet (glTF allows a joint once per vertex), weighted lightly."""
+    character = synth.humanoid()
+    rows = np.arange(character.vertex_count)[:, None]
+    used = np.zeros((character.vertex_count, character.skeleton.joint_count), bool)
+    np.logical_or.at(used, (rows, character.joints), character.weights > 0.0)
+    spare = np.argsort(used, axis=1, kind="stable")[:, :4]
+    return SkinnedMesh(
+        character.rest_positions,
+        character.faces,
+        np.concatenate([character.joints, spare], axis=1),
+        np.concatenate([character.weights, np.full(spare.shape, 0.05)], axis=1),
+        character.inverse_bind,
+        character.skeleton,
+    )
+
+
+def test_merged_duplicate_influences_keep_a_vertex_where_a_shader_puts_it():
+    # Exporters can list one joint twice for a vertex: a shader adds both; glTF forbids it.
+    character = synth.humanoid()
+    twice = SkinnedMesh(
+        character.rest_positions,
+        character.faces,
+        np.concatenate([character.joints, character.joints], axis=1),
+        np.concatenate([character.weights, character.weights], axis=1) / 2.0,
+        character.inverse_bind,
+        character.skeleton,
+    )
+    np.testing.assert_array_equal(twice.joints[:, :4], character.joints)
+    np.testing.assert_allclose(twice.weights[:, :4], character.weights, atol=1e-6)
+    assert not twice.weights[:, 4:].any()
+
+
 def test_round_trip_eight_influences_and_no_optional_attributes(tmp_path):
-    mesh = _chain_mesh(influences=8, extras=False)
-    assert np.count_nonzero(mesh.weights[:, 4:]) > 0
+    mesh = _eight_influences()
+    assert (np.count_nonzero(mesh.weights, axis=1) > 4).all()  # every vertex needs the second set
     path = tmp_path / "k8.glb"
     write_glb(path, mesh, [])
     read, motions = read_skinned(path)
@@ -804,7 +835,7 @@ def test_tinygltf_loads_what_animlod_writes(tmp_path):
     probe = os.environ.get("ANIMLOD_GLTF_PROBE")
     if not probe:
         pytest.skip("ANIMLOD_GLTF_PROBE is not set (make test sets it to the built animlod_gltf_probe)")
-    mesh = _chain_mesh(influences=8)
+    mesh = _chain_mesh()
     motions = [_chain_motion(mesh.skeleton), _chain_motion(mesh.skeleton, frames=11, fps=30.0, name="long")]
     path = tmp_path / "probe.glb"
     write_glb(path, mesh, motions)

@@ -514,8 +514,8 @@ def _check_images(glb: _Glb, report) -> None:
     for index, image in enumerate(glb.json.get("images", [])):
         if "bufferView" not in image:
             continue
-        if "mimeType" not in image:
-            report("UNSATISFIED_DEPENDENCY", f"/images/{index}", "mimeType")
+        if not isinstance(image.get("mimeType"), str):
+            report("UNSATISFIED_DEPENDENCY", f"/images/{index}", f"mimeType {image.get('mimeType')!r}")
             continue
         signature = _SIGNATURES.get(image["mimeType"])
         if signature and not glb.view_bytes(image["bufferView"]).startswith(signature):

@@ -688,6 +688,25 @@ def test_an_image_written_with_backslashes_is_embedded_and_a_missing_one_keeps_i
     assert kept == {"uri": "C:\\Users\\me\\gone.png"}
 
 
+def test_embedded_images_take_the_type_their_bytes_say(humanoid_glb, tmp_path):
+    # Texture files without a suffix, DDS textures (MSFT_texture_dds) and PNG data named .jpg:
+    # the type came from the name, so two were written with "mimeType": null (invalid JSON for
+    # glTF) and one as JPEG.
+    png = b"\x89PNG\r\n\x1a\n" + bytes(8)
+    for name, data in (("noext", png), ("actually_png.jpg", png), ("tex.dds", b"DDS " + bytes(124))):
+        (tmp_path / name).write_bytes(data)
+    (tmp_path / "unknown.tex").write_bytes(bytes(16))
+    images = [{"uri": name} for name in ("noext", "actually_png.jpg", "tex.dds", "unknown.tex")]
+    source = _edited(humanoid_glb, tmp_path, lambda js: js.__setitem__("images", images))
+    output = tmp_path / "out.glb"
+    with pytest.warns(UserWarning, match="image 3: 'unknown.tex' is of no image type glTF knows"):
+        simplify_document(source, output, [0.5], **QUICK)
+    written = GltfDocument(output).json["images"]
+    assert [image.get("mimeType") for image in written] == ["image/png", "image/png", "image/vnd-ms.dds", None]
+    assert written[3] == {"uri": "unknown.tex"}
+    assert [code for code, _, _ in problems(output)] == []
+
+
 def test_a_document_in_latin_1_is_read_with_a_warning_and_written_as_utf_8(humanoid_glb, tmp_path, capsys):
     # assimp's glTF exporter writes names in Latin-1 ("Terraind\xe6k" of its OBJ test set).
     data = humanoid_glb.read_bytes()

@@ -37,7 +37,17 @@ _COMPONENT_TYPES = {
     np.dtype("uint32"): UNSIGNED_INT,
 }
 _ACCESSOR_TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
-_IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".webp": "image/webp"}
+_IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".webp": "image/webp",
+                ".ktx2": "image/ktx2", ".dds": "image/vnd-ms.dds", ".avif": "image/avif"}  # fmt: skip
+# Leading bytes of the image formats glTF and its extensions embed: (offset, bytes) -> MIME type.
+_IMAGE_SIGNATURES = (
+    ((0, b"\x89PNG\r\n\x1a\n"), "image/png"),
+    ((0, b"\xff\xd8\xff"), "image/jpeg"),
+    ((8, b"WEBP"), "image/webp"),
+    ((0, b"\xabKTX 20\xbb\r\n\x1a\n"), "image/ktx2"),
+    ((0, b"DDS "), "image/vnd-ms.dds"),
+    ((4, b"ftypavif"), "image/avif"),
+)
 _GLB_MAGIC, _GLB_VERSION = b"glTF", 2
 # Extensions known not to refer to accessors or buffer views from places prune() does not scan.
 _PRUNE_SAFE_EXTENSIONS = (
@@ -76,12 +86,18 @@ class GlbBuilder:
             _drop_extension(builder.json, name)
         for index, image in enumerate(builder.json.get("images", [])):
             found = _image_bytes(doc, index, image["uri"]) if "uri" in image else None
-            if found is not None:
-                data, mime = found
-                del image["uri"]
-                image["bufferView"] = len(views)
-                views.append({"buffer": 0, "byteOffset": builder._append(data), "byteLength": len(data)})
-                image.setdefault("mimeType", mime)
+            if found is None:
+                continue
+            data, mime = found
+            mime = image_type(data) or image.get("mimeType") or mime
+            if mime is None:  # glTF needs the type of an embedded image: it stays a file
+                warnings.warn(f"{doc.path}: image {index}: {image['uri']!r} is of no image type glTF knows; "
+                              "the output refers to it as the input did", stacklevel=2)  # fmt: skip
+                continue
+            del image["uri"]
+            image["bufferView"] = len(views)
+            views.append({"buffer": 0, "byteOffset": builder._append(data), "byteLength": len(data)})
+            image["mimeType"] = mime
         if views:
             builder.json["bufferViews"] = views
         return builder
@@ -232,6 +248,16 @@ def _animates_meshes(js: dict) -> bool:
     return any(isinstance(p, dict) and str(p.get("pointer", "")).startswith("/meshes/") for p in pointers)
 
 
+def image_type(data: bytes) -> str | None:
+    """The MIME type of an image by its leading bytes (PNG, JPEG, WebP, KTX2, DDS, AVIF), or None.
+    Files say what they are better than their names: exporters write PNG data as ``.jpg``, and
+    texture names without a suffix."""
+    for (offset, signature), mime in _IMAGE_SIGNATURES:
+        if data[offset : offset + len(signature)] == signature:
+            return mime
+    return None
+
+
 def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | None] | None:
     """The bytes and MIME type of an image given by a data URI or a file next to the document;
     None, with a warning, for a file that is not there. Textures left behind are common (a path
@@ -245,7 +271,8 @@ def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | 
             raise doc.fail(f"image {index}", f"malformed data URI ({error})") from None
     if (path := image_file(doc.path, uri)) is not None:
         with contextlib.suppress(OSError):  # there but unreadable: kept by its URI as a missing one is
-            return path.read_bytes(), _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0]
+            guess = _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0] or ""
+            return path.read_bytes(), guess if guess.startswith("image/") else None  # not .tex's text/x-tex
     missing = uri_path(doc.path, uri.replace("\\", "/"))
     warnings.warn(f"{doc.path}: image {index}: {missing} not found; the output refers to {uri!r} as the input did",
                   stacklevel=3)  # fmt: skip

@@ -265,6 +265,17 @@ def _parents(doc: dict, report) -> dict[int, int]:
     return parent
 
 
+def _scene_nodes(doc: dict, scene: dict) -> list[int]:
+    """Every node of ``scene``'s trees."""
+    found, stack = [], list(scene.get("nodes", []))
+    while stack:
+        node = stack.pop()
+        if node not in found:
+            found.append(node)
+            stack.extend(doc["nodes"][node].get("children", []))
+    return found
+
+
 def _check_nodes(doc: dict, report) -> None:
     nodes = doc.get("nodes", [])
     parent = _parents(doc, report)
@@ -437,10 +448,31 @@ def _check_influences(glb: _Glb, attributes: dict, max_joint: int, where: str, r
         report("ACCESSOR_WEIGHTS_NON_NORMALIZED", f"{where}/attributes/WEIGHTS_0", detail)
 
 
+def _ancestry(parent: dict[int, int], node: int) -> list[int]:
+    """``node`` and its ancestors, up to its root (a loop, reported elsewhere, stops the walk)."""
+    chain = [node]
+    while chain[-1] in parent and parent[chain[-1]] not in chain:
+        chain.append(parent[chain[-1]])
+    return chain
+
+
 def _check_skins(glb: _Glb, report) -> None:
-    for index, skin in enumerate(glb.json.get("skins", [])):
+    doc = glb.json
+    parent = _parents(doc, lambda *args: None)
+    in_scene = [set(_scene_nodes(doc, scene)) for scene in doc.get("scenes", [])]
+    for index, skin in enumerate(doc.get("skins", [])):
         if len(set(skin["joints"])) != len(skin["joints"]):
             report("DUPLICATE_ELEMENTS", f"/skins/{index}/joints", "")
+        ancestries = [_ancestry(parent, joint) for joint in skin["joints"]]
+        roots = {chain[-1] for chain in ancestries}
+        if len(roots) > 1:
+            report("SKIN_NO_COMMON_ROOT", f"/skins/{index}", f"roots {sorted(roots)}")
+        elif "skeleton" in skin and not all(skin["skeleton"] in chain for chain in ancestries):
+            report("SKIN_SKELETON_INVALID", f"/skins/{index}/skeleton", str(skin["skeleton"]))
+        for scene_index, nodes in enumerate(in_scene):
+            drawn = any(doc["nodes"][n].get("skin") == index and "mesh" in doc["nodes"][n] for n in nodes)
+            if drawn and not roots <= nodes:
+                report("NODE_SKIN_NO_SCENE", f"/scenes/{scene_index}", f"skin {index}'s root not in the scene")
         if "inverseBindMatrices" in skin:
             accessor = glb.json["accessors"][skin["inverseBindMatrices"]]
             if accessor["count"] != len(skin["joints"]):

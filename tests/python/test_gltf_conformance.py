@@ -47,6 +47,7 @@ def _edited(source, target, edit):
         ("stale bounds", "ACCESSOR_MAX_MISMATCH"),
         ("index past the vertices", "ACCESSOR_INDEX_OOB"),
         ("rotation key of length 2", "ACCESSOR_ANIMATION_SAMPLER_OUTPUT_NON_NORMALIZED_QUATERNION"),
+        ("a joint made a scene root", "SKIN_NO_COMMON_ROOT"),
     ],
 )
 def test_the_checker_finds_each_kind_of_error(humanoid_glb, tmp_path, edit, code):
@@ -69,6 +70,10 @@ def test_the_checker_finds_each_kind_of_error(humanoid_glb, tmp_path, edit, code
             faces = np.array(doc.accessor(primitive.indices, "t")).astype(np.uint32)
             faces[0] = gltf.accessors[attributes.POSITION].count
             primitive.indices = append_accessor(gltf, blob, faces, "SCALAR")
+        elif edit == "a joint made a scene root":
+            joint = gltf.skins[0].joints[5]
+            next(node for node in gltf.nodes if joint in (node.children or [])).children.remove(joint)
+            gltf.scenes[0].nodes.append(joint)
         else:
             sampler = next(s for c, s in zip(gltf.animations[0].channels, gltf.animations[0].samplers)
                            if c.target.path == "rotation")  # fmt: skip

@@ -30,3 +30,15 @@ def binary() -> Path:
     if not os.environ.get("DISPLAY") and not shutil.which("xvfb-run"):
         pytest.skip("no display and no xvfb-run")
     return found
+
+
+@pytest.fixture(scope="session")
+def humanoid_glb(tmp_path_factory) -> Path:
+    """The procedural humanoid with a walk, as a GLB (animlod's own writer)."""
+    from animlod import synth
+    from animlod.io import write_glb
+
+    path = tmp_path_factory.mktemp("humanoid") / "humanoid.glb"
+    character = synth.humanoid()
+    write_glb(path, character, [synth.humanoid_motion(character.skeleton, "walk")])
+    return path

@@ -10,9 +10,7 @@ import pytest
 from gltf_conformance import added_problems, problems
 from gltf_edits import append_accessor, edit_glb
 
-from animlod import synth
 from animlod.cli import main
-from animlod.io import write_glb
 from animlod.io.gltf_document import GltfDocument
 from animlod.pipelines import simplify_document
 from animlod.pipelines.character import build_character
@@ -20,14 +18,6 @@ from animlod.pipelines.character import build_character
 QUICK = {"frame_budget": 12, "measured_frames": 2}
 SKINNED = ["gltf/Monster.glb", "gltf/RiggedFigure.glb", "gltf/Soldier.glb", "gltf/Xbot.glb", "gltf/SimpleSkin.gltf"]
 MORPHED = ["morph/MorphStressTest.gltf", "morph/Parrot.glb", "morph/Stork.glb"]
-
-
-@pytest.fixture(scope="module")
-def humanoid_glb(tmp_path_factory):
-    path = tmp_path_factory.mktemp("humanoid") / "humanoid.glb"
-    character = synth.humanoid()
-    write_glb(path, character, [synth.humanoid_motion(character.skeleton, "walk")])
-    return path
 
 
 def _edited(source, target, edit):

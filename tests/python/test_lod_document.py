@@ -26,14 +26,6 @@ QUICK = {"frame_budget": 12, "measured_frames": 2}
 DEV_FILES = ["gltf/RiggedFigure.glb", "gltf/SimpleSkin.gltf", "morph/MorphStressTest.gltf", "morph/Stork.glb"]
 
 
-@pytest.fixture(scope="module")
-def humanoid_glb(tmp_path_factory):
-    path = tmp_path_factory.mktemp("humanoid") / "humanoid.glb"
-    character = synth.humanoid()
-    write_glb(path, character, [synth.humanoid_motion(character.skeleton, "walk")])
-    return path
-
-
 def _accessor_values(doc: GltfDocument, index: int) -> np.ndarray:
     return np.asarray(doc.accessor(index, "test"))
 

@@ -493,7 +493,8 @@ def _check_animations(glb: _Glb, report) -> None:
         for channel_index, channel in enumerate(animation["channels"]):
             where = f"/animations/{animation_index}/channels/{channel_index}"
             target = channel["target"]
-            key = (target.get("node"), target["path"])
+            pointer = (target.get("extensions") or {}).get("KHR_animation_pointer", {}).get("pointer")
+            key = (target.get("node"), target["path"], pointer)
             if key in targets:
                 report("ANIMATION_DUPLICATE_TARGETS", where, f"same as channel {targets[key]}")
             targets.setdefault(key, channel_index)

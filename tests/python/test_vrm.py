@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from gltf_conformance import problems
 
 from animlod import synth
 from animlod.batch.spec import read_spec
@@ -41,6 +42,7 @@ def test_simplify_writes_a_vrm_that_keeps_the_avatar_extension(avatar, tmp_path)
     assert main(["simplify", str(avatar), "-o", str(tmp_path), "--ratio", "0.5", "--max-frames", "6"]) == 0
     output = tmp_path / "avatar_lod.vrm"
     assert _hips_name(output) == "Hips"
+    assert problems(output) == []
     (chain,) = read_lod_chains(output)
     assert len(chain.levels) == 2
 
@@ -50,6 +52,7 @@ def test_character_writes_the_vrm_it_is_given(avatar, tmp_path) -> None:
     arguments = ["--ratio", "0.5", "--solver", "newton", "--max-frames", "6"]
     assert main(["character", str(avatar), "-o", str(output), *arguments]) == 0
     assert _hips_name(output) == "Hips"
+    assert problems(output) == []
     (chain,) = read_lod_chains(output)
     assert chain.levels[1].mesh.face_count < chain.levels[0].mesh.face_count
 

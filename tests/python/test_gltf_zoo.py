@@ -503,3 +503,22 @@ def test_meshes_on_skins_of_the_same_joints_share_one_skeleton_per_motion_level(
                 tuple(doc.json["skins"][node["skin"]]["joints"])
             )
     assert sorted(joints_by_level) == [1, 2] and all(len(joints) == 1 for joints in joints_by_level.values())
+
+
+def test_motion_level_clips_last_as_long_as_the_clip_they_stand_for(tmp_path: Path) -> None:
+    # A clip keyed at 25 fps (or 120, as BVH clips added with --clips are) sampled at 30 fps
+    # ended up to a frame early at every motion level: a player looping each clip by its own
+    # length (the crowd benchmark does) drifted between levels by that much per loop.
+    character = synth.humanoid()
+    walk = synth.humanoid_motion(character.skeleton, "walk", cycles=1, fps=25.0)
+    duration = (walk.frame_count - 1) / walk.fps
+    assert duration * 30.0 % 1.0 > 0.1  # not a whole number of 30-fps frames
+    write_glb(tmp_path / "walk25.glb", character, [walk])
+    build_character(tmp_path / "walk25.glb", tmp_path / "lod.glb", [0.5], solver="newton",
+                    frame_budget=12, measured_frames=2)  # fmt: skip
+    doc = GltfDocument(tmp_path / "lod.glb")
+    ends = {
+        animation["name"]: max(doc.accessor(s["input"], "t").max() for s in animation["samplers"])
+        for animation in doc.json["animations"]
+    }
+    assert len(ends) > 1 and all(end == pytest.approx(duration, abs=1e-6) for end in ends.values()), ends

@@ -477,13 +477,19 @@ class GltfDocument:
         name = self.gltf.animations[index].name
         return f"animation {name!r}" if name else f"animation {index}"
 
-    def animation_frame_times(self, index: int, fps: float) -> np.ndarray:
-        """Sample times ``(T,)`` at ``fps`` from 0 to the last key time over all samplers of
-        animation ``index``: the clip length a viewer plays."""
+    def animation_duration(self, index: int) -> float:
+        """The last key time over all samplers of animation ``index``: the clip length a viewer
+        plays (from 0)."""
         label = self.animation_label(index)
         samplers = self.gltf.animations[index].samplers or []
         ends = [self.accessor(s.input, f"{label} sampler {k} input").max(initial=0.0) for k, s in enumerate(samplers)]
-        duration = float(max(ends, default=0.0))
+        return float(max(ends, default=0.0))
+
+    def animation_frame_times(self, index: int, fps: float) -> np.ndarray:
+        """Sample times ``(T,)`` at ``fps`` from 0 to the animation's duration (the last sample
+        within one frame of it)."""
+        label = self.animation_label(index)
+        duration = self.animation_duration(index)
         if duration * fps >= self.max_animation_frames:
             reason = (
                 f"lasts {duration:g} s: {int(duration * fps) + 1} frames at {fps:g} fps, more than the limit of "

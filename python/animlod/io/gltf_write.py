@@ -99,13 +99,26 @@ def add_skin(builder: GlbBuilder, joint_nodes: Sequence[int], inverse_bind: np.n
 
 
 def add_animation(
-    builder: GlbBuilder, motion: Motion, joint_nodes: Sequence[int], name: str, extras: dict | None = None
+    builder: GlbBuilder,
+    motion: Motion,
+    joint_nodes: Sequence[int],
+    name: str,
+    extras: dict | None = None,
+    duration: float | None = None,
 ) -> int:
     """``motion`` as a LINEAR animation of ``joint_nodes`` (one per joint of its skeleton); its index.
-    A rigid motion only: joint deformations have no TRS channels of their own (ValueError)."""
+    A rigid motion only: joint deformations have no TRS channels of their own (ValueError).
+
+    ``duration``: the length of the clip ``motion`` was sampled from, when its last frame falls
+    short of it (a clip of 8.275 s sampled at 30 fps ends at 8.267 s): a last key there holds the
+    last frame, so that the animation lasts as long as the clip it stands for and a player that
+    loops each by its own length keeps them in step."""
     motion.require_rigid("a glTF animation of a skeleton")
-    times = (np.arange(motion.frame_count) / motion.fps).astype(np.float32)[:, None]
-    time_accessor = builder.add(times, bounds=True)
+    times = np.arange(motion.frame_count) / motion.fps
+    held = duration is not None and np.float32(duration) > np.float32(times[-1])
+    if held:
+        times = np.append(times, duration)
+    time_accessor = builder.add(times.astype(np.float32)[:, None], bounds=True)
     joint_count = motion.skeleton.joint_count
     tracks = [(0, "translation", motion.root_positions)]
     if motion.joint_translations is not None:  # bones that stretch or slide get their own tracks
@@ -115,6 +128,8 @@ def add_animation(
     samplers, channels = [], []
     for joint, path, values in tracks:
         channels.append({"sampler": len(samplers), "target": {"node": joint_nodes[joint], "path": path}})
+        if held:
+            values = np.concatenate([values, values[-1:]])
         output = builder.add(np.ascontiguousarray(values, dtype=np.float32))
         samplers.append({"input": time_accessor, "output": output, "interpolation": _LINEAR})
     animation = {"name": name, "samplers": samplers, "channels": channels}

@@ -404,7 +404,8 @@ def _add_motion_levels(builder: GlbBuilder, doc: GltfDocument, motion: _SkinMoti
             name = f"{clip.name or f'animation {clip.index}'}@motion{m}"
             extras = {"animlod": {"clip": clip.index, "motion_level": m}}
             clip_motion = level.motion.take_frames(np.arange(span.start, span.stop))
-            animation = add_animation(builder, clip_motion, joint_nodes, name, extras)
+            duration = doc.animation_duration(clip.index)
+            animation = add_animation(builder, clip_motion, joint_nodes, name, extras, duration)
             carry_other_channels(builder, doc, posing, clip.index, animation, copies)
         nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))
     return nodes

@@ -688,14 +688,18 @@ def test_embedded_images_take_the_type_their_bytes_say(humanoid_glb, tmp_path):
     for name, data in (("noext", png), ("actually_png.jpg", png), ("tex.dds", b"DDS " + bytes(124))):
         (tmp_path / name).write_bytes(data)
     (tmp_path / "unknown.tex").write_bytes(bytes(16))
-    images = [{"uri": name} for name in ("noext", "actually_png.jpg", "tex.dds", "unknown.tex")]
+    unknown = "data:;base64," + "A" * 4000
+    images = [{"uri": name} for name in ("noext", "actually_png.jpg", "tex.dds", "unknown.tex", unknown)]
     source = _edited(humanoid_glb, tmp_path, lambda js: js.__setitem__("images", images))
     output = tmp_path / "out.glb"
-    with pytest.warns(UserWarning, match="image 3: 'unknown.tex' is of no image type glTF knows"):
+    with pytest.warns(UserWarning) as caught:
         simplify_document(source, output, [0.5], **QUICK)
+    said = [str(warning.message) for warning in caught]
+    assert any("image 3: 'unknown.tex' is of no image type glTF knows" in line for line in said)
+    assert any("image 4: its data URI is of no image type" in line and len(line) < 300 for line in said)
     written = GltfDocument(output).json["images"]
-    assert [image.get("mimeType") for image in written] == ["image/png", "image/png", "image/vnd-ms.dds", None]
-    assert written[3] == {"uri": "unknown.tex"}
+    assert [image.get("mimeType") for image in written] == ["image/png", "image/png", "image/vnd-ms.dds", None, None]
+    assert written[3:] == [{"uri": "unknown.tex"}, {"uri": unknown}]
     assert [code for code, _, _ in problems(output)] == []
 
 

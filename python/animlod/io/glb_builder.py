@@ -90,8 +90,9 @@ class GlbBuilder:
                 continue
             data, mime = found
             mime = image_type(data) or image.get("mimeType") or mime
-            if mime is None:  # glTF needs the type of an embedded image: it stays a file
-                warnings.warn(f"{doc.path}: image {index}: {image['uri']!r} is of no image type glTF knows; "
+            if mime is None:  # glTF needs the type of an embedded image: it stays as the input had it
+                uri = "its data URI" if image["uri"].startswith("data:") else repr(image["uri"])
+                warnings.warn(f"{doc.path}: image {index}: {uri} is of no image type glTF knows; "
                               "the output refers to it as the input did", stacklevel=2)  # fmt: skip
                 continue
             del image["uri"]

@@ -403,16 +403,37 @@ def _tidy_directions(attributes: dict[str, np.ndarray]) -> None:
             np.clip(attributes[name], 0.0, 1.0, out=attributes[name])
 
 
-def _tangent_directions(tangents: np.ndarray, normals: np.ndarray | None) -> np.ndarray:
+def _tangent_directions(
+    tangents: np.ndarray, normals: np.ndarray | None, fallback: np.ndarray | None = None
+) -> np.ndarray:
     """Unit ``tangents`` made perpendicular to the unit ``normals`` (Gram-Schmidt), if any. A
     tangent along its normal (a hard edge's corner that kept another face's vertex) has nothing
-    across it and takes any perpendicular direction: a zero vector is no tangent."""
+    across it: it takes ``fallback`` (its face's texture direction) across the normal where that
+    has a part across it, else any perpendicular direction: a zero vector is no tangent."""
     if normals is None:
         return _unit(tangents)
-    across = tangents - np.einsum("vc,vc->v", tangents, normals)[:, None] * normals
-    lost = ~across.any(axis=1)
-    across[lost] = np.cross(normals[lost], np.eye(3)[np.argmin(np.abs(normals[lost]), axis=1)])
-    return _unit(across)
+
+    def across(vectors: np.ndarray, unit_normals: np.ndarray) -> np.ndarray:
+        return vectors - np.einsum("vc,vc->v", vectors, unit_normals)[:, None] * unit_normals
+
+    result = across(tangents, normals)
+    lost = ~result.any(axis=1)
+    if fallback is not None:
+        result[lost] = across(fallback[lost], normals[lost])
+        lost = ~result.any(axis=1)
+    result[lost] = np.cross(normals[lost], np.eye(3)[np.argmin(np.abs(normals[lost]), axis=1)])
+    return _unit(result)
+
+
+def _texture_tangents(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) each face's direction of increasing u (dP/du from its corners' texture
+    coordinates, as MikkTSpace starts from); zero where the face's UVs are degenerate."""
+    edges = positions[faces[:, 1:]] - positions[faces[:, :1]]  # (F, 2, 3)
+    steps = (uvs[faces[:, 1:]] - uvs[faces[:, :1]]).astype(np.float64)  # (F, 2, 2)
+    area = steps[:, 0, 0] * steps[:, 1, 1] - steps[:, 1, 0] * steps[:, 0, 1]
+    usable = np.abs(area) > 1e-12
+    direction = edges[:, 0] * steps[:, 1, 1:2] - edges[:, 1] * steps[:, 0, 1:2]
+    return np.where(usable[:, None], direction / np.where(usable, area, 1.0)[:, None], 0.0)
 
 
 def _unit(vectors: np.ndarray) -> np.ndarray:
@@ -461,7 +482,9 @@ def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveA
     attributes["NORMAL"] = normal[first].astype(np.float32)
     if "TANGENT" in attributes:
         tangent = attributes["TANGENT"]
-        tangent[:, :3] = _tangent_directions(tangent[:, :3], attributes["NORMAL"])
+        uvs = primitive.attributes.get("TEXCOORD_0")
+        fallback = None if uvs is None else _texture_tangents(positions, uvs, faces)[corner_face[first]]
+        tangent[:, :3] = _tangent_directions(tangent[:, :3], attributes["NORMAL"], fallback)
     targets = [{name: values[source] for name, values in target.items()} for target in primitive.targets]
     return PrimitiveArrays(primitive.source, attributes, new_index.reshape(-1, 3), targets, primitive.vertices[source])
 

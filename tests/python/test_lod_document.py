@@ -564,6 +564,50 @@ def test_hard_edges_keep_their_tangents_and_normal_deltas_make_no_seams(tmp_path
     assert np.abs(doc.accessor(primitive["targets"][0]["NORMAL"], "d")).max() > 0.05
 
 
+def _hard_edged_box(path):
+    """A box, each face its own 4 vertices with the face's normal, texture coordinates and their
+    tangent (u along it), as exporters write hard-edged, normal-mapped props."""
+    axes = np.eye(3)
+    faces, columns = [], {"POSITION": [], "NORMAL": [], "TANGENT": [], "TEXCOORD_0": []}
+    for normal in np.r_[axes, -axes]:
+        tangent = np.roll(np.abs(normal), 1) * (1.0 if normal.sum() > 0 else -1.0)
+        bitangent = np.cross(normal, tangent)
+        base = len(columns["POSITION"])
+        for u, v in ((0, 0), (1, 0), (1, 1), (0, 1)):
+            columns["POSITION"].append(0.5 * normal + (u - 0.5) * tangent + (v - 0.5) * bitangent)
+            columns["NORMAL"].append(normal)
+            columns["TANGENT"].append([*tangent, 1.0])
+            columns["TEXCOORD_0"].append([u, v])
+        faces += [[base, base + 1, base + 2], [base, base + 2, base + 3]]
+    builder = GlbBuilder()
+    attributes = {
+        name: builder.add(np.asarray(values, np.float32), bounds=name == "POSITION") for name, values in columns.items()
+    }
+    indices = builder.add(np.asarray(faces, np.uint32).reshape(-1, 1))
+    builder.append("meshes", {"primitives": [{"attributes": attributes, "indices": indices}]})
+    builder.append("nodes", {"mesh": 0})
+    builder.json["scenes"], builder.json["scene"] = [{"nodes": [0]}], 0
+    builder.save(path)
+    return np.asarray(columns["NORMAL"]), np.asarray(columns["TANGENT"])
+
+
+def test_a_hard_edged_boxs_levels_keep_each_faces_own_tangents(tmp_path):
+    # Welded, the box's corners kept one face's vertex: the other two faces at the corner took its
+    # tangent, 90 degrees off their own (normal maps shaded them wrong). Each level vertex now
+    # takes the input copy of its corner whose normal is its own.
+    normals, tangents = _hard_edged_box(tmp_path / "box.glb")
+    report = simplify_document(tmp_path / "box.glb", tmp_path / "box_lod.glb", [1.0], **QUICK)
+    doc = GltfDocument(tmp_path / "box_lod.glb")
+    (level_node,) = doc.json["nodes"][0]["extensions"]["MSFT_lod"]["ids"]
+    level = doc.json["meshes"][doc.json["nodes"][level_node]["mesh"]]["primitives"][0]
+    level_normals = doc.accessor(level["attributes"]["NORMAL"], "n")
+    level_tangents = doc.accessor(level["attributes"]["TANGENT"], "t")
+    face_of = np.argmax(level_normals @ normals[::4].T, axis=1)  # which of the 6 faces
+    np.testing.assert_allclose(level_normals, normals[::4][face_of], atol=1e-6)
+    np.testing.assert_allclose(level_tangents, tangents[::4][face_of], atol=1e-6)
+    assert report.drawables[0].levels[1].faces == 12 and len(set(face_of)) == 6
+
+
 def test_a_double_sided_copy_simplifies_with_its_front_and_faces_away_from_it(humanoid_glb, tmp_path):
     # How exporters write double-sided meshes: every face again in the reverse turn, on vertices
     # of its own whose normals point the other way.

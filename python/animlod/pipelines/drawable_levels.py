@@ -366,6 +366,9 @@ def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> Drawa
         primitive = PrimitiveArrays(source.index, attributes, local_faces, targets, used)
         if layout.crease[k] is not None:
             primitive = with_crease_normals(primitive, layout.crease[k])
+            if "TANGENT" in primitive.attributes:
+                inputs = kept[np.searchsorted(used, primitive.vertices)]
+                _take_corner_tangents(primitive.attributes, source.attributes, inputs)
         primitives.append(primitive)
     return DrawableLevel(level, primitives, skinned, rest, deltas, drawable.default_weights)
 
@@ -423,6 +426,30 @@ def _tangent_directions(
         lost = ~result.any(axis=1)
     result[lost] = np.cross(normals[lost], np.eye(3)[np.argmin(np.abs(normals[lost]), axis=1)])
     return _unit(result)
+
+
+def _take_corner_tangents(attributes: dict[str, np.ndarray], inputs: dict[str, np.ndarray], kept: np.ndarray) -> None:
+    """Each vertex of a level with rebuilt normals takes the tangent (and handedness) of the input
+    vertex that shares its kept vertex's position and texture coordinates and whose normal is
+    nearest its own: the input's copy of that corner on the vertex's own side of the hard edge.
+    The kept vertex's tangent is one side's, 90 degrees off on a box's other faces."""
+    positions = inputs["POSITION"]
+    uvs = inputs.get("TEXCOORD_0", np.zeros((len(positions), 0)))
+    _, group = np.unique(np.c_[positions.astype(np.float64), uvs], axis=0, return_inverse=True)
+    group = group.ravel()
+    order = np.argsort(group, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(np.bincount(group))])
+    # Every (level vertex, candidate input vertex) pair: the candidates are the kept vertex's group.
+    first, count = starts[group[kept]], np.diff(starts)[group[kept]]
+    vertex = np.repeat(np.arange(len(kept)), count)
+    block = np.cumsum(count) - count
+    candidate = order[first[vertex] + np.arange(vertex.size) - block[vertex]]
+    closeness = np.einsum("pc,pc->p", inputs["NORMAL"][candidate].astype(np.float64), attributes["NORMAL"][vertex])
+    chosen = candidate[np.lexsort((-closeness, vertex))[block]]
+    tangent = inputs["TANGENT"][chosen].astype(np.float32)
+    tangent[:, :3] = _tangent_directions(tangent[:, :3], attributes["NORMAL"], attributes["TANGENT"][:, :3])
+    tangent[:, 3] = np.where(tangent[:, 3] < 0.0, -1.0, 1.0)
+    attributes["TANGENT"] = tangent
 
 
 def _texture_tangents(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray) -> np.ndarray:

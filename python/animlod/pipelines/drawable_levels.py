@@ -428,6 +428,17 @@ def _tangent_directions(
     return _unit(result)
 
 
+def _group_pairs(group: np.ndarray, asked: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair (k, member) of an index k into ``asked`` (groups) and an item ``member`` of that
+    group, ``group`` (N,) giving each item's; k ascending, members in item order within it."""
+    order = np.argsort(group, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(np.bincount(group))])
+    first, count = starts[asked], np.diff(starts)[asked]
+    k = np.repeat(np.arange(len(asked)), count)
+    block = np.cumsum(count) - count
+    return k, order[first[k] + np.arange(k.size) - block[k]]
+
+
 def _take_corner_tangents(attributes: dict[str, np.ndarray], inputs: dict[str, np.ndarray], kept: np.ndarray) -> None:
     """Each vertex of a level with rebuilt normals takes the tangent (and handedness) of the input
     vertex that shares its kept vertex's position and texture coordinates and whose normal is
@@ -437,14 +448,9 @@ def _take_corner_tangents(attributes: dict[str, np.ndarray], inputs: dict[str, n
     uvs = inputs.get("TEXCOORD_0", np.zeros((len(positions), 0)))
     _, group = np.unique(np.c_[positions.astype(np.float64), uvs], axis=0, return_inverse=True)
     group = group.ravel()
-    order = np.argsort(group, kind="stable")
-    starts = np.concatenate([[0], np.cumsum(np.bincount(group))])
-    # Every (level vertex, candidate input vertex) pair: the candidates are the kept vertex's group.
-    first, count = starts[group[kept]], np.diff(starts)[group[kept]]
-    vertex = np.repeat(np.arange(len(kept)), count)
-    block = np.cumsum(count) - count
-    candidate = order[first[vertex] + np.arange(vertex.size) - block[vertex]]
+    vertex, candidate = _group_pairs(group, group[kept])  # the kept vertex itself among them
     closeness = np.einsum("pc,pc->p", inputs["NORMAL"][candidate].astype(np.float64), attributes["NORMAL"][vertex])
+    block = np.flatnonzero(np.r_[True, vertex[1:] != vertex[:-1]])  # each level vertex's first pair
     chosen = candidate[np.lexsort((-closeness, vertex))[block]]
     tangent = inputs["TANGENT"][chosen].astype(np.float32)
     tangent[:, :3] = _tangent_directions(tangent[:, :3], attributes["NORMAL"], attributes["TANGENT"][:, :3])
@@ -479,14 +485,7 @@ def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveA
     length = np.linalg.norm(area_normal, axis=1, keepdims=True)
     unit = area_normal / np.where(length > 0.0, length, 1.0)
     corner_vertex, corner_face = faces.ravel(), np.repeat(np.arange(len(faces)), 3)
-    # Every pair of corners at one vertex: (a, b) with b running over a's vertex group.
-    order = np.argsort(corner_vertex, kind="stable")
-    counts = np.bincount(corner_vertex, minlength=len(positions))
-    group_start = np.concatenate([[0], np.cumsum(counts)])[corner_vertex[order]]
-    group_size = counts[corner_vertex[order]]
-    a = np.repeat(order, group_size)
-    offsets = np.arange(a.size) - np.repeat(np.cumsum(group_size) - group_size, group_size)
-    b = order[np.repeat(group_start, group_size) + offsets]
+    a, b = _group_pairs(corner_vertex, corner_vertex)  # every pair of corners at one vertex
     # A corner always takes its own face (at crease 0, rounding can put a unit vector's dot with
     # itself below cos 0 = 1, which left flat-shaded levels with zero normals).
     close = (a == b) | (np.einsum("pc,pc->p", unit[corner_face[a]], unit[corner_face[b]]) >= np.cos(crease) - 1e-9)

@@ -231,6 +231,15 @@ def _weights_of_unweighted_vertices(doc: GltfDocument, mesh_index: int, weights:
         "have no positive skin weight; they follow their first listed joint, as three.js and Blender do",
         stacklevel=5,
     )
+    return on_first_joint_when_unweighted(weights)
+
+
+def on_first_joint_when_unweighted(weights: np.ndarray) -> np.ndarray:
+    """``weights (V, K)`` with full weight on the first listed joint of every row without a
+    positive weight: the reading of such vertices that the levels and level 0 share."""
+    unweighted = ~(weights > 0.0).any(axis=1)
+    if not unweighted.any():
+        return weights
     weights = weights.copy()
     weights[unweighted, 0] = 1.0
     return weights

@@ -18,6 +18,7 @@ from .glb_builder import ARRAY_BUFFER, GlbBuilder
 from .gltf_document import GltfDocument
 from .gltf_draco import DRACO_EXTENSION
 from .gltf_drawable import Drawable
+from .gltf_read import on_first_joint_when_unweighted
 
 _SUM_STEP = 0.0039216  # the validator's allowance per two weights beyond two: about 1/255
 
@@ -71,11 +72,9 @@ def _normalise_primitive(builder: GlbBuilder, doc: GltfDocument, mesh_index: int
     broken = unit_sum_breaks(weights)
     if not broken.any():
         return 0, 0.0
-    rows = np.maximum(weights[broken], 0.0)
-    totals = rows.sum(axis=1, keepdims=True)
-    first_joint = np.zeros_like(rows)
-    first_joint[:, 0] = 1.0
-    weights[broken] = np.where(totals > 0.0, rows / np.where(totals > 0.0, totals, 1.0), first_joint)
+    stored = np.maximum(weights[broken], 0.0)
+    rows = on_first_joint_when_unweighted(stored)
+    weights[broken] = rows / rows.sum(axis=1, keepdims=True)
     for set_index, name in enumerate(names):
         written[name] = builder.add(weights[:, 4 * set_index : 4 * set_index + 4].astype(np.float32), ARRAY_BUFFER)
-    return int(broken.sum()), float(np.abs(totals - 1.0).max())
+    return int(broken.sum()), float(np.abs(stored.sum(axis=1) - 1.0).max())

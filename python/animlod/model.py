@@ -545,7 +545,7 @@ def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.
             weights[repeat, later] = 0.0
     order = np.argsort(-weights, axis=1, kind="stable")
     weights = np.take_along_axis(weights, order, axis=1) / totals[:, None]
-    joints = np.take_along_axis(np.asarray(joints), order, axis=1)
+    joints = np.take_along_axis(joints, order, axis=1)
     # Unused influences point at joint 0 with weight 0, as glTF allows.
     joints = np.where(weights > 0.0, joints, 0)
     return np.ascontiguousarray(joints, dtype=np.int32), np.ascontiguousarray(weights, dtype=np.float32)

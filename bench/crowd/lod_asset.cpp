@@ -438,16 +438,13 @@ class Loader {
   // The animation playing original clip `original` at the level's motion level.
   int animation_for(const Level& level, int original, int finest_rig, const std::string& label, size_t k) {
     if (level.motion_level == 0) return original;
-    const std::set<int> nodes(asset_.rigs[static_cast<size_t>(level.rig)].nodes.begin(),
-                              asset_.rigs[static_cast<size_t>(level.rig)].nodes.end());
     for (size_t a = 0; a < model_.animations.size(); ++a) {
       const tinygltf::Animation& animation = model_.animations[a];
       const Value* extras = animlod_extras(animation.extras);
       const Value* clip = extras ? object_member(*extras, "clip") : nullptr;
       if (!clip || !clip->IsNumber() || clip->GetNumberAsInt() != original) continue;
       if (motion_level_of_animation(animation) != level.motion_level) continue;
-      for (const tinygltf::AnimationChannel& channel : animation.channels)
-        if (nodes.count(channel.target_node)) return static_cast<int>(a);
+      if (moves_rig(level.rig, static_cast<int>(a))) return static_cast<int>(a);
     }
     // A clip of another character in the same file moves none of this chain's joints, so the
     // character writes no motion level of it: the level stands still, as level 0 does.

@@ -7,6 +7,7 @@ influences per vertex. Positions are float32, indices int32, quaternions (x, y, 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -464,10 +465,6 @@ class SkinnedMesh:
         """
         from ._core import bake_lbs
 
-        if motion.skeleton.joint_count != self.skeleton.joint_count:
-            raise ValueError(
-                f"motion has {motion.skeleton.joint_count} joints, the skin's skeleton {self.skeleton.joint_count}"
-            )
         if morph_weights is not None:
             morph_weights = np.asarray(morph_weights, np.float64)
             target_count = 0 if self.morph_targets is None else len(self.morph_targets)
@@ -476,15 +473,37 @@ class SkinnedMesh:
                 morph_weights.shape == expected, f"morph_weights: expected shape {expected}, got {morph_weights.shape}"
             )
             check_finite("morph_weights", morph_weights)
-        matrices = motion.skin_matrices(self.inverse_bind).astype(np.float32)
         if morph_weights is None or self.morph_targets is None:
-            frames = bake_lbs(self.default_shape(), self.joints, self.weights, matrices)
-            return AnimatedMesh(self.faces, frames, fps=motion.fps)
+            return AnimatedMesh(self.faces, bake_lbs(*self._lbs_inputs(motion)), fps=motion.fps)
+        matrices = self._skin_matrices(motion)
         frames = np.empty((motion.frame_count, self.vertex_count, 3), np.float32)
         for t in range(motion.frame_count):  # O(T) calls, each a whole frame in C++
             rest = morphed(self.rest_positions, self.morph_targets, morph_weights[t])
             frames[t] = bake_lbs(rest, self.joints, self.weights, matrices[t : t + 1])[0]
         return AnimatedMesh(self.faces, frames, fps=motion.fps)
+
+    def distance_maxima(self, motion: Motion, others: Sequence[tuple[SkinnedMesh, Motion]]) -> np.ndarray:
+        """(N, T) float32: in each frame of ``motion``, the largest distance between where this
+        skin played with ``motion`` and each of the N ``(skin, motion)`` pairs ``others`` (the
+        same vertices and frame count; another skeleton or weights: reduced skins) put a vertex,
+        all at their default morph weights. Equal to the maxima of the distances between the
+        :meth:`bake` results, computed in the core without storing the frames (a long clip of a
+        dense mesh would take gigabytes per skin)."""
+        return _core.skin_distance_maxima(
+            self._lbs_inputs(motion), [skin._lbs_inputs(played) for skin, played in others]
+        )
+
+    def _lbs_inputs(self, motion: Motion) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """What the core's skinning takes to play ``motion`` on this skin at its default morph weights."""
+        return self.default_shape(), self.joints, self.weights, self._skin_matrices(motion)
+
+    def _skin_matrices(self, motion: Motion) -> np.ndarray:
+        """(T, J, 4, 4) float32 skinning matrices of ``motion`` on this skin's skeleton."""
+        if motion.skeleton.joint_count != self.skeleton.joint_count:
+            raise ValueError(
+                f"motion has {motion.skeleton.joint_count} joints, the skin's skeleton {self.skeleton.joint_count}"
+            )
+        return motion.skin_matrices(self.inverse_bind).astype(np.float32)
 
     def default_shape(self) -> np.ndarray:
         """(V, 3) float32 bind shape with the morph targets at their default weights: what the

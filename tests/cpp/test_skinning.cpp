@@ -52,3 +52,26 @@ TEST_CASE("bake_lbs names the vertex with a joint index out of range") {
   CHECK_FALSE(status.ok);
   CHECK(status.message.find("vertex 1") != std::string::npos);
 }
+
+TEST_CASE("skin_distance_maxima is each frame's largest distance between two skins") {
+  const std::vector<float> rest = {0, 0, 0, 1, 0, 0};
+  const std::vector<int32_t> joints = {0, 0};
+  const std::vector<float> weights = {1, 1};
+  std::vector<float> moved = translation(3, 4, 0);  // frame 0: 5 units off; frame 1: in place
+  const std::vector<float> still = translation(0, 0, 0);
+  moved.insert(moved.end(), still.begin(), still.end());
+  std::vector<float> twice_still = still;
+  twice_still.insert(twice_still.end(), still.begin(), still.end());
+  animlod::SkinningInput a = one_frame(rest, joints, weights, twice_still), b = one_frame(rest, joints, weights, moved);
+  a.frame_count = b.frame_count = 2;
+  a.joint_count = b.joint_count = 1;
+  std::vector<float> out(2, -1.0f);
+  REQUIRE(animlod::skin_distance_maxima(a, &b, 1, out.data()).ok);
+  CHECK(out[0] == doctest::Approx(5));
+  CHECK(out[1] == 0.0f);
+
+  b.frame_count = 1;
+  const animlod::Status status = animlod::skin_distance_maxima(a, &b, 1, out.data());
+  CHECK_FALSE(status.ok);
+  CHECK(status.message == "skin 0: 2 vertices and 1 frames, expected 2 and 2");
+}

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from animlod import AnimatedMesh, Motion, Skeleton, SkinnedMesh, rotations
-from animlod._core import bake_lbs
+from animlod._core import bake_lbs, skin_distance_maxima
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -65,6 +65,53 @@ def test_bake_lbs_matches_numpy_reference():
     got = bake_lbs(rest, joints, weights, matrices)
     assert got.shape == (3, 50, 3) and got.dtype == np.float32
     np.testing.assert_allclose(got, _numpy_lbs(rest, joints, weights, matrices), atol=1e-5)
+
+
+def _skinned_tube(vertices: int) -> SkinnedMesh:
+    """``vertices`` points along the chain, each on two of its joints."""
+    rng = np.random.default_rng(3)
+    skeleton = _chain()
+    rest = np.column_stack([np.linspace(0.0, 2.0, vertices), rng.normal(0.0, 0.1, (vertices, 2))])
+    joints = rng.integers(0, 3, (vertices, 2))
+    return SkinnedMesh(
+        rest, np.array([[0, 1, 2]]), joints, rng.random((vertices, 2)) + 0.1,
+        np.linalg.inv(skeleton.rest_world_transforms()), skeleton,
+    )  # fmt: skip
+
+
+def test_a_long_bake_on_every_core_equals_its_frames_baked_one_by_one():
+    # 3,000 vertices x 60 frames: contiguous ranges of vertex-frames on each core, split
+    # inside a frame; one frame alone is too little work for a second thread.
+    skin, motion = _skinned_tube(3000), _bend(np.linspace(0.0, 2.0, 60))
+    whole = skin.bake(motion).frames
+    for t in range(motion.frame_count):
+        np.testing.assert_array_equal(whole[t], skin.bake(motion.take_frames([t])).frames[0])
+
+
+def test_distance_maxima_are_the_maxima_of_the_distances_between_two_bakes_bit_for_bit():
+    skin, motion = _skinned_tube(3000), _bend(np.linspace(0.0, 2.0, 60))
+    rigid = SkinnedMesh(skin.rest_positions, skin.faces, np.zeros((3000, 1), int), np.ones((3000, 1)),
+                        skin.inverse_bind, skin.skeleton)  # fmt: skip
+    other_motion = _bend(np.linspace(0.5, 0.0, 60))
+    maxima = skin.distance_maxima(motion, [(rigid, motion), (skin, other_motion), (skin, motion)])
+    baked = skin.bake(motion).frames
+    for row, (other, played) in zip(maxima, [(rigid, motion), (skin, other_motion), (skin, motion)]):
+        expected = np.linalg.norm(other.bake(played).frames - baked, axis=-1).max(axis=1)
+        np.testing.assert_array_equal(row, expected)
+    assert maxima.shape == (3, 60) and maxima[0, -1] > 0.1 and not maxima[2].any()
+
+
+def test_distance_maxima_name_the_skin_that_does_not_match_and_keep_a_nan():
+    skin, motion = _skinned_tube(10), _bend(np.zeros(2))
+    with pytest.raises(ValueError, match=r"skin 1: 20 vertices and 2 frames, expected 10 and 2"):
+        skin.distance_maxima(motion, [(skin, motion), (_skinned_tube(20), motion)])
+    with pytest.raises(ValueError, match=r"skin 0: 10 vertices and 1 frames, expected 10 and 2"):
+        skin.distance_maxima(motion, [(skin, motion.take_frames([0]))])
+    arrays = skin._lbs_inputs(motion)
+    matrices = arrays[3].copy()
+    matrices[1, 2, 0, 3] = np.nan  # frame 1, joint 2
+    maxima = skin_distance_maxima(arrays, [(*arrays[:3], matrices)])
+    assert maxima[0, 0] == 0.0 and np.isnan(maxima[0, 1])
 
 
 def _skinned_bar() -> SkinnedMesh:

@@ -205,23 +205,11 @@ def build_motion_levels(
 # Frames per second at which a glTF input's clips are sampled.
 _GLTF_FPS = 30.0
 
-# Vertex positions baked at a time by skin_distances: a chunk of frames holds two copies of each.
-_BAKED_POSITIONS_PER_CHUNK = 4_000_000
-
 
 def skin_distances(skin: SkinnedMesh, motion: Motion, levels: Sequence[MotionLevel]) -> list[np.ndarray]:
     """Per level, (T,) the largest distance, in each frame of ``motion``, of a vertex of the
-    level's skin played with the level's motion from where ``motion`` puts it on the input ``skin``
-    (the input baked once per chunk of frames for every level)."""
-    chunk = max(1, _BAKED_POSITIONS_PER_CHUNK // max(1, skin.vertex_count))
-    out = [np.empty(motion.frame_count) for _ in levels]
-    for start in range(0, motion.frame_count, chunk):
-        frames = slice(start, min(start + chunk, motion.frame_count))
-        original = skin.bake(motion.take_frames(frames)).frames
-        for level, distances in zip(levels, out):
-            posed = level.skin.bake(level.motion.take_frames(frames)).frames
-            distances[frames] = np.linalg.norm(posed - original, axis=-1).max(axis=1)
-    return out
+    level's skin played with the level's motion from where ``motion`` puts it on the input ``skin``."""
+    return list(skin.distance_maxima(motion, [(level.skin, level.motion) for level in levels]).astype(np.float64))
 
 
 def _read_input(

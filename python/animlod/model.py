@@ -556,18 +556,25 @@ def normalize_skin_weights(joints: np.ndarray, weights: np.ndarray) -> tuple[np.
         vertex = int(np.argmax(totals <= 0.0))
         raise ValueError(f"weights: vertex {vertex} has no positive skin weight")
     joints = np.asarray(joints)
-    weights = weights.copy()
-    for later in range(1, weights.shape[1]):  # into the joint's first slot; the slots' order stays
-        for first in range(later):
-            repeat = joints[:, later] == joints[:, first]
-            weights[repeat, first] += weights[repeat, later]
-            weights[repeat, later] = 0.0
+    weights = merge_repeated_influences(joints, weights)
     order = np.argsort(-weights, axis=1, kind="stable")
     weights = np.take_along_axis(weights, order, axis=1) / totals[:, None]
     joints = np.take_along_axis(joints, order, axis=1)
     # Unused influences point at joint 0 with weight 0, as glTF allows.
     joints = np.where(weights > 0.0, joints, 0)
     return np.ascontiguousarray(joints, dtype=np.int32), np.ascontiguousarray(weights, dtype=np.float32)
+
+
+def merge_repeated_influences(joints: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """(V, K) float64 ``weights`` with the influences of a joint listed twice for a vertex added
+    into its first slot (in slot order) and the later slots zero; the slots' order stays."""
+    weights = np.array(weights, dtype=np.float64)
+    for later in range(1, weights.shape[1]):
+        for first in range(later):
+            repeat = joints[:, later] == joints[:, first]
+            weights[repeat, first] += weights[repeat, later]
+            weights[repeat, later] = 0.0
+    return weights
 
 
 @dataclass

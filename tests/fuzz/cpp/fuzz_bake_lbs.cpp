@@ -8,7 +8,8 @@
 //   V * 3 rest coordinates; V * K joint indices (u16, FuzzInput::index over J); V * K weights
 //   (u8: value / 255, except 255 -> NaN, 254 -> inf, 253 -> -1); T * J * 16 matrix entries.
 // Invariants: an error has a message and comes from a bad joint index or weight; on success
-// with every input finite and small (int16 mode) every output is finite.
+// with every input finite and small (int16 mode) every output is finite. skin_distance_maxima
+// of the skin against itself fails alike, and is 0 in a frame of finite positions, else NaN.
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -61,6 +62,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<float> out(frame_count * vertex_count * 3);
   const animlod::Status status = animlod::bake_lbs(input, out.data());
   ANIMLOD_FUZZ_REQUIRE(status.ok == inputs_valid);
+  // The skin against itself: the same errors; each frame's largest distance 0, or NaN where a
+  // position is not finite (inf - inf), as numpy's max keeps a NaN.
+  std::vector<float> maxima(frame_count);
+  const animlod::Status self = animlod::skin_distance_maxima(input, &input, 1, maxima.data());
+  ANIMLOD_FUZZ_REQUIRE(self.ok == status.ok);
+  for (size_t t = 0; status && t < frame_count; ++t) {
+    bool finite = true;
+    for (size_t i = 3 * t * vertex_count; i < 3 * (t + 1) * vertex_count; ++i) finite = finite && std::isfinite(out[i]);
+    ANIMLOD_FUZZ_REQUIRE(finite ? maxima[t] == 0.0f : std::isnan(maxima[t]));
+  }
   if (!status) {
     ANIMLOD_FUZZ_REQUIRE(!status.message.empty());
     return 0;

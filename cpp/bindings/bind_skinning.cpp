@@ -64,7 +64,8 @@ py::array_t<float> skin_distance_maxima_py(const py::tuple& skin, const py::sequ
   const SkinArrays a = skin_from_tuple(skin, "skin");
   std::vector<SkinArrays> kept;
   kept.reserve(others.size());
-  for (size_t i = 0; i < others.size(); ++i) kept.push_back(skin_from_tuple(others[i], "others[" + std::to_string(i) + "]"));
+  for (size_t i = 0; i < others.size(); ++i)
+    kept.push_back(skin_from_tuple(others[i], "others[" + std::to_string(i) + "]"));
   std::vector<SkinningInput> inputs;
   for (const SkinArrays& other : kept) inputs.push_back(other.input);
   py::array_t<float> out({static_cast<py::ssize_t>(inputs.size()), static_cast<py::ssize_t>(a.input.frame_count)});

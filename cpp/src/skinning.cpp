@@ -28,6 +28,10 @@ namespace {
 
 // Vertex-frames below which a thread costs more to start than it saves.
 constexpr size_t kVertexFramesPerThread = 1 << 16;
+// Vertices of a block of skin_distance_maxima: their positions, joints and weights (44 bytes a
+// vertex with 4 influences) of ten skins stay in a core's L2 cache beside their matrices: nine
+// distinct skins of 175k vertices over 300 frames took 2.6-3.4 s so, 3.5-4.9 s frame by frame.
+constexpr size_t kBlockVertices = 256;
 
 Status validate(const SkinningInput& in) {
   const size_t k_count = in.influence_count;
@@ -108,23 +112,28 @@ Status skin_distance_maxima(const SkinningInput& a, const SkinningInput* others,
                            std::to_string(a.vertex_count) + " and " + std::to_string(a.frame_count));
   if (Status status = validate(a); !status) return status;
   for (size_t i = 0; i < other_count; ++i)
-    if (Status status = validate(others[i]); !status) return Status::error("skin " + std::to_string(i) + ": " + status.message);
+    if (Status status = validate(others[i]); !status)
+      return Status::error("skin " + std::to_string(i) + ": " + status.message);
   const size_t frames = a.frame_count;
-  // Frames to each thread, so that a frame's maxima are its own thread's; skin `a` once per
-  // vertex-frame.
+  // Frames to each thread, so that a frame's maxima are its own thread's; vertices in blocks
+  // whose data of every skin stays in cache while the thread's frames visit them; skin `a` once
+  // per vertex-frame.
   const size_t workers = std::min(worker_count(a), frames);
   detail::run_in_ranges(frames, workers, [&](size_t first, size_t last, size_t) {
-    for (size_t t = first; t < last; ++t) {
-      for (size_t i = 0; i < other_count; ++i) out_maxima[i * frames + t] = 0.0f;
-      for (size_t v = 0; v < a.vertex_count; ++v) {
-        const glm::vec3 p = skinned_vertex(a, t, v);
-        for (size_t i = 0; i < other_count; ++i) {
-          const glm::vec3 d = skinned_vertex(others[i], t, v) - p;
-          const float distance = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-          float& maximum = out_maxima[i * frames + t];
-          if (maximum == maximum && !(distance <= maximum)) maximum = distance;  // a NaN stays, as in numpy
+    for (size_t i = 0; i < other_count; ++i)
+      std::fill(out_maxima + i * frames + first, out_maxima + i * frames + last, 0.0f);
+    for (size_t begin = 0; begin < a.vertex_count; begin += kBlockVertices) {
+      const size_t end = std::min(begin + kBlockVertices, a.vertex_count);
+      for (size_t t = first; t < last; ++t)
+        for (size_t v = begin; v < end; ++v) {
+          const glm::vec3 p = skinned_vertex(a, t, v);
+          for (size_t i = 0; i < other_count; ++i) {
+            const glm::vec3 d = skinned_vertex(others[i], t, v) - p;
+            const float distance = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+            float& maximum = out_maxima[i * frames + t];
+            if (maximum == maximum && !(distance <= maximum)) maximum = distance;  // a NaN stays, as in numpy
+          }
         }
-      }
     }
   });
   return Status::success();

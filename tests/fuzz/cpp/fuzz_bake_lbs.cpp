@@ -69,7 +69,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   ANIMLOD_FUZZ_REQUIRE(self.ok == status.ok);
   for (size_t t = 0; status && t < frame_count; ++t) {
     bool finite = true;
-    for (size_t i = 3 * t * vertex_count; i < 3 * (t + 1) * vertex_count; ++i) finite = finite && std::isfinite(out[i]);
+    for (size_t i = 3 * t * vertex_count; i < 3 * (t + 1) * vertex_count; ++i)
+      finite = finite && std::isfinite(out[i]);
     ANIMLOD_FUZZ_REQUIRE(finite ? maxima[t] == 0.0f : std::isnan(maxima[t]));
   }
   if (!status) {

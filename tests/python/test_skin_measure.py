@@ -29,6 +29,7 @@ from animlod.motion_lod.skin_measure import (
     without_skin_tips,
 )
 from animlod.motion_lod.skin_transfer import transfer_skin
+from animlod.pipelines import motion as motion_pipeline
 from animlod.pipelines.motion import build_motion_levels
 
 NAMES = ["root", "spine", "head", "control"]
@@ -171,10 +172,16 @@ def test_the_skin_trial_measure_is_the_mean_distance_of_the_skin_on_the_input_jo
     assert both == pytest.approx(measure(level.frozen, level.motion.take_frames(frames), frames), rel=1e-6)
 
 
-def test_motion_reports_the_skins_largest_distance_for_a_skinned_gltf(twisting_arm, tmp_path) -> None:
+def test_motion_reports_the_skins_largest_distance_for_a_skinned_gltf(twisting_arm, tmp_path, monkeypatch) -> None:
     skin, motion = twisting_arm
     write_glb(tmp_path / "twist.glb", skin, [motion])
-    report = build_motion_levels(tmp_path / "twist.glb", tmp_path / "levels", joints=[4, 2])
+    monkeypatch.setattr(motion_pipeline, "_MEASURED_PER_STEP", 7 * skin.vertex_count * 2)  # 7 frames a step
+    measured = []
+    report = build_motion_levels(
+        tmp_path / "twist.glb", tmp_path / "levels", joints=[4, 2], on_measure=lambda *step: measured.append(step)
+    )
+    frames = report.motion.frame_count
+    assert measured == [(min(done, frames), frames) for done in range(7, frames + 7, 7)] and report.skin_seconds > 0
     levels = json.loads((tmp_path / "levels" / "twist_motion_lod.json").read_text())["levels"]
     assert levels[0]["skin_error"] < 1e-5
     level = report.chain.levels[1]  # the level's skin, moved onto its joints, with its clip

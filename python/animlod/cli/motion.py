@@ -95,8 +95,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 class _Progress:
-    """tqdm over the default ranking's choice of joints, then over levels, and over frames inside
-    each level."""
+    """tqdm over the default ranking's choice of joints, then over levels and over frames inside
+    each level, then over the frames of the skin measurement."""
 
     def __init__(self) -> None:
         from functools import partial
@@ -107,6 +107,7 @@ class _Progress:
         self.choice = None
         self.levels = None
         self.frames = None
+        self.measure = None
 
     def chose(self, chosen: int, to_choose: int) -> None:
         if self.choice is None:
@@ -118,20 +119,33 @@ class _Progress:
     def start_level(self, index: int, joints: int, frame_count: int, level_count: int):
         if self.levels is None:
             self.levels = self._tqdm(total=level_count, desc="levels", unit="level", position=0)
-        if self.frames is not None:
-            self.frames.close()
-            self.levels.update(1)
+        self._end_level()
+        # The re-fit reports fractions of frames (a share of each group of points): shown whole.
         self.frames = self._tqdm(total=frame_count, desc=f"level {index} ({joints} joints)", unit="frame",
-                                 position=1, leave=False)  # fmt: skip
+                                 position=1, leave=False, bar_format=_WHOLE_FRAMES)  # fmt: skip
         return self.frames.update
 
-    def close(self) -> None:
+    def measured(self, frames: int, frame_count: int) -> None:
+        if self.measure is None:
+            self._end_level()
+            self.levels.close()
+            self.measure = self._tqdm(total=frame_count, desc="measuring the skins", unit="frame", position=0)
+        self.measure.update(frames - self.measure.n)
+
+    def _end_level(self) -> None:
         if self.frames is not None:
             self.frames.close()
             self.levels.update(1)
-        for bar in (self.choice, self.levels):
+            self.frames = None
+
+    def close(self) -> None:
+        self._end_level()
+        for bar in (self.choice, self.levels, self.measure):
             if bar is not None:
                 bar.close()
+
+
+_WHOLE_FRAMES = "{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total_fmt} [{elapsed}<{remaining}, {rate_fmt}]"
 
 
 def _clip(text: str) -> int | str:
@@ -183,6 +197,7 @@ def run(args: argparse.Namespace) -> int:
             joint_map=args.joint_map,
             on_level=on_level,
             on_choice=lambda chosen, to_choose: progress().chose(chosen, to_choose),
+            on_measure=lambda frames, frame_count: progress().measured(frames, frame_count),
             on_note=lambda text: print(text, file=sys.stderr),
         )
     finally:
@@ -198,9 +213,10 @@ def run(args: argparse.Namespace) -> int:
         written += 1
     total = time.perf_counter() - start
     levels = sum(level.report.seconds for level in report.chain.levels)
+    measuring = f", {report.skin_seconds:.1f} s measuring the skins" if report.skin_errors is not None else ""
     print(
-        f"wrote {written} files to {args.output} in {total:.1f} s "
-        f"({levels:.1f} s re-fitting the levels, the rest reading, analysis and the choice of joints)"
+        f"wrote {written} files to {args.output} in {total:.1f} s ({levels:.1f} s re-fitting the levels{measuring}, "
+        "the rest reading, analysis and the choice of joints)"
     )
     return 0
 

@@ -93,6 +93,7 @@ size_t worker_count(const SkinningInput& in) {
 Status bake_lbs(const SkinningInput& in, float* out_positions) {
   if (Status status = validate(in); !status) return status;
   const size_t vertices = in.vertex_count;
+  if (vertices == 0) return Status::success();  // (the ranges below divide by it)
   detail::run_in_ranges(in.frame_count * vertices, worker_count(in), [&](size_t begin, size_t end, size_t) {
     for (size_t i = begin, t = begin / vertices, v = begin % vertices; i < end; ++i) {  // i = t * V + v
       const glm::vec3 p = skinned_vertex(in, t, v);

@@ -53,6 +53,19 @@ TEST_CASE("bake_lbs names the vertex with a joint index out of range") {
   CHECK(status.message.find("vertex 1") != std::string::npos);
 }
 
+TEST_CASE("bake_lbs and skin_distance_maxima take a skin without vertices") {
+  const std::vector<float> matrices = translation(1, 2, 3);
+  animlod::SkinningInput input;  // no vertices, one frame of one joint
+  input.skin_matrices = matrices.data();
+  input.influence_count = 4;
+  input.joint_count = 1;
+  input.frame_count = 1;
+  CHECK(animlod::bake_lbs(input, nullptr).ok);
+  float maximum = -1.0f;
+  REQUIRE(animlod::skin_distance_maxima(input, &input, 1, &maximum).ok);
+  CHECK(maximum == 0.0f);
+}
+
 TEST_CASE("skin_distance_maxima is each frame's largest distance between two skins") {
   const std::vector<float> rest = {0, 0, 0, 1, 0, 0};
   const std::vector<int32_t> joints = {0, 0};

@@ -230,11 +230,11 @@ def skin_distances(
     step = max(1, _MEASURED_PER_STEP // max(1, skin.vertex_count * len(levels)))
     out = np.empty((len(levels), motion.frame_count))
     for start in range(0, motion.frame_count, step):
-        frames = np.arange(start, min(start + step, motion.frame_count))
+        frames = slice(start, min(start + step, motion.frame_count))
         played = [(level.skin, level.motion.take_frames(frames)) for level in levels]
         out[:, frames] = skin.distance_maxima(motion.take_frames(frames), played)
         if progress is not None:
-            progress(int(frames[-1]) + 1, motion.frame_count)
+            progress(frames.stop, motion.frame_count)
     return list(out)
 
 

@@ -19,16 +19,13 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
-import time
-from collections.abc import Callable
 from pathlib import Path
-from typing import TypeVar
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from devdata import DATA_DIR
-from table import print_table
+from table import print_table, wall_and_cpu
 
 from animlod.io import read_skinned, write_glb
 from animlod.model import Motion, SkinnedMesh
@@ -38,7 +35,6 @@ XBOT = DATA_DIR / "gltf" / "Xbot.glb"
 SPLITS = 2
 WALK_REPEATS = 40
 LEVELS = 8
-T = TypeVar("T")
 
 
 def split_in_four(skin: SkinnedMesh) -> SkinnedMesh:
@@ -91,13 +87,6 @@ def numpy_distances(skin: SkinnedMesh, motion: Motion, others: list[tuple[Skinne
     return out
 
 
-def timed(action: Callable[[], T]) -> tuple[T, float, float]:
-    """``action()``'s result, wall seconds and CPU seconds."""
-    wall, cpu = time.perf_counter(), time.process_time()
-    result = action()
-    return result, time.perf_counter() - wall, time.process_time() - cpu
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--write", metavar="GLB", type=Path, help="only write the dense character to GLB")
@@ -111,12 +100,12 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         source = Path(folder) / "dense_xbot.glb"
         size = dense_xbot(source)
-        report, wall, cpu = timed(lambda: build_motion_levels(source, Path(folder) / "levels", LEVELS))
+        report, wall, cpu = wall_and_cpu(lambda: build_motion_levels(source, Path(folder) / "levels", LEVELS))
         rows = [("build_motion_levels, 8 levels (animlod motion)", wall, cpu, "-")]
         motion, _, skin, _ = _read_input(source, None, (), None, lambda note: None)
     others = [(level.skin, level.motion) for level in report.chain.levels]
-    core, wall, cpu = timed(lambda: skin.distance_maxima(motion, others))
-    peer, peer_wall, peer_cpu = timed(lambda: numpy_distances(skin, motion, others))
+    core, wall, cpu = wall_and_cpu(lambda: skin.distance_maxima(motion, others))
+    peer, peer_wall, peer_cpu = wall_and_cpu(lambda: numpy_distances(skin, motion, others))
     same = "yes" if np.array_equal(core.view(np.uint32), peer.view(np.uint32)) else "NO"
     rows.append((f"skin distances of its {len(others)} levels, core (SkinnedMesh.distance_maxima)", wall, cpu, same))
     rows.append((f"skin distances of its {len(others)} levels, numpy bakes (peer)", peer_wall, peer_cpu, same))

@@ -38,13 +38,14 @@ import dataclasses
 import os
 import sys
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from devdata import DATA_DIR
-from table import print_table
+from table import print_table, wall_and_cpu
 
 from animlod.io.bvh import read_bvh
 from animlod.model import Motion
@@ -133,9 +134,7 @@ def level_table(label: str, motion: Motion) -> tuple[float, float]:
     analysis = analyze_motion(motion)
     floor = joint_floor(motion, analysis)
     levels = min(8, floor.possible_levels)
-    wall, cpu = time.perf_counter(), time.process_time()
-    chain = build_motion_chain(motion, levels, analysis=analysis)
-    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    chain, wall, cpu = wall_and_cpu(lambda: build_motion_chain(motion, levels, analysis=analysis))
     size = chain.figure_size
     rows = []
     for k, level in enumerate(chain.levels):
@@ -181,9 +180,7 @@ def speed_table(quick: bool) -> None:
     best: dict[int, tuple[float, float, float, int]] = {}
     for _ in range(rounds):
         for index, (_, motion, threads, ranking) in enumerate(runs):
-            wall, cpu = time.perf_counter(), time.process_time()
-            chain = build_motion_chain(motion, 8, workers=threads, ranking=ranking)
-            wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+            chain, wall, cpu = wall_and_cpu(partial(build_motion_chain, motion, 8, workers=threads, ranking=ranking))
             solved = sum(level.report.joint_count * motion.frame_count for level in chain.levels[1:])
             failed = sum(len(level.report.failures) for level in chain.levels)
             if index not in best or cpu < best[index][1]:

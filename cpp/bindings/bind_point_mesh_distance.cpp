@@ -96,7 +96,7 @@ points : (N, 3) float64 query points (other float dtypes are converted), or (T, 
     points of T frames, each measured against the mesh in its frame.
 vertices : (V, 3) float64 mesh vertices, or (T, V, 3) with the points' T.
 faces : (F, 3) int32 or int64 vertex indices, F >= 1, shared by every frame.
-threads : threads to query on (0: every core); the result does not depend on it.
+threads : threads to query on (0: :func:`thread_limit`); the result does not depend on it.
 
 Returns
 -------

@@ -34,7 +34,7 @@ Parameters
 ----------
 directions : (n, B, 3) float64 unit (or zero) direction of each of B bones at n frames.
 radii : (n, B) float64 the bones' lengths.
-threads : threads sharing the bones (0: every hardware thread); the result does not depend on it.
+threads : threads sharing the bones (0: :func:`thread_limit`); the result does not depend on it.
 
 Returns
 -------

@@ -79,7 +79,7 @@ py::array_t<float> skin_distance_maxima_py(const py::tuple& skin, const py::sequ
 void bind_skinning(py::module_& m) {
   m.def("bake_lbs", &bake_lbs_py, py::arg("rest_positions"), py::arg("joints"), py::arg("weights"),
         py::arg("skin_matrices"),
-        R"doc(Linear blend skinning of every frame, on every core for large inputs.
+        R"doc(Linear blend skinning of every frame, on :func:`thread_limit` threads for large inputs.
 
 Parameters
 ----------
@@ -107,7 +107,7 @@ Returns
 -------
 (N, T) float32: row n equal, bit for bit, to ``np.linalg.norm(bake_lbs(*others[n]) -
 bake_lbs(*skin), axis=-1).max(axis=1)``, computed without storing the (T, V, 3) frames, on
-every core.
+:func:`thread_limit` threads.
 
 Raises ValueError on a wrong shape, different V or T, or bake_lbs's errors, naming the skin.
 The GIL is released.)doc");

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
-#include <thread>
 #include <utility>
 
 #include "cost_order.hpp"
@@ -602,8 +601,7 @@ void CollapseEngine::rank_collapsible_edges(CollapsePolicy& policy, std::vector<
   RankingCache& cache = ranking_cache_;
   const bool from_last = cache.valid && options_.rank_from_last;
   const size_t item_count = from_last ? ranked.size() : connectivity_.n_edges();
-  const size_t hardware = std::max<size_t>(std::thread::hardware_concurrency(), 1);
-  const size_t workers = std::min({policy.concurrency(), hardware, std::max<size_t>(item_count / kMinimumChunk, 1)});
+  const size_t workers = std::min({policy.concurrency(), size_t{thread_limit()}, std::max<size_t>(item_count / kMinimumChunk, 1)});
   if (!from_last) ranked.resize(item_count);
   auto rank_edge = [&](int32_t edge, size_t worker, size_t& out) {
     if (connectivity_.status(connectivity_.edge_handle(edge)).deleted()) return;
@@ -827,7 +825,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       return attempt == Attempt::collapsed;
     };
     const std::vector<RankedEdge>* one_by_one = &chosen;
-    if (chosen.size() >= kMinimumHalves && policy.concurrency() >= 2 && std::thread::hardware_concurrency() >= 2) {
+    if (chosen.size() >= kMinimumHalves && policy.concurrency() >= 2 && thread_limit() >= 2) {
       const Performed performed = perform_in_halves(policy, chosen, targets, levels, record, deferred);
       pass_collapses += performed.collapses;
       edge_goal += performed.illegal;

@@ -15,7 +15,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -73,7 +72,7 @@ void angle_changes(const AnimatedMeshView& mesh, const detail::EdgeTable& edges,
   change.assign(edge_count, 0.0f);
   amplitude.assign(edge_count, 0.0f);
   const size_t workers =
-      std::min<size_t>(std::max(std::thread::hardware_concurrency(), 1u), edge_count / kEdgesPerThread);
+      std::min<size_t>(thread_limit(), edge_count / kEdgesPerThread);
   detail::run_in_ranges(edge_count, workers, [&](size_t begin, size_t end, size_t) {
     const size_t count = end - begin;
     std::vector<double> previous(count, 0.0), unwrapped(count, 0.0), lowest(count, 0.0), highest(count, 0.0);

@@ -10,6 +10,7 @@
 // Ericson's (Real-Time Collision Detection 5.1.5), checked against its vertices: the quantity
 // libigl's point_mesh_squared_distance returns.
 #include "animlod/point_mesh_distance.hpp"
+#include "animlod/threads.hpp"
 
 #include <algorithm>
 #include <array>
@@ -265,9 +266,9 @@ Status check_inputs(const TriangleMeshView& mesh, const double* points, size_t p
   return Status::success();
 }
 
-// Threads for `threads` requested (0: every core), fewer for few points.
+// Threads for `threads` requested (0: thread_limit()), fewer for few points.
 size_t worker_count(size_t point_count, unsigned threads) {
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cores = thread_limit();
   return std::clamp<size_t>(point_count / kPointsPerThread, 1, threads == 0 ? cores : std::min(threads, cores));
 }
 

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <thread>
 
 #include <glm/glm.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -84,7 +83,7 @@ glm::vec3 skinned_vertex(const SkinningInput& in, size_t t, size_t v) {
 }
 
 size_t worker_count(const SkinningInput& in) {
-  const size_t cores = std::max(1u, std::thread::hardware_concurrency());
+  const size_t cores = thread_limit();
   return std::clamp<size_t>(in.frame_count * in.vertex_count / kVertexFramesPerThread, 1, cores);
 }
 

@@ -8,13 +8,16 @@
 #include <thread>
 #include <vector>
 
+#include "animlod/threads.hpp"
+
 namespace animlod::detail {
 
-// Runs `worker` on `requested` threads (0: every hardware thread), never on more than `tasks`,
-// and on the calling thread alone when that comes to one.
+// Runs `worker` on `requested` threads (0: thread_limit()), never on more than thread_limit() or
+// `tasks`, and on the calling thread alone when that comes to one.
 template <typename Worker>
 void run_workers(unsigned requested, size_t tasks, const Worker& worker) {
-  unsigned threads = requested > 0 ? requested : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned limit = thread_limit();
+  unsigned threads = requested > 0 ? std::min(requested, limit) : limit;
   threads = static_cast<unsigned>(std::min<size_t>(threads, std::max<size_t>(tasks, 1)));
   if (threads <= 1) {
     worker();

@@ -9,6 +9,7 @@ from .model import AnimatedMesh, LodChain, LodLevel, Motion, Skeleton, SkinnedMe
 from .motion_lod import analyze_motion, build_motion_chain
 from .options import AqemOptions, MotionFeatureOptions, TdagOptions
 from .tdag import TemporalDag
+from .threads import set_thread_limit, thread_limit
 
 __version__ = "0.1.0"
 
@@ -27,6 +28,8 @@ __all__ = [
     "analyze_motion",
     "build_motion_chain",
     "motion_features",
+    "set_thread_limit",
     "simplify_animated",
     "simplify_skinned",
+    "thread_limit",
 ]

@@ -2,7 +2,8 @@
 
 They stand for what goes wrong on a farm: a worker process that dies in the middle of an
 asset (a crash in native code, the kernel's out-of-memory killer), once or every time; and for
-a studio's job whose options may each take values of several kinds.
+a studio's job whose options may each take values of several kinds; and for the core's thread
+limit an asset runs under.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import signal
 from collections.abc import Sequence
 from pathlib import Path
 
+from animlod import thread_limit
 from animlod.pipelines import simplify_asset
 
 
@@ -43,3 +45,10 @@ def several_kinds(
     """Options that take a value of either of two kinds (``frames``: a list of whole numbers or a
     string such as "all"), and a list whose default is empty (``tags``); runs the simplify job."""
     return simplify_asset(source, output, progress=progress)
+
+
+def report_threads(source: str, output: str, *, progress=None, **options: object):
+    """The simplify job, with a note of the core's thread limit while it ran."""
+    result = simplify_asset(source, output, progress=progress, **options)
+    result.notes.append(f"core threads: {thread_limit()}")
+    return result

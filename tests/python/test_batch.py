@@ -5,6 +5,7 @@ worker leaving nothing half-written."""
 from __future__ import annotations
 
 import json
+import os
 import re
 from pathlib import Path
 
@@ -214,6 +215,18 @@ def test_killed_worker_leaves_no_partial_file_and_the_asset_is_redone(client, li
     assert [(row["level"], row["triangles"]) for row in face] == [(0, 320), (1, 160)] and face[1]["error"] > 0
     assert not list((tmp_path / "out").rglob("half_written*"))
     client.wait_for_workers(2, timeout=30)  # the nannies restarted the killed workers
+
+
+def test_each_asset_shares_the_cores_of_its_host(client, library, tmp_path):
+    # Two single-threaded workers on one host: an asset's core loops take half of the cores
+    # (animlod.set_thread_limit), not every core each.
+    manifest = tmp_path / "assets.json"
+    entries = [{"input": str(library / "bar.npz"), "name": f"bar{index}", "job": "batch_jobs:report_threads"}
+               for index in range(2)]  # fmt: skip
+    manifest.write_text(json.dumps({"assets": entries}))
+    result = run_batch(read_spec(manifest), tmp_path / "out", client=client)
+    share = max(1, (os.cpu_count() or 1) // 2)
+    assert all(f"core threads: {share}" in record["result"]["notes"] for record in result.records), result.records
 
 
 def test_cli_bad_inputs_are_one_line_exit_2(library, tmp_path, capsys):

@@ -121,7 +121,7 @@ struct MotionRefitOptions {
   bool rigid_bodies = true;
   int chunk_frames = 64;        // with warm_start, consecutive frames per task (warm starts run
                                 // inside a chunk); without, each frame is a task
-  int threads = 0;              // worker threads; 0 uses every hardware thread
+  int threads = 0;              // worker threads; 0 uses thread_limit() (animlod/threads.hpp)
 };
 
 // One frame whose first solve was not kept.

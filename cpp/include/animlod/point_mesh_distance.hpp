@@ -23,7 +23,7 @@ struct TriangleMeshView {
 // triangle of the mesh in the same frame (degenerate triangles count as their edges). A
 // bounding-volume hierarchy over the triangles, built on the first frame and refitted to the
 // others (a point's search starts from its nearest triangle of the frame before), queried on
-// up to `threads` threads (0: every core); a point's result does not depend on the thread count.
+// up to `threads` threads (0: thread_limit(), animlod/threads.hpp); a point's result does not depend on the thread count.
 // Errors: no triangle, a face index outside [0, V), a non-finite vertex or point (naming it).
 Status point_mesh_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
                                    unsigned threads, double* out);

@@ -18,7 +18,7 @@ namespace animlod {
 // that frame, is at a right angle to any direction). These are the rows of Eq. 1's n x n table
 // before the division by 2 pi r_max, one bone at a time (the paper sums them over a joint's
 // child bones); the table itself is never stored. A bone whose direction never changes gets
-// exact zeros. `threads` share the bones (0: every hardware thread); the result does not
+// exact zeros. `threads` share the bones (0: thread_limit(), animlod/threads.hpp); the result does not
 // depend on it. Errors: a non-finite direction or radius, naming the frame and the bone.
 Status posture_error_row_sums(const double* directions, const double* radii, size_t frame_count, size_t bone_count,
                               unsigned threads, double* out);

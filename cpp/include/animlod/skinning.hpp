@@ -23,13 +23,13 @@ struct SkinningInput {
 // Writes out_positions (T, V, 3): sum_k w_k * M[t, j_k] * rest. The caller owns
 // out_positions, which must hold T * V * 3 floats.
 // Errors: a joint index outside [0, J) or a non-finite weight (naming the vertex).
-// Runs on every core when T * V is large enough.
+// Runs on thread_limit() threads (animlod/threads.hpp) when T * V is large enough.
 Status bake_lbs(const SkinningInput& input, float* out_positions);
 
 // Writes out_maxima (N, T): in each frame t, the largest distance between where skin `a` and
 // skin others[n] put a vertex (the same V vertices and T frames; K and J may differ), without
 // storing the frames: how far reduced skins stray from the input over a whole clip. Equal to the
-// maxima over vertices of the distances between bake_lbs's outputs, bit for bit. On every core.
+// maxima over vertices of the distances between bake_lbs's outputs, bit for bit. On thread_limit() threads.
 // Errors: V or T differ (naming the skin n), or bake_lbs's errors of a skin.
 Status skin_distance_maxima(const SkinningInput& a, const SkinningInput* others, size_t other_count,
                             float* out_maxima);

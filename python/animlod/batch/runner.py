@@ -220,11 +220,11 @@ def _run_pending(
 
     def submit_while_free() -> None:
         nonlocal submitted
-        slots = max(1, _threads(client))  # read each time: a cluster may grow or shrink
-        while waiting and len(futures) < slots:
+        sharing = _threads_by_host(client)  # read each time: a cluster may grow or shrink
+        while waiting and len(futures) < max(1, sum(sharing.values())):
             asset, digest, _size = waiting.popleft()
             key = f"animlod-{submitted}-{topic}"
-            future = client.submit(run_asset, asset, os.fspath(root), digest, topic, key=key, pure=False)
+            future = client.submit(run_asset, asset, os.fspath(root), digest, topic, sharing, key=key, pure=False)
             futures[future] = (asset, digest)
             running.add(future)
             submitted += 1
@@ -255,9 +255,14 @@ def _run_pending(
         client.unsubscribe_topic(topic)
 
 
-def _threads(client) -> int:
-    """Worker threads in the cluster now (a synchronous client asks the scheduler each time)."""
-    return sum(int(worker.get("nthreads", 1)) for worker in _workers(client).values())
+def _threads_by_host(client) -> dict[str, int]:
+    """Worker threads in the cluster now, by host (a synchronous client asks the scheduler each
+    time): each runs an asset, and an asset's core loops share the host's cores with the others."""
+    sharing: dict[str, int] = {}
+    for worker in _workers(client).values():
+        host = str(worker.get("host", ""))
+        sharing[host] = sharing.get(host, 0) + int(worker.get("nthreads", 1))
+    return sharing
 
 
 def _workers(client) -> dict:

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..io.errors import FormatError
+from ..threads import set_thread_limit
 from .jobs import find_job
 from .outputs import discard, publish, staging_folder
 from .spec import AssetSpec
@@ -33,8 +34,15 @@ PROGRESS_INTERVAL = 0.25
 WARNING_NOTE = "warning: "
 
 
-def run_asset(asset: AssetSpec, root: str, fingerprint: str, topic: str | None = None) -> dict:
+def run_asset(
+    asset: AssetSpec, root: str, fingerprint: str, topic: str | None = None, sharing: dict[str, int] | None = None
+) -> dict:
     """Run ``asset``'s job into ``root/<asset.name>``; the record of what happened.
+
+    On a Dask worker the core's loops take this process's cores divided by the worker threads
+    on its host (``sharing``: host -> worker threads, from the scheduler; a host missing from it
+    counts this worker's threads alone), so that assets running side by side do not each take
+    every core (:func:`animlod.set_thread_limit`; the result does not depend on it).
 
     The record (JSON values): name, job, input, fingerprint, status ("ok" or "failed"), result
     (:meth:`AssetResult.to_dict` with outputs relative to the asset's folder; ok only), error
@@ -55,6 +63,7 @@ def run_asset(asset: AssetSpec, root: str, fingerprint: str, topic: str | None =
         folder = Path(root)
         staging = staging_folder(folder, asset.name)
         job = find_job(asset.job).function()
+        _share_cores(sharing)
         # The readers' warnings (a texture not found, a BVH's frame count one short) go with the
         # asset's notes, not to the worker's stderr. Exact on single-threaded workers, as the
         # local cluster's are: catch_warnings is process-wide.
@@ -113,6 +122,19 @@ def _worker_name() -> str:
         return get_worker().address
     except (ImportError, ValueError):
         return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def _share_cores(sharing: dict[str, int] | None) -> None:
+    """Caps the core's threads at this worker's share of its host's cores (nothing outside Dask)."""
+    try:
+        from distributed import get_worker
+        from distributed.comm.addressing import get_address_host
+
+        worker = get_worker()
+    except (ImportError, ValueError):
+        return
+    threads = (sharing or {}).get(get_address_host(worker.address)) or worker.state.nthreads
+    set_thread_limit(max(1, (os.cpu_count() or 1) // max(1, threads)))
 
 
 def _progress(topic: str | None, name: str) -> Progress | None:

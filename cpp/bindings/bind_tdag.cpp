@@ -260,20 +260,26 @@ void bind_tdag(py::module_& m) {
           [](const TemporalDag& d) {
             std::vector<uint8_t> bytes;
             call_released([&] { return serialize_temporal_dag(d, bytes); });
-            return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+            const auto size = static_cast<py::ssize_t>(bytes.size());
+            return numpy_from_vector(std::move(bytes), {size});
           },
-          "the .tdag file contents (versioned, checksummed)")
+          "the .tdag file contents (versioned, checksummed) as a (N,) uint8 array: no copy of a long "
+          "clip's gigabytes")
       .def_static(
           "from_bytes",
-          [](const py::bytes& data) {
-            const std::string_view view = data;
+          [](const py::buffer& data) {
+            const py::buffer_info info = data.request();
+            if (info.ndim != 1 || info.itemsize != 1 || info.strides[0] != 1)
+              throw py::value_error("TemporalDag.from_bytes: expected contiguous bytes");
             TemporalDag dag;
             call_released([&] {
-              return deserialize_temporal_dag(reinterpret_cast<const uint8_t*>(view.data()), view.size(), dag);
+              return deserialize_temporal_dag(static_cast<const uint8_t*>(info.ptr), static_cast<size_t>(info.size), dag);
             });
             return dag;
           },
-          py::arg("data"), "reads .tdag contents; ValueError for a non-TDAG, another version or a corrupted file");
+          py::arg("data"),
+          "reads .tdag contents from any bytes-like object (bytes, a mapped file); ValueError for a non-TDAG, "
+          "another version or a corrupted file");
 
   m.def("build_temporal_dag", &build_py, py::arg("frames"), py::arg("faces"), py::arg("options") = TdagOptions{},
         py::arg("progress") = py::none(),

@@ -281,7 +281,7 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
 
   // The TDAG's vertices: welded points, degenerate and repeated faces dropped, non-manifold
   // spots cut apart (as the collapse engine needs them).
-  const PointMesh points(mesh, options.weld);
+  PointMesh points(mesh, options.weld);
   if (points.view.face_count == 0)
     return Status::error("faces: every face is degenerate (no face has three distinct positions)");
   const AnimatedMeshView& view = points.view;
@@ -372,6 +372,9 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
       progress(static_cast<size_t>(t) + 1);
     }
   }
+  // The points' frames are read no more: freed, a long clip's fields are gathered beside the
+  // input and the residuals only, not beside a third copy of the frames.
+  std::vector<float>().swap(points.frames);
   fields.finish(table, *data);
   if (Status status = detail::derive_links(*data); !status) return Status::error("internal: " + status.message);
   out.data_ = std::move(data);

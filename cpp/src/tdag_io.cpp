@@ -35,6 +35,7 @@
 #include <string>
 
 #include "animlod/tdag.hpp"
+#include "crc32.hpp"
 #include "tdag_data.hpp"
 
 namespace animlod {
@@ -43,21 +44,6 @@ namespace {
 
 constexpr char kMagic[8] = {'A', 'N', 'L', 'D', 'T', 'D', 'A', 'G'};
 constexpr size_t kHeaderSize = 8 + 4 + 8;
-
-uint32_t crc32(const uint8_t* bytes, size_t size) {
-  static const auto table = [] {
-    std::array<uint32_t, 256> t{};
-    for (uint32_t i = 0; i < 256; ++i) {
-      uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  uint32_t c = 0xFFFFFFFFu;
-  for (size_t i = 0; i < size; ++i) c = table[(c ^ bytes[i]) & 0xFFu] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
-}
 
 class Writer {
  public:
@@ -329,8 +315,17 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
   if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
   const detail::TdagData& d = *dag.data_;
   const auto frame_count = static_cast<size_t>(d.frame_count), vertex_count = static_cast<size_t>(d.vertex_count);
-  std::vector<uint8_t> body;
-  Writer w(body);
+  // The body goes straight after the header, whose length is filled in at the end: a body apart
+  // and its copy held a long clip's residuals twice. Reserved for every residual stored (untouched
+  // pages cost nothing), so that growing does not copy them either.
+  const size_t per_frame = vertex_count * 3;
+  out.reserve(kHeaderSize + d.maps.size() * sizeof(double) + frame_count * (per_frame * sizeof(float) + vertex_count / 8 + 1) +
+              16 * (d.faces.size() + d.input_points.size() + d.dep_nodes.size() + d.error_runs.size()) +
+              64 * d.collapse_count() + 1024);
+  Writer w(out);
+  w.raw_array(kMagic, sizeof(kMagic));
+  w.raw(kTdagFormatVersion);
+  w.raw(uint64_t{0});  // the body's length, below
   w.varint(frame_count);
   w.varint(vertex_count);
   w.varint(d.face_count());
@@ -366,7 +361,6 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
       previous_face = static_cast<int64_t>(f);
     }
   w.raw_array(d.maps.data(), d.maps.size());
-  const size_t per_frame = vertex_count * 3;
   w.raw_array(d.residuals.data(), per_frame);
   std::vector<uint8_t> changed((vertex_count + 7) / 8);
   for (size_t f = 1; f < frame_count; ++f) {
@@ -376,8 +370,14 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
     for (size_t v = 0; v < vertex_count; ++v)
       if (std::memcmp(now + 3 * v, before + 3 * v, 3 * sizeof(float)) != 0) changed[v / 8] |= uint8_t(1u << (v % 8));
     w.raw_array(changed.data(), changed.size());
-    for (size_t v = 0; v < vertex_count; ++v)
-      if (changed[v / 8] & (1u << (v % 8))) w.raw_array(now + 3 * v, 3);
+    auto is_changed = [&](size_t v) { return (changed[v / 8] & (1u << (v % 8))) != 0; };
+    for (size_t v = 0; v < vertex_count; ++v) {  // each run of changed vertices in one copy
+      if (!is_changed(v)) continue;
+      size_t end = v + 1;
+      while (end < vertex_count && is_changed(end)) ++end;
+      w.raw_array(now + 3 * v, 3 * (end - v));
+      v = end;  // unchanged (or the end)
+    }
   }
   for (size_t c = 0; c < d.collapse_count(); ++c) {
     const int64_t node = static_cast<int64_t>(vertex_count + c);
@@ -416,13 +416,9 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
     }
   }
 
-  out.reserve(kHeaderSize + body.size() + 4);
-  Writer header(out);
-  header.raw_array(kMagic, sizeof(kMagic));
-  header.raw(kTdagFormatVersion);
-  header.raw(static_cast<uint64_t>(body.size()));
-  out.insert(out.end(), body.begin(), body.end());
-  header.raw(crc32(body.data(), body.size()));
+  const uint64_t body_size = out.size() - kHeaderSize;
+  std::memcpy(out.data() + kHeaderSize - sizeof(body_size), &body_size, sizeof(body_size));
+  w.raw(detail::crc32(out.data() + kHeaderSize, static_cast<size_t>(body_size)));
   return Status::success();
 }
 
@@ -446,7 +442,7 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
   const uint8_t* body = bytes + kHeaderSize;
   uint32_t stored_crc = 0;
   std::memcpy(&stored_crc, body + body_size, 4);
-  if (crc32(body, static_cast<size_t>(body_size)) != stored_crc)
+  if (detail::crc32(body, static_cast<size_t>(body_size)) != stored_crc)
     return Status::error("corrupted TDAG file: checksum mismatch");
 
   Reader r(body, static_cast<size_t>(body_size));

@@ -356,10 +356,10 @@ class TemporalDag:
 
     def to_bytes(self) -> bytes:
         """The contents of a .tdag file (versioned, checksummed)."""
-        return self._core.to_bytes()
+        return self._core.to_bytes().tobytes()
 
     @classmethod
-    def from_bytes(cls, data: bytes) -> TemporalDag:
+    def from_bytes(cls, data: bytes | bytearray | memoryview) -> TemporalDag:
         """Read .tdag contents; ValueError for something else, another format version or damage."""
         return cls(_core.TemporalDag.from_bytes(data))
 
@@ -367,10 +367,10 @@ class TemporalDag:
         """Write the TDAG and its affine maps to ``path`` atomically; returns the size in bytes."""
         from .io.atomic import atomic_write
 
-        data = self.to_bytes()
+        data = self._core.to_bytes()  # written from the core's own buffer, not a copy as bytes
         with atomic_write(path, "wb") as handle:
             handle.write(data)
-        return len(data)
+        return int(data.size)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> TemporalDag:

@@ -153,7 +153,11 @@ def test_save_load_round_trip_and_damaged_files(dag: TemporalDag, tmp_path):
     size = dag.save(path)
     assert path.stat().st_size == size
     loaded = TemporalDag.load(path)
-    assert loaded.to_bytes() == dag.to_bytes() and loaded.report is None
+    assert loaded.to_bytes() == dag.to_bytes() == path.read_bytes() and loaded.report is None
+    for view in (bytearray(path.read_bytes()), memoryview(path.read_bytes())):  # any bytes-like object
+        assert TemporalDag.from_bytes(view).to_bytes() == dag.to_bytes()
+    with pytest.raises(ValueError, match="expected contiguous bytes"):
+        TemporalDag.from_bytes(np.frombuffer(path.read_bytes(), np.uint8)[::2])
     for frame in (0, 4):
         np.testing.assert_array_equal(loaded.frame_positions(frame), dag.frame_positions(frame))
         assert _canonical(loaded.query(frame, 0.02)) == _canonical(dag.cut(frame, 0.02).mesh())

@@ -151,25 +151,26 @@ def run_build(args: argparse.Namespace) -> int:
         )
     finally:
         bar.close()
+    raw = mesh.frames.size * 4
+    counts = mesh.frame_count, mesh.vertex_count, mesh.face_count
+    del mesh  # the input frames, no longer needed: a long clip's save then holds the file's bytes instead
     start = time.perf_counter()
     size = dag.save(args.output)
     save_seconds = time.perf_counter() - start
     report = dag.report
-    raw = mesh.frames.size * 4
     average, median = report.quality_measure()
     print(f"wrote {args.output}")
     rows = [
         (
             "frames, vertices, faces",
-            f"{mesh.frame_count}, {mesh.vertex_count}, {mesh.face_count} (TDAG: {dag.vertex_count} welded "
-            f"vertices, {dag.face_count} faces)",
+            f"{counts[0]}, {counts[1]}, {counts[2]} (TDAG: {dag.vertex_count} welded vertices, {dag.face_count} faces)",
         ),
         ("governing", f"{dag.governing}" + (f" (lambda {args.history_weight:g})" if dag.governing == "online" else "")),
         ("collapses (nodes), per frame", f"{dag.collapse_count}, {report.collapse_counts.mean():.0f}"),
         (
             "build s (affine, hierarchy, fields)",
             f"{report.seconds:.3f} ({report.seconds_affine:.3f}, {report.seconds_hierarchy:.3f}, "
-            f"{report.seconds_fields:.3f}); {report.seconds / mesh.frame_count * 1e3:.1f} ms per frame",
+            f"{report.seconds_fields:.3f}); {report.seconds / counts[0] * 1e3:.1f} ms per frame",
         ),
         ("file bytes / raw float32 frames", f"{size} / {raw} = {size / raw:.3f} (written in {save_seconds:.3f} s)"),
         ("Figure 6 measure: average, median", f"{average:.4g}, {median:.4g} (squared asset units)"),

@@ -9,7 +9,8 @@
 //   fields           per frame and collapse: the quadric cost c_{i,t} on the real frame
 //                    (Section 4 stresses real meshes, not residuals; Figure 6's measure), and
 //                    the error bound, made monotone along dependencies and stored as time-
-//                    tagged runs (Section 2), so that a tolerance query always gives a valid cut.
+//                    tagged runs (Section 2), so that a tolerance query always gives a valid cut;
+//                    with one hierarchy for all frames, threads measure a frame each.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -26,6 +27,7 @@
 #include "tdag_data.hpp"
 #include "tdag_hierarchy.hpp"
 #include "tdag_policy.hpp"
+#include "worker_threads.hpp"
 
 namespace animlod {
 
@@ -82,7 +84,59 @@ struct PointMesh {
   }
 };
 
-// Per-frame fields of the collapses, accumulated frame after frame.
+// One frame's fields of a hierarchy's collapses, in its order: the cost c_{i,t} and the code of
+// the error bound. A frame's do not depend on the other frames', so threads measure several.
+struct FrameFields {
+  std::vector<double> costs;
+  std::vector<uint16_t> codes;
+};
+
+// A measuring thread's scratch, over the nodes (V + C).
+struct FieldScratch {
+  std::vector<Quadric> quadrics;
+  std::vector<double> bound;    // monotone bound in the frame
+  std::vector<float> ordered;   // (V, 3) the frame's positions in ClusterRanges::leaves order
+};
+
+// The input vertices of every node's cluster in a hierarchy as one range of a depth-first order
+// of the vertices: a node's farthest vertex is then sought in one contiguous run of a frame's
+// positions instead of by walking its subtree through the frame at random.
+struct ClusterRanges {
+  std::vector<int32_t> leaves;  // (V,) the vertices, each cluster's contiguous
+  std::vector<int32_t> begin;   // (V + C,) a node's first position in `leaves`
+  std::vector<int32_t> count;   // (V + C,) its cluster's vertex count
+
+  ClusterRanges(const CollapseTable& table, const FrameHierarchy& h) {
+    const int32_t vertex_count = table.vertex_count();
+    const size_t node_count = table.representative.size();
+    begin.assign(node_count, -1);
+    count.assign(node_count, 1);
+    std::vector<uint8_t> has_parent(node_count, 0);
+    for (const int32_t node : h.nodes) {  // children before parents
+      const auto c = static_cast<size_t>(node - vertex_count);
+      count[static_cast<size_t>(node)] = count[static_cast<size_t>(table.kept_child[c])] +
+                                         count[static_cast<size_t>(table.removed_child[c])];
+      has_parent[static_cast<size_t>(table.kept_child[c])] = has_parent[static_cast<size_t>(table.removed_child[c])] = 1;
+    }
+    int32_t next = 0;
+    for (int32_t v = 0; v < vertex_count; ++v)  // vertices no collapse of h takes
+      if (!has_parent[static_cast<size_t>(v)]) begin[static_cast<size_t>(v)] = next++;
+    for (auto it = h.nodes.rbegin(); it != h.nodes.rend(); ++it) {  // parents before children
+      const auto node = static_cast<size_t>(*it);
+      if (!has_parent[node]) {
+        begin[node] = next;
+        next += count[node];
+      }
+      const size_t c = node - static_cast<size_t>(vertex_count);
+      begin[static_cast<size_t>(table.kept_child[c])] = begin[node];
+      begin[static_cast<size_t>(table.removed_child[c])] = begin[node] + count[static_cast<size_t>(table.kept_child[c])];
+    }
+    leaves.resize(static_cast<size_t>(vertex_count));
+    for (int32_t v = 0; v < vertex_count; ++v) leaves[static_cast<size_t>(begin[static_cast<size_t>(v)])] = v;
+  }
+};
+
+// Per-frame fields of the collapses, measured frame by frame and recorded in frame order.
 class FieldBuilder {
  public:
   FieldBuilder(const AnimatedMeshView& mesh, const TdagOptions& options, double scale)
@@ -91,8 +145,13 @@ class FieldBuilder {
     use_boundary_ = options.boundary_quadrics;
   }
 
-  // Adds frame t of hierarchy h (its collapses are already in `table`).
-  void add_frame(int32_t t, const CollapseTable& table, const FrameHierarchy& h, TdagBuildReport& report);
+  // Frame t's fields of hierarchy h (its collapses are already in `table`); safe on several
+  // threads at once, each with its own scratch.
+  void measure(int32_t t, const CollapseTable& table, const FrameHierarchy& h, const ClusterRanges& clusters,
+               FieldScratch& scratch, FrameFields& out) const;
+  // Adds measured frame t to the time-tagged fields and the report; frames in increasing order.
+  void record(int32_t t, const CollapseTable& table, const FrameHierarchy& h, const FrameFields& fields,
+              TdagBuildReport& report);
   void finish(const CollapseTable& table, detail::TdagData& data);
 
  private:
@@ -116,59 +175,68 @@ class FieldBuilder {
   std::vector<TimeTag> alive_;                   // (C,)
   std::vector<TaggedSet<int32_t>> links_;        // (C,) dependencies
   std::vector<TaggedValue<uint16_t>> errors_;    // (C,) error codes
-  std::vector<Quadric> quadrics_;                // (V + C,) scratch
-  std::vector<double> bound_;                    // (V + C,) scratch: monotone bound in this frame
-  std::vector<int32_t> stack_;
 };
 
-void FieldBuilder::add_frame(int32_t t, const CollapseTable& table, const FrameHierarchy& h,
-                             TdagBuildReport& report) {
+void FieldBuilder::measure(int32_t t, const CollapseTable& table, const FrameHierarchy& h,
+                           const ClusterRanges& clusters, FieldScratch& scratch, FrameFields& out) const {
   const int32_t vertex_count = table.vertex_count();
   const size_t node_count = table.representative.size();
-  grow(table.collapse_count(), report);
-  report.collapse_counts.push_back(static_cast<int32_t>(h.nodes.size()));
+  std::vector<Quadric>& quadrics = scratch.quadrics;
+  std::vector<double>& bounds = scratch.bound;
+  std::vector<float>& ordered = scratch.ordered;
+  out.costs.resize(h.nodes.size());
+  out.codes.resize(h.nodes.size());
 
   // Costs c_{i,t}: the quadric of a node is the sum of its cluster's vertex quadrics in frame t.
   const float* positions = mesh_.frames + static_cast<size_t>(t) * mesh_.vertex_count * 3;
   detail::vertex_quadrics(positions, mesh_.faces, mesh_.vertex_count, mesh_.face_count,
-                          use_boundary_ ? &boundary_ : nullptr, quadrics_);
-  quadrics_.resize(node_count);
-  bound_.assign(node_count, 0.0);
+                          use_boundary_ ? &boundary_ : nullptr, quadrics);
+  quadrics.resize(node_count);
+  bounds.assign(node_count, 0.0);
+  ordered.resize(clusters.leaves.size() * 3);
+  for (size_t k = 0; k < clusters.leaves.size(); ++k)
+    std::copy_n(positions + 3 * static_cast<size_t>(clusters.leaves[k]), 3, &ordered[3 * k]);
   for (size_t i = 0; i < h.nodes.size(); ++i) {
     const int32_t node = h.nodes[i];
     const size_t c = static_cast<size_t>(node - vertex_count);
     const int32_t kept = table.kept_child[c], removed = table.removed_child[c];
-    const Quadric merged = quadrics_[static_cast<size_t>(kept)] + quadrics_[static_cast<size_t>(removed)];
-    quadrics_[static_cast<size_t>(node)] = merged;
-    const double cost = merged.evaluate(point(t, table.representative[static_cast<size_t>(node)]));
-    report.max_cost[c] = report.use_counts[c] == 0 ? cost : std::max(report.max_cost[c], cost);
-    report.use_counts[c] += 1;
+    const Quadric merged = quadrics[static_cast<size_t>(kept)] + quadrics[static_cast<size_t>(removed)];
+    quadrics[static_cast<size_t>(node)] = merged;
+    out.costs[i] = merged.evaluate(point(t, table.representative[static_cast<size_t>(node)]));
 
     // Error bound: the farthest input vertex of the cluster from the node's position, then
     // the largest bound of the children and of the dependencies (all earlier in h).
     const Eigen::Vector3d centre = point(t, table.representative[static_cast<size_t>(node)]);
     double farthest = 0.0;
-    stack_.assign({kept, removed});
-    while (!stack_.empty()) {
-      const int32_t x = stack_.back();
-      stack_.pop_back();
-      if (x < vertex_count) {
-        farthest = std::max(farthest, (point(t, x) - centre).squaredNorm());
-        continue;
-      }
-      const size_t cx = static_cast<size_t>(x - vertex_count);
-      stack_.push_back(table.kept_child[cx]);
-      stack_.push_back(table.removed_child[cx]);
+    const auto first = static_cast<size_t>(clusters.begin[static_cast<size_t>(node)]);
+    const size_t end = first + static_cast<size_t>(clusters.count[static_cast<size_t>(node)]);
+    for (size_t k = first; k < end; ++k) {
+      const double dx = ordered[3 * k] - centre.x(), dy = ordered[3 * k + 1] - centre.y(),
+                   dz = ordered[3 * k + 2] - centre.z();
+      farthest = std::max(farthest, dx * dx + dy * dy + dz * dz);
     }
     double bound = std::sqrt(farthest);
-    bound = std::max({bound, bound_[static_cast<size_t>(kept)], bound_[static_cast<size_t>(removed)]});
+    bound = std::max({bound, bounds[static_cast<size_t>(kept)], bounds[static_cast<size_t>(removed)]});
     for (int32_t d = h.dep_offsets[i]; d < h.dep_offsets[i + 1]; ++d)
-      bound = std::max(bound, bound_[static_cast<size_t>(h.dep_nodes[static_cast<size_t>(d)])]);
-    bound_[static_cast<size_t>(node)] = bound;
+      bound = std::max(bound, bounds[static_cast<size_t>(h.dep_nodes[static_cast<size_t>(d)])]);
+    bounds[static_cast<size_t>(node)] = bound;
+    out.codes[i] = detail::encode_error(bound, scale_);
+  }
+}
 
+void FieldBuilder::record(int32_t t, const CollapseTable& table, const FrameHierarchy& h, const FrameFields& fields,
+                          TdagBuildReport& report) {
+  const int32_t vertex_count = table.vertex_count();
+  grow(table.collapse_count(), report);
+  report.collapse_counts.push_back(static_cast<int32_t>(h.nodes.size()));
+  for (size_t i = 0; i < h.nodes.size(); ++i) {
+    const size_t c = static_cast<size_t>(h.nodes[i] - vertex_count);
+    const double cost = fields.costs[i];
+    report.max_cost[c] = report.use_counts[c] == 0 ? cost : std::max(report.max_cost[c], cost);
+    report.use_counts[c] += 1;
     alive_[c].add(t);
     for (int32_t d = h.dep_offsets[i]; d < h.dep_offsets[i + 1]; ++d) links_[c].add(h.dep_nodes[static_cast<size_t>(d)], t);
-    errors_[c].append({t, t + 1}, detail::encode_error(bound, scale_));
+    errors_[c].append({t, t + 1}, fields.codes[i]);
   }
 }
 
@@ -343,13 +411,25 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
     }
     progress(0);
     const detail::PhaseTimer timer(rep.seconds_fields);
-    for (int32_t t = 0; t < frame_count; ++t) {
-      fields.add_frame(t, table, hierarchy, rep);
-      progress(static_cast<size_t>(t) + 1);
+    // One hierarchy for every frame: threads measure a frame each, recorded in frame order
+    // (recording on the threads too, each its share of the collapses, gained nothing).
+    const auto workers = static_cast<int32_t>(std::min<size_t>(thread_limit(), mesh.frame_count));
+    const ClusterRanges clusters(table, hierarchy);
+    std::vector<FieldScratch> scratch(static_cast<size_t>(workers));
+    std::vector<FrameFields> measured(static_cast<size_t>(workers));
+    for (int32_t first = 0; first < frame_count; first += workers) {
+      const auto count = static_cast<size_t>(std::min(workers, frame_count - first));
+      detail::run_in_ranges(count, count, [&](size_t k, size_t, size_t) {
+        fields.measure(first + static_cast<int32_t>(k), table, hierarchy, clusters, scratch[k], measured[k]);
+      });
+      for (size_t k = 0; k < count; ++k) fields.record(first + static_cast<int32_t>(k), table, hierarchy, measured[k], rep);
+      progress(static_cast<size_t>(first) + count);
     }
   } else {
     FrameHierarchy previous, current;
     std::vector<double> previous_costs;
+    FieldScratch scratch;
+    FrameFields measured;
     progress(0);
     for (int32_t t = 0; t < frame_count; ++t) {
       {
@@ -365,7 +445,8 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
       }
       {
         const detail::PhaseTimer timer(rep.seconds_fields);
-        fields.add_frame(t, table, current, rep);
+        fields.measure(t, table, current, ClusterRanges(table, current), scratch, measured);
+        fields.record(t, table, current, measured, rep);
       }
       std::swap(previous, current);
       previous_costs = costs;

@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from animlod import AnimatedMesh, set_thread_limit, simplify_animated, synth, thread_limit
+from animlod import AnimatedMesh, TemporalDag, set_thread_limit, simplify_animated, synth, thread_limit
 
 
 @pytest.fixture
@@ -60,3 +60,15 @@ def test_the_environment_sets_the_starting_limit(value, expected, warns) -> None
     )
     assert int(run.stdout) == (expected or os.cpu_count())
     assert ("ANIMLOD_THREADS='x2' is not a whole number" in run.stderr) == warns
+
+
+def test_tdag_fields_measured_on_threads_equal_one_threads(one_thread) -> None:
+    # Threads measure a frame each (tdag_build.cpp); recorded in frame order, every field and
+    # the build report are those of one thread.
+    mesh = synth.bending_cylinder(frames=7, rings=12, segments=10)
+    alone = TemporalDag.build(mesh, "first")
+    set_thread_limit(0)
+    shared = TemporalDag.build(mesh, "first")
+    assert alone.to_bytes() == shared.to_bytes()
+    for name in ("collapse_counts", "max_cost", "use_counts"):
+        np.testing.assert_array_equal(getattr(alone.report, name), getattr(shared.report, name))

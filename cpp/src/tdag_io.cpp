@@ -45,6 +45,20 @@ namespace {
 constexpr char kMagic[8] = {'A', 'N', 'L', 'D', 'T', 'D', 'A', 'G'};
 constexpr size_t kHeaderSize = 8 + 4 + 8;
 
+// Calls run(begin, end) for each run of vertices whose bit is set in `changed` (one bit per
+// vertex), in order, while it returns true: a frame's changed residuals are copied a run at a time.
+template <typename Run>
+void for_each_changed_run(const std::vector<uint8_t>& changed, size_t vertex_count, const Run& run) {
+  auto is_changed = [&](size_t v) { return (changed[v / 8] & (1u << (v % 8))) != 0; };
+  for (size_t v = 0; v < vertex_count; ++v) {
+    if (!is_changed(v)) continue;
+    size_t end = v + 1;
+    while (end < vertex_count && is_changed(end)) ++end;
+    if (!run(v, end)) return;
+    v = end;  // unchanged (or the end)
+  }
+}
+
 class Writer {
  public:
   explicit Writer(std::vector<uint8_t>& out) : out_(out) {}
@@ -370,14 +384,10 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
     for (size_t v = 0; v < vertex_count; ++v)
       if (std::memcmp(now + 3 * v, before + 3 * v, 3 * sizeof(float)) != 0) changed[v / 8] |= uint8_t(1u << (v % 8));
     w.raw_array(changed.data(), changed.size());
-    auto is_changed = [&](size_t v) { return (changed[v / 8] & (1u << (v % 8))) != 0; };
-    for (size_t v = 0; v < vertex_count; ++v) {  // each run of changed vertices in one copy
-      if (!is_changed(v)) continue;
-      size_t end = v + 1;
-      while (end < vertex_count && is_changed(end)) ++end;
-      w.raw_array(now + 3 * v, 3 * (end - v));
-      v = end;  // unchanged (or the end)
-    }
+    for_each_changed_run(changed, vertex_count, [&](size_t begin, size_t end) {
+      w.raw_array(now + 3 * begin, 3 * (end - begin));
+      return true;
+    });
   }
   for (size_t c = 0; c < d.collapse_count(); ++c) {
     const int64_t node = static_cast<int64_t>(vertex_count + c);
@@ -513,8 +523,9 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
     float* now = &d->residuals[f * per_frame];
     std::copy_n(now - per_frame, per_frame, now);
     if (!r.raw_array(changed.data(), changed.size(), "residuals")) break;
-    for (size_t v = 0; v < vertex_count; ++v)
-      if (changed[v / 8] & (1u << (v % 8))) r.raw_array(now + 3 * v, 3, "residuals");
+    for_each_changed_run(changed, vertex_count, [&](size_t begin, size_t end) {
+      return r.raw_array(now + 3 * begin, 3 * (end - begin), "residuals");
+    });
   }
   for (double value : d->maps)
     if (!std::isfinite(value)) r.fail("a non-finite affine map");

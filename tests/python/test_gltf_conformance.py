@@ -97,6 +97,23 @@ def test_level_zero_weights_that_break_the_unit_sum_are_written_normalised(human
     np.testing.assert_allclose(written[:40], 2.0 * stored[:40], rtol=1e-6)
     np.testing.assert_array_equal(written[40:45], [[1.0, 0.0, 0.0, 0.0]] * 5)
     np.testing.assert_array_equal(written[45:], stored[45:])
+    # The stored weights' accessor and data are not left behind unused (the input's own unused
+    # accessor, the edit's replaced one, stays: nothing of the input is lost).
+    assert len(_unused_accessors(after.json)) == len(_unused_accessors(before.json)) == 1
+    assert len(after.json["bufferViews"]) == len(before.json["bufferViews"]) + len(after.json["accessors"]) - len(
+        before.json["accessors"]
+    )
+
+
+def _unused_accessors(document: dict) -> set[int]:
+    used = {index for mesh in document["meshes"] for p in mesh["primitives"] for index in p["attributes"].values()}
+    used |= {p["indices"] for mesh in document["meshes"] for p in mesh["primitives"] if "indices" in p}
+    used |= {
+        t for mesh in document["meshes"] for p in mesh["primitives"] for m in p.get("targets", []) for t in m.values()
+    }
+    used |= {skin["inverseBindMatrices"] for skin in document.get("skins", []) if "inverseBindMatrices" in skin}
+    used |= {s[key] for a in document.get("animations", []) for s in a["samplers"] for key in ("input", "output")}
+    return set(range(len(document["accessors"]))) - used
 
 
 def test_levels_of_a_skin_that_lists_a_joint_twice_list_it_once(humanoid_glb, tmp_path):

@@ -85,7 +85,8 @@ def _assert_weights_kept_or_normalised(before: GltfDocument, after: GltfDocument
 
 def _assert_document_kept(source, output) -> None:
     """Every object of ``source`` is in ``output`` at the same index with the same content, but
-    for level 0's skin weights made to sum to 1 where they did not."""
+    for level 0's skin weights made to sum to 1 where they did not (over the stored data, or in
+    new accessors)."""
     before, after = GltfDocument(source), GltfDocument(output)
     for kind in ("materials", "textures", "samplers", "skins", "scenes", "cameras"):
         assert after.json.get(kind, [])[: len(before.json.get(kind, []))] == before.json.get(kind, []), kind
@@ -100,7 +101,9 @@ def _assert_document_kept(source, output) -> None:
         assert all(c["target"]["path"] == "weights" and c["target"]["node"] >= nodes for c in kept["channels"][count:])
     for index, node in enumerate(before.json.get("nodes", [])):
         assert _without_chain(after.json["nodes"][index]) == _without_chain(node), f"node {index}"
-    for index in range(len(before.json.get("accessors", []))):
+    primitives = [p for mesh in meshes for p in mesh.get("primitives", [])]
+    weights = {i for p in primitives for name, i in p.get("attributes", {}).items() if name.startswith("WEIGHTS_")}
+    for index in set(range(len(before.json.get("accessors", [])))) - weights:  # weights: checked above
         np.testing.assert_array_equal(_accessor_values(after, index), _accessor_values(before, index))
     for index, image in enumerate(before.json.get("images", [])):
         assert _image_bytes(after, after.json["images"][index]) == _image_bytes(before, image), f"image {index}"
@@ -780,3 +783,19 @@ def test_three_component_texture_coordinates_give_levels_their_u_and_v(humanoid_
         written.accessor(level["attributes"]["TEXCOORD_0"], "uv"),
         expected.accessor(expected_level["attributes"]["TEXCOORD_0"], "uv"),
     )
+
+
+def test_overwrite_writes_an_accessors_own_float_data_or_nothing(humanoid_glb):
+    builder = GlbBuilder.from_document(GltfDocument(humanoid_glb))
+    attributes = builder.json["meshes"][0]["primitives"][0]["attributes"]
+    weights, joints = attributes["WEIGHTS_0"], attributes["JOINTS_0"]
+    count = builder.json["accessors"][weights]["count"]
+    halves = np.full((count, 4), 0.25, np.float32)
+    assert not builder.overwrite(joints, halves)  # not float data
+    assert not builder.overwrite(weights, halves[:-1])  # another shape
+    builder.json["meshes"][0]["primitives"].append({"attributes": {"POSITION": 0, "WEIGHTS_0": weights}})
+    assert not builder.overwrite(weights, halves)  # used twice: the other user keeps its data
+    builder.json["meshes"][0]["primitives"].pop()
+    assert builder.overwrite(weights, halves) and builder.overwritten == {weights}
+    written = GltfDocument(humanoid_glb, data=builder.to_bytes())
+    np.testing.assert_array_equal(written.accessor(weights, "t"), halves)

@@ -67,6 +67,7 @@ class GlbBuilder:
     def __init__(self, document: dict | None = None, blob: bytes = b"") -> None:
         self.json = document if document is not None else {"asset": {"version": "2.0", "generator": "animlod"}}
         self.blob = bytearray(blob)
+        self.overwritten: set[int] = set()  # accessors whose data overwrite() replaced
 
     @classmethod
     def from_document(cls, doc: GltfDocument) -> GlbBuilder:
@@ -140,6 +141,29 @@ class GlbBuilder:
             accessor["min"] = values.min(axis=0).tolist()
             accessor["max"] = values.max(axis=0).tolist()
         return self.append("accessors", accessor)
+
+    def overwrite(self, index: int, values: np.ndarray) -> bool:
+        """Writes float32 ``values (count, width)`` over accessor ``index``'s own data when it is a
+        float accessor of that shape with a buffer view, not sparse, and used once in the
+        document: a rewritten attribute then leaves no unused accessor and data behind, and every
+        index stays as it was. False (nothing written) otherwise."""
+        accessors = self.json.get("accessors", [])
+        accessor = accessors[index] if 0 <= index < len(accessors) else {}
+        count, width = values.shape
+        uses = sum(holder[key] == index for holder, key in _accessor_references(self.json))
+        shape = (accessor.get("componentType"), accessor.get("type"), accessor.get("count"))
+        if shape != (FLOAT, _ACCESSOR_TYPES.get(width), count) or "sparse" in accessor or "bufferView" not in accessor:
+            return False
+        if uses != 1:
+            return False
+        view = self.json["bufferViews"][accessor["bufferView"]]
+        start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)
+        stride = view.get("byteStride", 4 * width)
+        np.ndarray((count, width), "<f4", buffer=self.blob, offset=start, strides=(stride, 4))[...] = values
+        if "min" in accessor or "max" in accessor:
+            accessor["min"], accessor["max"] = values.min(axis=0).tolist(), values.max(axis=0).tolist()
+        self.overwritten.add(index)
+        return True
 
     def prune(self) -> None:
         """Drops meshes no node draws (all kept when an animation points at a mesh by index, through

@@ -37,8 +37,9 @@ def unit_sum_breaks(weights: np.ndarray) -> np.ndarray:
 
 def normalise_stored_weights(builder: GlbBuilder, doc: GltfDocument, drawable: Drawable) -> str | None:
     """Rewrites, in ``builder`` (taken over from ``doc``), the WEIGHTS_n of the skinned
-    ``drawable``'s primitives whose rows break the rule, as new float32 accessors (once per mesh,
-    however many drawables draw it). Draco-compressed primitives keep theirs: their decoder
+    ``drawable``'s primitives whose rows break the rule (once per mesh, however many drawables
+    draw it): over the stored float32 data where nothing else uses it, else as new float32
+    accessors. Draco-compressed primitives keep theirs: their decoder
     reads the compressed data. Returns a note for the report, None when nothing was rewritten."""
     if drawable.skin_index is None:
         return None
@@ -63,7 +64,8 @@ def _normalise_primitive(builder: GlbBuilder, doc: GltfDocument, mesh_index: int
         (name for name in attributes if name[:8] == "WEIGHTS_" and name[8:].isdigit()), key=lambda n: int(n[8:])
     )
     written = builder.json["meshes"][mesh_index]["primitives"][index]["attributes"]
-    if any(written[name] != attributes[name] for name in names):  # done for another drawable of the mesh
+    if any(written[name] != attributes[name] or written[name] in builder.overwritten for name in names):
+        # done for another drawable of the mesh
         return 0, 0.0
     if not names or DRACO_EXTENSION in (primitive.get("extensions") or {}):
         return 0, 0.0
@@ -76,5 +78,7 @@ def _normalise_primitive(builder: GlbBuilder, doc: GltfDocument, mesh_index: int
     rows = on_first_joint_when_unweighted(stored)
     weights[broken] = rows / rows.sum(axis=1, keepdims=True)
     for set_index, name in enumerate(names):
-        written[name] = builder.add(weights[:, 4 * set_index : 4 * set_index + 4].astype(np.float32), ARRAY_BUFFER)
+        rewritten = weights[:, 4 * set_index : 4 * set_index + 4].astype(np.float32)
+        if not builder.overwrite(attributes[name], rewritten):  # the input's float weights, in place
+            written[name] = builder.add(rewritten, ARRAY_BUFFER)
     return int(broken.sum()), float(np.abs(stored.sum(axis=1) - 1.0).max())

@@ -456,6 +456,7 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
   // The points' frames are read no more: freed, a long clip's fields are gathered beside the
   // input and the residuals only, not beside a third copy of the frames.
   std::vector<float>().swap(points.frames);
+  points.view.frames = nullptr;
   fields.finish(table, *data);
   if (Status status = detail::derive_links(*data); !status) return Status::error("internal: " + status.message);
   out.data_ = std::move(data);

@@ -267,8 +267,10 @@ void bind_tdag(py::module_& m) {
           "clip's gigabytes")
       .def_static(
           "from_bytes",
-          [](const py::buffer& data) {
-            const py::buffer_info info = data.request();
+          [](const py::object& data) {  // any bytes-like object (an object, not py::buffer: the stub
+                                          // would name typing_extensions.Buffer, not installed)
+            if (!PyObject_CheckBuffer(data.ptr())) throw py::type_error("TemporalDag.from_bytes: expected bytes");
+            const py::buffer_info info = py::reinterpret_borrow<py::buffer>(data).request();
             if (info.ndim != 1 || info.itemsize != 1 || info.strides[0] != 1)
               throw py::value_error("TemporalDag.from_bytes: expected contiguous bytes");
             TemporalDag dag;

@@ -450,3 +450,30 @@ def test_the_fingerprint_covers_the_images_the_job_reads(tmp_path):
         before = fingerprint(asset)
         (tmp_path / "tex" / "wood.png").write_bytes(b"\x89PNG oak " + name.encode())
         assert fingerprint(asset) != before
+
+
+def test_a_workers_share_of_its_host_and_its_own_thread_cap(monkeypatch):
+    from types import SimpleNamespace
+
+    import distributed
+
+    from animlod import set_thread_limit, thread_limit
+    from animlod.batch.task import _share_cores
+
+    worker = SimpleNamespace(address="tcp://10.0.0.5:4000", state=SimpleNamespace(nthreads=1))
+    monkeypatch.setattr(distributed, "get_worker", lambda: worker)
+    monkeypatch.setattr(os, "cpu_count", lambda: 64)
+    monkeypatch.delenv("ANIMLOD_THREADS", raising=False)
+    set_thread_limit(0)
+    every = thread_limit()
+    try:
+        _share_cores({"10.0.0.5": 64})  # 64 single-threaded workers on a 64-core host
+        assert thread_limit() == 1
+        _share_cores({})  # a host the scheduler did not list: this worker's one thread alone
+        assert thread_limit() == every
+        set_thread_limit(0)
+        monkeypatch.setenv("ANIMLOD_THREADS", "3")  # the worker sets its own cap: no share imposed
+        _share_cores({"10.0.0.5": 64})
+        assert thread_limit() == every
+    finally:
+        set_thread_limit(0)

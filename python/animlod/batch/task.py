@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..io.errors import FormatError
-from ..threads import set_thread_limit
+from ..threads import ENVIRONMENT_VARIABLE, set_thread_limit
 from .jobs import find_job
 from .outputs import discard, publish, staging_folder
 from .spec import AssetSpec
@@ -42,7 +42,8 @@ def run_asset(
     On a Dask worker the core's loops take this process's cores divided by the worker threads
     on its host (``sharing``: host -> worker threads, from the scheduler; a host missing from it
     counts this worker's threads alone), so that assets running side by side do not each take
-    every core (:func:`animlod.set_thread_limit`; the result does not depend on it).
+    every core (:func:`animlod.set_thread_limit`; the result does not depend on it), unless the
+    worker's environment sets ANIMLOD_THREADS.
 
     The record (JSON values): name, job, input, fingerprint, status ("ok" or "failed"), result
     (:meth:`AssetResult.to_dict` with outputs relative to the asset's folder; ok only), error
@@ -125,7 +126,10 @@ def _worker_name() -> str:
 
 
 def _share_cores(sharing: dict[str, int] | None) -> None:
-    """Caps the core's threads at this worker's share of its host's cores (nothing outside Dask)."""
+    """Caps the core's threads at this worker's share of its host's cores (nothing outside Dask,
+    or where the worker's environment sets ANIMLOD_THREADS: the user's cap stands)."""
+    if os.environ.get(ENVIRONMENT_VARIABLE):
+        return
     try:
         from distributed import get_worker
         from distributed.comm.addressing import get_address_host

@@ -173,7 +173,7 @@ Eigen::Vector3d point_position(const AnimatedMeshView& points, int32_t point, si
 // the points each.
 std::vector<int32_t> tips_in_every_frame(const std::vector<int32_t>& faces, const AnimatedMeshView& points,
                                          const std::vector<int32_t>& frames) {
-  const size_t workers = faces.size() >= 3 * 65536 && thread_limit() >= 2 ? 2 : 1;
+  const size_t workers = detail::halves_from(faces.size(), 3 * 65536);
   std::vector<uint8_t> tip_so_far(points.vertex_count, 1);
   std::vector<std::vector<int32_t>> found(workers);
   std::vector<int32_t> tips;
@@ -205,7 +205,7 @@ FaceQuadrics face_quadrics(const std::vector<int32_t>& faces, const AnimatedMesh
   // Two workers take half of the frames each, or with one frame half of the points (a face
   // between the halves is planed by both); every quadric sums its planes in the same order as
   // one worker would.
-  const size_t workers = faces.size() * used_count >= 3 * 65536 && thread_limit() >= 2 ? 2 : 1;
+  const size_t workers = detail::halves_from(faces.size() * used_count, 3 * 65536);
   detail::run_in_ranges(workers, workers, [&](size_t, size_t, size_t worker) {
     size_t frame_begin = 0, frame_end = used_count;
     int32_t point_begin = 0, point_end = static_cast<int32_t>(point_count);

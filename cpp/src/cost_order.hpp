@@ -41,7 +41,7 @@ class CostOrder {
     next_bucket_ = ordered_ = 0;
     // Two workers for many items, each counting and then placing its half of them (the first
     // half's entries first in every bucket, as one worker places them).
-    const size_t workers = count >= kTwoWorkersFrom && thread_limit() >= 2 ? 2 : 1;
+    const size_t workers = halves_from(count, kTwoWorkersFrom);
     for (size_t worker = 0; worker < workers; ++worker) offsets_[worker].assign(kTopBuckets, 0);
     run_in_ranges(count, workers, [&](size_t begin, size_t end, size_t worker) {
       std::vector<uint32_t>& offset = offsets_[worker];

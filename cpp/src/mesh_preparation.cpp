@@ -192,7 +192,7 @@ void bucket_by_point(size_t item_count, size_t point_count, PointOf point_of, st
 constexpr size_t kCornersPerWorker = 1 << 17;  // fewer corners per worker: one worker
 
 size_t workers_for(size_t corner_count) {
-  return corner_count >= 2 * kCornersPerWorker && thread_limit() >= 2 ? 2 : 1;
+  return halves_from(corner_count, 2 * kCornersPerWorker);
 }
 
 // The simple case of pair_sides without sorting every side: each side a -> b looks for its

@@ -28,6 +28,12 @@ void run_workers(unsigned requested, size_t tasks, const Worker& worker) {
   for (std::thread& thread : pool) thread.join();
 }
 
+// Two workers for `items` of work from `threshold` on, when the thread limit allows two; else
+// one: the loops that split their work in halves.
+inline size_t halves_from(size_t items, size_t threshold) {
+  return items >= threshold && thread_limit() >= 2 ? 2 : 1;
+}
+
 // Splits [0, count) into `workers` contiguous ranges and runs range(begin, end, worker) for each,
 // the calling thread taking the first.
 template <typename Range>

@@ -150,11 +150,10 @@ class GlbBuilder:
         accessors = self.json.get("accessors", [])
         accessor = accessors[index] if 0 <= index < len(accessors) else {}
         count, width = values.shape
-        uses = sum(holder[key] == index for holder, key in _accessor_references(self.json))
         shape = (accessor.get("componentType"), accessor.get("type"), accessor.get("count"))
         if shape != (FLOAT, _ACCESSOR_TYPES.get(width), count) or "sparse" in accessor or "bufferView" not in accessor:
             return False
-        if uses != 1:
+        if sum(holder[key] == index for holder, key in _accessor_references(self.json)) != 1:  # used elsewhere too
             return False
         view = self.json["bufferViews"][accessor["bufferView"]]
         start = view.get("byteOffset", 0) + accessor.get("byteOffset", 0)

@@ -242,12 +242,12 @@ void bind_tdag(py::module_& m) {
       .def_property_readonly(
           "stored_counts",
           [](const TemporalDag& d) {
-            size_t links = 0, runs = 0, ranges = 0;
+            size_t links = 0, ranges = 0;
             for (size_t c = 0; c < d.collapse_count(); ++c) {
               links += d.dependency_link_count(c);
-              runs += d.error_run_count(c);
               ranges += d.alive(c).ranges().size();
             }
+            const size_t runs = d.error_run_count();
             py::dict out;
             out["dependency_links"] = links;
             out["error_runs"] = runs;

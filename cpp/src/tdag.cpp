@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <string>
 
@@ -45,8 +46,11 @@ Status derive_links(TdagData& data) {
   const auto node_count = static_cast<int64_t>(data.node_count());
   if (data.removed_child.size() != collapse_count || data.killed.size() != collapse_count ||
       data.alive.size() != collapse_count || data.dep_offsets.size() != collapse_count + 1 ||
-      data.error_offsets.size() != collapse_count + 1 || data.dep_tags.size() != data.dep_nodes.size())
+      data.dep_tags.size() != data.dep_nodes.size())
     return Status::error("collapse fields of different lengths");
+  if (data.codes_by_frame.size() != static_cast<size_t>(frame_count) * collapse_count)
+    return Status::error("error codes: " + std::to_string(data.codes_by_frame.size()) + " for " +
+                         std::to_string(frame_count) + " frames of " + std::to_string(collapse_count) + " collapses");
   const auto face_count = static_cast<int32_t>(data.face_count());
   for (size_t v = 0; v < data.input_points.size(); ++v)
     if (data.input_points[v] < -1 || data.input_points[v] >= vertex_count)
@@ -78,11 +82,9 @@ Status derive_links(TdagData& data) {
       return Status::error(collapse_name(c) + ": alive outside [0, " + std::to_string(frame_count) + ")");
     static_structure &= data.alive[c] == TimeTag(0, frame_count);
     data.representative[static_cast<size_t>(node)] = data.representative[static_cast<size_t>(kept)];
-    if (data.dep_offsets[c] > data.dep_offsets[c + 1] || data.error_offsets[c] > data.error_offsets[c + 1])
-      return Status::error(collapse_name(c) + ": negative field length");
+    if (data.dep_offsets[c] > data.dep_offsets[c + 1]) return Status::error(collapse_name(c) + ": negative field length");
   }
-  if (data.dep_offsets.front() != 0 || static_cast<size_t>(data.dep_offsets.back()) != data.dep_nodes.size() ||
-      data.error_offsets.front() != 0 || static_cast<size_t>(data.error_offsets.back()) != data.error_runs.size())
+  if (data.dep_offsets.front() != 0 || static_cast<size_t>(data.dep_offsets.back()) != data.dep_nodes.size())
     return Status::error("field offsets do not match the stored values");
   for (size_t c = 0; c < collapse_count; ++c) {
     for (int32_t link = data.dep_offsets[c]; link < data.dep_offsets[c + 1]; ++link) {
@@ -94,23 +96,8 @@ Status derive_links(TdagData& data) {
         return Status::error(collapse_name(c) + ": dependency tag outside [0, " + std::to_string(frame_count) + ")");
       static_structure &= tag == TimeTag(0, frame_count);
     }
-    int32_t previous_death = std::numeric_limits<int32_t>::min();
-    for (int32_t r = data.error_offsets[c]; r < data.error_offsets[c + 1]; ++r) {
-      const FrameRange range = data.error_runs[static_cast<size_t>(r)].range;
-      if (range.birth < std::max(previous_death, 0) || range.death <= range.birth || range.death > frame_count)
-        return Status::error(collapse_name(c) + ": error run [" + std::to_string(range.birth) + ", " +
-                             std::to_string(range.death) + ") out of order or outside the frames");
-      previous_death = range.death;
-    }
   }
   data.static_structure = static_structure;
-  data.codes_by_frame.assign(static_cast<size_t>(frame_count) * collapse_count, 65535);
-  for (size_t c = 0; c < collapse_count; ++c)
-    for (int32_t r = data.error_offsets[c]; r < data.error_offsets[c + 1]; ++r) {
-      const ErrorRun& run = data.error_runs[static_cast<size_t>(r)];
-      for (int32_t t = run.range.birth; t < run.range.death; ++t)
-        data.codes_by_frame[static_cast<size_t>(t) * collapse_count + c] = run.code;
-    }
 
   // Parents: every collapse that has the node as a child; at most one alive per frame.
   data.parent_offsets.assign(static_cast<size_t>(node_count) + 1, 0);
@@ -190,21 +177,21 @@ Status derive_links(TdagData& data) {
       }
   }
 
-  // Frames at which a collapse's structure (alive, links) or error changes.
-  std::vector<std::pair<int32_t, int32_t>> events, changes;
-  auto boundaries = [&](const TimeTag& tag, int32_t node, std::vector<std::pair<int32_t, int32_t>>& into) {
+  // Frames at which a collapse's structure (alive, links) changes.
+  std::vector<std::pair<int32_t, int32_t>> events;
+  auto boundaries = [&](const TimeTag& tag, int32_t node) {
     for (const FrameRange& r : tag.ranges()) {
-      if (r.birth > 0) into.emplace_back(r.birth, node);
-      if (r.death < frame_count) into.emplace_back(r.death, node);
+      if (r.birth > 0) events.emplace_back(r.birth, node);
+      if (r.death < frame_count) events.emplace_back(r.death, node);
     }
   };
   if (!static_structure) {
     for (size_t c = 0; c < collapse_count; ++c) {
       const auto node = static_cast<int32_t>(vertex_count + static_cast<int64_t>(c));
-      boundaries(data.alive[c], node, events);
+      boundaries(data.alive[c], node);
       for (int32_t link = data.dep_offsets[c]; link < data.dep_offsets[c + 1]; ++link) {
         const size_t before = events.size();
-        boundaries(data.dep_tags[static_cast<size_t>(link)], node, events);
+        boundaries(data.dep_tags[static_cast<size_t>(link)], node);
         for (size_t i = before, end = events.size(); i < end; ++i) {
           const int32_t frame = events[i].first;  // a copy: emplace_back may reallocate
           events.emplace_back(frame, data.dep_nodes[static_cast<size_t>(link)]);
@@ -212,17 +199,22 @@ Status derive_links(TdagData& data) {
       }
     }
   }
-  changes = events;
-  for (size_t c = 0; c < collapse_count; ++c) {
-    const auto node = static_cast<int32_t>(vertex_count + static_cast<int64_t>(c));
-    for (int32_t r = data.error_offsets[c]; r < data.error_offsets[c + 1]; ++r) {
-      const FrameRange range = data.error_runs[static_cast<size_t>(r)].range;
-      if (range.birth > 0) changes.emplace_back(range.birth, node);
-      if (range.death < frame_count) changes.emplace_back(range.death, node);
-    }
-  }
   frame_lists(events, frame_count, data.event_offsets, data.event_nodes);
-  frame_lists(changes, frame_count, data.change_offsets, data.change_nodes);
+  // ... or its structure or error code: a frame's events and the codes that differ from the
+  // frame before, both in node order.
+  data.change_offsets.assign(static_cast<size_t>(frame_count) + 1, 0);
+  data.change_nodes.clear();
+  std::vector<int32_t> recoded;
+  for (size_t t = 1; t < static_cast<size_t>(frame_count); ++t) {
+    const uint16_t* now = data.codes_by_frame.data() + t * collapse_count;
+    const uint16_t* before = now - collapse_count;
+    recoded.clear();
+    for (size_t c = 0; c < collapse_count; ++c)
+      if (now[c] != before[c]) recoded.push_back(static_cast<int32_t>(vertex_count + static_cast<int64_t>(c)));
+    std::set_union(recoded.begin(), recoded.end(), data.event_nodes.begin() + data.event_offsets[t],
+                   data.event_nodes.begin() + data.event_offsets[t + 1], std::back_inserter(data.change_nodes));
+    data.change_offsets[t + 1] = static_cast<int32_t>(data.change_nodes.size());
+  }
   return Status::success();
 }
 
@@ -272,7 +264,7 @@ std::vector<int32_t> TemporalDag::dependencies_at(size_t c, int32_t frame) const
 
 double TemporalDag::error_bound(size_t c, int32_t frame) const {
   const uint16_t code = data_->error_code(c, frame);
-  if (code == 65535 && !data_->collapse_alive(c, frame)) return std::numeric_limits<double>::infinity();
+  if (code == detail::kNoCode && !data_->collapse_alive(c, frame)) return std::numeric_limits<double>::infinity();
   return detail::decode_error(code, data_->scale);
 }
 
@@ -280,7 +272,14 @@ size_t TemporalDag::dependency_link_count(size_t c) const {
   return static_cast<size_t>(data_->dep_offsets[c + 1] - data_->dep_offsets[c]);
 }
 size_t TemporalDag::error_run_count(size_t c) const {
-  return static_cast<size_t>(data_->error_offsets[c + 1] - data_->error_offsets[c]);
+  std::vector<uint16_t> codes(static_cast<size_t>(data_->frame_count));
+  for (int32_t t = 0; t < data_->frame_count; ++t) codes[static_cast<size_t>(t)] = data_->error_code(c, t);
+  size_t runs = 0;
+  detail::for_each_error_run(codes.data(), data_->frame_count, [&](int32_t, int32_t, uint16_t) { ++runs; });
+  return runs;
+}
+size_t TemporalDag::error_run_count() const {
+  return detail::count_error_runs(data_->codes_by_frame, static_cast<size_t>(data_->frame_count), collapse_count());
 }
 
 }  // namespace animlod

@@ -163,7 +163,6 @@ class FieldBuilder {
     if (alive_.size() >= collapse_count) return;
     alive_.resize(collapse_count);
     links_.resize(collapse_count);
-    errors_.resize(collapse_count);
     report.max_cost.resize(collapse_count, 0.0);
     report.use_counts.resize(collapse_count, 0);
   }
@@ -174,7 +173,9 @@ class FieldBuilder {
   std::vector<detail::BoundarySide> boundary_;
   std::vector<TimeTag> alive_;                   // (C,)
   std::vector<TaggedSet<int32_t>> links_;        // (C,) dependencies
-  std::vector<TaggedValue<uint16_t>> errors_;    // (C,) error codes
+  // Frame t's error codes of the collapses known then (C_t, in collapse order; kNoCode for those
+  // not in its hierarchy): an online build's collapse count grows with the frames.
+  std::vector<std::vector<uint16_t>> code_rows_;
 };
 
 void FieldBuilder::measure(int32_t t, const CollapseTable& table, const FrameHierarchy& h,
@@ -229,6 +230,7 @@ void FieldBuilder::record(int32_t t, const CollapseTable& table, const FrameHier
   const int32_t vertex_count = table.vertex_count();
   grow(table.collapse_count(), report);
   report.collapse_counts.push_back(static_cast<int32_t>(h.nodes.size()));
+  std::vector<uint16_t>& codes = code_rows_.emplace_back(table.collapse_count(), detail::kNoCode);
   for (size_t i = 0; i < h.nodes.size(); ++i) {
     const size_t c = static_cast<size_t>(h.nodes[i] - vertex_count);
     const double cost = fields.costs[i];
@@ -236,7 +238,7 @@ void FieldBuilder::record(int32_t t, const CollapseTable& table, const FrameHier
     report.use_counts[c] += 1;
     alive_[c].add(t);
     for (int32_t d = h.dep_offsets[i]; d < h.dep_offsets[i + 1]; ++d) links_[c].add(h.dep_nodes[static_cast<size_t>(d)], t);
-    errors_[c].append({t, t + 1}, fields.codes[i]);
+    codes[c] = fields.codes[i];
   }
 }
 
@@ -247,15 +249,18 @@ void FieldBuilder::finish(const CollapseTable& table, detail::TdagData& data) {
   data.killed = table.killed;
   data.alive.assign(alive_.begin(), alive_.begin() + static_cast<std::ptrdiff_t>(collapse_count));
   data.dep_offsets.assign(1, 0);
-  data.error_offsets.assign(1, 0);
   for (size_t c = 0; c < collapse_count; ++c) {
     for (const auto& entry : links_[c].entries()) {
       data.dep_nodes.push_back(entry.value);
       data.dep_tags.push_back(entry.tag);
     }
     data.dep_offsets.push_back(static_cast<int32_t>(data.dep_nodes.size()));
-    for (const auto& run : errors_[c].runs()) data.error_runs.push_back({run.range, run.value});
-    data.error_offsets.push_back(static_cast<int32_t>(data.error_runs.size()));
+  }
+  // The rows into the (F, C) table, each freed once copied.
+  data.codes_by_frame.assign(code_rows_.size() * collapse_count, detail::kNoCode);
+  for (size_t t = 0; t < code_rows_.size(); ++t) {
+    std::copy(code_rows_[t].begin(), code_rows_[t].end(), data.codes_by_frame.begin() + static_cast<std::ptrdiff_t>(t * collapse_count));
+    std::vector<uint16_t>().swap(code_rows_[t]);
   }
 }
 

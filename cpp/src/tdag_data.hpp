@@ -3,52 +3,14 @@
 #pragma once
 
 #include <array>
-#include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "animlod/tdag.hpp"
 #include "animlod/tdag_time_tag.hpp"
+#include "tdag_error_codes.hpp"
 
 namespace animlod::detail {
-
-// Error bounds are stored as 16-bit codes on a log scale relative to the mesh size `scale`:
-// code 0 is 0, code q > 0 stands for scale * 2^((q - kErrorCodeZero) / kErrorCodeSteps).
-// Encoding rounds up, so a decoded bound is never below the bound it encodes (0.27% steps);
-// encoding is monotone, so it keeps the bounds monotone up the hierarchy.
-constexpr int kErrorCodeSteps = 256;
-constexpr int kErrorCodeZero = 32768;
-
-inline uint16_t encode_error(double error, double scale) {
-  if (!(error > 0.0)) return 0;
-  if (std::isinf(error)) return 65535;
-  const double code = std::ceil(std::log2(error / scale) * kErrorCodeSteps) + kErrorCodeZero;
-  if (code < 1.0) return 1;
-  if (code > 65535.0) return 65535;
-  auto q = static_cast<uint16_t>(code);
-  // log2 rounding: make sure the decoded value really is >= error.
-  while (q < 65535 && std::exp2(double(q - kErrorCodeZero) / kErrorCodeSteps) * scale < error) ++q;
-  return q;
-}
-
-inline double decode_error(uint16_t code, double scale) {
-  if (code == 0) return 0.0;
-  return scale * std::exp2(double(int(code) - kErrorCodeZero) / kErrorCodeSteps);
-}
-
-// The largest code whose bound is <= tolerance (0 for tolerance 0: only exact collapses).
-inline uint16_t largest_code_within(double tolerance, double scale) {
-  if (!(tolerance > 0.0)) return 0;
-  uint16_t q = encode_error(tolerance, scale);
-  while (q > 0 && decode_error(q, scale) > tolerance) --q;
-  return q;
-}
-
-struct ErrorRun {
-  FrameRange range;
-  uint16_t code = 0;
-  bool operator==(const ErrorRun& o) const { return range == o.range && code == o.code; }
-};
 
 struct TdagData {
   // ---- stored ----
@@ -76,9 +38,9 @@ struct TdagData {
   std::vector<int32_t> dep_offsets;  // (C + 1,)
   std::vector<int32_t> dep_nodes;
   std::vector<TimeTag> dep_tags;
-  // Error bounds (single-valued, tagged): runs per collapse, CSR.
-  std::vector<int32_t> error_offsets;  // (C + 1,)
-  std::vector<ErrorRun> error_runs;
+  // Error bounds (single-valued, tagged): (F, C) the code of every collapse in every frame,
+  // kNoCode where it has none (not alive). Stored as runs per collapse (tdag_error_codes.hpp).
+  std::vector<uint16_t> codes_by_frame;
 
   // ---- derived (build and load) ----
   std::vector<int32_t> representative;     // (V + C,) the leaf whose position a node takes
@@ -97,9 +59,6 @@ struct TdagData {
   // under node n" is O(1). Empty otherwise.
   std::vector<int32_t> leaf_position;
   std::vector<std::array<int32_t, 2>> leaf_range;
-  // (F, C) the error code of every collapse in every frame (65535 where not alive): the runs
-  // expanded for O(1) lookups in queries; memory only, never stored.
-  std::vector<uint16_t> codes_by_frame;
 
   size_t collapse_count() const { return kept_child.size(); }
   size_t node_count() const { return static_cast<size_t>(vertex_count) + collapse_count(); }
@@ -108,18 +67,9 @@ struct TdagData {
   bool collapse_alive(size_t c, int32_t frame) const { return static_structure || alive[c].alive_at(frame); }
   bool link_alive(size_t link, int32_t frame) const { return static_structure || dep_tags[link].alive_at(frame); }
 
-  // The error code of collapse c at `frame`; 65535 (never collapsed) where it is not alive.
+  // The error code of collapse c at `frame`; kNoCode (never collapsed) where it is not alive.
   uint16_t error_code(size_t c, int32_t frame) const {
     return codes_by_frame[static_cast<size_t>(frame) * collapse_count() + c];
-  }
-  // The same from the stored runs (derive_links expands them into codes_by_frame).
-  uint16_t error_code_from_runs(size_t c, int32_t frame) const {
-    const ErrorRun* begin = error_runs.data() + error_offsets[c];
-    const ErrorRun* end = error_runs.data() + error_offsets[c + 1];
-    const ErrorRun* run = std::upper_bound(begin, end, frame, [](int32_t f, const ErrorRun& r) { return f < r.range.birth; });
-    if (run == begin) return 65535;
-    --run;
-    return run->range.contains(frame) ? run->code : 65535;
   }
 
   // The collapse node that has `node` as a child at `frame`, or -1 (a root at that frame).

@@ -334,7 +334,8 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
   // pages cost nothing), so that growing does not copy them either.
   const size_t per_frame = vertex_count * 3;
   out.reserve(kHeaderSize + d.maps.size() * sizeof(double) + frame_count * (per_frame * sizeof(float) + vertex_count / 8 + 1) +
-              16 * (d.faces.size() + d.input_points.size() + d.dep_nodes.size() + d.error_runs.size()) +
+              16 * (d.faces.size() + d.input_points.size() + d.dep_nodes.size() +
+                    detail::count_error_runs(d.codes_by_frame, frame_count, d.collapse_count())) +
               64 * d.collapse_count() + 1024);
   Writer w(out);
   w.raw_array(kMagic, sizeof(kMagic));
@@ -389,8 +390,10 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
       return true;
     });
   }
+  detail::ErrorCodeBlock codes(frame_count, d.collapse_count());
   for (size_t c = 0; c < d.collapse_count(); ++c) {
     const int64_t node = static_cast<int64_t>(vertex_count + c);
+    if (c % detail::ErrorCodeBlock::kWidth == 0) codes.gather(d.codes_by_frame, c);
     w.varint(static_cast<uint64_t>(node - d.kept_child[c]));
     w.varint(static_cast<uint64_t>(node - d.removed_child[c]));
     w.varint(static_cast<uint64_t>(d.killed[c][0] + 1));
@@ -412,18 +415,19 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
         last = r.death;
       }
     }
-    w.varint(static_cast<uint64_t>(d.error_offsets[c + 1] - d.error_offsets[c]));
-    int32_t death = 0;
-    int32_t code = 0;
-    for (int32_t r = d.error_offsets[c]; r < d.error_offsets[c + 1]; ++r) {
-      const detail::ErrorRun& run = d.error_runs[static_cast<size_t>(r)];
-      const auto gap = static_cast<uint64_t>(run.range.birth - death);
-      w.varint((static_cast<uint64_t>(run.range.death - run.range.birth - 1) << 1) | (gap > 0 ? 1u : 0u));
+    uint64_t runs = 0;
+    detail::for_each_error_run(codes.column(c), d.frame_count, [&](int32_t, int32_t, uint16_t) { ++runs; });
+    w.varint(runs);
+    int32_t last_death = 0;
+    int32_t last_code = 0;
+    detail::for_each_error_run(codes.column(c), d.frame_count, [&](int32_t birth, int32_t death, uint16_t code) {
+      const auto gap = static_cast<uint64_t>(birth - last_death);
+      w.varint((static_cast<uint64_t>(death - birth - 1) << 1) | (gap > 0 ? 1u : 0u));
       if (gap > 0) w.varint(gap);
-      w.zigzag(int32_t(run.code) - code);
-      death = run.range.death;
-      code = run.code;
-    }
+      w.zigzag(int32_t(code) - last_code);
+      last_death = death;
+      last_code = code;
+    });
   }
 
   const uint64_t body_size = out.size() - kHeaderSize;
@@ -534,10 +538,15 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
   d->killed.resize(collapse_count);
   d->alive.resize(collapse_count);
   d->dep_offsets.assign(1, 0);
-  d->error_offsets.assign(1, 0);
   const auto frames = static_cast<int32_t>(frame_count);
+  d->codes_by_frame.assign(frame_count * collapse_count, detail::kNoCode);
+  detail::ErrorCodeBlock codes(frame_count, collapse_count);
   for (size_t c = 0; c < collapse_count && r.ok(); ++c) {
     const int64_t node = static_cast<int64_t>(vertex_count + c);
+    if (c % detail::ErrorCodeBlock::kWidth == 0) {
+      if (c > 0) codes.scatter(d->codes_by_frame);
+      codes.start(c);
+    }
     d->kept_child[c] = static_cast<int32_t>(node - static_cast<int64_t>(r.count("children", static_cast<uint64_t>(node))));
     d->removed_child[c] = static_cast<int32_t>(node - static_cast<int64_t>(r.count("children", static_cast<uint64_t>(node))));
     for (auto& face : d->killed[c]) face = static_cast<int32_t>(r.count("removed faces", face_count)) - 1;
@@ -565,6 +574,7 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
     d->dep_offsets.push_back(static_cast<int32_t>(d->dep_nodes.size()));
     const uint64_t runs = r.count("error run count", frame_count);
     int64_t death = 0, code = 0;
+    uint16_t* column = codes.column(c);
     for (uint64_t i = 0; i < runs && r.ok(); ++i) {
       const uint64_t head = r.varint("error runs");
       if ((head >> 1) >= frame_count) {
@@ -578,10 +588,10 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
         r.fail("error runs: a run outside the frames or an invalid code");
         break;
       }
-      d->error_runs.push_back({{static_cast<int32_t>(birth), static_cast<int32_t>(death)}, static_cast<uint16_t>(code)});
+      std::fill(column + birth, column + death, static_cast<uint16_t>(code));
     }
-    d->error_offsets.push_back(static_cast<int32_t>(d->error_runs.size()));
   }
+  if (r.ok() && collapse_count > 0) codes.scatter(d->codes_by_frame);
   if (r.ok() && r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " unexpected bytes after the last collapse");
   if (!r.ok()) return Status::error("corrupted TDAG file: " + r.error());
   if (Status status = detail::derive_links(*d); !status) return Status::error("corrupted TDAG file: " + status.message);

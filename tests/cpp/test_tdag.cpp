@@ -276,7 +276,15 @@ TEST_CASE("tdag: save and load round trip, damaged files are named errors") {
   REQUIRE(animlod::serialize_temporal_dag(loaded, again).ok);
   CHECK(again == bytes);
   CHECK(loaded.governing() == Governing::online);
-  for (size_t c = 0; c < dag.collapse_count(); ++c) CHECK(loaded.alive(c) == dag.alive(c));
+  size_t runs = 0;
+  for (size_t c = 0; c < dag.collapse_count(); ++c) {
+    CHECK(loaded.alive(c) == dag.alive(c));
+    CHECK(loaded.error_run_count(c) == dag.error_run_count(c));
+    runs += dag.error_run_count(c);
+    for (int32_t t = 0; t < 4; ++t) CHECK(loaded.error_bound(c, t) == dag.error_bound(c, t));
+  }
+  CHECK(dag.error_run_count() == runs);
+  CHECK(loaded.error_run_count() == runs);
   for (int32_t t = 0; t < 4; ++t) {
     std::vector<float> a(mesh.vertex_count * 3), b(mesh.vertex_count * 3);
     dag.frame_positions(t, a.data());

@@ -132,9 +132,11 @@ class TemporalDag {
   std::vector<int32_t> dependencies_at(size_t c, int32_t frame) const;
   // Error bound of collapse c at `frame`, asset units; +infinity where c is not alive.
   double error_bound(size_t c, int32_t frame) const;
-  // The tagged dependency links and error runs of collapse c (the stored fields).
+  // The tagged dependency links and error runs of collapse c (the stored fields), and the error
+  // runs of every collapse.
   size_t dependency_link_count(size_t c) const;
   size_t error_run_count(size_t c) const;
+  size_t error_run_count() const;
 
  private:
   std::shared_ptr<const detail::TdagData> data_;

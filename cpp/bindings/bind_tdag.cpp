@@ -281,7 +281,17 @@ void bind_tdag(py::module_& m) {
           },
           py::arg("data"),
           "reads .tdag contents from any bytes-like object (bytes, a mapped file); ValueError for a non-TDAG, "
-          "another version or a corrupted file");
+          "another version or a corrupted file")
+      .def_static(
+          "load",
+          [](const std::string& path) {
+            TemporalDag dag;
+            call_released([&] { return load_temporal_dag(path, dag); });
+            return dag;
+          },
+          py::arg("path"),
+          "reads a .tdag file a chunk at a time (never the whole file in memory); ValueError starting with the "
+          "path for a missing file, a non-TDAG, another version or a corrupted file");
 
   m.def("build_temporal_dag", &build_py, py::arg("frames"), py::arg("faces"), py::arg("options") = TdagOptions{},
         py::arg("progress") = py::none(),

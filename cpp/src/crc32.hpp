@@ -8,7 +8,9 @@
 
 namespace animlod::detail {
 
-inline uint32_t crc32(const uint8_t* bytes, size_t size) {
+// `previous`: the CRC of the bytes before (zlib's continuation), so that a file read a chunk at
+// a time gets the CRC of the whole.
+inline uint32_t crc32(const uint8_t* bytes, size_t size, uint32_t previous = 0) {
   static const auto tables = [] {
     std::array<std::array<uint32_t, 256>, 8> t{};
     for (uint32_t i = 0; i < 256; ++i) {
@@ -24,7 +26,7 @@ inline uint32_t crc32(const uint8_t* bytes, size_t size) {
   auto word = [](const uint8_t* p) {  // little-endian whatever the machine's order
     return uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 | uint32_t{p[3]} << 24;
   };
-  uint32_t c = 0xFFFFFFFFu;
+  uint32_t c = previous ^ 0xFFFFFFFFu;
   size_t i = 0;
   for (; i + 8 <= size; i += 8) {
     const uint32_t low = word(bytes + i) ^ c, high = word(bytes + i + 4);

@@ -96,43 +96,39 @@ class Writer {
   std::vector<uint8_t>& out_;
 };
 
-// Reads the body; every read checks the end, and failures keep the first message.
+// Reads the body; every read checks the end, and failures keep the first message. The bytes are
+// all in memory, or come from a file a chunk at a time: a long clip's file need not be held
+// beside the residuals it fills.
 class Reader {
  public:
   Reader(const uint8_t* bytes, size_t size) : p_(bytes), end_(bytes + size) {}
+  // `chunk`: the buffer, whose size is the largest read but for long arrays read in place.
+  Reader(std::istream& file, uint64_t size, std::vector<uint8_t> chunk) : file_(&file), left_(size), chunk_(std::move(chunk)) {}
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
   void fail(const std::string& why) {
     if (error_.empty()) error_ = why;
     p_ = end_;
+    left_ = 0;
   }
   uint8_t u8(const char* what) {
-    if (p_ >= end_) {
-      fail(std::string("truncated in ") + what);
-      return 0;
-    }
+    if (p_ == end_ && !refill(what)) return 0;
     return *p_++;
   }
   template <typename T>
   T raw(const char* what) {
     T v{};
-    if (static_cast<size_t>(end_ - p_) < sizeof(T)) {
-      fail(std::string("truncated in ") + what);
-      return v;
-    }
-    std::memcpy(&v, p_, sizeof(T));
-    p_ += sizeof(T);
+    uint8_t bytes[sizeof(T)];
+    if (take(bytes, sizeof(T), what)) std::memcpy(&v, bytes, sizeof(T));
     return v;
   }
   template <typename T>
   bool raw_array(T* out, size_t count, const char* what) {
-    if (static_cast<size_t>(end_ - p_) / sizeof(T) < count) {
+    if (remaining() / sizeof(T) < count) {
       fail(std::string("truncated in ") + what);
       return false;
     }
-    std::memcpy(out, p_, count * sizeof(T));
-    p_ += count * sizeof(T);
-    return true;
+    return take(reinterpret_cast<uint8_t*>(out), count * sizeof(T), what);
   }
   uint64_t varint(const char* what) {
     uint64_t v = 0;
@@ -171,11 +167,50 @@ class Reader {
     }
     return out;
   }
-  size_t remaining() const { return static_cast<size_t>(end_ - p_); }
+  size_t remaining() const { return static_cast<size_t>(end_ - p_) + static_cast<size_t>(left_); }
 
  private:
-  const uint8_t* p_;
-  const uint8_t* end_;
+  // The next chunk of the file into the window; false (failed) at the end of the body.
+  bool refill(const char* what) {
+    const size_t size = static_cast<size_t>(std::min<uint64_t>(left_, chunk_.size()));
+    if (size == 0 || !read_file(chunk_.data(), size)) {
+      fail(std::string("truncated in ") + what);
+      return false;
+    }
+    p_ = chunk_.data();
+    end_ = p_ + size;
+    return true;
+  }
+  bool read_file(uint8_t* out, size_t size) {
+    file_->read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(size));
+    left_ -= size;
+    return static_cast<size_t>(file_->gcount()) == size;
+  }
+  // `size` bytes into `out`: what the window holds, then a large rest straight from the file.
+  bool take(uint8_t* out, size_t size, const char* what) {
+    while (size > 0) {
+      if (p_ == end_) {
+        if (file_ != nullptr && size >= chunk_.size() && size <= left_) {
+          if (read_file(out, size)) return true;
+          fail(std::string("truncated in ") + what);
+          return false;
+        }
+        if (!refill(what)) return false;
+      }
+      const size_t n = std::min(size, static_cast<size_t>(end_ - p_));
+      std::memcpy(out, p_, n);
+      p_ += n;
+      out += n;
+      size -= n;
+    }
+    return true;
+  }
+
+  const uint8_t* p_ = nullptr;
+  const uint8_t* end_ = nullptr;
+  std::istream* file_ = nullptr;  // null: every byte is in [p_, end_)
+  uint64_t left_ = 0;             // the file's body bytes not yet read
+  std::vector<uint8_t> chunk_;
   std::string error_;
 };
 
@@ -436,13 +471,14 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
   return Status::success();
 }
 
-Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& out) {
-  out = TemporalDag{};
+namespace {
+
+// The format version and the body's length from the file's first bytes (`bytes`: at least the
+// first min(size, kHeaderSize)), checked against the file's size.
+Status read_header(const uint8_t* bytes, size_t size, uint32_t& version, uint64_t& body_size) {
   if (size < sizeof(kMagic) || std::memcmp(bytes, kMagic, sizeof(kMagic)) != 0)
     return Status::error("not a TDAG file (no ANLDTDAG signature)");
   if (size < kHeaderSize) return Status::error("truncated TDAG file (incomplete header)");
-  uint32_t version = 0;
-  uint64_t body_size = 0;
   std::memcpy(&version, bytes + 8, 4);
   std::memcpy(&body_size, bytes + 12, 8);
   if (version < kTdagOldestReadableVersion || version > kTdagFormatVersion)
@@ -453,13 +489,31 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
   if (size - kHeaderSize < 4 || body_size != size - kHeaderSize - 4)
     return Status::error("truncated or padded TDAG file: the header announces " + std::to_string(body_size) +
                          " bytes of data, the file holds " + std::to_string(size < kHeaderSize + 4 ? 0 : size - kHeaderSize - 4));
+  return Status::success();
+}
+
+// The TDAG's fields from its body, whose checksum has been checked.
+Status read_body(Reader& r, uint32_t version, std::shared_ptr<const detail::TdagData>& data);
+
+}  // namespace
+
+Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& out) {
+  out = TemporalDag{};
+  uint32_t version = 0;
+  uint64_t body_size = 0;
+  if (Status status = read_header(bytes, size, version, body_size); !status) return status;
   const uint8_t* body = bytes + kHeaderSize;
   uint32_t stored_crc = 0;
   std::memcpy(&stored_crc, body + body_size, 4);
   if (detail::crc32(body, static_cast<size_t>(body_size)) != stored_crc)
     return Status::error("corrupted TDAG file: checksum mismatch");
-
   Reader r(body, static_cast<size_t>(body_size));
+  return read_body(r, version, out.data_);
+}
+
+namespace {
+
+Status read_body(Reader& r, uint32_t version, std::shared_ptr<const detail::TdagData>& data) {
   auto d = std::make_shared<detail::TdagData>();
   constexpr uint64_t kMaxIndex = INT32_MAX;
   const uint64_t frame_count = r.count("frame count", kMaxIndex - 1);
@@ -596,9 +650,11 @@ Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& 
   if (!r.ok()) return Status::error("corrupted TDAG file: " + r.error());
   if (Status status = detail::derive_links(*d); !status) return Status::error("corrupted TDAG file: " + status.message);
   if (Status status = DependencyOrderCheck(*d).run(); !status) return Status::error("corrupted TDAG file: " + status.message);
-  out.data_ = std::move(d);
+  data = std::move(d);
   return Status::success();
 }
+
+}  // namespace
 
 Status save_temporal_dag(const TemporalDag& dag, const std::string& path) {
   std::vector<uint8_t> bytes;
@@ -622,13 +678,41 @@ Status save_temporal_dag(const TemporalDag& dag, const std::string& path) {
   return Status::success();
 }
 
-Status load_temporal_dag(const std::string& path, TemporalDag& out) {
+// Read a chunk at a time, so that the file's bytes (as large as the residuals of a long clip) are
+// never held whole.
+Status load_temporal_dag(const std::string& path, TemporalDag& out, size_t chunk_size) {
   out = TemporalDag{};
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return Status::error(path + ": cannot open");
-  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (Status status = deserialize_temporal_dag(bytes.data(), bytes.size(), out); !status)
-    return Status::error(path + ": " + status.message);
+  chunk_size = std::max<size_t>(chunk_size, 1);
+  auto fail = [&](const std::string& why) { return Status::error(path + ": " + why); };
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) return fail("a directory, not a TDAG file");
+  std::ifstream file(path, std::ios::binary | std::ios::ate);
+  const std::streamoff end = file ? static_cast<std::streamoff>(file.tellg()) : -1;
+  if (end < 0) return fail("cannot open");
+  const auto size = static_cast<size_t>(end);
+  file.seekg(0);
+  uint8_t header[kHeaderSize];
+  file.read(reinterpret_cast<char*>(header), static_cast<std::streamsize>(std::min(size, kHeaderSize)));
+  uint32_t version = 0;
+  uint64_t body_size = 0;
+  if (Status status = read_header(header, size, version, body_size); !status) return fail(status.message);
+
+  std::vector<uint8_t> chunk(chunk_size);
+  uint32_t crc = 0;
+  for (uint64_t left = body_size; left > 0;) {
+    const auto n = static_cast<size_t>(std::min<uint64_t>(left, chunk.size()));
+    if (!file.read(reinterpret_cast<char*>(chunk.data()), static_cast<std::streamsize>(n)))
+      return fail("truncated TDAG file (it changed while read)");
+    crc = detail::crc32(chunk.data(), n, crc);
+    left -= n;
+  }
+  uint32_t stored_crc = 0;
+  if (!file.read(reinterpret_cast<char*>(&stored_crc), 4)) return fail("truncated TDAG file (it changed while read)");
+  if (crc != stored_crc) return fail("corrupted TDAG file: checksum mismatch");
+
+  file.seekg(static_cast<std::streamoff>(kHeaderSize));
+  Reader r(file, body_size, std::move(chunk));
+  if (Status status = read_body(r, version, out.data_); !status) return fail(status.message);
   return Status::success();
 }
 

@@ -376,11 +376,10 @@ class TemporalDag:
     def load(cls, path: str | os.PathLike) -> TemporalDag:
         """Read a .tdag file. Raises OSError when it cannot be read and ValueError (starting with
         the path) when it is not a TDAG, has another format version or is damaged."""
-        data = Path(path).read_bytes()
-        try:
-            return cls.from_bytes(data)
-        except ValueError as error:
-            raise ValueError(f"{os.fspath(path)}: {error}") from None
+        path = os.fsdecode(path)
+        with open(path, "rb"):  # the OSError Python raises: missing, a directory, no permission
+            pass
+        return cls(_core.TemporalDag.load(path))  # a chunk at a time: the file is never held whole
 
     # -- structure -------------------------------------------------------------------------------
 

@@ -31,3 +31,13 @@ TEST_CASE("crc32: the standard check value, and the bit loop's value at every le
     for (size_t size = 0; offset + size <= bytes.size(); ++size)
       REQUIRE(animlod::detail::crc32(bytes.data() + offset, size) == crc32_bytewise(bytes.data() + offset, size));
 }
+
+TEST_CASE("crc32: continued over two pieces, the CRC of the whole at every split") {
+  std::mt19937 random(7);
+  std::vector<uint8_t> bytes(50);
+  for (uint8_t& b : bytes) b = static_cast<uint8_t>(random());
+  const uint32_t whole = animlod::detail::crc32(bytes.data(), bytes.size());
+  for (size_t split = 0; split <= bytes.size(); ++split)
+    REQUIRE(animlod::detail::crc32(bytes.data() + split, bytes.size() - split,
+                                   animlod::detail::crc32(bytes.data(), split)) == whole);
+}

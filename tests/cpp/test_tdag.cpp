@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "../../cpp/src/crc32.hpp"
 #include "animlod/mesh_validation.hpp"
 #include "animlod/tdag.hpp"
 #include "animlod/tdag_player.hpp"
@@ -310,6 +312,64 @@ TEST_CASE("tdag: save and load round trip, damaged files are named errors") {
   CHECK(load_error(damaged).find("written by a newer animlod") != std::string::npos);
   CHECK(load_error({bytes.begin(), bytes.end() - 10}).find("truncated") != std::string::npos);
   CHECK(load_error({'h', 'e', 'l', 'l', 'o'}) == "not a TDAG file (no ANLDTDAG signature)");
+}
+
+TEST_CASE("tdag: a file loads a chunk at a time as from bytes, its errors named with the path") {
+  const OwnedAnimatedMesh mesh = swinging_tube(6);
+  TdagOptions options;
+  options.governing = Governing::online;
+  const TemporalDag dag = build(mesh, options);
+  std::vector<uint8_t> bytes;
+  REQUIRE(animlod::serialize_temporal_dag(dag, bytes).ok);
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "animlod_test_tdag_chunks";
+  std::filesystem::create_directories(folder);
+  auto write = [&](const std::string& name, const std::vector<uint8_t>& data) {
+    const std::string path = (folder / name).string();
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size()));
+    return path;
+  };
+  // The body between the header and the checksum replaced, with its length and checksum made right.
+  auto rewrapped = [&](std::vector<uint8_t> body) {
+    std::vector<uint8_t> file(bytes.begin(), bytes.begin() + 20);
+    const uint64_t length = body.size();
+    std::memcpy(&file[12], &length, 8);
+    const uint32_t crc = animlod::detail::crc32(body.data(), body.size());
+    file.insert(file.end(), body.begin(), body.end());
+    file.insert(file.end(), reinterpret_cast<const uint8_t*>(&crc), reinterpret_cast<const uint8_t*>(&crc) + 4);
+    return file;
+  };
+  const std::vector<uint8_t> body(bytes.begin() + 20, bytes.end() - 4);
+  std::vector<uint8_t> longer = body, damaged = bytes;
+  longer.push_back(0);
+  damaged[bytes.size() / 2] ^= 0x40;
+  const std::vector<std::string> refused = {write("short.tdag", rewrapped({body.begin(), body.end() - 9})),
+                                            write("long.tdag", rewrapped(longer)), write("damaged.tdag", damaged),
+                                            write("cut.tdag", {bytes.begin(), bytes.end() - 10})};
+  const std::string path = write("good.tdag", bytes);
+  for (const size_t chunk : {size_t{1}, size_t{2}, size_t{3}, size_t{7}, size_t{64}, size_t{4096}, size_t{1} << 20}) {
+    CAPTURE(chunk);
+    TemporalDag loaded;
+    const animlod::Status status = animlod::load_temporal_dag(path, loaded, chunk);
+    REQUIRE_MESSAGE(status.ok, status.message);
+    std::vector<uint8_t> again;
+    REQUIRE(animlod::serialize_temporal_dag(loaded, again).ok);
+    CHECK(again == bytes);
+    for (const std::string& bad : refused) {
+      std::ifstream stream(bad, std::ios::binary);
+      const std::vector<uint8_t> data((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+      TemporalDag from_bytes, from_file;
+      const animlod::Status expected = animlod::deserialize_temporal_dag(data.data(), data.size(), from_bytes);
+      const animlod::Status found = animlod::load_temporal_dag(bad, from_file, chunk);
+      CHECK_FALSE(expected.ok);
+      CHECK(found.message == bad + ": " + expected.message);
+      CHECK(from_file.empty());
+    }
+  }
+  TemporalDag none;
+  CHECK(animlod::load_temporal_dag((folder / "missing.tdag").string(), none).message ==
+        (folder / "missing.tdag").string() + ": cannot open");
+  CHECK(animlod::load_temporal_dag(folder.string(), none).message == folder.string() + ": a directory, not a TDAG file");
+  std::filesystem::remove_all(folder);
 }
 
 TEST_CASE("tdag: every file the builder writes loads, a collapse ordered before its child does not") {

@@ -175,6 +175,13 @@ def test_save_load_round_trip_and_damaged_files(dag: TemporalDag, tmp_path):
     (tmp_path / "text.tdag").write_text("hello")
     with pytest.raises(ValueError, match="not a TDAG file"):
         TemporalDag.load(tmp_path / "text.tdag")
+    (tmp_path / "cut.tdag").write_bytes(path.read_bytes()[:-10])
+    with pytest.raises(ValueError, match=r"cut\.tdag: truncated or padded TDAG file"):
+        TemporalDag.load(tmp_path / "cut.tdag")
+    with pytest.raises(FileNotFoundError):
+        TemporalDag.load(tmp_path / "missing.tdag")
+    with pytest.raises(IsADirectoryError):
+        TemporalDag.load(tmp_path)
 
 
 def test_a_two_sided_sheet_simplifies_like_its_front_and_queries_give_both_sides(tmp_path, capsys):

@@ -143,6 +143,7 @@ class TemporalDag {
   friend class TdagCut;
   friend Status build_temporal_dag(const AnimatedMeshView&, const TdagOptions&, TemporalDag&, TdagBuildReport*);
   friend Status deserialize_temporal_dag(const uint8_t*, size_t, TemporalDag&);
+  friend Status load_temporal_dag(const std::string&, TemporalDag&, size_t);
   friend Status serialize_temporal_dag(const TemporalDag&, std::vector<uint8_t>&);
 };
 
@@ -174,9 +175,10 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
 // ranked between it and its children (again on frames where the structure changes).
 Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& out);
 // File versions: the message of an error starts with the path. save writes `path` through a
-// temporary file renamed into place.
+// temporary file renamed into place. load reads the file twice, `chunk_size` bytes at a time
+// (the memory it costs beyond the TDAG): once for the checksum, then into the fields.
 Status save_temporal_dag(const TemporalDag& dag, const std::string& path);
-Status load_temporal_dag(const std::string& path, TemporalDag& out);
+Status load_temporal_dag(const std::string& path, TemporalDag& out, size_t chunk_size = size_t{1} << 20);
 
 // The three temporal approximation levels of Section 5.
 enum class ApproximationLevel : int {

@@ -39,11 +39,22 @@ bool well_conditioned(const Eigen::Matrix3d& m) {
 }  // namespace
 
 Status affine_split(const AnimatedMeshView& mesh, AffineBase base, AffineSplit& out) {
+  return affine_split(mesh, nullptr, mesh.vertex_count, base, out);
+}
+
+Status affine_split(const AnimatedMeshView& mesh, const int32_t* vertices, size_t count, AffineBase base,
+                    AffineSplit& out) {
   out = AffineSplit{};
   if (Status status = check_mesh(mesh); !status) return status;
-  const size_t frame_count = mesh.frame_count, vertex_count = mesh.vertex_count;
+  if (count == 0) return Status::error("vertices: none selected");
+  for (size_t v = 0; vertices != nullptr && v < count; ++v)
+    if (vertices[v] < 0 || static_cast<size_t>(vertices[v]) >= mesh.vertex_count)
+      return Status::error("vertices: " + std::to_string(vertices[v]) + " outside [0, " +
+                           std::to_string(mesh.vertex_count) + ")");
+  const size_t frame_count = mesh.frame_count, vertex_count = count;
   auto point = [&](size_t frame, size_t v) {
-    const float* p = mesh.frames + (frame * vertex_count + v) * 3;
+    const size_t vertex = vertices != nullptr ? static_cast<size_t>(vertices[v]) : v;
+    const float* p = mesh.frames + (frame * mesh.vertex_count + vertex) * 3;
     return Eigen::Vector3d(p[0], p[1], p[2]);
   };
 

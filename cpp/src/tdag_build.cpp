@@ -47,27 +47,21 @@ Status check_options(const AnimatedMeshView& mesh, const TdagOptions& options) {
   return Status::success();
 }
 
-// The TDAG's vertices: the prepared points, with their frames (F, P, 3). A face repeated in the
-// reverse turn (a two-sided sheet) leaves the surface as AQEM's does: kept, both sides were cut
-// apart at every edge and locked, and nothing collapsed.
+// The TDAG's vertices: the prepared points, each an input vertex's position (point_source), read
+// from the input's frames (a copy of a long dense clip's frames would cost as much as the
+// input). A face repeated in the reverse turn (a two-sided sheet) leaves the surface as AQEM's
+// does: kept, both sides were cut apart at every edge and locked, and nothing collapsed.
 struct PointMesh {
+  const AnimatedMeshView& input;
   detail::PreparedMesh prepared;
-  std::vector<float> frames;
-  AnimatedMeshView view;  // over `frames` and prepared.faces
   std::vector<std::vector<int32_t>> twins;  // (P,) other points cut from the same input vertex
 
-  PointMesh(const AnimatedMeshView& mesh, bool weld) {
-    detail::WeldInput input;
-    input.weld = weld;
-    input.mirror_two_sided = true;
-    prepared = detail::prepare_mesh(mesh, input);
+  PointMesh(const AnimatedMeshView& mesh, bool weld) : input(mesh) {
+    detail::WeldInput options;
+    options.weld = weld;
+    options.mirror_two_sided = true;
+    prepared = detail::prepare_mesh(mesh, options);
     const size_t point_count = prepared.point_source.size();
-    frames.resize(mesh.frame_count * point_count * 3);
-    for (size_t f = 0; f < mesh.frame_count; ++f)
-      for (size_t p = 0; p < point_count; ++p)
-        std::copy_n(mesh.frames + (f * mesh.vertex_count + static_cast<size_t>(prepared.point_source[p])) * 3, 3,
-                    &frames[(f * point_count + p) * 3]);
-    view = {frames.data(), prepared.faces.data(), mesh.frame_count, point_count, prepared.faces.size() / 3};
     twins.resize(point_count);
     if (prepared.split_points == 0) return;
     std::vector<std::pair<int32_t, int32_t>> by_source;
@@ -82,6 +76,16 @@ struct PointMesh {
       i = j;
     }
   }
+
+  size_t point_count() const { return prepared.point_source.size(); }
+  size_t face_count() const { return prepared.faces.size() / 3; }
+  // Frame t's point positions (P, 3) into `out`.
+  void gather(size_t frame, std::vector<float>& out) const {
+    out.resize(point_count() * 3);
+    const float* positions = input.frames + frame * input.vertex_count * 3;
+    for (size_t p = 0; p < point_count(); ++p)
+      std::copy_n(positions + static_cast<size_t>(prepared.point_source[p]) * 3, 3, &out[p * 3]);
+  }
 };
 
 // One frame's fields of a hierarchy's collapses, in its order: the cost c_{i,t} and the code of
@@ -95,6 +99,7 @@ struct FrameFields {
 struct FieldScratch {
   std::vector<Quadric> quadrics;
   std::vector<double> bound;    // monotone bound in the frame
+  std::vector<float> positions; // (V, 3) the frame's
   std::vector<float> ordered;   // (V, 3) the frame's positions in ClusterRanges::leaves order
 };
 
@@ -139,9 +144,8 @@ struct ClusterRanges {
 // Per-frame fields of the collapses, measured frame by frame and recorded in frame order.
 class FieldBuilder {
  public:
-  FieldBuilder(const AnimatedMeshView& mesh, const TdagOptions& options, double scale)
-      : mesh_(mesh), scale_(scale) {
-    if (options.boundary_quadrics) boundary_ = detail::boundary_sides(mesh.faces, mesh.face_count);
+  FieldBuilder(const PointMesh& points, const TdagOptions& options, double scale) : points_(points), scale_(scale) {
+    if (options.boundary_quadrics) boundary_ = detail::boundary_sides(points.prepared.faces.data(), points.face_count());
     use_boundary_ = options.boundary_quadrics;
   }
 
@@ -155,10 +159,6 @@ class FieldBuilder {
   void finish(const CollapseTable& table, detail::TdagData& data);
 
  private:
-  Eigen::Vector3d point(int32_t frame, int32_t vertex) const {
-    const float* p = mesh_.frames + (static_cast<size_t>(frame) * mesh_.vertex_count + static_cast<size_t>(vertex)) * 3;
-    return {p[0], p[1], p[2]};
-  }
   void grow(size_t collapse_count, TdagBuildReport& report) {
     if (alive_.size() >= collapse_count) return;
     alive_.resize(collapse_count);
@@ -167,7 +167,7 @@ class FieldBuilder {
     report.use_counts.resize(collapse_count, 0);
   }
 
-  const AnimatedMeshView& mesh_;
+  const PointMesh& points_;
   double scale_;
   bool use_boundary_ = true;
   std::vector<detail::BoundarySide> boundary_;
@@ -189,8 +189,13 @@ void FieldBuilder::measure(int32_t t, const CollapseTable& table, const FrameHie
   out.codes.resize(h.nodes.size());
 
   // Costs c_{i,t}: the quadric of a node is the sum of its cluster's vertex quadrics in frame t.
-  const float* positions = mesh_.frames + static_cast<size_t>(t) * mesh_.vertex_count * 3;
-  detail::vertex_quadrics(positions, mesh_.faces, mesh_.vertex_count, mesh_.face_count,
+  points_.gather(static_cast<size_t>(t), scratch.positions);
+  const float* positions = scratch.positions.data();
+  auto point = [&](int32_t vertex) {
+    const float* p = positions + static_cast<size_t>(vertex) * 3;
+    return Eigen::Vector3d(p[0], p[1], p[2]);
+  };
+  detail::vertex_quadrics(positions, points_.prepared.faces.data(), points_.point_count(), points_.face_count(),
                           use_boundary_ ? &boundary_ : nullptr, quadrics);
   quadrics.resize(node_count);
   bounds.assign(node_count, 0.0);
@@ -203,11 +208,11 @@ void FieldBuilder::measure(int32_t t, const CollapseTable& table, const FrameHie
     const int32_t kept = table.kept_child[c], removed = table.removed_child[c];
     const Quadric merged = quadrics[static_cast<size_t>(kept)] + quadrics[static_cast<size_t>(removed)];
     quadrics[static_cast<size_t>(node)] = merged;
-    out.costs[i] = merged.evaluate(point(t, table.representative[static_cast<size_t>(node)]));
+    out.costs[i] = merged.evaluate(point(table.representative[static_cast<size_t>(node)]));
 
     // Error bound: the farthest input vertex of the cluster from the node's position, then
     // the largest bound of the children and of the dependencies (all earlier in h).
-    const Eigen::Vector3d centre = point(t, table.representative[static_cast<size_t>(node)]);
+    const Eigen::Vector3d centre = point(table.representative[static_cast<size_t>(node)]);
     double farthest = 0.0;
     const auto first = static_cast<size_t>(clusters.begin[static_cast<size_t>(node)]);
     const size_t end = first + static_cast<size_t>(clusters.count[static_cast<size_t>(node)]);
@@ -264,10 +269,13 @@ void FieldBuilder::finish(const CollapseTable& table, detail::TdagData& data) {
   }
 }
 
-double bounding_box_diagonal(const AnimatedMeshView& mesh) {
+// Of the points in frame 0.
+double bounding_box_diagonal(const PointMesh& points) {
+  std::vector<float> positions;
+  points.gather(0, positions);
   Eigen::Vector3d low = Eigen::Vector3d::Constant(INFINITY), high = Eigen::Vector3d::Constant(-INFINITY);
-  for (size_t v = 0; v < mesh.vertex_count; ++v) {
-    const Eigen::Vector3d p(mesh.frames[3 * v], mesh.frames[3 * v + 1], mesh.frames[3 * v + 2]);
+  for (size_t v = 0; v < points.point_count(); ++v) {
+    const Eigen::Vector3d p(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
     low = low.cwiseMin(p);
     high = high.cwiseMax(p);
   }
@@ -301,18 +309,18 @@ Status decimate(const AnimatedMeshView& mesh, const PointMesh& points, const flo
   engine_options.check_inversion = options.check_inversion;
   const detail::CarriedData carried;
   detail::CollapseEngine engine(one_frame, points.prepared, carried, engine_options);
-  std::vector<float> point_positions(points.view.vertex_count * 3);
-  for (size_t p = 0; p < points.view.vertex_count; ++p)
+  std::vector<float> point_positions(points.point_count() * 3);
+  for (size_t p = 0; p < points.point_count(); ++p)
     std::copy_n(positions + static_cast<size_t>(points.prepared.point_source[p]) * 3, 3, &point_positions[p * 3]);
   std::vector<Quadric> quadrics;
-  detail::vertex_quadrics(point_positions.data(), points.view.faces, points.view.vertex_count,
-                          points.view.face_count, boundary, quadrics);
+  detail::vertex_quadrics(point_positions.data(), points.prepared.faces.data(), points.point_count(),
+                          points.face_count(), boundary, quadrics);
   detail::TdagCollapsePolicy policy(engine, std::move(quadrics), table, history);
   std::vector<detail::EngineLevel> levels;
   detail::EngineRecord record;
   engine.run(policy, {1}, levels, record);
   costs = policy.costs();
-  return detail::record_hierarchy(points.view.faces, points.view.face_count, points.view.vertex_count,
+  return detail::record_hierarchy(points.prepared.faces.data(), points.face_count(), points.point_count(),
                                   policy.collapses(), nullptr, table, out);
 }
 
@@ -335,7 +343,7 @@ Status aqem_hierarchy(const AnimatedMeshView& mesh, const PointMesh& points, con
     collapses[i].removed = points.prepared.wedge_point[static_cast<size_t>(result.collapses.removed[i])];
     collapses[i].kept = points.prepared.wedge_point[static_cast<size_t>(result.collapses.kept[i])];
   }
-  if (Status status = detail::record_hierarchy(points.view.faces, points.view.face_count, points.view.vertex_count,
+  if (Status status = detail::record_hierarchy(points.prepared.faces.data(), points.face_count(), points.point_count(),
                                                collapses, &points.twins, table, out);
       !status)
     return Status::error("AQEM order: " + status.message);
@@ -355,9 +363,8 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
   // The TDAG's vertices: welded points, degenerate and repeated faces dropped, non-manifold
   // spots cut apart (as the collapse engine needs them).
   PointMesh points(mesh, options.weld);
-  if (points.view.face_count == 0)
+  if (points.face_count() == 0)
     return Status::error("faces: every face is degenerate (no face has three distinct positions)");
-  const AnimatedMeshView& view = points.view;
 
   auto data = std::make_shared<detail::TdagData>();
   TdagBuildReport local_report;
@@ -365,7 +372,7 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
   rep = TdagBuildReport{};
   const auto frame_count = static_cast<int32_t>(mesh.frame_count);
   data->frame_count = frame_count;
-  data->vertex_count = static_cast<int32_t>(view.vertex_count);
+  data->vertex_count = static_cast<int32_t>(points.point_count());
   data->faces = points.prepared.faces;
   data->input_points = points.prepared.wedge_point;
   for (int32_t source : points.prepared.mirror_sources) data->two_sided.push_back(source >= 0 ? 1 : 0);
@@ -379,22 +386,26 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
   data->governing = options.governing;
   data->governing_frame = options.governing == Governing::frame ? options.governing_frame : 0;
   data->history_weight = options.governing == Governing::online ? options.history_weight : 0.0;
-  data->scale = bounding_box_diagonal(view);
+  data->scale = bounding_box_diagonal(points);
 
   // Section 3: the affine split.
   {
     const detail::PhaseTimer timer(rep.seconds_affine);
     AffineSplit split;
-    if (Status status = affine_split(view, options.affine_base, split); !status) return status;
+    if (Status status = affine_split(mesh, points.prepared.point_source.data(), points.point_count(),
+                                     options.affine_base, split);
+        !status)
+      return status;
     data->maps = std::move(split.maps);
     data->residuals = std::move(split.residuals);
   }
 
   // Section 4: the hierarchy (one order, or one per frame online) and the per-frame fields.
   CollapseTable table(data->vertex_count);
-  FieldBuilder fields(view, options, data->scale);
+  FieldBuilder fields(points, options, data->scale);
   const std::vector<detail::BoundarySide> boundary =
-      options.boundary_quadrics ? detail::boundary_sides(view.faces, view.face_count) : std::vector<detail::BoundarySide>{};
+      options.boundary_quadrics ? detail::boundary_sides(points.prepared.faces.data(), points.face_count())
+                                : std::vector<detail::BoundarySide>{};
   const std::vector<detail::BoundarySide>* boundary_or_null = options.boundary_quadrics ? &boundary : nullptr;
   auto progress = [&](size_t done) {
     if (options.progress) options.progress(done, mesh.frame_count);
@@ -458,10 +469,6 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
       progress(static_cast<size_t>(t) + 1);
     }
   }
-  // The points' frames are read no more: freed, a long clip's fields are gathered beside the
-  // input and the residuals only, not beside a third copy of the frames.
-  std::vector<float>().swap(points.frames);
-  points.view.frames = nullptr;
   fields.finish(table, *data);
   if (Status status = detail::derive_links(*data); !status) return Status::error("internal: " + status.message);
   out.data_ = std::move(data);

@@ -35,6 +35,10 @@ struct AffineSplit {
 // Errors (naming the element): no frames or vertices; a non-finite position (frame and vertex
 // named). Connectivity is not looked at (faces may be null).
 Status affine_split(const AnimatedMeshView& mesh, AffineBase base, AffineSplit& out);
+// The split of the vertices vertices[0 .. count) of `mesh` only (indices into it, in that order:
+// the residuals are (F, count, 3)), e.g. a welded mesh's points, without a copy of their frames.
+Status affine_split(const AnimatedMeshView& mesh, const int32_t* vertices, size_t count, AffineBase base,
+                    AffineSplit& out);
 
 // Applies a (3, 4) row-major affine map to `count` points (count, 3) float32, writing
 // (count, 3) float32 into `out` (may not alias `points`).

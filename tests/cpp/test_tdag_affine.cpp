@@ -83,3 +83,27 @@ TEST_CASE("affine split of a flat base falls back on translations, bad input is 
   CHECK_FALSE(status.ok);
   CHECK(status.message == "frame 1, vertex 3: non-finite position");
 }
+
+TEST_CASE("affine split of chosen vertices equals the split of a mesh of those vertices alone") {
+  const OwnedAnimatedMesh tube = animlod::testing::bending_tube(12, 10, 5, 1.2);
+  const std::vector<int32_t> chosen = {7, 3, 3, 50, 0, 119, 64, 21};  // any order, repeats too
+  OwnedAnimatedMesh alone = tube;
+  alone.vertex_count = chosen.size();
+  alone.frames.clear();
+  for (size_t f = 0; f < tube.frame_count; ++f)
+    for (int32_t v : chosen)
+      for (size_t k = 0; k < 3; ++k) alone.frames.push_back(tube.frames[(f * tube.vertex_count + size_t(v)) * 3 + k]);
+  for (AffineBase base : {AffineBase::first, AffineBase::average}) {
+    AffineSplit expected, found;
+    REQUIRE(animlod::affine_split(alone.view(), base, expected).ok);
+    REQUIRE(animlod::affine_split(tube.view(), chosen.data(), chosen.size(), base, found).ok);
+    CHECK(found.maps == expected.maps);
+    CHECK(found.residuals == expected.residuals);
+    CHECK(found.translation_only == expected.translation_only);
+  }
+  AffineSplit split;
+  const std::vector<int32_t> outside = {0, 120};
+  CHECK(animlod::affine_split(tube.view(), outside.data(), outside.size(), AffineBase::first, split).message ==
+        "vertices: 120 outside [0, 120)");
+  CHECK(animlod::affine_split(tube.view(), outside.data(), 0, AffineBase::first, split).message == "vertices: none selected");
+}

@@ -43,6 +43,7 @@ void bind_options(py::module_& m) {
       .field("strict_inversion", &AqemOptions::strict_inversion)
       .field("max_frames", &AqemOptions::max_frames)
       .field("frame_subset", &AqemOptions::frame_subset)
+      .field("quadric_memory_limit", &AqemOptions::quadric_memory_limit)
       .choice("placement", &AqemOptions::placement)
       .field("weld", &AqemOptions::weld)
       .finish();

@@ -82,6 +82,9 @@ Status resolve_frames(const AnimatedMeshView& mesh, const AqemOptions& options, 
     frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
   } else if (options.max_frames > 0 && options.max_frames < mesh.frame_count) {
     frames = detail::sample_frames(mesh, options.max_frames);
+  } else if (const size_t fit = options.quadric_memory_limit / (sizeof(Quadric) * mesh.vertex_count);
+             options.max_frames == 0 && options.quadric_memory_limit > 0 && fit < mesh.frame_count) {
+    frames = detail::sample_frames(mesh, std::max<size_t>(fit, 1));
   } else {
     frames.resize(mesh.frame_count);
     for (size_t f = 0; f < mesh.frame_count; ++f) frames[f] = static_cast<int32_t>(f);

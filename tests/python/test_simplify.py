@@ -11,6 +11,7 @@ from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
 
 from animlod import _core
 from animlod.aqem import simplify_animated
+from animlod.io.npz import write_npz
 from animlod.model import AnimatedMesh
 
 
@@ -109,6 +110,32 @@ def test_frame_sampling_covers_the_motion_and_positions_every_frame():
     assert result.levels[0].mesh.frame_count == 9
     explicit = simplify_animated(mesh, (0.3,), frame_subset=[8, 0, 4])
     np.testing.assert_array_equal(explicit.levels[0].mesh.faces, result.levels[0].mesh.faces)
+
+
+def test_quadrics_over_every_frame_past_the_memory_limit_take_the_frames_that_fit():
+    # A long dense capture's quadrics over every frame (80 bytes per point and frame) failed to
+    # allocate; past the limit they are taken over the most frames that fit, as max_frames takes them.
+    mesh = bending_tube(frames=9)
+    every = simplify_animated(mesh, (0.3,))
+    assert every.frames_used.size == 9
+    fits_three = 80 * mesh.vertex_count * 3 + 79
+    limited = simplify_animated(mesh, (0.3,), quadric_memory_limit=fits_three)
+    sampled = simplify_animated(mesh, (0.3,), max_frames=3)
+    np.testing.assert_array_equal(limited.frames_used, sampled.frames_used)
+    np.testing.assert_array_equal(limited.levels[0].mesh.frames, sampled.levels[0].mesh.frames)
+    assert simplify_animated(mesh, (0.3,), quadric_memory_limit=0).frames_used.size == 9  # no limit
+    chosen = simplify_animated(mesh, (0.3,), quadric_memory_limit=fits_three, max_frames=5)
+    assert chosen.frames_used.size == 5  # the caller's max_frames wins
+
+
+def test_a_limited_sequence_says_how_many_frames_its_quadrics_took(tmp_path):
+    from animlod.pipelines.lod_sequence import simplify_sequence
+
+    mesh = bending_tube(frames=6)
+    write_npz(tmp_path / "tube.npz", mesh)
+    report = simplify_sequence(tmp_path / "tube.npz", tmp_path / "out", (0.5,), measure=False,
+                               quadric_memory_limit=80 * mesh.vertex_count * 2)  # fmt: skip
+    assert report.frames_used == 2 and report.levels[0].faces > 0
 
 
 def test_uvs_are_carried_as_attributes():

@@ -78,6 +78,11 @@ struct AqemOptions {
   size_t max_frames = 0;
   // Explicit frames for the quadrics; overrides max_frames when not empty.
   std::vector<int32_t> frame_subset;
+  // With max_frames 0 and no frame_subset: quadrics over every frame unless they would take
+  // more than this many bytes (80 per welded point and frame: 16 GB for a 1,200-frame capture
+  // of 166k points, which failed to allocate); then over the most frames that fit, chosen as
+  // max_frames chooses them (frames_used says which). 0: no limit.
+  size_t quadric_memory_limit = size_t{2} << 30;
   // Called now and then with (collapses done, collapses needed for the last level).
   std::function<void(size_t, size_t)> progress;
   // Where the vertex of a collapse goes (see Placement).

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind, input_stem
 from ..model import AnimatedMesh
+from ..options import AqemOptions
 from . import UserError, add_joint_map_argument, non_negative_int, print_rows
 
 
@@ -181,6 +182,13 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
         error = f"{level.aqem_error:.3g}"
         rows.append((index, level.faces, level.target_faces, error, hausdorff, rms, f"{report.seconds:.2f}"))
     print_rows(rows)
+    frame_count = report.original.frame_count
+    if report.frames_used < frame_count and not args.max_frames:
+        limit = AqemOptions().quadric_memory_limit / 2**30
+        print(
+            f"note: quadrics over {report.frames_used} of {frame_count} frames chosen to cover the motion: over "
+            f"every frame they would take more than {limit:g} GiB (--max-frames {frame_count} takes them all)"
+        )
     # A level short of its target (--max-error, or no legal collapse left) can equal the one before
     # it; without a word the table read as two levels that happen to agree.
     for index, level in enumerate(report.levels, start=1):

@@ -45,6 +45,7 @@ class SequenceReport:
     levels: list[SequenceLevel]
     preparation: Preparation
     seconds: float  # the simplification (all levels), without reading, writing or measuring
+    frames_used: int  # frames whose quadrics drove it (fewer than the sequence's when limited)
 
 
 def simplify_sequence(
@@ -92,7 +93,7 @@ def simplify_sequence(
         levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error))
     if measure and measuring is not None:
         measuring(len(result.levels), len(result.levels))
-    return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds)
+    return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used))
 
 
 # Points measured per chunk of frames: each frame holds its vertices and the samples in float64,

@@ -48,7 +48,7 @@ def test_a_write_failing_part_way_keeps_the_old_file(tmp_path: Path, monkeypatch
         handle.write(b"PK\x03\x04 half an archive")
         raise OSError("disk full")
 
-    monkeypatch.setattr(np, "savez_compressed", write_a_header_then_fail)
+    monkeypatch.setattr(np, "savez", write_a_header_then_fail)
     with pytest.raises(OSError, match="disk full"):
         write_npz(path, _mesh(30.0))
     assert path.read_bytes() == old
@@ -93,8 +93,9 @@ def test_not_an_archive(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("damage", [b"\xff" * 8, b"\x00" * 8])
 def test_damaged_compressed_member(tmp_path: Path, damage: bytes) -> None:
-    path = tmp_path / "mesh.npz"
-    write_npz(path, _mesh(24.0))
+    path = tmp_path / "mesh.npz"  # deflated, as other writers (and animlod before 2026-12-06) write
+    mesh = _mesh(24.0)
+    np.savez_compressed(path, format_version=np.int32(1), faces=mesh.faces, frames=mesh.frames, fps=np.float64(24.0))
     data = bytearray(path.read_bytes())
     with zipfile.ZipFile(path) as archive:
         local_header = archive.getinfo("frames.npy").header_offset
@@ -103,6 +104,21 @@ def test_damaged_compressed_member(tmp_path: Path, damage: bytes) -> None:
     data[start : start + len(damage)] = damage
     path.write_bytes(bytes(data))
     with pytest.raises(FormatError, match="archive: not a readable npz archive .*decompressing"):
+        read_npz(path)
+
+
+def test_damaged_stored_member(tmp_path: Path) -> None:
+    path = tmp_path / "mesh.npz"  # write_npz stores its members: damage shows in their checksum
+    write_npz(path, _mesh(24.0))
+    data = bytearray(path.read_bytes())
+    with zipfile.ZipFile(path) as archive:
+        member = archive.getinfo("frames.npy")
+        assert member.compress_type == zipfile.ZIP_STORED
+    name_length, extra_length = struct.unpack("<HH", data[member.header_offset + 26 : member.header_offset + 30])
+    start = member.header_offset + 30 + name_length + extra_length + member.file_size - 8  # the last positions
+    data[start : start + 8] = b"\xff" * 8
+    path.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match=r"archive: not a readable npz archive \(BadZipFile: Bad CRC-32"):
         read_npz(path)
 
 

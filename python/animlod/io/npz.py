@@ -28,9 +28,11 @@ _MAX_NPY_HEADER = 10_000  # numpy's own default limit of a header's size
 
 
 def write_npz(path: str | os.PathLike, mesh: AnimatedMesh) -> None:
-    """Write ``mesh`` with ``np.savez_compressed``, atomically."""
+    """Write ``mesh`` with ``np.savez``, atomically. Stored, not deflated: float positions
+    deflate by about a tenth, and deflating took 35x as long as storing (a dense capture's level
+    of 1.1 GB: 52.8 s against 1.5 s, and reading it back 12.9 s)."""
     with atomic_write(path, "wb") as handle:
-        np.savez_compressed(
+        np.savez(
             handle,
             format_version=np.int32(FORMAT_VERSION),
             faces=mesh.faces,

@@ -1,6 +1,7 @@
 // Bindings of animlod/tdag.hpp, tdag_affine.hpp and tdag_player.hpp: the TDAG, its cuts, the
 // player and the affine split. Thin: check shapes, convert, call with the GIL released.
 #include <cstring>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -265,6 +266,48 @@ void bind_tdag(py::module_& m) {
           },
           "the .tdag file contents (versioned, checksummed) as a (N,) uint8 array: no copy of a long "
           "clip's gigabytes")
+      .def(
+          "write",
+          [](const TemporalDag& d, const py::object& handle) {
+            // The core runs without the GIL and takes it for each piece it hands to the file; a
+            // Python error (a full disk) stops the writing and is raised as it came.
+            struct HandleSink : TdagFileSink {
+              const py::object& handle;
+              std::optional<py::error_already_set> error;
+              explicit HandleSink(const py::object& h) : handle(h) {}
+              bool call(const std::function<void()>& write) {
+                py::gil_scoped_acquire acquire;
+                try {
+                  write();
+                  return true;
+                } catch (py::error_already_set& e) {
+                  error = std::move(e);
+                  return false;
+                }
+              }
+              bool append(const uint8_t* bytes, size_t size) override {
+                return call([&] { handle.attr("write")(py::memoryview::from_memory(bytes, static_cast<py::ssize_t>(size))); });
+              }
+              bool overwrite(size_t offset, const uint8_t* bytes, size_t size) override {
+                return call([&] {
+                  const py::object end = handle.attr("tell")();
+                  handle.attr("seek")(offset);
+                  handle.attr("write")(py::memoryview::from_memory(bytes, static_cast<py::ssize_t>(size)));
+                  handle.attr("seek")(end);
+                });
+              }
+            } sink(handle);
+            Status status;
+            {
+              py::gil_scoped_release release;
+              status = write_temporal_dag(d, sink);
+            }
+            if (sink.error) throw std::move(*sink.error);
+            raise_if_error(status);
+          },
+          py::arg("handle"),
+          "writes the .tdag file into a binary file object opened for writing and seeking, a piece at a time "
+          "(never the whole file in memory); what its write raises is raised")
       .def_static(
           "from_bytes",
           [](const py::object& data) {  // any bytes-like object (an object, not py::buffer: the stub

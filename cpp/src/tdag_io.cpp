@@ -59,20 +59,33 @@ void for_each_changed_run(const std::vector<uint8_t>& changed, size_t vertex_cou
   }
 }
 
+// Writes the file into `out`, whole; or, given a sink, into `out` as a buffer handed to the sink
+// whenever it holds a chunk (a long clip's file is then never held whole).
 class Writer {
  public:
-  explicit Writer(std::vector<uint8_t>& out) : out_(out) {}
-  void u8(uint8_t v) { out_.push_back(v); }
+  explicit Writer(std::vector<uint8_t>& out, TdagFileSink* sink = nullptr, size_t chunk = 0)
+      : out_(out), sink_(sink), chunk_(std::max<size_t>(chunk, 1)) {}
+  void u8(uint8_t v) {
+    out_.push_back(v);
+    flush_when_full();
+  }
   template <typename T>
   void raw(T v) {
     uint8_t bytes[sizeof(T)];
     std::memcpy(bytes, &v, sizeof(T));
-    out_.insert(out_.end(), bytes, bytes + sizeof(T));
+    raw_array(bytes, sizeof(T));
   }
   template <typename T>
   void raw_array(const T* values, size_t count) {
     const auto* bytes = reinterpret_cast<const uint8_t*>(values);
-    out_.insert(out_.end(), bytes, bytes + count * sizeof(T));
+    const size_t size = count * sizeof(T);
+    if (sink_ != nullptr && size >= chunk_) {  // a long array goes to the sink as it is
+      flush();
+      pass(bytes, size);
+      return;
+    }
+    out_.insert(out_.end(), bytes, bytes + size);
+    flush_when_full();
   }
   void varint(uint64_t v) {
     while (v >= 0x80) {
@@ -80,6 +93,7 @@ class Writer {
       v >>= 7;
     }
     out_.push_back(static_cast<uint8_t>(v));
+    flush_when_full();
   }
   void zigzag(int64_t v) { varint((static_cast<uint64_t>(v) << 1) ^ static_cast<uint64_t>(v >> 63)); }
   void tag(const TimeTag& tag) {
@@ -91,9 +105,46 @@ class Writer {
       previous = r.death;
     }
   }
+  // The body's length into the header, then its checksum after it; false when the sink failed.
+  bool finish() {
+    if (sink_ == nullptr) {
+      const uint64_t body_size = out_.size() - kHeaderSize;
+      std::memcpy(out_.data() + kHeaderSize - sizeof(body_size), &body_size, sizeof(body_size));
+      raw(detail::crc32(out_.data() + kHeaderSize, static_cast<size_t>(body_size)));
+      return true;
+    }
+    flush();
+    const uint64_t body_size = written_ - kHeaderSize;
+    const uint32_t crc = crc_;
+    uint8_t length[sizeof(body_size)];
+    std::memcpy(length, &body_size, sizeof(body_size));
+    return ok_ && sink_->append(reinterpret_cast<const uint8_t*>(&crc), sizeof(crc)) &&
+           sink_->overwrite(kHeaderSize - sizeof(body_size), length, sizeof(body_size));
+  }
 
  private:
+  void flush_when_full() {
+    if (sink_ != nullptr && out_.size() >= chunk_) flush();
+  }
+  void flush() {
+    pass(out_.data(), out_.size());
+    out_.clear();
+  }
+  // To the sink, the body's part of it into the checksum.
+  void pass(const uint8_t* bytes, size_t size) {
+    if (size == 0 || !ok_) return;
+    const size_t header = written_ < kHeaderSize ? std::min(size, kHeaderSize - static_cast<size_t>(written_)) : 0;
+    crc_ = detail::crc32(bytes + header, size - header, crc_);
+    written_ += size;
+    ok_ = sink_->append(bytes, size);
+  }
+
   std::vector<uint8_t>& out_;
+  TdagFileSink* sink_;
+  size_t chunk_;
+  uint64_t written_ = 0;  // bytes handed to the sink
+  uint32_t crc_ = 0;      // of the body's bytes among them
+  bool ok_ = true;
 };
 
 // Reads the body; every read checks the end, and failures keep the first message. The bytes are
@@ -359,20 +410,12 @@ class DependencyOrderCheck {
 
 }  // namespace
 
-Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out) {
-  out.clear();
-  if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
-  const detail::TdagData& d = *dag.data_;
+namespace {
+
+// The file through `w`: the header with its length zero, the body, then Writer::finish.
+void write_file(const detail::TdagData& d, Writer& w) {
   const auto frame_count = static_cast<size_t>(d.frame_count), vertex_count = static_cast<size_t>(d.vertex_count);
-  // The body goes straight after the header, whose length is filled in at the end: a body apart
-  // and its copy held a long clip's residuals twice. Reserved for every residual stored (untouched
-  // pages cost nothing), so that growing does not copy them either.
   const size_t per_frame = vertex_count * 3;
-  out.reserve(kHeaderSize + d.maps.size() * sizeof(double) + frame_count * (per_frame * sizeof(float) + vertex_count / 8 + 1) +
-              16 * (d.faces.size() + d.input_points.size() + d.dep_nodes.size() +
-                    detail::count_error_runs(d.codes_by_frame, frame_count, d.collapse_count())) +
-              64 * d.collapse_count() + 1024);
-  Writer w(out);
   w.raw_array(kMagic, sizeof(kMagic));
   w.raw(kTdagFormatVersion);
   w.raw(uint64_t{0});  // the body's length, below
@@ -465,9 +508,35 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
     });
   }
 
-  const uint64_t body_size = out.size() - kHeaderSize;
-  std::memcpy(out.data() + kHeaderSize - sizeof(body_size), &body_size, sizeof(body_size));
-  w.raw(detail::crc32(out.data() + kHeaderSize, static_cast<size_t>(body_size)));
+}
+
+}  // namespace
+
+Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out) {
+  out.clear();
+  if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
+  const detail::TdagData& d = *dag.data_;
+  const auto frame_count = static_cast<size_t>(d.frame_count), vertex_count = static_cast<size_t>(d.vertex_count);
+  // Reserved for every residual stored (untouched pages cost nothing), so that growing does not
+  // copy a long clip's residuals.
+  out.reserve(kHeaderSize + d.maps.size() * sizeof(double) +
+              frame_count * (vertex_count * 3 * sizeof(float) + vertex_count / 8 + 1) +
+              16 * (d.faces.size() + d.input_points.size() + d.dep_nodes.size() +
+                    detail::count_error_runs(d.codes_by_frame, frame_count, d.collapse_count())) +
+              64 * d.collapse_count() + 1024);
+  Writer w(out);
+  write_file(d, w);
+  w.finish();
+  return Status::success();
+}
+
+Status write_temporal_dag(const TemporalDag& dag, TdagFileSink& sink, size_t chunk_size) {
+  if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
+  std::vector<uint8_t> buffer;
+  buffer.reserve(chunk_size + 64);
+  Writer w(buffer, &sink, chunk_size);
+  write_file(*dag.data_, w);
+  if (!w.finish()) return Status::error("write failed");
   return Status::success();
 }
 
@@ -657,17 +726,31 @@ Status read_body(Reader& r, uint32_t version, std::shared_ptr<const detail::Tdag
 }  // namespace
 
 Status save_temporal_dag(const TemporalDag& dag, const std::string& path) {
-  std::vector<uint8_t> bytes;
-  if (Status status = serialize_temporal_dag(dag, bytes); !status) return Status::error(path + ": " + status.message);
   const std::string temporary = path + ".tmp";
+  Status written;
   {
     std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
     if (!file) return Status::error(path + ": cannot open for writing");
-    file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!file) {
-      std::remove(temporary.c_str());
-      return Status::error(path + ": write failed");
-    }
+    struct FileSink : TdagFileSink {
+      std::ofstream& file;
+      explicit FileSink(std::ofstream& f) : file(f) {}
+      bool append(const uint8_t* bytes, size_t size) override {
+        return static_cast<bool>(file.write(reinterpret_cast<const char*>(bytes), static_cast<std::streamsize>(size)));
+      }
+      bool overwrite(size_t offset, const uint8_t* bytes, size_t size) override {
+        const std::streampos end = file.tellp();
+        file.seekp(static_cast<std::streamoff>(offset));
+        append(bytes, size);
+        return static_cast<bool>(file.seekp(end));
+      }
+    } sink(file);
+    written = write_temporal_dag(dag, sink);
+    file.close();
+    if (written && !file) written = Status::error("write failed");
+  }
+  if (!written) {
+    std::remove(temporary.c_str());
+    return Status::error(path + ": " + written.message);
   }
   std::error_code error;
   std::filesystem::rename(temporary, path, error);

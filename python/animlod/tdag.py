@@ -367,10 +367,9 @@ class TemporalDag:
         """Write the TDAG and its affine maps to ``path`` atomically; returns the size in bytes."""
         from .io.atomic import atomic_write
 
-        data = self._core.to_bytes()  # written from the core's own buffer, not a copy as bytes
         with atomic_write(path, "wb") as handle:
-            handle.write(data)
-        return int(data.size)
+            self._core.write(handle)  # a piece at a time: the file is never held whole
+            return handle.tell()
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> TemporalDag:

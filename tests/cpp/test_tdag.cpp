@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -370,6 +371,45 @@ TEST_CASE("tdag: a file loads a chunk at a time as from bytes, its errors named 
         (folder / "missing.tdag").string() + ": cannot open");
   CHECK(animlod::load_temporal_dag(folder.string(), none).message == folder.string() + ": a directory, not a TDAG file");
   std::filesystem::remove_all(folder);
+}
+
+TEST_CASE("tdag: a file written a chunk at a time has the bytes of one written whole") {
+  const TemporalDag dag = build(swinging_tube(6));
+  std::vector<uint8_t> whole;
+  REQUIRE(animlod::serialize_temporal_dag(dag, whole).ok);
+  struct MemorySink : animlod::TdagFileSink {
+    std::vector<uint8_t> bytes;
+    size_t fail_after = SIZE_MAX;  // bytes appended before append fails
+    size_t appends = 0;
+    bool append(const uint8_t* data, size_t size) override {
+      if (bytes.size() + size > fail_after) return false;
+      bytes.insert(bytes.end(), data, data + size);
+      appends += 1;
+      return true;
+    }
+    bool overwrite(size_t offset, const uint8_t* data, size_t size) override {
+      if (offset + size > bytes.size()) return false;
+      std::copy_n(data, size, bytes.begin() + static_cast<std::ptrdiff_t>(offset));
+      return true;
+    }
+  };
+  for (const size_t chunk : {size_t{1}, size_t{3}, size_t{64}, size_t{4096}, size_t{1} << 20}) {
+    CAPTURE(chunk);
+    MemorySink sink;
+    const animlod::Status status = animlod::write_temporal_dag(dag, sink, chunk);
+    REQUIRE_MESSAGE(status.ok, status.message);
+    CHECK(sink.bytes == whole);
+    CHECK(sink.appends >= std::min<size_t>(whole.size() / (chunk + 64), 100));  // handed out in pieces
+  }
+  MemorySink full_disk;
+  full_disk.fail_after = whole.size() / 2;
+  CHECK(animlod::write_temporal_dag(dag, full_disk, 64).message == "write failed");
+
+  const std::filesystem::path path = std::filesystem::temp_directory_path() / "animlod_test_tdag_written.tdag";
+  REQUIRE(animlod::save_temporal_dag(dag, path.string()).ok);
+  std::ifstream stream(path, std::ios::binary);
+  CHECK(std::vector<uint8_t>((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>()) == whole);
+  std::filesystem::remove(path);
 }
 
 TEST_CASE("tdag: every file the builder writes loads, a collapse ordered before its child does not") {

@@ -4,6 +4,10 @@ one, files round-trip, and bad input is a ValueError naming the element."""
 
 from __future__ import annotations
 
+import io
+import os
+from unittest import mock
+
 import numpy as np
 import pytest
 
@@ -182,6 +186,60 @@ def test_save_load_round_trip_and_damaged_files(dag: TemporalDag, tmp_path):
         TemporalDag.load(tmp_path / "missing.tdag")
     with pytest.raises(IsADirectoryError):
         TemporalDag.load(tmp_path)
+
+
+def test_save_writes_a_piece_at_a_time_and_a_failing_write_keeps_the_old_file(dag: TemporalDag, tmp_path):
+    class Recording(io.BytesIO):
+        def __init__(self) -> None:
+            super().__init__()
+            self.writes = 0
+
+        def write(self, data) -> int:
+            self.writes += 1
+            return super().write(data)
+
+    handle = Recording()
+    dag._core.write(handle)
+    assert handle.getvalue() == dag.to_bytes() and handle.writes > 2
+
+    class DiskFull(Recording):
+        def write(self, data) -> int:
+            if self.writes == 2:
+                raise OSError(28, "No space left on device")
+            return super().write(data)
+
+    with pytest.raises(OSError, match="No space left"):
+        dag._core.write(DiskFull())
+    path = tmp_path / "mesh.tdag"
+    path.write_bytes(b"the old file")
+    real_open = os.fdopen
+
+    class FullDisk:  # the temporary file atomic_write opens, full after one write
+        def __init__(self, fd, mode, **kwargs) -> None:
+            self.file, self.writes = real_open(fd, mode, **kwargs), 0
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc) -> None:
+            self.file.close()
+
+        def write(self, data) -> int:
+            self.writes += 1
+            if self.writes == 2:
+                raise OSError(28, "No space left on device")
+            return self.file.write(data)
+
+        def tell(self) -> int:
+            return self.file.tell()
+
+        def seek(self, *where) -> int:
+            return self.file.seek(*where)
+
+    with mock.patch("animlod.io.atomic.os.fdopen", FullDisk), pytest.raises(OSError, match="No space left"):
+        dag.save(path)
+    assert path.read_bytes() == b"the old file"
+    assert [entry.name for entry in tmp_path.iterdir()] == ["mesh.tdag"]
 
 
 def test_a_two_sided_sheet_simplifies_like_its_front_and_queries_give_both_sides(tmp_path, capsys):

@@ -86,6 +86,8 @@ struct TdagBuildReport {
   double seconds_fields = 0.0;           // costs, error bounds, time tags
 };
 
+class TdagFileSink;
+
 // The TDAG: immutable once built or loaded; copies share the data.
 class TemporalDag {
  public:
@@ -145,6 +147,7 @@ class TemporalDag {
   friend Status deserialize_temporal_dag(const uint8_t*, size_t, TemporalDag&);
   friend Status load_temporal_dag(const std::string&, TemporalDag&, size_t);
   friend Status serialize_temporal_dag(const TemporalDag&, std::vector<uint8_t>&);
+  friend Status write_temporal_dag(const TemporalDag&, TdagFileSink&, size_t);
 };
 
 // Builds the TDAG of `mesh` (Sections 3-4). The collapse orders come from the collapse engine
@@ -174,6 +177,19 @@ Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out)
 // linear in the file, plus for the order check a search from each collapse through the ones
 // ranked between it and its children (again on frames where the structure changes).
 Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& out);
+// Where write_temporal_dag puts a .tdag file: its bytes in order (`append`), then the body's
+// length written over the 8 bytes at offset 12 (`overwrite`), which hold zeros until the body is
+// complete. Each returns false when it could not write.
+class TdagFileSink {
+ public:
+  virtual ~TdagFileSink() = default;
+  virtual bool append(const uint8_t* bytes, size_t size) = 0;
+  virtual bool overwrite(size_t offset, const uint8_t* bytes, size_t size) = 0;
+};
+// The bytes serialize_temporal_dag makes, handed to `sink` about `chunk_size` at a time (and
+// long arrays as they are), so that a long clip's file is never held whole. Error "write failed"
+// when the sink returns false.
+Status write_temporal_dag(const TemporalDag& dag, TdagFileSink& sink, size_t chunk_size = size_t{1} << 20);
 // File versions: the message of an error starts with the path. save writes `path` through a
 // temporary file renamed into place. load reads the file twice, `chunk_size` bytes at a time
 // (the memory it costs beyond the TDAG): once for the checksum, then into the fields.

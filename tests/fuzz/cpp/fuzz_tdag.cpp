@@ -8,7 +8,7 @@
 //   u8  frame       the first frame queried: value % F (255 -> F, refused)
 //   the rest        body or file (serialize_temporal_dag's layout, tdag_io.cpp)
 // Invariants: an error has a message; an accepted TDAG serializes to bytes that load again and
-// serialize to the same bytes; its faces and input points are in range; every query, advance,
+// serialize to the same bytes, also when written a few bytes at a time; its faces and input points are in range; every query, advance,
 // refine and approximation at each level hands out a mesh whose faces index its positions and
 // whose nodes exist, with a map of the TDAG's vertices (leaves) into those positions.
 #include <array>
@@ -93,6 +93,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   ANIMLOD_FUZZ_REQUIRE(animlod::deserialize_temporal_dag(saved.data(), saved.size(), reloaded).ok);
   ANIMLOD_FUZZ_REQUIRE(animlod::serialize_temporal_dag(reloaded, again).ok);
   ANIMLOD_FUZZ_REQUIRE(saved == again);
+  struct MemorySink : animlod::TdagFileSink {  // the same bytes handed out a few at a time
+    std::vector<uint8_t> bytes;
+    bool append(const uint8_t* data, size_t size) override {
+      bytes.insert(bytes.end(), data, data + size);
+      return true;
+    }
+    bool overwrite(size_t offset, const uint8_t* data, size_t size) override {
+      if (offset + size > bytes.size()) return false;
+      std::memcpy(bytes.data() + offset, data, size);
+      return true;
+    }
+  } pieces;
+  ANIMLOD_FUZZ_REQUIRE(animlod::write_temporal_dag(reloaded, pieces, 5).ok);
+  ANIMLOD_FUZZ_REQUIRE(pieces.bytes == saved);
 
   // Cuts: a query, every approximation level over a few frames, a refinement, a view query.
   const auto frames = static_cast<int32_t>(dag.frame_count());

@@ -147,6 +147,12 @@ class PointFrames {
     view_.frames = copy_.data();
   }
   const AnimatedMeshView& view() const { return view_; }
+  // Frees a copy once the quadrics and features are made: the collapses read the engine's own
+  // positions, and a long clip's levels and record are as large as the frames.
+  void release() {
+    std::vector<float>().swap(copy_);
+    view_.frames = nullptr;
+  }
 
  private:
   AnimatedMeshView view_;
@@ -512,7 +518,7 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
 
   std::vector<size_t> targets;
   if (Status status = resolve_targets(report.face_count, mesh.face_count, options, targets); !status) return status;
-  const PointFrames points(mesh, prepared);
+  PointFrames points(mesh, prepared);
   if (Status status = resolve_frames(points.view(), options, result.frames_used); !status) return status;
 
   // Steps 3-4: motion features of the welded surface give the point weights of Eq. 6;
@@ -561,6 +567,7 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   CollapseEngine engine(mesh, prepared, carried, engine_options);
   timer.emplace(seconds.quadrics);
   AqemPolicy policy(engine, options, result.frames_used, std::move(weights), face.get());
+  points.release();
   timer.reset();
   std::vector<detail::EngineLevel> levels;
   detail::EngineRecord record;

@@ -503,6 +503,10 @@ void CollapseEngine::run(CollapsePolicy& policy, const std::vector<size_t>& targ
 void CollapseEngine::run_collapses(CollapsePolicy& policy, const std::vector<size_t>& targets,
                                    std::vector<EngineLevel>& levels, EngineRecord& record) {
   planned_ = face_count_ > targets.back() ? (face_count_ - targets.back() + 1) / 2 : 0;
+  // A long clip's record holds every collapse's position in every frame: reserved (with room for
+  // border collapses, which remove one face) so that growing does not copy gigabytes.
+  const size_t expected = std::min(point_count_, planned_ + planned_ / 8 + 16);
+  record.positions.reserve(expected * frame_count_ * 3);
   next_level_ = 0;
   take_reached_levels(targets, levels);
   if (options_.progress) options_.progress(0, planned_);

@@ -79,12 +79,15 @@ struct PointMesh {
 
   size_t point_count() const { return prepared.point_source.size(); }
   size_t face_count() const { return prepared.faces.size() / 3; }
-  // Frame t's point positions (P, 3) into `out`.
-  void gather(size_t frame, std::vector<float>& out) const {
+  // The point positions (P, 3) of input positions (V, 3) into `out`.
+  void gather(const float* positions, std::vector<float>& out) const {
     out.resize(point_count() * 3);
-    const float* positions = input.frames + frame * input.vertex_count * 3;
     for (size_t p = 0; p < point_count(); ++p)
       std::copy_n(positions + static_cast<size_t>(prepared.point_source[p]) * 3, 3, &out[p * 3]);
+  }
+  // Frame t's.
+  void gather_frame(size_t frame, std::vector<float>& out) const {
+    gather(input.frames + frame * input.vertex_count * 3, out);
   }
 };
 
@@ -144,10 +147,9 @@ struct ClusterRanges {
 // Per-frame fields of the collapses, measured frame by frame and recorded in frame order.
 class FieldBuilder {
  public:
-  FieldBuilder(const PointMesh& points, const TdagOptions& options, double scale) : points_(points), scale_(scale) {
-    if (options.boundary_quadrics) boundary_ = detail::boundary_sides(points.prepared.faces.data(), points.face_count());
-    use_boundary_ = options.boundary_quadrics;
-  }
+  // `boundary`: the points' boundary sides, or null without boundary quadrics.
+  FieldBuilder(const PointMesh& points, const std::vector<detail::BoundarySide>* boundary, double scale)
+      : points_(points), boundary_(boundary), scale_(scale) {}
 
   // Frame t's fields of hierarchy h (its collapses are already in `table`); safe on several
   // threads at once, each with its own scratch.
@@ -168,9 +170,8 @@ class FieldBuilder {
   }
 
   const PointMesh& points_;
+  const std::vector<detail::BoundarySide>* boundary_;
   double scale_;
-  bool use_boundary_ = true;
-  std::vector<detail::BoundarySide> boundary_;
   std::vector<TimeTag> alive_;                   // (C,)
   std::vector<TaggedSet<int32_t>> links_;        // (C,) dependencies
   // Frame t's error codes of the collapses known then (C_t, in collapse order; kNoCode for those
@@ -189,14 +190,14 @@ void FieldBuilder::measure(int32_t t, const CollapseTable& table, const FrameHie
   out.codes.resize(h.nodes.size());
 
   // Costs c_{i,t}: the quadric of a node is the sum of its cluster's vertex quadrics in frame t.
-  points_.gather(static_cast<size_t>(t), scratch.positions);
+  points_.gather_frame(static_cast<size_t>(t), scratch.positions);
   const float* positions = scratch.positions.data();
   auto point = [&](int32_t vertex) {
     const float* p = positions + static_cast<size_t>(vertex) * 3;
     return Eigen::Vector3d(p[0], p[1], p[2]);
   };
   detail::vertex_quadrics(positions, points_.prepared.faces.data(), points_.point_count(), points_.face_count(),
-                          use_boundary_ ? &boundary_ : nullptr, quadrics);
+                          boundary_, quadrics);
   quadrics.resize(node_count);
   bounds.assign(node_count, 0.0);
   ordered.resize(clusters.leaves.size() * 3);
@@ -272,7 +273,7 @@ void FieldBuilder::finish(const CollapseTable& table, detail::TdagData& data) {
 // Of the points in frame 0.
 double bounding_box_diagonal(const PointMesh& points) {
   std::vector<float> positions;
-  points.gather(0, positions);
+  points.gather_frame(0, positions);
   Eigen::Vector3d low = Eigen::Vector3d::Constant(INFINITY), high = Eigen::Vector3d::Constant(-INFINITY);
   for (size_t v = 0; v < points.point_count(); ++v) {
     const Eigen::Vector3d p(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
@@ -309,9 +310,8 @@ Status decimate(const AnimatedMeshView& mesh, const PointMesh& points, const flo
   engine_options.check_inversion = options.check_inversion;
   const detail::CarriedData carried;
   detail::CollapseEngine engine(one_frame, points.prepared, carried, engine_options);
-  std::vector<float> point_positions(points.point_count() * 3);
-  for (size_t p = 0; p < points.point_count(); ++p)
-    std::copy_n(positions + static_cast<size_t>(points.prepared.point_source[p]) * 3, 3, &point_positions[p * 3]);
+  std::vector<float> point_positions;
+  points.gather(positions, point_positions);
   std::vector<Quadric> quadrics;
   detail::vertex_quadrics(point_positions.data(), points.prepared.faces.data(), points.point_count(),
                           points.face_count(), boundary, quadrics);
@@ -402,11 +402,11 @@ Status build_temporal_dag(const AnimatedMeshView& mesh, const TdagOptions& optio
 
   // Section 4: the hierarchy (one order, or one per frame online) and the per-frame fields.
   CollapseTable table(data->vertex_count);
-  FieldBuilder fields(points, options, data->scale);
   const std::vector<detail::BoundarySide> boundary =
       options.boundary_quadrics ? detail::boundary_sides(points.prepared.faces.data(), points.face_count())
                                 : std::vector<detail::BoundarySide>{};
   const std::vector<detail::BoundarySide>* boundary_or_null = options.boundary_quadrics ? &boundary : nullptr;
+  FieldBuilder fields(points, boundary_or_null, data->scale);
   auto progress = [&](size_t done) {
     if (options.progress) options.progress(done, mesh.frame_count);
   };

@@ -115,10 +115,9 @@ class Writer {
     }
     flush();
     const uint64_t body_size = written_ - kHeaderSize;
-    const uint32_t crc = crc_;
     uint8_t length[sizeof(body_size)];
     std::memcpy(length, &body_size, sizeof(body_size));
-    return ok_ && sink_->append(reinterpret_cast<const uint8_t*>(&crc), sizeof(crc)) &&
+    return ok_ && sink_->append(reinterpret_cast<const uint8_t*>(&crc_), sizeof(crc_)) &&
            sink_->overwrite(kHeaderSize - sizeof(body_size), length, sizeof(body_size));
   }
 
@@ -408,10 +407,6 @@ class DependencyOrderCheck {
   std::vector<uint8_t> recheck_;  // (C,) whether the frame checked searches from the collapse
 };
 
-}  // namespace
-
-namespace {
-
 // The file through `w`: the header with its length zero, the body, then Writer::finish.
 void write_file(const detail::TdagData& d, Writer& w) {
   const auto frame_count = static_cast<size_t>(d.frame_count), vertex_count = static_cast<size_t>(d.vertex_count);
@@ -507,40 +502,7 @@ void write_file(const detail::TdagData& d, Writer& w) {
       last_code = code;
     });
   }
-
 }
-
-}  // namespace
-
-Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out) {
-  out.clear();
-  if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
-  const detail::TdagData& d = *dag.data_;
-  const auto frame_count = static_cast<size_t>(d.frame_count), vertex_count = static_cast<size_t>(d.vertex_count);
-  // Reserved for every residual stored (untouched pages cost nothing), so that growing does not
-  // copy a long clip's residuals.
-  out.reserve(kHeaderSize + d.maps.size() * sizeof(double) +
-              frame_count * (vertex_count * 3 * sizeof(float) + vertex_count / 8 + 1) +
-              16 * (d.faces.size() + d.input_points.size() + d.dep_nodes.size() +
-                    detail::count_error_runs(d.codes_by_frame, frame_count, d.collapse_count())) +
-              64 * d.collapse_count() + 1024);
-  Writer w(out);
-  write_file(d, w);
-  w.finish();
-  return Status::success();
-}
-
-Status write_temporal_dag(const TemporalDag& dag, TdagFileSink& sink, size_t chunk_size) {
-  if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
-  std::vector<uint8_t> buffer;
-  buffer.reserve(chunk_size + 64);
-  Writer w(buffer, &sink, chunk_size);
-  write_file(*dag.data_, w);
-  if (!w.finish()) return Status::error("write failed");
-  return Status::success();
-}
-
-namespace {
 
 // The format version and the body's length from the file's first bytes (`bytes`: at least the
 // first min(size, kHeaderSize)), checked against the file's size.
@@ -562,26 +524,6 @@ Status read_header(const uint8_t* bytes, size_t size, uint32_t& version, uint64_
 }
 
 // The TDAG's fields from its body, whose checksum has been checked.
-Status read_body(Reader& r, uint32_t version, std::shared_ptr<const detail::TdagData>& data);
-
-}  // namespace
-
-Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& out) {
-  out = TemporalDag{};
-  uint32_t version = 0;
-  uint64_t body_size = 0;
-  if (Status status = read_header(bytes, size, version, body_size); !status) return status;
-  const uint8_t* body = bytes + kHeaderSize;
-  uint32_t stored_crc = 0;
-  std::memcpy(&stored_crc, body + body_size, 4);
-  if (detail::crc32(body, static_cast<size_t>(body_size)) != stored_crc)
-    return Status::error("corrupted TDAG file: checksum mismatch");
-  Reader r(body, static_cast<size_t>(body_size));
-  return read_body(r, version, out.data_);
-}
-
-namespace {
-
 Status read_body(Reader& r, uint32_t version, std::shared_ptr<const detail::TdagData>& data) {
   auto d = std::make_shared<detail::TdagData>();
   constexpr uint64_t kMaxIndex = INT32_MAX;
@@ -724,6 +666,48 @@ Status read_body(Reader& r, uint32_t version, std::shared_ptr<const detail::Tdag
 }
 
 }  // namespace
+
+Status serialize_temporal_dag(const TemporalDag& dag, std::vector<uint8_t>& out) {
+  out.clear();
+  if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
+  const detail::TdagData& d = *dag.data_;
+  const auto frame_count = static_cast<size_t>(d.frame_count), vertex_count = static_cast<size_t>(d.vertex_count);
+  // Reserved for every residual stored (untouched pages cost nothing), so that growing does not
+  // copy a long clip's residuals.
+  out.reserve(kHeaderSize + d.maps.size() * sizeof(double) +
+              frame_count * (vertex_count * 3 * sizeof(float) + vertex_count / 8 + 1) +
+              16 * (d.faces.size() + d.input_points.size() + d.dep_nodes.size() +
+                    detail::count_error_runs(d.codes_by_frame, frame_count, d.collapse_count())) +
+              64 * d.collapse_count() + 1024);
+  Writer w(out);
+  write_file(d, w);
+  w.finish();
+  return Status::success();
+}
+
+Status write_temporal_dag(const TemporalDag& dag, TdagFileSink& sink, size_t chunk_size) {
+  if (dag.empty()) return Status::error("TemporalDag: empty, nothing to save");
+  std::vector<uint8_t> buffer;
+  buffer.reserve(chunk_size + 64);
+  Writer w(buffer, &sink, chunk_size);
+  write_file(*dag.data_, w);
+  if (!w.finish()) return Status::error("write failed");
+  return Status::success();
+}
+
+Status deserialize_temporal_dag(const uint8_t* bytes, size_t size, TemporalDag& out) {
+  out = TemporalDag{};
+  uint32_t version = 0;
+  uint64_t body_size = 0;
+  if (Status status = read_header(bytes, size, version, body_size); !status) return status;
+  const uint8_t* body = bytes + kHeaderSize;
+  uint32_t stored_crc = 0;
+  std::memcpy(&stored_crc, body + body_size, 4);
+  if (detail::crc32(body, static_cast<size_t>(body_size)) != stored_crc)
+    return Status::error("corrupted TDAG file: checksum mismatch");
+  Reader r(body, static_cast<size_t>(body_size));
+  return read_body(r, version, out.data_);
+}
 
 Status save_temporal_dag(const TemporalDag& dag, const std::string& path) {
   const std::string temporary = path + ".tmp";

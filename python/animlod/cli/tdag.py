@@ -153,7 +153,7 @@ def run_build(args: argparse.Namespace) -> int:
         bar.close()
     raw = mesh.frames.size * 4
     counts = mesh.frame_count, mesh.vertex_count, mesh.face_count
-    del mesh  # the input frames, no longer needed: a long clip's save then holds the file's bytes instead
+    del mesh  # the input frames, no longer needed: freed before the save
     start = time.perf_counter()
     size = dag.save(args.output)
     save_seconds = time.perf_counter() - start

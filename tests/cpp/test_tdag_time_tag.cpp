@@ -6,7 +6,6 @@
 
 using animlod::FrameRange;
 using animlod::TaggedSet;
-using animlod::TaggedValue;
 using animlod::TimeTag;
 
 namespace {
@@ -67,22 +66,6 @@ TEST_CASE("time tag: removing splits a range, union, intersection and difference
   TimeTag c(0, 2), d(0, 1);
   d.add(1);
   CHECK(c == d);
-}
-
-TEST_CASE("tagged value: a value constant over time is one run, lookups by frame") {
-  TaggedValue<int> field;
-  CHECK(field.append({0, 1}, 7));
-  CHECK(field.append({1, 2}, 7));
-  CHECK(field.append({2, 4}, 9));
-  CHECK(field.append({6, 7}, 9));  // a gap: the value is not alive at 4 and 5
-  CHECK_FALSE(field.append({5, 8}, 1));  // overlaps the last run: refused
-  CHECK(field.runs().size() == 3);
-  CHECK(*field.value_at(1) == 7);
-  CHECK(*field.value_at(3) == 9);
-  CHECK(field.value_at(4) == nullptr);
-  CHECK(*field.value_at(6) == 9);
-  CHECK(field.value_at(7) == nullptr);
-  CHECK(field.tag().ranges() == ranges({{0, 4}, {6, 7}}));
 }
 
 TEST_CASE("tagged set: several values alive at once, each on its own frames") {

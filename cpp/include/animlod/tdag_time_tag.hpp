@@ -1,9 +1,9 @@
 // Time tags of the TDAG (Shamir and Pascucci, "Temporal and spatial level of details for
 // dynamic meshes", Section 2): a value of a field is alive on one or more half-open frame
-// ranges [birth, death). A single-valued field (error, position, colour) holds at most one
-// alive value per frame; a multiple-valued field (parent, child and dependency links) holds
-// several values, each with its own tag. A value that does not change over a range is stored
-// once, with that range.
+// ranges [birth, death). The TDAG tags each collapse with the frames whose hierarchy uses it;
+// a multiple-valued field (the dependency links) holds several values, each with its own tag.
+// Its error bounds, which on a capture change nearly every frame, are held as one value per
+// collapse and frame instead.
 #pragma once
 
 #include <algorithm>
@@ -54,62 +54,6 @@ class TimeTag {
 
  private:
   std::vector<FrameRange> ranges_;  // sorted by birth; ranges_[i].death < ranges_[i + 1].birth
-};
-
-// A single-valued field over time: runs of one value each, on disjoint ranges. set() merges a
-// run with an adjacent run of the same value, so that a value constant over time is one run.
-template <typename T>
-class TaggedValue {
- public:
-  struct Run {
-    FrameRange range;
-    T value;
-  };
-
-  // Gives the field `value` on `range` (frames after every run already set, or touching the
-  // last one: the field is written forwards in time, as the online construction does).
-  // Returns false (and changes nothing) for an empty range or one that starts before the end
-  // of the last run.
-  bool append(FrameRange range, const T& value) {
-    if (range.death <= range.birth) return false;
-    if (!runs_.empty()) {
-      Run& last = runs_.back();
-      if (range.birth < last.range.death) return false;
-      if (range.birth == last.range.death && last.value == value) {
-        last.range.death = range.death;
-        return true;
-      }
-    }
-    runs_.push_back({range, value});
-    return true;
-  }
-
-  // The value alive at `frame`, or nullptr when there is none. O(log runs).
-  const T* value_at(int32_t frame) const {
-    auto after = std::upper_bound(runs_.begin(), runs_.end(), frame,
-                                  [](int32_t f, const Run& run) { return f < run.range.birth; });
-    if (after == runs_.begin()) return nullptr;
-    const Run& run = *(after - 1);
-    return run.range.contains(frame) ? &run.value : nullptr;
-  }
-
-  // The frames on which the field has a value.
-  TimeTag tag() const {
-    TimeTag out;
-    for (const Run& run : runs_) out.add(run.range);
-    return out;
-  }
-
-  const std::vector<Run>& runs() const { return runs_; }
-  bool operator==(const TaggedValue& other) const {
-    if (runs_.size() != other.runs_.size()) return false;
-    for (size_t i = 0; i < runs_.size(); ++i)
-      if (!(runs_[i].range == other.runs_[i].range) || !(runs_[i].value == other.runs_[i].value)) return false;
-    return true;
-  }
-
- private:
-  std::vector<Run> runs_;  // sorted, disjoint
 };
 
 // A multiple-valued field over time: several values, each alive on its own tag (e.g. the

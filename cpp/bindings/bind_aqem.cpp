@@ -110,7 +110,8 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   py::dict collapses;
   collapses["removed"] = numpy_from_vector(std::move(record.removed), {collapse_count});
   collapses["kept"] = numpy_from_vector(std::move(record.kept), {collapse_count});
-  collapses["positions"] = numpy_from_vector(std::move(record.positions), {collapse_count, frame_count, 3});
+  const size_t recorded = record.positions.empty() ? 0 : collapse_count;
+  collapses["positions"] = numpy_from_vector(std::move(record.positions), {recorded, frame_count, 3});
   collapses["cost"] = numpy_from_vector(std::move(record.cost), {collapse_count});
   collapses["error"] = numpy_from_vector(std::move(record.error), {collapse_count});
   py::dict out;

@@ -46,6 +46,7 @@ void bind_options(py::module_& m) {
       .field("quadric_memory_limit", &AqemOptions::quadric_memory_limit)
       .choice("placement", &AqemOptions::placement)
       .field("weld", &AqemOptions::weld)
+      .field("record_positions", &AqemOptions::record_positions)
       .finish();
 
   OptionsClass<TdagOptions>(m, "TdagOptions")

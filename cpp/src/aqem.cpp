@@ -555,6 +555,7 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   engine_options.max_error = options.max_error;
   engine_options.progress = options.progress;
   engine_options.collapse_passes = true;
+  engine_options.record_positions = options.record_positions;
   // The face quadrics need no connectivity: they are summed while the engine builds it (a
   // third thread on two cores; the phases then split the wall time: connectivity is the
   // engine's build, quadrics what the face quadrics take beyond it and the sides' planes).

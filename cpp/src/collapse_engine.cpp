@@ -279,13 +279,12 @@ int32_t CollapseEngine::collapse(CollapsePolicy& policy, const Candidate& candid
   record.kept.push_back(prepared_.point_source[candidate.kept]);
   record.cost.push_back(candidate.cost);
   record.error.push_back(candidate.error);
-  for (size_t frame = 0; frame < frame_count_; ++frame) {
-    float* out = &positions_[(static_cast<size_t>(candidate.kept) * frame_count_ + frame) * 3];
-    for (int axis = 0; axis < 3; ++axis) {
-      out[axis] = static_cast<float>(workspace.placed[frame][axis]);
-      record.positions.push_back(out[axis]);
-    }
-  }
+  float* const kept_positions = &positions_[static_cast<size_t>(candidate.kept) * frame_count_ * 3];
+  for (size_t frame = 0; frame < frame_count_; ++frame)
+    for (int axis = 0; axis < 3; ++axis)
+      kept_positions[frame * 3 + axis] = static_cast<float>(workspace.placed[frame][axis]);
+  if (options_.record_positions)
+    record.positions.insert(record.positions.end(), kept_positions, kept_positions + frame_count_ * 3);
   policy.merge(candidate);
   const auto t = static_cast<float>(candidate.t);
   const size_t attribute_count = data_.attribute_count;
@@ -506,7 +505,7 @@ void CollapseEngine::run_collapses(CollapsePolicy& policy, const std::vector<siz
   // A long clip's record holds every collapse's position in every frame: reserved (with room for
   // border collapses, which remove one face) so that growing does not copy gigabytes.
   const size_t expected = std::min(point_count_, planned_ + planned_ / 8 + 16);
-  record.positions.reserve(expected * frame_count_ * 3);
+  if (options_.record_positions) record.positions.reserve(expected * frame_count_ * 3);
   next_level_ = 0;
   take_reached_levels(targets, levels);
   if (options_.progress) options_.progress(0, planned_);

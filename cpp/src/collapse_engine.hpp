@@ -106,6 +106,8 @@ struct EngineOptions {
   // points a collapse changed; false evaluates every edge at every pass (the same result,
   // slower: the reference the reuse is tested against).
   bool rank_from_last = true;
+  // Fills EngineRecord::positions (C F 3 floats), which only AQEM's public record gives out.
+  bool record_positions = false;
 };
 
 // One level: the surviving faces over the surviving wedges (input vertex indices).
@@ -132,7 +134,7 @@ struct EngineTimings {
 
 struct EngineRecord {
   std::vector<int32_t> removed, kept;  // (C,) input vertex standing for each point
-  std::vector<float> positions;        // (C, F, 3)
+  std::vector<float> positions;        // (C, F, 3) with EngineOptions::record_positions, else empty
   std::vector<double> cost, error;     // (C,)
 };
 

@@ -336,6 +336,7 @@ Status aqem_hierarchy(const AnimatedMeshView& mesh, const PointMesh& points, con
   aqem.tip_quadrics = false;  // the paper's quadrics, like the TDAG's own (Fig. 6 compares them)
   aqem.check_inversion = options.check_inversion;
   aqem.weld = options.weld;
+  aqem.record_positions = false;  // the hierarchy needs the order alone
   AqemResult result;
   if (Status status = simplify_animated(mesh, {}, aqem, result); !status) return Status::error("AQEM: " + status.message);
   std::vector<detail::VertexCollapse> collapses(result.collapses.removed.size());

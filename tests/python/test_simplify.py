@@ -47,6 +47,21 @@ def test_collapse_record_replays_to_the_last_level():
     assert np.all(record.cost >= 0) and np.all(record.error >= 0)
 
 
+@pytest.mark.parametrize("passes", [False, True])
+def test_a_record_without_positions_keeps_the_levels_and_the_order(passes: bool):
+    # Over 100k edges the engine runs collapse passes, whose two halves keep records of their own.
+    mesh = ellipsoid(frames=2, rings=190, segments=190) if passes else bending_tube()
+    full = simplify_animated(mesh, (0.5, 0.1))
+    lean = simplify_animated(mesh, (0.5, 0.1), record_positions=False)
+    assert full.collapses.positions.shape == (full.collapses.removed.size, mesh.frame_count, 3)
+    assert lean.collapses.positions.shape == (0, mesh.frame_count, 3)
+    for name in ("removed", "kept", "cost", "error"):
+        np.testing.assert_array_equal(getattr(lean.collapses, name), getattr(full.collapses, name))
+    for a, b in zip(full.levels, lean.levels, strict=True):
+        assert a.mesh.faces.tobytes() == b.mesh.faces.tobytes()
+        assert a.mesh.frames.tobytes() == b.mesh.frames.tobytes()
+
+
 def test_output_is_deterministic():
     mesh = bending_tube()
     first = simplify_animated(mesh, (0.2,))

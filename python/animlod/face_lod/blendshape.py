@@ -291,6 +291,7 @@ def _simplified_levels(face: BlendshapeFace, counts: list[int], importance: np.n
         attributes=face.uvs,
         position_attributes=face.targets.transpose(1, 0, 2).reshape(face.vertex_count, -1),
         placement="on_edge",
+        record_positions=False,
     )
     levels = []
     for level in result.levels:

@@ -171,6 +171,7 @@ def build_face_lod(
         target_face_counts=counts,
         importance=importance,
         use_motion_features=options.use_motion_features,
+        record_positions=False,
     )
     level_count = 1 + len(counts)
     floors = _floors(options.animation_floor, level_count, tree)

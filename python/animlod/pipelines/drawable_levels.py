@@ -168,6 +168,7 @@ def simplify_drawable(
         "placement": "on_edge" if animated else "optimal",
         "use_motion_features": False,
         **settings.aqem,
+        "record_positions": False,  # the levels are all this keeps
     }
     rest = drawable.rest_positions()
     size = float(np.linalg.norm(np.ptp(rest, axis=0)))

@@ -14,6 +14,9 @@ depend on it.)doc");
   m.def("thread_limit", &thread_limit,
         R"doc(The threads a parallel loop of the core may take now: the cap, at most the hardware threads,
 at least 1.)doc");
+  m.def("thread_environment_ignored", &thread_environment_ignored,
+        R"doc(True when ANIMLOD_THREADS is set to something other than a whole number, which the core
+ignores.)doc");
 }
 
 }  // namespace animlod::bindings

@@ -31,8 +31,8 @@ def thread_limit() -> int:
 
 def _check_environment() -> None:
     """A warning for an ``ANIMLOD_THREADS`` the core ignores (it reads whole numbers only)."""
-    value = os.environ.get(ENVIRONMENT_VARIABLE, "")
-    if value and not (value.isascii() and value.isdigit() and len(value) <= 9):
+    if _core.thread_environment_ignored():
+        value = os.environ.get(ENVIRONMENT_VARIABLE)
         warnings.warn(
             f"{ENVIRONMENT_VARIABLE}={value!r} is not a whole number of threads; ignored, the core uses every core",
             stacklevel=2,

@@ -17,4 +17,8 @@ void set_thread_limit(unsigned threads);
 // The threads a parallel loop may take now: the cap, at most the hardware threads, at least 1.
 unsigned thread_limit();
 
+// True when ANIMLOD_THREADS is set, now, to something other than a whole number, which the
+// starting cap ignores (for a caller that warns about it).
+bool thread_environment_ignored();
+
 }  // namespace animlod

@@ -9,6 +9,7 @@
 #include <limits>
 #include <utility>
 
+#include "bit_scan.hpp"
 #include "cost_order.hpp"
 #include "interior_collapse.hpp"
 #include "inversion_test.hpp"
@@ -800,7 +801,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
         // choices before it.
         constexpr size_t kLookahead = 16;
         if (const int64_t ahead = cost_order.ordered_index(next + kLookahead); ahead >= 0)
-          __builtin_prefetch(&ranked[static_cast<size_t>(ahead)]);
+          prefetch_for_read(&ranked[static_cast<size_t>(ahead)]);
         const uint32_t index = cost_order[next];
         const RankedEdge& entry = ranked[index];
         if (!within_cost_goal(entry.cost, planned_faces)) break;
@@ -814,7 +815,7 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
       chosen.clear();
       for (size_t word = 0; word < chosen_places.size(); ++word)
         for (uint64_t bits = chosen_places[word]; bits != 0; bits &= bits - 1)
-          chosen.push_back(ranked[64 * word + static_cast<size_t>(__builtin_ctzll(bits))]);
+          chosen.push_back(ranked[64 * word + static_cast<size_t>(lowest_set_bit(bits))]);
     }
     const size_t faces_before = face_count_;
     size_t pass_collapses = 0;

@@ -17,6 +17,11 @@ Run: ``.venv/bin/python bench/bench_tdag.py [--quick]``. Tables:
    bounding-box diagonal against a fresh query from the roots (median over frames, best of three
    walks, so that other processes on the machine do not count), the largest vertex error of
    each, and the level-3 walk on one thread and double-buffered.
+5. How tight the error bound is: at tolerances of 0.5% to 5% of the diagonal, the faces of a
+   query's cut at the middle frame and its measured two-sided Hausdorff distance to the input
+   frame (``animlod.metrics.hausdorff_distance``), against the coarsest cut the same TDAG has
+   whose measured distance is within the tolerance (bisecting face counts with
+   ``tolerance_for_faces``): what a query would give if its bound were the measured distance.
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -36,8 +42,10 @@ from devdata import DATA_DIR
 from table import print_table
 
 from animlod import AnimatedMesh, TemporalDag, synth
+from animlod.metrics import hausdorff_distance
 
 TOLERANCE = 0.02  # of the bounding-box diagonal
+BOUND_TOLERANCES = (0.005, 0.01, 0.02, 0.05)  # of the bounding-box diagonal
 LONG_CLIP_FRAMES = 1200
 
 # Run in a process of its own, so that its peak memory is the step's: build (and save) or load.
@@ -196,6 +204,43 @@ def query_table(inputs: list[tuple[str, AnimatedMesh]]) -> None:
     )  # fmt: skip
 
 
+def _measured(original: AnimatedMesh, size: float, cut) -> float:
+    """The two-sided Hausdorff distance from a one-frame input to a query's cut, over ``size``."""
+    return hausdorff_distance(original, AnimatedMesh(cut.faces, cut.positions[None])) / size
+
+
+def bound_table(inputs: list[tuple[str, AnimatedMesh]]) -> None:
+    rows = []
+    for name, mesh in inputs:
+        dag, frame = TemporalDag.build(mesh), mesh.frame_count // 2
+        size = diagonal(mesh)
+        measured = partial(_measured, AnimatedMesh(mesh.faces, mesh.frames[frame : frame + 1]), size)
+        for tolerance in BOUND_TOLERANCES:
+            cut = dag.query(frame, tolerance * size)
+            # The coarsest face budget whose cut measures within the tolerance (bisection: the
+            # measured distance falls with the faces nearly, not strictly, monotonically).
+            low, high = 1, len(cut.faces)
+            while low < high:
+                middle = (low + high) // 2
+                if measured(dag.query(frame, dag.tolerance_for_faces(frame, middle))) <= tolerance:
+                    high = middle
+                else:
+                    low = middle + 1
+            coarsest = dag.query(frame, dag.tolerance_for_faces(frame, low))
+            error = measured(cut)
+            ratio = f"{tolerance / error:.1f}" if error > 1e-6 else "- (rounding)"  # the input's own faces
+            rows.append((name, f"{tolerance:.1%}", len(cut.faces), f"{error:.3%}", ratio,
+                         len(coarsest.faces), f"{measured(coarsest):.3%}",
+                         f"{len(cut.faces) / len(coarsest.faces):.1f}"))  # fmt: skip
+    print_table(
+        "How tight the error bound is: a query's cut at the middle frame against the coarsest cut measuring within "
+        "the tolerance (governed by frame 0; Hausdorff: two-sided, 20,000 samples, % of the diagonal)",
+        ["sequence", "tolerance", "cut faces", "measured Hausdorff", "tolerance / measured",
+         "coarsest cut within it: faces", "its Hausdorff", "faces / coarsest"],
+        rows,
+    )  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller inputs, for a smoke test")
@@ -207,6 +252,7 @@ def main() -> None:
     build_table(inputs)
     long_clip_table(inputs)
     query_table(inputs)
+    bound_table(inputs)
 
 
 if __name__ == "__main__":

@@ -29,6 +29,12 @@ def thread_limit() -> int:
     return _core.thread_limit()
 
 
+def environment_sets_limit() -> bool:
+    """Whether ``ANIMLOD_THREADS`` sets the core's starting cap (set to a whole number, which the
+    core reads; another value is ignored)."""
+    return bool(os.environ.get(ENVIRONMENT_VARIABLE)) and not _core.thread_environment_ignored()
+
+
 def _check_environment() -> None:
     """A warning for an ``ANIMLOD_THREADS`` the core ignores (it reads whole numbers only)."""
     if _core.thread_environment_ignored():

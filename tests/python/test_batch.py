@@ -475,5 +475,8 @@ def test_a_workers_share_of_its_host_and_its_own_thread_cap(monkeypatch):
         monkeypatch.setenv("ANIMLOD_THREADS", "3")  # the worker sets its own cap: no share imposed
         _share_cores({"10.0.0.5": 64})
         assert thread_limit() == every
+        monkeypatch.setenv("ANIMLOD_THREADS", "x2")  # no cap the core takes: the share stands
+        _share_cores({"10.0.0.5": 64})
+        assert thread_limit() == 1
     finally:
         set_thread_limit(0)

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..io.errors import FormatError
-from ..threads import ENVIRONMENT_VARIABLE, set_thread_limit
+from ..threads import environment_sets_limit, set_thread_limit
 from .jobs import find_job
 from .outputs import discard, publish, staging_folder
 from .spec import AssetSpec
@@ -127,8 +127,9 @@ def _worker_name() -> str:
 
 def _share_cores(sharing: dict[str, int] | None) -> None:
     """Caps the core's threads at this worker's share of its host's cores (nothing outside Dask,
-    or where the worker's environment sets ANIMLOD_THREADS: the user's cap stands)."""
-    if os.environ.get(ENVIRONMENT_VARIABLE):
+    or where the worker's environment sets ANIMLOD_THREADS to a cap the core takes: the user's
+    cap stands)."""
+    if environment_sets_limit():
         return
     try:
         from distributed import get_worker

@@ -90,3 +90,20 @@ def test_errors_and_coverages_do_not_depend_on_the_stored_scale(character, tmp_p
     for ours, theirs in zip(*levels):
         assert theirs.relative_error == pytest.approx(ours.relative_error, rel=0.1, abs=1e-4)
         assert theirs.coverage == pytest.approx(ours.coverage, rel=0.1, abs=1e-4)
+
+
+def test_the_skinned_nodes_own_transform_changes_no_level(character, tmp_path):
+    # glTF skinning ignores the skinned mesh node's transform, so a viewer shows the same figure;
+    # the bind shape under it (3x here) must not weigh in the collapses as a pose of its own.
+    plain, _, _ = character
+    doc = GltfDocument(plain)
+    builder = GlbBuilder.from_document(doc)
+    node = next(node for node in builder.json["nodes"] if "skin" in node)
+    node.update(scale=[3.0, 3.0, 3.0], translation=[0.5, 0.0, -0.25])
+    moved = tmp_path / "humanoid_moved.glb"
+    builder.save(moved)
+    reports = [simplify_document(path, tmp_path / f"{path.stem}_lod.glb") for path in (plain, moved)]
+    levels = [report.drawables[0].levels for report in reports]
+    assert [level.faces for level in levels[0]] == [level.faces for level in levels[1]]
+    for ours, theirs in zip(*levels):
+        assert theirs.relative_error == pytest.approx(ours.relative_error, rel=1e-3, abs=1e-6)

@@ -172,7 +172,9 @@ def simplify_drawable(
     }
     rest = drawable.rest_positions()
     size = float(np.linalg.norm(np.ptp(rest, axis=0)))
-    frames = _drive_frames(drawable, rest, size, settings.frame_budget)
+    frames, bind_drives = _drive_frames(drawable, rest, size, settings.frame_budget)
+    if not bind_drives and not {"frame_subset", "max_frames"} & options.keys():
+        options["frame_subset"] = tuple(range(1, len(frames)))  # frame 0 carried along the edges, no quadrics
     result = simplify_animated(
         AnimatedMesh(geometry.faces, frames),
         ratios,
@@ -197,15 +199,19 @@ def simplify_drawable(
     return DrawableLevels(levels, size, result.preparation, notes)
 
 
-def _drive_frames(drawable: Drawable, rest: np.ndarray, size: float, budget: int) -> np.ndarray:
+def _drive_frames(drawable: Drawable, rest: np.ndarray, size: float, budget: int) -> tuple[np.ndarray, bool]:
     """(F, V, 3) world positions AQEM works over: the bind shape (frame 0, from which _level reads
     the levels' stored positions), the rest pose ``rest`` (diagonal ``size``) where a viewer shows
     something else, each morph target at full weight on the rest pose (the others at 0), then
     frames spread evenly over every clip (at least two per clip), F <= ``budget`` where the clips
-    allow."""
+    allow; and whether the bind shape drives the collapses. It does where it is the rest pose. A
+    viewer never shows any other bind shape (a skinned mesh node's own transform, which skinning
+    ignores, scales and moves it; a morphed mesh shows its default weights): its quadrics would
+    weigh a pose nobody sees, by the square of that scale."""
     bind = drawable.bind_positions()
     frames = [bind[None]]
-    if np.abs(rest - bind).max() > _SAME_SHAPE * size:
+    bind_drives = bool(np.abs(rest - bind).max() <= _SAME_SHAPE * size)
+    if not bind_drives:
         frames.append(rest[None])
     if drawable.geometry.targets is not None:
         deltas = drawable.rest_morph_targets()
@@ -217,7 +223,7 @@ def _drive_frames(drawable: Drawable, rest: np.ndarray, size: float, budget: int
     for clip, share in zip(clips, lengths / max(lengths.sum(), 1.0)):
         count = int(np.clip(round(share * remaining), 2, clip.frame_count))
         frames.append(drawable.clip_frames(clip, spread_frames(clip.frame_count, count)))
-    return np.concatenate(frames).astype(np.float32, copy=False)
+    return np.concatenate(frames).astype(np.float32, copy=False), bind_drives
 
 
 def _attribute_matrix(drawable: Drawable) -> tuple[np.ndarray, _Layout]:

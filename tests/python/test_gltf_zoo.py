@@ -203,6 +203,59 @@ def test_motion_levels_show_every_part_of_a_character_on_one_skin(tmp_path: Path
     assert any("one mesh" in note for note in report.notes)
 
 
+def test_motion_level_clips_last_as_long_as_the_input_clips(tmp_path: Path) -> None:
+    """A glTF clip's last key may fall between two frames at 30 fps: the level GLBs' clips ended up
+    to a frame short of it, the last key's pose lost (a STEP clip's only change). The clip's length
+    is its animation's, found also after an animation that moves none of the skeleton's nodes."""
+    _, motion = two_bone_tube()
+
+    def late_last_key_after_a_prop_clip(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        times = (np.arange(motion.frame_count) / motion.fps * 1.05).astype(np.float32)[:, None]
+        late = append_accessor(gltf, blob, times, "SCALAR")
+        gltf.accessors[late].min, gltf.accessors[late].max = [float(times[0, 0])], [float(times[-1, 0])]
+        for sampler in gltf.animations[0].samplers:
+            sampler.input = late
+        gltf.nodes.append(pygltflib.Node(name="prop"))
+        gltf.scenes[gltf.scene or 0].nodes.append(len(gltf.nodes) - 1)
+        keys = append_accessor(gltf, blob, np.array([[0.0], [5.0]], np.float32), "SCALAR")
+        gltf.accessors[keys].min, gltf.accessors[keys].max = [0.0], [5.0]
+        moves = append_accessor(gltf, blob, np.array([[0, 0, 0], [1, 0, 0]], np.float32), "VEC3")
+        prop = pygltflib.AnimationChannelTarget(node=len(gltf.nodes) - 1, path="translation")
+        gltf.animations.insert(0, pygltflib.Animation(
+            name="prop", samplers=[pygltflib.AnimationSampler(input=keys, output=moves)],
+            channels=[pygltflib.AnimationChannel(sampler=0, target=prop)]))  # fmt: skip
+
+    source = edit_glb(_two_bone_glb(tmp_path / "body.glb"), tmp_path / "late.glb", late_last_key_after_a_prop_clip)
+    clip_end = GltfDocument(source).animation_duration(1)
+    assert clip_end * 30.0 % 1.0 > 0.1  # between two frames
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    for files in report.files:
+        written = GltfDocument(tmp_path / "levels" / files[-1])
+        assert written.animation_duration(0) == pytest.approx(clip_end, abs=1e-6)
+
+
+def test_motion_levels_say_what_their_glbs_leave_out(tmp_path: Path) -> None:
+    """The motion levels' GLBs hold the skinned mesh, its skeleton and its clips: a file's
+    materials, props and cameras were left out of them without a word."""
+
+    def material_and_camera(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        gltf.materials.append(pygltflib.Material(name="skin"))
+        gltf.meshes[0].primitives[0].material = 0
+        gltf.cameras.append(
+            pygltflib.Camera(type="perspective", perspective=pygltflib.Perspective(yfov=0.8, znear=0.1))
+        )
+        gltf.nodes.append(pygltflib.Node(name="camera", camera=0))
+        gltf.scenes[gltf.scene or 0].nodes.append(len(gltf.nodes) - 1)
+
+    plain = _two_bone_glb(tmp_path / "body.glb")
+    dressed = edit_glb(plain, tmp_path / "dressed.glb", material_and_camera)
+    left_out = [
+        note for note in build_motion_levels(dressed, tmp_path / "dressed", levels=2).notes if "not its" in note
+    ]
+    assert left_out and "material" in left_out[0] and "cameras and lights" in left_out[0]
+    assert not [note for note in build_motion_levels(plain, tmp_path / "plain", levels=2).notes if "not its" in note]
+
+
 def test_motion_levels_show_a_part_on_a_skin_of_its_own_over_the_same_joints(tmp_path: Path) -> None:
     """Exporters may give each mesh a skin of its own over the joints it uses (Soldier's visor): such
     a part was left out of every motion level's GLB. It joins the character where its skin was bound

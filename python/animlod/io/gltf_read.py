@@ -163,19 +163,19 @@ def read_node_motions(path: str | os.PathLike | GltfDocument, fps: float = 30.0)
     naming the file when no animation translates, turns or scales a node."""
     doc = path if isinstance(path, GltfDocument) else GltfDocument(path)
     rig = SkinRig(doc, None)
-    return _rig_motions(doc, rig, fps), rig.trees_left_out
+    return rig_motions(doc, rig, fps), rig.trees_left_out
 
 
-def _rig_motions(doc: GltfDocument, rig: SkinRig, fps: float) -> list[Motion]:
-    """Every animation that moves one of ``rig``'s nodes, as a motion of its skeleton."""
-    motions = [rig.motion(doc, animation, fps) for animation in range(len(doc.gltf.animations or []))]
-    return [motion for motion in motions if motion is not None]
+def rig_motions(doc: GltfDocument, rig: SkinRig, fps: float) -> list[Motion]:
+    """Every animation that moves one of ``rig``'s nodes (``rig.animations(doc)``), as a motion of
+    its skeleton."""
+    return [rig.motion(doc, animation, fps) for animation in rig.animations(doc)]
 
 
 def read_skinned_node(doc: GltfDocument, node: int, rig: SkinRig, fps: float) -> tuple[SkinnedMesh, list[Motion]]:
     """The skinned mesh node ``node`` draws with ``rig`` and every animation that moves the rig."""
     mesh = skinned_mesh_of_node(doc, node, rig, read_mesh_geometry(doc, doc.gltf.nodes[node].mesh, skinned=True))
-    return mesh, _rig_motions(doc, rig, fps)
+    return mesh, rig_motions(doc, rig, fps)
 
 
 def skinned_mesh_of_node(

@@ -147,6 +147,17 @@ class SkinRig:
         scale = self.scales[:, None, None] * np.eye(3)
         return scale if self.rest_shape is None else self.rest_shape @ scale
 
+    def animations(self, doc: GltfDocument) -> list[int]:
+        """The animations of ``doc`` that move one of its nodes (:meth:`motion` gives a motion for each)."""
+        return [
+            index
+            for index, targets in enumerate(doc.channel_targets)
+            if any(self._moves(*target) for target in targets)
+        ]
+
+    def _moves(self, node: int, path: str) -> bool:
+        return node in self.rest_translation and path in NODE_PATHS
+
     def motion(self, doc: GltfDocument, animation_index: int, fps: float) -> Motion | None:
         """Animation ``animation_index`` sampled at ``fps`` on this skeleton; None if it moves none of its nodes.
 
@@ -160,7 +171,7 @@ class SkinRig:
             for index, (channel, (node, path)) in enumerate(
                 zip(animation.channels or [], doc.channel_targets[animation_index])
             )
-            if node in self.rest_translation and path in NODE_PATHS
+            if self._moves(node, path)
         ]
         if not channels:
             return None

@@ -33,6 +33,7 @@ def write_glb(
     skinned: SkinnedMesh | None,
     motions: Sequence[Motion] = (),
     names: Sequence[str] | None = None,
+    durations: Sequence[float | None] | None = None,
 ) -> None:
     """Write ``skinned`` and ``motions`` (on its skeleton) to the GLB file ``path``, atomically.
 
@@ -43,13 +44,17 @@ def write_glb(
         the skeleton of ``motions[0]`` and the motions only (an animation library's file).
     motions : animations on ``skinned.skeleton`` (same joint names, parents and offsets).
     names : animation names, one per motion; defaults to each motion's name, or "motion<i>".
+    durations : per motion, the length of the clip it was sampled from, or None (see
+        :func:`add_animation`): a glTF clip's last key may fall between two sampled frames.
 
     Raises
     ------
-    ValueError if a motion is on another skeleton, ``names`` has the wrong length, or there is
-    neither a mesh nor a motion.
+    ValueError if a motion is on another skeleton, ``names`` or ``durations`` has the wrong
+    length, or there is neither a mesh nor a motion.
     """
     names = _animation_names(motions, names)
+    if durations is not None and len(durations) != len(motions):
+        raise ValueError(f"durations: {len(durations)} given for {len(motions)} motions")
     if skinned is None and not motions:
         raise ValueError("motions: a GLB without a skinned mesh needs a motion to give its skeleton")
     skeleton = motions[0].skeleton if skinned is None else skinned.skeleton
@@ -62,8 +67,8 @@ def write_glb(
         skin = add_skin(builder, joint_nodes, skinned.inverse_bind)
         mesh = builder.append("meshes", _mesh(builder, skinned))
         scene_nodes.append(builder.append("nodes", {"name": "skinned mesh", "mesh": mesh, "skin": skin}))
-    for motion, name in zip(motions, names):
-        add_animation(builder, motion, joint_nodes, name)
+    for motion, name, duration in zip(motions, names, durations or [None] * len(motions)):
+        add_animation(builder, motion, joint_nodes, name, duration=duration)
     builder.json["scenes"] = [{"nodes": scene_nodes}]
     builder.json["scene"] = 0
     builder.save(path)

@@ -13,6 +13,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -24,6 +25,9 @@ from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis
 from ..motion_lod.chain import SOLVERS, JointFloor, MotionLevel, MotionLodChain, TrialMeasure
 from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from .result import AssetResult, LevelRow, Progress
+
+if TYPE_CHECKING:
+    from ..io.gltf_document import GltfDocument
 
 
 @dataclass
@@ -137,7 +141,7 @@ def build_motion_levels(
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
-    spans = [frames for _, frames in played] if len(played) > 1 else None
+    spans = [clip.frames for clip in played] if len(played) > 1 else None
     tipped, analysis, trial_measure, counts, floor = _plan_levels(
         motion, skin, spans, levels, joints, lock, max_frames, translation_tolerance, ranking, workers
     )
@@ -172,7 +176,7 @@ def build_motion_levels(
     stem = input_stem(source)
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
     orders = layout.rotation_orders if layout is not None else "ZXY"
-    suffixes = _clip_suffixes([name for name, _ in played])
+    suffixes = _clip_suffixes([clip.name for clip in played])
     gltf_input = input_kind(source) == "gltf"
     measuring = time.perf_counter()
     skin_errors = None if skin is None else skin_distances(skin, motion, chain.levels, on_measure)
@@ -180,7 +184,7 @@ def build_motion_levels(
     files, rows = [], []
     for index, level in enumerate(chain.levels):
         names = []
-        level_clips = [level.motion.take_frames(frames) for _, frames in played]
+        level_clips = [level.motion.take_frames(clip.frames) for clip in played]
         for clip_motion, suffix in zip(level_clips, suffixes):
             names.append(Path(f"{stem}_lod{index}{suffix}.bvh"))
             write_bvh(folder / names[-1], clip_motion, rotation_order=orders)
@@ -188,7 +192,8 @@ def build_motion_levels(
             from ..io.gltf import write_glb
 
             names.append(Path(f"{stem}_lod{index}.glb"))
-            write_glb(folder / names[-1], level.skin, level_clips, names=[name for name, _ in played])
+            clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
+            write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations)
         files.append(names)
         row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
                "error": level.report.max_error}  # fmt: skip
@@ -196,8 +201,9 @@ def build_motion_levels(
             row["skin_error"] = float(skin_errors[index].max())
         if len(played) > 1:  # a runtime may pick each clip's level by its own error
             row["clips"] = []
-            for name, span in played:
-                row["clips"].append({"name": name, "error": float(level.report.frame_errors[span].max())})
+            for clip in played:
+                span = clip.frames
+                row["clips"].append({"name": clip.name, "error": float(level.report.frame_errors[span].max())})
                 if skin_errors is not None:
                     row["clips"][-1]["skin_error"] = float(skin_errors[index][span].max())
         rows.append(row)
@@ -211,6 +217,15 @@ def build_motion_levels(
 
 # Frames per second at which a glTF input's clips are sampled.
 _GLTF_FPS = 30.0
+
+
+class PlayedClip(NamedTuple):
+    """A clip of the simplified motion: its name, its frames in the motion, and for a glTF clip
+    its length in seconds (its last key, which may fall between two sampled frames)."""
+
+    name: str
+    frames: slice
+    duration: float | None = None
 
 
 # Vertex-frames times levels measured between two progress calls of skin_distances (about half a
@@ -244,7 +259,7 @@ def _read_input(
     clip_files: Sequence[str],
     joint_map: str | os.PathLike | None,
     note: Callable[[str], None],
-) -> tuple[Motion, list[tuple[str, slice]], SkinnedMesh | None, BvhLayout | None]:
+) -> tuple[Motion, list[PlayedClip], SkinnedMesh | None, BvhLayout | None]:
     """The motion to simplify, the clips it is made of (each one's name and frames in it), for a
     skinned glTF its skin (None for a glTF without skins: the animated node tree is the skeleton)
     and for a BVH its layout. ``clip_files`` add to a glTF's clips (BVH ones matched by ``joint_map``)."""
@@ -257,11 +272,13 @@ def _read_input(
         from ..io.bvh import read_bvh_with_layout
 
         motion, layout = read_bvh_with_layout(source)
-        return motion, [(motion.name, slice(None))], None, layout
+        return motion, [PlayedClip(motion.name, slice(None))], None, layout
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
-    from ..io.gltf import read_gltf, read_node_motions
+    from ..io.gltf import read_gltf
     from ..io.gltf_document import GltfDocument
+    from ..io.gltf_read import rig_motions
+    from ..io.gltf_skin import SkinRig
     from .clip_import import with_clips
     from .whole_skin import whole_skin
 
@@ -269,7 +286,7 @@ def _read_input(
     document = with_clips(document, clip_files, note, joint_map)
     scene = read_gltf(document, _GLTF_FPS)
     if scene.skinned_meshes:
-        skin, motions, left_out = whole_skin(document, scene, note, _GLTF_FPS)
+        skin, motions, animations, left_out = whole_skin(document, scene, note, _GLTF_FPS)
         if skin.vertex_count > scene.skinned_meshes[scene.body].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
@@ -278,8 +295,17 @@ def _read_input(
                  "takes every skin)")  # fmt: skip
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
+        unwritten = _left_out_of_level_files(document)
+        if unwritten:
+            note(f"{path}: the levels' GLBs hold the skinned mesh, its skeleton and its clips' joint channels; "
+                 f"not {unwritten} (`animlod character` keeps the whole document)")  # fmt: skip
     else:  # an animation library exported without its mesh
-        (motions, other_trees), skin = read_node_motions(document), None
+        rig, skin = SkinRig(document, None), None
+        motions, animations, other_trees = (
+            rig_motions(document, rig, _GLTF_FPS),
+            rig.animations(document),
+            rig.trees_left_out,
+        )
         skeleton = motions[0].skeleton
         note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
              f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clips")  # fmt: skip
@@ -287,6 +313,7 @@ def _read_input(
             note(f"{path}: animated nodes under no node in common with the skeleton's left out: "
                  f"{', '.join(other_trees)}")  # fmt: skip
     names = [motion.name or f"animation{index}" for index, motion in enumerate(motions)]
+    durations = [document.animation_duration(animation) for animation in animations]
     if clip is None:
         from ..motion_lod.clips import join_clips, merge_split_clips
 
@@ -294,7 +321,8 @@ def _read_input(
         if merged is not None:
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
-            return _rigid(path, motions, range(len(motions)), merged), [(merged.name, slice(None))], skin, None
+            played = PlayedClip(merged.name, slice(None), max(durations))
+            return _rigid(path, motions, range(len(motions)), merged), [played], skin, None
         # A clip that scales a joint cannot be re-fitted; the others still make levels.
         rigid = [index for index, motion in enumerate(motions) if motion.deforming_joint() is None]
         scaling = [names[index] for index in range(len(motions)) if index not in rigid]
@@ -305,7 +333,8 @@ def _read_input(
             note(f"{path}: its {len(rigid)} animations simplified together, one skeleton per level for all of "
                  "them (use --clip to take one)")  # fmt: skip
             joined, spans = join_clips([motions[index] for index in rigid])
-            return joined, [(names[index], span) for index, span in zip(rigid, spans)], skin, None
+            played = [PlayedClip(names[index], span, durations[index]) for index, span in zip(rigid, spans)]
+            return joined, played, skin, None
         clip = rigid[0] if rigid else 0
     if isinstance(clip, str):
         if clip not in names:
@@ -314,7 +343,26 @@ def _read_input(
         clip = names.index(clip)
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
-    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), [(names[clip], slice(None))], skin, None
+    played = [PlayedClip(names[clip], slice(None), durations[clip])]
+    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, None
+
+
+def _left_out_of_level_files(doc: GltfDocument) -> str:
+    """What of ``doc`` the motion levels' GLBs (a skinned mesh, a skeleton and its joint channels)
+    do not carry, as words for a note; empty where that is nothing."""
+    gltf = doc.gltf
+    parts = []
+    if gltf.materials:
+        materials = "material" if len(gltf.materials) == 1 else f"{len(gltf.materials)} materials"
+        parts.append(f"its {materials}" + (" and textures" if gltf.textures else ""))
+    meshes = sum(node.mesh is not None and node.skin is None for node in gltf.nodes or [])
+    if meshes:
+        parts.append(f"{meshes} mesh{'es' if meshes > 1 else ''} without a skin (props, static parts)")
+    if any(path == "weights" for targets in doc.channel_targets for _, path in targets):
+        parts.append("its morph weight channels")
+    if gltf.cameras or (gltf.extensions or {}).get("KHR_lights_punctual"):
+        parts.append("its cameras and lights")
+    return ", ".join(parts[:-1]) + (" or " if len(parts) > 1 else "") + (parts[-1] if parts else "")
 
 
 def _clip_suffixes(names: list[str]) -> list[str]:

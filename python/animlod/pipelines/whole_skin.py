@@ -25,9 +25,10 @@ from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
 
 def whole_skin(
     doc: GltfDocument, scene: GltfScene, note: Callable[[str], None], fps: float
-) -> tuple[SkinnedMesh, list[Motion], int]:
+) -> tuple[SkinnedMesh, list[Motion], list[int], int]:
     """The body of ``scene`` (``scene.body``) with every other skinned mesh on its skeleton joined
-    to it, its motions (sampled at ``fps``), and how many meshes stay out: those on other joints,
+    to it, its motions (sampled at ``fps``), the animation each motion is (its index in ``doc``),
+    and how many meshes stay out: those on other joints,
     bound in another pose, or whose morph targets lack names where the others' have them. A part's
     joints match the body's by node; bones of its own that move in its clips join the skeleton,
     the body read again with them, and ``note`` names them. Morph targets join by name
@@ -55,7 +56,7 @@ def whole_skin(
             parts.append(moved_onto(mesh, body, placement))
     parts[0] = body
     if len(parts) == 1:
-        return body, motions, len(scene.skinned_meshes) - 1
+        return body, motions, rig.animations(doc), len(scene.skinned_meshes) - 1
     influences = max(part.joints.shape[1] for part in parts)
     starts = np.cumsum([0] + [part.vertex_count for part in parts])
 
@@ -84,7 +85,7 @@ def whole_skin(
         morph_target_names=target_names,
         default_morph_weights=defaults,
     )
-    return whole, motions, len(scene.skinned_meshes) - len(parts)
+    return whole, motions, rig.animations(doc), len(scene.skinned_meshes) - len(parts)
 
 
 def _target_keys(mesh: SkinnedMesh) -> list[tuple[str | None, int]]:

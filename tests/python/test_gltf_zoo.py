@@ -256,6 +256,46 @@ def test_motion_levels_say_what_their_glbs_leave_out(tmp_path: Path) -> None:
     assert not [note for note in build_motion_levels(plain, tmp_path / "plain", levels=2).notes if "not its" in note]
 
 
+def test_motion_levels_keep_the_materials(tmp_path: Path) -> None:
+    """The motion levels' GLBs drew the character without its materials and textures: each
+    material's faces are now a primitive of their own, over the vertices they use."""
+    skinned, _ = two_bone_tube()
+    halves = np.array_split(skinned.faces, 2)
+    png = b"\x89PNG\r\n\x1a\n" + bytes(24)  # an image is copied by its bytes, never decoded
+
+    def two_materials_one_textured(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        primitive = gltf.meshes[0].primitives[0]
+        parts = []
+        for material, faces in enumerate(halves):
+            indices = append_accessor(gltf, blob, faces.astype(np.uint32).reshape(-1, 1), "SCALAR")
+            parts.append(pygltflib.Primitive(attributes=primitive.attributes, indices=indices, material=material))
+        gltf.meshes[0].primitives = parts
+        offset = len(blob)
+        blob.extend(png)
+        gltf.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=offset, byteLength=len(png)))
+        gltf.images.append(pygltflib.Image(bufferView=len(gltf.bufferViews) - 1, mimeType="image/png"))
+        gltf.textures.append(pygltflib.Texture(source=0))
+        info = pygltflib.TextureInfo(index=0)
+        gltf.materials += [pygltflib.Material(name="cloth", pbrMetallicRoughness=pygltflib.PbrMetallicRoughness(
+            baseColorTexture=info)), pygltflib.Material(name="skin")]  # fmt: skip
+
+    source = edit_glb(_two_bone_glb(tmp_path / "body.glb"), tmp_path / "dressed.glb", two_materials_one_textured)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    assert not [note for note in report.notes if "not its" in note]
+    for level, files in enumerate(report.files):
+        written = GltfDocument(tmp_path / "levels" / files[-1])
+        assert [material["name"] for material in written.json["materials"]] == ["cloth", "skin"]
+        assert written.view_bytes(written.json["images"][0]["bufferView"], "image") == png
+        primitives = written.json["meshes"][0]["primitives"]
+        assert [primitive["material"] for primitive in primitives] == [0, 1]
+        for primitive, faces in zip(primitives, halves):
+            used = np.unique(faces)
+            np.testing.assert_array_equal(used[written.accessor(primitive["indices"], "test").reshape(-1, 3)], faces)
+            if level == 0:  # the input's skin (a coarser level's bind differs)
+                stored = written.accessor(primitive["attributes"]["POSITION"], "test")
+                np.testing.assert_allclose(stored, skinned.rest_positions[used], atol=1e-6)
+
+
 def test_motion_levels_show_a_part_on_a_skin_of_its_own_over_the_same_joints(tmp_path: Path) -> None:
     """Exporters may give each mesh a skin of its own over the joints it uses (Soldier's visor): such
     a part was left out of every motion level's GLB. It joins the character where its skin was bound

@@ -2,7 +2,8 @@
 
 ``write_glb`` writes one skinned mesh (or none: a skeleton's clips) and its motions to a new
 file: one node per joint (rest translation and rotation, parents before children, end sites
-marked with ``extras.animlod_end_site``), a mesh node with the skin, one mesh primitive
+marked with ``extras.animlod_end_site``), a mesh node with the skin, one mesh primitive (one per
+material, with the materials of a given document: :class:`FaceMaterials`)
 (POSITION, NORMAL and TEXCOORD_0 when present, JOINTS_0/WEIGHTS_0 and, for 8 influences,
 JOINTS_1/WEIGHTS_1, uint16/uint32 indices, morph targets with their names in
 ``extras.targetNames``), and one LINEAR animation per motion: the root's translation and every
@@ -17,15 +18,30 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 
 from ..model import Motion, Skeleton, SkinnedMesh
 from .glb_builder import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, GlbBuilder
+from .gltf_document import GltfDocument
 from .gltf_skin import END_SITE_EXTRA
 
 INFLUENCES_PER_SET = 4
 _TRIANGLES, _LINEAR = 4, "LINEAR"
+# What of a document's root a mesh drawn with its materials needs; the extensions kept are those
+# materials and textures use.
+_MATERIAL_KEYS = ("asset", "materials", "textures", "samplers", "images", "bufferViews")
+_MATERIAL_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "EXT_texture_")
+
+
+class FaceMaterials(NamedTuple):
+    """The material of each face of a written mesh: ``indices`` (F,) into ``document``'s materials,
+    -1 for none. The mesh is then drawn as one primitive per material, with the document's
+    materials, textures, samplers and images."""
+
+    document: GltfDocument
+    indices: np.ndarray
 
 
 def write_glb(
@@ -34,6 +50,7 @@ def write_glb(
     motions: Sequence[Motion] = (),
     names: Sequence[str] | None = None,
     durations: Sequence[float | None] | None = None,
+    materials: FaceMaterials | None = None,
 ) -> None:
     """Write ``skinned`` and ``motions`` (on its skeleton) to the GLB file ``path``, atomically.
 
@@ -46,11 +63,12 @@ def write_glb(
     names : animation names, one per motion; defaults to each motion's name, or "motion<i>".
     durations : per motion, the length of the clip it was sampled from, or None (see
         :func:`add_animation`): a glTF clip's last key may fall between two sampled frames.
+    materials : the material of each of ``skinned``'s faces, or None (no material).
 
     Raises
     ------
-    ValueError if a motion is on another skeleton, ``names`` or ``durations`` has the wrong
-    length, or there is neither a mesh nor a motion.
+    ValueError if a motion is on another skeleton, ``names``, ``durations`` or ``materials`` has
+    the wrong length, or there is neither a mesh nor a motion.
     """
     names = _animation_names(motions, names)
     if durations is not None and len(durations) != len(motions):
@@ -60,18 +78,38 @@ def write_glb(
     skeleton = motions[0].skeleton if skinned is None else skinned.skeleton
     for index, motion in enumerate(motions):
         _check_same_skeleton(skeleton, motion, index)
-    builder = GlbBuilder()
+    if materials is not None and (skinned is None or len(materials.indices) != skinned.face_count):
+        faces = 0 if skinned is None else skinned.face_count
+        raise ValueError(f"materials: {len(materials.indices)} face materials for {faces} faces")
+    builder = GlbBuilder() if materials is None else _materials_of(materials.document)
     joint_nodes = add_skeleton(builder, skeleton)
     scene_nodes = [joint_nodes[0]]
     if skinned is not None:
         skin = add_skin(builder, joint_nodes, skinned.inverse_bind)
-        mesh = builder.append("meshes", _mesh(builder, skinned))
+        mesh = builder.append("meshes", _mesh(builder, skinned, None if materials is None else materials.indices))
         scene_nodes.append(builder.append("nodes", {"name": "skinned mesh", "mesh": mesh, "skin": skin}))
     for motion, name, duration in zip(motions, names, durations or [None] * len(motions)):
         add_animation(builder, motion, joint_nodes, name, duration=duration)
     builder.json["scenes"] = [{"nodes": scene_nodes}]
     builder.json["scene"] = 0
+    if materials is not None:
+        builder.prune()  # the document's mesh and animation data
     builder.save(path)
+
+
+def _materials_of(document: GltfDocument) -> GlbBuilder:
+    """A new document holding ``document``'s materials at their indices, with their textures,
+    samplers and images (embedded) and the extensions they use."""
+    builder = GlbBuilder.from_document(document)
+    js = builder.json
+    for key in set(js) - set(_MATERIAL_KEYS):
+        del js[key]
+    for listed in ("extensionsUsed", "extensionsRequired"):
+        kept = [name for name in document.json.get(listed, []) if name.startswith(_MATERIAL_EXTENSIONS)]
+        if kept:
+            js[listed] = kept
+    js["asset"] = {**js.get("asset", {}), "generator": "animlod"}
+    return builder
 
 
 def add_skeleton(builder: GlbBuilder, skeleton: Skeleton, name_suffix: str = "") -> list[int]:
@@ -201,28 +239,43 @@ def _check_same_skeleton(written: Skeleton, motion: Motion, index: int) -> None:
         )
 
 
-def _mesh(builder: GlbBuilder, skinned: SkinnedMesh) -> dict:
-    attributes = {"POSITION": builder.add(skinned.rest_positions, ARRAY_BUFFER, bounds=True)}
-    if skinned.normals is not None:
-        attributes["NORMAL"] = builder.add(skinned.normals, ARRAY_BUFFER)
-    if skinned.uvs is not None:
-        attributes["TEXCOORD_0"] = builder.add(skinned.uvs, ARRAY_BUFFER)
-    attributes.update(skin_attributes(builder, skinned.joints, skinned.weights, skinned.skeleton.joint_count))
-    primitive = {
-        "attributes": attributes,
-        "indices": index_accessor(builder, skinned.faces, skinned.vertex_count),
-        "mode": _TRIANGLES,
-    }
-    mesh = {"name": "skinned mesh", "primitives": [primitive]}
+def _mesh(builder: GlbBuilder, skinned: SkinnedMesh, face_materials: np.ndarray | None) -> dict:
+    """The mesh of ``skinned``: one primitive, or one per material of ``face_materials`` (F,),
+    each over the vertices its faces use (a renderer skins each primitive's vertices)."""
+    groups = np.full(skinned.face_count, -1) if face_materials is None else np.asarray(face_materials)
+    materials = np.unique(groups)
+    primitives = []
+    for material in materials:
+        faces = skinned.faces[groups == material]
+        used = np.arange(skinned.vertex_count) if len(materials) == 1 else np.unique(faces)
+        primitive = _primitive(builder, skinned, used, np.searchsorted(used, faces))
+        if material >= 0:
+            primitive["material"] = int(material)
+        primitives.append(primitive)
+    mesh = {"name": "skinned mesh", "primitives": primitives}
     if skinned.morph_targets is not None:
-        primitive["targets"] = [
-            {"POSITION": builder.add(delta, ARRAY_BUFFER, bounds=True)} for delta in skinned.morph_targets
-        ]
         defaults = skinned.default_morph_weights
         mesh["weights"] = [0.0] * len(skinned.morph_targets) if defaults is None else defaults.tolist()
         if skinned.morph_target_names is not None:
             mesh["extras"] = {"targetNames": list(skinned.morph_target_names)}
     return mesh
+
+
+def _primitive(builder: GlbBuilder, skinned: SkinnedMesh, used: np.ndarray, faces: np.ndarray) -> dict:
+    """A triangle primitive of ``skinned``'s vertices ``used`` and ``faces`` over them."""
+    attributes = {"POSITION": builder.add(skinned.rest_positions[used], ARRAY_BUFFER, bounds=True)}
+    if skinned.normals is not None:
+        attributes["NORMAL"] = builder.add(skinned.normals[used], ARRAY_BUFFER)
+    if skinned.uvs is not None:
+        attributes["TEXCOORD_0"] = builder.add(skinned.uvs[used], ARRAY_BUFFER)
+    joints, weights = skinned.joints[used], skinned.weights[used]
+    attributes.update(skin_attributes(builder, joints, weights, skinned.skeleton.joint_count))
+    primitive = {"attributes": attributes, "indices": index_accessor(builder, faces, len(used)), "mode": _TRIANGLES}
+    if skinned.morph_targets is not None:
+        primitive["targets"] = [
+            {"POSITION": builder.add(delta[used], ARRAY_BUFFER, bounds=True)} for delta in skinned.morph_targets
+        ]
+    return primitive
 
 
 def sign_continuous(quaternions: np.ndarray) -> np.ndarray:

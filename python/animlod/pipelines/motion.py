@@ -28,6 +28,7 @@ from .result import AssetResult, LevelRow, Progress
 
 if TYPE_CHECKING:
     from ..io.gltf_document import GltfDocument
+    from ..io.gltf_write import FaceMaterials
 
 
 @dataclass
@@ -137,7 +138,7 @@ def build_motion_levels(
         if on_note is not None:
             on_note(text)
 
-    motion, played, skin, layout = _read_input(source, clip, clips, joint_map, note)
+    motion, played, skin, materials, layout = _read_input(source, clip, clips, joint_map, note)
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
@@ -193,7 +194,7 @@ def build_motion_levels(
 
             names.append(Path(f"{stem}_lod{index}.glb"))
             clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
-            write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations)
+            write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations, materials)
         files.append(names)
         row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
                "error": level.report.max_error}  # fmt: skip
@@ -259,7 +260,7 @@ def _read_input(
     clip_files: Sequence[str],
     joint_map: str | os.PathLike | None,
     note: Callable[[str], None],
-) -> tuple[Motion, list[PlayedClip], SkinnedMesh | None, BvhLayout | None]:
+) -> tuple[Motion, list[PlayedClip], SkinnedMesh | None, FaceMaterials | None, BvhLayout | None]:
     """The motion to simplify, the clips it is made of (each one's name and frames in it), for a
     skinned glTF its skin (None for a glTF without skins: the animated node tree is the skeleton)
     and for a BVH its layout. ``clip_files`` add to a glTF's clips (BVH ones matched by ``joint_map``)."""
@@ -272,13 +273,14 @@ def _read_input(
         from ..io.bvh import read_bvh_with_layout
 
         motion, layout = read_bvh_with_layout(source)
-        return motion, [PlayedClip(motion.name, slice(None))], None, layout
+        return motion, [PlayedClip(motion.name, slice(None))], None, None, layout
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
     from ..io.gltf import read_gltf
     from ..io.gltf_document import GltfDocument
     from ..io.gltf_read import rig_motions
     from ..io.gltf_skin import SkinRig
+    from ..io.gltf_write import FaceMaterials
     from .clip_import import with_clips
     from .whole_skin import whole_skin
 
@@ -286,7 +288,9 @@ def _read_input(
     document = with_clips(document, clip_files, note, joint_map)
     scene = read_gltf(document, _GLTF_FPS)
     if scene.skinned_meshes:
-        skin, motions, animations, left_out = whole_skin(document, scene, note, _GLTF_FPS)
+        whole = whole_skin(document, scene, note, _GLTF_FPS)
+        skin, motions, animations, left_out = whole.mesh, whole.motions, whole.animations, whole.left_out
+        materials = FaceMaterials(document, whole.face_materials)
         if skin.vertex_count > scene.skinned_meshes[scene.body].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
@@ -297,10 +301,10 @@ def _read_input(
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
         unwritten = _left_out_of_level_files(document)
         if unwritten:
-            note(f"{path}: the levels' GLBs hold the skinned mesh, its skeleton and its clips' joint channels; "
-                 f"not {unwritten} (`animlod character` keeps the whole document)")  # fmt: skip
+            note(f"{path}: the levels' GLBs hold the skinned mesh with its materials, its skeleton and its clips' "
+                 f"joint channels; not {unwritten} (`animlod character` keeps the whole document)")  # fmt: skip
     else:  # an animation library exported without its mesh
-        rig, skin = SkinRig(document, None), None
+        rig, skin, materials = SkinRig(document, None), None, None
         motions, animations, other_trees = (
             rig_motions(document, rig, _GLTF_FPS),
             rig.animations(document),
@@ -322,7 +326,7 @@ def _read_input(
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
             played = PlayedClip(merged.name, slice(None), max(durations))
-            return _rigid(path, motions, range(len(motions)), merged), [played], skin, None
+            return _rigid(path, motions, range(len(motions)), merged), [played], skin, materials, None
         # A clip that scales a joint cannot be re-fitted; the others still make levels.
         rigid = [index for index, motion in enumerate(motions) if motion.deforming_joint() is None]
         scaling = [names[index] for index in range(len(motions)) if index not in rigid]
@@ -334,7 +338,7 @@ def _read_input(
                  "them (use --clip to take one)")  # fmt: skip
             joined, spans = join_clips([motions[index] for index in rigid])
             played = [PlayedClip(names[index], span, durations[index]) for index, span in zip(rigid, spans)]
-            return joined, played, skin, None
+            return joined, played, skin, materials, None
         clip = rigid[0] if rigid else 0
     if isinstance(clip, str):
         if clip not in names:
@@ -344,17 +348,14 @@ def _read_input(
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
     played = [PlayedClip(names[clip], slice(None), durations[clip])]
-    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, None
+    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None
 
 
 def _left_out_of_level_files(doc: GltfDocument) -> str:
-    """What of ``doc`` the motion levels' GLBs (a skinned mesh, a skeleton and its joint channels)
-    do not carry, as words for a note; empty where that is nothing."""
+    """What of ``doc`` the motion levels' GLBs (a skinned mesh with its materials, a skeleton and
+    its joint channels) do not carry, as words for a note; empty where that is nothing."""
     gltf = doc.gltf
     parts = []
-    if gltf.materials:
-        materials = "material" if len(gltf.materials) == 1 else f"{len(gltf.materials)} materials"
-        parts.append(f"its {materials}" + (" and textures" if gltf.textures else ""))
     meshes = sum(node.mesh is not None and node.skin is None for node in gltf.nodes or [])
     if meshes:
         parts.append(f"{meshes} mesh{'es' if meshes > 1 else ''} without a skin (props, static parts)")

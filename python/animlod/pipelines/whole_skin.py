@@ -12,10 +12,12 @@ ones, and one without texture coordinates (0, 0), where other parts have them.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..io.gltf_document import GltfDocument
+from ..io.gltf_mesh import read_mesh_geometry
 from ..io.gltf_read import GltfScene, read_skinned_node
 from ..model import Motion, SkinnedMesh, morphed
 from ..motion_lod.clips import join_clips
@@ -23,19 +25,36 @@ from ..normals import vertex_normals
 from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
 
 
-def whole_skin(
-    doc: GltfDocument, scene: GltfScene, note: Callable[[str], None], fps: float
-) -> tuple[SkinnedMesh, list[Motion], list[int], int]:
+@dataclass
+class WholeSkin:
+    """The skinned meshes on one skeleton as one mesh (:func:`whole_skin`).
+
+    Attributes
+    ----------
+    mesh : the joined mesh, the body's vertices and faces first.
+    motions : its animations, sampled.
+    animations : the animation each motion is (its index in the document).
+    face_materials : (F,) each face's material (index in the document's materials, -1 for none).
+    left_out : how many skinned meshes of the document are not in it.
+    """
+
+    mesh: SkinnedMesh
+    motions: list[Motion]
+    animations: list[int]
+    face_materials: np.ndarray
+    left_out: int
+
+
+def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None], fps: float) -> WholeSkin:
     """The body of ``scene`` (``scene.body``) with every other skinned mesh on its skeleton joined
-    to it, its motions (sampled at ``fps``), the animation each motion is (its index in ``doc``),
-    and how many meshes stay out: those on other joints,
+    to it, with its motions (sampled at ``fps``). Meshes stay out that lie on other joints, are
     bound in another pose, or whose morph targets lack names where the others' have them. A part's
     joints match the body's by node; bones of its own that move in its clips join the skeleton,
     the body read again with them, and ``note`` names them. Morph targets join by name
     (:func:`_joined_targets`), each part keeping the shape of its default weights."""
     body, motions, rig, body_node = (scene.skinned_meshes[scene.body], scene.skinned_motions[scene.body],
                                      scene.skinned_rigs[scene.body], scene.skinned_nodes[scene.body])  # fmt: skip
-    parts = [body]
+    parts, part_nodes = [body], [body_node]
     for index, mesh in enumerate(scene.skinned_meshes):
         if index == scene.body or not _targets_join(parts, mesh):
             continue
@@ -54,9 +73,12 @@ def whole_skin(
             placement = placement_on(body, mesh, JointKeys(rig.joint_nodes, part_rig.joint_nodes))
         if placement is not None:
             parts.append(moved_onto(mesh, body, placement))
+            part_nodes.append(node)
     parts[0] = body
+    materials = np.concatenate([_face_materials(doc, doc.gltf.nodes[node].mesh) for node in part_nodes])
+    left_out = len(scene.skinned_meshes) - len(parts)
     if len(parts) == 1:
-        return body, motions, rig.animations(doc), len(scene.skinned_meshes) - 1
+        return WholeSkin(body, motions, rig.animations(doc), materials, left_out)
     influences = max(part.joints.shape[1] for part in parts)
     starts = np.cumsum([0] + [part.vertex_count for part in parts])
 
@@ -85,7 +107,17 @@ def whole_skin(
         morph_target_names=target_names,
         default_morph_weights=defaults,
     )
-    return whole, motions, rig.animations(doc), len(scene.skinned_meshes) - len(parts)
+    return WholeSkin(whole, motions, rig.animations(doc), materials, left_out)
+
+
+def _face_materials(doc: GltfDocument, mesh: int) -> np.ndarray:
+    """(F,) the material of each face of mesh ``mesh`` as read (its triangle primitives in order),
+    -1 for a primitive without one."""
+    geometry = read_mesh_geometry(doc, mesh, skinned=True)
+    primitives = doc.gltf.meshes[mesh].primitives
+    of_part = [-1 if primitives[part.index].material is None else primitives[part.index].material
+               for part in geometry.primitives]  # fmt: skip
+    return np.asarray(of_part, np.int64)[geometry.face_groups]
 
 
 def _target_keys(mesh: SkinnedMesh) -> list[tuple[str | None, int]]:

@@ -296,6 +296,36 @@ def test_motion_levels_keep_the_materials(tmp_path: Path) -> None:
                 np.testing.assert_allclose(stored, skinned.rest_positions[used], atol=1e-6)
 
 
+def test_motion_levels_keep_the_morph_weight_channels(tmp_path: Path) -> None:
+    """A clip that drives the skinned mesh's morph weights as well as its joints (a face's
+    expression over a walk): the levels' GLBs dropped the weights channel."""
+    skinned, motion = two_bone_tube()
+    ramp = np.linspace(0.0, 1.0, motion.frame_count, dtype=np.float32)
+
+    def swelling_clip(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        swell = append_accessor(gltf, blob, (skinned.rest_positions * [0.0, 0.5, 0.5]).astype(np.float32), "VEC3")
+        gltf.accessors[swell].min, gltf.accessors[swell].max = [0.0, -0.1, -0.1], [0.0, 0.1, 0.1]
+        gltf.meshes[0].primitives[0].targets = [{"POSITION": swell}]
+        gltf.meshes[0].weights = [0.0]
+        animation = gltf.animations[0]
+        output = append_accessor(gltf, blob, ramp[:, None], "SCALAR")
+        animation.samplers.append(pygltflib.AnimationSampler(input=animation.samplers[0].input, output=output))
+        node = next(index for index, node in enumerate(gltf.nodes) if node.skin is not None)
+        target = pygltflib.AnimationChannelTarget(node=node, path="weights")
+        animation.channels.append(pygltflib.AnimationChannel(sampler=len(animation.samplers) - 1, target=target))
+
+    source = edit_glb(_two_bone_glb(tmp_path / "body.glb"), tmp_path / "swelling.glb", swelling_clip)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    assert not [note for note in report.notes if "morph weight" in note]
+    for files in report.files:
+        written = GltfDocument(tmp_path / "levels" / files[-1])
+        (animation,) = written.json["animations"]
+        (channel,) = [channel for channel in animation["channels"] if channel["target"]["path"] == "weights"]
+        assert "mesh" in written.json["nodes"][channel["target"]["node"]]
+        values = written.accessor(animation["samplers"][channel["sampler"]]["output"], "test").ravel()
+        np.testing.assert_allclose(values[: motion.frame_count], ramp, atol=1e-6)
+
+
 def test_motion_levels_show_a_part_on_a_skin_of_its_own_over_the_same_joints(tmp_path: Path) -> None:
     """Exporters may give each mesh a skin of its own over the joints it uses (Soldier's visor): such
     a part was left out of every motion level's GLB. It joins the character where its skin was bound

@@ -51,6 +51,7 @@ def write_glb(
     names: Sequence[str] | None = None,
     durations: Sequence[float | None] | None = None,
     materials: FaceMaterials | None = None,
+    morph_weights: Sequence[np.ndarray | None] | None = None,
 ) -> None:
     """Write ``skinned`` and ``motions`` (on its skeleton) to the GLB file ``path``, atomically.
 
@@ -64,11 +65,13 @@ def write_glb(
     durations : per motion, the length of the clip it was sampled from, or None (see
         :func:`add_animation`): a glTF clip's last key may fall between two sampled frames.
     materials : the material of each of ``skinned``'s faces, or None (no material).
+    morph_weights : per motion, (T, N) the weights of ``skinned``'s N morph targets at its T
+        frames, written as a channel of the mesh node, or None.
 
     Raises
     ------
-    ValueError if a motion is on another skeleton, ``names``, ``durations`` or ``materials`` has
-    the wrong length, or there is neither a mesh nor a motion.
+    ValueError if a motion is on another skeleton, ``names``, ``durations``, ``materials`` or
+    ``morph_weights`` has the wrong length or shape, or there is neither a mesh nor a motion.
     """
     names = _animation_names(motions, names)
     if durations is not None and len(durations) != len(motions):
@@ -81,6 +84,7 @@ def write_glb(
     if materials is not None and (skinned is None or len(materials.indices) != skinned.face_count):
         faces = 0 if skinned is None else skinned.face_count
         raise ValueError(f"materials: {len(materials.indices)} face materials for {faces} faces")
+    weights = _checked_morph_weights(skinned, motions, morph_weights)
     builder = GlbBuilder() if materials is None else _materials_of(materials.document)
     joint_nodes = add_skeleton(builder, skeleton)
     scene_nodes = [joint_nodes[0]]
@@ -88,13 +92,45 @@ def write_glb(
         skin = add_skin(builder, joint_nodes, skinned.inverse_bind)
         mesh = builder.append("meshes", _mesh(builder, skinned, None if materials is None else materials.indices))
         scene_nodes.append(builder.append("nodes", {"name": "skinned mesh", "mesh": mesh, "skin": skin}))
-    for motion, name, duration in zip(motions, names, durations or [None] * len(motions)):
-        add_animation(builder, motion, joint_nodes, name, duration=duration)
+    for motion, name, duration, track in zip(motions, names, durations or [None] * len(motions), weights):
+        animation = add_animation(builder, motion, joint_nodes, name, duration=duration)
+        if track is not None:
+            _add_weights_channel(builder, builder.json["animations"][animation], scene_nodes[-1], track)
     builder.json["scenes"] = [{"nodes": scene_nodes}]
     builder.json["scene"] = 0
     if materials is not None:
         builder.prune()  # the document's mesh and animation data
     builder.save(path)
+
+
+def _checked_morph_weights(
+    skinned: SkinnedMesh | None, motions: Sequence[Motion], morph_weights: Sequence[np.ndarray | None] | None
+) -> list[np.ndarray | None]:
+    """``morph_weights`` (None: one None per motion), each checked against its motion's frames and
+    the mesh's targets."""
+    if morph_weights is None:
+        return [None] * len(motions)
+    if len(morph_weights) != len(motions):
+        raise ValueError(f"morph_weights: {len(morph_weights)} given for {len(motions)} motions")
+    targets = 0 if skinned is None or skinned.morph_targets is None else len(skinned.morph_targets)
+    for index, (motion, weights) in enumerate(zip(motions, morph_weights)):
+        if weights is not None and (targets == 0 or np.shape(weights) != (motion.frame_count, targets)):
+            raise ValueError(f"morph_weights[{index}]: shape {np.shape(weights)}, expected "
+                             f"({motion.frame_count}, {targets}): a weight per frame and morph target")  # fmt: skip
+    return list(morph_weights)
+
+
+def _add_weights_channel(builder: GlbBuilder, animation: dict, node: int, weights: np.ndarray) -> None:
+    """``weights`` (T, N) as a channel of ``node``'s morph weights in ``animation``, on its joint
+    channels' keys (a key held past the last frame holds the last weights too)."""
+    times = animation["samplers"][0]["input"]
+    held = builder.json["accessors"][times]["count"] - len(weights)
+    values = np.concatenate([weights, np.repeat(weights[-1:], held, axis=0)]).reshape(-1, 1)
+    animation["samplers"].append({"input": times, "output": builder.add(values.astype(np.float32)),
+                                  "interpolation": _LINEAR})  # fmt: skip
+    animation["channels"].append(
+        {"sampler": len(animation["samplers"]) - 1, "target": {"node": node, "path": "weights"}}
+    )
 
 
 def _materials_of(document: GltfDocument) -> GlbBuilder:

@@ -194,7 +194,8 @@ def build_motion_levels(
 
             names.append(Path(f"{stem}_lod{index}.glb"))
             clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
-            write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations, materials)
+            weights = [clip.morph_weights for clip in played]
+            write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations, materials, weights)
         files.append(names)
         row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
                "error": level.report.max_error}  # fmt: skip
@@ -222,11 +223,13 @@ _GLTF_FPS = 30.0
 
 class PlayedClip(NamedTuple):
     """A clip of the simplified motion: its name, its frames in the motion, and for a glTF clip
-    its length in seconds (its last key, which may fall between two sampled frames)."""
+    its length in seconds (its last key, which may fall between two sampled frames) and the
+    weights its channels give the skinned mesh's morph targets at its frames (T, N), if any."""
 
     name: str
     frames: slice
     duration: float | None = None
+    morph_weights: np.ndarray | None = None
 
 
 # Vertex-frames times levels measured between two progress calls of skin_distances (about half a
@@ -290,7 +293,7 @@ def _read_input(
     if scene.skinned_meshes:
         whole = whole_skin(document, scene, note, _GLTF_FPS)
         skin, motions, animations, left_out = whole.mesh, whole.motions, whole.animations, whole.left_out
-        materials = FaceMaterials(document, whole.face_materials)
+        materials, morph_weights = FaceMaterials(document, whole.face_materials), whole.morph_weights
         if skin.vertex_count > scene.skinned_meshes[scene.body].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
@@ -299,12 +302,12 @@ def _read_input(
                  "takes every skin)")  # fmt: skip
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
-        unwritten = _left_out_of_level_files(document)
+        unwritten = _left_out_of_level_files(document, set(whole.part_nodes))
         if unwritten:
-            note(f"{path}: the levels' GLBs hold the skinned mesh with its materials, its skeleton and its clips' "
-                 f"joint channels; not {unwritten} (`animlod character` keeps the whole document)")  # fmt: skip
+            note(f"{path}: the levels' GLBs hold the skinned mesh with its materials, its skeleton and its clips; "
+                 f"not {unwritten} (`animlod character` keeps the whole document)")  # fmt: skip
     else:  # an animation library exported without its mesh
-        rig, skin, materials = SkinRig(document, None), None, None
+        rig, skin, materials, morph_weights = SkinRig(document, None), None, None, {}
         motions, animations, other_trees = (
             rig_motions(document, rig, _GLTF_FPS),
             rig.animations(document),
@@ -325,6 +328,9 @@ def _read_input(
         if merged is not None:
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
+            if morph_weights:
+                note(f"{path}: its morph weight channels are not in the levels' GLBs (their animations are joined "
+                     "into one motion)")  # fmt: skip
             played = PlayedClip(merged.name, slice(None), max(durations))
             return _rigid(path, motions, range(len(motions)), merged), [played], skin, materials, None
         # A clip that scales a joint cannot be re-fitted; the others still make levels.
@@ -337,7 +343,8 @@ def _read_input(
             note(f"{path}: its {len(rigid)} animations simplified together, one skeleton per level for all of "
                  "them (use --clip to take one)")  # fmt: skip
             joined, spans = join_clips([motions[index] for index in rigid])
-            played = [PlayedClip(names[index], span, durations[index]) for index, span in zip(rigid, spans)]
+            played = [PlayedClip(names[index], span, durations[index], morph_weights.get(animations[index]))
+                      for index, span in zip(rigid, spans)]  # fmt: skip
             return joined, played, skin, materials, None
         clip = rigid[0] if rigid else 0
     if isinstance(clip, str):
@@ -347,20 +354,21 @@ def _read_input(
         clip = names.index(clip)
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
-    played = [PlayedClip(names[clip], slice(None), durations[clip])]
+    played = [PlayedClip(names[clip], slice(None), durations[clip], morph_weights.get(animations[clip]))]
     return _rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None
 
 
-def _left_out_of_level_files(doc: GltfDocument) -> str:
-    """What of ``doc`` the motion levels' GLBs (a skinned mesh with its materials, a skeleton and
-    its joint channels) do not carry, as words for a note; empty where that is nothing."""
+def _left_out_of_level_files(doc: GltfDocument, joined: set[int]) -> str:
+    """What of ``doc`` the motion levels' GLBs (a skinned mesh with its materials and the morph
+    weight channels of the ``joined`` nodes' meshes, a skeleton and its joint channels) do not
+    carry, as words for a note; empty where that is nothing."""
     gltf = doc.gltf
     parts = []
     meshes = sum(node.mesh is not None and node.skin is None for node in gltf.nodes or [])
     if meshes:
         parts.append(f"{meshes} mesh{'es' if meshes > 1 else ''} without a skin (props, static parts)")
-    if any(path == "weights" for targets in doc.channel_targets for _, path in targets):
-        parts.append("its morph weight channels")
+    if any(path == "weights" and node not in joined for targets in doc.channel_targets for node, path in targets):
+        parts.append("the morph weight channels of other meshes")
     if gltf.cameras or (gltf.extensions or {}).get("KHR_lights_punctual"):
         parts.append("its cameras and lights")
     return ", ".join(parts[:-1]) + (" or " if len(parts) > 1 else "") + (parts[-1] if parts else "")

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_mesh import read_mesh_geometry
-from ..io.gltf_read import GltfScene, read_skinned_node
+from ..io.gltf_read import GltfScene, morph_weight_tracks, read_skinned_node
 from ..model import Motion, SkinnedMesh, morphed
 from ..motion_lod.clips import join_clips
 from ..normals import vertex_normals
@@ -36,6 +36,10 @@ class WholeSkin:
     animations : the animation each motion is (its index in the document).
     face_materials : (F,) each face's material (index in the document's materials, -1 for none).
     left_out : how many skinned meshes of the document are not in it.
+    part_nodes : the nodes whose meshes it joins, the body's first.
+    morph_weights : per animation that drives a part's morph weights (its index in the document),
+        (T, N) the joined targets' weights at the animation's sampled frames; a target no part's
+        channel drives keeps its default, and the first part's channel drives a shared one.
     """
 
     mesh: SkinnedMesh
@@ -43,6 +47,8 @@ class WholeSkin:
     animations: list[int]
     face_materials: np.ndarray
     left_out: int
+    part_nodes: list[int]
+    morph_weights: dict[int, np.ndarray]
 
 
 def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None], fps: float) -> WholeSkin:
@@ -78,7 +84,10 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
     materials = np.concatenate([_face_materials(doc, doc.gltf.nodes[node].mesh) for node in part_nodes])
     left_out = len(scene.skinned_meshes) - len(parts)
     if len(parts) == 1:
-        return WholeSkin(body, motions, rig.animations(doc), materials, left_out)
+        count = 0 if body.morph_targets is None else len(body.morph_targets)
+        defaults = np.zeros(count) if body.default_morph_weights is None else body.default_morph_weights
+        tracks = _weight_tracks(doc, part_nodes, [list(range(count))], defaults, fps)
+        return WholeSkin(body, motions, rig.animations(doc), materials, left_out, part_nodes, tracks)
     influences = max(part.joints.shape[1] for part in parts)
     starts = np.cumsum([0] + [part.vertex_count for part in parts])
 
@@ -93,7 +102,7 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
             return None
         return np.concatenate([missing(part) if value is None else value for part, value in zip(parts, values)])
 
-    targets, target_names, defaults, shapes = _joined_targets(parts)
+    targets, target_names, defaults, shapes, places = _joined_targets(parts)
     whole = SkinnedMesh(
         rest_positions=np.concatenate(shapes).astype(np.float32),
         faces=np.concatenate([part.faces + start for part, start in zip(parts, starts)]),
@@ -107,7 +116,23 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
         morph_target_names=target_names,
         default_morph_weights=defaults,
     )
-    return WholeSkin(whole, motions, rig.animations(doc), materials, left_out)
+    tracks = {} if defaults is None else _weight_tracks(doc, part_nodes, places, defaults, fps)
+    return WholeSkin(whole, motions, rig.animations(doc), materials, left_out, part_nodes, tracks)
+
+
+def _weight_tracks(
+    doc: GltfDocument, nodes: list[int], places: list[list[int]], defaults: np.ndarray, fps: float
+) -> dict[int, np.ndarray]:
+    """WholeSkin.morph_weights of the parts drawn by ``nodes``, whose targets are the joined
+    mesh's ``places``."""
+    tracks: dict[int, np.ndarray] = {}
+    for node, targets in reversed(list(zip(nodes, places))):  # the first part's channel written last
+        if not targets:
+            continue
+        for animation, weights in morph_weight_tracks(doc, node, len(targets), fps):
+            track = tracks.setdefault(animation, np.tile(defaults, (len(weights), 1)))
+            track[:, targets] = weights
+    return tracks
 
 
 def _face_materials(doc: GltfDocument, mesh: int) -> np.ndarray:
@@ -143,30 +168,30 @@ def _targets_join(parts: list[SkinnedMesh], mesh: SkinnedMesh) -> bool:
 
 def _joined_targets(
     parts: list[SkinnedMesh],
-) -> tuple[np.ndarray | None, list[str] | None, np.ndarray | None, list[np.ndarray]]:
+) -> tuple[np.ndarray | None, list[str] | None, np.ndarray | None, list[np.ndarray], list[list[int]]]:
     """The parts' morph targets as one mesh's, (N, V, 3) with their names (None where unnamed) and
     default weights: one target per key (:func:`_target_keys`) of any part, no offset on the parts
-    without it, at the default weight of the first part that has it. Last, each part's bind shape
+    without it, at the default weight of the first part that has it. Then each part's bind shape
     with the difference of its own defaults from those folded in, so that every part shows its own
-    default shape."""
+    default shape; last, where each part's targets are among the joined ones."""
     keys = [_target_keys(part) for part in parts]
     union = list(dict.fromkeys(key for part_keys in keys for key in part_keys))
     shapes = [part.rest_positions for part in parts]
-    if not union:
-        return None, None, None, shapes
     place = {key: index for index, key in enumerate(union)}
+    places = [[place[key] for key in part_keys] for part_keys in keys]
+    if not union:
+        return None, None, None, shapes, places
     targets = np.zeros((len(union), sum(part.vertex_count for part in parts), 3), np.float32)
     defaults = np.full(len(union), np.nan)
     start = 0
-    for k, (part, part_keys) in enumerate(zip(parts, keys)):
-        if part_keys:
-            places = [place[key] for key in part_keys]
-            targets[places, start : start + part.vertex_count] = part.morph_targets
-            own = np.zeros(len(places)) if part.default_morph_weights is None else part.default_morph_weights
-            unset = np.isnan(defaults[places])
-            defaults[np.asarray(places)[unset]] = own[unset]
-            if np.any(own != defaults[places]):
-                shapes[k] = morphed(part.rest_positions, part.morph_targets, own - defaults[places])
+    for k, (part, part_places) in enumerate(zip(parts, places)):
+        if part_places:
+            targets[part_places, start : start + part.vertex_count] = part.morph_targets
+            own = np.zeros(len(part_places)) if part.default_morph_weights is None else part.default_morph_weights
+            unset = np.isnan(defaults[part_places])
+            defaults[np.asarray(part_places)[unset]] = own[unset]
+            if np.any(own != defaults[part_places]):
+                shapes[k] = morphed(part.rest_positions, part.morph_targets, own - defaults[part_places])
         start += part.vertex_count
     names = None if union[0][0] is None else [name for name, _ in union]
-    return targets, names, defaults, shapes
+    return targets, names, defaults, shapes, places

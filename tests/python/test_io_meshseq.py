@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -21,6 +22,7 @@ from animlod.io import (
     write_ply,
     write_sequence,
 )
+from animlod.io.obj import UnreadAttributesWarning
 from animlod.model import AnimatedMesh
 
 # A unit square (quad) and a triangle on top, written with CRLF, comments, texture/normal
@@ -58,6 +60,22 @@ def test_obj_statements_corners_quads_and_negative_indices(tmp_path: Path) -> No
     np.testing.assert_array_equal(vertices, EXPECTED_VERTICES)
     np.testing.assert_array_equal(faces, EXPECTED_FACES)
     assert vertices.dtype == np.float32 and faces.dtype == np.int32
+
+
+def test_obj_texture_coordinates_and_normals_are_said_to_be_unread(tmp_path: Path) -> None:
+    """OBJ frames with ``vt`` and ``vn`` lines: levels were written without them and nothing said
+    so. One warning names the first frame; frames without them give none."""
+    textured = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\n"
+    for index in range(3):
+        (tmp_path / "textured" / f"frame{index}.obj").parent.mkdir(exist_ok=True)
+        (tmp_path / "textured" / f"frame{index}.obj").write_text(textured)
+    with pytest.warns(UnreadAttributesWarning) as caught:
+        read_sequence(tmp_path / "textured")
+    assert len(caught) == 1 and "frame0.obj" in str(caught[0].message) and "vt, vn" in str(caught[0].message)
+    (tmp_path / "plain.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnreadAttributesWarning)
+        read_obj(tmp_path / "plain.obj")
 
 
 def test_ascii_ply_with_mixed_polygons_and_extra_properties(tmp_path: Path) -> None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import glob
 import os
 import re
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -16,7 +17,7 @@ import numpy as np
 from ..model import AnimatedMesh
 from .atomic import atomic_folder
 from .errors import FormatError
-from .obj import read_obj, write_obj
+from .obj import UnreadAttributesWarning, read_obj, write_obj
 from .ply import read_ply, write_ply
 
 MESH_SUFFIXES = (".obj", ".ply")
@@ -53,10 +54,12 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
         raise FormatError(paths[0], "mesh", f"{what}; a frame needs triangles")
     frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
     frames[0] = first_vertices
-    for index, path in enumerate(paths[1:], start=1):
-        vertices, frame_faces = read_mesh(path)
-        _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
-        frames[index] = vertices
+    with warnings.catch_warnings():  # the first frame's warning speaks for the sequence
+        warnings.simplefilter("ignore", UnreadAttributesWarning)
+        for index, path in enumerate(paths[1:], start=1):
+            vertices, frame_faces = read_mesh(path)
+            _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
+            frames[index] = vertices
     return AnimatedMesh(faces, frames, fps=fps)
 
 

@@ -1,13 +1,15 @@
 """Wavefront OBJ geometry: ``v`` and ``f`` lines read (1-based or negative indices, ``a/b/c``
 corners, polygons fan-triangulated, ``#`` comments also at a line's end, a statement continued
 on the next line after a ``\\`` that ends its line; other statements such as ``vt``, ``vn``,
-``g``, ``usemtl`` are ignored; statements may be indented) and written. Parsing works on the
-whole file's bytes with numpy: there is no Python loop over lines, vertices or faces."""
+``g``, ``usemtl`` are ignored, with a warning for ``vt`` and ``vn``; statements may be indented)
+and written. Parsing works on the whole file's bytes with numpy: there is no Python loop over
+lines, vertices or faces."""
 
 from __future__ import annotations
 
 import os
 import re
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -66,6 +68,7 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
         data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
     (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines) = _obj_statements(data, (b"v", b"f", b"l"))
+    _warn_unread_attributes(path, data)
     if not len(vertex_lines):
         _require_obj_statement(path, data)
     if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
@@ -165,6 +168,21 @@ def _join_continued_lines(data: bytes) -> bytes:
     joined[joined == 0] = ord(" ")
     tail = marks.size - (int(marks_before[-1]) if newlines.size else 0)  # continued into the file's end
     return joined.tobytes() + b"\n" * tail
+
+
+class UnreadAttributesWarning(UserWarning):
+    """An OBJ file's texture coordinates or normals (``vt``, ``vn``), which animlod does not read."""
+
+
+def _warn_unread_attributes(path: Path, data: bytes) -> None:
+    """Says that ``vt`` and ``vn`` lines are not read, so that levels written without them are
+    no silent loss."""
+    unread = [tag for tag in ("vt", "vn") if data.startswith(f"{tag} ".encode()) or f"\n{tag} ".encode() in data]
+    if unread:
+        kinds = " and ".join({"vt": "texture coordinates", "vn": "normals"}[tag] for tag in unread)
+        warnings.warn(f"{path}: its {kinds} ({', '.join(unread)} lines) are not read: OBJ input gives positions "
+                      "and faces only, and the levels are written without them", UnreadAttributesWarning,
+                      stacklevel=3)  # fmt: skip
 
 
 def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:

@@ -311,6 +311,16 @@ def test_cli_refuses_a_json_it_could_not_write_before_running(tmp_path, capsys) 
     )
 
 
+def test_cli_names_the_element_of_a_truncated_chain_before_running(tmp_path, capsys) -> None:
+    # The renderer's loader said only "Invalid glTF binary."; the reader names what is wrong.
+    whole = tmp_path / "whole.glb"
+    write_hand_built_chain(whole)
+    truncated = tmp_path / "truncated.glb"
+    truncated.write_bytes(whole.read_bytes()[:200])
+    assert cli_main(["crowd", str(truncated), "--count", "2", "--frames", "2"]) == 2
+    assert f"{truncated}: GLB header: file is truncated" in capsys.readouterr().err
+
+
 def test_mode_list() -> None:
     assert mode_list("all") == [
         "Original",

@@ -53,6 +53,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..crowd import CrowdError, mode_list, procedural_chain, run_crowd, write_heat_map
     from ..io.atomic import atomic_write, unwritable
+    from ..io.gltf_document import GltfDocument
 
     if args.heat_map and not args.grid:
         raise UserError("--heat-map: needs --grid")
@@ -69,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
         for chain in chains:
             if not chain.is_file():
                 raise UserError(f"{chain}: no such file")
+            GltfDocument(chain)  # a malformed file named with its element here, not by the renderer's loader
         if not chains:
             chains = [procedural_chain(Path(scratch) / "humanoid.glb")]
             print(f"chain: the procedural humanoid ({chains[0].name})")

@@ -334,7 +334,9 @@ def test_frames_with_different_faces(tmp_path: Path) -> None:
     _write(tmp_path / "a_1.obj", OBJ_TEXT)
     _write(tmp_path / "a_2.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 2 5"))
     message = _error(tmp_path)
-    assert message == f"{tmp_path / 'a_2.obj'}: face 2: [3, 1, 4] differs from [3, 2, 4] in the first frame a_1.obj"
+    # Counted from 0 unlike OBJ's own indices (f 4 2 5), and said so.
+    expected = "face 2: vertices [3, 1, 4] (counted from 0) differ from [3, 2, 4] in the first frame a_1.obj"
+    assert message == f"{tmp_path / 'a_2.obj'}: {expected}"
 
 
 @pytest.mark.parametrize(

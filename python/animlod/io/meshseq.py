@@ -140,7 +140,7 @@ def _check_same_connectivity(
     differs = np.any(faces != first_faces, axis=1)
     if differs.any():
         face = int(np.argmax(differs))
-        reason = f"{faces[face].tolist()} differs from {first_faces[face].tolist()} in {first}"
+        reason = f"vertices {faces[face].tolist()} (counted from 0) differ from {first_faces[face].tolist()} in {first}"
         raise FormatError(path, f"face {face}", reason)
 
 

@@ -56,6 +56,7 @@ def test_face_pose_folder(tmp_path, capsys):
     assert main(arguments) == 0
     printed = capsys.readouterr().out
     assert "1 targets" in printed and "poses_lod.glb" in printed
+    assert "neutral face neutral.obj, every other file an expression" in printed  # the choice is said
     manifest = json.loads((tmp_path / "out" / "poses_face_lod.json").read_text())
     assert [level["targets"] for level in manifest["levels"]] == [["bulge"], []]
     # A triangle count the face does not have is named as such, for poses and a glTF face alike

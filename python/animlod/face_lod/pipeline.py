@@ -169,15 +169,17 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
                     error_frames) -> FaceRun:  # fmt: skip
     from ..io.detect import glb_name, input_kind, input_stem
     from ..io.manifest import write_lod_manifest
-    from .sources import read_pose_face
+    from .sources import pose_files, read_pose_face
 
     kind = input_kind(source)
-    gltf = None
+    gltf, read_notes = None, []
     if kind == "gltf":
         gltf = read_gltf_face(source)
         face = gltf.face
     elif kind == "sequence" and source.is_dir():
         face = read_pose_face(source, neutral)
+        chosen = pose_files(source, neutral)[0].name
+        read_notes.append(f"{source}: neutral face {chosen}, every other file an expression (--neutral names another)")
     else:
         raise ValueError(f"{source}: face LoD reads a .glb/.gltf with morph targets or a folder of OBJ/PLY poses")
     plot_weights = _plot_weights(face, expression) if plot else None
@@ -201,7 +203,7 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
          "Hausdorff (% of diagonal)", "coverage >="],
         [],
         notes=[f"{source}: {face.vertex_count} vertices, {len(face.faces)} triangles, {face.target_count} targets, "
-               f"{len(face.weights)} animation frames"],
+               f"{len(face.weights)} animation frames", *read_notes],
     )  # fmt: skip
     glb = output / glb_name(source, "_lod")
     if gltf is not None:

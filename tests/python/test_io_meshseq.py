@@ -65,7 +65,7 @@ def test_obj_statements_corners_quads_and_negative_indices(tmp_path: Path) -> No
 def test_obj_texture_coordinates_and_normals_are_said_to_be_unread(tmp_path: Path) -> None:
     """OBJ frames with ``vt`` and ``vn`` lines: levels were written without them and nothing said
     so. One warning names the first frame; frames without them give none."""
-    textured = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\n"
+    textured = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn\t0 0 1\nf 1/1/1 2/2/1 3/3/1\n"  # a tab too
     for index in range(3):
         (tmp_path / "textured" / f"frame{index}.obj").parent.mkdir(exist_ok=True)
         (tmp_path / "textured" / f"frame{index}.obj").write_text(textured)

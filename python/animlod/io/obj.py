@@ -177,7 +177,8 @@ class UnreadAttributesWarning(UserWarning):
 def _warn_unread_attributes(path: Path, data: bytes) -> None:
     """Says that ``vt`` and ``vn`` lines are not read, so that levels written without them are
     no silent loss."""
-    unread = [tag for tag in ("vt", "vn") if data.startswith(f"{tag} ".encode()) or f"\n{tag} ".encode() in data]
+    # A statement's tag ends at a space or a tab, as _obj_statements reads the others.
+    unread = [tag for tag in ("vt", "vn") if re.search(rb"(?m)^" + tag.encode() + rb"[ \t]", data)]
     if unread:
         kinds = " and ".join({"vt": "texture coordinates", "vn": "normals"}[tag] for tag in unread)
         warnings.warn(f"{path}: its {kinds} ({', '.join(unread)} lines) are not read: OBJ input gives positions "

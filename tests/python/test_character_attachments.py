@@ -1,15 +1,18 @@
-"""Nodes hung from a character's joints follow every motion level (pipelines/attachments.py)."""
+"""Nodes hung from a character's joints follow every motion level, in `animlod character`'s LoD GLB
+and in `animlod motion`'s level GLBs (pipelines/attachments.py)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from gltf_poses import posed_worlds, skinned_vertex
 
 from animlod import rotations, synth
 from animlod.io import write_glb
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
 from animlod.pipelines.character import build_character
+from animlod.pipelines.motion import build_motion_levels
 
 QUICK = {"frame_budget": 12, "measured_frames": 2}
 # A finger (frozen early), the head and a foot; each socket turned, moved and scaled on its joint.
@@ -83,47 +86,29 @@ def _animate(animation: dict, node: int, path: str, output: int) -> None:
     animation["channels"].append({"sampler": len(animation["samplers"]) - 1, "target": {"node": node, "path": path}})
 
 
-def _posed_worlds(doc: GltfDocument, animation: int) -> list[np.ndarray]:
-    """World matrix of every node at the first key of ``animation``."""
-    local = [doc.rest_matrix(n) for n in range(len(doc.gltf.nodes))]
-    keyed: dict[int, dict[str, np.ndarray]] = {}
-    clip = doc.gltf.animations[animation]
-    for channel in clip.channels:
-        if channel.target.node is None:  # the material colour's pointer channel
-            continue
-        values = np.asarray(doc.accessor(clip.samplers[channel.sampler].output, "test"))
-        keyed.setdefault(channel.target.node, {})[channel.target.path] = values[0]
-    for node, paths in keyed.items():
-        translation, rotation, scale = doc.rest_trs(node)
-        local[node] = rotations.compose_transform(
-            paths.get("translation", translation), rotations.normalize(paths.get("rotation", rotation)), scale
-        )
-    worlds = []
-    for node in range(len(local)):
-        world = local[node]
-        for ancestor in doc.ancestors(node):
-            world = local[ancestor] @ world
-        worlds.append(world)
-    return worlds
-
-
-def _skinned_vertex(doc: GltfDocument, node: int, vertex: int, worlds: list[np.ndarray]) -> np.ndarray:
-    """World position of ``vertex`` of the skinned mesh drawn by ``node``, posed by ``worlds``."""
-    primitive = doc.gltf.meshes[doc.gltf.nodes[node].mesh].primitives[0]
-    skin = doc.gltf.skins[doc.gltf.nodes[node].skin]
-    position = np.append(np.asarray(doc.accessor(primitive.attributes.POSITION, "test"))[vertex], 1.0)
-    joints = np.asarray(doc.accessor(primitive.attributes.JOINTS_0, "test"))[vertex]
-    weights = np.asarray(doc.accessor(primitive.attributes.WEIGHTS_0, "test"))[vertex]
-    inverse_binds = np.asarray(doc.accessor(skin.inverseBindMatrices, "test")).reshape(-1, 4, 4).transpose(0, 2, 1)
-    matrix = sum(w * worlds[skin.joints[j]] @ inverse_binds[j] for j, w in zip(joints, weights) if w > 0)
-    return (matrix @ position)[:3]
-
-
 def _node(doc: GltfDocument, name: str) -> int:
     return next(n for n, node in enumerate(doc.gltf.nodes) if node.name == name)
 
 
-@pytest.mark.parametrize("joint, holder", [*[(joint, f"socket {joint}") for joint in SOCKET_JOINTS], ("Head", "Head")])
+def _vertex_in_holder(doc: GltfDocument, joint: str, holder: str) -> tuple[int, np.ndarray, float]:
+    """A vertex of the input's skinned mesh bound to ``joint`` alone, its place in the frame of
+    node ``holder`` at the first key of the clip, and the mesh's size."""
+    base = next(n for n, node in enumerate(doc.gltf.nodes) if node.skin is not None)
+    primitive = doc.gltf.meshes[doc.gltf.nodes[base].mesh].primitives[0]
+    joints = np.asarray(doc.accessor(primitive.attributes.JOINTS_0, "test"))
+    weights = np.asarray(doc.accessor(primitive.attributes.WEIGHTS_0, "test"))
+    slot = doc.gltf.skins[doc.gltf.nodes[base].skin].joints.index(_node(doc, joint))
+    vertex = int(np.flatnonzero((joints[:, 0] == slot) & (weights[:, 0] > 0.999))[0])
+    worlds = posed_worlds(doc, 0)
+    place = np.linalg.inv(worlds[_node(doc, holder)]) @ np.append(skinned_vertex(doc, base, vertex, worlds), 1.0)
+    size = np.ptp(np.asarray(doc.accessor(primitive.attributes.POSITION, "test")), axis=0).max()
+    return vertex, place[:3], size
+
+
+HOLDERS = [*[(joint, f"socket {joint}") for joint in SOCKET_JOINTS], ("Head", "Head")]
+
+
+@pytest.mark.parametrize("joint, holder", HOLDERS)
 def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(character_with_sockets, joint, holder):
     # A vertex bound to the socket's joint alone is rigid with the socket (holder: the socket node,
     # or the joint node for the hat it draws): in the input, and at each motion level (where a
@@ -131,31 +116,91 @@ def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(cha
     # sits at the same place in the holder's frame as in its copy's.
     source, output, report = character_with_sockets
     doc_in, doc_out = GltfDocument(source), GltfDocument(output)
+    vertex, expected, size = _vertex_in_holder(doc_in, joint, holder)
     base = _node(doc_in, next(node.name for node in doc_in.gltf.nodes if node.skin is not None))
-    primitive = doc_in.gltf.meshes[doc_in.gltf.nodes[base].mesh].primitives[0]
-    joints = np.asarray(doc_in.accessor(primitive.attributes.JOINTS_0, "test"))
-    weights = np.asarray(doc_in.accessor(primitive.attributes.WEIGHTS_0, "test"))
-    slot = doc_in.gltf.skins[doc_in.gltf.nodes[base].skin].joints.index(_node(doc_in, joint))
-    vertex = int(np.flatnonzero((joints[:, 0] == slot) & (weights[:, 0] > 0.999))[0])
-    worlds = _posed_worlds(doc_in, 0)
-    socket = worlds[_node(doc_in, holder)]
-    expected = (np.linalg.inv(socket) @ np.append(_skinned_vertex(doc_in, base, vertex, worlds), 1.0))[:3]
     grid = doc_out.gltf.nodes[base].extras["animlod_grid"][0]  # geometry level 0, each motion level
-    size = np.ptp(np.asarray(doc_in.accessor(primitive.attributes.POSITION, "test")), axis=0).max()
     frozen_somewhere = False
     for m in range(1, len(grid)):
         animation = next(a for a, clip in enumerate(doc_out.gltf.animations) if clip.name.endswith(f"@motion{m}"))
-        worlds = _posed_worlds(doc_out, animation)
+        worlds = posed_worlds(doc_out, animation)
         copy = _node(doc_out, f"{holder}@motion{m}")
         level_skin = doc_out.gltf.skins[doc_out.gltf.nodes[grid[m]].skin]
         hung = doc_out.parents[copy]  # from the level's own skeleton, or a static frame node on it
         assert hung in level_skin.joints or doc_out.parents[hung] in level_skin.joints
         frozen_somewhere |= joint not in {doc_out.gltf.nodes[n].name for n in level_skin.joints}
-        vertex_world = _skinned_vertex(doc_out, grid[m], vertex, worlds)
+        vertex_world = skinned_vertex(doc_out, grid[m], vertex, worlds)
         seen = (np.linalg.inv(worlds[copy]) @ np.append(vertex_world, 1.0))[:3]
         np.testing.assert_allclose(seen, expected, atol=1e-5 * size)
     if joint == "LeftHandIndex2":
         assert frozen_somewhere  # the frozen path (key posture between the kept ancestor) is tested
+
+
+@pytest.fixture(scope="module")
+def motion_levels_with_sockets(character_with_sockets, tmp_path_factory):
+    """``animlod motion``'s level GLBs of the character with sockets, and the notes of the run."""
+    source, _, _ = character_with_sockets
+    folder = tmp_path_factory.mktemp("socket_motion")
+    notes: list[str] = []
+    report = build_motion_levels(source, folder, levels=4, ranking="importance", on_note=notes.append)
+    return source, [folder / files[-1] for files in report.files], notes
+
+
+@pytest.mark.parametrize("joint, holder", HOLDERS)
+def test_a_socket_moves_with_the_vertices_of_its_joint_in_every_motion_level_glb(
+    motion_levels_with_sockets, joint, holder
+):
+    # As above, in `animlod motion`'s files: one skeleton each, the copy named as the input's
+    # node (what a joint node draws: "<joint> content", beside the level's joint node).
+    source, levels, _ = motion_levels_with_sockets
+    vertex, expected, size = _vertex_in_holder(GltfDocument(source), joint, holder)
+    frozen_somewhere = False
+    for level in levels:
+        doc = GltfDocument(level)
+        worlds = posed_worlds(doc, 0)
+        copy = _node(doc, f"{holder} content" if holder == joint else holder)
+        skin = doc.gltf.skins[0]
+        assert doc.parents[copy] in skin.joints or doc.parents[doc.parents[copy]] in skin.joints
+        frozen_somewhere |= joint not in {doc.gltf.nodes[n].name for n in skin.joints}
+        vertex_world = skinned_vertex(doc, _node(doc, "skinned mesh"), vertex, worlds)
+        seen = (np.linalg.inv(worlds[copy]) @ np.append(vertex_world, 1.0))[:3]
+        np.testing.assert_allclose(seen, expected, atol=1e-5 * size)
+    if joint == "LeftHandIndex2":
+        assert frozen_somewhere
+
+
+def test_motion_level_glbs_play_the_channels_of_what_hangs_from_the_joints(motion_levels_with_sockets):
+    # The sliding socket's translation, the hat's morph weights and the material colour's pointer
+    # channel play in every level GLB with the input clip's values; the hat's mesh comes along,
+    # and nothing is said to be left out.
+    source, levels, notes = motion_levels_with_sockets
+    doc_in = GltfDocument(source)
+    clip = doc_in.gltf.animations[0]
+
+    def played(doc: GltfDocument, animation, rename: dict[str, str]) -> dict[tuple[str, str], np.ndarray]:
+        found = {}
+        for channel in animation.channels:
+            if channel.target.path == "pointer":
+                key = ("pointer", channel.target.extensions["KHR_animation_pointer"]["pointer"])
+            else:
+                name = doc.gltf.nodes[channel.target.node].name
+                key = (rename.get(name, name), channel.target.path)
+            if key in hung_channels:
+                found[key] = np.asarray(doc.accessor(animation.samplers[channel.sampler].output, "test"))
+        return found
+
+    hung_channels = {("moving socket", "translation"), ("Head", "weights"),
+                     ("pointer", "/materials/0/pbrMetallicRoughness/baseColorFactor")}  # fmt: skip
+    expected = played(doc_in, clip, {})
+    assert expected.keys() == hung_channels
+    for level in levels:
+        doc = GltfDocument(level)
+        carried = played(doc, doc.gltf.animations[0], {"Head content": "Head", "Head": "Head joint"})
+        assert carried.keys() == expected.keys()
+        for key, values in expected.items():
+            np.testing.assert_array_equal(carried[key], values)
+        assert doc.gltf.nodes[_node(doc, "Head content")].mesh is not None
+        assert "KHR_animation_pointer" in doc.json["extensionsUsed"]
+    assert not [note for note in notes if "not " in note and "GLBs" in note]
 
 
 def test_each_level_clip_plays_what_the_input_clip_moves_besides_the_skeleton(character_with_sockets):

@@ -9,6 +9,7 @@ import numpy as np
 import pygltflib
 import pytest
 from gltf_edits import append_accessor, edit_glb
+from gltf_poses import posed_worlds
 from simplify_inputs import ellipsoid, tube, two_bone_tube
 
 from animlod import rotations, synth
@@ -452,11 +453,25 @@ def test_motion_levels_of_an_animation_library_without_skins(tmp_path: Path, cap
     report = build_motion_levels(source, tmp_path / "levels", levels=3)
     assert any("no skinned mesh; the skeleton is its animated node tree (42 joints" in note for note in report.notes)
     assert any("under no node in common with the skeleton's left out: node 44 'sword'" in n for n in report.notes)
+    assert any("GLBs hold the skeleton, its clips" in note and "not its cameras and lights" in note
+               for note in report.notes)  # fmt: skip
+    document = GltfDocument(source)
+    held = posed_worlds(document, 0)[[node.name for node in document.gltf.nodes].index("prop")]
     for index, level in enumerate(report.chain.levels):
         assert report.files[index][1].name == f"clips_lod{index}.glb"
         (written,), _ = read_node_motions(tmp_path / "levels" / report.files[index][1])
         assert written.skeleton.names == level.motion.skeleton.names
         np.testing.assert_allclose(written.world_positions(), level.motion.world_positions(), atol=1e-4)
+        # The prop in the hand comes along, held by the hand or, once it is frozen, by the kept
+        # arm with the hand's key posture between.
+        doc = GltfDocument(tmp_path / "levels" / report.files[index][1])
+        prop = [node.name for node in doc.gltf.nodes].index("prop")
+        assert doc.gltf.nodes[prop].mesh is not None
+        holder = doc.gltf.nodes[doc.parents[prop]].name
+        assert holder == "RightHand" if "RightHand" in written.skeleton.names else holder == "prop frame"
+        if index == 0:
+            np.testing.assert_allclose(posed_worlds(doc, 0)[prop], held, atol=1e-5)
+    assert report.chain.levels[-1].report.joint_count < 42
     assert report.chain.levels[-1].report.joint_count < 42
     capsys.readouterr()
     assert main(["info", str(source)]) == 0

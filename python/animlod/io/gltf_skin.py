@@ -2,7 +2,8 @@
 
 A file without skins (an animation library exported without its mesh) gives its animated node
 tree instead: the nodes its animations move and every node below one that draws nothing (end
-sites, helper bones), with an identity inverse bind.
+sites, helper bones) and holds no prop (a keyless node over a mesh, as animlod's level files hang
+a prop from a frozen joint's kept ancestor), with an identity inverse bind.
 
 The skin's joints are put in topological order (parents first; an order that already is
 topological is kept, so JOINTS_0 of such files need no remapping). Every joint and every
@@ -345,10 +346,11 @@ class SkinRig:
 
 def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
     """The nodes an animation translates, turns or scales, but cameras and lights (the scene's, not
-    the skeleton's), and every node below one that draws nothing (an end site or a bone without
-    keys), in node order; and the labels of the top nodes of trees left out. Animated nodes under
-    no common node (a weapon animated beside the character, a second character) are several
-    trees: the one of the most nodes is the skeleton."""
+    the skeleton's), and every node below one that draws nothing and, unless it holds one of
+    those, holds nothing that draws (an end site or a bone without keys), in node order; and the
+    labels of the top nodes of trees left out. Animated nodes under no common node (a weapon
+    animated beside the character, a second character) are several trees: the one of the most
+    nodes is the skeleton."""
     nodes = doc.gltf.nodes or []
     staging = {
         index
@@ -360,10 +362,19 @@ def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
         raise doc.fail(
             "animations", "no skin, and no animation translates, turns or scales a node: no skeleton to read"
         )
+    # A keyless node whose subtree draws and moves nothing holds a prop (or a camera): not a bone.
+    drawing = {index for index, node in enumerate(nodes) if node.mesh is not None} | staging
+    holds = {ancestor for index in drawing - moved for ancestor in doc.ancestors(index)}
+    carries = {ancestor for index in moved for ancestor in doc.ancestors(index)}
     tree = [
         index
-        for index, node in enumerate(nodes)
-        if index in moved or (node.mesh is None and index not in staging and not moved.isdisjoint(doc.ancestors(index)))
+        for index in range(len(nodes))
+        if index in moved
+        or (
+            index not in drawing
+            and (index in carries or index not in holds)
+            and not moved.isdisjoint(doc.ancestors(index))
+        )
     ]
     trees: dict[int, list[int]] = {}  # by the top node of the scene tree each lies in
     for index in tree:

@@ -8,7 +8,8 @@ material, with the materials of a given document: :class:`FaceMaterials`)
 JOINTS_1/WEIGHTS_1, uint16/uint32 indices, morph targets with their names in
 ``extras.targetNames``), and one LINEAR animation per motion: the root's translation and every
 joint's rotation at every frame (and every joint's translation when the motion has per-frame
-``joint_translations``).
+``joint_translations``). What hangs from the skeleton in a given document (props, sockets, meshes
+its joint nodes draw) can be copied onto the written joints: :class:`HungNodes`.
 
 The pieces (``add_skeleton``, ``add_skin``, ``add_animation``, ``skin_attributes``) also serve
 the LoD GLB writer, which adds reduced skeletons and their clips to a whole input document.
@@ -17,7 +18,7 @@ the LoD GLB writer, which adds reduced skeletons and their clips to a whole inpu
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -29,10 +30,13 @@ from .gltf_skin import END_SITE_EXTRA
 
 INFLUENCES_PER_SET = 4
 _TRIANGLES, _LINEAR = 4, "LINEAR"
-# What of a document's root a mesh drawn with its materials needs; the extensions kept are those
-# materials and textures use.
+# What of a document's root a mesh drawn with its materials needs, and what copies of its nodes
+# need besides (their meshes, cameras and lights).
 _MATERIAL_KEYS = ("asset", "materials", "textures", "samplers", "images", "bufferViews")
-_MATERIAL_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "EXT_texture_")
+_NODE_KEYS = ("nodes", "meshes", "accessors", "cameras")
+_LIGHTS = "KHR_lights_punctual"
+# Extensions a document uses without an "extensions" object naming them where they are used.
+_USAGE_ONLY_EXTENSIONS = ("KHR_mesh_quantization",)
 
 
 class FaceMaterials(NamedTuple):
@@ -44,6 +48,17 @@ class FaceMaterials(NamedTuple):
     indices: np.ndarray
 
 
+class HungNodes(NamedTuple):
+    """What hangs from the written skeleton in ``document``: ``add(builder, joint_nodes,
+    animations)`` appends copies of its nodes (with their meshes, cameras and lights, and the
+    accessors, at the document's indices) under the written joint nodes, and their channels to
+    the written animations (one per motion); the document's own nodes, and its meshes and
+    accessors nothing written uses, are left out of the file."""
+
+    document: GltfDocument
+    add: Callable[[GlbBuilder, list[int], list[int]], None]
+
+
 def write_glb(
     path: str | os.PathLike,
     skinned: SkinnedMesh | None,
@@ -52,6 +67,7 @@ def write_glb(
     durations: Sequence[float | None] | None = None,
     materials: FaceMaterials | None = None,
     morph_weights: Sequence[np.ndarray | None] | None = None,
+    hung: HungNodes | None = None,
 ) -> None:
     """Write ``skinned`` and ``motions`` (on its skeleton) to the GLB file ``path``, atomically.
 
@@ -67,11 +83,13 @@ def write_glb(
     materials : the material of each of ``skinned``'s faces, or None (no material).
     morph_weights : per motion, (T, N) the weights of ``skinned``'s N morph targets at its T
         frames, written as a channel of the mesh node, or None.
+    hung : what hangs from the skeleton, copied from a document (the same as ``materials``'s).
 
     Raises
     ------
     ValueError if a motion is on another skeleton, ``names``, ``durations``, ``materials`` or
-    ``morph_weights`` has the wrong length or shape, or there is neither a mesh nor a motion.
+    ``morph_weights`` has the wrong length or shape, ``materials`` and ``hung`` are of two
+    documents, or there is neither a mesh nor a motion.
     """
     names = _animation_names(motions, names)
     if durations is not None and len(durations) != len(motions):
@@ -85,21 +103,32 @@ def write_glb(
         faces = 0 if skinned is None else skinned.face_count
         raise ValueError(f"materials: {len(materials.indices)} face materials for {faces} faces")
     weights = _checked_morph_weights(skinned, motions, morph_weights)
-    builder = GlbBuilder() if materials is None else _materials_of(materials.document)
+    if materials is not None and hung is not None and materials.document is not hung.document:
+        raise ValueError("hung: its document is not the one of materials")
+    source = materials.document if materials is not None else hung.document if hung is not None else None
+    builder = GlbBuilder() if source is None else _base_of(source, hung is not None)
+    dropped = len(builder.json.get("nodes", []))  # the document's own, for the copies to read
     joint_nodes = add_skeleton(builder, skeleton)
     scene_nodes = [joint_nodes[0]]
     if skinned is not None:
         skin = add_skin(builder, joint_nodes, skinned.inverse_bind)
         mesh = builder.append("meshes", _mesh(builder, skinned, None if materials is None else materials.indices))
         scene_nodes.append(builder.append("nodes", {"name": "skinned mesh", "mesh": mesh, "skin": skin}))
+    animations = []
     for motion, name, duration, track in zip(motions, names, durations or [None] * len(motions), weights):
-        animation = add_animation(builder, motion, joint_nodes, name, duration=duration)
+        animations.append(add_animation(builder, motion, joint_nodes, name, duration=duration))
         if track is not None:
-            _add_weights_channel(builder, builder.json["animations"][animation], scene_nodes[-1], track)
+            _add_weights_channel(builder, builder.json["animations"][animations[-1]], scene_nodes[-1], track)
+    if hung is not None:
+        hung.add(builder, joint_nodes, animations)
     builder.json["scenes"] = [{"nodes": scene_nodes}]
     builder.json["scene"] = 0
-    if materials is not None:
-        builder.prune()  # the document's mesh and animation data
+    if source is not None:
+        own_meshes = 0 if skinned is None else 1
+        _drop_first_nodes(builder.json, dropped)
+        _list_extensions_used(builder.json, source, own_meshes)  # for prune to know what may refer to data
+        builder.prune()  # the document's meshes and accessors nothing written uses
+        _list_extensions_used(builder.json, source, own_meshes)
     builder.save(path)
 
 
@@ -133,19 +162,65 @@ def _add_weights_channel(builder: GlbBuilder, animation: dict, node: int, weight
     )
 
 
-def _materials_of(document: GltfDocument) -> GlbBuilder:
+def _base_of(document: GltfDocument, with_nodes: bool) -> GlbBuilder:
     """A new document holding ``document``'s materials at their indices, with their textures,
-    samplers and images (embedded) and the extensions they use."""
+    samplers and images (embedded); ``with_nodes``: its nodes, meshes, accessors, cameras and
+    lights too, for copies of its nodes to read (:func:`_drop_first_nodes` then leaves the nodes)."""
     builder = GlbBuilder.from_document(document)
     js = builder.json
-    for key in set(js) - set(_MATERIAL_KEYS):
+    kept = _MATERIAL_KEYS + (_NODE_KEYS if with_nodes else ())
+    lights = (js.get("extensions") or {}).get(_LIGHTS)
+    for key in set(js) - set(kept):
         del js[key]
-    for listed in ("extensionsUsed", "extensionsRequired"):
-        kept = [name for name in document.json.get(listed, []) if name.startswith(_MATERIAL_EXTENSIONS)]
-        if kept:
-            js[listed] = kept
+    if with_nodes and lights is not None:
+        js["extensions"] = {_LIGHTS: lights}
     js["asset"] = {**js.get("asset", {}), "generator": "animlod"}
     return builder
+
+
+def _drop_first_nodes(js: dict, count: int) -> None:
+    """The first ``count`` nodes out of ``js``, whose other nodes refer to none of them; the node
+    indices of the scenes, nodes, skins and animations shifted down. A node's MSFT_lod levels
+    among them go with them."""
+    nodes = js.get("nodes", [])
+    del nodes[:count]
+    for node in nodes:
+        if "children" in node:
+            node["children"] = [child - count for child in node["children"]]
+        lod = (node.get("extensions") or {}).pop("MSFT_lod", None)
+        if lod is not None and not node["extensions"]:
+            del node["extensions"]
+    for scene in js.get("scenes", []):
+        scene["nodes"] = [node - count for node in scene["nodes"]]
+    for skin in js.get("skins", []):
+        skin["joints"] = [joint - count for joint in skin["joints"]]
+        if "skeleton" in skin:
+            skin["skeleton"] -= count
+    for animation in js.get("animations", []):
+        for channel in animation["channels"]:
+            if "node" in channel["target"]:  # not a KHR_animation_pointer channel
+                channel["target"]["node"] -= count
+
+
+def _list_extensions_used(js: dict, document: GltfDocument, own_meshes: int) -> None:
+    """``js``'s extensionsUsed and extensionsRequired: those of ``document`` that it uses; the
+    meshes beyond the ``own_meshes`` written are ``document``'s."""
+    used = set(_USAGE_ONLY_EXTENSIONS) if len(js.get("meshes", [])) > own_meshes else set()
+    stack = [js]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, dict):
+            extensions = item.get("extensions")
+            used.update(extensions if isinstance(extensions, dict) else ())
+            stack.extend(item.values())
+        elif isinstance(item, list):
+            stack.extend(item)
+    for listed in ("extensionsUsed", "extensionsRequired"):
+        kept = [name for name in document.json.get(listed, []) if name in used]
+        if kept:
+            js[listed] = kept
+        else:
+            js.pop(listed, None)
 
 
 def add_skeleton(builder: GlbBuilder, skeleton: Skeleton, name_suffix: str = "") -> list[int]:

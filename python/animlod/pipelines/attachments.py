@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..io.glb_builder import GlbBuilder
-from ..io.gltf_document import GltfDocument
+from ..io.gltf_document import POINTER_EXTENSION, GltfDocument
 from ..io.gltf_skin import SkinRig
 from ..model import Motion
 from ..motion_lod.chain import MotionLevel
@@ -32,6 +32,8 @@ from ..motion_lod.skeleton_reduce import expand_motion
 
 # What a joint node draws or holds besides its transform and children (lights are an extension).
 _CONTENT = ("mesh", "camera", "weights", "extensions")
+# What KHR_animation_pointer channels of a standalone level file may point at.
+_STANDALONE_POINTERS = ("/materials/", "/textures/", "/cameras/", "/extensions/KHR_lights_punctual/")
 
 
 @dataclass(frozen=True)
@@ -62,6 +64,14 @@ def find_attachments(doc: GltfDocument, rig: SkinRig) -> list[Attachment]:
     return attachments
 
 
+def hung_nodes(doc: GltfDocument, attachments: list[Attachment]) -> set[int]:
+    """The nodes whose content the copies of ``attachments`` carry."""
+    found = set()
+    for attachment in attachments:
+        found |= {attachment.node} if attachment.content_only else _subtree(doc, attachment.node)
+    return found
+
+
 def posing_nodes(doc: GltfDocument) -> set[int]:
     """Nodes that pose a skeleton: every skin's joints and their ancestors (a level's clip poses
     its own skeleton in their place)."""
@@ -79,12 +89,12 @@ def add_level_attachments(
     attachments: list[Attachment],
     original: Motion,
     level: MotionLevel,
-    level_index: int,
     joint_nodes: list[int],
+    suffix: str = "",
 ) -> dict[int, int]:
-    """Copies of ``attachments`` on motion level ``level_index``'s skeleton, whose joint nodes
-    (level joint order) are ``joint_nodes``; ``original`` is the motion the level reduces.
-    Returns the copy of each node of the copied subtrees."""
+    """Copies of ``attachments`` on ``level``'s skeleton, whose joint nodes (level joint order) are
+    ``joint_nodes``, their names ending in ``suffix``; ``original`` is the motion the level
+    reduces. Returns the copy of each node of the copied subtrees."""
     frozen = level.frozen
     level_joint = np.full(frozen.frozen.size, -1, dtype=np.int64)
     level_joint[frozen.kept_indices] = np.arange(frozen.kept_indices.size)
@@ -93,7 +103,6 @@ def add_level_attachments(
     first = np.array([0])
     world = expand_motion(frozen, level.motion.take_frames(first), original.take_frames(first)).world_transforms()[0]
     parents = frozen.skeleton.parents
-    suffix = f"@motion{level_index}"
     copies: dict[int, int] = {}
     for attachment in attachments:
         ancestor = attachment.joint
@@ -112,9 +121,9 @@ def add_level_attachments(
         if attachment.content_only:
             source = builder.json["nodes"][attachment.node]
             content = {key: deepcopy(source[key]) for key in _CONTENT if key in source}
-            top = copies[attachment.node] = builder.append(
-                "nodes", {"name": f"{_name(builder, attachment.node)}{suffix}", **content}
-            )
+            # Named apart from the joint's own node where no suffix does.
+            name = f"{_name(builder, attachment.node)}{suffix or ' content'}"
+            top = copies[attachment.node] = builder.append("nodes", {"name": name, **content})
         else:
             top = _copy_subtree(builder, attachment.node, suffix, copies)
         builder.json["nodes"][parent].setdefault("children", []).append(top)
@@ -128,15 +137,21 @@ def carry_other_channels(
     animation: int,
     level_animation: int,
     copies: dict[int, int],
+    standalone: bool = False,
 ) -> None:
-    """Adds to ``level_animation`` the channels of the document's ``animation`` that pose no
-    skeleton (not on a node of ``posing``, :func:`posing_nodes`; a joint's morph weights do not
-    pose it), on the attachments' copies where they have one; KHR_animation_pointer channels of
-    anything but a node (a material's colour) as they are. The samplers reuse the input's
-    accessors: both clips' times start at 0."""
-    source = builder.json["animations"][animation]
+    """Adds to ``level_animation`` of ``builder`` (which holds the accessors of ``doc``'s at their
+    indices) the channels of the document's ``animation`` that pose no skeleton (not on a node
+    of ``posing``, :func:`posing_nodes`; a joint's morph weights do not pose it), on the
+    attachments' copies where they have one; KHR_animation_pointer channels of anything but a
+    node (a material's colour) as they are. ``standalone``: for a file of its own, which holds
+    of the document only the copies and its materials, textures, cameras and lights (at their
+    indices): the channels of the copies and the pointers at those. The samplers reuse the
+    input's accessors: both clips' times start at 0."""
+    source = doc.json["animations"][animation]
     target = builder.json["animations"][level_animation]
     for channel, (node, path) in zip(source.get("channels", []), doc.channel_targets[animation]):
+        if standalone and node not in copies and not standalone_pointer(channel["target"]):
+            continue
         if path == "pointer":
             carried = deepcopy(channel["target"])
         elif node is None or (node in posing and path != "weights"):
@@ -146,6 +161,13 @@ def carry_other_channels(
             carried = {**kept, "node": copies.get(node, node), "path": path}
         target["samplers"].append(deepcopy(source["samplers"][channel["sampler"]]))
         target["channels"].append({"sampler": len(target["samplers"]) - 1, "target": carried})
+
+
+def standalone_pointer(target: dict) -> bool:
+    """Whether a channel's ``target`` is a KHR_animation_pointer at what a standalone level file
+    keeps at the document's indices (:func:`carry_other_channels`)."""
+    pointer = (target.get("extensions") or {}).get(POINTER_EXTENSION) or {}
+    return str(pointer.get("pointer", "")).startswith(_STANDALONE_POINTERS)
 
 
 def _subtree(doc: GltfDocument, node: int) -> set[int]:

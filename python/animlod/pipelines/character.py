@@ -399,7 +399,9 @@ def _add_motion_levels(builder: GlbBuilder, doc: GltfDocument, motion: _SkinMoti
     attachments, posing = find_attachments(doc, motion.rig), posing_nodes(doc)
     for m, level in enumerate(motion.reduced_levels, start=1):
         joint_nodes = add_skeleton(builder, level.motion.skeleton)
-        copies = add_level_attachments(builder, doc, motion.rig, attachments, motion.joined, level, m, joint_nodes)
+        copies = add_level_attachments(
+            builder, doc, motion.rig, attachments, motion.joined, level, joint_nodes, f"@motion{m}"
+        )
         for clip, span in motion.clips:
             name = f"{clip.name or f'animation {clip.index}'}@motion{m}"
             extras = {"animlod": {"clip": clip.index, "motion_level": m}}

@@ -27,8 +27,11 @@ from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from .result import AssetResult, LevelRow, Progress
 
 if TYPE_CHECKING:
+    from ..io.glb_builder import GlbBuilder
     from ..io.gltf_document import GltfDocument
-    from ..io.gltf_write import FaceMaterials
+    from ..io.gltf_skin import SkinRig
+    from ..io.gltf_write import FaceMaterials, HungNodes
+    from .attachments import Attachment
 
 
 @dataclass
@@ -138,7 +141,7 @@ def build_motion_levels(
         if on_note is not None:
             on_note(text)
 
-    motion, played, skin, materials, layout = _read_input(source, clip, clips, joint_map, note)
+    motion, played, skin, materials, layout, hanging = _read_input(source, clip, clips, joint_map, note)
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
@@ -195,7 +198,8 @@ def build_motion_levels(
             names.append(Path(f"{stem}_lod{index}.glb"))
             clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
             weights = [clip.morph_weights for clip in played]
-            write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations, materials, weights)
+            hung = None if hanging is None else hanging.on_level(motion, level, played)
+            write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations, materials, weights, hung)
         files.append(names)
         row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
                "error": level.report.max_error}  # fmt: skip
@@ -223,13 +227,52 @@ _GLTF_FPS = 30.0
 
 class PlayedClip(NamedTuple):
     """A clip of the simplified motion: its name, its frames in the motion, and for a glTF clip
-    its length in seconds (its last key, which may fall between two sampled frames) and the
-    weights its channels give the skinned mesh's morph targets at its frames (T, N), if any."""
+    its length in seconds (its last key, which may fall between two sampled frames), the
+    weights its channels give the skinned mesh's morph targets at its frames (T, N), if any, and
+    the document's animation it is (None for several joined into one)."""
 
     name: str
     frames: slice
     duration: float | None = None
     morph_weights: np.ndarray | None = None
+    animation: int | None = None
+
+
+class _Hanging(NamedTuple):
+    """What hangs from a glTF rig's joints (props, sockets, meshes its joint nodes draw)."""
+
+    document: GltfDocument
+    rig: SkinRig
+    attachments: list[Attachment]
+
+    def on_level(self, original: Motion, level: MotionLevel, played: list[PlayedClip]) -> HungNodes:
+        """The attachments' copies on ``level`` of ``original``, for its GLB, with the channels that
+        animate them in each of the ``played`` clips that is one of the document's animations."""
+        from ..io.gltf_write import HungNodes
+        from .attachments import add_level_attachments, carry_other_channels, posing_nodes
+
+        def add(builder: GlbBuilder, joint_nodes: list[int], animations: list[int]) -> None:
+            document, rig = self.document, self.rig
+            copies = add_level_attachments(builder, document, rig, self.attachments, original, level, joint_nodes)
+            posing = posing_nodes(document)
+            for clip, animation in zip(played, animations):
+                if clip.animation is not None:
+                    carry_other_channels(builder, document, posing, clip.animation, animation, copies, standalone=True)
+
+        return HungNodes(self.document, add)
+
+
+class _Input(NamedTuple):
+    """What :func:`_read_input` reads: the motion to simplify, the clips it is made of, for a
+    skinned glTF its skin and materials, for a BVH its layout, and what hangs from a glTF's
+    skeleton (None where nothing does)."""
+
+    motion: Motion
+    played: list[PlayedClip]
+    skin: SkinnedMesh | None = None
+    materials: FaceMaterials | None = None
+    layout: BvhLayout | None = None
+    hanging: _Hanging | None = None
 
 
 # Vertex-frames times levels measured between two progress calls of skin_distances (about half a
@@ -263,10 +306,11 @@ def _read_input(
     clip_files: Sequence[str],
     joint_map: str | os.PathLike | None,
     note: Callable[[str], None],
-) -> tuple[Motion, list[PlayedClip], SkinnedMesh | None, FaceMaterials | None, BvhLayout | None]:
+) -> _Input:
     """The motion to simplify, the clips it is made of (each one's name and frames in it), for a
-    skinned glTF its skin (None for a glTF without skins: the animated node tree is the skeleton)
-    and for a BVH its layout. ``clip_files`` add to a glTF's clips (BVH ones matched by ``joint_map``)."""
+    skinned glTF its skin (None for a glTF without skins: the animated node tree is the skeleton),
+    for a BVH its layout, and what hangs from a glTF's skeleton. ``clip_files`` add to a glTF's
+    clips (BVH ones matched by ``joint_map``)."""
     path = os.fspath(source)
     kind = input_kind(source)
     if (clip_files or joint_map is not None) and kind != "gltf":
@@ -276,7 +320,7 @@ def _read_input(
         from ..io.bvh import read_bvh_with_layout
 
         motion, layout = read_bvh_with_layout(source)
-        return motion, [PlayedClip(motion.name, slice(None))], None, None, layout
+        return _Input(motion, [PlayedClip(motion.name, slice(None))], layout=layout)
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
     from ..io.gltf import read_gltf
@@ -284,6 +328,7 @@ def _read_input(
     from ..io.gltf_read import rig_motions
     from ..io.gltf_skin import SkinRig
     from ..io.gltf_write import FaceMaterials
+    from .attachments import find_attachments
     from .clip_import import with_clips
     from .whole_skin import whole_skin
 
@@ -293,6 +338,7 @@ def _read_input(
     if scene.skinned_meshes:
         whole = whole_skin(document, scene, note, _GLTF_FPS)
         skin, motions, animations, left_out = whole.mesh, whole.motions, whole.animations, whole.left_out
+        rig = whole.rig
         materials, morph_weights = FaceMaterials(document, whole.face_materials), whole.morph_weights
         if skin.vertex_count > scene.skinned_meshes[scene.body].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
@@ -302,10 +348,7 @@ def _read_input(
                  "takes every skin)")  # fmt: skip
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
-        unwritten = _left_out_of_level_files(document, set(whole.part_nodes))
-        if unwritten:
-            note(f"{path}: the levels' GLBs hold the skinned mesh with its materials, its skeleton and its clips; "
-                 f"not {unwritten} (`animlod character` keeps the whole document)")  # fmt: skip
+        joined_nodes = set(whole.part_nodes)
     else:  # an animation library exported without its mesh
         rig, skin, materials, morph_weights = SkinRig(document, None), None, None, {}
         motions, animations, other_trees = (
@@ -313,12 +356,19 @@ def _read_input(
             rig.animations(document),
             rig.trees_left_out,
         )
-        skeleton = motions[0].skeleton
+        skeleton, joined_nodes = motions[0].skeleton, set()
         note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
              f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clips")  # fmt: skip
         if other_trees:
             note(f"{path}: animated nodes under no node in common with the skeleton's left out: "
                  f"{', '.join(other_trees)}")  # fmt: skip
+    attachments = find_attachments(document, rig)
+    hanging = _Hanging(document, rig, attachments) if attachments else None
+    unwritten = _left_out_of_level_files(document, joined_nodes, attachments)
+    if unwritten:
+        whole_document = " (`animlod character` keeps the whole document)" if skin is not None else ""
+        note(f"{path}: the levels' GLBs hold the skeleton, its clips, the skinned mesh if any with its materials, "
+             f"and what hangs from the joints; not {unwritten}{whole_document}")  # fmt: skip
     names = [motion.name or f"animation{index}" for index, motion in enumerate(motions)]
     durations = [document.animation_duration(animation) for animation in animations]
     if clip is None:
@@ -328,11 +378,11 @@ def _read_input(
         if merged is not None:
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
-            if morph_weights:
-                note(f"{path}: its morph weight channels are not in the levels' GLBs (their animations are joined "
-                     "into one motion)")  # fmt: skip
+            if morph_weights or _animates(document, hanging):
+                note(f"{path}: its morph weight channels and those of what hangs from its joints are not in the "
+                     "levels' GLBs (their animations are joined into one motion)")  # fmt: skip
             played = PlayedClip(merged.name, slice(None), max(durations))
-            return _rigid(path, motions, range(len(motions)), merged), [played], skin, materials, None
+            return _Input(_rigid(path, motions, range(len(motions)), merged), [played], skin, materials, None, hanging)
         # A clip that scales a joint cannot be re-fitted; the others still make levels.
         rigid = [index for index, motion in enumerate(motions) if motion.deforming_joint() is None]
         scaling = [names[index] for index in range(len(motions)) if index not in rigid]
@@ -343,9 +393,10 @@ def _read_input(
             note(f"{path}: its {len(rigid)} animations simplified together, one skeleton per level for all of "
                  "them (use --clip to take one)")  # fmt: skip
             joined, spans = join_clips([motions[index] for index in rigid])
-            played = [PlayedClip(names[index], span, durations[index], morph_weights.get(animations[index]))
+            played = [PlayedClip(names[index], span, durations[index], morph_weights.get(animations[index]),
+                                 animations[index])
                       for index, span in zip(rigid, spans)]  # fmt: skip
-            return joined, played, skin, materials, None
+            return _Input(joined, played, skin, materials, None, hanging)
         clip = rigid[0] if rigid else 0
     if isinstance(clip, str):
         if clip not in names:
@@ -354,24 +405,43 @@ def _read_input(
         clip = names.index(clip)
     if not 0 <= clip < len(motions):
         raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
-    played = [PlayedClip(names[clip], slice(None), durations[clip], morph_weights.get(animations[clip]))]
-    return _rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None
+    animation = animations[clip]
+    played = [PlayedClip(names[clip], slice(None), durations[clip], morph_weights.get(animation), animation)]
+    return _Input(_rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None, hanging)
 
 
-def _left_out_of_level_files(doc: GltfDocument, joined: set[int]) -> str:
+def _left_out_of_level_files(doc: GltfDocument, joined: set[int], attachments: list[Attachment]) -> str:
     """What of ``doc`` the motion levels' GLBs (a skinned mesh with its materials and the morph
-    weight channels of the ``joined`` nodes' meshes, a skeleton and its joint channels) do not
-    carry, as words for a note; empty where that is nothing."""
-    gltf = doc.gltf
+    weight channels of the ``joined`` nodes' meshes, a skeleton and its joint channels, copies of
+    the ``attachments`` with their channels) do not carry, as words for a note; empty where that
+    is nothing."""
+    from .attachments import hung_nodes, standalone_pointer
+
+    hung = hung_nodes(doc, attachments)
+    elsewhere = [node for n, node in enumerate(doc.gltf.nodes or []) if n not in hung]
     parts = []
-    meshes = sum(node.mesh is not None and node.skin is None for node in gltf.nodes or [])
+    meshes = sum(node.mesh is not None and node.skin is None for node in elsewhere)
     if meshes:
-        parts.append(f"{meshes} mesh{'es' if meshes > 1 else ''} without a skin (props, static parts)")
-    if any(path == "weights" and node not in joined for targets in doc.channel_targets for node, path in targets):
+        parts.append(f"{meshes} mesh{'es' if meshes > 1 else ''} without a skin elsewhere (static parts, scenery)")
+    channels = [(node, path) for targets in doc.channel_targets for node, path in targets]
+    if any(path == "weights" and node not in joined | hung for node, path in channels):
         parts.append("the morph weight channels of other meshes")
-    if gltf.cameras or (gltf.extensions or {}).get("KHR_lights_punctual"):
-        parts.append("its cameras and lights")
+    pointers = [channel["target"] for animation in doc.json.get("animations", []) for channel in animation["channels"]]
+    if any(target.get("path") == "pointer" and not standalone_pointer(target) for target in pointers):
+        parts.append("KHR_animation_pointer channels at meshes or other objects")
+    if any(node.camera is not None or "KHR_lights_punctual" in (node.extensions or {}) for node in elsewhere):
+        parts.append("its cameras and lights elsewhere")
     return ", ".join(parts[:-1]) + (" or " if len(parts) > 1 else "") + (parts[-1] if parts else "")
+
+
+def _animates(doc: GltfDocument, hanging: _Hanging | None) -> bool:
+    """Whether an animation of ``doc`` moves what hangs from its skeleton."""
+    if hanging is None:
+        return False
+    from .attachments import hung_nodes
+
+    hung = hung_nodes(doc, hanging.attachments)
+    return any(node in hung for targets in doc.channel_targets for node, _ in targets)
 
 
 def _clip_suffixes(names: list[str]) -> list[str]:

@@ -19,6 +19,7 @@ import numpy as np
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_mesh import read_mesh_geometry
 from ..io.gltf_read import GltfScene, morph_weight_tracks, read_skinned_node
+from ..io.gltf_skin import SkinRig
 from ..model import Motion, SkinnedMesh, morphed
 from ..motion_lod.clips import join_clips
 from ..normals import vertex_normals
@@ -37,6 +38,7 @@ class WholeSkin:
     face_materials : (F,) each face's material (index in the document's materials, -1 for none).
     left_out : how many skinned meshes of the document are not in it.
     part_nodes : the nodes whose meshes it joins, the body's first.
+    rig : the skeleton's rig (the body's, with the bones of parts that join it).
     morph_weights : per animation that drives a part's morph weights (its index in the document),
         (T, N) the joined targets' weights at the animation's sampled frames; a target no part's
         channel drives keeps its default, and the first part's channel drives a shared one.
@@ -49,6 +51,7 @@ class WholeSkin:
     left_out: int
     part_nodes: list[int]
     morph_weights: dict[int, np.ndarray]
+    rig: SkinRig
 
 
 def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None], fps: float) -> WholeSkin:
@@ -87,7 +90,7 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
         count = 0 if body.morph_targets is None else len(body.morph_targets)
         defaults = np.zeros(count) if body.default_morph_weights is None else body.default_morph_weights
         tracks = _weight_tracks(doc, part_nodes, [list(range(count))], defaults, fps)
-        return WholeSkin(body, motions, rig.animations(doc), materials, left_out, part_nodes, tracks)
+        return WholeSkin(body, motions, rig.animations(doc), materials, left_out, part_nodes, tracks, rig)
     influences = max(part.joints.shape[1] for part in parts)
     starts = np.cumsum([0] + [part.vertex_count for part in parts])
 
@@ -117,7 +120,7 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
         default_morph_weights=defaults,
     )
     tracks = {} if defaults is None else _weight_tracks(doc, part_nodes, places, defaults, fps)
-    return WholeSkin(whole, motions, rig.animations(doc), materials, left_out, part_nodes, tracks)
+    return WholeSkin(whole, motions, rig.animations(doc), materials, left_out, part_nodes, tracks, rig)
 
 
 def _weight_tracks(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from simplify_inputs import bending_tube
 
 from animlod.cli import main
@@ -22,6 +23,37 @@ def test_simplify_an_obj_sequence_writes_each_level_as_a_sequence(tmp_path, caps
     printed = capsys.readouterr()
     assert "AQEM error" in printed.out and "180" in printed.out
     assert "\r" not in printed.err  # no progress bar where stderr is no terminal
+
+
+def test_each_level_frame_keeps_its_input_file_name(tmp_path):
+    """Level frames were written as frame_0000, frame_0001, ...: a capture's frame numbers
+    (mesh_0048 .. mesh_0050) were lost. Where two frames share a name (a.obj and a.ply), the
+    level's frames are numbered."""
+    tube = bending_tube(frames=3)
+    write_sequence(tmp_path / "capture", tube, names=["mesh_0048", "mesh_0049", "mesh_0050"])
+    assert main(["simplify", str(tmp_path / "capture"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    for level in (1, 2, 3):
+        written = sorted(path.name for path in (tmp_path / "out" / f"capture_lod{level}").iterdir())
+        assert written == ["mesh_0048.obj", "mesh_0049.obj", "mesh_0050.obj"]
+    # Each name holds its own frame: the level's frame is nearest to the input's of its name.
+    level = read_sequence(tmp_path / "out" / "capture_lod1")
+    centres = tube.frames.mean(axis=1)
+    nearest = [np.linalg.norm(centres - frame.mean(axis=0), axis=1).argmin() for frame in level.frames]
+    assert nearest == [0, 1, 2] and len(np.unique(centres.round(3), axis=0)) == 3
+    (tmp_path / "twice").mkdir()
+    write_mesh(tmp_path / "twice" / "a.obj", tube.frames[0], tube.faces)
+    write_mesh(tmp_path / "twice" / "a.ply", tube.frames[1], tube.faces)
+    assert main(["simplify", str(tmp_path / "twice"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    assert sorted(path.name for path in (tmp_path / "out" / "twice_lod1").iterdir()) == [
+        "frame_0000.ply",
+        "frame_0001.ply",
+    ]
+    with pytest.raises(ValueError, match="names: 2 names for 3 frames, or names that repeat"):
+        write_sequence(tmp_path / "bad", tube, names=["a", "b"])
+    for names in (["a", "A", "b"], ["a", "b", "../c"], ["a", "b", ".c"]):
+        with pytest.raises(ValueError, match="names that repeat"):
+            write_sequence(tmp_path / "bad", tube, names=names)
+    assert not (tmp_path / "bad").exists()
 
 
 def test_one_mesh_file_gives_one_file_per_level_and_dotted_names_keep_their_levels_apart(tmp_path):

@@ -63,23 +63,43 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
     return AnimatedMesh(faces, frames, fps=fps)
 
 
-def write_sequence(folder: str | os.PathLike, mesh: AnimatedMesh, fmt: str = "obj", stem: str = "frame") -> list[Path]:
-    """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, the folder atomically.
+def write_sequence(
+    folder: str | os.PathLike,
+    mesh: AnimatedMesh,
+    fmt: str = "obj",
+    stem: str = "frame",
+    names: Sequence[str] | None = None,
+) -> list[Path]:
+    """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
+    ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically.
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
     ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
     interrupted run never leaves a folder short of frames under the final name. An existing
     ``folder`` is replaced as a whole. ``fmt`` is "obj" or "ply" (binary little-endian).
-    Returns the written paths in frame order.
+    Returns the written paths in frame order. ValueError for another ``fmt``, or ``names`` that
+    are not one file name per frame, distinct regardless of case.
     """
     if fmt not in ("obj", "ply"):
         raise ValueError(f"{os.fspath(folder)}: fmt: must be 'obj' or 'ply', got {fmt!r}")
-    width = max(4, len(str(mesh.frame_count - 1)))
-    names = [f"{stem}_{index:0{width}d}.{fmt}" for index in range(mesh.frame_count)]
+    if names is None:
+        width = max(4, len(str(mesh.frame_count - 1)))
+        names = [f"{stem}_{index:0{width}d}" for index in range(mesh.frame_count)]
+    elif not frame_names_fit(names, mesh.frame_count):
+        raise ValueError(f"{os.fspath(folder)}: names: {len(names)} names for {mesh.frame_count} frames, or names "
+                         "that repeat (regardless of case) or are not plain file names")  # fmt: skip
+    names = [f"{name}.{fmt}" for name in names]
     with atomic_folder(folder) as temporary:
         for name, vertices in zip(names, mesh.frames):
             write_mesh(temporary / name, vertices, mesh.faces)
     return [Path(folder) / name for name in names]
+
+
+def frame_names_fit(names: Sequence[str], frames: int) -> bool:
+    """Whether ``names`` can name ``frames`` frame files of one folder: one each, plain file names
+    (no folder, not hidden), distinct regardless of case (as case-insensitive file systems see them)."""
+    plain = all(name and Path(name).name == name and not name.startswith(".") for name in names)
+    return plain and len(names) == frames and len({name.casefold() for name in names}) == frames
 
 
 # A number in a frame name, with its sign where a minus follows a separator.

@@ -1,9 +1,9 @@
 """A deforming mesh sequence in (OBJ/PLY frames or NPZ), its AQEM levels out in the same format.
 
-Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OBJ/PLY frames,
-``<stem>_lod<i>.obj`` (or ``.ply``) for one mesh file, ``<stem>_lod<i>.npz`` for NPZ input, and
-measured against the input frame by frame (symmetric Hausdorff and RMS distance relative to the
-bounding-box diagonal).
+Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OBJ/PLY frames
+(each frame under its input file's name), ``<stem>_lod<i>.obj`` (or ``.ply``) for one mesh file,
+``<stem>_lod<i>.npz`` for NPZ input, and measured against the input frame by frame (symmetric
+Hausdorff and RMS distance relative to the bounding-box diagonal).
 """
 
 from __future__ import annotations
@@ -127,21 +127,26 @@ def _surface_error(original: AnimatedMesh, level: AnimatedMesh) -> SurfaceError:
 @dataclass(frozen=True)
 class _LevelFormat:
     """How the levels are written: ``suffix`` "npz", "obj" or "ply"; ``one_file`` for a single
-    mesh or an NPZ, else a folder of frames per level."""
+    mesh or an NPZ, else a folder of frames per level, each frame under its input file's name
+    (``frame_names``, without the suffix), or numbered where those names would collide."""
 
     suffix: str
     one_file: bool
+    frame_names: list[str] | None = None
 
 
 def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
     """The input's format: NPZ, one OBJ/PLY file, or frames (PLY when a frame is PLY)."""
     if kind == "npz":
         return _LevelFormat("npz", True)
-    from ..io.meshseq import sequence_paths
+    from ..io.meshseq import frame_names_fit, sequence_paths
 
     # The frames read, not the source's name: "frames/*" holds PLY frames without saying so.
-    suffix = "ply" if any(path.suffix.lower() == ".ply" for path in sequence_paths(source)) else "obj"
-    return _LevelFormat(suffix, isinstance(source, str | os.PathLike) and Path(source).is_file())
+    paths = sequence_paths(source)
+    suffix = "ply" if any(path.suffix.lower() == ".ply" for path in paths) else "obj"
+    names = [path.stem for path in paths]  # two frames of one name (a.obj, a.ply; a glob over folders): numbered
+    return _LevelFormat(suffix, isinstance(source, str | os.PathLike) and Path(source).is_file(),
+                        names if frame_names_fit(names, len(paths)) else None)  # fmt: skip
 
 
 def _write_level(fmt: _LevelFormat, target: Path, mesh: AnimatedMesh) -> Path:
@@ -152,7 +157,7 @@ def _write_level(fmt: _LevelFormat, target: Path, mesh: AnimatedMesh) -> Path:
         from ..io.meshseq import write_sequence
 
         target.mkdir(parents=True, exist_ok=True)
-        write_sequence(target, mesh, fmt.suffix)
+        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names)
         return target
     path = target.with_name(f"{target.name}.{fmt.suffix}")
     if fmt.suffix == "npz":

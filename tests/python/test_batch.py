@@ -177,6 +177,19 @@ def test_second_run_does_no_work_and_a_changed_option_redoes_one_asset(client, l
         run_batch(changed, tmp_path / "out", scheduler="tcp://127.0.0.1:9", connect_timeout=1)
     assert read_catalogue(third.catalogue).to_pylist() == [{**row, "ran": False} for row in listed]
 
+    # An asset renamed ("seq" -> "seq_frames") or taken out of the spec ("bar") leaves its folder
+    # as it is: named in a note, out of the catalogue.
+    assert not [note for note in [*first.notes, *third.notes] if "earlier runs" in note]
+    renamed = [type(asset)("seq_frames" if asset.name == "seq" else asset.name, asset.input, asset.kind, asset.job,
+                           asset.options) for asset in assets if asset.name != "bar"]  # fmt: skip
+    fourth = run_batch(renamed, tmp_path / "out", client=client)
+    assert (fourth.ran, fourth.skipped) == (1, 3)
+    (earlier,) = [note for note in fourth.notes if "earlier runs" in note]
+    assert "2 asset folders of earlier runs not in this batch (bar, seq): left as they are" in earlier
+    assert (tmp_path / "out" / "seq").is_dir() and (tmp_path / "out" / "bar").is_dir()
+    listed = {row["asset"] for row in read_catalogue(fourth.catalogue).to_pylist()}
+    assert "seq_frames" in listed and not listed & {"seq", "bar"}
+
 
 def test_killed_worker_leaves_no_partial_file_and_the_asset_is_redone(client, library, tmp_path):
     source = library / "characters" / "cyl0.glb"

@@ -114,5 +114,12 @@ def read_record(root: Path, name: str) -> dict | None:
     return record if isinstance(record, dict) else None
 
 
+def earlier_assets(root: Path, names: set[str]) -> list[str]:
+    """The assets of earlier runs into ``root`` that ``names`` does not hold: the folders with a
+    record (an asset renamed or taken out of the spec since), by name."""
+    found = (path.parent.relative_to(root).as_posix() for path in root.rglob(RECORD))
+    return sorted(name for name in found if name not in names and not name.startswith(BATCH_STATE))
+
+
 def discard(staging: Path) -> None:
     shutil.rmtree(staging, ignore_errors=True)

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 
 from .catalogue import record_rows, write_catalogue
 from .fingerprint import fingerprint
-from .outputs import CATALOGUE, clear_staging, output_lock, prepare_output, read_record
+from .outputs import CATALOGUE, clear_staging, earlier_assets, output_lock, prepare_output, read_record
 from .progress import BatchProgress
 from .spec import AssetSpec
 from .task import describe_error, run_asset
@@ -182,6 +182,11 @@ def run_batch(
             on_disk = {asset.name: read_record(root, asset.name) for asset in assets if asset.name not in records}
             _write(root, assets, records, ran_flags, on_disk)
             clear_staging(root)
+        others = earlier_assets(root, {asset.name for asset in assets})
+        if others:
+            shown = ", ".join(others[:5]) + (f" and {len(others) - 5} more" if len(others) > 5 else "")
+            notes.append(f"{root}: {len(others)} asset folder{'s' if len(others) > 1 else ''} of earlier runs "
+                         f"not in this batch ({shown}): left as they are, and out of the catalogue")  # fmt: skip
     ordered = [records[asset.name] for asset in assets if asset.name in records]
     failed = sum(1 for record in ordered if record["status"] != "ok")
     ran = sum(1 for asset in assets if ran_flags.get(asset.name))

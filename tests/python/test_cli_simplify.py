@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from simplify_inputs import bending_tube
 
+from animlod import synth
 from animlod.cli import main
 from animlod.io.meshseq import read_mesh, read_sequence, write_mesh, write_sequence
 from animlod.io.npz import read_npz, write_npz
+from animlod.io.obj import ObjTexture, UnreadAttributesWarning, read_obj_textured, write_obj
 
 
 def test_simplify_an_obj_sequence_writes_each_level_as_a_sequence(tmp_path, capsys):
@@ -54,6 +58,43 @@ def test_each_level_frame_keeps_its_input_file_name(tmp_path):
         with pytest.raises(ValueError, match="names that repeat"):
             write_sequence(tmp_path / "bad", tube, names=names)
     assert not (tmp_path / "bad").exists()
+
+
+def _wrapped_texture(mesh) -> ObjTexture:
+    """Cylindrical texture coordinates of the synthetic cylinder (axis y) at rest: u the angle
+    about the axis, v the height; the faces across u = 0 take u + 1, a seam."""
+    rest = mesh.frames[0]
+    u = np.arctan2(rest[:, 2], rest[:, 0]) / (2 * np.pi) % 1.0
+    v = (rest[:, 1] - rest[:, 1].min()) / np.ptp(rest[:, 1])
+    corner_u = u[mesh.faces]
+    wraps = np.ptp(corner_u, axis=1) > 0.5
+    corner_u = np.where(wraps[:, None] & (corner_u < 0.5), corner_u + 1.0, corner_u)
+    uvs, corners = np.unique(np.stack([corner_u, v[mesh.faces]], axis=2).reshape(-1, 2), axis=0, return_inverse=True)
+    return ObjTexture(uvs.astype(np.float32), corners.reshape(-1, 3).astype(np.int32))
+
+
+def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path):
+    """OBJ frames with vt lines: the levels were written without them (a warning said so). Now
+    each level frame has them, the seam's copies apart, each corner's u the angle of its
+    position about the axis, as in the input; one OBJ file's level too."""
+    cylinder = synth.bending_cylinder(frames=4, rings=16, segments=16)
+    texture = _wrapped_texture(cylinder)
+    (tmp_path / "shot").mkdir()
+    for index, frame in enumerate(cylinder.frames):
+        write_obj(tmp_path / "shot" / f"shot_{index}.obj", frame, cylinder.faces, texture)
+    write_obj(tmp_path / "rest.obj", cylinder.frames[0], cylinder.faces, texture)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnreadAttributesWarning)
+        for source in ("shot", "rest.obj"):
+            assert main(["simplify", str(tmp_path / source), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    levels = [tmp_path / "out" / f"shot_lod{level}" / "shot_0.obj" for level in (1, 2, 3)]
+    for path in [*levels, *(tmp_path / "out" / f"rest_lod{level}.obj" for level in (1, 2, 3))]:
+        positions, faces, written = read_obj_textured(path)
+        assert written is not None and len(written.uvs) > len(positions)  # the seam stays open in uv
+        corners = positions[faces]
+        angle = np.arctan2(corners[..., 2], corners[..., 0]) / (2 * np.pi)
+        off = np.abs((written.uvs[written.corners][..., 0] - angle + 0.5) % 1.0 - 0.5)
+        assert off.max() < 0.01, (path, off.max())
 
 
 def test_one_mesh_file_gives_one_file_per_level_and_dotted_names_keep_their_levels_apart(tmp_path):

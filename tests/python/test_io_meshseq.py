@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -12,6 +13,7 @@ import pytest
 from animlod.io import (
     FormatError,
     meshseq,
+    obj,
     ply,
     read_mesh,
     read_obj,
@@ -76,6 +78,74 @@ def test_obj_texture_coordinates_and_normals_are_said_to_be_unread(tmp_path: Pat
     with warnings.catch_warnings():
         warnings.simplefilter("error", UnreadAttributesWarning)
         read_obj(tmp_path / "plain.obj")
+
+
+def test_obj_texture_coordinates_are_read_per_corner(tmp_path: Path) -> None:
+    """vt lines (u alone: v 0) and each corner's texture index, negative ones counting back from
+    the last vt above the face; a quad fanned as its positions are."""
+    text = ("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1 0\nvt\t0.5\nvn 0 0 1\n"
+            "f 1/1/1 2/2/1 3/3/1 4/4/1\nf 1/5 3/-3 4/-2\n")  # fmt: skip
+    (tmp_path / "quad.obj").write_text(text)
+    with pytest.warns(UnreadAttributesWarning, match=r"its normals \(vn lines\) are not read"):
+        vertices, faces, texture = obj.read_obj_textured(tmp_path / "quad.obj")
+    np.testing.assert_array_equal(faces, [[0, 1, 2], [0, 2, 3], [0, 2, 3]])
+    np.testing.assert_array_equal(texture.uvs, [[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0]])
+    np.testing.assert_array_equal(texture.corners, [[0, 1, 2], [0, 2, 3], [4, 2, 3]])
+    # Round trip: written as v/vt corners, read back the same.
+    obj.write_obj(tmp_path / "again.obj", vertices, faces, texture)
+    again_vertices, again_faces, again = obj.read_obj_textured(tmp_path / "again.obj")
+    for read, written in ((again_vertices, vertices), (again_faces, faces), (again.uvs, texture.uvs),
+                          (again.corners, texture.corners)):  # fmt: skip
+        np.testing.assert_array_equal(read, written)
+
+
+@pytest.mark.parametrize(
+    "faces, problem",
+    [
+        ("f 1/1 2/2 3/9\n", "face 0 (line 7): texture index 9 is outside the 3 texture coordinates"),
+        ("f 1/1 2/2 3/x\n", "face 0 (line 7)"),
+        ("vt 0 nan\nf 1/1 2/2 3/3\n", "texture coordinate 3 (line 7)"),
+    ],
+)
+def test_bad_texture_coordinates_name_the_line(tmp_path: Path, faces: str, problem: str) -> None:
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n" + faces)
+    with pytest.raises(FormatError, match=re.escape(problem)):
+        obj.read_obj_textured(tmp_path / "bad.obj")
+
+
+def test_texture_coordinates_on_some_corners_only_are_left_out_with_a_warning(tmp_path: Path) -> None:
+    (tmp_path / "mixed.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 2 4 3\n")
+    with pytest.warns(UnreadAttributesWarning, match="3 of 6 face corners have texture coordinates"):
+        _, faces, texture = obj.read_obj_textured(tmp_path / "mixed.obj")
+    assert texture is None and len(faces) == 2
+
+
+def test_a_textured_sequence_has_a_vertex_per_position_and_texture_coordinate(tmp_path: Path) -> None:
+    """A seam: vertices 0 and 2 carry two texture coordinates each, so 4 positions give 6
+    vertices. Frames whose texture coordinates differ from the first's are read without them."""
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], np.float32)
+    faces = np.array([[0, 1, 2], [1, 3, 2], [2, 3, 0]], np.int32)
+    texture = obj.ObjTexture(np.array([[0, 0], [1, 0], [0, 1], [1, 1], [0.5, 0.5], [0.2, 0.2]], np.float32),
+                             np.array([[0, 1, 2], [1, 3, 2], [4, 3, 5]], np.int32))  # fmt: skip
+    (tmp_path / "seam").mkdir()
+    for index in range(3):
+        obj.write_obj(tmp_path / "seam" / f"f{index}.obj", positions + index, faces, texture)
+    mesh, split = meshseq.read_textured_sequence(tmp_path / "seam")
+    assert mesh.vertex_count == 6 and mesh.frame_count == 3
+    np.testing.assert_array_equal(mesh.frames[2], positions[split.points] + 2)
+    np.testing.assert_array_equal(split.uvs[mesh.faces], texture.uvs[texture.corners])
+    # Written back: one v per position, the seam's two texture coordinates apart.
+    paths = write_sequence(tmp_path / "out", mesh, texture=split)
+    vertices, written_faces, written = obj.read_obj_textured(paths[1])
+    np.testing.assert_array_equal(vertices[written_faces], positions[faces] + 1)
+    np.testing.assert_array_equal(written.uvs[written.corners], texture.uvs[texture.corners])
+    with pytest.raises(ValueError, match="written as ply"):
+        write_sequence(tmp_path / "ply", mesh, fmt="ply", texture=split)
+    # A frame with other texture coordinates: none are carried, and a warning says why.
+    obj.write_obj(tmp_path / "seam" / "f2.obj", positions, faces, texture._replace(uvs=texture.uvs[::-1].copy()))
+    with pytest.warns(UnreadAttributesWarning, match=r"f2.obj: its texture coordinates \(vt\) differ"):
+        mesh, split = meshseq.read_textured_sequence(tmp_path / "seam")
+    assert split is None and mesh.vertex_count == 4
 
 
 def test_ascii_ply_with_mixed_polygons_and_extra_properties(tmp_path: Path) -> None:

@@ -3,15 +3,17 @@
 from .bvh import BvhLayout, read_bvh, read_bvh_with_layout, write_bvh
 from .errors import FormatError
 from .gltf import GltfScene, read_gltf, read_lod_chains, read_node_motions, read_skinned, write_glb
-from .meshseq import read_mesh, read_sequence, write_mesh, write_sequence
+from .meshseq import SequenceTexture, read_mesh, read_sequence, read_textured_sequence, write_mesh, write_sequence
 from .npz import read_npz, write_npz
-from .obj import read_obj, write_obj
+from .obj import ObjTexture, read_obj, read_obj_textured, write_obj
 from .ply import read_ply, write_ply
 
 __all__ = [
     "BvhLayout",
     "FormatError",
     "GltfScene",
+    "ObjTexture",
+    "SequenceTexture",
     "read_bvh",
     "read_bvh_with_layout",
     "read_gltf",
@@ -20,9 +22,11 @@ __all__ = [
     "read_node_motions",
     "read_npz",
     "read_obj",
+    "read_obj_textured",
     "read_ply",
     "read_sequence",
     "read_skinned",
+    "read_textured_sequence",
     "write_bvh",
     "write_glb",
     "write_mesh",

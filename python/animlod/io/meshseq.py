@@ -1,6 +1,7 @@
 """OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
 
-Only geometry is read (:mod:`.obj`, :mod:`.ply`).
+Geometry is read (:mod:`.obj`, :mod:`.ply`), and with :func:`read_textured_sequence` an OBJ
+sequence's texture coordinates, which :func:`write_sequence` writes back.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import os
 import re
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +19,7 @@ import numpy as np
 from ..model import AnimatedMesh
 from .atomic import atomic_folder
 from .errors import FormatError
-from .obj import UnreadAttributesWarning, read_obj, write_obj
+from .obj import ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
 from .ply import read_ply, write_ply
 
 MESH_SUFFIXES = (".obj", ".ply")
@@ -46,21 +48,74 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
         When no frame is found, a file cannot be read, or a frame's vertex count or faces
         differ from the first frame's (naming the file and the first differing face).
     """
-    paths = sequence_paths(source)
-    first_vertices, faces = read_mesh(paths[0])
+    return _read_frames(sequence_paths(source), fps, textured=False)[0]
+
+
+@dataclass(frozen=True)
+class SequenceTexture:
+    """The texture coordinates of a sequence read with them (:func:`read_textured_sequence`).
+    Each vertex of its mesh is one (position, texture coordinate) pair of the files' corners, so
+    that the copies of a position along a UV seam are vertices of their own.
+
+    uvs : (V, 2) float32 per vertex of the mesh.
+    points : (V,) int32 the position (0-based ``v`` line of the files) each vertex stands on.
+    """
+
+    uvs: np.ndarray
+    points: np.ndarray
+
+
+def read_textured_sequence(
+    source: str | os.PathLike | Sequence[str | os.PathLike], fps: float | None = None
+) -> tuple[AnimatedMesh, SequenceTexture | None]:
+    """:func:`read_sequence` with an OBJ sequence's texture coordinates: the mesh then has a
+    vertex per (position, texture coordinate) pair of the corners (:class:`SequenceTexture`).
+    None, and the files' positions as the vertices, where the frames have none (PLY frames, OBJ
+    frames without ``vt``), or where one frame's differ from the first's (with an
+    :class:`~animlod.io.obj.UnreadAttributesWarning`)."""
+    return _read_frames(sequence_paths(source), fps, textured=True)
+
+
+def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> tuple[AnimatedMesh, SequenceTexture | None]:
+    """The frames of ``paths`` (:func:`read_sequence`), and with ``textured`` their texture
+    coordinates (:func:`read_textured_sequence`)."""
+    first_vertices, faces, texture = read_mesh_textured(paths[0]) if textured else (*read_mesh(paths[0]), None)
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
     if not len(faces):
         what = "no vertices and no faces" if not len(first_vertices) else f"{len(first_vertices)} vertices but no faces"
         raise FormatError(paths[0], "mesh", f"{what}; a frame needs triangles")
     frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
     frames[0] = first_vertices
+    differing = None  # the first frame whose texture coordinates are not the first frame's
     with warnings.catch_warnings():  # the first frame's warning speaks for the sequence
         warnings.simplefilter("ignore", UnreadAttributesWarning)
         for index, path in enumerate(paths[1:], start=1):
-            vertices, frame_faces = read_mesh(path)
+            vertices, frame_faces, frame_texture = read_mesh_textured(path) if texture else (*read_mesh(path), None)
             _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
             frames[index] = vertices
-    return AnimatedMesh(faces, frames, fps=fps)
+            if texture is not None and not _same_texture(texture, frame_texture):
+                differing, texture = path, None
+    if differing is not None:
+        warnings.warn(f"{differing}: its texture coordinates (vt) differ from those of the first frame "
+                      f"{paths[0].name}: the levels are written without them", UnreadAttributesWarning,
+                      stacklevel=3)  # fmt: skip
+    if texture is None:
+        return AnimatedMesh(faces, frames, fps=fps), None
+    # A vertex per (position, texture coordinate) pair that a corner uses.
+    pairs = np.stack([faces.ravel(), texture.corners.ravel()], axis=1)
+    wedges, corner_wedge = np.unique(pairs, axis=0, return_inverse=True)
+    split = AnimatedMesh(corner_wedge.reshape(faces.shape).astype(np.int32), frames[:, wedges[:, 0]], fps=fps)
+    return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32))
+
+
+def _same_texture(first: ObjTexture, other: ObjTexture | None) -> bool:
+    """Whether a frame's texture coordinates are the first frame's."""
+    return (
+        other is not None
+        and np.array_equal(first.corners, other.corners)
+        and first.uvs.shape == other.uvs.shape
+        and np.array_equal(first.uvs, other.uvs)
+    )
 
 
 def write_sequence(
@@ -69,19 +124,26 @@ def write_sequence(
     fmt: str = "obj",
     stem: str = "frame",
     names: Sequence[str] | None = None,
+    texture: SequenceTexture | None = None,
 ) -> list[Path]:
     """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
-    ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically.
+    ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically; with ``texture``
+    (OBJ only) its texture coordinates, the vertices of one point that stand at one place in
+    every frame (a UV seam's copies) written as one ``v`` line.
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
     ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
     interrupted run never leaves a folder short of frames under the final name. An existing
     ``folder`` is replaced as a whole. ``fmt`` is "obj" or "ply" (binary little-endian).
-    Returns the written paths in frame order. ValueError for another ``fmt``, or ``names`` that
-    are not one file name per frame, distinct regardless of case.
+    Returns the written paths in frame order. ValueError for another ``fmt``, ``names`` that
+    are not one file name per frame, distinct regardless of case, or a ``texture`` for PLY or
+    of another vertex count.
     """
     if fmt not in ("obj", "ply"):
         raise ValueError(f"{os.fspath(folder)}: fmt: must be 'obj' or 'ply', got {fmt!r}")
+    if texture is not None and (fmt != "obj" or len(texture.uvs) != mesh.vertex_count):
+        raise ValueError(f"{os.fspath(folder)}: texture: {len(texture.uvs)} texture coordinates for "
+                         f"{mesh.vertex_count} vertices, written as {fmt} (OBJ only)")  # fmt: skip
     if names is None:
         width = max(4, len(str(mesh.frame_count - 1)))
         names = [f"{stem}_{index:0{width}d}" for index in range(mesh.frame_count)]
@@ -89,10 +151,28 @@ def write_sequence(
         raise ValueError(f"{os.fspath(folder)}: names: {len(names)} names for {mesh.frame_count} frames, or names "
                          "that repeat (regardless of case) or are not plain file names")  # fmt: skip
     names = [f"{name}.{fmt}" for name in names]
+    written, faces, obj_texture = obj_layout(mesh, texture)
     with atomic_folder(folder) as temporary:
         for name, vertices in zip(names, mesh.frames):
-            write_mesh(temporary / name, vertices, mesh.faces)
+            write_mesh(temporary / name, vertices[written], faces, obj_texture)
     return [Path(folder) / name for name in names]
+
+
+def obj_layout(mesh: AnimatedMesh, texture: SequenceTexture | None) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
+    """How ``mesh``'s frames are written as OBJ files with ``texture``: the vertices whose
+    positions are written (in vertex order), the faces over those positions and the texture
+    coordinates with each corner's index; the vertices of one point that stand at one place in
+    every frame (a seam's copies) share one position. Without ``texture``: every vertex."""
+    if texture is None:
+        return np.arange(mesh.vertex_count), mesh.faces, None
+    keys = np.concatenate([texture.points[:, None], mesh.frames.transpose(1, 0, 2).reshape(mesh.vertex_count, -1)],
+                          axis=1, dtype=np.float64)  # fmt: skip
+    _, first, group = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first)  # positions in the order of their first vertex
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    position = rank[group.ravel()].astype(np.int32)
+    return first[order], position[mesh.faces], ObjTexture(texture.uvs, mesh.faces)
 
 
 def frame_names_fit(names: Sequence[str], frames: int) -> bool:
@@ -168,6 +248,14 @@ def _check_same_connectivity(
 # Single meshes
 
 
+def read_mesh_textured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
+    """:func:`read_mesh` with an OBJ file's texture coordinates (:func:`~.obj.read_obj_textured`;
+    None for PLY)."""
+    if Path(path).suffix.lower() == ".obj":
+        return read_obj_textured(path)
+    return (*read_mesh(path), None)
+
+
 def read_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     """Read one .obj or .ply file: ``vertices (V, 3) float32`` and triangle ``faces (M, 3) int32``."""
     path = Path(path)
@@ -179,11 +267,16 @@ def read_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     raise FormatError(path, "file name", f"expected one of {', '.join(MESH_SUFFIXES)}")
 
 
-def write_mesh(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) -> None:
-    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``."""
+def write_mesh(
+    path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, texture: ObjTexture | None = None
+) -> None:
+    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``; ``texture``: an
+    OBJ file's texture coordinates (ValueError for PLY)."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
-        write_obj(path, vertices, faces)
+        write_obj(path, vertices, faces, texture)
+    elif texture is not None:
+        raise ValueError(f"{os.fspath(path)}: texture: written to OBJ files only")
     elif suffix == ".ply":
         write_ply(path, vertices, faces)
     else:

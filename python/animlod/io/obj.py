@@ -1,9 +1,10 @@
 """Wavefront OBJ geometry: ``v`` and ``f`` lines read (1-based or negative indices, ``a/b/c``
 corners, polygons fan-triangulated, ``#`` comments also at a line's end, a statement continued
-on the next line after a ``\\`` that ends its line; other statements such as ``vt``, ``vn``,
-``g``, ``usemtl`` are ignored, with a warning for ``vt`` and ``vn``; statements may be indented)
-and written. Parsing works on the whole file's bytes with numpy: there is no Python loop over
-lines, vertices or faces."""
+on the next line after a ``\\`` that ends its line; with :func:`read_obj_textured` also ``vt``
+lines and the corners' texture indices; other statements such as ``vn``, ``g``, ``usemtl`` are
+ignored, with a warning for ``vn`` and an unread ``vt``; statements may be indented) and
+written, with texture coordinates where given. Parsing works on the whole file's bytes with
+numpy: there is no Python loop over lines, vertices or faces."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import re
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -26,6 +28,15 @@ from .polygon_mesh import (
     polygon_mask,
 )
 from .tokens import parse_all, tokens_per_line
+
+
+class ObjTexture(NamedTuple):
+    """An OBJ mesh's texture coordinates: ``uvs (T, 2) float32``, the ``vt`` lines' u and v (v 0
+    where a line gives u alone), and ``corners (M, 3) int32``, each triangle corner's index into
+    ``uvs`` (the triangles of the faces, in their order)."""
+
+    uvs: np.ndarray
+    corners: np.ndarray
 
 
 def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
@@ -48,6 +59,20 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         index outside the vertices defined so far, or faces that all have fewer than three
         corners (some such faces among polygons are left out with a warning).
     """
+    vertices, faces, _ = _read_obj(path, textured=False)
+    return vertices, faces
+
+
+def read_obj_textured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
+    """:func:`read_obj` with the texture coordinates: also the ``vt`` lines and each corner's
+    texture index (``v/vt`` or ``v/vt/vn``), or None where the file has none, or where some
+    corners have one and others not (with an :class:`UnreadAttributesWarning`). FormatError
+    also names a malformed ``vt`` line and a texture index outside them."""
+    return _read_obj(path, textured=True)
+
+
+def _read_obj(path: str | os.PathLike, textured: bool) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
+    """:func:`read_obj`, and with ``textured`` its texture coordinates (:func:`read_obj_textured`)."""
     path = Path(path)
     data = path.read_bytes()
     if data.startswith((b"\xfe\xff", b"\xff\xfe")):  # UTF-16 after its byte order mark (assimp's box_UTF16BE.obj)
@@ -67,8 +92,9 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         data = _join_continued_lines(data)
     if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
         data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
-    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines) = _obj_statements(data, (b"v", b"f", b"l"))
-    _warn_unread_attributes(path, data)
+    statements = _obj_statements(data, (b"v", b"f", b"l", b"vt"))
+    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines), (uv_block, uv_lines) = statements
+    _warn_unread_attributes(path, data, ("vn",) if textured else ("vt", "vn"))
     if not len(vertex_lines):
         _require_obj_statement(path, data)
     if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
@@ -93,6 +119,7 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     def name_face(face: int) -> str:
         return f"face {face} (line {face_lines[face]})"
 
+    texture_block = face_block
     if b"/" in face_block:
         face_block = re.sub(rb"/\S*", b"", face_block)  # v of v/vt/vn
     sizes = _row_sizes(face_block, len(face_lines))
@@ -110,22 +137,91 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     defined = np.searchsorted(vertex_lines, face_lines)[owner]
     resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
     check_face_indices(path, resolved, written, owner, len(vertices), name_face)
-    return vertices, fan_triangulate(resolved[polygons[owner]], sizes[polygons])
+    faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
+    if not textured or not len(uv_lines):
+        return vertices, faces, None
+    texture = _texture(path, uv_block, uv_lines, texture_block, face_lines, sizes, name_face)
+    if texture is None:
+        return vertices, faces, None
+    uvs, corners = texture
+    return vertices, faces, ObjTexture(uvs, fan_triangulate(corners[polygons[owner]], sizes[polygons]))
 
 
-def write_obj(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray) -> None:
-    """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically.
+def _texture(
+    path: Path,
+    uv_block: bytes,
+    uv_lines: np.ndarray,
+    face_block: bytes,
+    face_lines: np.ndarray,
+    sizes: np.ndarray,
+    name_face: Callable[[int], str],
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The ``vt`` lines' (u, v) and every face corner's 0-based index into them (``face_block``:
+    the ``f`` lines as written, of ``sizes`` corners); None, with a warning, where some corners
+    have a texture index and others none."""
+    texture_block, indexed = _corner_texture_indices(face_block)
+    if indexed < sizes.sum():
+        if indexed:
+            warnings.warn(f"{path}: {indexed} of {sizes.sum()} face corners have texture coordinates (vt), the "
+                          "others none: read without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
+        return None
+
+    def name_uv(row: int) -> str:
+        return f"texture coordinate {row} (line {uv_lines[row]})"
+
+    counts = _row_sizes(uv_block, len(uv_lines))
+    _require_sizes(path, counts, 1, name_uv, "values")
+    values = _untagged_values(uv_block, np.float64, counts)
+    first = np.cumsum(counts) - counts
+    if values is None:
+        tokens, starts = _row_tokens(uv_block, counts)
+        row = np.repeat(np.arange(counts.size), counts)
+        values = parse_numbers(path, np.delete(tokens, starts), np.float64, lambda token: name_uv(int(row[token])))
+    uvs = np.stack([values[first], np.where(counts > 1, values[np.minimum(first + 1, values.size - 1)], 0.0)], axis=1)
+    check_finite_vertices(path, uvs.astype(np.float32), name_uv)
+    owner = np.repeat(np.arange(sizes.size), sizes)
+    written = _untagged_values(texture_block, np.int64, sizes)
+    if written is None:
+        tokens, starts = _row_tokens(texture_block, sizes)
+        written = parse_numbers(path, np.delete(tokens, starts), np.int64, lambda corner: name_face(owner[corner]))
+    defined = np.searchsorted(uv_lines, face_lines)[owner]  # negative: back from the last vt above
+    resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
+    outside = np.flatnonzero((resolved < 0) | (resolved >= len(uvs)))
+    if outside.size:
+        corner = outside[0]
+        reason = f"texture index {written[corner]} is outside the {len(uvs)} texture coordinates"
+        raise FormatError(path, name_face(int(owner[corner])), reason)
+    return uvs.astype(np.float32), resolved
+
+
+def write_obj(
+    path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, texture: ObjTexture | None = None
+) -> None:
+    """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically; with
+    ``texture`` also its ``vt`` lines and ``v/vt`` corners.
 
     Coordinates are written with 9 significant digits, which round-trips float32 exactly. A wrong
     shape, a coordinate that is not finite as float32 or a face index outside the vertices is a
-    ValueError naming the file and the argument (``vertices`` or ``faces``); nothing is written.
+    ValueError naming the file and the argument (``vertices``, ``faces`` or ``texture``); nothing
+    is written.
     """
     vertices, faces = checked_for_writing(path, vertices, faces)
     vertices, faces = vertices.astype(np.float64), faces.astype(np.int64) + 1
+    if texture is not None:
+        uvs, corners = np.asarray(texture.uvs, dtype=np.float64), np.asarray(texture.corners)
+        fits = uvs.ndim == 2 and uvs.shape[1] == 2 and corners.shape == faces.shape and np.isfinite(uvs).all()
+        if not fits or corners.size and not 0 <= corners.min() <= corners.max() < len(uvs):
+            raise ValueError(f"{os.fspath(path)}: texture: expected finite uvs (T, 2) and a (M, 3) corner index "
+                             f"into them per face, got {uvs.shape} uvs and {corners.shape} corners")  # fmt: skip
     with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
         handle.write("# written by animlod\n")
         handle.write(("v %.9g %.9g %.9g\n" * len(vertices)) % tuple(vertices.ravel()))
-        handle.write(("f %d %d %d\n" * len(faces)) % tuple(faces.ravel()))
+        if texture is None:
+            handle.write(("f %d %d %d\n" * len(faces)) % tuple(faces.ravel()))
+            return
+        handle.write(("vt %.9g %.9g\n" * len(uvs)) % tuple(uvs.ravel()))
+        pairs = np.stack([faces, corners.astype(np.int64) + 1], axis=2)
+        handle.write(("f %d/%d %d/%d %d/%d\n" * len(faces)) % tuple(pairs.ravel()))
 
 
 # The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.
@@ -174,27 +270,45 @@ class UnreadAttributesWarning(UserWarning):
     """An OBJ file's texture coordinates or normals (``vt``, ``vn``), which animlod does not read."""
 
 
-def _warn_unread_attributes(path: Path, data: bytes) -> None:
-    """Says that ``vt`` and ``vn`` lines are not read, so that levels written without them are
-    no silent loss."""
+def _corner_texture_indices(face_block: bytes) -> tuple[bytes, int]:
+    """``face_block`` (``f`` lines, tags first) with each corner cut to its texture index (vt of
+    ``v/vt/vn`` or ``v/vt``: the bytes after its first slash, up to the next), and how many
+    corners have one."""
+    codes = np.frombuffer(face_block, dtype=np.uint8)
+    separator = np.isin(codes, np.frombuffer(b" \t\n", dtype=np.uint8))
+    slash = codes == ord("/")
+    slashes = np.cumsum(slash)
+    in_corner = slashes - np.maximum.accumulate(np.where(separator, slashes, 0))  # slashes so far in its word
+    index_follows = ~np.append(separator[1:] | slash[1:], True)  # "1/2": an index after the slash
+    indexed = int(np.count_nonzero(slash & (in_corner == 1) & index_follows))
+    line_start = np.append(True, codes[:-1] == ord("\n"))
+    keep = separator | line_start | ((in_corner == 1) & ~slash)
+    return codes[keep].tobytes(), indexed
+
+
+def _warn_unread_attributes(path: Path, data: bytes, tags: tuple[str, ...]) -> None:
+    """Says that the file's lines of ``tags`` ("vt", "vn") are not read, so that levels written
+    without them are no silent loss."""
     # A statement's tag ends at a space or a tab, as _obj_statements reads the others.
-    unread = [tag for tag in ("vt", "vn") if re.search(rb"(?m)^" + tag.encode() + rb"[ \t]", data)]
+    unread = [tag for tag in tags if re.search(rb"(?m)^" + tag.encode() + rb"[ \t]", data)]
     if unread:
         kinds = " and ".join({"vt": "texture coordinates", "vn": "normals"}[tag] for tag in unread)
-        warnings.warn(f"{path}: its {kinds} ({', '.join(unread)} lines) are not read: OBJ input gives positions "
-                      "and faces only, and the levels are written without them", UnreadAttributesWarning,
-                      stacklevel=3)  # fmt: skip
+        warnings.warn(f"{path}: its {kinds} ({', '.join(unread)} lines) are not read, and the levels are written "
+                      "without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
 
 
 def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:
-    """For each one-letter tag: the bytes of all lines starting with it, and their 1-based line numbers."""
-    codes = np.frombuffer(data + b"\n\n", dtype=np.uint8)  # padding: every line start has two bytes
+    """For each tag of one or two letters: the bytes of all lines starting with it, and their
+    1-based line numbers."""
+    codes = np.frombuffer(data + b"\n\n\n", dtype=np.uint8)  # padding: every line start has three bytes
     line_starts = np.concatenate(([0], np.flatnonzero(codes[: len(data)] == ord("\n")) + 1))
     line_lengths = np.diff(line_starts, append=len(data))
-    separated = np.isin(codes[line_starts + 1], np.frombuffer(b" \t", dtype=np.uint8))
+    separators = np.frombuffer(b" \t", dtype=np.uint8)
     result = []
     for tag in tags:
-        selected = (codes[line_starts] == tag[0]) & separated
+        selected = np.isin(codes[line_starts + len(tag)], separators)
+        for offset, letter in enumerate(tag):
+            selected &= codes[line_starts + offset] == letter
         result.append((codes[: len(data)][np.repeat(selected, line_lengths)].tobytes(), np.flatnonzero(selected) + 1))
     return result
 

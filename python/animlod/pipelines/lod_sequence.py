@@ -3,7 +3,10 @@
 Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OBJ/PLY frames
 (each frame under its input file's name), ``<stem>_lod<i>.obj`` (or ``.ply``) for one mesh file,
 ``<stem>_lod<i>.npz`` for NPZ input, and measured against the input frame by frame (symmetric
-Hausdorff and RMS distance relative to the bounding-box diagonal).
+Hausdorff and RMS distance relative to the bounding-box diagonal). An OBJ sequence's texture
+coordinates are carried: each (position, texture coordinate) pair of its corners is a vertex,
+the copies of a position along a UV seam welded by AQEM and kept apart where their coordinates
+differ, and written back as ``vt`` lines.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import numpy as np
 from ..aqem import Preparation, simplify_animated
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
+from ..io.meshseq import SequenceTexture
 from ..metrics import SurfaceError, surface_error
 from ..model import AnimatedMesh
 
@@ -67,27 +71,32 @@ def simplify_sequence(
     for unreadable input.
     """
     kind = input_kind(source)
+    texture = None  # an OBJ sequence's texture coordinates, carried as AQEM attributes
     if kind == "npz":
         from ..io.npz import read_npz
 
         original = read_npz(source)
     elif kind == "sequence":
-        from ..io.meshseq import read_sequence
+        from ..io.meshseq import read_textured_sequence
 
-        original = read_sequence(source)
+        original, texture = read_textured_sequence(source)
     else:
         raise FormatError(os.fspath(source), "file", f"a {kind} file is not a mesh sequence")
     started = time.perf_counter()
     # The report keeps no collapse record, whose positions would take 12 bytes per collapse and frame.
     aqem_options = {**aqem_options, "record_positions": False}
-    result = simplify_animated(original, ratios, progress=progress, **aqem_options)
+    uvs = None if texture is None else texture.uvs
+    result = simplify_animated(original, ratios, progress=progress, attributes=uvs, **aqem_options)
     seconds = time.perf_counter() - started
     folder, stem, fmt = Path(output), input_stem(source), _level_format(kind, source)
     levels = []
     for index, level in enumerate(result.levels, start=1):
         if measure and measuring is not None:
             measuring(index - 1, len(result.levels))
-        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh)
+        level_texture = (
+            None if texture is None else SequenceTexture(level.attributes, texture.points[level.kept_vertices])
+        )
+        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture)
         measured = _surface_error(original, level.mesh) if measure else None
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
@@ -149,15 +158,16 @@ def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
                         names if frame_names_fit(names, len(paths)) else None)  # fmt: skip
 
 
-def _write_level(fmt: _LevelFormat, target: Path, mesh: AnimatedMesh) -> Path:
-    """Write a level as ``fmt`` says; its path. A file's suffix is appended, not swapped:
+def _write_level(fmt: _LevelFormat, target: Path, mesh: AnimatedMesh, texture: SequenceTexture | None) -> Path:
+    """Write a level as ``fmt`` says, with its texture coordinates if any; its path. A file's
+    suffix is appended, not swapped:
     ``walk.v2_lod1`` has the suffix ``.v2_lod1`` (every level of walk.v2.npz was written to
     walk.npz)."""
     if not fmt.one_file:
         from ..io.meshseq import write_sequence
 
         target.mkdir(parents=True, exist_ok=True)
-        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names)
+        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture)
         return target
     path = target.with_name(f"{target.name}.{fmt.suffix}")
     if fmt.suffix == "npz":
@@ -165,7 +175,8 @@ def _write_level(fmt: _LevelFormat, target: Path, mesh: AnimatedMesh) -> Path:
 
         write_npz(path, mesh)
     else:  # one mesh in, one mesh out
-        from ..io.meshseq import write_mesh
+        from ..io.meshseq import obj_layout, write_mesh
 
-        write_mesh(path, mesh.frames[0], mesh.faces)
+        written, faces, obj_texture = obj_layout(mesh, texture)
+        write_mesh(path, mesh.frames[0][written], faces, obj_texture)
     return path

@@ -43,3 +43,23 @@ def skinned_vertex(doc: GltfDocument, node: int, vertex: int, worlds: list[np.nd
     inverse_binds = np.asarray(doc.accessor(skin.inverseBindMatrices, "test")).reshape(-1, 4, 4).transpose(0, 2, 1)
     matrix = sum(w * worlds[skin.joints[j]] @ inverse_binds[j] for j, w in zip(joints, weights) if w > 0)
     return (matrix @ position)[:3]
+
+
+def node_named(doc: GltfDocument, name: str) -> int:
+    """The first node called ``name``."""
+    return next(n for n, node in enumerate(doc.gltf.nodes) if node.name == name)
+
+
+def vertex_in_holder(doc: GltfDocument, joint: str, holder: str) -> tuple[int, np.ndarray, float]:
+    """A vertex of the input's skinned mesh bound to ``joint`` alone, its place in the frame of
+    node ``holder`` at the first key of the clip, and the mesh's size."""
+    base = next(n for n, node in enumerate(doc.gltf.nodes) if node.skin is not None)
+    primitive = doc.gltf.meshes[doc.gltf.nodes[base].mesh].primitives[0]
+    joints = np.asarray(doc.accessor(primitive.attributes.JOINTS_0, "test"))
+    weights = np.asarray(doc.accessor(primitive.attributes.WEIGHTS_0, "test"))
+    slot = doc.gltf.skins[doc.gltf.nodes[base].skin].joints.index(node_named(doc, joint))
+    vertex = int(np.flatnonzero((joints[:, 0] == slot) & (weights[:, 0] > 0.999))[0])
+    worlds = posed_worlds(doc, 0)
+    place = np.linalg.inv(worlds[node_named(doc, holder)]) @ np.append(skinned_vertex(doc, base, vertex, worlds), 1.0)
+    size = np.ptp(np.asarray(doc.accessor(primitive.attributes.POSITION, "test")), axis=0).max()
+    return vertex, place[:3], size

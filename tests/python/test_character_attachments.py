@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from gltf_poses import posed_worlds, skinned_vertex
+from gltf_poses import node_named, posed_worlds, skinned_vertex, vertex_in_holder
 
 from animlod import rotations, synth
 from animlod.io import write_glb
@@ -86,25 +86,6 @@ def _animate(animation: dict, node: int, path: str, output: int) -> None:
     animation["channels"].append({"sampler": len(animation["samplers"]) - 1, "target": {"node": node, "path": path}})
 
 
-def _node(doc: GltfDocument, name: str) -> int:
-    return next(n for n, node in enumerate(doc.gltf.nodes) if node.name == name)
-
-
-def _vertex_in_holder(doc: GltfDocument, joint: str, holder: str) -> tuple[int, np.ndarray, float]:
-    """A vertex of the input's skinned mesh bound to ``joint`` alone, its place in the frame of
-    node ``holder`` at the first key of the clip, and the mesh's size."""
-    base = next(n for n, node in enumerate(doc.gltf.nodes) if node.skin is not None)
-    primitive = doc.gltf.meshes[doc.gltf.nodes[base].mesh].primitives[0]
-    joints = np.asarray(doc.accessor(primitive.attributes.JOINTS_0, "test"))
-    weights = np.asarray(doc.accessor(primitive.attributes.WEIGHTS_0, "test"))
-    slot = doc.gltf.skins[doc.gltf.nodes[base].skin].joints.index(_node(doc, joint))
-    vertex = int(np.flatnonzero((joints[:, 0] == slot) & (weights[:, 0] > 0.999))[0])
-    worlds = posed_worlds(doc, 0)
-    place = np.linalg.inv(worlds[_node(doc, holder)]) @ np.append(skinned_vertex(doc, base, vertex, worlds), 1.0)
-    size = np.ptp(np.asarray(doc.accessor(primitive.attributes.POSITION, "test")), axis=0).max()
-    return vertex, place[:3], size
-
-
 HOLDERS = [*[(joint, f"socket {joint}") for joint in SOCKET_JOINTS], ("Head", "Head")]
 
 
@@ -116,14 +97,14 @@ def test_a_socket_moves_with_the_vertices_of_its_joint_at_every_motion_level(cha
     # sits at the same place in the holder's frame as in its copy's.
     source, output, report = character_with_sockets
     doc_in, doc_out = GltfDocument(source), GltfDocument(output)
-    vertex, expected, size = _vertex_in_holder(doc_in, joint, holder)
-    base = _node(doc_in, next(node.name for node in doc_in.gltf.nodes if node.skin is not None))
+    vertex, expected, size = vertex_in_holder(doc_in, joint, holder)
+    base = node_named(doc_in, next(node.name for node in doc_in.gltf.nodes if node.skin is not None))
     grid = doc_out.gltf.nodes[base].extras["animlod_grid"][0]  # geometry level 0, each motion level
     frozen_somewhere = False
     for m in range(1, len(grid)):
         animation = next(a for a, clip in enumerate(doc_out.gltf.animations) if clip.name.endswith(f"@motion{m}"))
         worlds = posed_worlds(doc_out, animation)
-        copy = _node(doc_out, f"{holder}@motion{m}")
+        copy = node_named(doc_out, f"{holder}@motion{m}")
         level_skin = doc_out.gltf.skins[doc_out.gltf.nodes[grid[m]].skin]
         hung = doc_out.parents[copy]  # from the level's own skeleton, or a static frame node on it
         assert hung in level_skin.joints or doc_out.parents[hung] in level_skin.joints
@@ -152,16 +133,16 @@ def test_a_socket_moves_with_the_vertices_of_its_joint_in_every_motion_level_glb
     # As above, in `animlod motion`'s files: one skeleton each, the copy named as the input's
     # node (what a joint node draws: "<joint> content", beside the level's joint node).
     source, levels, _ = motion_levels_with_sockets
-    vertex, expected, size = _vertex_in_holder(GltfDocument(source), joint, holder)
+    vertex, expected, size = vertex_in_holder(GltfDocument(source), joint, holder)
     frozen_somewhere = False
     for level in levels:
         doc = GltfDocument(level)
         worlds = posed_worlds(doc, 0)
-        copy = _node(doc, f"{holder} content" if holder == joint else holder)
+        copy = node_named(doc, f"{holder} content" if holder == joint else holder)
         skin = doc.gltf.skins[0]
         assert doc.parents[copy] in skin.joints or doc.parents[doc.parents[copy]] in skin.joints
         frozen_somewhere |= joint not in {doc.gltf.nodes[n].name for n in skin.joints}
-        vertex_world = skinned_vertex(doc, _node(doc, "skinned mesh"), vertex, worlds)
+        vertex_world = skinned_vertex(doc, node_named(doc, "skinned mesh"), vertex, worlds)
         seen = (np.linalg.inv(worlds[copy]) @ np.append(vertex_world, 1.0))[:3]
         np.testing.assert_allclose(seen, expected, atol=1e-5 * size)
     if joint == "LeftHandIndex2":
@@ -198,7 +179,7 @@ def test_motion_level_glbs_play_the_channels_of_what_hangs_from_the_joints(motio
         assert carried.keys() == expected.keys()
         for key, values in expected.items():
             np.testing.assert_array_equal(carried[key], values)
-        assert doc.gltf.nodes[_node(doc, "Head content")].mesh is not None
+        assert doc.gltf.nodes[node_named(doc, "Head content")].mesh is not None
         assert "KHR_animation_pointer" in doc.json["extensionsUsed"]
     assert not [note for note in notes if "not " in note and "GLBs" in note]
 

@@ -164,7 +164,7 @@ def test_cli_takes_a_glb_clip_by_name_and_names_the_clips_it_has(tmp_path, capsy
     assert [m.name for m in written] == [names[1]]
     assert main(["motion", str(source), "-o", str(tmp_path / "bad"), "--clip", "dance"]) == 2
     error = capsys.readouterr().err
-    assert "no animation named 'dance'" in error and f"1: {names[1]!r}" in error
+    assert "the animation named 'dance' is not in the file" in error and f"1: {names[1]!r}" in error
     assert not (tmp_path / "bad").exists()
 
 

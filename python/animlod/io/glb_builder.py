@@ -49,15 +49,15 @@ _IMAGE_SIGNATURES = (
     ((4, b"ftypavif"), "image/avif"),
 )
 _GLB_MAGIC, _GLB_VERSION = b"glTF", 2
-# Extensions known not to refer to accessors or buffer views from places prune() does not scan.
+# Extensions known not to refer to accessors or buffer views from places prune() does not scan
+# (it scans Draco's buffer views and EXT_mesh_gpu_instancing's accessors).
 _PRUNE_SAFE_EXTENSIONS = (
     "KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_mesh_quantization", "KHR_animation_pointer", "MSFT_lod",
+    "KHR_xmp", "KHR_node_visibility", DRACO_EXTENSION, "EXT_mesh_gpu_instancing",
 )  # fmt: skip
 # Extensions known to refer to no mesh by index (KHR_animation_pointer's mesh pointers are looked
 # for); an extension unknown here may (VRM 0.x's blend shapes and first-person annotations do).
-_NO_MESH_REFERENCES = (
-    *_PRUNE_SAFE_EXTENSIONS, DRACO_EXTENSION, *MESHOPT_EXTENSIONS, "EXT_mesh_gpu_instancing", "EXT_texture_",
-)  # fmt: skip
+_NO_MESH_REFERENCES = (*_PRUNE_SAFE_EXTENSIONS, *MESHOPT_EXTENSIONS, "EXT_texture_")
 _JSON_CHUNK, _BIN_CHUNK = 0x4E4F534A, 0x004E4942
 
 
@@ -197,6 +197,8 @@ class GlbBuilder:
             sparse = accessor.get("sparse", {})
             view_refs += [(sparse[part], "bufferView") for part in ("indices", "values") if part in sparse]
         view_refs += [(image, "bufferView") for image in js.get("images", []) if "bufferView" in image]
+        draco = (p.get("extensions", {}).get(DRACO_EXTENSION) for m in js.get("meshes", []) for p in m["primitives"])
+        view_refs += [(compressed, "bufferView") for compressed in draco if compressed and "bufferView" in compressed]
         kept_views = sorted({holder[key] for holder, key in view_refs})
         old_views, old_blob = js.get("bufferViews", []), bytes(self.blob)
         self.blob = bytearray()
@@ -254,6 +256,9 @@ def _accessor_references(js: dict):
         for sampler in animation.get("samplers", []):
             yield sampler, "input"
             yield sampler, "output"
+    for node in js.get("nodes", []):
+        instances = (node.get("extensions") or {}).get("EXT_mesh_gpu_instancing", {}).get("attributes", {})
+        yield from ((instances, name) for name in instances)
 
 
 def _drop_extension(js: dict, name: str) -> None:

@@ -24,6 +24,10 @@ def index_references(doc: GltfDocument) -> Iterator[Reference]:
         yield from _optional(node, "mesh", "meshes", doc.node_label(n))
         yield from _optional(node, "skin", "skins", doc.node_label(n))
         yield from _optional(node, "camera", "cameras", f"{doc.node_label(n)} camera")
+        instancing = (node.get("extensions") or {}).get("EXT_mesh_gpu_instancing")
+        attributes = instancing.get("attributes") if isinstance(instancing, dict) else None
+        for name, index in attributes.items() if isinstance(attributes, dict) else ():
+            yield "accessors", index, f"{doc.node_label(n)} EXT_mesh_gpu_instancing {name}"
     for s, skin in enumerate(document.get("skins", [])):
         yield from (("nodes", joint, f"skin {s} joint {slot}") for slot, joint in enumerate(skin.get("joints", [])))
         yield from _optional(skin, "skeleton", "nodes", f"skin {s} skeleton")

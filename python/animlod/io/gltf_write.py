@@ -34,9 +34,13 @@ _TRIANGLES, _LINEAR = 4, "LINEAR"
 # need besides (their meshes, cameras and lights).
 _MATERIAL_KEYS = ("asset", "materials", "textures", "samplers", "images", "bufferViews")
 _NODE_KEYS = ("nodes", "meshes", "accessors", "cameras")
-_LIGHTS = "KHR_lights_punctual"
-# Extensions a document uses without an "extensions" object naming them where they are used.
-_USAGE_ONLY_EXTENSIONS = ("KHR_mesh_quantization",)
+# The document-level extensions and the extensions of copied nodes a file of its own keeps: none
+# of them names a node by index (an unknown one may: VRMC_node_constraint's source, MSFT_lod's ids).
+STANDALONE_ROOT_EXTENSIONS = ("KHR_lights_punctual", "KHR_materials_variants", "KHR_xmp_json_ld")
+STANDALONE_NODE_EXTENSIONS = (
+    "KHR_lights_punctual", "KHR_xmp_json_ld", "KHR_node_visibility", "EXT_mesh_gpu_instancing",
+)  # fmt: skip
+_FLOAT, _BYTE, _UNSIGNED_BYTE, _SHORT, _UNSIGNED_SHORT = 5126, 5120, 5121, 5122, 5123
 
 
 class FaceMaterials(NamedTuple):
@@ -124,11 +128,10 @@ def write_glb(
     builder.json["scenes"] = [{"nodes": scene_nodes}]
     builder.json["scene"] = 0
     if source is not None:
-        own_meshes = 0 if skinned is None else 1
         _drop_first_nodes(builder.json, dropped)
-        _list_extensions_used(builder.json, source, own_meshes)  # for prune to know what may refer to data
+        _list_extensions_used(builder.json, source)  # for prune to know what may refer to data
         builder.prune()  # the document's meshes and accessors nothing written uses
-        _list_extensions_used(builder.json, source, own_meshes)
+        _list_extensions_used(builder.json, source)
     builder.save(path)
 
 
@@ -169,27 +172,31 @@ def _base_of(document: GltfDocument, with_nodes: bool) -> GlbBuilder:
     builder = GlbBuilder.from_document(document)
     js = builder.json
     kept = _MATERIAL_KEYS + (_NODE_KEYS if with_nodes else ())
-    lights = (js.get("extensions") or {}).get(_LIGHTS)
+    extensions = {
+        name: value for name, value in (js.get("extensions") or {}).items() if name in STANDALONE_ROOT_EXTENSIONS
+    }
     for key in set(js) - set(kept):
         del js[key]
-    if with_nodes and lights is not None:
-        js["extensions"] = {_LIGHTS: lights}
+    if extensions:  # those nothing written uses are dropped at the end (_list_extensions_used)
+        js["extensions"] = extensions
     js["asset"] = {**js.get("asset", {}), "generator": "animlod"}
     return builder
 
 
 def _drop_first_nodes(js: dict, count: int) -> None:
     """The first ``count`` nodes out of ``js``, whose other nodes refer to none of them; the node
-    indices of the scenes, nodes, skins and animations shifted down. A node's MSFT_lod levels
-    among them go with them."""
+    indices of the scenes, nodes, skins and animations shifted down. The other nodes keep only
+    the extensions of STANDALONE_NODE_EXTENSIONS (a copied node's MSFT_lod levels were among the
+    dropped nodes)."""
     nodes = js.get("nodes", [])
     del nodes[:count]
     for node in nodes:
         if "children" in node:
             node["children"] = [child - count for child in node["children"]]
-        lod = (node.get("extensions") or {}).pop("MSFT_lod", None)
-        if lod is not None and not node["extensions"]:
-            del node["extensions"]
+        if "extensions" in node:
+            node["extensions"] = {k: v for k, v in node["extensions"].items() if k in STANDALONE_NODE_EXTENSIONS}
+            if not node["extensions"]:
+                del node["extensions"]
     for scene in js.get("scenes", []):
         scene["nodes"] = [node - count for node in scene["nodes"]]
     for skin in js.get("skins", []):
@@ -202,11 +209,11 @@ def _drop_first_nodes(js: dict, count: int) -> None:
                 channel["target"]["node"] -= count
 
 
-def _list_extensions_used(js: dict, document: GltfDocument, own_meshes: int) -> None:
-    """``js``'s extensionsUsed and extensionsRequired: those of ``document`` that it uses; the
-    meshes beyond the ``own_meshes`` written are ``document``'s."""
-    used = set(_USAGE_ONLY_EXTENSIONS) if len(js.get("meshes", [])) > own_meshes else set()
-    stack = [js]
+def _list_extensions_used(js: dict, document: GltfDocument) -> None:
+    """``js``'s extensionsUsed and extensionsRequired: those of ``document`` that it uses (its
+    document-level extensions those that something in it refers to, the others dropped)."""
+    used = {"KHR_mesh_quantization"} if _quantized(js) else set()
+    stack = [value for key, value in js.items() if key != "extensions"]
     while stack:
         item = stack.pop()
         if isinstance(item, dict):
@@ -215,12 +222,36 @@ def _list_extensions_used(js: dict, document: GltfDocument, own_meshes: int) -> 
             stack.extend(item.values())
         elif isinstance(item, list):
             stack.extend(item)
+    root = {name: value for name, value in (js.get("extensions") or {}).items() if name in used}
+    js.pop("extensions", None)
+    if root:
+        js["extensions"] = root
     for listed in ("extensionsUsed", "extensionsRequired"):
         kept = [name for name in document.json.get(listed, []) if name in used]
         if kept:
             js[listed] = kept
         else:
             js.pop(listed, None)
+
+
+def _quantized(js: dict) -> bool:
+    """Whether a mesh attribute has a type of KHR_mesh_quantization's that core glTF does not
+    allow (a position, normal or tangent not in float, a texture coordinate in signed or
+    unnormalized integers, a morph target's anything not in float)."""
+    accessors = js.get("accessors", [])
+    for primitive in (p for mesh in js.get("meshes", []) for p in mesh.get("primitives", [])):
+        targets = primitive.get("targets", [])
+        for name, index in primitive.get("attributes", {}).items():
+            accessor = accessors[index]
+            kind, normalized = accessor.get("componentType"), accessor.get("normalized", False)
+            texture = name.startswith("TEXCOORD_")
+            if texture and (kind in (_BYTE, _SHORT) or kind in (_UNSIGNED_BYTE, _UNSIGNED_SHORT) and not normalized):
+                return True
+            if name in ("POSITION", "NORMAL", "TANGENT") and kind != _FLOAT:
+                return True
+        if any(accessors[index].get("componentType") != _FLOAT for target in targets for index in target.values()):
+            return True
+    return False
 
 
 def add_skeleton(builder: GlbBuilder, skeleton: Skeleton, name_suffix: str = "") -> list[int]:

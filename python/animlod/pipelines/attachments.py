@@ -11,7 +11,9 @@ its subtree, or what a joint's own node draws: an unskinned mesh, a camera, a li
 for every motion level: under the level's node of its joint, or, where that joint is frozen,
 under its nearest kept ancestor with the frozen joints' key posture in between (seeds/000,
 Section 5.1: a frozen joint keeps the local transformation of its key frame), so that it moves
-as the level's skin moves the vertices bound to its joint. The copies share the input's meshes,
+as the level's skin moves the vertices bound to its joint. What hangs from a node between joints
+(an exporter's helper node), or what such a node draws, hangs from its nearest joint through
+the rest transforms of the nodes between. The copies share the input's meshes,
 cameras and lights. Each level clip then takes the input clip's channels that pose no skeleton,
 retargeted to the copies where they animate an attachment.
 """
@@ -39,29 +41,48 @@ _STANDALONE_POINTERS = ("/materials/", "/textures/", "/cameras/", "/extensions/K
 @dataclass(frozen=True)
 class Attachment:
     """A node (with its subtree) hung from joint ``joint`` (skeleton order) of a rig, or, with
-    ``content_only``, the joint's own node for what it draws (a mesh, camera or light on it)."""
+    ``content_only``, a node for what it draws (a mesh, camera or light on it): the joint's own,
+    or a node between joints. ``via``: the nodes between the joint and ``node`` (``node``
+    itself for its content), whose rest transforms hold it there (an exporter's helper node
+    such as assimp's ``RightHand_$AssimpFbx$_PostRotation``, a sword holding tassel bones)."""
 
     joint: int
     node: int
     content_only: bool = False
+    via: tuple[int, ...] = ()
 
 
 def find_attachments(doc: GltfDocument, rig: SkinRig) -> list[Attachment]:
     """The subtrees hung from the rig's joint nodes that hold no joint and no skinned mesh, and
-    the joint nodes that draw an unskinned mesh or hold a camera or a light."""
+    the nodes that draw an unskinned mesh or hold a camera or a light: the joint nodes, and the
+    nodes between joints (each with what hangs from it, through it, from its nearest joint)."""
     joint_of = {node: j for j, node in enumerate(rig.joint_nodes)}
-    skeletal = posing_nodes(doc) | {n for n, node in enumerate(doc.gltf.nodes) if node.skin is not None}
+    skeletal = posing_nodes(doc, rig) | {n for n, node in enumerate(doc.gltf.nodes) if node.skin is not None}
     attachments = []
     for node, joint in joint_of.items():
-        own = doc.gltf.nodes[node]
-        light = "KHR_lights_punctual" in (own.extensions or {})
-        if (own.mesh is not None and own.skin is None) or own.camera is not None or light:
+        if _draws(doc, node):
             attachments.append(Attachment(joint, node, content_only=True))
-        for child in own.children or []:
-            if child in joint_of or not skeletal.isdisjoint(_subtree(doc, child)):
-                continue  # a joint, a node between joints, or a skinned mesh (LoD'd on its own)
-            attachments.append(Attachment(joint, child))
+        below = [(child, ()) for child in doc.gltf.nodes[node].children or []]
+        while below:
+            child, via = below.pop()
+            if child in joint_of:
+                continue
+            if skeletal.isdisjoint(_subtree(doc, child)):
+                attachments.append(Attachment(joint, child, via=via))
+                continue
+            # A node between joints or a skinned mesh's (LoD'd on its own): what it draws, and
+            # what hangs from it, hang from the joint through it.
+            if _draws(doc, child):
+                attachments.append(Attachment(joint, child, content_only=True, via=(*via, child)))
+            below += [(grandchild, (*via, child)) for grandchild in doc.gltf.nodes[child].children or []]
     return attachments
+
+
+def _draws(doc: GltfDocument, node: int) -> bool:
+    """Whether ``node`` draws an unskinned mesh or holds a camera or a light."""
+    own = doc.gltf.nodes[node]
+    light = "KHR_lights_punctual" in (own.extensions or {})
+    return (own.mesh is not None and own.skin is None) or own.camera is not None or light
 
 
 def hung_nodes(doc: GltfDocument, attachments: list[Attachment]) -> set[int]:
@@ -72,10 +93,10 @@ def hung_nodes(doc: GltfDocument, attachments: list[Attachment]) -> set[int]:
     return found
 
 
-def posing_nodes(doc: GltfDocument) -> set[int]:
-    """Nodes that pose a skeleton: every skin's joints and their ancestors (a level's clip poses
-    its own skeleton in their place)."""
-    joints = {node for skin in doc.gltf.skins for node in skin.joints}
+def posing_nodes(doc: GltfDocument, rig: SkinRig) -> set[int]:
+    """Nodes that pose a skeleton: every skin's joints, ``rig``'s (a skin's, or an animated node
+    tree's) and their ancestors (a level's clip poses its own skeleton in their place)."""
+    joints = {node for skin in doc.gltf.skins for node in skin.joints} | set(rig.joint_nodes)
     found = set(joints)
     for joint in joints:
         found.update(doc.ancestors(joint))
@@ -112,6 +133,8 @@ def add_level_attachments(
         rest_linear = np.eye(4)
         rest_linear[:3, :3] = rig.rest_linear[attachment.joint]
         frame = np.linalg.inv(world[ancestor]) @ world[attachment.joint] @ rest_linear
+        for between in attachment.via:
+            frame = frame @ doc.rest_matrix(between)
         parent = joint_nodes[level_joint[ancestor]]
         if not np.allclose(frame, np.eye(4), rtol=0.0, atol=1e-12):  # a static node between: the
             name = f"{_name(builder, attachment.node)} frame{suffix}"  # copy keeps its own TRS
@@ -121,8 +144,8 @@ def add_level_attachments(
         if attachment.content_only:
             source = builder.json["nodes"][attachment.node]
             content = {key: deepcopy(source[key]) for key in _CONTENT if key in source}
-            # Named apart from the joint's own node where no suffix does.
-            name = f"{_name(builder, attachment.node)}{suffix or ' content'}"
+            # A joint's own content is named apart from the level's joint node where no suffix does.
+            name = f"{_name(builder, attachment.node)}{suffix or ('' if attachment.via else ' content')}"
             top = copies[attachment.node] = builder.append("nodes", {"name": name, **content})
         else:
             top = _copy_subtree(builder, attachment.node, suffix, copies)

@@ -396,7 +396,7 @@ def _add_motion_levels(builder: GlbBuilder, doc: GltfDocument, motion: _SkinMoti
     """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's),
     with what hangs from the skeleton and the clips' other channels (:mod:`.attachments`)."""
     nodes = [_MotionLevelNodes(None, motion.joint_count)]
-    attachments, posing = find_attachments(doc, motion.rig), posing_nodes(doc)
+    attachments, posing = find_attachments(doc, motion.rig), posing_nodes(doc, motion.rig)
     for m, level in enumerate(motion.reduced_levels, start=1):
         joint_nodes = add_skeleton(builder, level.motion.skeleton)
         copies = add_level_attachments(

@@ -254,7 +254,7 @@ class _Hanging(NamedTuple):
         def add(builder: GlbBuilder, joint_nodes: list[int], animations: list[int]) -> None:
             document, rig = self.document, self.rig
             copies = add_level_attachments(builder, document, rig, self.attachments, original, level, joint_nodes)
-            posing = posing_nodes(document)
+            posing = posing_nodes(document, rig)
             for clip, animation in zip(played, animations):
                 if clip.animation is not None:
                     carry_other_channels(builder, document, posing, clip.animation, animation, copies, standalone=True)
@@ -363,14 +363,18 @@ def _read_input(
             note(f"{path}: animated nodes under no node in common with the skeleton's left out: "
                  f"{', '.join(other_trees)}")  # fmt: skip
     attachments = find_attachments(document, rig)
-    hanging = _Hanging(document, rig, attachments) if attachments else None
-    unwritten = _left_out_of_level_files(document, joined_nodes, attachments)
+    hanging = _Hanging(document, rig, attachments)
+    unwritten = _left_out_of_level_files(document, rig, joined_nodes, attachments)
     if unwritten:
         whole_document = " (`animlod character` keeps the whole document)" if skin is not None else ""
         note(f"{path}: the levels' GLBs hold the skeleton, its clips, the skinned mesh if any with its materials, "
              f"and what hangs from the joints; not {unwritten}{whole_document}")  # fmt: skip
     names = [motion.name or f"animation{index}" for index, motion in enumerate(motions)]
     durations = [document.animation_duration(animation) for animation in animations]
+    still = [index for index in range(len(document.gltf.animations)) if index not in animations]
+    if still:  # a prop's spin, a blink of morph weights alone
+        labels = ", ".join(document.animation_label(index) for index in still)
+        note(f"{path}: {labels} move{'s' if len(still) == 1 else ''} no joint of the skeleton: not in the levels")
     if clip is None:
         from ..motion_lod.clips import join_clips, merge_split_clips
 
@@ -378,9 +382,10 @@ def _read_input(
         if merged is not None:
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
-            if morph_weights or _animates(document, hanging):
-                note(f"{path}: its morph weight channels and those of what hangs from its joints are not in the "
-                     "levels' GLBs (their animations are joined into one motion)")  # fmt: skip
+            if _poses_nothing(document, rig):
+                note(f"{path}: the channels of its animations that pose no joint (morph weights, what hangs from the "
+                     "joints, KHR_animation_pointer) are not in the levels' GLBs (the animations are joined into one "
+                     "motion)")  # fmt: skip
             played = PlayedClip(merged.name, slice(None), max(durations))
             return _Input(_rigid(path, motions, range(len(motions)), merged), [played], skin, materials, None, hanging)
         # A clip that scales a joint cannot be re-fitted; the others still make levels.
@@ -398,24 +403,28 @@ def _read_input(
                       for index, span in zip(rigid, spans)]  # fmt: skip
             return _Input(joined, played, skin, materials, None, hanging)
         clip = rigid[0] if rigid else 0
+    listed = ", ".join(f"{i}: {name!r}" for i, name in enumerate(names))
     if isinstance(clip, str):
         if clip not in names:
-            listed = ", ".join(f"{i}: {name!r}" for i, name in enumerate(names))
-            raise FormatError(path, "clip", f"no animation named {clip!r}; the file has {listed}")
+            moves_no_joint = any(document.gltf.animations[index].name == clip for index in still)
+            reason = "moves no joint of the skeleton" if moves_no_joint else "is not in the file"
+            raise FormatError(path, "clip", f"the animation named {clip!r} {reason}; those that move it: {listed}")
         clip = names.index(clip)
     if not 0 <= clip < len(motions):
-        raise FormatError(path, "clip", f"the file has {len(motions)} animations, got index {clip}")
+        raise FormatError(path, "clip", f"the file has {len(motions)} animations that move the skeleton ({listed}), "
+                                        f"got index {clip}")  # fmt: skip
     animation = animations[clip]
     played = [PlayedClip(names[clip], slice(None), durations[clip], morph_weights.get(animation), animation)]
     return _Input(_rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None, hanging)
 
 
-def _left_out_of_level_files(doc: GltfDocument, joined: set[int], attachments: list[Attachment]) -> str:
+def _left_out_of_level_files(doc: GltfDocument, rig: SkinRig, joined: set[int], attachments: list[Attachment]) -> str:
     """What of ``doc`` the motion levels' GLBs (a skinned mesh with its materials and the morph
-    weight channels of the ``joined`` nodes' meshes, a skeleton and its joint channels, copies of
-    the ``attachments`` with their channels) do not carry, as words for a note; empty where that
-    is nothing."""
-    from .attachments import hung_nodes, standalone_pointer
+    weight channels of the ``joined`` nodes' meshes, ``rig``'s skeleton and its joint channels,
+    copies of the ``attachments`` with their channels) do not carry, as words for a note; empty
+    where that is nothing."""
+    from ..io.gltf_write import STANDALONE_NODE_EXTENSIONS, STANDALONE_ROOT_EXTENSIONS
+    from .attachments import hung_nodes, posing_nodes, standalone_pointer
 
     hung = hung_nodes(doc, attachments)
     elsewhere = [node for n, node in enumerate(doc.gltf.nodes or []) if n not in hung]
@@ -426,22 +435,33 @@ def _left_out_of_level_files(doc: GltfDocument, joined: set[int], attachments: l
     channels = [(node, path) for targets in doc.channel_targets for node, path in targets]
     if any(path == "weights" and node not in joined | hung for node, path in channels):
         parts.append("the morph weight channels of other meshes")
-    pointers = [channel["target"] for animation in doc.json.get("animations", []) for channel in animation["channels"]]
-    if any(target.get("path") == "pointer" and not standalone_pointer(target) for target in pointers):
+    posing = posing_nodes(doc, rig)
+    moving = {node for node, path in channels if node is not None and path != "weights"} - posing - hung
+    if moving and rig.skin is not None:  # a skeleton of an animated node tree: the others are named apart
+        parts.append(
+            f"the animation of {len(moving)} node{'s that hang' if len(moving) > 1 else ' that hangs'} from no joint"
+        )
+    raw = [channel["target"] for animation in doc.json.get("animations", []) for channel in animation["channels"]]
+    resolved = [path for targets in doc.channel_targets for _, path in targets]  # pointers at nodes: node channels
+    if any(path == "pointer" and not standalone_pointer(target) for target, path in zip(raw, resolved)):
         parts.append("KHR_animation_pointer channels at meshes or other objects")
     if any(node.camera is not None or "KHR_lights_punctual" in (node.extensions or {}) for node in elsewhere):
         parts.append("its cameras and lights elsewhere")
+    dropped = sorted({name for name in doc.json.get("extensions") or {} if name not in STANDALONE_ROOT_EXTENSIONS}
+                     | {name for n in hung for name in doc.json["nodes"][n].get("extensions") or {}
+                        if name not in STANDALONE_NODE_EXTENSIONS})  # fmt: skip
+    if dropped:
+        parts.append(f"the extensions {', '.join(dropped)} (they may name nodes of the input)")
     return ", ".join(parts[:-1]) + (" or " if len(parts) > 1 else "") + (parts[-1] if parts else "")
 
 
-def _animates(doc: GltfDocument, hanging: _Hanging | None) -> bool:
-    """Whether an animation of ``doc`` moves what hangs from its skeleton."""
-    if hanging is None:
-        return False
-    from .attachments import hung_nodes
+def _poses_nothing(doc: GltfDocument, rig: SkinRig) -> bool:
+    """Whether an animation of ``doc`` has a channel that poses no joint of ``rig`` (morph
+    weights, a prop's own motion, a KHR_animation_pointer channel at anything but a node)."""
+    from .attachments import posing_nodes
 
-    hung = hung_nodes(doc, hanging.attachments)
-    return any(node in hung for targets in doc.channel_targets for node, _ in targets)
+    posing = posing_nodes(doc, rig)
+    return any(node not in posing or path == "weights" for targets in doc.channel_targets for node, path in targets)
 
 
 def _clip_suffixes(names: list[str]) -> list[str]:

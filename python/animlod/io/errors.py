@@ -58,3 +58,8 @@ def _names_a_path(message: str, source: str) -> bool:
     """Whether ``message`` starts with ``source`` or with some path (``dir/file.ext: ...``)."""
     head = message.split(": ", 1)[0]
     return message.startswith(source) or os.sep in head or os.path.splitext(head)[1] != ""
+
+
+class UnreadAttributesWarning(UserWarning):
+    """Data of a mesh file that animlod does not read (an OBJ file's normals, a PLY file's vertex
+    colours), so that levels written without them are no silent loss."""

@@ -18,7 +18,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .atomic import atomic_write
-from .errors import FormatError
+from .errors import FormatError, UnreadAttributesWarning
 from .polygon_mesh import (
     check_face_indices,
     check_finite_vertices,
@@ -264,10 +264,6 @@ def _join_continued_lines(data: bytes) -> bytes:
     joined[joined == 0] = ord(" ")
     tail = marks.size - (int(marks_before[-1]) if newlines.size else 0)  # continued into the file's end
     return joined.tobytes() + b"\n" * tail
-
-
-class UnreadAttributesWarning(UserWarning):
-    """An OBJ file's texture coordinates or normals (``vt``, ``vn``), which animlod does not read."""
 
 
 def _corner_texture_indices(face_block: bytes) -> tuple[bytes, int]:

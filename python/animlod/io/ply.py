@@ -1,5 +1,6 @@
 """PLY geometry: ``vertex`` x, y, z and the ``face`` list ``vertex_indices`` read (ascii,
-binary_little_endian, binary_big_endian; other elements and properties are skipped) and written.
+binary_little_endian, binary_big_endian; other elements and properties are skipped, with a
+warning for the vertices' and faces' other properties) and written.
 Parsing works on the whole file's bytes with numpy: there is no Python loop over rows."""
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import atomic_write
-from .errors import FormatError
+from .errors import FormatError, UnreadAttributesWarning
 from .polygon_mesh import (
     check_face_indices,
     check_finite_vertices,
@@ -88,6 +89,11 @@ def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     check_finite_vertices(path, vertices, lambda index: f"vertex {index}")
     face = values.get("face", {})
     face_list = next((face[name] for name in _FACE_LIST_NAMES if isinstance(face.get(name), tuple)), None)
+    unread = [f"{element} {name}" for element, read in (("vertex", ("x", "y", "z")), ("face", _FACE_LIST_NAMES))
+              for name in values.get(element, {}) if name not in read]  # fmt: skip
+    if unread:  # colours, normals, texture coordinates, a face's flags
+        warnings.warn(f"{path}: its properties {', '.join(unread)} are not read, and the levels are written without "
+                      "them", UnreadAttributesWarning, stacklevel=2)  # fmt: skip
     if face_list is None:
         if any(element.name == "face" and element.count for element in elements):
             raise FormatError(path, "element face", "has no list property vertex_indices")

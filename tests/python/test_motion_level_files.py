@@ -67,7 +67,8 @@ def test_a_node_tree_keeps_what_its_joints_draw_once_and_in_place(walker, tmp_pa
     """An animation library whose joints draw meshes (a rigid robot's links): each joint node's
     mesh was copied with the joint's own channels on the copy, so it moved twice; a static mesh
     node holding an animated joint ("gripper" over "jaw") came along as a copy holding that joint
-    again. Now each mesh sits where the input draws it, and every node is there once."""
+    again; a mesh that only scaled was read as a bone and the motion refused. Now each mesh sits
+    where the input draws it, and every node is there once."""
 
     def robot(builder: GlbBuilder, named: dict) -> None:
         js = builder.json
@@ -80,6 +81,11 @@ def test_a_node_tree_keeps_what_its_joints_draw_once_and_in_place(walker, tmp_pa
         js["nodes"][gripper]["children"] = [jaw]
         js["nodes"][named["LeftHand"]]["children"].append(gripper)
         _channel(builder, jaw, "rotation", np.array([[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.38268343, 0.92387953]]))
+        # A light that only scales (blinks): a prop on the head, not a bone that would make the
+        # motion scale (refused: motion LoD re-fits rigid motions only).
+        led = builder.append("nodes", {"name": "led", "mesh": _box(builder, "led")})
+        js["nodes"][named["Head"]]["children"].append(led)
+        _channel(builder, led, "scale", np.array([[1.0, 1, 1], [0.1, 0.1, 0.1]]))
 
     source = _edited(walker, tmp_path / "robot.glb", robot)
     report = build_motion_levels(source, tmp_path / "levels", levels=3)
@@ -90,11 +96,11 @@ def test_a_node_tree_keeps_what_its_joints_draw_once_and_in_place(walker, tmp_pa
         names = [node.name for node in doc.gltf.nodes]
         assert len(names) == len(set(names)), sorted(name for name in names if names.count(name) > 1)
         animated = {names[c.target.node] for c in doc.gltf.animations[0].channels if c.target.node is not None}
-        assert not animated & {"Head content", "gripper"}  # the joints' channels stay the joints'
+        assert not animated & {"Head content", "gripper"} and "led" in animated  # the joints' channels stay theirs
         assert ("jaw" in animated) == ("jaw" in names)  # a joint, frozen at the coarser levels
         if index == 0:  # the input's pose: level 0's clip plays it unchanged
             worlds = posed_worlds(doc, 0)
-            for copy, original in (("Head content", "Head"), ("gripper", "gripper"), ("jaw", "jaw")):
+            for copy, original in (("Head content", "Head"), ("gripper", "gripper"), ("jaw", "jaw"), ("led", "led")):
                 np.testing.assert_allclose(worlds[names.index(copy)], expected[input_names.index(original)], atol=1e-5)
 
 

@@ -346,11 +346,11 @@ class SkinRig:
 
 def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
     """The nodes an animation translates, turns or scales, but cameras and lights (the scene's, not
-    the skeleton's), and every node below one that draws nothing and, unless it holds one of
-    those, holds nothing that draws (an end site or a bone without keys), in node order; and the
-    labels of the top nodes of trees left out. Animated nodes under no common node (a weapon
-    animated beside the character, a second character) are several trees: the one of the most
-    nodes is the skeleton."""
+    the skeleton's) and meshes that only scale, and every node below one that draws nothing and,
+    unless it holds one of those, holds nothing that draws (an end site or a bone without keys),
+    in node order; and the labels of the top nodes of trees left out. Animated nodes under no
+    common node (a weapon animated beside the character, a second character) are several trees:
+    the one of the most nodes is the skeleton."""
     nodes = doc.gltf.nodes or []
     staging = {
         index
@@ -358,6 +358,11 @@ def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
         if node.camera is not None or _LIGHTS_EXTENSION in (node.extensions or {})
     }
     moved = doc.moved_nodes() - staging
+    # A mesh that only scales, with nothing moving below it (a blinking light), is a prop on its
+    # parent, not a bone: a rigid skeleton has none that scales.
+    turned = {node for targets in doc.channel_targets for node, path in targets if path in ("translation", "rotation")}
+    carried_moves = {ancestor for node in moved for ancestor in doc.ancestors(node)}
+    moved -= {node for node in moved - turned - carried_moves if nodes[node].mesh is not None}
     if not moved:
         raise doc.fail(
             "animations", "no skin, and no animation translates, turns or scales a node: no skeleton to read"

@@ -27,11 +27,8 @@ from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
 from .result import AssetResult, LevelRow, Progress
 
 if TYPE_CHECKING:
-    from ..io.glb_builder import GlbBuilder
-    from ..io.gltf_document import GltfDocument
-    from ..io.gltf_skin import SkinRig
-    from ..io.gltf_write import FaceMaterials, HungNodes
-    from .attachments import Attachment
+    from ..io.gltf_write import FaceMaterials
+    from .motion_level_files import LevelContent
 
 
 @dataclass
@@ -141,7 +138,7 @@ def build_motion_levels(
         if on_note is not None:
             on_note(text)
 
-    motion, played, skin, materials, layout, hanging = _read_input(source, clip, clips, joint_map, note)
+    motion, played, skin, materials, layout, content = _read_input(source, clip, clips, joint_map, note)
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
@@ -198,7 +195,7 @@ def build_motion_levels(
             names.append(Path(f"{stem}_lod{index}.glb"))
             clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
             weights = [clip.morph_weights for clip in played]
-            hung = None if hanging is None else hanging.on_level(motion, level, played)
+            hung = None if content is None else content.on_level(motion, level, played)
             write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations, materials, weights, hung)
         files.append(names)
         row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
@@ -238,41 +235,17 @@ class PlayedClip(NamedTuple):
     animation: int | None = None
 
 
-class _Hanging(NamedTuple):
-    """What hangs from a glTF rig's joints (props, sockets, meshes its joint nodes draw)."""
-
-    document: GltfDocument
-    rig: SkinRig
-    attachments: list[Attachment]
-
-    def on_level(self, original: Motion, level: MotionLevel, played: list[PlayedClip]) -> HungNodes:
-        """The attachments' copies on ``level`` of ``original``, for its GLB, with the channels that
-        animate them in each of the ``played`` clips that is one of the document's animations."""
-        from ..io.gltf_write import HungNodes
-        from .attachments import add_level_attachments, carry_other_channels, posing_nodes
-
-        def add(builder: GlbBuilder, joint_nodes: list[int], animations: list[int]) -> None:
-            document, rig = self.document, self.rig
-            copies = add_level_attachments(builder, document, rig, self.attachments, original, level, joint_nodes)
-            posing = posing_nodes(document, rig)
-            for clip, animation in zip(played, animations):
-                if clip.animation is not None:
-                    carry_other_channels(builder, document, posing, clip.animation, animation, copies, standalone=True)
-
-        return HungNodes(self.document, add)
-
-
 class _Input(NamedTuple):
     """What :func:`_read_input` reads: the motion to simplify, the clips it is made of, for a
-    skinned glTF its skin and materials, for a BVH its layout, and what hangs from a glTF's
-    skeleton (None where nothing does)."""
+    skinned glTF its skin and materials, for a BVH its layout, and for a glTF what its level
+    files carry besides (:class:`.motion_level_files.LevelContent`)."""
 
     motion: Motion
     played: list[PlayedClip]
     skin: SkinnedMesh | None = None
     materials: FaceMaterials | None = None
     layout: BvhLayout | None = None
-    hanging: _Hanging | None = None
+    content: LevelContent | None = None
 
 
 # Vertex-frames times levels measured between two progress calls of skin_distances (about half a
@@ -330,6 +303,7 @@ def _read_input(
     from ..io.gltf_write import FaceMaterials
     from .attachments import find_attachments
     from .clip_import import with_clips
+    from .motion_level_files import LevelContent, left_out_of_level_files, poses_nothing
     from .whole_skin import whole_skin
 
     document = GltfDocument(source)
@@ -358,13 +332,14 @@ def _read_input(
         )
         skeleton, joined_nodes = motions[0].skeleton, set()
         note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
-             f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton and its clips")  # fmt: skip
+             f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton, its clips and what hangs from "
+             "it")  # fmt: skip
         if other_trees:
             note(f"{path}: animated nodes under no node in common with the skeleton's left out: "
                  f"{', '.join(other_trees)}")  # fmt: skip
     attachments = find_attachments(document, rig)
-    hanging = _Hanging(document, rig, attachments)
-    unwritten = _left_out_of_level_files(document, rig, joined_nodes, attachments)
+    content = LevelContent(document, rig, attachments)
+    unwritten = left_out_of_level_files(document, rig, joined_nodes, attachments)
     if unwritten:
         whole_document = " (`animlod character` keeps the whole document)" if skin is not None else ""
         note(f"{path}: the levels' GLBs hold the skeleton, its clips, the skinned mesh if any with its materials, "
@@ -382,12 +357,12 @@ def _read_input(
         if merged is not None:
             note(f"{path}: its {len(motions)} animations each move other joints: simplifying them as one motion "
                  "(use --clip to take one)")  # fmt: skip
-            if _poses_nothing(document, rig):
+            if poses_nothing(document, rig):
                 note(f"{path}: the channels of its animations that pose no joint (morph weights, what hangs from the "
                      "joints, KHR_animation_pointer) are not in the levels' GLBs (the animations are joined into one "
                      "motion)")  # fmt: skip
             played = PlayedClip(merged.name, slice(None), max(durations))
-            return _Input(_rigid(path, motions, range(len(motions)), merged), [played], skin, materials, None, hanging)
+            return _Input(_rigid(path, motions, range(len(motions)), merged), [played], skin, materials, None, content)
         # A clip that scales a joint cannot be re-fitted; the others still make levels.
         rigid = [index for index, motion in enumerate(motions) if motion.deforming_joint() is None]
         scaling = [names[index] for index in range(len(motions)) if index not in rigid]
@@ -401,7 +376,7 @@ def _read_input(
             played = [PlayedClip(names[index], span, durations[index], morph_weights.get(animations[index]),
                                  animations[index])
                       for index, span in zip(rigid, spans)]  # fmt: skip
-            return _Input(joined, played, skin, materials, None, hanging)
+            return _Input(joined, played, skin, materials, None, content)
         clip = rigid[0] if rigid else 0
     listed = ", ".join(f"{i}: {name!r}" for i, name in enumerate(names))
     if isinstance(clip, str):
@@ -415,53 +390,7 @@ def _read_input(
                                         f"got index {clip}")  # fmt: skip
     animation = animations[clip]
     played = [PlayedClip(names[clip], slice(None), durations[clip], morph_weights.get(animation), animation)]
-    return _Input(_rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None, hanging)
-
-
-def _left_out_of_level_files(doc: GltfDocument, rig: SkinRig, joined: set[int], attachments: list[Attachment]) -> str:
-    """What of ``doc`` the motion levels' GLBs (a skinned mesh with its materials and the morph
-    weight channels of the ``joined`` nodes' meshes, ``rig``'s skeleton and its joint channels,
-    copies of the ``attachments`` with their channels) do not carry, as words for a note; empty
-    where that is nothing."""
-    from ..io.gltf_write import STANDALONE_NODE_EXTENSIONS, STANDALONE_ROOT_EXTENSIONS
-    from .attachments import hung_nodes, posing_nodes, standalone_pointer
-
-    hung = hung_nodes(doc, attachments)
-    elsewhere = [node for n, node in enumerate(doc.gltf.nodes or []) if n not in hung]
-    parts = []
-    meshes = sum(node.mesh is not None and node.skin is None for node in elsewhere)
-    if meshes:
-        parts.append(f"{meshes} mesh{'es' if meshes > 1 else ''} without a skin elsewhere (static parts, scenery)")
-    channels = [(node, path) for targets in doc.channel_targets for node, path in targets]
-    if any(path == "weights" and node not in joined | hung for node, path in channels):
-        parts.append("the morph weight channels of other meshes")
-    posing = posing_nodes(doc, rig)
-    moving = {node for node, path in channels if node is not None and path != "weights"} - posing - hung
-    if moving and rig.skin is not None:  # a skeleton of an animated node tree: the others are named apart
-        parts.append(
-            f"the animation of {len(moving)} node{'s that hang' if len(moving) > 1 else ' that hangs'} from no joint"
-        )
-    raw = [channel["target"] for animation in doc.json.get("animations", []) for channel in animation["channels"]]
-    resolved = [path for targets in doc.channel_targets for _, path in targets]  # pointers at nodes: node channels
-    if any(path == "pointer" and not standalone_pointer(target) for target, path in zip(raw, resolved)):
-        parts.append("KHR_animation_pointer channels at meshes or other objects")
-    if any(node.camera is not None or "KHR_lights_punctual" in (node.extensions or {}) for node in elsewhere):
-        parts.append("its cameras and lights elsewhere")
-    dropped = sorted({name for name in doc.json.get("extensions") or {} if name not in STANDALONE_ROOT_EXTENSIONS}
-                     | {name for n in hung for name in doc.json["nodes"][n].get("extensions") or {}
-                        if name not in STANDALONE_NODE_EXTENSIONS})  # fmt: skip
-    if dropped:
-        parts.append(f"the extensions {', '.join(dropped)} (they may name nodes of the input)")
-    return ", ".join(parts[:-1]) + (" or " if len(parts) > 1 else "") + (parts[-1] if parts else "")
-
-
-def _poses_nothing(doc: GltfDocument, rig: SkinRig) -> bool:
-    """Whether an animation of ``doc`` has a channel that poses no joint of ``rig`` (morph
-    weights, a prop's own motion, a KHR_animation_pointer channel at anything but a node)."""
-    from .attachments import posing_nodes
-
-    posing = posing_nodes(doc, rig)
-    return any(node not in posing or path == "weights" for targets in doc.channel_targets for node, path in targets)
+    return _Input(_rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None, content)
 
 
 def _clip_suffixes(names: list[str]) -> list[str]:

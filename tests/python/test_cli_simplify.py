@@ -73,7 +73,7 @@ def _wrapped_texture(mesh) -> ObjTexture:
     return ObjTexture(uvs.astype(np.float32), corners.reshape(-1, 3).astype(np.int32))
 
 
-def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path):
+def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path, capsys):
     """OBJ frames with vt lines: the levels were written without them (a warning said so). Now
     each level frame has them, the seam's copies apart, each corner's u the angle of its
     position about the axis, as in the input; one OBJ file's level too."""
@@ -87,6 +87,8 @@ def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path):
         warnings.simplefilter("error", UnreadAttributesWarning)
         for source in ("shot", "rest.obj"):
             assert main(["simplify", str(tmp_path / source), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+        assert main(["info", str(tmp_path / "shot")]) == 0  # without a warning that they are not read
+    assert f"vertices: {cylinder.vertex_count}, 276 with their texture coordinates (vt)" in capsys.readouterr().out
     levels = [tmp_path / "out" / f"shot_lod{level}" / "shot_0.obj" for level in (1, 2, 3)]
     for path in [*levels, *(tmp_path / "out" / f"rest_lod{level}.obj" for level in (1, 2, 3))]:
         positions, faces, written = read_obj_textured(path)

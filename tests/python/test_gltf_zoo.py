@@ -468,7 +468,7 @@ def test_motion_levels_of_an_animation_library_without_skins(tmp_path: Path, cap
         prop = [node.name for node in doc.gltf.nodes].index("prop")
         assert doc.gltf.nodes[prop].mesh is not None
         holder = doc.gltf.nodes[doc.parents[prop]].name
-        assert holder == "RightHand" if "RightHand" in written.skeleton.names else holder == "prop frame"
+        assert holder == "RightHand" if "RightHand" in written.skeleton.names else holder == "RightHand frame"
         if index == 0:
             np.testing.assert_allclose(posed_worlds(doc, 0)[prop], held, atol=1e-5)
     assert report.chain.levels[-1].report.joint_count < 42

@@ -197,6 +197,23 @@ def test_round_trip_preserves_world_positions(tmp_path: Path, order: str, animat
     assert channel_lines == expected
 
 
+def test_float_noise_on_translations_is_no_animated_translation(tmp_path: Path) -> None:
+    """A glTF clip whose one joint translates (a node between joints turning) gives every joint
+    per-frame translations, composed through the nodes with 1e-18 of float noise: the end site's
+    was refused as "an end site with animated translation; BVH cannot store it". Noise the
+    written digits cannot show is no translation."""
+    motion = _hand_made_motion(seed=5, animated_translation=True)
+    noise = np.random.default_rng(5).normal(scale=1e-18, size=motion.joint_translations.shape)
+    noisy = Motion(motion.skeleton, motion.root_positions, motion.local_rotations, motion.fps,
+                   joint_translations=motion.joint_translations + noise)  # fmt: skip
+    write_bvh(tmp_path / "noisy.bvh", noisy)
+    channel_lines = [
+        line.split()[1] for line in (tmp_path / "noisy.bvh").read_text().splitlines() if "CHANNELS" in line
+    ]
+    assert channel_lines == ["6", "3", "3", "6", "3"]  # the translating joint keeps its own
+    np.testing.assert_allclose(read_bvh(tmp_path / "noisy.bvh").world_positions(), motion.world_positions(), atol=1e-5)
+
+
 def test_a_tiny_skeleton_keeps_its_precision_through_a_round_trip(tmp_path: Path) -> None:
     motion = _hand_made_motion(seed=3, animated_translation=False)
     s = motion.skeleton

@@ -143,9 +143,15 @@ def test_a_textured_sequence_has_a_vertex_per_position_and_texture_coordinate(tm
         write_sequence(tmp_path / "ply", mesh, fmt="ply", texture=split)
     # A frame with other texture coordinates: none are carried, and a warning says why.
     obj.write_obj(tmp_path / "seam" / "f2.obj", positions, faces, texture._replace(uvs=texture.uvs[::-1].copy()))
-    with pytest.warns(UnreadAttributesWarning, match=r"f2.obj: its texture coordinates \(vt\) differ"):
+    with pytest.warns(UnreadAttributesWarning, match=r"f2.obj: its texture coordinates \(vt\) are not the first "
+                      r"frame's \(f0.obj has others\)"):  # fmt: skip
         mesh, split = meshseq.read_textured_sequence(tmp_path / "seam")
     assert split is None and mesh.vertex_count == 4
+    # The first frame without them, the others with: the same.
+    obj.write_obj(tmp_path / "seam" / "f0.obj", positions, faces)
+    with pytest.warns(UnreadAttributesWarning, match=r"f1.obj: .* \(f0.obj has none\)"):
+        mesh, split = meshseq.read_textured_sequence(tmp_path / "seam")
+    assert split is None
 
 
 def test_ascii_ply_with_mixed_polygons_and_extra_properties(tmp_path: Path) -> None:

@@ -207,9 +207,9 @@ def _read_level(path: Path) -> AnimatedMesh:
         from ..io.npz import read_npz
 
         return read_npz(path)
-    from ..io.meshseq import read_sequence
+    from ..io.meshseq import read_textured_sequence
 
-    return read_sequence(path)
+    return read_textured_sequence(path)[0]  # its texture coordinates, if any, read as written
 
 
 class _ProgressBar:

@@ -509,10 +509,16 @@ def write_bvh(
         motion.require_rigid("BVH")
     except ValueError as error:
         raise ValueError(f"{os.fspath(path)}: {error}") from None
+    if precision is None:
+        longest = float(np.abs(skeleton.offsets[1:]).max(initial=0.0))
+        precision = max(6, 6 - int(np.floor(np.log10(longest)))) if longest > 0.0 else 6
     translations = motion.local_translations()
     has_position = np.zeros(skeleton.joint_count, dtype=bool)
     has_position[0] = True
-    has_position[1:] = np.any(translations[:, 1:] != skeleton.offsets[None, 1:], axis=(0, 2))
+    # A translation the written digits cannot tell from the offset does not move (float noise of
+    # poses composed through a node between joints: 1e-18 on every joint of the clip).
+    moves = np.abs(translations[:, 1:] - skeleton.offsets[None, 1:]) > 0.5 * 10.0**-precision
+    has_position[1:] = np.any(moves, axis=(0, 2))
     animated_end_sites = np.nonzero(has_position & skeleton.end_sites)[0]
     if animated_end_sites.size:
         name = skeleton.names[animated_end_sites[0]]
@@ -530,9 +536,6 @@ def write_bvh(
         if rotated[joint]:
             blocks.append(angles[:, joint])
     table = np.concatenate(blocks, axis=1)
-    if precision is None:
-        longest = float(np.abs(skeleton.offsets[1:]).max(initial=0.0))
-        precision = max(6, 6 - int(np.floor(np.log10(longest)))) if longest > 0.0 else 6
     hierarchy = _hierarchy_text(skeleton, has_position, orders, precision)
     with atomic_write(path, "w", encoding="utf-8", newline="\n") as handle:
         handle.write(hierarchy)

@@ -86,18 +86,19 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> tuple[
         raise FormatError(paths[0], "mesh", f"{what}; a frame needs triangles")
     frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
     frames[0] = first_vertices
-    differing = None  # the first frame whose texture coordinates are not the first frame's
+    first_texture, differing = texture, None  # the first frame whose texture coordinates are not the first's
     with warnings.catch_warnings():  # the first frame's warning speaks for the sequence
         warnings.simplefilter("ignore", UnreadAttributesWarning)
         for index, path in enumerate(paths[1:], start=1):
-            vertices, frame_faces, frame_texture = read_mesh_textured(path) if texture else (*read_mesh(path), None)
+            vertices, frame_faces, frame_texture = read_mesh_textured(path) if textured else (*read_mesh(path), None)
             _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
             frames[index] = vertices
-            if texture is not None and not _same_texture(texture, frame_texture):
+            if textured and differing is None and not _same_texture(texture, frame_texture):
                 differing, texture = path, None
     if differing is not None:
-        warnings.warn(f"{differing}: its texture coordinates (vt) differ from those of the first frame "
-                      f"{paths[0].name}: the levels are written without them", UnreadAttributesWarning,
+        first = "has none" if first_texture is None else "has others"
+        warnings.warn(f"{differing}: its texture coordinates (vt) are not the first frame's ({paths[0].name} "
+                      f"{first}): the levels are written without them", UnreadAttributesWarning,
                       stacklevel=3)  # fmt: skip
     if texture is None:
         return AnimatedMesh(faces, frames, fps=fps), None
@@ -108,11 +109,12 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> tuple[
     return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32))
 
 
-def _same_texture(first: ObjTexture, other: ObjTexture | None) -> bool:
-    """Whether a frame's texture coordinates are the first frame's."""
+def _same_texture(first: ObjTexture | None, other: ObjTexture | None) -> bool:
+    """Whether a frame's texture coordinates (None: it has none) are the first frame's."""
+    if first is None or other is None:
+        return first is other
     return (
-        other is not None
-        and np.array_equal(first.corners, other.corners)
+        np.array_equal(first.corners, other.corners)
         and first.uvs.shape == other.uvs.shape
         and np.array_equal(first.uvs, other.uvs)
     )

@@ -13,7 +13,7 @@ under its nearest kept ancestor with the frozen joints' key posture in between (
 Section 5.1: a frozen joint keeps the local transformation of its key frame), so that it moves
 as the level's skin moves the vertices bound to its joint. What hangs from a node between joints
 (an exporter's helper node), or what such a node draws, hangs from its nearest joint through
-the rest transforms of the nodes between. The copies share the input's meshes,
+copies of the nodes between, which play their own channels. The copies share the input's meshes,
 cameras and lights. Each level clip then takes the input clip's channels that pose no skeleton,
 retargeted to the copies where they animate an attachment.
 """
@@ -34,6 +34,7 @@ from ..motion_lod.skeleton_reduce import expand_motion
 
 # What a joint node draws or holds besides its transform and children (lights are an extension).
 _CONTENT = ("mesh", "camera", "weights", "extensions")
+_TRANSFORM = ("translation", "rotation", "scale", "matrix")
 # What KHR_animation_pointer channels of a standalone level file may point at.
 _STANDALONE_POINTERS = ("/materials/", "/textures/", "/cameras/", "/extensions/KHR_lights_punctual/")
 
@@ -43,8 +44,8 @@ class Attachment:
     """A node (with its subtree) hung from joint ``joint`` (skeleton order) of a rig, or, with
     ``content_only``, a node for what it draws (a mesh, camera or light on it): the joint's own,
     or a node between joints. ``via``: the nodes between the joint and ``node`` (``node``
-    itself for its content), whose rest transforms hold it there (an exporter's helper node
-    such as assimp's ``RightHand_$AssimpFbx$_PostRotation``, a sword holding tassel bones)."""
+    itself for its content), copied with it (an exporter's helper node such as assimp's
+    ``RightHand_$AssimpFbx$_PostRotation``, a sword holding tassel bones)."""
 
     joint: int
     node: int
@@ -103,6 +104,13 @@ def posing_nodes(doc: GltfDocument, rig: SkinRig) -> set[int]:
     return found
 
 
+def posed_by_level_clips(doc: GltfDocument, rig: SkinRig, attachments: list[Attachment]) -> set[int]:
+    """The nodes whose channels a level's clip leaves out (its own joints take their place): those
+    that pose a skeleton (:func:`posing_nodes`) but the nodes between joints that ``attachments``
+    hang through, whose copies take their channels."""
+    return posing_nodes(doc, rig) - {node for attachment in attachments for node in attachment.via}
+
+
 def add_level_attachments(
     builder: GlbBuilder,
     doc: GltfDocument,
@@ -115,7 +123,9 @@ def add_level_attachments(
 ) -> dict[int, int]:
     """Copies of ``attachments`` on ``level``'s skeleton, whose joint nodes (level joint order) are
     ``joint_nodes``, their names ending in ``suffix``; ``original`` is the motion the level
-    reduces. Returns the copy of each node of the copied subtrees."""
+    reduces. The nodes between a joint and what hangs through them are copied once each, with
+    their own transforms and content, so that their channels can move the copies. Returns the
+    copy of each node of the copied subtrees and of the nodes between."""
     frozen = level.frozen
     level_joint = np.full(frozen.frozen.size, -1, dtype=np.int64)
     level_joint[frozen.kept_indices] = np.arange(frozen.kept_indices.size)
@@ -125,32 +135,48 @@ def add_level_attachments(
     world = expand_motion(frozen, level.motion.take_frames(first), original.take_frames(first)).world_transforms()[0]
     parents = frozen.skeleton.parents
     copies: dict[int, int] = {}
+    places: dict[int, int] = {}  # the node a joint's attachments hang from in the level
     for attachment in attachments:
-        ancestor = attachment.joint
-        while level_joint[ancestor] < 0:
-            ancestor = int(parents[ancestor])
-        # The document's joint node carries its rest scale, the rigid level joint does not.
-        rest_linear = np.eye(4)
-        rest_linear[:3, :3] = rig.rest_linear[attachment.joint]
-        frame = np.linalg.inv(world[ancestor]) @ world[attachment.joint] @ rest_linear
-        for between in attachment.via:
-            frame = frame @ doc.rest_matrix(between)
-        parent = joint_nodes[level_joint[ancestor]]
-        if not np.allclose(frame, np.eye(4), rtol=0.0, atol=1e-12):  # a static node between: the
-            name = f"{_name(builder, attachment.node)} frame{suffix}"  # copy keeps its own TRS
-            between = builder.append("nodes", {"name": name, "matrix": frame.T.reshape(16).tolist()})
-            builder.json["nodes"][parent].setdefault("children", []).append(between)
-            parent = between
+        joint = attachment.joint
+        if joint not in places:
+            ancestor = joint
+            while level_joint[ancestor] < 0:
+                ancestor = int(parents[ancestor])
+            # The document's joint node carries its rest scale, the rigid level joint does not.
+            rest_linear = np.eye(4)
+            rest_linear[:3, :3] = rig.rest_linear[joint]
+            frame = np.linalg.inv(world[ancestor]) @ world[joint] @ rest_linear
+            places[joint] = joint_nodes[level_joint[ancestor]]
+            if not np.allclose(frame, np.eye(4), rtol=0.0, atol=1e-12):  # a static node for the joint's frame
+                name = f"{_name(builder, rig.joint_nodes[joint])} frame{suffix}"
+                places[joint] = _child(builder, places[joint], {"name": name, "matrix": frame.T.reshape(16).tolist()})
+        parent = places[joint]
+        for between in attachment.via:  # each copied once, with its content: it holds its own channels
+            if between not in copies:
+                source = builder.json["nodes"][between]
+                own = {key: deepcopy(source[key]) for key in (*_TRANSFORM, *_CONTENT) if key in source}
+                copies[between] = _child(builder, parent, {"name": f"{_name(builder, between)}{suffix}", **own})
+            parent = copies[between]
+        if attachment.content_only and attachment.via:
+            continue  # a node between joints: its copy above draws what it draws
         if attachment.content_only:
             source = builder.json["nodes"][attachment.node]
             content = {key: deepcopy(source[key]) for key in _CONTENT if key in source}
             # A joint's own content is named apart from the level's joint node where no suffix does.
-            name = f"{_name(builder, attachment.node)}{suffix or ('' if attachment.via else ' content')}"
-            top = copies[attachment.node] = builder.append("nodes", {"name": name, **content})
+            name = f"{_name(builder, attachment.node)}{suffix or ' content'}"
+            copies[attachment.node] = _child(builder, parent, {"name": name, **content})
         else:
-            top = _copy_subtree(builder, attachment.node, suffix, copies)
-        builder.json["nodes"][parent].setdefault("children", []).append(top)
+            builder.json["nodes"][parent].setdefault("children", []).append(
+                _copy_subtree(builder, attachment.node, suffix, copies)
+            )
     return copies
+
+
+def _child(builder: GlbBuilder, parent: int, node: dict) -> int:
+    """``node`` appended as the last child of ``parent``; its index."""
+    index = builder.append("nodes", node)
+    builder.json["nodes"][parent].setdefault("children", []).append(index)
+    return index
 
 
 def carry_other_channels(
@@ -164,7 +190,7 @@ def carry_other_channels(
 ) -> None:
     """Adds to ``level_animation`` of ``builder`` (which holds the accessors of ``doc``'s at their
     indices) the channels of the document's ``animation`` that pose no skeleton (not on a node
-    of ``posing``, :func:`posing_nodes`; a joint's morph weights do not pose it), on the
+    of ``posing``, :func:`posed_by_level_clips`; a joint's morph weights do not pose it), on the
     attachments' copies where they have one; KHR_animation_pointer channels of anything but a
     node (a material's colour) as they are. ``standalone``: for a file of its own, which holds
     of the document only the copies and its materials, textures, cameras and lights (at their

@@ -58,7 +58,7 @@ from ..motion_lod.clips import join_clips
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_measure import analyze_skinned_motion, hidden_note, without_skin_tips
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
-from .attachments import add_level_attachments, carry_other_channels, find_attachments, posing_nodes
+from .attachments import add_level_attachments, carry_other_channels, find_attachments, posed_by_level_clips
 from .clip_import import with_clips
 from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, measure_samples, simplify_drawable
 from .lod_document import DEFAULT_RATIOS
@@ -396,7 +396,8 @@ def _add_motion_levels(builder: GlbBuilder, doc: GltfDocument, motion: _SkinMoti
     """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's),
     with what hangs from the skeleton and the clips' other channels (:mod:`.attachments`)."""
     nodes = [_MotionLevelNodes(None, motion.joint_count)]
-    attachments, posing = find_attachments(doc, motion.rig), posing_nodes(doc, motion.rig)
+    attachments = find_attachments(doc, motion.rig)
+    posing = posed_by_level_clips(doc, motion.rig, attachments)
     for m, level in enumerate(motion.reduced_levels, start=1):
         joint_nodes = add_skeleton(builder, level.motion.skeleton)
         copies = add_level_attachments(

@@ -85,6 +85,8 @@ def simplify_sequence(
     started = time.perf_counter()
     # The report keeps no collapse record, whose positions would take 12 bytes per collapse and frame.
     aqem_options = {**aqem_options, "record_positions": False}
+    if texture is not None:  # a point of the edge in every frame, where its texture coordinate is
+        aqem_options = {"placement": "on_edge", **aqem_options}
     uvs = None if texture is None else texture.uvs
     result = simplify_animated(original, ratios, progress=progress, attributes=uvs, **aqem_options)
     seconds = time.perf_counter() - started

@@ -22,6 +22,7 @@ from .attachments import (
     add_level_attachments,
     carry_other_channels,
     hung_nodes,
+    posed_by_level_clips,
     posing_nodes,
     standalone_pointer,
 )
@@ -46,7 +47,7 @@ class LevelContent(NamedTuple):
         def add(builder: GlbBuilder, joint_nodes: list[int], animations: list[int]) -> None:
             document, rig = self.document, self.rig
             copies = add_level_attachments(builder, document, rig, self.attachments, original, level, joint_nodes)
-            posing = posing_nodes(document, rig)
+            posing = posed_by_level_clips(document, rig, self.attachments)
             for clip, animation in zip(played, animations):
                 if clip.animation is not None:
                     carry_other_channels(builder, document, posing, clip.animation, animation, copies, standalone=True)

@@ -113,6 +113,14 @@ def test_bad_texture_coordinates_name_the_line(tmp_path: Path, faces: str, probl
         obj.read_obj_textured(tmp_path / "bad.obj")
 
 
+def test_a_texture_coordinates_extra_values_are_dropped_as_a_vertexs_are(tmp_path: Path) -> None:
+    (tmp_path / "extra.obj").write_text(
+        "v 0 0 0 1 abc\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0 0 abc\nvt 0.5\nf 1/1 2/2 3/3\n"
+    )
+    _, _, texture = obj.read_obj_textured(tmp_path / "extra.obj")
+    np.testing.assert_array_equal(texture.uvs, [[0, 0], [1, 0], [0.5, 0]])
+
+
 def test_texture_coordinates_on_some_corners_only_are_left_out_with_a_warning(tmp_path: Path) -> None:
     (tmp_path / "mixed.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 2 4 3\n")
     with pytest.warns(UnreadAttributesWarning, match="3 of 6 face corners have texture coordinates"):

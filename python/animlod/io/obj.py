@@ -172,12 +172,14 @@ def _texture(
     counts = _row_sizes(uv_block, len(uv_lines))
     _require_sizes(path, counts, 1, name_uv, "values")
     values = _untagged_values(uv_block, np.float64, counts)
-    first = np.cumsum(counts) - counts
-    if values is None:
+    if values is not None:
+        first = np.cumsum(counts) - counts
+        uvs = np.stack([values[first], np.where(counts > 1, values[np.minimum(first + 1, values.size - 1)], 0.0)], 1)
+    else:  # find the bad one among u and v (a w or extra values are dropped unread, as a vertex's are)
         tokens, starts = _row_tokens(uv_block, counts)
-        row = np.repeat(np.arange(counts.size), counts)
-        values = parse_numbers(path, np.delete(tokens, starts), np.float64, lambda token: name_uv(int(row[token])))
-    uvs = np.stack([values[first], np.where(counts > 1, values[np.minimum(first + 1, values.size - 1)], 0.0)], axis=1)
+        columns = tokens[np.minimum(starts[:, None] + np.arange(1, 3), np.append(starts[1:], tokens.size)[:, None] - 1)]
+        uvs = parse_numbers(path, columns, np.float64, lambda token: name_uv(token // 2))
+        uvs[counts < 2, 1] = 0.0
     check_finite_vertices(path, uvs.astype(np.float32), name_uv)
     owner = np.repeat(np.arange(sizes.size), sizes)
     written = _untagged_values(texture_block, np.int64, sizes)

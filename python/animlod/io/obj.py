@@ -104,15 +104,7 @@ def _read_obj(path: str | os.PathLike, textured: bool) -> tuple[np.ndarray, np.n
     def name_vertex(vertex: int) -> str:
         return f"vertex {vertex} (line {vertex_lines[vertex]})"
 
-    sizes = _row_sizes(vertex_block, len(vertex_lines))
-    _require_sizes(path, sizes, 3, name_vertex, "coordinates")
-    values = _untagged_values(vertex_block, np.float64, sizes)
-    if values is not None:
-        vertices = values[(np.cumsum(sizes) - sizes)[:, None] + np.arange(3)]
-    else:  # find the bad one among x, y, z (extra values are dropped unread)
-        tokens, starts = _row_tokens(vertex_block, sizes)
-        columns = tokens[starts[:, None] + np.arange(1, 4)]
-        vertices = parse_numbers(path, columns, np.float64, lambda token: name_vertex(token // 3))
+    vertices = _leading_values(path, vertex_block, len(vertex_lines), 3, 3, name_vertex, "coordinates")
     vertices = vertices.astype(np.float32)
     check_finite_vertices(path, vertices, name_vertex)
 
@@ -169,17 +161,7 @@ def _texture(
     def name_uv(row: int) -> str:
         return f"texture coordinate {row} (line {uv_lines[row]})"
 
-    counts = _row_sizes(uv_block, len(uv_lines))
-    _require_sizes(path, counts, 1, name_uv, "values")
-    values = _untagged_values(uv_block, np.float64, counts)
-    if values is not None:
-        first = np.cumsum(counts) - counts
-        uvs = np.stack([values[first], np.where(counts > 1, values[np.minimum(first + 1, values.size - 1)], 0.0)], 1)
-    else:  # find the bad one among u and v (a w or extra values are dropped unread, as a vertex's are)
-        tokens, starts = _row_tokens(uv_block, counts)
-        columns = tokens[np.minimum(starts[:, None] + np.arange(1, 3), np.append(starts[1:], tokens.size)[:, None] - 1)]
-        uvs = parse_numbers(path, columns, np.float64, lambda token: name_uv(token // 2))
-        uvs[counts < 2, 1] = 0.0
+    uvs = _leading_values(path, uv_block, len(uv_lines), 2, 1, name_uv, "values")  # (u, v), a w dropped
     check_finite_vertices(path, uvs.astype(np.float32), name_uv)
     owner = np.repeat(np.arange(sizes.size), sizes)
     written = _untagged_values(texture_block, np.int64, sizes)
@@ -309,6 +291,26 @@ def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, n
             selected &= codes[line_starts + offset] == letter
         result.append((codes[: len(data)][np.repeat(selected, line_lengths)].tobytes(), np.flatnonzero(selected) + 1))
     return result
+
+
+def _leading_values(
+    path: Path, block: bytes, line_count: int, width: int, minimum: int, element: Callable[[int], str], what: str
+) -> np.ndarray:
+    """(line_count, width) float64: the first ``width`` values after the tag on each line of
+    ``block``, 0 where a line gives fewer (it must give ``minimum``); values past them are dropped
+    unread. FormatError names the line (``element``) with too few values or a bad one."""
+    sizes = _row_sizes(block, line_count)
+    _require_sizes(path, sizes, minimum, element, what)
+    given = np.arange(width)[None] < sizes[:, None]
+    values = _untagged_values(block, np.float64, sizes)
+    if values is not None:
+        first = np.cumsum(sizes) - sizes
+        columns = values[np.where(given, first[:, None] + np.arange(width), 0)]
+    else:  # find the bad one among the values read
+        tokens, starts = _row_tokens(block, sizes)
+        taken = tokens[np.where(given, starts[:, None] + 1 + np.arange(width), starts[:, None] + 1)]
+        columns = parse_numbers(path, taken, np.float64, lambda token: element(token // width))
+    return np.where(given, columns, 0.0)
 
 
 def _row_sizes(block: bytes, line_count: int) -> np.ndarray:

@@ -156,6 +156,7 @@ def channels_as_pointers(gltf: pygltflib.GLTF2) -> None:
                 path="pointer", extensions={"KHR_animation_pointer": {"pointer": pointer}}
             )
     animation, sampler = rotation
+    gltf.materials = gltf.materials or [pygltflib.Material(name="painted")]  # what the pointer names must exist
     colour = {"KHR_animation_pointer": {"pointer": "/materials/0/pbrMetallicRoughness/baseColorFactor"}}
     target = pygltflib.AnimationChannelTarget(path="pointer", extensions=colour)
     animation.channels.insert(0, pygltflib.AnimationChannel(sampler=sampler, target=target))

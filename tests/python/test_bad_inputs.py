@@ -186,6 +186,15 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
     ("readers", "glTF instancing accessor past the list", lambda t: ["info", str(_gltf(t / "g.gltf",
         b'{"nodes": [{"extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 9}}}}]}'))],
      "g.gltf: node 0 EXT_mesh_gpu_instancing TRANSLATION: refers to accessor 9, but the file has 0 accessors"),
+    ("readers", "glTF light past the list", lambda t: ["info", str(_gltf(t / "l.gltf",
+        b'{"extensions": {"KHR_lights_punctual": {"lights": [{"type": "point"}]}},'
+        b' "nodes": [{"extensions": {"KHR_lights_punctual": {"light": 5}}}]}'))],
+     "l.gltf: node 0 light: refers to light 5, but the file has 1 lights"),
+    ("readers", "glTF pointer at a material past the list", lambda t: ["info", str(_edit_gltf(_small_glb(t / "a.glb"),
+        _json_edit(lambda d: d["animations"][0]["channels"][0].update(target={"path": "pointer", "extensions":
+            {"KHR_animation_pointer": {"pointer": "/materials/7/pbrMetallicRoughness/baseColorFactor"}}})),
+        t / "p.gltf"))],
+     "p.gltf: animation 0 channel 0 target pointer: refers to material 7, but the file has 0 materials"),
     ("readers", "glTF skin's skeleton past the list", lambda t: ["info", str(_gltf(t / "k.gltf",
         b'{"nodes": [{}], "skins": [{"joints": [0], "skeleton": 4}]}'))],
      "k.gltf: skin 0 skeleton: refers to node 4, but the file has 1 nodes"),

@@ -67,6 +67,8 @@ def character_with_sockets(tmp_path_factory):
     lowering = builder.add(np.linspace(1.0, 0.0, keys).astype(np.float32)[:, None])
     _animate(animation, by_name["Head"], "weights", lowering)
     # A material colour the clip animates through KHR_animation_pointer.
+    builder.json["materials"] = [{"name": "skin"}]
+    mesh["primitives"][0]["material"] = 0
     colour = builder.add(np.linspace([1.0, 1.0, 1.0, 1.0], [1.0, 0.2, 0.2, 1.0], keys).astype(np.float32))
     animation["samplers"].append({"input": animation["samplers"][0]["input"], "output": colour})
     pointer = {"KHR_animation_pointer": {"pointer": "/materials/0/pbrMetallicRoughness/baseColorFactor"}}

@@ -772,6 +772,7 @@ def _as_pointer_channels(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
         pointer = f"/nodes/{channel.target.node}/{channel.target.path}"
         channel.target = pygltflib.AnimationChannelTarget(path="pointer")
         channel.target.extensions = {"KHR_animation_pointer": {"pointer": pointer}}
+    gltf.materials = gltf.materials or [pygltflib.Material(name="painted")]  # what the pointer names must exist
     colour = pygltflib.AnimationChannelTarget(path="pointer")
     colour.extensions = {"KHR_animation_pointer": {"pointer": "/materials/0/pbrMetallicRoughness/baseColorFactor"}}
     animation.channels.append(pygltflib.AnimationChannel(sampler=1, target=colour))  # a VEC4 output

@@ -27,7 +27,7 @@ from .gltf_decode import decode_gltf, is_whole_number, labels_as_text
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
 from .gltf_keyframes import INTERPOLATIONS, frame_times
 from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
-from .gltf_references import index_references
+from .gltf_references import LIGHTS_EXTENSION, index_references
 from .json_limits import load_json
 
 _GLB_MAGIC = b"glTF"
@@ -84,6 +84,9 @@ _CHANNEL_PATHS = (*NODE_PATHS, "weights")
 # names; those of a node's TRS or weights are read as that node's channels.
 POINTER_EXTENSION = "KHR_animation_pointer"
 NODE_POINTER = re.compile(r"/nodes/(\d+)/(translation|rotation|scale|weights)")
+# A pointer at a property of a listed object: its list (None: KHR_lights_punctual's lights) and index.
+_POINTER_TARGET = re.compile(r"/(?:(materials|meshes|cameras|textures|images|samplers|skins|nodes|accessors)"
+                             r"|extensions/KHR_lights_punctual/lights)/(\d+)/")  # fmt: skip
 # Top-level arrays whose singular is not the name without its last letter.
 _IRREGULAR_SINGULARS = {"meshes": "mesh"}
 
@@ -129,8 +132,9 @@ class GltfDocument:
         return FormatError(self.path, element, reason)
 
     def item(self, kind: str, index: Any, referrer: str) -> Any:
-        """``gltf.<kind>[index]``, or FormatError naming ``referrer`` when the index is invalid."""
-        items = getattr(self.gltf, kind) or []
+        """``gltf.<kind>[index]`` (``lights``: KHR_lights_punctual's), or FormatError naming
+        ``referrer`` when the index is invalid."""
+        items = self._lights() if kind == "lights" else getattr(self.gltf, kind) or []
         if not isinstance(index, int) or isinstance(index, bool) or not 0 <= index < len(items):
             singular = _IRREGULAR_SINGULARS.get(kind, kind[:-1])
             raise self.fail(referrer, f"refers to {singular} {index!r}, but the file has {len(items)} {kind}")
@@ -358,6 +362,12 @@ class GltfDocument:
             for a, animation in enumerate(gltf.animations or [])
         ]
 
+    def _lights(self) -> list:
+        """The document's KHR_lights_punctual lights (none where it has no such list)."""
+        extension = (self.json.get("extensions") or {}).get(LIGHTS_EXTENSION)
+        lights = extension.get("lights") if isinstance(extension, dict) else None
+        return lights if isinstance(lights, list) else []
+
     def _check_references(self) -> None:
         """Every other index of the file refers to something it has (gltf_references.py)."""
         for kind, index, referrer in index_references(self):
@@ -377,6 +387,9 @@ class GltfDocument:
                 raise self.fail(element, f"path 'pointer' needs a {POINTER_EXTENSION} pointer string")
             match = NODE_POINTER.fullmatch(pointer)
             if match is None:
+                target = _POINTER_TARGET.match(pointer)  # an object of the document: it must exist
+                if target is not None:
+                    self.item(target.group(1) or "lights", int(target.group(2)), f"{element} pointer")
                 return None, "pointer"
             node = int(match.group(1))
             self.item("nodes", node, f"{element} pointer")

@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from .gltf_document import GltfDocument
 
+LIGHTS_EXTENSION = "KHR_lights_punctual"  # its lights are the document extension's list
+
 # (top-level array, index, the element that refers to it, for messages)
 Reference = tuple[str, Any, str]
 
@@ -24,6 +26,8 @@ def index_references(doc: GltfDocument) -> Iterator[Reference]:
         yield from _optional(node, "mesh", "meshes", doc.node_label(n))
         yield from _optional(node, "skin", "skins", doc.node_label(n))
         yield from _optional(node, "camera", "cameras", f"{doc.node_label(n)} camera")
+        light = (node.get("extensions") or {}).get(LIGHTS_EXTENSION)
+        yield from _optional(light if isinstance(light, dict) else {}, "light", "lights", f"{doc.node_label(n)} light")
         instancing = (node.get("extensions") or {}).get("EXT_mesh_gpu_instancing")
         attributes = instancing.get("attributes") if isinstance(instancing, dict) else None
         for name, index in attributes.items() if isinstance(attributes, dict) else ():

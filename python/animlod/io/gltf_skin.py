@@ -40,13 +40,12 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton
-from .gltf_document import NODE_PATHS, UNIFORM_SCALE_TOLERANCE, GltfDocument
+from .gltf_document import LIGHTS_EXTENSION, NODE_PATHS, UNIFORM_SCALE_TOLERANCE, GltfDocument
 from .gltf_keyframes import sample_keyframes
 
 # Animated bone offsets within this fraction of the skeleton's largest rest offset of their
 # rest value count as held, so the motion needs no per-frame joint translations.
 _HELD_TRANSLATION_TOLERANCE = 1e-4
-_LIGHTS_EXTENSION = "KHR_lights_punctual"
 # Below this relative volume (|det| over the product of the column lengths) a 3x3 part counts as
 # singular: its inverse would amplify float32 noise by more than a million.
 _SINGULAR_VOLUME = 1e-6
@@ -355,7 +354,7 @@ def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
     staging = {
         index
         for index, node in enumerate(nodes)
-        if node.camera is not None or _LIGHTS_EXTENSION in (node.extensions or {})
+        if node.camera is not None or LIGHTS_EXTENSION in (node.extensions or {})
     }
     moved = doc.moved_nodes() - staging
     # A mesh that only scales, with nothing moving below it (a blinking light), is a prop on its

@@ -113,11 +113,7 @@ def _same_texture(first: ObjTexture | None, other: ObjTexture | None) -> bool:
     """Whether a frame's texture coordinates (None: it has none) are the first frame's."""
     if first is None or other is None:
         return first is other
-    return (
-        np.array_equal(first.corners, other.corners)
-        and first.uvs.shape == other.uvs.shape
-        and np.array_equal(first.uvs, other.uvs)
-    )
+    return np.array_equal(first.corners, other.corners) and np.array_equal(first.uvs, other.uvs)
 
 
 def write_sequence(

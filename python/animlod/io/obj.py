@@ -12,6 +12,7 @@ import os
 import re
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
@@ -121,41 +122,56 @@ def _read_obj(path: str | os.PathLike, textured: bool) -> tuple[np.ndarray, np.n
         refusal = f"needs at least 3 vertices, has {sizes[first]}; so does every face"
         polygons = polygon_mask(path, sizes, name_face(first), refusal)
     owner = np.repeat(np.arange(sizes.size), sizes)
-    written = _untagged_values(face_block, np.int64, sizes)
-    if written is None:
-        tokens, starts = _row_tokens(face_block, sizes)
-        written = parse_numbers(path, np.delete(tokens, starts), np.int64, lambda corner: name_face(owner[corner]))
-    # Negative indices count back from the last vertex defined above the face's line.
-    defined = np.searchsorted(vertex_lines, face_lines)[owner]
-    resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
-    check_face_indices(path, resolved, written, owner, len(vertices), name_face)
+    corners = _FaceCorners(path, sizes, owner, face_lines, name_face)
+    resolved = corners.resolved(face_block, vertex_lines, len(vertices), ("vertex", "vertices"))
     faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
     if not textured or not len(uv_lines):
         return vertices, faces, None
-    texture = _texture(path, uv_block, uv_lines, texture_block, face_lines, sizes, name_face)
+    texture = _texture(path, uv_block, uv_lines, texture_block, corners)
     if texture is None:
         return vertices, faces, None
-    uvs, corners = texture
-    return vertices, faces, ObjTexture(uvs, fan_triangulate(corners[polygons[owner]], sizes[polygons]))
+    uvs, indices = texture
+    return vertices, faces, ObjTexture(uvs, fan_triangulate(indices[polygons[owner]], sizes[polygons]))
+
+
+@dataclass(frozen=True)
+class _FaceCorners:
+    """The corners of an OBJ file's ``f`` lines: ``sizes`` per face, ``owner`` the face of each
+    corner, the faces' ``lines`` and how messages name a face."""
+
+    path: Path
+    sizes: np.ndarray
+    owner: np.ndarray
+    lines: np.ndarray
+    name_face: Callable[[int], str]
+
+    def resolved(self, block: bytes, item_lines: np.ndarray, count: int, indexed: tuple[str, str]) -> np.ndarray:
+        """Every corner's 0-based index into the ``count`` items defined on ``item_lines`` (v or
+        vt lines), from ``block`` (the ``f`` lines, one number per corner): negative indices count
+        back from the last item defined above the face's line. FormatError names the face of a
+        corner that does not parse or lies outside the items."""
+        written = _untagged_values(block, np.int64, self.sizes)
+        if written is None:
+            tokens, starts = _row_tokens(block, self.sizes)
+            written = parse_numbers(self.path, np.delete(tokens, starts), np.int64,
+                                    lambda corner: self.name_face(self.owner[corner]))  # fmt: skip
+        defined = np.searchsorted(item_lines, self.lines)[self.owner]
+        resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
+        check_face_indices(self.path, resolved, written, self.owner, count, self.name_face, indexed)
+        return resolved
 
 
 def _texture(
-    path: Path,
-    uv_block: bytes,
-    uv_lines: np.ndarray,
-    face_block: bytes,
-    face_lines: np.ndarray,
-    sizes: np.ndarray,
-    name_face: Callable[[int], str],
+    path: Path, uv_block: bytes, uv_lines: np.ndarray, face_block: bytes, corners: _FaceCorners
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """The ``vt`` lines' (u, v) and every face corner's 0-based index into them (``face_block``:
-    the ``f`` lines as written, of ``sizes`` corners); None, with a warning, where some corners
-    have a texture index and others none."""
+    the ``f`` lines as written); None, with a warning, where some corners have a texture index
+    and others none."""
     texture_block, indexed = _corner_texture_indices(face_block)
-    if indexed < sizes.sum():
+    if indexed < corners.sizes.sum():
         if indexed:
-            warnings.warn(f"{path}: {indexed} of {sizes.sum()} face corners have texture coordinates (vt), the "
-                          "others none: read without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
+            warnings.warn(f"{path}: {indexed} of {corners.sizes.sum()} face corners have texture coordinates (vt), "
+                          "the others none: read without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
         return None
 
     def name_uv(row: int) -> str:
@@ -163,19 +179,8 @@ def _texture(
 
     uvs = _leading_values(path, uv_block, len(uv_lines), 2, 1, name_uv, "values")  # (u, v), a w dropped
     check_finite_vertices(path, uvs.astype(np.float32), name_uv)
-    owner = np.repeat(np.arange(sizes.size), sizes)
-    written = _untagged_values(texture_block, np.int64, sizes)
-    if written is None:
-        tokens, starts = _row_tokens(texture_block, sizes)
-        written = parse_numbers(path, np.delete(tokens, starts), np.int64, lambda corner: name_face(owner[corner]))
-    defined = np.searchsorted(uv_lines, face_lines)[owner]  # negative: back from the last vt above
-    resolved = np.where(written > 0, written - 1, np.where(written < 0, defined + written, -1))
-    outside = np.flatnonzero((resolved < 0) | (resolved >= len(uvs)))
-    if outside.size:
-        corner = outside[0]
-        reason = f"texture index {written[corner]} is outside the {len(uvs)} texture coordinates"
-        raise FormatError(path, name_face(int(owner[corner])), reason)
-    return uvs.astype(np.float32), resolved
+    indices = corners.resolved(texture_block, uv_lines, len(uvs), ("texture", "texture coordinates"))
+    return uvs.astype(np.float32), indices
 
 
 def write_obj(

@@ -81,12 +81,14 @@ def check_face_indices(
     owner: np.ndarray,
     vertex_count: int,
     element: Callable[[int], str],
+    indexed: tuple[str, str] = ("vertex", "vertices"),
 ) -> None:
-    """``indices`` are 0-based corners, ``written`` as in the file, ``owner`` the face of each corner."""
+    """``indices`` are 0-based corners, ``written`` as in the file, ``owner`` the face of each
+    corner; ``indexed``: what they index, for the message (an OBJ corner's texture coordinates)."""
     outside = np.flatnonzero((indices < 0) | (indices >= vertex_count))
     if outside.size:
         corner = outside[0]
-        reason = f"vertex index {written[corner]} is outside the {vertex_count} vertices"
+        reason = f"{indexed[0]} index {written[corner]} is outside the {vertex_count} {indexed[1]}"
         raise FormatError(path, element(int(owner[corner])), reason)
 
 

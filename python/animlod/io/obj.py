@@ -93,9 +93,9 @@ def _read_obj(path: str | os.PathLike, textured: bool) -> tuple[np.ndarray, np.n
         data = _join_continued_lines(data)
     if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
         data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
-    statements = _obj_statements(data, (b"v", b"f", b"l", b"vt"))
-    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines), (uv_block, uv_lines) = statements
-    _warn_unread_attributes(path, data, ("vn",) if textured else ("vt", "vn"))
+    statements = _obj_statements(data, (b"v", b"f", b"l", b"vt", b"vn"))
+    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines), (uv_block, uv_lines), normals = statements
+    _warn_unread_attributes(path, vt=not textured and len(uv_lines) > 0, vn=len(normals[1]) > 0)
     if not len(vertex_lines):
         _require_obj_statement(path, data)
     if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
@@ -271,11 +271,10 @@ def _corner_texture_indices(face_block: bytes) -> tuple[bytes, int]:
     return codes[keep].tobytes(), indexed
 
 
-def _warn_unread_attributes(path: Path, data: bytes, tags: tuple[str, ...]) -> None:
-    """Says that the file's lines of ``tags`` ("vt", "vn") are not read, so that levels written
-    without them are no silent loss."""
-    # A statement's tag ends at a space or a tab, as _obj_statements reads the others.
-    unread = [tag for tag in tags if re.search(rb"(?m)^" + tag.encode() + rb"[ \t]", data)]
+def _warn_unread_attributes(path: Path, **unread_tags: bool) -> None:
+    """Says that the file's ``vt`` or ``vn`` lines, where flagged, are not read, so that levels
+    written without them are no silent loss."""
+    unread = [tag for tag, flagged in unread_tags.items() if flagged]
     if unread:
         kinds = " and ".join({"vt": "texture coordinates", "vn": "normals"}[tag] for tag in unread)
         warnings.warn(f"{path}: its {kinds} ({', '.join(unread)} lines) are not read, and the levels are written "

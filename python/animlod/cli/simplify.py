@@ -11,6 +11,7 @@ import numpy as np
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind, input_stem
 from ..model import AnimatedMesh
 from ..options import AqemOptions
+from ..pipelines.lod_sequence import MEASURED_FRAMES
 from . import UserError, add_joint_map_argument, non_negative_int, print_rows
 
 
@@ -78,6 +79,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_joint_map_argument(parser)
     parser.add_argument("--no-metrics", action="store_true", help="sequences: skip the Hausdorff/RMS measurement")
     parser.add_argument(
+        "--metric-frames", type=int, default=MEASURED_FRAMES, metavar="K",
+        help=f"sequences: measure at most K frames, evenly spaced (default {MEASURED_FRAMES})",
+    )  # fmt: skip
+    parser.add_argument(
         "--plot", action="store_true", help="write a PNG of one frame: features in red, levels side by side"
     )
     parser.set_defaults(run=run)
@@ -86,6 +91,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if any(not 0.0 < ratio <= 1.0 for ratio in args.ratio):
         raise UserError(f"--ratio: every ratio must be in (0, 1], got {args.ratio}")
+    if args.metric_frames < 1:
+        raise UserError(f"--metric-frames: expected at least 1 frame, got {args.metric_frames}")
     kind = input_kind(args.input)
     if kind == "bvh":
         raise UserError(f"{args.input}: a BVH file holds motion only; simplify needs a mesh")
@@ -160,6 +167,7 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
             args.output,
             args.ratio,
             measure=not args.no_metrics,
+            measured_frames=args.metric_frames,
             progress=progress,
             measuring=measuring,
             max_frames=args.max_frames,
@@ -168,9 +176,14 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
     finally:
         progress.close()
         measuring.close()
+    frame_count = report.original.frame_count
+    over = "frames"
+    if 0 < report.frames_measured < frame_count:
+        measured = report.frames_measured
+        over = f"{measured} of the {frame_count} frames, evenly spaced (--metric-frames {frame_count}: all)"
     print(
         "AQEM error: the largest collapse error, asset units; Hausdorff and RMS: relative to the bounding-box"
-        " diagonal, over frames; time is the whole simplification"
+        f" diagonal, over {over}; time is the whole simplification"
     )
     rows = [("level", "faces", "target", "AQEM error", "Hausdorff mean / max", "RMS mean / max", "time s")]
     faces = report.original.face_count
@@ -182,7 +195,6 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
         error = f"{level.aqem_error:.3g}"
         rows.append((index, level.faces, level.target_faces, error, hausdorff, rms, f"{report.seconds:.2f}"))
     print_rows(rows)
-    frame_count = report.original.frame_count
     if report.frames_used < frame_count and not args.max_frames:
         limit = AqemOptions().quadric_memory_limit / 2**30
         print(

@@ -3,7 +3,8 @@
 Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OBJ/PLY frames
 (each frame under its input file's name), ``<stem>_lod<i>.obj`` (or ``.ply``) for one mesh file,
 ``<stem>_lod<i>.npz`` for NPZ input, and measured against the input frame by frame (symmetric
-Hausdorff and RMS distance relative to the bounding-box diagonal). An OBJ sequence's texture
+Hausdorff and RMS distance relative to the bounding-box diagonal), on at most 64 frames evenly
+spaced over a longer sequence. An OBJ sequence's texture
 coordinates are carried: each (position, texture coordinate) pair of its corners is a vertex,
 the copies of a position along a UV seam welded by AQEM and kept apart where their coordinates
 differ, and written back as ``vt`` lines.
@@ -24,7 +25,11 @@ from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
 from ..io.meshseq import SequenceTexture
 from ..metrics import SurfaceError, surface_error
-from ..model import AnimatedMesh
+from ..model import AnimatedMesh, whole_number
+
+# Frames of a longer sequence measured by default, evenly spaced: every frame of a 300-frame,
+# 20k-triangle sequence took 61 s to measure against 2.3 s to simplify.
+MEASURED_FRAMES = 64
 
 
 @dataclass
@@ -50,6 +55,7 @@ class SequenceReport:
     preparation: Preparation
     seconds: float  # the simplification (all levels), without reading, writing or measuring
     frames_used: int  # frames whose quadrics drove it (fewer than the sequence's when limited)
+    frames_measured: int  # frames the surface errors are over (0: not measured)
 
 
 def simplify_sequence(
@@ -58,6 +64,7 @@ def simplify_sequence(
     ratios: Sequence[float] = (0.5, 0.25, 0.1),
     *,
     measure: bool = True,
+    measured_frames: int | None = MEASURED_FRAMES,
     progress: Callable[[int, int], None] | None = None,
     measuring: Callable[[int, int], None] | None = None,
     **aqem_options: object,
@@ -67,9 +74,12 @@ def simplify_sequence(
 
     ``aqem_options`` are keyword arguments of :func:`animlod.simplify_animated`; ``progress``
     receives its (done, total) collapse counts, ``measuring`` the (done, total) levels measured
-    (on long sequences the measurement takes longer than the simplification). Raises FormatError
-    for unreadable input.
+    (on long sequences the measurement takes longer than the simplification). The surface errors
+    are over at most ``measured_frames`` frames, evenly spaced from the first to the last (None:
+    every frame). Raises FormatError for unreadable input, ValueError for ``measured_frames`` < 1.
     """
+    if measured_frames is not None:
+        measured_frames = whole_number("measured_frames", measured_frames, 1)
     kind = input_kind(source)
     texture = None  # an OBJ sequence's texture coordinates, carried as AQEM attributes
     if kind == "npz":
@@ -91,6 +101,7 @@ def simplify_sequence(
     result = simplify_animated(original, ratios, progress=progress, attributes=uvs, **aqem_options)
     seconds = time.perf_counter() - started
     folder, stem, fmt = Path(output), input_stem(source), _level_format(kind, source)
+    frames = _measured_frames(original.frame_count, measured_frames) if measure else np.arange(0)
     levels = []
     for index, level in enumerate(result.levels, start=1):
         if measure and measuring is not None:
@@ -99,14 +110,28 @@ def simplify_sequence(
             None if texture is None else SequenceTexture(level.attributes, texture.points[level.kept_vertices])
         )
         path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture)
-        measured = _surface_error(original, level.mesh) if measure else None
+        measured = _surface_error(*(_frames_of(mesh, frames) for mesh in (original, level.mesh))) if measure else None
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
         faces, target = level.mesh.face_count, level.target_face_count
         levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error))
     if measure and measuring is not None:
         measuring(len(result.levels), len(result.levels))
-    return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used))
+    return SequenceReport(
+        os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used), len(frames)
+    )
+
+
+def _measured_frames(frame_count: int, limit: int | None) -> np.ndarray:
+    """The frames measured: every one, or ``limit`` evenly spaced from the first to the last (the
+    first is where the measured points are drawn)."""
+    if limit is None or frame_count <= limit:
+        return np.arange(frame_count)
+    return np.round(np.linspace(0, frame_count - 1, limit)).astype(np.int64)  # at least 1 apart: distinct
+
+
+def _frames_of(mesh: AnimatedMesh, frames: np.ndarray) -> AnimatedMesh:
+    return mesh if len(frames) == mesh.frame_count else AnimatedMesh(mesh.faces, mesh.frames[frames])
 
 
 # Points measured per chunk of frames: each frame holds its vertices and the samples in float64,

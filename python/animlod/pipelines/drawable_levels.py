@@ -32,14 +32,10 @@ from ..io.gltf_mesh import PrimitiveGeometry, transform_points
 from ..io.gltf_write import influence_sets
 from ..metrics import hausdorff_distances
 from ..model import AnimatedMesh, SkinnedMesh, morphed, spread_frames
+from ..normals import corner_normals, pairs_within_groups, shading_crease, unit_vectors
 from ..options import AqemOptions
 
 _SKIN_PREFIXES = ("JOINTS_", "WEIGHTS_")
-# A primitive is flat shaded when this share of its faces has equal corner normals along the
-# face's own normal (cosine above _FLAT_COSINE).
-_FLAT_SHARE, _FLAT_COSINE = 0.99, 0.999
-# Rebuilt normals smooth across edges whose faces turn by less than this (radians).
-CREASE_ANGLE = np.radians(60.0)
 _NORMAL_ATTRIBUTES = ("NORMAL", "TANGENT")
 # Most points sampled on each surface per measured frame (on top of the vertices; measure_samples).
 _MEASURE_SAMPLES = 4000
@@ -282,14 +278,7 @@ def _crease_angle(primitive: PrimitiveGeometry) -> float | None:
     """None when the primitive's normals can be carried (no two copies of a position differ in
     them); otherwise the crease angle its rebuilt normals use: 0 for flat shading."""
     normals = primitive.attributes.get("NORMAL")
-    if normals is None:
-        return None
-    positions = primitive.attributes["POSITION"]
-    _, point = np.unique(positions, axis=0, return_inverse=True)
-    keyed = np.unique(np.concatenate([point.reshape(-1, 1), normals], axis=1), axis=0)
-    if len(keyed) == point.max(initial=-1) + 1:
-        return None
-    return 0.0 if _is_flat_shaded(normals, positions, primitive.faces) else float(CREASE_ANGLE)
+    return None if normals is None else shading_crease(primitive.attributes["POSITION"], normals, primitive.faces)
 
 
 def _sharp_corners(drawable: Drawable, layout: _Layout) -> np.ndarray:
@@ -306,20 +295,6 @@ def _sharp_corners(drawable: Drawable, layout: _Layout) -> np.ndarray:
         normals_at = np.bincount(distinct[:, 0].astype(np.int64), minlength=point.max() + 1)
         corners.append(np.flatnonzero(normals_at[point] >= 3) + starts[k])
     return np.concatenate(corners) if corners else np.zeros(0, np.int64)
-
-
-def _is_flat_shaded(normals: np.ndarray | None, positions: np.ndarray, faces: np.ndarray) -> bool:
-    """Whether (nearly) every face's three corners carry the face's own normal."""
-    if normals is None or len(faces) == 0:
-        return False
-    corners = positions[faces].astype(np.float64)
-    face_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    length = np.linalg.norm(face_normal, axis=1)
-    usable = length > 0.0
-    face_normal = face_normal[usable] / length[usable, None]
-    corner_normals = normals[faces[usable]].astype(np.float64)
-    agree = np.all(np.einsum("fkc,fc->fk", corner_normals, face_normal) > _FLAT_COSINE, axis=1)
-    return bool(agree.mean() >= _FLAT_SHARE) if agree.size else False
 
 
 def _level(drawable: Drawable, level: SimplifiedLevel, layout: _Layout) -> DrawableLevel:
@@ -403,7 +378,7 @@ def _tidy_directions(attributes: dict[str, np.ndarray]) -> None:
     """Interpolated normals back to unit length, tangents too (perpendicular to the normals)
     with w = +-1, colours in [0, 1]."""
     if "NORMAL" in attributes:
-        attributes["NORMAL"] = _unit(attributes["NORMAL"])
+        attributes["NORMAL"] = unit_vectors(attributes["NORMAL"])
     if "TANGENT" in attributes:
         tangent = attributes["TANGENT"]
         tangent[:, :3] = _tangent_directions(tangent[:, :3], attributes.get("NORMAL"))
@@ -421,7 +396,7 @@ def _tangent_directions(
     across it: it takes ``fallback`` (its face's texture direction) across the normal where that
     has a part across it, else any perpendicular direction: a zero vector is no tangent."""
     if normals is None:
-        return _unit(tangents)
+        return unit_vectors(tangents)
 
     def across(vectors: np.ndarray, unit_normals: np.ndarray) -> np.ndarray:
         return vectors - np.einsum("vc,vc->v", vectors, unit_normals)[:, None] * unit_normals
@@ -432,18 +407,7 @@ def _tangent_directions(
         result[lost] = across(fallback[lost], normals[lost])
         lost = ~result.any(axis=1)
     result[lost] = np.cross(normals[lost], np.eye(3)[np.argmin(np.abs(normals[lost]), axis=1)])
-    return _unit(result)
-
-
-def _group_pairs(group: np.ndarray, asked: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Every pair (k, member) of an index k into ``asked`` (groups) and an item ``member`` of that
-    group, ``group`` (N,) giving each item's; k ascending, members in item order within it."""
-    order = np.argsort(group, kind="stable")
-    starts = np.concatenate([[0], np.cumsum(np.bincount(group))])
-    first, count = starts[asked], np.diff(starts)[asked]
-    k = np.repeat(np.arange(len(asked)), count)
-    block = np.cumsum(count) - count
-    return k, order[first[k] + np.arange(k.size) - block[k]]
+    return unit_vectors(result)
 
 
 def _take_corner_tangents(attributes: dict[str, np.ndarray], inputs: dict[str, np.ndarray], kept: np.ndarray) -> None:
@@ -455,7 +419,7 @@ def _take_corner_tangents(attributes: dict[str, np.ndarray], inputs: dict[str, n
     uvs = inputs.get("TEXCOORD_0", np.zeros((len(positions), 0)))
     _, group = np.unique(np.c_[positions.astype(np.float64), uvs], axis=0, return_inverse=True)
     group = group.ravel()
-    vertex, candidate = _group_pairs(group, group[kept])  # the kept vertex itself among them
+    vertex, candidate = pairs_within_groups(group, group[kept])  # the kept vertex itself among them
     closeness = np.einsum("pc,pc->p", inputs["NORMAL"][candidate].astype(np.float64), attributes["NORMAL"][vertex])
     block = np.flatnonzero(np.r_[True, vertex[1:] != vertex[:-1]])  # each level vertex's first pair
     chosen = candidate[np.lexsort((-closeness, vertex))[block]]
@@ -476,37 +440,14 @@ def _texture_tangents(positions: np.ndarray, uvs: np.ndarray, faces: np.ndarray)
     return np.where(usable[:, None], direction / np.where(usable, area, 1.0)[:, None], 0.0)
 
 
-def _unit(vectors: np.ndarray) -> np.ndarray:
-    length = np.linalg.norm(vectors, axis=1, keepdims=True)
-    return (vectors / np.where(length > 0.0, length, 1.0)).astype(np.float32)
-
-
 def with_crease_normals(primitive: PrimitiveArrays, crease: float) -> PrimitiveArrays:
     """``primitive`` with normals from its own faces: each corner gets the area-weighted normal
     of the faces around its vertex that turn from its face by at most ``crease`` radians, and
     a vertex whose corners get different normals is split. Tangents are re-orthogonalised."""
     positions = primitive.attributes["POSITION"].astype(np.float64)
     faces = primitive.faces
-    corners = positions[faces]
-    area_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    length = np.linalg.norm(area_normal, axis=1, keepdims=True)
-    unit = area_normal / np.where(length > 0.0, length, 1.0)
     corner_vertex, corner_face = faces.ravel(), np.repeat(np.arange(len(faces)), 3)
-    a, b = _group_pairs(corner_vertex, corner_vertex)  # every pair of corners at one vertex
-    # A corner always takes its own face (at crease 0, rounding can put a unit vector's dot with
-    # itself below cos 0 = 1, which left flat-shaded levels with zero normals).
-    close = (a == b) | (np.einsum("pc,pc->p", unit[corner_face[a]], unit[corner_face[b]]) >= np.cos(crease) - 1e-9)
-    normal = np.zeros((corner_vertex.size, 3))
-    np.add.at(normal, a[close], area_normal[corner_face[b[close]]])
-    normal = _unit(normal)
-    # A degenerate face's corner gets nothing (its face has no normal): it takes its vertex's
-    # smooth normal, or +Z where every face at the vertex is degenerate.
-    lost = ~normal.any(axis=1)
-    if lost.any():
-        smooth = np.zeros((len(positions), 3))
-        np.add.at(smooth, corner_vertex, area_normal[corner_face])
-        normal[lost] = _unit(smooth[corner_vertex[lost]])
-        normal[~normal.any(axis=1)] = (0.0, 0.0, 1.0)
+    normal = corner_normals(positions, faces, crease)
     # One output vertex per (vertex, normal).
     keys = np.concatenate([corner_vertex[:, None].astype(np.float32), normal], axis=1)
     _, first, new_index = np.unique(keys, axis=0, return_index=True, return_inverse=True)

@@ -100,17 +100,54 @@ def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path, capsys
     levels = [sorted((tmp_path / "out" / f"shot_lod{level}").iterdir()) for level in (1, 2, 3)]
     for frames in [*levels, *([tmp_path / "out" / f"rest_lod{level}.obj"] for level in (1, 2, 3))]:
         for path in frames:
-            positions, faces, written = read_obj_textured(path)
+            positions, faces, written, _ = read_obj_textured(path)
             assert written is not None and len(written.uvs) > len(positions)  # the seam stays open in uv
             corners, uvs = positions[faces], written.uvs[written.corners]
             np.testing.assert_allclose(
                 uvs[..., 1] * height, corners[..., 1] - rest.frames[0][:, 1].min(), atol=1e-3 * height
             )
         # u: the angle at rest, linear along each edge (chord) as the coordinates are: near it
-        positions, faces, written = read_obj_textured(frames[0])
+        positions, faces, written, _ = read_obj_textured(frames[0])
         angle = np.arctan2(positions[faces][..., 2], positions[faces][..., 0]) / (2 * np.pi)
         off = np.abs((written.uvs[written.corners][..., 0] - angle + 0.5) % 1.0 - 0.5)
         assert off.max() < 0.05, (frames[0], off.max())
+
+
+@pytest.mark.parametrize("shading", ["smooth", "flat"])
+def test_an_obj_sequences_normals_are_rebuilt_on_every_level_as_shaded(tmp_path, capsys, shading):
+    # Levels were written without the input's vn lines; now each level frame gets normals from its
+    # own faces, one per position where the input is smooth, each face's own where it is flat.
+    from animlod.io.obj import ObjNormals
+    from animlod.normals import vertex_normals
+
+    tube = bending_tube(frames=3)
+    (tmp_path / "shot").mkdir()
+    for index, frame in enumerate(tube.frames):
+        if shading == "smooth":
+            normals = ObjNormals(vertex_normals(frame, tube.faces), tube.faces)
+        else:
+            corners = frame[tube.faces]
+            face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+            face_normals /= np.linalg.norm(face_normals, axis=1, keepdims=True)
+            normals = ObjNormals(face_normals, np.repeat(np.arange(tube.face_count), 3).reshape(-1, 3))
+        write_obj(tmp_path / "shot" / f"shot_{index}.obj", frame, tube.faces, normals=normals)
+    assert main(["info", str(tmp_path / "shot")]) == 0
+    assert f"normals (vn): {shading}, rebuilt on each level" in capsys.readouterr().out
+    assert main(["simplify", str(tmp_path / "shot"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    assert "not read" not in capsys.readouterr().err
+    for level in (1, 2, 3):
+        for path in sorted((tmp_path / "out" / f"shot_lod{level}").iterdir()):
+            positions, faces, _, written = read_obj_textured(path)
+            assert written is not None
+            corner_normals = written.normals[written.corners]
+            if shading == "smooth":
+                np.testing.assert_array_equal(written.corners, faces)  # one normal per position
+                np.testing.assert_allclose(written.normals, vertex_normals(positions, faces), atol=1e-6)
+            else:
+                corners = positions[faces].astype(np.float64)
+                own = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+                own /= np.linalg.norm(own, axis=1, keepdims=True)
+                assert np.einsum("fkc,fc->fk", corner_normals, own).min() > 0.9999
 
 
 def test_one_mesh_file_gives_one_file_per_level_and_dotted_names_keep_their_levels_apart(tmp_path):

@@ -221,7 +221,7 @@ def _read_level(path: Path) -> AnimatedMesh:
         return read_npz(path)
     from ..io.meshseq import read_textured_sequence
 
-    return read_textured_sequence(path)[0]  # its texture coordinates, if any, read as written
+    return read_textured_sequence(path)[0]  # its texture coordinates and normals, if any, read as written
 
 
 class _ProgressBar:

@@ -1,7 +1,8 @@
 """OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
 
 Geometry is read (:mod:`.obj`, :mod:`.ply`), and with :func:`read_textured_sequence` an OBJ
-sequence's texture coordinates, which :func:`write_sequence` writes back.
+sequence's texture coordinates and how its normals shade it, which :func:`write_sequence`
+writes back (normals rebuilt from each written frame's faces).
 """
 
 from __future__ import annotations
@@ -17,9 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from ..model import AnimatedMesh
+from ..normals import corner_normals, shading_crease, vertex_normals
 from .atomic import atomic_folder
 from .errors import FormatError
-from .obj import ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
+from .obj import ObjNormals, ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
 from .ply import read_ply, write_ply
 
 MESH_SUFFIXES = (".obj", ".ply")
@@ -67,19 +69,24 @@ class SequenceTexture:
 
 def read_textured_sequence(
     source: str | os.PathLike | Sequence[str | os.PathLike], fps: float | None = None
-) -> tuple[AnimatedMesh, SequenceTexture | None]:
+) -> tuple[AnimatedMesh, SequenceTexture | None, float | None]:
     """:func:`read_sequence` with an OBJ sequence's texture coordinates: the mesh then has a
     vertex per (position, texture coordinate) pair of the corners (:class:`SequenceTexture`).
     None, and the files' positions as the vertices, where the frames have none (PLY frames, OBJ
     frames without ``vt``), or where one frame's differ from the first's (with an
-    :class:`~animlod.io.obj.UnreadAttributesWarning`)."""
+    :class:`~animlod.io.obj.UnreadAttributesWarning`). Third, where the first frame has normals
+    (``vn``), the crease angle that rebuilds them from the faces: 0 for flat shading,
+    :data:`~animlod.normals.CREASE_ANGLE` for hard edges, pi for smooth shading; else None."""
     return _read_frames(sequence_paths(source), fps, textured=True)
 
 
-def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> tuple[AnimatedMesh, SequenceTexture | None]:
+def _read_frames(
+    paths: list[Path], fps: float | None, textured: bool
+) -> tuple[AnimatedMesh, SequenceTexture | None, float | None]:
     """The frames of ``paths`` (:func:`read_sequence`), and with ``textured`` their texture
-    coordinates (:func:`read_textured_sequence`)."""
-    first_vertices, faces, texture = read_mesh_textured(paths[0]) if textured else (*read_mesh(paths[0]), None)
+    coordinates and normals' crease angle (:func:`read_textured_sequence`)."""
+    read = read_mesh_textured if textured else _geometry_of
+    first_vertices, faces, texture, normals = read(paths[0])
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
     if not len(faces):
         what = "no vertices and no faces" if not len(first_vertices) else f"{len(first_vertices)} vertices but no faces"
@@ -90,7 +97,7 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> tuple[
     with warnings.catch_warnings():  # the first frame's warning speaks for the sequence
         warnings.simplefilter("ignore", UnreadAttributesWarning)
         for index, path in enumerate(paths[1:], start=1):
-            vertices, frame_faces, frame_texture = read_mesh_textured(path) if textured else (*read_mesh(path), None)
+            vertices, frame_faces, frame_texture, _ = read(path)
             _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
             frames[index] = vertices
             if textured and differing is None and not _same_texture(texture, frame_texture):
@@ -100,13 +107,33 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> tuple[
         warnings.warn(f"{differing}: its texture coordinates (vt) are not the first frame's ({paths[0].name} "
                       f"{first}): the levels are written without them", UnreadAttributesWarning,
                       stacklevel=3)  # fmt: skip
+    crease = None if normals is None else _shading_of(first_vertices, faces, normals)
     if texture is None:
-        return AnimatedMesh(faces, frames, fps=fps), None
+        return AnimatedMesh(faces, frames, fps=fps), None, crease
     # A vertex per (position, texture coordinate) pair that a corner uses.
     pairs = np.stack([faces.ravel(), texture.corners.ravel()], axis=1)
     wedges, corner_wedge = np.unique(pairs, axis=0, return_inverse=True)
     split = AnimatedMesh(corner_wedge.reshape(faces.shape).astype(np.int32), frames[:, wedges[:, 0]], fps=fps)
-    return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32))
+    return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32)), crease
+
+
+def _shading_of(vertices: np.ndarray, faces: np.ndarray, normals: ObjNormals) -> float:
+    """The crease angle of :func:`~animlod.normals.corner_normals` that rebuilds a frame's
+    normals from its faces (pi where they are smooth)."""
+    pairs = np.stack([faces.ravel(), normals.corners.ravel()], axis=1)
+    split, corner = np.unique(pairs, axis=0, return_inverse=True)
+    crease = shading_crease(vertices[split[:, 0]], normals.normals[split[:, 1]], corner.reshape(faces.shape))
+    return np.pi if crease is None else crease
+
+
+def rebuilt_normals(positions: np.ndarray, faces: np.ndarray, crease: float) -> ObjNormals:
+    """The normals of one frame ``positions (P, 3)`` from its own ``faces`` at ``crease``
+    (:func:`read_textured_sequence`): one per position where smooth, else one per distinct corner
+    normal."""
+    if crease >= np.pi:
+        return ObjNormals(vertex_normals(positions, faces), faces)
+    values, index = np.unique(corner_normals(positions, faces, crease), axis=0, return_inverse=True)
+    return ObjNormals(values, index.reshape(faces.shape).astype(np.int32))
 
 
 def _same_texture(first: ObjTexture | None, other: ObjTexture | None) -> bool:
@@ -123,11 +150,14 @@ def write_sequence(
     stem: str = "frame",
     names: Sequence[str] | None = None,
     texture: SequenceTexture | None = None,
+    normals_crease: float | None = None,
 ) -> list[Path]:
     """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
     ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically; with ``texture``
     (OBJ only) its texture coordinates, the vertices of one point that stand at one place in
-    every frame (a UV seam's copies) written as one ``v`` line.
+    every frame (a UV seam's copies) written as one ``v`` line; with ``normals_crease`` (OBJ
+    only) each frame's normals rebuilt from its faces at that crease angle
+    (:func:`rebuilt_normals`).
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
     ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
@@ -142,6 +172,8 @@ def write_sequence(
     if texture is not None and (fmt != "obj" or len(texture.uvs) != mesh.vertex_count):
         raise ValueError(f"{os.fspath(folder)}: texture: {len(texture.uvs)} texture coordinates for "
                          f"{mesh.vertex_count} vertices, written as {fmt} (OBJ only)")  # fmt: skip
+    if normals_crease is not None and fmt != "obj":
+        raise ValueError(f"{os.fspath(folder)}: normals_crease: normals are written to OBJ files only, not {fmt}")
     if names is None:
         width = max(4, len(str(mesh.frame_count - 1)))
         names = [f"{stem}_{index:0{width}d}" for index in range(mesh.frame_count)]
@@ -152,7 +184,9 @@ def write_sequence(
     written, faces, obj_texture = obj_layout(mesh, texture)
     with atomic_folder(folder) as temporary:
         for name, vertices in zip(names, mesh.frames):
-            write_mesh(temporary / name, vertices[written], faces, obj_texture)
+            positions = vertices[written]
+            normals = None if normals_crease is None else rebuilt_normals(positions, faces, normals_crease)
+            write_mesh(temporary / name, positions, faces, obj_texture, normals)
     return [Path(folder) / name for name in names]
 
 
@@ -246,12 +280,17 @@ def _check_same_connectivity(
 # Single meshes
 
 
-def read_mesh_textured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
-    """:func:`read_mesh` with an OBJ file's texture coordinates (:func:`~.obj.read_obj_textured`;
-    None for PLY)."""
-    if Path(path).suffix.lower() == ".obj":
-        return read_obj_textured(path)
-    return (*read_mesh(path), None)
+def read_mesh_textured(
+    path: str | os.PathLike,
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
+    """:func:`read_mesh` with an OBJ file's texture coordinates and normals
+    (:func:`~.obj.read_obj_textured`; None for PLY)."""
+    return read_obj_textured(path) if Path(path).suffix.lower() == ".obj" else _geometry_of(path)
+
+
+def _geometry_of(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, None, None]:
+    """:func:`read_mesh` in the shape of :func:`read_mesh_textured`."""
+    return (*read_mesh(path), None, None)
 
 
 def read_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
@@ -266,15 +305,20 @@ def read_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
 
 
 def write_mesh(
-    path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, texture: ObjTexture | None = None
+    path: str | os.PathLike,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    texture: ObjTexture | None = None,
+    normals: ObjNormals | None = None,
 ) -> None:
-    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``; ``texture``: an
-    OBJ file's texture coordinates (ValueError for PLY)."""
+    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``; ``texture`` and
+    ``normals``: an OBJ file's texture coordinates and normals (ValueError for PLY)."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
-        write_obj(path, vertices, faces, texture)
-    elif texture is not None:
-        raise ValueError(f"{os.fspath(path)}: texture: written to OBJ files only")
+        write_obj(path, vertices, faces, texture, normals)
+    elif texture is not None or normals is not None:
+        name = "texture" if texture is not None else "normals"
+        raise ValueError(f"{os.fspath(path)}: {name}: written to OBJ files only")
     elif suffix == ".ply":
         write_ply(path, vertices, faces)
     else:

@@ -1,9 +1,9 @@
 """Wavefront OBJ geometry: ``v`` and ``f`` lines read (1-based or negative indices, ``a/b/c``
 corners, polygons fan-triangulated, ``#`` comments also at a line's end, a statement continued
 on the next line after a ``\\`` that ends its line; with :func:`read_obj_textured` also ``vt``
-lines and the corners' texture indices; other statements such as ``vn``, ``g``, ``usemtl`` are
-ignored, with a warning for ``vn`` and an unread ``vt``; statements may be indented) and
-written, with texture coordinates where given. Parsing works on the whole file's bytes with
+and ``vn`` lines and the corners' indices into them; other statements such as ``g``,
+``usemtl`` are ignored, with a warning for unread ``vt`` and ``vn``; statements may be
+indented) and written, with texture coordinates and normals where given. Parsing works on the whole file's bytes with
 numpy: there is no Python loop over lines, vertices or faces."""
 
 from __future__ import annotations
@@ -40,6 +40,14 @@ class ObjTexture(NamedTuple):
     corners: np.ndarray
 
 
+class ObjNormals(NamedTuple):
+    """An OBJ mesh's normals: ``normals (N, 3) float32``, the ``vn`` lines, and ``corners (M, 3)
+    int32``, each triangle corner's index into ``normals``."""
+
+    normals: np.ndarray
+    corners: np.ndarray
+
+
 def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     """Read the ``v`` and ``f`` lines of a Wavefront OBJ file.
 
@@ -60,20 +68,26 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         index outside the vertices defined so far, or faces that all have fewer than three
         corners (some such faces among polygons are left out with a warning).
     """
-    vertices, faces, _ = _read_obj(path, textured=False)
+    vertices, faces, _, _ = _read_obj(path, textured=False)
     return vertices, faces
 
 
-def read_obj_textured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
-    """:func:`read_obj` with the texture coordinates: also the ``vt`` lines and each corner's
-    texture index (``v/vt`` or ``v/vt/vn``), or None where the file has none, or where some
+def read_obj_textured(
+    path: str | os.PathLike,
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
+    """:func:`read_obj` with the texture coordinates and normals: also the ``vt`` lines and each
+    corner's texture index (``v/vt`` or ``v/vt/vn``), and the ``vn`` lines and each corner's
+    normal index (``v/vt/vn`` or ``v//vn``); each None where the file has none, or where some
     corners have one and others not (with an :class:`UnreadAttributesWarning`). FormatError
-    also names a malformed ``vt`` line and a texture index outside them."""
+    also names a malformed ``vt`` or ``vn`` line and an index outside them."""
     return _read_obj(path, textured=True)
 
 
-def _read_obj(path: str | os.PathLike, textured: bool) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
-    """:func:`read_obj`, and with ``textured`` its texture coordinates (:func:`read_obj_textured`)."""
+def _read_obj(
+    path: str | os.PathLike, textured: bool
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
+    """:func:`read_obj`, and with ``textured`` its texture coordinates and normals
+    (:func:`read_obj_textured`)."""
     path = Path(path)
     data = path.read_bytes()
     if data.startswith((b"\xfe\xff", b"\xff\xfe")):  # UTF-16 after its byte order mark (assimp's box_UTF16BE.obj)
@@ -94,8 +108,11 @@ def _read_obj(path: str | os.PathLike, textured: bool) -> tuple[np.ndarray, np.n
     if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
         data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
     statements = _obj_statements(data, (b"v", b"f", b"l", b"vt", b"vn"))
-    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines), (uv_block, uv_lines), normals = statements
-    _warn_unread_attributes(path, vt=not textured and len(uv_lines) > 0, vn=len(normals[1]) > 0)
+    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines), uv_statements, normal_statements = (
+        statements
+    )
+    _warn_unread_attributes(path, vt=not textured and len(uv_statements[1]) > 0,
+                            vn=not textured and len(normal_statements[1]) > 0)  # fmt: skip
     if not len(vertex_lines):
         _require_obj_statement(path, data)
     if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
@@ -125,13 +142,14 @@ def _read_obj(path: str | os.PathLike, textured: bool) -> tuple[np.ndarray, np.n
     corners = _FaceCorners(path, sizes, owner, face_lines, name_face)
     resolved = corners.resolved(face_block, vertex_lines, len(vertices), ("vertex", "vertices"))
     faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
-    if not textured or not len(uv_lines):
-        return vertices, faces, None
-    texture = _texture(path, uv_block, uv_lines, texture_block, corners)
-    if texture is None:
-        return vertices, faces, None
-    uvs, indices = texture
-    return vertices, faces, ObjTexture(uvs, fan_triangulate(indices[polygons[owner]], sizes[polygons]))
+    if not textured:
+        return vertices, faces, None, None
+    read = []
+    for (block, lines), attribute in ((uv_statements, _TEXTURE), (normal_statements, _NORMALS)):
+        found = _corner_attribute(path, attribute, block, lines, texture_block, corners) if len(lines) else None
+        read.append(found and (found[0], fan_triangulate(found[1][polygons[owner]], sizes[polygons])))
+    texture, normals = read
+    return vertices, faces, texture and ObjTexture(*texture), normals and ObjNormals(*normals)
 
 
 @dataclass(frozen=True)
@@ -161,56 +179,83 @@ class _FaceCorners:
         return resolved
 
 
-def _texture(
-    path: Path, uv_block: bytes, uv_lines: np.ndarray, face_block: bytes, corners: _FaceCorners
+class _Attribute(NamedTuple):
+    """A per-corner attribute of the ``f`` lines: the ``field`` of a corner it is indexed by (1:
+    vt, 2: vn), the values its lines give (``width``, of which ``minimum`` are required) and its
+    names in messages."""
+
+    tag: str
+    field: int
+    width: int
+    minimum: int
+    item: str  # one line's values, in "texture coordinate 3 (line 9)"
+    items: tuple[str, str]  # the index's and the lines' names, in "texture index ... outside the texture coordinates"
+    kind: str  # in "12 of 40 face corners have texture coordinates (vt)"
+
+
+_TEXTURE = _Attribute("vt", 1, 2, 1, "texture coordinate", ("texture", "texture coordinates"), "texture coordinates")
+_NORMALS = _Attribute("vn", 2, 3, 3, "normal", ("normal", "normals"), "normals")
+
+
+def _corner_attribute(
+    path: Path, attribute: _Attribute, block: bytes, lines: np.ndarray, face_block: bytes, corners: _FaceCorners
 ) -> tuple[np.ndarray, np.ndarray] | None:
-    """The ``vt`` lines' (u, v) and every face corner's 0-based index into them (``face_block``:
-    the ``f`` lines as written); None, with a warning, where some corners have a texture index
-    and others none."""
-    texture_block, indexed = _corner_texture_indices(face_block)
+    """The ``attribute``'s lines (``block``: u and v of ``vt``, a w dropped; x, y, z of ``vn``) as
+    float32, and every face corner's 0-based index into them (``face_block``: the ``f`` lines as
+    written); None, with a warning, where some corners have an index and others none."""
+    index_block, indexed = _corner_field(face_block, attribute.field)
     if indexed < corners.sizes.sum():
         if indexed:
-            warnings.warn(f"{path}: {indexed} of {corners.sizes.sum()} face corners have texture coordinates (vt), "
-                          "the others none: read without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
+            warnings.warn(f"{path}: {indexed} of {corners.sizes.sum()} face corners have {attribute.kind} "
+                          f"({attribute.tag}), the others none: read without them", UnreadAttributesWarning,
+                          stacklevel=4)  # fmt: skip
         return None
 
-    def name_uv(row: int) -> str:
-        return f"texture coordinate {row} (line {uv_lines[row]})"
+    def name_row(row: int) -> str:
+        return f"{attribute.item} {row} (line {lines[row]})"
 
-    uvs = _leading_values(path, uv_block, len(uv_lines), 2, 1, name_uv, "values")  # (u, v), a w dropped
-    check_finite_vertices(path, uvs.astype(np.float32), name_uv)
-    indices = corners.resolved(texture_block, uv_lines, len(uvs), ("texture", "texture coordinates"))
-    return uvs.astype(np.float32), indices
+    values = _leading_values(path, block, len(lines), attribute.width, attribute.minimum, name_row, "values")
+    check_finite_vertices(path, values.astype(np.float32), name_row)
+    return values.astype(np.float32), corners.resolved(index_block, lines, len(values), attribute.items)
 
 
 def write_obj(
-    path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, texture: ObjTexture | None = None
+    path: str | os.PathLike,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    texture: ObjTexture | None = None,
+    normals: ObjNormals | None = None,
 ) -> None:
     """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically; with
-    ``texture`` also its ``vt`` lines and ``v/vt`` corners.
+    ``texture`` also its ``vt`` lines, with ``normals`` its ``vn`` lines, and each corner's
+    indices into them (``v/vt``, ``v//vn`` or ``v/vt/vn``).
 
     Coordinates are written with 9 significant digits, which round-trips float32 exactly. A wrong
     shape, a coordinate that is not finite as float32 or a face index outside the vertices is a
-    ValueError naming the file and the argument (``vertices``, ``faces`` or ``texture``); nothing
-    is written.
+    ValueError naming the file and the argument (``vertices``, ``faces``, ``texture`` or
+    ``normals``); nothing is written.
     """
     vertices, faces = checked_for_writing(path, vertices, faces)
     vertices, faces = vertices.astype(np.float64), faces.astype(np.int64) + 1
-    if texture is not None:
-        uvs, corners = np.asarray(texture.uvs, dtype=np.float64), np.asarray(texture.corners)
-        fits = uvs.ndim == 2 and uvs.shape[1] == 2 and corners.shape == faces.shape and np.isfinite(uvs).all()
-        if not fits or corners.size and not 0 <= corners.min() <= corners.max() < len(uvs):
-            raise ValueError(f"{os.fspath(path)}: texture: expected finite uvs (T, 2) and a (M, 3) corner index "
-                             f"into them per face, got {uvs.shape} uvs and {corners.shape} corners")  # fmt: skip
+    columns, corner, lines = [faces], "%d", ""
+    for name, attribute, tag, width in (("texture", texture, "vt", 2), ("normals", normals, "vn", 3)):
+        if attribute is None:
+            corner += "/" if tag == "vt" and normals is not None else ""  # v//vn
+            continue
+        values, indices = np.asarray(attribute[0], dtype=np.float64), np.asarray(attribute[1])
+        fits = values.ndim == 2 and values.shape[1] == width and np.isfinite(values).all()
+        fits = fits and indices.shape == faces.shape and (not indices.size or 0 <= indices.min() <= indices.max())
+        if not fits or indices.size and indices.max() >= len(values):
+            raise ValueError(f"{os.fspath(path)}: {name}: expected finite values (N, {width}) and a (M, 3) "
+                             f"corner index into them per face, got {values.shape} and {indices.shape}")  # fmt: skip
+        lines += ((tag + " %.9g" * width + "\n") * len(values)) % tuple(values.ravel())
+        columns.append(indices.astype(np.int64) + 1)
+        corner += "/%d"
     with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
         handle.write("# written by animlod\n")
         handle.write(("v %.9g %.9g %.9g\n" * len(vertices)) % tuple(vertices.ravel()))
-        if texture is None:
-            handle.write(("f %d %d %d\n" * len(faces)) % tuple(faces.ravel()))
-            return
-        handle.write(("vt %.9g %.9g\n" * len(uvs)) % tuple(uvs.ravel()))
-        pairs = np.stack([faces, corners.astype(np.int64) + 1], axis=2)
-        handle.write(("f %d/%d %d/%d %d/%d\n" * len(faces)) % tuple(pairs.ravel()))
+        handle.write(lines)
+        handle.write((f"f {corner} {corner} {corner}\n" * len(faces)) % tuple(np.stack(columns, axis=2).ravel()))
 
 
 # The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.
@@ -255,19 +300,19 @@ def _join_continued_lines(data: bytes) -> bytes:
     return joined.tobytes() + b"\n" * tail
 
 
-def _corner_texture_indices(face_block: bytes) -> tuple[bytes, int]:
-    """``face_block`` (``f`` lines, tags first) with each corner cut to its texture index (vt of
-    ``v/vt/vn`` or ``v/vt``: the bytes after its first slash, up to the next), and how many
-    corners have one."""
+def _corner_field(face_block: bytes, field: int) -> tuple[bytes, int]:
+    """``face_block`` (``f`` lines, tags first) with each corner cut to its ``field`` (1: vt of
+    ``v/vt/vn`` or ``v/vt``, the bytes after its first slash up to the next; 2: vn of ``v/vt/vn``
+    or ``v//vn``, after the second), and how many corners have one."""
     codes = np.frombuffer(face_block, dtype=np.uint8)
     separator = np.isin(codes, np.frombuffer(b" \t\n", dtype=np.uint8))
     slash = codes == ord("/")
     slashes = np.cumsum(slash)
     in_corner = slashes - np.maximum.accumulate(np.where(separator, slashes, 0))  # slashes so far in its word
     index_follows = ~np.append(separator[1:] | slash[1:], True)  # "1/2": an index after the slash
-    indexed = int(np.count_nonzero(slash & (in_corner == 1) & index_follows))
+    indexed = int(np.count_nonzero(slash & (in_corner == field) & index_follows))
     line_start = np.append(True, codes[:-1] == ord("\n"))
-    keep = separator | line_start | ((in_corner == 1) & ~slash)
+    keep = separator | line_start | ((in_corner == field) & ~slash)
     return codes[keep].tobytes(), indexed
 
 

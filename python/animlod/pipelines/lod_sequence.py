@@ -4,10 +4,11 @@ Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OB
 (each frame under its input file's name), ``<stem>_lod<i>.obj`` (or ``.ply``) for one mesh file,
 ``<stem>_lod<i>.npz`` for NPZ input, and measured against the input frame by frame (symmetric
 Hausdorff and RMS distance relative to the bounding-box diagonal), on at most 64 frames evenly
-spaced over a longer sequence. An OBJ sequence's texture
-coordinates are carried: each (position, texture coordinate) pair of its corners is a vertex,
-the copies of a position along a UV seam welded by AQEM and kept apart where their coordinates
-differ, and written back as ``vt`` lines.
+spaced over a longer sequence. An OBJ sequence's texture coordinates are carried: each
+(position, texture coordinate) pair of its corners is a vertex, the copies of a position along a
+UV seam welded by AQEM and kept apart where their coordinates differ, and written back as ``vt``
+lines. Its normals are rebuilt on each level frame from the level's own faces, shaded as the
+input is (flat, hard edges, or smooth), and written as ``vn`` lines.
 """
 
 from __future__ import annotations
@@ -82,6 +83,7 @@ def simplify_sequence(
         measured_frames = whole_number("measured_frames", measured_frames, 1)
     kind = input_kind(source)
     texture = None  # an OBJ sequence's texture coordinates, carried as AQEM attributes
+    normals_crease = None  # how an OBJ sequence's normals shade it, for the levels' rebuilt normals
     if kind == "npz":
         from ..io.npz import read_npz
 
@@ -89,7 +91,7 @@ def simplify_sequence(
     elif kind == "sequence":
         from ..io.meshseq import read_textured_sequence
 
-        original, texture = read_textured_sequence(source)
+        original, texture, normals_crease = read_textured_sequence(source)
     else:
         raise FormatError(os.fspath(source), "file", f"a {kind} file is not a mesh sequence")
     started = time.perf_counter()
@@ -109,7 +111,7 @@ def simplify_sequence(
         level_texture = (
             None if texture is None else SequenceTexture(level.attributes, texture.points[level.kept_vertices])
         )
-        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture)
+        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture, normals_crease)
         measured = _surface_error(*(_frames_of(mesh, frames) for mesh in (original, level.mesh))) if measure else None
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
@@ -185,16 +187,18 @@ def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
                         names if frame_names_fit(names, len(paths)) else None)  # fmt: skip
 
 
-def _write_level(fmt: _LevelFormat, target: Path, mesh: AnimatedMesh, texture: SequenceTexture | None) -> Path:
-    """Write a level as ``fmt`` says, with its texture coordinates if any; its path. A file's
-    suffix is appended, not swapped:
+def _write_level(
+    fmt: _LevelFormat, target: Path, mesh: AnimatedMesh, texture: SequenceTexture | None, normals_crease: float | None
+) -> Path:
+    """Write a level as ``fmt`` says, with its texture coordinates and rebuilt normals if any; its
+    path. A file's suffix is appended, not swapped:
     ``walk.v2_lod1`` has the suffix ``.v2_lod1`` (every level of walk.v2.npz was written to
     walk.npz)."""
     if not fmt.one_file:
         from ..io.meshseq import write_sequence
 
         target.mkdir(parents=True, exist_ok=True)
-        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture)
+        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture, normals_crease=normals_crease)
         return target
     path = target.with_name(f"{target.name}.{fmt.suffix}")
     if fmt.suffix == "npz":
@@ -202,8 +206,10 @@ def _write_level(fmt: _LevelFormat, target: Path, mesh: AnimatedMesh, texture: S
 
         write_npz(path, mesh)
     else:  # one mesh in, one mesh out
-        from ..io.meshseq import obj_layout, write_mesh
+        from ..io.meshseq import obj_layout, rebuilt_normals, write_mesh
 
         written, faces, obj_texture = obj_layout(mesh, texture)
-        write_mesh(path, mesh.frames[0][written], faces, obj_texture)
+        positions = mesh.frames[0][written]
+        normals = None if normals_crease is None else rebuilt_normals(positions, faces, normals_crease)
+        write_mesh(path, positions, faces, obj_texture, normals)
     return path

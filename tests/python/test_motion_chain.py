@@ -192,13 +192,14 @@ def test_a_level_reuses_its_chosen_trial_refit_for_those_frames(monkeypatch) -> 
         return refit(problem, original, *args, **kwargs)
 
     monkeypatch.setattr(chain, "_refit", counting_refit)
+    monkeypatch.setattr(chain, "restart_from_neighbours", lambda result, solve: result)  # solves of their own
     reused = build_motion_chain(motion, [38, 28, 18, 10], workers=1)
     level_frames = solved_frames[-3:]  # the three re-fitted levels come after the trials
     assert 16 in solved_frames[:-3]  # the trials
     assert all(count == motion.frame_count - 16 for count in level_frames), (level_frames, motion.frame_count)
 
     solve_level = chain._solve_level
-    monkeypatch.setattr(chain, "_solve_level", lambda *args: solve_level(*args[:7]))  # no reuse
+    monkeypatch.setattr(chain, "_solve_level", lambda *args, **kwargs: solve_level(*args[:7], **kwargs))  # no reuse
     solved_frames.clear()
     alone = build_motion_chain(motion, [38, 28, 18, 10], workers=1)
     assert solved_frames[-3:] == [motion.frame_count] * 3

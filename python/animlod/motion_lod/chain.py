@@ -20,6 +20,7 @@ from .analysis import MotionAnalysis, analyze_motion
 from .core_refit import core_energy, refit_core
 from .frozen import FrozenLevel, freeze, frozen_motion
 from .grouped_solve import FrameFailure, RefitResult, combine_frames
+from .neighbour_restarts import restart_from_neighbours
 from .newton import refit_newton
 from .objective import RefitProblem, Weights, build_problem
 from .ranking import DEFAULT_RANKING
@@ -294,9 +295,12 @@ def _solve_level(
     workers: int,
     progress: Callable[[float], None] | None,
     known: _KnownFrames | None = None,
+    restarts: bool = True,
 ) -> _Solved:
     """Re-fits ``level`` on every frame of ``motion`` (but ``known``'s, whose re-fit is given) and
-    places every original point."""
+    places every original point; with ``restarts``, frames whose E stands above their
+    neighbours' are solved again from the neighbours' solutions (``motion``: consecutive
+    frames)."""
     problem = build_problem(level, weights)
     original = motion.world_positions()
     if level.frozen.any():
@@ -314,7 +318,15 @@ def _solve_level(
             starts = None if cold_starts is None else cold_starts[rest]
             solved = _refit(problem, original[rest], fallback[rest], starts, solver, slsqp_options, workers, progress)
             parts.append((rest, solved))
+
+        def solve_from(frames: np.ndarray, starts: np.ndarray) -> RefitResult:
+            if solver == "newton":
+                return refit_newton(problem, original[frames], start=starts, workers=max(workers, 1))
+            return _refit(problem, original[frames], fallback[frames], starts, solver, slsqp_options, workers, None)
+
         result = combine_frames(motion.frame_count, parts)
+        if restarts:
+            result = restart_from_neighbours(result, solve_from)
     else:  # E = 0 at the original positions, its global minimum: nothing to solve
         result = RefitResult(original, np.zeros(motion.frame_count), np.zeros(motion.frame_count, dtype=np.int64))
         if progress:
@@ -431,7 +443,8 @@ def build_motion_chain(
         slsqp_options = _resolve_solver(solver, slsqp_options)
 
         def trial_error(level: FrozenLevel, frames: np.ndarray) -> float:
-            solved = _solve_level(level, motion.take_frames(frames), weights, solver, slsqp_options, workers, None)
+            trial_motion = motion.take_frames(frames)  # frames spread over the clip: not neighbours
+            solved = _solve_level(level, trial_motion, weights, solver, slsqp_options, workers, None, restarts=False)
             if not slsqp_options.warm_start:
                 trials[_trial_key(level)] = _KnownFrames(frames, solved.result)
             if trial_measure is not None:

@@ -1,0 +1,88 @@
+"""Frames whose re-fit stopped in a worse minimum of E (Eq. 5) than their neighbours', solved
+again from the neighbours' solutions.
+
+Every frame starts cold (a warm start carries one frame's minimum into the next, and that
+raised E on the dev clips), and at coarse levels E has several minima: now and then one frame
+lands in another than the frames around it, and a kept joint jumps for that frame alone (7% of
+a 61-joint figure's height at its 5-joint level, back to 0.3% on the next frame). A frame whose
+E stands above both neighbours' is solved again from each neighbour's solution (feasible for
+it: bone lengths and frozen angles do not change between frames), and the solve with the
+lowest E is kept; E only goes down. A frame next to one that changed is looked at again where
+its E stands above that neighbour's, so a run of poor frames is mended from its ends inward.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from .grouped_solve import RefitResult
+
+# A frame is looked at again where its E exceeds both neighbours' by this factor and by this
+# share of the clip's median E: the small peaks of a smooth motion's E, and rounding noise at
+# fine levels whose E is nearly 0, cost no second solve.
+_PEAK_RATIO = 1.1
+_PEAK_SHARE_OF_MEDIAN = 0.25
+# Differences of E below this are not looked at, nor kept: one point 0.3% of L from its place
+# (E is over lengths divided by L, Eq. 5 with weight 1), far below a visible jump.
+_NOTICEABLE = 1e-5
+# Rounds of restarts at most; each looks only at neighbours of frames the round before changed
+# (a run of poor frames mends from its ends inward, a frame or two per round), and each change
+# lowers E.
+_ROUNDS = 16
+# The frames whose solutions a frame is started from, by offset: the next frame's solution can
+# lie in the same poor basin (a fast swing of the arm), the one after it often not.
+_SIDES = (-1, 1, -2, 2)
+
+# solve(frames, starts (F, P, 3)) -> RefitResult of those frames, each started from its start.
+FrameSolver = Callable[[np.ndarray, np.ndarray], RefitResult]
+
+
+def restart_from_neighbours(result: RefitResult, solve: FrameSolver) -> RefitResult:
+    """``result`` with each frame whose E stands above its neighbours' replaced by the solve from
+    a neighbour's solution (``_SIDES``) with the lowest E, where that is lower (by
+    ``_NOTICEABLE``) and the solve did not fail (the frame's failure, if any, then dropped);
+    ``evaluations`` counts the extra solves. ``solve(frames, starts)`` solves the clip's
+    ``frames`` (repeats allowed) from ``starts``."""
+    frame_count = result.objective.size
+    if frame_count < 2:
+        return result
+    positions, objective = result.positions.copy(), result.objective.copy()
+    evaluations = result.evaluations.copy()
+    failures = {failure.frame: failure for failure in result.failures}
+    candidates = _peaks(objective, np.arange(frame_count), both=True)
+    for _ in range(_ROUNDS):
+        # Every (frame, neighbour) pair in one solve: a solve has a fixed cost per call.
+        neighbours = (candidates[None] + np.array(_SIDES)[:, None]).ravel()
+        frames = np.tile(candidates, len(_SIDES))
+        inside = (neighbours >= 0) & (neighbours < frame_count)
+        frames, neighbours = frames[inside], neighbours[inside]
+        if not frames.size:
+            break
+        trial = solve(frames, positions[neighbours])
+        np.add.at(evaluations, frames, trial.evaluations)
+        value = trial.objective.copy()
+        value[np.array([failure.frame for failure in trial.failures], dtype=np.int64)] = np.inf
+        best = np.lexsort((value, frames))  # by frame, the lowest E first
+        first = best[np.r_[True, frames[best][1:] != frames[best][:-1]]]
+        better = first[value[first] < objective[frames[first]] - _NOTICEABLE]
+        changed = frames[better]
+        positions[changed], objective[changed] = trial.positions[better], trial.objective[better]
+        for frame in changed:
+            failures.pop(int(frame), None)
+        # Beside a mended frame, a frame above that one alone is the next of a run of poor frames.
+        candidates = _peaks(objective, np.unique(np.concatenate([changed - 1, changed + 1])), both=False)
+    return RefitResult(positions, objective, evaluations, sorted(failures.values(), key=lambda f: f.frame))
+
+
+def _peaks(objective: np.ndarray, frames: np.ndarray, both: bool) -> np.ndarray:
+    """The frames among ``frames`` (clipped to the clip) whose E stands above (``_PEAK_RATIO``,
+    ``_PEAK_SHARE_OF_MEDIAN``) both neighbours' E, or with ``both`` False the lower one's."""
+    count = objective.size
+    frames = frames[(frames >= 0) & (frames < count)]
+    end = -np.inf if both else np.inf  # a clip's end has one neighbour
+    padded = np.concatenate([[end], objective, [end]])
+    neighbours = (np.maximum if both else np.minimum)(padded[frames], padded[frames + 2])
+    above = objective[frames] - _PEAK_RATIO * neighbours
+    return frames[above > max(_PEAK_SHARE_OF_MEDIAN * np.median(objective), _NOTICEABLE)]

@@ -358,6 +358,27 @@ def test_read_gltf_on_a_written_file_lists_the_skin_and_motion(chain_glb):
     assert scene.morph_animations == [] and scene.static_meshes == []
 
 
+def test_a_sampler_that_no_channel_uses_does_not_set_the_clips_length(chain_glb, tmp_path, capsys):
+    # Exporters leave such samplers behind; one keyed to 10 s made a 1-second clip's levels
+    # hold still for 9 s, and info report 10 s.
+    from animlod.cli import main
+
+    path, mesh, motion = chain_glb
+
+    def leftover_sampler(gltf, blob):
+        times = append_accessor(gltf, blob, np.float32([[0.0], [10.0]]), "SCALAR")
+        gltf.accessors[times].min, gltf.accessors[times].max = [0.0], [10.0]
+        values = append_accessor(gltf, blob, np.float32([[0, 0, 0], [1, 1, 1]]), "VEC3")
+        gltf.animations[0].samplers.append(pygltflib.AnimationSampler(input=times, output=values))
+
+    edited = edit_glb(path, tmp_path / "leftover.glb", leftover_sampler)
+    duration = (motion.frame_count - 1) / motion.fps
+    assert GltfDocument(edited).animation_duration(0) == pytest.approx(duration)
+    assert read_skinned(edited, fps=motion.fps)[1][0].frame_count == motion.frame_count
+    assert main(["info", str(edited)]) == 0
+    assert f"channels, {duration:.2f} s" in capsys.readouterr().out
+
+
 # ---- skeleton building --------------------------------------------------------------------
 
 

@@ -177,13 +177,14 @@ def _document_lines(path: str) -> list[str]:
     if doc.gltf.animations and not doc.gltf.skins:
         lines += _node_tree_lines(doc)
     for index, animation in enumerate(doc.gltf.animations or []):
-        frames = doc.animation_frame_times(index, 30.0)
+        doc.animation_frame_times(index, 30.0)  # refuses a clip too long to sample
         extras = animation.extras.get("animlod") if isinstance(animation.extras, dict) else None
         level = (
             f", motion level {extras['motion_level']}" if isinstance(extras, dict) and "motion_level" in extras else ""
         )
         lines.append(
-            f"{doc.animation_label(index)}: {len(animation.channels or [])} channels, {frames[-1]:.2f} s{level}"
+            f"{doc.animation_label(index)}: {len(animation.channels or [])} channels, "
+            f"{doc.animation_duration(index):.2f} s{level}"
         )
     for index, node in enumerate(doc.json.get("nodes", [])):
         ids = node.get("extensions", {}).get("MSFT_lod", {}).get("ids")

@@ -491,11 +491,18 @@ class GltfDocument:
         return f"animation {name!r}" if name else f"animation {index}"
 
     def animation_duration(self, index: int) -> float:
-        """The last key time over all samplers of animation ``index``: the clip length a viewer
-        plays (from 0)."""
+        """The last key time over the samplers that animation ``index``'s channels use: the clip
+        length a viewer plays (from 0). A sampler no channel uses (exporters leave them behind)
+        sets nothing: one of 10 s beside a 1.25 s clip made its levels hold still for 8.75 s."""
         label = self.animation_label(index)
-        samplers = self.gltf.animations[index].samplers or []
-        ends = [self.accessor(s.input, f"{label} sampler {k} input").max(initial=0.0) for k, s in enumerate(samplers)]
+        animation = self.gltf.animations[index]
+        samplers = animation.samplers or []
+        used = {channel.sampler for channel in animation.channels or []}
+        ends = [
+            self.accessor(sampler.input, f"{label} sampler {k} input").max(initial=0.0)
+            for k, sampler in enumerate(samplers)
+            if k in used
+        ]
         return float(max(ends, default=0.0))
 
     def animation_frame_times(self, index: int, fps: float) -> np.ndarray:

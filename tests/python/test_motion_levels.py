@@ -222,6 +222,44 @@ def test_cli_unknown_ranking_is_one_line(tmp_path, capsys) -> None:
     )
 
 
+def test_cli_a_level_that_cannot_be_written_leaves_no_level_beside_the_folders_files(tmp_path, capsys) -> None:
+    # A folder where the last level's file goes: the first levels were written, then the error,
+    # and they stayed beside no manifest (or an earlier run's).
+    source = _write(tmp_path, figure_motion())
+    out = tmp_path / "out"
+    (out / "clip_lod2.bvh").mkdir(parents=True)
+    assert main(["motion", str(source), "-o", str(out), "--levels", "3"]) == 2
+    assert f"{out / 'clip_lod2.bvh'}: Is a directory" in capsys.readouterr().err
+    assert sorted(path.name for path in out.iterdir()) == ["clip_lod2.bvh"]
+
+
+def test_cli_names_the_level_files_an_earlier_run_left_in_the_folder(tmp_path, capsys) -> None:
+    source = _write(tmp_path, figure_motion())
+    out = tmp_path / "out"
+    assert main(["motion", str(source), "-o", str(out), "--levels", "4"]) == 0
+    capsys.readouterr()
+    assert main(["motion", str(source), "-o", str(out), "--levels", "2"]) == 0
+    assert "holds level files this run did not write, of an earlier run with other levels or clips: " \
+        "clip_lod2.bvh, clip_lod3.bvh" in capsys.readouterr().err  # fmt: skip
+
+
+def test_cli_an_output_that_is_a_file_or_a_clip_of_a_bvh_is_refused_before_the_work(
+    tmp_path, capsys, monkeypatch
+) -> None:
+    import animlod.motion_lod.chain as chain
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("the levels were built before the refusal")
+
+    monkeypatch.setattr(chain, "build_motion_chain", no_work)
+    source = _write(tmp_path, figure_motion())
+    (tmp_path / "taken").write_text("")
+    assert main(["motion", str(source), "-o", str(tmp_path / "taken")]) == 2
+    assert f"{tmp_path / 'taken'}: is a file where the output needs a folder" in capsys.readouterr().err
+    assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--clip", "1"]) == 2
+    assert "clip: picks one of a glTF input's animations; a bvh file holds one clip" in capsys.readouterr().err
+
+
 def test_cli_a_clip_whose_every_joint_translates_writes_one_level(tmp_path, capsys) -> None:
     source = _write(tmp_path, tree_motion(8, tuple(range(1, 8))))
     out = tmp_path / "out"

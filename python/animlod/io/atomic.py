@@ -13,6 +13,7 @@ whose process is gone (:func:`clean_stale`).
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
 import secrets
@@ -101,6 +102,34 @@ def atomic_folder(path: str | os.PathLike) -> Iterator[Path]:
     except BaseException:
         shutil.rmtree(temporary, ignore_errors=True)
         raise
+
+
+@contextlib.contextmanager
+def staged_files(folder: str | os.PathLike) -> Iterator[Path]:
+    """Yield an empty temporary folder inside ``folder``; on success each file written into it
+    is renamed into ``folder`` (replacing a file of its name), on error none is.
+
+    For a set of files that belong together in a folder that holds others (a chain's levels
+    and its manifest): a write that fails half-way no longer leaves the first levels beside an
+    earlier run's manifest. The renames at the end take no time, but are one by one: a crash
+    among them can still leave a mixed set, never a half-written file.
+    """
+    target = Path(folder)
+    if target.exists() and not target.is_dir():
+        raise FileExistsError(17, "File exists (expected a folder)", os.fspath(target))
+    target.mkdir(parents=True, exist_ok=True)
+    clean_stale(target)
+    temporary = Path(tempfile.mkdtemp(prefix=_prefix(target / "staged"), suffix=".partdir", dir=target))
+    try:
+        yield temporary
+        entries = sorted(temporary.iterdir())
+        for entry in entries:  # a folder in a file's place fails the rename: before any is made
+            if (target / entry.name).is_dir():
+                raise IsADirectoryError(errno.EISDIR, "Is a directory", os.fspath(target / entry.name))
+        for entry in entries:
+            os.replace(entry, target / entry.name)
+    finally:
+        shutil.rmtree(temporary, ignore_errors=True)
 
 
 def clean_stale(folder: str | os.PathLike) -> list[Path]:

@@ -7,6 +7,7 @@ call :func:`build_motion_levels`.
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import time
@@ -17,6 +18,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from ..io.atomic import staged_files, unwritable
 from ..io.bvh import BvhLayout
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
@@ -131,6 +133,8 @@ def build_motion_levels(
         raise ValueError(f"ranking: no ranking named {ranking!r} (choose from {', '.join(RANKINGS)})")
     if len(weights) != 3:
         raise ValueError(f"weights: expected (alpha, beta, gamma), got {len(weights)} values")
+    if unwritable(Path(output) / "level"):  # found before the work, not after it
+        raise NotADirectoryError(errno.ENOTDIR, "Not a directory", os.fspath(output))
     notes: list[str] = []
 
     def note(text: str) -> None:
@@ -173,7 +177,6 @@ def build_motion_levels(
     from ..io.manifest import write_lod_manifest
 
     folder = Path(output)
-    folder.mkdir(parents=True, exist_ok=True)
     stem = input_stem(source)
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
     orders = layout.rotation_orders if layout is not None else "ZXY"
@@ -183,43 +186,62 @@ def build_motion_levels(
     skin_errors = None if skin is None else skin_distances(skin, motion, chain.levels, on_measure)
     skin_seconds = time.perf_counter() - measuring
     files, rows = [], []
-    for index, level in enumerate(chain.levels):
-        names = []
-        level_clips = [level.motion.take_frames(clip.frames) for clip in played]
-        for clip_motion, suffix in zip(level_clips, suffixes):
-            names.append(Path(f"{stem}_lod{index}{suffix}.bvh"))
-            write_bvh(folder / names[-1], clip_motion, rotation_order=orders)
-        if gltf_input:  # every clip in one GLB per level
-            from ..io.gltf import write_glb
-
-            names.append(Path(f"{stem}_lod{index}.glb"))
-            clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
-            weights = [clip.morph_weights for clip in played]
-            hung = None if content is None else content.on_level(motion, level, played)
-            write_glb(folder / names[-1], level.skin, level_clips, clip_names, durations, materials, weights, hung)
-        files.append(names)
-        row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
-               "error": level.report.max_error}  # fmt: skip
-        if skin_errors is not None:  # what a runtime drawing the skin sees
-            row["skin_error"] = float(skin_errors[index].max())
-        if len(played) > 1:  # a runtime may pick each clip's level by its own error
-            row["clips"] = []
-            for clip in played:
-                span = clip.frames
-                row["clips"].append({"name": clip.name, "error": float(level.report.frame_errors[span].max())})
-                if skin_errors is not None:
-                    row["clips"][-1]["skin_error"] = float(skin_errors[index][span].max())
-        rows.append(row)
-    # The runtime's level chooser: each level's largest joint position error in asset units (and
-    # the skin's largest distance, for a skinned glTF).
     manifest = Path(f"{stem}_motion_lod.json")
-    write_lod_manifest(folder / manifest, "motion", rows)
+    with staged_files(folder) as staged:  # no level reaches the folder unless every file is written
+        for index, level in enumerate(chain.levels):
+            names = []
+            level_clips = [level.motion.take_frames(clip.frames) for clip in played]
+            for clip_motion, suffix in zip(level_clips, suffixes):
+                names.append(Path(f"{stem}_lod{index}{suffix}.bvh"))
+                write_bvh(staged / names[-1], clip_motion, rotation_order=orders)
+            if gltf_input:  # every clip in one GLB per level
+                from ..io.gltf import write_glb
+
+                names.append(Path(f"{stem}_lod{index}.glb"))
+                clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
+                weights = [clip.morph_weights for clip in played]
+                hung = None if content is None else content.on_level(motion, level, played)
+                write_glb(staged / names[-1], level.skin, level_clips, clip_names, durations, materials, weights, hung)
+            files.append(names)
+            rows.append(_manifest_row(level, index, names, played, skin_errors))
+        # The runtime's level chooser: each level's largest joint position error in asset units
+        # (and the skin's largest distance, for a skinned glTF).
+        write_lod_manifest(staged / manifest, "motion", rows)
+    earlier = _earlier_level_files(folder, stem, {name.name for names in files for name in names})
+    if earlier:
+        note(f"{folder}: holds level files this run did not write, of an earlier run with other levels or "
+             f"clips: {', '.join(earlier)} (the manifest {manifest} names this run's)")  # fmt: skip
     faces = None if skin is None else int(skin.faces.shape[0])
     return MotionReport(chain, files, manifest, faces, motion, floor, notes, skin_errors, skin_seconds)
 
 
 # Frames per second at which a glTF input's clips are sampled.
 _GLTF_FPS = 30.0
+
+
+def _manifest_row(
+    level: MotionLevel, index: int, names: list[Path], played: list[PlayedClip], skin_errors: list | None
+) -> dict:
+    """A level's row of the manifest: its files, joints and largest error (and per clip, for several)."""
+    row = {"files": [name.as_posix() for name in names], "joints": level.report.joint_count,
+           "error": level.report.max_error}  # fmt: skip
+    if skin_errors is not None:  # what a runtime drawing the skin sees
+        row["skin_error"] = float(skin_errors[index].max())
+    if len(played) > 1:  # a runtime may pick each clip's level by its own error
+        row["clips"] = []
+        for clip in played:
+            span = clip.frames
+            row["clips"].append({"name": clip.name, "error": float(level.report.frame_errors[span].max())})
+            if skin_errors is not None:
+                row["clips"][-1]["skin_error"] = float(skin_errors[index][span].max())
+    return row
+
+
+def _earlier_level_files(folder: Path, stem: str, written: set[str]) -> list[str]:
+    """Level files of ``stem`` in ``folder`` that this run did not write (an earlier run's with
+    more levels or other clips), by name."""
+    pattern = re.compile(rf"{re.escape(stem)}_lod\d+(_.+)?\.(bvh|glb)")
+    return sorted(path.name for path in folder.iterdir() if pattern.fullmatch(path.name) and path.name not in written)
 
 
 class PlayedClip(NamedTuple):
@@ -289,6 +311,8 @@ def _read_input(
     if (clip_files or joint_map is not None) and kind != "gltf":
         option = "clips" if clip_files else "joint_map"
         raise ValueError(f"{option}: adds glTF clips to a glTF input, not to a {kind} input")
+    if clip is not None and kind != "gltf":
+        raise ValueError(f"clip: picks one of a glTF input's animations; a {kind} file holds one clip")
     if kind == "bvh":
         from ..io.bvh import read_bvh_with_layout
 

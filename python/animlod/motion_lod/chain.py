@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -270,9 +270,10 @@ def _trial_key(level: FrozenLevel) -> bytes:
 
 @dataclass
 class _Solved:
-    """A level re-fitted on a motion's frames: the problem, the solve, the level's output motion,
-    every original point placed by it (frozen parts by their key posture), the original, and
-    which points the errors count (FrozenLevel.measured)."""
+    """A level re-fitted on a motion's frames: the problem, the solve (each frame's positions with
+    its root at the origin), the level's output motion, every original point placed by it
+    (frozen parts by their key posture), the original, and which points the errors count
+    (FrozenLevel.measured)."""
 
     problem: RefitProblem
     result: RefitResult
@@ -302,11 +303,15 @@ def _solve_level(
     neighbours' are solved again from the neighbours' solutions (``motion``: consecutive
     frames)."""
     problem = build_problem(level, weights)
-    original = motion.world_positions()
+    # E (Eq. 5) is the same for a frame moved as a whole, and a clip 1e9 units from the origin
+    # had its held lengths rounded away (fallbacks, 20% errors): every frame is solved with its
+    # root at the origin, and the root's path is put back on the level's motion.
+    at_origin = replace(motion, root_positions=np.zeros_like(motion.root_positions))
+    original = at_origin.world_positions()
     if level.frozen.any():
-        fallback = frozen_motion(level, motion).world_positions()
+        fallback = frozen_motion(level, at_origin).world_positions()
         hard = slsqp_options.hard_constraints
-        cold_starts = _cold_starts(level, problem, motion, original, fallback) if hard else None
+        cold_starts = _cold_starts(level, problem, at_origin, original, fallback) if hard else None
         rest = np.arange(motion.frame_count)
         parts = []
         if known is not None:
@@ -331,9 +336,10 @@ def _solve_level(
         result = RefitResult(original, np.zeros(motion.frame_count), np.zeros(motion.frame_count, dtype=np.int64))
         if progress:
             progress(motion.frame_count)
-    output = recover_motion(level, result.positions, motion)
+    output = recover_motion(level, result.positions, at_origin)
+    output = replace(output, root_positions=output.root_positions + motion.root_positions)
     placed = expand_motion(level, output, motion).world_positions()
-    return _Solved(problem, result, output, placed, original, level.measured)
+    return _Solved(problem, result, output, placed, motion.world_positions(), level.measured)
 
 
 def build_level(
@@ -357,7 +363,7 @@ def build_level(
     level = freeze(motion, analysis, frozen_joints)
     known = trials.get(_trial_key(level)) if trials else None
     solved = _solve_level(level, motion, weights, solver, slsqp_options, workers, progress, known)
-    result = solved.result
+    result = replace(solved.result, positions=solved.result.positions + motion.root_positions[:, None, :])
     fk = solved.output.world_positions()
     error = solved.errors()
     bone_error, bone_variation = _bone_statistics(solved.problem, result.positions)

@@ -122,6 +122,16 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
      "empty.glb: file: empty file"),
     ("readers", "a BVH named .gltf", lambda t: ["info", str(_bvh(t / "walk.gltf", "0 -1 0"))],
      "walk.gltf: file: not a glTF file: neither GLB (magic 'glTF') nor a JSON object"),
+    ("readers", "a BVH whose every CHANNELS is 0", lambda t: ["info", str(_write(t / "pose.bvh", _bvh(
+        t / "x.bvh", "0 -1 0").read_bytes().replace(b"CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+        b"Yrotation", b"CHANNELS 0").replace(b"CHANNELS 3 Zrotation Xrotation Yrotation", b"CHANNELS 0")
+        .replace(b"0 0 0 0 0 0 0 0 0\n0 0 0 0 0 0 10 0 0\n", b"\n\n")))],
+     "pose.bvh: HIERARCHY: no joint has channels (every CHANNELS is 0): the file holds no motion"),
+    ("readers", "a BVH without its Frame Time line", lambda t: ["info", str(_write(t / "rows.bvh", _bvh(
+        t / "x.bvh", "0 -1 0").read_bytes().replace(b"Frame Time: 0.0333333\n", b"").replace(
+        b"0 0 0 0 0 0 0 0 0\n", b" ".join([b"1.5"] * 200) + b"\n")))],  # a row quoted whole was 799 characters
+     "rows.bvh: line 18: expected 'Frame Time: SECONDS' > 0 with a finite frame rate, found '" + "1.5 " * 15
+     + "'... (799 characters)"),
     ("readers", "gltf nesting 100,000 deep", lambda t: ["info", str(_write(t / "deep.gltf",
         b'{"asset": {"version": "2.0"}, "extras": ' + b"[" * 100_000 + b"]" * 100_000 + b"}"))],
      "deep.gltf: JSON: nests deeper than 100 levels"),

@@ -346,18 +346,23 @@ def _parse_motion_header(path: Path, text: str, motion_line: int) -> tuple[int, 
     (frames_line, frames_text), (time_line, time_text) = header
     frames_match = _FRAMES_LINE.fullmatch(frames_text)
     if frames_match is None:
-        raise FormatError(path, f"line {frames_line}", f"expected 'Frames: N', found {frames_text.strip()!r}")
+        raise FormatError(path, f"line {frames_line}", f"expected 'Frames: N', found {_quoted(frames_text)}")
     time_match = _FRAME_TIME_LINE.fullmatch(time_text)
     frame_time = float(time_match.group(1)) if time_match and parses(time_match.group(1), np.float64) else None
     # The rate 1 / Frame Time must be finite too: Frame Time: 1e-320 is positive but its inverse is not.
     if frame_time is None or not (frame_time > 0.0 and np.isfinite(frame_time) and np.isfinite(1.0 / frame_time)):
-        found = time_text.strip()
-        reason = f"expected 'Frame Time: SECONDS' > 0 with a finite frame rate, found {found!r}"
+        reason = f"expected 'Frame Time: SECONDS' > 0 with a finite frame rate, found {_quoted(time_text)}"
         raise FormatError(path, f"line {time_line}", reason)
     frame_count = int(frames_match.group(1))
     if frame_count < 1:
         raise FormatError(path, f"line {frames_line}", "Frames: must be at least 1")
     return frame_count, _frame_rate(time_match.group(1)), line + 1, text[position:] if position > 0 else ""
+
+
+def _quoted(line: str) -> str:
+    """A line quoted in a message, cut after 60 characters (a frame's row can hold thousands)."""
+    line = line.strip()
+    return repr(line) if len(line) <= 60 else f"{line[:60]!r}... ({len(line)} characters)"
 
 
 def _frame_rate(frame_time: str) -> float:
@@ -376,6 +381,8 @@ def _parse_motion_table(
     path: Path, text: str, first_line: int, frame_count: int, channel_count: int, joints: list[_JointSpec]
 ) -> np.ndarray:
     """Channel values ``(T, C)`` of the MOTION rows, checked row by row against the hierarchy."""
+    if channel_count == 0:  # every row empty: read as no row, "truncated" misled
+        raise FormatError(path, "HIERARCHY", "no joint has channels (every CHANNELS is 0): the file holds no motion")
     counts = tokens_per_line(text.encode("utf-8"))
     rows = np.nonzero(counts)[0]  # blank lines are skipped
     wrong = rows[counts[rows] != channel_count]

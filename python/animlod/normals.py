@@ -4,6 +4,8 @@ on its simplified levels."""
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 
@@ -19,36 +21,55 @@ def vertex_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return (normals / np.where(length > 0.0, length, 1.0)).astype(np.float32)
 
 
-# A mesh is flat shaded when this share of its faces has equal corner normals along the face's
-# own normal (cosine above _FLAT_COSINE).
-_FLAT_SHARE, _FLAT_COSINE = 0.99, 0.999
+# Normals within this angle (about 1.8 degrees) of their position's mean are one normal: exporters
+# write a corner's normal with rounding noise, and 1e-4 apart split a smooth sphere into hard edges.
+_SAME_NORMAL_COSINE = 0.9995
+# A mesh is flat shaded when this share of its faces have one normal at their three corners (a
+# quad's own, 3 degrees off its triangles when bent) and this share of its positions carry more
+# than one normal: a dense smooth mesh also has nearly one normal per face, but splits only
+# along its hard edges.
+_FLAT_SHARE = 0.9
 # Rebuilt normals smooth across edges whose faces turn by less than this (radians).
 CREASE_ANGLE = np.radians(60.0)
 
 
+class Shading(NamedTuple):
+    """How a mesh's own normals shade it: ``crease`` the angle of :func:`corner_normals` that
+    rebuilds them (0 flat, :data:`CREASE_ANGLE` hard edges, pi smooth), and ``inward`` where they
+    point against the faces' winding (clockwise faces with outward normals)."""
+
+    crease: float
+    inward: bool
+
+
+def shading_of(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> Shading:
+    """The :class:`Shading` of a mesh with ``normals (V, 3)`` (any length) at its vertices."""
+    crease = shading_crease(positions, normals, faces)
+    corners = np.asarray(positions, dtype=np.float64)[faces]
+    area_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    agreement = np.einsum("fkc,fc->f", unit_vectors(normals)[faces].astype(np.float64), area_normal)
+    return Shading(np.pi if crease is None else crease, bool(np.count_nonzero(agreement < 0.0) > agreement.size / 2))
+
+
 def shading_crease(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> float | None:
     """How a mesh's own ``normals (V, 3)`` shade it, as the crease angle of :func:`corner_normals`
-    that rebuilds them: None where no two vertices at one position differ in normal (smooth), 0
-    for flat shading, :data:`CREASE_ANGLE` for hard edges among smooth faces."""
+    that rebuilds them: None where the vertices at each position agree in normal (smooth), 0 for
+    flat shading, :data:`CREASE_ANGLE` for hard edges among smooth faces."""
     _, point = np.unique(positions, axis=0, return_inverse=True)
-    keyed = np.unique(np.concatenate([point.reshape(-1, 1), normals], axis=1), axis=0)
-    if len(keyed) == point.max(initial=-1) + 1:
+    point = point.ravel()
+    unit = unit_vectors(normals).astype(np.float64)
+    mean = np.zeros((point.max(initial=-1) + 1, 3))
+    np.add.at(mean, point, unit)
+    differs = np.einsum("vc,vc->v", unit, unit_vectors(mean)[point]) < _SAME_NORMAL_COSINE
+    split = np.zeros(mean.shape[0], dtype=bool)
+    split[point[differs]] = True
+    if not split.any():
         return None
-    return 0.0 if is_flat_shaded(normals, positions, faces) else float(CREASE_ANGLE)
-
-
-def is_flat_shaded(normals: np.ndarray | None, positions: np.ndarray, faces: np.ndarray) -> bool:
-    """Whether (nearly) every face's three corners carry the face's own normal."""
-    if normals is None or len(faces) == 0:
-        return False
-    corners = positions[faces].astype(np.float64)
-    face_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    length = np.linalg.norm(face_normal, axis=1)
-    usable = length > 0.0
-    face_normal = face_normal[usable] / length[usable, None]
-    corner_normals = normals[faces[usable]].astype(np.float64)
-    agree = np.all(np.einsum("fkc,fc->fk", corner_normals, face_normal) > _FLAT_COSINE, axis=1)
-    return bool(agree.mean() >= _FLAT_SHARE) if agree.size else False
+    used = np.bincount(point[np.unique(faces)], minlength=mean.shape[0]) > 0
+    corner = unit[faces]
+    one_normal = np.all(np.einsum("fkc,fc->fk", corner[:, 1:], corner[:, 0]) >= _SAME_NORMAL_COSINE, axis=1)
+    flat = split[used].mean() >= _FLAT_SHARE and one_normal.mean() >= _FLAT_SHARE
+    return 0.0 if flat else float(CREASE_ANGLE)
 
 
 def corner_normals(positions: np.ndarray, faces: np.ndarray, crease: float) -> np.ndarray:

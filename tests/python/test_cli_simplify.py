@@ -113,41 +113,68 @@ def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path, capsys
         assert off.max() < 0.05, (frames[0], off.max())
 
 
-@pytest.mark.parametrize("shading", ["smooth", "flat"])
-def test_an_obj_sequences_normals_are_rebuilt_on_every_level_as_shaded(tmp_path, capsys, shading):
-    # Levels were written without the input's vn lines; now each level frame gets normals from its
-    # own faces, one per position where the input is smooth, each face's own where it is flat.
+def _unit_rows(vectors: np.ndarray) -> np.ndarray:
+    return vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+
+
+def _face_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    corners = positions[faces].astype(np.float64)
+    return _unit_rows(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
+
+
+def _shaded_normals(shading: str, frame: np.ndarray, faces: np.ndarray, rng: np.random.Generator):
+    """The normals an exporter writes for ``shading``: smooth (one per position), noisy (one per
+    corner, 1e-4 apart), flat (each face's own, at half length), quads (each quad's own, its two
+    triangles 3 degrees apart: the tube's quads are bent)."""
     from animlod.io.obj import ObjNormals
     from animlod.normals import vertex_normals
 
+    count = len(faces)
+    if shading == "smooth":
+        return ObjNormals(vertex_normals(frame, faces), faces)
+    if shading == "noisy":
+        per_corner = vertex_normals(frame, faces)[faces].reshape(-1, 3) + rng.normal(0.0, 1e-4, (3 * count, 3))
+        return ObjNormals(per_corner.astype(np.float32), np.arange(3 * count).reshape(-1, 3))
+    own = _face_normals(frame, faces)
+    if shading == "quads":  # tube(): triangle q and q + count / 2 make quad q
+        own = np.tile(_unit_rows(own[: count // 2] + own[count // 2 :]), (2, 1))
+    return ObjNormals(0.5 * own, np.repeat(np.arange(count), 3).reshape(-1, 3))
+
+
+@pytest.mark.parametrize(
+    "shading, said",
+    [("smooth", "smooth"), ("noisy", "smooth"), ("flat", "flat"), ("quads", "flat"),
+     ("clockwise", "flat, pointing against the faces' winding")],
+)  # fmt: skip
+def test_an_obj_sequences_normals_are_rebuilt_on_every_level_as_shaded(tmp_path, capsys, shading, said):
+    # Levels were written without the input's vn lines; now each level frame gets normals from its
+    # own faces: one per position where the input is smooth (exporters' rounding aside), each
+    # face's own where it is flat (a bent quad's normal, shorter than 1, included), pointing where
+    # the input's point.
+    from animlod.normals import vertex_normals
+
     tube = bending_tube(frames=3)
+    faces = tube.faces[:, ::-1] if shading == "clockwise" else tube.faces
+    rng = np.random.default_rng(5)
     (tmp_path / "shot").mkdir()
     for index, frame in enumerate(tube.frames):
-        if shading == "smooth":
-            normals = ObjNormals(vertex_normals(frame, tube.faces), tube.faces)
-        else:
-            corners = frame[tube.faces]
-            face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-            face_normals /= np.linalg.norm(face_normals, axis=1, keepdims=True)
-            normals = ObjNormals(face_normals, np.repeat(np.arange(tube.face_count), 3).reshape(-1, 3))
-        write_obj(tmp_path / "shot" / f"shot_{index}.obj", frame, tube.faces, normals=normals)
+        normals = _shaded_normals("flat" if shading == "clockwise" else shading, frame, tube.faces, rng)
+        write_obj(tmp_path / "shot" / f"shot_{index}.obj", frame, faces, normals=normals)
     assert main(["info", str(tmp_path / "shot")]) == 0
-    assert f"normals (vn): {shading}, rebuilt on each level" in capsys.readouterr().out
+    assert f"normals (vn): {said}, rebuilt on each level" in capsys.readouterr().out
     assert main(["simplify", str(tmp_path / "shot"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
     assert "not read" not in capsys.readouterr().err
+    outward = -1.0 if shading == "clockwise" else 1.0  # along the winding's normal, or against it
     for level in (1, 2, 3):
         for path in sorted((tmp_path / "out" / f"shot_lod{level}").iterdir()):
-            positions, faces, _, written = read_obj_textured(path)
+            positions, level_faces, _, written = read_obj_textured(path)
             assert written is not None
-            corner_normals = written.normals[written.corners]
-            if shading == "smooth":
-                np.testing.assert_array_equal(written.corners, faces)  # one normal per position
-                np.testing.assert_allclose(written.normals, vertex_normals(positions, faces), atol=1e-6)
+            if said == "smooth":
+                np.testing.assert_array_equal(written.corners, level_faces)  # one normal per position
+                np.testing.assert_allclose(written.normals, vertex_normals(positions, level_faces), atol=1e-6)
             else:
-                corners = positions[faces].astype(np.float64)
-                own = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-                own /= np.linalg.norm(own, axis=1, keepdims=True)
-                assert np.einsum("fkc,fc->fk", corner_normals, own).min() > 0.9999
+                along = np.einsum("fkc,fc->fk", written.normals[written.corners], _face_normals(positions, level_faces))
+                assert (outward * along).min() > 0.9999
 
 
 def test_one_mesh_file_gives_one_file_per_level_and_dotted_names_keep_their_levels_apart(tmp_path):

@@ -159,8 +159,8 @@ def test_a_textured_sequence_has_a_vertex_per_position_and_texture_coordinate(tm
     (tmp_path / "seam").mkdir()
     for index in range(3):
         obj.write_obj(tmp_path / "seam" / f"f{index}.obj", positions + index, faces, texture)
-    mesh, split, normals_crease = meshseq.read_textured_sequence(tmp_path / "seam")
-    assert mesh.vertex_count == 6 and normals_crease is None and mesh.frame_count == 3
+    mesh, split, shading = meshseq.read_textured_sequence(tmp_path / "seam")
+    assert mesh.vertex_count == 6 and shading is None and mesh.frame_count == 3
     np.testing.assert_array_equal(mesh.frames[2], positions[split.points] + 2)
     np.testing.assert_array_equal(split.uvs[mesh.faces], texture.uvs[texture.corners])
     # Written back: one v per position, the seam's two texture coordinates apart.

@@ -116,15 +116,16 @@ def _describe(kind: str, path: str) -> list[str]:
     if kind == "sequence":
         from ..io.meshseq import read_textured_sequence, sequence_paths
 
-        mesh, texture, normals_crease = read_textured_sequence(path)
+        mesh, texture, shading = read_textured_sequence(path)
         lines = _animated_lines(mesh)
         if texture is not None:  # the mesh has a vertex per position and texture coordinate
             positions = np.unique(texture.points).size
             lines[0] = (f"vertices: {positions}, {mesh.vertex_count} with their texture coordinates (vt), "
                         f"triangles: {mesh.face_count}")  # fmt: skip
-        if normals_crease is not None:
-            shading = {0.0: "flat", np.pi: "smooth"}.get(normals_crease, "smooth with hard edges")
-            lines[0] += f"; normals (vn): {shading}, rebuilt on each level"
+        if shading is not None:
+            kind = {0.0: "flat", np.pi: "smooth"}.get(shading.crease, "smooth with hard edges")
+            inward = ", pointing against the faces' winding" if shading.inward else ""
+            lines[0] += f"; normals (vn): {kind}{inward}, rebuilt on each level"
         names = [frame.name for frame in sequence_paths(path)]
         if len(names) > 1:  # the order the frames are read in: a stray file shows at an end
             lines[-1] += f", {names[0]} .. {names[-1]}"

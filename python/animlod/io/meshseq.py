@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import AnimatedMesh
-from ..normals import corner_normals, shading_crease, vertex_normals
+from ..normals import Shading, corner_normals, shading_of, vertex_normals
 from .atomic import atomic_folder
 from .errors import FormatError
 from .obj import ObjNormals, ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
@@ -69,22 +69,22 @@ class SequenceTexture:
 
 def read_textured_sequence(
     source: str | os.PathLike | Sequence[str | os.PathLike], fps: float | None = None
-) -> tuple[AnimatedMesh, SequenceTexture | None, float | None]:
+) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None]:
     """:func:`read_sequence` with an OBJ sequence's texture coordinates: the mesh then has a
     vertex per (position, texture coordinate) pair of the corners (:class:`SequenceTexture`).
     None, and the files' positions as the vertices, where the frames have none (PLY frames, OBJ
     frames without ``vt``), or where one frame's differ from the first's (with an
     :class:`~animlod.io.obj.UnreadAttributesWarning`). Third, where the first frame has normals
-    (``vn``), the crease angle that rebuilds them from the faces: 0 for flat shading,
-    :data:`~animlod.normals.CREASE_ANGLE` for hard edges, pi for smooth shading; else None."""
+    (``vn``), how they shade it (:class:`~animlod.normals.Shading`: flat, hard edges or smooth,
+    and whether they point against the winding); else None."""
     return _read_frames(sequence_paths(source), fps, textured=True)
 
 
 def _read_frames(
     paths: list[Path], fps: float | None, textured: bool
-) -> tuple[AnimatedMesh, SequenceTexture | None, float | None]:
+) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None]:
     """The frames of ``paths`` (:func:`read_sequence`), and with ``textured`` their texture
-    coordinates and normals' crease angle (:func:`read_textured_sequence`)."""
+    coordinates and normals' shading (:func:`read_textured_sequence`)."""
     read = read_mesh_textured if textured else _geometry_of
     first_vertices, faces, texture, normals = read(paths[0])
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
@@ -107,33 +107,34 @@ def _read_frames(
         warnings.warn(f"{differing}: its texture coordinates (vt) are not the first frame's ({paths[0].name} "
                       f"{first}): the levels are written without them", UnreadAttributesWarning,
                       stacklevel=3)  # fmt: skip
-    crease = None if normals is None else _shading_of(first_vertices, faces, normals)
+    shading = None if normals is None else _shading_of(first_vertices, faces, normals)
     if texture is None:
-        return AnimatedMesh(faces, frames, fps=fps), None, crease
+        return AnimatedMesh(faces, frames, fps=fps), None, shading
     # A vertex per (position, texture coordinate) pair that a corner uses.
     pairs = np.stack([faces.ravel(), texture.corners.ravel()], axis=1)
     wedges, corner_wedge = np.unique(pairs, axis=0, return_inverse=True)
     split = AnimatedMesh(corner_wedge.reshape(faces.shape).astype(np.int32), frames[:, wedges[:, 0]], fps=fps)
-    return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32)), crease
+    return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32)), shading
 
 
-def _shading_of(vertices: np.ndarray, faces: np.ndarray, normals: ObjNormals) -> float:
-    """The crease angle of :func:`~animlod.normals.corner_normals` that rebuilds a frame's
-    normals from its faces (pi where they are smooth)."""
+def _shading_of(vertices: np.ndarray, faces: np.ndarray, normals: ObjNormals) -> Shading:
+    """How a frame's normals shade it (:func:`~animlod.normals.shading_of` over its (position,
+    normal) pairs)."""
     pairs = np.stack([faces.ravel(), normals.corners.ravel()], axis=1)
     split, corner = np.unique(pairs, axis=0, return_inverse=True)
-    crease = shading_crease(vertices[split[:, 0]], normals.normals[split[:, 1]], corner.reshape(faces.shape))
-    return np.pi if crease is None else crease
+    return shading_of(vertices[split[:, 0]], normals.normals[split[:, 1]], corner.reshape(faces.shape))
 
 
-def rebuilt_normals(positions: np.ndarray, faces: np.ndarray, crease: float) -> ObjNormals:
-    """The normals of one frame ``positions (P, 3)`` from its own ``faces`` at ``crease``
-    (:func:`read_textured_sequence`): one per position where smooth, else one per distinct corner
-    normal."""
-    if crease >= np.pi:
-        return ObjNormals(vertex_normals(positions, faces), faces)
-    values, index = np.unique(corner_normals(positions, faces, crease), axis=0, return_inverse=True)
-    return ObjNormals(values, index.reshape(faces.shape).astype(np.int32))
+def rebuilt_normals(positions: np.ndarray, faces: np.ndarray, shading: Shading) -> ObjNormals:
+    """The normals of one frame ``positions (P, 3)`` from its own ``faces``, shaded as ``shading``
+    says (:func:`read_textured_sequence`): one per position where smooth, else one per distinct
+    corner normal; against the winding where the input's were."""
+    if shading.crease >= np.pi:
+        normals = ObjNormals(vertex_normals(positions, faces), faces)
+    else:
+        values, index = np.unique(corner_normals(positions, faces, shading.crease), axis=0, return_inverse=True)
+        normals = ObjNormals(values, index.reshape(faces.shape).astype(np.int32))
+    return normals._replace(normals=-normals.normals) if shading.inward else normals
 
 
 def _same_texture(first: ObjTexture | None, other: ObjTexture | None) -> bool:
@@ -150,14 +151,13 @@ def write_sequence(
     stem: str = "frame",
     names: Sequence[str] | None = None,
     texture: SequenceTexture | None = None,
-    normals_crease: float | None = None,
+    shading: Shading | None = None,
 ) -> list[Path]:
     """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
     ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically; with ``texture``
     (OBJ only) its texture coordinates, the vertices of one point that stand at one place in
-    every frame (a UV seam's copies) written as one ``v`` line; with ``normals_crease`` (OBJ
-    only) each frame's normals rebuilt from its faces at that crease angle
-    (:func:`rebuilt_normals`).
+    every frame (a UV seam's copies) written as one ``v`` line; with ``shading`` (OBJ only) each
+    frame's normals rebuilt from its faces, shaded so (:func:`rebuilt_normals`).
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
     ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
@@ -172,8 +172,8 @@ def write_sequence(
     if texture is not None and (fmt != "obj" or len(texture.uvs) != mesh.vertex_count):
         raise ValueError(f"{os.fspath(folder)}: texture: {len(texture.uvs)} texture coordinates for "
                          f"{mesh.vertex_count} vertices, written as {fmt} (OBJ only)")  # fmt: skip
-    if normals_crease is not None and fmt != "obj":
-        raise ValueError(f"{os.fspath(folder)}: normals_crease: normals are written to OBJ files only, not {fmt}")
+    if shading is not None and fmt != "obj":
+        raise ValueError(f"{os.fspath(folder)}: shading: normals are written to OBJ files only, not {fmt}")
     if names is None:
         width = max(4, len(str(mesh.frame_count - 1)))
         names = [f"{stem}_{index:0{width}d}" for index in range(mesh.frame_count)]
@@ -185,7 +185,7 @@ def write_sequence(
     with atomic_folder(folder) as temporary:
         for name, vertices in zip(names, mesh.frames):
             positions = vertices[written]
-            normals = None if normals_crease is None else rebuilt_normals(positions, faces, normals_crease)
+            normals = None if shading is None else rebuilt_normals(positions, faces, shading)
             write_mesh(temporary / name, positions, faces, obj_texture, normals)
     return [Path(folder) / name for name in names]
 

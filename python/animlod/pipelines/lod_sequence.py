@@ -27,6 +27,7 @@ from ..io.errors import FormatError
 from ..io.meshseq import SequenceTexture
 from ..metrics import SurfaceError, surface_error
 from ..model import AnimatedMesh, whole_number
+from ..normals import Shading
 
 # Frames of a longer sequence measured by default, evenly spaced: every frame of a 300-frame,
 # 20k-triangle sequence took 61 s to measure against 2.3 s to simplify.
@@ -83,7 +84,7 @@ def simplify_sequence(
         measured_frames = whole_number("measured_frames", measured_frames, 1)
     kind = input_kind(source)
     texture = None  # an OBJ sequence's texture coordinates, carried as AQEM attributes
-    normals_crease = None  # how an OBJ sequence's normals shade it, for the levels' rebuilt normals
+    shading = None  # how an OBJ sequence's normals shade it, for the levels' rebuilt normals
     if kind == "npz":
         from ..io.npz import read_npz
 
@@ -91,7 +92,7 @@ def simplify_sequence(
     elif kind == "sequence":
         from ..io.meshseq import read_textured_sequence
 
-        original, texture, normals_crease = read_textured_sequence(source)
+        original, texture, shading = read_textured_sequence(source)
     else:
         raise FormatError(os.fspath(source), "file", f"a {kind} file is not a mesh sequence")
     started = time.perf_counter()
@@ -111,7 +112,7 @@ def simplify_sequence(
         level_texture = (
             None if texture is None else SequenceTexture(level.attributes, texture.points[level.kept_vertices])
         )
-        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture, normals_crease)
+        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture, shading)
         measured = _surface_error(*(_frames_of(mesh, frames) for mesh in (original, level.mesh))) if measure else None
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
@@ -188,7 +189,7 @@ def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
 
 
 def _write_level(
-    fmt: _LevelFormat, target: Path, mesh: AnimatedMesh, texture: SequenceTexture | None, normals_crease: float | None
+    fmt: _LevelFormat, target: Path, mesh: AnimatedMesh, texture: SequenceTexture | None, shading: Shading | None
 ) -> Path:
     """Write a level as ``fmt`` says, with its texture coordinates and rebuilt normals if any; its
     path. A file's suffix is appended, not swapped:
@@ -198,7 +199,7 @@ def _write_level(
         from ..io.meshseq import write_sequence
 
         target.mkdir(parents=True, exist_ok=True)
-        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture, normals_crease=normals_crease)
+        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture, shading=shading)
         return target
     path = target.with_name(f"{target.name}.{fmt.suffix}")
     if fmt.suffix == "npz":
@@ -210,6 +211,6 @@ def _write_level(
 
         written, faces, obj_texture = obj_layout(mesh, texture)
         positions = mesh.frames[0][written]
-        normals = None if normals_crease is None else rebuilt_normals(positions, faces, normals_crease)
+        normals = None if shading is None else rebuilt_normals(positions, faces, shading)
         write_mesh(path, positions, faces, obj_texture, normals)
     return path

@@ -464,6 +464,15 @@ def test_channel_count_larger_than_names(tmp_path: Path) -> None:
     assert "joint 'A'" in message
 
 
+def test_a_joint_name_keeps_the_spaces_written_inside_it(tmp_path: Path) -> None:
+    # "Left  Shoulder" was read, and written back, as "Left Shoulder".
+    text = SMALL_BVH.replace("JOINT A", "JOINT Left  Shoulder").replace("\tJOINT B", "\tJOINT  B\t x  ")
+    motion = read_bvh(_write(tmp_path, text))
+    assert motion.skeleton.names[1:4:2] == ["Left  Shoulder", "B\t x"]
+    write_bvh(tmp_path / "again.bvh", motion)
+    assert read_bvh(tmp_path / "again.bvh").skeleton.names == motion.skeleton.names
+
+
 def test_duplicate_joint_name(tmp_path: Path) -> None:
     assert "joint name 'A' is used twice" in _read_error(tmp_path, SMALL_BVH.replace("JOINT B", "JOINT A"))
 

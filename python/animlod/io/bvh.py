@@ -95,7 +95,10 @@ class _TokenCursor:
 
     def __init__(self, path: Path, lines: list[str]) -> None:
         self.path = path
-        self.tokens = [(token, number) for number, line in enumerate(lines, start=1) for token in line.split()]
+        self.lines = lines
+        found = [(match, number) for number, line in enumerate(lines, start=1) for match in re.finditer(r"\S+", line)]
+        self.tokens = [(match.group(), number) for match, number in found]
+        self.spans = [match.span() for match, _ in found]  # where each token stands on its line
         self.position = 0
         self.last_line = len(lines)
 
@@ -131,11 +134,14 @@ class _TokenCursor:
         return value
 
     def rest_of_line(self, line: int) -> str:
-        """Join the tokens left on ``line`` up to an opening brace (joint names may hold spaces)."""
-        words = []
+        """The text of the tokens left on ``line`` up to an opening brace, as written between them
+        (joint names may hold spaces: "Left  Shoulder" stays as it is)."""
+        first = self.position
         while (token := self.peek()) is not None and token[1] == line and token[0] != "{":
-            words.append(self.next("name")[0])
-        return " ".join(words)
+            self.next("name")
+        if self.position == first:
+            return ""
+        return self.lines[line - 1][self.spans[first][0] : self.spans[self.position - 1][1]]
 
 
 def read_bvh(path: str | os.PathLike) -> Motion:

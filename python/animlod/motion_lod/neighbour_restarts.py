@@ -3,8 +3,9 @@ again from the neighbours' solutions.
 
 Every frame starts cold (a warm start carries one frame's minimum into the next, and that
 raised E on the dev clips), and at coarse levels E has several minima: now and then one frame
-lands in another than the frames around it, and a kept joint jumps for that frame alone (7% of
-a 61-joint figure's height at its 5-joint level, back to 0.3% on the next frame). A frame whose
+lands in another than the frames around it, and a kept joint jumps for that frame alone (an
+elbow of a 61-joint figure at its 5-joint level: 3.3%, 6.8%, 2.9% of its height off in three
+frames in a row, with E 40% above its neighbours'). A frame whose
 E stands above both neighbours' is solved again from each neighbour's solution (feasible for
 it: bone lengths and frozen angles do not change between frames), and the solve with the
 lowest E is kept; E only goes down. A frame next to one that changed is looked at again where

@@ -120,6 +120,20 @@ def test_obj_normals_are_read_per_corner_and_written_back(tmp_path: Path) -> Non
         obj.read_obj_textured(tmp_path / "bad.obj")
 
 
+def test_flat_normals_of_coplanar_faces_are_written_once() -> None:
+    # Coplanar faces' area-weighted sums differ in their last bits: a flat box's 6 normals were
+    # written as up to 37 vn lines.
+    from animlod.normals import Shading
+
+    rng = np.random.default_rng(3)
+    ring = 2 * np.pi * (np.arange(12) + rng.uniform(0.0, 0.5, 12)) / 12
+    xy = np.c_[rng.uniform(0.5, 2.0, 12) * np.cos(ring), rng.uniform(0.5, 2.0, 12) * np.sin(ring)]
+    plane = np.c_[np.r_[[[0.0, 0.0]], xy], np.r_[0.0, 0.3 * xy[:, 0] + 0.7 * xy[:, 1]]].astype(np.float32)
+    fan = np.stack([np.zeros(12, int), 1 + np.arange(12), 1 + (np.arange(12) + 1) % 12], axis=1).astype(np.int32)
+    normals = meshseq.rebuilt_normals(plane, fan, Shading(0.0, False))
+    assert len(normals.normals) == 1 and np.linalg.norm(normals.normals[0]) == pytest.approx(1.0, abs=1e-6)
+
+
 @pytest.mark.parametrize(
     "faces, problem",
     [

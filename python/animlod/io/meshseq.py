@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import AnimatedMesh
-from ..normals import Shading, corner_normals, shading_of, vertex_normals
+from ..normals import Shading, corner_normals, shading_of, unit_vectors, vertex_normals
 from .atomic import atomic_folder
 from .errors import FormatError
 from .obj import ObjNormals, ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
@@ -132,8 +132,11 @@ def rebuilt_normals(positions: np.ndarray, faces: np.ndarray, shading: Shading) 
     if shading.crease >= np.pi:
         normals = ObjNormals(vertex_normals(positions, faces), faces)
     else:
-        values, index = np.unique(corner_normals(positions, faces, shading.crease), axis=0, return_inverse=True)
-        normals = ObjNormals(values, index.reshape(faces.shape).astype(np.int32))
+        # Rounded before they are told apart: coplanar faces' sums differ in their last bits, which
+        # wrote a flat box's 6 normals as up to 37 vn lines.
+        rounded = np.round(corner_normals(positions, faces, shading.crease), 6)
+        values, index = np.unique(rounded, axis=0, return_inverse=True)
+        normals = ObjNormals(unit_vectors(values), index.reshape(faces.shape).astype(np.int32))
     return normals._replace(normals=-normals.normals) if shading.inward else normals
 
 

@@ -177,6 +177,19 @@ def test_an_obj_sequences_normals_are_rebuilt_on_every_level_as_shaded(tmp_path,
                 assert (outward * along).min() > 0.9999
 
 
+def test_normals_of_obj_frames_among_ply_ones_are_named_not_written(tmp_path, capsys):
+    # A PLY frame makes the levels PLY, which carry no normals: the OBJ frame's vn stopped the run
+    # after the simplification.
+    tube = bending_tube(frames=2)
+    (tmp_path / "mixed").mkdir()
+    normals = _shaded_normals("smooth", tube.frames[0], tube.faces, np.random.default_rng(0))
+    write_obj(tmp_path / "mixed" / "f_0.obj", tube.frames[0], tube.faces, normals=normals)
+    write_mesh(tmp_path / "mixed" / "f_1.ply", tube.frames[1], tube.faces)
+    assert main(["simplify", str(tmp_path / "mixed"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    assert "its normals (vn) are not written: the levels are PLY files" in capsys.readouterr().err
+    assert sorted(path.name for path in (tmp_path / "out" / "mixed_lod1").iterdir()) == ["f_0.ply", "f_1.ply"]
+
+
 def test_one_mesh_file_gives_one_file_per_level_and_dotted_names_keep_their_levels_apart(tmp_path):
     """A single OBJ/PLY gave a folder per level holding frame_0000; NPZ levels of walk.v2.npz were
     all written to walk.npz (the suffix swapped instead of appended), each over the last."""

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,7 +24,7 @@ import numpy as np
 
 from ..aqem import Preparation, simplify_animated
 from ..io.detect import input_kind, input_stem
-from ..io.errors import FormatError
+from ..io.errors import FormatError, UnreadAttributesWarning
 from ..io.meshseq import SequenceTexture
 from ..metrics import SurfaceError, surface_error
 from ..model import AnimatedMesh, whole_number
@@ -104,6 +105,10 @@ def simplify_sequence(
     result = simplify_animated(original, ratios, progress=progress, attributes=uvs, **aqem_options)
     seconds = time.perf_counter() - started
     folder, stem, fmt = Path(output), input_stem(source), _level_format(kind, source)
+    if shading is not None and fmt.suffix != "obj":  # a PLY frame among OBJ ones makes PLY levels
+        warnings.warn(f"{os.fspath(source)}: its normals (vn) are not written: the levels are PLY files, as some of "
+                      "its frames are", UnreadAttributesWarning, stacklevel=2)  # fmt: skip
+        shading = None
     frames = _measured_frames(original.frame_count, measured_frames) if measure else np.arange(0)
     levels = []
     for index, level in enumerate(result.levels, start=1):

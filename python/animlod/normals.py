@@ -12,13 +12,15 @@ import numpy as np
 def vertex_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Area-weighted unit vertex normals ``(V, 3) float32`` of a counter-clockwise mesh (zero for
     a vertex no face uses)."""
-    positions = np.asarray(positions, dtype=np.float64)
-    corners = positions[faces]
-    face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])  # length = 2 * area
-    normals = np.zeros_like(positions)
-    np.add.at(normals, faces.ravel(), np.repeat(face_normals, 3, axis=0))
-    length = np.linalg.norm(normals, axis=1, keepdims=True)
-    return (normals / np.where(length > 0.0, length, 1.0)).astype(np.float32)
+    normals = np.zeros((len(positions), 3))
+    np.add.at(normals, faces.ravel(), np.repeat(area_normals(positions, faces), 3, axis=0))
+    return unit_vectors(normals)
+
+
+def area_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """``(M, 3) float64`` each face's normal by its winding, twice its area long."""
+    corners = np.asarray(positions, dtype=np.float64)[faces]
+    return np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
 
 
 # Normals within this angle (about 1.8 degrees) of their position's mean are one normal: exporters
@@ -45,9 +47,7 @@ class Shading(NamedTuple):
 def shading_of(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> Shading:
     """The :class:`Shading` of a mesh with ``normals (V, 3)`` (any length) at its vertices."""
     crease = shading_crease(positions, normals, faces)
-    corners = np.asarray(positions, dtype=np.float64)[faces]
-    area_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    agreement = np.einsum("fkc,fc->f", unit_vectors(normals)[faces].astype(np.float64), area_normal)
+    agreement = np.einsum("fkc,fc->f", unit_vectors(normals)[faces].astype(np.float64), area_normals(positions, faces))
     return Shading(np.pi if crease is None else crease, bool(np.count_nonzero(agreement < 0.0) > agreement.size / 2))
 
 
@@ -65,7 +65,8 @@ def shading_crease(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray
     split[point[differs]] = True
     if not split.any():
         return None
-    used = np.bincount(point[np.unique(faces)], minlength=mean.shape[0]) > 0
+    used = np.zeros(mean.shape[0], dtype=bool)  # positions some face uses
+    used[point[faces.ravel()]] = True
     corner = unit[faces]
     one_normal = np.all(np.einsum("fkc,fc->fk", corner[:, 1:], corner[:, 0]) >= _SAME_NORMAL_COSINE, axis=1)
     flat = split[used].mean() >= _FLAT_SHARE and one_normal.mean() >= _FLAT_SHARE
@@ -76,9 +77,7 @@ def corner_normals(positions: np.ndarray, faces: np.ndarray, crease: float) -> n
     """``(3M, 3) float32`` unit normal of each corner of ``faces (M, 3)`` (in ``faces.ravel()``
     order): the area-weighted normal of the faces around its vertex that turn from its own face
     by at most ``crease`` radians (0: flat shading; pi: smooth)."""
-    positions = np.asarray(positions, dtype=np.float64)
-    corners = positions[faces]
-    area_normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    area_normal = area_normals(positions, faces)
     length = np.linalg.norm(area_normal, axis=1, keepdims=True)
     unit = area_normal / np.where(length > 0.0, length, 1.0)
     corner_vertex, corner_face = faces.ravel(), np.repeat(np.arange(len(faces)), 3)

@@ -3,8 +3,8 @@ corners, polygons fan-triangulated, ``#`` comments also at a line's end, a state
 on the next line after a ``\\`` that ends its line; with :func:`read_obj_textured` also ``vt``
 and ``vn`` lines and the corners' indices into them; other statements such as ``g``,
 ``usemtl`` are ignored, with a warning for unread ``vt`` and ``vn``; statements may be
-indented) and written, with texture coordinates and normals where given. Parsing works on the whole file's bytes with
-numpy: there is no Python loop over lines, vertices or faces."""
+indented) and written, with texture coordinates and normals where given. Parsing works on the
+whole file's bytes with numpy: there is no Python loop over lines, vertices or faces."""
 
 from __future__ import annotations
 
@@ -164,8 +164,8 @@ class _FaceCorners:
     name_face: Callable[[int], str]
 
     def resolved(self, block: bytes, item_lines: np.ndarray, count: int, indexed: tuple[str, str]) -> np.ndarray:
-        """Every corner's 0-based index into the ``count`` items defined on ``item_lines`` (v or
-        vt lines), from ``block`` (the ``f`` lines, one number per corner): negative indices count
+        """Every corner's 0-based index into the ``count`` items defined on ``item_lines`` (v, vt
+        or vn lines), from ``block`` (the ``f`` lines, one number per corner): negative indices count
         back from the last item defined above the face's line. FormatError names the face of a
         corner that does not parse or lies outside the items."""
         written = _untagged_values(block, np.int64, self.sizes)

@@ -85,8 +85,12 @@ def _read_frames(
 ) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None]:
     """The frames of ``paths`` (:func:`read_sequence`), and with ``textured`` their texture
     coordinates and normals' shading (:func:`read_textured_sequence`)."""
-    read = read_mesh_textured if textured else _geometry_of
-    first_vertices, faces, texture, normals = read(paths[0])
+
+    def read(path: Path, first: bool) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
+        # Only the first frame's normals are read: they tell the shading the levels rebuild.
+        return read_mesh_textured(path, normals=first) if textured else _geometry_of(path)
+
+    first_vertices, faces, texture, normals = read(paths[0], first=True)
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
     if not len(faces):
         what = "no vertices and no faces" if not len(first_vertices) else f"{len(first_vertices)} vertices but no faces"
@@ -97,7 +101,7 @@ def _read_frames(
     with warnings.catch_warnings():  # the first frame's warning speaks for the sequence
         warnings.simplefilter("ignore", UnreadAttributesWarning)
         for index, path in enumerate(paths[1:], start=1):
-            vertices, frame_faces, frame_texture, _ = read(path)
+            vertices, frame_faces, frame_texture, _ = read(path, first=False)
             _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
             frames[index] = vertices
             if textured and differing is None and not _same_texture(texture, frame_texture):
@@ -284,11 +288,11 @@ def _check_same_connectivity(
 
 
 def read_mesh_textured(
-    path: str | os.PathLike,
+    path: str | os.PathLike, normals: bool = True
 ) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
-    """:func:`read_mesh` with an OBJ file's texture coordinates and normals
-    (:func:`~.obj.read_obj_textured`; None for PLY)."""
-    return read_obj_textured(path) if Path(path).suffix.lower() == ".obj" else _geometry_of(path)
+    """:func:`read_mesh` with an OBJ file's texture coordinates and, with ``normals``, its
+    normals (:func:`~.obj.read_obj_textured`; None for PLY)."""
+    return read_obj_textured(path, normals) if Path(path).suffix.lower() == ".obj" else _geometry_of(path)
 
 
 def _geometry_of(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, None, None]:

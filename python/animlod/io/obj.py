@@ -73,21 +73,23 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
 
 
 def read_obj_textured(
-    path: str | os.PathLike,
+    path: str | os.PathLike, normals: bool = True
 ) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
     """:func:`read_obj` with the texture coordinates and normals: also the ``vt`` lines and each
     corner's texture index (``v/vt`` or ``v/vt/vn``), and the ``vn`` lines and each corner's
     normal index (``v/vt/vn`` or ``v//vn``); each None where the file has none, or where some
     corners have one and others not (with an :class:`UnreadAttributesWarning`). FormatError
-    also names a malformed ``vt`` or ``vn`` line and an index outside them."""
-    return _read_obj(path, textured=True)
+    also names a malformed ``vt`` or ``vn`` line and an index outside them. ``normals=False``
+    leaves the ``vn`` lines unread, without a warning (a sequence's later frames, whose normals
+    the levels do not take)."""
+    return _read_obj(path, textured=True, normals=normals)
 
 
 def _read_obj(
-    path: str | os.PathLike, textured: bool
+    path: str | os.PathLike, textured: bool, normals: bool = False
 ) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
-    """:func:`read_obj`, and with ``textured`` its texture coordinates and normals
-    (:func:`read_obj_textured`)."""
+    """:func:`read_obj`, and with ``textured`` its texture coordinates and, with ``normals``,
+    its normals (:func:`read_obj_textured`)."""
     path = Path(path)
     data = path.read_bytes()
     if data.startswith((b"\xfe\xff", b"\xff\xfe")):  # UTF-16 after its byte order mark (assimp's box_UTF16BE.obj)
@@ -144,12 +146,16 @@ def _read_obj(
     faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
     if not textured:
         return vertices, faces, None, None
-    read = []
-    for (block, lines), attribute in ((uv_statements, _TEXTURE), (normal_statements, _NORMALS)):
+
+    def per_triangle(statements: tuple[bytes, np.ndarray], attribute: _Attribute) -> tuple | None:
+        """The attribute's values and each triangle corner's index into them, or None."""
+        block, lines = statements
         found = _corner_attribute(path, attribute, block, lines, texture_block, corners) if len(lines) else None
-        read.append(found and (found[0], fan_triangulate(found[1][polygons[owner]], sizes[polygons])))
-    texture, normals = read
-    return vertices, faces, texture and ObjTexture(*texture), normals and ObjNormals(*normals)
+        return found and (found[0], fan_triangulate(found[1][polygons[owner]], sizes[polygons]))
+
+    texture = per_triangle(uv_statements, _TEXTURE)
+    corner_normals = per_triangle(normal_statements, _NORMALS) if normals else None
+    return vertices, faces, texture and ObjTexture(*texture), corner_normals and ObjNormals(*corner_normals)
 
 
 @dataclass(frozen=True)

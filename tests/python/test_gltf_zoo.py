@@ -235,6 +235,41 @@ def test_motion_level_clips_last_as_long_as_the_input_clips(tmp_path: Path) -> N
         assert written.animation_duration(0) == pytest.approx(clip_end, abs=1e-6)
 
 
+def test_a_clip_that_ends_between_two_frames_keeps_its_last_pose(tmp_path: Path) -> None:
+    """The elbow's last key comes 10 ms after a 30 fps frame and turns it by 90 degrees more. The
+    clip was sampled on the frame grid only, so its last frame and the levels' last key held the
+    pose of the frame before: the snap was lost (13% of a character's size in a helper's file)."""
+    snap = rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.pi)  # elbow at 180 degrees
+
+    def late_snap(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        frames = 8
+        times = (np.arange(frames) / 30.0).astype(np.float32)[:, None]
+        times[-1] = times[-2] + 0.01
+        late = append_accessor(gltf, blob, times, "SCALAR")
+        gltf.accessors[late].min, gltf.accessors[late].max = [float(times[0, 0])], [float(times[-1, 0])]
+        animation = gltf.animations[0]
+        for sampler in animation.samplers:
+            sampler.input = late
+        elbow = next(c.sampler for c in animation.channels if c.target.node == 1 and c.target.path == "rotation")
+        keys = two_bone_tube(frames)[1].local_rotations[:, 1].copy()
+        keys[-1] = snap
+        animation.samplers[elbow].output = append_accessor(gltf, blob, keys.astype(np.float32), "VEC4")
+
+    source = edit_glb(_two_bone_glb(tmp_path / "body.glb"), tmp_path / "snap.glb", late_snap)
+    clip_end = GltfDocument(source).animation_duration(0)
+    motion = read_gltf(source).motions[0]
+    assert motion.frame_count == 8
+    np.testing.assert_allclose(np.abs(motion.local_rotations[-1, 1] @ snap), 1.0, atol=1e-6)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    written = GltfDocument(tmp_path / "levels" / report.files[0][-1])
+    assert written.animation_duration(0) == pytest.approx(clip_end, abs=1e-6)
+    channels = written.gltf.animations[0].channels
+    elbow = next(c.sampler for c in channels if c.target.path == "rotation" and c.target.node == 1)
+    times, keys, _ = written.sampler_keys(0, elbow, 4, "elbow")
+    assert times[-1] == pytest.approx(clip_end, abs=1e-6) and times[-2] < times[-1] - 0.005
+    np.testing.assert_allclose(np.abs(keys[-1] @ snap), 1.0, atol=1e-6)
+
+
 def test_motion_levels_say_what_their_glbs_leave_out(tmp_path: Path) -> None:
     """The motion levels' GLBs hold the skinned mesh, its skeleton and its clips: a file's
     materials, props and cameras were left out of them without a word."""

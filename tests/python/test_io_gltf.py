@@ -172,6 +172,7 @@ def test_frame_times_cover_the_clip_and_tolerate_float32_key_times():
     assert len(frame_times(float(np.float32(21 / 30)), 30.0)) == 22  # 0.7 s stored a hair below
     assert len(frame_times(0.0, 30.0)) == 1
     np.testing.assert_allclose(frame_times(0.1, 30.0), [0.0, 1 / 30, 2 / 30, 3 / 30])
+    np.testing.assert_allclose(frame_times(1.25, 30.0), np.r_[np.arange(38) / 30, 1.25])  # its end, not 37 / 30
 
 
 def test_step_and_linear_interpolation():
@@ -347,6 +348,21 @@ def test_animation_names_override_and_mismatched_skeleton_is_refused(tmp_path):
         write_glb(tmp_path / "bad.glb", mesh, [Motion(other, motion.root_positions, motion.local_rotations, 24.0)])
     assert not (tmp_path / "bad.glb").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["named.glb"]  # no temporary left behind
+
+
+def test_a_clip_duration_puts_the_last_key_at_the_clips_end(tmp_path):
+    """The last frame of a glTF clip is sampled at the clip's end (frame_times), so its key goes
+    there; a duration that would put it at or before the frame before it is refused."""
+    mesh = _chain_mesh()
+    motion = _chain_motion(mesh.skeleton)
+    end = (motion.frame_count - 2 + 0.25) / motion.fps
+    write_glb(tmp_path / "end.glb", mesh, [motion], durations=[end])
+    written = GltfDocument(tmp_path / "end.glb")
+    times, _, _ = written.sampler_keys(0, 0, 3, "root")
+    assert len(times) == motion.frame_count and times[-1] == pytest.approx(end)
+    with pytest.raises(ValueError, match="duration"):
+        write_glb(tmp_path / "bad.glb", mesh, [motion], durations=[(motion.frame_count - 2) / motion.fps])
+    assert not (tmp_path / "bad.glb").exists()
 
 
 def test_read_gltf_on_a_written_file_lists_the_skin_and_motion(chain_glb):
@@ -888,7 +904,7 @@ def test_rigged_figure(data_dir):
     assert (mesh.vertex_count, mesh.face_count, mesh.skeleton.joint_count, len(motions)) == (370, 256, 19, 1)
     assert np.all(mesh.skeleton.parents[1:] < np.arange(1, 19))
     np.testing.assert_allclose(mesh.weights.sum(axis=1), 1.0, atol=1e-6)  # the file's own sums reach 0.2
-    assert motions[0].frame_count == 38 and motions[0].fps == 30.0  # 1.25 s at 30 fps
+    assert motions[0].frame_count == 39 and motions[0].fps == 30.0  # 1.25 s at 30 fps, and its end
     _assert_rest_bake_matches(mesh)
     frames = mesh.bake(motions[0]).frames
     assert np.all(np.isfinite(frames))

@@ -25,7 +25,7 @@ from .. import rotations
 from .errors import FormatError
 from .gltf_decode import decode_gltf, is_whole_number, labels_as_text
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
-from .gltf_keyframes import INTERPOLATIONS, frame_times
+from .gltf_keyframes import INTERPOLATIONS, frame_count, frame_times
 from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
 from .gltf_references import LIGHTS_EXTENSION, index_references
 from .json_limits import load_json
@@ -506,13 +506,14 @@ class GltfDocument:
         return float(max(ends, default=0.0))
 
     def animation_frame_times(self, index: int, fps: float) -> np.ndarray:
-        """Sample times ``(T,)`` at ``fps`` from 0 to the animation's duration (the last sample
-        within one frame of it)."""
+        """Sample times ``(T,)`` at ``fps`` from 0 to the animation's duration, the last one at
+        the duration itself (:func:`~.gltf_keyframes.frame_times`)."""
         label = self.animation_label(index)
         duration = self.animation_duration(index)
-        if duration * fps >= self.max_animation_frames:
+        count = frame_count(duration, fps)
+        if count > self.max_animation_frames:
             reason = (
-                f"lasts {duration:g} s: {int(duration * fps) + 1} frames at {fps:g} fps, more than the limit of "
+                f"lasts {duration:g} s: {count} frames at {fps:g} fps, more than the limit of "
                 f"{self.max_animation_frames} (ANIMLOD_MAX_ANIMATION_FRAMES raises it)"
             )
             raise self.fail(label, reason)

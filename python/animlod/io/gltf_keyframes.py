@@ -16,9 +16,16 @@ _FRAME_SLACK = 1e-3
 
 
 def frame_times(duration: float, fps: float) -> np.ndarray:
-    """Sample times ``(T,)`` in seconds: ``k / fps`` from 0 up to ``duration`` (T >= 1)."""
-    count = int(np.floor(max(duration, 0.0) * fps + _FRAME_SLACK)) + 1
-    return np.arange(count) / fps
+    """Sample times ``(T,)`` in seconds: ``k / fps`` from 0, the last one at ``duration`` itself
+    (T >= 1). A clip that ends between two frames (1.25 s at 30 fps) gets a last, shorter step to
+    its end (1.2333, 1.25): its last pose is sampled, not the pose of its last whole frame."""
+    duration = max(duration, 0.0)
+    return np.minimum(np.arange(frame_count(duration, fps)) / fps, duration)
+
+
+def frame_count(duration: float, fps: float) -> int:
+    """How many samples :func:`frame_times` takes of a clip of ``duration`` seconds."""
+    return int(np.ceil(max(duration, 0.0) * fps - _FRAME_SLACK)) + 1
 
 
 def sample_keyframes(

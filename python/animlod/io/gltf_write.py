@@ -82,8 +82,9 @@ def write_glb(
         the skeleton of ``motions[0]`` and the motions only (an animation library's file).
     motions : animations on ``skinned.skeleton`` (same joint names, parents and offsets).
     names : animation names, one per motion; defaults to each motion's name, or "motion<i>".
-    durations : per motion, the length of the clip it was sampled from, or None (see
-        :func:`add_animation`): a glTF clip's last key may fall between two sampled frames.
+    durations : per motion, the length of the glTF clip it was sampled from, or None (see
+        :func:`add_animation`): its last frame is at the clip's end, which may fall less than a
+        frame after the one before it.
     materials : the material of each of ``skinned``'s faces, or None (no material).
     morph_weights : per motion, (T, N) the weights of ``skinned``'s N morph targets at its T
         frames, written as a channel of the mesh node, or None.
@@ -91,7 +92,8 @@ def write_glb(
 
     Raises
     ------
-    ValueError if a motion is on another skeleton, ``names``, ``durations``, ``materials`` or
+    ValueError if a motion is on another skeleton, a duration ends before its motion's frame
+    before the last, ``names``, ``durations``, ``materials`` or
     ``morph_weights`` has the wrong length or shape, ``materials`` and ``hung`` are of two
     documents, or there is neither a mesh nor a motion.
     """
@@ -154,10 +156,9 @@ def _checked_morph_weights(
 
 def _add_weights_channel(builder: GlbBuilder, animation: dict, node: int, weights: np.ndarray) -> None:
     """``weights`` (T, N) as a channel of ``node``'s morph weights in ``animation``, on its joint
-    channels' keys (a key held past the last frame holds the last weights too)."""
+    channels' keys."""
     times = animation["samplers"][0]["input"]
-    held = builder.json["accessors"][times]["count"] - len(weights)
-    values = np.concatenate([weights, np.repeat(weights[-1:], held, axis=0)]).reshape(-1, 1)
+    values = np.asarray(weights).reshape(-1, 1)
     animation["samplers"].append({"input": times, "output": builder.add(values.astype(np.float32)),
                                   "interpolation": _LINEAR})  # fmt: skip
     animation["channels"].append(
@@ -294,15 +295,17 @@ def add_animation(
     """``motion`` as a LINEAR animation of ``joint_nodes`` (one per joint of its skeleton); its index.
     A rigid motion only: joint deformations have no TRS channels of their own (ValueError).
 
-    ``duration``: the length of the clip ``motion`` was sampled from, when its last frame falls
-    short of it (a clip of 8.275 s sampled at 30 fps ends at 8.267 s): a last key there holds the
-    last frame, so that the animation lasts as long as the clip it stands for and a player that
-    loops each by its own length keeps them in step."""
+    ``duration``: the length of the glTF clip ``motion`` was sampled from, whose last frame is at
+    its end rather than on the frame grid (:func:`~.gltf_keyframes.frame_times`: a clip of 8.275 s
+    at 30 fps ends ..., 8.2667, 8.275): the last key is put there, so that the animation lasts as
+    long as the clip it stands for and a player that loops each by its own length keeps them in
+    step. It must come after the frame before the last (ValueError)."""
     motion.require_rigid("a glTF animation of a skeleton")
     times = np.arange(motion.frame_count) / motion.fps
-    held = duration is not None and np.float32(duration) > np.float32(times[-1])
-    if held:
-        times = np.append(times, duration)
+    if duration is not None and motion.frame_count > 1:
+        if not duration > times[-2]:
+            raise ValueError(f"duration: {duration:g} s is not after the frame before the last ({times[-2]:g} s)")
+        times[-1] = duration
     time_accessor = builder.add(times.astype(np.float32)[:, None], bounds=True)
     joint_count = motion.skeleton.joint_count
     tracks = [(0, "translation", motion.root_positions)]
@@ -313,8 +316,6 @@ def add_animation(
     samplers, channels = [], []
     for joint, path, values in tracks:
         channels.append({"sampler": len(samplers), "target": {"node": joint_nodes[joint], "path": path}})
-        if held:
-            values = np.concatenate([values, values[-1:]])
         output = builder.add(np.ascontiguousarray(values, dtype=np.float32))
         samplers.append({"input": time_accessor, "output": output, "interpolation": _LINEAR})
     animation = {"name": name, "samplers": samplers, "channels": channels}

@@ -246,7 +246,7 @@ def _earlier_level_files(folder: Path, stem: str, written: set[str]) -> list[str
 
 class PlayedClip(NamedTuple):
     """A clip of the simplified motion: its name, its frames in the motion, and for a glTF clip
-    its length in seconds (its last key, which may fall between two sampled frames), the
+    its length in seconds (its last key, where its last frame is sampled), the
     weights its channels give the skinned mesh's morph targets at its frames (T, N), if any, and
     the document's animation it is (None for several joined into one)."""
 

@@ -12,10 +12,12 @@ import pygltflib
 import pytest
 from gltf_conformance import added_problems, problems
 from gltf_edits import append_accessor, draco_compressed, edit_glb, meshopt_compressed
+from simplify_inputs import ellipsoid
 
 from animlod import synth
 from animlod.cli import main
 from animlod.io import read_gltf, write_glb
+from animlod.io.errors import FormatError
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_drawable import read_drawables
@@ -211,6 +213,69 @@ def test_settings_take_their_fields_and_aqem_options_by_name(humanoid_glb, tmp_p
     with pytest.raises(ValueError, match=r"^AqemOptions: unknown option 'frame_budjet'"):
         simplify_document(humanoid_glb, output, [0.5], frame_budjet=6)
     assert not output.exists()
+
+
+@pytest.mark.parametrize(
+    "option, value",
+    [("viewport_px", 0), ("pixel_error", -1.0), ("fps", 0.0), ("fps", float("nan")), ("frame_budget", 0),
+     ("measured_frames", 2.5)],
+)  # fmt: skip
+def test_a_setting_it_cannot_hold_is_refused_before_any_work(humanoid_glb, tmp_path, option, value):
+    """A zero viewport divided the coverages by zero, a negative pixel error wrote negative
+    MSFT_screencoverage values, and a zero fps was blamed on the file's rotation keys."""
+    output = tmp_path / "out.glb"
+    with pytest.raises(ValueError, match=rf"^{option}: must be"):
+        simplify_document(humanoid_glb, output, [0.5], **{option: value})
+    assert not output.exists()
+
+
+def _ellipsoid_glb(path, placeholder: str | None = None):
+    """An ellipsoid, and with ``placeholder`` two triangles on four vertices at its centre: a
+    second "primitive" of the ellipsoid's mesh, a "mesh" of their own on a second node, or
+    "alone", in place of the ellipsoid."""
+    surface = ellipsoid(frames=1)
+    builder = GlbBuilder()
+
+    def primitive(positions, faces):
+        return {
+            "attributes": {"POSITION": builder.add(positions.astype(np.float32), bounds=True)},
+            "indices": builder.add(faces.astype(np.uint32).reshape(-1, 1)),
+        }
+
+    primitives = [primitive(surface.frames[0], surface.faces)]
+    collapsed = primitive(np.zeros((4, 3)), np.array([0, 1, 2, 0, 2, 3]))
+    builder.json["nodes"] = [{"mesh": 0}]
+    if placeholder in ("primitive", "alone"):
+        primitives = primitives[1:] if placeholder == "alone" else primitives
+        primitives.append(collapsed)
+    builder.append("meshes", {"primitives": primitives})
+    if placeholder == "mesh":
+        builder.append("meshes", {"name": "placeholder", "primitives": [collapsed]})
+        builder.json["nodes"].append({"mesh": 1})
+    builder.json["scenes"], builder.json["scene"] = [{"nodes": list(range(len(builder.json["nodes"])))}], 0
+    builder.save(path)
+    return path
+
+
+def test_triangles_that_draw_nothing_are_neither_measured_nor_refused(tmp_path):
+    """Two triangles collapsed to the origin: as a second primitive, AQEM dropped them but the
+    error still measured their corners, so every level's error was the surface's distance from
+    its centre and every coverage the same; as a mesh of their own, the whole document was refused."""
+    plain = simplify_document(_ellipsoid_glb(tmp_path / "plain.glb"), tmp_path / "plain_lod.glb", [0.5, 0.25], **QUICK)
+    source = _ellipsoid_glb(tmp_path / "primitive.glb", "primitive")
+    report = simplify_document(source, tmp_path / "primitive_lod.glb", [0.5, 0.25], **QUICK)
+    expected = [level.error for level in plain.drawables[0].levels]
+    np.testing.assert_allclose([level.error for level in report.drawables[0].levels], expected, rtol=1e-6)
+    source = _ellipsoid_glb(tmp_path / "mesh.glb", "mesh")
+    report = simplify_document(source, tmp_path / "mesh_lod.glb", [0.5, 0.25], **QUICK)
+    assert [drawable.label for drawable in report.drawables] == ["mesh 0"]
+    assert any("mesh 1 'placeholder'" in note and "without levels" in note for note in report.notes)
+    written = GltfDocument(tmp_path / "mesh_lod.glb").json
+    assert "extensions" not in written["nodes"][1] and written["meshes"][1]["name"] == "placeholder"
+    source = _ellipsoid_glb(tmp_path / "alone.glb", "alone")
+    with pytest.raises(FormatError, match=r"alone.glb: meshes: every triangle mesh is degenerate"):
+        simplify_document(source, tmp_path / "alone_lod.glb", [0.5], **QUICK)
+    assert not (tmp_path / "alone_lod.glb").exists()
 
 
 def test_separate_writes_one_whole_document_per_level(humanoid_glb, tmp_path):

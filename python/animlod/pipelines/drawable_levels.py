@@ -20,7 +20,7 @@ moving them.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -69,6 +69,18 @@ class DrawableSettings:
     pixel_error: float = 1.0
     viewport_px: float = 1080.0
     aqem: Mapping[str, object] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        # A zero viewport divided the coverages by zero and a negative pixel error wrote negative
+        # MSFT_screencoverage; a zero fps was blamed on the input's keys.
+        for name in ("fps", "pixel_error", "viewport_px"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value < np.inf:
+                raise ValueError(f"{name}: must be a positive number, got {value!r}")
+        for name in ("frame_budget", "measured_frames"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+                raise ValueError(f"{name}: must be a whole number of at least 1, got {value!r}")
 
     @classmethod
     def resolve(cls, settings: DrawableSettings | None, keywords: Mapping[str, object]) -> DrawableSettings:
@@ -483,19 +495,39 @@ def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: i
     """Each level's error: max over clips and ``measured_frames`` frames per clip (the rest pose
     when there is no clip) of the Hausdorff distance to the input, in asset units."""
     faces = drawable.geometry.faces
-    samples: list[tuple[Clip | None, np.ndarray]] = [(None, np.zeros(1, int))]
-    for clip in drawable.clips:
-        samples.append((clip, spread_frames(clip.frame_count, measured_frames)))
-    for clip, frames in samples:
-        original = AnimatedMesh(
-            faces, drawable.rest_positions()[None] if clip is None else drawable.clip_frames(clip, frames)
-        )
+    for clip, frames, positions in _measured_poses(drawable, measured_frames):
+        original = AnimatedMesh(faces[_drawn(faces, positions)], positions)
         posed = [AnimatedMesh(lv.simplified.mesh.faces, posed_frames(drawable, lv, clip, frames)) for lv in levels]
         errors = hausdorff_distances(
             original, posed, measure_samples(drawable), at_least=[level.error for level in levels]
         )
         for level, error in zip(levels, errors):
             level.error = error
+
+
+def draws_nothing(drawable: Drawable, measured_frames: int) -> bool:
+    """Whether no triangle of ``drawable`` has three distinct corner positions at rest or in the
+    measured frames of its clips (a placeholder collapsed to a point): there is nothing to simplify."""
+    faces = drawable.geometry.faces
+    return not any(_drawn(faces, positions).any() for _, _, positions in _measured_poses(drawable, measured_frames))
+
+
+def _measured_poses(drawable: Drawable, measured_frames: int) -> Iterator[tuple[Clip | None, np.ndarray, np.ndarray]]:
+    """``(clip, frames, positions (T, V, 3))`` of the poses a level's error is measured in: the
+    rest pose (clip None), then ``measured_frames`` frames spread over each clip."""
+    yield None, np.zeros(1, int), drawable.rest_positions()[None]
+    for clip in drawable.clips:
+        frames = spread_frames(clip.frame_count, measured_frames)
+        yield clip, frames, drawable.clip_frames(clip, frames)
+
+
+def _drawn(faces: np.ndarray, frames: np.ndarray) -> np.ndarray:
+    """``(F,) bool``: the faces with three distinct corner positions in some of ``frames`` (T, V, 3).
+    The others draw nothing, and AQEM drops them: measured, a placeholder primitive collapsed to
+    the origin set every level's error to the distance from there to the surface."""
+    corners = frames[:, faces]  # (T, F, 3, 3)
+    coincide = [np.all(corners[:, :, a] == corners[:, :, b], axis=-1) for a, b in ((0, 1), (1, 2), (2, 0))]
+    return ~np.all(np.logical_or.reduce(coincide), axis=0)
 
 
 def posed_frames(drawable: Drawable, level: DrawableLevel, clip: Clip | None, frames: np.ndarray) -> np.ndarray:

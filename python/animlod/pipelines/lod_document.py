@@ -25,7 +25,7 @@ from ..io.gltf_lod import LevelInfo, add_level_mesh, add_level_node, attach_chai
 from ..io.stored_weights import normalise_stored_weights
 from ..model import AnimatedMesh
 from .clip_import import with_clips
-from .drawable_levels import DrawableLevels, DrawableSettings, simplify_drawable
+from .drawable_levels import DrawableLevels, DrawableSettings, draws_nothing, simplify_drawable
 
 DEFAULT_RATIOS = (0.5, 0.25, 0.1)
 
@@ -111,9 +111,18 @@ def simplify_document(
     doc = GltfDocument(source)
     doc = with_clips(doc, clips, notes.append, joint_map)
     drawables = read_drawables(doc, settings.fps)
+    # Degenerate triangles are valid glTF: a placeholder collapsed to a point stays as it is.
+    degenerate = [draws_nothing(drawable, settings.measured_frames) for drawable in drawables]
+    empty = [drawable for drawable, skip in zip(drawables, degenerate) if skip]
+    drawables = [drawable for drawable, skip in zip(drawables, degenerate) if not skip]
+    if empty:
+        notes.append(f"kept as they are, without levels (every triangle has two corners at one place): "
+                     f"{', '.join(drawable.label for drawable in empty)}")  # fmt: skip
     if not drawables:
         reason = "no node draws a triangle mesh, nothing to simplify"
-        if doc.gltf.animations:  # an animation library: its clips are motion LoD's input
+        if empty:
+            reason = "every triangle mesh is degenerate (two corners of each triangle at one place)"
+        elif doc.gltf.animations:  # an animation library: its clips are motion LoD's input
             reason += " (its animations are `animlod motion`'s input)"
         raise FormatError(doc.path, "meshes", reason)
     simplified = []

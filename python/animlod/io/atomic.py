@@ -56,8 +56,16 @@ def unwritable(path: str | os.PathLike) -> str | None:
 
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> Iterator[IO]:
-    """Open a temporary file beside ``path``; on success rename it to ``path``, on error remove it."""
-    target = Path(path)
+    """Open a temporary file beside ``path``; on success rename it to ``path``, on error remove it.
+
+    A symbolic link is written through, to the file it names, as ``open`` would (the rename
+    replaced the link with a file of its own). A device or pipe is written in place: renaming over
+    it replaced ``/dev/null`` with a regular file when run as root."""
+    target = Path(os.path.realpath(path))
+    if target.exists() and not target.is_file() and not target.is_dir():
+        with open(target, mode, **open_kwargs) as handle:
+            yield handle
+        return
     target.parent.mkdir(parents=True, exist_ok=True)
     clean_stale(target.parent)
     fd, temporary = tempfile.mkstemp(prefix=_prefix(target), suffix=".part", dir=target.parent)

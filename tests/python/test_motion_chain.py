@@ -192,7 +192,7 @@ def test_a_level_reuses_its_chosen_trial_refit_for_those_frames(monkeypatch) -> 
         return refit(problem, original, *args, **kwargs)
 
     monkeypatch.setattr(chain, "_refit", counting_refit)
-    monkeypatch.setattr(chain, "restart_from_neighbours", lambda result, solve: result)  # solves of their own
+    monkeypatch.setattr(chain, "restart_from_neighbours", lambda result, solve, clip_of: result)  # solves of their own
     reused = build_motion_chain(motion, [38, 28, 18, 10], workers=1)
     level_frames = solved_frames[-3:]  # the three re-fitted levels come after the trials
     assert 16 in solved_frames[:-3]  # the trials

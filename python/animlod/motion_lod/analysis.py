@@ -72,6 +72,8 @@ class MotionAnalysis:
     hidden : points that move nothing measured (no skin on or below them, nor on their parent:
         a rig's IK targets and controls and their end sites, skin_measure.py): the joints first
         in ``priority``, translating or not, and every one left out of every error.
+    clips : the frames of each clip of a motion made of several played one after another
+        (clips.join_clips); empty for one clip.
     """
 
     key_frames: np.ndarray
@@ -84,6 +86,14 @@ class MotionAnalysis:
     ranking: str = "importance"
     markers: list[int] = field(default_factory=list)
     hidden: list[int] = field(default_factory=list)
+    clips: tuple[slice, ...] = ()
+
+    def clip_of_frames(self, frame_count: int) -> np.ndarray:
+        """``(frame_count,)`` int64 index of each frame's clip in ``clips`` (0 for one clip)."""
+        label = np.zeros(frame_count, dtype=np.int64)
+        for index, clip in enumerate(self.clips):
+            label[clip] = index
+        return label
 
     def key_rotations(self, motion: Motion) -> np.ndarray:
         """Key posture (Section 4.2): every joint's local rotation at its key frame, ``(J, 4)``."""
@@ -270,4 +280,5 @@ def analyze_motion(
         r_max,
         [int(j) for j in np.flatnonzero(translating)],
         ranking,
+        clips=tuple(clips or ()),
     )

@@ -15,12 +15,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..model import Motion, SkinnedMesh
-from ..options import MotionRefitOptions
+from ..options import MotionRefitOptions, resolve_options
 from .analysis import MotionAnalysis, analyze_motion
 from .core_refit import core_energy, refit_core
 from .frozen import FrozenLevel, freeze, frozen_motion
 from .grouped_solve import FrameFailure, RefitResult, combine_frames
-from .neighbour_restarts import restart_from_neighbours
+from .neighbour_restarts import RESTART_EVALUATIONS, restart_from_neighbours
 from .newton import refit_newton
 from .objective import RefitProblem, Weights, build_problem
 from .ranking import DEFAULT_RANKING
@@ -296,12 +296,12 @@ def _solve_level(
     workers: int,
     progress: Callable[[float], None] | None,
     known: _KnownFrames | None = None,
-    restarts: bool = True,
+    clip_of: np.ndarray | None = None,
 ) -> _Solved:
     """Re-fits ``level`` on every frame of ``motion`` (but ``known``'s, whose re-fit is given) and
-    places every original point; with ``restarts``, frames whose E stands above their
-    neighbours' are solved again from the neighbours' solutions (``motion``: consecutive
-    frames)."""
+    places every original point. With ``clip_of``, the clip of each frame (consecutive frames
+    of one clip are neighbours), frames whose E stands above their neighbours' are solved again
+    from the neighbours' solutions; None: no restarts (a trial's frames are not neighbours)."""
     problem = build_problem(level, weights)
     # E (Eq. 5) is the same for a frame moved as a whole, and a clip 1e9 units from the origin
     # had its held lengths rounded away (fallbacks, 20% errors): every frame is solved with its
@@ -324,14 +324,17 @@ def _solve_level(
             solved = _refit(problem, original[rest], fallback[rest], starts, solver, slsqp_options, workers, progress)
             parts.append((rest, solved))
 
+        evaluations = min(slsqp_options.max_evaluations, RESTART_EVALUATIONS)
+        restart_options = resolve_options(MotionRefitOptions, slsqp_options, {"max_evaluations": evaluations})
+
         def solve_from(frames: np.ndarray, starts: np.ndarray) -> RefitResult:
             if solver == "newton":
                 return refit_newton(problem, original[frames], start=starts, workers=max(workers, 1))
-            return _refit(problem, original[frames], fallback[frames], starts, solver, slsqp_options, workers, None)
+            return _refit(problem, original[frames], fallback[frames], starts, solver, restart_options, workers, None)
 
         result = combine_frames(motion.frame_count, parts)
-        if restarts:
-            result = restart_from_neighbours(result, solve_from)
+        if clip_of is not None:
+            result = restart_from_neighbours(result, solve_from, clip_of)
     else:  # E = 0 at the original positions, its global minimum: nothing to solve
         result = RefitResult(original, np.zeros(motion.frame_count), np.zeros(motion.frame_count, dtype=np.int64))
         if progress:
@@ -362,7 +365,8 @@ def build_level(
     frozen_joints = analysis.priority[: total - joint_count]
     level = freeze(motion, analysis, frozen_joints)
     known = trials.get(_trial_key(level)) if trials else None
-    solved = _solve_level(level, motion, weights, solver, slsqp_options, workers, progress, known)
+    clip_of = analysis.clip_of_frames(motion.frame_count)
+    solved = _solve_level(level, motion, weights, solver, slsqp_options, workers, progress, known, clip_of)
     result = replace(solved.result, positions=solved.result.positions + motion.root_positions[:, None, :])
     fk = solved.output.world_positions()
     error = solved.errors()
@@ -450,7 +454,7 @@ def build_motion_chain(
 
         def trial_error(level: FrozenLevel, frames: np.ndarray) -> float:
             trial_motion = motion.take_frames(frames)  # frames spread over the clip: not neighbours
-            solved = _solve_level(level, trial_motion, weights, solver, slsqp_options, workers, None, restarts=False)
+            solved = _solve_level(level, trial_motion, weights, solver, slsqp_options, workers, None)
             if not slsqp_options.warm_start:
                 trials[_trial_key(level)] = _KnownFrames(frames, solved.result)
             if trial_measure is not None:

@@ -79,6 +79,20 @@ def test_info_on_a_folder_of_models_describes_each(tmp_path, capsys):
     assert f"{tmp_path / 'a.bvh'}: bvh" in out and f"{tmp_path / 'b.npz'}: npz" in out
 
 
+def test_info_on_a_glob_of_models_describes_each_and_of_frames_one_sequence(tmp_path, capsys):
+    # A glob of models, as `batch` takes it, was read as a frame glob: "expected one of .obj, .ply".
+    from animlod.io.meshseq import write_sequence
+
+    write_bvh(tmp_path / "a.bvh", _small_motion())
+    write_bvh(tmp_path / "b.bvh", _small_motion())
+    assert main(["info", str(tmp_path / "*.bvh")]) == 0
+    out = capsys.readouterr().out
+    assert f"{tmp_path / 'a.bvh'}: bvh" in out and f"{tmp_path / 'b.bvh'}: bvh" in out
+    write_sequence(tmp_path / "walk", AnimatedMesh([[0, 1, 2]], np.tile(np.eye(3), (2, 1, 1)), fps=10.0))
+    assert main(["info", str(tmp_path / "walk" / "*.obj")]) == 0
+    assert "frames: 2, frame_0000.obj .. frame_0001.obj" in capsys.readouterr().out
+
+
 def test_info_on_a_library_names_an_unreadable_asset_and_lists_the_rest(tmp_path, capsys):
     # It stopped at the first unreadable asset with its error, so the assets after it were never listed.
     (tmp_path / "a_broken.bvh").write_text("HIERARCHY\nROOT hips\n")

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import glob
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..io.detect import assets_in, input_kind, unread_models_note
+from ..io.detect import assets_in, input_kind, is_pattern, unread_models_note
+from ..io.meshseq import is_frame_name
 from ..model import AnimatedMesh, Motion
 from ..pipelines.humanoid_roles import naming_label
 
@@ -94,7 +96,11 @@ def _own_output(path: str) -> tuple[str, list[str]] | None:
 
 def _models(path: str) -> list[str]:
     """``path`` itself, or for a folder every asset in and below it that ``animlod batch`` would
-    take: model files and frame folders (a folder of OBJ/PLY frames alone is one sequence)."""
+    take: model files and frame folders (a folder of OBJ/PLY frames alone is one sequence); for a
+    glob, its matches, as ``batch`` takes them, unless they are all OBJ/PLY frames (one sequence)."""
+    if is_pattern(path):
+        matches = sorted(glob.glob(path, recursive=True))
+        return matches if not all(is_frame_name(Path(match).name) for match in matches) else [path]
     if not Path(path).is_dir():
         return [path]
     return [str(asset) for asset in assets_in(Path(path))] or [path]

@@ -273,7 +273,7 @@ def test_triangles_that_draw_nothing_are_neither_measured_nor_refused(tmp_path):
     written = GltfDocument(tmp_path / "mesh_lod.glb").json
     assert "extensions" not in written["nodes"][1] and written["meshes"][1]["name"] == "placeholder"
     source = _ellipsoid_glb(tmp_path / "alone.glb", "alone")
-    with pytest.raises(FormatError, match=r"alone.glb: meshes: every triangle mesh is degenerate"):
+    with pytest.raises(FormatError, match=r"alone.glb: meshes: no mesh has a triangle with three distinct corners"):
         simplify_document(source, tmp_path / "alone_lod.glb", [0.5], **QUICK)
     assert not (tmp_path / "alone_lod.glb").exists()
 
@@ -864,3 +864,25 @@ def test_overwrite_writes_an_accessors_own_float_data_or_nothing(humanoid_glb):
     assert builder.overwrite(weights, halves) and builder.overwritten == {weights}
     written = GltfDocument(humanoid_glb, data=builder.to_bytes())
     np.testing.assert_array_equal(written.accessor(weights, "t"), halves)
+
+
+@pytest.mark.parametrize(
+    "ids, reason",
+    [([0], "lists the node itself"), ([1, 1], "lists node 1 twice"), (["a"], "refers to node 'a'")],
+)
+def test_a_chain_whose_level_ids_are_not_other_nodes_is_refused(tmp_path, capsys, ids, reason):
+    """`info` printed "levels at nodes [0, 'a']" and exited 0 for such a chain."""
+    from animlod.io import read_lod_chains
+
+    lod = tmp_path / "lod.glb"
+    simplify_document(_ellipsoid_glb(tmp_path / "plain.glb"), lod, [0.5], **QUICK)
+
+    def relist(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        gltf.nodes[0].extensions["MSFT_lod"]["ids"] = ids
+
+    edited = edit_glb(lod, tmp_path / "edited.glb", relist)
+    with pytest.raises(FormatError, match=rf"edited.glb: node 0 MSFT_lod: {reason}"):
+        read_lod_chains(edited)
+    capsys.readouterr()
+    assert main(["info", str(edited)]) == 2
+    assert reason in capsys.readouterr().err

@@ -143,6 +143,7 @@ def _document_lines(path: str) -> list[str]:
     """Every drawn (mesh, skin) pair with its primitives, every animation, and LoD chains."""
     from ..io.gltf_document import GltfDocument
     from ..io.gltf_drawable import read_drawables
+    from ..io.gltf_lod import lod_ids
 
     doc = GltfDocument(path)
     drawables = read_drawables(doc)
@@ -194,7 +195,7 @@ def _document_lines(path: str) -> list[str]:
             f"{doc.animation_duration(index):.2f} s{level}"
         )
     for index, node in enumerate(doc.json.get("nodes", [])):
-        ids = node.get("extensions", {}).get("MSFT_lod", {}).get("ids")
+        ids = lod_ids(doc, index)
         if ids is not None:
             coverage = (
                 (node.get("extras") or {}).get("MSFT_screencoverage") if isinstance(node.get("extras"), dict) else None

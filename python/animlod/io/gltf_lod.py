@@ -238,6 +238,25 @@ def screen_coverages(
     return [*thresholds, 0.0]
 
 
+def lod_ids(doc: GltfDocument, base: int) -> list[int] | None:
+    """The level nodes node ``base``'s MSFT_lod lists, None when it has none. FormatError naming
+    the element unless they are indices of other nodes, each once."""
+    lod = doc.json["nodes"][base].get("extensions", {}).get(LOD_EXTENSION)
+    if lod is None:
+        return None
+    element = f"{doc.node_label(base)} {LOD_EXTENSION}"
+    ids = lod.get("ids") if isinstance(lod, dict) else None
+    if not isinstance(ids, list):
+        raise doc.fail(element, "has no list of level node ids")
+    for index in ids:
+        doc.item("nodes", index, element)
+    repeated = next((index for index in ids if index == base or ids.count(index) > 1), None)
+    if repeated is not None:
+        reason = "the node itself" if repeated == base else f"node {repeated} twice"
+        raise doc.fail(element, f"lists {reason}: each level is another node")
+    return ids
+
+
 def read_lod_chains(path: str | os.PathLike, fps: float = 30.0) -> list[LodChain]:
     """Every chain of a LoD GLB (one per node with MSFT_lod), levels finest first.
 
@@ -250,15 +269,9 @@ def read_lod_chains(path: str | os.PathLike, fps: float = 30.0) -> list[LodChain
     rigs: dict[int, SkinRig] = {}
     chains = []
     for base, node in enumerate(doc.json.get("nodes", [])):
-        lod = node.get("extensions", {}).get(LOD_EXTENSION)
-        if lod is None:
+        ids = lod_ids(doc, base)
+        if ids is None:
             continue
-        element = f"{doc.node_label(base)} {LOD_EXTENSION}"
-        ids = lod.get("ids") if isinstance(lod, dict) else None
-        if not isinstance(ids, list):
-            raise doc.fail(element, "has no list of level node ids")
-        for index in ids:
-            doc.item("nodes", index, element)
         extras = node.get("extras") if isinstance(node.get("extras"), dict) else {}
         coverages = extras.get(COVERAGE_EXTRA, [None] * (len(ids) + 1))
         if not isinstance(coverages, list) or len(coverages) != len(ids) + 1:

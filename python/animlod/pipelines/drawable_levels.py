@@ -507,7 +507,8 @@ def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: i
 
 def draws_nothing(drawable: Drawable, measured_frames: int) -> bool:
     """Whether no triangle of ``drawable`` has three distinct corner positions at rest or in the
-    measured frames of its clips (a placeholder collapsed to a point): there is nothing to simplify."""
+    measured frames of its clips (a placeholder collapsed to a point, or no triangle at all):
+    there is nothing to simplify."""
     faces = drawable.geometry.faces
     return not any(_drawn(faces, positions).any() for _, _, positions in _measured_poses(drawable, measured_frames))
 

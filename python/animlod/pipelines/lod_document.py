@@ -116,12 +116,12 @@ def simplify_document(
     empty = [drawable for drawable, skip in zip(drawables, degenerate) if skip]
     drawables = [drawable for drawable, skip in zip(drawables, degenerate) if not skip]
     if empty:
-        notes.append(f"kept as they are, without levels (every triangle has two corners at one place): "
+        notes.append(f"kept as they are, without levels (no triangle with three distinct corners): "
                      f"{', '.join(drawable.label for drawable in empty)}")  # fmt: skip
     if not drawables:
         reason = "no node draws a triangle mesh, nothing to simplify"
         if empty:
-            reason = "every triangle mesh is degenerate (two corners of each triangle at one place)"
+            reason = "no mesh has a triangle with three distinct corners, nothing to simplify"
         elif doc.gltf.animations:  # an animation library: its clips are motion LoD's input
             reason += " (its animations are `animlod motion`'s input)"
         raise FormatError(doc.path, "meshes", reason)

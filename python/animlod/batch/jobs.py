@@ -14,8 +14,10 @@ step.
 from __future__ import annotations
 
 import collections.abc
+import functools
 import importlib
 import inspect
+import json
 import math
 import types
 import typing
@@ -30,8 +32,8 @@ DEFAULT_JOBS = {"gltf": "simplify", "npz": "simplify", "sequence": "simplify", "
 # annotated Callable) are left out too.
 # A pipeline's settings object is given by its fields (DrawableSettings, listed as a source).
 # Files besides the asset (character clips) would escape its fingerprint, so reruns would miss
-# their changes.
-_RESERVED = frozenset({"source", "output", "progress", "workers", "settings", "aqem", "clips"})
+# their changes; a joint map only maps the joints of BVH clips, so without them it is refused.
+_RESERVED = frozenset({"source", "output", "progress", "workers", "settings", "aqem", "clips", "joint_map"})
 
 
 def default_job(source: str, kind: str) -> str | None:
@@ -72,13 +74,16 @@ class Job:
     def function(self) -> Callable:
         return _import(self.path)
 
+    def sources(self, kind: str) -> tuple[str, ...]:
+        """The "module:attribute" paths of the functions and options classes that give its
+        options for input of ``kind``."""
+        return self.option_sources.get(kind, self.option_sources.get("*", (self.path,)))
+
     def options(self, kind: str) -> dict[str, object] | None:
         """Option name -> default for input of ``kind``; None when the job takes any keyword."""
-        sources = self.option_sources.get(kind, self.option_sources.get("*", (self.path,)))
         accepted: dict[str, object] = {}
-        for source in sources:
-            imported = _import(source)
-            found = _option_fields(imported) if hasattr(imported, "fields") else _keywords(imported)
+        for source in self.sources(kind):
+            found = _source_options(source)
             if found is None:
                 return None
             accepted.update(found)
@@ -153,6 +158,51 @@ def check_options(job: Job, kind: str, options: dict[str, object]) -> str | None
         if problem:
             return f"option {name!r}: {problem}"
     return None
+
+
+def check_values(job: Job, kind: str, options: dict[str, object]) -> str | None:
+    """Why the values of ``options`` (of the types :func:`check_options` checks) would stop
+    ``job`` on input of ``kind``, naming the option, or None. Asked of the code that refuses them
+    as the job runs, so that no range is written twice: the glTF pipelines' settings are resolved
+    from them, and AQEM, whose core checks the level targets (``ratios``, which every job with
+    AQEM levels passes on as its target_ratios) and ``max_error`` only as it simplifies,
+    simplifies one triangle with them. The other jobs check their values as they run."""
+    sources = job.sources(kind)
+    if _AQEM not in sources:
+        return None
+    settings = tuple(source for source in (_DRAWABLE, _AQEM) if source in sources)
+    names = {"ratios"}.union(*map(_source_options, settings))
+    values = {name: value for name, value in options.items() if name in names}
+    return _settings_problem(settings, json.dumps(values, sort_keys=True))
+
+
+@functools.lru_cache(maxsize=256)
+def _settings_problem(settings: tuple[str, ...], values_json: str) -> str | None:
+    """:func:`check_values` for one set of values (a library's assets mostly share them)."""
+    values = json.loads(values_json)
+
+    def taken_by(source: str) -> dict[str, object]:
+        return {name: value for name, value in values.items() if name in _source_options(source)}
+
+    try:
+        if _DRAWABLE in settings:
+            _import(_DRAWABLE).resolve(None, taken_by(_DRAWABLE))
+        _simplify_one_triangle(values.get("ratios"), taken_by(_AQEM))
+    except ValueError as error:
+        return " ".join(str(error).split())
+    return None
+
+
+def _simplify_one_triangle(ratios: object, aqem: dict[str, object]) -> None:
+    """AQEM on one triangle with level targets ``ratios`` and the ``aqem`` options: ValueError
+    naming the option the core refuses."""
+    import numpy as np
+
+    from ..aqem import simplify_animated
+    from ..model import AnimatedMesh
+
+    triangle = AnimatedMesh(np.array([[0, 1, 2]], dtype=np.int32), np.eye(3, dtype=np.float32)[None])
+    simplify_animated(triangle, ratios, **aqem)
 
 
 class _Kind(typing.NamedTuple):
@@ -267,6 +317,14 @@ def _option_fields(options_type: type) -> dict[str, object]:
         elif isinstance(value, (bool, int, float, str)):
             found[name] = value
     return found
+
+
+@functools.cache  # signatures and options classes do not change while a process runs
+def _source_options(source: str) -> dict[str, object] | None:
+    """Option name -> default of one option source: a function's keywords (None when it takes any)
+    or a bound options class's fields."""
+    imported = _import(source)
+    return _option_fields(imported) if hasattr(imported, "fields") else _keywords(imported)
 
 
 def _import(path: str) -> Callable:

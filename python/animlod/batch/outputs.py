@@ -8,11 +8,14 @@ Layout of OUT::
     OUT/.animlod-batch/staging/...       assets being written
 
 A job writes into a staging folder of its own (unique per attempt: host, process, token); when
-it has finished, the record is added and the folder is renamed to ``OUT/<name>`` (an older
-version is renamed aside first, then removed). A worker killed mid-asset leaves only its
-staging folder, which no reader looks at, and which the runner removes when the batch ends or
-the next one starts. Unlike :func:`animlod.io.atomic.atomic_folder`, nothing here decides by
-process id whether a temporary is stale: workers may run on other machines that share OUT.
+it has finished, the record is added and the folder is renamed to ``OUT/<name>``, or, where that
+folder is there already, the asset's own files are moved into it (:func:`publish`): the folders
+of other assets nested in it (an earlier run's ``hero/run`` in ``hero``) stay as they are. A
+worker killed mid-asset leaves only its staging folder, which no reader looks at, and which the
+runner removes when the batch ends or the next one starts; one killed while it moves files into
+an existing folder leaves at worst a record whose outputs are not all there, which the next run
+redoes. Unlike :func:`animlod.io.atomic.atomic_folder`, nothing here decides by process id
+whether a temporary is stale: workers may run on other machines that share OUT.
 """
 
 from __future__ import annotations
@@ -28,9 +31,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ..io.atomic import atomic_write
-from ..io.detect import BATCH_STATE
+from ..io.detect import ASSET_RECORD, BATCH_STATE, recorded_outputs
 
-RECORD = ".animlod-asset.json"
 CATALOGUE = "catalogue.parquet"
 
 
@@ -87,28 +89,58 @@ def staging_folder(root: Path, name: str) -> Path:
 
 
 def publish(staging: Path, root: Path, name: str, record: dict) -> Path:
-    """Write ``record`` into ``staging`` and rename it to ``root/name``, replacing an older one."""
-    with atomic_write(staging / RECORD, "w", encoding="utf-8") as handle:
+    """Write ``record`` into ``staging`` and move the asset's files to ``root/name``: one rename
+    where that folder is new. Into an existing one, the outputs its older record lists and what
+    the new files take the place of go first, then the record moves in, then the new files: a
+    record never finds an older file in place of one of its outputs (a worker killed meanwhile
+    leaves some missing, and the next run redoes the asset). The rest stays: the folders of other
+    assets nested in it, files the asset did not write.
+
+    Raises FileExistsError, before anything moves, where a file is in the way of the folder or a
+    new file would take the place of another asset's folder."""
+    with atomic_write(staging / ASSET_RECORD, "w", encoding="utf-8") as handle:
         json.dump(record, handle, indent=1)
         handle.write("\n")
     target = root / name
-    if target.exists() and not target.is_dir():
-        raise FileExistsError(17, "is a file; the asset's outputs go in a folder of that name", os.fspath(target))
-    target.parent.mkdir(parents=True, exist_ok=True)
-    old = None
-    if target.exists():
-        old = staging.with_name(staging.name + ".old")
-        os.rename(target, old)
-    os.rename(staging, target)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
+    blocking = next((path for path in (target, *target.parents) if path.is_relative_to(root) and path.is_file()), None)
+    if blocking is not None:
+        raise FileExistsError(17, f"is a file where the outputs of asset {name!r} need a folder", os.fspath(blocking))
+    if not target.exists():
+        target.parent.mkdir(parents=True, exist_ok=True)
+        os.rename(staging, target)
+        return target
+    new = sorted(path.name for path in staging.iterdir() if path.name != ASSET_RECORD)
+    for entry in new:
+        if _holds_an_asset(target / entry):
+            reason = f"is another asset's folder, where asset {name!r} writes its output {entry}; left as it is"
+            raise FileExistsError(17, reason, os.fspath(target / entry))
+    older = (recorded_outputs(target) or set()) - set(new)  # None: a record it cannot read lists nothing
+    for entry in sorted(older) + new:
+        if not _holds_an_asset(target / entry):  # an older output another asset was written into stays
+            _remove(target / entry)
+    os.replace(staging / ASSET_RECORD, target / ASSET_RECORD)
+    for entry in new:
+        os.rename(staging / entry, target / entry)
+    staging.rmdir()
     return target
+
+
+def _holds_an_asset(path: Path) -> bool:
+    """Whether ``path`` is a folder with an asset's record in or below it."""
+    return path.is_dir() and not path.is_symlink() and any(path.rglob(ASSET_RECORD))
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    elif os.path.lexists(path):
+        path.unlink()
 
 
 def read_record(root: Path, name: str) -> dict | None:
     """The record of asset ``name`` from an earlier run, or None (absent or unreadable)."""
     try:
-        record = json.loads((root / name / RECORD).read_text(encoding="utf-8"))
+        record = json.loads((root / name / ASSET_RECORD).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
     return record if isinstance(record, dict) else None
@@ -117,7 +149,7 @@ def read_record(root: Path, name: str) -> dict | None:
 def earlier_assets(root: Path, names: set[str]) -> list[str]:
     """The assets of earlier runs into ``root`` that ``names`` does not hold: the folders with a
     record (an asset renamed or taken out of the spec since), by name."""
-    found = (path.parent.relative_to(root).as_posix() for path in root.rglob(RECORD))
+    found = (path.parent.relative_to(root).as_posix() for path in root.rglob(ASSET_RECORD))
     return sorted(name for name in found if name not in names and not name.startswith(BATCH_STATE))
 
 

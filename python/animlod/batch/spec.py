@@ -5,7 +5,7 @@ SPEC forms (:func:`read_spec`):
 - a folder: every .glb/.gltf/.vrm/.bvh/.npz file in and below it is an asset, and every folder
   holding OBJ/PLY frames is one sequence asset, or each of its files one when they are separate
   meshes (:func:`animlod.io.detect.separate_meshes`); hidden files and folders, links to no file
-  and batch output folders are skipped; the output of ``a/b/hero.glb`` goes to ``OUT/a/b/hero``,
+  and batch outputs are skipped; the output of ``a/b/hero.glb`` goes to ``OUT/a/b/hero``,
   and where a name would repeat or hold another asset's folder (``hero.glb`` and ``hero.bvh``,
   ``hero.glb`` beside ``hero/walk.bvh``) it takes its input's kind: ``hero_glb``, ``hero_frames``;
 - a glob (``"library/**/*.glb"``): every match is an asset (a file, or a folder of frames);
@@ -25,7 +25,8 @@ SPEC forms (:func:`read_spec`):
       frame_budget = 24
 
 The whole spec is checked before anything runs (:class:`SpecError` names the file, the element
-and the reason): unknown jobs and options, option types, missing inputs, clashing names.
+and the reason): unknown jobs and options, option types and values, missing inputs, clashing
+names.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ from pathlib import Path, PurePosixPath
 from ..io.detect import BATCH_STATE, MODEL_SUFFIXES, assets_in, input_kind, is_pattern, unread_models_note
 from ..io.errors import FormatError
 from ..io.meshseq import MESH_SUFFIXES
-from .jobs import check_options, default_job, find_job
+from .jobs import check_options, check_values, default_job, find_job
 
 MANIFEST_SUFFIXES = (".toml", ".json")
 _ENTRY_KEYS = frozenset({"input", "glob", "name", "job"})
@@ -217,7 +218,8 @@ def _asset(
     spec: str | Path, where: str, source: str, name: str, job: str | None, options: dict, shared: dict
 ) -> AssetSpec:
     """One checked asset: ``options`` must all suit its job, ``shared`` ones are added where they
-    do (a type error in one is still an error); SpecError naming ``where`` in ``spec`` otherwise."""
+    do (a type error in one is still an error), and the values of both must be ones the job can
+    run with; SpecError naming ``where`` in ``spec`` otherwise."""
     try:
         kind = input_kind(source)
     except FormatError as error:
@@ -241,6 +243,9 @@ def _asset(
             merged[key] = value
         elif "unknown for job" not in problem and "does not take" not in problem:
             raise SpecError(spec, where, f"{source}: {problem}")
+    problem = check_values(found, kind, merged)
+    if problem:
+        raise SpecError(spec, where, f"{source}: {problem}")
     return AssetSpec(name, source, kind, job_name, merged)
 
 

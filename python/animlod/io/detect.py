@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import glob
 import itertools
+import json
 import os
 import re
 from collections import Counter
 from collections.abc import Iterator
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 from .errors import FormatError
 from .meshseq import MESH_SUFFIXES, frame_files, is_frame_name, natural_key
@@ -19,6 +20,8 @@ MODEL_SUFFIXES = (*GLTF_SUFFIXES, ".bvh", ".npz")
 GLB_OUTPUT_SUFFIXES = (".glb", ".vrm")
 # The folder where animlod batch keeps its state under OUT: it marks a batch output, never an input.
 BATCH_STATE = ".animlod-batch"
+# The record animlod batch writes into each asset's folder, listing the asset's outputs.
+ASSET_RECORD = ".animlod-asset.json"
 
 
 def is_pattern(path: str | os.PathLike) -> bool:
@@ -73,7 +76,8 @@ def assets_in(folder: Path) -> Iterator[Path]:
     too when it holds frames), in a stable order: a folder's frames, then its files by name, then
     its folders. A folder whose OBJ/PLY files are separate meshes (:func:`separate_meshes`) gives
     each of them instead. Skipped: hidden files and folders, links to no file (dangling or
-    looping) and batch output folders (an output inside the library is not read back as input)."""
+    looping) and batch outputs (a batch's output folder inside the library, an asset's outputs
+    where the library is, or holds, the output folder): no output is read back as input."""
     for here, files in _library_folders(folder):
         frames = [here / name for name in files if is_frame_name(name)]
         if frames and separate_meshes(frames):
@@ -113,13 +117,36 @@ def unread_models_note(folder: Path) -> str | None:
 
 def _library_folders(folder: Path) -> Iterator[tuple[Path, list[str]]]:
     """Each folder in and below ``folder`` with its files (by name, hidden ones left out), skipping
-    hidden folders and batch output folders."""
+    hidden folders, batch output folders and the outputs an asset record lists."""
     for root, folders, files in os.walk(folder):
         here = Path(root)
-        yield here, [name for name in sorted(files) if not name.startswith(".") and (here / name).is_file()]
+        outputs = recorded_outputs(here) if ASSET_RECORD in files else set()
+        if outputs is None:  # a record it cannot read: anything here may be an output
+            folders.clear()
+            continue
+        taken = (name for name in sorted(files) if not name.startswith(".") and name not in outputs)
+        yield here, [name for name in taken if (here / name).is_file()]
         folders[:] = sorted(
-            name for name in folders if not name.startswith(".") and not (here / name / BATCH_STATE).exists()
+            name
+            for name in folders
+            if not name.startswith(".") and name not in outputs and not (here / name / BATCH_STATE).exists()
         )
+
+
+def recorded_outputs(folder: Path) -> set[str] | None:
+    """The names in ``folder`` of the outputs its asset record (:data:`ASSET_RECORD`) lists: the
+    files and folders an asset of animlod batch wrote there (empty when it holds no record). None
+    when its record cannot be read."""
+    try:
+        record = json.loads((folder / ASSET_RECORD).read_text(encoding="utf-8"))
+        paths = [PurePosixPath(path) for path in record["result"]["outputs"]]
+    except FileNotFoundError:
+        return set()
+    except (OSError, ValueError, TypeError, KeyError):
+        return None
+    if any(path.is_absolute() or not path.parts or path.parts[0] == ".." for path in paths):
+        return None  # animlod writes an asset's outputs inside its folder: not a record of its
+    return {path.parts[0] for path in paths}
 
 
 # A file stem that ends in a number, and the text before it: "mesh_0048" -> "mesh_".

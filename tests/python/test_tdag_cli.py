@@ -73,7 +73,6 @@ def test_play_prints_every_level(built, capsys):
 @pytest.mark.parametrize(
     "arguments, message",
     [
-        (["query", "{dir}/bar.tdag", "--frame", "6", "--tolerance", "0.1", "-o", "{dir}/x.obj"], "frame: 6 outside"),
         (["query", "{dir}/bar.tdag", "--frame", "0", "--tolerance", "-1", "-o", "{dir}/x.obj"], "--tolerance"),
         (["query", "{dir}/bar.npz", "--frame", "0", "--tolerance", "1", "-o", "{dir}/x.obj"], "not a TDAG file"),
         (["query", "{dir}/bar.tdag", "--frame", "0", "--tolerance", "1", "-o", "{dir}/x.stl"], "expected an .obj"),
@@ -88,6 +87,32 @@ def test_user_mistakes_exit_2_with_one_line(built, capsys, arguments, message):
     assert main(["tdag", *[a.format(dir=built) for a in arguments]]) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        (["--frame", "6", "--tolerance", "0.1"], "bar.tdag: --frame 6 outside the frames 0 to 5"),
+        (["--frame", "-1", "--tolerance", "0.1"], "bar.tdag: --frame -1 outside the frames 0 to 5"),
+        (["--frame", "1", "--from-frame", "9", "--level", "2", "--tolerance", "0.1"],
+         "bar.tdag: --from-frame 9 outside the frames 0 to 5"),
+        (["--frame", "1", "--faces", "0"], "bar.tdag: faces: expected a whole number"),  # the core's check
+    ],
+)  # fmt: skip
+def test_query_errors_name_the_tdag_file_and_the_option(built, capsys, arguments, message):
+    """A frame out of range was "frame: 6 outside [0, 6)": no file, and --from-frame's blamed --frame."""
+    assert main(["tdag", "query", str(built / "bar.tdag"), *arguments, "-o", str(built / "x.obj")]) == 2
+    err = capsys.readouterr().err
+    assert f"animlod tdag: error: {built}/{message}" in err and err.count("\n") == 1
+
+
+def test_query_refuses_a_view_with_a_plot_before_writing_the_mesh(built, capsys):
+    """--plot draws tolerances, not a view: the OBJ was written before --camera --plot was refused."""
+    target = built / "view.obj"
+    arguments = ["--frame", "1", "--tolerance", "0.1", "--camera", "0", "0", "5", "--plot", "-o", str(target)]
+    assert main(["tdag", "query", str(built / "bar.tdag"), *arguments]) == 2
+    assert "--plot: draws tolerances, not a view; drop --camera" in capsys.readouterr().err
+    assert not target.exists()
 
 
 def test_build_from_a_gltf_of_several_clips_says_which_one_it_took(tmp_path, capsys):

@@ -209,7 +209,7 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as stop:  # --help (0), or the one-line usage error of _Parser (2)
         return int(stop.code or 0)
-    source = getattr(args, "input", None) or getattr(args, "path", None)
+    source = getattr(args, "input", None) or getattr(args, "path", None) or getattr(args, "tdag", None)
     if not isinstance(source, (str, os.PathLike)):
         source = None  # e.g. crowd's --path, a list of navigation paths, names no input file
     output = getattr(args, "output", None)

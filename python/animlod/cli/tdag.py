@@ -94,8 +94,9 @@ def _governing(text: str) -> str | int:
 
 def read_animation(path: str):
     """The deforming mesh of ``path``: OBJ/PLY frames, an NPZ, or a glTF's first morph-animated
-    mesh (baked frames) or its body's skinned mesh (``GltfScene.body``) baked with its first
-    animation."""
+    mesh without a skin (baked frames, under its node's animation) or its body's skinned mesh
+    baked with its first clip, skin and morph weights as the clip moves them (the drawable reader's
+    clips; a clip of morph weights alone holds the skeleton at rest)."""
     from ..io.detect import input_kind
 
     kind = input_kind(path)
@@ -109,18 +110,25 @@ def read_animation(path: str):
         from ..io.meshseq import read_sequence
 
         return read_sequence(path)
-    from ..io.gltf import read_gltf
+    from ..io.gltf_document import GltfDocument
+    from ..io.gltf_drawable import read_drawables
+    from ..io.gltf_read import body_node, read_unskinned_meshes
 
-    scene = read_gltf(path)
-    if scene.morph_animations:
-        mesh, others = scene.morph_animations[0], len(scene.morph_animations) - 1
+    doc = GltfDocument(path)
+    morph_animations, _ = read_unskinned_meshes(doc)
+    if morph_animations:
+        mesh, others = morph_animations[0], len(morph_animations) - 1
         taken = "the first morph-animated mesh and clip"
-    elif scene.skinned_meshes and scene.motions:
-        mesh = scene.skinned_meshes[scene.body].bake(scene.motions[0])
-        others = sum(len(motions) for motions in scene.skinned_motions) - 1
-        taken = f"the body's skinned mesh baked with its first clip, {scene.motions[0].name or 'unnamed'!r}"
     else:
-        raise UserError(f"{path}: no morph-animated mesh and no animated skinned mesh to build a TDAG of")
+        animated = [drawable for drawable in read_drawables(doc) if drawable.skinned is not None and drawable.clips]
+        if not animated:
+            raise UserError(f"{path}: no morph-animated mesh and no animated skinned mesh to build a TDAG of")
+        body = body_node(doc, [drawable.nodes[0] for drawable in animated])
+        drawable = next(drawable for drawable in animated if drawable.nodes[0] == body)
+        clip = drawable.clips[0]
+        mesh = drawable.skinned.bake(clip.motion, clip.morph_weights)
+        others = sum(len(drawable.clips) for drawable in animated) - 1
+        taken = f"the body's skinned mesh baked with its first clip, {clip.name or 'unnamed'!r}"
     if others:  # a TDAG is one mesh over one run of frames
         print(f"note: {path}: the TDAG is of {taken}; {others} other (mesh, clip) pair{'s' if others > 1 else ''} "
               "left out", file=sys.stderr)  # fmt: skip
@@ -196,20 +204,31 @@ def _load(path: str):
     return TemporalDag.load(path)
 
 
+def _check_frame(dag, path: str, option: str, frame: int) -> None:
+    if not 0 <= frame < dag.frame_count:
+        raise UserError(f"{path}: {option} {frame} outside the frames 0 to {dag.frame_count - 1}")
+
+
 def run_query(args: argparse.Namespace) -> int:
     from ..io.meshseq import write_mesh
 
-    dag = _load(args.tdag)
+    # Combinations of options are refused before any work: nothing is written for a refused query.
+    if args.faces is not None and (args.camera is not None or args.relative):
+        raise UserError("--faces: sets the tolerance itself; drop " + ("--camera" if args.camera else "--relative"))
+    if args.plot and args.camera is not None:
+        raise UserError("--plot: draws tolerances, not a view; drop --camera")
     output = Path(args.output)
     if output.suffix.lower() not in (".obj", ".ply"):
         raise UserError(f"{output}: expected an .obj or .ply output")
+    dag = _load(args.tdag)
+    _check_frame(dag, args.tdag, "--frame", args.frame)
+    if args.from_frame is not None:
+        _check_frame(dag, args.tdag, "--from-frame", args.from_frame)
     # Levels 1-2 keep the cut of an earlier frame (and its face count).
     start = args.from_frame if args.from_frame is not None else max(args.frame - 1, 0)
     cut_frame = args.frame if args.level == 3 else start
     if args.faces is None:
         tolerance = _tolerance(dag, args.tolerance, args.relative)
-    elif args.camera is not None or args.relative:
-        raise UserError("--faces: sets the tolerance itself; drop " + ("--camera" if args.camera else "--relative"))
     else:
         tolerance = dag.tolerance_for_faces(cut_frame, args.faces)
     what = f"tolerance {tolerance:.4g}" + (f" (for at most {args.faces} faces)" if args.faces else "")
@@ -231,8 +250,6 @@ def run_query(args: argparse.Namespace) -> int:
     if args.plot:
         from ..tdag import plot_tolerances
 
-        if args.camera is not None:
-            raise UserError("--plot: draws tolerances, not a view; drop --camera")
         picture = output.with_name(f"{output.stem}_tolerances.png")
         plot_tolerances(dag, args.frame, [tolerance / 4, tolerance, tolerance * 4], picture)
         print(f"wrote {picture}")
@@ -244,8 +261,7 @@ def run_play(args: argparse.Namespace) -> int:
     tolerance = _tolerance(dag, args.tolerance, args.relative)
     # The walk starts at --first-frame and measures the frames after it: none after it would print
     # a table of zeros measured over nothing.
-    if not 0 <= args.first_frame < dag.frame_count:
-        raise UserError(f"{args.tdag}: --first-frame {args.first_frame} outside the frames 0 to {dag.frame_count - 1}")
+    _check_frame(dag, args.tdag, "--first-frame", args.first_frame)
     if args.first_frame == dag.frame_count - 1:
         raise UserError(
             f"{args.tdag}: --first-frame {args.first_frame} leaves no frame to play after it "

@@ -5,7 +5,8 @@ What a file becomes:
 - every (mesh, skin) pair used by a node -> a :class:`SkinnedMesh` on the skin's skeleton
   (:mod:`.gltf_skin`), with one :class:`Motion` per animation that moves it;
 - every mesh without a skin whose morph weights are animated -> one :class:`AnimatedMesh` per
-  animation, the targets baked at ``fps`` (rest + sum_i w_i * delta_i);
+  animation, the targets baked at ``fps`` (rest + sum_i w_i * delta_i) and placed by the node's
+  world transform as that animation moves the node and its ancestors;
 - every other mesh without a skin -> a one-frame :class:`AnimatedMesh`.
 
 Placement follows what a glTF viewer shows. A skinned mesh's node transform does not affect
@@ -24,7 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import AnimatedMesh, Motion, SkinnedMesh
-from .gltf_document import GltfDocument
+from .errors import FormatError
+from .gltf_document import NODE_PATHS, GltfDocument
 from .gltf_keyframes import sample_keyframes
 from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_normals, transform_points
 from .gltf_skin import SkinRig
@@ -40,7 +42,7 @@ class GltfScene:
     motions : the animations on the skeleton of the body, ``skinned_meshes[body]`` (empty
         without skins).
     morph_animations : meshes without a skin whose morph weights an animation drives, baked
-        at ``fps``, one per (node, animation).
+        at ``fps`` under the node's world transform in that animation, one per (node, animation).
     static_meshes : the other meshes without a skin, one frame each, in world space.
     skinned_motions : the animations of every skinned mesh, parallel to ``skinned_meshes``.
     skinned_nodes : the node that draws each skinned mesh, parallel to ``skinned_meshes``.
@@ -80,8 +82,8 @@ def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> Gltf
         mesh, motions = read_skinned_node(doc, node, rigs[skin], fps)
         skinned.append(mesh)
         skinned_motions.append(motions)
-    morph_animations, static_meshes = _read_unskinned_meshes(doc, fps)
-    body = nodes.index(_body_node(doc, nodes)) if nodes else 0
+    morph_animations, static_meshes = read_unskinned_meshes(doc, fps)
+    body = nodes.index(body_node(doc, nodes)) if nodes else 0
     return GltfScene(
         skinned_meshes=skinned,
         motions=skinned_motions[body] if skinned_motions else [],
@@ -111,7 +113,7 @@ def read_skinned(
     if not chosen:
         available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes}))
         raise doc.fail(f"skin {skin!r}", f"not in the file (skinned meshes use skins: {available})")
-    node = _body_node(doc, chosen)
+    node = body_node(doc, chosen)
     return read_skinned_node(doc, node, SkinRig(doc, doc.gltf.nodes[node].skin), fps)
 
 
@@ -127,7 +129,7 @@ def _skinned_mesh_nodes(doc: GltfDocument) -> list[int]:
     return nodes
 
 
-def _body_node(doc: GltfDocument, nodes: list[int]) -> int:
+def body_node(doc: GltfDocument, nodes: list[int]) -> int:
     """The node of ``nodes`` that draws the character's body: the one whose skin lists the most
     joints the animations move, then the most joints, the first in node order among equals. A
     visor skinned to a few head joints, or hair to a hundred hair bones that only a runtime's
@@ -245,8 +247,9 @@ def on_first_joint_when_unweighted(weights: np.ndarray) -> np.ndarray:
     return weights
 
 
-def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[AnimatedMesh], list[AnimatedMesh]]:
-    """Morph-animated meshes (one per node and animation) and static meshes, in world space."""
+def read_unskinned_meshes(doc: GltfDocument, fps: float = 30.0) -> tuple[list[AnimatedMesh], list[AnimatedMesh]]:
+    """Morph-animated meshes (one per node and animation, :attr:`GltfScene.morph_animations`) and
+    static meshes (:attr:`GltfScene.static_meshes`), in world space."""
     morphs, statics = [], []
     geometries: dict[int, MeshGeometry] = {}
     for node_index, node in enumerate(doc.gltf.nodes or []):
@@ -260,7 +263,9 @@ def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[Animated
         faces = geometry.faces[:, ::-1] if np.linalg.det(world[:3, :3]) < 0.0 else geometry.faces
         tracks = [] if geometry.targets is None else morph_weight_tracks(doc, node_index, len(geometry.targets), fps)
         for animation, weights in tracks:
-            frames = transform_points(world, geometry.positions + np.einsum("tn,nvc->tvc", weights, geometry.targets))
+            worlds = _animated_world_matrices(doc, node_index, animation, fps)
+            positions = geometry.positions + np.einsum("tn,nvc->tvc", weights, geometry.targets)
+            frames = positions @ np.swapaxes(worlds[:, :3, :3], 1, 2) + worlds[:, None, :3, 3]
             label = f"{doc.node_label(node_index)} {doc.animation_label(animation)}"
             morphs.append(_animated_mesh(doc, label, faces, frames, fps))
         if not tracks:
@@ -271,6 +276,42 @@ def _read_unskinned_meshes(doc: GltfDocument, fps: float) -> tuple[list[Animated
             frames = transform_points(world, positions)[None]
             statics.append(_animated_mesh(doc, doc.node_label(node_index), faces, frames, None))
     return morphs, statics
+
+
+def _animated_world_matrices(doc: GltfDocument, node: int, animation: int, fps: float) -> np.ndarray:
+    """(T, 4, 4) world transforms of node ``node`` in the frames of ``animation`` sampled at ``fps``.
+
+    The animated node tree (:class:`SkinRig` without a skin) poses the node's nearest joint, which
+    carries the node by its rest transform relative to that joint. The rest world transform is
+    held when the animation moves neither the node nor an ancestor, and, with a warning saying
+    that the node's own motion is left out, when the tree leaves that motion out (a mesh that
+    only scales, a tree beside the largest one) or is no skeleton animlod reads.
+    """
+    rest = doc.rest_world_matrix(node)
+    held = np.broadcast_to(rest, (len(doc.animation_frame_times(animation, fps)), 4, 4))
+    chain = [node, *doc.ancestors(node)]
+    moved = {target for target, path in doc.channel_targets[animation] if path in NODE_PATHS}.intersection(chain)
+    if not moved:
+        return held
+    try:
+        rig = SkinRig(doc, None)
+    except FormatError:  # no skeleton to read: the moved nodes are meshes that only scale, or one scales to 0
+        rig = None
+    joint = None if rig is None else next((link for link in chain if link in rig.joint_nodes), None)
+    if joint is not None and moved.isdisjoint(chain[: chain.index(joint)]):
+        # The rigid skeleton's joints leave their rest scale and shape out; a skin's inverse binds
+        # carry them (SkinRig.rest_linear), and here an identity bind with them does.
+        binds = np.broadcast_to(np.eye(4), (len(rig.joint_nodes), 4, 4)).copy()
+        binds[:, :3, :3] = rig.rest_linear
+        joint_worlds = rig.motion(doc, animation, fps).skin_matrices(binds)[:, rig.joint_nodes.index(joint)]
+        return joint_worlds @ np.linalg.solve(doc.rest_world_matrix(joint), rest)
+    warnings.warn(
+        f"{doc.path}: {doc.node_label(node)} {doc.animation_label(animation)}: its morph-animated mesh is baked at the "
+        "node's rest transform, without the node's own motion, which the skeleton animlod reads from the animated "
+        "nodes leaves out (a mesh that only scales, a tree beside the largest one)",
+        stacklevel=4,
+    )
+    return held
 
 
 def node_weights(doc: GltfDocument, node: int, mesh_weights: np.ndarray) -> np.ndarray:

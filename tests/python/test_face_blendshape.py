@@ -9,12 +9,14 @@ import pygltflib
 import pytest
 
 from animlod.face_lod import BlendshapeFace, BlendshapeLodOptions, build_blendshape_lod, procedural_face, rank_targets
-from animlod.face_lod.blendshape import measure_blendshape_lod, prune_levels, target_contributions
+from animlod.face_lod.blendshape import measure_blendshape_lod, one_at_a_time, prune_levels, target_contributions
 from animlod.face_lod.lod_glb import gltf_face_levels, read_gltf_face, write_gltf_face_lod
+from animlod.face_lod.measure import measured_frames
 from animlod.face_lod.mpa import expression_sequence
 from animlod.face_lod.sources import pose_files, read_pose_face
 from animlod.io import write_obj
 from animlod.io.errors import FormatError
+from animlod.synth import icosphere
 
 
 @pytest.fixture(scope="module")
@@ -89,6 +91,25 @@ def test_the_input_level_is_not_measured(face, monkeypatch):
     copy = dataclasses.replace(levels[0], neutral=levels[0].neutral.copy())
     measure_blendshape_lod(face, [copy], repeats=1, max_frames=4, samples=500)
     assert len(measured) == 2
+
+
+def test_errors_are_measured_where_every_target_peaks():
+    """A pose folder's animation raises one target at a time from rest and back (15 frames
+    each): of its 45 frames, 4 evenly spaced ones (0, 15, 29, 44) are all at rest, which
+    reported the coarsest level (no targets) at its rest error, 0.28% for face-poses against
+    18.9% over every frame."""
+    positions, faces = icosphere(2, 0.1)
+    targets = np.broadcast_to(0.02 * np.eye(3)[:, None], (3, len(positions), 3))  # shifts along x, y, z
+    face = BlendshapeFace(positions, faces, targets, ["x", "y", "z"], one_at_a_time(3))
+    weights = face.weights.copy()
+    weights[:, 1] *= -1.0  # a clip may drive a target below zero: its peak is its largest |weight|
+    np.testing.assert_array_equal(np.abs(weights[measured_frames(weights, 4)]).max(axis=0), [1.0, 1.0, 1.0])
+    levels = build_blendshape_lod(face, BlendshapeLodOptions(ratios=(0.5,)))
+    assert levels[-1].kept_targets.size == 0
+    few = measure_blendshape_lod(face, levels, repeats=1, max_frames=4, samples=500)
+    every = measure_blendshape_lod(face, levels, repeats=1, max_frames=len(face.weights), samples=500)
+    assert few[-1].hausdorff_units == pytest.approx(every[-1].hausdorff_units, rel=1e-3)
+    assert few[-1].hausdorff_units > 0.019  # a whole target's 0.02 shift, not the rest pose's error
 
 
 def test_targets_that_only_turn_normals_are_kept(face):

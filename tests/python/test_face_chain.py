@@ -106,6 +106,16 @@ def test_table_one_measurement(chain, animation):
     assert errors[0] == 0.0 and errors == sorted(errors) and errors[-1] > 0.0
 
 
+def test_measured_frames_hold_every_mpas_peak(chain, animation):
+    """The expression sequence rises from rest and falls back: its first and last frames, the
+    two evenly spaced ones, are both at rest, and measured alone the active tree lost nothing."""
+    sampled = every_nth(animation, 2)
+    peaks = np.abs(animation.intensities).max(axis=0)
+    np.testing.assert_array_equal(np.abs(sampled.intensities).max(axis=0), peaks)
+    assert sampled.frame_count < animation.frame_count
+    assert animation_errors(chain, sampled) == animation_errors(chain, animation)
+
+
 def test_projected_coverage_and_thresholds():
     camera = Camera()
     near, far = projected_coverage(0.12, 0.5, camera), projected_coverage(0.12, 5.0, camera)

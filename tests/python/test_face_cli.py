@@ -11,6 +11,16 @@ from gltf_edits import append_accessor, edit_glb
 
 from animlod.cli import main
 from animlod.io import write_obj
+from animlod.synth import icosphere
+
+
+def _bulging_poses(folder):
+    """A pose folder: a sphere as the neutral face and one expression bulging its top."""
+    positions, faces = icosphere(2, 0.1)
+    folder.mkdir()
+    write_obj(folder / "neutral.obj", positions, faces)
+    write_obj(folder / "bulge.obj", positions * (1.0 + 0.2 * np.clip(positions[:, 1:2] / 0.1, 0, 1)), faces)
+    return folder
 
 
 def test_face_procedural_writes_levels_manifest_and_plot(tmp_path, capsys):
@@ -43,14 +53,7 @@ def test_face_procedural_writes_levels_manifest_and_plot(tmp_path, capsys):
 
 
 def test_face_pose_folder(tmp_path, capsys):
-    from animlod.synth import icosphere
-
-    positions, faces = icosphere(2, 0.1)
-    poses = tmp_path / "poses"
-    poses.mkdir()
-    write_obj(poses / "neutral.obj", positions, faces)
-    bulge = positions * (1.0 + 0.2 * np.clip(positions[:, 1:2] / 0.1, 0, 1))
-    write_obj(poses / "bulge.obj", bulge, faces)
+    poses = _bulging_poses(tmp_path / "poses")
     out = str(tmp_path / "out")
     arguments = ["face", str(poses), "-o", out, "--ratio", "0.5", "--repeats", "1", "--error-frames", "4"]
     assert main(arguments) == 0
@@ -78,6 +81,48 @@ def test_face_pose_folder(tmp_path, capsys):
     assert main(["face", str(head), "-o", str(tmp_path / "head"), "--ratio", "0.5", "--repeats", "1"]) == 0
     printed = capsys.readouterr().out
     assert "the face is mesh 0 'face' (320 triangles" in printed and "written unchanged: mesh 2 'eye'" in printed
+
+
+def test_face_run_that_cannot_write_every_file_writes_none(tmp_path, capsys):
+    """The LoD GLB, the manifest(s) and the picture land together: before, each was renamed into
+    place as it was written, so a run failing on its last file left the new GLB beside an earlier
+    run's manifest, and the error named the hidden temporary."""
+    poses = _bulging_poses(tmp_path / "poses")
+    out = tmp_path / "out"
+    quick = ["--repeats", "1", "--error-frames", "2"]
+    assert main(["face", str(poses), "-o", str(out), "--ratio", "0.5", *quick]) == 0
+    earlier = {path.name: path.read_bytes() for path in out.iterdir()}
+    assert sorted(earlier) == ["poses_face_lod.json", "poses_lod.glb"]
+    capsys.readouterr()
+    (out / "poses_face_lod.png").mkdir()  # the picture, written last, cannot land
+    assert main(["face", str(poses), "-o", str(out), "--ratio", "0.25", "--plot", *quick]) == 2
+    assert capsys.readouterr().err == f"animlod face: error: {out / 'poses_face_lod.png'}: Is a directory\n"
+    assert {path.name: path.read_bytes() for path in out.iterdir() if path.is_file()} == earlier
+    assert sorted(path.name for path in out.iterdir()) == ["poses_face_lod.json", "poses_face_lod.png", "poses_lod.glb"]
+    # The procedural face: its GLB and manifest do not land without the active tree's manifest.
+    procedural = tmp_path / "procedural"
+    (procedural / "face_lod_animation.json").mkdir(parents=True)
+    assert main(["face", "-o", str(procedural), *quick]) == 2
+    assert f"{procedural / 'face_lod_animation.json'}: Is a directory" in capsys.readouterr().err
+    assert [path.name for path in procedural.iterdir()] == ["face_lod_animation.json"]
+
+
+def test_face_of_fewer_triangles_than_levels(tmp_path, capsys):
+    """A 2-triangle pose folder was refused ("target_face_counts: 4 outside [1, 2]", an option
+    never given: the levels were made at least 4 triangles) while the same face as a glTF was
+    not; both get levels of one triangle, said in a note."""
+    poses = tmp_path / "square"
+    poses.mkdir()
+    square, faces = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float), [[0, 1, 2], [0, 2, 3]]
+    write_obj(poses / "neutral.obj", square, faces)
+    write_obj(poses / "up.obj", square + [0, 0, 0.5], faces)
+    for source in (poses, tmp_path / "out" / "square_lod.glb"):  # the second written by the first run
+        assert main(["face", str(source), "-o", str(tmp_path / "out"), "--repeats", "1"]) == 0
+        printed = capsys.readouterr().out
+        assert "levels 2, 3: no fewer triangles than the level before (2 / 1 / 1 / 1)" in printed
+        levels = json.loads((tmp_path / "out" / f"{source.stem}_face_lod.json").read_text())["levels"]
+        assert [level["triangles"] for level in levels] == [2, 1, 1, 1]
+        assert [level["targets"] for level in levels] == [["up"], ["up"], ["up"], []]
 
 
 def test_face_user_mistakes_exit_2_with_one_line(tmp_path, capsys):

@@ -18,8 +18,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "already lost as much. With a .glb/.gltf with morph targets, or a folder of OBJ/PLY poses (the "
             "neutral face named *neutral*/*reference*, else after its folder, else the first; then the "
             "expressions): targets ranked by the largest displacement they cause, the least important pruned per "
-            "level, the mesh simplified with the kept targets carried. Writes one GLB per level (morph targets), a "
-            "JSON manifest and a table of sizes, time per frame and surface error against the full face."
+            "level, the mesh simplified with the kept targets carried. Writes one LoD GLB (the levels attached by "
+            "MSFT_lod, with morph targets), a JSON manifest and a table of sizes, time per frame and surface error "
+            "against the full face; the files land together, or none if the run fails."
         ),
     )
     parser.add_argument("input", nargs="?", help="a .glb/.gltf with morph targets or a folder of poses "
@@ -45,7 +46,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--error-frames",
         type=int,
         default=24,
-        help="animation frames the surface error is measured on, evenly spaced (default 24)",
+        help="animation frames the surface error is measured on, evenly spaced (default 24); the frame where "
+        "each target (MPA for the procedural face) has its largest weight is measured too",
     )
     parser.set_defaults(run=run)
 

@@ -32,8 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..aqem import simplify_animated
-from ..model import AnimatedMesh, spread_frames
+from ..model import AnimatedMesh
 from .grow import GrowOptions, grow_regions, motion_of_targets
+from .measure import measured_frames
 from .regions import FaceRegions
 
 
@@ -202,27 +203,29 @@ def target_regions(face: BlendshapeFace, options: GrowOptions | None = None) -> 
 
 
 def build_blendshape_lod(face: BlendshapeFace, options: BlendshapeLodOptions | None = None) -> list[BlendshapeLevel]:
-    """Levels of ``face``, the input first: each with fewer triangles and no more targets.
+    """Levels of ``face``, the input first: each with no more triangles and no more targets.
+    A level has fewer triangles than the one before unless the face is too small for its ratio
+    (a level keeps one triangle at least) or AQEM finds no legal collapse left.
 
     Raises ValueError for fractions of the wrong length or outside [0, 1] and whatever AQEM
     rejects (naming the element).
     """
     options = options or BlendshapeLodOptions()
-    counts = (
-        checked_face_counts(options.face_counts, len(face.faces))
-        if options.face_counts is not None
-        else [max(4, round(r * len(face.faces))) for r in options.ratios]
-    )
-    check_fractions(options.target_fractions, len(counts) + 1)
+    if options.face_counts is not None:
+        sizes = {"target_face_counts": checked_face_counts(options.face_counts, len(face.faces))}
+    else:  # the core rounds ratios to triangle counts, one at least, as for glTF faces
+        sizes = {"target_ratios": list(options.ratios)}
+    [requested] = sizes.values()
+    check_fractions(options.target_fractions, len(requested) + 1)
     everything = np.arange(face.target_count)
     identity = np.arange(face.vertex_count, dtype=np.int32)
     levels = [BlendshapeLevel(face.faces, face.neutral, face.targets, everything, identity, face.uvs, 0.0, 0.0)]
-    if not counts:
+    if not requested:
         return levels
     importance = None
     if options.grow is not None and face.target_count and np.any(face.targets):
         importance = target_regions(face, options.grow).vertex_importance()
-    levels += _simplified_levels(face, counts, importance)
+    levels += _simplified_levels(face, sizes, importance)
     prune_levels(face, levels, options)
     return levels
 
@@ -278,20 +281,23 @@ def prune_levels(
         level.targets = np.ascontiguousarray(level.targets[kept])
 
 
-def _simplified_levels(face: BlendshapeFace, counts: list[int], importance: np.ndarray | None) -> list[BlendshapeLevel]:
+def _simplified_levels(
+    face: BlendshapeFace, sizes: dict[str, list], importance: np.ndarray | None
+) -> list[BlendshapeLevel]:
     """One AQEM run over the neutral face and every target at its reach weight, carrying UVs
     (attributes: copies with other UVs form seams) and every target's deltas (position
-    attributes); one level per count, every target still attached."""
+    attributes); one level per size (``sizes``: ``target_ratios`` or ``target_face_counts``, as
+    :func:`animlod.simplify_animated` takes them), every target still attached."""
     reach = face.reach_weights()
     frames = np.concatenate([face.neutral[None], face.neutral[None] + reach[:, None, None] * face.targets])
     result = simplify_animated(
         AnimatedMesh(face.faces, frames),
-        target_face_counts=counts,
         importance=importance,
         attributes=face.uvs,
         position_attributes=face.targets.transpose(1, 0, 2).reshape(face.vertex_count, -1),
         placement="on_edge",
         record_positions=False,
+        **sizes,
     )
     levels = []
     for level in result.levels:
@@ -334,13 +340,14 @@ def measure_blendshape_lod(
 ) -> list[BlendshapeMeasurement]:  # fmt: skip
     """Per level: the largest (and median) time to blend one frame over the whole animation
     (numpy, the fastest of ``repeats`` runs per frame) and the largest symmetric Hausdorff
-    distance to the full face over up to ``max_frames`` evenly spaced frames, relative to its
+    distance to the full face over ``max_frames`` evenly spaced frames and each target's
+    peak-weight frame (:func:`~animlod.face_lod.measure.measured_frames`), relative to its
     bounding-box diagonal. A level that is the input itself (its arrays, every target) is not
     measured: its error is 0 (measuring it gave float rounding, 5e-10 of face-poses' size, at a
     quarter of the measuring time)."""
     from ..metrics import surface_error
 
-    picked = spread_frames(len(face.weights), max_frames)
+    picked = measured_frames(face.weights, max_frames)
     weights = face.weights[picked]
     reference = face.frames(weights)
     rows = []

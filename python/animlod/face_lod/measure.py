@@ -109,10 +109,11 @@ def measure_level(
     times: np.ndarray | None = None,
 ) -> LevelMeasurement:
     """Measure one (geometry, animation) level pair: time over every frame of ``animation``,
-    error over ``error_frames`` evenly spaced ones (0: all); ``reference`` is the full face
-    animated at full detail over those frames (computed when None); ``focus (V,) bool`` marks the
-    full face's vertices whose distance to the level is reported as ``focus_error``; ``times``
-    (T,) are the frame times when already measured (:func:`time_animators`)."""
+    error over ``error_frames`` evenly spaced ones and each MPA's peak (0: all; :func:`every_nth`);
+    ``reference`` is the full face animated at full detail over those frames (computed when
+    None); ``focus (V,) bool`` marks the full face's vertices whose distance to the level is
+    reported as ``focus_error``; ``times`` (T,) are the frame times when already measured
+    (:func:`time_animators`)."""
     sampled = every_nth(animation, error_frames)
     if reference is None:
         reference = animate(chain.animator(0, 0), chain.rig.faces, sampled)
@@ -174,11 +175,28 @@ def measure_chain(
     ]
 
 
+def measured_frames(weights: np.ndarray, count: int) -> np.ndarray:
+    """Sorted indices of the frames an animation's error is measured on, for ``weights (T, N)``
+    (blendshape weights or MPA intensities): ``count`` evenly spaced frames and, besides them,
+    the frame where each driven target or MPA has its largest absolute weight; every frame when
+    ``count`` is 0 or at least T.
+
+    Evenly spaced frames alone can miss every peak: a pose folder's animation raises one target
+    at a time from rest and back, and 4 of its 45 frames were all rest poses."""
+    frame_count = len(weights)
+    if count <= 0 or count >= frame_count:
+        return np.arange(frame_count)
+    magnitudes = np.abs(weights)
+    peaks = magnitudes.argmax(axis=0)[magnitudes.max(axis=0) > 0.0]
+    return np.union1d(spread_frames(frame_count, count), peaks)
+
+
 def every_nth(animation: MpaAnimation, count: int) -> MpaAnimation:
-    """At most ``count`` evenly spaced frames of ``animation`` (all of them when ``count`` is 0)."""
-    if count <= 0 or count >= animation.frame_count:
+    """The frames of ``animation`` its errors are measured on (:func:`measured_frames`: ``count``
+    evenly spaced ones and each MPA's peak; all of them when ``count`` is 0)."""
+    picked = measured_frames(animation.intensities, count)
+    if len(picked) == animation.frame_count:
         return animation
-    picked = spread_frames(animation.frame_count, count)
     return MpaAnimation(animation.mpa_names, animation.intensities[picked], animation.fps)
 
 

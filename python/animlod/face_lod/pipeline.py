@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.atomic import staged_files
 from .blendshape import (
     BlendshapeLevel,
     BlendshapeLodOptions,
@@ -75,16 +76,18 @@ def run_face_lod(
     Parameters
     ----------
     source : None for the procedural face, a .glb/.gltf with morph targets, or a pose folder.
-    output : folder for the files (created when the first one is written).
+    output : folder for the files (created when they are written, together at the end: a run
+        that fails writes none of them).
     ratios, face_counts : triangle fractions or counts of the levels after the full face.
     target_fractions : blendshape faces: fraction of targets kept per level (the full face included).
     neutral : pose folders: the file name of the neutral face.
     plot : also write a PNG with every level showing one expression.
     expression : the expression (procedural face) or target (blendshape face) to plot.
     repeats : timing runs per frame (the fastest is kept).
-    error_frames : animation frames the surface error is measured on, at most.
+    error_frames : evenly spaced animation frames the surface error is measured on, besides
+        each target's (or MPA's) peak-weight frame (:func:`animlod.face_lod.measure.measured_frames`).
     """
-    output = Path(output)  # created by the first file written (io.atomic), so a refused run leaves nothing
+    output = Path(output)  # created only by the writing (io.atomic.staged_files), so a refused run leaves nothing
     if source is None:
         return _run_procedural(output, ratios, face_counts, plot, expression, repeats, error_frames)
     return _run_blendshape(
@@ -118,7 +121,7 @@ def _run_procedural(output, ratios, face_counts, plot, expression, repeats, erro
         [],
     )  # fmt: skip
     manifest, as_blendshapes = [], []
-    glb = output / "face_lod.glb"
+    glb = Path("face_lod.glb")
     for row, threshold in zip(measured, thresholds):
         g = row.geometry_level
         level = chain.geometry[g]
@@ -135,33 +138,33 @@ def _run_procedural(output, ratios, face_counts, plot, expression, repeats, erro
             "active_regions": sorted(chain.tree.active(row.animation_level)),
             "lattices": {name: "2x2x2" if name in level.reduced else "3x3x3" for name in animator.regions},
         })  # fmt: skip
-    write_new_face_lod(glb, as_blendshapes, rig.mpa_names, animation.intensities, animation.fps,
-                       [row.hausdorff_units for row in measured], thresholds, "expressions")  # fmt: skip
-    manifest_path = output / "face_lod.json"
-    write_lod_manifest(manifest_path, "face", manifest)
-    run.files += [glb, manifest_path]
     # The active tree's levels with their own errors and thresholds: a runtime picks the animation
     # level from the coverage too, then lowers it to the geometry level's floor (Figure 6).
     errors = animation_errors(chain, every_nth(animation, error_frames))
     animation_thresholds = coverage_thresholds(errors, radius, Camera(), PIXEL_TOLERANCE)
-    tree_path = output / "face_lod_animation.json"
-    write_lod_manifest(tree_path, "face_animation", [
-        {"regions": sorted(chain.tree.active(k)), "error": error, "screen_coverage": threshold}
-        for k, (error, threshold) in enumerate(zip(errors, animation_thresholds))
-    ])  # fmt: skip
-    run.files.append(tree_path)
     run.notes.append(
         "active tree levels (regions animated, largest vertex error in asset units): "
         + "; ".join(f"{k}: {len(chain.tree.active(k))}, {e:.3g}" for k, e in enumerate(errors))
     )
-    if chosen is not None:
-        weights = expression_intensities(chosen, rig.mpa_names)
-        panels = [
-            (chain.animator(g).frame(weights), chain.geometry[g].faces, chain.geometry[g].face_regions,
-             f"level {g}: {chain.geometry[g].triangle_count} triangles, {run.rows[g][3]} regions")
-            for g in range(len(chain.geometry))
-        ]  # fmt: skip
-        run.files.append(_plot(output / "face_lod.png", panels, f"procedural face, {chosen.name}"))
+    written = [glb, Path("face_lod.json"), Path("face_lod_animation.json")]
+    with staged_files(output) as staged:  # every file lands together, or none
+        write_new_face_lod(staged / glb, as_blendshapes, rig.mpa_names, animation.intensities, animation.fps,
+                           [row.hausdorff_units for row in measured], thresholds, "expressions")  # fmt: skip
+        write_lod_manifest(staged / written[1], "face", manifest)
+        write_lod_manifest(staged / written[2], "face_animation", [
+            {"regions": sorted(chain.tree.active(k)), "error": error, "screen_coverage": threshold}
+            for k, (error, threshold) in enumerate(zip(errors, animation_thresholds))
+        ])  # fmt: skip
+        if chosen is not None:
+            weights = expression_intensities(chosen, rig.mpa_names)
+            panels = [
+                (chain.animator(g).frame(weights), chain.geometry[g].faces, chain.geometry[g].face_regions,
+                 f"level {g}: {chain.geometry[g].triangle_count} triangles, {run.rows[g][3]} regions")
+                for g in range(len(chain.geometry))
+            ]  # fmt: skip
+            written.append(Path("face_lod.png"))
+            _plot(staged / written[-1], panels, f"procedural face, {chosen.name}")
+    run.files += [output / name for name in written]
     return run
 
 
@@ -203,14 +206,9 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
          "Hausdorff (% of diagonal)", "coverage >="],
         [],
         notes=[f"{source}: {face.vertex_count} vertices, {len(face.faces)} triangles, {face.target_count} targets, "
-               f"{len(face.weights)} animation frames", *read_notes],
+               f"{len(face.weights)} animation frames", *read_notes, *_repeated_sizes_note(source, levels)],
     )  # fmt: skip
-    glb = output / glb_name(source, "_lod")
-    if gltf is not None:
-        weights_note = write_gltf_face_lod(glb, gltf, gltf_levels, errors, thresholds)
-        run.notes += gltf_levels.notes + ([weights_note] if weights_note else [])
-    else:
-        write_new_face_lod(glb, levels, face.names, face.weights, face.fps, errors, thresholds, "expressions")
+    glb = Path(glb_name(source, "_lod"))
     manifest = []
     base = measured[0].median_frame_seconds
     for level, row, threshold in zip(levels, measured, thresholds):
@@ -220,20 +218,39 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
                          100 * row.hausdorff, threshold])  # fmt: skip
         manifest.append({"files": [glb.name], "triangles": row.triangles, "vertices": row.vertices,
                          "targets": names, "error": row.hausdorff_units, "screen_coverage": threshold})  # fmt: skip
-    manifest_path = output / f"{stem}_face_lod.json"
-    write_lod_manifest(manifest_path, "blendshape_face", manifest)
-    run.files += [glb, manifest_path]
-    if plot_weights is not None:
-        # Coloured by the regions grown from the targets' motion (the importance AQEM used).
-        regions = target_regions(face, options.grow) if options.grow and np.any(face.targets) else None
-        panels = [
-            (level.frame(plot_weights), level.faces,
-             None if regions is None else regions.subset(level.kept_vertices).face_regions(level.faces),
-             f"level {i}: {level.triangle_count} triangles, {len(level.kept_targets)} targets")
-            for i, level in enumerate(levels)
-        ]  # fmt: skip
-        run.files.append(_plot(output / f"{stem}_face_lod.png", panels, f"{stem}"))
+    written = [glb, Path(f"{stem}_face_lod.json")]
+    with staged_files(output) as staged:  # every file lands together, or none
+        if gltf is not None:
+            weights_note = write_gltf_face_lod(staged / glb, gltf, gltf_levels, errors, thresholds)
+            run.notes += gltf_levels.notes + ([weights_note] if weights_note else [])
+        else:
+            write_new_face_lod(staged / glb, levels, face.names, face.weights, face.fps, errors, thresholds,
+                               "expressions")  # fmt: skip
+        write_lod_manifest(staged / written[1], "blendshape_face", manifest)
+        if plot_weights is not None:
+            # Coloured by the regions grown from the targets' motion (the importance AQEM used).
+            regions = target_regions(face, options.grow) if options.grow and np.any(face.targets) else None
+            panels = [
+                (level.frame(plot_weights), level.faces,
+                 None if regions is None else regions.subset(level.kept_vertices).face_regions(level.faces),
+                 f"level {i}: {level.triangle_count} triangles, {len(level.kept_targets)} targets")
+                for i, level in enumerate(levels)
+            ]  # fmt: skip
+            written.append(Path(f"{stem}_face_lod.png"))
+            _plot(staged / written[-1], panels, f"{stem}")
+    run.files += [output / name for name in written]
     return run
+
+
+def _repeated_sizes_note(source: Path, levels: Sequence[BlendshapeLevel]) -> list[str]:
+    """A note naming the levels no smaller than the one before (a tiny face's), or none."""
+    counts = [level.triangle_count for level in levels]
+    repeated = (np.flatnonzero(np.diff(counts) >= 0) + 1).tolist()
+    if not repeated:
+        return []
+    return [f"{source}: level{'s' if len(repeated) > 1 else ''} {', '.join(map(str, repeated))}: no fewer triangles "
+            f"than the level before ({' / '.join(map(str, counts))}): the face is too small for the sizes asked (a "
+            "level keeps one triangle at least) or has no legal collapse left"]  # fmt: skip
 
 
 def _plot_weights(face, expression: str | None) -> np.ndarray:
@@ -248,13 +265,12 @@ def _plot_weights(face, expression: str | None) -> np.ndarray:
     return face.weights[int(np.argmax(motion))]
 
 
-def _plot(path: Path, panels, title: str) -> Path:
+def _plot(path: Path, panels, title: str) -> None:
     from .plots import Panel, plot_panels
 
     dense = max(len(faces) for _, faces, _, _ in panels) > 20000  # a wireframe would hide the surface
     plot_panels(path, [[Panel(positions, faces, text, colours) for positions, faces, colours, text in panels]],
                 title=title, wireframe=not dense)  # fmt: skip
-    return path
 
 
 def _radius(positions: np.ndarray) -> float:

@@ -160,7 +160,7 @@ EXPORTS = [
     ("ASE/MotionCaptureROM.ase", "motion", None),  # 3ds Max's Biped scale noise: shears of 2e-4
     ("OBJ/box_mat_with_spaces.obj", "simplify", "not UTF-8 text"),  # a material name in Latin-1
     ("Collada/cube_with_2UVs.DAE", "simplify", "TEXCOORD_0: VEC3"),
-    ("OBJ/spider.obj", "simplify", "the output refers to '.\\\\drkwood2.jpg' as the input did"),
+    ("OBJ/spider.obj", "simplify", "the output refers to where the input's '.\\\\drkwood2.jpg' does"),
 ]
 
 

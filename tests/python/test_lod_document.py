@@ -815,6 +815,21 @@ def test_embedded_images_take_the_type_their_bytes_say(humanoid_glb, tmp_path):
     assert [code for code, _, _ in problems(output)] == []
 
 
+def test_an_image_kept_by_its_uri_is_referred_to_from_the_outputs_folder(humanoid_glb, tmp_path):
+    """An image glTF has no type for (a .tga) or a missing one keeps its URI; written into another
+    folder (always so in `batch`, OUT/<name>/), the relative URI as the input had it named no file."""
+    (tmp_path / "textures").mkdir()
+    (tmp_path / "textures" / "skin tone.tga").write_bytes(bytes(18))
+    images = [{"uri": "textures/skin%20tone.tga"}, {"uri": "gone/eyes.png"}, {"uri": "https://example.com/a.png"}]
+    source = _edited(humanoid_glb, tmp_path, lambda js: js.__setitem__("images", images))
+    output = tmp_path / "out" / "hero" / "hero_lod.glb"
+    with pytest.warns(UserWarning):
+        simplify_document(source, output, [0.5], **QUICK)
+    written = GltfDocument(output).json["images"]
+    assert written == [{"uri": "../../textures/skin%20tone.tga"}, {"uri": "../../gone/eyes.png"}, images[2]]
+    assert (output.parent / "../../textures/skin tone.tga").is_file()
+
+
 def test_a_document_in_latin_1_is_read_with_a_warning_and_written_as_utf_8(humanoid_glb, tmp_path, capsys):
     # assimp's glTF exporter writes names in Latin-1 ("Terraind\xe6k" of its OBJ test set).
     data = humanoid_glb.read_bytes()

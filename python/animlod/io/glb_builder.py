@@ -17,6 +17,8 @@ import mimetypes
 import os
 import struct
 import warnings
+from pathlib import Path, PurePosixPath, PureWindowsPath
+from urllib.parse import quote, unquote, urlsplit
 
 import numpy as np
 
@@ -68,6 +70,9 @@ class GlbBuilder:
         self.json = document if document is not None else {"asset": {"version": "2.0", "generator": "animlod"}}
         self.blob = bytearray(blob)
         self.overwritten: set[int] = set()  # accessors whose data overwrite() replaced
+        # Images kept by a URI relative to the input document (not embedded): index -> the file
+        # it names, so that :meth:`save` can refer to it from wherever the output goes.
+        self.linked_images: dict[int, Path] = {}
 
     @classmethod
     def from_document(cls, doc: GltfDocument) -> GlbBuilder:
@@ -88,13 +93,15 @@ class GlbBuilder:
         for index, image in enumerate(builder.json.get("images", [])):
             found = _image_bytes(doc, index, image["uri"]) if "uri" in image else None
             if found is None:
+                builder._link(doc, index, image)
                 continue
             data, mime = found
             mime = image_type(data) or image.get("mimeType") or mime
             if mime is None:  # glTF needs the type of an embedded image: it stays as the input had it
                 uri = "its data URI" if image["uri"].startswith("data:") else repr(image["uri"])
                 warnings.warn(f"{doc.path}: image {index}: {uri} is of no image type glTF knows; "
-                              "the output refers to it as the input did", stacklevel=2)  # fmt: skip
+                              "the output refers to the same file", stacklevel=2)  # fmt: skip
+                builder._link(doc, index, image)
                 continue
             del image["uri"]
             image["bufferView"] = len(views)
@@ -103,6 +110,15 @@ class GlbBuilder:
         if views:
             builder.json["bufferViews"] = views
         return builder
+
+    def _link(self, doc: GltfDocument, index: int, image: dict) -> None:
+        """Remember the file ``image`` names when its URI is a path relative to ``doc``."""
+        uri = image.get("uri", "")
+        text = unquote(uri)
+        if not uri or urlsplit(uri).scheme or PurePosixPath(text).anchor or PureWindowsPath(text).anchor:
+            return  # a data URI, a URL or an absolute path: the same from anywhere
+        named = image_file(doc.path, uri) or uri_path(doc.path, uri.replace("\\", "/"))
+        self.linked_images[index] = Path(os.path.abspath(named))
 
     def _append(self, data: bytes) -> int:
         """Appends ``data`` at the next 4-byte boundary; its offset."""
@@ -233,7 +249,12 @@ class GlbBuilder:
         return _GLB_MAGIC + struct.pack("<II", _GLB_VERSION, 12 + len(chunks)) + chunks
 
     def save(self, path: str | os.PathLike) -> None:
-        """Writes the GLB atomically: ``path`` appears only once complete."""
+        """Writes the GLB atomically: ``path`` appears only once complete. An image kept by a
+        relative URI is referred to from ``path``'s folder (written elsewhere than the input, the
+        URI as the input had it named no file)."""
+        folder = os.path.abspath(Path(path).parent)
+        for index, linked in self.linked_images.items():
+            self.json["images"][index]["uri"] = quote(Path(os.path.relpath(linked, folder)).as_posix())
         data = self.to_bytes()
         with atomic_write(path, "wb") as handle:
             handle.write(data)
@@ -303,6 +324,6 @@ def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | 
             guess = _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0] or ""
             return path.read_bytes(), guess if guess.startswith("image/") else None  # not .tex's text/x-tex
     missing = uri_path(doc.path, uri.replace("\\", "/"))
-    warnings.warn(f"{doc.path}: image {index}: {missing} not found; the output refers to {uri!r} as the input did",
-                  stacklevel=3)  # fmt: skip
+    warnings.warn(f"{doc.path}: image {index}: {missing} not found; the output refers to where the input's "
+                  f"{uri!r} does", stacklevel=3)  # fmt: skip
     return None

@@ -19,6 +19,17 @@ def data_dir() -> Path:
     return DATA_DIR
 
 
+@pytest.fixture(scope="module")
+def client():
+    """A local Dask cluster of two workers for one module's batch runs."""
+    from animlod.batch import connect
+
+    client, cluster = connect(workers=2)
+    yield client
+    client.close()
+    cluster.close()
+
+
 @pytest.fixture(scope="session")
 def binary() -> Path:
     """The crowd benchmark's binary (skipped cleanly where it is not built or no display can run)."""

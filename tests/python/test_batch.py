@@ -16,7 +16,7 @@ pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
 from animlod import Motion, Skeleton, rotations, synth
-from animlod.batch import BatchProgress, SpecError, connect, read_catalogue, read_spec, run_batch
+from animlod.batch import BatchProgress, SpecError, read_catalogue, read_spec, run_batch
 from animlod.batch.jobs import check_options, find_job
 from animlod.cli import main
 from animlod.io import write_bvh, write_glb
@@ -42,14 +42,6 @@ def _arm_motion() -> Motion:
     for joint, axis in ((1, [1.0, 0, 0]), (2, [0, 0, 1.0]), (3, [1.0, 0, 0])):
         local[:, joint] = rotations.from_axis_angle(np.array(axis), np.linspace(0, 0.3 * joint, 8))
     return Motion(skeleton, np.tile([0.0, 1.0, 0.0], (8, 1)), local, fps=24.0)
-
-
-@pytest.fixture(scope="module")
-def client():
-    client, cluster = connect(workers=2)
-    yield client
-    client.close()
-    cluster.close()
 
 
 @pytest.fixture(scope="module")

@@ -13,20 +13,12 @@ pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
 from animlod import synth
-from animlod.batch import SpecError, connect, read_spec, run_batch
+from animlod.batch import SpecError, read_spec, run_batch
 from animlod.cli import main
 from animlod.io import write_glb
 from animlod.io.detect import ASSET_RECORD
 from animlod.io.meshseq import write_sequence
 from animlod.io.npz import write_npz
-
-
-@pytest.fixture(scope="module")
-def client():
-    client, cluster = connect(workers=1)
-    yield client
-    client.close()
-    cluster.close()
 
 
 def _bar(path: Path, rings: int = 10) -> Path:

@@ -107,7 +107,6 @@ void CrowdAnimator::start(const Mode& mode, const int* forced) {
     const Asset& asset = assets_[static_cast<size_t>(scene_.placements()[i].asset)];
     characters_[i].selectors.assign(asset.chains.size(), animlod::LodSelector(selector_options));
     characters_[i].levels.assign(asset.chains.size(), 0);
-    characters_[i].tints.assign(asset.chains.size(), 0);
   }
 }
 
@@ -183,15 +182,13 @@ void CrowdAnimator::animate(const Camera& camera, const animlod::LodCamera& lod_
       else if (subset.forced < 0 && chain.selection_count > 1 && chain.has_coverages)
         selected = character.selectors[c].select_by_coverage(subset.coverages.data(), subset.coverages.size(),
                                                              sphere.coverage);
-      const int level = subset.forced >= 0 ? subset.forced : subset.drawn[static_cast<size_t>(selected)];
-      character.levels[c] = level;
-      character.tints[c] = subset.forced >= 0 ? level : selected;
+      character.levels[c] = subset.forced >= 0 ? subset.forced : subset.drawn[static_cast<size_t>(selected)];
     }
     share_motion_levels(asset, character.levels);
     for (size_t c = 0; c < asset.chains.size(); ++c) {
       const Level& chosen = asset.chains[c].levels[static_cast<size_t>(character.levels[c])];
       counts.triangles += static_cast<int64_t>(asset.meshes[static_cast<size_t>(chosen.mesh)].triangle_count());
-      ++counts.levels[static_cast<size_t>(std::min(character.tints[c], 15))];
+      ++counts.levels[static_cast<size_t>(std::min(chosen.lod_index(), 15))];
     }
     // Poses due this frame, once per skeleton the chosen levels use.
     const int interval = mode_.frame_skipping ? animlod::animation_update_interval(sphere.coverage, rate) : 1;
@@ -243,7 +240,8 @@ void CrowdAnimator::gather(float* palettes, InstanceGpu* instances, size_t& pale
     const std::vector<int>& base = bucket_base_[static_cast<size_t>(placement.asset)];
     for (size_t c = 0; c < character.levels.size(); ++c) {
       const int level = character.levels[c];
-      PoseCache& cache = cache_for(character, asset.chains[c].levels[static_cast<size_t>(level)].rig);
+      const Level& drawn = asset.chains[c].levels[static_cast<size_t>(level)];
+      PoseCache& cache = cache_for(character, drawn.rig);
       if (cache.gathered_frame != frame_) {  // upload each skeleton's palette once per frame
         cache.gathered_frame = frame_;
         cache.gathered_base = static_cast<uint32_t>(palette_floats / 12);
@@ -252,7 +250,7 @@ void CrowdAnimator::gather(float* palettes, InstanceGpu* instances, size_t& pale
       }
       InstanceGpu& out = instances[next[static_cast<size_t>(base[c] + level)]++];
       out = {placement.position.x, placement.position.y, placement.position.z, placement.yaw, cache.gathered_base,
-             static_cast<uint32_t>(character.tints[c])};
+             static_cast<uint32_t>(drawn.lod_index())};
     }
   }
   instance_count = total;

@@ -20,7 +20,7 @@ namespace crowd {
 struct InstanceGpu {
   float x, y, z, yaw;     // placement
   uint32_t palette_base;  // first palette matrix of the instance
-  uint32_t tint;          // selected level index, for --level-colors
+  uint32_t tint;          // Level::lod_index() of the level drawn, for --level-colors
 };
 
 // One instanced draw: the instances [first, first + count) of the gathered instance array.
@@ -35,7 +35,7 @@ struct FrameCounts {
   int64_t joints = 0;         // pose nodes evaluated by FK (characters whose pose was due)
   int64_t palette_joints = 0; // matrices uploaded
   int updates = 0;            // (character, skeleton) poses updated
-  std::vector<int> levels;    // drawn chain instances per selected MSFT_lod level index
+  std::vector<int> levels;    // drawn chain instances per Level::lod_index() of the level drawn
 };
 
 class CrowdAnimator {
@@ -72,7 +72,6 @@ class CrowdAnimator {
   struct Character {
     std::vector<animlod::LodSelector> selectors;  // per chain
     std::vector<int> levels;                      // per chain, this frame: the level node drawn
-    std::vector<int> tints;                       // per chain, this frame: the level selected
     std::vector<PoseCache> caches;                // per rig used so far
     bool visible = false;
     bool was_visible = false;

@@ -2,8 +2,11 @@
 #include "crowd_options.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
+#include <set>
 #include <sstream>
 
 namespace crowd {
@@ -44,10 +47,13 @@ a path and reports frame times per LoD mode as a Markdown table (stdout) and JSO
   --screenshot F FILE    save measured frame F of the first mode as PNG (repeatable)
 )";
 
+// The largest count an integer option takes (frames, characters, pixels).
+constexpr long kLargestInt = 1000000000L;
+
 bool to_int(const std::string& text, int& out) {
   char* end = nullptr;
   const long value = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || value < -1000000000L || value > 1000000000L) return false;
+  if (text.empty() || *end != '\0' || value < -kLargestInt || value > kLargestInt) return false;
   out = static_cast<int>(value);
   return true;
 }
@@ -102,6 +108,10 @@ bool parse_modes(const std::string& list, std::vector<Mode>& out, std::string& e
 
 }  // namespace
 
+int round_begin(const CrowdOptions& options, int round) {
+  return static_cast<int>(static_cast<int64_t>(options.frames) * round / options.rounds);
+}
+
 const char* path_name(CameraPath path) {
   switch (path) {
     case CameraPath::nav1: return "nav1";
@@ -127,7 +137,8 @@ bool parse_options(int argc, char** argv, CrowdOptions& out, std::string& error)
     auto int_option = [&](int& into, int lowest) {
       if (!value(text)) return false;
       if (!to_int(text, into) || into < lowest) {
-        error = arg + ": expected an integer >= " + std::to_string(lowest) + ", got '" + text + "'";
+        error = arg + ": expected an integer from " + std::to_string(lowest) + " to " + std::to_string(kLargestInt) +
+                ", got '" + text + "'";
         return false;
       }
       return true;
@@ -224,6 +235,24 @@ bool parse_options(int argc, char** argv, CrowdOptions& out, std::string& error)
               " measured frames";
       return false;
     }
+  }
+  // A screenshot's frame is left out of every mode's timings: each round needs a frame to time,
+  // or its modes would report an FPS over no frame at all.
+  std::set<int> shot_frames;
+  for (const auto& shot : out.screenshots) shot_frames.insert(shot.first);
+  for (int frame : shot_frames) {
+    int round = static_cast<int>(static_cast<int64_t>(frame) * out.rounds / out.frames);
+    while (round_begin(out, round + 1) <= frame) ++round;
+    while (round_begin(out, round) > frame) --round;
+    const int begin = round_begin(out, round), end = round_begin(out, round + 1);
+    if (std::distance(shot_frames.lower_bound(begin), shot_frames.lower_bound(end)) < end - begin) continue;
+    const std::string which = out.rounds == 1 ? " (--frames " + std::to_string(out.frames) + ")"
+                                              : " of round " + std::to_string(round + 1) + " (frames " + std::to_string(begin) +
+                                                    " to " + std::to_string(end - 1) + " of --frames " +
+                                                    std::to_string(out.frames) + " --rounds " + std::to_string(out.rounds) + ")";
+    error = "--screenshot: takes every measured frame" + which +
+            " out of the timings, so nothing would be measured: measure more frames or screenshot fewer";
+    return false;
   }
   return true;
 }

@@ -50,6 +50,10 @@ struct CrowdOptions {
 
 const char* path_name(CameraPath path);
 
+// The first measured frame of round `round` in [0, rounds]: the rounds split the frames evenly
+// (round `rounds` begins past the last frame).
+int round_begin(const CrowdOptions& options, int round);
+
 // Parses argv; on a mistake returns false with `error` set to one line (and on --help returns
 // false with error empty after printing the usage).
 bool parse_options(int argc, char** argv, CrowdOptions& out, std::string& error);

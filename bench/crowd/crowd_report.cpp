@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -12,13 +13,17 @@ namespace crowd {
 
 namespace {
 
+// What was not measured: null in the JSON, "-" in the table, never a number made up.
+constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
+
 double mean(const std::vector<double>& values) {
-  return values.empty() ? 0.0 : std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
+  return values.empty() ? kNotMeasured
+                        : std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
 }
 
 // Linear-interpolated percentile (numpy's default).
 double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0.0;
+  if (values.empty()) return kNotMeasured;
   std::sort(values.begin(), values.end());
   const double at = p / 100.0 * static_cast<double>(values.size() - 1);
   const size_t low = static_cast<size_t>(at);
@@ -46,6 +51,14 @@ std::string number(double value) {
   return text;
 }
 
+// `value` with `decimals` decimals and `suffix` for the table, "-" where nothing was measured.
+std::string fixed(double value, int decimals, const char* suffix = "") {
+  if (!std::isfinite(value)) return "-";
+  char text[48];
+  std::snprintf(text, sizeof text, "%.*f%s", decimals, value, suffix);
+  return text;
+}
+
 // The mode every speed-up is measured against: Original without frame skipping.
 const ModeResult* original_of(const std::vector<ModeResult>& results) {
   for (const ModeResult& r : results)
@@ -53,13 +66,18 @@ const ModeResult* original_of(const std::vector<ModeResult>& results) {
   return nullptr;
 }
 
-double fps(const ModeResult& r) { return 1000.0 / std::max(mean(r.frame_ms), 1e-9); }
+double fps(const ModeResult& r) { return 1000.0 / mean(r.frame_ms); }
+
+// A sum over the measured frames, per frame.
+double per_frame(double sum, const ModeResult& r) {
+  return r.frame_ms.empty() ? kNotMeasured : sum / static_cast<double>(r.frame_ms.size());
+}
 
 // Speed-up over `base` in each round (the modes took turns on the same path segment).
 std::vector<double> round_speedups(const ModeResult& r, const ModeResult& base) {
   std::vector<double> out;
   for (size_t k = 0; k < r.round_fps.size() && k < base.round_fps.size(); ++k)
-    out.push_back(base.round_fps[k] > 0.0 ? r.round_fps[k] / base.round_fps[k] : 0.0);
+    out.push_back(base.round_fps[k] > 0.0 ? r.round_fps[k] / base.round_fps[k] : kNotMeasured);
   return out;
 }
 
@@ -118,31 +136,28 @@ std::string markdown_report(const RunInfo& info, const std::vector<ModeResult>& 
            "palette joints | CPU anim ms | upload ms | submit ms | swap ms | GPU ms |\n";
     out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   }
-  char line[512];
   for (const ModeResult& r : results) {
-    const double frames = std::max<double>(static_cast<double>(r.frame_ms.size()), 1.0);
     if (options.grid) {
-      std::snprintf(line, sizeof line, "| %d | %d | %.0f | %.0f | %.2f | %.1f |\n", r.mesh_level, r.motion_level,
-                    r.triangles / frames, r.joints / frames, fps(r), percentile(r.frame_ms, 50));
-    } else {
-      const ModeResult* base = original_of(results);
-      char speedup[32] = "-", range[64] = "-";
-      if (base) {
-        std::snprintf(speedup, sizeof speedup, "%.2fx", fps(r) / fps(*base));
-        const std::vector<double> rounds = round_speedups(r, *base);
-        if (rounds.size() > 1)
-          std::snprintf(range, sizeof range, "%.2f-%.2fx", *std::min_element(rounds.begin(), rounds.end()),
-                        *std::max_element(rounds.begin(), rounds.end()));
-      }
-      char gpu[32] = "-";
-      if (!r.gpu_ms.empty()) std::snprintf(gpu, sizeof gpu, "%.2f", mean(r.gpu_ms));
-      std::snprintf(line, sizeof line,
-                    "| %s | %.2f | %s | %s | %.1f | %.1f | %.0f | %.0f | %.0f | %.0f | %.2f | %.2f | %.2f | %.1f | %s |\n",
-                    r.name.c_str(), fps(r), speedup, range, percentile(r.frame_ms, 50), percentile(r.frame_ms, 95),
-                    r.drawn / frames, r.triangles / frames, r.joints / frames, r.palette_joints / frames,
-                    mean(r.animation_ms), mean(r.upload_ms), mean(r.submit_ms), mean(r.swap_ms), gpu);
+      out << "| " << r.mesh_level << " | " << r.motion_level << " | " << fixed(per_frame(r.triangles, r), 0) << " | "
+          << fixed(per_frame(r.joints, r), 0) << " | " << fixed(fps(r), 2) << " | " << fixed(percentile(r.frame_ms, 50), 1)
+          << " |\n";
+      continue;
     }
-    out << line;
+    const ModeResult* base = original_of(results);
+    std::string speedup = "-", range = "-";
+    if (base) {
+      speedup = fixed(fps(r) / fps(*base), 2, "x");
+      const std::vector<double> rounds = round_speedups(r, *base);
+      if (rounds.size() > 1)
+        range = fixed(*std::min_element(rounds.begin(), rounds.end()), 2) + "-" +
+                fixed(*std::max_element(rounds.begin(), rounds.end()), 2, "x");
+    }
+    out << "| " << r.name << " | " << fixed(fps(r), 2) << " | " << speedup << " | " << range << " | "
+        << fixed(percentile(r.frame_ms, 50), 1) << " | " << fixed(percentile(r.frame_ms, 95), 1) << " | "
+        << fixed(per_frame(r.drawn, r), 0) << " | " << fixed(per_frame(r.triangles, r), 0) << " | "
+        << fixed(per_frame(r.joints, r), 0) << " | " << fixed(per_frame(r.palette_joints, r), 0) << " | "
+        << fixed(mean(r.animation_ms), 2) << " | " << fixed(mean(r.upload_ms), 2) << " | " << fixed(mean(r.submit_ms), 2)
+        << " | " << fixed(mean(r.swap_ms), 1) << " | " << fixed(mean(r.gpu_ms), 2) << " |\n";
   }
   const ModeResult* base = options.grid ? nullptr : original_of(results);
   std::string alike;
@@ -171,6 +186,8 @@ std::string json_report(const RunInfo& info, const std::vector<ModeResult>& resu
     out << (first_asset ? "\n" : ",\n") << "    {\"file\": " << quoted(asset.path) << ", \"height\": " << number(asset.height())
         << ", \"clips\": [";
     for (size_t k = 0; k < asset.clip_names.size(); ++k) out << (k ? ", " : "") << quoted(asset.clip_names[k]);
+    out << "], \"warnings\": [";
+    for (size_t w = 0; w < asset.warnings.size(); ++w) out << (w ? ", " : "") << quoted(asset.warnings[w]);
     out << "], \"nodes\": [";
     for (size_t c = 0; c < asset.chains.size(); ++c) {
       const Chain& chain = asset.chains[c];
@@ -191,7 +208,6 @@ std::string json_report(const RunInfo& info, const std::vector<ModeResult>& resu
   out << "\n  ],\n  \"" << (options.grid ? "grid" : "modes") << "\": " << (options.grid ? "[" : "{");
   for (size_t i = 0; i < results.size(); ++i) {
     const ModeResult& r = results[i];
-    const double frames = std::max<double>(static_cast<double>(r.frame_ms.size()), 1.0);
     out << (i ? ",\n    " : "\n    ");
     if (!options.grid) out << quoted(r.name) << ": ";
     out << "{";
@@ -199,13 +215,14 @@ std::string json_report(const RunInfo& info, const std::vector<ModeResult>& resu
     const ModeResult* base = options.grid ? nullptr : original_of(results);
     out << "\"fps\": " << number(fps(r)) << ", \"speedup\": " << (base ? number(fps(r) / fps(*base)) : "null")
         << ", \"frame_ms_mean\": " << number(mean(r.frame_ms)) << ", \"frame_ms_p50\": " << number(percentile(r.frame_ms, 50))
-        << ", \"frame_ms_p95\": " << number(percentile(r.frame_ms, 95)) << ", \"drawn\": " << number(r.drawn / frames)
-        << ", \"triangles\": " << number(r.triangles / frames) << ", \"joints\": " << number(r.joints / frames)
-        << ", \"palette_joints\": " << number(r.palette_joints / frames) << ", \"pose_updates\": " << number(r.updates / frames)
-        << ", \"draw_calls\": " << number(r.draw_calls / frames) << ", \"cpu_animation_ms\": " << number(mean(r.animation_ms))
+        << ", \"frame_ms_p95\": " << number(percentile(r.frame_ms, 95)) << ", \"drawn\": " << number(per_frame(r.drawn, r))
+        << ", \"triangles\": " << number(per_frame(r.triangles, r)) << ", \"joints\": " << number(per_frame(r.joints, r))
+        << ", \"palette_joints\": " << number(per_frame(r.palette_joints, r))
+        << ", \"pose_updates\": " << number(per_frame(r.updates, r))
+        << ", \"draw_calls\": " << number(per_frame(r.draw_calls, r)) << ", \"cpu_animation_ms\": " << number(mean(r.animation_ms))
         << ", \"upload_ms\": " << number(mean(r.upload_ms)) << ", \"submit_ms\": " << number(mean(r.submit_ms))
         << ", \"swap_ms\": " << number(mean(r.swap_ms))
-        << ", \"gpu_ms\": " << (r.gpu_ms.empty() ? "null" : number(mean(r.gpu_ms))) << ", \"measured_frames\": " << r.frame_ms.size()
+        << ", \"gpu_ms\": " << number(mean(r.gpu_ms)) << ", \"measured_frames\": " << r.frame_ms.size()
         << ", \"same_work_as_original\": " << (base && &r != base && same_work(r, *base) ? "true" : "false") << ", \"round_fps\": [";
     for (size_t k = 0; k < r.round_fps.size(); ++k) out << (k ? ", " : "") << number(r.round_fps[k]);
     out << "], \"round_speedups\": [";
@@ -217,7 +234,7 @@ std::string json_report(const RunInfo& info, const std::vector<ModeResult>& resu
     size_t last = 0;
     for (size_t l = 0; l < r.levels.size(); ++l)
       if (r.levels[l] > 0) last = l + 1;
-    for (size_t l = 0; l < last; ++l) out << (l ? ", " : "") << number(r.levels[l] / frames);
+    for (size_t l = 0; l < last; ++l) out << (l ? ", " : "") << number(per_frame(r.levels[l], r));
     out << "]}";
   }
   out << "\n  " << (options.grid ? "]" : "}") << "\n}\n";

@@ -14,6 +14,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 
 #define GLM_ENABLE_EXPERIMENTAL
 #include <glm/gtc/quaternion.hpp>
@@ -22,6 +23,7 @@
 #include <tiny_gltf.h>
 
 #include "animation_pointers.hpp"
+#include "animlod/lod_selector.hpp"
 #include "animlod/skinning.hpp"
 
 namespace crowd {
@@ -98,8 +100,27 @@ double read_component(const unsigned char* at, int type, bool normalized) {
   }
 }
 
-// Accessor `index` as doubles, `components` per element (checked against its type), bounds
-// checked against its buffer view and buffer.
+// Buffer view `index`, checked to exist with its buffer.
+const tinygltf::BufferView& buffer_view(const Model& model, int index, const std::string& label) {
+  if (index < 0 || static_cast<size_t>(index) >= model.bufferViews.size()) fail(label, "buffer view does not exist");
+  const tinygltf::BufferView& view = model.bufferViews[static_cast<size_t>(index)];
+  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model.buffers.size()) fail(label, "buffer does not exist");
+  return view;
+}
+
+// The bytes [offset, offset + length) of `view`, checked to lie in the view and the view in its buffer.
+const unsigned char* view_bytes(const Model& model, const tinygltf::BufferView& view, size_t offset, size_t length,
+                                const std::string& label) {
+  const std::vector<unsigned char>& data = model.buffers[static_cast<size_t>(view.buffer)].data;
+  if (offset + length > view.byteLength || view.byteOffset + view.byteLength > data.size())
+    fail(label, "reaches past its buffer view or buffer (" + std::to_string(view.byteOffset + offset + length) +
+                    " bytes needed)");
+  return data.data() + view.byteOffset + offset;
+}
+
+// Accessor `index` as doubles, `components` per element (checked against its type), sparse
+// substitutions applied (Blender writes shape keys so), bounds checked against its buffer views
+// and buffers.
 std::vector<double> read_accessor(const Model& model, int index, int components, const std::string& element) {
   const std::string label = element + " accessor " + std::to_string(index);
   if (index < 0 || static_cast<size_t>(index) >= model.accessors.size()) fail(element, "accessor " + std::to_string(index) + " does not exist");
@@ -109,26 +130,45 @@ std::vector<double> read_accessor(const Model& model, int index, int components,
     fail(label, std::to_string(per_element) + " components per element, expected " + std::to_string(components));
   const size_t size = component_size(accessor.componentType);
   if (size == 0) fail(label, "unknown component type " + std::to_string(accessor.componentType));
-  if (accessor.sparse.isSparse) fail(label, "sparse accessors are not supported by animlod_crowd");
-  std::vector<double> out(accessor.count * static_cast<size_t>(components), 0.0);
-  if (accessor.bufferView < 0) return out;  // all zeros (glTF 3.6.2.3)
-  if (static_cast<size_t>(accessor.bufferView) >= model.bufferViews.size()) fail(label, "buffer view does not exist");
-  const tinygltf::BufferView& view = model.bufferViews[static_cast<size_t>(accessor.bufferView)];
-  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model.buffers.size()) fail(label, "buffer does not exist");
-  const std::vector<unsigned char>& data = model.buffers[static_cast<size_t>(view.buffer)].data;
+  // A count near 2^64 wrapped the sizes below round to small numbers (an out-of-bounds write).
+  if (accessor.count > std::numeric_limits<uint32_t>::max())
+    fail(label, "count " + std::to_string(accessor.count) + " is more than animlod_crowd reads (2^32 - 1 elements)");
   const size_t element_size = size * static_cast<size_t>(components);
-  const size_t stride = view.byteStride ? view.byteStride : element_size;
-  const size_t start = view.byteOffset + accessor.byteOffset;
-  if (accessor.count > 0) {
-    const size_t end = start + stride * (accessor.count - 1) + element_size;
-    if (end > view.byteOffset + view.byteLength || view.byteOffset + view.byteLength > data.size())
-      fail(label, "reaches past its buffer view or buffer (" + std::to_string(end) + " bytes needed)");
-  }
-  for (size_t e = 0; e < accessor.count; ++e)
+  std::vector<double> out(accessor.count * static_cast<size_t>(components), 0.0);  // no buffer view: zeros (glTF 3.6.2.3)
+  auto read_element = [&](const unsigned char* at, size_t e) {
     for (int c = 0; c < components; ++c)
       out[e * static_cast<size_t>(components) + static_cast<size_t>(c)] =
-          read_component(data.data() + start + e * stride + static_cast<size_t>(c) * size, accessor.componentType,
-                         accessor.normalized);
+          read_component(at + static_cast<size_t>(c) * size, accessor.componentType, accessor.normalized);
+  };
+  if (accessor.bufferView >= 0 && accessor.count > 0) {
+    const tinygltf::BufferView& view = buffer_view(model, accessor.bufferView, label);
+    const size_t stride = view.byteStride ? view.byteStride : element_size;
+    const unsigned char* data = view_bytes(model, view, accessor.byteOffset, stride * (accessor.count - 1) + element_size, label);
+    for (size_t e = 0; e < accessor.count; ++e) read_element(data + e * stride, e);
+  }
+  if (accessor.sparse.isSparse) {
+    const auto& sparse = accessor.sparse;
+    const int index_type = sparse.indices.componentType;
+    if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      fail(label, "sparse indices of component type " + std::to_string(index_type) + ", expected an unsigned integer type");
+    if (sparse.count < 0 || sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
+      fail(label, "sparse count and byte offsets must be >= 0");
+    const size_t count = static_cast<size_t>(sparse.count), index_size = component_size(index_type);
+    const unsigned char* indices = view_bytes(model, buffer_view(model, sparse.indices.bufferView, label + " sparse indices"),
+                                              static_cast<size_t>(sparse.indices.byteOffset), count * index_size,
+                                              label + " sparse indices");
+    const unsigned char* values = view_bytes(model, buffer_view(model, sparse.values.bufferView, label + " sparse values"),
+                                             static_cast<size_t>(sparse.values.byteOffset), count * element_size,
+                                             label + " sparse values");
+    for (size_t i = 0; i < count; ++i) {
+      const double e = read_component(indices + i * index_size, index_type, false);
+      if (e >= static_cast<double>(accessor.count))
+        fail(label, "sparse index " + std::to_string(static_cast<long long>(e)) + " outside [0, " +
+                        std::to_string(accessor.count) + ")");
+      read_element(values + i * element_size, static_cast<size_t>(e));
+    }
+  }
   return out;
 }
 
@@ -170,6 +210,23 @@ void rest_trs(const tinygltf::Node& node, float* t, float* r, float* s) {
 const Value* object_member(const Value& value, const char* key) {
   if (!value.IsObject() || !value.Has(key)) return nullptr;
   return &value.Get(key);
+}
+
+// A JSON value of the file as a message quotes it.
+std::string json_text(const Value& value) {
+  if (value.IsString()) return "'" + value.Get<std::string>() + "'";
+  if (!value.IsNumber()) return "a JSON " + std::string(value.IsArray() ? "array" : value.IsObject() ? "object" : "value");
+  std::ostringstream text;
+  text << value.GetNumberAsDouble();
+  return text.str();
+}
+
+// The node a JSON id names, or -1 unless it is a whole number in [0, node count) (4.7 is not node 4).
+int node_id(const Model& model, const Value& id) {
+  if (!id.IsNumber()) return -1;
+  const double value = id.GetNumberAsDouble();
+  if (!(value >= 0.0 && value < static_cast<double>(model.nodes.size())) || value != std::floor(value)) return -1;
+  return static_cast<int>(value);
 }
 
 class Loader {
@@ -269,7 +326,8 @@ class Loader {
       auto add_levels = [&](const Value* list) {
         for (size_t i = 0; list && list->IsArray() && i < list->ArrayLen(); ++i) {
           const Value& id = list->Get(static_cast<int>(i));
-          if (id.IsNumber() && id.GetNumberAsInt() != static_cast<int>(n)) out.insert(id.GetNumberAsInt());
+          const int level = node_id(model_, id);
+          if (level >= 0 && level != static_cast<int>(n)) out.insert(level);
         }
       };
       const tinygltf::Node& node = model_.nodes[n];
@@ -338,19 +396,32 @@ class Loader {
       if (!ids || !ids->IsArray()) fail(node_label(model_, node), "MSFT_lod has no 'ids' array");
       for (size_t i = 0; i < ids->ArrayLen(); ++i) {
         const Value& id = ids->Get(static_cast<int>(i));
-        const int level_node = id.IsNumber() ? id.GetNumberAsInt() : -1;
-        if (level_node < 0 || static_cast<size_t>(level_node) >= model_.nodes.size())
-          fail(node_label(model_, node), "MSFT_lod id " + std::to_string(i) + " is not a node");
+        const std::string which = "MSFT_lod id " + std::to_string(i) + " (" + json_text(id) + ")";
+        const int level_node = node_id(model_, id);
+        const std::string base_label = node_label(model_, node);
+        if (level_node < 0)
+          fail(base_label, which + " is not a node: ids are node indices below " + std::to_string(model_.nodes.size()));
+        if (level_node == node) fail(base_label, which + " is the node itself: its ids list the lower levels, other nodes");
+        if (std::find(level_nodes.begin(), level_nodes.end(), level_node) != level_nodes.end())
+          fail(base_label, which + " repeats an earlier id: each level is a different node");
         level_nodes.push_back(level_node);
       }
     }
     std::vector<float> coverages;
     if (const Value* list = object_member(base.extras, "MSFT_screencoverage")) {
-      for (size_t i = 0; list->IsArray() && i < list->ArrayLen(); ++i)
-        coverages.push_back(static_cast<float>(list->Get(static_cast<int>(i)).GetNumberAsDouble()));
+      for (size_t i = 0; list->IsArray() && i < list->ArrayLen(); ++i) {
+        const Value& value = list->Get(static_cast<int>(i));
+        if (!value.IsNumber())
+          fail(node_label(model_, node),
+               "MSFT_screencoverage value " + std::to_string(i) + " (" + json_text(value) + ") is not a number");
+        coverages.push_back(static_cast<float>(value.GetNumberAsDouble()));
+      }
       if (coverages.size() != level_nodes.size())
         fail(node_label(model_, node), "MSFT_screencoverage has " + std::to_string(coverages.size()) + " values for " +
                                            std::to_string(level_nodes.size()) + " levels");
+      // The selector's level_for_coverage relies on it (asserted in debug builds only).
+      const animlod::Status status = animlod::validate_screen_coverages(coverages.data(), coverages.size());
+      if (!status) fail(node_label(model_, node) + " MSFT_screencoverage", status.message);
       chain.has_coverages = true;
     }
     chain.has_errors = true;
@@ -369,10 +440,9 @@ class Loader {
         const Value& row = grid->Get(static_cast<int>(g));
         for (size_t m = 0; row.IsArray() && m < row.ArrayLen(); ++m) {
           const Value& id = row.Get(static_cast<int>(m));
-          const int cell = id.IsNumber() ? id.GetNumberAsInt() : -1;
+          const int cell = node_id(model_, id);
           const std::string label = "animlod_grid[" + std::to_string(g) + "][" + std::to_string(m) + "]";
-          if (cell < 0 || static_cast<size_t>(cell) >= model_.nodes.size())
-            fail(node_label(model_, node), label + " is not a node");
+          if (cell < 0) fail(node_label(model_, node), label + " (" + json_text(id) + ") is not a node");
           bool listed = false;
           for (const Level& level : chain.levels) listed = listed || level.node == cell;
           if (listed) continue;
@@ -425,7 +495,7 @@ class Loader {
     }
     level.rig = rig_for_skin(n.skin);
     level.mesh = static_cast<int>(asset_.meshes.size());
-    asset_.meshes.push_back(read_mesh(n.mesh, asset_.rigs[static_cast<size_t>(level.rig)].joint_count(), label));
+    asset_.meshes.push_back(read_mesh(n.mesh, n.weights, asset_.rigs[static_cast<size_t>(level.rig)].joint_count(), label));
     for (size_t k = 0; k < original_clips_.size(); ++k) {
       std::vector<int> animations;
       for (int original : original_clips_[k])
@@ -596,40 +666,46 @@ class Loader {
     return clip;
   }
 
-  MeshData read_mesh(int mesh_index, size_t joint_count, const std::string& level) {
+  // A level's mesh; `node_weights` are the level node's morph weights (empty: its mesh's).
+  MeshData read_mesh(int mesh_index, const std::vector<double>& node_weights, size_t joint_count, const std::string& level) {
     const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(mesh_index)];
+    const std::string mesh_label = level + " mesh " + std::to_string(mesh_index);
+    auto drawn = [](const tinygltf::Primitive& primitive) {  // triangles; points and lines are not drawn
+      return primitive.mode < 0 || primitive.mode >= TINYGLTF_MODE_TRIANGLES;
+    };
+    size_t slots = 0;  // influences a vertex lists: 4 per JOINTS_n / WEIGHTS_n set, of the primitive with the most
+    for (size_t p = 0; p < mesh.primitives.size(); ++p)
+      if (drawn(mesh.primitives[p]))
+        slots = std::max(slots, 4 * influence_sets(mesh.primitives[p], mesh_label + " primitive " + std::to_string(p)));
     MeshData out;
-    for (const tinygltf::Primitive& primitive : mesh.primitives)
-      if (primitive.attributes.count("JOINTS_1") || primitive.attributes.count("WEIGHTS_1")) out.influences = 8;
-    const size_t influences = static_cast<size_t>(out.influences);
+    out.influences = static_cast<int>(std::min(slots, static_cast<size_t>(kMaxInfluences)));
+    size_t reduced_vertices = 0;
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
       const tinygltf::Primitive& primitive = mesh.primitives[p];
-      const std::string label = level + " mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p);
-      if (primitive.mode >= 0 && primitive.mode < TINYGLTF_MODE_TRIANGLES) continue;  // points and lines: not drawn
-      auto attribute = [&](const char* name) {
+      const std::string label = mesh_label + " primitive " + std::to_string(p);
+      if (!drawn(primitive)) continue;
+      auto attribute = [&](const std::string& name) {
         const auto found = primitive.attributes.find(name);
         return found == primitive.attributes.end() ? -1 : found->second;
       };
       if (attribute("POSITION") < 0) fail(label, "has no POSITION");
-      if (attribute("JOINTS_0") < 0 || attribute("WEIGHTS_0") < 0)
-        fail(label, "has no JOINTS_0 / WEIGHTS_0: a skinned mesh needs both");
-      if ((attribute("JOINTS_1") < 0) != (attribute("WEIGHTS_1") < 0)) fail(label, "has only one of JOINTS_1 / WEIGHTS_1");
-      const std::vector<float> positions = to_floats(read_accessor(model_, attribute("POSITION"), 3, label + " POSITION"), label);
+      std::vector<float> positions = to_floats(read_accessor(model_, attribute("POSITION"), 3, label + " POSITION"), label);
       const size_t count = positions.size() / 3, offset = out.vertex_count();
-      // (count, influences): each vertex's sets of 4 one after the other, zeros for a set the
+      // (count, slots): each vertex's sets of 4 one after the other, zeros for a set the
       // primitive does not have.
-      std::vector<double> joints(influences * count, 0.0), weights(influences * count, 0.0);
-      for (size_t set = 0; set < influences / 4; ++set) {
+      std::vector<double> joints(slots * count, 0.0), weights(slots * count, 0.0);
+      const size_t sets = influence_sets(primitive, label);
+      for (size_t set = 0; set < sets; ++set) {
         const std::string suffix = "_" + std::to_string(set);
-        if (attribute(("JOINTS" + suffix).c_str()) < 0) continue;
-        const std::vector<double> set_joints = read_accessor(model_, attribute(("JOINTS" + suffix).c_str()), 4, label + " JOINTS" + suffix);
-        const std::vector<double> set_weights = read_accessor(model_, attribute(("WEIGHTS" + suffix).c_str()), 4, label + " WEIGHTS" + suffix);
+        const std::vector<double> set_joints = read_accessor(model_, attribute("JOINTS" + suffix), 4, label + " JOINTS" + suffix);
+        const std::vector<double> set_weights =
+            read_accessor(model_, attribute("WEIGHTS" + suffix), 4, label + " WEIGHTS" + suffix);
         if (set_joints.size() != 4 * count || set_weights.size() != 4 * count)
           fail(label, "JOINTS" + suffix + " / WEIGHTS" + suffix + " do not have one element per vertex");
         for (size_t v = 0; v < count; ++v)
           for (size_t k = 0; k < 4; ++k) {
-            joints[influences * v + 4 * set + k] = set_joints[4 * v + k];
-            weights[influences * v + 4 * set + k] = set_weights[4 * v + k];
+            joints[slots * v + 4 * set + k] = set_joints[4 * v + k];
+            weights[slots * v + 4 * set + k] = set_weights[4 * v + k];
           }
       }
       std::vector<uint32_t> corners;
@@ -644,15 +720,15 @@ class Loader {
       }
       const std::vector<uint32_t> triangles = to_triangles(corners, primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode);
       for (uint32_t index : triangles) out.indices.push_back(static_cast<uint32_t>(offset) + index);
-      out.positions.insert(out.positions.end(), positions.begin(), positions.end());
+      std::vector<float> normals;
       if (attribute("NORMAL") >= 0) {
-        const std::vector<float> normals = to_floats(read_accessor(model_, attribute("NORMAL"), 3, label + " NORMAL"), label);
+        normals = to_floats(read_accessor(model_, attribute("NORMAL"), 3, label + " NORMAL"), label);
         if (normals.size() != positions.size()) fail(label, "NORMAL does not have one element per vertex");
-        out.normals.insert(out.normals.end(), normals.begin(), normals.end());
-      } else {
-        std::vector<float> normals = face_normals(positions, triangles);
-        out.normals.insert(out.normals.end(), normals.begin(), normals.end());
       }
+      apply_default_morph(primitive, node_weights.empty() ? mesh.weights : node_weights, positions, normals, label);
+      if (normals.empty()) normals = face_normals(positions, triangles);
+      out.positions.insert(out.positions.end(), positions.begin(), positions.end());
+      out.normals.insert(out.normals.end(), normals.begin(), normals.end());
       glm::vec3 color(0.8f);
       if (primitive.material >= 0 && static_cast<size_t>(primitive.material) < model_.materials.size()) {
         const std::vector<double>& factor = model_.materials[static_cast<size_t>(primitive.material)].pbrMetallicRoughness.baseColorFactor;
@@ -660,22 +736,103 @@ class Loader {
       }
       for (size_t v = 0; v < count; ++v) {
         out.colors.insert(out.colors.end(), {color.r, color.g, color.b});
-        double total = 0.0;
-        for (size_t k = 0; k < influences; ++k) total += std::max(weights[influences * v + k], 0.0);
-        if (!(total > 0.0) || !std::isfinite(total)) fail(label, "vertex " + std::to_string(v) + " has no positive skin weight");
-        for (size_t k = 0; k < influences; ++k) {
-          const double w = std::max(weights[influences * v + k], 0.0) / total;
-          const double j = joints[influences * v + k];
-          if (w > 0.0 && (j < 0 || j >= static_cast<double>(joint_count)))
-            fail(label, "vertex " + std::to_string(v) + " uses joint slot " + std::to_string(static_cast<long long>(j)) +
-                            ", the skin has " + std::to_string(joint_count));
-          out.joints.push_back(w > 0.0 ? static_cast<uint16_t>(j) : 0);
-          out.weights.push_back(static_cast<float>(w));
-        }
+        if (!append_skin(&joints[slots * v], &weights[slots * v], slots, joint_count, label, v, out)) ++reduced_vertices;
       }
     }
-    if (out.indices.empty()) fail(level + " mesh " + std::to_string(mesh_index), "has no triangles");
+    if (out.indices.empty()) fail(mesh_label, "has no triangles");
+    // Said once per mesh (several level nodes may draw it), not silently.
+    if (reduced_vertices > 0 && reduced_influence_meshes_.insert(mesh_index).second)
+      asset_.warnings.push_back(mesh_label + ": " + std::to_string(reduced_vertices) + " vertices have more than " +
+                                std::to_string(kMaxInfluences) + " skin influences; the GPU skinning keeps the " +
+                                std::to_string(kMaxInfluences) + " largest weights of each, renormalised");
     return out;
+  }
+
+  // How many JOINTS_n / WEIGHTS_n pairs a primitive has, numbered from 0 (glTF 3.7.2.1).
+  static size_t influence_sets(const tinygltf::Primitive& primitive, const std::string& label) {
+    auto has = [&](const std::string& name) { return primitive.attributes.count(name) > 0; };
+    size_t sets = 0;
+    for (; has("JOINTS_" + std::to_string(sets)) || has("WEIGHTS_" + std::to_string(sets)); ++sets) {
+      const std::string n = std::to_string(sets);
+      if (!has("JOINTS_" + n) || !has("WEIGHTS_" + n)) fail(label, "has only one of JOINTS_" + n + " / WEIGHTS_" + n);
+    }
+    if (sets == 0) fail(label, "has no JOINTS_0 / WEIGHTS_0: a skinned mesh needs both");
+    size_t named = 0;
+    for (const auto& attribute : primitive.attributes)
+      named += attribute.first.rfind("JOINTS_", 0) == 0 || attribute.first.rfind("WEIGHTS_", 0) == 0;
+    if (named != 2 * sets) fail(label, "numbers its JOINTS_n / WEIGHTS_n sets with a gap (glTF numbers them 0, 1, 2, ...)");
+    return sets;
+  }
+
+  // Appends the skin of vertex `vertex` of primitive `label`, `slots` (joint, weight) pairs as the
+  // file lists them, to `out` as MeshData::influences slots: its positive weights, a joint listed
+  // twice once with their sum, normalised. Where more joints remain than the GPU holds, the
+  // largest weights are kept (ties by joint) and renormalised, as animlod's simplifier merges
+  // skins (cpp/src/skin_merge.hpp); false then.
+  static bool append_skin(const double* joints, const double* weights, size_t slots, size_t joint_count,
+                          const std::string& label, size_t vertex, MeshData& out) {
+    std::vector<std::pair<double, double>> skin;  // (joint, weight)
+    for (size_t k = 0; k < slots; ++k) {
+      if (!std::isfinite(weights[k])) fail(label, "vertex " + std::to_string(vertex) + " has a non-finite skin weight");
+      if (!(weights[k] > 0.0)) continue;
+      if (joints[k] < 0 || joints[k] >= static_cast<double>(joint_count))
+        fail(label, "vertex " + std::to_string(vertex) + " uses joint slot " + std::to_string(static_cast<long long>(joints[k])) +
+                        ", the skin has " + std::to_string(joint_count));
+      const auto same =
+          std::find_if(skin.begin(), skin.end(), [&](const auto& influence) { return influence.first == joints[k]; });
+      if (same != skin.end()) same->second += weights[k];
+      else skin.emplace_back(joints[k], weights[k]);
+    }
+    if (skin.empty()) fail(label, "vertex " + std::to_string(vertex) + " has no positive skin weight");
+    const size_t kept = static_cast<size_t>(out.influences);
+    const bool whole = skin.size() <= kept;
+    if (!whole) {
+      std::sort(skin.begin(), skin.end(), [](const auto& a, const auto& b) {
+        return a.second != b.second ? a.second > b.second : a.first < b.first;
+      });
+      skin.resize(kept);
+    }
+    double total = 0.0;
+    for (const auto& influence : skin) total += influence.second;
+    for (size_t k = 0; k < kept; ++k) {
+      out.joints.push_back(k < skin.size() ? static_cast<uint16_t>(skin[k].first) : 0);
+      out.weights.push_back(k < skin.size() ? static_cast<float>(skin[k].second / total) : 0.0f);
+    }
+    return whole;
+  }
+
+  // Adds a primitive's morph targets at `morph_weights` (the default weights: the crowd plays no
+  // weights channel) to its positions and, where the targets move them, its normals (normalised
+  // again; `normals` empty: none read), as a viewer shows the mesh.
+  void apply_default_morph(const tinygltf::Primitive& primitive, const std::vector<double>& morph_weights,
+                           std::vector<float>& positions, std::vector<float>& normals, const std::string& label) const {
+    if (primitive.targets.empty() || morph_weights.empty()) return;  // no weights: all 0
+    if (morph_weights.size() != primitive.targets.size())
+      fail(label, "has " + std::to_string(primitive.targets.size()) + " morph targets for " +
+                      std::to_string(morph_weights.size()) + " default morph weights (the node's weights, else the mesh's)");
+    bool normals_moved = false;
+    for (size_t t = 0; t < primitive.targets.size(); ++t) {
+      const double weight = morph_weights[t];
+      if (!std::isfinite(weight)) fail(label, "default morph weight " + std::to_string(t) + " is not a finite number");
+      if (weight == 0.0) continue;
+      const std::string target = label + " target " + std::to_string(t);
+      auto add_delta = [&](const char* name, std::vector<float>& values) {
+        const auto found = primitive.targets[t].find(name);
+        if (found == primitive.targets[t].end()) return false;
+        const std::vector<float> delta = to_floats(read_accessor(model_, found->second, 3, target + " " + name), target);
+        if (delta.size() != values.size()) fail(target, std::string(name) + " does not have one element per vertex");
+        for (size_t i = 0; i < values.size(); ++i) values[i] += static_cast<float>(weight * delta[i]);
+        return true;
+      };
+      add_delta("POSITION", positions);
+      if (!normals.empty()) normals_moved = add_delta("NORMAL", normals) || normals_moved;
+    }
+    for (size_t v = 0; normals_moved && v < normals.size() / 3; ++v) {
+      float* normal = &normals[3 * v];
+      const float length = glm::length(glm::vec3(normal[0], normal[1], normal[2]));
+      if (length > 0.0f)
+        for (int c = 0; c < 3; ++c) normal[c] /= length;
+    }
   }
 
   static std::vector<uint32_t> to_triangles(const std::vector<uint32_t>& corners, int mode) {
@@ -753,6 +910,7 @@ class Loader {
   std::vector<int> parents_;
   std::vector<std::vector<int>> original_clips_;  // animations of each original clip
   std::vector<int> clip_rigs_;  // rig of every clip in asset_.clips
+  std::set<int> reduced_influence_meshes_;  // meshes warned about for keeping kMaxInfluences of a vertex's weights
 };
 
 }  // namespace

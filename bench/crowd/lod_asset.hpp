@@ -5,6 +5,7 @@
 // motion level 0, the re-fitted ones with extras.animlod {clip, motion_level} otherwise).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -16,14 +17,18 @@
 
 namespace crowd {
 
+// Skin influences a vertex holds on the GPU (gl_renderer.cpp: two sets of 4).
+constexpr int kMaxInfluences = 8;
+
 // One level's geometry: every triangle primitive of its mesh merged into one indexed mesh.
 struct MeshData {
-  std::vector<float> positions;   // (V, 3) bind-space positions
+  std::vector<float> positions;   // (V, 3) bind-space positions, default morph weights applied
   std::vector<float> normals;     // (V, 3) (area-weighted face normals where the file has none)
   std::vector<float> colors;      // (V, 3) base colour of the vertex's material
-  std::vector<uint16_t> joints;   // (V, K) skin joint slots
-  std::vector<float> weights;     // (V, K) normalised to sum 1
-  int influences = 4;             // K: 8 where a primitive has JOINTS_1 / WEIGHTS_1, else 4
+  std::vector<uint16_t> joints;   // (V, K) skin joint slots (each joint once)
+  std::vector<float> weights;     // (V, K) normalised to sum 1; a vertex of more than K joints
+                                  // keeps its K largest weights (Asset::warnings says so)
+  int influences = 4;             // K: 4, or kMaxInfluences where a primitive has JOINTS_1 / WEIGHTS_1
   std::vector<uint32_t> indices;  // (M * 3,)
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return indices.size() / 3; }
@@ -70,6 +75,11 @@ struct Level {
   int mesh = -1;             // index into Asset::meshes
   int rig = -1;              // index into Asset::rigs
   std::vector<int> clips;    // per original clip k: index into Asset::clips
+
+  // Where the level stands along its chain, what --level-colors and the report's level histogram
+  // count: the coarser of its mesh and motion levels, which is its MSFT_lod index on every chain
+  // animlod writes ((i, i), (i, 0) or (0, i)) and 0 for everything Original draws.
+  int lod_index() const { return std::max(mesh_level, motion_level); }
 };
 
 // A chain of one skinned mesh node. levels[0, selection_count) are the MSFT_lod chain, finest
@@ -104,6 +114,9 @@ struct Asset {
   std::vector<Rig> rigs;
   std::vector<Clip> clips;
   std::vector<std::string> clip_names;  // original clips (motion level 0) that move the character
+  // What is drawn other than a glTF viewer would, once per element, each naming it (animlod_crowd
+  // prints them on stderr and lists them in the JSON report).
+  std::vector<std::string> warnings;
   // Rest-pose bounds of every chain's level 0, posed and skinned by the core (world space).
   glm::vec3 bounds_min{0.0f}, bounds_max{0.0f};
   glm::vec3 sphere_center{0.0f};  // bounding sphere, slightly enlarged for the motion

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <new>
 #include <string>
 #include <vector>
@@ -65,8 +66,11 @@ int run(int argc, char** argv) {
 
   const Clock::time_point load_start = Clock::now();
   std::vector<crowd::Asset> assets(options.chains.size());
-  for (size_t a = 0; a < options.chains.size(); ++a)
+  for (size_t a = 0; a < options.chains.size(); ++a) {
     if (!crowd::load_asset(options.chains[a], assets[a], error)) return fail(2, error);
+    for (const std::string& warning : assets[a].warnings)
+      std::fprintf(stderr, "animlod_crowd: warning: %s: %s\n", assets[a].path.c_str(), warning.c_str());
+  }
   const double load_seconds = milliseconds(load_start, Clock::now()) / 1000.0;
 
   crowd::GlRenderer renderer;
@@ -168,7 +172,8 @@ int run(int argc, char** argv) {
     if (!measure) return true;
     double sum = 0.0;
     for (size_t i = first_measured; i < result.frame_ms.size(); ++i) sum += result.frame_ms[i];
-    const double fps = sum > 0.0 ? 1000.0 * static_cast<double>(result.frame_ms.size() - first_measured) / sum : 0.0;
+    const double fps = sum > 0.0 ? 1000.0 * static_cast<double>(result.frame_ms.size() - first_measured) / sum
+                                 : std::numeric_limits<double>::quiet_NaN();  // nothing timed: no FPS (null)
     result.round_fps.push_back(fps);
     return true;
   };
@@ -181,7 +186,7 @@ int run(int argc, char** argv) {
   // Rounds: segment r of the path is measured in every mode before segment r + 1, so that a
   // change in machine load during the run hits every mode alike.
   for (int round = 0; round < options.rounds; ++round) {
-    const int begin = options.frames * round / options.rounds, end = options.frames * (round + 1) / options.rounds;
+    const int begin = crowd::round_begin(options, round), end = crowd::round_begin(options, round + 1);
     for (size_t run = 0; run < runs.size(); ++run) {
       if (!play(run, begin, end, true)) return fail(1, error);
       std::fprintf(stderr, "animlod_crowd: round %d/%d %s: %.2f fps\n", round + 1, options.rounds,

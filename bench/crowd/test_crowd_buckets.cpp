@@ -148,10 +148,6 @@ TEST_CASE("crowd buckets: the selected chain level, reduced in geometry, motion 
   CHECK(counts.levels[0] == 1);
   CHECK(counts.levels[1] == 2);
   CHECK(counts.levels[2] == 1);
-  // The tint is the selected chain level, whatever the mode draws.
-  std::vector<uint32_t> tints;
-  for (const InstanceGpu& instance : instances) tints.push_back(instance.tint);
-  CHECK(tints == std::vector<uint32_t>{0, 1, 1, 2});
 
   cells = s.run("GLoD", true, false, counts, instances);
   CHECK(cells == Cells{{{0, 0}, 1}, {{1, 0}, 2}, {{2, 0}, 1}});
@@ -168,6 +164,35 @@ TEST_CASE("crowd buckets: the selected chain level, reduced in geometry, motion 
   CHECK(counts.joints == 4 * 3);
   // Each instance points at its own palette.
   for (size_t i = 0; i < instances.size(); ++i) CHECK(instances[i].palette_base == 3 * i);
+}
+
+TEST_CASE("crowd level colours: the tint and the level histogram follow the level drawn, not the one selected") {
+  // Selected chain levels 0, 1, 1, 2 (by distance) in every mode; Original draws level 0 for all
+  // of them (its tints and histogram counted the selected levels: no level-0 colour on screen).
+  HandBuiltScene s;
+  FrameCounts counts;
+  std::vector<InstanceGpu> instances;
+  auto tints = [&instances]() {
+    std::vector<uint32_t> out;
+    for (const InstanceGpu& instance : instances) out.push_back(instance.tint);
+    return out;
+  };
+  using Tints = std::vector<uint32_t>;
+  s.run("Original", false, false, counts, instances);
+  CHECK(tints() == Tints{0, 0, 0, 0});
+  CHECK(counts.levels[0] == 4);
+  CHECK(counts.levels[1] == 0);
+  CHECK(counts.levels[2] == 0);
+  s.run("GLoD", true, false, counts, instances);  // mesh levels 0, 1, 1, 2 at motion level 0
+  CHECK(tints() == Tints{0, 1, 1, 2});
+  CHECK(counts.levels[1] == 2);
+  s.run("G+MLoD", true, true, counts, instances);
+  CHECK(tints() == Tints{0, 1, 1, 2});
+  // A chain of geometry levels only: MLoD has no coarser level to draw and draws level 0.
+  for (Level& level : s.assets[0].chains[0].levels) level.motion_level = 0;
+  s.run("MLoD", false, true, counts, instances);
+  CHECK(tints() == Tints{0, 0, 0, 0});
+  CHECK(counts.levels[0] == 4);
 }
 
 TEST_CASE("crowd grid: a forced cell is drawn by every character, the nearest coarser-or-equal one if missing") {

@@ -73,7 +73,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (const crowd::MeshData& mesh : asset.meshes) {
     ANIMLOD_FUZZ_REQUIRE(mesh.positions.size() % 3 == 0 && mesh.indices.size() % 3 == 0 && !mesh.indices.empty());
     ANIMLOD_FUZZ_REQUIRE(mesh.normals.size() == mesh.positions.size() && mesh.colors.size() == mesh.positions.size());
-    ANIMLOD_FUZZ_REQUIRE(mesh.joints.size() == 4 * mesh.vertex_count() && mesh.weights.size() == 4 * mesh.vertex_count());
+    const size_t slots = static_cast<size_t>(mesh.influences) * mesh.vertex_count();
+    ANIMLOD_FUZZ_REQUIRE(mesh.joints.size() == slots && mesh.weights.size() == slots);
     for (uint32_t index : mesh.indices) ANIMLOD_FUZZ_REQUIRE(index < mesh.vertex_count());
   }
   for (const crowd::Rig& rig : asset.rigs) {

@@ -233,3 +233,23 @@ def test_animlod_debug_shows_the_traceback(tmp_path, monkeypatch):
     monkeypatch.setenv("ANIMLOD_DEBUG", "1")
     with pytest.raises(ValueError, match="does not exist"):
         main(["info", str(tmp_path / "missing.bvh")])
+
+
+def test_an_interrupted_demo_leaves_the_earlier_outputs_as_they_were(tmp_path, monkeypatch):
+    # The new seed's character.glb was written beside the earlier run's character_lod.glb and
+    # summary.txt when the minutes-long chain build was interrupted.
+    earlier = {name: f"earlier {name}" for name in ("character.glb", "character_lod.glb", "summary.txt")}
+    for name, text in earlier.items():
+        (tmp_path / name).write_text(text)
+
+    def interrupted(*arguments, **keywords):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("animlod.pipelines.character.build_character", interrupted)
+    assert main(["demo", "-o", str(tmp_path), "--seed", "5"]) == 130
+    assert {path.name: path.read_text() for path in tmp_path.iterdir()} == earlier
+
+
+def test_demo_names_a_negative_seed(tmp_path, capsys):
+    assert main(["demo", "-o", str(tmp_path), "--seed", "-1"]) == 2
+    assert "--seed: must be >= 0, got -1" in capsys.readouterr().err

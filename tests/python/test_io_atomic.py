@@ -3,7 +3,7 @@ import stat
 
 import pytest
 
-from animlod.io.atomic import atomic_write
+from animlod.io.atomic import atomic_write, unwritable
 
 
 def test_atomic_write_leaves_no_partial_file_and_normal_permissions(tmp_path):
@@ -46,3 +46,10 @@ def test_a_link_is_written_through_and_a_pipe_in_place(tmp_path):
         "pipe",
         "real",
     ]
+
+
+def test_unwritable_names_a_folder_in_the_files_place(tmp_path):
+    # atomic_write's rename onto the folder failed only after the work, naming its temporary file.
+    (tmp_path / "out").mkdir()
+    assert unwritable(tmp_path / "out") == "is a folder"
+    assert unwritable(tmp_path / "out" / "report.json") is None

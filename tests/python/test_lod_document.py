@@ -901,3 +901,23 @@ def test_a_chain_whose_level_ids_are_not_other_nodes_is_refused(tmp_path, capsys
     capsys.readouterr()
     assert main(["info", str(edited)]) == 2
     assert reason in capsys.readouterr().err
+
+
+def test_screen_coverages_that_rise_are_refused_by_info_and_read_lod_chains(tmp_path, capsys):
+    """`info` printed the extras as they were, a string or rising values included."""
+    from animlod.io import read_lod_chains
+
+    lod = tmp_path / "lod.glb"
+    simplify_document(_ellipsoid_glb(tmp_path / "plain.glb"), lod, [0.5], **QUICK)
+    capsys.readouterr()
+    assert main(["info", str(lod)]) == 0
+    assert "LoD chain on node 0: levels at nodes [0, 1], coverage " in capsys.readouterr().out
+
+    def rising(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        gltf.nodes[0].extras["MSFT_screencoverage"] = [0.1, 0.5]
+
+    edited = edit_glb(lod, tmp_path / "edited.glb", rising)
+    with pytest.raises(FormatError, match=r"node 0 extras MSFT_screencoverage: level 1: 0.5 is above level 0's 0.1"):
+        read_lod_chains(edited)
+    assert main(["info", str(edited)]) == 2
+    assert "level 1: 0.5 is above level 0's 0.1" in capsys.readouterr().err

@@ -194,13 +194,15 @@ def _stdout_gone() -> bool:
     return gone
 
 
-def _check_output_is_not_input(source: str | os.PathLike | None, output: object) -> None:
-    """UserError when ``-o`` names the input file itself: the levels would replace the file
-    they are built from (a LoD GLB holds the input, but not byte for byte)."""
+def check_output_is_not_input(
+    source: str | os.PathLike | None, output: object, option: str = "-o", what: str = "the levels"
+) -> None:
+    """UserError when ``option`` (``-o``) names the input file itself: ``what`` it writes would
+    replace the file it is made from (a LoD GLB holds the input, but not byte for byte)."""
     if source is None or not isinstance(output, (str, os.PathLike)) or not os.path.isfile(source):
         return
     if os.path.exists(output) and os.path.samefile(source, output):
-        raise UserError(f"-o {os.fspath(output)}: is the input file; write the levels to another file")
+        raise UserError(f"{option} {os.fspath(output)}: is the input file; write {what} to another file")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -214,10 +216,10 @@ def main(argv: list[str] | None = None) -> int:
         source = None  # e.g. crowd's --path, a list of navigation paths, names no input file
     output = getattr(args, "output", None)
     if os.environ.get("ANIMLOD_DEBUG"):  # tracebacks and live output, for telling a bug from a mistake
-        _check_output_is_not_input(source, output)
+        check_output_is_not_input(source, output)
         return int(args.run(args) or 0)
     try:
-        _check_output_is_not_input(source, output)
+        check_output_is_not_input(source, output)
         with _sigterm_unwinds(), _guarded_stderr(args.command):
             return int(args.run(args) or 0)
     except (UserError, MachineError) as error:

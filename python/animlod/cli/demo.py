@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_write
+from . import non_negative_int
 
 MESH_RATIOS = (0.5, 0.25, 0.1)
 # The damped Newton solver reaches SLSQP's optimum on this objective over ten times faster
@@ -38,13 +38,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "attached with MSFT_lod. summary.txt lists the levels and the level a runtime picks by distance.",
     )
     parser.add_argument("-o", "--output", default="out/demo", help="output folder (default: out/demo)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the procedural assets (default: 0)")
+    parser.add_argument("--seed", type=non_negative_int, default=0, help="seed of the procedural assets (default: 0)")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from .. import synth
     from ..io import read_lod_chains, write_glb
+    from ..io.atomic import staged_files
     from ..pipelines.character import build_character
 
     output = Path(args.output)
@@ -55,31 +56,36 @@ def run(args: argparse.Namespace) -> int:
         print(line, flush=True)
 
     start = time.perf_counter()
-    character = synth.humanoid(seed=args.seed)
-    motions = [synth.humanoid_motion(character.skeleton, kind, seed=args.seed) for kind in synth.KINDS]
-    skeleton = character.skeleton
-    write_glb(output / "character.glb", character, motions)
-    report(
-        f"character.glb: {skeleton.joint_count} joints ({int(np.count_nonzero(skeleton.end_sites))} end sites), "
-        f"{character.vertex_count} vertices, {character.face_count} triangles, clips "
-        f"{', '.join(f'{m.name} ({m.frame_count} frames)' for m in motions)} ({time.perf_counter() - start:.2f} s)"
-    )
-    result = build_character(output / "character.glb", output / "character_lod.glb", MESH_RATIOS, solver=MOTION_SOLVER)
-    report(
-        f"character_lod.glb: motion levels ({MOTION_SOLVER} re-fit) {result.motion_seconds:.2f} s, "
-        f"geometry levels (AQEM) {result.geometry_seconds:.2f} s"
-    )
-    for levels in result.chains.values():
-        for level in levels:
-            report(
-                f"  level {level.level}: {level.faces} triangles, {level.joints} joints, error {level.error:.4f} m "
-                f"(max Hausdorff distance over every clip), used while covering >= {level.coverage:.3f} of the screen"
-            )
-    (chain,) = read_lod_chains(output / "character_lod.glb")
-    for distance in SAMPLE_DISTANCES:
-        chosen = chain.level_for(PIXEL_BUDGET, distance, FOCAL_LENGTH_PX)
-        report(f"at {distance:g} m ({PIXEL_BUDGET:g} px budget, focal {FOCAL_LENGTH_PX:g} px): level {chosen}")
-    with atomic_write(output / "summary.txt", "w", encoding="utf-8") as handle:
-        handle.write("\n".join(lines) + "\n")
+    # The three files replace an earlier run's together: an interrupted build left its
+    # character.glb beside the earlier seed's character_lod.glb and summary.txt.
+    with staged_files(output) as staged:
+        character = synth.humanoid(seed=args.seed)
+        motions = [synth.humanoid_motion(character.skeleton, kind, seed=args.seed) for kind in synth.KINDS]
+        skeleton = character.skeleton
+        write_glb(staged / "character.glb", character, motions)
+        report(
+            f"character.glb: {skeleton.joint_count} joints ({int(np.count_nonzero(skeleton.end_sites))} end sites), "
+            f"{character.vertex_count} vertices, {character.face_count} triangles, clips "
+            f"{', '.join(f'{m.name} ({m.frame_count} frames)' for m in motions)} ({time.perf_counter() - start:.2f} s)"
+        )
+        result = build_character(
+            staged / "character.glb", staged / "character_lod.glb", MESH_RATIOS, solver=MOTION_SOLVER
+        )
+        report(
+            f"character_lod.glb: motion levels ({MOTION_SOLVER} re-fit) {result.motion_seconds:.2f} s, "
+            f"geometry levels (AQEM) {result.geometry_seconds:.2f} s"
+        )
+        for levels in result.chains.values():
+            for level in levels:
+                report(
+                    f"  level {level.level}: {level.faces} triangles, {level.joints} joints, error "
+                    f"{level.error:.4f} m (max Hausdorff distance over every clip), used while covering >= "
+                    f"{level.coverage:.3f} of the screen"
+                )
+        (chain,) = read_lod_chains(staged / "character_lod.glb")
+        for distance in SAMPLE_DISTANCES:
+            chosen = chain.level_for(PIXEL_BUDGET, distance, FOCAL_LENGTH_PX)
+            report(f"at {distance:g} m ({PIXEL_BUDGET:g} px budget, focal {FOCAL_LENGTH_PX:g} px): level {chosen}")
+        (staged / "summary.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
     print(f"wrote {output}/: character.glb, character_lod.glb and summary.txt")
     return 0

@@ -143,7 +143,7 @@ def _document_lines(path: str) -> list[str]:
     """Every drawn (mesh, skin) pair with its primitives, every animation, and LoD chains."""
     from ..io.gltf_document import GltfDocument
     from ..io.gltf_drawable import read_drawables
-    from ..io.gltf_lod import lod_ids
+    from ..io.gltf_lod import lod_coverages, lod_ids
 
     doc = GltfDocument(path)
     drawables = read_drawables(doc)
@@ -194,13 +194,12 @@ def _document_lines(path: str) -> list[str]:
             f"{doc.animation_label(index)}: {len(animation.channels or [])} channels, "
             f"{doc.animation_duration(index):.2f} s{level}"
         )
-    for index, node in enumerate(doc.json.get("nodes", [])):
+    for index in range(len(doc.json.get("nodes", []))):
         ids = lod_ids(doc, index)
         if ids is not None:
-            coverage = (
-                (node.get("extras") or {}).get("MSFT_screencoverage") if isinstance(node.get("extras"), dict) else None
-            )
-            lines.append(f"LoD chain on {doc.node_label(index)}: levels at nodes {[index, *ids]}, coverage {coverage}")
+            coverages = lod_coverages(doc, index, ids)
+            shown = "none" if coverages[0] is None else ", ".join(f"{coverage:.4g}" for coverage in coverages)
+            lines.append(f"LoD chain on {doc.node_label(index)}: levels at nodes {[index, *ids]}, coverage {shown}")
     return lines
 
 

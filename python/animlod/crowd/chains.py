@@ -29,18 +29,24 @@ def character_chain(
     return Path(output)
 
 
-def procedural_chain(path: str | os.PathLike, seed: int = 0, progress: Callable[[str], None] | None = None) -> Path:
-    """The procedural humanoid (walk, run and jump clips) as a LoD GLB at ``path``; its path.
-
-    The humanoid is written to ``<stem>_source.glb`` beside ``path`` and made a chain by
-    :func:`character_chain`.
-    """
+def procedural_source(path: str | os.PathLike, seed: int = 0) -> Path:
+    """The procedural humanoid (walk, run and jump clips) as a GLB of one level at ``path``, in
+    about a second; its path."""
     from .. import synth
     from ..io.gltf import write_glb
 
-    path = Path(path)
-    source = path.with_name(f"{path.stem}_source.glb")
     character = synth.humanoid(seed=seed)
     motions = [synth.humanoid_motion(character.skeleton, kind, seed=seed) for kind in synth.KINDS]
-    write_glb(source, character, motions)
+    write_glb(path, character, motions)
+    return Path(path)
+
+
+def procedural_chain(path: str | os.PathLike, seed: int = 0, progress: Callable[[str], None] | None = None) -> Path:
+    """The procedural humanoid as a LoD GLB at ``path``; its path.
+
+    :func:`procedural_source` is written to ``<stem>_source.glb`` beside ``path`` and made a
+    chain by :func:`character_chain`.
+    """
+    path = Path(path)
+    source = procedural_source(path.with_name(f"{path.stem}_source.glb"), seed)
     return character_chain(source, path, progress)

@@ -40,8 +40,11 @@ def nearest_existing(path: str | os.PathLike) -> Path:
 
 
 def unwritable(path: str | os.PathLike) -> str | None:
-    """Why :func:`atomic_write` could not write ``path`` (its nearest existing folder is a file or
-    takes no new file), or None: for work that writes its result only at the end."""
+    """Why :func:`atomic_write` could not write ``path`` (it is a folder, or its nearest existing
+    folder is a file or takes no new file), or None: for work that writes its result only at the
+    end."""
+    if os.path.isdir(path):  # the rename onto it would fail only after the work
+        return "is a folder"
     folder = nearest_existing(Path(os.path.abspath(path)).parent)
     if not folder.is_dir():
         return f"{folder} is not a folder"

@@ -257,6 +257,26 @@ def lod_ids(doc: GltfDocument, base: int) -> list[int] | None:
     return ids
 
 
+def lod_coverages(doc: GltfDocument, base: int, ids: list[int]) -> list[float | None]:
+    """The MSFT_screencoverage of node ``base``'s chain of ``ids``, one a level (None each where it
+    has none). FormatError naming the element unless they are as many finite numbers >= 0, none
+    above the one before (level i is used while the object covers at least c_i), as the crowd's
+    loader requires."""
+    extras = doc.json["nodes"][base].get("extras")
+    coverages = (extras if isinstance(extras, dict) else {}).get(COVERAGE_EXTRA)
+    if coverages is None:
+        return [None] * (len(ids) + 1)
+    element = f"{doc.node_label(base)} extras {COVERAGE_EXTRA}"
+    if not isinstance(coverages, list) or len(coverages) != len(ids) + 1:
+        raise doc.fail(element, f"needs {len(ids) + 1} values")
+    for level, value in enumerate(coverages):
+        if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value < float("inf"):
+            raise doc.fail(element, f"level {level}: {value!r} is not a finite number >= 0")
+        if level and value > coverages[level - 1]:
+            raise doc.fail(element, f"level {level}: {value} is above level {level - 1}'s {coverages[level - 1]}")
+    return [float(value) for value in coverages]
+
+
 def read_lod_chains(path: str | os.PathLike, fps: float = 30.0) -> list[LodChain]:
     """Every chain of a LoD GLB (one per node with MSFT_lod), levels finest first.
 
@@ -272,10 +292,7 @@ def read_lod_chains(path: str | os.PathLike, fps: float = 30.0) -> list[LodChain
         ids = lod_ids(doc, base)
         if ids is None:
             continue
-        extras = node.get("extras") if isinstance(node.get("extras"), dict) else {}
-        coverages = extras.get(COVERAGE_EXTRA, [None] * (len(ids) + 1))
-        if not isinstance(coverages, list) or len(coverages) != len(ids) + 1:
-            raise doc.fail(f"{doc.node_label(base)} extras", f"{COVERAGE_EXTRA} needs {len(ids) + 1} values")
+        coverages = lod_coverages(doc, base, ids)
         parent = doc.parents[base]
         parent_world = doc.rest_world_matrix(parent) if parent >= 0 else np.eye(4)
         levels = []

@@ -133,7 +133,10 @@ def build_motion_levels(
         raise ValueError(f"ranking: no ranking named {ranking!r} (choose from {', '.join(RANKINGS)})")
     if len(weights) != 3:
         raise ValueError(f"weights: expected (alpha, beta, gamma), got {len(weights)} values")
-    if unwritable(Path(output) / "level"):  # found before the work, not after it
+    manifest_path = Path(output) / f"{input_stem(source)}_motion_lod.json"
+    if manifest_path.is_dir():  # found before the work, not after it
+        raise IsADirectoryError(errno.EISDIR, "Is a directory", os.fspath(manifest_path))
+    if unwritable(manifest_path):
         raise NotADirectoryError(errno.ENOTDIR, "Not a directory", os.fspath(output))
     notes: list[str] = []
 

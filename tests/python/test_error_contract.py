@@ -38,7 +38,6 @@ ALLOWED = {
     ("model.py", None): "_require's own raise: its callers' messages are checked instead",
     ("model.py", "motion has {} joints, the skin's skeleton {}"): "model.py Motion/Skin part: lead's",
     ("model.py", "skeleton has no joint named {}"): "model.py Skeleton part: lead's",
-    ("cli/crowd.py", None): "CrowdError's message: the crowd runner's or animlod_crowd's own, each naming its element",
     ("synth/face_animation.py", "seconds and fps must be positive"): "procedural assets: no file, not user input",
 }
 

@@ -133,10 +133,11 @@ def build_motion_levels(
         raise ValueError(f"ranking: no ranking named {ranking!r} (choose from {', '.join(RANKINGS)})")
     if len(weights) != 3:
         raise ValueError(f"weights: expected (alpha, beta, gamma), got {len(weights)} values")
-    manifest_path = Path(output) / f"{input_stem(source)}_motion_lod.json"
-    if manifest_path.is_dir():  # found before the work, not after it
-        raise IsADirectoryError(errno.EISDIR, "Is a directory", os.fspath(manifest_path))
-    if unwritable(manifest_path):
+    folder, stem = Path(output), input_stem(source)
+    manifest = Path(f"{stem}_motion_lod.json")
+    if (folder / manifest).is_dir():  # found before the work, not after it
+        raise IsADirectoryError(errno.EISDIR, "Is a directory", os.fspath(folder / manifest))
+    if unwritable(folder / manifest):
         raise NotADirectoryError(errno.ENOTDIR, "Not a directory", os.fspath(output))
     notes: list[str] = []
 
@@ -179,8 +180,6 @@ def build_motion_levels(
     from ..io.bvh import write_bvh
     from ..io.manifest import write_lod_manifest
 
-    folder = Path(output)
-    stem = input_stem(source)
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
     orders = layout.rotation_orders if layout is not None else "ZXY"
     suffixes = _clip_suffixes([clip.name for clip in played])
@@ -189,7 +188,6 @@ def build_motion_levels(
     skin_errors = None if skin is None else skin_distances(skin, motion, chain.levels, on_measure)
     skin_seconds = time.perf_counter() - measuring
     files, rows = [], []
-    manifest = Path(f"{stem}_motion_lod.json")
     with staged_files(folder) as staged:  # no level reaches the folder unless every file is written
         for index, level in enumerate(chain.levels):
             names = []

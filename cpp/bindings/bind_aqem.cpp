@@ -147,6 +147,13 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
 }  // namespace
 
 void bind_aqem(py::module_& m) {
+  m.def(
+      "check_aqem_options", [](const AqemOptions& options) { raise_if_error(check_aqem_options(options)); },
+      py::arg("options"),
+      R"doc(Raises ValueError naming the option when ``options`` hold a value simplify_animated
+refuses whatever the mesh (no level, a ratio outside (0, 1], a face count of 0, a negative
+max_error, a negative frame, a motion-feature option out of range). Face counts above a mesh's
+face count and frames past its last are refused by simplify_animated alone.)doc");
   m.def("simplify_animated", &simplify_animated_py, py::arg("frames"), py::arg("faces"),
         py::arg("options") = AqemOptions{}, py::kw_only(), py::arg("locked") = py::none(),
         py::arg("guarded") = py::none(), py::arg("importance") = py::none(), py::arg("attributes") = py::none(),

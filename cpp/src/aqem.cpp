@@ -43,14 +43,15 @@ using detail::Candidate;
 using detail::CollapseEngine;
 using detail::Quadric;
 
-// Checks the options against the mesh and resolves the level targets (finest first).
-// `face_count` is M', the faces left after preparation; `input_faces` is M.
+// Checks the face counts against the mesh and resolves the level targets (finest first); the
+// rest was checked by check_aqem_options. `face_count` is M', the faces left after preparation;
+// `input_faces` is M.
 Status resolve_targets(size_t face_count, size_t input_faces, const AqemOptions& options,
                        std::vector<size_t>& targets) {
   targets.clear();
   if (!options.target_face_counts.empty()) {
     for (size_t count : options.target_face_counts) {
-      if (count < 1 || count > input_faces)
+      if (count > input_faces)
         return Status::error("target_face_counts: " + std::to_string(count) + " outside [1, " +
                              std::to_string(input_faces) + "] (the mesh has " + std::to_string(input_faces) +
                              " faces)");
@@ -58,16 +59,11 @@ Status resolve_targets(size_t face_count, size_t input_faces, const AqemOptions&
     }
   } else {
     for (double ratio : options.target_ratios) {
-      if (!(ratio > 0.0 && ratio <= 1.0))
-        return Status::error("target_ratios: " + std::to_string(ratio) + " outside (0, 1]");
       const auto count = static_cast<size_t>(std::llround(ratio * static_cast<double>(face_count)));
       targets.push_back(std::max<size_t>(count, 1));
     }
   }
-  if (targets.empty()) return Status::error("target_ratios: no level requested");
   std::sort(targets.begin(), targets.end(), std::greater<>());
-  if (std::isnan(options.max_error) || options.max_error < 0.0)
-    return Status::error("max_error: must be >= 0");
   return Status::success();
 }
 
@@ -75,7 +71,7 @@ Status resolve_frames(const AnimatedMeshView& mesh, const AqemOptions& options, 
   if (!options.frame_subset.empty()) {
     frames = options.frame_subset;
     for (int32_t f : frames)
-      if (f < 0 || static_cast<size_t>(f) >= mesh.frame_count)
+      if (static_cast<size_t>(f) >= mesh.frame_count)
         return Status::error("frame_subset: frame " + std::to_string(f) + " outside [0, " +
                              std::to_string(mesh.frame_count) + ")");
     std::sort(frames.begin(), frames.end());
@@ -481,6 +477,23 @@ AqemLevel to_level(detail::EngineLevel&& engine_level) {
 
 }  // namespace
 
+Status check_aqem_options(const AqemOptions& options) {
+  if (!options.target_face_counts.empty()) {
+    for (size_t count : options.target_face_counts)
+      if (count < 1) return Status::error("target_face_counts: 0 outside [1, M] (a level needs a face)");
+  } else {
+    if (options.target_ratios.empty()) return Status::error("target_ratios: no level requested");
+    for (double ratio : options.target_ratios)
+      if (!(ratio > 0.0 && ratio <= 1.0))
+        return Status::error("target_ratios: " + std::to_string(ratio) + " outside (0, 1]");
+  }
+  if (std::isnan(options.max_error) || options.max_error < 0.0) return Status::error("max_error: must be >= 0");
+  for (int32_t f : options.frame_subset)
+    if (f < 0) return Status::error("frame_subset: frame " + std::to_string(f) + " is negative");
+  if (options.use_motion_features) return check_motion_feature_options(options.motion_features);
+  return Status::success();
+}
+
 Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& vertex_data, const AqemOptions& options,
                          AqemResult& out) {
   // Everything is built in `result` and moved into `out` only on success, so that an error
@@ -489,6 +502,7 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   AqemResult result;
   AqemTimings& seconds = result.seconds;
   std::optional<detail::PhaseTimer> timer(std::in_place, seconds.preparation);
+  if (Status status = check_aqem_options(options); !status) return status;
   if (Status status = detail::check_sizes_values_and_indices(mesh); !status) return status;
   if (Status status = validate_vertex_data(mesh, vertex_data); !status) return status;
 

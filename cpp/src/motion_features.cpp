@@ -125,16 +125,21 @@ double amplitude_threshold(const std::vector<float>& amplitude, const detail::Ed
 
 }  // namespace
 
-Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeatureOptions& options,
-                               MotionFeatures& out) {
-  detail::EdgeTable edges;
-  if (Status status = detail::validate_and_build_edges(mesh, edges); !status) return status;
+Status check_motion_feature_options(const MotionFeatureOptions& options) {
   if (!(options.feature_threshold >= 0.0) || !(options.min_angle_change >= 0.0))
     return Status::error("motion features: feature_threshold and min_angle_change must be >= 0 radians");
   if (!(options.max_feature_weight >= 1.0) || !std::isfinite(options.max_feature_weight))
     return Status::error("motion features: max_feature_weight must be finite and >= 1");
   if (!(options.noise_mads >= 0.0) || !std::isfinite(options.noise_mads))
     return Status::error("motion features: noise_mads must be finite and >= 0");
+  return Status::success();
+}
+
+Status compute_motion_features(const AnimatedMeshView& mesh, const MotionFeatureOptions& options,
+                               MotionFeatures& out) {
+  if (Status status = check_motion_feature_options(options); !status) return status;
+  detail::EdgeTable edges;
+  if (Status status = detail::validate_and_build_edges(mesh, edges); !status) return status;
   const size_t edge_count = edges.size();
   const bool paper = options.feature_weighting == FeatureWeighting::paper;
 

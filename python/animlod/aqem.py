@@ -291,15 +291,10 @@ def simplify_animated(
     index outside [0, V), target out of range, bad per-vertex data, an unknown option or a value
     an option cannot hold.
     """
-    if target_ratios is not None:
-        if np.ndim(target_ratios) != 1:
-            raise ValueError(f"target_ratios: expected a list of fractions, one per level, got {target_ratios!r}")
-        option_fields["target_ratios"] = list(target_ratios)
-    resolved = resolve_options(AqemOptions, options, option_fields)
     raw = _core.simplify_animated(
         mesh.frames,
         mesh.faces,
-        resolved,
+        _resolved_options(target_ratios, options, option_fields),
         locked=_vertex_mask("locked_vertices", locked_vertices, mesh.vertex_count),
         guarded=_vertex_mask("guarded_vertices", guarded_vertices, mesh.vertex_count),
         importance=importance,
@@ -311,6 +306,34 @@ def simplify_animated(
         progress=progress,
     )
     return _result(raw, mesh.fps)
+
+
+def check_aqem_options(
+    target_ratios: Sequence[float] | None = None, options: AqemOptions | None = None, **option_fields: object
+) -> None:
+    """Refuse, as :func:`simplify_animated` would for any mesh, options it cannot take: a caller
+    that holds options long before the mesh (a batch manifest) checks them up front.
+
+    Raises
+    ------
+    ValueError naming the option: an unknown one, a value its type cannot hold, no level, a
+    ratio outside (0, 1], a face count of 0, a negative max_error, a negative frame in
+    ``frame_subset``, a motion-feature option out of range. What depends on the mesh (a face
+    count above its faces, a frame past its last) only :func:`simplify_animated` can refuse.
+    """
+    _core.check_aqem_options(_resolved_options(target_ratios, options, option_fields))
+
+
+def _resolved_options(
+    target_ratios: Sequence[float] | None, options: AqemOptions | None, option_fields: dict[str, object]
+) -> AqemOptions:
+    """The core's options from :func:`simplify_animated`'s ``target_ratios``, ``options`` and
+    fields by name."""
+    if target_ratios is not None:
+        if np.ndim(target_ratios) != 1:
+            raise ValueError(f"target_ratios: expected a list of fractions, one per level, got {target_ratios!r}")
+        option_fields["target_ratios"] = list(target_ratios)
+    return resolve_options(AqemOptions, options, option_fields)
 
 
 def skinned_lod_chain(

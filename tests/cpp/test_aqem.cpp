@@ -286,8 +286,50 @@ TEST_CASE("aqem names the element of bad input") {
     options.target_face_counts = {9};
     CHECK(failure(mesh, options).find("target_face_counts: 9 outside [1, 8]") == 0);
     options.target_face_counts = {0};
-    CHECK(failure(mesh, options).find("target_face_counts: 0 outside [1, 8]") == 0);
+    CHECK(failure(mesh, options).find("target_face_counts: 0 outside [1, M]") == 0);
     options.target_face_counts = {};
+    options.target_ratios = {1.5};
+    CHECK(failure(mesh, options).find("target_ratios: 1.5") == 0);
+  }
+}
+
+TEST_CASE("aqem options that no mesh can take are refused without a mesh, and first") {
+  AqemOptions options;
+  CHECK(check_aqem_options(options).ok);
+  SUBCASE("no level") {
+    options.target_ratios = {};
+    CHECK(check_aqem_options(options).message == "target_ratios: no level requested");
+  }
+  SUBCASE("a ratio outside (0, 1]") {
+    options.target_ratios = {0.5, 0.0};
+    CHECK(check_aqem_options(options).message.find("target_ratios: 0.0") == 0);
+  }
+  SUBCASE("a face count of 0, the ratios then unused") {
+    options.target_ratios = {7.0};
+    options.target_face_counts = {4, 0};
+    CHECK(check_aqem_options(options).message.find("target_face_counts: 0 outside [1, M]") == 0);
+    options.target_face_counts = {1000000};  // only a mesh can tell it is too many
+    CHECK(check_aqem_options(options).ok);
+  }
+  SUBCASE("max_error") {
+    options.max_error = -1.0;
+    CHECK(check_aqem_options(options).message == "max_error: must be >= 0");
+    options.max_error = NAN;
+    CHECK(check_aqem_options(options).message == "max_error: must be >= 0");
+  }
+  SUBCASE("a negative frame") {
+    options.frame_subset = {0, -2};
+    CHECK(check_aqem_options(options).message == "frame_subset: frame -2 is negative");
+  }
+  SUBCASE("motion-feature options, only when the features are used") {
+    options.motion_features.max_feature_weight = 0.5;
+    CHECK(check_aqem_options(options).message.find("motion features: max_feature_weight") == 0);
+    options.use_motion_features = false;
+    CHECK(check_aqem_options(options).ok);
+  }
+  SUBCASE("before the mesh is read: a bad ratio on a bad mesh names the ratio") {
+    OwnedAnimatedMesh mesh = animlod::testing::grid(2);
+    mesh.frames[0] = NAN;
     options.target_ratios = {1.5};
     CHECK(failure(mesh, options).find("target_ratios: 1.5") == 0);
   }

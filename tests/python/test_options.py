@@ -14,6 +14,7 @@ import pytest
 from simplify_inputs import bending_tube
 
 from animlod import _core, options, simplify_animated
+from animlod.aqem import check_aqem_options
 from animlod.options import AqemOptions, MotionFeatureOptions, MotionRefitOptions, TdagOptions
 
 HEADERS = Path(__file__).resolve().parents[2] / "cpp" / "include" / "animlod"
@@ -58,6 +59,30 @@ def test_keywords_reach_nested_options_and_bad_ones_are_named():
         AqemOptions(placement="edge")
     with pytest.raises(ValueError, match=r"^LodSelectorOptions.hysteresis: must be >= 0, got -0.5$"):
         _core.LodSelectorOptions().hysteresis = -0.5
+
+
+@pytest.mark.parametrize(
+    "ratios, fields, message",
+    [
+        ((1.5,), {}, r"^target_ratios: 1\.500000 outside \(0, 1\]$"),
+        ((), {}, r"^target_ratios: no level requested$"),
+        (None, {"max_error": -1.0}, r"^max_error: must be >= 0$"),
+        (None, {"target_face_counts": [3, 0]}, r"^target_face_counts: 0 outside \[1, M\]"),
+        (None, {"frame_subset": [-1]}, r"^frame_subset: frame -1 is negative$"),
+        (None, {"noise_mads": -1.0}, r"^motion features: noise_mads must be finite and >= 0$"),
+        (None, {"placement": "middle"}, r"^AqemOptions\.placement: expected one of"),
+    ],
+)
+def test_aqem_options_are_checked_without_a_mesh_as_simplify_refuses_them(ratios, fields, message):
+    with pytest.raises(ValueError, match=message):
+        check_aqem_options(ratios, **fields)
+    with pytest.raises(ValueError, match=message):
+        simplify_animated(bending_tube(frames=2), ratios, **fields)
+
+
+def test_aqem_options_a_mesh_decides_pass_the_check_without_one():
+    check_aqem_options((0.5, 1.0), target_face_counts=[10**9], frame_subset=[10**6], max_error=0.0)
+    check_aqem_options(noise_mads=-1.0, use_motion_features=False)
 
 
 def test_copies_are_deep_and_pickles_round_trip():

@@ -197,6 +197,13 @@ struct AqemResult {
   AqemTimings seconds;
 };
 
+// The checks of `options` that need no mesh, run first by simplify_animated: no level, a target
+// ratio outside (0, 1], a face count of 0, a negative or NaN max_error, a negative frame in
+// frame_subset, and the motion-feature options' (check_motion_feature_options) when
+// use_motion_features is on. A caller that takes options long before it has the mesh (a batch
+// manifest) can refuse them up front.
+Status check_aqem_options(const AqemOptions& options);
+
 // Simplifies `mesh` to every target of `options`.
 //
 // Placement (Eq. 5, Placement::optimal): per frame, v = X^-1 Y of the merged quadric; where a

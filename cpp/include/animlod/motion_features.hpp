@@ -70,6 +70,10 @@ struct MotionFeatures {
                                         //      all frames, unwrapped (0 on boundary edges)
 };
 
+// The checks of `options` that need no mesh: a negative or NaN threshold, max_feature_weight
+// below 1 or not finite, negative or non-finite noise_mads. compute_motion_features runs them.
+Status check_motion_feature_options(const MotionFeatureOptions& options);
+
 // Finds the motion features of `mesh` over all its frames.
 // Errors: the input checks of validate_animated_mesh (NaN, index out of range, degenerate,
 // duplicate or non-manifold faces, unreferenced vertices), each naming the element; a negative

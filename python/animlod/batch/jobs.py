@@ -17,7 +17,6 @@ import collections.abc
 import functools
 import importlib
 import inspect
-import json
 import math
 import types
 import typing
@@ -94,6 +93,8 @@ class Job:
 _AQEM = "animlod.options:AqemOptions"
 # The settings the glTF pipelines share, as keywords.
 _DRAWABLE = "animlod.pipelines.drawable_levels:DrawableSettings"
+# The core's check of AQEM's options, the mesh-independent part of what simplify_animated refuses.
+_CHECK_AQEM = "animlod.aqem:check_aqem_options"
 BUILTIN_JOBS = {
     "simplify": Job(
         "simplify",
@@ -164,45 +165,23 @@ def check_values(job: Job, kind: str, options: dict[str, object]) -> str | None:
     """Why the values of ``options`` (of the types :func:`check_options` checks) would stop
     ``job`` on input of ``kind``, naming the option, or None. Asked of the code that refuses them
     as the job runs, so that no range is written twice: the glTF pipelines' settings are resolved
-    from them, and AQEM, whose core checks the level targets (``ratios``, which every job with
-    AQEM levels passes on as its target_ratios) and ``max_error`` only as it simplifies,
-    simplifies one triangle with them. The other jobs check their values as they run."""
+    from them, and the core's check of AQEM's options (``ratios``, which every job with AQEM
+    levels passes on as its target_ratios, ``max_error`` and the rest) that needs no mesh. The
+    other jobs check their values as they run."""
     sources = job.sources(kind)
     if _AQEM not in sources:
         return None
-    settings = tuple(source for source in (_DRAWABLE, _AQEM) if source in sources)
-    names = {"ratios"}.union(*map(_source_options, settings))
-    values = {name: value for name, value in options.items() if name in names}
-    return _settings_problem(settings, json.dumps(values, sort_keys=True))
-
-
-@functools.lru_cache(maxsize=256)
-def _settings_problem(settings: tuple[str, ...], values_json: str) -> str | None:
-    """:func:`check_values` for one set of values (a library's assets mostly share them)."""
-    values = json.loads(values_json)
 
     def taken_by(source: str) -> dict[str, object]:
-        return {name: value for name, value in values.items() if name in _source_options(source)}
+        return {name: value for name, value in options.items() if name in _source_options(source)}
 
     try:
-        if _DRAWABLE in settings:
+        if _DRAWABLE in sources:
             _import(_DRAWABLE).resolve(None, taken_by(_DRAWABLE))
-        _simplify_one_triangle(values.get("ratios"), taken_by(_AQEM))
+        _import(_CHECK_AQEM)(options.get("ratios"), **taken_by(_AQEM))
     except ValueError as error:
         return " ".join(str(error).split())
     return None
-
-
-def _simplify_one_triangle(ratios: object, aqem: dict[str, object]) -> None:
-    """AQEM on one triangle with level targets ``ratios`` and the ``aqem`` options: ValueError
-    naming the option the core refuses."""
-    import numpy as np
-
-    from ..aqem import simplify_animated
-    from ..model import AnimatedMesh
-
-    triangle = AnimatedMesh(np.array([[0, 1, 2]], dtype=np.int32), np.eye(3, dtype=np.float32)[None])
-    simplify_animated(triangle, ratios, **aqem)
 
 
 class _Kind(typing.NamedTuple):

@@ -59,8 +59,7 @@ def run(args: argparse.Namespace) -> int:
     # The three files replace an earlier run's together: an interrupted build left its
     # character.glb beside the earlier seed's character_lod.glb and summary.txt.
     with staged_files(output) as staged:
-        character = synth.humanoid(seed=args.seed)
-        motions = [synth.humanoid_motion(character.skeleton, kind, seed=args.seed) for kind in synth.KINDS]
+        character, motions = synth.humanoid_with_clips(args.seed)
         skeleton = character.skeleton
         write_glb(staged / "character.glb", character, motions)
         report(

@@ -35,9 +35,7 @@ def procedural_source(path: str | os.PathLike, seed: int = 0) -> Path:
     from .. import synth
     from ..io.gltf import write_glb
 
-    character = synth.humanoid(seed=seed)
-    motions = [synth.humanoid_motion(character.skeleton, kind, seed=seed) for kind in synth.KINDS]
-    write_glb(path, character, motions)
+    write_glb(path, *synth.humanoid_with_clips(seed))
     return Path(path)
 
 

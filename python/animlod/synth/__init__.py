@@ -1,7 +1,7 @@
 """Procedural assets, deterministic from a seed: the embedded default and most tests' input.
 
 - :func:`humanoid` and :func:`humanoid_motion`: a 41-joint skinned character and its cyclic
-  walk, run and jump;
+  walk, run and jump (:func:`humanoid_with_clips`: the character with one clip of each);
 - :func:`face` and :func:`face_animation`: a head with named animation regions;
 - :func:`bending_cylinder`, :func:`twisting_bar`, :func:`translating_mesh`: small deforming
   meshes with known motion for unit tests;
@@ -11,7 +11,7 @@
 from .deforming import bending_cylinder, bending_cylinder_skinned, translating_mesh, twisting_bar
 from .face_animation import face_animation
 from .face_model import REGION_NAMES, STILL_REGIONS, FaceModel, face
-from .gait import KINDS, STILL_FINGER_CHAIN, humanoid_motion
+from .gait import KINDS, STILL_FINGER_CHAIN, humanoid_motion, humanoid_with_clips
 from .geometry import icosphere
 from .humanoid_body import END_SITES, humanoid, humanoid_skeleton
 
@@ -29,6 +29,7 @@ __all__ = [
     "humanoid",
     "humanoid_motion",
     "humanoid_skeleton",
+    "humanoid_with_clips",
     "icosphere",
     "translating_mesh",
     "twisting_bar",

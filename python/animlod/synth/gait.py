@@ -19,9 +19,9 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from .. import rotations
-from ..model import Motion, Skeleton
+from ..model import Motion, Skeleton, SkinnedMesh
 from .curves import bump, raised
-from .humanoid_body import FINGERS
+from .humanoid_body import FINGERS, humanoid
 
 STILL_FINGER_CHAIN = ("LeftHandRing1", "LeftHandRing2")
 KINDS = ("walk", "run", "jump")
@@ -165,6 +165,13 @@ def _sided(side: str, angles: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """Name left-side limb angles for ``side``, mirroring them for the right: ``(x, -y, -z)``."""
     mirror = np.array([1.0, -1.0, -1.0]) if side == "Right" else np.ones(3)
     return {side + name: value * mirror for name, value in angles.items()}
+
+
+def humanoid_with_clips(seed: int = 0) -> tuple[SkinnedMesh, list[Motion]]:
+    """:func:`~animlod.synth.humanoid` and one clip of each of ``KINDS`` for it (the default
+    cycles and fps), all from ``seed``: the procedural character `demo` and the crowd write."""
+    character = humanoid(seed=seed)
+    return character, [humanoid_motion(character.skeleton, kind, seed=seed) for kind in KINDS]
 
 
 def humanoid_motion(

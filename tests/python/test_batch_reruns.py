@@ -137,6 +137,26 @@ def test_a_bad_option_value_is_one_line_exit_2_before_anything_runs(gltf_library
     assert not out.exists()  # refused before the output folder, or a cluster, was made
 
 
+@pytest.mark.parametrize(
+    "job, option, message",
+    [
+        ("motion", "max_frames=1", "max_frames: must be at least 2, got 1"),
+        ("motion", "ranking=bogus", "ranking: no ranking named 'bogus'"),
+        ("motion", "weights=[0,1,1]", "weights: distance must be positive"),
+        ("motion", "levels=0", "levels: must be at least 1, got 0"),
+        ("face", "repeats=0", "repeats: must be at least 1, got 0"),
+        ("face", "ratios=[1.5]", "target_ratios: 1.500000 outside (0, 1]"),
+    ],
+)
+def test_motion_and_face_values_are_checked_before_anything_runs(gltf_library, tmp_path, capsys, job, option, message):
+    # They used to fail each asset as it ran (exit 1, an output folder made); face's repeats=0 ran.
+    out = tmp_path / "out"
+    assert main(["batch", str(gltf_library), "-o", str(out), "--job", job, "--set", option]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and message in err, err
+    assert not out.exists()
+
+
 def test_option_values_are_checked_for_every_job_that_takes_them(gltf_library, tmp_path):
     bar = _bar(tmp_path / "bar.npz")
     with pytest.raises(SpecError, match=r"target_ratios: 1\.500000 outside \(0, 1\]"):

@@ -7,9 +7,11 @@ import json
 
 import numpy as np
 import pygltflib
+import pytest
 from gltf_edits import append_accessor, edit_glb
 
 from animlod.cli import main
+from animlod.face_lod.pipeline import run_face_lod
 from animlod.io import write_obj
 from animlod.synth import icosphere
 
@@ -132,7 +134,7 @@ def test_face_user_mistakes_exit_2_with_one_line(tmp_path, capsys):
     assert main(["face", str(poses), "-o", str(tmp_path / "out")]) == 2
     assert "holds 1 OBJ/PLY file" in capsys.readouterr().err
     assert main(["face", "-o", str(tmp_path / "out"), "--ratio", "0.5", "--faces", "100"]) == 2
-    assert "--ratio and --faces: give one of them, not both" in capsys.readouterr().err
+    assert "ratios and face_counts: give one of them, not both" in capsys.readouterr().err
     assert main(["face", "-o", str(tmp_path / "out"), "--targets", "1", "0.5"]) == 2
     assert "apply to blendshape faces" in capsys.readouterr().err
     assert main(["face", str(tmp_path / "absent.glb"), "-o", str(tmp_path / "out")]) == 2
@@ -155,3 +157,18 @@ def test_face_gltf_without_morph_targets_is_named(tmp_path, capsys):
 def test_face_unknown_expression(tmp_path, capsys):
     assert main(["face", "-o", str(tmp_path / "out"), "--plot", "--expression", "boredom", "--repeats", "1"]) == 2
     assert "no expression 'boredom'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"repeats": 0}, "repeats: must be at least 1, got 0"),  # ran, and timed every level at inf
+        ({"error_frames": -1}, "error_frames: must be at least 1, got -1"),
+        ({"ratios": [-0.5]}, r"target_ratios: -0\.500000 outside \(0, 1\]"),  # ran, at 4 triangles
+        ({"target_fractions": [1.0, 2.0]}, r"target fraction of level 1: 2\.0 is outside \[0, 1\]"),
+    ],
+)
+def test_face_values_no_face_can_take_are_refused_before_the_work(tmp_path, options, message):
+    with pytest.raises(ValueError, match=message):
+        run_face_lod(None, tmp_path / "out", **options)
+    assert not (tmp_path / "out").exists()

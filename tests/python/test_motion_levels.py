@@ -15,6 +15,7 @@ from animlod.motion_lod import analyze_motion, joint_floor, level_joint_counts
 from animlod.motion_lod.analysis import translating_joints
 from animlod.motion_lod.chain import build_level, build_motion_chain
 from animlod.motion_lod.frozen import freeze
+from animlod.pipelines.motion import build_motion_levels
 
 
 def tree_motion(joints: int = 20, translating: tuple[int, ...] = (), frames: int = 16, seed: int = 3) -> Motion:
@@ -231,9 +232,15 @@ def test_cli_unknown_ranking_is_one_line(tmp_path, capsys) -> None:
     assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--ranking", "alphabetical"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        "animlod motion: error: --ranking: no ranking named 'alphabetical' (choose from refit, importance, paper, "
-        "depth, variance, cumulative)"
+        f"animlod motion: error: {source}: ranking: no ranking named 'alphabetical' (choose from refit, importance, "
+        "paper, depth, variance, cumulative)"
     )
+
+
+def test_levels_and_joint_counts_together_are_refused_before_the_clip_is_read(tmp_path) -> None:
+    # joints used to win silently over levels; the clip is not even read (an absent file here).
+    with pytest.raises(ValueError, match="^levels and joints: give one of them, not both$"):
+        build_motion_levels(tmp_path / "absent.bvh", tmp_path / "out", 3, joints=[8, 4])
 
 
 def test_cli_a_level_that_cannot_be_written_leaves_no_level_beside_the_folders_files(tmp_path, capsys) -> None:

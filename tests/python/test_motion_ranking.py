@@ -71,7 +71,7 @@ def test_depth_and_variance_orders() -> None:
 
 
 def test_an_unknown_ranking_is_refused_by_name() -> None:
-    expected = "ranking: expected one of refit, importance, paper, depth, variance, cumulative, got 'abc'"
+    expected = r"ranking: no ranking named 'abc' \(choose from refit, importance, paper, depth, variance, cumulative\)"
     with pytest.raises(ValueError, match=expected):
         analyze_motion(figure_motion(), ranking="abc")
 

@@ -69,6 +69,9 @@ class Job:
     path: str  # "module:function", imported where the job runs
     kinds: tuple[str, ...]  # input kinds it takes; empty: any
     option_sources: dict[str, tuple[str, ...]]  # kind -> "module:function" whose keywords are options
+    # "module:function" that refuses (ValueError) values no input can take, given the options
+    # among its keywords; the AQEM options' check is check_values' own.
+    value_check: str | None = None
 
     def function(self) -> Callable:
         return _import(self.path)
@@ -117,12 +120,14 @@ BUILTIN_JOBS = {
         "animlod.pipelines.assets:face_asset",
         ("gltf", "sequence"),
         {"*": ("animlod.face_lod.pipeline:run_face_lod",)},
+        "animlod.face_lod.pipeline:check_face_options",
     ),
     "motion": Job(
         "motion",
         "animlod.pipelines.motion:motion_asset",
         ("bvh", "gltf"),
         {"*": ("animlod.pipelines.motion:build_motion_levels",)},
+        "animlod.pipelines.motion:check_motion_options",
     ),
 }
 
@@ -165,20 +170,22 @@ def check_values(job: Job, kind: str, options: dict[str, object]) -> str | None:
     """Why the values of ``options`` (of the types :func:`check_options` checks) would stop
     ``job`` on input of ``kind``, naming the option, or None. Asked of the code that refuses them
     as the job runs, so that no range is written twice: the glTF pipelines' settings are resolved
-    from them, and the core's check of AQEM's options (``ratios``, which every job with AQEM
-    levels passes on as its target_ratios, ``max_error`` and the rest) that needs no mesh. The
-    other jobs check their values as they run."""
+    from them, the core's check of AQEM's options (``ratios``, which every job with AQEM levels
+    passes on as its target_ratios, ``max_error`` and the rest) that needs no mesh, and the job's
+    ``value_check`` (the motion and face pipelines' own)."""
     sources = job.sources(kind)
-    if _AQEM not in sources:
-        return None
 
     def taken_by(source: str) -> dict[str, object]:
         return {name: value for name, value in options.items() if name in _source_options(source)}
 
     try:
+        if job.value_check is not None:
+            check = _import(job.value_check)
+            check(**{name: value for name, value in options.items() if name in inspect.signature(check).parameters})
         if _DRAWABLE in sources:
             _import(_DRAWABLE).resolve(None, taken_by(_DRAWABLE))
-        _import(_CHECK_AQEM)(options.get("ratios"), **taken_by(_AQEM))
+        if _AQEM in sources:
+            _import(_CHECK_AQEM)(options.get("ratios"), **taken_by(_AQEM))
     except ValueError as error:
         return " ".join(str(error).split())
     return None

@@ -55,12 +55,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..face_lod.pipeline import run_face_lod
 
-    if args.ratio and args.faces:
-        raise UserError("--ratio and --faces: give one of them, not both")
-    if args.repeats < 1:
-        raise UserError(f"--repeats: must be at least 1, got {args.repeats}")
-    if args.error_frames < 1:
-        raise UserError(f"--error-frames: must be at least 1, got {args.error_frames}")
     if args.input is None and (args.targets or args.neutral):
         raise UserError("--targets and --neutral: apply to blendshape faces (give an INPUT)")
     result = run_face_lod(

@@ -161,10 +161,6 @@ def run(args: argparse.Namespace) -> int:
 
     if args.hard and args.solver == "newton":
         raise UserError("--hard: bone-length equality constraints need an SLSQP solver (slsqp or slsqp-python)")
-    if args.workers < 0:
-        raise UserError(f"--workers: must be at least 0, got {args.workers}")
-    if args.ranking not in RANKINGS:
-        raise UserError(f"--ranking: no ranking named {args.ranking!r} (choose from {', '.join(RANKINGS)})")
     if input_kind(args.input) not in ("bvh", "gltf"):
         raise UserError(f"{args.input}: motion LoD needs a .bvh or a skinned .glb/.gltf")
     bars: list[_Progress] = []  # made when the work starts: bad input fails before any bar

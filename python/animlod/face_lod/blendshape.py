@@ -239,11 +239,12 @@ def checked_face_counts(counts: Sequence[int], triangle_count: int) -> list[int]
     return [int(count) for count in counts]
 
 
-def check_fractions(fractions: Sequence[float] | None, level_count: int) -> None:
-    """ValueError unless ``fractions`` is None or one value in [0, 1] per level."""
+def check_fractions(fractions: Sequence[float] | None, level_count: int | None = None) -> None:
+    """ValueError unless ``fractions`` is None or one value in [0, 1] per level (any number of
+    them when ``level_count`` is None)."""
     if fractions is None:
         return
-    if len(fractions) != level_count:
+    if level_count is not None and len(fractions) != level_count:
         raise ValueError(f"target fractions: {len(fractions)} given for {level_count} levels")
     for index, fraction in enumerate(fractions):
         if not 0.0 <= fraction <= 1.0:

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..aqem import simplify_animated
+from ..aqem import check_aqem_options, simplify_animated
 from ..metrics import hausdorff_distance
 from ..model import AnimatedMesh, spread_frames
 from .active_tree import ActiveTree
@@ -163,7 +163,8 @@ def build_face_lod(
     importance = rig.regions.vertex_importance() if options.region_importance else None
     if options.face_counts is not None:
         counts = [int(c) for c in options.face_counts]
-    else:
+    else:  # the core sees counts only: a ratio outside (0, 1] would become a count it takes
+        check_aqem_options(list(options.ratios))
         counts = [max(4, round(ratio * len(rig.faces))) for ratio in options.ratios]
     # Phase 2: geometry levels.
     result = simplify_animated(

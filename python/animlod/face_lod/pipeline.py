@@ -19,11 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..aqem import check_aqem_options
 from ..io.atomic import staged_files
 from .blendshape import (
     BlendshapeLevel,
     BlendshapeLodOptions,
     build_blendshape_lod,
+    check_fractions,
     measure_blendshape_lod,
     target_regions,
 )
@@ -87,12 +89,38 @@ def run_face_lod(
     error_frames : evenly spaced animation frames the surface error is measured on, besides
         each target's (or MPA's) peak-weight frame (:func:`animlod.face_lod.measure.measured_frames`).
     """
+    check_face_options(ratios=ratios, face_counts=face_counts, target_fractions=target_fractions, repeats=repeats,
+                       error_frames=error_frames)  # fmt: skip
     output = Path(output)  # created only by the writing (io.atomic.staged_files), so a refused run leaves nothing
     if source is None:
         return _run_procedural(output, ratios, face_counts, plot, expression, repeats, error_frames)
     return _run_blendshape(
         Path(source), output, ratios, face_counts, target_fractions, neutral, plot, expression, repeats, error_frames
     )
+
+
+def check_face_options(
+    *,
+    ratios: Sequence[float] | None = None,
+    face_counts: Sequence[int] | None = None,
+    target_fractions: Sequence[float] | None = None,
+    repeats: int = 3,
+    error_frames: int = 24,
+) -> None:
+    """Refuse, naming the option, values :func:`run_face_lod` cannot take whatever the face: both
+    ``ratios`` and ``face_counts``, a ratio outside (0, 1] or a count of 0 (the core's check of
+    AQEM's level targets), a fraction outside [0, 1], fewer than one repeat or error frame. A batch
+    checks its manifest with it before anything runs."""
+    if ratios is not None and face_counts is not None:
+        raise ValueError("ratios and face_counts: give one of them, not both")
+    if face_counts is not None:
+        check_aqem_options(target_face_counts=list(face_counts))
+    elif ratios is not None:
+        check_aqem_options(list(ratios))
+    check_fractions(target_fractions)
+    for name, value in (("repeats", repeats), ("error_frames", error_frames)):
+        if value < 1:
+            raise ValueError(f"{name}: must be at least 1, got {value}")
 
 
 def _run_procedural(output, ratios, face_counts, plot, expression, repeats, error_frames) -> FaceRun:

@@ -123,8 +123,7 @@ def translating_joints(motion: Motion, tolerance: float = TRANSLATION_TOLERANCE)
     that translation, or 1 % of the longest bone when it is shorter (a joint at its parent's
     position has no length of its own to compare with). Float noise and constant keys stay below.
     """
-    if not (np.isfinite(tolerance) and tolerance >= 0.0):
-        raise ValueError(f"translation_tolerance: must be a finite number >= 0, got {tolerance}")
+    _check_translation_tolerance(tolerance)
     moving = np.zeros(motion.skeleton.joint_count, bool)
     if motion.joint_translations is None or motion.skeleton.joint_count < 2:
         return moving
@@ -205,6 +204,27 @@ def _r_max(motion: Motion) -> float:
     return float(lengths.max()) if lengths.size else 0.0
 
 
+def _check_translation_tolerance(tolerance: float) -> None:
+    if not (np.isfinite(tolerance) and tolerance >= 0.0):
+        raise ValueError(f"translation_tolerance: must be a finite number >= 0, got {tolerance}")
+
+
+def check_analysis_options(
+    max_frames: int = 600,
+    translation_tolerance: float = TRANSLATION_TOLERANCE,
+    ranking: str = DEFAULT_RANKING,
+    workers: int = 0,
+) -> None:
+    """ValueError naming the option for values :func:`analyze_motion` refuses whatever the clip."""
+    if ranking not in RANKINGS:
+        raise ValueError(f"ranking: no ranking named {ranking!r} (choose from {', '.join(RANKINGS)})")
+    if max_frames < 2:
+        raise ValueError(f"max_frames: must be at least 2, got {max_frames}")
+    if workers < 0:
+        raise ValueError(f"workers: must be >= 0 (0: every core), got {workers}")
+    _check_translation_tolerance(translation_tolerance)
+
+
 def analyze_motion(
     motion: Motion,
     locked: Iterable[str] = (),
@@ -235,14 +255,9 @@ def analyze_motion(
     frame), joint positions show no rotation, so Eqs. 1-3 are undefined: r_max 0, importance 0
     and no joint in ``priority`` (nothing freezes).
     """
+    check_analysis_options(max_frames, translation_tolerance, ranking, workers)
     motion.require_rigid("motion LoD")
     skeleton = motion.skeleton
-    if ranking not in RANKINGS:
-        raise ValueError(f"ranking: expected one of {', '.join(RANKINGS)}, got {ranking!r}")
-    if max_frames < 2:
-        raise ValueError(f"max_frames: must be at least 2, got {max_frames}")
-    if workers < 0:
-        raise ValueError(f"workers: must be >= 0 (0: every core), got {workers}")
     locked_indices = sorted({skeleton.index(name) for name in locked})
     end_site_locks = [skeleton.names[j] for j in locked_indices if skeleton.end_sites[j]]
     if end_site_locks:

@@ -140,6 +140,20 @@ def joint_floor(motion: Motion, analysis: MotionAnalysis) -> JointFloor:
     )
 
 
+def check_level_request(levels: int | Sequence[int]) -> None:
+    """ValueError naming ``levels`` unless it is a number of levels of at least 1 or a non-empty
+    list of whole joint counts; whether the skeleton allows them is :func:`level_joint_counts`'s."""
+    if isinstance(levels, int | np.integer):
+        if levels < 1:
+            raise ValueError(f"levels: must be at least 1, got {levels}")
+        return
+    given = np.asarray(levels)
+    if given.ndim != 1 or given.dtype.kind not in "iuf" or np.any(given != np.round(given)):
+        raise ValueError(f"levels: expected a whole number of levels or a list of joint counts, got {levels!r}")
+    if given.size == 0:
+        raise ValueError("levels: empty list of joint counts")
+
+
 def level_joint_counts(motion: Motion, analysis: MotionAnalysis, levels: int | Sequence[int]) -> list[int]:
     """Joint counts per level, strictly decreasing, first = every joint (end sites not counted).
 
@@ -149,11 +163,10 @@ def level_joint_counts(motion: Motion, analysis: MotionAnalysis, levels: int | S
     the same fractions mapped onto the range from the floor to every joint, so that the last
     level reaches the floor. A list gives the counts.
     """
+    check_level_request(levels)
     floor = joint_floor(motion, analysis)
     total, fewest = floor.total, floor.fewest
     if isinstance(levels, int | np.integer):
-        if levels < 1:
-            raise ValueError(f"levels: must be at least 1, got {levels}")
         if levels > floor.possible_levels:
             raise ValueError(
                 f"levels: {levels} levels need {levels} distinct joint counts, but the skeleton allows "
@@ -172,12 +185,7 @@ def level_joint_counts(motion: Motion, analysis: MotionAnalysis, levels: int | S
         for k in range(1, levels):
             counts[k] = min(counts[k], counts[k - 1] - 1)
         return [int(c) for c in counts]
-    given = np.asarray(levels)
-    if given.ndim != 1 or given.dtype.kind not in "iuf" or np.any(given != np.round(given)):
-        raise ValueError(f"levels: expected a whole number of levels or a list of joint counts, got {levels!r}")
-    counts = sorted({int(c) for c in given}, reverse=True)
-    if not counts:
-        raise ValueError("levels: empty list of joint counts")
+    counts = sorted({int(c) for c in levels}, reverse=True)
     if counts[0] > total or counts[-1] < fewest:
         raise ValueError(
             f"levels: joint counts must lie in {fewest}..{total} (at least {fewest} kept: {floor.explain()}), "
@@ -245,7 +253,7 @@ def _bone_statistics(problem: RefitProblem, positions: np.ndarray) -> tuple[floa
     return error, variation
 
 
-def _resolve_solver(solver: str, slsqp_options: MotionRefitOptions | None) -> MotionRefitOptions:
+def resolve_solver(solver: str, slsqp_options: MotionRefitOptions | None) -> MotionRefitOptions:
     """The SLSQP options a solver runs with (hard bone lengths for SLSQP, penalties for Newton)."""
     if solver not in SOLVERS:
         raise ValueError(f"solver: expected one of {SOLVERS}, got {solver!r}")
@@ -359,7 +367,7 @@ def build_level(
 ) -> MotionLevel:
     """One level with ``joint_count`` joints (see :func:`build_motion_chain` for the options);
     ``trials``: re-fits on some frames already done, by :func:`_trial_key`; the level's is reused."""
-    slsqp_options = _resolve_solver(solver, slsqp_options)
+    slsqp_options = resolve_solver(solver, slsqp_options)
     start = time.perf_counter()
     total = int(np.count_nonzero(~motion.skeleton.end_sites))
     frozen_joints = analysis.priority[: total - joint_count]
@@ -450,7 +458,7 @@ def build_motion_chain(
     # which carry a frame's result into the next).
     trials: dict[bytes, _KnownFrames] = {}
     if analysis.ranking == "refit":
-        slsqp_options = _resolve_solver(solver, slsqp_options)
+        slsqp_options = resolve_solver(solver, slsqp_options)
 
         def trial_error(level: FrozenLevel, frames: np.ndarray) -> float:
             trial_motion = motion.take_frames(frames)  # frames spread over the clip: not neighbours

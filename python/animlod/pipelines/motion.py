@@ -23,9 +23,18 @@ from ..io.bvh import BvhLayout
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
 from ..model import Motion, SkinnedMesh
-from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis
-from ..motion_lod.chain import SOLVERS, JointFloor, MotionLevel, MotionLodChain, TrialMeasure
-from ..motion_lod.ranking import DEFAULT_RANKING, RANKINGS
+from ..motion_lod.analysis import TRANSLATION_TOLERANCE, MotionAnalysis, check_analysis_options
+from ..motion_lod.chain import (
+    SOLVERS,
+    JointFloor,
+    MotionLevel,
+    MotionLodChain,
+    TrialMeasure,
+    check_level_request,
+    resolve_solver,
+)
+from ..motion_lod.ranking import DEFAULT_RANKING
+from ..options import MotionRefitOptions
 from .result import AssetResult, LevelRow, Progress
 
 if TYPE_CHECKING:
@@ -125,14 +134,11 @@ def build_motion_levels(
     from ..motion_lod.chain import build_motion_chain
     from ..motion_lod.objective import Weights
     from ..motion_lod.skin_measure import hidden_note, without_skin_tips
-    from ..options import MotionRefitOptions
 
-    if workers < 0:
-        raise ValueError(f"workers: must be at least 0, got {workers}")
-    if ranking not in RANKINGS:
-        raise ValueError(f"ranking: no ranking named {ranking!r} (choose from {', '.join(RANKINGS)})")
-    if len(weights) != 3:
-        raise ValueError(f"weights: expected (alpha, beta, gamma), got {len(weights)} values")
+    check_motion_options(
+        levels=levels, joints=joints, ranking=ranking, solver=solver, penalty=penalty, workers=workers,
+        translation_tolerance=translation_tolerance, weights=weights, max_frames=max_frames,
+    )  # fmt: skip
     folder, stem = Path(output), input_stem(source)
     manifest = Path(f"{stem}_motion_lod.json")
     if (folder / manifest).is_dir():  # found before the work, not after it
@@ -168,7 +174,7 @@ def build_motion_levels(
         counts,
         weights=Weights(*weights),
         solver=solver,
-        slsqp_options=MotionRefitOptions(hard_constraints=solver != "newton" and not penalty),
+        slsqp_options=_refit_options(solver, penalty),
         workers=workers,
         on_level=(lambda index, count: on_level(index, count, motion.frame_count, len(counts))) if on_level else None,
         analysis=analysis,
@@ -438,6 +444,40 @@ def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Mot
             reason = f"joint {joint!r} scales; motion LoD re-fits rigid motions only (animlod simplify takes it)"
             raise FormatError(path, element, reason)
     return motion
+
+
+def check_motion_options(
+    *,
+    levels: int | None = None,
+    joints: Sequence[int] | None = None,
+    ranking: str = DEFAULT_RANKING,
+    solver: str = SOLVERS[0],
+    penalty: bool = False,
+    workers: int = 0,
+    translation_tolerance: float = TRANSLATION_TOLERANCE,
+    weights: Sequence[float] = (0.2, 0.4, 0.4),
+    max_frames: int = 600,
+) -> None:
+    """Refuse, naming the option, values :func:`build_motion_levels` cannot take whatever the clip
+    (each checked by the code that uses it): both ``levels`` and ``joints``, a level request, a
+    ranking, solver, weight or analysis option out of range. A batch checks its manifest with it
+    before anything runs; whether the skeleton allows the levels only the clip can tell."""
+    from ..motion_lod.objective import Weights
+
+    if levels is not None and joints is not None:
+        raise ValueError("levels and joints: give one of them, not both")
+    if levels is not None or joints is not None:
+        check_level_request(levels if joints is None else list(joints))
+    check_analysis_options(max_frames, translation_tolerance, ranking, workers)
+    resolve_solver(solver, _refit_options(solver, penalty))
+    if len(weights) != 3:
+        raise ValueError(f"weights: expected (alpha, beta, gamma), got {len(weights)} values")
+    Weights(*weights)
+
+
+def _refit_options(solver: str, penalty: bool) -> MotionRefitOptions:
+    """Bone lengths as equality constraints with the SLSQP solvers unless ``penalty``."""
+    return MotionRefitOptions(hard_constraints=solver != "newton" and not penalty)
 
 
 def _plan_levels(

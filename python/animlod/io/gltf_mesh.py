@@ -154,6 +154,16 @@ def transform_normals(matrix: np.ndarray, normals: np.ndarray) -> np.ndarray:
     return turned / np.where(length > 0.0, length, 1.0)  # a zero normal stays zero
 
 
+def transform_tangents(matrix: np.ndarray, tangents: np.ndarray) -> np.ndarray:
+    """glTF tangents ``(V, 4)`` under ``matrix``'s linear part: xyz turned with the surface and
+    renormalised, w (the bitangent's side) flipped where the matrix mirrors."""
+    linear = matrix[:3, :3]
+    turned = tangents[:, :3] @ linear.T
+    length = np.linalg.norm(turned, axis=1, keepdims=True)
+    side = tangents[:, 3:] * np.sign(np.linalg.det(linear))
+    return np.concatenate([turned / np.where(length > 0.0, length, 1.0), side], axis=1).astype(np.float32)
+
+
 def _read_primitive(
     doc: GltfDocument, element: str, index: int, primitive: pygltflib.Primitive, skinned: bool
 ) -> PrimitiveGeometry:

@@ -4,12 +4,13 @@
 file: one node per joint (rest translation and rotation, parents before children, end sites
 marked with ``extras.animlod_end_site``), a mesh node with the skin, one mesh primitive (one per
 material, with the materials of a given document: :class:`FaceMaterials`)
-(POSITION, NORMAL and TEXCOORD_0 when present, JOINTS_0/WEIGHTS_0 and, for 8 influences,
-JOINTS_1/WEIGHTS_1, uint16/uint32 indices, morph targets with their names in
-``extras.targetNames``), and one LINEAR animation per motion: the root's translation and every
-joint's rotation at every frame (and every joint's translation when the motion has per-frame
-``joint_translations``). What hangs from the skeleton in a given document (props, sockets, meshes
-its joint nodes draw) can be copied onto the written joints: :class:`HungNodes`.
+(POSITION, NORMAL and TEXCOORD_0 when present, the other attributes the materials read,
+JOINTS_0/WEIGHTS_0 and, for 8 influences, JOINTS_1/WEIGHTS_1, uint16/uint32 indices, morph
+targets with their names in ``extras.targetNames``), and one LINEAR animation per motion: the
+root's translation and every joint's rotation at every frame (and every joint's translation when
+the motion has per-frame ``joint_translations``). What hangs from the skeleton in a given
+document (props, sockets, meshes its joint nodes draw) can be copied onto the written joints:
+:class:`HungNodes`.
 
 The pieces (``add_skeleton``, ``add_skin``, ``add_animation``, ``skin_attributes``) also serve
 the LoD GLB writer, which adds reduced skeletons and their clips to a whole input document.
@@ -18,7 +19,8 @@ the LoD GLB writer, which adds reduced skeletons and their clips to a whole inpu
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from types import MappingProxyType
 from typing import NamedTuple
 
 import numpy as np
@@ -46,10 +48,13 @@ _FLOAT, _BYTE, _UNSIGNED_BYTE, _SHORT, _UNSIGNED_SHORT = 5126, 5120, 5121, 5122,
 class FaceMaterials(NamedTuple):
     """The material of each face of a written mesh: ``indices`` (F,) into ``document``'s materials,
     -1 for none. The mesh is then drawn as one primitive per material, with the document's
-    materials, textures, samplers and images."""
+    materials, textures, samplers and images, and ``vertex_attributes``: what they read per vertex
+    (TANGENT, TEXCOORD_n, COLOR_n), ``(V, width)`` float32 by glTF name; a TEXCOORD_0 there stands
+    for the mesh's ``uvs``."""
 
     document: GltfDocument
     indices: np.ndarray
+    vertex_attributes: Mapping[str, np.ndarray] = MappingProxyType({})
 
 
 class HungNodes(NamedTuple):
@@ -108,6 +113,9 @@ def write_glb(
     if materials is not None and (skinned is None or len(materials.indices) != skinned.face_count):
         faces = 0 if skinned is None else skinned.face_count
         raise ValueError(f"materials: {len(materials.indices)} face materials for {faces} faces")
+    for name, values in ({} if materials is None else materials.vertex_attributes).items():
+        if len(values) != skinned.vertex_count:
+            raise ValueError(f"materials: {name} of {len(values)} vertices for {skinned.vertex_count}")
     weights = _checked_morph_weights(skinned, motions, morph_weights)
     if materials is not None and hung is not None and materials.document is not hung.document:
         raise ValueError("hung: its document is not the one of materials")
@@ -118,7 +126,8 @@ def write_glb(
     scene_nodes = [joint_nodes[0]]
     if skinned is not None:
         skin = add_skin(builder, joint_nodes, skinned.inverse_bind)
-        mesh = builder.append("meshes", _mesh(builder, skinned, None if materials is None else materials.indices))
+        face_materials, surface = (None, {}) if materials is None else (materials.indices, materials.vertex_attributes)
+        mesh = builder.append("meshes", _mesh(builder, skinned, face_materials, surface))
         scene_nodes.append(builder.append("nodes", {"name": "skinned mesh", "mesh": mesh, "skin": skin}))
     animations = []
     for motion, name, duration, track in zip(motions, names, durations or [None] * len(motions), weights):
@@ -382,16 +391,19 @@ def _check_same_skeleton(written: Skeleton, motion: Motion, index: int) -> None:
         )
 
 
-def _mesh(builder: GlbBuilder, skinned: SkinnedMesh, face_materials: np.ndarray | None) -> dict:
+def _mesh(
+    builder: GlbBuilder, skinned: SkinnedMesh, face_materials: np.ndarray | None, surface: Mapping[str, np.ndarray]
+) -> dict:
     """The mesh of ``skinned``: one primitive, or one per material of ``face_materials`` (F,),
-    each over the vertices its faces use (a renderer skins each primitive's vertices)."""
+    each over the vertices its faces use (a renderer skins each primitive's vertices), with the
+    ``surface`` attributes of those vertices."""
     groups = np.full(skinned.face_count, -1) if face_materials is None else np.asarray(face_materials)
     materials = np.unique(groups)
     primitives = []
     for material in materials:
         faces = skinned.faces[groups == material]
         used = np.arange(skinned.vertex_count) if len(materials) == 1 else np.unique(faces)
-        primitive = _primitive(builder, skinned, used, np.searchsorted(used, faces))
+        primitive = _primitive(builder, skinned, surface, used, np.searchsorted(used, faces))
         if material >= 0:
             primitive["material"] = int(material)
         primitives.append(primitive)
@@ -404,13 +416,18 @@ def _mesh(builder: GlbBuilder, skinned: SkinnedMesh, face_materials: np.ndarray 
     return mesh
 
 
-def _primitive(builder: GlbBuilder, skinned: SkinnedMesh, used: np.ndarray, faces: np.ndarray) -> dict:
-    """A triangle primitive of ``skinned``'s vertices ``used`` and ``faces`` over them."""
+def _primitive(
+    builder: GlbBuilder, skinned: SkinnedMesh, surface: Mapping[str, np.ndarray], used: np.ndarray, faces: np.ndarray
+) -> dict:
+    """A triangle primitive of ``skinned``'s vertices ``used`` and ``faces`` over them, with the
+    ``surface`` attributes of those vertices."""
     attributes = {"POSITION": builder.add(skinned.rest_positions[used], ARRAY_BUFFER, bounds=True)}
     if skinned.normals is not None:
         attributes["NORMAL"] = builder.add(skinned.normals[used], ARRAY_BUFFER)
-    if skinned.uvs is not None:
+    if skinned.uvs is not None and "TEXCOORD_0" not in surface:
         attributes["TEXCOORD_0"] = builder.add(skinned.uvs[used], ARRAY_BUFFER)
+    for name, values in surface.items():
+        attributes[name] = builder.add(np.asarray(values, np.float32)[used], ARRAY_BUFFER)
     joints, weights = skinned.joints[used], skinned.weights[used]
     attributes.update(skin_attributes(builder, joints, weights, skinned.skeleton.joint_count))
     primitive = {"attributes": attributes, "indices": index_accessor(builder, faces, len(used)), "mode": _TRIANGLES}

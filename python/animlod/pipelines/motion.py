@@ -344,7 +344,7 @@ def _read_input(
         whole = whole_skin(document, scene, note, _GLTF_FPS)
         skin, motions, animations, left_out = whole.mesh, whole.motions, whole.animations, whole.left_out
         rig = whole.rig
-        materials, morph_weights = FaceMaterials(document, whole.face_materials), whole.morph_weights
+        materials, morph_weights = FaceMaterials(document, whole.face_materials, whole.surface), whole.morph_weights
         if skin.vertex_count > scene.skinned_meshes[scene.body].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:

@@ -6,7 +6,8 @@ Each part lies on the body's skeleton as :mod:`.skin_parts` places it; bones of 
 that move in its clips join that skeleton. Morph targets join by name: a target some parts name
 moves those parts' vertices and leaves the others', so one weight drives it everywhere, as
 engines drive a face's and its teeth's "jawOpen" together. A part without normals gets smooth
-ones, and one without texture coordinates (0, 0), where other parts have them.
+ones where other parts have them; the attributes the materials read (texture coordinates, colours,
+tangents) join as :mod:`.surface_attributes` says.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from ..model import Motion, SkinnedMesh, morphed
 from ..motion_lod.clips import join_clips
 from ..normals import vertex_normals
 from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
+from .surface_attributes import joined_surface, node_surface
 
 
 @dataclass
@@ -36,6 +38,8 @@ class WholeSkin:
     motions : its animations, sampled.
     animations : the animation each motion is (its index in the document).
     face_materials : (F,) each face's material (index in the document's materials, -1 for none).
+    surface : the attributes the materials read besides normals (texture coordinates, colours,
+        tangents: :mod:`.surface_attributes`), (V, width) float32 by glTF name.
     left_out : how many skinned meshes of the document are not in it.
     part_nodes : the nodes whose meshes it joins, the body's first.
     rig : the skeleton's rig (the body's, with the bones of parts that join it).
@@ -48,6 +52,7 @@ class WholeSkin:
     motions: list[Motion]
     animations: list[int]
     face_materials: np.ndarray
+    surface: dict[str, np.ndarray]
     left_out: int
     part_nodes: list[int]
     morph_weights: dict[int, np.ndarray]
@@ -63,7 +68,7 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
     (:func:`_joined_targets`), each part keeping the shape of its default weights."""
     body, motions, rig, body_node = (scene.skinned_meshes[scene.body], scene.skinned_motions[scene.body],
                                      scene.skinned_rigs[scene.body], scene.skinned_nodes[scene.body])  # fmt: skip
-    parts, part_nodes = [body], [body_node]
+    parts, part_nodes, vertex_spaces = [body], [body_node], [doc.rest_world_matrix(body_node)]
     for index, mesh in enumerate(scene.skinned_meshes):
         if index == scene.body or not _targets_join(parts, mesh):
             continue
@@ -83,14 +88,17 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
         if placement is not None:
             parts.append(moved_onto(mesh, body, placement))
             part_nodes.append(node)
+            vertex_spaces.append(placement.transform @ doc.rest_world_matrix(node))
     parts[0] = body
     materials = np.concatenate([_face_materials(doc, doc.gltf.nodes[node].mesh) for node in part_nodes])
+    surfaces = [node_surface(doc, node, space) for node, space in zip(part_nodes, vertex_spaces)]
+    surface = joined_surface([(attributes, part.vertex_count) for attributes, part in zip(surfaces, parts)])
     left_out = len(scene.skinned_meshes) - len(parts)
     if len(parts) == 1:
         count = 0 if body.morph_targets is None else len(body.morph_targets)
         defaults = np.zeros(count) if body.default_morph_weights is None else body.default_morph_weights
         tracks = _weight_tracks(doc, part_nodes, [list(range(count))], defaults, fps)
-        return WholeSkin(body, motions, rig.animations(doc), materials, left_out, part_nodes, tracks, rig)
+        return WholeSkin(body, motions, rig.animations(doc), materials, surface, left_out, part_nodes, tracks, rig)
     influences = max(part.joints.shape[1] for part in parts)
     starts = np.cumsum([0] + [part.vertex_count for part in parts])
 
@@ -120,7 +128,7 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
         default_morph_weights=defaults,
     )
     tracks = {} if defaults is None else _weight_tracks(doc, part_nodes, places, defaults, fps)
-    return WholeSkin(whole, motions, rig.animations(doc), materials, left_out, part_nodes, tracks, rig)
+    return WholeSkin(whole, motions, rig.animations(doc), materials, surface, left_out, part_nodes, tracks, rig)
 
 
 def _weight_tracks(

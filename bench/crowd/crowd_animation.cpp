@@ -8,9 +8,16 @@
 
 namespace crowd {
 
+namespace {
+
+// Floats of `count` values in whole RGBA32F texels.
+size_t padded_to_texels(size_t count) { return (count + 3) / 4 * 4; }
+
+}  // namespace
+
 CrowdAnimator::CrowdAnimator(const std::vector<Asset>& assets, const CrowdScene& scene, const CrowdOptions& options)
     : assets_(assets), scene_(scene), options_(options) {
-  size_t most_joints = 0, most_chains = 0;
+  size_t most_floats = 0, most_chains = 0;
   bucket_base_.resize(assets.size());
   rig_clips_.resize(assets.size());
   for (size_t a = 0; a < assets.size(); ++a) {
@@ -19,13 +26,16 @@ CrowdAnimator::CrowdAnimator(const std::vector<Asset>& assets, const CrowdScene&
     for (const Chain& chain : assets[a].chains)
       for (const Level& level : chain.levels)
         if (!rig_clips_[a][static_cast<size_t>(level.rig)]) rig_clips_[a][static_cast<size_t>(level.rig)] = &level.clips;
-    size_t joints = 0;  // a character draws one level per chain: at most one skeleton each
+    // A character draws one level per chain: at most one skeleton and one set of weights each.
+    size_t floats = 0;
     for (const Chain& chain : assets[a].chains) {
       size_t most = 0;
-      for (const Level& level : chain.levels) most = std::max(most, assets[a].rigs[static_cast<size_t>(level.rig)].joint_count());
-      joints += most;
+      for (const Level& level : chain.levels)
+        most = std::max(most, 12 * assets[a].rigs[static_cast<size_t>(level.rig)].joint_count() +
+                                  padded_to_texels(level.morph.target_count()));
+      floats += most;
     }
-    most_joints = std::max(most_joints, joints);
+    most_floats = std::max(most_floats, floats);
     most_chains = std::max(most_chains, assets[a].chains.size());
     for (size_t c = 0; c < assets[a].chains.size(); ++c) {
       bucket_base_[a].push_back(static_cast<int>(all_buckets_.size()));
@@ -39,7 +49,7 @@ CrowdAnimator::CrowdAnimator(const std::vector<Asset>& assets, const CrowdScene&
     }
   }
   const size_t count = scene.placements().size();
-  max_palette_floats_ = count * most_joints * 12;
+  max_buffer_floats_ = count * most_floats;
   max_instances_ = count * most_chains;
 }
 
@@ -107,6 +117,7 @@ void CrowdAnimator::start(const Mode& mode, const int* forced) {
     const Asset& asset = assets_[static_cast<size_t>(scene_.placements()[i].asset)];
     characters_[i].selectors.assign(asset.chains.size(), animlod::LodSelector(selector_options));
     characters_[i].levels.assign(asset.chains.size(), 0);
+    characters_[i].morph_weights.assign(asset.chains.size(), {});
   }
 }
 
@@ -130,14 +141,10 @@ void CrowdAnimator::update_pose(const Asset& asset, const Placement& placement, 
   const std::vector<int>* clips = rig_clips_[static_cast<size_t>(placement.asset)][static_cast<size_t>(rig_index)];
   const Clip* clip = clips ? &asset.clips[static_cast<size_t>((*clips)[static_cast<size_t>(placement.clip)])] : nullptr;
   const animlod::LocalPose pose{translations_.data(), rotations_.data(), scales_.data(), poses};
-  if (clip && clip->duration > 0.0f) {
-    // A skipped frame keeps the last pose; an update samples the current time, so the clip keeps
-    // its speed (the facial LoD paper's skipping changed the clip's duration).
-    const float t = std::fmod(time + placement.phase, clip->duration);
-    animlod::sample_clip(clip->view(), t, animlod::RotationBlend::nlerp, pose);
-  } else if (clip) {
-    animlod::sample_clip(clip->view(), 0.0f, animlod::RotationBlend::nlerp, pose);
-  }
+  // A skipped frame keeps the last pose; an update samples the current time, so the clip keeps
+  // its speed (the facial LoD paper's skipping changed the clip's duration).
+  cache.clip_time = clip && clip->duration > 0.0f ? std::fmod(time + placement.phase, clip->duration) : 0.0f;
+  if (clip) animlod::sample_clip(clip->view(), cache.clip_time, animlod::RotationBlend::nlerp, pose);
   // The rig's parents were validated at load (FK of the rest pose for the bounds).
   animlod::forward_kinematics(rig.parents.data(), pose, world_.data());
   animlod::skin_palette(world_.data(), rig.joint_nodes.data(), rig.inverse_bind.data(), joints, palette_.data());
@@ -206,10 +213,18 @@ void CrowdAnimator::animate(const Camera& camera, const animlod::LodCamera& lod_
       ++counts.updates;
       counts.joints += static_cast<int64_t>(asset.rigs[static_cast<size_t>(rig)].pose_count());
     }
+    // Morph weights at the clip time of the pose drawn with them (held on skipped frames alike).
+    for (size_t c = 0; c < asset.chains.size(); ++c) {
+      const Level& level = asset.chains[c].levels[static_cast<size_t>(character.levels[c])];
+      std::vector<float>& weights = character.morph_weights[c];
+      weights.resize(level.morph.target_count());
+      if (!weights.empty())
+        level.morph.sample(static_cast<size_t>(placement.clip), cache_for(character, level.rig).clip_time, weights.data());
+    }
   }
 }
 
-void CrowdAnimator::gather(float* palettes, InstanceGpu* instances, size_t& palette_floats, size_t& instance_count) {
+Gathered CrowdAnimator::gather(float* buffer, InstanceGpu* instances) {
   // Count instances per bucket, then place them bucket by bucket.
   std::vector<uint32_t> sizes(all_buckets_.size(), 0);
   const std::vector<Placement>& placements = scene_.placements();
@@ -231,7 +246,7 @@ void CrowdAnimator::gather(float* palettes, InstanceGpu* instances, size_t& pale
     buckets_.push_back(bucket);
     total += sizes[b];
   }
-  palette_floats = 0;
+  Gathered out;
   for (size_t i = 0; i < characters_.size(); ++i) {
     Character& character = characters_[i];
     if (!character.visible) continue;
@@ -244,16 +259,23 @@ void CrowdAnimator::gather(float* palettes, InstanceGpu* instances, size_t& pale
       PoseCache& cache = cache_for(character, drawn.rig);
       if (cache.gathered_frame != frame_) {  // upload each skeleton's palette once per frame
         cache.gathered_frame = frame_;
-        cache.gathered_base = static_cast<uint32_t>(palette_floats / 12);
-        std::copy(cache.rows.begin(), cache.rows.end(), palettes + palette_floats);
-        palette_floats += cache.rows.size();
+        cache.gathered_base = static_cast<uint32_t>(out.floats / 4);
+        std::copy(cache.rows.begin(), cache.rows.end(), buffer + out.floats);
+        out.floats += cache.rows.size();
+        out.matrices += cache.rows.size() / 12;
       }
-      InstanceGpu& out = instances[next[static_cast<size_t>(base[c] + level)]++];
-      out = {placement.position.x, placement.position.y, placement.position.z, placement.yaw, cache.gathered_base,
-             static_cast<uint32_t>(drawn.lod_index())};
+      const std::vector<float>& weights = character.morph_weights[c];
+      const uint32_t morph_base = weights.empty() ? 0 : static_cast<uint32_t>(out.floats / 4);
+      std::copy(weights.begin(), weights.end(), buffer + out.floats);
+      std::fill(buffer + out.floats + weights.size(), buffer + out.floats + padded_to_texels(weights.size()), 0.0f);
+      out.floats += padded_to_texels(weights.size());
+      instances[next[static_cast<size_t>(base[c] + level)]++] = {placement.position.x, placement.position.y, placement.position.z,
+                                                                  placement.yaw, cache.gathered_base,
+                                                                  static_cast<uint32_t>(drawn.lod_index()), morph_base};
     }
   }
-  instance_count = total;
+  out.instances = total;
+  return out;
 }
 
 }  // namespace crowd

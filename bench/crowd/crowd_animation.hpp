@@ -2,7 +2,8 @@
 // frame, cull each character against the view frustum, choose its level per chain with the
 // core's LodSelector (hysteresis) among the levels the mode allows, decide with the core's
 // frame-skipping rate whether its pose is due, and if so sample its clip and run FK + the skin
-// palette (pose.hpp). The palettes of all drawn characters are then gathered into one buffer
+// palette (pose.hpp), and the morph weights of levels whose clips animate them at the same clip
+// time. The palettes and morph weights of all drawn characters are then gathered into one buffer
 // and the instances sorted into one bucket per (chain, level) for instanced drawing.
 #pragma once
 
@@ -16,11 +17,20 @@
 
 namespace crowd {
 
-// Per-instance data the vertex shader reads (24 bytes).
+// Per-instance data the vertex shader reads (28 bytes). Bases count RGBA32F texels of the
+// gathered buffer.
 struct InstanceGpu {
   float x, y, z, yaw;     // placement
-  uint32_t palette_base;  // first palette matrix of the instance
+  uint32_t palette_base;  // first texel of the instance's palette (3 rows a joint)
   uint32_t tint;          // Level::lod_index() of the level drawn, for --level-colors
+  uint32_t morph_base;    // first texel of its morph weights (4 a texel; 0 where its mesh has none)
+};
+
+// What CrowdAnimator::gather wrote.
+struct Gathered {
+  size_t floats = 0;     // palette rows and morph weights: the floats of the texture buffer
+  size_t matrices = 0;   // palette matrices among them
+  size_t instances = 0;
 };
 
 // One instanced draw: the instances [first, first + count) of the gathered instance array.
@@ -53,18 +63,20 @@ class CrowdAnimator {
   void animate(const Camera& camera, const animlod::LodCamera& lod_camera, uint64_t frame, float time, FrameCounts& counts);
 
   // Upper bounds of the gathered sizes, for buffer allocation.
-  size_t max_palette_floats() const { return max_palette_floats_; }
+  size_t max_buffer_floats() const { return max_buffer_floats_; }
   size_t max_instances() const { return max_instances_; }
 
-  // Writes the drawn characters' palettes (3 x 4 rows per joint, 12 floats) and instances
-  // (sorted by bucket); returns the floats and instances written. buckets() then lists the draws.
-  void gather(float* palettes, InstanceGpu* instances, size_t& palette_floats, size_t& instance_count);
+  // Writes the drawn characters' palettes (3 x 4 rows per joint, 12 floats), each drawn chain's
+  // morph weights where its level plays them (padded to 4 floats) and the instances (sorted by
+  // bucket) into `buffer` and `instances`. buckets() then lists the draws.
+  Gathered gather(float* buffer, InstanceGpu* instances);
   const std::vector<Bucket>& buckets() const { return buckets_; }
 
  private:
   struct PoseCache {
     int rig = -1;
     std::vector<float> rows;   // (S, 12) palette rows
+    float clip_time = 0.0f;    // seconds into the clip the pose was sampled at
     bool valid = false;
     uint64_t gathered_frame = UINT64_MAX;
     uint32_t gathered_base = 0;
@@ -72,6 +84,7 @@ class CrowdAnimator {
   struct Character {
     std::vector<animlod::LodSelector> selectors;  // per chain
     std::vector<int> levels;                      // per chain, this frame: the level node drawn
+    std::vector<std::vector<float>> morph_weights;  // per chain: its level's played weights (T,), else empty
     std::vector<PoseCache> caches;                // per rig used so far
     bool visible = false;
     bool was_visible = false;
@@ -94,7 +107,7 @@ class CrowdAnimator {
   std::vector<std::vector<int>> bucket_base_;      // [asset][chain] first bucket id
   std::vector<std::vector<const std::vector<int>*>> rig_clips_;  // [asset][rig] clip per original clip
   std::vector<Bucket> all_buckets_, buckets_;
-  size_t max_palette_floats_ = 0, max_instances_ = 0;
+  size_t max_buffer_floats_ = 0, max_instances_ = 0;
   uint64_t frame_ = 0;
   // Scratch for one pose.
   std::vector<float> translations_, rotations_, scales_, world_, palette_;

@@ -7,7 +7,6 @@
 #include <cstdlib>
 #include <iterator>
 #include <set>
-#include <sstream>
 
 namespace crowd {
 
@@ -64,6 +63,18 @@ bool to_float(const std::string& text, float& out) {
   return !text.empty() && *end == '\0' && std::isfinite(out);
 }
 
+// The items of a comma-separated list, empty ones included (getline drops a trailing one:
+// "Original," read as "Original").
+std::vector<std::string> comma_items(const std::string& list) {
+  std::vector<std::string> items;
+  for (size_t begin = 0;;) {
+    const size_t end = list.find(',', begin);
+    items.push_back(list.substr(begin, end == std::string::npos ? std::string::npos : end - begin));
+    if (end == std::string::npos) return items;
+    begin = end + 1;
+  }
+}
+
 bool parse_modes(const std::string& list, std::vector<Mode>& out, std::string& error) {
   out.clear();
   if (list == "all") {
@@ -75,9 +86,15 @@ bool parse_modes(const std::string& list, std::vector<Mode>& out, std::string& e
       }
     return true;
   }
-  std::stringstream stream(list);
-  std::string item;
-  while (std::getline(stream, item, ',')) {
+  if (list.empty()) {
+    error = "--modes: no mode given";
+    return false;
+  }
+  for (const std::string& item : comma_items(list)) {
+    if (item.empty()) {
+      error = "--modes: empty item in '" + list + "' (a comma too many?)";
+      return false;
+    }
     Mode mode;
     mode.name = item;
     std::string base = item;
@@ -98,10 +115,6 @@ bool parse_modes(const std::string& list, std::vector<Mode>& out, std::string& e
       return false;
     }
     out.push_back(mode);
-  }
-  if (out.empty()) {
-    error = "--modes: no mode given";
-    return false;
   }
   return true;
 }

@@ -26,7 +26,9 @@ void on_glfw_error(int code, const char* description) {
 // Skinning in the vertex shader: the palette holds 3 rows (RGBA32F texels) of each joint's
 // affine matrix; a vertex blends the rows of its 4 or 8 joints by weight (linear blend
 // skinning). A mesh of 4 influences leaves the second set's arrays off: its weights read the
-// constant 0 (set in init).
+// constant 0 (set in init). Before skinning, a mesh with morph targets adds each target's
+// position and normal deltas at the instance's weights, which follow its palette in the same
+// buffer (4 a texel).
 const char* kCharacterVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
@@ -34,10 +36,12 @@ layout(location = 2) in vec3 a_color;
 layout(location = 3) in uvec4 a_joints;
 layout(location = 4) in vec4 a_weights;
 layout(location = 5) in vec4 a_placement;  // x, y, z, yaw
-layout(location = 6) in uvec2 a_instance;  // palette base, level
+layout(location = 6) in uvec3 a_instance;  // palette base, level, morph weights base (texels)
 layout(location = 7) in uvec4 a_joints_1;
 layout(location = 8) in vec4 a_weights_1;
 uniform samplerBuffer u_palette;
+uniform samplerBuffer u_morph_deltas;  // (V, T, 2) texels: position delta, normal delta
+uniform int u_morph_targets;           // T, 0 for a mesh without played morph weights
 uniform mat4 u_view_projection;
 uniform float u_tint_amount;
 out vec3 v_normal;
@@ -50,7 +54,7 @@ void blend(uvec4 joints, vec4 weights) {
   for (int k = 0; k < 4; ++k) {
     float w = weights[k];
     if (w > 0.0) {
-      int base = 3 * int(a_instance.x + joints[k]);
+      int base = int(a_instance.x) + 3 * int(joints[k]);
       r0 += w * texelFetch(u_palette, base);
       r1 += w * texelFetch(u_palette, base + 1);
       r2 += w * texelFetch(u_palette, base + 2);
@@ -58,11 +62,20 @@ void blend(uvec4 joints, vec4 weights) {
   }
 }
 void main() {
+  vec3 position = a_position, normal = a_normal;
+  for (int t = 0; t < u_morph_targets; ++t) {
+    float w = texelFetch(u_palette, int(a_instance.z) + t / 4)[t % 4];
+    if (w != 0.0) {
+      int delta = 2 * (gl_VertexID * u_morph_targets + t);
+      position += w * texelFetch(u_morph_deltas, delta).xyz;
+      normal += w * texelFetch(u_morph_deltas, delta + 1).xyz;
+    }
+  }
   blend(a_joints, a_weights);
   blend(a_joints_1, a_weights_1);
-  vec4 p = vec4(a_position, 1.0);
+  vec4 p = vec4(position, 1.0);
   vec3 skinned = vec3(dot(r0, p), dot(r1, p), dot(r2, p));
-  vec3 n = vec3(dot(r0.xyz, a_normal), dot(r1.xyz, a_normal), dot(r2.xyz, a_normal));
+  vec3 n = vec3(dot(r0.xyz, normal), dot(r1.xyz, normal), dot(r2.xyz, normal));
   float c = cos(a_placement.w), s = sin(a_placement.w);
   mat3 yaw = mat3(c, 0.0, -s, 0.0, 1.0, 0.0, s, 0.0, c);
   v_normal = yaw * n;
@@ -282,9 +295,11 @@ bool GlRenderer::open(int width, int height, bool orphan_uploads, std::string& e
   if (!ground_program_) return false;
   u_view_projection_ = glGetUniformLocation(character_program_, "u_view_projection");
   u_tint_amount_ = glGetUniformLocation(character_program_, "u_tint_amount");
+  u_morph_targets_ = glGetUniformLocation(character_program_, "u_morph_targets");
   u_ground_view_projection_ = glGetUniformLocation(ground_program_, "u_view_projection");
   glUseProgram(character_program_);
   glUniform1i(glGetUniformLocation(character_program_, "u_palette"), 0);
+  glUniform1i(glGetUniformLocation(character_program_, "u_morph_deltas"), 1);
   glVertexAttribI4ui(7, 0, 0, 0, 0);  // the second influence set of 4-influence meshes
   glVertexAttrib4f(8, 0.0f, 0.0f, 0.0f, 0.0f);
   glGenTextures(1, &palette_texture_);
@@ -294,8 +309,10 @@ bool GlRenderer::open(int width, int height, bool orphan_uploads, std::string& e
   return true;
 }
 
-int GlRenderer::upload_meshes(const std::vector<MeshData>& meshes) {
-  const int first = static_cast<int>(meshes_.size());
+bool GlRenderer::upload_meshes(const std::vector<MeshData>& meshes, int& first, std::string& error) {
+  GLint texels = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texels);
+  first = static_cast<int>(meshes_.size());
   for (const MeshData& mesh : meshes) {
     GpuMesh gpu;
     glGenVertexArrays(1, &gpu.vao);
@@ -314,10 +331,26 @@ int GlRenderer::upload_meshes(const std::vector<MeshData>& meshes) {
     glVertexAttribDivisor(5, 1);
     glVertexAttribDivisor(6, 1);
     gpu.index_count = static_cast<int32_t>(mesh.indices.size());
+    gpu.morph_targets = mesh.morph_targets;
+    if (mesh.morph_targets > 0) {
+      if (mesh.morph_deltas.size() / 4 > static_cast<size_t>(texels)) {
+        error = "a mesh of " + std::to_string(mesh.vertex_count()) + " vertices and " + std::to_string(mesh.morph_targets) +
+                " played morph targets needs " + std::to_string(mesh.morph_deltas.size() / 4) +
+                " texels, the texture buffer holds " + std::to_string(texels);
+        return false;
+      }
+      glGenBuffers(1, &gpu.morph_buffer);
+      glBindBuffer(GL_TEXTURE_BUFFER, gpu.morph_buffer);
+      glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(mesh.morph_deltas.size() * sizeof(float)),
+                   mesh.morph_deltas.data(), GL_STATIC_DRAW);
+      glGenTextures(1, &gpu.morph_texture);
+      glBindTexture(GL_TEXTURE_BUFFER, gpu.morph_texture);
+      glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, gpu.morph_buffer);
+    }
     meshes_.push_back(gpu);
   }
   glBindVertexArray(0);
-  return first;
+  return true;
 }
 
 void GlRenderer::upload_ground(const std::vector<float>& positions, const std::vector<uint32_t>& indices) {
@@ -383,8 +416,14 @@ void GlRenderer::draw(const glm::mat4& view_projection, const std::vector<Bucket
     // Point the per-instance attributes at this bucket's instances (GL 3.3: no base instance).
     const size_t offset = instance_offset_ + bucket.first * sizeof(InstanceGpu);
     glVertexAttribPointer(5, 4, GL_FLOAT, GL_FALSE, sizeof(InstanceGpu), reinterpret_cast<const void*>(offset));
-    glVertexAttribIPointer(6, 2, GL_UNSIGNED_INT, sizeof(InstanceGpu),
+    glVertexAttribIPointer(6, 3, GL_UNSIGNED_INT, sizeof(InstanceGpu),
                            reinterpret_cast<const void*>(offset + offsetof(InstanceGpu, palette_base)));
+    glUniform1i(u_morph_targets_, mesh.morph_targets);
+    if (mesh.morph_targets > 0) {
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_BUFFER, mesh.morph_texture);
+      glActiveTexture(GL_TEXTURE0);
+    }
     glDrawElementsInstanced(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr,
                             static_cast<GLsizei>(bucket.count));
   }

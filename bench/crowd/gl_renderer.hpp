@@ -1,6 +1,7 @@
 // The GPU half of the crowd pipeline: a GLFW window with an OpenGL 3.3+ core context, meshes in
 // vertex buffers, the frame's palettes in one texture buffer (persistent-mapped ring with fences
-// on GL 4.4+, orphaned and mapped on 3.3), per-instance data in one vertex buffer, and one
+// on GL 4.4+, orphaned and mapped on 3.3; the instances' morph weights follow their palettes),
+// meshes' played morph targets in texture buffers, per-instance data in one vertex buffer, and one
 // instanced draw per (chain, level) bucket; skinning happens in the vertex shader. Also the GL
 // timer queries, and PNG screenshots read from GL_BACK before the swap (needed under Xvfb).
 #pragma once
@@ -44,6 +45,8 @@ class StreamBuffer {
 struct GpuMesh {
   unsigned vao = 0, buffers[6] = {0, 0, 0, 0, 0, 0};
   int32_t index_count = 0;
+  int morph_targets = 0;                          // MeshData::morph_targets
+  unsigned morph_buffer = 0, morph_texture = 0;   // its MeshData::morph_deltas, where it has targets
 };
 
 class GlRenderer {
@@ -61,8 +64,9 @@ class GlRenderer {
   int framebuffer_width() const { return width_; }
   int framebuffer_height() const { return height_; }
 
-  // Uploads every level mesh of an asset; the mesh id of Asset::meshes[i] is first + i.
-  int upload_meshes(const std::vector<MeshData>& meshes);
+  // Uploads every level mesh of an asset; the mesh id of Asset::meshes[i] is first + i. False
+  // with `error` when a mesh's morph targets exceed the texture buffer size.
+  bool upload_meshes(const std::vector<MeshData>& meshes, int& first, std::string& error);
   void upload_ground(const std::vector<float>& positions, const std::vector<uint32_t>& indices);
   // Sizes the stream buffers. False with `error` when the palettes exceed the texture buffer size.
   bool reserve(size_t palette_floats, size_t instances, std::string& error);
@@ -87,7 +91,7 @@ class GlRenderer {
   bool persistent_ = false, timers_ = false, buffer_range_ = false;
   int width_ = 0, height_ = 0;
   unsigned character_program_ = 0, ground_program_ = 0, palette_texture_ = 0;
-  int u_view_projection_ = -1, u_tint_amount_ = -1, u_ground_view_projection_ = -1;
+  int u_view_projection_ = -1, u_tint_amount_ = -1, u_morph_targets_ = -1, u_ground_view_projection_ = -1;
   std::vector<GpuMesh> meshes_;
   GpuMesh ground_;
   StreamBuffer palettes_, instances_;

@@ -494,15 +494,59 @@ class Loader {
       if (!std::isfinite(level.error) || level.error < 0.0f) fail(label, "extras.animlod.error must be a number >= 0");
     }
     level.rig = rig_for_skin(n.skin);
-    level.mesh = static_cast<int>(asset_.meshes.size());
-    asset_.meshes.push_back(read_mesh(n.mesh, n.weights, asset_.rigs[static_cast<size_t>(level.rig)].joint_count(), label));
+    std::vector<ChannelRef> morph_channels;  // per original clip, the channel of the node's weights
+    bool morph_played = false;
     for (size_t k = 0; k < original_clips_.size(); ++k) {
       std::vector<int> animations;
       for (int original : original_clips_[k])
         animations.push_back(animation_for(level, original, finest_rig, label, k));
       level.clips.push_back(clip_for(level.rig, animations));
+      morph_channels.push_back(weights_channel(node, animations));
+      morph_played = morph_played || morph_channels.back().animation >= 0;
     }
+    level.mesh = static_cast<int>(asset_.meshes.size());
+    asset_.meshes.push_back(
+        read_mesh(n.mesh, n.weights, asset_.rigs[static_cast<size_t>(level.rig)].joint_count(), label, morph_played));
+    const size_t targets = static_cast<size_t>(asset_.meshes.back().morph_targets);
+    if (targets > 0) level.morph = read_morph_playback(n, targets, morph_channels, label);
     return level;
+  }
+
+  // An animation channel by index, or none (animation -1).
+  struct ChannelRef {
+    int animation = -1;
+    size_t channel = 0;
+  };
+
+  // The channel of `animations` that animates the morph weights of `node`, or none.
+  ChannelRef weights_channel(int node, const std::vector<int>& animations) const {
+    for (int a : animations) {
+      const std::vector<tinygltf::AnimationChannel>& channels = model_.animations[static_cast<size_t>(a)].channels;
+      for (size_t c = 0; c < channels.size(); ++c)
+        if (channels[c].target_node == node && channels[c].target_path == "weights") return {a, c};
+    }
+    return {};
+  }
+
+  // The morph weights level node `n` plays, its mesh of `targets` morph targets on the GPU: per
+  // original clip its weights channel (`channels`), or its default weights.
+  MorphPlayback read_morph_playback(const tinygltf::Node& n, size_t targets, const std::vector<ChannelRef>& channels,
+                                    const std::string& label) const {
+    MorphPlayback playback;
+    const std::vector<double> defaults =
+        default_morph_weights(n.weights, model_.meshes[static_cast<size_t>(n.mesh)], targets, label + " mesh " + std::to_string(n.mesh));
+    playback.defaults.assign(defaults.begin(), defaults.end());
+    for (const ChannelRef& ref : channels) {
+      playback.tracks.emplace_back();
+      if (ref.animation < 0) continue;
+      const tinygltf::Animation& animation = model_.animations[static_cast<size_t>(ref.animation)];
+      const std::string element = animation_label(model_, ref.animation) + " channel " + std::to_string(ref.channel);
+      SamplerKeys keys = read_sampler(animation, animation.channels[ref.channel], 1, element);
+      std::string error;
+      if (!MorphWeightsTrack::make(std::move(keys.times), keys.values, targets, keys.interpolation, playback.tracks.back(), error))
+        fail(element, error + " (the morph weights of " + label + ")");
+    }
+    return playback;
   }
 
   // The animation playing original clip `original` at the level's motion level.
@@ -608,6 +652,36 @@ class Loader {
     return static_cast<int>(asset_.clips.size()) - 1;
   }
 
+  // The keys of a channel's sampler: its interpolation, key times (N,) and outputs, `width`
+  // numbers an element (glTF stores a weights channel's T weights a key as T scalars).
+  struct SamplerKeys {
+    animlod::Interpolation interpolation = animlod::Interpolation::linear;
+    std::vector<float> times, values;
+  };
+  SamplerKeys read_sampler(const tinygltf::Animation& animation, const tinygltf::AnimationChannel& channel, int width,
+                           const std::string& element) const {
+    if (channel.sampler < 0 || static_cast<size_t>(channel.sampler) >= animation.samplers.size())
+      fail(element, "sampler " + std::to_string(channel.sampler) + " does not exist");
+    const tinygltf::AnimationSampler& sampler = animation.samplers[static_cast<size_t>(channel.sampler)];
+    SamplerKeys keys;
+    if (sampler.interpolation.empty() || sampler.interpolation == "LINEAR") keys.interpolation = animlod::Interpolation::linear;
+    else if (sampler.interpolation == "STEP") keys.interpolation = animlod::Interpolation::step;
+    else if (sampler.interpolation == "CUBICSPLINE") keys.interpolation = animlod::Interpolation::cubic_spline;
+    else fail(element, "unknown interpolation '" + sampler.interpolation + "'");
+    keys.times = to_floats(read_accessor(model_, sampler.input, 1, element + " input"), element + " input");
+    keys.values = to_floats(read_accessor(model_, sampler.output, width, element + " output"), element + " output");
+    return keys;
+  }
+
+  // Whether `channel` sets the morph weights of a mesh that skin `skin` deforms: the crowd plays it
+  // on the level node (Level::morph), and the clip lasts until its last key.
+  bool morphs_skinned_mesh(const tinygltf::AnimationChannel& channel, int skin) const {
+    if (channel.target_path != "weights" || channel.target_node < 0 || static_cast<size_t>(channel.target_node) >= model_.nodes.size())
+      return false;
+    const tinygltf::Node& node = model_.nodes[static_cast<size_t>(channel.target_node)];
+    return node.mesh >= 0 && node.skin == skin;
+  }
+
   // The channels of `animations` (one clip, or one split into per-node animations) that move the rig.
   Clip read_clip(int rig_index, const std::vector<int>& animations) {
     const Rig& rig = asset_.rigs[static_cast<size_t>(rig_index)];
@@ -621,30 +695,30 @@ class Loader {
       const std::string label = animation_label(model_, animation_index);
       for (size_t c = 0; c < animation.channels.size(); ++c) {
         const tinygltf::AnimationChannel& channel = animation.channels[c];
+        const std::string element = label + " channel " + std::to_string(c);
+        if (morphs_skinned_mesh(channel, rig.skin)) {
+          const std::vector<float> times = read_sampler(animation, channel, 1, element).times;
+          if (!times.empty()) clip.duration = std::max(clip.duration, times.back());
+          continue;
+        }
         const auto target = pose_of.find(channel.target_node);
         if (target == pose_of.end()) continue;
         animlod::ClipChannel out;
-        const std::string element = label + " channel " + std::to_string(c);
         if (channel.target_path == "translation") out.path = animlod::ChannelPath::translation;
         else if (channel.target_path == "rotation") out.path = animlod::ChannelPath::rotation;
         else if (channel.target_path == "scale") out.path = animlod::ChannelPath::scale;
-        else continue;  // morph weights: not drawn by the crowd
-        if (channel.sampler < 0 || static_cast<size_t>(channel.sampler) >= animation.samplers.size())
-          fail(element, "sampler " + std::to_string(channel.sampler) + " does not exist");
-        const tinygltf::AnimationSampler& sampler = animation.samplers[static_cast<size_t>(channel.sampler)];
+        else continue;  // a joint's own morph weights (a mesh on a joint node): not drawn by the crowd
         const int width = out.path == animlod::ChannelPath::rotation ? 4 : 3;
-        if (sampler.interpolation.empty() || sampler.interpolation == "LINEAR") out.track.interpolation = animlod::Interpolation::linear;
-        else if (sampler.interpolation == "STEP") out.track.interpolation = animlod::Interpolation::step;
-        else if (sampler.interpolation == "CUBICSPLINE") out.track.interpolation = animlod::Interpolation::cubic_spline;
-        else fail(element, "unknown interpolation '" + sampler.interpolation + "'");
-        clip.times.push_back(to_floats(read_accessor(model_, sampler.input, 1, element + " input"), element + " input"));
-        clip.values.push_back(to_floats(read_accessor(model_, sampler.output, width, element + " output"), element + " output"));
-        const size_t keys = clip.times.back().size();
+        SamplerKeys keys = read_sampler(animation, channel, width, element);
+        out.track.interpolation = keys.interpolation;
+        clip.times.push_back(std::move(keys.times));
+        clip.values.push_back(std::move(keys.values));
+        const size_t count = clip.times.back().size();
         const size_t per_key = out.track.interpolation == animlod::Interpolation::cubic_spline ? 3 : 1;
-        if (clip.values.back().size() != keys * per_key * static_cast<size_t>(width))
-          fail(element, "output holds " + std::to_string(clip.values.back().size()) + " numbers for " + std::to_string(keys) +
+        if (clip.values.back().size() != count * per_key * static_cast<size_t>(width))
+          fail(element, "output holds " + std::to_string(clip.values.back().size()) + " numbers for " + std::to_string(count) +
                             " keys");
-        out.track.key_count = keys;
+        out.track.key_count = count;
         out.track.component_count = static_cast<size_t>(width);
         out.track.times = clip.times.back().data();  // re-pointed below once every channel is read
         out.track.values = clip.values.back().data();
@@ -652,7 +726,7 @@ class Loader {
         if (!status) fail(element, status.message);
         out.joint = target->second;
         channels.push_back(out);
-        if (keys > 0) clip.duration = std::max(clip.duration, clip.times.back().back());
+        if (count > 0) clip.duration = std::max(clip.duration, clip.times.back().back());
       }
     }
     for (size_t c = 0; c < channels.size(); ++c) {
@@ -666,20 +740,27 @@ class Loader {
     return clip;
   }
 
+  // Triangles; points and lines are not drawn.
+  static bool drawn(const tinygltf::Primitive& primitive) { return primitive.mode < 0 || primitive.mode >= TINYGLTF_MODE_TRIANGLES; }
+
   // A level's mesh; `node_weights` are the level node's morph weights (empty: its mesh's).
-  MeshData read_mesh(int mesh_index, const std::vector<double>& node_weights, size_t joint_count, const std::string& level) {
+  // `play_morph`: a clip animates the node's weights, so the morph targets go to the GPU
+  // (MeshData::morph_targets) and the positions stay without the default weights.
+  MeshData read_mesh(int mesh_index, const std::vector<double>& node_weights, size_t joint_count, const std::string& level,
+                     bool play_morph) {
     const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(mesh_index)];
     const std::string mesh_label = level + " mesh " + std::to_string(mesh_index);
-    auto drawn = [](const tinygltf::Primitive& primitive) {  // triangles; points and lines are not drawn
-      return primitive.mode < 0 || primitive.mode >= TINYGLTF_MODE_TRIANGLES;
-    };
+    const size_t targets = morph_target_count(mesh, mesh_label);
+    const std::vector<double> default_weights = default_morph_weights(node_weights, mesh, targets, mesh_label);
     size_t slots = 0;  // influences a vertex lists: 4 per JOINTS_n / WEIGHTS_n set, of the primitive with the most
     for (size_t p = 0; p < mesh.primitives.size(); ++p)
       if (drawn(mesh.primitives[p]))
         slots = std::max(slots, 4 * influence_sets(mesh.primitives[p], mesh_label + " primitive " + std::to_string(p)));
     MeshData out;
     out.influences = static_cast<int>(std::min(slots, static_cast<size_t>(kMaxInfluences)));
+    out.morph_targets = play_morph ? static_cast<int>(targets) : 0;
     size_t reduced_vertices = 0;
+    std::vector<std::string> warnings;  // said once per mesh (several level nodes may draw it), not silently
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
       const tinygltf::Primitive& primitive = mesh.primitives[p];
       const std::string label = mesh_label + " primitive " + std::to_string(p);
@@ -725,7 +806,8 @@ class Loader {
         normals = to_floats(read_accessor(model_, attribute("NORMAL"), 3, label + " NORMAL"), label);
         if (normals.size() != positions.size()) fail(label, "NORMAL does not have one element per vertex");
       }
-      apply_default_morph(primitive, node_weights.empty() ? mesh.weights : node_weights, positions, normals, label);
+      if (play_morph) append_morph_deltas(primitive, count, !normals.empty(), label, out);
+      else apply_default_morph(primitive, default_weights, positions, normals, label);
       if (normals.empty()) normals = face_normals(positions, triangles);
       out.positions.insert(out.positions.end(), positions.begin(), positions.end());
       out.normals.insert(out.normals.end(), normals.begin(), normals.end());
@@ -734,17 +816,25 @@ class Loader {
         const std::vector<double>& factor = model_.materials[static_cast<size_t>(primitive.material)].pbrMetallicRoughness.baseColorFactor;
         if (factor.size() >= 3) color = glm::vec3(factor[0], factor[1], factor[2]);
       }
+      std::vector<size_t> unweighted;  // vertices without a positive skin weight
       for (size_t v = 0; v < count; ++v) {
         out.colors.insert(out.colors.end(), {color.r, color.g, color.b});
-        if (!append_skin(&joints[slots * v], &weights[slots * v], slots, joint_count, label, v, out)) ++reduced_vertices;
+        const SkinRead read = append_skin(&joints[slots * v], &weights[slots * v], slots, joint_count, label, v, out);
+        if (read == SkinRead::reduced) ++reduced_vertices;
+        if (read == SkinRead::unweighted) unweighted.push_back(v);
       }
+      if (!unweighted.empty())
+        warnings.push_back(label + ": " + std::to_string(unweighted.size()) + " of " + std::to_string(count) +
+                           " vertices (first: " + std::to_string(unweighted.front()) +
+                           ") have no positive skin weight; they follow their first listed joint, as three.js and "
+                           "Blender do");
     }
     if (out.indices.empty()) fail(mesh_label, "has no triangles");
-    // Said once per mesh (several level nodes may draw it), not silently.
-    if (reduced_vertices > 0 && reduced_influence_meshes_.insert(mesh_index).second)
-      asset_.warnings.push_back(mesh_label + ": " + std::to_string(reduced_vertices) + " vertices have more than " +
-                                std::to_string(kMaxInfluences) + " skin influences; the GPU skinning keeps the " +
-                                std::to_string(kMaxInfluences) + " largest weights of each, renormalised");
+    if (reduced_vertices > 0)
+      warnings.push_back(mesh_label + ": " + std::to_string(reduced_vertices) + " vertices have more than " +
+                         std::to_string(kMaxInfluences) + " skin influences; the GPU skinning keeps the " +
+                         std::to_string(kMaxInfluences) + " largest weights of each, renormalised");
+    if (warned_meshes_.insert(mesh_index).second) asset_.warnings.insert(asset_.warnings.end(), warnings.begin(), warnings.end());
     return out;
   }
 
@@ -764,26 +854,39 @@ class Loader {
     return sets;
   }
 
+  // How append_skin read a vertex's skin.
+  enum class SkinRead {
+    whole,       // every positive weight kept
+    reduced,     // more joints than the GPU holds: the largest weights kept
+    unweighted,  // no positive weight: full weight on the first listed joint
+  };
+
   // Appends the skin of vertex `vertex` of primitive `label`, `slots` (joint, weight) pairs as the
   // file lists them, to `out` as MeshData::influences slots: its positive weights, a joint listed
   // twice once with their sum, normalised. Where more joints remain than the GPU holds, the
   // largest weights are kept (ties by joint) and renormalised, as animlod's simplifier merges
-  // skins (cpp/src/skin_merge.hpp); false then.
-  static bool append_skin(const double* joints, const double* weights, size_t slots, size_t joint_count,
-                          const std::string& label, size_t vertex, MeshData& out) {
+  // skins (cpp/src/skin_merge.hpp). A vertex without a positive weight (glTF forbids it; Blender
+  // before 2.90 and Maya2glTF write the vertices no bone deforms so) follows its first listed
+  // joint, as three.js, Blender's importer and animlod's reader (gltf_read.py) move it.
+  static SkinRead append_skin(const double* joints, const double* weights, size_t slots, size_t joint_count,
+                              const std::string& label, size_t vertex, MeshData& out) {
+    auto joint_at = [&](size_t k) {
+      if (joints[k] < 0 || joints[k] >= static_cast<double>(joint_count))
+        fail(label, "vertex " + std::to_string(vertex) + " uses joint slot " + std::to_string(static_cast<long long>(joints[k])) +
+                        ", the skin has " + std::to_string(joint_count));
+      return joints[k];
+    };
     std::vector<std::pair<double, double>> skin;  // (joint, weight)
     for (size_t k = 0; k < slots; ++k) {
       if (!std::isfinite(weights[k])) fail(label, "vertex " + std::to_string(vertex) + " has a non-finite skin weight");
       if (!(weights[k] > 0.0)) continue;
-      if (joints[k] < 0 || joints[k] >= static_cast<double>(joint_count))
-        fail(label, "vertex " + std::to_string(vertex) + " uses joint slot " + std::to_string(static_cast<long long>(joints[k])) +
-                        ", the skin has " + std::to_string(joint_count));
-      const auto same =
-          std::find_if(skin.begin(), skin.end(), [&](const auto& influence) { return influence.first == joints[k]; });
+      const double joint = joint_at(k);
+      const auto same = std::find_if(skin.begin(), skin.end(), [&](const auto& influence) { return influence.first == joint; });
       if (same != skin.end()) same->second += weights[k];
-      else skin.emplace_back(joints[k], weights[k]);
+      else skin.emplace_back(joint, weights[k]);
     }
-    if (skin.empty()) fail(label, "vertex " + std::to_string(vertex) + " has no positive skin weight");
+    const bool unweighted = skin.empty();
+    if (unweighted) skin.emplace_back(joint_at(0), 1.0);
     const size_t kept = static_cast<size_t>(out.influences);
     const bool whole = skin.size() <= kept;
     if (!whole) {
@@ -798,41 +901,90 @@ class Loader {
       out.joints.push_back(k < skin.size() ? static_cast<uint16_t>(skin[k].first) : 0);
       out.weights.push_back(k < skin.size() ? static_cast<float>(skin[k].second / total) : 0.0f);
     }
-    return whole;
+    return unweighted ? SkinRead::unweighted : whole ? SkinRead::whole : SkinRead::reduced;
   }
 
-  // Adds a primitive's morph targets at `morph_weights` (the default weights: the crowd plays no
-  // weights channel) to its positions and, where the targets move them, its normals (normalised
-  // again; `normals` empty: none read), as a viewer shows the mesh.
-  void apply_default_morph(const tinygltf::Primitive& primitive, const std::vector<double>& morph_weights,
-                           std::vector<float>& positions, std::vector<float>& normals, const std::string& label) const {
-    if (primitive.targets.empty() || morph_weights.empty()) return;  // no weights: all 0
-    if (morph_weights.size() != primitive.targets.size())
-      fail(label, "has " + std::to_string(primitive.targets.size()) + " morph targets for " +
-                      std::to_string(morph_weights.size()) + " default morph weights (the node's weights, else the mesh's)");
-    bool normals_moved = false;
-    for (size_t t = 0; t < primitive.targets.size(); ++t) {
-      const double weight = morph_weights[t];
-      if (!std::isfinite(weight)) fail(label, "default morph weight " + std::to_string(t) + " is not a finite number");
-      if (weight == 0.0) continue;
-      const std::string target = label + " target " + std::to_string(t);
-      auto add_delta = [&](const char* name, std::vector<float>& values) {
-        const auto found = primitive.targets[t].find(name);
-        if (found == primitive.targets[t].end()) return false;
-        const std::vector<float> delta = to_floats(read_accessor(model_, found->second, 3, target + " " + name), target);
-        if (delta.size() != values.size()) fail(target, std::string(name) + " does not have one element per vertex");
-        for (size_t i = 0; i < values.size(); ++i) values[i] += static_cast<float>(weight * delta[i]);
-        return true;
-      };
-      add_delta("POSITION", positions);
-      if (!normals.empty()) normals_moved = add_delta("NORMAL", normals) || normals_moved;
+  // The morph targets of a mesh's drawn primitives: each has as many (glTF 3.7.2.2), or none.
+  static size_t morph_target_count(const tinygltf::Mesh& mesh, const std::string& mesh_label) {
+    size_t targets = 0;
+    for (const tinygltf::Primitive& primitive : mesh.primitives)
+      if (drawn(primitive)) targets = std::max(targets, primitive.targets.size());
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+      const size_t own = mesh.primitives[p].targets.size();
+      if (drawn(mesh.primitives[p]) && own != 0 && own != targets)
+        fail(mesh_label + " primitive " + std::to_string(p), "has " + std::to_string(own) + " morph targets, another primitive of its mesh " +
+                                                               std::to_string(targets) + " (glTF gives every primitive of a mesh the same targets)");
     }
-    for (size_t v = 0; normals_moved && v < normals.size() / 3; ++v) {
+    return targets;
+  }
+
+  // A mesh node's default morph weights (T,): the node's `weights`, else the mesh's, else zeros.
+  static std::vector<double> default_morph_weights(const std::vector<double>& node_weights, const tinygltf::Mesh& mesh,
+                                                   size_t targets, const std::string& mesh_label) {
+    const std::vector<double>& weights = node_weights.empty() ? mesh.weights : node_weights;
+    if (targets == 0) return {};
+    if (weights.empty()) return std::vector<double>(targets, 0.0);
+    if (weights.size() != targets)
+      fail(mesh_label, "has " + std::to_string(targets) + " morph targets for " + std::to_string(weights.size()) +
+                           " default morph weights (the node's weights, else the mesh's)");
+    for (size_t t = 0; t < targets; ++t)
+      if (!std::isfinite(weights[t])) fail(mesh_label, "default morph weight " + std::to_string(t) + " is not a finite number");
+    return weights;
+  }
+
+  // Target `t`'s `name` (POSITION, NORMAL) deltas of a primitive of `count` vertices, (count, 3);
+  // empty where the target does not move it.
+  std::vector<float> target_deltas(const tinygltf::Primitive& primitive, size_t t, const char* name, size_t count,
+                                   const std::string& label) const {
+    const auto found = primitive.targets[t].find(name);
+    if (found == primitive.targets[t].end()) return {};
+    const std::string target = label + " target " + std::to_string(t);
+    std::vector<float> deltas = to_floats(read_accessor(model_, found->second, 3, target + " " + name), target);
+    if (deltas.size() != 3 * count) fail(target, std::string(name) + " does not have one element per vertex");
+    return deltas;
+  }
+
+  // Adds a primitive's morph targets at `weights` (its mesh's default weights, checked by
+  // default_morph_weights) to its positions and, where the targets move them, its normals
+  // (normalised again; `normals` empty: none read), as a viewer shows the mesh.
+  void apply_default_morph(const tinygltf::Primitive& primitive, const std::vector<double>& weights,
+                           std::vector<float>& positions, std::vector<float>& normals, const std::string& label) const {
+    bool normals_moved = false;
+    const size_t count = positions.size() / 3;
+    for (size_t t = 0; t < primitive.targets.size(); ++t) {
+      if (weights[t] == 0.0) continue;
+      auto add = [&](const std::vector<float>& deltas, std::vector<float>& values) {
+        for (size_t i = 0; i < deltas.size(); ++i) values[i] += static_cast<float>(weights[t] * deltas[i]);
+        return !deltas.empty();
+      };
+      add(target_deltas(primitive, t, "POSITION", count, label), positions);
+      if (!normals.empty()) normals_moved = add(target_deltas(primitive, t, "NORMAL", count, label), normals) || normals_moved;
+    }
+    for (size_t v = 0; normals_moved && v < count; ++v) {
       float* normal = &normals[3 * v];
       const float length = glm::length(glm::vec3(normal[0], normal[1], normal[2]));
       if (length > 0.0f)
         for (int c = 0; c < 3; ++c) normal[c] /= length;
     }
+  }
+
+  // Appends a primitive's morph targets, `count` vertices, to out.morph_deltas (a primitive
+  // without targets moves nothing); normal deltas only `with_normals` (the file's normals).
+  void append_morph_deltas(const tinygltf::Primitive& primitive, size_t count, bool with_normals, const std::string& label,
+                           MeshData& out) const {
+    const size_t targets = static_cast<size_t>(out.morph_targets);
+    std::vector<float> deltas(count * targets * 8, 0.0f);  // (count, T, 2, 4)
+    for (size_t t = 0; t < primitive.targets.size(); ++t) {
+      const std::vector<float> moved = target_deltas(primitive, t, "POSITION", count, label);
+      const std::vector<float> turned = with_normals ? target_deltas(primitive, t, "NORMAL", count, label) : std::vector<float>();
+      for (size_t v = 0; v < count; ++v)
+        for (size_t c = 0; c < 3; ++c) {
+          float* at = &deltas[(v * targets + t) * 8];
+          if (!moved.empty()) at[c] = moved[3 * v + c];
+          if (!turned.empty()) at[4 + c] = turned[3 * v + c];
+        }
+    }
+    out.morph_deltas.insert(out.morph_deltas.end(), deltas.begin(), deltas.end());
   }
 
   static std::vector<uint32_t> to_triangles(const std::vector<uint32_t>& corners, int mode) {
@@ -864,14 +1016,44 @@ class Loader {
     return out;
   }
 
-  // Rest-pose world bounds: level 0 of every chain posed by the core (FK + palette) and skinned
-  // by bake_lbs.
+  // The bind-space positions (V, 3) of a level's mesh at its default morph weights.
+  static std::vector<float> rest_shape(const MeshData& mesh, const MorphPlayback& morph) {
+    std::vector<float> positions = mesh.positions;
+    const size_t targets = static_cast<size_t>(mesh.morph_targets);
+    for (size_t v = 0; v < mesh.vertex_count(); ++v)
+      for (size_t t = 0; t < targets; ++t)
+        for (size_t c = 0; c < 3; ++c) positions[3 * v + c] += morph.defaults[t] * mesh.morph_deltas[(v * targets + t) * 8 + c];
+    return positions;
+  }
+
+  // How far the weights a level's clips play move a vertex of its mesh from where it is at no
+  // weight (bind space), at most: the farthest at a key, since between keys the weights blend
+  // those of the keys and the displacement is linear in them.
+  static float morph_reach(const MeshData& mesh, const MorphPlayback& morph) {
+    const size_t targets = static_cast<size_t>(mesh.morph_targets);
+    float reach = 0.0f;
+    for (const std::vector<float>& weights : targets > 0 ? morph.keyed_weights() : std::vector<std::vector<float>>())
+      for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        glm::vec3 moved(0.0f);
+        for (size_t t = 0; t < targets; ++t) moved += weights[t] * glm::make_vec3(&mesh.morph_deltas[(v * targets + t) * 8]);
+        reach = std::max(reach, glm::length(moved));
+      }
+    return reach;
+  }
+
+  // Rest-pose world bounds: level 0 of every chain at its default morph weights, posed by the
+  // core (FK + palette) and skinned by bake_lbs. The bounding sphere also holds what the played
+  // morph weights move, of every level.
   void compute_bounds() {
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    float reach = 0.0f;
     for (const Chain& chain : asset_.chains) {
+      for (const Level& level : chain.levels)
+        reach = std::max(reach, morph_reach(asset_.meshes[static_cast<size_t>(level.mesh)], level.morph));
       const Level& level = chain.levels.front();
       const Rig& rig = asset_.rigs[static_cast<size_t>(level.rig)];
       const MeshData& mesh = asset_.meshes[static_cast<size_t>(level.mesh)];
+      const std::vector<float> positions = rest_shape(mesh, level.morph);
       std::vector<float> t = rig.rest_translations, r = rig.rest_rotations, s = rig.rest_scales;
       std::vector<float> world(16 * rig.pose_count()), palette(16 * rig.joint_count());
       const animlod::LocalPose pose{t.data(), r.data(), s.data(), rig.pose_count()};
@@ -879,9 +1061,9 @@ class Loader {
       if (!status) fail("skin " + std::to_string(rig.skin), status.message);
       animlod::skin_palette(world.data(), rig.joint_nodes.data(), rig.inverse_bind.data(), rig.joint_count(), palette.data());
       std::vector<int32_t> joints(mesh.joints.begin(), mesh.joints.end());
-      std::vector<float> skinned(mesh.positions.size());
+      std::vector<float> skinned(positions.size());
       animlod::SkinningInput input;
-      input.rest_positions = mesh.positions.data();
+      input.rest_positions = positions.data();
       input.joints = joints.data();
       input.weights = mesh.weights.data();
       input.skin_matrices = palette.data();
@@ -900,7 +1082,7 @@ class Loader {
     asset_.bounds_min = lo;
     asset_.bounds_max = hi;
     asset_.sphere_center = 0.5f * (lo + hi);
-    asset_.sphere_radius = 0.5f * glm::length(hi - lo) * 1.1f;  // room for limbs swinging out
+    asset_.sphere_radius = 0.5f * glm::length(hi - lo) * 1.1f + reach;  // room for limbs swinging out
     if (!(asset_.sphere_radius > 0.0f) || !std::isfinite(asset_.sphere_radius))
       fail("scene", "the skinned meshes have no extent in their rest pose");
   }
@@ -910,7 +1092,7 @@ class Loader {
   std::vector<int> parents_;
   std::vector<std::vector<int>> original_clips_;  // animations of each original clip
   std::vector<int> clip_rigs_;  // rig of every clip in asset_.clips
-  std::set<int> reduced_influence_meshes_;  // meshes warned about for keeping kMaxInfluences of a vertex's weights
+  std::set<int> warned_meshes_;  // meshes whose warnings were said (several level nodes may draw one)
 };
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include "animlod/pose.hpp"
+#include "morph_weights.hpp"
 
 namespace crowd {
 
@@ -23,6 +24,7 @@ constexpr int kMaxInfluences = 8;
 // One level's geometry: every triangle primitive of its mesh merged into one indexed mesh.
 struct MeshData {
   std::vector<float> positions;   // (V, 3) bind-space positions, default morph weights applied
+                                  // unless the GPU plays them (morph_targets > 0)
   std::vector<float> normals;     // (V, 3) (area-weighted face normals where the file has none)
   std::vector<float> colors;      // (V, 3) base colour of the vertex's material
   std::vector<uint16_t> joints;   // (V, K) skin joint slots (each joint once)
@@ -30,6 +32,10 @@ struct MeshData {
                                   // keeps its K largest weights (Asset::warnings says so)
   int influences = 4;             // K: 4, or kMaxInfluences where a primitive has JOINTS_1 / WEIGHTS_1
   std::vector<uint32_t> indices;  // (M * 3,)
+  // Morph targets the GPU adds at each instance's weights, where a clip animates the level node's
+  // weights (Level::morph); 0 otherwise.
+  int morph_targets = 0;             // T
+  std::vector<float> morph_deltas;   // (V, T, 2, 4): position then normal delta of each target, w 0
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return indices.size() / 3; }
 };
@@ -60,7 +66,7 @@ struct Clip {
   Clip& operator=(const Clip&) = delete;
 
   std::vector<int> animations;  // glTF animations played together (usually one)
-  float duration = 0.0f;  // seconds, the last key time over its channels
+  float duration = 0.0f;  // seconds, the last key time over its channels and its animations' morph weights
   std::vector<std::vector<float>> times, values;  // per channel
   std::vector<animlod::ClipChannel> channels;     // pointing into times / values
   animlod::ClipView view() const { return {channels.data(), channels.size()}; }
@@ -75,6 +81,9 @@ struct Level {
   int mesh = -1;             // index into Asset::meshes
   int rig = -1;              // index into Asset::rigs
   std::vector<int> clips;    // per original clip k: index into Asset::clips
+  // Morph weights played per instance, where a clip animates the node's weights (target_count()
+  // equals its mesh's morph_targets; 0: the mesh holds its default weights).
+  MorphPlayback morph;
 
   // Where the level stands along its chain, what --level-colors and the report's level histogram
   // count: the coarser of its mesh and motion levels, which is its MSFT_lod index on every chain

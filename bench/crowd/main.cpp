@@ -81,7 +81,8 @@ int run(int argc, char** argv) {
   // Meshes, and the mesh id of every (asset, chain, level) bucket.
   std::vector<std::vector<std::vector<int>>> mesh_ids(assets.size());
   for (size_t a = 0; a < assets.size(); ++a) {
-    const int first = renderer.upload_meshes(assets[a].meshes);
+    int first = 0;
+    if (!renderer.upload_meshes(assets[a].meshes, first, error)) return fail(2, assets[a].path + ": " + error);
     for (const crowd::Chain& chain : assets[a].chains) {
       mesh_ids[a].emplace_back();
       for (const crowd::Level& level : chain.levels) mesh_ids[a].back().push_back(first + level.mesh);
@@ -91,7 +92,7 @@ int run(int argc, char** argv) {
   std::vector<uint32_t> ground_indices;
   scene.ground_mesh(ground_positions, ground_indices);
   renderer.upload_ground(ground_positions, ground_indices);
-  if (!renderer.reserve(animator.max_palette_floats(), animator.max_instances(), error)) return fail(2, error);
+  if (!renderer.reserve(animator.max_buffer_floats(), animator.max_instances(), error)) return fail(2, error);
 
   // What to run: the modes, or for --grid one forced level per cell.
   std::vector<crowd::Mode> runs = options.modes;
@@ -135,11 +136,10 @@ int run(int argc, char** argv) {
       crowd::FrameCounts counts;
       animator.animate(camera, lod_camera, static_cast<uint64_t>(frame), time, counts);
       const Clock::time_point t1 = Clock::now();
-      size_t palette_floats = 0, instances = 0;
-      float* palettes = renderer.begin_palettes();
+      float* buffer = renderer.begin_palettes();
       crowd::InstanceGpu* instance_data = renderer.begin_instances();
-      animator.gather(palettes, instance_data, palette_floats, instances);
-      renderer.end_uploads(palette_floats);
+      const crowd::Gathered gathered = animator.gather(buffer, instance_data);
+      renderer.end_uploads(gathered.floats);
       const Clock::time_point t2 = Clock::now();
       bucket_meshes.clear();
       for (const crowd::Bucket& bucket : animator.buckets())
@@ -165,7 +165,7 @@ int run(int argc, char** argv) {
         result.submit_ms.push_back(milliseconds(t2, t3));
         result.swap_ms.push_back(milliseconds(t3, t4));
         if (gpu >= 0.0) result.gpu_ms.push_back(gpu);
-        result.add(counts, animator.buckets().size(), palette_floats / 12);
+        result.add(counts, animator.buckets().size(), gathered.matrices);
       }
       previous_end = Clock::now();
     }

@@ -1,10 +1,11 @@
 // Level buckets of the crowd for a hand-built scene (no GL, no file): characters at known
 // distances in front of the camera get the levels their projected errors allow in each mode,
-// and the gathered instances and palettes are laid out bucket by bucket.
+// and the gathered instances, palettes and morph weights are laid out bucket by bucket.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "crowd_animation.hpp"
@@ -113,11 +114,10 @@ struct HandBuiltScene {
     mode.motion_levels = motion;
     animator.start(mode);
     animator.animate(camera, lod_camera, 0, 0.0f, counts);
-    std::vector<float> palettes(animator.max_palette_floats());
+    std::vector<float> buffer(animator.max_buffer_floats());
     instances.resize(animator.max_instances());
-    size_t floats = 0, count = 0;
-    animator.gather(palettes.data(), instances.data(), floats, count);
-    instances.resize(count);
+    const Gathered gathered = animator.gather(buffer.data(), instances.data());
+    instances.resize(gathered.instances);
     std::map<std::pair<int, int>, uint32_t> cells;
     uint32_t next = 0;
     const Chain& chain = assets[0].chains[0];
@@ -127,7 +127,8 @@ struct HandBuiltScene {
       const Level& level = chain.levels[static_cast<size_t>(bucket.level)];
       cells[{level.mesh_level, level.motion_level}] = bucket.count;
     }
-    CHECK(floats == 12 * static_cast<size_t>(counts.joints));  // every drawn skeleton uploaded once
+    CHECK(gathered.floats == 12 * static_cast<size_t>(counts.joints));  // every drawn skeleton uploaded once
+    CHECK(gathered.matrices == static_cast<size_t>(counts.joints));
     return cells;
   }
 };
@@ -162,8 +163,8 @@ TEST_CASE("crowd buckets: the selected chain level, reduced in geometry, motion 
   cells = s.run("Original", false, false, counts, instances);
   CHECK(cells == Cells{{{0, 0}, 4}});
   CHECK(counts.joints == 4 * 3);
-  // Each instance points at its own palette.
-  for (size_t i = 0; i < instances.size(); ++i) CHECK(instances[i].palette_base == 3 * i);
+  // Each instance points at its own palette (3 joints of 3 texels).
+  for (size_t i = 0; i < instances.size(); ++i) CHECK(instances[i].palette_base == 9 * i);
 }
 
 TEST_CASE("crowd level colours: the tint and the level histogram follow the level drawn, not the one selected") {
@@ -225,4 +226,39 @@ TEST_CASE("crowd frame skipping: far characters keep their pose for several fram
   CHECK(updates > 0);
   CHECK(updates >= 8);           // the near character every frame
   CHECK(updates <= 8 + 3 + 2 + 1);  // the others every 3, 7 and 8 frames
+}
+
+TEST_CASE("crowd morph weights: each instance gets its level's weights at its clip time, after its palette") {
+  // The crowd drew a mesh's default weights only: a clip's weights channel was not played.
+  HandBuiltScene s;
+  Asset& asset = s.assets[0];
+  asset.clips[0].duration = 2.0f;  // a clip of 2 s (no joint channel: the rest pose)
+  MorphPlayback& morph = asset.chains[0].levels[0].morph;
+  morph.defaults = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  morph.tracks.emplace_back();
+  std::string error;
+  REQUIRE(MorphWeightsTrack::make({0.0f, 2.0f}, {0, 0, 0, 0, 0, 2, 4, 6, 8, 10}, 5, animlod::Interpolation::linear,
+                                  morph.tracks.back(), error));
+  std::vector<Placement> placements = HandBuiltScene::placements();
+  placements[1].phase = 1.0f;
+  const CrowdScene scene(placements, 200.0f, 1.8f);
+  CrowdAnimator animator(s.assets, scene, s.options);
+  Mode original;
+  animator.start(original);
+  FrameCounts counts;
+  animator.animate(s.camera, s.lod_camera, 15, 0.5f, counts);
+  std::vector<float> buffer(animator.max_buffer_floats());
+  std::vector<InstanceGpu> instances(animator.max_instances());
+  const Gathered gathered = animator.gather(buffer.data(), instances.data());
+  REQUIRE(gathered.instances == 4);
+  // The instances in placement order, each 3 joints (9 texels) then 5 weights padded to 8 floats.
+  for (size_t i = 0; i < 4; ++i) {
+    CHECK(instances[i].palette_base == 11 * i);
+    CHECK(instances[i].morph_base == 11 * i + 9);
+    const float t = i == 1 ? 1.5f : 0.5f;  // seconds into the clip: time 0.5 plus the phase
+    const float* weights = buffer.data() + 4 * instances[i].morph_base;
+    CHECK(std::vector<float>(weights, weights + 8) == std::vector<float>{t, 2 * t, 3 * t, 4 * t, 5 * t, 0, 0, 0});
+  }
+  CHECK(gathered.matrices == 12);
+  CHECK(gathered.floats == 4 * (36 + 8));
 }

@@ -43,3 +43,11 @@ TEST_CASE("crowd options: an integer out of range is refused with the range it t
   CHECK(parse({"a.glb", "--warmup", "-1"}) == "--warmup: expected an integer from 0 to 1000000000, got '-1'");
   CHECK(parse({"a.glb", "--modes", ""}) == "--modes: no mode given");
 }
+
+TEST_CASE("crowd options: an empty item in a list is refused") {
+  // "Original," ran Original alone: the trailing empty item was dropped unseen.
+  CHECK(parse({"a.glb", "--modes", "Original,"}) == "--modes: empty item in 'Original,' (a comma too many?)");
+  CHECK(parse({"a.glb", "--modes", ",GLoD"}) == "--modes: empty item in ',GLoD' (a comma too many?)");
+  CHECK(parse({"a.glb", "--modes", "Original,,GLoD"}) == "--modes: empty item in 'Original,,GLoD' (a comma too many?)");
+  CHECK(parse({"a.glb", "--modes", "Original,GLoD+skip"}).empty());
+}

@@ -261,7 +261,12 @@ def test_bad_chains_are_refused_with_one_line(binary, chain, tmp_path, edit, mes
 
 @pytest.mark.parametrize(
     ("arguments", "message"),
-    [(["--modes", "Fast"], "unknown mode 'Fast'"), (["--count", "0"], "--count"), (["--path", "up"], "--path")],
+    [
+        (["--modes", "Fast"], "unknown mode 'Fast'"),
+        (["--modes", "Original,"], "--modes: empty item in 'Original,'"),
+        (["--count", "0"], "--count"),
+        (["--path", "up"], "--path"),
+    ],
 )
 def test_bad_arguments_exit_2_with_one_line(binary, chain, arguments, message) -> None:
     completed = subprocess.run([str(binary), str(chain), *arguments], capture_output=True, text=True, check=False)

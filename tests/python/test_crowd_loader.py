@@ -1,5 +1,6 @@
 """The crowd binary's glTF reader (bench/crowd/lod_asset.cpp) on hand-written GLBs: every skin
-influence set read, default morph weights drawn, damaged MSFT_lod chains refused.
+influence set read, vertices without skin weight on their first joint, default and animated morph
+weights drawn, damaged MSFT_lod chains refused.
 
 Each GLB is a 2 m strip of 10 vertices skinned to a chain of three joints (root, mid, top), bent
 at a constant angle by its one clip, so that a screenshot shows the skin and two files that skin
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import matplotlib.image
 import numpy as np
+import pygltflib
 import pytest
 
 ROWS = np.linspace(0.0, 2.0, 5)
@@ -97,10 +99,12 @@ def strip(
     lod_ids: list | None = None,
     coverages: list | None = None,
     positions: np.ndarray = POSITIONS,
+    weight_keys: tuple[str, np.ndarray] | None = None,
 ) -> Path:
     """The strip as a GLB: `skin` its JOINTS_n / WEIGHTS_n, `extra_joints` more joints at
     mid; `lod_ids` the base node's MSFT_lod ids, of which id 4 + extra_joints is a level node
-    drawing the same mesh (the node after the joints)."""
+    drawing the same mesh (the node after the joints); `weight_keys` (interpolation, outputs
+    (2 or 6, T)) a channel of the clip setting the strip's morph weights, keys at 0 and 1 s."""
     glb = Glb()
     attributes = {"POSITION": glb.accessor(positions)}
     if normals is not None:
@@ -138,14 +142,19 @@ def strip(
         "input": glb.accessor(np.array([[0.0], [1.0]], np.float32)),
         "output": glb.accessor(np.array([bent, bent], np.float32)),
     }
-    channel = {"sampler": 0, "target": {"node": 2, "path": "rotation"}}
+    samplers, channels = [clip], [{"sampler": 0, "target": {"node": 2, "path": "rotation"}}]
+    if weight_keys is not None:
+        interpolation, outputs = weight_keys
+        times, values = glb.accessor(np.array([[0.0], [1.0]], np.float32)), glb.accessor(outputs.reshape(-1, 1))
+        samplers.append({"input": times, "output": values, "interpolation": interpolation})
+        channels.append({"sampler": 1, "target": {"node": 0, "path": "weights"}})
     glb.json.update(
         scene=0,
         scenes=[{"nodes": [0, 1]}],
         nodes=nodes,
         meshes=[mesh],
         skins=[{"joints": [1, 2, 3, *extra], "inverseBindMatrices": glb.accessor(inverse_binds)}],
-        animations=[{"name": "bend", "samplers": [clip], "channels": [channel]}],
+        animations=[{"name": "bend", "samplers": samplers, "channels": channels}],
     )
     return glb.write(path)
 
@@ -263,6 +272,83 @@ def test_default_morph_weights_are_drawn(binary, tmp_path) -> None:
     assert differing_pixels(morphed, baked) == 0
 
 
+def _push_and_turn() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A target pushing the top two rows 0.5 m towards the camera and turning every normal:
+    (push, facing, turned) (10, 3). It leaves the strip's height, which places the camera, as it is."""
+    push = np.zeros_like(POSITIONS)
+    push[POSITIONS[:, 1] > 1.4, 2] = 0.5
+    facing = np.tile(np.array([0.0, 0.0, 1.0], np.float32), (10, 1))
+    turned = np.tile(np.array([0.0, 0.8, 0.6], np.float32), (10, 1))
+    return push, facing, turned
+
+
+@pytest.mark.parametrize(
+    ("interpolation", "weight"),
+    [("LINEAR", [[1.0], [1.0]]), ("STEP", [[1.0], [1.0]]), ("CUBICSPLINE", [[0.0], [1.0], [0.0]] * 2)],
+)
+def test_a_clip_of_morph_weights_is_played(binary, tmp_path, interpolation, weight) -> None:
+    # The clip holds the target at 1 over a default weight of 0 (at every clip time, so that the
+    # character's random phase does not matter): the crowd drew the default weights only, as if
+    # the clip had no weights channel.
+    push, facing, turned = _push_and_turn()
+    skin = rigid_skin()
+    keys = (interpolation, np.array(weight, np.float32))
+    target = [{"POSITION": push, "NORMAL": turned - facing}]
+    played = strip(tmp_path / "played.glb", skin, normals=facing, targets=target, mesh_weights=[0.0], weight_keys=keys)
+    baked = screenshot(binary, strip(tmp_path / "baked.glb", skin, normals=turned, positions=POSITIONS + push))
+    unmorphed = screenshot(binary, strip(tmp_path / "unmorphed.glb", skin, normals=facing))
+    shot = screenshot(binary, played)
+    assert differing_pixels(baked, unmorphed) > 100  # the control: the target shows
+    assert differing_pixels(shot, baked) == 0
+
+
+def test_a_clip_of_morph_weights_overrides_the_default_weights(binary, tmp_path) -> None:
+    # Weights 0 over a default of 1: the clip's weights are drawn, not the node's (a shape key left
+    # on in the file, which the clip turns off).
+    push, facing, turned = _push_and_turn()
+    skin = rigid_skin()
+    target = [{"POSITION": push, "NORMAL": turned - facing}]
+    played = strip(tmp_path / "played.glb", skin, normals=facing, targets=target, node_weights=[1.0],
+                   weight_keys=("LINEAR", np.zeros((2, 1), np.float32)))  # fmt: skip
+    unmorphed = screenshot(binary, strip(tmp_path / "unmorphed.glb", skin, normals=facing))
+    shown = screenshot(binary, strip(tmp_path / "shown.glb", skin, normals=facing, targets=target, node_weights=[1.0]))
+    assert differing_pixels(shown, unmorphed) > 100  # the control: the default weight shows without the clip
+    assert differing_pixels(screenshot(binary, played), unmorphed) == 0
+
+
+def test_a_weights_channel_of_the_wrong_size_is_refused_with_one_line(binary, tmp_path) -> None:
+    push, _, _ = _push_and_turn()
+    glb = strip(tmp_path / "short.glb", rigid_skin(), targets=[{"POSITION": push}] * 2,
+                weight_keys=("LINEAR", np.zeros((3, 1), np.float32)))  # fmt: skip
+    completed = run(binary, glb, display=False)
+    assert completed.returncode == 2 and completed.stderr.count("\n") == 1
+    assert "animation 0 'bend' channel 1: output holds 3 numbers for 2 keys of 2 morph weights" in completed.stderr
+
+
+def test_vertices_without_skin_weight_follow_their_first_joint_with_a_warning(binary, tmp_path) -> None:
+    # glTF forbids them, but Blender before 2.90 and Maya2glTF write the vertices no bone deforms
+    # with all-zero weights; three.js, Blender's importer and animlod's reader move them with their
+    # first listed joint. The crowd refused the file ("vertex 8 has no positive skin weight").
+    skin = rigid_skin()
+    joints, weights = skin[0]
+    unweighted = weights.copy()
+    unweighted[8:] = 0.0  # the top row, on joint 2 (top) first
+    glb = strip(tmp_path / "unweighted.glb", {0: (joints, unweighted)})
+    entry, stderr = report(binary, glb)
+    warning = (
+        f"animlod_crowd: warning: {glb}: level 0 (node 0 'strip') mesh 0 primitive 0: 2 of 10 vertices (first: 8) "
+        "have no positive skin weight; they follow their first listed joint, as three.js and Blender do"
+    )
+    assert warning in stderr.splitlines() and stderr.count("warning") == 1
+    assert entry["warnings"] == [warning.split(f"{glb}: ", 1)[1]]
+    on_root = joints.copy()
+    on_root[8:, 0] = 0
+    rooted = screenshot(binary, strip(tmp_path / "rooted.glb", {0: (on_root, weights)}))
+    rigid = screenshot(binary, strip(tmp_path / "rigid.glb", skin))
+    assert differing_pixels(rigid, rooted) > 10  # the control: the top row on another joint
+    assert differing_pixels(screenshot(binary, glb), rigid) == 0
+
+
 @pytest.mark.parametrize(
     ("options", "reason"),
     [
@@ -314,3 +400,46 @@ def test_an_accessor_count_near_2_to_the_64_is_refused(binary, tmp_path) -> None
     completed = run(binary, glb, display=False)
     assert completed.returncode == 2 and completed.stderr.count("\n") == 1
     assert "JOINTS_0 accessor 1: count 4611686018427387904 is more than animlod_crowd reads" in completed.stderr
+
+
+def _on_a_still_joint(gltf, blob, weights_channel: bool) -> None:
+    """A morph-animated bird (no skin) bound wholly to one joint that its first clip holds at rest,
+    so that the crowd takes it; without `weights_channel` that clip no longer sets the weights."""
+    from gltf_edits import append_accessor
+
+    node = next(i for i, n in enumerate(gltf.nodes) if n.mesh is not None)
+    for primitive in gltf.meshes[gltf.nodes[node].mesh].primitives:
+        count = gltf.accessors[primitive.attributes.POSITION].count
+        primitive.attributes.JOINTS_0 = append_accessor(gltf, blob, np.zeros((count, 4), np.uint16), "VEC4")
+        weights = np.tile(np.array([1.0, 0.0, 0.0, 0.0], np.float32), (count, 1))
+        primitive.attributes.WEIGHTS_0 = append_accessor(gltf, blob, weights, "VEC4")
+    gltf.nodes.append(pygltflib.Node(name="still joint"))
+    gltf.scenes[gltf.scene or 0].nodes.append(len(gltf.nodes) - 1)
+    gltf.skins.append(pygltflib.Skin(joints=[len(gltf.nodes) - 1]))
+    gltf.nodes[node].skin = len(gltf.skins) - 1
+    animation = gltf.animations[0]
+    if not weights_channel:
+        animation.channels = []
+    times = animation.samplers[0].input
+    rest = np.tile(np.array([0.0, 0.0, 0.0, 1.0], np.float32), (gltf.accessors[times].count, 1))
+    animation.samplers.append(pygltflib.AnimationSampler(input=times, output=append_accessor(gltf, blob, rest, "VEC4")))
+    target = pygltflib.AnimationChannelTarget(node=len(gltf.nodes) - 1, path="rotation")
+    animation.channels.append(pygltflib.AnimationChannel(sampler=len(animation.samplers) - 1, target=target))
+
+
+def test_the_morph_clips_of_the_development_birds_play(binary, data_dir, tmp_path) -> None:
+    # The development files whose clips set morph weights (three.js' parrot and stork, 12 and 13
+    # targets of POSITION deltas, LINEAR) have no skin; bound to a joint held still, they drew the
+    # same frame whether their clip set the weights or not.
+    from gltf_edits import edit_glb
+
+    birds = sorted((data_dir / "morph").glob("*.glb"))
+    assert birds
+    for bird in birds:
+        shots = {}
+        for played in (True, False):
+            glb = tmp_path / f"{bird.stem}_{'played' if played else 'still'}.glb"
+            edit_glb(bird, glb, lambda gltf, blob, played=played: _on_a_still_joint(gltf, blob, played))
+            shots[played] = screenshot(binary, glb)
+        assert strip_pixels(shots[False]) > 100, bird.name  # the bird is in view
+        assert differing_pixels(shots[True], shots[False]) > 100, bird.name

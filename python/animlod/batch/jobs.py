@@ -69,8 +69,9 @@ class Job:
     path: str  # "module:function", imported where the job runs
     kinds: tuple[str, ...]  # input kinds it takes; empty: any
     option_sources: dict[str, tuple[str, ...]]  # kind -> "module:function" whose keywords are options
-    # "module:function" that refuses (ValueError) values no input can take, given the options
-    # among its keywords; the AQEM options' check is check_values' own.
+    # "module:function" that refuses (ValueError) values no input can take: its keywords, each the
+    # manifest's value or the default of the job's first option source; the AQEM options' check is
+    # check_values' own.
     value_check: str | None = None
 
     def function(self) -> Callable:
@@ -181,7 +182,8 @@ def check_values(job: Job, kind: str, options: dict[str, object]) -> str | None:
     try:
         if job.value_check is not None:
             check = _import(job.value_check)
-            check(**{name: value for name, value in options.items() if name in inspect.signature(check).parameters})
+            defaults = inspect.signature(_import(sources[0])).parameters
+            check(**{name: options.get(name, defaults[name].default) for name in inspect.signature(check).parameters})
         if _DRAWABLE in sources:
             _import(_DRAWABLE).resolve(None, taken_by(_DRAWABLE))
         if _AQEM in sources:

@@ -101,16 +101,16 @@ def run_face_lod(
 
 def check_face_options(
     *,
-    ratios: Sequence[float] | None = None,
-    face_counts: Sequence[int] | None = None,
-    target_fractions: Sequence[float] | None = None,
-    repeats: int = 3,
-    error_frames: int = 24,
+    ratios: Sequence[float] | None,
+    face_counts: Sequence[int] | None,
+    target_fractions: Sequence[float] | None,
+    repeats: int,
+    error_frames: int,
 ) -> None:
-    """Refuse, naming the option, values :func:`run_face_lod` cannot take whatever the face: both
-    ``ratios`` and ``face_counts``, a ratio outside (0, 1] or a count of 0 (the core's check of
-    AQEM's level targets), a fraction outside [0, 1], fewer than one repeat or error frame. A batch
-    checks its manifest with it before anything runs."""
+    """Refuse, naming the option, values of :func:`run_face_lod`'s options it cannot take whatever
+    the face: both ``ratios`` and ``face_counts``, a ratio outside (0, 1] or a count of 0 (the
+    core's check of AQEM's level targets), a fraction outside [0, 1], fewer than one repeat or
+    error frame. A batch checks its manifest with it before anything runs."""
     if ratios is not None and face_counts is not None:
         raise ValueError("ratios and face_counts: give one of them, not both")
     if face_counts is not None:

@@ -448,20 +448,21 @@ def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Mot
 
 def check_motion_options(
     *,
-    levels: int | None = None,
-    joints: Sequence[int] | None = None,
-    ranking: str = DEFAULT_RANKING,
-    solver: str = SOLVERS[0],
-    penalty: bool = False,
-    workers: int = 0,
-    translation_tolerance: float = TRANSLATION_TOLERANCE,
-    weights: Sequence[float] = (0.2, 0.4, 0.4),
-    max_frames: int = 600,
+    levels: int | None,
+    joints: Sequence[int] | None,
+    ranking: str,
+    solver: str,
+    penalty: bool,
+    workers: int,
+    translation_tolerance: float,
+    weights: Sequence[float],
+    max_frames: int,
 ) -> None:
-    """Refuse, naming the option, values :func:`build_motion_levels` cannot take whatever the clip
-    (each checked by the code that uses it): both ``levels`` and ``joints``, a level request, a
-    ranking, solver, weight or analysis option out of range. A batch checks its manifest with it
-    before anything runs; whether the skeleton allows the levels only the clip can tell."""
+    """Refuse, naming the option, values of :func:`build_motion_levels`'s options it cannot take
+    whatever the clip (each checked by the code that uses it): both ``levels`` and ``joints``, a
+    level request, a ranking, solver, weight or analysis option out of range. A batch checks its
+    manifest with it before anything runs; whether the skeleton allows the levels only the clip
+    can tell."""
     from ..motion_lod.objective import Weights
 
     if levels is not None and joints is not None:

@@ -9,7 +9,13 @@ import pygltflib
 import pytest
 
 from animlod.face_lod import BlendshapeFace, BlendshapeLodOptions, build_blendshape_lod, procedural_face, rank_targets
-from animlod.face_lod.blendshape import measure_blendshape_lod, one_at_a_time, prune_levels, target_contributions
+from animlod.face_lod.blendshape import (
+    BlendshapeLevel,
+    measure_blendshape_lod,
+    one_at_a_time,
+    prune_levels,
+    target_contributions,
+)
 from animlod.face_lod.lod_glb import gltf_face_levels, read_gltf_face, write_gltf_face_lod
 from animlod.face_lod.measure import measured_frames
 from animlod.face_lod.mpa import expression_sequence
@@ -226,3 +232,18 @@ def test_the_face_pose_scans_as_a_blendshape_face(data_dir):
     rows = measure_blendshape_lod(face, levels[:2], repeats=1, max_frames=3, samples=2000)
     assert rows[1].hausdorff < 0.01
     assert levels[1].frames(weights).frame_count == 3
+
+
+def test_a_target_no_clip_drives_is_measured_at_full_weight():
+    # Pruned at weight 1 (rigs drive it at run time) but measured only over the clip, where it
+    # never moves: a level without it reported error 0.
+    positions, faces = icosphere(2, 0.1)
+    targets = np.zeros((2, len(positions), 3), np.float32)
+    targets[0, :, 0], targets[1, :, 1] = 0.02, 0.005  # x driven by the clip, y by nothing
+    weights = np.column_stack([one_at_a_time(1)[:, 0], np.zeros(len(one_at_a_time(1)))])
+    face = BlendshapeFace(positions, faces, targets, ["x", "y"], weights)
+    without_y = BlendshapeLevel(
+        face.faces, face.neutral, face.targets[:1], np.array([0]), np.arange(len(positions)), None, 0.0
+    )
+    (row,) = measure_blendshape_lod(face, [without_y], repeats=1, max_frames=4, samples=500)
+    assert row.hausdorff_units == pytest.approx(0.005, rel=1e-3)

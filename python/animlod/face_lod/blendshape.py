@@ -342,14 +342,16 @@ def measure_blendshape_lod(
     """Per level: the largest (and median) time to blend one frame over the whole animation
     (numpy, the fastest of ``repeats`` runs per frame) and the largest symmetric Hausdorff
     distance to the full face over ``max_frames`` evenly spaced frames and each target's
-    peak-weight frame (:func:`~animlod.face_lod.measure.measured_frames`), relative to its
+    peak-weight frame (:func:`~animlod.face_lod.measure.measured_frames`), and over a pose of each
+    target the animation never drives at weight 1 (it is ranked and pruned at that weight, as rigs
+    drive such targets at run time: :meth:`BlendshapeFace.reach_weights`), relative to its
     bounding-box diagonal. A level that is the input itself (its arrays, every target) is not
     measured: its error is 0 (measuring it gave float rounding, 5e-10 of face-poses' size, at a
     quarter of the measuring time)."""
     from ..metrics import surface_error
 
-    picked = measured_frames(face.weights, max_frames)
-    weights = face.weights[picked]
+    undriven = np.eye(face.target_count)[np.abs(face.weights).max(axis=0) == 0.0]
+    weights = np.concatenate([face.weights[measured_frames(face.weights, max_frames)], undriven])
     reference = face.frames(weights)
     rows = []
     for index, level in enumerate(levels):

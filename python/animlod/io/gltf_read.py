@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import rotations
 from ..model import AnimatedMesh, Motion, SkinnedMesh
-from .errors import FormatError
 from .gltf_document import NODE_PATHS, GltfDocument
 from .gltf_keyframes import sample_keyframes
 from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_normals, transform_points
@@ -279,39 +279,34 @@ def read_unskinned_meshes(doc: GltfDocument, fps: float = 30.0) -> tuple[list[An
 
 
 def _animated_world_matrices(doc: GltfDocument, node: int, animation: int, fps: float) -> np.ndarray:
-    """(T, 4, 4) world transforms of node ``node`` in the frames of ``animation`` sampled at ``fps``.
+    """(T, 4, 4) world transforms of node ``node`` in the frames of ``animation`` sampled at ``fps``:
+    each node from the root down to it posed by the animation's translation, rotation and scale
+    channels (its rest transform where it has none) and composed as a viewer composes them."""
+    at = doc.animation_frame_times(animation, fps)
+    channels = {target: index for index, target in enumerate(doc.channel_targets[animation]) if target[1] in NODE_PATHS}
+    world = np.broadcast_to(np.eye(4), (len(at), 4, 4))
+    for link in [*reversed(doc.ancestors(node)), node]:
+        if not any((link, path) in channels for path in NODE_PATHS):
+            world = world @ doc.rest_matrix(link)
+            continue
+        trs = list(doc.rest_trs(link))  # an animated node has TRS, no matrix (glTF 2.0, 3.7.3.2)
+        for slot, path in enumerate(NODE_PATHS):
+            if (link, path) in channels:
+                trs[slot] = _sampled_channel(doc, animation, channels[link, path], path, at)
+        translation, rotation, scale = (np.broadcast_to(value, (len(at), value.shape[-1])) for value in trs)
+        world = world @ rotations.compose_transform(translation, rotation, scale)
+    return world
 
-    The animated node tree (:class:`SkinRig` without a skin) poses the node's nearest joint, which
-    carries the node by its rest transform relative to that joint. The rest world transform is
-    held when the animation moves neither the node nor an ancestor, and, with a warning saying
-    that the node's own motion is left out, when the tree leaves that motion out (a mesh that
-    only scales, a tree beside the largest one) or is no skeleton animlod reads.
-    """
-    rest = doc.rest_world_matrix(node)
-    held = np.broadcast_to(rest, (len(doc.animation_frame_times(animation, fps)), 4, 4))
-    chain = [node, *doc.ancestors(node)]
-    moved = {target for target, path in doc.channel_targets[animation] if path in NODE_PATHS}.intersection(chain)
-    if not moved:
-        return held
+
+def _sampled_channel(doc: GltfDocument, animation: int, channel: int, path: str, at: np.ndarray) -> np.ndarray:
+    """Channel ``channel`` of ``animation`` (a node's ``path``) sampled at the times ``at``."""
+    element = f"{doc.animation_label(animation)} channel {channel}"
+    sampler = doc.gltf.animations[animation].channels[channel].sampler
+    times, values, interpolation = doc.sampler_keys(animation, sampler, 4 if path == "rotation" else 3, element)
     try:
-        rig = SkinRig(doc, None)
-    except FormatError:  # no skeleton to read: the moved nodes are meshes that only scale, or one scales to 0
-        rig = None
-    joint = None if rig is None else next((link for link in chain if link in rig.joint_nodes), None)
-    if joint is not None and moved.isdisjoint(chain[: chain.index(joint)]):
-        # The rigid skeleton's joints leave their rest scale and shape out; a skin's inverse binds
-        # carry them (SkinRig.rest_linear), and here an identity bind with them does.
-        binds = np.broadcast_to(np.eye(4), (len(rig.joint_nodes), 4, 4)).copy()
-        binds[:, :3, :3] = rig.rest_linear
-        joint_worlds = rig.motion(doc, animation, fps).skin_matrices(binds)[:, rig.joint_nodes.index(joint)]
-        return joint_worlds @ np.linalg.solve(doc.rest_world_matrix(joint), rest)
-    warnings.warn(
-        f"{doc.path}: {doc.node_label(node)} {doc.animation_label(animation)}: its morph-animated mesh is baked at the "
-        "node's rest transform, without the node's own motion, which the skeleton animlod reads from the animated "
-        "nodes leaves out (a mesh that only scales, a tree beside the largest one)",
-        stacklevel=4,
-    )
-    return held
+        return sample_keyframes(times, values, interpolation, at, rotation=path == "rotation")
+    except ValueError as error:  # a zero or non-finite quaternion among the keys
+        raise doc.fail(element, str(error)) from None
 
 
 def node_weights(doc: GltfDocument, node: int, mesh_weights: np.ndarray) -> np.ndarray:

@@ -136,6 +136,16 @@ def test_a_helmet_on_the_head_plays_the_bodys_motion_levels(helmeted) -> None:
     assert _plays_the_bodys_levels(output, "helmet") >= 1  # the case that tore the helmet off
 
 
+def test_the_level_clips_list_the_parts_skin_beside_the_bodys(helmeted) -> None:
+    # A runtime choosing a chain's clips by extras.animlod.skins finds the body's for the helmet's
+    # chain too; one skeleton's clips keep their names (test_character_naming.py).
+    output, _ = helmeted
+    animations = GltfDocument(output).json["animations"]
+    clips = [animation for animation in animations if "animlod" in animation.get("extras", {})]
+    assert len(clips) == 3 and all(clip["extras"]["animlod"]["skins"] == [0, 1] for clip in clips)
+    assert all("@skin" not in clip["name"] for clip in clips)
+
+
 def test_hair_on_a_bone_of_its_own_that_holds_still_plays_the_bodys_levels(tmp_path) -> None:
     # VRoid's hair: a skin over the head and hair bones the body's skin does not list. Bones that
     # hold their bind pose on the head move their vertices with it.

@@ -39,8 +39,9 @@ def _image_bytes(doc: GltfDocument, image: dict) -> bytes:
         start = view.get("byteOffset", 0)
         return data[start : start + view["byteLength"]]
     from animlod.io.glb_builder import _image_bytes as read
+    from animlod.io.gltf_document import image_file
 
-    return read(doc, 0, image["uri"])[0]
+    return read(doc, 0, image["uri"], image_file(doc.path, image["uri"]))[0]
 
 
 def _without_chain(node: dict) -> dict:

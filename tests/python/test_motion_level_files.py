@@ -234,3 +234,35 @@ def test_a_prop_drawn_as_instances_leaves_the_inputs_other_data_out(walker, tmp_
         size, plain_size = (path.stat().st_size for path in (tmp_path / "levels" / files[-1],
                                                              tmp_path / "plain" / plain_files[-1]))  # fmt: skip
         assert size < 1.1 * plain_size  # the input's own skinned mesh kept would double it
+
+
+def _renamed_body(builder: GlbBuilder, named: dict) -> None:
+    body = builder.json["nodes"][named["skinned mesh"]]
+    body["name"] = "Body"
+    builder.json["meshes"][body["mesh"]]["name"] = "Body mesh"
+
+
+def _with_a_skinned_hat(builder: GlbBuilder, named: dict) -> None:
+    """The body renamed, and a box skinned to the head on the body's skin (a part, joined)."""
+    _renamed_body(builder, named)
+    hat = _box(builder, "hat")
+    head = builder.json["skins"][0]["joints"].index(named["Head"])
+    attributes = builder.json["meshes"][hat]["primitives"][0]["attributes"]
+    attributes["JOINTS_0"] = builder.add(np.tile(np.array([[head, 0, 0, 0]], np.uint16), (8, 1)))
+    attributes["WEIGHTS_0"] = builder.add(np.tile(np.array([[1.0, 0, 0, 0]], np.float32), (8, 1)))
+    builder.json["scenes"][0]["nodes"].append(builder.append("nodes", {"name": "Hat", "mesh": hat, "skin": 0}))
+
+
+@pytest.mark.parametrize(
+    ("edit", "node", "mesh"),
+    [(_renamed_body, "Body", "Body mesh"), (_with_a_skinned_hat, "Body + Hat", "Body mesh + hat")],
+)
+def test_level_glbs_keep_the_names_of_the_skinned_mesh(walker, tmp_path, edit, node, mesh):
+    """The level files named their skinned mesh and its node "skinned mesh" whatever the input called
+    them (RiggedFigure's mesh 'Proxy'): they keep the input's names, and joined parts say so."""
+    source = _edited(walker, tmp_path / "named.glb", edit)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    for files in report.files:
+        doc = GltfDocument(tmp_path / "levels" / files[-1])
+        (skinned,) = [written for written in doc.json["nodes"] if "skin" in written]
+        assert (skinned["name"], doc.json["meshes"][skinned["mesh"]]["name"]) == (node, mesh)

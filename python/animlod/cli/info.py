@@ -142,8 +142,9 @@ def _describe(kind: str, path: str) -> list[str]:
 def _document_lines(path: str) -> list[str]:
     """Every drawn (mesh, skin) pair with its primitives, every animation, and LoD chains."""
     from ..io.gltf_document import GltfDocument
-    from ..io.gltf_drawable import read_drawables
+    from ..io.gltf_drawable import mesh_label, points_and_lines_meshes, read_drawables
     from ..io.gltf_lod import lod_coverages, lod_ids
+    from ..io.stored_weights import stored_unit_sum_breaks
 
     doc = GltfDocument(path)
     drawables = read_drawables(doc)
@@ -178,10 +179,11 @@ def _document_lines(path: str) -> list[str]:
                 f"  skin: {skeleton.joint_count} joints, {drawable.skinned.joints.shape[1]} influences per vertex"
                 + (f", {naming}" if naming else "")
             )
-            if drawable.renormalised_weights:
-                lines.append(
-                    f"  skin weights of {drawable.renormalised_weights} vertices did not sum to 1 (normalised)"
-                )
+            breaks = stored_unit_sum_breaks(doc, drawable.mesh_index)  # what a LoD GLB's level 0 rewrites
+            if breaks.vertices:
+                lines.append(f"  {breaks.describe()}; read normalised")
+    for mesh, nodes in points_and_lines_meshes(doc).items():
+        lines.append(f"{mesh_label(doc, mesh)}, drawn by nodes {nodes}: points or lines only")
     if doc.gltf.animations and not doc.gltf.skins:
         lines += _node_tree_lines(doc)
     for index, animation in enumerate(doc.gltf.animations or []):

@@ -91,17 +91,19 @@ class GlbBuilder:
         for name in MESHOPT_EXTENSIONS:
             _drop_extension(builder.json, name)
         for index, image in enumerate(builder.json.get("images", [])):
-            found = _image_bytes(doc, index, image["uri"]) if "uri" in image else None
+            uri = image.get("uri")
+            file = None if uri is None or uri.startswith("data:") else image_file(doc.path, uri)
+            found = None if uri is None else _image_bytes(doc, index, uri, file)
             if found is None:
-                builder._link(doc, index, image)
+                builder._link(doc, index, image, file)
                 continue
             data, mime = found
             mime = image_type(data) or image.get("mimeType") or mime
             if mime is None:  # glTF needs the type of an embedded image: it stays as the input had it
-                uri = "its data URI" if image["uri"].startswith("data:") else repr(image["uri"])
-                warnings.warn(f"{doc.path}: image {index}: {uri} is of no image type glTF knows; "
+                shown = "its data URI" if uri.startswith("data:") else repr(uri)
+                warnings.warn(f"{doc.path}: image {index}: {shown} is of no image type glTF knows; "
                               "the output refers to the same file", stacklevel=2)  # fmt: skip
-                builder._link(doc, index, image)
+                builder._link(doc, index, image, file)
                 continue
             del image["uri"]
             image["bufferView"] = len(views)
@@ -111,13 +113,14 @@ class GlbBuilder:
             builder.json["bufferViews"] = views
         return builder
 
-    def _link(self, doc: GltfDocument, index: int, image: dict) -> None:
-        """Remember the file ``image`` names when its URI is a path relative to ``doc``."""
+    def _link(self, doc: GltfDocument, index: int, image: dict, file: Path | None) -> None:
+        """Remember the file ``image`` names when its URI is a path relative to ``doc``: ``file``,
+        as :func:`image_file` found it, or where the URI points when it found none."""
         uri = image.get("uri", "")
         text = unquote(uri)
         if not uri or urlsplit(uri).scheme or PurePosixPath(text).anchor or PureWindowsPath(text).anchor:
             return  # a data URI, a URL or an absolute path: the same from anywhere
-        named = image_file(doc.path, uri) or uri_path(doc.path, uri.replace("\\", "/"))
+        named = file or uri_path(doc.path, uri.replace("\\", "/"))
         self.linked_images[index] = Path(os.path.abspath(named))
 
     def _append(self, data: bytes) -> int:
@@ -308,21 +311,22 @@ def image_type(data: bytes) -> str | None:
     return None
 
 
-def _image_bytes(doc: GltfDocument, index: int, uri: str) -> tuple[bytes, str | None] | None:
-    """The bytes and MIME type of an image given by a data URI or a file next to the document;
-    None, with a warning, for a file that is not there. Textures left behind are common (a path
-    on the author's machine, ``C:\\Users\\...\\wood.jpg``, or a file not shipped) and play no
-    part in the levels: the image keeps its URI, as the input had it, instead of failing the run."""
+def _image_bytes(doc: GltfDocument, index: int, uri: str, file: Path | None) -> tuple[bytes, str | None] | None:
+    """The bytes and MIME type of an image given by a data URI or a file next to the document
+    (``file``, as :func:`image_file` found it for ``uri``); None, with a warning, for a file
+    that is not there. Textures left behind are common (a path on the author's machine,
+    ``C:\\Users\\...\\wood.jpg``, or a file not shipped) and play no part in the levels: the
+    image keeps its URI, as the input had it, instead of failing the run."""
     if uri.startswith("data:"):
         header, _, payload = uri.partition(",")
         try:
             return base64.b64decode(payload, validate=True), header[5:].split(";")[0] or None
         except ValueError as error:
             raise doc.fail(f"image {index}", f"malformed data URI ({error})") from None
-    if (path := image_file(doc.path, uri)) is not None:
+    if file is not None:
         with contextlib.suppress(OSError):  # there but unreadable: kept by its URI as a missing one is
-            guess = _IMAGE_TYPES.get(path.suffix.lower()) or mimetypes.guess_type(path.name)[0] or ""
-            return path.read_bytes(), guess if guess.startswith("image/") else None  # not .tex's text/x-tex
+            guess = _IMAGE_TYPES.get(file.suffix.lower()) or mimetypes.guess_type(file.name)[0] or ""
+            return file.read_bytes(), guess if guess.startswith("image/") else None  # not .tex's text/x-tex
     missing = uri_path(doc.path, uri.replace("\\", "/"))
     warnings.warn(f"{doc.path}: image {index}: {missing} not found; the output refers to where the input's "
                   f"{uri!r} does", stacklevel=3)  # fmt: skip

@@ -16,16 +16,19 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+import pygltflib
 
 from ..model import Motion, SkinnedMesh, morphed
 from .gltf_document import GltfDocument
 from .gltf_lod import GRID_EXTRA
-from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_points
+from .gltf_mesh import TRIANGLES, MeshGeometry, read_mesh_geometry, transform_points
 from .gltf_read import morph_weight_tracks, node_weights, skinned_mesh_of_node
 from .gltf_skin import SkinRig
+from .stored_weights import stored_unit_sum_breaks
 
-# Weight sums further than this from 1 count as "normalised on load" in the report.
-_WEIGHT_SUM_TOLERANCE = 1e-3
+# A rest world transform whose 3x3 part has a smaller determinant has no inverse (a zero scale).
+_SINGULAR_DETERMINANT = 1e-30
+_POINTS_AND_LINES = range(4)  # primitive modes POINTS, LINES, LINE_LOOP, LINE_STRIP
 
 
 @dataclass
@@ -70,8 +73,9 @@ class Drawable:
     clips : the animations that move this drawable.
     default_weights : (N,) morph weights the first node shows where no animation drives them
         (glTF's node or mesh ``weights``), or None without morph targets.
-    renormalised_weights : vertices whose stored skin weights did not sum to 1 (not counting those
-        with no weight at all, which get a warning of their own).
+    renormalised_weights : vertices whose stored skin weights break glTF's unit sum
+        (:func:`~animlod.io.stored_weights.stored_unit_sum_breaks`, as ``animlod info`` and level 0
+        of a LoD GLB count them).
     """
 
     mesh_index: int
@@ -135,22 +139,18 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
     pairs: dict[tuple[int, int | None], list[int]] = {}
     for index, node in enumerate(doc.gltf.nodes or []):
         if node.mesh is not None and index not in alternates:
-            doc.item("meshes", node.mesh, doc.node_label(index))
+            mesh = doc.item("meshes", node.mesh, doc.node_label(index))
             if node.skin is not None:
                 doc.item("skins", node.skin, doc.node_label(index))
-            pairs.setdefault((node.mesh, node.skin), []).append(index)
+            if not points_and_lines_only(mesh):
+                pairs.setdefault((node.mesh, node.skin), []).append(index)
     rigs: dict[int, SkinRig] = {}
     motions: dict[tuple[int, int], Motion | None] = {}  # (skin, animation): sampled once per skin
     drawables = []
     for (mesh_index, skin_index), nodes in pairs.items():
-        name = doc.gltf.meshes[mesh_index].name
-        label = f"mesh {mesh_index}" + (f" {name!r}" if name else "")
-        if skin_index is not None:
-            label += f" with skin {skin_index}"
+        label = mesh_label(doc, mesh_index) + ("" if skin_index is None else f" with skin {skin_index}")
         geometry = read_mesh_geometry(doc, mesh_index, skinned=skin_index is not None)
-        world = doc.rest_world_matrix(nodes[0])
-        if abs(np.linalg.det(world[:3, :3])) < 1e-30:
-            raise doc.fail(doc.node_label(nodes[0]), "its world transform is singular (a zero scale)")
+        nodes, world = _placed_first(doc, nodes)
         placement = np.zeros(3)
         if skin_index is None:
             placement, world[:3, 3] = world[:3, 3].copy(), 0.0
@@ -161,11 +161,8 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
             if skin_index not in rigs:
                 rigs[skin_index] = SkinRig(doc, skin_index)
             drawable.rig = rigs[skin_index]
-            drawable.skinned = skinned_mesh_of_node(doc, nodes[0], drawable.rig, geometry)
-            sums = np.asarray(geometry.weights, np.float64).sum(axis=1)
-            # Vertices with no weight at all are a warning of their own (skinned_mesh_of_node).
-            off = (sums > 0.0) & (np.abs(sums - 1.0) > _WEIGHT_SUM_TOLERANCE)
-            drawable.renormalised_weights = int(np.count_nonzero(off))
+            drawable.skinned = skinned_mesh_of_node(doc, nodes[0], drawable.rig, geometry, world)
+            drawable.renormalised_weights = stored_unit_sum_breaks(doc, mesh_index).vertices
         drawable.clips = _clips(doc, drawable, fps, motions)
         drawables.append(drawable)
     return drawables
@@ -182,10 +179,47 @@ def on_rig(doc: GltfDocument, drawable: Drawable, rig: SkinRig, fps: float = 30.
     (SkinRig): its skinned mesh over that skeleton and its clips sampled on it."""
     with warnings.catch_warnings():  # its weights warned when it was first read
         warnings.simplefilter("ignore")
-        skinned = skinned_mesh_of_node(doc, drawable.nodes[0], rig, drawable.geometry)
+        skinned = skinned_mesh_of_node(doc, drawable.nodes[0], rig, drawable.geometry, drawable.world)
     moved = dataclasses.replace(drawable, rig=rig, skinned=skinned)
     moved.clips = _clips(doc, moved, fps, {})
     return moved
+
+
+def mesh_label(doc: GltfDocument, mesh_index: int) -> str:
+    """``mesh 0 'Body'`` (``mesh 0`` when unnamed), for messages."""
+    name = doc.gltf.meshes[mesh_index].name
+    return f"mesh {mesh_index}" + (f" {name!r}" if name else "")
+
+
+def points_and_lines_only(mesh: pygltflib.Mesh) -> bool:
+    """Whether every primitive of ``mesh`` draws points or lines (a point cloud, a wireframe
+    helper): there is nothing to simplify, and the mesh stays as it is. A mesh without
+    primitives, or with one of an unknown mode, is read_mesh_geometry's to refuse."""
+    modes = [TRIANGLES if primitive.mode is None else primitive.mode for primitive in mesh.primitives or []]
+    return bool(modes) and all(mode in _POINTS_AND_LINES for mode in modes)
+
+
+def points_and_lines_meshes(doc: GltfDocument) -> dict[int, list[int]]:
+    """The meshes of points and lines only (:func:`points_and_lines_only`) that nodes draw: mesh
+    index -> the nodes, in node order."""
+    drawn: dict[int, list[int]] = {}
+    for index, node in enumerate(doc.gltf.nodes or []):
+        if node.mesh is not None and points_and_lines_only(doc.item("meshes", node.mesh, doc.node_label(index))):
+            drawn.setdefault(node.mesh, []).append(index)
+    return drawn
+
+
+def _placed_first(doc: GltfDocument, nodes: list[int]) -> tuple[list[int], np.ndarray]:
+    """``nodes`` with the first whose rest world transform is invertible moved to the front, and
+    that transform: the space the drawable is read, simplified and measured in. A node at zero
+    scale is valid glTF (an instance hidden at rest, a prop that pops in by an animated scale)
+    and draws nothing at rest; where every node is at zero scale, the mesh is taken in its own
+    space (identity), which a skinned mesh shows anyway: skinning ignores its node's transform."""
+    for position, node in enumerate(nodes):
+        world = doc.rest_world_matrix(node)
+        if abs(np.linalg.det(world[:3, :3])) >= _SINGULAR_DETERMINANT:
+            return [node, *nodes[:position], *nodes[position + 1 :]], world
+    return nodes, np.eye(4)
 
 
 def _alternate_nodes(node: dict) -> list[int]:

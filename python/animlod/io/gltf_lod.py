@@ -15,7 +15,9 @@ primitives keep the input primitives' materials and attribute sets:
 
 Motion levels (fewer joints, see :mod:`animlod.pipelines.character`) add a reduced skeleton as
 its own joint nodes, a skin over them, and one animation per input clip with
-``extras.animlod = {"clip": <input animation index>, "motion_level": m}``; every combination of
+``extras.animlod = {"clip": <input animation index>, "motion_level": m, "skins": [<input skins
+that play it>]}`` (named ``<clip>@motion<m>``, or ``<clip>@skin<s>@motion<m>`` in a file where
+several skeletons have motion levels); every combination of
 geometry and motion level is a node, listed by ``base.extras.animlod_grid[g][m]``.
 """
 
@@ -175,14 +177,26 @@ def attach_chain(
         raise ValueError(f"coverages: {len(coverages)} values for {len(level_nodes) + 1} levels")
     node = builder.json["nodes"][base]
     node.setdefault("extensions", {})[LOD_EXTENSION] = {"ids": list(level_nodes)}
-    extras = node.get("extras")
-    if not isinstance(extras, dict):  # glTF allows any JSON value; keep it beside ours
-        extras = {} if extras is None else {"original_extras": extras}
+    extras = node_extras(node)
     extras[COVERAGE_EXTRA] = [float(c) for c in coverages]
     extras[ANIMLOD_EXTRA] = base_info.extras()
     node["extras"] = extras
     builder.add_extension_used(LOD_EXTENSION)
     drive_level_nodes(builder, base, level_nodes)
+
+
+def node_extras(node: dict) -> dict:
+    """A copy of ``node``'s extras as an object animlod can add its keys to. glTF allows any JSON
+    value there; one that is not an object is kept beside ours as ``original_extras``."""
+    extras = node.get("extras")
+    if not isinstance(extras, dict):
+        return {} if extras is None else {"original_extras": extras}
+    return dict(extras)
+
+
+def has_lod_chain(node: dict) -> bool:
+    """Whether ``node`` (its JSON) is the base of an MSFT_lod chain."""
+    return LOD_EXTENSION in (node.get("extensions") or {})
 
 
 def drive_level_nodes(builder: GlbBuilder, base: int, level_nodes: list[int]) -> None:

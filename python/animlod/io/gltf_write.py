@@ -57,6 +57,16 @@ class FaceMaterials(NamedTuple):
     vertex_attributes: Mapping[str, np.ndarray] = MappingProxyType({})
 
 
+class MeshNames(NamedTuple):
+    """The names of a written skinned mesh's node and of the mesh (None: unnamed)."""
+
+    node: str | None
+    mesh: str | None
+
+
+_SKINNED_MESH = MeshNames("skinned mesh", "skinned mesh")  # a mesh made, not read from a file
+
+
 class HungNodes(NamedTuple):
     """What hangs from the written skeleton in ``document``: ``add(builder, joint_nodes,
     animations)`` appends copies of its nodes (with their meshes, cameras and lights, and the
@@ -77,6 +87,7 @@ def write_glb(
     materials: FaceMaterials | None = None,
     morph_weights: Sequence[np.ndarray | None] | None = None,
     hung: HungNodes | None = None,
+    mesh_names: MeshNames = _SKINNED_MESH,
 ) -> None:
     """Write ``skinned`` and ``motions`` (on its skeleton) to the GLB file ``path``, atomically.
 
@@ -94,6 +105,7 @@ def write_glb(
     morph_weights : per motion, (T, N) the weights of ``skinned``'s N morph targets at its T
         frames, written as a channel of the mesh node, or None.
     hung : what hangs from the skeleton, copied from a document (the same as ``materials``'s).
+    mesh_names : the names of ``skinned``'s node and mesh (an input's own, for a mesh read from one).
 
     Raises
     ------
@@ -127,8 +139,8 @@ def write_glb(
     if skinned is not None:
         skin = add_skin(builder, joint_nodes, skinned.inverse_bind)
         face_materials, surface = (None, {}) if materials is None else (materials.indices, materials.vertex_attributes)
-        mesh = builder.append("meshes", _mesh(builder, skinned, face_materials, surface))
-        scene_nodes.append(builder.append("nodes", {"name": "skinned mesh", "mesh": mesh, "skin": skin}))
+        mesh = builder.append("meshes", _named(_mesh(builder, skinned, face_materials, surface), mesh_names.mesh))
+        scene_nodes.append(builder.append("nodes", _named({"mesh": mesh, "skin": skin}, mesh_names.node)))
     animations = []
     for motion, name, duration, track in zip(motions, names, durations or [None] * len(motions), weights):
         animations.append(add_animation(builder, motion, joint_nodes, name, duration=duration))
@@ -407,13 +419,18 @@ def _mesh(
         if material >= 0:
             primitive["material"] = int(material)
         primitives.append(primitive)
-    mesh = {"name": "skinned mesh", "primitives": primitives}
+    mesh = {"primitives": primitives}
     if skinned.morph_targets is not None:
         defaults = skinned.default_morph_weights
         mesh["weights"] = [0.0] * len(skinned.morph_targets) if defaults is None else defaults.tolist()
         if skinned.morph_target_names is not None:
             mesh["extras"] = {"targetNames": list(skinned.morph_target_names)}
     return mesh
+
+
+def _named(item: dict, name: str | None) -> dict:
+    """``item`` (a node or mesh) with ``name`` first, where there is one."""
+    return item if name is None else {"name": name, **item}
 
 
 def _primitive(

@@ -8,17 +8,22 @@ differ on such rows (three.js normalises them, others skin with them as stored),
 level was built and measured from the normalised weights; a viewer of the second kind would jump
 between level 0 and level 1. So the rows that break the rule are written normalised, all-zero
 rows on their first joint (as the readers take them), and nothing else of level 0 changes.
+`animlod info` counts the same rows (:func:`stored_unit_sum_breaks`) and says it in the same words.
 """
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from .glb_builder import ARRAY_BUFFER, GlbBuilder
 from .gltf_document import GltfDocument
 from .gltf_draco import DRACO_EXTENSION
-from .gltf_drawable import Drawable
 from .gltf_read import on_first_joint_when_unweighted
+
+if TYPE_CHECKING:  # gltf_drawable may count with this module (stored_unit_sum_breaks)
+    from .gltf_drawable import Drawable
 
 _SUM_STEP = 0.0039216  # the validator's allowance per two weights beyond two: about 1/255
 
@@ -35,6 +40,25 @@ def unit_sum_breaks(weights: np.ndarray) -> np.ndarray:
     return np.abs(total.astype(np.float64) - 1.0) > allowed
 
 
+class UnitSumBreaks(NamedTuple):
+    """The vertices of a mesh whose stored skin weights break glTF's unit sum, and how far their
+    sums were from 1 at most."""
+
+    vertices: int
+    worst: float
+
+    def describe(self) -> str:
+        """The finding in words, as `animlod info` and the LoD writers' notes give it."""
+        return (f"skin weights of {self.vertices} vertices did not sum to 1 as glTF requires "
+                f"(off by up to {self.worst:.3g})")  # fmt: skip
+
+
+def stored_unit_sum_breaks(doc: GltfDocument, mesh_index: int) -> UnitSumBreaks:
+    """The vertices of mesh ``mesh_index`` whose stored weights break the rule (:func:`unit_sum_breaks`):
+    those level 0 of a LoD GLB writes normalised."""
+    return _breaks(_stored_weights(doc, mesh_index))
+
+
 def normalise_stored_weights(builder: GlbBuilder, doc: GltfDocument, drawable: Drawable) -> str | None:
     """Rewrites, in ``builder`` (taken over from ``doc``), the WEIGHTS_n of the skinned
     ``drawable``'s primitives whose rows break the rule (once per mesh, however many drawables
@@ -44,41 +68,67 @@ def normalise_stored_weights(builder: GlbBuilder, doc: GltfDocument, drawable: D
     if drawable.skin_index is None:
         return None
     mesh = drawable.mesh_index
-    rewritten = [
-        _normalise_primitive(builder, doc, mesh, index) for index in range(len(doc.json["meshes"][mesh]["primitives"]))
-    ]
-    rows = sum(count for count, _ in rewritten)
-    if not rows:
+    stored = _stored_weights(doc, mesh)
+    written = builder.json["meshes"][mesh]["primitives"]
+    if any(
+        written[weights.primitive]["attributes"][name] != accessor or accessor in builder.overwritten
+        for weights in stored
+        for name, accessor in weights.accessors.items()
+    ):  # done for another drawable of the mesh
         return None
-    worst = max(off for _, off in rewritten)
-    return (f"level 0 (the input mesh): skin weights of {rows} vertices rewritten to sum to 1, as glTF requires "
-            f"(they were off by up to {worst:.3g})")  # fmt: skip
+    breaks = _breaks(stored)
+    if not breaks.vertices:
+        return None
+    for weights in stored:
+        _write_normalised(builder, written[weights.primitive]["attributes"], weights)
+    return f"level 0 (the input mesh): {breaks.describe()}; written normalised"
 
 
-def _normalise_primitive(builder: GlbBuilder, doc: GltfDocument, mesh_index: int, index: int) -> tuple[int, float]:
-    """Rows of primitive ``index`` of mesh ``mesh_index`` rewritten (read from the input), and how
-    far their sums were from 1 at most."""
-    primitive = doc.json["meshes"][mesh_index]["primitives"][index]
-    attributes = primitive.get("attributes", {})
-    names = sorted(
-        (name for name in attributes if name[:8] == "WEIGHTS_" and name[8:].isdigit()), key=lambda n: int(n[8:])
-    )
-    written = builder.json["meshes"][mesh_index]["primitives"][index]["attributes"]
-    if any(written[name] != attributes[name] or written[name] in builder.overwritten for name in names):
-        # done for another drawable of the mesh
-        return 0, 0.0
-    if not names or DRACO_EXTENSION in (primitive.get("extensions") or {}):
-        return 0, 0.0
-    element = f"mesh {mesh_index} primitive {index}"
-    weights = np.concatenate([doc.accessor(attributes[name], element) for name in names], axis=1).astype(np.float64)
+class _StoredWeights(NamedTuple):
+    """A primitive's skin weights as stored: its index in the mesh, its WEIGHTS_n accessors by
+    name (set order), and ``values (V, 4 S)`` float64, set after set."""
+
+    primitive: int
+    accessors: dict[str, int]
+    values: np.ndarray
+
+
+def _stored_weights(doc: GltfDocument, mesh_index: int) -> list[_StoredWeights]:
+    """The skin weights of each primitive of mesh ``mesh_index`` that has them, but for
+    Draco-compressed ones (level 0 keeps their compressed data)."""
+    found = []
+    for index, primitive in enumerate(doc.json["meshes"][mesh_index]["primitives"]):
+        attributes = primitive.get("attributes", {})
+        names = sorted(
+            (name for name in attributes if name[:8] == "WEIGHTS_" and name[8:].isdigit()), key=lambda n: int(n[8:])
+        )
+        if not names or DRACO_EXTENSION in (primitive.get("extensions") or {}):
+            continue
+        element = f"mesh {mesh_index} primitive {index}"
+        values = np.concatenate([doc.accessor(attributes[name], element) for name in names], axis=1)
+        found.append(_StoredWeights(index, {name: attributes[name] for name in names}, values.astype(np.float64)))
+    return found
+
+
+def _breaks(stored: list[_StoredWeights]) -> UnitSumBreaks:
+    """What breaks the rule in ``stored``, each set of accessors counted once (UniVRM's primitives
+    share one vertex buffer)."""
+    distinct = {tuple(weights.accessors.values()): weights.values for weights in stored}
+    sums = [np.maximum(values[unit_sum_breaks(values)], 0.0).sum(axis=1) for values in distinct.values()]
+    off = np.abs(np.concatenate(sums or [np.zeros(0)]) - 1.0)
+    return UnitSumBreaks(len(off), float(off.max(initial=0.0)))
+
+
+def _write_normalised(builder: GlbBuilder, written: dict, stored: _StoredWeights) -> None:
+    """The rows of ``stored`` that break the rule normalised, all-zero ones on their first joint
+    (as the readers take them), into ``written`` (the primitive's attributes in ``builder``)."""
+    weights = stored.values.copy()
     broken = unit_sum_breaks(weights)
     if not broken.any():
-        return 0, 0.0
-    stored = np.maximum(weights[broken], 0.0)
-    rows = on_first_joint_when_unweighted(stored)
+        return
+    rows = on_first_joint_when_unweighted(np.maximum(weights[broken], 0.0))
     weights[broken] = rows / rows.sum(axis=1, keepdims=True)
-    for set_index, name in enumerate(names):
+    for set_index, (name, accessor) in enumerate(stored.accessors.items()):
         rewritten = weights[:, 4 * set_index : 4 * set_index + 4].astype(np.float32)
-        if not builder.overwrite(attributes[name], rewritten):  # the input's float weights, in place
+        if not builder.overwrite(accessor, rewritten):  # the input's float weights, in place
             written[name] = builder.add(rewritten, ARRAY_BUFFER)
-    return int(broken.sum()), float(np.abs(stored.sum(axis=1) - 1.0).max())

@@ -16,10 +16,11 @@ them (hair bones), bound in the same pose, is a part (:mod:`.skin_parts`): it pl
 motion levels, on its reduced skeletons, and the chains of one skeleton switch at one distance.
 Its own bones that move in its clips join that skin's skeleton first. Motion level m >= 1 adds, per skin, a reduced
 skeleton as joint nodes of its own, a skin over them and one animation per input clip
-(``extras.animlod = {"clip", "motion_level"}``); a level node at motion level m uses that skin,
-so any glTF engine can play it. Nodes hung from the input's joints (props, sockets) are copied
-onto each level's skeleton, and each level clip also plays what its input clip moves besides the
-skeleton (morph weights; :mod:`.attachments`).
+(``extras.animlod = {"clip", "motion_level", "skins"}``, the input skins that play it; named
+``<clip>@motion<m>``, or ``<clip>@skin<s>@motion<m>`` where several skeletons have motion levels);
+a level node at motion level m uses that skin, so any glTF engine can play it. Nodes hung from the
+input's joints (props, sockets) are copied onto each level's skeleton, and each level clip also
+plays what its input clip moves besides the skeleton (morph weights; :mod:`.attachments`).
 """
 
 from __future__ import annotations
@@ -200,7 +201,13 @@ def build_character(
     geometry_seconds = time.perf_counter() - started
 
     builder = GlbBuilder.from_document(doc)
-    motion_nodes = {skin: _add_motion_levels(builder, doc, motion) for skin, motion in motion_chains.items()}
+    # Where several skeletons have motion levels, one input clip has a level clip on each: their
+    # names and extras say whose skeleton each poses.
+    leveled = [skin for skin, motion in motion_chains.items() if motion.reduced_levels]
+    motion_nodes = {
+        skin: _add_motion_levels(builder, doc, motion, _players(chain_of, skin), len(leveled) > 1)
+        for skin, motion in motion_chains.items()
+    }
     motion_nodes = {skin: motion_nodes[owner] for skin, owner in chain_of.items()}
     motion_chains = {skin: motion_chains[owner] for skin, owner in chain_of.items()}
     chains, grids = {}, {}
@@ -383,6 +390,11 @@ def _played(skinned: SkinnedMesh, part: _Part | None) -> SkinnedMesh:
     return skinned if part is None else moved_onto(skinned, part.first, part.placement)
 
 
+def _players(chain_of: dict[int, int], skin: int) -> list[int]:
+    """The skins that play ``skin``'s motion levels: ``skin`` first, then its parts and twins."""
+    return [skin, *sorted(other for other, owner in chain_of.items() if owner == skin and other != skin)]
+
+
 @dataclass
 class _MotionLevelNodes:
     """What one motion level adds to the document for one skin: the joint nodes of its reduced
@@ -392,20 +404,24 @@ class _MotionLevelNodes:
     joints: int
 
 
-def _add_motion_levels(builder: GlbBuilder, doc: GltfDocument, motion: _SkinMotion) -> list[_MotionLevelNodes]:
+def _add_motion_levels(
+    builder: GlbBuilder, doc: GltfDocument, motion: _SkinMotion, skins: list[int], several: bool
+) -> list[_MotionLevelNodes]:
     """Reduced skeletons and re-fitted clips of motion levels 1, 2, ... (level 0 is the input's),
-    with what hangs from the skeleton and the clips' other channels (:mod:`.attachments`)."""
+    with what hangs from the skeleton and the clips' other channels (:mod:`.attachments`).
+    ``skins``: the input skins that play these levels (``skins[0]`` the one whose skeleton they
+    reduce, then parts and twins), listed in each clip's extras; ``several``: other skeletons have
+    motion levels too, so the names of the clips and copies say ``@skin<s>`` before ``@motion<m>``."""
     nodes = [_MotionLevelNodes(None, motion.joint_count)]
     attachments = find_attachments(doc, motion.rig)
     posing = posed_by_level_clips(doc, motion.rig, attachments)
     for m, level in enumerate(motion.reduced_levels, start=1):
+        suffix = (f"@skin{skins[0]}" if several else "") + f"@motion{m}"
         joint_nodes = add_skeleton(builder, level.motion.skeleton)
-        copies = add_level_attachments(
-            builder, doc, motion.rig, attachments, motion.joined, level, joint_nodes, f"@motion{m}"
-        )
+        copies = add_level_attachments(builder, doc, motion.rig, attachments, motion.joined, level, joint_nodes, suffix)
         for clip, span in motion.clips:
-            name = f"{clip.name or f'animation {clip.index}'}@motion{m}"
-            extras = {"animlod": {"clip": clip.index, "motion_level": m}}
+            name = f"{clip.name or f'animation {clip.index}'}{suffix}"
+            extras = {"animlod": {"clip": clip.index, "motion_level": m, "skins": list(skins)}}
             clip_motion = level.motion.take_frames(np.arange(span.start, span.stop))
             duration = doc.animation_duration(clip.index)
             animation = add_animation(builder, clip_motion, joint_nodes, name, extras, duration)

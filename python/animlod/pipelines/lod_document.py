@@ -20,8 +20,17 @@ from ..io.detect import glb_name
 from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
-from ..io.gltf_drawable import Drawable, read_drawables
-from ..io.gltf_lod import LevelInfo, add_level_mesh, add_level_node, attach_chain, screen_coverages
+from ..io.gltf_drawable import Drawable, mesh_label, points_and_lines_meshes, read_drawables
+from ..io.gltf_lod import (
+    ANIMLOD_EXTRA,
+    LevelInfo,
+    add_level_mesh,
+    add_level_node,
+    attach_chain,
+    has_lod_chain,
+    node_extras,
+    screen_coverages,
+)
 from ..io.stored_weights import normalise_stored_weights
 from ..model import AnimatedMesh
 from .clip_import import with_clips
@@ -111,6 +120,16 @@ def simplify_document(
     doc = GltfDocument(source)
     doc = with_clips(doc, clips, notes.append, joint_map)
     drawables = read_drawables(doc, settings.fps)
+    lines = [f"{mesh_label(doc, mesh)} (nodes {nodes})" for mesh, nodes in points_and_lines_meshes(doc).items()]
+    if lines:
+        notes.append(f"kept as they are, without levels (points or lines only): {', '.join(lines)}")
+    # An input's own MSFT_lod chain (an artist's levels, or animlod's output simplified again)
+    # stays as it is: a new chain would replace its ids and leave its level nodes in no chain.
+    chained = [drawable for drawable in drawables if not _unchained(doc, drawable.nodes)]
+    drawables = [drawable for drawable in drawables if _unchained(doc, drawable.nodes)]
+    if chained:
+        notes.append("kept with the MSFT_lod chains they have: "
+                     + ", ".join(f"{drawable.label} (nodes {drawable.nodes})" for drawable in chained))  # fmt: skip
     # Degenerate triangles are valid glTF: a placeholder collapsed to a point stays as it is.
     degenerate = [draws_nothing(drawable, settings.measured_frames) for drawable in drawables]
     empty = [drawable for drawable, skip in zip(drawables, degenerate) if skip]
@@ -122,6 +141,8 @@ def simplify_document(
         reason = "no node draws a triangle mesh, nothing to simplify"
         if empty:
             reason = "no mesh has a triangle with three distinct corners, nothing to simplify"
+        elif chained:
+            reason = "every node that draws a mesh has an MSFT_lod chain already, nothing to simplify"
         elif doc.gltf.animations:  # an animation library: its clips are motion LoD's input
             reason += " (its animations are `animlod motion`'s input)"
         raise FormatError(doc.path, "meshes", reason)
@@ -192,7 +213,7 @@ def _write_chain(
         coverages = [level.coverage for level in report.levels]
         joints = len(doc.gltf.skins[drawable.skin_index].joints) if drawable.skin_index is not None else 0
         infos = [LevelInfo(level.level, level.error, level.faces, level.level, 0, joints) for level in report.levels]
-        for base in drawable.nodes:
+        for base in _unchained(doc, drawable.nodes):
             nodes = [
                 add_level_node(builder, base, mesh, drawable.skin_index, info) for mesh, info in zip(meshes, infos[1:])
             ]
@@ -220,16 +241,20 @@ def _write_separate(
                 builder, drawable.mesh_index, levels.levels[index].primitives, drawable.geometry.other_primitives, name
             )
             info = LevelInfo(index + 1, report.levels[index + 1].error, report.levels[index + 1].faces, index + 1)
-            for base in drawable.nodes:
+            for base in _unchained(doc, drawable.nodes):
                 node = builder.json["nodes"][base]
                 node["mesh"] = mesh
-                extras = node.get("extras") if isinstance(node.get("extras"), dict) else {}
-                node["extras"] = {**extras, "animlod": info.extras()}
+                node["extras"] = {**node_extras(node), ANIMLOD_EXTRA: info.extras()}
         builder.prune()
         path = folder / glb_name(source, f"_lod{index + 1}")
         builder.save(path)
         outputs.append(path)
     return outputs
+
+
+def _unchained(doc: GltfDocument, nodes: list[int]) -> list[int]:
+    """Those of ``nodes`` that are not the base of an MSFT_lod chain in the input."""
+    return [node for node in nodes if not has_lod_chain(doc.json["nodes"][node])]
 
 
 def _level_names(doc: GltfDocument, drawable: Drawable, count: int) -> list[str]:

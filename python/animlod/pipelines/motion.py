@@ -207,8 +207,9 @@ def build_motion_levels(
                 names.append(Path(f"{stem}_lod{index}.glb"))
                 clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
                 weights = [clip.morph_weights for clip in played]
-                hung = None if content is None else content.on_level(motion, level, played)
-                write_glb(staged / names[-1], level.skin, level_clips, clip_names, durations, materials, weights, hung)
+                hung = content.on_level(motion, level, played)
+                write_glb(staged / names[-1], level.skin, level_clips, clip_names, durations, materials, weights, hung,
+                          content.mesh_names)  # fmt: skip
             files.append(names)
             rows.append(_manifest_row(level, index, names, played, skin_errors))
         # The runtime's level chooser: each level's largest joint position error in asset units
@@ -331,10 +332,10 @@ def _read_input(
     from ..io.gltf_document import GltfDocument
     from ..io.gltf_read import rig_motions
     from ..io.gltf_skin import SkinRig
-    from ..io.gltf_write import FaceMaterials
+    from ..io.gltf_write import FaceMaterials, MeshNames
     from .attachments import find_attachments
     from .clip_import import with_clips
-    from .motion_level_files import LevelContent, left_out_of_level_files, poses_nothing
+    from .motion_level_files import LevelContent, left_out_of_level_files, level_mesh_names, poses_nothing
     from .whole_skin import whole_skin
 
     document = GltfDocument(source)
@@ -353,7 +354,7 @@ def _read_input(
                  "takes every skin)")  # fmt: skip
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
-        joined_nodes = set(whole.part_nodes)
+        joined_nodes, mesh_names = set(whole.part_nodes), level_mesh_names(document, whole.part_nodes)
     else:  # an animation library exported without its mesh
         rig, skin, materials, morph_weights = SkinRig(document, None), None, None, {}
         motions, animations, other_trees = (
@@ -361,7 +362,7 @@ def _read_input(
             rig.animations(document),
             rig.trees_left_out,
         )
-        skeleton, joined_nodes = motions[0].skeleton, set()
+        skeleton, joined_nodes, mesh_names = motions[0].skeleton, set(), MeshNames(None, None)  # no mesh to name
         note(f"{path}: no skinned mesh; the skeleton is its animated node tree ({skeleton.joint_count} joints "
              f"from {skeleton.names[0]!r}), and each level's GLB holds the skeleton, its clips and what hangs from "
              "it")  # fmt: skip
@@ -369,7 +370,7 @@ def _read_input(
             note(f"{path}: animated nodes under no node in common with the skeleton's left out: "
                  f"{', '.join(other_trees)}")  # fmt: skip
     attachments = find_attachments(document, rig)
-    content = LevelContent(document, rig, attachments)
+    content = LevelContent(document, rig, attachments, mesh_names)
     unwritten = left_out_of_level_files(document, rig, joined_nodes, attachments)
     if unwritten:
         whole_document = " (`animlod character` keeps the whole document)" if skin is not None else ""

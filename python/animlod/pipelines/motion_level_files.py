@@ -2,7 +2,8 @@
 level's skeleton, its clips and the skin, and what it leaves out, in words for the run's notes.
 
 A level file is a new document (:func:`animlod.io.gltf.write_glb`): the input's nodes are not in
-it, so what hangs from the joints is copied onto the level's skeleton (:mod:`.attachments`)
+it, so its skinned mesh takes the names of the input's (:func:`level_mesh_names`), and what hangs
+from the joints is copied onto the level's skeleton (:mod:`.attachments`)
 with the channels that animate it, and of the input's extensions only those that name no node
 go along. `animlod character` keeps the whole document instead.
 """
@@ -14,7 +15,7 @@ from typing import TYPE_CHECKING, NamedTuple
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_skin import SkinRig
-from ..io.gltf_write import STANDALONE_NODE_EXTENSIONS, STANDALONE_ROOT_EXTENSIONS, HungNodes
+from ..io.gltf_write import STANDALONE_NODE_EXTENSIONS, STANDALONE_ROOT_EXTENSIONS, HungNodes, MeshNames
 from ..model import Motion
 from ..motion_lod.chain import MotionLevel
 from .attachments import (
@@ -34,11 +35,13 @@ if TYPE_CHECKING:
 class LevelContent(NamedTuple):
     """What a glTF input's motion level files carry besides the skeleton, its clips and the skin:
     what hangs from ``rig``'s joints (:func:`~.attachments.find_attachments`) with the channels
-    that animate it, and the pointer channels at materials, textures, cameras and lights."""
+    that animate it, the pointer channels at materials, textures, cameras and lights, and the
+    names of the skinned mesh's node and mesh (:func:`level_mesh_names`)."""
 
     document: GltfDocument
     rig: SkinRig
     attachments: list[Attachment]
+    mesh_names: MeshNames
 
     def on_level(self, original: Motion, level: MotionLevel, played: list[PlayedClip]) -> HungNodes:
         """The attachments' copies on ``level`` of ``original``, for its GLB, with the channels that
@@ -53,6 +56,19 @@ class LevelContent(NamedTuple):
                     carry_other_channels(builder, document, posing, clip.animation, animation, copies, standalone=True)
 
         return HungNodes(self.document, add)
+
+
+def level_mesh_names(doc: GltfDocument, part_nodes: list[int]) -> MeshNames:
+    """The names of the level files' skinned mesh node and mesh, joined from the meshes of
+    ``part_nodes`` (the body's first): the input's own for one (unnamed where it is), else the
+    parts' names joined by " + " (``node <n>`` or ``mesh <m>`` for an unnamed one)."""
+    nodes = [doc.json["nodes"][node] for node in part_nodes]
+    meshes = [doc.json["meshes"][node["mesh"]] for node in nodes]
+    if len(nodes) == 1:
+        return MeshNames(nodes[0].get("name"), meshes[0].get("name"))
+    node_names = [node.get("name") or f"node {index}" for node, index in zip(nodes, part_nodes)]
+    mesh_names = [mesh.get("name") or f"mesh {node['mesh']}" for mesh, node in zip(meshes, nodes)]
+    return MeshNames(" + ".join(node_names), " + ".join(mesh_names))
 
 
 def left_out_of_level_files(doc: GltfDocument, rig: SkinRig, joined: set[int], attachments: list[Attachment]) -> str:

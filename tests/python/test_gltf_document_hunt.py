@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pygltflib
 import pytest
-from gltf_edits import edit_glb
+from gltf_edits import append_accessor, edit_glb
 from simplify_inputs import ellipsoid, two_bone_tube
 
 from animlod.cli import main
@@ -125,3 +125,24 @@ def test_separate_levels_keep_node_extras_that_are_not_objects(tmp_path: Path) -
     (level,) = simplify_document(source, tmp_path / "levels", (0.5,), separate=True).outputs
     extras = GltfDocument(level).json["nodes"][0]["extras"]
     assert extras["original_extras"] == "exported by X" and extras["animlod"]["level"] == 1
+
+
+def test_the_levels_of_an_animated_node_are_no_animated_trees_of_their_own(tmp_path: Path, capsys) -> None:
+    """A level node plays its base node's channels, so a simplified file of a turning static mesh
+    had one animated tree per level beside the base's: `info` named them "other animated trees",
+    and a skeleton of the animated nodes would have taken them for bones."""
+
+    def turning(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        times = append_accessor(gltf, blob, np.array([[0.0], [1.0]], np.float32), "SCALAR")
+        turns = append_accessor(gltf, blob, np.array([[0, 0, 0, 1], [0, 0.6, 0, 0.8]], np.float32), "VEC4")
+        sampler = pygltflib.AnimationSampler(input=times, output=turns)
+        target = pygltflib.AnimationChannelTarget(node=0, path="rotation")
+        channel = pygltflib.AnimationChannel(sampler=0, target=target)
+        gltf.animations.append(pygltflib.Animation(name="turn", samplers=[sampler], channels=[channel]))
+
+    source = edit_glb(_sphere_glb(tmp_path / "still.glb", [{"name": "ball"}]), tmp_path / "turning.glb", turning)
+    simplify_document(source, tmp_path / "turning_lod.glb")
+    assert GltfDocument(tmp_path / "turning_lod.glb").alternate_nodes() == {1, 2, 3}
+    assert main(["info", str(tmp_path / "turning_lod.glb")]) == 0
+    out = capsys.readouterr().out
+    assert "animated node tree: 1 joints, root 'ball'" in out and "other animated trees" not in out

@@ -36,6 +36,10 @@ _GLB_JSON_CHUNK = 0x4E4F534A  # "JSON"
 _GLB_BIN_CHUNK = 0x004E4942  # "BIN\0"
 _DATA_URI_BASE64 = ";base64,"
 INSTANCING_EXTENSION = "EXT_mesh_gpu_instancing"
+LOD_EXTENSION = "MSFT_lod"
+# Node extras key of the (mesh level x motion level) grid of level nodes that character chains
+# write beside MSFT_lod: grid[g][m] lists the node drawing geometry level g at motion level m.
+GRID_EXTRA = "animlod_grid"
 # Required extensions animlod reads: those that leave geometry, skins and animation readable as
 # plain glTF (quantized attributes are ordinary normalised or integer accessors), Draco's, decoded
 # into its accessors (gltf_draco.py), and meshopt's, decoded into its buffer views
@@ -405,6 +409,19 @@ class GltfDocument:
         """The nodes an animation channel translates, turns or scales (a "weights" channel morphs a
         mesh and moves no node)."""
         return {node for targets in self.channel_targets for node, path in targets if path in NODE_PATHS}
+
+    def alternate_nodes(self) -> set[int]:
+        """Nodes that stand in for another node at other levels of detail: the ids of its MSFT_lod
+        chain and the nodes of animlod's level grid. They are that node drawn otherwise, not
+        meshes or bones of their own (a level node plays its base node's channels)."""
+        alternates = set()
+        for index, node in enumerate(self.json.get("nodes", [])):
+            ids = list(((node.get("extensions") or {}).get(LOD_EXTENSION) or {}).get("ids") or [])
+            extras = node.get("extras")
+            grid = extras.get(GRID_EXTRA) or [] if isinstance(extras, dict) else []
+            ids += [other for row in grid if isinstance(row, list) for other in row]
+            alternates.update(other for other in ids if isinstance(other, int) and other != index)
+        return alternates
 
     def node_label(self, index: int) -> str:
         """``node 5 'Hips'`` for messages."""

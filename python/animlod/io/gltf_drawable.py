@@ -20,7 +20,6 @@ import pygltflib
 
 from ..model import Motion, SkinnedMesh, morphed
 from .gltf_document import GltfDocument
-from .gltf_lod import GRID_EXTRA
 from .gltf_mesh import TRIANGLES, MeshGeometry, read_mesh_geometry, transform_points
 from .gltf_read import morph_weight_tracks, node_weights, skinned_mesh_of_node
 from .gltf_skin import SkinRig
@@ -134,8 +133,7 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
     sampled at ``fps``. Nodes that are lower levels of an MSFT_lod chain are alternates of their
     base node, not drawables of their own. Raises FormatError naming the element for anything
     it cannot read."""
-    nodes = doc.json.get("nodes", [])
-    alternates = {other for index, node in enumerate(nodes) for other in _alternate_nodes(node) if other != index}
+    alternates = doc.alternate_nodes()
     pairs: dict[tuple[int, int | None], list[int]] = {}
     for index, node in enumerate(doc.gltf.nodes or []):
         if node.mesh is not None and index not in alternates:
@@ -220,15 +218,6 @@ def _placed_first(doc: GltfDocument, nodes: list[int]) -> tuple[list[int], np.nd
         if abs(np.linalg.det(world[:3, :3])) >= _SINGULAR_DETERMINANT:
             return [node, *nodes[:position], *nodes[position + 1 :]], world
     return nodes, np.eye(4)
-
-
-def _alternate_nodes(node: dict) -> list[int]:
-    """Nodes standing in for ``node`` at other levels: its MSFT_lod ids and animlod's level grid."""
-    ids = list((node.get("extensions") or {}).get("MSFT_lod", {}).get("ids", []))
-    extras = node.get("extras")
-    grid = extras.get(GRID_EXTRA, []) if isinstance(extras, dict) else []
-    ids += [index for row in grid if isinstance(row, list) for index in row]
-    return [index for index in ids if isinstance(index, int)]
 
 
 def _clips(

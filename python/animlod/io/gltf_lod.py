@@ -31,19 +31,22 @@ import numpy as np
 
 from ..model import AnimatedMesh, LodChain, LodLevel
 from .glb_builder import ARRAY_BUFFER, GlbBuilder
-from .gltf_document import COMPONENT_DTYPES, INSTANCING_EXTENSION, NODE_POINTER, POINTER_EXTENSION, GltfDocument
+from .gltf_document import (
+    COMPONENT_DTYPES,
+    INSTANCING_EXTENSION,
+    LOD_EXTENSION,
+    NODE_POINTER,
+    POINTER_EXTENSION,
+    GltfDocument,
+)
 from .gltf_draco import DRACO_EXTENSION
 from .gltf_mesh import read_mesh_geometry, transform_points
 from .gltf_read import skinned_mesh_of_node
 from .gltf_skin import SkinRig
 from .gltf_write import index_accessor
 
-LOD_EXTENSION = "MSFT_lod"
 COVERAGE_EXTRA = "MSFT_screencoverage"
 ANIMLOD_EXTRA = "animlod"
-# Node extras key of the (mesh level x motion level) grid of level nodes that character chains
-# write beside MSFT_lod: grid[g][m] lists the node drawing geometry level g at motion level m.
-GRID_EXTRA = "animlod_grid"
 _NODE_TRANSFORM = ("matrix", "translation", "rotation", "scale")
 
 

@@ -345,7 +345,8 @@ class SkinRig:
 
 def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
     """The nodes an animation translates, turns or scales, but cameras and lights (the scene's, not
-    the skeleton's) and meshes that only scale, and every node below one that draws nothing and,
+    the skeleton's), meshes that only scale and the lower levels of MSFT_lod chains, and every
+    node below one that draws nothing and,
     unless it holds one of those, holds nothing that draws (an end site or a bone without keys),
     in node order; and the labels of the top nodes of trees left out. Animated nodes under no
     common node (a weapon animated beside the character, a second character) are several trees:
@@ -356,7 +357,7 @@ def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
         for index, node in enumerate(nodes)
         if node.camera is not None or LIGHTS_EXTENSION in (node.extensions or {})
     }
-    moved = doc.moved_nodes() - staging
+    moved = doc.moved_nodes() - staging - doc.alternate_nodes()  # a level node plays its base's channels
     # A mesh that only scales, with nothing moving below it (a blinking light), is a prop on its
     # parent, not a bone: a rigid skeleton has none that scales.
     turned = {node for targets in doc.channel_targets for node, path in targets if path in ("translation", "rotation")}

@@ -35,10 +35,9 @@ import numpy as np
 
 from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
-from ..io.gltf_document import GltfDocument
+from ..io.gltf_document import GRID_EXTRA, GltfDocument
 from ..io.gltf_drawable import Clip, Drawable, on_rig, read_drawables
 from ..io.gltf_lod import (
-    GRID_EXTRA,
     LevelInfo,
     PrimitiveArrays,
     add_level_mesh,

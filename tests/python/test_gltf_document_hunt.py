@@ -146,3 +146,16 @@ def test_the_levels_of_an_animated_node_are_no_animated_trees_of_their_own(tmp_p
     assert main(["info", str(tmp_path / "turning_lod.glb")]) == 0
     out = capsys.readouterr().out
     assert "animated node tree: 1 joints, root 'ball'" in out and "other animated trees" not in out
+
+
+def test_character_keeps_the_chain_a_skinned_mesh_has(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """`animlod character` on `simplify`'s output replaced the skinned mesh node's chain as
+    `simplify` did (its ids changed, its level nodes left in no chain); nothing else is left to
+    build a character chain of here, so it is refused in one line, before anything is written."""
+    skinned, motion = two_bone_tube()
+    write_glb(tmp_path / "arm.glb", skinned, [motion])
+    simplify_document(tmp_path / "arm.glb", tmp_path / "levels.glb", (0.5,))
+    assert main(["character", str(tmp_path / "levels.glb"), "-o", str(tmp_path / "character.glb")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "levels.glb: skins: every skinned mesh's node has an MSFT_lod chain already" in err
+    assert len(err.splitlines()) == 1 and not (tmp_path / "character.glb").exists()

@@ -202,6 +202,13 @@ def has_lod_chain(node: dict) -> bool:
     return LOD_EXTENSION in (node.get("extensions") or {})
 
 
+def unchained(doc: GltfDocument, nodes: list[int]) -> list[int]:
+    """Those of ``nodes`` that are not the base of an MSFT_lod chain in ``doc``: an input's own
+    chain (an artist's levels, or animlod's output simplified again) stays as it is, since a new
+    chain would replace its ids and leave its level nodes in no chain."""
+    return [node for node in nodes if not has_lod_chain(doc.json["nodes"][node])]
+
+
 def drive_level_nodes(builder: GlbBuilder, base: int, level_nodes: list[int]) -> None:
     """Every clip's channel that moves node ``base`` (its translation, rotation or scale) or sets its
     morph weights also drives ``level_nodes`` through the same sampler; morph weights only those

@@ -46,6 +46,7 @@ from ..io.gltf_lod import (
     drive_level_nodes,
     level_node_name,
     screen_coverages,
+    unchained,
 )
 from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import add_animation, add_skeleton, add_skin, influence_sets
@@ -130,10 +131,17 @@ def build_character(
     doc = GltfDocument(source)
     doc = with_clips(doc, clips, notes.append, joint_map)
     all_drawables = read_drawables(doc, settings.fps)
-    drawables = [d for d in all_drawables if d.skinned is not None]
+    chained = {d.label: d for d in all_drawables if unchained(doc, d.nodes) != d.nodes}
+    if chained:
+        notes.append("kept with the MSFT_lod chains they have: "
+                     + ", ".join(f"{d.label} (nodes {d.nodes})" for d in chained.values()))  # fmt: skip
+    drawables = [d for d in all_drawables if d.skinned is not None and d.label not in chained]
     animated = [d for d in drawables if any(clip.motion is not None for clip in d.clips)]
     if not animated:
         reason = "no skinned mesh with an animation: a character chain needs both"
+        if any(d.skinned is not None for d in chained.values()):
+            raise FormatError(doc.path, "skins", "every skinned mesh's node has an MSFT_lod chain already, "
+                              "nothing to build a character chain of")  # fmt: skip
         if all_drawables or not doc.gltf.animations:
             raise FormatError(doc.path, "skins", f"{reason} (`animlod simplify` gives mesh levels alone)")
         raise FormatError(doc.path, "skins", f"{reason} (it draws no mesh: `animlod motion` takes its clips)")
@@ -234,7 +242,7 @@ def build_character(
         _switch_together([chains[d.label] for d in members], [geometry[d.label].size for d in members])
     for drawable in animated:
         _attach(builder, drawable, chains[drawable.label], grids[drawable.label])
-    skipped = [d.label for d in all_drawables if d.label not in chains]
+    skipped = [d.label for d in all_drawables if d.label not in chains and d.label not in chained]
     if skipped:
         notes.append(f"not simplified (no skin or no animation): {', '.join(skipped)}")
     builder.save(output)

@@ -27,9 +27,9 @@ from ..io.gltf_lod import (
     add_level_mesh,
     add_level_node,
     attach_chain,
-    has_lod_chain,
     node_extras,
     screen_coverages,
+    unchained,
 )
 from ..io.stored_weights import normalise_stored_weights
 from ..model import AnimatedMesh
@@ -123,10 +123,8 @@ def simplify_document(
     lines = [f"{mesh_label(doc, mesh)} (nodes {nodes})" for mesh, nodes in points_and_lines_meshes(doc).items()]
     if lines:
         notes.append(f"kept as they are, without levels (points or lines only): {', '.join(lines)}")
-    # An input's own MSFT_lod chain (an artist's levels, or animlod's output simplified again)
-    # stays as it is: a new chain would replace its ids and leave its level nodes in no chain.
-    chained = [drawable for drawable in drawables if not _unchained(doc, drawable.nodes)]
-    drawables = [drawable for drawable in drawables if _unchained(doc, drawable.nodes)]
+    chained = [drawable for drawable in drawables if not unchained(doc, drawable.nodes)]
+    drawables = [drawable for drawable in drawables if unchained(doc, drawable.nodes)]
     if chained:
         notes.append("kept with the MSFT_lod chains they have: "
                      + ", ".join(f"{drawable.label} (nodes {drawable.nodes})" for drawable in chained))  # fmt: skip
@@ -213,7 +211,7 @@ def _write_chain(
         coverages = [level.coverage for level in report.levels]
         joints = len(doc.gltf.skins[drawable.skin_index].joints) if drawable.skin_index is not None else 0
         infos = [LevelInfo(level.level, level.error, level.faces, level.level, 0, joints) for level in report.levels]
-        for base in _unchained(doc, drawable.nodes):
+        for base in unchained(doc, drawable.nodes):
             nodes = [
                 add_level_node(builder, base, mesh, drawable.skin_index, info) for mesh, info in zip(meshes, infos[1:])
             ]
@@ -241,7 +239,7 @@ def _write_separate(
                 builder, drawable.mesh_index, levels.levels[index].primitives, drawable.geometry.other_primitives, name
             )
             info = LevelInfo(index + 1, report.levels[index + 1].error, report.levels[index + 1].faces, index + 1)
-            for base in _unchained(doc, drawable.nodes):
+            for base in unchained(doc, drawable.nodes):
                 node = builder.json["nodes"][base]
                 node["mesh"] = mesh
                 node["extras"] = {**node_extras(node), ANIMLOD_EXTRA: info.extras()}
@@ -250,11 +248,6 @@ def _write_separate(
         builder.save(path)
         outputs.append(path)
     return outputs
-
-
-def _unchained(doc: GltfDocument, nodes: list[int]) -> list[int]:
-    """Those of ``nodes`` that are not the base of an MSFT_lod chain in the input."""
-    return [node for node in nodes if not has_lod_chain(doc.json["nodes"][node])]
 
 
 def _level_names(doc: GltfDocument, drawable: Drawable, count: int) -> list[str]:

@@ -13,6 +13,7 @@ from gltf_edits import append_accessor, edit_glb
 from simplify_inputs import ellipsoid, two_bone_tube
 
 from animlod.cli import main
+from animlod.io import read_lod_chains
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf import write_glb
 from animlod.io.gltf_document import GltfDocument
@@ -76,6 +77,9 @@ def test_a_skinned_mesh_nodes_zero_scale_changes_nothing(tmp_path: Path) -> None
     plain = simplify_document(tmp_path / "tube.glb", tmp_path / "tube_lod.glb")
     zero = simplify_document(tmp_path / "zero.glb", tmp_path / "zero_lod.glb")
     np.testing.assert_allclose(_level_errors(zero), _level_errors(plain), rtol=1e-5)
+    # And the LoD GLB reads back (read_lod_chains refused the zero-scale base node as singular).
+    (read,), (written,) = read_lod_chains(tmp_path / "zero_lod.glb"), read_lod_chains(tmp_path / "tube_lod.glb")
+    assert [level.mesh.face_count for level in read.levels] == [level.mesh.face_count for level in written.levels]
 
 
 def test_a_point_cloud_beside_a_mesh_is_kept_and_named(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:

@@ -20,13 +20,11 @@ import pygltflib
 
 from ..model import Motion, SkinnedMesh, morphed
 from .gltf_document import GltfDocument
-from .gltf_mesh import TRIANGLES, MeshGeometry, read_mesh_geometry, transform_points
+from .gltf_mesh import SINGULAR_DETERMINANT, TRIANGLES, MeshGeometry, read_mesh_geometry, transform_points
 from .gltf_read import morph_weight_tracks, node_weights, skinned_mesh_of_node
 from .gltf_skin import SkinRig
 from .stored_weights import stored_unit_sum_breaks
 
-# A rest world transform whose 3x3 part has a smaller determinant has no inverse (a zero scale).
-_SINGULAR_DETERMINANT = 1e-30
 _POINTS_AND_LINES = range(4)  # primitive modes POINTS, LINES, LINE_LOOP, LINE_STRIP
 
 
@@ -215,7 +213,7 @@ def _placed_first(doc: GltfDocument, nodes: list[int]) -> tuple[list[int], np.nd
     space (identity), which a skinned mesh shows anyway: skinning ignores its node's transform."""
     for position, node in enumerate(nodes):
         world = doc.rest_world_matrix(node)
-        if abs(np.linalg.det(world[:3, :3])) >= _SINGULAR_DETERMINANT:
+        if abs(np.linalg.det(world[:3, :3])) >= SINGULAR_DETERMINANT:
             return [node, *nodes[:position], *nodes[position + 1 :]], world
     return nodes, np.eye(4)
 

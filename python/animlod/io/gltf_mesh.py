@@ -22,6 +22,8 @@ from .gltf_document import GltfDocument
 TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN = 4, 5, 6
 _TRIANGLE_MODES = (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN)
 _INFLUENCE_SETS = (0, 1)
+# A transform whose 3x3 part has a smaller determinant has no inverse (a node at zero scale).
+SINGULAR_DETERMINANT = 1e-30
 # Widths glTF 2.0 allows for the attributes animlod interprets (section 3.7.2.1); others
 # (custom _ATTRIBUTES) are carried with their accessor's own width.
 _ATTRIBUTE_WIDTHS = {"POSITION": 3, "NORMAL": 3, "TANGENT": 4}

@@ -28,7 +28,7 @@ from .. import rotations
 from ..model import AnimatedMesh, Motion, SkinnedMesh
 from .gltf_document import NODE_PATHS, GltfDocument
 from .gltf_keyframes import sample_keyframes
-from .gltf_mesh import MeshGeometry, read_mesh_geometry, transform_normals, transform_points
+from .gltf_mesh import SINGULAR_DETERMINANT, MeshGeometry, read_mesh_geometry, transform_normals, transform_points
 from .gltf_skin import SkinRig
 
 
@@ -196,8 +196,10 @@ def skinned_mesh_of_node(
         reason = f"vertex {vertex} uses joint slot {int(joints[vertex].max())}, skin {rig.skin} has {slots}"
         raise doc.fail(f"mesh {mesh_index} JOINTS", reason)
     mesh_world = doc.rest_world_matrix(node) if mesh_world is None else mesh_world
-    if abs(np.linalg.det(mesh_world[:3, :3])) < 1e-30:
-        raise doc.fail(doc.node_label(node), "its world transform is singular (a zero scale): the mesh has no extent")
+    if abs(np.linalg.det(mesh_world[:3, :3])) < SINGULAR_DETERMINANT:
+        # Skinning ignores the node's transform (glTF 2.0, 3.7.3.3): at zero scale the mesh is
+        # taken in its own space, as read_drawables takes it.
+        mesh_world = np.eye(4)
     inverse_bind = rig.inverse_bind.copy()
     inverse_bind[:, :3] = rig.rest_linear @ inverse_bind[:, :3]
     inverse_bind = inverse_bind @ np.linalg.inv(mesh_world)

@@ -124,7 +124,7 @@ def test_info_and_character_count_the_same_weights_that_break_the_unit_sum(human
     report = build_character(source, tmp_path / "out.glb", [0.5], solver="newton", **QUICK)
     assert any(said in note for note in report.notes)
     # simplify's summary counted them with info's old tolerance (10 of these 30).
-    assert [drawable.renormalised_weights for drawable in read_drawables(GltfDocument(source))] == [30]
+    assert [drawable.weight_breaks.vertices for drawable in read_drawables(GltfDocument(source))] == [30]
 
 
 def _unused_accessors(document: dict) -> set[int]:

@@ -144,7 +144,6 @@ def _document_lines(path: str) -> list[str]:
     from ..io.gltf_document import GltfDocument
     from ..io.gltf_drawable import mesh_label, points_and_lines_meshes, read_drawables
     from ..io.gltf_lod import lod_coverages, lod_ids
-    from ..io.stored_weights import stored_unit_sum_breaks
 
     doc = GltfDocument(path)
     drawables = read_drawables(doc)
@@ -179,9 +178,8 @@ def _document_lines(path: str) -> list[str]:
                 f"  skin: {skeleton.joint_count} joints, {drawable.skinned.joints.shape[1]} influences per vertex"
                 + (f", {naming}" if naming else "")
             )
-            breaks = stored_unit_sum_breaks(doc, drawable.mesh_index)  # what a LoD GLB's level 0 rewrites
-            if breaks.vertices:
-                lines.append(f"  {breaks.describe()}; read normalised")
+            if drawable.weight_breaks.vertices:  # what a LoD GLB's level 0 rewrites
+                lines.append(f"  {drawable.weight_breaks.describe()}; read normalised")
     for mesh, nodes in points_and_lines_meshes(doc).items():
         lines.append(f"{mesh_label(doc, mesh)}, drawn by nodes {nodes}: points or lines only")
     if doc.gltf.animations and not doc.gltf.skins:

@@ -23,7 +23,7 @@ from .gltf_document import GltfDocument
 from .gltf_mesh import SINGULAR_DETERMINANT, TRIANGLES, MeshGeometry, read_mesh_geometry, transform_points
 from .gltf_read import morph_weight_tracks, node_weights, skinned_mesh_of_node
 from .gltf_skin import SkinRig
-from .stored_weights import stored_unit_sum_breaks
+from .stored_weights import UnitSumBreaks, stored_unit_sum_breaks
 
 _POINTS_AND_LINES = range(4)  # primitive modes POINTS, LINES, LINE_LOOP, LINE_STRIP
 
@@ -70,9 +70,9 @@ class Drawable:
     clips : the animations that move this drawable.
     default_weights : (N,) morph weights the first node shows where no animation drives them
         (glTF's node or mesh ``weights``), or None without morph targets.
-    renormalised_weights : vertices whose stored skin weights break glTF's unit sum
-        (:func:`~animlod.io.stored_weights.stored_unit_sum_breaks`, as ``animlod info`` and level 0
-        of a LoD GLB count them).
+    weight_breaks : the vertices whose stored skin weights break glTF's unit sum
+        (:func:`~animlod.io.stored_weights.stored_unit_sum_breaks`, as ``animlod info`` reports
+        them and level 0 of a LoD GLB rewrites them).
     """
 
     mesh_index: int
@@ -86,7 +86,7 @@ class Drawable:
     rig: SkinRig | None = None
     clips: list[Clip] = field(default_factory=list)
     default_weights: np.ndarray | None = None
-    renormalised_weights: int = 0
+    weight_breaks: UnitSumBreaks = UnitSumBreaks(0, 0.0)
 
     @property
     def morph_targets(self) -> np.ndarray | None:
@@ -158,7 +158,7 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
                 rigs[skin_index] = SkinRig(doc, skin_index)
             drawable.rig = rigs[skin_index]
             drawable.skinned = skinned_mesh_of_node(doc, nodes[0], drawable.rig, geometry, world)
-            drawable.renormalised_weights = stored_unit_sum_breaks(doc, mesh_index).vertices
+            drawable.weight_breaks = stored_unit_sum_breaks(doc, mesh_index)
         drawable.clips = _clips(doc, drawable, fps, motions)
         drawables.append(drawable)
     return drawables

@@ -167,7 +167,7 @@ def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettin
         faces=int(drawable.geometry.faces.shape[0]),
         clips=len(drawable.clips),
         preparation=levels.preparation,
-        renormalised_weights=drawable.renormalised_weights,
+        renormalised_weights=drawable.weight_breaks.vertices,
         notes=list(levels.notes),
         rest_meshes=[AnimatedMesh(drawable.geometry.faces, drawable.rest_positions()[None])]
         + [AnimatedMesh(level.simplified.mesh.faces, level.rest_positions()[None]) for level in levels.levels],

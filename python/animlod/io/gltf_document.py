@@ -25,7 +25,7 @@ from .. import rotations
 from .errors import FormatError
 from .gltf_decode import decode_gltf, is_whole_number, labels_as_text
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
-from .gltf_keyframes import INTERPOLATIONS, frame_count, frame_times
+from .gltf_keyframes import INTERPOLATIONS, frame_count, frame_times, sample_keyframes
 from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
 from .gltf_references import LIGHTS_EXTENSION, index_references
 from .json_limits import load_json
@@ -565,6 +565,18 @@ class GltfDocument:
         if output.size != count * per_key * width:
             raise self.fail(element, f"output holds {output.size} numbers, {count} keys x {per_key} x {width} expected")
         return times, output.reshape((count, 3, width) if per_key == 3 else (count, width)), interpolation
+
+    def sampled_channel(self, animation_index: int, channel_index: int, path: str, at: np.ndarray) -> np.ndarray:
+        """Channel ``channel_index`` of animation ``animation_index``, which sets a node's ``path``
+        (translation, rotation or scale), sampled at the times ``at``: ``(T, 3)`` or ``(T, 4)``."""
+        element = f"{self.animation_label(animation_index)} channel {channel_index}"
+        sampler = self.gltf.animations[animation_index].channels[channel_index].sampler
+        width = 4 if path == "rotation" else 3
+        times, values, interpolation = self.sampler_keys(animation_index, sampler, width, element)
+        try:
+            return sample_keyframes(times, values, interpolation, at, rotation=path == "rotation")
+        except ValueError as error:  # a zero or non-finite quaternion among the keys
+            raise self.fail(element, str(error)) from None
 
 
 def _parse(path: str, data: bytes | None = None) -> tuple[pygltflib.GLTF2, dict]:

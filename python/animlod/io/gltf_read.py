@@ -294,21 +294,10 @@ def _animated_world_matrices(doc: GltfDocument, node: int, animation: int, fps: 
         trs = list(doc.rest_trs(link))  # an animated node has TRS, no matrix (glTF 2.0, 3.7.3.2)
         for slot, path in enumerate(NODE_PATHS):
             if (link, path) in channels:
-                trs[slot] = _sampled_channel(doc, animation, channels[link, path], path, at)
+                trs[slot] = doc.sampled_channel(animation, channels[link, path], path, at)
         translation, rotation, scale = (np.broadcast_to(value, (len(at), value.shape[-1])) for value in trs)
         world = world @ rotations.compose_transform(translation, rotation, scale)
     return world
-
-
-def _sampled_channel(doc: GltfDocument, animation: int, channel: int, path: str, at: np.ndarray) -> np.ndarray:
-    """Channel ``channel`` of ``animation`` (a node's ``path``) sampled at the times ``at``."""
-    element = f"{doc.animation_label(animation)} channel {channel}"
-    sampler = doc.gltf.animations[animation].channels[channel].sampler
-    times, values, interpolation = doc.sampler_keys(animation, sampler, 4 if path == "rotation" else 3, element)
-    try:
-        return sample_keyframes(times, values, interpolation, at, rotation=path == "rotation")
-    except ValueError as error:  # a zero or non-finite quaternion among the keys
-        raise doc.fail(element, str(error)) from None
 
 
 def node_weights(doc: GltfDocument, node: int, mesh_weights: np.ndarray) -> np.ndarray:

@@ -180,20 +180,14 @@ class SkinRig:
         scales = dict(self._rest_scale)
         scaled = self.rest_shape is not None
         for index, sampler, node, path in channels:
-            element = f"{label} channel {index}"
-            times, values, interpolation = doc.sampler_keys(
-                animation_index, sampler, 4 if path == "rotation" else 3, element
-            )
-            if path == "scale":
+            if path == "scale":  # its keys, not only its samples, tell float noise from a stretch
+                times, values, interpolation = doc.sampler_keys(animation_index, sampler, 3, f"{label} channel {index}")
                 scales[node] = sample_keyframes(times, values, interpolation, at)
                 scaled |= self._scale_moves(node, values)
             elif path == "translation":
-                translations[node] = sample_keyframes(times, values, interpolation, at)
+                translations[node] = doc.sampled_channel(animation_index, index, path, at)
             else:
-                try:
-                    local_rotations[node] = sample_keyframes(times, values, interpolation, at, rotation=True)
-                except ValueError as error:  # a zero or non-finite quaternion among the keys
-                    raise doc.fail(element, str(error)) from None
+                local_rotations[node] = doc.sampled_channel(animation_index, index, path, at)
         # Scale keys within float noise of the rest scale leave the motion rigid.
         positions, world_rotations, deformations = self._pose(
             translations, local_rotations, frames=len(at), scales=scales if scaled else None

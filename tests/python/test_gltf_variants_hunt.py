@@ -72,6 +72,22 @@ def test_motion_levels_keep_the_attributes_the_materials_read(tmp_path: Path) ->
         np.testing.assert_array_equal(read["TANGENT"][:, 3], stored["TANGENT"][:, 3])
 
 
+def test_tangents_of_a_skinned_mesh_at_zero_scale_stay_as_stored(tmp_path: Path) -> None:
+    """Skinning ignores the mesh node's transform, and a mesh at zero scale is read in its own
+    space; its tangents were turned by the zero-scale transform instead, to zero vectors."""
+    source, stored = _lightmapped_tube(tmp_path)
+
+    def squashed(gltf: pygltflib.GLTF2, blob: bytearray) -> None:
+        next(node for node in gltf.nodes if node.name == "armature").scale = [0.0, 0.0, 0.0]
+
+    edit_glb(source, tmp_path / "squashed.glb", squashed)
+    report = build_motion_levels(tmp_path / "squashed.glb", tmp_path / "levels", levels=2)
+    for files in report.files:
+        written = GltfDocument(tmp_path / "levels" / files[-1])
+        (primitive,) = written.json["meshes"][0]["primitives"]
+        np.testing.assert_allclose(written.accessor(primitive["attributes"]["TANGENT"], "test"), stored["TANGENT"])
+
+
 def test_motion_levels_keep_the_texture_coordinates_of_a_textured_primitive_beside_a_plain_one(
     tmp_path: Path,
 ) -> None:

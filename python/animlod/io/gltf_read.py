@@ -195,11 +195,7 @@ def skinned_mesh_of_node(
         vertex = int(np.argmax((joints >= slots).any(axis=1)))
         reason = f"vertex {vertex} uses joint slot {int(joints[vertex].max())}, skin {rig.skin} has {slots}"
         raise doc.fail(f"mesh {mesh_index} JOINTS", reason)
-    mesh_world = doc.rest_world_matrix(node) if mesh_world is None else mesh_world
-    if abs(np.linalg.det(mesh_world[:3, :3])) < SINGULAR_DETERMINANT:
-        # Skinning ignores the node's transform (glTF 2.0, 3.7.3.3): at zero scale the mesh is
-        # taken in its own space, as read_drawables takes it.
-        mesh_world = np.eye(4)
+    mesh_world = skinned_mesh_space(doc.rest_world_matrix(node) if mesh_world is None else mesh_world)
     inverse_bind = rig.inverse_bind.copy()
     inverse_bind[:, :3] = rig.rest_linear @ inverse_bind[:, :3]
     inverse_bind = inverse_bind @ np.linalg.inv(mesh_world)
@@ -220,6 +216,13 @@ def skinned_mesh_of_node(
         )
     except ValueError as error:
         raise doc.fail(f"mesh {mesh_index} with skin {rig.skin}", str(error)) from None
+
+
+def skinned_mesh_space(mesh_world: np.ndarray) -> np.ndarray:
+    """The space a skinned mesh is read in from its node's world transform ``mesh_world (4, 4)``:
+    that transform, or the identity at zero scale. Skinning ignores the node's transform (glTF
+    2.0, 3.7.3.3), so any invertible space shows the same; read_drawables takes such a mesh so."""
+    return np.eye(4) if abs(np.linalg.det(mesh_world[:3, :3])) < SINGULAR_DETERMINANT else mesh_world
 
 
 def _weights_of_unweighted_vertices(doc: GltfDocument, mesh_index: int, weights: np.ndarray) -> np.ndarray:

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..io.gltf_document import GltfDocument
 from ..io.gltf_mesh import read_mesh_geometry
-from ..io.gltf_read import GltfScene, morph_weight_tracks, read_skinned_node
+from ..io.gltf_read import GltfScene, morph_weight_tracks, read_skinned_node, skinned_mesh_space
 from ..io.gltf_skin import SkinRig
 from ..model import Motion, SkinnedMesh, morphed
 from ..motion_lod.clips import join_clips
@@ -68,7 +68,7 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
     (:func:`_joined_targets`), each part keeping the shape of its default weights."""
     body, motions, rig, body_node = (scene.skinned_meshes[scene.body], scene.skinned_motions[scene.body],
                                      scene.skinned_rigs[scene.body], scene.skinned_nodes[scene.body])  # fmt: skip
-    parts, part_nodes, vertex_spaces = [body], [body_node], [doc.rest_world_matrix(body_node)]
+    parts, part_nodes, vertex_spaces = [body], [body_node], [skinned_mesh_space(doc.rest_world_matrix(body_node))]
     for index, mesh in enumerate(scene.skinned_meshes):
         if index == scene.body or not _targets_join(parts, mesh):
             continue
@@ -88,7 +88,7 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
         if placement is not None:
             parts.append(moved_onto(mesh, body, placement))
             part_nodes.append(node)
-            vertex_spaces.append(placement.transform @ doc.rest_world_matrix(node))
+            vertex_spaces.append(placement.transform @ skinned_mesh_space(doc.rest_world_matrix(node)))
     parts[0] = body
     materials = np.concatenate([_face_materials(doc, doc.gltf.nodes[node].mesh) for node in part_nodes])
     surfaces = [node_surface(doc, node, space) for node, space in zip(part_nodes, vertex_spaces)]

@@ -114,7 +114,7 @@ def publish(staging: Path, root: Path, name: str, record: dict) -> Path:
         if _holds_an_asset(target / entry):
             reason = f"is another asset's folder, where asset {name!r} writes its output {entry}; left as it is"
             raise FileExistsError(17, reason, os.fspath(target / entry))
-    older = (recorded_outputs(target) or set()) - set(new)  # None: a record it cannot read lists nothing
+    older = (recorded_outputs(target) or set()) - set(new)  # None: no record it can read lists nothing
     for entry in sorted(older) + new:
         if not _holds_an_asset(target / entry):  # an older output another asset was written into stays
             _remove(target / entry)
@@ -135,15 +135,6 @@ def _remove(path: Path) -> None:
         shutil.rmtree(path)
     elif os.path.lexists(path):
         path.unlink()
-
-
-def read_record(root: Path, name: str) -> dict | None:
-    """The record of asset ``name`` from an earlier run, or None (absent or unreadable)."""
-    try:
-        record = json.loads((root / name / ASSET_RECORD).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return record if isinstance(record, dict) else None
 
 
 def earlier_assets(root: Path, names: set[str]) -> list[str]:

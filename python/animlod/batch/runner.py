@@ -27,9 +27,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..io.detect import read_asset_record
 from .catalogue import record_rows, write_catalogue
 from .fingerprint import fingerprint
-from .outputs import CATALOGUE, clear_staging, earlier_assets, output_lock, prepare_output, read_record
+from .outputs import CATALOGUE, clear_staging, earlier_assets, output_lock, prepare_output
 from .progress import BatchProgress
 from .spec import AssetSpec
 from .task import describe_error, run_asset
@@ -153,7 +154,7 @@ def run_batch(
                 records[asset.name] = _failed(asset, "", describe_error(error, asset.input))
                 ran_flags[asset.name] = True
                 continue
-            previous = read_record(root, asset.name)
+            previous = read_asset_record(root / asset.name)
             if not force and previous is not None and _unchanged(previous, digest, root):
                 records[asset.name], ran_flags[asset.name] = previous, False
                 continue
@@ -179,7 +180,9 @@ def run_batch(
                         owned.close()
         finally:
             progress.close()
-            on_disk = {asset.name: read_record(root, asset.name) for asset in assets if asset.name not in records}
+            on_disk = {
+                asset.name: read_asset_record(root / asset.name) for asset in assets if asset.name not in records
+            }
             _write(root, assets, records, ran_flags, on_disk)
             clear_staging(root)
         others = earlier_assets(root, {asset.name for asset in assets})

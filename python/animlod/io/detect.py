@@ -133,16 +133,24 @@ def _library_folders(folder: Path) -> Iterator[tuple[Path, list[str]]]:
         )
 
 
-def recorded_outputs(folder: Path) -> set[str] | None:
-    """The names in ``folder`` of the outputs its asset record (:data:`ASSET_RECORD`) lists: the
-    files and folders an asset of animlod batch wrote there (empty when it holds no record). None
-    when its record cannot be read."""
+def read_asset_record(folder: Path) -> dict | None:
+    """The asset record (:data:`ASSET_RECORD`) in ``folder`` that animlod batch wrote, or None
+    (absent or unreadable)."""
     try:
         record = json.loads((folder / ASSET_RECORD).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return record if isinstance(record, dict) else None
+
+
+def recorded_outputs(folder: Path) -> set[str] | None:
+    """The names in ``folder`` of the outputs its asset record (:data:`ASSET_RECORD`) lists: the
+    files and folders an asset of animlod batch wrote there. None when it holds no record that
+    can be read."""
+    record = read_asset_record(folder)
+    try:
         paths = [PurePosixPath(path) for path in record["result"]["outputs"]]
-    except FileNotFoundError:
-        return set()
-    except (OSError, ValueError, TypeError, KeyError):
+    except (TypeError, KeyError):  # no record (None), or one without a list of paths
         return None
     if any(path.is_absolute() or not path.parts or path.parts[0] == ".." for path in paths):
         return None  # animlod writes an asset's outputs inside its folder: not a record of its

@@ -13,8 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..io.gltf_document import GltfDocument
-from ..io.gltf_mesh import read_mesh_geometry, transform_tangents
+from ..io.gltf_mesh import MeshGeometry, transform_tangents
 
 # Normals are SkinnedMesh's (made where a part lacks them); skinning attributes are rewritten per level.
 _SURFACE_PREFIXES = ("TANGENT", "TEXCOORD_", "COLOR_")
@@ -41,10 +40,9 @@ def joined_surface(pieces: list[tuple[dict[str, np.ndarray], int]]) -> dict[str,
     return joined
 
 
-def node_surface(doc: GltfDocument, node: int, placement: np.ndarray) -> dict[str, np.ndarray]:
-    """The surface attributes of the skinned mesh ``node`` draws, its primitives joined, in the
-    space ``placement (4, 4)`` takes its vertices to (tangents turned with them)."""
-    geometry = read_mesh_geometry(doc, doc.gltf.nodes[node].mesh, skinned=True)
+def node_surface(geometry: MeshGeometry, placement: np.ndarray) -> dict[str, np.ndarray]:
+    """The surface attributes of a skinned mesh's ``geometry``, its primitives joined, in the space
+    ``placement (4, 4)`` takes its vertices to (tangents turned with them)."""
     surface = joined_surface([(primitive.attributes, primitive.vertex_count) for primitive in geometry.primitives])
     if "TANGENT" in surface:
         surface["TANGENT"] = transform_tangents(placement, surface["TANGENT"])

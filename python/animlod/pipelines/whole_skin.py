@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..io.gltf_document import GltfDocument
-from ..io.gltf_mesh import read_mesh_geometry
+from ..io.gltf_mesh import MeshGeometry, read_mesh_geometry
 from ..io.gltf_read import GltfScene, morph_weight_tracks, read_skinned_node, skinned_mesh_space
 from ..io.gltf_skin import SkinRig
 from ..model import Motion, SkinnedMesh, morphed
@@ -90,8 +90,10 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
             part_nodes.append(node)
             vertex_spaces.append(placement.transform @ skinned_mesh_space(doc.rest_world_matrix(node)))
     parts[0] = body
-    materials = np.concatenate([_face_materials(doc, doc.gltf.nodes[node].mesh) for node in part_nodes])
-    surfaces = [node_surface(doc, node, space) for node, space in zip(part_nodes, vertex_spaces)]
+    meshes = [doc.gltf.nodes[node].mesh for node in part_nodes]
+    geometries = [read_mesh_geometry(doc, mesh, skinned=True) for mesh in meshes]
+    materials = np.concatenate([_face_materials(doc, mesh, geometry) for mesh, geometry in zip(meshes, geometries)])
+    surfaces = [node_surface(geometry, space) for geometry, space in zip(geometries, vertex_spaces)]
     surface = joined_surface([(attributes, part.vertex_count) for attributes, part in zip(surfaces, parts)])
     left_out = len(scene.skinned_meshes) - len(parts)
     if len(parts) == 1:
@@ -146,10 +148,9 @@ def _weight_tracks(
     return tracks
 
 
-def _face_materials(doc: GltfDocument, mesh: int) -> np.ndarray:
-    """(F,) the material of each face of mesh ``mesh`` as read (its triangle primitives in order),
-    -1 for a primitive without one."""
-    geometry = read_mesh_geometry(doc, mesh, skinned=True)
+def _face_materials(doc: GltfDocument, mesh: int, geometry: MeshGeometry) -> np.ndarray:
+    """(F,) the material of each face of mesh ``mesh`` as read (``geometry``: its triangle
+    primitives in order), -1 for a primitive without one."""
     primitives = doc.gltf.meshes[mesh].primitives
     of_part = [-1 if primitives[part.index].material is None else primitives[part.index].material
                for part in geometry.primitives]  # fmt: skip

@@ -15,6 +15,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #define GLM_ENABLE_EXPERIMENTAL
 #include <glm/gtc/quaternion.hpp>
@@ -48,6 +49,10 @@ std::string node_label(const Model& model, int node) {
 std::string animation_label(const Model& model, int animation) {
   const std::string& name = model.animations[static_cast<size_t>(animation)].name;
   return "animation " + std::to_string(animation) + (name.empty() ? "" : " '" + name + "'");
+}
+
+std::string channel_label(const Model& model, int animation, size_t channel) {
+  return animation_label(model, animation) + " channel " + std::to_string(channel);
 }
 
 size_t component_size(int type) {
@@ -531,7 +536,7 @@ class Loader {
   // The morph weights level node `n` plays, its mesh of `targets` morph targets on the GPU: per
   // original clip its weights channel (`channels`), or its default weights.
   MorphPlayback read_morph_playback(const tinygltf::Node& n, size_t targets, const std::vector<ChannelRef>& channels,
-                                    const std::string& label) const {
+                                    const std::string& label) {
     MorphPlayback playback;
     const std::vector<double> defaults =
         default_morph_weights(n.weights, model_.meshes[static_cast<size_t>(n.mesh)], targets, label + " mesh " + std::to_string(n.mesh));
@@ -539,12 +544,10 @@ class Loader {
     for (const ChannelRef& ref : channels) {
       playback.tracks.emplace_back();
       if (ref.animation < 0) continue;
-      const tinygltf::Animation& animation = model_.animations[static_cast<size_t>(ref.animation)];
-      const std::string element = animation_label(model_, ref.animation) + " channel " + std::to_string(ref.channel);
-      SamplerKeys keys = read_sampler(animation, animation.channels[ref.channel], 1, element);
+      const SamplerKeys& keys = morph_weight_keys(ref.animation, ref.channel);
       std::string error;
-      if (!MorphWeightsTrack::make(std::move(keys.times), keys.values, targets, keys.interpolation, playback.tracks.back(), error))
-        fail(element, error + " (the morph weights of " + label + ")");
+      if (!MorphWeightsTrack::make(keys.times, keys.values, targets, keys.interpolation, playback.tracks.back(), error))
+        fail(channel_label(model_, ref.animation, ref.channel), error + " (the morph weights of " + label + ")");
     }
     return playback;
   }
@@ -673,6 +676,20 @@ class Loader {
     return keys;
   }
 
+  // The keys of a morph weights channel, read once for both of their uses: the duration of each
+  // clip that plays the channel (read_clip) and the tracks of the level node it animates
+  // (read_morph_playback).
+  const SamplerKeys& morph_weight_keys(int animation_index, size_t channel) {
+    const std::pair<int, size_t> ref(animation_index, channel);
+    auto found = morph_weight_keys_.find(ref);
+    if (found == morph_weight_keys_.end()) {
+      const tinygltf::Animation& animation = model_.animations[static_cast<size_t>(animation_index)];
+      SamplerKeys keys = read_sampler(animation, animation.channels[channel], 1, channel_label(model_, animation_index, channel));
+      found = morph_weight_keys_.emplace(ref, std::move(keys)).first;
+    }
+    return found->second;
+  }
+
   // Whether `channel` sets the morph weights of a mesh that skin `skin` deforms: the crowd plays it
   // on the level node (Level::morph), and the clip lasts until its last key.
   bool morphs_skinned_mesh(const tinygltf::AnimationChannel& channel, int skin) const {
@@ -692,12 +709,11 @@ class Loader {
     std::vector<animlod::ClipChannel> channels;
     for (int animation_index : animations) {
       const tinygltf::Animation& animation = model_.animations[static_cast<size_t>(animation_index)];
-      const std::string label = animation_label(model_, animation_index);
       for (size_t c = 0; c < animation.channels.size(); ++c) {
         const tinygltf::AnimationChannel& channel = animation.channels[c];
-        const std::string element = label + " channel " + std::to_string(c);
+        const std::string element = channel_label(model_, animation_index, c);
         if (morphs_skinned_mesh(channel, rig.skin)) {
-          const std::vector<float> times = read_sampler(animation, channel, 1, element).times;
+          const std::vector<float>& times = morph_weight_keys(animation_index, c).times;
           if (!times.empty()) clip.duration = std::max(clip.duration, times.back());
           continue;
         }
@@ -1092,6 +1108,7 @@ class Loader {
   std::vector<int> parents_;
   std::vector<std::vector<int>> original_clips_;  // animations of each original clip
   std::vector<int> clip_rigs_;  // rig of every clip in asset_.clips
+  std::map<std::pair<int, size_t>, SamplerKeys> morph_weight_keys_;  // (animation, channel): morph_weight_keys
   std::set<int> warned_meshes_;  // meshes whose warnings were said (several level nodes may draw one)
 };
 

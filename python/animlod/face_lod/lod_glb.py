@@ -67,11 +67,13 @@ class GltfFace:
     others: list[str]
 
 
-def read_gltf_face(path: str | os.PathLike, fps: float = 30.0, frames_each: int = 15) -> GltfFace:
-    """The face of a .glb/.gltf file: its drawable with morph targets and the most triangles.
+def read_gltf_face(path: str | os.PathLike, fps: float | None = None, frames_each: int = 15) -> GltfFace:
+    """The face of a .glb/.gltf file: its drawable with morph targets and the most triangles, its
+    clips sampled at ``fps`` (None: at the rate of their keys, as :func:`animlod.io.read_gltf`).
     Raises FormatError naming the file when none has morph targets, and the reader's errors for
     malformed files."""
     doc = GltfDocument(path)
+    fps = doc.sample_rate(fps)
     morphed = [drawable for drawable in read_drawables(doc, fps) if drawable.geometry.targets is not None]
     morphed = [drawable for drawable in morphed if len(drawable.geometry.targets)]
     if not morphed:

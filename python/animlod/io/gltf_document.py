@@ -25,7 +25,7 @@ from .. import rotations
 from .errors import FormatError
 from .gltf_decode import decode_gltf, is_whole_number, labels_as_text
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
-from .gltf_keyframes import INTERPOLATIONS, frame_count, frame_times, sample_keyframes
+from .gltf_keyframes import INTERPOLATIONS, frame_count, frame_times, key_sample_rate, sample_keyframes
 from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
 from .gltf_references import LIGHTS_EXTENSION, index_references
 from .json_limits import load_json
@@ -511,16 +511,32 @@ class GltfDocument:
         """The last key time over the samplers that animation ``index``'s channels use: the clip
         length a viewer plays (from 0). A sampler no channel uses (exporters leave them behind)
         sets nothing: one of 10 s beside a 1.25 s clip made its levels hold still for 8.75 s."""
+        return float(max((times.max(initial=0.0) for times in self._key_times(index)), default=0.0))
+
+    def sample_rate(self, fps: float | None = None) -> float:
+        """``fps``, or where it is None the rate at which the document's clips are sampled: their
+        keys' rate, within 30 to 240 fps (:func:`~.gltf_keyframes.key_sample_rate`; a clip keyed at
+        60 fps keeps its keys, one keyed at 24 fps or more sparsely is sampled at 30)."""
+        if fps is not None:
+            return fps
+        key_times = []
+        for index in range(len(self.gltf.animations or [])):
+            try:
+                key_times += self._key_times(index)
+            except FormatError:  # refused by whatever reads that clip, not by the rate of the others
+                continue
+        return key_sample_rate(key_times)
+
+    def _key_times(self, index: int) -> list[np.ndarray]:
+        """The key times of each sampler that animation ``index``'s channels use."""
         label = self.animation_label(index)
         animation = self.gltf.animations[index]
-        samplers = animation.samplers or []
         used = {channel.sampler for channel in animation.channels or []}
-        ends = [
-            self.accessor(sampler.input, f"{label} sampler {k} input").max(initial=0.0)
-            for k, sampler in enumerate(samplers)
+        return [
+            self.accessor(sampler.input, f"{label} sampler {k} input")
+            for k, sampler in enumerate(animation.samplers or [])
             if k in used
         ]
-        return float(max(ends, default=0.0))
 
     def animation_frame_times(self, index: int, fps: float) -> np.ndarray:
         """Sample times ``(T,)`` at ``fps`` from 0 to the animation's duration, the last one at

@@ -126,11 +126,12 @@ class Drawable:
         return morphed(self.bind_positions(), self.morph_targets, weights, len(frames))
 
 
-def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
+def read_drawables(doc: GltfDocument, fps: float | None = None) -> list[Drawable]:
     """Every (mesh, skin) pair drawn by a node of ``doc``, in order of first use, with its clips
-    sampled at ``fps``. Nodes that are lower levels of an MSFT_lod chain are alternates of their
-    base node, not drawables of their own. Raises FormatError naming the element for anything
-    it cannot read."""
+    sampled at ``fps`` (None: at the rate of their keys, :meth:`GltfDocument.sample_rate`). Nodes
+    that are lower levels of an MSFT_lod chain are alternates of their base node, not drawables
+    of their own. Raises FormatError naming the element for anything it cannot read."""
+    fps = doc.sample_rate(fps)
     alternates = doc.alternate_nodes()
     pairs: dict[tuple[int, int | None], list[int]] = {}
     for index, node in enumerate(doc.gltf.nodes or []):
@@ -164,7 +165,7 @@ def read_drawables(doc: GltfDocument, fps: float = 30.0) -> list[Drawable]:
     return drawables
 
 
-def read_document_drawables(path: str | os.PathLike, fps: float = 30.0) -> tuple[GltfDocument, list[Drawable]]:
+def read_document_drawables(path: str | os.PathLike, fps: float | None = None) -> tuple[GltfDocument, list[Drawable]]:
     """The parsed document at ``path`` and its drawables."""
     doc = GltfDocument(path)
     return doc, read_drawables(doc, fps)

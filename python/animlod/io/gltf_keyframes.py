@@ -15,6 +15,27 @@ INTERPOLATIONS = ("LINEAR", "STEP", "CUBICSPLINE")
 _FRAME_SLACK = 1e-3
 
 
+# glTF clips are sampled at their keys' rate, but no more sparsely than a frame rate that keeps a
+# sparse clip's level smooth, nor more densely than an exporter's rate needs.
+MIN_SAMPLE_RATE, MAX_SAMPLE_RATE = 30.0, 240.0
+
+
+def key_sample_rate(key_times: list[np.ndarray]) -> float:
+    """The frame rate at which to sample clips keyed at ``key_times`` (each sampler's input): the
+    rate of their keys, 1 / the median spacing of every sampler's keys taken together (so that a
+    few keys set close together, an instant change, do not set the rate of a whole file), rounded
+    to a whole rate where it is one but for float32 rounding (60 fps keys), within
+    [MIN_SAMPLE_RATE, MAX_SAMPLE_RATE]. MIN_SAMPLE_RATE where there are no two keys."""
+    steps = np.concatenate([np.diff(np.asarray(times, np.float64).ravel()) for times in key_times] or [[]])
+    steps = steps[np.isfinite(steps) & (steps > 0.0)]
+    if steps.size == 0:
+        return MIN_SAMPLE_RATE
+    rate = 1.0 / float(np.median(steps))
+    if abs(rate - round(rate)) <= 1e-3 * rate:
+        rate = float(round(rate))
+    return min(max(rate, MIN_SAMPLE_RATE), MAX_SAMPLE_RATE)
+
+
 def frame_times(duration: float, fps: float) -> np.ndarray:
     """Sample times ``(T,)`` in seconds: ``k / fps`` from 0, the last one at ``duration`` itself
     (T >= 1). A clip that ends between two frames (1.25 s at 30 fps) gets a last, shorter step to

@@ -63,15 +63,17 @@ class GltfScene:
     body: int = 0
 
 
-def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> GltfScene:
+def read_gltf(path: str | os.PathLike | GltfDocument, fps: float | None = None) -> GltfScene:
     """Read every skinned mesh, motion, morph animation and static mesh of a .glb / .gltf file
     (or of a document already parsed).
 
-    Animations are sampled at ``fps`` from time 0 to their last key. Raises
+    Animations are sampled at ``fps`` from time 0 to their last key (None: at the rate of their
+    keys, :meth:`~animlod.io.gltf_document.GltfDocument.sample_rate`). Raises
     :class:`~animlod.io.FormatError` naming the file, the element and the reason for input it
     cannot read.
     """
     doc = path if isinstance(path, GltfDocument) else GltfDocument(path)
+    fps = doc.sample_rate(fps)
     rigs: dict[int, SkinRig] = {}
     skinned, skinned_motions = [], []
     nodes = _skinned_mesh_nodes(doc)
@@ -97,9 +99,10 @@ def read_gltf(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> Gltf
 
 
 def read_skinned(
-    path: str | os.PathLike, skin: int | str | None = None, fps: float = 30.0
+    path: str | os.PathLike, skin: int | str | None = None, fps: float | None = None
 ) -> tuple[SkinnedMesh, list[Motion]]:
-    """One skinned mesh of a glTF file and its motions sampled at ``fps``.
+    """One skinned mesh of a glTF file and its motions sampled at ``fps`` (None: at the rate of
+    their keys, as :func:`read_gltf`).
 
     ``skin`` picks the skin by index, or by skin or mesh name; None takes the body (as
     :attr:`GltfScene.body` picks it). A file without that skin raises FormatError naming the file
@@ -114,7 +117,7 @@ def read_skinned(
         available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes}))
         raise doc.fail(f"skin {skin!r}", f"not in the file (skinned meshes use skins: {available})")
     node = body_node(doc, chosen)
-    return read_skinned_node(doc, node, SkinRig(doc, doc.gltf.nodes[node].skin), fps)
+    return read_skinned_node(doc, node, SkinRig(doc, doc.gltf.nodes[node].skin), doc.sample_rate(fps))
 
 
 def _skinned_mesh_nodes(doc: GltfDocument) -> list[int]:
@@ -157,15 +160,18 @@ def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:
     return wanted in (doc.gltf.skins[skin].name, doc.gltf.meshes[doc.gltf.nodes[node].mesh].name)
 
 
-def read_node_motions(path: str | os.PathLike | GltfDocument, fps: float = 30.0) -> tuple[list[Motion], list[str]]:
-    """The animations of a glTF file (or parsed document), sampled at ``fps``, as motions of its
+def read_node_motions(
+    path: str | os.PathLike | GltfDocument, fps: float | None = None
+) -> tuple[list[Motion], list[str]]:
+    """The animations of a glTF file (or parsed document), sampled at ``fps`` (None: at the rate of
+    their keys, as :func:`read_gltf`), as motions of its
     animated node tree: the skeleton of a file without skins, as animation libraries are exported
     without their mesh (:class:`~animlod.io.gltf_skin.SkinRig` without a skin); and the labels of
     animated trees left out (under no node in common with the skeleton's). Raises FormatError
     naming the file when no animation translates, turns or scales a node."""
     doc = path if isinstance(path, GltfDocument) else GltfDocument(path)
     rig = SkinRig(doc, None)
-    return rig_motions(doc, rig, fps), rig.trees_left_out
+    return rig_motions(doc, rig, doc.sample_rate(fps)), rig.trees_left_out
 
 
 def rig_motions(doc: GltfDocument, rig: SkinRig, fps: float) -> list[Motion]:
@@ -252,9 +258,11 @@ def on_first_joint_when_unweighted(weights: np.ndarray) -> np.ndarray:
     return weights
 
 
-def read_unskinned_meshes(doc: GltfDocument, fps: float = 30.0) -> tuple[list[AnimatedMesh], list[AnimatedMesh]]:
-    """Morph-animated meshes (one per node and animation, :attr:`GltfScene.morph_animations`) and
-    static meshes (:attr:`GltfScene.static_meshes`), in world space."""
+def read_unskinned_meshes(doc: GltfDocument, fps: float | None = None) -> tuple[list[AnimatedMesh], list[AnimatedMesh]]:
+    """Morph-animated meshes (one per node and animation, :attr:`GltfScene.morph_animations`,
+    sampled at ``fps``, None: at the rate of their keys) and static meshes
+    (:attr:`GltfScene.static_meshes`), in world space."""
+    fps = doc.sample_rate(fps)
     morphs, statics = [], []
     geometries: dict[int, MeshGeometry] = {}
     for node_index, node in enumerate(doc.gltf.nodes or []):

@@ -130,7 +130,8 @@ def build_character(
     notes: list[str] = []
     doc = GltfDocument(source)
     doc = with_clips(doc, clips, notes.append, joint_map)
-    all_drawables = read_drawables(doc, settings.fps)
+    fps = doc.sample_rate(settings.fps)
+    all_drawables = read_drawables(doc, fps)
     chained = {d.label: d for d in all_drawables if unchained(doc, d.nodes) != d.nodes}
     if chained:
         notes.append("kept with the MSFT_lod chains they have: "
@@ -149,7 +150,7 @@ def build_character(
     started = time.perf_counter()
     joints_of = {d.skin_index: set(doc.gltf.skins[d.skin_index].joints) for d in animated}
     played_clips = {d.skin_index: _joined_clips(d) for d in animated}
-    roles = _assign_skeletons(doc, animated, joints_of, played_clips, notes, settings.fps)
+    roles = _assign_skeletons(doc, animated, joints_of, played_clips, notes, fps)
     chain_of, parts, owners, sharing = roles.chain_of, roles.parts, roles.owners, roles.sharing
     animated = [roles.current(d) for d in animated]
     motion_chains: dict[int, _SkinMotion] = {}

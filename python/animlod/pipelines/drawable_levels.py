@@ -52,7 +52,8 @@ class DrawableSettings:
 
     Attributes
     ----------
-    fps : rate at which animations are sampled.
+    fps : rate at which animations are sampled; None (the default): the rate of their keys, at
+        least 30 fps (:meth:`~animlod.io.gltf_document.GltfDocument.sample_rate`).
     frame_budget : most frames that drive AQEM per drawable (the rest pose, each morph target at
         full weight and frames spread over every clip).
     measured_frames : frames per clip at which each level's error is measured.
@@ -63,7 +64,7 @@ class DrawableSettings:
         that the carried weights and deltas reproduce the poses, else ``"optimal"``).
     """
 
-    fps: float = 30.0
+    fps: float | None = None
     frame_budget: int = 48
     measured_frames: int = 12
     pixel_error: float = 1.0
@@ -75,6 +76,8 @@ class DrawableSettings:
         # MSFT_screencoverage; a zero fps was blamed on the input's keys.
         for name in ("fps", "pixel_error", "viewport_px"):
             value = getattr(self, name)
+            if name == "fps" and value is None:
+                continue
             if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value < np.inf:
                 raise ValueError(f"{name}: must be a positive number, got {value!r}")
         for name in ("frame_budget", "measured_frames"):

@@ -223,10 +223,6 @@ def build_motion_levels(
     return MotionReport(chain, files, manifest, faces, motion, floor, notes, skin_errors, skin_seconds)
 
 
-# Frames per second at which a glTF input's clips are sampled.
-_GLTF_FPS = 30.0
-
-
 def _manifest_row(
     level: MotionLevel, index: int, names: list[Path], played: list[PlayedClip], skin_errors: list | None
 ) -> dict:
@@ -340,9 +336,10 @@ def _read_input(
 
     document = GltfDocument(source)
     document = with_clips(document, clip_files, note, joint_map)
-    scene = read_gltf(document, _GLTF_FPS)
+    fps = document.sample_rate()
+    scene = read_gltf(document, fps)
     if scene.skinned_meshes:
-        whole = whole_skin(document, scene, note, _GLTF_FPS)
+        whole = whole_skin(document, scene, note, fps)
         skin, motions, animations, left_out = whole.mesh, whole.motions, whole.animations, whole.left_out
         rig = whole.rig
         materials, morph_weights = FaceMaterials(document, whole.face_materials, whole.surface), whole.morph_weights
@@ -358,7 +355,7 @@ def _read_input(
     else:  # an animation library exported without its mesh
         rig, skin, materials, morph_weights = SkinRig(document, None), None, None, {}
         motions, animations, other_trees = (
-            rig_motions(document, rig, _GLTF_FPS),
+            rig_motions(document, rig, fps),
             rig.animations(document),
             rig.trees_left_out,
         )

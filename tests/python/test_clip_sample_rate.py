@@ -1,0 +1,74 @@
+"""glTF clips are sampled at the rate of their keys (at least 30 fps): a 60 fps clip keeps its
+keys through the readers and the commands that write levels, where it was resampled at 30 fps."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from animlod import synth
+from animlod.io import write_glb
+from animlod.io.gltf_document import GltfDocument
+from animlod.io.gltf_keyframes import key_sample_rate
+from animlod.io.gltf_read import read_gltf
+
+
+def _key_spacings(path) -> set[float]:
+    """The key spacings (rounded to 0.1 ms) of every sampler of every animation in ``path``."""
+    doc = GltfDocument(path)
+    spacings = set()
+    for animation in doc.gltf.animations:
+        for sampler in animation.samplers:
+            times = doc.accessor(sampler.input, "test")[:, 0].astype(np.float64)
+            spacings |= set(np.round(np.diff(times), 4).tolist())
+    return spacings
+
+
+@pytest.fixture(scope="module")
+def walk_at_60(tmp_path_factory):
+    character = synth.humanoid()
+    motion = synth.humanoid_motion(character.skeleton, "walk", cycles=1, fps=60.0)
+    path = tmp_path_factory.mktemp("rate") / "walk60.glb"
+    write_glb(path, character, [motion])
+    return path, motion
+
+
+@pytest.mark.parametrize(
+    ("key_times", "rate"),
+    [
+        ([np.arange(61, dtype=np.float32) / np.float32(60)] * 3, 60.0),  # float32 keys, a whole rate
+        ([np.arange(31) / 30.0] * 5 + [np.array([0.0, 0.001])], 30.0),  # an instant change among 30 fps keys
+        ([np.arange(25) / 24.0], 30.0),  # sparser than 30 fps: sampled at 30
+        ([np.array([0.0, 1.25])], 30.0),
+        ([np.arange(1001) / 1000.0], 240.0),
+        ([np.zeros(1)], 30.0),  # no two keys
+        ([], 30.0),
+    ],
+)
+def test_key_sample_rate(key_times, rate):
+    assert key_sample_rate(key_times) == rate
+
+
+def test_a_60_fps_clip_is_read_at_60_fps(walk_at_60):
+    path, motion = walk_at_60
+    read = read_gltf(path).motions[0]
+    assert read.fps == 60.0 and read.frame_count == motion.frame_count
+    assert read_gltf(path, fps=30.0).motions[0].frame_count == int(np.ceil((motion.frame_count - 1) / 2)) + 1
+
+
+def test_motion_levels_of_a_60_fps_clip_keep_its_keys(walk_at_60, tmp_path):
+    from animlod.pipelines.motion import build_motion_levels
+
+    path, _ = walk_at_60
+    report = build_motion_levels(path, tmp_path / "levels", 2)
+    level_glbs = sorted((tmp_path / "levels").glob("*.glb"))
+    assert len(level_glbs) == 2 and report.motion.fps == 60.0
+    assert _key_spacings(level_glbs[-1]) == {round(1 / 60, 4)}
+
+
+def test_character_clips_of_a_60_fps_clip_keep_its_keys(walk_at_60, tmp_path):
+    from animlod.pipelines.character import build_character
+
+    path, _ = walk_at_60
+    build_character(path, tmp_path / "character.glb", ratios=(0.5,))
+    assert _key_spacings(tmp_path / "character.glb") == {round(1 / 60, 4)}

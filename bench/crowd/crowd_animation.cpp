@@ -118,6 +118,7 @@ void CrowdAnimator::start(const Mode& mode, const int* forced) {
     characters_[i].selectors.assign(asset.chains.size(), animlod::LodSelector(selector_options));
     characters_[i].levels.assign(asset.chains.size(), 0);
     characters_[i].morph_weights.assign(asset.chains.size(), {});
+    characters_[i].morph_levels.assign(asset.chains.size(), -1);
   }
 }
 
@@ -156,6 +157,7 @@ void CrowdAnimator::update_pose(const Asset& asset, const Placement& placement, 
       for (int c = 0; c < 4; ++c) rows[4 * r + c] = m[4 * c + r];
   }
   cache.valid = true;
+  cache.posed_frame = frame_;
 }
 
 void CrowdAnimator::animate(const Camera& camera, const animlod::LodCamera& lod_camera, uint64_t frame, float time,
@@ -213,13 +215,17 @@ void CrowdAnimator::animate(const Camera& camera, const animlod::LodCamera& lod_
       ++counts.updates;
       counts.joints += static_cast<int64_t>(asset.rigs[static_cast<size_t>(rig)].pose_count());
     }
-    // Morph weights at the clip time of the pose drawn with them (held on skipped frames alike).
+    // Morph weights at the clip time of the pose drawn with them, sampled with it and held with it
+    // on skipped frames.
     for (size_t c = 0; c < asset.chains.size(); ++c) {
-      const Level& level = asset.chains[c].levels[static_cast<size_t>(character.levels[c])];
+      const int drawn = character.levels[c];
+      const Level& level = asset.chains[c].levels[static_cast<size_t>(drawn)];
+      const PoseCache& cache = cache_for(character, level.rig);
+      if (!morph_weights_due(cache.posed_frame == frame, character.morph_levels[c], drawn)) continue;
+      character.morph_levels[c] = drawn;
       std::vector<float>& weights = character.morph_weights[c];
       weights.resize(level.morph.target_count());
-      if (!weights.empty())
-        level.morph.sample(static_cast<size_t>(placement.clip), cache_for(character, level.rig).clip_time, weights.data());
+      if (!weights.empty()) level.morph.sample(static_cast<size_t>(placement.clip), cache.clip_time, weights.data());
     }
   }
 }

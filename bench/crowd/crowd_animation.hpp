@@ -78,6 +78,7 @@ class CrowdAnimator {
     std::vector<float> rows;   // (S, 12) palette rows
     float clip_time = 0.0f;    // seconds into the clip the pose was sampled at
     bool valid = false;
+    uint64_t posed_frame = UINT64_MAX;  // the frame the pose was last updated
     uint64_t gathered_frame = UINT64_MAX;
     uint32_t gathered_base = 0;
   };
@@ -85,6 +86,7 @@ class CrowdAnimator {
     std::vector<animlod::LodSelector> selectors;  // per chain
     std::vector<int> levels;                      // per chain, this frame: the level node drawn
     std::vector<std::vector<float>> morph_weights;  // per chain: its level's played weights (T,), else empty
+    std::vector<int> morph_levels;                // per chain: the level morph_weights were sampled for, -1: none
     std::vector<PoseCache> caches;                // per rig used so far
     bool visible = false;
     bool was_visible = false;

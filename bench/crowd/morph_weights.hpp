@@ -52,4 +52,12 @@ struct MorphPlayback {
   std::vector<std::vector<float>> keyed_weights() const;
 };
 
+// Whether a chain's morph weights are sampled this frame. They depend on the level drawn and its
+// skeleton's clip time, which only a pose update changes: they are sampled when the pose was
+// updated or the chain draws another level than the one they were sampled for (-1: none yet),
+// and held with the pose on the frames that frame skipping skips.
+inline bool morph_weights_due(bool pose_updated, int sampled_level, int drawn_level) {
+  return pose_updated || sampled_level != drawn_level;
+}
+
 }  // namespace crowd

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "crowd_animation.hpp"
@@ -261,4 +262,38 @@ TEST_CASE("crowd morph weights: each instance gets its level's weights at its cl
   }
   CHECK(gathered.matrices == 12);
   CHECK(gathered.floats == 4 * (36 + 8));
+}
+
+TEST_CASE("crowd morph weights: a level drawn on a frame its pose is held plays its own weights") {
+  // GLoD draws mesh levels 0 and 1 on one skeleton: the nearest character, stepping back into
+  // level 1 on a frame that frame skipping holds its pose on, shows level 1's weights.
+  HandBuiltScene s;
+  s.options.skip_full_coverage = 0.5f;  // from 15 units on every 3 to 8 frames
+  Chain& chain = s.assets[0].chains[0];
+  chain.levels[0].morph.defaults = {1.0f};
+  chain.levels[static_cast<size_t>(chain.find(1, 0))].morph.defaults = {2.0f};
+  CrowdAnimator animator(s.assets, s.scene, s.options);
+  Mode mode;
+  mode.geometry_levels = true;
+  mode.frame_skipping = true;
+  animator.start(mode);
+  FrameCounts counts;
+  std::vector<float> buffer(animator.max_buffer_floats());
+  std::vector<InstanceGpu> instances(animator.max_instances());
+  // (level tint, morph weight) of the character placed 5 units in front of the camera's start.
+  auto nearest = [&]() {
+    const Gathered gathered = animator.gather(buffer.data(), instances.data());
+    for (size_t i = 0; i < gathered.instances; ++i)
+      if (instances[i].z == -5.0f) return std::make_pair(instances[i].tint, buffer[4 * instances[i].morph_base]);
+    return std::make_pair(0u, -1.0f);
+  };
+  animator.animate(s.camera, s.lod_camera, 0, 0.0f, counts);
+  CHECK(nearest() == std::make_pair(0u, 1.0f));
+  const Camera back = make_camera(s.camera.eye + glm::vec3(0.0f, 0.0f, 10.0f), glm::vec3(0.0f, 0.9f, -1.0f), 2.0f * std::atan(0.5f),
+                                  1.0f, 0.1f, 1000.0f);
+  animlod::LodCamera lod_back = s.lod_camera;
+  lod_back.position = back.eye;
+  animator.animate(back, lod_back, 1, 1.0f / 30.0f, counts);
+  REQUIRE(counts.updates == 0);  // every pose held (updated every 3, 6, 8 and 8 frames)
+  CHECK(nearest() == std::make_pair(1u, 2.0f));
 }

@@ -1,5 +1,6 @@
 // Morph weight tracks of the crowd (morph_weights.hpp): glTF's T weights a key, split into the
-// core's tracks of up to 4, sample as one track of T would, in each interpolation.
+// core's tracks of up to 4, sample as one track of T would, in each interpolation, and are
+// sampled again only when the pose they are drawn with moves.
 #include <doctest/doctest.h>
 
 #include <initializer_list>
@@ -62,4 +63,12 @@ TEST_CASE("crowd morph weights: outputs of another size are refused, and the key
   CHECK(weights == playback.defaults);
   playback.sample(1, 0.5f, weights.data());
   CHECK(weights == std::vector<float>{-1, 0.5f});
+}
+
+TEST_CASE("crowd morph weights follow the pose: held on the frames it is held, sampled when it moves or the level changes") {
+  // They were sampled every frame, also on frames that frame skipping held the pose (and the clip time) on.
+  CHECK_FALSE(crowd::morph_weights_due(false, 1, 1));
+  CHECK(crowd::morph_weights_due(true, 1, 1));
+  CHECK(crowd::morph_weights_due(false, 1, 2));   // another level: its own weights at its skeleton's clip time
+  CHECK(crowd::morph_weights_due(false, -1, 0));  // none sampled yet
 }

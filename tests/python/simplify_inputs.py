@@ -87,6 +87,33 @@ def two_bone_tube(frames: int = 8) -> tuple[SkinnedMesh, Motion]:
     return skinned, motion
 
 
+def twisting_cylinder(frames: int = 5) -> tuple[AnimatedMesh, np.ndarray]:
+    """A cylinder (axis y) at rest, and ``(frames, V, 3)`` frames that twist it about its axis from
+    that rest pose (up to 1.2 radians at the top), which keeps every surface point's height."""
+    from animlod import synth
+
+    rest = synth.bending_cylinder(frames=1, rings=16, segments=16)
+    turns = np.linspace(0.0, 1.2, frames)[:, None] * (rest.frames[0][:, 1] - rest.frames[0][:, 1].min())
+    x, y, z = rest.frames[0].T
+    twisted = np.stack([np.cos(turns) * x - np.sin(turns) * z, np.broadcast_to(y, turns.shape),
+                        np.sin(turns) * x + np.cos(turns) * z], axis=-1)  # fmt: skip
+    return rest, twisted
+
+
+def wrapped_texture(mesh: AnimatedMesh) -> tuple[np.ndarray, np.ndarray]:
+    """Cylindrical texture coordinates of :func:`twisting_cylinder`'s rest mesh: ``uvs (T, 2)``,
+    u the angle about the axis and v the height, and each triangle corner's index into them
+    ``(M, 3)``; the faces across u = 0 take u + 1, a seam."""
+    rest = mesh.frames[0]
+    u = np.arctan2(rest[:, 2], rest[:, 0]) / (2 * np.pi) % 1.0
+    v = (rest[:, 1] - rest[:, 1].min()) / np.ptp(rest[:, 1])
+    corner_u = u[mesh.faces]
+    wraps = np.ptp(corner_u, axis=1) > 0.5
+    corner_u = np.where(wraps[:, None] & (corner_u < 0.5), corner_u + 1.0, corner_u)
+    uvs, corners = np.unique(np.stack([corner_u, v[mesh.faces]], axis=2).reshape(-1, 2), axis=0, return_inverse=True)
+    return uvs.astype(np.float32), corners.reshape(-1, 3).astype(np.int32)
+
+
 def directed_edges_unique(faces: np.ndarray) -> bool:
     """True when no directed edge appears twice: the faces form an oriented manifold."""
     directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from simplify_inputs import bending_tube
+from simplify_inputs import bending_tube, twisting_cylinder, wrapped_texture
 
-from animlod import synth
 from animlod.cli import main
 from animlod.io.meshseq import read_mesh, read_sequence, write_mesh, write_sequence
 from animlod.io.npz import read_npz, write_npz
@@ -58,19 +57,6 @@ def test_each_level_frame_keeps_its_input_file_name(tmp_path):
     assert not (tmp_path / "bad").exists()
 
 
-def _wrapped_texture(mesh) -> ObjTexture:
-    """Cylindrical texture coordinates of the synthetic cylinder (axis y) at rest: u the angle
-    about the axis, v the height; the faces across u = 0 take u + 1, a seam."""
-    rest = mesh.frames[0]
-    u = np.arctan2(rest[:, 2], rest[:, 0]) / (2 * np.pi) % 1.0
-    v = (rest[:, 1] - rest[:, 1].min()) / np.ptp(rest[:, 1])
-    corner_u = u[mesh.faces]
-    wraps = np.ptp(corner_u, axis=1) > 0.5
-    corner_u = np.where(wraps[:, None] & (corner_u < 0.5), corner_u + 1.0, corner_u)
-    uvs, corners = np.unique(np.stack([corner_u, v[mesh.faces]], axis=2).reshape(-1, 2), axis=0, return_inverse=True)
-    return ObjTexture(uvs.astype(np.float32), corners.reshape(-1, 3).astype(np.int32))
-
-
 def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path, capsys):
     """OBJ frames with vt lines: the levels were written without them (a warning said so). Now
     each level frame has them, the seam's copies apart, each corner's u near the angle of its
@@ -79,12 +65,8 @@ def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path, capsys
     every frame, as it can only where a level's vertex is one point of the surface in all of
     them (the placement on the collapsed edge; the default elsewhere, one optimal position per
     frame, slid the vertices by up to 1.5 rings between the rest frame and the others)."""
-    rest = synth.bending_cylinder(frames=1, rings=16, segments=16)
-    turns = np.linspace(0.0, 1.2, 5)[:, None] * (rest.frames[0][:, 1] - rest.frames[0][:, 1].min())
-    x, y, z = rest.frames[0].T
-    twisted = np.stack([np.cos(turns) * x - np.sin(turns) * z, np.broadcast_to(y, turns.shape),
-                        np.sin(turns) * x + np.cos(turns) * z], axis=-1)  # fmt: skip
-    texture = _wrapped_texture(rest)
+    rest, twisted = twisting_cylinder()
+    texture = ObjTexture(*wrapped_texture(rest))
     (tmp_path / "shot").mkdir()
     for index, frame in enumerate(twisted):
         write_obj(tmp_path / "shot" / f"shot_{index}.obj", frame, rest.faces, texture)
@@ -95,7 +77,7 @@ def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path, capsys
     assert main(["info", str(tmp_path / "shot")]) == 0
     printed = capsys.readouterr()
     assert "not read" not in printed.err  # no warning that they are not read (the levels' included)
-    assert f"vertices: {rest.vertex_count}, 276 with their texture coordinates (vt)" in printed.out
+    assert f"vertices: {rest.vertex_count}, 276 with their texture coordinates" in printed.out
     height = np.ptp(rest.frames[0][:, 1])
     levels = [sorted((tmp_path / "out" / f"shot_lod{level}").iterdir()) for level in (1, 2, 3)]
     for frames in [*levels, *([tmp_path / "out" / f"rest_lod{level}.obj"] for level in (1, 2, 3))]:

@@ -125,9 +125,9 @@ def _describe(kind: str, path: str) -> list[str]:
         mesh, texture, shading = read_textured_sequence(path)
         lines = _animated_lines(mesh)
         if texture is not None:  # the mesh has a vertex per position and texture coordinate
-            positions = np.unique(texture.points).size
-            lines[0] = (f"vertices: {positions}, {mesh.vertex_count} with their texture coordinates (vt), "
-                        f"triangles: {mesh.face_count}")  # fmt: skip
+            positions = np.unique(texture.points).size  # an OBJ's; a PLY's vertices have their own
+            counts = f"{positions}, {mesh.vertex_count}" if positions != mesh.vertex_count else f"{positions}"
+            lines[0] = f"vertices: {counts} with their texture coordinates, triangles: {mesh.face_count}"
         if shading is not None:
             kind = {0.0: "flat", np.pi: "smooth"}.get(shading.crease, "smooth with hard edges")
             inward = ", pointing against the faces' winding" if shading.inward else ""

@@ -1,8 +1,9 @@
 """OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
 
-Geometry is read (:mod:`.obj`, :mod:`.ply`), and with :func:`read_textured_sequence` an OBJ
-sequence's texture coordinates and how its normals shade it, which :func:`write_sequence`
-writes back (normals rebuilt from each written frame's faces).
+Geometry is read (:mod:`.obj`, :mod:`.ply`), and with :func:`read_textured_sequence` the
+sequence's texture coordinates (an OBJ's ``vt``, a PLY's per-vertex s, t) and how an OBJ
+sequence's normals shade it, which :func:`write_sequence` writes back (normals rebuilt from each
+written frame's faces).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from ..normals import Shading, corner_normals, shading_of, unit_vectors, vertex_
 from .atomic import atomic_folder
 from .errors import FormatError
 from .obj import ObjNormals, ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
-from .ply import read_ply, write_ply
+from .ply import read_ply, read_ply_textured, write_ply
 
 MESH_SUFFIXES = (".obj", ".ply")
 
@@ -70,10 +71,10 @@ class SequenceTexture:
 def read_textured_sequence(
     source: str | os.PathLike | Sequence[str | os.PathLike], fps: float | None = None
 ) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None]:
-    """:func:`read_sequence` with an OBJ sequence's texture coordinates: the mesh then has a
-    vertex per (position, texture coordinate) pair of the corners (:class:`SequenceTexture`).
-    None, and the files' positions as the vertices, where the frames have none (PLY frames, OBJ
-    frames without ``vt``), or where one frame's differ from the first's (with an
+    """:func:`read_sequence` with the sequence's texture coordinates (OBJ ``vt`` lines, PLY
+    vertices' s, t): the mesh then has a vertex per (position, texture coordinate) pair of the
+    corners (:class:`SequenceTexture`). None, and the files' positions as the vertices, where the
+    frames have none, or where one frame's differ from the first's (with an
     :class:`~animlod.io.obj.UnreadAttributesWarning`). Third, where the first frame has normals
     (``vn``), how they shade it (:class:`~animlod.normals.Shading`: flat, hard edges or smooth,
     and whether they point against the winding); else None."""
@@ -162,8 +163,7 @@ def write_sequence(
 ) -> list[Path]:
     """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
     ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically; with ``texture``
-    (OBJ only) its texture coordinates, the vertices of one point that stand at one place in
-    every frame (a UV seam's copies) written as one ``v`` line; with ``shading`` (OBJ only) each
+    its texture coordinates (:func:`frame_layout`); with ``shading`` (OBJ only) each
     frame's normals rebuilt from its faces, shaded so (:func:`rebuilt_normals`).
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
@@ -171,14 +171,14 @@ def write_sequence(
     interrupted run never leaves a folder short of frames under the final name. An existing
     ``folder`` is replaced as a whole. ``fmt`` is "obj" or "ply" (binary little-endian).
     Returns the written paths in frame order. ValueError for another ``fmt``, ``names`` that
-    are not one file name per frame, distinct regardless of case, or a ``texture`` for PLY or
-    of another vertex count.
+    are not one file name per frame, distinct regardless of case, or a ``texture`` of another
+    vertex count.
     """
     if fmt not in ("obj", "ply"):
         raise ValueError(f"{os.fspath(folder)}: fmt: must be 'obj' or 'ply', got {fmt!r}")
-    if texture is not None and (fmt != "obj" or len(texture.uvs) != mesh.vertex_count):
+    if texture is not None and len(texture.uvs) != mesh.vertex_count:
         raise ValueError(f"{os.fspath(folder)}: texture: {len(texture.uvs)} texture coordinates for "
-                         f"{mesh.vertex_count} vertices, written as {fmt} (OBJ only)")  # fmt: skip
+                         f"{mesh.vertex_count} vertices")  # fmt: skip
     if shading is not None and fmt != "obj":
         raise ValueError(f"{os.fspath(folder)}: shading: normals are written to OBJ files only, not {fmt}")
     if names is None:
@@ -188,13 +188,29 @@ def write_sequence(
         raise ValueError(f"{os.fspath(folder)}: names: {len(names)} names for {mesh.frame_count} frames, or names "
                          "that repeat (regardless of case) or are not plain file names")  # fmt: skip
     names = [f"{name}.{fmt}" for name in names]
-    written, faces, obj_texture = obj_layout(mesh, texture)
+    written, faces, obj_texture = frame_layout(mesh, texture, fmt)
     with atomic_folder(folder) as temporary:
         for name, vertices in zip(names, mesh.frames):
             positions = vertices[written]
             normals = None if shading is None else rebuilt_normals(positions, faces, shading)
             write_mesh(temporary / name, positions, faces, obj_texture, normals)
     return [Path(folder) / name for name in names]
+
+
+def frame_layout(
+    mesh: AnimatedMesh, texture: SequenceTexture | None, fmt: str
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
+    """How ``mesh``'s frames are written as ``fmt`` ("obj" or "ply") files with ``texture``: the
+    vertices whose positions are written, the faces over them and the texture coordinates with
+    each corner's index. A PLY file holds a texture coordinate per vertex, so every vertex is
+    written; an OBJ file's are per corner (:func:`obj_layout`)."""
+    if fmt == "ply":
+        return (
+            np.arange(mesh.vertex_count),
+            mesh.faces,
+            None if texture is None else ObjTexture(texture.uvs, mesh.faces),
+        )
+    return obj_layout(mesh, texture)
 
 
 def obj_layout(mesh: AnimatedMesh, texture: SequenceTexture | None) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
@@ -290,9 +306,16 @@ def _check_same_connectivity(
 def read_mesh_textured(
     path: str | os.PathLike, normals: bool = True
 ) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
-    """:func:`read_mesh` with an OBJ file's texture coordinates and, with ``normals``, its
-    normals (:func:`~.obj.read_obj_textured`; None for PLY)."""
-    return read_obj_textured(path, normals) if Path(path).suffix.lower() == ".obj" else _geometry_of(path)
+    """:func:`read_mesh` with the file's texture coordinates (an OBJ's ``vt`` lines, a PLY's
+    per-vertex s, t: :func:`~.ply.read_ply_textured`) and, with ``normals``, an OBJ file's normals
+    (:func:`~.obj.read_obj_textured`; None for PLY)."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".obj":
+        return read_obj_textured(path, normals)
+    if suffix != ".ply":
+        return _geometry_of(path)  # refused, naming the suffixes read
+    vertices, faces, uvs = read_ply_textured(path)
+    return vertices, faces, None if uvs is None else ObjTexture(uvs, faces), None
 
 
 def _geometry_of(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, None, None]:
@@ -318,15 +341,31 @@ def write_mesh(
     texture: ObjTexture | None = None,
     normals: ObjNormals | None = None,
 ) -> None:
-    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``; ``texture`` and
-    ``normals``: an OBJ file's texture coordinates and normals (ValueError for PLY)."""
+    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``; ``texture``: its
+    texture coordinates (a PLY file's one per vertex: ValueError where a vertex's corners have
+    two); ``normals``: an OBJ file's normals (ValueError for PLY)."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
         write_obj(path, vertices, faces, texture, normals)
-    elif texture is not None or normals is not None:
-        name = "texture" if texture is not None else "normals"
-        raise ValueError(f"{os.fspath(path)}: {name}: written to OBJ files only")
+    elif normals is not None:
+        raise ValueError(f"{os.fspath(path)}: normals: written to OBJ files only")
     elif suffix == ".ply":
-        write_ply(path, vertices, faces)
+        write_ply(
+            path, vertices, faces, uvs=None if texture is None else _vertex_uvs(path, len(vertices), faces, texture)
+        )
     else:
         raise ValueError(f"{os.fspath(path)}: expected one of {', '.join(MESH_SUFFIXES)}")
+
+
+def _vertex_uvs(path: str | os.PathLike, vertex_count: int, faces: np.ndarray, texture: ObjTexture) -> np.ndarray:
+    """``texture``'s coordinates as one per vertex of ``faces`` (0, 0 for a vertex no face uses);
+    ValueError naming the first vertex whose corners have two."""
+    corner_uvs = texture.uvs[texture.corners].reshape(-1, 2)
+    uvs = np.zeros((vertex_count, 2), np.float32)
+    uvs[faces.ravel()] = corner_uvs
+    differing = np.flatnonzero(np.any(uvs[faces.ravel()] != corner_uvs, axis=1))
+    if differing.size:
+        vertex = int(faces.ravel()[differing[0]])
+        raise ValueError(f"{os.fspath(path)}: texture: vertex {vertex} has two texture coordinates, and a PLY file "
+                         "holds one per vertex")  # fmt: skip
+    return uvs

@@ -4,11 +4,12 @@ Each level is written beside the others: ``<stem>_lod<i>/`` frame folders for OB
 (each frame under its input file's name), ``<stem>_lod<i>.obj`` (or ``.ply``) for one mesh file,
 ``<stem>_lod<i>.npz`` for NPZ input, and measured against the input frame by frame (symmetric
 Hausdorff and RMS distance relative to the bounding-box diagonal), on at most 64 frames evenly
-spaced over a longer sequence. An OBJ sequence's texture coordinates are carried: each
-(position, texture coordinate) pair of its corners is a vertex, the copies of a position along a
-UV seam welded by AQEM and kept apart where their coordinates differ, and written back as ``vt``
-lines. Its normals are rebuilt on each level frame from the level's own faces, shaded as the
-input is (flat, hard edges, or smooth), and written as ``vn`` lines.
+spaced over a longer sequence. A sequence's texture coordinates (OBJ ``vt`` lines, PLY vertices'
+s, t) are carried: each (position, texture coordinate) pair of its corners is a vertex, the copies
+of a position along a UV seam welded by AQEM and kept apart where their coordinates differ, and
+written back as ``vt`` lines or per PLY vertex. An OBJ sequence's normals are rebuilt on each
+level frame from the level's own faces, shaded as the input is (flat, hard edges, or smooth),
+and written as ``vn`` lines.
 """
 
 from __future__ import annotations
@@ -84,7 +85,7 @@ def simplify_sequence(
     if measured_frames is not None:
         measured_frames = whole_number("measured_frames", measured_frames, 1)
     kind = input_kind(source)
-    texture = None  # an OBJ sequence's texture coordinates, carried as AQEM attributes
+    texture = None  # the sequence's texture coordinates, carried as AQEM attributes
     shading = None  # how an OBJ sequence's normals shade it, for the levels' rebuilt normals
     if kind == "npz":
         from ..io.npz import read_npz
@@ -212,9 +213,9 @@ def _write_level(
 
         write_npz(path, mesh)
     else:  # one mesh in, one mesh out
-        from ..io.meshseq import obj_layout, rebuilt_normals, write_mesh
+        from ..io.meshseq import frame_layout, rebuilt_normals, write_mesh
 
-        written, faces, obj_texture = obj_layout(mesh, texture)
+        written, faces, obj_texture = frame_layout(mesh, texture, fmt.suffix)
         positions = mesh.frames[0][written]
         normals = None if shading is None else rebuilt_normals(positions, faces, shading)
         write_mesh(path, positions, faces, obj_texture, normals)

@@ -1,0 +1,89 @@
+"""A PLY sequence's per-vertex texture coordinates (s, t and the other names exporters give them)
+reach every level `simplify` writes, as an OBJ sequence's vt lines do; they were dropped with a
+warning."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from simplify_inputs import twisting_cylinder, wrapped_texture
+
+from animlod.cli import main
+from animlod.io.meshseq import write_mesh
+from animlod.io.obj import ObjTexture
+from animlod.io.ply import read_ply, read_ply_textured, write_ply
+
+
+def _ply_wedges(faces: np.ndarray, uvs: np.ndarray, corners: np.ndarray):
+    """A PLY vertex per (position, texture coordinate) pair of the corners, as exporters split a
+    mesh at its UV seams: each wedge's position index, its texture coordinate and the faces over
+    the wedges."""
+    pairs, corner_wedge = np.unique(np.stack([faces.ravel(), corners.ravel()], axis=1), axis=0, return_inverse=True)
+    return pairs[:, 0], uvs[pairs[:, 1]], corner_wedge.reshape(faces.shape).astype(np.int32)
+
+
+@pytest.fixture(scope="module")
+def textured_ply_sequence(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("ply") / "shot"
+    folder.mkdir()
+    rest, twisted = twisting_cylinder()
+    positions, uvs, faces = _ply_wedges(rest.faces, *wrapped_texture(rest))
+    for index, frame in enumerate(twisted):
+        write_ply(folder / f"shot_{index}.ply", frame[positions], faces, uvs=uvs)
+    return folder, rest
+
+
+def test_a_ply_sequences_texture_coordinates_reach_every_level(textured_ply_sequence, tmp_path, capsys):
+    folder, rest = textured_ply_sequence
+    for source in (folder, folder / "shot_0.ply"):  # a sequence, and one mesh file
+        assert main(["simplify", str(source), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    assert main(["info", str(folder)]) == 0
+    printed = capsys.readouterr()
+    assert "not read" not in printed.err
+    assert "vertices: 276 with their texture coordinates" in printed.out  # the seam's copies are rows of their own
+    height, bottom = np.ptp(rest.frames[0][:, 1]), rest.frames[0][:, 1].min()
+    for level in (1, 2, 3):
+        frames = sorted((tmp_path / "out" / f"shot_lod{level}").iterdir())
+        assert [path.name for path in frames] == [f"shot_{index}.ply" for index in range(5)]
+        for path in [*frames, tmp_path / "out" / f"shot_0_lod{level}.ply"]:
+            positions, faces, uvs = read_ply_textured(path)
+            assert uvs is not None and len(np.unique(positions, axis=0)) < len(positions)  # the seam stays open
+            # The twist keeps each point's height, so v (the height at rest) holds in every frame.
+            np.testing.assert_allclose(uvs[faces, 1] * height, positions[faces, 1] - bottom, atol=1e-3 * height)
+
+
+@pytest.mark.parametrize("names", [("u", "v"), ("texture_u", "texture_v"), ("texture_s", "texture_t")])
+def test_texture_coordinates_are_read_by_every_name_exporters_give_them(tmp_path, names):
+    path = tmp_path / "quad.ply"
+    path.write_text(
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+        f"property float {names[0]}\nproperty float {names[1]}\nproperty uchar red\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0 0 0 9\n1 0 0 1 0 9\n1 1 0 1 1 9\n0 1 0 0 0.5 9\n4 0 1 2 3\n"
+    )
+    with pytest.warns(UserWarning, match=r"its properties vertex red are not read"):
+        vertices, faces, uvs = read_ply_textured(path)
+    np.testing.assert_array_equal(uvs, [[0, 0], [1, 0], [1, 1], [0, 0.5]])
+    assert faces.tolist() == [[0, 1, 2], [0, 2, 3]]
+    with pytest.warns(UserWarning, match=rf"vertex {names[0]}, vertex {names[1]}, vertex red are not read"):
+        read_ply(path)  # geometry alone: the texture coordinates are named among what it leaves
+
+
+def test_texture_coordinates_are_written_in_both_encodings_and_checked(tmp_path):
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], np.float32)
+    faces = np.array([[0, 1, 2], [1, 3, 2]], np.int32)
+    uvs = np.array([[0.1, 0.2], [0.3, 0.4], [0.5, 0.6], [0.7, 0.8]], np.float32)
+    for binary in (True, False):
+        write_ply(tmp_path / f"t{binary}.ply", vertices, faces, binary=binary, uvs=uvs)
+        np.testing.assert_array_equal(read_ply_textured(tmp_path / f"t{binary}.ply")[2], uvs)
+    write_ply(tmp_path / "plain.ply", vertices, faces)
+    assert read_ply_textured(tmp_path / "plain.ply")[2] is None
+    with pytest.raises(ValueError, match="uvs: expected"):
+        write_ply(tmp_path / "bad.ply", vertices, faces, uvs=uvs[:3])
+    # Per corner as an OBJ's: written per vertex where each vertex's corners agree, else refused.
+    per_corner = np.concatenate([uvs, [[0.9, 0.9]]]).astype(np.float32)
+    write_mesh(tmp_path / "agree.ply", vertices, faces, ObjTexture(per_corner, faces))
+    np.testing.assert_array_equal(read_ply_textured(tmp_path / "agree.ply")[2], uvs)
+    with pytest.raises(ValueError, match="vertex 1 has two texture coordinates"):
+        write_mesh(tmp_path / "two.ply", vertices, faces, ObjTexture(per_corner, np.array([[0, 1, 2], [4, 3, 2]])))
+    assert not (tmp_path / "two.ply").exists()

@@ -143,7 +143,7 @@ def test_an_obj_sequences_normals_are_rebuilt_on_every_level_as_shaded(tmp_path,
         normals = _shaded_normals("flat" if shading == "clockwise" else shading, frame, tube.faces, rng)
         write_obj(tmp_path / "shot" / f"shot_{index}.obj", frame, faces, normals=normals)
     assert main(["info", str(tmp_path / "shot")]) == 0
-    assert f"normals (vn): {said}, rebuilt on each level" in capsys.readouterr().out
+    assert f"normals: {said}, rebuilt on each level" in capsys.readouterr().out
     assert main(["simplify", str(tmp_path / "shot"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
     assert "not read" not in capsys.readouterr().err
     outward = -1.0 if shading == "clockwise" else 1.0  # along the winding's normal, or against it
@@ -159,17 +159,28 @@ def test_an_obj_sequences_normals_are_rebuilt_on_every_level_as_shaded(tmp_path,
                 assert (outward * along).min() > 0.9999
 
 
-def test_normals_of_obj_frames_among_ply_ones_are_named_not_written(tmp_path, capsys):
-    # A PLY frame makes the levels PLY, which carry no normals: the OBJ frame's vn stopped the run
-    # after the simplification.
+@pytest.mark.parametrize("shading", ["smooth", "flat"])
+def test_normals_of_obj_frames_among_ply_ones_are_written_per_vertex_where_smooth(tmp_path, capsys, shading):
+    # A PLY frame makes the levels PLY, whose vertices hold one normal each: smooth normals are
+    # written so (they were dropped with a warning), flat ones named and not written.
+    from animlod.io.ply import read_ply_attributes
+    from animlod.normals import vertex_normals
+
     tube = bending_tube(frames=2)
     (tmp_path / "mixed").mkdir()
-    normals = _shaded_normals("smooth", tube.frames[0], tube.faces, np.random.default_rng(0))
+    normals = _shaded_normals(shading, tube.frames[0], tube.faces, np.random.default_rng(0))
     write_obj(tmp_path / "mixed" / "f_0.obj", tube.frames[0], tube.faces, normals=normals)
     write_mesh(tmp_path / "mixed" / "f_1.ply", tube.frames[1], tube.faces)
     assert main(["simplify", str(tmp_path / "mixed"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
-    assert "its normals (vn) are not written: the levels are PLY files" in capsys.readouterr().err
+    said = capsys.readouterr().err
     assert sorted(path.name for path in (tmp_path / "out" / "mixed_lod1").iterdir()) == ["f_0.ply", "f_1.ply"]
+    positions, faces, _, written = read_ply_attributes(tmp_path / "out" / "mixed_lod1" / "f_1.ply")
+    if shading == "smooth":
+        assert "not written" not in said
+        np.testing.assert_allclose(written, vertex_normals(positions, faces), atol=1e-6)
+    else:
+        assert "its normals are not written: they shade it flat or with hard edges, and the levels are PLY" in said
+        assert written is None
 
 
 def test_one_mesh_file_gives_one_file_per_level_and_dotted_names_keep_their_levels_apart(tmp_path):

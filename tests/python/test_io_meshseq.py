@@ -25,7 +25,7 @@ from animlod.io import (
     write_sequence,
 )
 from animlod.io.obj import UnreadAttributesWarning
-from animlod.io.ply import read_ply_textured
+from animlod.io.ply import read_ply_attributes
 from animlod.model import AnimatedMesh
 
 # A unit square (quad) and a triangle on top, written with CRLF, comments, texture/normal
@@ -185,7 +185,7 @@ def test_a_textured_sequence_has_a_vertex_per_position_and_texture_coordinate(tm
     np.testing.assert_array_equal(written.uvs[written.corners], texture.uvs[texture.corners])
     # As PLY: a row per vertex, the seam's copies each with its own texture coordinate.
     ply_paths = write_sequence(tmp_path / "ply", mesh, fmt="ply", texture=split)
-    ply_vertices, ply_faces, ply_uvs = read_ply_textured(ply_paths[1])
+    ply_vertices, ply_faces, ply_uvs, _ = read_ply_attributes(ply_paths[1])
     np.testing.assert_array_equal(ply_vertices, positions[split.points] + 1)
     np.testing.assert_array_equal(ply_uvs[ply_faces], texture.uvs[texture.corners])
     # A frame with other texture coordinates: none are carried, and a warning says why.

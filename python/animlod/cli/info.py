@@ -131,7 +131,7 @@ def _describe(kind: str, path: str) -> list[str]:
         if shading is not None:
             kind = {0.0: "flat", np.pi: "smooth"}.get(shading.crease, "smooth with hard edges")
             inward = ", pointing against the faces' winding" if shading.inward else ""
-            lines[0] += f"; normals (vn): {kind}{inward}, rebuilt on each level"
+            lines[0] += f"; normals: {kind}{inward}, rebuilt on each level"
         names = [frame.name for frame in sequence_paths(path)]
         if len(names) > 1:  # the order the frames are read in: a stray file shows at an end
             lines[-1] += f", {names[0]} .. {names[-1]}"

@@ -23,7 +23,7 @@ from ..normals import Shading, corner_normals, shading_of, unit_vectors, vertex_
 from .atomic import atomic_folder
 from .errors import FormatError
 from .obj import ObjNormals, ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
-from .ply import read_ply, read_ply_textured, write_ply
+from .ply import read_ply, read_ply_attributes, write_ply
 
 MESH_SUFFIXES = (".obj", ".ply")
 
@@ -163,24 +163,25 @@ def write_sequence(
 ) -> list[Path]:
     """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
     ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically; with ``texture``
-    its texture coordinates (:func:`frame_layout`); with ``shading`` (OBJ only) each
-    frame's normals rebuilt from its faces, shaded so (:func:`rebuilt_normals`).
+    its texture coordinates (:func:`frame_layout`); with ``shading`` each frame's normals rebuilt
+    from its faces, shaded so (:func:`rebuilt_normals`; smooth only for PLY, whose vertices hold
+    one normal each).
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
     ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
     interrupted run never leaves a folder short of frames under the final name. An existing
     ``folder`` is replaced as a whole. ``fmt`` is "obj" or "ply" (binary little-endian).
     Returns the written paths in frame order. ValueError for another ``fmt``, ``names`` that
-    are not one file name per frame, distinct regardless of case, or a ``texture`` of another
-    vertex count.
+    are not one file name per frame, distinct regardless of case, a ``texture`` of another
+    vertex count, or a ``shading`` other than smooth for PLY.
     """
     if fmt not in ("obj", "ply"):
         raise ValueError(f"{os.fspath(folder)}: fmt: must be 'obj' or 'ply', got {fmt!r}")
     if texture is not None and len(texture.uvs) != mesh.vertex_count:
         raise ValueError(f"{os.fspath(folder)}: texture: {len(texture.uvs)} texture coordinates for "
                          f"{mesh.vertex_count} vertices")  # fmt: skip
-    if shading is not None and fmt != "obj":
-        raise ValueError(f"{os.fspath(folder)}: shading: normals are written to OBJ files only, not {fmt}")
+    if shading is not None and fmt == "ply" and shading.crease < np.pi:
+        raise ValueError(f"{os.fspath(folder)}: shading: a PLY file holds a normal per vertex, smooth shading only")
     if names is None:
         width = max(4, len(str(mesh.frame_count - 1)))
         names = [f"{stem}_{index:0{width}d}" for index in range(mesh.frame_count)]
@@ -188,29 +189,55 @@ def write_sequence(
         raise ValueError(f"{os.fspath(folder)}: names: {len(names)} names for {mesh.frame_count} frames, or names "
                          "that repeat (regardless of case) or are not plain file names")  # fmt: skip
     names = [f"{name}.{fmt}" for name in names]
-    written, faces, obj_texture = frame_layout(mesh, texture, fmt)
+    layout = frame_layout(mesh, texture, fmt, normals=shading is not None)
     with atomic_folder(folder) as temporary:
         for name, vertices in zip(names, mesh.frames):
-            positions = vertices[written]
-            normals = None if shading is None else rebuilt_normals(positions, faces, shading)
-            write_mesh(temporary / name, positions, faces, obj_texture, normals)
+            positions = vertices[layout.written]
+            normals = None if shading is None else layout.normals(positions, shading)
+            write_mesh(temporary / name, positions, layout.faces, layout.texture, normals)
     return [Path(folder) / name for name in names]
 
 
-def frame_layout(
-    mesh: AnimatedMesh, texture: SequenceTexture | None, fmt: str
-) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
-    """How ``mesh``'s frames are written as ``fmt`` ("obj" or "ply") files with ``texture``: the
-    vertices whose positions are written, the faces over them and the texture coordinates with
-    each corner's index. A PLY file holds a texture coordinate per vertex, so every vertex is
-    written; an OBJ file's are per corner (:func:`obj_layout`)."""
-    if fmt == "ply":
-        return (
-            np.arange(mesh.vertex_count),
-            mesh.faces,
-            None if texture is None else ObjTexture(texture.uvs, mesh.faces),
-        )
-    return obj_layout(mesh, texture)
+@dataclass(frozen=True)
+class FrameLayout:
+    """How a mesh's frames are written as OBJ or PLY files (:func:`frame_layout`).
+
+    written : (P,) the vertices whose positions are written, in order.
+    faces : (M, 3) the faces over the written positions.
+    texture : the texture coordinates with each corner's index, or None.
+    welded : (P,) for PLY files written with normals, the group of the written vertices that
+        stand at one place in every frame (a seam's copies, rows of their own), which share a
+        smooth normal; None for OBJ files, whose seam's copies share a position.
+    """
+
+    written: np.ndarray
+    faces: np.ndarray
+    texture: ObjTexture | None
+    welded: np.ndarray | None = None
+
+    def normals(self, positions: np.ndarray, shading: Shading) -> ObjNormals:
+        """A frame's normals rebuilt from its written ``positions``, shaded as ``shading`` says
+        (:func:`rebuilt_normals`); per vertex, smooth across a seam, for a PLY file."""
+        if self.welded is None:
+            return rebuilt_normals(positions, self.faces, shading)
+        points = np.zeros((int(self.welded.max(initial=-1)) + 1, 3), np.float64)
+        points[self.welded] = positions
+        normals = vertex_normals(points, self.welded[self.faces])[self.welded]
+        return ObjNormals(-normals if shading.inward else normals, self.faces)
+
+
+def frame_layout(mesh: AnimatedMesh, texture: SequenceTexture | None, fmt: str, normals: bool) -> FrameLayout:
+    """How ``mesh``'s frames are written as ``fmt`` ("obj" or "ply") files with ``texture``, and
+    with ``normals`` or without. A PLY file holds a texture coordinate and a normal per vertex,
+    so every vertex is written; an OBJ file's are per corner (:func:`obj_layout`)."""
+    if fmt != "ply":
+        return FrameLayout(*obj_layout(mesh, texture))
+    uvs = None if texture is None else ObjTexture(texture.uvs, mesh.faces)
+    if not normals:
+        return FrameLayout(np.arange(mesh.vertex_count), mesh.faces, uvs)
+    paths = mesh.frames.transpose(1, 0, 2).reshape(mesh.vertex_count, -1)  # each vertex's place in every frame
+    welded = np.unique(paths, axis=0, return_inverse=True)[1].ravel().astype(np.int64)
+    return FrameLayout(np.arange(mesh.vertex_count), mesh.faces, uvs, welded)
 
 
 def obj_layout(mesh: AnimatedMesh, texture: SequenceTexture | None) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
@@ -306,16 +333,18 @@ def _check_same_connectivity(
 def read_mesh_textured(
     path: str | os.PathLike, normals: bool = True
 ) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
-    """:func:`read_mesh` with the file's texture coordinates (an OBJ's ``vt`` lines, a PLY's
-    per-vertex s, t: :func:`~.ply.read_ply_textured`) and, with ``normals``, an OBJ file's normals
-    (:func:`~.obj.read_obj_textured`; None for PLY)."""
+    """:func:`read_mesh` with the file's texture coordinates and, with ``normals``, its normals,
+    each an index per corner into its values: an OBJ's ``vt`` and ``vn`` lines
+    (:func:`~.obj.read_obj_textured`), a PLY's per-vertex s, t and nx, ny, nz
+    (:func:`~.ply.read_ply_attributes`)."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
         return read_obj_textured(path, normals)
     if suffix != ".ply":
         return _geometry_of(path)  # refused, naming the suffixes read
-    vertices, faces, uvs = read_ply_textured(path)
-    return vertices, faces, None if uvs is None else ObjTexture(uvs, faces), None
+    vertices, faces, uvs, normal_rows = read_ply_attributes(path)
+    return (vertices, faces, None if uvs is None else ObjTexture(uvs, faces),
+            None if normal_rows is None or not normals else ObjNormals(normal_rows, faces))  # fmt: skip
 
 
 def _geometry_of(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, None, None]:
@@ -341,31 +370,33 @@ def write_mesh(
     texture: ObjTexture | None = None,
     normals: ObjNormals | None = None,
 ) -> None:
-    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``; ``texture``: its
-    texture coordinates (a PLY file's one per vertex: ValueError where a vertex's corners have
-    two); ``normals``: an OBJ file's normals (ValueError for PLY)."""
+    """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``, with ``texture``
+    and ``normals``, each an index per corner into its values (a PLY file's are one per vertex:
+    ValueError where a vertex's corners have two)."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
         write_obj(path, vertices, faces, texture, normals)
-    elif normals is not None:
-        raise ValueError(f"{os.fspath(path)}: normals: written to OBJ files only")
     elif suffix == ".ply":
-        write_ply(
-            path, vertices, faces, uvs=None if texture is None else _vertex_uvs(path, len(vertices), faces, texture)
+        uvs, normal_rows = (
+            None if given is None else _per_vertex(path, name, len(vertices), faces, *given)
+            for name, given in (("texture", texture), ("normals", normals))
         )
+        write_ply(path, vertices, faces, uvs=uvs, normals=normal_rows)
     else:
         raise ValueError(f"{os.fspath(path)}: expected one of {', '.join(MESH_SUFFIXES)}")
 
 
-def _vertex_uvs(path: str | os.PathLike, vertex_count: int, faces: np.ndarray, texture: ObjTexture) -> np.ndarray:
-    """``texture``'s coordinates as one per vertex of ``faces`` (0, 0 for a vertex no face uses);
-    ValueError naming the first vertex whose corners have two."""
-    corner_uvs = texture.uvs[texture.corners].reshape(-1, 2)
-    uvs = np.zeros((vertex_count, 2), np.float32)
-    uvs[faces.ravel()] = corner_uvs
-    differing = np.flatnonzero(np.any(uvs[faces.ravel()] != corner_uvs, axis=1))
+def _per_vertex(
+    path: str | os.PathLike, name: str, vertex_count: int, faces: np.ndarray, values: np.ndarray, corners: np.ndarray
+) -> np.ndarray:
+    """``values[corners]`` (an index per corner of ``faces``) as one value per vertex (zeros for a
+    vertex no face uses); ValueError naming the first vertex whose corners have two."""
+    corner_values = values[corners].reshape(faces.size, -1)
+    per_vertex = np.zeros((vertex_count, corner_values.shape[1]), np.float32)
+    per_vertex[faces.ravel()] = corner_values
+    differing = np.flatnonzero(np.any(per_vertex[faces.ravel()] != corner_values, axis=1))
     if differing.size:
         vertex = int(faces.ravel()[differing[0]])
-        raise ValueError(f"{os.fspath(path)}: texture: vertex {vertex} has two texture coordinates, and a PLY file "
+        raise ValueError(f"{os.fspath(path)}: {name}: vertex {vertex} has two values at its corners, and a PLY file "
                          "holds one per vertex")  # fmt: skip
-    return uvs
+    return per_vertex

@@ -1,7 +1,7 @@
 """PLY geometry: ``vertex`` x, y, z, the vertices' texture coordinates (s, t or its aliases) and
-the ``face`` list ``vertex_indices`` read (ascii, binary_little_endian, binary_big_endian; other
-elements and properties are skipped, with a warning for the vertices' and faces' other
-properties) and written.
+normals (nx, ny, nz), and the ``face`` list ``vertex_indices`` read (ascii,
+binary_little_endian, binary_big_endian; other elements and properties are skipped, with a
+warning for the vertices' and faces' other properties) and written.
 Parsing works on the whole file's bytes with numpy: there is no Python loop over rows."""
 
 from __future__ import annotations
@@ -46,6 +46,7 @@ _FACE_LIST_NAMES = ("vertex_indices", "vertex_index")
 # A vertex's texture coordinates under the names exporters give them (Blender's s, t first, as
 # Blender's importer looks for them); the first pair a file has is read.
 _TEXTURE_NAMES = (("s", "t"), ("u", "v"), ("texture_u", "texture_v"), ("texture_s", "texture_t"))
+_NORMAL_NAMES = ("nx", "ny", "nz")
 # Prefix of the field of a binary row holding a list's length, followed by the list's name; the
 # spaces keep it apart from any PLY property name.
 _LIST_SIZE_FIELD = "list size of "
@@ -78,18 +79,21 @@ def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         For an unreadable header, a body shorter than the header announces, a missing x/y/z,
         a non-finite coordinate or a face index out of range.
     """
-    vertices, faces, _ = _read_ply(Path(path), textured=False)
+    vertices, faces, _, _ = _read_ply(Path(path), attributes=False)
     return vertices, faces
 
 
-def read_ply_textured(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """:func:`read_ply` and the vertices' texture coordinates, ``uvs (V, 2) float32`` from the first
-    of the property pairs s, t / u, v / texture_u, texture_v / texture_s, texture_t the vertex
-    element has (None where it has none); FormatError naming the vertex for a non-finite one."""
-    return _read_ply(Path(path), textured=True)
+def read_ply_attributes(
+    path: str | os.PathLike,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """:func:`read_ply`, the vertices' texture coordinates ``uvs (V, 2) float32`` from the first of
+    the property pairs s, t / u, v / texture_u, texture_v / texture_s, texture_t the vertex
+    element has, and their normals ``(V, 3) float32`` from nx, ny, nz (each None where it has
+    none). FormatError naming the vertex for a non-finite one."""
+    return _read_ply(Path(path), attributes=True)
 
 
-def _read_ply(path: Path, textured: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+def _read_ply(path: Path, attributes: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
     data = path.read_bytes()
     byte_order, elements, body = _read_ply_header(path, data)
     if byte_order is None:
@@ -102,28 +106,26 @@ def _read_ply(path: Path, textured: bool) -> tuple[np.ndarray, np.ndarray, np.nd
         raise FormatError(path, "element vertex", f"has no scalar property {missing[0]}")
     vertices = np.stack([vertex[axis] for axis in "xyz"], axis=1).astype(np.float32)
     check_finite_vertices(path, vertices, lambda index: f"vertex {index}")
-    texture_names = (
-        next((pair for pair in _TEXTURE_NAMES if all(name in vertex for name in pair)), ()) if textured else ()
+    texture_names = next((pair for pair in _TEXTURE_NAMES if all(name in vertex for name in pair)), ())
+    normal_names = _NORMAL_NAMES if all(name in vertex for name in _NORMAL_NAMES) else ()
+    read = ("x", "y", "z", *texture_names, *normal_names) if attributes else ("x", "y", "z")
+    uvs, normals = (
+        _vertex_columns(path, vertex, names, what) if attributes and names else None
+        for names, what in ((texture_names, "texture coordinate"), (normal_names, "normal"))
     )
-    uvs = None
-    if texture_names:
-        if any(isinstance(vertex[name], tuple) for name in texture_names):
-            raise FormatError(path, "element vertex", f"texture coordinates {', '.join(texture_names)} are lists")
-        uvs = np.stack([vertex[name] for name in texture_names], axis=1).astype(np.float32)
-        check_finite_vertices(path, uvs, lambda index: f"vertex {index} texture coordinate")
     face = values.get("face", {})
     face_list = next((face[name] for name in _FACE_LIST_NAMES if isinstance(face.get(name), tuple)), None)
-    read_names = (("vertex", ("x", "y", "z", *texture_names)), ("face", _FACE_LIST_NAMES))
+    read_names = (("vertex", read), ("face", _FACE_LIST_NAMES))
     unread = [
         f"{element} {name}" for element, read in read_names for name in values.get(element, {}) if name not in read
     ]
-    if unread:  # colours, normals, texture coordinates of a face's corners, a face's flags
+    if unread:  # colours, texture coordinates of a face's corners, a face's flags
         warnings.warn(f"{path}: its properties {', '.join(unread)} are not read, and the levels are written without "
                       "them", UnreadAttributesWarning, stacklevel=3)  # fmt: skip
     if face_list is None:
         if any(element.name == "face" and element.count for element in elements):
             raise FormatError(path, "element face", "has no list property vertex_indices")
-        return vertices, np.zeros((0, 3), dtype=np.int32), uvs
+        return vertices, np.zeros((0, 3), dtype=np.int32), uvs, normals
     sizes, corners = face_list
     if corners.dtype.kind == "f":
         raise FormatError(path, "element face", "vertex index list has float items; indices must be integers")
@@ -139,32 +141,52 @@ def _read_ply(path: Path, textured: bool) -> tuple[np.ndarray, np.ndarray, np.nd
 
     corners = corners.astype(np.int64)
     check_face_indices(path, corners, corners, np.repeat(np.arange(sizes.size), sizes), len(vertices), name_face)
-    return vertices, fan_triangulate(corners, sizes), uvs
+    return vertices, fan_triangulate(corners, sizes), uvs, normals
+
+
+def _vertex_columns(path: Path, vertex: dict, names: tuple[str, ...], what: str) -> np.ndarray:
+    """The vertex properties ``names`` side by side, float32; FormatError for a list or a
+    non-finite value, naming the vertex."""
+    if any(isinstance(vertex[name], tuple) for name in names):
+        raise FormatError(path, "element vertex", f"{what} properties {', '.join(names)} are lists")
+    columns = np.stack([vertex[name] for name in names], axis=1).astype(np.float32)
+    check_finite_vertices(path, columns, lambda index: f"vertex {index} {what}")
+    return columns
 
 
 def write_ply(
-    path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray, binary: bool = True, uvs: np.ndarray | None = None
+    path: str | os.PathLike,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    binary: bool = True,
+    uvs: np.ndarray | None = None,
+    normals: np.ndarray | None = None,
 ) -> None:
-    """Write ``vertices (V, 3)`` as float x, y, z (and ``uvs (V, 2)``, the vertices' texture
-    coordinates, as float s, t) and ``faces (M, 3)`` as uchar/int lists, atomically.
+    """Write ``vertices (V, 3)`` as float x, y, z (with ``uvs (V, 2)``, the vertices' texture
+    coordinates, as float s, t, and ``normals (V, 3)`` as float nx, ny, nz) and ``faces (M, 3)``
+    as uchar/int lists, atomically.
 
     ``binary=True`` writes binary_little_endian (exact); ``binary=False`` ascii with 9
     significant digits (exact for float32). Bad input is refused as :func:`write_obj` refuses it,
-    and ``uvs`` of another vertex count or not finite with ValueError.
+    and ``uvs`` or ``normals`` of another vertex count or not finite with ValueError.
     """
     vertices, faces = checked_for_writing(path, vertices, faces)
-    columns = [vertices.astype("<f4")]
-    if uvs is not None:
-        uvs = np.asarray(uvs)
-        if uvs.shape != (len(vertices), 2) or not np.isfinite(uvs).all():
-            raise ValueError(f"{os.fspath(path)}: uvs: expected ({len(vertices)}, 2) finite values, got {uvs.shape}")
-        columns.append(uvs.astype("<f4"))
+    columns, properties = [vertices.astype("<f4")], ["x", "y", "z"]
+    for name, values, names in (("uvs", uvs, ("s", "t")), ("normals", normals, _NORMAL_NAMES)):
+        if values is None:
+            continue
+        values = np.asarray(values)
+        if values.shape != (len(vertices), len(names)) or not np.isfinite(values).all():
+            shape = (len(vertices), len(names))
+            raise ValueError(f"{os.fspath(path)}: {name}: expected {shape} finite values, got {values.shape}")
+        columns.append(values.astype("<f4"))
+        properties += names
     vertex_rows, faces = np.concatenate(columns, axis=1), faces.astype(np.int64)
-    texture_properties = "property float s\nproperty float t\n" if uvs is not None else ""
+    property_lines = "".join(f"property float {name}\n" for name in properties)
     header = (
         f"ply\nformat {'binary_little_endian' if binary else 'ascii'} 1.0\ncomment written by animlod\n"
-        f"element vertex {len(vertices)}\nproperty float x\nproperty float y\nproperty float z\n"
-        f"{texture_properties}element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n"
+        f"element vertex {len(vertices)}\n{property_lines}"
+        f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n"
     )
     if binary:
         face_rows = np.empty(len(faces), dtype=[("size", "u1"), ("indices", "<i4", (3,))])

@@ -7,9 +7,9 @@ Hausdorff and RMS distance relative to the bounding-box diagonal), on at most 64
 spaced over a longer sequence. A sequence's texture coordinates (OBJ ``vt`` lines, PLY vertices'
 s, t) are carried: each (position, texture coordinate) pair of its corners is a vertex, the copies
 of a position along a UV seam welded by AQEM and kept apart where their coordinates differ, and
-written back as ``vt`` lines or per PLY vertex. An OBJ sequence's normals are rebuilt on each
-level frame from the level's own faces, shaded as the input is (flat, hard edges, or smooth),
-and written as ``vn`` lines.
+written back as ``vt`` lines or per PLY vertex. Its normals (OBJ ``vn``, PLY nx, ny, nz) are
+rebuilt on each level frame from the level's own faces, shaded as the input is (flat, hard
+edges, or smooth; PLY levels smooth only, one normal per vertex), and written back.
 """
 
 from __future__ import annotations
@@ -86,7 +86,7 @@ def simplify_sequence(
         measured_frames = whole_number("measured_frames", measured_frames, 1)
     kind = input_kind(source)
     texture = None  # the sequence's texture coordinates, carried as AQEM attributes
-    shading = None  # how an OBJ sequence's normals shade it, for the levels' rebuilt normals
+    shading = None  # how the sequence's normals shade it, for the levels' rebuilt normals
     if kind == "npz":
         from ..io.npz import read_npz
 
@@ -106,9 +106,10 @@ def simplify_sequence(
     result = simplify_animated(original, ratios, progress=progress, attributes=uvs, **aqem_options)
     seconds = time.perf_counter() - started
     folder, stem, fmt = Path(output), input_stem(source), _level_format(kind, source)
-    if shading is not None and fmt.suffix != "obj":  # a PLY frame among OBJ ones makes PLY levels
-        warnings.warn(f"{os.fspath(source)}: its normals (vn) are not written: the levels are PLY files, as some of "
-                      "its frames are", UnreadAttributesWarning, stacklevel=2)  # fmt: skip
+    if shading is not None and fmt.suffix == "ply" and shading.crease < np.pi:
+        warnings.warn(f"{os.fspath(source)}: its normals are not written: they shade it flat or with hard edges, "
+                      "and the levels are PLY files, whose vertices hold one normal each", UnreadAttributesWarning,
+                      stacklevel=2)  # fmt: skip
         shading = None
     frames = _measured_frames(original.frame_count, measured_frames) if measure else np.arange(0)
     levels = []
@@ -213,10 +214,10 @@ def _write_level(
 
         write_npz(path, mesh)
     else:  # one mesh in, one mesh out
-        from ..io.meshseq import frame_layout, rebuilt_normals, write_mesh
+        from ..io.meshseq import frame_layout, write_mesh
 
-        written, faces, obj_texture = frame_layout(mesh, texture, fmt.suffix)
-        positions = mesh.frames[0][written]
-        normals = None if shading is None else rebuilt_normals(positions, faces, shading)
-        write_mesh(path, positions, faces, obj_texture, normals)
+        layout = frame_layout(mesh, texture, fmt.suffix, normals=shading is not None)
+        positions = mesh.frames[0][layout.written]
+        normals = None if shading is None else layout.normals(positions, shading)
+        write_mesh(path, positions, layout.faces, layout.texture, normals)
     return path

@@ -1,6 +1,6 @@
 """A PLY sequence's per-vertex texture coordinates (s, t and the other names exporters give them)
-reach every level `simplify` writes, as an OBJ sequence's vt lines do; they were dropped with a
-warning."""
+and normals (nx, ny, nz) reach every level `simplify` writes, as an OBJ sequence's vt and vn
+lines do; they were dropped with a warning."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from simplify_inputs import twisting_cylinder, wrapped_texture
 from animlod.cli import main
 from animlod.io.meshseq import write_mesh
 from animlod.io.obj import ObjTexture
-from animlod.io.ply import read_ply, read_ply_textured, write_ply
+from animlod.io.ply import read_ply, read_ply_attributes, write_ply
 
 
 def _ply_wedges(faces: np.ndarray, uvs: np.ndarray, corners: np.ndarray):
@@ -46,7 +46,7 @@ def test_a_ply_sequences_texture_coordinates_reach_every_level(textured_ply_sequ
         frames = sorted((tmp_path / "out" / f"shot_lod{level}").iterdir())
         assert [path.name for path in frames] == [f"shot_{index}.ply" for index in range(5)]
         for path in [*frames, tmp_path / "out" / f"shot_0_lod{level}.ply"]:
-            positions, faces, uvs = read_ply_textured(path)
+            positions, faces, uvs, _ = read_ply_attributes(path)
             assert uvs is not None and len(np.unique(positions, axis=0)) < len(positions)  # the seam stays open
             # The twist keeps each point's height, so v (the height at rest) holds in every frame.
             np.testing.assert_allclose(uvs[faces, 1] * height, positions[faces, 1] - bottom, atol=1e-3 * height)
@@ -62,7 +62,7 @@ def test_texture_coordinates_are_read_by_every_name_exporters_give_them(tmp_path
         "0 0 0 0 0 9\n1 0 0 1 0 9\n1 1 0 1 1 9\n0 1 0 0 0.5 9\n4 0 1 2 3\n"
     )
     with pytest.warns(UserWarning, match=r"its properties vertex red are not read"):
-        vertices, faces, uvs = read_ply_textured(path)
+        vertices, faces, uvs, _ = read_ply_attributes(path)
     np.testing.assert_array_equal(uvs, [[0, 0], [1, 0], [1, 1], [0, 0.5]])
     assert faces.tolist() == [[0, 1, 2], [0, 2, 3]]
     with pytest.warns(UserWarning, match=rf"vertex {names[0]}, vertex {names[1]}, vertex red are not read"):
@@ -75,15 +75,53 @@ def test_texture_coordinates_are_written_in_both_encodings_and_checked(tmp_path)
     uvs = np.array([[0.1, 0.2], [0.3, 0.4], [0.5, 0.6], [0.7, 0.8]], np.float32)
     for binary in (True, False):
         write_ply(tmp_path / f"t{binary}.ply", vertices, faces, binary=binary, uvs=uvs)
-        np.testing.assert_array_equal(read_ply_textured(tmp_path / f"t{binary}.ply")[2], uvs)
+        np.testing.assert_array_equal(read_ply_attributes(tmp_path / f"t{binary}.ply")[2], uvs)
     write_ply(tmp_path / "plain.ply", vertices, faces)
-    assert read_ply_textured(tmp_path / "plain.ply")[2] is None
+    assert read_ply_attributes(tmp_path / "plain.ply")[2] is None
     with pytest.raises(ValueError, match="uvs: expected"):
         write_ply(tmp_path / "bad.ply", vertices, faces, uvs=uvs[:3])
     # Per corner as an OBJ's: written per vertex where each vertex's corners agree, else refused.
     per_corner = np.concatenate([uvs, [[0.9, 0.9]]]).astype(np.float32)
     write_mesh(tmp_path / "agree.ply", vertices, faces, ObjTexture(per_corner, faces))
-    np.testing.assert_array_equal(read_ply_textured(tmp_path / "agree.ply")[2], uvs)
-    with pytest.raises(ValueError, match="vertex 1 has two texture coordinates"):
+    np.testing.assert_array_equal(read_ply_attributes(tmp_path / "agree.ply")[2], uvs)
+    with pytest.raises(ValueError, match="texture: vertex 1 has two values at its corners"):
         write_mesh(tmp_path / "two.ply", vertices, faces, ObjTexture(per_corner, np.array([[0, 1, 2], [4, 3, 2]])))
     assert not (tmp_path / "two.ply").exists()
+
+
+@pytest.mark.parametrize("textured", [False, True])
+def test_a_ply_sequences_smooth_normals_are_rebuilt_on_every_level(tmp_path, textured):
+    """Smooth normals per vertex, the same on a UV seam's two copies (rows of their own in a PLY
+    file, one point of the surface)."""
+    from animlod.normals import vertex_normals
+
+    rest, twisted = twisting_cylinder()
+    if textured:
+        positions, uvs, faces = _ply_wedges(rest.faces, *wrapped_texture(rest))
+    else:
+        positions, uvs, faces = np.arange(rest.vertex_count), None, rest.faces
+    (tmp_path / "shot").mkdir()
+    for index, frame in enumerate(twisted):
+        normals = vertex_normals(frame, rest.faces)[positions]
+        write_ply(tmp_path / "shot" / f"shot_{index}.ply", frame[positions], faces, uvs=uvs, normals=normals)
+    assert main(["simplify", str(tmp_path / "shot"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    for path in sorted((tmp_path / "out" / "shot_lod2").iterdir()):
+        level_positions, level_faces, level_uvs, level_normals = read_ply_attributes(path)
+        assert (level_uvs is not None) == textured and level_normals is not None
+        points, point = np.unique(level_positions, axis=0, return_inverse=True)
+        assert (len(points) < len(level_positions)) == textured  # the seam's copies
+        np.testing.assert_allclose(level_normals, vertex_normals(points, point[level_faces])[point], atol=1e-6)
+
+
+def test_a_flat_shaded_ply_sequences_normals_are_named_and_not_written(tmp_path, capsys):
+    rest, twisted = twisting_cylinder(frames=2)
+    corners = rest.faces.ravel()
+    faces = np.arange(corners.size, dtype=np.int32).reshape(-1, 3)  # a row per corner: flat shading
+    (tmp_path / "flat").mkdir()
+    for index, frame in enumerate(twisted):
+        edges = frame[rest.faces[:, 1:]] - frame[rest.faces[:, :1]]
+        normals = np.repeat(np.cross(edges[:, 0], edges[:, 1]), 3, axis=0)
+        write_ply(tmp_path / "flat" / f"f_{index}.ply", frame[corners], faces, normals=normals)
+    assert main(["simplify", str(tmp_path / "flat"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    assert "its normals are not written: they shade it flat or with hard edges" in capsys.readouterr().err
+    assert read_ply_attributes(tmp_path / "out" / "flat_lod1" / "f_0.ply")[3] is None

@@ -6,7 +6,7 @@ from .gltf import GltfScene, read_gltf, read_lod_chains, read_node_motions, read
 from .meshseq import SequenceTexture, read_mesh, read_sequence, read_textured_sequence, write_mesh, write_sequence
 from .npz import read_npz, write_npz
 from .obj import ObjTexture, read_obj, read_obj_textured, write_obj
-from .ply import read_ply, write_ply
+from .ply import read_ply, read_ply_attributes, write_ply
 
 __all__ = [
     "BvhLayout",
@@ -24,6 +24,7 @@ __all__ = [
     "read_obj",
     "read_obj_textured",
     "read_ply",
+    "read_ply_attributes",
     "read_sequence",
     "read_skinned",
     "read_textured_sequence",

@@ -1,5 +1,6 @@
 """glTF clips are sampled at the rate of their keys (at least 30 fps): a 60 fps clip keeps its
-keys through the readers and the commands that write levels, where it was resampled at 30 fps."""
+keys through the readers and the commands that write levels, where it was resampled at 30 fps,
+also beside a 30 fps clip of the same file."""
 
 from __future__ import annotations
 
@@ -33,11 +34,20 @@ def walk_at_60(tmp_path_factory):
     return path, motion
 
 
+_REDUCED_60 = np.delete(np.arange(181) / 60.0, np.s_[2::3])  # every third key of a 60 fps clip dropped
+_STEPPED = np.sort(np.concatenate([np.arange(40) * 0.5, np.arange(1, 40) * 0.5 - 0.001]))  # 1 ms before each pose
+_HELD = np.sort(np.concatenate([np.arange(40) * 0.5, np.arange(40) * 0.5 + 0.001]))  # 1 ms after each pose
+
+
 @pytest.mark.parametrize(
     ("key_times", "rate"),
     [
         ([np.arange(61, dtype=np.float32) / np.float32(60)] * 3, 60.0),  # float32 keys, a whole rate
         ([np.arange(31) / 30.0] * 5 + [np.array([0.0, 0.001])], 30.0),  # an instant change among 30 fps keys
+        ([_REDUCED_60], 60.0),  # steps of 1/60 and 2/60 s: the 60 fps grid, though most steps are 1/30
+        ([_STEPPED], 30.0),  # a pose every 0.5 s, each changed in 1 ms: not a 1000 fps clip
+        ([_HELD], 30.0),
+        ([np.append(np.arange(31) / 30.0, 1.005)], 30.0),  # one odd step at the end
         ([np.arange(25) / 24.0], 30.0),  # sparser than 30 fps: sampled at 30
         ([np.array([0.0, 1.25])], 30.0),
         ([np.arange(1001) / 1000.0], 240.0),
@@ -72,3 +82,21 @@ def test_character_clips_of_a_60_fps_clip_keep_its_keys(walk_at_60, tmp_path):
     path, _ = walk_at_60
     build_character(path, tmp_path / "character.glb", ratios=(0.5,))
     assert _key_spacings(tmp_path / "character.glb") == {round(1 / 60, 4)}
+    from animlod.io import read_lod_chains
+
+    level = read_lod_chains(tmp_path / "character.glb")[0].levels[-1]  # read back at the same rate
+    assert {(clip.fps, clip.frame_count) for clip in level.motions} == {(60.0, 66)}
+
+
+def test_a_60_fps_clip_beside_a_30_fps_one_keeps_its_keys(tmp_path):
+    from animlod.pipelines.motion import build_motion_levels
+
+    character = synth.humanoid()
+    walk = synth.humanoid_motion(character.skeleton, "walk", cycles=1, fps=60.0)
+    run = synth.humanoid_motion(character.skeleton, "run", cycles=8, fps=30.0)  # more keys than the walk
+    write_glb(tmp_path / "two.glb", character, [walk, run])
+    assert GltfDocument(tmp_path / "two.glb").sample_rate() == 60.0
+    build_motion_levels(tmp_path / "two.glb", tmp_path / "levels", 2)
+    level = GltfDocument(sorted((tmp_path / "levels").glob("*.glb"))[-1])
+    walk_keys = level.accessor(level.gltf.animations[0].samplers[0].input, "test")[:, 0]
+    assert len(walk_keys) == walk.frame_count and np.allclose(np.diff(walk_keys), 1 / 60)

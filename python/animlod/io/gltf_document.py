@@ -25,7 +25,14 @@ from .. import rotations
 from .errors import FormatError
 from .gltf_decode import decode_gltf, is_whole_number, labels_as_text
 from .gltf_draco import DRACO_EXTENSION, decode_draco, draco_elements, draco_sources
-from .gltf_keyframes import INTERPOLATIONS, frame_count, frame_times, key_sample_rate, sample_keyframes
+from .gltf_keyframes import (
+    INTERPOLATIONS,
+    MIN_SAMPLE_RATE,
+    frame_count,
+    frame_times,
+    key_sample_rate,
+    sample_keyframes,
+)
 from .gltf_meshopt import MESHOPT_EXTENSIONS, decode_meshopt_view, meshopt_extension
 from .gltf_references import LIGHTS_EXTENSION, index_references
 from .json_limits import load_json
@@ -514,18 +521,19 @@ class GltfDocument:
         return float(max((times.max(initial=0.0) for times in self._key_times(index)), default=0.0))
 
     def sample_rate(self, fps: float | None = None) -> float:
-        """``fps``, or where it is None the rate at which the document's clips are sampled: their
-        keys' rate, within 30 to 240 fps (:func:`~.gltf_keyframes.key_sample_rate`; a clip keyed at
-        60 fps keeps its keys, one keyed at 24 fps or more sparsely is sampled at 30)."""
+        """``fps``, or where it is None the rate at which the document's clips are sampled: the
+        highest of its clips' key rates (:func:`~.gltf_keyframes.key_sample_rate`), within 30 to
+        240 fps. Clips played together share one rate: a clip keyed at 60 fps keeps its keys,
+        beside it a 30 fps clip is sampled at 60; one keyed at 24 fps or more sparsely at 30."""
         if fps is not None:
             return fps
-        key_times = []
+        rates = [MIN_SAMPLE_RATE]
         for index in range(len(self.gltf.animations or [])):
             try:
-                key_times += self._key_times(index)
+                rates.append(key_sample_rate(self._key_times(index)))
             except FormatError:  # refused by whatever reads that clip, not by the rate of the others
                 continue
-        return key_sample_rate(key_times)
+        return max(rates)
 
     def _key_times(self, index: int) -> list[np.ndarray]:
         """The key times of each sampler that animation ``index``'s channels use."""

@@ -18,19 +18,23 @@ _FRAME_SLACK = 1e-3
 # glTF clips are sampled at their keys' rate, but no more sparsely than a frame rate that keeps a
 # sparse clip's level smooth, nor more densely than an exporter's rate needs.
 MIN_SAMPLE_RATE, MAX_SAMPLE_RATE = 30.0, 240.0
+# The share of a clip's time its finest key spacing must cover to set the clip's rate.
+_DENSE_SHARE = 0.1
 
 
 def key_sample_rate(key_times: list[np.ndarray]) -> float:
-    """The frame rate at which to sample clips keyed at ``key_times`` (each sampler's input): the
-    rate of their keys, 1 / the median spacing of every sampler's keys taken together (so that a
-    few keys set close together, an instant change, do not set the rate of a whole file), rounded
-    to a whole rate where it is one but for float32 rounding (60 fps keys), within
-    [MIN_SAMPLE_RATE, MAX_SAMPLE_RATE]. MIN_SAMPLE_RATE where there are no two keys."""
+    """The frame rate at which to sample a clip keyed at ``key_times`` (each of its samplers'
+    input): the rate of its finest key spacing that covers a tenth of its time or more, over
+    every sampler's steps taken together. A reduced clip (steps of 1/60 and 2/60 s) keeps its
+    60 fps; keys set close together for an instant change, or one odd step, cover too little
+    time to set it. Rounded to a whole rate where it is one but for float32 rounding, within
+    [MIN_SAMPLE_RATE, MAX_SAMPLE_RATE]; MIN_SAMPLE_RATE where there are no two keys."""
     steps = np.concatenate([np.diff(np.asarray(times, np.float64).ravel()) for times in key_times] or [[]])
-    steps = steps[np.isfinite(steps) & (steps > 0.0)]
+    steps = np.sort(steps[np.isfinite(steps) & (steps > 0.0)])
     if steps.size == 0:
         return MIN_SAMPLE_RATE
-    rate = 1.0 / float(np.median(steps))
+    covered = np.cumsum(steps) / steps.sum()
+    rate = 1.0 / float(steps[np.searchsorted(covered, _DENSE_SHARE)])
     if abs(rate - round(rate)) <= 1e-3 * rate:
         rate = float(round(rate))
     return min(max(rate, MIN_SAMPLE_RATE), MAX_SAMPLE_RATE)

@@ -301,15 +301,17 @@ def lod_coverages(doc: GltfDocument, base: int, ids: list[int]) -> list[float | 
     return [float(value) for value in coverages]
 
 
-def read_lod_chains(path: str | os.PathLike, fps: float = 30.0) -> list[LodChain]:
+def read_lod_chains(path: str | os.PathLike, fps: float | None = None) -> list[LodChain]:
     """Every chain of a LoD GLB (one per node with MSFT_lod), levels finest first.
 
     A level's mesh is a world-space :class:`~animlod.model.SkinnedMesh` with the clips that
-    move its skin (a reduced skeleton's own clips at motion levels), or a one-frame
+    move its skin (a reduced skeleton's own clips at motion levels, sampled at ``fps``; None: at
+    the rate of their keys, :meth:`~.gltf_document.GltfDocument.sample_rate`), or a one-frame
     :class:`~animlod.model.AnimatedMesh`; its error and coverage come from the extras.
     A file without MSFT_lod has no chains. Raises FormatError naming the element.
     """
     doc = GltfDocument(path)
+    fps = doc.sample_rate(fps)
     rigs: dict[int, SkinRig] = {}
     chains = []
     for base, node in enumerate(doc.json.get("nodes", [])):

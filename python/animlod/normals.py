@@ -57,10 +57,12 @@ def shading_crease(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray
     flat shading, :data:`CREASE_ANGLE` for hard edges among smooth faces."""
     _, point = np.unique(positions, axis=0, return_inverse=True)
     point = point.ravel()
-    unit = unit_vectors(normals).astype(np.float64)
+    # A zero normal (an exporter's for a vertex it could not shade) tells nothing of the shading.
+    given = np.any(normals != 0.0, axis=1)
+    unit = np.where(given[:, None], unit_vectors(normals), 0.0).astype(np.float64)
     mean = np.zeros((point.max(initial=-1) + 1, 3))
     np.add.at(mean, point, unit)
-    differs = np.einsum("vc,vc->v", unit, unit_vectors(mean)[point]) < _SAME_NORMAL_COSINE
+    differs = given & (np.einsum("vc,vc->v", unit, unit_vectors(mean)[point]) < _SAME_NORMAL_COSINE)
     split = np.zeros(mean.shape[0], dtype=bool)
     split[point[differs]] = True
     if not split.any():

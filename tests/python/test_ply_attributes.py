@@ -125,3 +125,68 @@ def test_a_flat_shaded_ply_sequences_normals_are_named_and_not_written(tmp_path,
     assert main(["simplify", str(tmp_path / "flat"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
     assert "its normals are not written: they shade it flat or with hard edges" in capsys.readouterr().err
     assert read_ply_attributes(tmp_path / "out" / "flat_lod1" / "f_0.ply")[3] is None
+
+
+def _quad_ply(path, extra_names: str, extra_rows: list[str]) -> None:
+    """An ascii PLY quad (two triangles) with more vertex properties (``extra_names``, e.g.
+    "float nx", one line each) and their values per vertex row."""
+    properties = "".join(f"property {name}\n" for name in extra_names.split(",") if name)
+    rows = "".join(f"{xyz} {extra}\n" for xyz, extra in zip(["0 0 0", "1 0 0", "1 1 0", "0 1 0"], extra_rows))
+    path.write_text(
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+        f"{properties}element face 1\nproperty list uchar int vertex_indices\nend_header\n{rows}4 0 1 2 3\n"
+    )
+
+
+def main_info(path, capsys) -> str:
+    assert main(["info", str(path)]) == 0
+    return capsys.readouterr().out
+
+
+def test_bad_attribute_values_cost_the_attribute_not_the_sequence(tmp_path, capsys):
+    """One NaN normal (a zero-area face's, as exporters leave them), non-finite texture coordinates
+    or texture coordinates written as lists refused the whole sequence, whose geometry was read
+    before the attributes were."""
+    (tmp_path / "nan_normal").mkdir()
+    (tmp_path / "nan_uv").mkdir()
+    (tmp_path / "list_uv").mkdir()
+    for index in range(2):
+        _quad_ply(tmp_path / "nan_normal" / f"f{index}.ply", "float nx,float ny,float nz",
+                  ["0 0 1", "0 0 1", "nan nan nan", "0 0 1"])  # fmt: skip
+        _quad_ply(tmp_path / "nan_uv" / f"f{index}.ply", "float s,float t", ["0 0", "1 0", "inf 1", "0 1"])
+        _quad_ply(tmp_path / "list_uv" / f"f{index}.ply", "list uchar float s,list uchar float t",
+                  ["1 0 1 0", "1 1 1 0", "1 1 1 1", "1 0 1 1"])  # fmt: skip
+    for name, said in (("nan_normal", ""), ("nan_uv", "vertex 2: its texture coordinates [inf, 1.0] are not finite"),
+                       ("list_uv", "its properties vertex s, vertex t are not read")):  # fmt: skip
+        assert main(["info", str(tmp_path / name)]) == 0
+        assert main(["simplify", str(tmp_path / name), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+        printed = capsys.readouterr()
+        assert said in printed.err and "error" not in printed.err
+    assert "normals: smooth, rebuilt on each level" in main_info(tmp_path / "nan_normal", capsys)
+
+
+def test_a_zero_normal_does_not_make_a_smooth_mesh_hard_edged(tmp_path, capsys):
+    _quad_ply(tmp_path / "zero.ply", "float nx,float ny,float nz", ["0 0 1", "0 0 1", "0 0 0", "0 0 1"])
+    assert "normals: smooth, rebuilt on each level" in main_info(tmp_path / "zero.ply", capsys)
+
+
+def test_info_says_a_ply_sequences_flat_normals_are_not_written(tmp_path, capsys):
+    corners = ["0 0 0", "1 0 0", "1 1 0", "0 0 0", "1 1 0", "0 1 0"]  # a row per corner: flat shading
+    normals = ["0 0 1"] * 3 + ["0 0.6 0.8"] * 3
+    properties = "".join(f"property float {name}\n" for name in ("x", "y", "z", "nx", "ny", "nz"))
+    text = f"ply\nformat ascii 1.0\nelement vertex 6\n{properties}"
+    text += "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+    text += "".join(f"{c} {n}\n" for c, n in zip(corners, normals)) + "3 0 1 2\n3 3 4 5\n"
+    (tmp_path / "flat.ply").write_text(text)
+    said = main_info(tmp_path / "flat.ply", capsys)  # two faces: too few to tell flat from hard edges
+    assert "not written to the levels (PLY files: one normal per vertex)" in said
+
+
+def test_attributes_that_only_later_frames_have_are_named(tmp_path, capsys):
+    # The first frame's warning spoke for the sequence: one without extra properties hid the
+    # colours and normals of every later frame.
+    (tmp_path / "seq").mkdir()
+    _quad_ply(tmp_path / "seq" / "f0.ply", "", ["", "", "", ""])
+    _quad_ply(tmp_path / "seq" / "f1.ply", "uchar red", ["9", "9", "9", "9"])
+    assert main(["simplify", str(tmp_path / "seq"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    assert "f1.ply: its properties vertex red are not read" in capsys.readouterr().err

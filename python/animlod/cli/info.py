@@ -128,11 +128,17 @@ def _describe(kind: str, path: str) -> list[str]:
             positions = np.unique(texture.points).size  # an OBJ's; a PLY's vertices have their own
             counts = f"{positions}, {mesh.vertex_count}" if positions != mesh.vertex_count else f"{positions}"
             lines[0] = f"vertices: {counts} with their texture coordinates, triangles: {mesh.face_count}"
+        paths = sequence_paths(path)
         if shading is not None:
             kind = {0.0: "flat", np.pi: "smooth"}.get(shading.crease, "smooth with hard edges")
             inward = ", pointing against the faces' winding" if shading.inward else ""
-            lines[0] += f"; normals: {kind}{inward}, rebuilt on each level"
-        names = [frame.name for frame in sequence_paths(path)]
+            ply_levels = any(frame.suffix.lower() == ".ply" for frame in paths)  # as simplify writes them
+            if ply_levels and shading.crease < np.pi:
+                fate = "not written to the levels (PLY files: one normal per vertex)"
+            else:
+                fate = "rebuilt on each level"
+            lines[0] += f"; normals: {kind}{inward}, {fate}"
+        names = [frame.name for frame in paths]
         if len(names) > 1:  # the order the frames are read in: a stray file shows at an end
             lines[-1] += f", {names[0]} .. {names[-1]}"
         return lines

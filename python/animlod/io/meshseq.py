@@ -91,7 +91,11 @@ def _read_frames(
         # Only the first frame's normals are read: they tell the shading the levels rebuild.
         return read_mesh_textured(path, normals=first) if textured else _geometry_of(path)
 
-    first_vertices, faces, texture, normals = read(paths[0], first=True)
+    with warnings.catch_warnings(record=True) as first_warnings:
+        warnings.simplefilter("always")
+        first_vertices, faces, texture, normals = read(paths[0], first=True)
+    for warning in first_warnings:
+        warnings.warn(warning.message, stacklevel=3)
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
     if not len(faces):
         what = "no vertices and no faces" if not len(first_vertices) else f"{len(first_vertices)} vertices but no faces"
@@ -99,18 +103,26 @@ def _read_frames(
     frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
     frames[0] = first_vertices
     first_texture, differing = texture, None  # the first frame whose texture coordinates are not the first's
-    with warnings.catch_warnings():  # the first frame's warning speaks for the sequence
-        warnings.simplefilter("ignore", UnreadAttributesWarning)
+    with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
+        warnings.simplefilter("always", UnreadAttributesWarning)
         for index, path in enumerate(paths[1:], start=1):
             vertices, frame_faces, frame_texture, _ = read(path, first=False)
             _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
             frames[index] = vertices
             if textured and differing is None and not _same_texture(texture, frame_texture):
-                differing, texture = path, None
+                differing, differing_texture, texture = path, frame_texture, None
+    unread = [w for w in later_warnings if issubclass(w.category, UnreadAttributesWarning)]
+    if unread and not any(issubclass(w.category, UnreadAttributesWarning) for w in first_warnings):
+        warnings.warn(unread[0].message, stacklevel=3)  # a later frame's own, where the first has none
     if differing is not None:
-        first = "has none" if first_texture is None else "has others"
-        warnings.warn(f"{differing}: its texture coordinates (vt) are not the first frame's ({paths[0].name} "
-                      f"{first}): the levels are written without them", UnreadAttributesWarning,
+        first = paths[0].name
+        if differing_texture is None:
+            what = f"has no texture coordinates, and {first} has"
+        elif first_texture is None:
+            what = f"has texture coordinates, and {first} has none"
+        else:
+            what = f"has texture coordinates other than {first}'s"
+        warnings.warn(f"{differing}: {what}: the levels are written without them", UnreadAttributesWarning,
                       stacklevel=3)  # fmt: skip
     shading = None if normals is None else _shading_of(first_vertices, faces, normals)
     if texture is None:
@@ -391,6 +403,8 @@ def _per_vertex(
 ) -> np.ndarray:
     """``values[corners]`` (an index per corner of ``faces``) as one value per vertex (zeros for a
     vertex no face uses); ValueError naming the first vertex whose corners have two."""
+    if corners is faces and len(values) == vertex_count:  # indexed by vertex already (frame_layout's)
+        return values
     corner_values = values[corners].reshape(faces.size, -1)
     per_vertex = np.zeros((vertex_count, corner_values.shape[1]), np.float32)
     per_vertex[faces.ravel()] = corner_values

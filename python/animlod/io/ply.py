@@ -87,9 +87,10 @@ def read_ply_attributes(
     path: str | os.PathLike,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
     """:func:`read_ply`, the vertices' texture coordinates ``uvs (V, 2) float32`` from the first of
-    the property pairs s, t / u, v / texture_u, texture_v / texture_s, texture_t the vertex
-    element has, and their normals ``(V, 3) float32`` from nx, ny, nz (each None where it has
-    none). FormatError naming the vertex for a non-finite one."""
+    the scalar property pairs s, t / u, v / texture_u, texture_v / texture_s, texture_t the
+    vertex element has, and their normals ``(V, 3) float32`` from nx, ny, nz (each None where it
+    has none). Texture coordinates with a non-finite value are left out with a warning naming
+    the vertex; a non-finite normal reads as zero (no direction)."""
     return _read_ply(Path(path), attributes=True)
 
 
@@ -106,13 +107,19 @@ def _read_ply(path: Path, attributes: bool) -> tuple[np.ndarray, np.ndarray, np.
         raise FormatError(path, "element vertex", f"has no scalar property {missing[0]}")
     vertices = np.stack([vertex[axis] for axis in "xyz"], axis=1).astype(np.float32)
     check_finite_vertices(path, vertices, lambda index: f"vertex {index}")
-    texture_names = next((pair for pair in _TEXTURE_NAMES if all(name in vertex for name in pair)), ())
-    normal_names = _NORMAL_NAMES if all(name in vertex for name in _NORMAL_NAMES) else ()
-    read = ("x", "y", "z", *texture_names, *normal_names) if attributes else ("x", "y", "z")
-    uvs, normals = (
-        _vertex_columns(path, vertex, names, what) if attributes and names else None
-        for names, what in ((texture_names, "texture coordinate"), (normal_names, "normal"))
-    )
+    scalar = {name for name, column in vertex.items() if not isinstance(column, tuple)}  # a list is not read
+    texture_names = next((pair for pair in _TEXTURE_NAMES if scalar.issuperset(pair)), ()) if attributes else ()
+    normal_names = _NORMAL_NAMES if attributes and scalar.issuperset(_NORMAL_NAMES) else ()
+    uvs = np.stack([vertex[name] for name in texture_names], axis=1).astype(np.float32) if texture_names else None
+    if uvs is not None and not np.isfinite(uvs).all():  # carried to the levels, so all or none
+        bad = int(np.argmin(np.isfinite(uvs).all(axis=1)))
+        warnings.warn(f"{path}: vertex {bad}: its texture coordinates {uvs[bad].tolist()} are not finite; the levels "
+                      "are written without texture coordinates", UnreadAttributesWarning, stacklevel=3)  # fmt: skip
+        uvs = None
+    normals = np.stack([vertex[name] for name in normal_names], axis=1).astype(np.float32) if normal_names else None
+    if normals is not None:  # they only tell how the levels' rebuilt normals shade: a bad one tells nothing
+        normals[~np.isfinite(normals).all(axis=1)] = 0.0
+    read = ("x", "y", "z", *texture_names, *normal_names)
     face = values.get("face", {})
     face_list = next((face[name] for name in _FACE_LIST_NAMES if isinstance(face.get(name), tuple)), None)
     read_names = (("vertex", read), ("face", _FACE_LIST_NAMES))
@@ -142,16 +149,6 @@ def _read_ply(path: Path, attributes: bool) -> tuple[np.ndarray, np.ndarray, np.
     corners = corners.astype(np.int64)
     check_face_indices(path, corners, corners, np.repeat(np.arange(sizes.size), sizes), len(vertices), name_face)
     return vertices, fan_triangulate(corners, sizes), uvs, normals
-
-
-def _vertex_columns(path: Path, vertex: dict, names: tuple[str, ...], what: str) -> np.ndarray:
-    """The vertex properties ``names`` side by side, float32; FormatError for a list or a
-    non-finite value, naming the vertex."""
-    if any(isinstance(vertex[name], tuple) for name in names):
-        raise FormatError(path, "element vertex", f"{what} properties {', '.join(names)} are lists")
-    columns = np.stack([vertex[name] for name in names], axis=1).astype(np.float32)
-    check_finite_vertices(path, columns, lambda index: f"vertex {index} {what}")
-    return columns
 
 
 def write_ply(

@@ -1,8 +1,8 @@
 """OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
 
 Geometry is read (:mod:`.obj`, :mod:`.ply`), and with :func:`read_textured_sequence` the
-sequence's texture coordinates (an OBJ's ``vt``, a PLY's per-vertex s, t) and how an OBJ
-sequence's normals shade it, which :func:`write_sequence` writes back (normals rebuilt from each
+sequence's texture coordinates (an OBJ's ``vt``, a PLY's per-vertex s, t) and how its normals
+shade it (``vn``; nx, ny, nz), which :func:`write_sequence` writes back (normals rebuilt from each
 written frame's faces).
 """
 
@@ -76,7 +76,7 @@ def read_textured_sequence(
     corners (:class:`SequenceTexture`). None, and the files' positions as the vertices, where the
     frames have none, or where one frame's differ from the first's (with an
     :class:`~animlod.io.obj.UnreadAttributesWarning`). Third, where the first frame has normals
-    (``vn``), how they shade it (:class:`~animlod.normals.Shading`: flat, hard edges or smooth,
+    (OBJ ``vn``, PLY nx, ny, nz), how they shade it (:class:`~animlod.normals.Shading`: flat, hard edges or smooth,
     and whether they point against the winding); else None."""
     return _read_frames(sequence_paths(source), fps, textured=True)
 
@@ -104,7 +104,7 @@ def _read_frames(
     frames[0] = first_vertices
     first_texture, differing = texture, None  # the first frame whose texture coordinates are not the first's
     with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
-        warnings.simplefilter("always", UnreadAttributesWarning)
+        warnings.simplefilter("always")
         for index, path in enumerate(paths[1:], start=1):
             vertices, frame_faces, frame_texture, _ = read(path, first=False)
             _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
@@ -114,6 +114,9 @@ def _read_frames(
     unread = [w for w in later_warnings if issubclass(w.category, UnreadAttributesWarning)]
     if unread and not any(issubclass(w.category, UnreadAttributesWarning) for w in first_warnings):
         warnings.warn(unread[0].message, stacklevel=3)  # a later frame's own, where the first has none
+    for warning in later_warnings:  # any other, as each frame gave it
+        if not issubclass(warning.category, UnreadAttributesWarning):
+            warnings.warn(warning.message, stacklevel=3)
     if differing is not None:
         first = paths[0].name
         if differing_texture is None:

@@ -100,3 +100,10 @@ def test_a_60_fps_clip_beside_a_30_fps_one_keeps_its_keys(tmp_path):
     level = GltfDocument(sorted((tmp_path / "levels").glob("*.glb"))[-1])
     walk_keys = level.accessor(level.gltf.animations[0].samplers[0].input, "test")[:, 0]
     assert len(walk_keys) == walk.frame_count and np.allclose(np.diff(walk_keys), 1 / 60)
+
+
+def test_info_says_the_rate_the_clips_are_sampled_at(walk_at_60, capsys):
+    from animlod.cli import main
+
+    assert main(["info", str(walk_at_60[0])]) == 0
+    assert "1 animations, sampled at 60 fps" in capsys.readouterr().out

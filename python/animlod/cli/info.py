@@ -157,6 +157,7 @@ def _document_lines(path: str) -> list[str]:
         f"{len(doc.json.get('nodes', []))} nodes, {len(doc.json.get('meshes', []))} meshes, "
         f"{len(doc.json.get('materials', []))} materials, {len(doc.json.get('textures', []))} textures, "
         f"{len(doc.json.get('skins', []))} skins, {len(doc.json.get('animations', []))} animations"
+        + (f", sampled at {doc.sample_rate():g} fps" if doc.json.get("animations") else "")
     ]
     materials = doc.json.get("materials", [])
     for drawable in drawables:

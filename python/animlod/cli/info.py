@@ -120,7 +120,7 @@ def _describe(kind: str, path: str) -> list[str]:
 
         return _animated_lines(read_npz(path))
     if kind == "sequence":
-        from ..io.meshseq import read_textured_sequence, sequence_paths
+        from ..io.meshseq import level_format, normals_fit, read_textured_sequence, sequence_paths
 
         mesh, texture, shading = read_textured_sequence(path)
         lines = _animated_lines(mesh)
@@ -132,11 +132,10 @@ def _describe(kind: str, path: str) -> list[str]:
         if shading is not None:
             kind = {0.0: "flat", np.pi: "smooth"}.get(shading.crease, "smooth with hard edges")
             inward = ", pointing against the faces' winding" if shading.inward else ""
-            ply_levels = any(frame.suffix.lower() == ".ply" for frame in paths)  # as simplify writes them
-            if ply_levels and shading.crease < np.pi:
-                fate = "not written to the levels (PLY files: one normal per vertex)"
-            else:
+            if normals_fit(level_format(paths), shading):
                 fate = "rebuilt on each level"
+            else:
+                fate = "not written to the levels (PLY files: one normal per vertex)"
             lines[0] += f"; normals: {kind}{inward}, {fate}"
         names = [frame.name for frame in paths]
         if len(names) > 1:  # the order the frames are read in: a stray file shows at an end

@@ -195,7 +195,7 @@ def write_sequence(
     if texture is not None and len(texture.uvs) != mesh.vertex_count:
         raise ValueError(f"{os.fspath(folder)}: texture: {len(texture.uvs)} texture coordinates for "
                          f"{mesh.vertex_count} vertices")  # fmt: skip
-    if shading is not None and fmt == "ply" and shading.crease < np.pi:
+    if shading is not None and not normals_fit(fmt, shading):
         raise ValueError(f"{os.fspath(folder)}: shading: a PLY file holds a normal per vertex, smooth shading only")
     if names is None:
         width = max(4, len(str(mesh.frame_count - 1)))
@@ -232,13 +232,13 @@ class FrameLayout:
 
     def normals(self, positions: np.ndarray, shading: Shading) -> ObjNormals:
         """A frame's normals rebuilt from its written ``positions``, shaded as ``shading`` says
-        (:func:`rebuilt_normals`); per vertex, smooth across a seam, for a PLY file."""
+        (:func:`rebuilt_normals`); for a PLY file smooth ones (:func:`normals_fit`), per vertex and
+        the same across a seam."""
         if self.welded is None:
             return rebuilt_normals(positions, self.faces, shading)
         points = np.zeros((int(self.welded.max(initial=-1)) + 1, 3), np.float64)
         points[self.welded] = positions
-        normals = vertex_normals(points, self.welded[self.faces])[self.welded]
-        return ObjNormals(-normals if shading.inward else normals, self.faces)
+        return ObjNormals(rebuilt_normals(points, self.welded[self.faces], shading).normals[self.welded], self.faces)
 
 
 def frame_layout(mesh: AnimatedMesh, texture: SequenceTexture | None, fmt: str, normals: bool) -> FrameLayout:
@@ -253,6 +253,18 @@ def frame_layout(mesh: AnimatedMesh, texture: SequenceTexture | None, fmt: str, 
     paths = mesh.frames.transpose(1, 0, 2).reshape(mesh.vertex_count, -1)  # each vertex's place in every frame
     welded = np.unique(paths, axis=0, return_inverse=True)[1].ravel().astype(np.int64)
     return FrameLayout(np.arange(mesh.vertex_count), mesh.faces, uvs, welded)
+
+
+def level_format(paths: Sequence[Path]) -> str:
+    """The format ("obj" or "ply") the levels of the frames ``paths`` are written in: PLY when a
+    frame is PLY (a PLY frame cannot be written as OBJ with what OBJ adds), else OBJ."""
+    return "ply" if any(path.suffix.lower() == ".ply" for path in paths) else "obj"
+
+
+def normals_fit(fmt: str, shading: Shading) -> bool:
+    """Whether ``fmt`` files hold normals shaded as ``shading`` says: a PLY vertex holds one normal,
+    so smooth shading only; an OBJ corner has its own."""
+    return fmt != "ply" or shading.crease >= np.pi
 
 
 def obj_layout(mesh: AnimatedMesh, texture: SequenceTexture | None) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:

@@ -26,7 +26,7 @@ import numpy as np
 from ..aqem import Preparation, simplify_animated
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError, UnreadAttributesWarning
-from ..io.meshseq import SequenceTexture
+from ..io.meshseq import SequenceTexture, normals_fit
 from ..metrics import SurfaceError, surface_error
 from ..model import AnimatedMesh, whole_number
 from ..normals import Shading
@@ -106,7 +106,7 @@ def simplify_sequence(
     result = simplify_animated(original, ratios, progress=progress, attributes=uvs, **aqem_options)
     seconds = time.perf_counter() - started
     folder, stem, fmt = Path(output), input_stem(source), _level_format(kind, source)
-    if shading is not None and fmt.suffix == "ply" and shading.crease < np.pi:
+    if shading is not None and not normals_fit(fmt.suffix, shading):
         warnings.warn(f"{os.fspath(source)}: its normals are not written: they shade it flat or with hard edges, "
                       "and the levels are PLY files, whose vertices hold one normal each", UnreadAttributesWarning,
                       stacklevel=2)  # fmt: skip
@@ -185,11 +185,11 @@ def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
     """The input's format: NPZ, one OBJ/PLY file, or frames (PLY when a frame is PLY)."""
     if kind == "npz":
         return _LevelFormat("npz", True)
-    from ..io.meshseq import frame_names_fit, sequence_paths
+    from ..io.meshseq import frame_names_fit, level_format, sequence_paths
 
     # The frames read, not the source's name: "frames/*" holds PLY frames without saying so.
     paths = sequence_paths(source)
-    suffix = "ply" if any(path.suffix.lower() == ".ply" for path in paths) else "obj"
+    suffix = level_format(paths)
     names = [path.stem for path in paths]  # two frames of one name (a.obj, a.ply; a glob over folders): numbered
     return _LevelFormat(suffix, isinstance(source, str | os.PathLike) and Path(source).is_file(),
                         names if frame_names_fit(names, len(paths)) else None)  # fmt: skip

@@ -46,7 +46,7 @@ def test_a_ply_sequences_texture_coordinates_reach_every_level(textured_ply_sequ
         frames = sorted((tmp_path / "out" / f"shot_lod{level}").iterdir())
         assert [path.name for path in frames] == [f"shot_{index}.ply" for index in range(5)]
         for path in [*frames, tmp_path / "out" / f"shot_0_lod{level}.ply"]:
-            positions, faces, uvs, _ = read_ply_attributes(path)
+            positions, faces, uvs, _, _ = read_ply_attributes(path)
             assert uvs is not None and len(np.unique(positions, axis=0)) < len(positions)  # the seam stays open
             # The twist keeps each point's height, so v (the height at rest) holds in every frame.
             np.testing.assert_allclose(uvs[faces, 1] * height, positions[faces, 1] - bottom, atol=1e-3 * height)
@@ -62,7 +62,7 @@ def test_texture_coordinates_are_read_by_every_name_exporters_give_them(tmp_path
         "0 0 0 0 0 9\n1 0 0 1 0 9\n1 1 0 1 1 9\n0 1 0 0 0.5 9\n4 0 1 2 3\n"
     )
     with pytest.warns(UserWarning, match=r"its properties vertex red are not read"):
-        vertices, faces, uvs, _ = read_ply_attributes(path)
+        vertices, faces, uvs, _, _ = read_ply_attributes(path)
     np.testing.assert_array_equal(uvs, [[0, 0], [1, 0], [1, 1], [0, 0.5]])
     assert faces.tolist() == [[0, 1, 2], [0, 2, 3]]
     with pytest.warns(UserWarning, match=rf"vertex {names[0]}, vertex {names[1]}, vertex red are not read"):
@@ -106,7 +106,7 @@ def test_a_ply_sequences_smooth_normals_are_rebuilt_on_every_level(tmp_path, tex
         write_ply(tmp_path / "shot" / f"shot_{index}.ply", frame[positions], faces, uvs=uvs, normals=normals)
     assert main(["simplify", str(tmp_path / "shot"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
     for path in sorted((tmp_path / "out" / "shot_lod2").iterdir()):
-        level_positions, level_faces, level_uvs, level_normals = read_ply_attributes(path)
+        level_positions, level_faces, level_uvs, level_normals, _ = read_ply_attributes(path)
         assert (level_uvs is not None) == textured and level_normals is not None
         points, point = np.unique(level_positions, axis=0, return_inverse=True)
         assert (len(points) < len(level_positions)) == textured  # the seam's copies

@@ -61,7 +61,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         choices=("optimal", "on_edge"),
         default=None,
         help="optimal: Eq. 5 per frame (default for sequences and static meshes); on_edge: one point of the "
-        "edge (default for skinned and morphed meshes)",
+        "edge (default for skinned and morphed meshes, and for sequences with texture coordinates or vertex "
+        "colours, whose values are those of that point)",
     )
     parser.add_argument(
         "--no-tip-quadrics",

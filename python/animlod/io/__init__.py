@@ -7,6 +7,7 @@ from .meshseq import SequenceTexture, read_mesh, read_sequence, read_textured_se
 from .npz import read_npz, write_npz
 from .obj import ObjTexture, read_obj, read_obj_textured, write_obj
 from .ply import read_ply, read_ply_attributes, write_ply
+from .vertex_colours import VertexColours
 
 __all__ = [
     "BvhLayout",
@@ -14,6 +15,7 @@ __all__ = [
     "GltfScene",
     "ObjTexture",
     "SequenceTexture",
+    "VertexColours",
     "read_bvh",
     "read_bvh_with_layout",
     "read_gltf",

@@ -1,9 +1,9 @@
 """OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
 
 Geometry is read (:mod:`.obj`, :mod:`.ply`), and with :func:`read_textured_sequence` the
-sequence's texture coordinates (an OBJ's ``vt``, a PLY's per-vertex s, t) and how its normals
-shade it (``vn``; nx, ny, nz), which :func:`write_sequence` writes back (normals rebuilt from each
-written frame's faces).
+sequence's texture coordinates (an OBJ's ``vt``, a PLY's per-vertex s, t), how its normals
+shade it (``vn``; nx, ny, nz) and its vertex colours (each frame's, :mod:`.vertex_colours`),
+which :func:`write_sequence` writes back (normals rebuilt from each written frame's faces).
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from .atomic import atomic_folder
 from .errors import FormatError
 from .obj import ObjNormals, ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
 from .ply import read_ply, read_ply_attributes, write_ply
+from .vertex_colours import VertexColours
 
 MESH_SUFFIXES = (".obj", ".ply")
 
@@ -70,30 +71,36 @@ class SequenceTexture:
 
 def read_textured_sequence(
     source: str | os.PathLike | Sequence[str | os.PathLike], fps: float | None = None
-) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None]:
+) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None, VertexColours | None]:
     """:func:`read_sequence` with the sequence's texture coordinates (OBJ ``vt`` lines, PLY
     vertices' s, t): the mesh then has a vertex per (position, texture coordinate) pair of the
     corners (:class:`SequenceTexture`). None, and the files' positions as the vertices, where the
     frames have none, or where one frame's differ from the first's (with an
     :class:`~animlod.io.obj.UnreadAttributesWarning`). Third, where the first frame has normals
     (OBJ ``vn``, PLY nx, ny, nz), how they shade it (:class:`~animlod.normals.Shading`: flat, hard edges or smooth,
-    and whether they point against the winding); else None."""
+    and whether they point against the winding); else None. Fourth, where every frame has vertex
+    colours stored alike (PLY red, green, blue and alpha; OBJ ``v x y z r g b``), each mesh
+    vertex's colours: one set where every frame's are the first's, else one per frame
+    (:class:`~animlod.io.vertex_colours.VertexColours`); else None (with an
+    :class:`~animlod.io.obj.UnreadAttributesWarning` where some frames have them)."""
     return _read_frames(sequence_paths(source), fps, textured=True)
 
 
 def _read_frames(
     paths: list[Path], fps: float | None, textured: bool
-) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None]:
+) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None, VertexColours | None]:
     """The frames of ``paths`` (:func:`read_sequence`), and with ``textured`` their texture
-    coordinates and normals' shading (:func:`read_textured_sequence`)."""
+    coordinates, normals' shading and colours (:func:`read_textured_sequence`)."""
 
-    def read(path: Path, first: bool) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
+    def read(
+        path: Path, first: bool
+    ) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None, VertexColours | None]:
         # Only the first frame's normals are read: they tell the shading the levels rebuild.
         return read_mesh_textured(path, normals=first) if textured else _geometry_of(path)
 
     with warnings.catch_warnings(record=True) as first_warnings:
         warnings.simplefilter("always")
-        first_vertices, faces, texture, normals = read(paths[0], first=True)
+        first_vertices, faces, texture, normals, colours = read(paths[0], first=True)
     for warning in first_warnings:
         warnings.warn(warning.message, stacklevel=3)
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
@@ -103,12 +110,14 @@ def _read_frames(
     frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
     frames[0] = first_vertices
     first_texture, differing = texture, None  # the first frame whose texture coordinates are not the first's
+    frame_colours = _ColourFrames(paths[0], colours, len(paths))
     with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
         warnings.simplefilter("always")
         for index, path in enumerate(paths[1:], start=1):
-            vertices, frame_faces, frame_texture, _ = read(path, first=False)
+            vertices, frame_faces, frame_texture, _, colours = read(path, first=False)
             _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
             frames[index] = vertices
+            frame_colours.add(index, path, colours)
             if textured and differing is None and not _same_texture(texture, frame_texture):
                 differing, differing_texture, texture = path, frame_texture, None
     unread = [w for w in later_warnings if issubclass(w.category, UnreadAttributesWarning)]
@@ -127,14 +136,56 @@ def _read_frames(
             what = f"has texture coordinates other than {first}'s"
         warnings.warn(f"{differing}: {what}: the levels are written without them", UnreadAttributesWarning,
                       stacklevel=3)  # fmt: skip
+    colours = frame_colours.read()
     shading = None if normals is None else _shading_of(first_vertices, faces, normals)
     if texture is None:
-        return AnimatedMesh(faces, frames, fps=fps), None, shading
+        return AnimatedMesh(faces, frames, fps=fps), None, shading, colours
     # A vertex per (position, texture coordinate) pair that a corner uses.
     pairs = np.stack([faces.ravel(), texture.corners.ravel()], axis=1)
     wedges, corner_wedge = np.unique(pairs, axis=0, return_inverse=True)
     split = AnimatedMesh(corner_wedge.reshape(faces.shape).astype(np.int32), frames[:, wedges[:, 0]], fps=fps)
-    return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32)), shading
+    if colours is not None:
+        colours = VertexColours(colours.values[:, wedges[:, 0]], colours.names, colours.type_code)
+    return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32)), shading, colours
+
+
+class _ColourFrames:
+    """The vertex colours of a sequence's frames, gathered as they are read: every frame's where
+    each has colours stored as the first frame's; none, with a warning naming the first frame
+    that has none or others, where not."""
+
+    def __init__(self, first_path: Path, first: VertexColours | None, frame_count: int) -> None:
+        self.first_path, self.first = first_path, first
+        self.values = None if first is None else np.empty((frame_count, *first.values.shape[1:]), np.float32)
+        if self.values is not None:
+            self.values[0] = first.values[0]
+        self.dropped: str | None = None  # why they are not read: the first frame that differs, and how
+
+    def add(self, index: int, path: Path, colours: VertexColours | None) -> None:
+        """Take frame ``index``'s colours (read from ``path``)."""
+        if self.dropped or (self.first is None and colours is None):
+            return
+        if self.first is not None and self.first.same_layout(colours):
+            self.values[index] = colours.values[0]
+            return
+        first = self.first_path.name
+        if colours is None:
+            what = f"has no vertex colours, and {first} has"
+        elif self.first is None:
+            what = f"has vertex colours, and {first} has none"
+        else:
+            what = f"stores its vertex colours otherwise than {first} ({', '.join(colours.names)}, {colours.type_code})"
+        self.dropped, self.values = f"{path}: {what}: the levels are written without them", None
+
+    def read(self) -> VertexColours | None:
+        """The frames' colours: one set where every frame's are the first's, else one per frame;
+        None, with the warning saying why, where a frame differs in having them or how."""
+        if self.dropped:
+            warnings.warn(self.dropped, UnreadAttributesWarning, stacklevel=4)
+        if self.values is None:
+            return None
+        values = self.values[:1] if np.all(self.values == self.values[:1]) else self.values
+        return VertexColours(values, self.first.names, self.first.type_code)
 
 
 def _shading_of(vertices: np.ndarray, faces: np.ndarray, normals: ObjNormals) -> Shading:
@@ -175,12 +226,14 @@ def write_sequence(
     names: Sequence[str] | None = None,
     texture: SequenceTexture | None = None,
     shading: Shading | None = None,
+    colours: VertexColours | None = None,
 ) -> list[Path]:
     """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
     ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically; with ``texture``
     its texture coordinates (:func:`frame_layout`); with ``shading`` each frame's normals rebuilt
     from its faces, shaded so (:func:`rebuilt_normals`; smooth only for PLY, whose vertices hold
-    one normal each).
+    one normal each); with ``colours`` each frame's vertex colours (one set for every frame, or
+    one per frame).
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
     ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
@@ -188,13 +241,18 @@ def write_sequence(
     ``folder`` is replaced as a whole. ``fmt`` is "obj" or "ply" (binary little-endian).
     Returns the written paths in frame order. ValueError for another ``fmt``, ``names`` that
     are not one file name per frame, distinct regardless of case, a ``texture`` of another
-    vertex count, or a ``shading`` other than smooth for PLY.
+    vertex count, a ``shading`` other than smooth for PLY, or ``colours`` of another vertex or
+    frame count.
     """
     if fmt not in ("obj", "ply"):
         raise ValueError(f"{os.fspath(folder)}: fmt: must be 'obj' or 'ply', got {fmt!r}")
     if texture is not None and len(texture.uvs) != mesh.vertex_count:
         raise ValueError(f"{os.fspath(folder)}: texture: {len(texture.uvs)} texture coordinates for "
                          f"{mesh.vertex_count} vertices")  # fmt: skip
+    if colours is not None and (colours.values.shape[1] != mesh.vertex_count
+                                or len(colours.values) not in (1, mesh.frame_count)):  # fmt: skip
+        raise ValueError(f"{os.fspath(folder)}: colours: {colours.values.shape[:2]} (frames, vertices) of colours "
+                         f"for {mesh.frame_count} frames of {mesh.vertex_count} vertices")  # fmt: skip
     if shading is not None and not normals_fit(fmt, shading):
         raise ValueError(f"{os.fspath(folder)}: shading: a PLY file holds a normal per vertex, smooth shading only")
     if names is None:
@@ -206,10 +264,8 @@ def write_sequence(
     names = [f"{name}.{fmt}" for name in names]
     layout = frame_layout(mesh, texture, fmt, normals=shading is not None)
     with atomic_folder(folder) as temporary:
-        for name, vertices in zip(names, mesh.frames):
-            positions = vertices[layout.written]
-            normals = None if shading is None else layout.normals(positions, shading)
-            write_mesh(temporary / name, positions, layout.faces, layout.texture, normals)
+        for frame, name in enumerate(names):
+            layout.write(temporary / name, mesh, frame, shading, colours)
     return [Path(folder) / name for name in names]
 
 
@@ -239,6 +295,16 @@ class FrameLayout:
         points = np.zeros((int(self.welded.max(initial=-1)) + 1, 3), np.float64)
         points[self.welded] = positions
         return ObjNormals(rebuilt_normals(points, self.welded[self.faces], shading).normals[self.welded], self.faces)
+
+    def write(
+        self, path: Path, mesh: AnimatedMesh, frame: int, shading: Shading | None, colours: VertexColours | None
+    ) -> None:
+        """Write ``mesh``'s ``frame`` to ``path`` (:func:`write_mesh`) laid out so, with its
+        normals rebuilt where ``shading`` is given and its ``colours``."""
+        positions = mesh.frames[frame][self.written]
+        normals = None if shading is None else self.normals(positions, shading)
+        written_colours = None if colours is None else colours.of_frame(frame, self.written)
+        write_mesh(path, positions, self.faces, self.texture, normals, written_colours)
 
 
 def frame_layout(mesh: AnimatedMesh, texture: SequenceTexture | None, fmt: str, normals: bool) -> FrameLayout:
@@ -359,24 +425,24 @@ def _check_same_connectivity(
 
 def read_mesh_textured(
     path: str | os.PathLike, normals: bool = True
-) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None, VertexColours | None]:
     """:func:`read_mesh` with the file's texture coordinates and, with ``normals``, its normals,
     each an index per corner into its values: an OBJ's ``vt`` and ``vn`` lines
     (:func:`~.obj.read_obj_textured`), a PLY's per-vertex s, t and nx, ny, nz
-    (:func:`~.ply.read_ply_attributes`)."""
+    (:func:`~.ply.read_ply_attributes`); and its vertex colours."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
         return read_obj_textured(path, normals)
     if suffix != ".ply":
         return _geometry_of(path)  # refused, naming the suffixes read
-    vertices, faces, uvs, normal_rows = read_ply_attributes(path)
+    vertices, faces, uvs, normal_rows, colours = read_ply_attributes(path)
     return (vertices, faces, None if uvs is None else ObjTexture(uvs, faces),
-            None if normal_rows is None or not normals else ObjNormals(normal_rows, faces))  # fmt: skip
+            None if normal_rows is None or not normals else ObjNormals(normal_rows, faces), colours)  # fmt: skip
 
 
-def _geometry_of(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, None, None]:
+def _geometry_of(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, None, None, None]:
     """:func:`read_mesh` in the shape of :func:`read_mesh_textured`."""
-    return (*read_mesh(path), None, None)
+    return (*read_mesh(path), None, None, None)
 
 
 def read_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
@@ -396,19 +462,20 @@ def write_mesh(
     faces: np.ndarray,
     texture: ObjTexture | None = None,
     normals: ObjNormals | None = None,
+    colours: VertexColours | None = None,
 ) -> None:
     """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``, with ``texture``
     and ``normals``, each an index per corner into its values (a PLY file's are one per vertex:
-    ValueError where a vertex's corners have two)."""
+    ValueError where a vertex's corners have two), and one frame's vertex ``colours``."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
-        write_obj(path, vertices, faces, texture, normals)
+        write_obj(path, vertices, faces, texture, normals, colours)
     elif suffix == ".ply":
         uvs, normal_rows = (
             None if given is None else _per_vertex(path, name, len(vertices), faces, *given)
             for name, given in (("texture", texture), ("normals", normals))
         )
-        write_ply(path, vertices, faces, uvs=uvs, normals=normal_rows)
+        write_ply(path, vertices, faces, uvs=uvs, normals=normal_rows, colours=colours)
     else:
         raise ValueError(f"{os.fspath(path)}: expected one of {', '.join(MESH_SUFFIXES)}")
 

@@ -1,10 +1,11 @@
 """Wavefront OBJ geometry: ``v`` and ``f`` lines read (1-based or negative indices, ``a/b/c``
 corners, polygons fan-triangulated, ``#`` comments also at a line's end, a statement continued
 on the next line after a ``\\`` that ends its line; with :func:`read_obj_textured` also ``vt``
-and ``vn`` lines and the corners' indices into them; other statements such as ``g``,
-``usemtl`` are ignored, with a warning for unread ``vt`` and ``vn``; statements may be
-indented) and written, with texture coordinates and normals where given. Parsing works on the
-whole file's bytes with numpy: there is no Python loop over lines, vertices or faces."""
+and ``vn`` lines and the corners' indices into them, and colours (``v x y z r g b``); other
+statements such as ``g``, ``usemtl`` are ignored, with a warning for unread ``vt`` and ``vn``;
+statements may be indented) and written, with texture coordinates, normals and colours where
+given. Parsing works on the whole file's bytes with numpy: there is no Python loop over lines,
+vertices or faces."""
 
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ import numpy as np
 from .atomic import atomic_write
 from .errors import FormatError, UnreadAttributesWarning
 from .polygon_mesh import (
+    all_finite,
     check_face_indices,
     check_finite_vertices,
     checked_for_writing,
@@ -29,6 +31,7 @@ from .polygon_mesh import (
     polygon_mask,
 )
 from .tokens import parse_all, tokens_per_line
+from .vertex_colours import OBJ_COLOUR_NAMES, VertexColours
 
 
 class ObjTexture(NamedTuple):
@@ -68,28 +71,29 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         index outside the vertices defined so far, or faces that all have fewer than three
         corners (some such faces among polygons are left out with a warning).
     """
-    vertices, faces, _, _ = _read_obj(path, textured=False)
+    vertices, faces, _, _, _ = _read_obj(path, textured=False)
     return vertices, faces
 
 
 def read_obj_textured(
     path: str | os.PathLike, normals: bool = True
-) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
-    """:func:`read_obj` with the texture coordinates and normals: also the ``vt`` lines and each
-    corner's texture index (``v/vt`` or ``v/vt/vn``), and the ``vn`` lines and each corner's
-    normal index (``v/vt/vn`` or ``v//vn``); each None where the file has none, or where some
-    corners have one and others not (with an :class:`UnreadAttributesWarning`). FormatError
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None, VertexColours | None]:
+    """:func:`read_obj` with the texture coordinates, normals and colours: also the ``vt`` lines
+    and each corner's texture index (``v/vt`` or ``v/vt/vn``), and the ``vn`` lines and each
+    corner's normal index (``v/vt/vn`` or ``v//vn``); each None where the file has none, or where
+    some corners have one and others not (with an :class:`UnreadAttributesWarning`). FormatError
     also names a malformed ``vt`` or ``vn`` line and an index outside them. ``normals=False``
     leaves the ``vn`` lines unread, without a warning (a sequence's later frames, whose normals
-    the levels do not take)."""
+    the levels do not take). Where every ``v`` line has six values, the last three are the
+    vertex's colour (r, g, b); None otherwise, or, with a warning, where one is not finite."""
     return _read_obj(path, textured=True, normals=normals)
 
 
 def _read_obj(
     path: str | os.PathLike, textured: bool, normals: bool = False
-) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None]:
-    """:func:`read_obj`, and with ``textured`` its texture coordinates and, with ``normals``,
-    its normals (:func:`read_obj_textured`)."""
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None, VertexColours | None]:
+    """:func:`read_obj`, and with ``textured`` its texture coordinates, colours and, with
+    ``normals``, its normals (:func:`read_obj_textured`)."""
     path = Path(path)
     data = path.read_bytes()
     if data.startswith((b"\xfe\xff", b"\xff\xfe")):  # UTF-16 after its byte order mark (assimp's box_UTF16BE.obj)
@@ -124,9 +128,12 @@ def _read_obj(
     def name_vertex(vertex: int) -> str:
         return f"vertex {vertex} (line {vertex_lines[vertex]})"
 
-    vertices = _leading_values(path, vertex_block, len(vertex_lines), 3, 3, name_vertex, "coordinates")
-    vertices = vertices.astype(np.float32)
+    # Six values on every v line are x, y, z and a colour; otherwise values past z (a w) are dropped.
+    coloured = textured and len(vertex_lines) and np.all(_row_sizes(vertex_block, len(vertex_lines)) == 6)
+    values = _leading_values(path, vertex_block, len(vertex_lines), 6 if coloured else 3, 3, name_vertex, "coordinates")
+    vertices = values[:, :3].astype(np.float32)
     check_finite_vertices(path, vertices, name_vertex)
+    colours = all_finite(path, values[:, 3:].astype(np.float32), "colours", name_vertex) if coloured else None
 
     def name_face(face: int) -> str:
         return f"face {face} (line {face_lines[face]})"
@@ -145,7 +152,7 @@ def _read_obj(
     resolved = corners.resolved(face_block, vertex_lines, len(vertices), ("vertex", "vertices"))
     faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
     if not textured:
-        return vertices, faces, None, None
+        return vertices, faces, None, None, None
 
     def per_triangle(statements: tuple[bytes, np.ndarray], attribute: _Attribute) -> tuple | None:
         """The attribute's values and each triangle corner's index into them, or None."""
@@ -155,7 +162,8 @@ def _read_obj(
 
     texture = per_triangle(uv_statements, _TEXTURE)
     corner_normals = per_triangle(normal_statements, _NORMALS) if normals else None
-    return vertices, faces, texture and ObjTexture(*texture), corner_normals and ObjNormals(*corner_normals)
+    return (vertices, faces, texture and ObjTexture(*texture), corner_normals and ObjNormals(*corner_normals),
+            None if colours is None else VertexColours(colours[None], OBJ_COLOUR_NAMES, "f4"))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -231,15 +239,17 @@ def write_obj(
     faces: np.ndarray,
     texture: ObjTexture | None = None,
     normals: ObjNormals | None = None,
+    colours: VertexColours | None = None,
 ) -> None:
     """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically; with
     ``texture`` also its ``vt`` lines, with ``normals`` its ``vn`` lines, and each corner's
-    indices into them (``v/vt``, ``v//vn`` or ``v/vt/vn``).
+    indices into them (``v/vt``, ``v//vn`` or ``v/vt/vn``); with one frame's ``colours`` (three
+    channels) each ``v`` line's r, g, b after its x, y, z.
 
     Coordinates are written with 9 significant digits, which round-trips float32 exactly. A wrong
     shape, a coordinate that is not finite as float32 or a face index outside the vertices is a
-    ValueError naming the file and the argument (``vertices``, ``faces``, ``texture`` or
-    ``normals``); nothing is written.
+    ValueError naming the file and the argument (``vertices``, ``faces``, ``texture``,
+    ``normals`` or ``colours``); nothing is written.
     """
     vertices, faces = checked_for_writing(path, vertices, faces)
     vertices, faces = vertices.astype(np.float64), faces.astype(np.int64) + 1
@@ -257,9 +267,15 @@ def write_obj(
         lines += ((tag + " %.9g" * width + "\n") * len(values)) % tuple(values.ravel())
         columns.append(indices.astype(np.int64) + 1)
         corner += "/%d"
+    vertex_line = "v %.9g %.9g %.9g\n"
+    if colours is not None:
+        if len(colours.names) != 3:
+            raise ValueError(f"{os.fspath(path)}: colours: an OBJ v line holds r, g, b, got {', '.join(colours.names)}")
+        vertices = np.concatenate([vertices, colours.checked(path, len(vertices)).values[0]], axis=1)
+        vertex_line = "v %.9g %.9g %.9g %.9g %.9g %.9g\n"
     with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
         handle.write("# written by animlod\n")
-        handle.write(("v %.9g %.9g %.9g\n" * len(vertices)) % tuple(vertices.ravel()))
+        handle.write((vertex_line * len(vertices)) % tuple(vertices.ravel()))
         handle.write(lines)
         handle.write((f"f {corner} {corner} {corner}\n" * len(faces)) % tuple(np.stack(columns, axis=2).ravel()))
 

@@ -1,5 +1,6 @@
-"""PLY geometry: ``vertex`` x, y, z, the vertices' texture coordinates (s, t or its aliases) and
-normals (nx, ny, nz), and the ``face`` list ``vertex_indices`` read (ascii,
+"""PLY geometry: ``vertex`` x, y, z, the vertices' texture coordinates (s, t or its aliases),
+normals (nx, ny, nz) and colours (red, green, blue, alpha or their aliases), and the ``face``
+list ``vertex_indices`` read (ascii,
 binary_little_endian, binary_big_endian; other elements and properties are skipped, with a
 warning for the vertices' and faces' other properties) and written.
 Parsing works on the whole file's bytes with numpy: there is no Python loop over rows."""
@@ -17,6 +18,7 @@ import numpy as np
 from .atomic import atomic_write
 from .errors import FormatError, UnreadAttributesWarning
 from .polygon_mesh import (
+    all_finite,
     check_face_indices,
     check_finite_vertices,
     checked_for_writing,
@@ -26,6 +28,7 @@ from .polygon_mesh import (
     within_runs,
 )
 from .tokens import integer_tokens, parse_all, tokens_per_line
+from .vertex_colours import PLY_COLOUR_NAMES, VertexColours
 
 _PLY_TYPES = {
     name: code
@@ -41,6 +44,8 @@ _PLY_TYPES = {
     ]
     for name in names
 }
+# The name written for each type: PLY 1.0's original names, which every reader knows.
+_PLY_TYPE_NAMES = {code: name for name, code in _PLY_TYPES.items() if name.isalpha()}
 _PLY_FORMATS = {"ascii": None, "binary_little_endian": "<", "binary_big_endian": ">"}
 _FACE_LIST_NAMES = ("vertex_indices", "vertex_index")
 # A vertex's texture coordinates under the names exporters give them (Blender's s, t first, as
@@ -79,22 +84,25 @@ def read_ply(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         For an unreadable header, a body shorter than the header announces, a missing x/y/z,
         a non-finite coordinate or a face index out of range.
     """
-    vertices, faces, _, _ = _read_ply(Path(path), attributes=False)
+    vertices, faces, _, _, _ = _read_ply(Path(path), attributes=False)
     return vertices, faces
 
 
 def read_ply_attributes(
     path: str | os.PathLike,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, VertexColours | None]:
     """:func:`read_ply`, the vertices' texture coordinates ``uvs (V, 2) float32`` from the first of
     the scalar property pairs s, t / u, v / texture_u, texture_v / texture_s, texture_t the
-    vertex element has, and their normals ``(V, 3) float32`` from nx, ny, nz (each None where it
-    has none). Texture coordinates with a non-finite value are left out with a warning naming
-    the vertex; a non-finite normal reads as zero (no direction)."""
+    vertex element has, their normals ``(V, 3) float32`` from nx, ny, nz, and their colours from
+    red, green, blue (or diffuse_red, ...) and alpha where it has one, as stored (each None where
+    it has none). Texture coordinates or colours with a non-finite value are left out with a
+    warning naming the vertex; a non-finite normal reads as zero (no direction)."""
     return _read_ply(Path(path), attributes=True)
 
 
-def _read_ply(path: Path, attributes: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+def _read_ply(
+    path: Path, attributes: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, VertexColours | None]:
     data = path.read_bytes()
     byte_order, elements, body = _read_ply_header(path, data)
     if byte_order is None:
@@ -111,15 +119,13 @@ def _read_ply(path: Path, attributes: bool) -> tuple[np.ndarray, np.ndarray, np.
     texture_names = next((pair for pair in _TEXTURE_NAMES if scalar.issuperset(pair)), ()) if attributes else ()
     normal_names = _NORMAL_NAMES if attributes and scalar.issuperset(_NORMAL_NAMES) else ()
     uvs = np.stack([vertex[name] for name in texture_names], axis=1).astype(np.float32) if texture_names else None
-    if uvs is not None and not np.isfinite(uvs).all():  # carried to the levels, so all or none
-        bad = int(np.argmin(np.isfinite(uvs).all(axis=1)))
-        warnings.warn(f"{path}: vertex {bad}: its texture coordinates {uvs[bad].tolist()} are not finite; the levels "
-                      "are written without texture coordinates", UnreadAttributesWarning, stacklevel=3)  # fmt: skip
-        uvs = None
+    uvs = all_finite(path, uvs, "texture coordinates", _name_vertex)  # carried to the levels, so all or none
     normals = np.stack([vertex[name] for name in normal_names], axis=1).astype(np.float32) if normal_names else None
     if normals is not None:  # they only tell how the levels' rebuilt normals shade: a bad one tells nothing
         normals[~np.isfinite(normals).all(axis=1)] = 0.0
-    read = ("x", "y", "z", *texture_names, *normal_names)
+    colour_names = _colour_names(scalar) if attributes else ()
+    colours = _vertex_colours(path, elements, vertex, colour_names) if colour_names else None
+    read = ("x", "y", "z", *texture_names, *normal_names, *colour_names)
     face = values.get("face", {})
     face_list = next((face[name] for name in _FACE_LIST_NAMES if isinstance(face.get(name), tuple)), None)
     read_names = (("vertex", read), ("face", _FACE_LIST_NAMES))
@@ -132,7 +138,7 @@ def _read_ply(path: Path, attributes: bool) -> tuple[np.ndarray, np.ndarray, np.
     if face_list is None:
         if any(element.name == "face" and element.count for element in elements):
             raise FormatError(path, "element face", "has no list property vertex_indices")
-        return vertices, np.zeros((0, 3), dtype=np.int32), uvs, normals
+        return vertices, np.zeros((0, 3), dtype=np.int32), uvs, normals, colours
     sizes, corners = face_list
     if corners.dtype.kind == "f":
         raise FormatError(path, "element face", "vertex index list has float items; indices must be integers")
@@ -148,7 +154,30 @@ def _read_ply(path: Path, attributes: bool) -> tuple[np.ndarray, np.ndarray, np.
 
     corners = corners.astype(np.int64)
     check_face_indices(path, corners, corners, np.repeat(np.arange(sizes.size), sizes), len(vertices), name_face)
-    return vertices, fan_triangulate(corners, sizes), uvs, normals
+    return vertices, fan_triangulate(corners, sizes), uvs, normals, colours
+
+
+def _name_vertex(index: int) -> str:
+    return f"vertex {index}"
+
+
+def _colour_names(scalar: set[str]) -> tuple[str, ...]:
+    """The first of :data:`PLY_COLOUR_NAMES`' sets whose red, green and blue are among the vertex
+    element's ``scalar`` properties, with its alpha where that is one too; () for none."""
+    names = next((names for names in PLY_COLOUR_NAMES if scalar.issuperset(names[:3])), ())
+    return names if not names or names[3] in scalar else names[:3]
+
+
+def _vertex_colours(
+    path: Path, elements: list[_PlyElement], vertex: _ElementValues, names: tuple[str, ...]
+) -> VertexColours | None:
+    """The vertices' colours ``names``, in the type they are stored in (float32 where the
+    channels' types differ); None, with a warning, where one is not finite."""
+    declared = next(element for element in elements if element.name == "vertex").properties
+    types = {prop.type_code for prop in declared if prop.name in names}
+    values = np.stack([vertex[name] for name in names], axis=1).astype(np.float32)
+    values = all_finite(path, values, "colours", _name_vertex)
+    return None if values is None else VertexColours(values[None], names, types.pop() if len(types) == 1 else "f4")
 
 
 def write_ply(
@@ -158,17 +187,19 @@ def write_ply(
     binary: bool = True,
     uvs: np.ndarray | None = None,
     normals: np.ndarray | None = None,
+    colours: VertexColours | None = None,
 ) -> None:
     """Write ``vertices (V, 3)`` as float x, y, z (with ``uvs (V, 2)``, the vertices' texture
-    coordinates, as float s, t, and ``normals (V, 3)`` as float nx, ny, nz) and ``faces (M, 3)``
-    as uchar/int lists, atomically.
+    coordinates, as float s, t, ``normals (V, 3)`` as float nx, ny, nz, and one frame's
+    ``colours`` under their names and in their type) and ``faces (M, 3)`` as uchar/int lists,
+    atomically.
 
     ``binary=True`` writes binary_little_endian (exact); ``binary=False`` ascii with 9
     significant digits (exact for float32). Bad input is refused as :func:`write_obj` refuses it,
-    and ``uvs`` or ``normals`` of another vertex count or not finite with ValueError.
+    and ``uvs``, ``normals`` or ``colours`` of another vertex count or not finite with ValueError.
     """
     vertices, faces = checked_for_writing(path, vertices, faces)
-    columns, properties = [vertices.astype("<f4")], ["x", "y", "z"]
+    columns = [("x", vertices[:, 0]), ("y", vertices[:, 1]), ("z", vertices[:, 2])]
     for name, values, names in (("uvs", uvs, ("s", "t")), ("normals", normals, _NORMAL_NAMES)):
         if values is None:
             continue
@@ -176,10 +207,16 @@ def write_ply(
         if values.shape != (len(vertices), len(names)) or not np.isfinite(values).all():
             shape = (len(vertices), len(names))
             raise ValueError(f"{os.fspath(path)}: {name}: expected {shape} finite values, got {values.shape}")
-        columns.append(values.astype("<f4"))
-        properties += names
-    vertex_rows, faces = np.concatenate(columns, axis=1), faces.astype(np.int64)
-    property_lines = "".join(f"property float {name}\n" for name in properties)
+        columns += [(names[axis], values[:, axis].astype(np.float32)) for axis in range(len(names))]
+    if colours is not None:
+        stored = colours.stored(colours.checked(path, len(vertices)).values[0])
+        columns += [(name, stored[:, channel]) for channel, name in enumerate(colours.names)]
+    row = np.dtype([(name, values.dtype.newbyteorder("<")) for name, values in columns])
+    vertex_rows = np.empty(len(vertices), row)
+    for name, values in columns:
+        vertex_rows[name] = values
+    faces = faces.astype(np.int64)
+    property_lines = "".join(f"property {_PLY_TYPE_NAMES[row[name].str[1:]]} {name}\n" for name in row.names)
     header = (
         f"ply\nformat {'binary_little_endian' if binary else 'ascii'} 1.0\ncomment written by animlod\n"
         f"element vertex {len(vertices)}\n{property_lines}"
@@ -191,8 +228,9 @@ def write_ply(
         face_rows["indices"] = faces
         body = vertex_rows.tobytes() + face_rows.tobytes()
     else:
-        row = " ".join(["%.9g"] * vertex_rows.shape[1]) + "\n"
-        text = (row * len(vertex_rows)) % tuple(vertex_rows.astype(np.float64).ravel())
+        line = " ".join("%.9g" if row[name].kind == "f" else "%d" for name in row.names) + "\n"
+        table = np.stack([vertex_rows[name].astype(np.float64) for name in row.names], axis=1)
+        text = (line * len(vertex_rows)) % tuple(table.ravel())
         text += ("3 %d %d %d\n" * len(faces)) % tuple(faces.ravel())
         body = text.encode("ascii")
     with atomic_write(path, "wb") as handle:

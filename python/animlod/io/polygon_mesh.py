@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import AnimatedMesh
-from .errors import FormatError
+from .errors import FormatError, UnreadAttributesWarning
 from .tokens import parses
 
 
@@ -28,6 +28,20 @@ def polygon_mask(path: Path, sizes: np.ndarray, element: str, refusal: str) -> n
         warnings.warn(f"{path}: {element}: {short} of {sizes.size} faces have fewer than 3 vertices (points or "
                       "lines); left out", stacklevel=4)  # fmt: skip
     return polygons
+
+
+def all_finite(
+    path: Path, values: np.ndarray | None, what: str, name_vertex: Callable[[int], str]
+) -> np.ndarray | None:
+    """``values`` (a vertex attribute, a row per vertex) if every one is finite; else None, with a
+    warning naming the first vertex that is not: levels carry an attribute for every vertex or
+    for none."""
+    if values is None or np.isfinite(values).all():
+        return values
+    bad = int(np.argmin(np.isfinite(values).all(axis=1)))
+    warnings.warn(f"{path}: {name_vertex(bad)}: its {what} {values[bad].tolist()} are not finite; the levels are "
+                  f"written without {what}", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
+    return None
 
 
 def checked_for_writing(

@@ -9,7 +9,9 @@ s, t) are carried: each (position, texture coordinate) pair of its corners is a 
 of a position along a UV seam welded by AQEM and kept apart where their coordinates differ, and
 written back as ``vt`` lines or per PLY vertex. Its normals (OBJ ``vn``, PLY nx, ny, nz) are
 rebuilt on each level frame from the level's own faces, shaded as the input is (flat, hard
-edges, or smooth; PLY levels smooth only, one normal per vertex), and written back.
+edges, or smooth; PLY levels smooth only, one normal per vertex), and written back. Its vertex
+colours (PLY red, green, blue, alpha; OBJ ``v x y z r g b``), each frame's where they change,
+are interpolated along the collapses and written back as stored (PLY uchar stays uchar).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from ..aqem import Preparation, simplify_animated
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError, UnreadAttributesWarning
 from ..io.meshseq import SequenceTexture, normals_fit
+from ..io.vertex_colours import VertexColours
 from ..metrics import SurfaceError, surface_error
 from ..model import AnimatedMesh, whole_number
 from ..normals import Shading
@@ -87,6 +90,7 @@ def simplify_sequence(
     kind = input_kind(source)
     texture = None  # the sequence's texture coordinates, carried as AQEM attributes
     shading = None  # how the sequence's normals shade it, for the levels' rebuilt normals
+    colours = None  # its vertex colours, carried as AQEM attributes too
     if kind == "npz":
         from ..io.npz import read_npz
 
@@ -94,16 +98,16 @@ def simplify_sequence(
     elif kind == "sequence":
         from ..io.meshseq import read_textured_sequence
 
-        original, texture, shading = read_textured_sequence(source)
+        original, texture, shading, colours = read_textured_sequence(source)
     else:
         raise FormatError(os.fspath(source), "file", f"a {kind} file is not a mesh sequence")
     started = time.perf_counter()
     # The report keeps no collapse record, whose positions would take 12 bytes per collapse and frame.
     aqem_options = {**aqem_options, "record_positions": False}
-    if texture is not None:  # a point of the edge in every frame, where its texture coordinate is
+    if texture is not None or colours is not None:  # a point of the edge in every frame, where its attributes are
         aqem_options = {"placement": "on_edge", **aqem_options}
-    uvs = None if texture is None else texture.uvs
-    result = simplify_animated(original, ratios, progress=progress, attributes=uvs, **aqem_options)
+    carried = _CarriedAttributes(texture, colours)
+    result = simplify_animated(original, ratios, progress=progress, attributes=carried.columns(), **aqem_options)
     seconds = time.perf_counter() - started
     folder, stem, fmt = Path(output), input_stem(source), _level_format(kind, source)
     if shading is not None and not normals_fit(fmt.suffix, shading):
@@ -116,10 +120,8 @@ def simplify_sequence(
     for index, level in enumerate(result.levels, start=1):
         if measure and measuring is not None:
             measuring(index - 1, len(result.levels))
-        level_texture = (
-            None if texture is None else SequenceTexture(level.attributes, texture.points[level.kept_vertices])
-        )
-        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture, shading)
+        level_texture, level_colours = carried.of_level(level.attributes, level.kept_vertices)
+        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture, shading, level_colours)
         measured = _surface_error(*(_frames_of(mesh, frames) for mesh in (original, level.mesh))) if measure else None
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
@@ -130,6 +132,38 @@ def simplify_sequence(
     return SequenceReport(
         os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used), len(frames)
     )
+
+
+@dataclass(frozen=True)
+class _CarriedAttributes:
+    """The sequence's vertex attributes AQEM interpolates along its collapses: the texture
+    coordinates, then every frame's colours, as the columns of one array."""
+
+    texture: SequenceTexture | None
+    colours: VertexColours | None
+
+    def columns(self) -> np.ndarray | None:
+        """(V, A) float32: u, v where textured, then each frame's colour channels; None for none."""
+        parts = [] if self.texture is None else [self.texture.uvs]
+        if self.colours is not None:
+            frames, vertices, channels = self.colours.values.shape
+            parts.append(self.colours.values.transpose(1, 0, 2).reshape(vertices, frames * channels))
+        return np.concatenate(parts, axis=1, dtype=np.float32) if parts else None
+
+    def of_level(
+        self, attributes: np.ndarray | None, kept_vertices: np.ndarray
+    ) -> tuple[SequenceTexture | None, VertexColours | None]:
+        """A level's texture coordinates and colours, from its interpolated ``attributes`` and
+        the original vertices it ``kept``."""
+        texture = colours = None
+        if self.texture is not None:
+            texture = SequenceTexture(attributes[:, :2], self.texture.points[kept_vertices])
+        if self.colours is not None:
+            frames, _, channels = self.colours.values.shape
+            values = attributes[:, attributes.shape[1] - frames * channels :].reshape(-1, frames, channels)
+            colours = VertexColours(np.ascontiguousarray(values.transpose(1, 0, 2)), self.colours.names,
+                                    self.colours.type_code)  # fmt: skip
+        return texture, colours
 
 
 def _measured_frames(frame_count: int, limit: int | None) -> np.ndarray:
@@ -196,17 +230,23 @@ def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
 
 
 def _write_level(
-    fmt: _LevelFormat, target: Path, mesh: AnimatedMesh, texture: SequenceTexture | None, shading: Shading | None
+    fmt: _LevelFormat,
+    target: Path,
+    mesh: AnimatedMesh,
+    texture: SequenceTexture | None,
+    shading: Shading | None,
+    colours: VertexColours | None,
 ) -> Path:
-    """Write a level as ``fmt`` says, with its texture coordinates and rebuilt normals if any; its
-    path. A file's suffix is appended, not swapped:
+    """Write a level as ``fmt`` says, with its texture coordinates, rebuilt normals and colours if
+    any; its path. A file's suffix is appended, not swapped:
     ``walk.v2_lod1`` has the suffix ``.v2_lod1`` (every level of walk.v2.npz was written to
     walk.npz)."""
     if not fmt.one_file:
         from ..io.meshseq import write_sequence
 
         target.mkdir(parents=True, exist_ok=True)
-        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture, shading=shading)
+        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture, shading=shading,
+                       colours=colours)  # fmt: skip
         return target
     path = target.with_name(f"{target.name}.{fmt.suffix}")
     if fmt.suffix == "npz":
@@ -214,10 +254,7 @@ def _write_level(
 
         write_npz(path, mesh)
     else:  # one mesh in, one mesh out
-        from ..io.meshseq import frame_layout, write_mesh
+        from ..io.meshseq import frame_layout
 
-        layout = frame_layout(mesh, texture, fmt.suffix, normals=shading is not None)
-        positions = mesh.frames[0][layout.written]
-        normals = None if shading is None else layout.normals(positions, shading)
-        write_mesh(path, positions, layout.faces, layout.texture, normals)
+        frame_layout(mesh, texture, fmt.suffix, normals=shading is not None).write(path, mesh, 0, shading, colours)
     return path

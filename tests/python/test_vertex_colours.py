@@ -1,0 +1,192 @@
+"""An OBJ or PLY sequence's vertex colours (PLY red, green, blue, alpha; OBJ ``v x y z r g b``)
+reach every level `simplify` writes, stored as the input stores them and each frame's where they
+change; they were dropped (PLY, with a warning) or lost without a word (OBJ)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from simplify_inputs import twisting_cylinder, wrapped_texture
+
+from animlod.cli import main
+from animlod.io import VertexColours
+from animlod.io.meshseq import read_textured_sequence, write_mesh
+from animlod.io.obj import ObjTexture, read_obj, read_obj_textured, write_obj
+from animlod.io.ply import read_ply_attributes, write_ply
+
+
+def _height_colours(heights: np.ndarray, scale: float = 1.0) -> np.ndarray:
+    """(V, 4) RGBA 0-255 that follow the height linearly: red up, green down, blue and alpha flat."""
+    rising = (heights - heights.min()) / np.ptp(heights)
+    return np.stack([250 * rising * scale, 250 * (1 - rising), np.full_like(rising, 40), np.full_like(rising, 200)], 1)
+
+
+def _write_frames(folder, suffix, frames, faces, colours, texture=None):
+    """One file per frame; ``colours`` a VertexColours with one set or one per frame."""
+    folder.mkdir()
+    for index, frame in enumerate(frames):
+        write_mesh(folder / f"shot_{index}.{suffix}", frame, faces, texture, None, colours.of_frame(index))
+
+
+def _check_colours_follow_height(positions, colours, heights_range, scale=1.0, tolerance=1.0):
+    """The twist keeps each point's height, so a colour that follows the height at rest still
+    does at every level vertex of every frame (interpolated along the collapsed edges)."""
+    bottom, height = heights_range
+    expected = _height_colours(np.concatenate([positions[:, 1], [bottom, bottom + height]]), scale)[:-2]
+    np.testing.assert_allclose(colours, expected[:, : colours.shape[1]], atol=tolerance)
+
+
+@pytest.mark.parametrize("textured", [False, True])
+def test_a_ply_sequences_colours_reach_every_level_as_uchar(tmp_path, textured, capsys):
+    rest, twisted = twisting_cylinder()
+    heights = rest.frames[0][:, 1]
+    texture = ObjTexture(*wrapped_texture(rest)) if textured else None
+    faces, frames, rgba = rest.faces, twisted, _height_colours(heights)
+    if textured:  # a PLY vertex per (position, texture coordinate) pair, as exporters split a mesh
+        pairs, corner = np.unique(np.stack([faces.ravel(), texture.corners.ravel()], 1), axis=0, return_inverse=True)
+        faces, frames, rgba = corner.reshape(faces.shape), twisted[:, pairs[:, 0]], rgba[pairs[:, 0]]
+        texture = ObjTexture(texture.uvs[pairs[:, 1]], faces)
+    colours = VertexColours(rgba[None].astype(np.float32), ("red", "green", "blue", "alpha"), "u1")
+    _write_frames(tmp_path / "shot", "ply", frames, faces, colours, texture)
+    _write_frames(tmp_path / "plain", "ply", frames, faces, VertexColours(rgba[None, :, :0], (), "u1"), texture)
+    assert main(["info", str(tmp_path / "shot")]) == 0
+    assert "vertex colours: red, green, blue, alpha (u1)" in capsys.readouterr().out
+    for source in ("shot", "plain", "shot/shot_0.ply"):  # with colours, without, and one mesh file
+        on_edge = ["--placement", "on_edge"] if source == "plain" else []  # where a colour is a point's
+        assert main(["simplify", str(tmp_path / source), "-o", str(tmp_path / "out"), "--no-metrics", *on_edge]) == 0
+    assert "not read" not in capsys.readouterr().err
+    measure = (heights.min(), np.ptp(heights))
+    for level in (1, 2, 3):
+        for index in range(len(frames)):
+            path = tmp_path / "out" / f"shot_lod{level}" / f"shot_{index}.ply"
+            header = path.read_bytes().split(b"end_header")[0]
+            assert b"property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n" in header
+            positions, level_faces, _, _, read = read_ply_attributes(path)
+            assert read.values.shape == (1, len(positions), 4)
+            _check_colours_follow_height(positions, read.values[0], measure)
+            # Colours ride along: the same collapses as the sequence without them.
+            plain_positions, plain_faces, _, _, _ = read_ply_attributes(
+                tmp_path / "out" / f"plain_lod{level}" / path.name
+            )
+            np.testing.assert_array_equal(positions, plain_positions)
+            np.testing.assert_array_equal(level_faces, plain_faces)
+        positions, _, _, _, read = read_ply_attributes(tmp_path / "out" / f"shot_0_lod{level}.ply")
+        _check_colours_follow_height(positions, read.values[0], measure)
+
+
+def test_an_obj_sequences_colours_change_per_frame_and_reach_every_level(tmp_path, capsys):
+    rest, twisted = twisting_cylinder()
+    heights = rest.frames[0][:, 1]
+    # Each frame's colours its own: red brightens frame by frame (a capture's lighting changes).
+    scales = np.linspace(0.2, 1.0, len(twisted))
+    values = np.stack([_height_colours(heights, scale)[:, :3] / 255 for scale in scales]).astype(np.float32)
+    _write_frames(tmp_path / "shot", "obj", twisted, rest.faces, VertexColours(values, ("r", "g", "b"), "f4"))
+    assert read_obj(tmp_path / "shot" / "shot_0.obj")[0].shape == (len(heights), 3)  # geometry alone: x, y, z
+    assert main(["info", str(tmp_path / "shot")]) == 0
+    assert "vertex colours: r, g, b (f4, each frame's own)" in capsys.readouterr().out
+    assert main(["simplify", str(tmp_path / "shot"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    for level in (1, 2, 3):
+        for index, scale in enumerate(scales):
+            positions, _, _, _, read = read_obj_textured(tmp_path / "out" / f"shot_lod{level}" / f"shot_{index}.obj")
+            assert read.names == ("r", "g", "b") and read.type_code == "f4"
+            _check_colours_follow_height(positions, read.values[0] * 255, (heights.min(), np.ptp(heights)), scale)
+
+
+def test_colour_seams_stay_sharp(tmp_path):
+    """A PLY exporter splits a vertex where two colours meet: the copies weld for the collapses
+    and keep their own colours, so no level vertex takes a mix of the two."""
+    rest, twisted = twisting_cylinder()
+    angle = np.arctan2(rest.frames[0][:, 2], rest.frames[0][:, 0])
+    red_face = np.sin(angle[rest.faces]).mean(axis=1) > 0  # half of the cylinder red, the other blue
+    corner_colour = np.repeat(red_face, 3)
+    pairs, corner = np.unique(np.stack([rest.faces.ravel(), corner_colour], 1), axis=0, return_inverse=True)
+    rgb = np.where(pairs[:, 1:] == 1, [255.0, 0, 0], [0, 0, 255.0]).astype(np.float32)
+    colours = VertexColours(rgb[None], ("red", "green", "blue"), "u1")
+    _write_frames(tmp_path / "split", "ply", twisted[:, pairs[:, 0]], corner.reshape(-1, 3), colours)
+    assert main(["simplify", str(tmp_path / "split"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    for level in (1, 2, 3):
+        positions, _, _, _, read = read_ply_attributes(tmp_path / "out" / f"split_lod{level}" / "shot_2.ply")
+        assert {tuple(row) for row in read.values[0].tolist()} == {(255, 0, 0), (0, 0, 255)}
+        assert len(np.unique(positions, axis=0)) < len(positions)  # the seam's copies kept apart
+
+
+def test_frames_whose_colours_disagree_leave_them_out_with_a_warning(tmp_path):
+    rest, twisted = twisting_cylinder()
+    rgb = VertexColours(
+        _height_colours(rest.frames[0][:, 1])[None, :, :3].astype(np.float32), ("red", "green", "blue"), "u1"
+    )
+    _write_frames(tmp_path / "shot", "ply", twisted, rest.faces, rgb)
+    write_ply(tmp_path / "shot" / "shot_3.ply", twisted[3], rest.faces)
+    with pytest.warns(
+        UserWarning, match=r"shot_3.ply: has no vertex colours, and shot_0.ply has: the levels are written"
+    ):
+        mesh, _, _, colours = read_textured_sequence(tmp_path / "shot")
+    assert colours is None and mesh.frame_count == 5
+    as_float = VertexColours(rgb.values, rgb.names, "f4")
+    write_ply(tmp_path / "shot" / "shot_3.ply", twisted[3], rest.faces, colours=as_float)
+    with pytest.warns(UserWarning, match=r"shot_3.ply: stores its vertex colours otherwise than shot_0.ply"):
+        assert read_textured_sequence(tmp_path / "shot")[3] is None
+
+
+def test_colours_are_read_by_the_names_and_types_files_store_them_in(tmp_path):
+    header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    face = "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+    rows = "0 0 0 {}\n1 0 0 {}\n0 1 0 {}\n3 0 1 2\n"
+    # assimp's float-color.ply: float channels with alpha.
+    path = tmp_path / "float.ply"
+    channels = "property float red\nproperty float green\nproperty float blue\nproperty float alpha\n"
+    path.write_text(header + channels + face + rows.format("1 0 0 1", "0 1 0 0.5", "0 0 1 0"))
+    colours = read_ply_attributes(path)[4]
+    assert colours.names == ("red", "green", "blue", "alpha") and colours.type_code == "f4"
+    np.testing.assert_array_equal(colours.values[0], [[1, 0, 0, 1], [0, 1, 0, 0.5], [0, 0, 1, 0]])
+    path = tmp_path / "diffuse.ply"
+    channels = "property uchar diffuse_red\nproperty uchar diffuse_green\nproperty uchar diffuse_blue\n"
+    path.write_text(header + channels + face + rows.format("1 2 3", "4 5 6", "7 8 9"))
+    colours = read_ply_attributes(path)[4]
+    assert colours.names == ("diffuse_red", "diffuse_green", "diffuse_blue") and colours.type_code == "u1"
+    path = tmp_path / "nan.ply"
+    path.write_text(header + "property float red\nproperty float green\nproperty float blue\n" + face
+                    + rows.format("1 0 0", "nan 0 0", "0 0 1"))  # fmt: skip
+    with pytest.warns(UserWarning) as warned:
+        assert read_ply_attributes(path)[4] is None
+    assert [str(w.message).split(": ", 1)[1] for w in warned] == [
+        "vertex 1: its colours [nan, 0.0, 0.0] are not finite; the levels are written without colours"
+    ]
+
+
+def test_colours_are_written_in_their_type_in_both_encodings_and_checked(tmp_path):
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    faces = np.array([[0, 1, 2]], np.int32)
+    interpolated = np.array([[254.6, 0.4, 300], [-3, 127.5, 12], [1, 2, 3]], np.float32)  # rounded and clipped
+    colours = VertexColours(interpolated[None], ("red", "green", "blue"), "u1")
+    for binary in (True, False):
+        write_ply(tmp_path / f"c{binary}.ply", vertices, faces, binary=binary, colours=colours)
+        read = read_ply_attributes(tmp_path / f"c{binary}.ply")[4]
+        np.testing.assert_array_equal(read.values[0], [[255, 0, 255], [0, 128, 12], [1, 2, 3]])
+    assert "property uchar red" in (tmp_path / "cFalse.ply").read_text()
+    with pytest.raises(ValueError, match="colours: expected"):
+        write_ply(
+            tmp_path / "bad.ply", vertices, faces, colours=VertexColours(interpolated[None, :2], colours.names, "u1")
+        )
+    assert not (tmp_path / "bad.ply").exists()
+    write_obj(
+        tmp_path / "c.obj", vertices, faces, colours=VertexColours(interpolated[None] / 255, ("r", "g", "b"), "f4")
+    )
+    assert len((tmp_path / "c.obj").read_text().splitlines()[1].split()) == 7  # v x y z r g b
+    np.testing.assert_allclose(read_obj_textured(tmp_path / "c.obj")[4].values[0], interpolated / 255)
+    with pytest.raises(ValueError, match="colours: an OBJ v line holds r, g, b"):
+        write_obj(
+            tmp_path / "four.obj", vertices, faces, colours=VertexColours(np.zeros((1, 3, 4)), tuple("rgba"), "f4")
+        )
+
+
+def test_obj_v_lines_are_coloured_only_when_every_one_has_six_values(tmp_path):
+    faces = "f 1 2 3\n"
+    for name, lines, coloured in (("six", "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\n", True),
+                                  ("w", "v 0 0 0 1\nv 1 0 0 1\nv 0 1 0 1\n", False),
+                                  ("mixed", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\n", False)):  # fmt: skip
+        (tmp_path / f"{name}.obj").write_text(lines + faces)
+        vertices, _, _, _, colours = read_obj_textured(tmp_path / f"{name}.obj")
+        np.testing.assert_array_equal(vertices, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
+        assert (colours is not None) == coloured
+    np.testing.assert_array_equal(read_obj_textured(tmp_path / "six.obj")[4].values[0], np.eye(3))

@@ -74,7 +74,11 @@ def test_obj_texture_coordinates_and_normals_are_said_to_be_unread(tmp_path: Pat
         (tmp_path / "textured" / f"frame{index}.obj").write_text(textured)
     with pytest.warns(UnreadAttributesWarning) as caught:
         read_sequence(tmp_path / "textured")
-    assert len(caught) == 1 and "frame0.obj" in str(caught[0].message) and "vt, vn" in str(caught[0].message)
+    assert (
+        len(caught) == 1
+        and "frame0.obj" in str(caught[0].message)
+        and "(vt lines) and normals (vn lines)" in str(caught[0].message)
+    )
     (tmp_path / "plain.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     with warnings.catch_warnings():
         warnings.simplefilter("error", UnreadAttributesWarning)

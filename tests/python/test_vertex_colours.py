@@ -46,11 +46,11 @@ def test_a_ply_sequences_colours_reach_every_level_as_uchar(tmp_path, textured, 
         pairs, corner = np.unique(np.stack([faces.ravel(), texture.corners.ravel()], 1), axis=0, return_inverse=True)
         faces, frames, rgba = corner.reshape(faces.shape), twisted[:, pairs[:, 0]], rgba[pairs[:, 0]]
         texture = ObjTexture(texture.uvs[pairs[:, 1]], faces)
-    colours = VertexColours(rgba[None].astype(np.float32), ("red", "green", "blue", "alpha"), "u1")
+    colours = VertexColours(rgba[None].astype(np.float32), ("red", "green", "blue", "alpha"), ("u1",) * 4)
     _write_frames(tmp_path / "shot", "ply", frames, faces, colours, texture)
-    _write_frames(tmp_path / "plain", "ply", frames, faces, VertexColours(rgba[None, :, :0], (), "u1"), texture)
+    _write_frames(tmp_path / "plain", "ply", frames, faces, VertexColours(rgba[None, :, :0], (), ()), texture)
     assert main(["info", str(tmp_path / "shot")]) == 0
-    assert "vertex colours: red, green, blue, alpha (u1)" in capsys.readouterr().out
+    assert "vertex colours: red, green, blue, alpha (uchar)" in capsys.readouterr().out
     for source in ("shot", "plain", "shot/shot_0.ply"):  # with colours, without, and one mesh file
         on_edge = ["--placement", "on_edge"] if source == "plain" else []  # where a colour is a point's
         assert main(["simplify", str(tmp_path / source), "-o", str(tmp_path / "out"), "--no-metrics", *on_edge]) == 0
@@ -64,6 +64,9 @@ def test_a_ply_sequences_colours_reach_every_level_as_uchar(tmp_path, textured, 
             positions, level_faces, _, _, read = read_ply_attributes(path)
             assert read.values.shape == (1, len(positions), 4)
             _check_colours_follow_height(positions, read.values[0], measure)
+            # A UV seam's copies of a point keep one colour as the point moves.
+            _, first, copy_of = np.unique(positions, axis=0, return_index=True, return_inverse=True)
+            np.testing.assert_array_equal(read.values[0], read.values[0][first[copy_of.ravel()]])
             # Colours ride along: the same collapses as the sequence without them.
             plain_positions, plain_faces, _, _, _ = read_ply_attributes(
                 tmp_path / "out" / f"plain_lod{level}" / path.name
@@ -80,15 +83,14 @@ def test_an_obj_sequences_colours_change_per_frame_and_reach_every_level(tmp_pat
     # Each frame's colours its own: red brightens frame by frame (a capture's lighting changes).
     scales = np.linspace(0.2, 1.0, len(twisted))
     values = np.stack([_height_colours(heights, scale)[:, :3] / 255 for scale in scales]).astype(np.float32)
-    _write_frames(tmp_path / "shot", "obj", twisted, rest.faces, VertexColours(values, ("r", "g", "b"), "f4"))
-    assert read_obj(tmp_path / "shot" / "shot_0.obj")[0].shape == (len(heights), 3)  # geometry alone: x, y, z
+    _write_frames(tmp_path / "shot", "obj", twisted, rest.faces, VertexColours(values, ("r", "g", "b"), ("f4",) * 3))
     assert main(["info", str(tmp_path / "shot")]) == 0
-    assert "vertex colours: r, g, b (f4, each frame's own)" in capsys.readouterr().out
+    assert "vertex colours: r, g, b (float), each frame's own" in capsys.readouterr().out
     assert main(["simplify", str(tmp_path / "shot"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
     for level in (1, 2, 3):
         for index, scale in enumerate(scales):
             positions, _, _, _, read = read_obj_textured(tmp_path / "out" / f"shot_lod{level}" / f"shot_{index}.obj")
-            assert read.names == ("r", "g", "b") and read.type_code == "f4"
+            assert read.names == ("r", "g", "b") and read.types == ("f4",) * 3
             _check_colours_follow_height(positions, read.values[0] * 255, (heights.min(), np.ptp(heights)), scale)
 
 
@@ -101,7 +103,7 @@ def test_colour_seams_stay_sharp(tmp_path):
     corner_colour = np.repeat(red_face, 3)
     pairs, corner = np.unique(np.stack([rest.faces.ravel(), corner_colour], 1), axis=0, return_inverse=True)
     rgb = np.where(pairs[:, 1:] == 1, [255.0, 0, 0], [0, 0, 255.0]).astype(np.float32)
-    colours = VertexColours(rgb[None], ("red", "green", "blue"), "u1")
+    colours = VertexColours(rgb[None], ("red", "green", "blue"), ("u1",) * 3)
     _write_frames(tmp_path / "split", "ply", twisted[:, pairs[:, 0]], corner.reshape(-1, 3), colours)
     assert main(["simplify", str(tmp_path / "split"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
     for level in (1, 2, 3):
@@ -110,21 +112,46 @@ def test_colour_seams_stay_sharp(tmp_path):
         assert len(np.unique(positions, axis=0)) < len(positions)  # the seam's copies kept apart
 
 
+def test_a_uv_seams_copies_keep_one_colour(tmp_path):
+    """A file vertex's colour, copied to each side of a UV seam (an OBJ's v line; a PLY exporter's
+    split vertices), is one colour of one point: it moves with the point, and both copies say so
+    (each side interpolated alone, copies of one point drifted up to 19 uchar steps apart here)."""
+    rest, twisted = twisting_cylinder()
+    texture = ObjTexture(*wrapped_texture(rest))
+    pairs, corner = np.unique(np.stack([rest.faces.ravel(), texture.corners.ravel()], 1), axis=0, return_inverse=True)
+    rough = np.random.default_rng(5).uniform(0, 255, (rest.vertex_count, 3)).round().astype(np.float32)
+    colours = VertexColours(rough[pairs[:, 0]][None], ("red", "green", "blue"), ("u1",) * 3)
+    faces = corner.reshape(-1, 3).astype(np.int32)
+    _write_frames(tmp_path / "seam", "ply", twisted[:, pairs[:, 0]], faces, colours,
+                  ObjTexture(texture.uvs[pairs[:, 1]], faces))  # fmt: skip
+    assert main(["simplify", str(tmp_path / "seam"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    for level in (1, 2, 3):
+        positions, _, uvs, _, read = read_ply_attributes(tmp_path / "out" / f"seam_lod{level}" / "shot_4.ply")
+        _, first, copy_of = np.unique(positions, axis=0, return_index=True, return_inverse=True)
+        assert len(first) < len(positions) and len(np.unique(uvs[:, 0])) > 1  # the seam is there
+        np.testing.assert_array_equal(read.values[0], read.values[0][first[copy_of.ravel()]])
+
+
 def test_frames_whose_colours_disagree_leave_them_out_with_a_warning(tmp_path):
     rest, twisted = twisting_cylinder()
     rgb = VertexColours(
-        _height_colours(rest.frames[0][:, 1])[None, :, :3].astype(np.float32), ("red", "green", "blue"), "u1"
+        _height_colours(rest.frames[0][:, 1])[None, :, :3].astype(np.float32), ("red", "green", "blue"), ("u1",) * 3
     )
     _write_frames(tmp_path / "shot", "ply", twisted, rest.faces, rgb)
     write_ply(tmp_path / "shot" / "shot_3.ply", twisted[3], rest.faces)
     with pytest.warns(
-        UserWarning, match=r"shot_3.ply: has no vertex colours, and shot_0.ply has: the levels are written"
+        UserWarning,
+        match=r"shot_3.ply: has no vertex colours that can be read, and shot_0.ply has: the levels are written",
     ):
         mesh, _, _, colours = read_textured_sequence(tmp_path / "shot")
     assert colours is None and mesh.frame_count == 5
-    as_float = VertexColours(rgb.values, rgb.names, "f4")
+    as_float = VertexColours(rgb.values, rgb.names, ("u1", "u1", "f4"))
     write_ply(tmp_path / "shot" / "shot_3.ply", twisted[3], rest.faces, colours=as_float)
-    with pytest.warns(UserWarning, match=r"shot_3.ply: stores its vertex colours otherwise than shot_0.ply"):
+    with pytest.warns(
+        UserWarning,
+        match=r"shot_3.ply: stores its vertex colours as red, green, blue \(float, uchar\), and shot_0.ply as "
+        r"red, green, blue \(uchar\)",
+    ):
         assert read_textured_sequence(tmp_path / "shot")[3] is None
 
 
@@ -137,13 +164,13 @@ def test_colours_are_read_by_the_names_and_types_files_store_them_in(tmp_path):
     channels = "property float red\nproperty float green\nproperty float blue\nproperty float alpha\n"
     path.write_text(header + channels + face + rows.format("1 0 0 1", "0 1 0 0.5", "0 0 1 0"))
     colours = read_ply_attributes(path)[4]
-    assert colours.names == ("red", "green", "blue", "alpha") and colours.type_code == "f4"
+    assert colours.names == ("red", "green", "blue", "alpha") and colours.types == ("f4",) * 4
     np.testing.assert_array_equal(colours.values[0], [[1, 0, 0, 1], [0, 1, 0, 0.5], [0, 0, 1, 0]])
     path = tmp_path / "diffuse.ply"
     channels = "property uchar diffuse_red\nproperty uchar diffuse_green\nproperty uchar diffuse_blue\n"
     path.write_text(header + channels + face + rows.format("1 2 3", "4 5 6", "7 8 9"))
     colours = read_ply_attributes(path)[4]
-    assert colours.names == ("diffuse_red", "diffuse_green", "diffuse_blue") and colours.type_code == "u1"
+    assert colours.names == ("diffuse_red", "diffuse_green", "diffuse_blue") and colours.types == ("u1",) * 3
     path = tmp_path / "nan.ply"
     path.write_text(header + "property float red\nproperty float green\nproperty float blue\n" + face
                     + rows.format("1 0 0", "nan 0 0", "0 0 1"))  # fmt: skip
@@ -157,36 +184,54 @@ def test_colours_are_read_by_the_names_and_types_files_store_them_in(tmp_path):
 def test_colours_are_written_in_their_type_in_both_encodings_and_checked(tmp_path):
     vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
     faces = np.array([[0, 1, 2]], np.int32)
-    interpolated = np.array([[254.6, 0.4, 300], [-3, 127.5, 12], [1, 2, 3]], np.float32)  # rounded and clipped
-    colours = VertexColours(interpolated[None], ("red", "green", "blue"), "u1")
-    for binary in (True, False):
-        write_ply(tmp_path / f"c{binary}.ply", vertices, faces, binary=binary, colours=colours)
-        read = read_ply_attributes(tmp_path / f"c{binary}.ply")[4]
-        np.testing.assert_array_equal(read.values[0], [[255, 0, 255], [0, 128, 12], [1, 2, 3]])
-    assert "property uchar red" in (tmp_path / "cFalse.ply").read_text()
+    interpolated = np.array([[254.6, 0.4, 300, 0.25], [-3, 127.5, 12, 2**31], [1, 2, 3, -(2**31)]], np.float32)
+    # Each channel in its own type: uchar rounded and clipped, a double alpha, a full-range int.
+    as_double = [[255, 0, 255, 0.25], [0, 128, 12, 2**31], [1, 2, 3, -(2**31)]]
+    as_int = [[255, 0, 255, 0], [0, 128, 12, 2**31 - 1], [1, 2, 3, -(2**31)]]
+    for types, expected in ((("u1", "u1", "u1", "f8"), as_double), (("u1", "u1", "u1", "i4"), as_int)):
+        colours = VertexColours(interpolated[None], ("red", "green", "blue", "alpha"), types)
+        for binary in (True, False):
+            path = tmp_path / f"c{binary}{types[3]}.ply"
+            write_ply(path, vertices, faces, binary=binary, colours=colours)
+            read = read_ply_attributes(path)[4]
+            assert read.types == types
+            np.testing.assert_array_equal(read.values[0], np.float32(expected))
+    header = (tmp_path / "cFalsef8.ply").read_text()
+    assert "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty double alpha\n" in header
     with pytest.raises(ValueError, match="colours: expected"):
         write_ply(
-            tmp_path / "bad.ply", vertices, faces, colours=VertexColours(interpolated[None, :2], colours.names, "u1")
+            tmp_path / "bad.ply", vertices, faces, colours=VertexColours(interpolated[None, :2], ("red",), ("u1",))
         )
     assert not (tmp_path / "bad.ply").exists()
-    write_obj(
-        tmp_path / "c.obj", vertices, faces, colours=VertexColours(interpolated[None] / 255, ("r", "g", "b"), "f4")
-    )
-    assert len((tmp_path / "c.obj").read_text().splitlines()[1].split()) == 7  # v x y z r g b
-    np.testing.assert_allclose(read_obj_textured(tmp_path / "c.obj")[4].values[0], interpolated / 255)
-    with pytest.raises(ValueError, match="colours: an OBJ v line holds r, g, b"):
+    for channels in (3, 4):
+        floats = VertexColours(interpolated[None, :, :channels] / 255, tuple("rgba"[:channels]), ("f4",) * channels)
+        write_obj(tmp_path / "c.obj", vertices, faces, colours=floats)
+        assert len((tmp_path / "c.obj").read_text().splitlines()[1].split()) == 4 + channels  # v x y z r g b [a]
+        np.testing.assert_allclose(read_obj_textured(tmp_path / "c.obj")[4].values[0], floats.values[0])
+    with pytest.raises(ValueError, match="colours: an OBJ v line holds r, g, b and perhaps a"):
         write_obj(
-            tmp_path / "four.obj", vertices, faces, colours=VertexColours(np.zeros((1, 3, 4)), tuple("rgba"), "f4")
+            tmp_path / "two.obj", vertices, faces, colours=VertexColours(np.zeros((1, 3, 2)), ("r", "g"), ("f4",) * 2)
         )
 
 
-def test_obj_v_lines_are_coloured_only_when_every_one_has_six_values(tmp_path):
+def test_obj_v_lines_hold_colours_where_every_one_has_six_or_seven_values(tmp_path):
     faces = "f 1 2 3\n"
-    for name, lines, coloured in (("six", "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\n", True),
-                                  ("w", "v 0 0 0 1\nv 1 0 0 1\nv 0 1 0 1\n", False),
-                                  ("mixed", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\n", False)):  # fmt: skip
+    for name, lines, channels in (("six", "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\n", 3),
+                                  ("seven", "v 0 0 0 1 0 0 1\nv 1 0 0 0 1 0 1\nv 0 1 0 0 0 1 0.5\n", 4),
+                                  ("w", "v 0 0 0 1\nv 1 0 0 1\nv 0 1 0 1\n", 0)):  # fmt: skip
         (tmp_path / f"{name}.obj").write_text(lines + faces)
         vertices, _, _, _, colours = read_obj_textured(tmp_path / f"{name}.obj")
         np.testing.assert_array_equal(vertices, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
-        assert (colours is not None) == coloured
-    np.testing.assert_array_equal(read_obj_textured(tmp_path / "six.obj")[4].values[0], np.eye(3))
+        assert (0 if colours is None else colours.values.shape[2]) == channels
+    np.testing.assert_array_equal(read_obj_textured(tmp_path / "seven.obj")[4].values[0][:, 3], [1, 1, 0.5])
+    # Colours on some lines only, or one that is no number: read without them, aloud; geometry as ever.
+    for name, lines, reason in (
+        ("mixed", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\n", "2 of its 3 v lines have more"),
+        ("hex", "v 0 0 0 0x10 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\n", r"vertex 0 \(line 1\)"),
+    ):
+        (tmp_path / f"{name}.obj").write_text(lines + faces)
+        with pytest.warns(UserWarning, match=rf"{name}.obj: {reason}.*its colours are not read"):
+            vertices, _, _, _, colours = read_obj_textured(tmp_path / f"{name}.obj")
+        assert colours is None and len(vertices) == 3
+    with pytest.warns(UserWarning, match=r"six.obj: its colours \(on v lines\) are not read"):
+        read_obj(tmp_path / "six.obj")  # geometry alone, as tdag and face read a sequence

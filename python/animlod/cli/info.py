@@ -139,7 +139,7 @@ def _describe(kind: str, path: str) -> list[str]:
             lines[0] += f"; normals: {kind}{inward}, {fate}"
         if colours is not None:
             changing = ", each frame's own" if len(colours.values) > 1 else ""
-            lines[0] += f"; vertex colours: {', '.join(colours.names)} ({colours.type_code}{changing})"
+            lines[0] += f"; vertex colours: {colours.layout()}{changing}"
         names = [frame.name for frame in paths]
         if len(names) > 1:  # the order the frames are read in: a stray file shows at an end
             lines[-1] += f", {names[0]} .. {names[-1]}"

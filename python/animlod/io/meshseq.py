@@ -13,7 +13,7 @@ import os
 import re
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -145,7 +145,7 @@ def _read_frames(
     wedges, corner_wedge = np.unique(pairs, axis=0, return_inverse=True)
     split = AnimatedMesh(corner_wedge.reshape(faces.shape).astype(np.int32), frames[:, wedges[:, 0]], fps=fps)
     if colours is not None:
-        colours = VertexColours(colours.values[:, wedges[:, 0]], colours.names, colours.type_code)
+        colours = replace(colours, values=colours.values[:, wedges[:, 0]])
     return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32)), shading, colours
 
 
@@ -170,11 +170,11 @@ class _ColourFrames:
             return
         first = self.first_path.name
         if colours is None:
-            what = f"has no vertex colours, and {first} has"
+            what = f"has no vertex colours that can be read, and {first} has"
         elif self.first is None:
             what = f"has vertex colours, and {first} has none"
         else:
-            what = f"stores its vertex colours otherwise than {first} ({', '.join(colours.names)}, {colours.type_code})"
+            what = f"stores its vertex colours as {colours.layout()}, and {first} as {self.first.layout()}"
         self.dropped, self.values = f"{path}: {what}: the levels are written without them", None
 
     def read(self) -> VertexColours | None:
@@ -185,7 +185,7 @@ class _ColourFrames:
         if self.values is None:
             return None
         values = self.values[:1] if np.all(self.values == self.values[:1]) else self.values
-        return VertexColours(values, self.first.names, self.first.type_code)
+        return replace(self.first, values=values)
 
 
 def _shading_of(vertices: np.ndarray, faces: np.ndarray, normals: ObjNormals) -> Shading:

@@ -117,8 +117,10 @@ def _read_obj(
     (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines), uv_statements, normal_statements = (
         statements
     )
+    values_per_vertex = _row_sizes(vertex_block, len(vertex_lines))
     _warn_unread_attributes(path, vt=not textured and len(uv_statements[1]) > 0,
-                            vn=not textured and len(normal_statements[1]) > 0)  # fmt: skip
+                            vn=not textured and len(normal_statements[1]) > 0,
+                            colours=not textured and bool(np.any(values_per_vertex >= 6)))  # fmt: skip
     if not len(vertex_lines):
         _require_obj_statement(path, data)
     if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
@@ -128,12 +130,10 @@ def _read_obj(
     def name_vertex(vertex: int) -> str:
         return f"vertex {vertex} (line {vertex_lines[vertex]})"
 
-    # Six values on every v line are x, y, z and a colour; otherwise values past z (a w) are dropped.
-    coloured = textured and len(vertex_lines) and np.all(_row_sizes(vertex_block, len(vertex_lines)) == 6)
-    values = _leading_values(path, vertex_block, len(vertex_lines), 6 if coloured else 3, 3, name_vertex, "coordinates")
-    vertices = values[:, :3].astype(np.float32)
+    vertices = _leading_values(path, vertex_block, len(vertex_lines), 3, 3, name_vertex, "coordinates")
+    vertices = vertices.astype(np.float32)
     check_finite_vertices(path, vertices, name_vertex)
-    colours = all_finite(path, values[:, 3:].astype(np.float32), "colours", name_vertex) if coloured else None
+    colours = _vertex_colours(path, vertex_block, values_per_vertex, name_vertex) if textured else None
 
     def name_face(face: int) -> str:
         return f"face {face} (line {face_lines[face]})"
@@ -163,7 +163,34 @@ def _read_obj(
     texture = per_triangle(uv_statements, _TEXTURE)
     corner_normals = per_triangle(normal_statements, _NORMALS) if normals else None
     return (vertices, faces, texture and ObjTexture(*texture), corner_normals and ObjNormals(*corner_normals),
-            None if colours is None else VertexColours(colours[None], OBJ_COLOUR_NAMES, "f4"))  # fmt: skip
+            colours)  # fmt: skip
+
+
+def _vertex_colours(
+    path: Path, block: bytes, sizes: np.ndarray, name_vertex: Callable[[int], str]
+) -> VertexColours | None:
+    """The colours of the ``v`` lines (``block``, ``sizes`` values each) where every line has six
+    (x, y, z, r, g, b) or every line seven (and a); None, with a warning, where only some lines
+    have one or one does not parse or is not finite; None where no line has one."""
+    if not sizes.size or sizes.max() < 6:
+        return None
+    channels = int(sizes[0]) - 3
+    reason = None
+    if np.any(sizes != sizes[0]):
+        reason = f"{np.count_nonzero(sizes >= 6)} of its {sizes.size} v lines have more than x, y, z, others not"
+    elif channels not in (3, 4):
+        reason = f"its v lines have {sizes[0]} values, not x, y, z and r, g, b (and a)"
+    else:
+        try:
+            values = _leading_values(path, block, sizes.size, 3 + channels, 3, name_vertex, "values")[:, 3:]
+        except FormatError as error:
+            reason = str(error).removeprefix(f"{path}: ")
+    if reason is not None:
+        warnings.warn(f"{path}: {reason}: its colours are not read, and the levels are written without them",
+                      UnreadAttributesWarning, stacklevel=4)  # fmt: skip
+        return None
+    values = all_finite(path, values.astype(np.float32), "colours", name_vertex)
+    return None if values is None else VertexColours(values[None], OBJ_COLOUR_NAMES[:channels], ("f4",) * channels)
 
 
 @dataclass(frozen=True)
@@ -269,10 +296,11 @@ def write_obj(
         corner += "/%d"
     vertex_line = "v %.9g %.9g %.9g\n"
     if colours is not None:
-        if len(colours.names) != 3:
-            raise ValueError(f"{os.fspath(path)}: colours: an OBJ v line holds r, g, b, got {', '.join(colours.names)}")
-        vertices = np.concatenate([vertices, colours.checked(path, len(vertices)).values[0]], axis=1)
-        vertex_line = "v %.9g %.9g %.9g %.9g %.9g %.9g\n"
+        if len(colours.names) not in (3, 4):
+            raise ValueError(f"{os.fspath(path)}: colours: an OBJ v line holds r, g, b and perhaps a, got "
+                             f"{', '.join(colours.names)}")  # fmt: skip
+        vertices = np.concatenate([vertices, np.stack(colours.stored(path, len(vertices)), axis=1)], axis=1)
+        vertex_line = "v" + " %.9g" * vertices.shape[1] + "\n"
     with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
         handle.write("# written by animlod\n")
         handle.write((vertex_line * len(vertices)) % tuple(vertices.ravel()))
@@ -339,13 +367,13 @@ def _corner_field(face_block: bytes, field: int) -> tuple[bytes, int]:
 
 
 def _warn_unread_attributes(path: Path, **unread_tags: bool) -> None:
-    """Says that the file's ``vt`` or ``vn`` lines, where flagged, are not read, so that levels
-    written without them are no silent loss."""
+    """Says that the file's ``vt`` or ``vn`` lines, or the colours of its ``v`` lines, where
+    flagged, are not read, so that levels written without them are no silent loss."""
     unread = [tag for tag, flagged in unread_tags.items() if flagged]
     if unread:
-        kinds = " and ".join({"vt": "texture coordinates", "vn": "normals"}[tag] for tag in unread)
-        warnings.warn(f"{path}: its {kinds} ({', '.join(unread)} lines) are not read, and the levels are written "
-                      "without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
+        kinds = {"vt": "texture coordinates (vt lines)", "vn": "normals (vn lines)", "colours": "colours (on v lines)"}
+        warnings.warn(f"{path}: its {' and '.join(kinds[tag] for tag in unread)} are not read, and the levels are "
+                      "written without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
 
 
 def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:

@@ -28,7 +28,7 @@ from .polygon_mesh import (
     within_runs,
 )
 from .tokens import integer_tokens, parse_all, tokens_per_line
-from .vertex_colours import PLY_COLOUR_NAMES, VertexColours
+from .vertex_colours import PLY_COLOUR_NAMES, PLY_TYPE_NAMES, VertexColours
 
 _PLY_TYPES = {
     name: code
@@ -44,8 +44,6 @@ _PLY_TYPES = {
     ]
     for name in names
 }
-# The name written for each type: PLY 1.0's original names, which every reader knows.
-_PLY_TYPE_NAMES = {code: name for name, code in _PLY_TYPES.items() if name.isalpha()}
 _PLY_FORMATS = {"ascii": None, "binary_little_endian": "<", "binary_big_endian": ">"}
 _FACE_LIST_NAMES = ("vertex_indices", "vertex_index")
 # A vertex's texture coordinates under the names exporters give them (Blender's s, t first, as
@@ -171,13 +169,12 @@ def _colour_names(scalar: set[str]) -> tuple[str, ...]:
 def _vertex_colours(
     path: Path, elements: list[_PlyElement], vertex: _ElementValues, names: tuple[str, ...]
 ) -> VertexColours | None:
-    """The vertices' colours ``names``, in the type they are stored in (float32 where the
-    channels' types differ); None, with a warning, where one is not finite."""
-    declared = next(element for element in elements if element.name == "vertex").properties
-    types = {prop.type_code for prop in declared if prop.name in names}
+    """The vertices' colours ``names``, each with the type it is stored in; None, with a
+    warning, where one is not finite."""
+    declared = {prop.name: prop.type_code for prop in next(e for e in elements if e.name == "vertex").properties}
     values = np.stack([vertex[name] for name in names], axis=1).astype(np.float32)
     values = all_finite(path, values, "colours", _name_vertex)
-    return None if values is None else VertexColours(values[None], names, types.pop() if len(types) == 1 else "f4")
+    return None if values is None else VertexColours(values[None], names, tuple(declared[name] for name in names))
 
 
 def write_ply(
@@ -195,7 +192,7 @@ def write_ply(
     atomically.
 
     ``binary=True`` writes binary_little_endian (exact); ``binary=False`` ascii with 9
-    significant digits (exact for float32). Bad input is refused as :func:`write_obj` refuses it,
+    significant digits (exact for float32; 17 for double colours). Bad input is refused as :func:`write_obj` refuses it,
     and ``uvs``, ``normals`` or ``colours`` of another vertex count or not finite with ValueError.
     """
     vertices, faces = checked_for_writing(path, vertices, faces)
@@ -209,14 +206,13 @@ def write_ply(
             raise ValueError(f"{os.fspath(path)}: {name}: expected {shape} finite values, got {values.shape}")
         columns += [(names[axis], values[:, axis].astype(np.float32)) for axis in range(len(names))]
     if colours is not None:
-        stored = colours.stored(colours.checked(path, len(vertices)).values[0])
-        columns += [(name, stored[:, channel]) for channel, name in enumerate(colours.names)]
+        columns += list(zip(colours.names, colours.stored(path, len(vertices))))
     row = np.dtype([(name, values.dtype.newbyteorder("<")) for name, values in columns])
     vertex_rows = np.empty(len(vertices), row)
     for name, values in columns:
         vertex_rows[name] = values
     faces = faces.astype(np.int64)
-    property_lines = "".join(f"property {_PLY_TYPE_NAMES[row[name].str[1:]]} {name}\n" for name in row.names)
+    property_lines = "".join(f"property {PLY_TYPE_NAMES[row[name].str[1:]]} {name}\n" for name in row.names)
     header = (
         f"ply\nformat {'binary_little_endian' if binary else 'ascii'} 1.0\ncomment written by animlod\n"
         f"element vertex {len(vertices)}\n{property_lines}"
@@ -228,7 +224,8 @@ def write_ply(
         face_rows["indices"] = faces
         body = vertex_rows.tobytes() + face_rows.tobytes()
     else:
-        line = " ".join("%.9g" if row[name].kind == "f" else "%d" for name in row.names) + "\n"
+        digits = {4: "%.9g", 8: "%.17g"}  # each float round-trips
+        line = " ".join(digits[row[name].itemsize] if row[name].kind == "f" else "%d" for name in row.names) + "\n"
         table = np.stack([vertex_rows[name].astype(np.float64) for name in row.names], axis=1)
         text = (line * len(vertex_rows)) % tuple(table.ravel())
         text += ("3 %d %d %d\n" * len(faces)) % tuple(faces.ravel())

@@ -20,12 +20,12 @@ import os
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..aqem import Preparation, simplify_animated
+from ..aqem import Preparation, SimplifiedLevel, simplify_animated
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError, UnreadAttributesWarning
 from ..io.meshseq import SequenceTexture, normals_fit
@@ -106,8 +106,10 @@ def simplify_sequence(
     aqem_options = {**aqem_options, "record_positions": False}
     if texture is not None or colours is not None:  # a point of the edge in every frame, where its attributes are
         aqem_options = {"placement": "on_edge", **aqem_options}
-    carried = _CarriedAttributes(texture, colours)
-    result = simplify_animated(original, ratios, progress=progress, attributes=carried.columns(), **aqem_options)
+    carried = _CarriedAttributes.of(original, texture, colours)
+    per_vertex, per_point = carried.columns()
+    result = simplify_animated(original, ratios, progress=progress, attributes=per_vertex,
+                               position_attributes=per_point, **aqem_options)  # fmt: skip
     seconds = time.perf_counter() - started
     folder, stem, fmt = Path(output), input_stem(source), _level_format(kind, source)
     if shading is not None and not normals_fit(fmt.suffix, shading):
@@ -120,7 +122,7 @@ def simplify_sequence(
     for index, level in enumerate(result.levels, start=1):
         if measure and measuring is not None:
             measuring(index - 1, len(result.levels))
-        level_texture, level_colours = carried.of_level(level.attributes, level.kept_vertices)
+        level_texture, level_colours = carried.of_level(level)
         path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture, shading, level_colours)
         measured = _surface_error(*(_frames_of(mesh, frames) for mesh in (original, level.mesh))) if measure else None
         surface = measured.summary() if measured is not None else None
@@ -137,33 +139,52 @@ def simplify_sequence(
 @dataclass(frozen=True)
 class _CarriedAttributes:
     """The sequence's vertex attributes AQEM interpolates along its collapses: the texture
-    coordinates, then every frame's colours, as the columns of one array."""
+    coordinates per vertex (a UV seam's copies apart), and every frame's colours. Colours are
+    carried per point where every copy of a position has its colour (an OBJ file's, which its
+    ``v`` lines hold; a PLY file's split at UV seams), so that a seam's copies keep one colour as
+    the point moves; per vertex where copies differ (a colour seam, kept sharp)."""
 
     texture: SequenceTexture | None
     colours: VertexColours | None
+    colours_by_point: bool
 
-    def columns(self) -> np.ndarray | None:
-        """(V, A) float32: u, v where textured, then each frame's colour channels; None for none."""
-        parts = [] if self.texture is None else [self.texture.uvs]
+    @classmethod
+    def of(cls, mesh: AnimatedMesh, texture: SequenceTexture | None, colours: VertexColours | None):
+        """The attributes of ``mesh`` carried: its ``texture`` and ``colours`` (either may be None)."""
+        by_point = False
+        if colours is not None:  # copies of a position in the first frame: those AQEM may weld
+            flat = _frame_columns(colours.values)
+            _, first, copy_of = np.unique(mesh.frames[0], axis=0, return_index=True, return_inverse=True)
+            by_point = bool(np.array_equal(flat, flat[first[copy_of.ravel()]]))
+        return cls(texture, colours, by_point)
+
+    def columns(self) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """(V, A) per-vertex and (V, B) per-point float32 columns (each None for none): u, v where
+        textured, and each frame's colour channels, with the one or the other."""
+        per_vertex = [] if self.texture is None else [self.texture.uvs]
+        per_point = []
         if self.colours is not None:
-            frames, vertices, channels = self.colours.values.shape
-            parts.append(self.colours.values.transpose(1, 0, 2).reshape(vertices, frames * channels))
-        return np.concatenate(parts, axis=1, dtype=np.float32) if parts else None
+            (per_point if self.colours_by_point else per_vertex).append(_frame_columns(self.colours.values))
+        return tuple(np.concatenate(parts, axis=1, dtype=np.float32) if parts else None
+                     for parts in (per_vertex, per_point))  # fmt: skip
 
-    def of_level(
-        self, attributes: np.ndarray | None, kept_vertices: np.ndarray
-    ) -> tuple[SequenceTexture | None, VertexColours | None]:
-        """A level's texture coordinates and colours, from its interpolated ``attributes`` and
-        the original vertices it ``kept``."""
+    def of_level(self, level: SimplifiedLevel) -> tuple[SequenceTexture | None, VertexColours | None]:
+        """A level's texture coordinates and colours, from its interpolated attributes."""
         texture = colours = None
         if self.texture is not None:
-            texture = SequenceTexture(attributes[:, :2], self.texture.points[kept_vertices])
+            texture = SequenceTexture(level.attributes[:, :2], self.texture.points[level.kept_vertices])
         if self.colours is not None:
             frames, _, channels = self.colours.values.shape
-            values = attributes[:, attributes.shape[1] - frames * channels :].reshape(-1, frames, channels)
-            colours = VertexColours(np.ascontiguousarray(values.transpose(1, 0, 2)), self.colours.names,
-                                    self.colours.type_code)  # fmt: skip
+            columns = level.position_attributes if self.colours_by_point else level.attributes[:, -frames * channels :]
+            values = columns.reshape(-1, frames, channels).transpose(1, 0, 2)
+            colours = replace(self.colours, values=np.ascontiguousarray(values))
         return texture, colours
+
+
+def _frame_columns(values: np.ndarray) -> np.ndarray:
+    """(K, V, C) values per frame and vertex as (V, K * C) columns."""
+    frames, vertices, channels = values.shape
+    return values.transpose(1, 0, 2).reshape(vertices, frames * channels)
 
 
 def _measured_frames(frame_count: int, limit: int | None) -> np.ndarray:

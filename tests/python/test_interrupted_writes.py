@@ -168,3 +168,23 @@ def test_a_non_finite_number_is_named_and_nothing_is_written(tmp_path: Path) -> 
     with pytest.raises(ValueError, match=r"JSON /nodes/0/extras/animlod/error: not a finite number"):
         builder.save(tmp_path / "level.glb")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sequence_level_interrupted_while_written_leaves_no_folder(tmp_path: Path, monkeypatch) -> None:
+    """`simplify` wrote each level's frames into a temporary folder beside an empty folder of the
+    level's name, made first: an interrupted run left that empty folder under a final name."""
+    import animlod.io.meshseq as meshseq
+    from animlod.pipelines.lod_sequence import simplify_sequence
+
+    write_sequence(tmp_path / "bar", synth.twisting_bar(frames=3, rings=8, segments=6), "obj")
+    written = meshseq.write_mesh
+
+    def interrupted_in_level_2(path, *args, **kwargs):
+        if "bar_lod2" in str(path):
+            raise KeyboardInterrupt
+        written(path, *args, **kwargs)
+
+    monkeypatch.setattr(meshseq, "write_mesh", interrupted_in_level_2)
+    with pytest.raises(KeyboardInterrupt):
+        simplify_sequence(tmp_path / "bar", tmp_path / "out", measure=False)
+    assert sorted(entry.name for entry in (tmp_path / "out").iterdir()) == ["bar_lod1"]

@@ -265,7 +265,6 @@ def _write_level(
     if not fmt.one_file:
         from ..io.meshseq import write_sequence
 
-        target.mkdir(parents=True, exist_ok=True)
         write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture, shading=shading,
                        colours=colours)  # fmt: skip
         return target

@@ -67,6 +67,18 @@ def ellipsoid(frames: int = 4, rings: int = 14, segments: int = 20) -> AnimatedM
     return AnimatedMesh(faces, (unit[None] * scale[:, None]).astype(np.float32))
 
 
+def tube_with_bow_tie_and_fin() -> AnimatedMesh:
+    """:func:`bending_tube` (2 frames) with a closed tetrahedron touching it at vertex 0 only (a
+    bow tie) and a fin: one more face on the tube's edge (0, 13)."""
+    mesh = bending_tube(frames=2)
+    apex = mesh.frames[:, :1] + np.array([-0.5, 0.0, 0.0], np.float32)
+    fin = mesh.frames[:, :1] + np.array([0.0, 0.0, 0.4], np.float32)
+    frames = np.concatenate([mesh.frames, apex, apex + [[[0, 0.3, 0]]], apex + [[[0, 0, 0.3]]], fin], axis=1)
+    a, b, c, tip = 192, 193, 194, 195
+    faces = np.concatenate([mesh.faces, [[0, b, a], [0, c, b], [0, a, c], [a, b, c], [0, 13, tip]]])
+    return AnimatedMesh(faces, frames)
+
+
 def two_bone_tube(frames: int = 8) -> tuple[SkinnedMesh, Motion]:
     """The tube skinned to two joints (root at x = -1, elbow at x = 0) and a motion bending the
     elbow by up to 90 degrees about z."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from simplify_inputs import bending_tube, twisting_cylinder, wrapped_texture
+from simplify_inputs import bending_tube, tube_with_bow_tie_and_fin, twisting_cylinder, wrapped_texture
 
 from animlod.cli import main
 from animlod.io.meshseq import read_mesh, read_sequence, write_mesh, write_sequence
@@ -240,6 +240,16 @@ def test_simplify_npz_with_metrics_and_plot(tmp_path, capsys):
     assert level.face_count <= 108
     assert (tmp_path / "out" / "tube_levels.png").stat().st_size > 1000
     assert "e-0" in capsys.readouterr().out  # a measured Hausdorff/RMS value
+
+
+def test_plot_of_a_sequence_with_a_bow_tie_shows_the_features_simplify_used(tmp_path, capsys):
+    """The plot found the features again on the raw input, which a bow tie (scans, CAD exports)
+    refuses: the levels were written, then the run failed with exit code 2."""
+    mesh = tube_with_bow_tie_and_fin()
+    write_sequence(tmp_path / "scan", mesh, "obj")
+    assert main(["simplify", str(tmp_path / "scan"), "-o", str(tmp_path / "out"), "--no-metrics", "--plot"]) == 0
+    assert (tmp_path / "out" / "scan_levels.png").stat().st_size > 1000
+    assert "non-manifold" not in capsys.readouterr().err
 
 
 def test_bad_ratio_and_bad_mesh_exit_with_code_2(tmp_path, capsys):

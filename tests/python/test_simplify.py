@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 import pytest
-from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube
+from simplify_inputs import bending_tube, directed_edges_unique, ellipsoid, tube, tube_with_bow_tie_and_fin
 
 from animlod import _core
 from animlod.aqem import simplify_animated
@@ -258,20 +258,8 @@ def test_crane_sequence_at_ten_percent(data_dir):
     assert result.levels[-1].error < 0.02 * diagonal
 
 
-def _tube_with_bow_tie_and_fin() -> AnimatedMesh:
-    mesh = bending_tube(frames=2)
-    # A closed tetrahedron that touches the tube at vertex 0 only (a bow tie), and a fin: one
-    # more face on the tube's edge (0, 13).
-    apex = mesh.frames[:, :1] + np.array([-0.5, 0.0, 0.0], np.float32)
-    fin = mesh.frames[:, :1] + np.array([0.0, 0.0, 0.4], np.float32)
-    frames = np.concatenate([mesh.frames, apex, apex + [[[0, 0.3, 0]]], apex + [[[0, 0, 0.3]]], fin], axis=1)
-    a, b, c, tip = 192, 193, 194, 195
-    faces = np.concatenate([mesh.faces, [[0, b, a], [0, c, b], [0, a, c], [a, b, c], [0, 13, tip]]])
-    return AnimatedMesh(faces, frames)
-
-
 def test_a_bow_tie_vertex_and_a_three_face_edge_simplify_without_new_holes():
-    mesh = _tube_with_bow_tie_and_fin()
+    mesh = tube_with_bow_tie_and_fin()
     faces, frames = mesh.faces, mesh.frames
     result = simplify_animated(mesh, (0.5,))
     assert result.preparation.split_vertices >= 1
@@ -289,7 +277,7 @@ def test_a_bow_tie_vertex_and_a_three_face_edge_simplify_without_new_holes():
 def test_many_non_manifold_pieces_are_prepared_as_each_piece_alone():
     # Enough copies for the preparation's two workers (each takes half of the points), which
     # must cut every bow tie and fin as the preparation of one piece does.
-    piece = _tube_with_bow_tie_and_fin()
+    piece = tube_with_bow_tie_and_fin()
     copies = 240
     offsets = (np.arange(copies) * piece.vertex_count)[:, None, None]
     faces = (piece.faces[None] + offsets).reshape(-1, 3)

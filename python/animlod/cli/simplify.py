@@ -154,7 +154,7 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
     if args.plot:
         first = report.drawables[0]
         folder = output.parent if not args.separate else output
-        _plot(folder / f"{input_stem(args.input)}_levels.png", first.rest_meshes[0], first.rest_meshes[1:], False)
+        _plot(folder / f"{input_stem(args.input)}_levels.png", first.rest_meshes[0], first.rest_meshes[1:], None)
     return 0
 
 
@@ -210,7 +210,9 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
             print(f"note: level {index}: stopped at {level.faces} faces (target {level.target_faces}): {why}")
     if args.plot:
         levels = [_read_level(level.path) for level in report.levels]
-        features = not args.no_features
+        # The weights AQEM used, per input vertex: features found on the raw input would need
+        # the manifold surface the simplifier prepares (welded, cut), which scanned meshes lack.
+        features = None if args.no_features else report.vertex_weights > 1.0
         _plot(Path(args.output) / f"{input_stem(args.input)}_levels.png", report.original, levels, features)
     return 0
 
@@ -244,27 +246,27 @@ class _ProgressBar:
             self.bar.close()
 
 
-def _plot(path: Path, original: AnimatedMesh, levels: list[AnimatedMesh], show_features: bool) -> None:
-    """One frame (the middle) of the original with its motion features in red, then each level."""
+def _plot(path: Path, original: AnimatedMesh, levels: list[AnimatedMesh], feature_vertices: np.ndarray | None) -> None:
+    """One frame (the middle) of the original, the faces touching ``feature_vertices`` (motion
+    features, per vertex) in red where given, then each level."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    from ..aqem import motion_features
     from ..io.atomic import atomic_write
 
     frame = original.frame_count // 2
-    red = np.zeros(original.face_count, dtype=bool)
-    if show_features:
-        in_feature = motion_features(original).vertex_feature >= 0
-        red = in_feature[original.faces].any(axis=1)
-    meshes = [(original, red, f"original, {original.face_count} faces" + (" (features red)" if show_features else ""))]
+    shown = feature_vertices is not None
+    red = feature_vertices[original.faces].any(axis=1) if shown else np.zeros(original.face_count, dtype=bool)
+    meshes = [(original, red, f"original, {original.face_count} faces" + (" (features red)" if shown else ""))]
     meshes += [(mesh, np.zeros(mesh.face_count, bool), f"{mesh.face_count} faces") for mesh in levels]
     figure = plt.figure(figsize=(4 * len(meshes), 4.5))
     corners = original.frames[frame]
     low, high = corners.min(axis=0), corners.max(axis=0)
+    flat = 0.5 * max(float(np.max(high - low)), 1e-9) * (high <= low)  # a planar mesh's third axis
+    low, high = low - flat, high + flat
     for index, (mesh, highlight, title) in enumerate(meshes):
         axes = figure.add_subplot(1, len(meshes), index + 1, projection="3d")
         triangles = mesh.frames[min(frame, mesh.frame_count - 1)][mesh.faces]

@@ -63,6 +63,7 @@ class SequenceReport:
     seconds: float  # the simplification (all levels), without reading, writing or measuring
     frames_used: int  # frames whose quadrics drove it (fewer than the sequence's when limited)
     frames_measured: int  # frames the surface errors are over (0: not measured)
+    vertex_weights: np.ndarray  # (V,) Eq. 6 weight of each input vertex, 1 outside motion features
 
 
 def simplify_sequence(
@@ -131,9 +132,8 @@ def simplify_sequence(
         levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error))
     if measure and measuring is not None:
         measuring(len(result.levels), len(result.levels))
-    return SequenceReport(
-        os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used), len(frames)
-    )
+    return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used),
+                          len(frames), result.vertex_weights)  # fmt: skip
 
 
 @dataclass(frozen=True)

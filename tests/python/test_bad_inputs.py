@@ -171,6 +171,9 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
     ("readers", "glTF 0.8 document", lambda t: ["info", str(_write(t / "v08.gltf",  # Qt 3D's wine.gltf
         b'{"asset": {"version": 0.8}, "accessors": {"a": {}}}'))],
      "v08.gltf: asset: glTF version 0.8 is not 2.x; convert it to glTF 2.0 first"),
+    ("readers", "glTF 1.0 document, version an integer", lambda t: ["info", str(_write(t / "v1i.gltf",  # collada2gltf's
+        b'{"asset": {"version": 1}, "accessors": {"a": {}}}'))],  # CesiumMilkTruck
+     "v1i.gltf: asset: glTF version 1 is not 2.x; convert it to glTF 2.0 first"),
     ("readers", "glTF 1.0 binary file", lambda t: ["info", str(_write(t / "v1.glb",
         b"glTF" + struct.pack("<IIII", 1, 28, 8, 0) + b'{"a": 1}'))],
      "v1.glb: GLB header: container version 1 is not 2: a glTF 1.0 binary file; convert it to glTF 2.0"),

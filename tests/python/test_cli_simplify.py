@@ -256,6 +256,9 @@ def test_bad_ratio_and_bad_mesh_exit_with_code_2(tmp_path, capsys):
     write_npz(tmp_path / "tube.npz", bending_tube(frames=2))
     assert main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), "--ratio", "1.5"]) == 2
     assert "--ratio" in capsys.readouterr().err
+    # 0 quietly meant the default; a count of frames is one or more.
+    assert main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), "--max-frames", "0"]) == 2
+    assert "--max-frames: must be >= 1, got 0" in capsys.readouterr().err
     mesh = bending_tube(frames=2)
     flat = np.zeros_like(mesh.frames)  # every vertex at one point: no face has an area
     write_npz(tmp_path / "bad.npz", type(mesh)(mesh.faces, flat))

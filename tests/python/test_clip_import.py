@@ -298,6 +298,10 @@ def test_a_bvh_clip_of_another_shape_plays_by_name_up_to_namespace(split_charact
     np.testing.assert_allclose(
         _played_positions(document, kept), _played_positions(GltfDocument(whole), kept), atol=2e-5
     )
+    # A joint the character has no counterpart for (a prop, a tail) is left out, and said so.
+    notes = []
+    with_clips(GltfDocument(rest), [_bvh_in(tmp_path, "tail", _edited(walk, order, {"Head": "Tail"}))], notes.append)
+    assert "; 1 BVH joint(s) with no counterpart in rest.glb left out (Tail)" in notes[0]
 
 
 def test_a_bvh_clip_of_another_rig_is_refused_naming_the_joint(split_character, tmp_path):

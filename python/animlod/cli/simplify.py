@@ -12,7 +12,7 @@ from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind, input_stem
 from ..model import AnimatedMesh
 from ..options import AqemOptions
 from ..pipelines.lod_sequence import MEASURED_FRAMES
-from . import UserError, add_joint_map_argument, non_negative_int, print_rows
+from . import UserError, add_joint_map_argument, positive_int, print_rows
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -51,10 +51,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument(
         "--max-frames",
-        type=non_negative_int,
-        default=0,
-        help="sequences: quadrics over K frames chosen to cover the motion; glTF: the most frames of all clips "
-        "that drive the simplification (default 48)",
+        type=positive_int,
+        default=None,
+        help="sequences: quadrics over K frames chosen to cover the motion (default: every frame, unless their "
+        "quadrics would not fit in memory); glTF: the most frames of all clips that drive the simplification "
+        "(default 48)",
     )
     parser.add_argument(
         "--placement",
@@ -171,7 +172,7 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
             measured_frames=args.metric_frames,
             progress=progress,
             measuring=measuring,
-            max_frames=args.max_frames,
+            max_frames=args.max_frames or 0,  # 0: every frame that fits
             **options,
         )
     finally:

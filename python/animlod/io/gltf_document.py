@@ -704,8 +704,10 @@ def _check_top_level(path: str, document: Any) -> None:
     version = asset.get("version") if isinstance(asset, dict) else None
     if not (isinstance(version, str) and version.startswith("2.")):
         reason = "has no version (glTF 2.0 requires one)" if version is None else f"glTF version {version!r} is not 2.x"
-        # Before 1.0 the version was a number (collada2gltf's 0.8, Qt 3D's examples).
-        if isinstance(version, (str, float)) and str(version).startswith(("0.", "1.")):
+        # Before 1.0 the version was a number (collada2gltf's 0.8, Qt 3D's examples), and
+        # collada2gltf wrote 1.0 as the integer 1 (Cesium's CesiumMilkTruck).
+        number = isinstance(version, (int, float)) and not isinstance(version, bool)
+        if (number and 0 <= version < 2) or (isinstance(version, str) and version.startswith(("0.", "1."))):
             reason += f"; {_UPGRADE_ADVICE}"
         raise FormatError(path, "asset", reason)
     for key in _TOP_LEVEL_ARRAYS:

@@ -116,7 +116,7 @@ def add_bvh_clip(
     if match.note:
         notes.append(match.note)
     if left_out:
-        notes.append(f"{len(left_out)} joint(s) {into} has not left out ({', '.join(left_out[:5])}"
+        notes.append(f"{len(left_out)} BVH joint(s) with no counterpart in {into} left out ({', '.join(left_out[:5])}"
                      f"{', ...' if len(left_out) > 5 else ''})")  # fmt: skip
     if pose_note:
         notes.append(pose_note)

@@ -84,7 +84,7 @@ def with_clips(
         into = Path(doc.path).name
         if not added:
             raise source.fail("animations", f"none moves a node of {into}'s by name (another rig?)")
-        dropped = f"; {left_out} channel(s) on nodes {into} has not, or of weights, left out" if left_out else ""
+        dropped = f"; {left_out} channel(s) on nodes {into} lacks, or on morph weights, left out" if left_out else ""
         total = len(source.gltf.animations)
         note(f"{os.fspath(clip_file)}: {added} of its {total} clip(s) added to {into}{dropped}")
     return GltfDocument(doc.path, doc.max_animation_frames, data=builder.to_bytes())

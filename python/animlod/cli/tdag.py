@@ -231,15 +231,20 @@ def run_query(args: argparse.Namespace) -> int:
         tolerance = _tolerance(dag, args.tolerance, args.relative)
     else:
         tolerance = dag.tolerance_for_faces(cut_frame, args.faces)
-    what = f"tolerance {tolerance:.4g}" + (f" (for at most {args.faces} faces)" if args.faces else "")
     if args.camera is not None:
         mesh = dag.query_view(args.frame, args.camera, args.pixels, args.focal)
-        what = f"view from {tuple(args.camera)}, {args.pixels:g} px at focal {args.focal:g}"
     elif args.level == 3:
         mesh = dag.query(args.frame, tolerance)
     else:
         dag.query(start, tolerance)
         mesh = dag.advance(args.frame, args.level)
+    what = f"tolerance {tolerance:.4g}"
+    if args.faces is not None:  # a budget below the coarsest cut gets that cut, which is over it
+        within = mesh.face_count <= args.faces
+        what += f" (for at most {args.faces} faces)" if within else f" (the coarsest cut, over {args.faces} faces)"
+    if args.camera is not None:
+        what = f"view from {tuple(args.camera)}, {args.pixels:g} px at focal {args.focal:g}"
+    elif args.level != 3:
         what += f", level {args.level} from the cut of frame {start}"
     write_mesh(output, mesh.positions, mesh.faces)
     backs = int(np.count_nonzero(dag.two_sided))  # a two-sided face is one face of the TDAG, two of the mesh

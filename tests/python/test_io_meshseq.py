@@ -693,3 +693,16 @@ def test_points_and_lines_in_a_ply_face_element_are_left_out_with_a_warning(tmp_
     np.testing.assert_array_equal(faces, [[0, 1, 2]])
     lines = _write(tmp_path / "lines.ply", _ascii_ply("property list uchar int vertex_indices", "2 0 1\n1 2\n"))
     assert _error(lines) == f"{lines}: element face: all 2 faces have fewer than 3 vertices (points or lines)"
+
+
+def test_obj_materials_not_carried_are_named(tmp_path):
+    """An OBJ file's materials (mtllib, usemtl) are not written to the levels: a textured scan's
+    levels came out untextured without a word."""
+    text = "mtllib scan.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl skin\nf 1 2 3\n  usemtl\tcloth\nf 2 4 3\n"
+    (tmp_path / "scan.obj").write_text(text)
+    with pytest.warns(UnreadAttributesWarning, match=r"scan.obj: its materials \(usemtl lines\) are not read"):
+        assert read_sequence(tmp_path / "scan.obj").face_count == 2
+    (tmp_path / "named.obj").write_text(text.replace("usemtl", "g"))  # groups alone are no material
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnreadAttributesWarning)
+        read_sequence(tmp_path / "named.obj")

@@ -2,10 +2,10 @@
 corners, polygons fan-triangulated, ``#`` comments also at a line's end, a statement continued
 on the next line after a ``\\`` that ends its line; with :func:`read_obj_textured` also ``vt``
 and ``vn`` lines and the corners' indices into them, and colours (``v x y z r g b``); other
-statements such as ``g``, ``usemtl`` are ignored, with a warning for unread ``vt`` and ``vn``;
-statements may be indented) and written, with texture coordinates, normals and colours where
-given. Parsing works on the whole file's bytes with numpy: there is no Python loop over lines,
-vertices or faces."""
+statements such as ``g``, ``usemtl`` are ignored, with a warning for unread ``vt``, ``vn`` and
+``usemtl``; statements may be indented) and written, with texture coordinates, normals and
+colours where given. Parsing works on the whole file's bytes with numpy: there is no Python
+loop over lines, vertices or faces."""
 
 from __future__ import annotations
 
@@ -120,7 +120,8 @@ def _read_obj(
     values_per_vertex = _row_sizes(vertex_block, len(vertex_lines))
     _warn_unread_attributes(path, vt=not textured and len(uv_statements[1]) > 0,
                             vn=not textured and len(normal_statements[1]) > 0,
-                            colours=not textured and bool(np.any(values_per_vertex >= 6)))  # fmt: skip
+                            colours=not textured and bool(np.any(values_per_vertex >= 6)),
+                            usemtl=re.search(rb"(?m)^usemtl[ \t]", data) is not None)  # fmt: skip
     if not len(vertex_lines):
         _require_obj_statement(path, data)
     if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
@@ -367,11 +368,13 @@ def _corner_field(face_block: bytes, field: int) -> tuple[bytes, int]:
 
 
 def _warn_unread_attributes(path: Path, **unread_tags: bool) -> None:
-    """Says that the file's ``vt`` or ``vn`` lines, or the colours of its ``v`` lines, where
-    flagged, are not read, so that levels written without them are no silent loss."""
+    """Says that the file's ``vt`` or ``vn`` lines, the colours of its ``v`` lines or its
+    materials (``usemtl`` lines), where flagged, are not read, so that levels written without
+    them are no silent loss."""
     unread = [tag for tag, flagged in unread_tags.items() if flagged]
     if unread:
-        kinds = {"vt": "texture coordinates (vt lines)", "vn": "normals (vn lines)", "colours": "colours (on v lines)"}
+        kinds = {"vt": "texture coordinates (vt lines)", "vn": "normals (vn lines)", "colours": "colours (on v lines)",
+                 "usemtl": "materials (usemtl lines)"}  # fmt: skip
         warnings.warn(f"{path}: its {' and '.join(kinds[tag] for tag in unread)} are not read, and the levels are "
                       "written without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
 

@@ -14,6 +14,18 @@ import numpy as np
 
 from . import _core, rotations
 
+# Joint deformations this close (on any matrix entry) count as equal when naming the joint that
+# deforms: float32 keys and rotations leave ~1e-7 between joints a scale carries into alike.
+_DEFORMATION_NOISE = 1e-5
+
+
+def joint_depths(parents: np.ndarray) -> np.ndarray:
+    """Number of ancestors of every joint, ``(J,) int64`` (parents in topological order)."""
+    depth = np.zeros(parents.size, dtype=np.int64)
+    for joint in range(1, parents.size):  # O(J): parents come first
+        depth[joint] = depth[parents[joint]] + 1
+    return depth
+
 
 def spread_frames(frame_count: int, count: int) -> np.ndarray:
     """(<= count,) int frame indices spread evenly over [0, frame_count), both ends included."""
@@ -319,11 +331,22 @@ class Motion:
         return self.joint_deformations.copy()
 
     def deforming_joint(self) -> str | None:
-        """The joint whose deformation strays furthest from the identity; None for a rigid motion."""
+        """The joint that starts the deformation: the one whose deformation strays furthest from
+        what its parent's gives it, the shallowest of those that float noise alone tells apart;
+        None for a rigid motion."""
         if self.joint_deformations is None:
             return None
-        deviation = np.abs(self.joint_deformations - np.eye(3)).max(axis=(0, 2, 3))
-        return self.skeleton.names[int(np.argmax(deviation))]
+        # A parent's scale carries into every joint below it: by the world deviation alone, a
+        # scaled root ties with all its descendants and float noise named one of them.
+        deformations = self.joint_deformations
+        parents = self.skeleton.parents[1:]
+        turns = rotations.to_matrix(self.local_rotations[:, 1:])  # a joint's rigid frame in its parent's
+        inherited = np.broadcast_to(np.eye(3), deformations.shape).copy()
+        inherited[:, 1:] = np.swapaxes(turns, -1, -2) @ deformations[:, parents] @ turns
+        deviation = np.abs(deformations - inherited).max(axis=(0, 2, 3))
+        depths = joint_depths(self.skeleton.parents)
+        largest = np.flatnonzero(deviation >= deviation.max() - _DEFORMATION_NOISE)
+        return self.skeleton.names[int(largest[np.argmin(depths[largest])])]
 
     def require_rigid(self, what: str) -> None:
         """ValueError saying that ``what`` takes rigid motions only, when joints of this one deform."""

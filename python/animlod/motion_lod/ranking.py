@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _core, rotations
-from ..model import Motion, spread_frames
+from ..model import Motion, joint_depths, spread_frames
 
 RANKINGS = ("refit", "importance", "paper", "depth", "variance", "cumulative")
 DEFAULT_RANKING = "refit"
@@ -41,14 +41,6 @@ PAPER_RANKING = "paper"
 PROPOSING_RANKINGS = ("importance", "cumulative", "depth", "variance")
 # Frames the cumulative ranking measures at most (evenly spaced among the analysis frames).
 CUMULATIVE_FRAMES = 150
-
-
-def joint_depths(parents: np.ndarray) -> np.ndarray:
-    """Number of ancestors of every joint, ``(J,) int64`` (parents in topological order)."""
-    depth = np.zeros(parents.size, dtype=np.int64)
-    for joint in range(1, parents.size):  # O(J): parents come first
-        depth[joint] = depth[parents[joint]] + 1
-    return depth
 
 
 def rotation_variance(motion: Motion, frames: np.ndarray) -> np.ndarray:

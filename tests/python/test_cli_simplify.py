@@ -82,14 +82,14 @@ def test_an_obj_sequences_texture_coordinates_reach_every_level(tmp_path, capsys
     levels = [sorted((tmp_path / "out" / f"shot_lod{level}").iterdir()) for level in (1, 2, 3)]
     for frames in [*levels, *([tmp_path / "out" / f"rest_lod{level}.obj"] for level in (1, 2, 3))]:
         for path in frames:
-            positions, faces, written, _, _ = read_obj_textured(path)
+            positions, faces, written, _, _, _ = read_obj_textured(path)
             assert written is not None and len(written.uvs) > len(positions)  # the seam stays open in uv
             corners, uvs = positions[faces], written.uvs[written.corners]
             np.testing.assert_allclose(
                 uvs[..., 1] * height, corners[..., 1] - rest.frames[0][:, 1].min(), atol=1e-3 * height
             )
         # u: the angle at rest, linear along each edge (chord) as the coordinates are: near it
-        positions, faces, written, _, _ = read_obj_textured(frames[0])
+        positions, faces, written, _, _, _ = read_obj_textured(frames[0])
         angle = np.arctan2(positions[faces][..., 2], positions[faces][..., 0]) / (2 * np.pi)
         off = np.abs((written.uvs[written.corners][..., 0] - angle + 0.5) % 1.0 - 0.5)
         assert off.max() < 0.05, (frames[0], off.max())
@@ -149,7 +149,7 @@ def test_an_obj_sequences_normals_are_rebuilt_on_every_level_as_shaded(tmp_path,
     outward = -1.0 if shading == "clockwise" else 1.0  # along the winding's normal, or against it
     for level in (1, 2, 3):
         for path in sorted((tmp_path / "out" / f"shot_lod{level}").iterdir()):
-            positions, level_faces, _, written, _ = read_obj_textured(path)
+            positions, level_faces, _, written, _, _ = read_obj_textured(path)
             assert written is not None
             if said == "smooth":
                 np.testing.assert_array_equal(written.corners, level_faces)  # one normal per position

@@ -92,14 +92,14 @@ def test_obj_texture_coordinates_are_read_per_corner(tmp_path: Path) -> None:
             "f 1/1/1 2/2/1 3/3/1 4/4/1\nf 1/5 3/-3 4/-2\n")  # fmt: skip
     (tmp_path / "quad.obj").write_text(text)
     with pytest.warns(UnreadAttributesWarning, match=r"4 of 7 face corners have normals \(vn\), the others none"):
-        vertices, faces, texture, normals, _ = obj.read_obj_textured(tmp_path / "quad.obj")
+        vertices, faces, texture, normals, _, _ = obj.read_obj_textured(tmp_path / "quad.obj")
     assert normals is None
     np.testing.assert_array_equal(faces, [[0, 1, 2], [0, 2, 3], [0, 2, 3]])
     np.testing.assert_array_equal(texture.uvs, [[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0]])
     np.testing.assert_array_equal(texture.corners, [[0, 1, 2], [0, 2, 3], [4, 2, 3]])
     # Round trip: written as v/vt corners, read back the same.
     obj.write_obj(tmp_path / "again.obj", vertices, faces, texture)
-    again_vertices, again_faces, again, _, _ = obj.read_obj_textured(tmp_path / "again.obj")
+    again_vertices, again_faces, again, _, _, _ = obj.read_obj_textured(tmp_path / "again.obj")
     for read, written in ((again_vertices, vertices), (again_faces, faces), (again.uvs, texture.uvs),
                           (again.corners, texture.corners)):  # fmt: skip
         np.testing.assert_array_equal(read, written)
@@ -110,14 +110,14 @@ def test_obj_normals_are_read_per_corner_and_written_back(tmp_path: Path) -> Non
     both attributes written back as v/vt/vn corners."""
     text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nvn 0 0.6 0.8\nf 1//1 2//2 3//-1\nf 2//1 4//2 3//-2\n"
     (tmp_path / "quad.obj").write_text(text)
-    vertices, faces, texture, normals, _ = obj.read_obj_textured(tmp_path / "quad.obj")
+    vertices, faces, texture, normals, _, _ = obj.read_obj_textured(tmp_path / "quad.obj")
     assert texture is None
     np.testing.assert_array_equal(normals.normals, np.float32([[0, 0, 1], [0, 0.6, 0.8]]))
     np.testing.assert_array_equal(normals.corners, [[0, 1, 1], [0, 1, 0]])
     uvs = obj.ObjTexture(np.array([[0, 0], [1, 1]], np.float32), np.array([[0, 1, 0], [1, 1, 0]], np.int32))
     obj.write_obj(tmp_path / "again.obj", vertices, faces, uvs, normals)
     assert "f 1/1/1 2/2/2 3/1/2" in (tmp_path / "again.obj").read_text()
-    _, _, again_uvs, again_normals, _ = obj.read_obj_textured(tmp_path / "again.obj")
+    _, _, again_uvs, again_normals, _, _ = obj.read_obj_textured(tmp_path / "again.obj")
     for read, written in zip((*again_uvs, *again_normals), (*uvs, *normals)):
         np.testing.assert_array_equal(read, written)
     (tmp_path / "bad.obj").write_text(text.replace("3//-2", "3//5"))
@@ -157,14 +157,14 @@ def test_a_texture_coordinates_extra_values_are_dropped_as_a_vertexs_are(tmp_pat
     (tmp_path / "extra.obj").write_text(
         "v 0 0 0 1 abc\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0 0 abc\nvt 0.5\nf 1/1 2/2 3/3\n"
     )
-    _, _, texture, _, _ = obj.read_obj_textured(tmp_path / "extra.obj")
+    _, _, texture, _, _, _ = obj.read_obj_textured(tmp_path / "extra.obj")
     np.testing.assert_array_equal(texture.uvs, [[0, 0], [1, 0], [0.5, 0]])
 
 
 def test_texture_coordinates_on_some_corners_only_are_left_out_with_a_warning(tmp_path: Path) -> None:
     (tmp_path / "mixed.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 2 4 3\n")
     with pytest.warns(UnreadAttributesWarning, match="3 of 6 face corners have texture coordinates"):
-        _, faces, texture, _, _ = obj.read_obj_textured(tmp_path / "mixed.obj")
+        _, faces, texture, _, _, _ = obj.read_obj_textured(tmp_path / "mixed.obj")
     assert texture is None and len(faces) == 2
 
 
@@ -178,13 +178,13 @@ def test_a_textured_sequence_has_a_vertex_per_position_and_texture_coordinate(tm
     (tmp_path / "seam").mkdir()
     for index in range(3):
         obj.write_obj(tmp_path / "seam" / f"f{index}.obj", positions + index, faces, texture)
-    mesh, split, shading, _ = meshseq.read_textured_sequence(tmp_path / "seam")
+    mesh, split, shading, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
     assert mesh.vertex_count == 6 and shading is None and mesh.frame_count == 3
     np.testing.assert_array_equal(mesh.frames[2], positions[split.points] + 2)
     np.testing.assert_array_equal(split.uvs[mesh.faces], texture.uvs[texture.corners])
     # Written back: one v per position, the seam's two texture coordinates apart.
     paths = write_sequence(tmp_path / "out", mesh, texture=split)
-    vertices, written_faces, written, _, _ = obj.read_obj_textured(paths[1])
+    vertices, written_faces, written, _, _, _ = obj.read_obj_textured(paths[1])
     np.testing.assert_array_equal(vertices[written_faces], positions[faces] + 1)
     np.testing.assert_array_equal(written.uvs[written.corners], texture.uvs[texture.corners])
     # As PLY: a row per vertex, the seam's copies each with its own texture coordinate.
@@ -195,12 +195,12 @@ def test_a_textured_sequence_has_a_vertex_per_position_and_texture_coordinate(tm
     # A frame with other texture coordinates: none are carried, and a warning says why.
     obj.write_obj(tmp_path / "seam" / "f2.obj", positions, faces, texture._replace(uvs=texture.uvs[::-1].copy()))
     with pytest.warns(UnreadAttributesWarning, match=r"f2.obj: has texture coordinates other than f0.obj's"):
-        mesh, split, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
+        mesh, split, _, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
     assert split is None and mesh.vertex_count == 4
     # The first frame without them, the others with: the same.
     obj.write_obj(tmp_path / "seam" / "f0.obj", positions, faces)
     with pytest.warns(UnreadAttributesWarning, match=r"f1.obj: has texture coordinates, and f0.obj has none"):
-        mesh, split, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
+        mesh, split, _, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
     assert split is None
 
 

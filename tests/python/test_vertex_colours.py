@@ -89,7 +89,7 @@ def test_an_obj_sequences_colours_change_per_frame_and_reach_every_level(tmp_pat
     assert main(["simplify", str(tmp_path / "shot"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
     for level in (1, 2, 3):
         for index, scale in enumerate(scales):
-            positions, _, _, _, read = read_obj_textured(tmp_path / "out" / f"shot_lod{level}" / f"shot_{index}.obj")
+            positions, _, _, _, read, _ = read_obj_textured(tmp_path / "out" / f"shot_lod{level}" / f"shot_{index}.obj")
             assert read.names == ("r", "g", "b") and read.types == ("f4",) * 3
             _check_colours_follow_height(positions, read.values[0] * 255, (heights.min(), np.ptp(heights)), scale)
 
@@ -143,7 +143,7 @@ def test_frames_whose_colours_disagree_leave_them_out_with_a_warning(tmp_path):
         UserWarning,
         match=r"shot_3.ply: has no vertex colours that can be read, and shot_0.ply has: the levels are written",
     ):
-        mesh, _, _, colours = read_textured_sequence(tmp_path / "shot")
+        mesh, _, _, colours, _ = read_textured_sequence(tmp_path / "shot")
     assert colours is None and mesh.frame_count == 5
     as_float = VertexColours(rgb.values, rgb.names, ("u1", "u1", "f4"))
     write_ply(tmp_path / "shot" / "shot_3.ply", twisted[3], rest.faces, colours=as_float)
@@ -220,7 +220,7 @@ def test_obj_v_lines_hold_colours_where_every_one_has_six_or_seven_values(tmp_pa
                                   ("seven", "v 0 0 0 1 0 0 1\nv 1 0 0 0 1 0 1\nv 0 1 0 0 0 1 0.5\n", 4),
                                   ("w", "v 0 0 0 1\nv 1 0 0 1\nv 0 1 0 1\n", 0)):  # fmt: skip
         (tmp_path / f"{name}.obj").write_text(lines + faces)
-        vertices, _, _, _, colours = read_obj_textured(tmp_path / f"{name}.obj")
+        vertices, _, _, _, colours, _ = read_obj_textured(tmp_path / f"{name}.obj")
         np.testing.assert_array_equal(vertices, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
         assert (0 if colours is None else colours.values.shape[2]) == channels
     np.testing.assert_array_equal(read_obj_textured(tmp_path / "seven.obj")[4].values[0][:, 3], [1, 1, 0.5])
@@ -231,7 +231,7 @@ def test_obj_v_lines_hold_colours_where_every_one_has_six_or_seven_values(tmp_pa
     ):
         (tmp_path / f"{name}.obj").write_text(lines + faces)
         with pytest.warns(UserWarning, match=rf"{name}.obj: {reason}.*its colours are not read"):
-            vertices, _, _, _, colours = read_obj_textured(tmp_path / f"{name}.obj")
+            vertices, _, _, _, colours, _ = read_obj_textured(tmp_path / f"{name}.obj")
         assert colours is None and len(vertices) == 3
     with pytest.warns(UserWarning, match=r"six.obj: its colours \(on v lines\) are not read"):
         read_obj(tmp_path / "six.obj")  # geometry alone, as tdag and face read a sequence

@@ -122,7 +122,7 @@ def _describe(kind: str, path: str) -> list[str]:
     if kind == "sequence":
         from ..io.meshseq import level_format, normals_fit, read_textured_sequence, sequence_paths
 
-        mesh, texture, shading, colours = read_textured_sequence(path)
+        mesh, texture, shading, colours, materials = read_textured_sequence(path)
         lines = _animated_lines(mesh)
         if texture is not None:  # the mesh has a vertex per position and texture coordinate
             positions = np.unique(texture.points).size  # an OBJ's; a PLY's vertices have their own
@@ -140,6 +140,9 @@ def _describe(kind: str, path: str) -> list[str]:
         if colours is not None:
             changing = ", each frame's own" if len(colours.values) > 1 else ""
             lines[0] += f"; vertex colours: {colours.layout()}{changing}"
+        if materials is not None:
+            libraries = f" from {', '.join(materials.libraries)}" if materials.libraries else ""
+            lines[0] += f"; materials: {', '.join(materials.names)}{libraries}"
         names = [frame.name for frame in paths]
         if len(names) > 1:  # the order the frames are read in: a stray file shows at an end
             lines[-1] += f", {names[0]} .. {names[-1]}"

@@ -15,6 +15,7 @@ import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -22,7 +23,16 @@ from ..model import AnimatedMesh
 from ..normals import Shading, corner_normals, shading_of, unit_vectors, vertex_normals
 from .atomic import atomic_folder
 from .errors import FormatError
-from .obj import ObjNormals, ObjTexture, UnreadAttributesWarning, read_obj, read_obj_textured, write_obj
+from .obj import (
+    ObjMaterials,
+    ObjNormals,
+    ObjTexture,
+    TexturedMesh,
+    UnreadAttributesWarning,
+    read_obj,
+    read_obj_textured,
+    write_obj,
+)
 from .ply import read_ply, read_ply_attributes, write_ply
 from .vertex_colours import VertexColours
 
@@ -69,9 +79,20 @@ class SequenceTexture:
     points: np.ndarray
 
 
+class TexturedSequence(NamedTuple):
+    """A sequence with what :func:`read_textured_sequence` reads beside its frames, each None
+    where the frames have none."""
+
+    mesh: AnimatedMesh
+    texture: SequenceTexture | None
+    shading: Shading | None
+    colours: VertexColours | None
+    materials: ObjMaterials | None
+
+
 def read_textured_sequence(
     source: str | os.PathLike | Sequence[str | os.PathLike], fps: float | None = None
-) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None, VertexColours | None]:
+) -> TexturedSequence:
     """:func:`read_sequence` with the sequence's texture coordinates (OBJ ``vt`` lines, PLY
     vertices' s, t): the mesh then has a vertex per (position, texture coordinate) pair of the
     corners (:class:`SequenceTexture`). None, and the files' positions as the vertices, where the
@@ -82,25 +103,23 @@ def read_textured_sequence(
     colours stored alike (PLY red, green, blue and alpha; OBJ ``v x y z r g b``), each mesh
     vertex's colours: one set where every frame's are the first's, else one per frame
     (:class:`~animlod.io.vertex_colours.VertexColours`); else None (with an
-    :class:`~animlod.io.obj.UnreadAttributesWarning` where some frames have them)."""
+    :class:`~animlod.io.obj.UnreadAttributesWarning` where some frames have them). Fifth, the
+    first frame's OBJ materials, one per face of the mesh (:class:`~animlod.io.obj.ObjMaterials`).
+    Read its fields by name: more may come."""
     return _read_frames(sequence_paths(source), fps, textured=True)
 
 
-def _read_frames(
-    paths: list[Path], fps: float | None, textured: bool
-) -> tuple[AnimatedMesh, SequenceTexture | None, Shading | None, VertexColours | None]:
+def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> TexturedSequence:
     """The frames of ``paths`` (:func:`read_sequence`), and with ``textured`` their texture
-    coordinates, normals' shading and colours (:func:`read_textured_sequence`)."""
+    coordinates, normals' shading, colours and materials (:func:`read_textured_sequence`)."""
 
-    def read(
-        path: Path, first: bool
-    ) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None, VertexColours | None]:
+    def read(path: Path, first: bool) -> TexturedMesh:
         # Only the first frame's normals are read: they tell the shading the levels rebuild.
         return read_mesh_textured(path, normals=first) if textured else _geometry_of(path)
 
     with warnings.catch_warnings(record=True) as first_warnings:
         warnings.simplefilter("always")
-        first_vertices, faces, texture, normals, colours = read(paths[0], first=True)
+        first_vertices, faces, texture, normals, colours, materials = read(paths[0], first=True)
     for warning in first_warnings:
         warnings.warn(warning.message, stacklevel=3)
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
@@ -114,7 +133,7 @@ def _read_frames(
     with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
         warnings.simplefilter("always")
         for index, path in enumerate(paths[1:], start=1):
-            vertices, frame_faces, frame_texture, _, colours = read(path, first=False)
+            vertices, frame_faces, frame_texture, _, colours, _ = read(path, first=False)
             _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
             frames[index] = vertices
             frame_colours.add(index, path, colours)
@@ -139,14 +158,15 @@ def _read_frames(
     colours = frame_colours.read()
     shading = None if normals is None else _shading_of(first_vertices, faces, normals)
     if texture is None:
-        return AnimatedMesh(faces, frames, fps=fps), None, shading, colours
+        return TexturedSequence(AnimatedMesh(faces, frames, fps=fps), None, shading, colours, materials)
     # A vertex per (position, texture coordinate) pair that a corner uses.
     pairs = np.stack([faces.ravel(), texture.corners.ravel()], axis=1)
     wedges, corner_wedge = np.unique(pairs, axis=0, return_inverse=True)
     split = AnimatedMesh(corner_wedge.reshape(faces.shape).astype(np.int32), frames[:, wedges[:, 0]], fps=fps)
     if colours is not None:
         colours = replace(colours, values=colours.values[:, wedges[:, 0]])
-    return split, SequenceTexture(texture.uvs[wedges[:, 1]], wedges[:, 0].astype(np.int32)), shading, colours
+    points = wedges[:, 0].astype(np.int32)
+    return TexturedSequence(split, SequenceTexture(texture.uvs[wedges[:, 1]], points), shading, colours, materials)
 
 
 class _ColourFrames:
@@ -227,13 +247,14 @@ def write_sequence(
     texture: SequenceTexture | None = None,
     shading: Shading | None = None,
     colours: VertexColours | None = None,
+    materials: ObjMaterials | None = None,
 ) -> list[Path]:
     """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
     ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically; with ``texture``
     its texture coordinates (:func:`frame_layout`); with ``shading`` each frame's normals rebuilt
     from its faces, shaded so (:func:`rebuilt_normals`; smooth only for PLY, whose vertices hold
     one normal each); with ``colours`` each frame's vertex colours (one set for every frame, or
-    one per frame).
+    one per frame); with ``materials`` (OBJ only) each face's material.
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
     ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
@@ -265,7 +286,7 @@ def write_sequence(
     layout = frame_layout(mesh, texture, fmt, normals=shading is not None)
     with atomic_folder(folder) as temporary:
         for frame, name in enumerate(names):
-            layout.write(temporary / name, mesh, frame, shading, colours)
+            layout.write(temporary / name, mesh, frame, shading, colours, materials)
     return [Path(folder) / name for name in names]
 
 
@@ -297,14 +318,20 @@ class FrameLayout:
         return ObjNormals(rebuilt_normals(points, self.welded[self.faces], shading).normals[self.welded], self.faces)
 
     def write(
-        self, path: Path, mesh: AnimatedMesh, frame: int, shading: Shading | None, colours: VertexColours | None
+        self,
+        path: Path,
+        mesh: AnimatedMesh,
+        frame: int,
+        shading: Shading | None,
+        colours: VertexColours | None,
+        materials: ObjMaterials | None = None,
     ) -> None:
         """Write ``mesh``'s ``frame`` to ``path`` (:func:`write_mesh`) laid out so, with its
-        normals rebuilt where ``shading`` is given and its ``colours``."""
+        normals rebuilt where ``shading`` is given, its ``colours`` and its faces' ``materials``."""
         positions = mesh.frames[frame][self.written]
         normals = None if shading is None else self.normals(positions, shading)
         written_colours = None if colours is None else colours.of_frame(frame, self.written)
-        write_mesh(path, positions, self.faces, self.texture, normals, written_colours)
+        write_mesh(path, positions, self.faces, self.texture, normals, written_colours, materials)
 
 
 def frame_layout(mesh: AnimatedMesh, texture: SequenceTexture | None, fmt: str, normals: bool) -> FrameLayout:
@@ -423,26 +450,25 @@ def _check_same_connectivity(
 # Single meshes
 
 
-def read_mesh_textured(
-    path: str | os.PathLike, normals: bool = True
-) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None, VertexColours | None]:
+def read_mesh_textured(path: str | os.PathLike, normals: bool = True) -> TexturedMesh:
     """:func:`read_mesh` with the file's texture coordinates and, with ``normals``, its normals,
     each an index per corner into its values: an OBJ's ``vt`` and ``vn`` lines
     (:func:`~.obj.read_obj_textured`), a PLY's per-vertex s, t and nx, ny, nz
-    (:func:`~.ply.read_ply_attributes`); and its vertex colours."""
+    (:func:`~.ply.read_ply_attributes`); and its vertex colours and (OBJ) materials."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
         return read_obj_textured(path, normals)
     if suffix != ".ply":
         return _geometry_of(path)  # refused, naming the suffixes read
     vertices, faces, uvs, normal_rows, colours = read_ply_attributes(path)
-    return (vertices, faces, None if uvs is None else ObjTexture(uvs, faces),
-            None if normal_rows is None or not normals else ObjNormals(normal_rows, faces), colours)  # fmt: skip
+    return TexturedMesh(vertices, faces, None if uvs is None else ObjTexture(uvs, faces),
+                        None if normal_rows is None or not normals else ObjNormals(normal_rows, faces), colours,
+                        None)  # fmt: skip
 
 
-def _geometry_of(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, None, None, None]:
+def _geometry_of(path: str | os.PathLike) -> TexturedMesh:
     """:func:`read_mesh` in the shape of :func:`read_mesh_textured`."""
-    return (*read_mesh(path), None, None, None)
+    return TexturedMesh(*read_mesh(path), None, None, None, None)
 
 
 def read_mesh(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
@@ -463,13 +489,15 @@ def write_mesh(
     texture: ObjTexture | None = None,
     normals: ObjNormals | None = None,
     colours: VertexColours | None = None,
+    materials: ObjMaterials | None = None,
 ) -> None:
     """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``, with ``texture``
     and ``normals``, each an index per corner into its values (a PLY file's are one per vertex:
-    ValueError where a vertex's corners have two), and one frame's vertex ``colours``."""
+    ValueError where a vertex's corners have two), one frame's vertex ``colours``, and (OBJ:
+    a PLY file has none) the faces' ``materials``."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
-        write_obj(path, vertices, faces, texture, normals, colours)
+        write_obj(path, vertices, faces, texture, normals, colours, materials)
     elif suffix == ".ply":
         uvs, normal_rows = (
             None if given is None else _per_vertex(path, name, len(vertices), faces, *given)

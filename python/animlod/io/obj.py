@@ -43,12 +43,34 @@ class ObjTexture(NamedTuple):
     corners: np.ndarray
 
 
+class ObjMaterials(NamedTuple):
+    """An OBJ mesh's materials: ``libraries``, what its ``mtllib`` lines name (as written);
+    ``names``, the materials its ``usemtl`` lines set; ``faces (M,) int32``, each triangle's
+    index into ``names`` (-1 before the first ``usemtl``)."""
+
+    libraries: tuple[str, ...]
+    names: tuple[str, ...]
+    faces: np.ndarray
+
+
 class ObjNormals(NamedTuple):
     """An OBJ mesh's normals: ``normals (N, 3) float32``, the ``vn`` lines, and ``corners (M, 3)
     int32``, each triangle corner's index into ``normals``."""
 
     normals: np.ndarray
     corners: np.ndarray
+
+
+class TexturedMesh(NamedTuple):
+    """A mesh file with what :func:`read_obj_textured` (and ``meshseq.read_mesh_textured``) reads
+    beside its geometry, each None where the file has none."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    texture: ObjTexture | None
+    normals: ObjNormals | None
+    colours: VertexColours | None
+    materials: ObjMaterials | None
 
 
 def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
@@ -71,29 +93,28 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         index outside the vertices defined so far, or faces that all have fewer than three
         corners (some such faces among polygons are left out with a warning).
     """
-    vertices, faces, _, _, _ = _read_obj(path, textured=False)
-    return vertices, faces
+    mesh = _read_obj(path, textured=False)
+    return mesh.vertices, mesh.faces
 
 
-def read_obj_textured(
-    path: str | os.PathLike, normals: bool = True
-) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None, VertexColours | None]:
-    """:func:`read_obj` with the texture coordinates, normals and colours: also the ``vt`` lines
+def read_obj_textured(path: str | os.PathLike, normals: bool = True) -> TexturedMesh:
+    """:func:`read_obj` with the texture coordinates, normals, colours and materials: also the ``vt`` lines
     and each corner's texture index (``v/vt`` or ``v/vt/vn``), and the ``vn`` lines and each
     corner's normal index (``v/vt/vn`` or ``v//vn``); each None where the file has none, or where
     some corners have one and others not (with an :class:`UnreadAttributesWarning`). FormatError
     also names a malformed ``vt`` or ``vn`` line and an index outside them. ``normals=False``
     leaves the ``vn`` lines unread, without a warning (a sequence's later frames, whose normals
-    the levels do not take). Where every ``v`` line has six values, the last three are the
-    vertex's colour (r, g, b); None otherwise, or, with a warning, where one is not finite."""
+    the levels do not take). Where every ``v`` line has six values (or every one seven), those
+    after z are the vertex's colour (r, g, b, a); None otherwise, or, with a warning, where only
+    some lines have one or one is not finite. The
+    ``usemtl`` lines give each triangle its material (:class:`ObjMaterials`, with the ``mtllib``
+    lines' libraries)."""
     return _read_obj(path, textured=True, normals=normals)
 
 
-def _read_obj(
-    path: str | os.PathLike, textured: bool, normals: bool = False
-) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, ObjNormals | None, VertexColours | None]:
-    """:func:`read_obj`, and with ``textured`` its texture coordinates, colours and, with
-    ``normals``, its normals (:func:`read_obj_textured`)."""
+def _read_obj(path: str | os.PathLike, textured: bool, normals: bool = False) -> TexturedMesh:
+    """:func:`read_obj`, and with ``textured`` its texture coordinates, colours, materials and,
+    with ``normals``, its normals (:func:`read_obj_textured`)."""
     path = Path(path)
     data = path.read_bytes()
     if data.startswith((b"\xfe\xff", b"\xff\xfe")):  # UTF-16 after its byte order mark (assimp's box_UTF16BE.obj)
@@ -121,7 +142,7 @@ def _read_obj(
     _warn_unread_attributes(path, vt=not textured and len(uv_statements[1]) > 0,
                             vn=not textured and len(normal_statements[1]) > 0,
                             colours=not textured and bool(np.any(values_per_vertex >= 6)),
-                            usemtl=re.search(rb"(?m)^usemtl[ \t]", data) is not None)  # fmt: skip
+                            usemtl=not textured and re.search(rb"(?m)^usemtl[ \t]", data) is not None)  # fmt: skip
     if not len(vertex_lines):
         _require_obj_statement(path, data)
     if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
@@ -153,7 +174,7 @@ def _read_obj(
     resolved = corners.resolved(face_block, vertex_lines, len(vertices), ("vertex", "vertices"))
     faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
     if not textured:
-        return vertices, faces, None, None, None
+        return TexturedMesh(vertices, faces, None, None, None, None)
 
     def per_triangle(statements: tuple[bytes, np.ndarray], attribute: _Attribute) -> tuple | None:
         """The attribute's values and each triangle corner's index into them, or None."""
@@ -163,8 +184,28 @@ def _read_obj(
 
     texture = per_triangle(uv_statements, _TEXTURE)
     corner_normals = per_triangle(normal_statements, _NORMALS) if normals else None
-    return (vertices, faces, texture and ObjTexture(*texture), corner_normals and ObjNormals(*corner_normals),
-            colours)  # fmt: skip
+    materials = _materials(data, face_lines[polygons], sizes[polygons] - 2)
+    return TexturedMesh(vertices, faces, texture and ObjTexture(*texture),
+                        corner_normals and ObjNormals(*corner_normals), colours, materials)  # fmt: skip
+
+
+def _materials(data: bytes, face_lines: np.ndarray, triangles: np.ndarray) -> ObjMaterials | None:
+    """The materials of ``data``'s usemtl lines for the faces on ``face_lines`` (1-based), each
+    fanned into ``triangles``; its mtllib lines' libraries. None without a usemtl line."""
+    uses = list(re.finditer(rb"(?m)^usemtl[ \t]+([^\n]*)", data))
+    if not uses:
+        return None
+    newlines = np.flatnonzero(np.frombuffer(data, np.uint8) == ord("\n"))
+    use_lines = np.searchsorted(newlines, [use.start() for use in uses]) + 1
+    used = np.array([use.group(1).strip().decode("utf-8", "replace") for use in uses], dtype=object)
+    distinct, first, material = np.unique(used, return_index=True, return_inverse=True)
+    rank = np.empty(first.size, np.int32)
+    rank[np.argsort(first)] = np.arange(first.size)  # the materials in the order of first use
+    in_effect = np.searchsorted(use_lines, face_lines) - 1  # the last usemtl line above each face
+    per_face = np.where(in_effect >= 0, rank[material.ravel()][np.maximum(in_effect, 0)], -1).astype(np.int32)
+    libraries = re.findall(rb"(?m)^mtllib[ \t]+([^\n]*)", data)
+    return ObjMaterials(tuple(found.decode("utf-8", "replace").strip() for found in libraries),
+                        tuple(distinct[np.argsort(first)].tolist()), np.repeat(per_face, triangles))  # fmt: skip
 
 
 def _vertex_colours(
@@ -268,11 +309,14 @@ def write_obj(
     texture: ObjTexture | None = None,
     normals: ObjNormals | None = None,
     colours: VertexColours | None = None,
+    materials: ObjMaterials | None = None,
 ) -> None:
     """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically; with
     ``texture`` also its ``vt`` lines, with ``normals`` its ``vn`` lines, and each corner's
     indices into them (``v/vt``, ``v//vn`` or ``v/vt/vn``); with one frame's ``colours`` (three
-    channels) each ``v`` line's r, g, b after its x, y, z.
+    or four channels) each ``v`` line's r, g, b (a) after its x, y, z; with ``materials`` (one
+    per face) its ``mtllib`` lines, and the faces in runs of one material, each after its
+    ``usemtl`` line (the faces of none first).
 
     Coordinates are written with 9 significant digits, which round-trips float32 exactly. A wrong
     shape, a coordinate that is not finite as float32 or a face index outside the vertices is a
@@ -302,11 +346,26 @@ def write_obj(
                              f"{', '.join(colours.names)}")  # fmt: skip
         vertices = np.concatenate([vertices, np.stack(colours.stored(path, len(vertices)), axis=1)], axis=1)
         vertex_line = "v" + " %.9g" * vertices.shape[1] + "\n"
-    with atomic_write(path, "w", encoding="ascii", newline="\n") as handle:
-        handle.write("# written by animlod\n")
+    corners = np.stack(columns, axis=2).reshape(len(faces), -1)
+    runs, header = [(None, corners)], ""
+    if materials is not None:
+        if np.shape(materials.faces) != (len(faces),) or np.any(materials.faces >= len(materials.names)):
+            raise ValueError(f"{os.fspath(path)}: materials: expected a material (< {len(materials.names)}) per "
+                             f"face, got {np.shape(materials.faces)}")  # fmt: skip
+        order = np.argsort(materials.faces, kind="stable")
+        starts = np.flatnonzero(np.diff(materials.faces[order], prepend=-2))
+        runs = [(materials.faces[order[start]], corners[order[start:end]])
+                for start, end in zip(starts, [*starts[1:], len(order)])]  # fmt: skip
+        header = "".join(f"mtllib {library}\n" for library in materials.libraries)
+    face_line = f"f {corner} {corner} {corner}\n"
+    with atomic_write(path, "w", encoding="utf-8", newline="\n") as handle:
+        handle.write("# written by animlod\n" + header)
         handle.write((vertex_line * len(vertices)) % tuple(vertices.ravel()))
         handle.write(lines)
-        handle.write((f"f {corner} {corner} {corner}\n" * len(faces)) % tuple(np.stack(columns, axis=2).ravel()))
+        for material, run in runs:
+            if material is not None and material >= 0:
+                handle.write(f"usemtl {materials.names[material]}\n")
+            handle.write((face_line * len(run)) % tuple(run.ravel()))
 
 
 # The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.

@@ -22,6 +22,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -29,6 +30,7 @@ from ..aqem import Preparation, SimplifiedLevel, simplify_animated
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError, UnreadAttributesWarning
 from ..io.meshseq import SequenceTexture, normals_fit
+from ..io.obj import ObjMaterials
 from ..io.vertex_colours import VertexColours
 from ..metrics import SurfaceError, surface_error
 from ..model import AnimatedMesh, whole_number
@@ -92,6 +94,7 @@ def simplify_sequence(
     texture = None  # the sequence's texture coordinates, carried as AQEM attributes
     shading = None  # how the sequence's normals shade it, for the levels' rebuilt normals
     colours = None  # its vertex colours, carried as AQEM attributes too
+    materials = None  # its OBJ materials per face: borders between them are kept
     if kind == "npz":
         from ..io.npz import read_npz
 
@@ -99,7 +102,7 @@ def simplify_sequence(
     elif kind == "sequence":
         from ..io.meshseq import read_textured_sequence
 
-        original, texture, shading, colours = read_textured_sequence(source)
+        original, texture, shading, colours, materials = read_textured_sequence(source)
     else:
         raise FormatError(os.fspath(source), "file", f"a {kind} file is not a mesh sequence")
     started = time.perf_counter()
@@ -107,8 +110,10 @@ def simplify_sequence(
     aqem_options = {**aqem_options, "record_positions": False}
     if texture is not None or colours is not None:  # a point of the edge in every frame, where its attributes are
         aqem_options = {"placement": "on_edge", **aqem_options}
-    carried = _CarriedAttributes.of(original, texture, colours)
+    carried = _CarriedAttributes.of(original, texture, colours, materials)
     per_vertex, per_point = carried.columns()
+    if materials is not None:  # a material's border is kept, as a glTF primitive's is
+        aqem_options = {"face_groups": materials.faces + 1, **aqem_options}
     result = simplify_animated(original, ratios, progress=progress, attributes=per_vertex,
                                position_attributes=per_point, **aqem_options)  # fmt: skip
     seconds = time.perf_counter() - started
@@ -118,13 +123,15 @@ def simplify_sequence(
                       "and the levels are PLY files, whose vertices hold one normal each", UnreadAttributesWarning,
                       stacklevel=2)  # fmt: skip
         shading = None
+    if materials is not None and fmt.suffix != "obj":
+        warnings.warn(f"{os.fspath(source)}: its materials are not written: the levels are PLY files, which have "
+                      "none", UnreadAttributesWarning, stacklevel=2)  # fmt: skip
     frames = _measured_frames(original.frame_count, measured_frames) if measure else np.arange(0)
     levels = []
     for index, level in enumerate(result.levels, start=1):
         if measure and measuring is not None:
             measuring(index - 1, len(result.levels))
-        level_texture, level_colours = carried.of_level(level)
-        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, level_texture, shading, level_colours)
+        path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, carried.of_level(level), shading)
         measured = _surface_error(*(_frames_of(mesh, frames) for mesh in (original, level.mesh))) if measure else None
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
@@ -147,16 +154,24 @@ class _CarriedAttributes:
     texture: SequenceTexture | None
     colours: VertexColours | None
     colours_by_point: bool
+    materials: ObjMaterials | None
 
     @classmethod
-    def of(cls, mesh: AnimatedMesh, texture: SequenceTexture | None, colours: VertexColours | None):
-        """The attributes of ``mesh`` carried: its ``texture`` and ``colours`` (either may be None)."""
+    def of(
+        cls,
+        mesh: AnimatedMesh,
+        texture: SequenceTexture | None,
+        colours: VertexColours | None,
+        materials: ObjMaterials | None,
+    ) -> _CarriedAttributes:
+        """The attributes of ``mesh`` carried: its ``texture``, ``colours`` and faces'
+        ``materials`` (each may be None)."""
         by_point = False
         if colours is not None:  # copies of a position in the first frame: those AQEM may weld
             flat = _frame_columns(colours.values)
             _, first, copy_of = np.unique(mesh.frames[0], axis=0, return_index=True, return_inverse=True)
             by_point = bool(np.array_equal(flat, flat[first[copy_of.ravel()]]))
-        return cls(texture, colours, by_point)
+        return cls(texture, colours, by_point, materials)
 
     def columns(self) -> tuple[np.ndarray | None, np.ndarray | None]:
         """(V, A) per-vertex and (V, B) per-point float32 columns (each None for none): u, v where
@@ -168,9 +183,10 @@ class _CarriedAttributes:
         return tuple(np.concatenate(parts, axis=1, dtype=np.float32) if parts else None
                      for parts in (per_vertex, per_point))  # fmt: skip
 
-    def of_level(self, level: SimplifiedLevel) -> tuple[SequenceTexture | None, VertexColours | None]:
-        """A level's texture coordinates and colours, from its interpolated attributes."""
-        texture = colours = None
+    def of_level(self, level: SimplifiedLevel) -> _LevelSurface:
+        """A level's texture coordinates and colours, from its interpolated attributes, and its
+        faces' materials, those of the input faces they come from."""
+        texture = colours = materials = None
         if self.texture is not None:
             texture = SequenceTexture(level.attributes[:, :2], self.texture.points[level.kept_vertices])
         if self.colours is not None:
@@ -178,7 +194,17 @@ class _CarriedAttributes:
             columns = level.position_attributes if self.colours_by_point else level.attributes[:, -frames * channels :]
             values = columns.reshape(-1, frames, channels).transpose(1, 0, 2)
             colours = replace(self.colours, values=np.ascontiguousarray(values))
-        return texture, colours
+        if self.materials is not None:
+            materials = self.materials._replace(faces=self.materials.faces[level.face_sources])
+        return _LevelSurface(texture, colours, materials)
+
+
+class _LevelSurface(NamedTuple):
+    """What a level is written with beside its positions and faces (each None for none)."""
+
+    texture: SequenceTexture | None
+    colours: VertexColours | None
+    materials: ObjMaterials | None
 
 
 def _frame_columns(values: np.ndarray) -> np.ndarray:
@@ -234,6 +260,7 @@ class _LevelFormat:
     suffix: str
     one_file: bool
     frame_names: list[str] | None = None
+    source_folder: Path | None = None  # where the frames are, which OBJ material libraries name files from
 
 
 def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
@@ -247,26 +274,23 @@ def _level_format(kind: str, source: str | os.PathLike) -> _LevelFormat:
     suffix = level_format(paths)
     names = [path.stem for path in paths]  # two frames of one name (a.obj, a.ply; a glob over folders): numbered
     return _LevelFormat(suffix, isinstance(source, str | os.PathLike) and Path(source).is_file(),
-                        names if frame_names_fit(names, len(paths)) else None)  # fmt: skip
+                        names if frame_names_fit(names, len(paths)) else None, paths[0].parent)  # fmt: skip
 
 
 def _write_level(
-    fmt: _LevelFormat,
-    target: Path,
-    mesh: AnimatedMesh,
-    texture: SequenceTexture | None,
-    shading: Shading | None,
-    colours: VertexColours | None,
+    fmt: _LevelFormat, target: Path, mesh: AnimatedMesh, surface: _LevelSurface, shading: Shading | None
 ) -> Path:
-    """Write a level as ``fmt`` says, with its texture coordinates, rebuilt normals and colours if
-    any; its path. A file's suffix is appended, not swapped:
+    """Write a level as ``fmt`` says, with its texture coordinates, rebuilt normals, colours and
+    materials if any; its path. A file's suffix is appended, not swapped:
     ``walk.v2_lod1`` has the suffix ``.v2_lod1`` (every level of walk.v2.npz was written to
     walk.npz)."""
+    written_in = target if not fmt.one_file else target.parent
+    materials = None if fmt.suffix != "obj" else _libraries_from(surface.materials, fmt.source_folder, written_in)
     if not fmt.one_file:
         from ..io.meshseq import write_sequence
 
-        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=texture, shading=shading,
-                       colours=colours)  # fmt: skip
+        write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=surface.texture, shading=shading,
+                       colours=surface.colours, materials=materials)  # fmt: skip
         return target
     path = target.with_name(f"{target.name}.{fmt.suffix}")
     if fmt.suffix == "npz":
@@ -276,5 +300,17 @@ def _write_level(
     else:  # one mesh in, one mesh out
         from ..io.meshseq import frame_layout
 
-        frame_layout(mesh, texture, fmt.suffix, normals=shading is not None).write(path, mesh, 0, shading, colours)
+        layout = frame_layout(mesh, surface.texture, fmt.suffix, normals=shading is not None)
+        layout.write(path, mesh, 0, shading, surface.colours, materials)
     return path
+
+
+def _libraries_from(materials: ObjMaterials | None, source: Path | None, written_in: Path) -> ObjMaterials | None:
+    """``materials`` with their libraries (named from the input's ``source`` folder) named from
+    the folder the level is ``written_in``: the levels use the input's .mtl files where they are."""
+    if materials is None or source is None:
+        return materials
+    libraries = tuple(library if os.path.isabs(library) else
+                      Path(os.path.relpath(source / library, written_in.absolute())).as_posix()
+                      for library in materials.libraries)  # fmt: skip
+    return materials._replace(libraries=libraries)

@@ -3,9 +3,17 @@
 from .bvh import BvhLayout, read_bvh, read_bvh_with_layout, write_bvh
 from .errors import FormatError
 from .gltf import GltfScene, read_gltf, read_lod_chains, read_node_motions, read_skinned, write_glb
-from .meshseq import SequenceTexture, read_mesh, read_sequence, read_textured_sequence, write_mesh, write_sequence
+from .meshseq import (
+    SequenceTexture,
+    TexturedSequence,
+    read_mesh,
+    read_sequence,
+    read_textured_sequence,
+    write_mesh,
+    write_sequence,
+)
 from .npz import read_npz, write_npz
-from .obj import ObjTexture, read_obj, read_obj_textured, write_obj
+from .obj import ObjMaterials, ObjTexture, TexturedMesh, read_obj, read_obj_textured, write_obj
 from .ply import read_ply, read_ply_attributes, write_ply
 from .vertex_colours import VertexColours
 
@@ -13,8 +21,11 @@ __all__ = [
     "BvhLayout",
     "FormatError",
     "GltfScene",
+    "ObjMaterials",
     "ObjTexture",
     "SequenceTexture",
+    "TexturedMesh",
+    "TexturedSequence",
     "VertexColours",
     "read_bvh",
     "read_bvh_with_layout",

@@ -23,6 +23,7 @@ py::dict level_to_dict(AqemLevel&& level, py::ssize_t frame_count, py::ssize_t a
   py::dict out;
   out["target_face_count"] = level.target_face_count;
   out["reached"] = level.reached;
+  out["stopped_by_max_error"] = level.stopped_by_max_error;
   out["collapse_count"] = level.collapse_count;
   out["error"] = level.error;
   out["faces"] = numpy_from_vector(std::move(level.faces), {face_count, 3});

@@ -461,6 +461,7 @@ AqemLevel to_level(detail::EngineLevel&& engine_level) {
   AqemLevel level;
   level.target_face_count = engine_level.target_face_count;
   level.reached = engine_level.reached;
+  level.stopped_by_max_error = engine_level.stopped_by_max_error;
   level.collapse_count = engine_level.collapse_count;
   level.error = engine_level.error;
   level.faces = std::move(engine_level.faces);

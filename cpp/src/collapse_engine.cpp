@@ -375,6 +375,7 @@ EngineLevel CollapseEngine::snapshot(size_t target, bool reached) {
   EngineLevel level;
   level.target_face_count = target;
   level.reached = reached;
+  level.stopped_by_max_error = !reached && stopped_by_max_error_;
   level.error = error_so_far_;
   level.collapse_count = collapse_count_;
   const size_t vertex_count = mesh_.vertex_count;
@@ -541,7 +542,10 @@ void CollapseEngine::run_greedy(CollapsePolicy& policy, const std::vector<Ranked
     const int32_t edge = heap_.top();
     const Candidate candidate = candidate_for(edge);
     const Attempt attempt = try_collapse(policy, candidate, edge, targets, levels, record);
-    if (attempt == Attempt::over_max_error) break;
+    if (attempt == Attempt::over_max_error) {
+      stopped_by_max_error_ = true;
+      break;
+    }
     if (attempt == Attempt::illegal) {
       park(edge);
       continue;
@@ -847,7 +851,10 @@ void CollapseEngine::run_passes(CollapsePolicy& policy, const std::vector<size_t
     }
     // A pass without a collapse went through every candidate: nothing legal remains (or the
     // cheapest legal collapse exceeds max_error), unless guarded points can be released.
-    if (pass_collapses == 0 && (over_max_error || !release_guards(policy))) break;
+    if (pass_collapses == 0 && (over_max_error || !release_guards(policy))) {
+      stopped_by_max_error_ = over_max_error;
+      break;
+    }
   }
   ranking_cache_ = {};
 }

@@ -114,6 +114,7 @@ struct EngineOptions {
 struct EngineLevel {
   size_t target_face_count = 0;
   bool reached = false;
+  bool stopped_by_max_error = false;    // not reached because the next collapse's error exceeds max_error
   size_t collapse_count = 0;
   double error = 0.0;                   // largest collapse error so far
   std::vector<int32_t> faces;           // (M', 3) output vertex indices
@@ -251,6 +252,7 @@ class CollapseEngine {
   IndexedMinHeap heap_{0};
   size_t face_count_ = 0;
   double error_so_far_ = 0.0;
+  bool stopped_by_max_error_ = false;  // the run ended at a collapse over max_error, not for want of one
   size_t collapse_count_ = 0;
   size_t next_level_ = 0;
   EngineTimings timings_;

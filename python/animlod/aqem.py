@@ -68,6 +68,8 @@ class SimplifiedLevel:
     error : asset units, the largest collapse error so far (see ``CollapseRecord.error``).
     target_face_count : the face count asked for; ``mesh`` has at most that many if ``reached``.
     reached : False when ``max_error`` (or no legal collapse left) stopped the run first.
+    stopped_by_max_error : not ``reached`` because the next collapse's error exceeds
+        ``max_error`` (False: no legal collapse was left, or the level was reached).
     collapse_count : this level is the first ``collapse_count`` entries of the collapse record.
     attributes : (V', A) float32 carried per-vertex attributes, or None.
     position_attributes : (V', B) float32 carried position-following attributes, or None.
@@ -83,6 +85,7 @@ class SimplifiedLevel:
     target_face_count: int
     reached: bool
     collapse_count: int
+    stopped_by_max_error: bool = False
     attributes: np.ndarray | None = None
     position_attributes: np.ndarray | None = None
     skin_joints: np.ndarray | None = None
@@ -475,6 +478,7 @@ def _result(raw: dict, fps: float | None) -> SimplifyResult:
             target_face_count=int(level["target_face_count"]),
             reached=bool(level["reached"]),
             collapse_count=int(level["collapse_count"]),
+            stopped_by_max_error=bool(level["stopped_by_max_error"]),
             attributes=optional(level["attributes"]),
             position_attributes=optional(level["position_attributes"]),
             skin_joints=optional(level["skin_joints"]),

@@ -252,6 +252,16 @@ def test_plot_of_a_sequence_with_a_bow_tie_shows_the_features_simplify_used(tmp_
     assert "non-manifold" not in capsys.readouterr().err
 
 
+def test_a_level_short_of_its_target_says_what_stopped_it(tmp_path, capsys):
+    """Any finite --max-error was named as the reason; a generous one is not what stops a level
+    that no legal collapse can reach (the core says which stopped it)."""
+    write_npz(tmp_path / "tube.npz", bending_tube(frames=2))
+    for max_error, why in (("1e9", "no legal collapse left"), ("1e-4", "--max-error reached")):
+        arguments = ["--ratio", "0.001", "--max-error", max_error, "--no-metrics"]
+        assert main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), *arguments]) == 0
+        assert f"): {why}" in capsys.readouterr().out
+
+
 def test_bad_ratio_and_bad_mesh_exit_with_code_2(tmp_path, capsys):
     write_npz(tmp_path / "tube.npz", bending_tube(frames=2))
     assert main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), "--ratio", "1.5"]) == 2

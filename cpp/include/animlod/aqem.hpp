@@ -126,6 +126,8 @@ struct AqemVertexData {
 struct AqemLevel {
   size_t target_face_count = 0;      // with the mirrors of its faces (AqemPreparation::mirrored_faces)
   bool reached = false;              // false when max_error or legality stopped the run first
+  bool stopped_by_max_error = false; // not reached because the next collapse's error exceeds max_error
+                                     // (false: no legal collapse was left)
   size_t collapse_count = 0;         // the level is the first collapse_count records applied
   double error = 0.0;                // asset units: the largest collapse error so far (see
                                      // CollapseRecord::error)

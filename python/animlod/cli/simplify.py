@@ -207,7 +207,7 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
     # it; without a word the table read as two levels that happen to agree.
     for index, level in enumerate(report.levels, start=1):
         if not level.reached:
-            why = "--max-error reached" if math.isfinite(args.max_error) else "no legal collapse left"
+            why = "--max-error reached" if level.stopped_by_max_error else "no legal collapse left"
             print(f"note: level {index}: stopped at {level.faces} faces (target {level.target_faces}): {why}")
     if args.plot:
         levels = [_read_level(level.path) for level in report.levels]

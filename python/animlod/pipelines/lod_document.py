@@ -4,11 +4,14 @@ Every (mesh, skin) pair a node draws is simplified once with AQEM over frames th
 its animations (skinning and morph weights), its primitives together so that material borders
 do not crack and the triangle budget goes where the error is. Each level is measured after
 re-skinning over every clip (max-over-frames Hausdorff distance, asset units), and the error
-sets the level's MSFT_screencoverage. Everything the simplifier does not touch stays as it was.
+sets the level's MSFT_screencoverage. The chain ends at the last level coarser than the one before
+(a max error or the topology can stop the collapses short of a target). Everything the simplifier
+does not touch stays as it was.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -96,7 +99,7 @@ def simplify_document(
     ----------
     source : a .glb, .gltf or .vrm file.
     output : the LoD GLB to write (atomically); with ``separate``, a folder that receives one
-        ``<stem>_lod<i>.glb`` per level instead, each the whole document at that level.
+        ``<stem>_lod<i>.glb`` per level written instead, each the whole document at that level.
     ratios : face ratios of the levels below level 0, in (0, 1].
     clips : glTF files of clips on the same rig, added to the document's own by node name
         (:mod:`.clip_import`): they drive the skinned meshes' levels, and the output plays them.
@@ -152,6 +155,8 @@ def simplify_document(
     reports = [_report(d, s, settings) for d, s in zip(drawables, simplified)]
     if separate:
         outputs = _write_separate(doc, drawables, simplified, reports, Path(output), source)
+        if not outputs:
+            notes.append("no file written: no drawable has a level coarser than its input (see its notes)")
     else:
         outputs = [Path(output)]
         _write_chain(doc, drawables, simplified, reports).save(output)
@@ -159,7 +164,9 @@ def simplify_document(
 
 
 def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettings) -> DrawableReport:
-    errors = [0.0] + [level.error for level in levels.levels]
+    """The drawable's report, whose ``levels`` are those written (:func:`_written_count`)."""
+    written = levels.levels[: _written_count(levels)]
+    errors = [0.0] + [level.error for level in written]
     coverages = screen_coverages(errors, levels.size, settings.pixel_error, settings.viewport_px)
     report = DrawableReport(
         label=drawable.label,
@@ -170,9 +177,16 @@ def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettin
         renormalised_weights=drawable.weight_breaks.vertices,
         notes=list(levels.notes),
         rest_meshes=[AnimatedMesh(drawable.geometry.faces, drawable.rest_positions()[None])]
-        + [AnimatedMesh(level.simplified.mesh.faces, level.rest_positions()[None]) for level in levels.levels],
+        + [AnimatedMesh(level.simplified.mesh.faces, level.rest_positions()[None]) for level in written],
     )
-    for index, (level, coverage) in enumerate(zip(levels.levels, coverages[1:]), start=1):
+    max_error = float(settings.aqem.get("max_error", math.inf))
+    by_max_error = any(level.simplified.stopped_by_max_error for level in levels.levels)
+    why = "no legal collapse left (seams, locked spots or the topology's minimum)"
+    cause = "no legal collapse was left"
+    if by_max_error:
+        why = f"max error {max_error:g} reached (the next collapse's AQEM error exceeds it)"
+        cause = f"the max error {max_error:g} stopped the collapses"
+    for index, (level, coverage) in enumerate(zip(written, coverages[1:]), start=1):
         simplified: SimplifiedLevel = level.simplified
         report.levels.append(
             LevelReport(
@@ -187,12 +201,32 @@ def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettin
         )
         if not simplified.reached:
             faces, target = simplified.mesh.face_count, simplified.target_face_count
-            report.notes.append(
-                f"level {index}: stopped at {faces} faces (target {target}): no legal collapse left "
-                "(seams, locked spots or the topology's minimum)"
-            )
+            largest = f"; this level's largest AQEM error: {simplified.error:.3g}" if by_max_error else ""
+            report.notes.append(f"level {index}: stopped at {faces} faces (target {target}): {why}{largest}")
+    dropped = levels.levels[len(written) :]
+    if dropped:
+        numbers = ", ".join(str(index) for index in range(len(written) + 1, len(levels.levels) + 1))
+        targets = ", ".join(str(level.simplified.target_face_count) for level in dropped)
+        plural = "s" if len(dropped) > 1 else ""
+        same = f"level {len(written)}" if written else "the input"
+        report.notes.append(
+            f"level{plural} {numbers} (target{plural} {targets}) not written: the same mesh as {same} "
+            f"({dropped[0].simplified.mesh.face_count} faces), where {cause}"
+        )
     report.levels.insert(0, LevelReport(0, report.faces, report.faces, True, 0.0, 0.0, coverages[0]))
     return report
+
+
+def _written_count(levels: DrawableLevels) -> int:
+    """How many of the levels are written: the chain ends at the last level coarser than the one
+    before. A level short of its target holds the mesh where the collapses stopped, and so do the
+    levels after it: written, they were copies with screen coverages of their own."""
+    collapses = 0  # the input's
+    for count, level in enumerate(levels.levels):
+        if not level.simplified.reached and level.simplified.collapse_count == collapses:
+            return count
+        collapses = level.simplified.collapse_count
+    return len(levels.levels)
 
 
 def _write_chain(
@@ -204,9 +238,12 @@ def _write_chain(
         note = normalise_stored_weights(builder, doc, drawable)
         if note:
             report.notes.append(note)
+        written = levels.levels[: len(report.levels) - 1]
+        if not written:
+            continue  # no level coarser than the input: its nodes stay as they are
         meshes = [
             add_level_mesh(builder, drawable.mesh_index, level.primitives, drawable.geometry.other_primitives, name)
-            for level, name in zip(levels.levels, _level_names(doc, drawable, len(levels.levels)))
+            for level, name in zip(written, _level_names(doc, drawable, len(written)))
         ]
         coverages = [level.coverage for level in report.levels]
         joints = len(doc.gltf.skins[drawable.skin_index].joints) if drawable.skin_index is not None else 0
@@ -227,13 +264,24 @@ def _write_separate(
     folder: Path,
     source: str | os.PathLike,
 ) -> list[Path]:
-    """One whole document per level, every drawable's nodes drawing that level's mesh."""
+    """One whole document per written level, every drawable's nodes drawing that level's mesh; a
+    drawable whose chain ends sooner draws its coarsest level (its input when it has none)."""
     if folder.exists() and not folder.is_dir():
         raise ValueError(f"{folder}: --separate writes a folder of levels, and this is a file")
     outputs = []
-    for index in range(len(simplified[0].levels)):
+    files = max(len(report.levels) for report in reports) - 1
+    for report in reports:
+        last = len(report.levels) - 1
+        if last < files:
+            names = ", ".join(glb_name(source, f"_lod{index}") for index in range(last + 1, files + 1))
+            drawn = f"level {last}" if last else "the input"
+            report.notes.append(f"{names} {'draws' if last + 1 == files else 'draw'} {drawn}")
+    for file_index in range(files):
         builder = GlbBuilder.from_document(doc)
         for drawable, levels, report in zip(drawables, simplified, reports):
+            index = min(file_index, len(report.levels) - 2)
+            if index < 0:
+                continue  # no level written: the input's mesh
             name = _level_names(doc, drawable, index + 1)[index]
             mesh = add_level_mesh(
                 builder, drawable.mesh_index, levels.levels[index].primitives, drawable.geometry.other_primitives, name
@@ -244,7 +292,7 @@ def _write_separate(
                 node["mesh"] = mesh
                 node["extras"] = {**node_extras(node), ANIMLOD_EXTRA: info.extras()}
         builder.prune()
-        path = folder / glb_name(source, f"_lod{index + 1}")
+        path = folder / glb_name(source, f"_lod{file_index + 1}")
         builder.save(path)
         outputs.append(path)
     return outputs

@@ -52,6 +52,7 @@ class SequenceLevel:
     aqem_error: float  # asset units, the largest collapse error (RMS plane distance)
     surface: dict[str, float] | None  # mean/max over frames of Hausdorff and RMS, relative; None unmeasured
     error: float | None = None  # asset units, max over frames of the Hausdorff distance; None unmeasured
+    stopped_by_max_error: bool = False  # short of its target because max_error stopped the collapses
 
 
 @dataclass
@@ -136,7 +137,8 @@ def simplify_sequence(
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
         faces, target = level.mesh.face_count, level.target_face_count
-        levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error))
+        levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error,
+                                    level.stopped_by_max_error))  # fmt: skip
     if measure and measuring is not None:
         measuring(len(result.levels), len(result.levels))
     return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used),

@@ -98,8 +98,8 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
 
 
 def read_obj_textured(path: str | os.PathLike, normals: bool = True) -> TexturedMesh:
-    """:func:`read_obj` with the texture coordinates, normals, colours and materials: also the ``vt`` lines
-    and each corner's texture index (``v/vt`` or ``v/vt/vn``), and the ``vn`` lines and each
+    """:func:`read_obj` with the texture coordinates, normals, colours and materials: also the
+    ``vt`` lines and each corner's texture index (``v/vt`` or ``v/vt/vn``), and the ``vn`` lines and each
     corner's normal index (``v/vt/vn`` or ``v//vn``); each None where the file has none, or where
     some corners have one and others not (with an :class:`UnreadAttributesWarning`). FormatError
     also names a malformed ``vt`` or ``vn`` line and an index outside them. ``normals=False``
@@ -199,13 +199,14 @@ def _materials(data: bytes, face_lines: np.ndarray, triangles: np.ndarray) -> Ob
     use_lines = np.searchsorted(newlines, [use.start() for use in uses]) + 1
     used = np.array([use.group(1).strip().decode("utf-8", "replace") for use in uses], dtype=object)
     distinct, first, material = np.unique(used, return_index=True, return_inverse=True)
+    order = np.argsort(first)  # the materials in the order of first use
     rank = np.empty(first.size, np.int32)
-    rank[np.argsort(first)] = np.arange(first.size)  # the materials in the order of first use
+    rank[order] = np.arange(first.size)
     in_effect = np.searchsorted(use_lines, face_lines) - 1  # the last usemtl line above each face
     per_face = np.where(in_effect >= 0, rank[material.ravel()][np.maximum(in_effect, 0)], -1).astype(np.int32)
     libraries = re.findall(rb"(?m)^mtllib[ \t]+([^\n]*)", data)
     return ObjMaterials(tuple(found.decode("utf-8", "replace").strip() for found in libraries),
-                        tuple(distinct[np.argsort(first)].tolist()), np.repeat(per_face, triangles))  # fmt: skip
+                        tuple(distinct[order].tolist()), np.repeat(per_face, triangles))  # fmt: skip
 
 
 def _vertex_colours(

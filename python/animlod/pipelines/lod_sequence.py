@@ -11,7 +11,9 @@ written back as ``vt`` lines or per PLY vertex. Its normals (OBJ ``vn``, PLY nx,
 rebuilt on each level frame from the level's own faces, shaded as the input is (flat, hard
 edges, or smooth; PLY levels smooth only, one normal per vertex), and written back. Its vertex
 colours (PLY red, green, blue, alpha; OBJ ``v x y z r g b``), each frame's where they change,
-are interpolated along the collapses and written back as stored (PLY uchar stays uchar).
+are interpolated along the collapses and written back as stored (PLY uchar stays uchar). An OBJ
+sequence's materials go with each level face's source face and are written as ``usemtl`` runs
+under ``mtllib`` lines that name the input's libraries from the level's folder.
 """
 
 from __future__ import annotations
@@ -95,7 +97,7 @@ def simplify_sequence(
     texture = None  # the sequence's texture coordinates, carried as AQEM attributes
     shading = None  # how the sequence's normals shade it, for the levels' rebuilt normals
     colours = None  # its vertex colours, carried as AQEM attributes too
-    materials = None  # its OBJ materials per face: borders between them are kept
+    materials = None  # its OBJ materials, one per face
     if kind == "npz":
         from ..io.npz import read_npz
 
@@ -113,7 +115,7 @@ def simplify_sequence(
         aqem_options = {"placement": "on_edge", **aqem_options}
     carried = _CarriedAttributes.of(original, texture, colours, materials)
     per_vertex, per_point = carried.columns()
-    if materials is not None:  # a material's border is kept, as a glTF primitive's is
+    if materials is not None:  # copies of a position in two materials never merge, as in glTF
         aqem_options = {"face_groups": materials.faces + 1, **aqem_options}
     result = simplify_animated(original, ratios, progress=progress, attributes=per_vertex,
                                position_attributes=per_point, **aqem_options)  # fmt: skip

@@ -224,10 +224,22 @@ TEST_CASE("aqem stops at max_error and marks the levels it did not reach") {
   options.max_error = bound;
   const AqemResult result = simplify(mesh, options);
   CHECK(result.levels[0].reached);
+  CHECK_FALSE(result.levels[0].stopped_by_max_error);
   CHECK(result.levels[0].faces == unbounded.levels[0].faces);
   CHECK_FALSE(result.levels[1].reached);
+  CHECK(result.levels[1].stopped_by_max_error);
   CHECK(result.levels[1].error <= bound);
   CHECK(result.levels[1].faces.size() / 3 > result.levels[1].target_face_count);
+}
+
+TEST_CASE("aqem says a level short of its target for want of a legal collapse is not max_error's") {
+  const OwnedAnimatedMesh mesh = animlod::testing::sphere(12, 16, 2);
+  AqemOptions options;
+  options.target_face_counts = {1};  // below any closed mesh's minimum
+  options.max_error = 1e9;
+  const AqemResult result = simplify(mesh, options);
+  CHECK_FALSE(result.levels[0].reached);
+  CHECK_FALSE(result.levels[0].stopped_by_max_error);
 }
 
 TEST_CASE("aqem samples frames that cover the motion") {

@@ -150,6 +150,7 @@ TEST_CASE("collapse passes stop at max_error like the greedy order") {
   const AqemResult result = simplify(mesh, options);
   CHECK(result.levels[0].reached);
   CHECK_FALSE(result.levels[1].reached);
+  CHECK(result.levels[1].stopped_by_max_error);
   CHECK(result.levels[1].error <= bound);
   for (double error : result.collapses.error) CHECK(error <= bound);
 }

@@ -56,6 +56,22 @@ def test_a_character_plays_the_clips_of_an_animation_library(split_character, tm
     np.testing.assert_allclose(played, read_gltf(whole).motions[0].world_positions(), atol=1e-5)
 
 
+def test_clips_of_one_name_are_named_apart_by_their_files(split_character, tmp_path):
+    """Every Mixamo export names its clip "mixamo.com": added side by side, they kept one name,
+    by which engines find clips."""
+    whole, rest, walk = split_character
+    (name,) = [animation.name for animation in GltfDocument(walk).gltf.animations]
+    copy = tmp_path / "walk_again.glb"
+    copy.write_bytes(walk.read_bytes())
+    notes = []
+    document = with_clips(GltfDocument(rest), [walk, copy], notes.append)
+    names = [animation.name for animation in document.gltf.animations]
+    assert names == [name, f"{name} (walk_again)"]
+    assert notes[-1].endswith(f"; renamed where another clip has the name: {name!r} -> '{name} (walk_again)'")
+    names = [animation.name for animation in with_clips(GltfDocument(whole), [walk, walk], print).gltf.animations]
+    assert names == [name, f"{name} (walk)", f"{name} (walk) 2"]  # the document's own clip first
+
+
 def test_a_clip_of_other_proportions_is_refused_naming_the_joint(split_character, tmp_path, capsys):
     _, rest, _ = split_character
     skeleton = synth.humanoid().skeleton

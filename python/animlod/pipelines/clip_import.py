@@ -17,6 +17,7 @@ poses, its joints matched by shape or body part (:mod:`.bvh_clips`).
 
 from __future__ import annotations
 
+import itertools
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -56,8 +57,9 @@ def with_clips(
         raise ValueError(f"joint map {os.fspath(joint_map)}: maps the joints of BVH clips, and no BVH clip is given")
     table = read_joint_map(joint_map) if joint_map is not None else None
     for clip_file in clip_files:
+        first_added = len(builder.json.get("animations", []))
         if clip_file in bvh_files:
-            note(add_bvh_clip(builder, doc, clip_file, table))
+            note(add_bvh_clip(builder, doc, clip_file, table) + _named_apart(builder, first_added, clip_file))
             continue
         source = GltfDocument(clip_file)
         if not source.gltf.animations:
@@ -86,8 +88,29 @@ def with_clips(
             raise source.fail("animations", f"none moves a node of {into}'s by name (another rig?)")
         dropped = f"; {left_out} channel(s) on nodes {into} lacks, or on morph weights, left out" if left_out else ""
         total = len(source.gltf.animations)
-        note(f"{os.fspath(clip_file)}: {added} of its {total} clip(s) added to {into}{dropped}")
+        renamed = _named_apart(builder, first_added, clip_file)
+        note(f"{os.fspath(clip_file)}: {added} of its {total} clip(s) added to {into}{dropped}{renamed}")
     return GltfDocument(doc.path, doc.max_animation_frames, data=builder.to_bytes())
+
+
+def _named_apart(builder: GlbBuilder, first_added: int, clip_file: str | os.PathLike) -> str:
+    """Rename the animations added from ``clip_file`` (from index ``first_added`` on) whose name
+    an animation before them has: every Mixamo export names its clip "mixamo.com", and engines
+    find clips by name. The file's stem tells them apart ("mixamo.com (Walking)"), then a count.
+    Returns the note's part that says so ("" when none is renamed)."""
+    animations = builder.json["animations"]
+    taken = {animation.get("name") for animation in animations[:first_added]}
+    renamed = []
+    for animation in animations[first_added:]:
+        name = animation.get("name")
+        if name in taken:
+            candidates = (
+                f"{name} ({Path(clip_file).stem})" + (f" {count}" if count > 1 else "") for count in itertools.count(1)
+            )
+            animation["name"] = next(candidate for candidate in candidates if candidate not in taken)
+            renamed.append(f"{name!r} -> {animation['name']!r}")
+        taken.add(animation["name"])
+    return f"; renamed where another clip has the name: {', '.join(renamed)}" if renamed else ""
 
 
 def _check_rests(source: GltfDocument, doc: GltfDocument, mapping: dict[int, int]) -> None:

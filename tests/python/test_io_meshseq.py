@@ -178,7 +178,7 @@ def test_a_textured_sequence_has_a_vertex_per_position_and_texture_coordinate(tm
     (tmp_path / "seam").mkdir()
     for index in range(3):
         obj.write_obj(tmp_path / "seam" / f"f{index}.obj", positions + index, faces, texture)
-    mesh, split, shading, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
+    mesh, split, shading, _, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
     assert mesh.vertex_count == 6 and shading is None and mesh.frame_count == 3
     np.testing.assert_array_equal(mesh.frames[2], positions[split.points] + 2)
     np.testing.assert_array_equal(split.uvs[mesh.faces], texture.uvs[texture.corners])
@@ -195,12 +195,12 @@ def test_a_textured_sequence_has_a_vertex_per_position_and_texture_coordinate(tm
     # A frame with other texture coordinates: none are carried, and a warning says why.
     obj.write_obj(tmp_path / "seam" / "f2.obj", positions, faces, texture._replace(uvs=texture.uvs[::-1].copy()))
     with pytest.warns(UnreadAttributesWarning, match=r"f2.obj: has texture coordinates other than f0.obj's"):
-        mesh, split, _, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
+        mesh, split, _, _, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
     assert split is None and mesh.vertex_count == 4
     # The first frame without them, the others with: the same.
     obj.write_obj(tmp_path / "seam" / "f0.obj", positions, faces)
     with pytest.warns(UnreadAttributesWarning, match=r"f1.obj: has texture coordinates, and f0.obj has none"):
-        mesh, split, _, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
+        mesh, split, _, _, _, _ = meshseq.read_textured_sequence(tmp_path / "seam")
     assert split is None
 
 

@@ -143,7 +143,7 @@ def test_frames_whose_colours_disagree_leave_them_out_with_a_warning(tmp_path):
         UserWarning,
         match=r"shot_3.ply: has no vertex colours that can be read, and shot_0.ply has: the levels are written",
     ):
-        mesh, _, _, colours, _ = read_textured_sequence(tmp_path / "shot")
+        mesh, _, _, colours, _, _ = read_textured_sequence(tmp_path / "shot")
     assert colours is None and mesh.frame_count == 5
     as_float = VertexColours(rgb.values, rgb.names, ("u1", "u1", "f4"))
     write_ply(tmp_path / "shot" / "shot_3.ply", twisted[3], rest.faces, colours=as_float)

@@ -122,12 +122,13 @@ def _describe(kind: str, path: str) -> list[str]:
     if kind == "sequence":
         from ..io.meshseq import level_format, normals_fit, read_textured_sequence, sequence_paths
 
-        mesh, texture, shading, colours, materials = read_textured_sequence(path)
+        mesh, texture, shading, colours, materials, points = read_textured_sequence(path)
         lines = _animated_lines(mesh)
-        if texture is not None:  # the mesh has a vertex per position and texture coordinate
-            positions = np.unique(texture.points).size  # an OBJ's; a PLY's vertices have their own
+        if points is not None:  # the mesh has a vertex per position and texture coordinate or material
+            positions = np.unique(points).size  # an OBJ's; a PLY's vertices have their own
             counts = f"{positions}, {mesh.vertex_count}" if positions != mesh.vertex_count else f"{positions}"
-            lines[0] = f"vertices: {counts} with their texture coordinates, triangles: {mesh.face_count}"
+            textured = " with their texture coordinates" if texture is not None else ""
+            lines[0] = f"vertices: {counts}{textured}, triangles: {mesh.face_count}"
         paths = sequence_paths(path)
         if shading is not None:
             kind = {0.0: "flat", np.pi: "smooth"}.get(shading.crease, "smooth with hard edges")

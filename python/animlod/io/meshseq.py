@@ -88,6 +88,7 @@ class TexturedSequence(NamedTuple):
     shading: Shading | None
     colours: VertexColours | None
     materials: ObjMaterials | None
+    points: np.ndarray | None = None  # (V,) int32 the files' position each vertex stands on, where split
 
 
 def read_textured_sequence(
@@ -104,8 +105,10 @@ def read_textured_sequence(
     vertex's colours: one set where every frame's are the first's, else one per frame
     (:class:`~animlod.io.vertex_colours.VertexColours`); else None (with an
     :class:`~animlod.io.obj.UnreadAttributesWarning` where some frames have them). Fifth, the
-    first frame's OBJ materials, one per face of the mesh (:class:`~animlod.io.obj.ObjMaterials`).
-    Read its fields by name: more may come."""
+    first frame's OBJ materials, one per face of the mesh (:class:`~animlod.io.obj.ObjMaterials`);
+    a position used by faces of two materials is then a vertex per material, as at a UV seam.
+    Sixth, where the mesh's vertices are such copies, the files' position each stands on
+    (``points``); else None. Read its fields by name: more may come."""
     return _read_frames(sequence_paths(source), fps, textured=True)
 
 
@@ -157,16 +160,22 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
                       stacklevel=3)  # fmt: skip
     colours = frame_colours.read()
     shading = None if normals is None else _shading_of(first_vertices, faces, normals)
-    if texture is None:
+    # A vertex per (position, texture coordinate, material) that a corner uses: copies of a point
+    # at a UV seam or a material border, which AQEM welds and keeps apart.
+    corner_keys = [faces.ravel()]
+    if texture is not None:
+        corner_keys.append(texture.corners.ravel())
+    if materials is not None:
+        corner_keys.append(np.repeat(materials.faces, 3))
+    if len(corner_keys) == 1:
         return TexturedSequence(AnimatedMesh(faces, frames, fps=fps), None, shading, colours, materials)
-    # A vertex per (position, texture coordinate) pair that a corner uses.
-    pairs = np.stack([faces.ravel(), texture.corners.ravel()], axis=1)
-    wedges, corner_wedge = np.unique(pairs, axis=0, return_inverse=True)
-    split = AnimatedMesh(corner_wedge.reshape(faces.shape).astype(np.int32), frames[:, wedges[:, 0]], fps=fps)
-    if colours is not None:
-        colours = replace(colours, values=colours.values[:, wedges[:, 0]])
+    wedges, corner_wedge = np.unique(np.stack(corner_keys, axis=1), axis=0, return_inverse=True)
     points = wedges[:, 0].astype(np.int32)
-    return TexturedSequence(split, SequenceTexture(texture.uvs[wedges[:, 1]], points), shading, colours, materials)
+    split = AnimatedMesh(corner_wedge.reshape(faces.shape).astype(np.int32), frames[:, points], fps=fps)
+    if colours is not None:
+        colours = replace(colours, values=colours.values[:, points])
+    texture = None if texture is None else SequenceTexture(texture.uvs[wedges[:, 1]], points)
+    return TexturedSequence(split, texture, shading, colours, materials, points)
 
 
 class _ColourFrames:
@@ -248,13 +257,15 @@ def write_sequence(
     shading: Shading | None = None,
     colours: VertexColours | None = None,
     materials: ObjMaterials | None = None,
+    points: np.ndarray | None = None,
 ) -> list[Path]:
     """Write every frame of ``mesh`` to ``folder/{stem}_{index:04d}.{fmt}``, or to
     ``folder/{name}.{fmt}`` with the frames' ``names``, the folder atomically; with ``texture``
     its texture coordinates (:func:`frame_layout`); with ``shading`` each frame's normals rebuilt
     from its faces, shaded so (:func:`rebuilt_normals`; smooth only for PLY, whose vertices hold
     one normal each); with ``colours`` each frame's vertex colours (one set for every frame, or
-    one per frame); with ``materials`` (OBJ only) each face's material.
+    one per frame); with ``materials`` (OBJ only) each face's material; with ``points`` the
+    position each vertex is a copy of, copies written as one OBJ ``v`` (:func:`obj_layout`).
 
     The frames are written into a temporary folder beside ``folder``, which is renamed to
     ``folder`` once every frame is written (:func:`~animlod.io.atomic.atomic_folder`): an
@@ -283,7 +294,7 @@ def write_sequence(
         raise ValueError(f"{os.fspath(folder)}: names: {len(names)} names for {mesh.frame_count} frames, or names "
                          "that repeat (regardless of case) or are not plain file names")  # fmt: skip
     names = [f"{name}.{fmt}" for name in names]
-    layout = frame_layout(mesh, texture, fmt, normals=shading is not None)
+    layout = frame_layout(mesh, texture, fmt, normals=shading is not None, points=points)
     with atomic_folder(folder) as temporary:
         for frame, name in enumerate(names):
             layout.write(temporary / name, mesh, frame, shading, colours, materials)
@@ -334,12 +345,19 @@ class FrameLayout:
         write_mesh(path, positions, self.faces, self.texture, normals, written_colours, materials)
 
 
-def frame_layout(mesh: AnimatedMesh, texture: SequenceTexture | None, fmt: str, normals: bool) -> FrameLayout:
+def frame_layout(
+    mesh: AnimatedMesh,
+    texture: SequenceTexture | None,
+    fmt: str,
+    normals: bool,
+    points: np.ndarray | None = None,
+) -> FrameLayout:
     """How ``mesh``'s frames are written as ``fmt`` ("obj" or "ply") files with ``texture``, and
-    with ``normals`` or without. A PLY file holds a texture coordinate and a normal per vertex,
-    so every vertex is written; an OBJ file's are per corner (:func:`obj_layout`)."""
+    with ``normals`` or without; ``points`` where its vertices are copies of the files' positions
+    (``texture.points`` where textured). A PLY file holds a texture coordinate and a normal per
+    vertex, so every vertex is written; an OBJ file's are per corner (:func:`obj_layout`)."""
     if fmt != "ply":
-        return FrameLayout(*obj_layout(mesh, texture))
+        return FrameLayout(*obj_layout(mesh, texture, points))
     uvs = None if texture is None else ObjTexture(texture.uvs, mesh.faces)
     if not normals:
         return FrameLayout(np.arange(mesh.vertex_count), mesh.faces, uvs)
@@ -360,21 +378,25 @@ def normals_fit(fmt: str, shading: Shading) -> bool:
     return fmt != "ply" or shading.crease >= np.pi
 
 
-def obj_layout(mesh: AnimatedMesh, texture: SequenceTexture | None) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
+def obj_layout(
+    mesh: AnimatedMesh, texture: SequenceTexture | None, points: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None]:
     """How ``mesh``'s frames are written as OBJ files with ``texture``: the vertices whose
     positions are written (in vertex order), the faces over those positions and the texture
-    coordinates with each corner's index; the vertices of one point that stand at one place in
-    every frame (a seam's copies) share one position. Without ``texture``: every vertex."""
-    if texture is None:
+    coordinates with each corner's index; the vertices of one point (``points``, else
+    ``texture.points``) that stand at one place in every frame (a seam's copies) share one
+    position. Without either: every vertex."""
+    points = texture.points if points is None and texture is not None else points
+    if points is None:
         return np.arange(mesh.vertex_count), mesh.faces, None
-    keys = np.concatenate([texture.points[:, None], mesh.frames.transpose(1, 0, 2).reshape(mesh.vertex_count, -1)],
+    keys = np.concatenate([points[:, None], mesh.frames.transpose(1, 0, 2).reshape(mesh.vertex_count, -1)],
                           axis=1, dtype=np.float64)  # fmt: skip
     _, first, group = np.unique(keys, axis=0, return_index=True, return_inverse=True)
     order = np.argsort(first)  # positions in the order of their first vertex
     rank = np.empty_like(order)
     rank[order] = np.arange(order.size)
     position = rank[group.ravel()].astype(np.int32)
-    return first[order], position[mesh.faces], ObjTexture(texture.uvs, mesh.faces)
+    return first[order], position[mesh.faces], None if texture is None else ObjTexture(texture.uvs, mesh.faces)
 
 
 def frame_names_fit(names: Sequence[str], frames: int) -> bool:

@@ -98,6 +98,7 @@ def simplify_sequence(
     shading = None  # how the sequence's normals shade it, for the levels' rebuilt normals
     colours = None  # its vertex colours, carried as AQEM attributes too
     materials = None  # its OBJ materials, one per face
+    points = None  # the files' position each vertex stands on, where split at seams
     if kind == "npz":
         from ..io.npz import read_npz
 
@@ -105,7 +106,7 @@ def simplify_sequence(
     elif kind == "sequence":
         from ..io.meshseq import read_textured_sequence
 
-        original, texture, shading, colours, materials = read_textured_sequence(source)
+        original, texture, shading, colours, materials, points = read_textured_sequence(source)
     else:
         raise FormatError(os.fspath(source), "file", f"a {kind} file is not a mesh sequence")
     started = time.perf_counter()
@@ -113,7 +114,7 @@ def simplify_sequence(
     aqem_options = {**aqem_options, "record_positions": False}
     if texture is not None or colours is not None:  # a point of the edge in every frame, where its attributes are
         aqem_options = {"placement": "on_edge", **aqem_options}
-    carried = _CarriedAttributes.of(original, texture, colours, materials)
+    carried = _CarriedAttributes.of(original, texture, colours, materials, points)
     per_vertex, per_point = carried.columns()
     if materials is not None:  # copies of a position in two materials never merge, as in glTF
         aqem_options = {"face_groups": materials.faces + 1, **aqem_options}
@@ -159,6 +160,7 @@ class _CarriedAttributes:
     colours: VertexColours | None
     colours_by_point: bool
     materials: ObjMaterials | None
+    points: np.ndarray | None
 
     @classmethod
     def of(
@@ -167,15 +169,16 @@ class _CarriedAttributes:
         texture: SequenceTexture | None,
         colours: VertexColours | None,
         materials: ObjMaterials | None,
+        points: np.ndarray | None,
     ) -> _CarriedAttributes:
-        """The attributes of ``mesh`` carried: its ``texture``, ``colours`` and faces'
-        ``materials`` (each may be None)."""
+        """The attributes of ``mesh`` carried: its ``texture``, ``colours``, faces' ``materials``
+        and the files' ``points`` its vertices stand on (each may be None)."""
         by_point = False
         if colours is not None:  # copies of a position in the first frame: those AQEM may weld
             flat = _frame_columns(colours.values)
             _, first, copy_of = np.unique(mesh.frames[0], axis=0, return_index=True, return_inverse=True)
             by_point = bool(np.array_equal(flat, flat[first[copy_of.ravel()]]))
-        return cls(texture, colours, by_point, materials)
+        return cls(texture, colours, by_point, materials, points)
 
     def columns(self) -> tuple[np.ndarray | None, np.ndarray | None]:
         """(V, A) per-vertex and (V, B) per-point float32 columns (each None for none): u, v where
@@ -190,7 +193,7 @@ class _CarriedAttributes:
     def of_level(self, level: SimplifiedLevel) -> _LevelSurface:
         """A level's texture coordinates and colours, from its interpolated attributes, and its
         faces' materials, those of the input faces they come from."""
-        texture = colours = materials = None
+        texture = colours = materials = points = None
         if self.texture is not None:
             texture = SequenceTexture(level.attributes[:, :2], self.texture.points[level.kept_vertices])
         if self.colours is not None:
@@ -200,7 +203,9 @@ class _CarriedAttributes:
             colours = replace(self.colours, values=np.ascontiguousarray(values))
         if self.materials is not None:
             materials = self.materials._replace(faces=self.materials.faces[level.face_sources])
-        return _LevelSurface(texture, colours, materials)
+        if self.points is not None:
+            points = self.points[level.kept_vertices]
+        return _LevelSurface(texture, colours, materials, points)
 
 
 class _LevelSurface(NamedTuple):
@@ -209,6 +214,7 @@ class _LevelSurface(NamedTuple):
     texture: SequenceTexture | None
     colours: VertexColours | None
     materials: ObjMaterials | None
+    points: np.ndarray | None  # the files' position each vertex stands on, where split at seams
 
 
 def _frame_columns(values: np.ndarray) -> np.ndarray:
@@ -294,7 +300,7 @@ def _write_level(
         from ..io.meshseq import write_sequence
 
         write_sequence(target, mesh, fmt.suffix, names=fmt.frame_names, texture=surface.texture, shading=shading,
-                       colours=surface.colours, materials=materials)  # fmt: skip
+                       colours=surface.colours, materials=materials, points=surface.points)  # fmt: skip
         return target
     path = target.with_name(f"{target.name}.{fmt.suffix}")
     if fmt.suffix == "npz":
@@ -304,7 +310,7 @@ def _write_level(
     else:  # one mesh in, one mesh out
         from ..io.meshseq import frame_layout
 
-        layout = frame_layout(mesh, surface.texture, fmt.suffix, normals=shading is not None)
+        layout = frame_layout(mesh, surface.texture, fmt.suffix, normals=shading is not None, points=surface.points)
         layout.write(path, mesh, 0, shading, surface.colours, materials)
     return path
 

@@ -152,10 +152,15 @@ def _read_obj(path: str | os.PathLike, textured: bool, normals: bool = False) ->
     def name_vertex(vertex: int) -> str:
         return f"vertex {vertex} (line {vertex_lines[vertex]})"
 
-    vertices = _leading_values(path, vertex_block, len(vertex_lines), 3, 3, name_vertex, "coordinates")
-    vertices = vertices.astype(np.float32)
+    channels = _colour_channels(path, values_per_vertex) if textured else 0
+    values = _vertex_values(path, vertex_block, len(vertex_lines), channels, name_vertex)
+    channels = values.shape[1] - 3  # 0 where a colour did not parse
+    vertices = values[:, :3].astype(np.float32)
     check_finite_vertices(path, vertices, name_vertex)
-    colours = _vertex_colours(path, vertex_block, values_per_vertex, name_vertex) if textured else None
+    colours = None
+    if channels:
+        rows = all_finite(path, values[:, 3:].astype(np.float32), "colours", name_vertex)
+        colours = None if rows is None else VertexColours(rows[None], OBJ_COLOUR_NAMES[:channels], ("f4",) * channels)
 
     def name_face(face: int) -> str:
         return f"face {face} (line {face_lines[face]})"
@@ -209,31 +214,41 @@ def _materials(data: bytes, face_lines: np.ndarray, triangles: np.ndarray) -> Ob
                         tuple(distinct[order].tolist()), np.repeat(per_face, triangles))  # fmt: skip
 
 
-def _vertex_colours(
-    path: Path, block: bytes, sizes: np.ndarray, name_vertex: Callable[[int], str]
-) -> VertexColours | None:
-    """The colours of the ``v`` lines (``block``, ``sizes`` values each) where every line has six
-    (x, y, z, r, g, b) or every line seven (and a); None, with a warning, where only some lines
-    have one or one does not parse or is not finite; None where no line has one."""
+def _colour_channels(path: Path, sizes: np.ndarray) -> int:
+    """How many colour channels the ``v`` lines (``sizes`` values each) hold after x, y, z: 3
+    where every line has six values, 4 where every one has seven; 0 where no line has six or
+    more, and, with a warning, where only some lines have them or every one has more."""
     if not sizes.size or sizes.max() < 6:
-        return None
-    channels = int(sizes[0]) - 3
-    reason = None
+        return 0
     if np.any(sizes != sizes[0]):
         reason = f"{np.count_nonzero(sizes >= 6)} of its {sizes.size} v lines have more than x, y, z, others not"
-    elif channels not in (3, 4):
+    elif sizes[0] - 3 not in (3, 4):
         reason = f"its v lines have {sizes[0]} values, not x, y, z and r, g, b (and a)"
     else:
-        try:
-            values = _leading_values(path, block, sizes.size, 3 + channels, 3, name_vertex, "values")[:, 3:]
-        except FormatError as error:
-            reason = str(error).removeprefix(f"{path}: ")
-    if reason is not None:
-        warnings.warn(f"{path}: {reason}: its colours are not read, and the levels are written without them",
-                      UnreadAttributesWarning, stacklevel=4)  # fmt: skip
-        return None
-    values = all_finite(path, values.astype(np.float32), "colours", name_vertex)
-    return None if values is None else VertexColours(values[None], OBJ_COLOUR_NAMES[:channels], ("f4",) * channels)
+        return int(sizes[0]) - 3
+    _warn_unread_colours(path, reason)
+    return 0
+
+
+def _vertex_values(
+    path: Path, block: bytes, count: int, channels: int, name_vertex: Callable[[int], str]
+) -> np.ndarray:
+    """(count, 3 + channels) float64: each ``v`` line's x, y, z and its ``channels`` colour
+    values, in one parse. A coordinate that does not parse is a FormatError as ever; a colour
+    value that does not parse costs only the colours (a warning), and gives (count, 3)."""
+    try:
+        return _leading_values(path, block, count, 3 + channels, 3, name_vertex, "coordinates")
+    except FormatError as error:
+        if not channels:
+            raise
+        coordinates = _leading_values(path, block, count, 3, 3, name_vertex, "coordinates")  # raises for theirs
+        _warn_unread_colours(path, str(error).removeprefix(f"{path}: "))
+        return coordinates
+
+
+def _warn_unread_colours(path: Path, reason: str) -> None:
+    warnings.warn(f"{path}: {reason}: its colours are not read, and the levels are written without them",
+                  UnreadAttributesWarning, stacklevel=5)  # fmt: skip
 
 
 @dataclass(frozen=True)

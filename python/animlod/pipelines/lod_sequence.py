@@ -193,9 +193,10 @@ class _CarriedAttributes:
     def of_level(self, level: SimplifiedLevel) -> _LevelSurface:
         """A level's texture coordinates and colours, from its interpolated attributes, and its
         faces' materials, those of the input faces they come from."""
-        texture = colours = materials = points = None
-        if self.texture is not None:
-            texture = SequenceTexture(level.attributes[:, :2], self.texture.points[level.kept_vertices])
+        texture = colours = materials = None
+        points = None if self.points is None else self.points[level.kept_vertices]
+        if self.texture is not None:  # split at its seams: points is the texture's
+            texture = SequenceTexture(level.attributes[:, :2], points)
         if self.colours is not None:
             frames, _, channels = self.colours.values.shape
             columns = level.position_attributes if self.colours_by_point else level.attributes[:, -frames * channels :]
@@ -203,8 +204,6 @@ class _CarriedAttributes:
             colours = replace(self.colours, values=np.ascontiguousarray(values))
         if self.materials is not None:
             materials = self.materials._replace(faces=self.materials.faces[level.face_sources])
-        if self.points is not None:
-            points = self.points[level.kept_vertices]
         return _LevelSurface(texture, colours, materials, points)
 
 

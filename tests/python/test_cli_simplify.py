@@ -256,10 +256,25 @@ def test_a_level_short_of_its_target_says_what_stopped_it(tmp_path, capsys):
     """Any finite --max-error was named as the reason; a generous one is not what stops a level
     that no legal collapse can reach (the core says which stopped it)."""
     write_npz(tmp_path / "tube.npz", bending_tube(frames=2))
-    for max_error, why in (("1e9", "no legal collapse left"), ("1e-4", "--max-error reached")):
+    for max_error, why in (("1e9", "no legal collapse left"), ("1e-4", "max error 0.0001 reached")):
         arguments = ["--ratio", "0.001", "--max-error", max_error, "--no-metrics"]
         assert main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), *arguments]) == 0
         assert f"): {why}" in capsys.readouterr().out
+
+
+def test_levels_where_max_error_stopped_the_collapses_are_not_written_twice(tmp_path, capsys):
+    """Levels 2 and 3 of a sequence stopped by --max-error were written as copies of one mesh,
+    folders that differ only in name, while a glTF chain left them out with a note."""
+    write_sequence(tmp_path / "tube", bending_tube(frames=3), "obj")
+    arguments = ["--ratio", "0.5", "0.25", "0.1", "--max-error", "1e-4", "--no-metrics"]
+    assert main(["simplify", str(tmp_path / "tube"), "-o", str(tmp_path / "out"), *arguments]) == 0
+    out = capsys.readouterr().out
+    assert sorted(path.name for path in (tmp_path / "out").iterdir()) == ["tube_lod1", "tube_lod2"]
+    faces = [read_sequence(tmp_path / "out" / f"tube_lod{level}").face_count for level in (1, 2)]
+    assert faces[0] > faces[1] > 36  # the second stopped short of its target, 90
+    assert f"note: level 2: stopped at {faces[1]} faces (target 90): max error 0.0001 reached" in out
+    assert f"note: level 3 (target 36) not written: the same mesh as level 2 ({faces[1]} faces)" in out
+    assert "where the max error 0.0001 stopped the collapses" in out
 
 
 def test_bad_ratio_and_bad_mesh_exit_with_code_2(tmp_path, capsys):

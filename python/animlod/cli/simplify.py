@@ -203,12 +203,8 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
             f"note: quadrics over {report.frames_used} of {frame_count} frames chosen to cover the motion: over "
             f"every frame they would take more than {limit:g} GiB (--max-frames {frame_count} takes them all)"
         )
-    # A level short of its target (--max-error, or no legal collapse left) can equal the one before
-    # it; without a word the table read as two levels that happen to agree.
-    for index, level in enumerate(report.levels, start=1):
-        if not level.reached:
-            why = "--max-error reached" if level.stopped_by_max_error else "no legal collapse left"
-            print(f"note: level {index}: stopped at {level.faces} faces (target {level.target_faces}): {why}")
+    for note in report.notes:  # levels short of their targets, and those not written
+        print(f"note: {note}")
     if args.plot:
         levels = [_read_level(level.path) for level in report.levels]
         # The weights AQEM used, per input vertex: features found on the raw input would need

@@ -71,13 +71,8 @@ def simplify_asset(
         for index, level in enumerate(report.levels, start=1):
             relative = level.surface["hausdorff_max"] if level.surface else None
             rows.append(LevelRow(index, "", level.faces, None, level.error, relative))
-        notes = [
-            f"level {index}: stopped at {level.faces} faces (target {level.target_faces})"
-            for index, level in enumerate(report.levels, start=1)
-            if not level.reached
-        ]
         outputs = [level.path for level in report.levels]
-        return AssetResult("simplify", os.fspath(source), outputs, rows, time.perf_counter() - started, notes)
+        return AssetResult("simplify", os.fspath(source), outputs, rows, time.perf_counter() - started, report.notes)
     reason = f"a {kind} file holds no mesh; simplify needs one (try the motion job)"
     raise FormatError(os.fspath(source), "file", reason)
 

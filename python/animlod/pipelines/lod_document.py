@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..aqem import Preparation, SimplifiedLevel
+from ..aqem import Preparation
 from ..io.detect import glb_name
 from ..io.errors import FormatError
 from ..io.glb_builder import GlbBuilder
@@ -38,6 +38,7 @@ from ..io.stored_weights import normalise_stored_weights
 from ..model import AnimatedMesh
 from .clip_import import with_clips
 from .drawable_levels import DrawableLevels, DrawableSettings, draws_nothing, simplify_drawable
+from .level_chain import coarser_level_count, short_level_note, unwritten_levels_note
 
 DEFAULT_RATIOS = (0.5, 0.25, 0.1)
 
@@ -164,8 +165,9 @@ def simplify_document(
 
 
 def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettings) -> DrawableReport:
-    """The drawable's report, whose ``levels`` are those written (:func:`_written_count`)."""
-    written = levels.levels[: _written_count(levels)]
+    """The drawable's report, whose ``levels`` are those written (:func:`coarser_level_count`)."""
+    simplified = [level.simplified for level in levels.levels]
+    written = levels.levels[: coarser_level_count(simplified)]
     errors = [0.0] + [level.error for level in written]
     coverages = screen_coverages(errors, levels.size, settings.pixel_error, settings.viewport_px)
     report = DrawableReport(
@@ -180,53 +182,23 @@ def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettin
         + [AnimatedMesh(level.simplified.mesh.faces, level.rest_positions()[None]) for level in written],
     )
     max_error = float(settings.aqem.get("max_error", math.inf))
-    by_max_error = any(level.simplified.stopped_by_max_error for level in levels.levels)
-    why = "no legal collapse left (seams, locked spots or the topology's minimum)"
-    cause = "no legal collapse was left"
-    if by_max_error:
-        why = f"max error {max_error:g} reached (the next collapse's AQEM error exceeds it)"
-        cause = f"the max error {max_error:g} stopped the collapses"
     for index, (level, coverage) in enumerate(zip(written, coverages[1:]), start=1):
-        simplified: SimplifiedLevel = level.simplified
         report.levels.append(
             LevelReport(
                 level=index,
-                faces=simplified.mesh.face_count,
-                target_faces=simplified.target_face_count,
-                reached=simplified.reached,
+                faces=level.simplified.mesh.face_count,
+                target_faces=level.simplified.target_face_count,
+                reached=level.simplified.reached,
                 error=level.error,
                 relative_error=level.error / levels.size if levels.size > 0 else 0.0,
                 coverage=coverage,
             )
         )
-        if not simplified.reached:
-            faces, target = simplified.mesh.face_count, simplified.target_face_count
-            largest = f"; this level's largest AQEM error: {simplified.error:.3g}" if by_max_error else ""
-            report.notes.append(f"level {index}: stopped at {faces} faces (target {target}): {why}{largest}")
-    dropped = levels.levels[len(written) :]
-    if dropped:
-        numbers = ", ".join(str(index) for index in range(len(written) + 1, len(levels.levels) + 1))
-        targets = ", ".join(str(level.simplified.target_face_count) for level in dropped)
-        plural = "s" if len(dropped) > 1 else ""
-        same = f"level {len(written)}" if written else "the input"
-        report.notes.append(
-            f"level{plural} {numbers} (target{plural} {targets}) not written: the same mesh as {same} "
-            f"({dropped[0].simplified.mesh.face_count} faces), where {cause}"
-        )
+    notes = [short_level_note(index, level, max_error) for index, level in enumerate(simplified[: len(written)], 1)]
+    notes.append(unwritten_levels_note(simplified, len(written), max_error))
+    report.notes.extend(note for note in notes if note)
     report.levels.insert(0, LevelReport(0, report.faces, report.faces, True, 0.0, 0.0, coverages[0]))
     return report
-
-
-def _written_count(levels: DrawableLevels) -> int:
-    """How many of the levels are written: the chain ends at the last level coarser than the one
-    before. A level short of its target holds the mesh where the collapses stopped, and so do the
-    levels after it: written, they were copies with screen coverages of their own."""
-    collapses = 0  # the input's
-    for count, level in enumerate(levels.levels):
-        if not level.simplified.reached and level.simplified.collapse_count == collapses:
-            return count
-        collapses = level.simplified.collapse_count
-    return len(levels.levels)
 
 
 def _write_chain(

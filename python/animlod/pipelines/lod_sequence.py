@@ -18,6 +18,7 @@ under ``mtllib`` lines that name the input's libraries from the level's folder.
 
 from __future__ import annotations
 
+import math
 import os
 import time
 import warnings
@@ -37,6 +38,7 @@ from ..io.vertex_colours import VertexColours
 from ..metrics import SurfaceError, surface_error
 from ..model import AnimatedMesh, whole_number
 from ..normals import Shading
+from .level_chain import coarser_level_count, short_level_note, unwritten_levels_note
 
 # Frames of a longer sequence measured by default, evenly spaced: every frame of a 300-frame,
 # 20k-triangle sequence took 61 s to measure against 2.3 s to simplify.
@@ -59,7 +61,9 @@ class SequenceLevel:
 
 @dataclass
 class SequenceReport:
-    """The result of :func:`simplify_sequence`."""
+    """The result of :func:`simplify_sequence`: its ``levels`` are those written, up to the last
+    one coarser than the one before it (see :mod:`.level_chain`); ``notes`` say which levels fell
+    short of their targets and which were not written."""
 
     source: str
     original: AnimatedMesh
@@ -69,6 +73,7 @@ class SequenceReport:
     frames_used: int  # frames whose quadrics drove it (fewer than the sequence's when limited)
     frames_measured: int  # frames the surface errors are over (0: not measured)
     vertex_weights: np.ndarray  # (V,) Eq. 6 weight of each input vertex, 1 outside motion features
+    notes: list[str]
 
 
 def simplify_sequence(
@@ -83,7 +88,8 @@ def simplify_sequence(
     **aqem_options: object,
 ) -> SequenceReport:
     """Simplify the sequence at ``source`` (a folder, glob or file of OBJ/PLY frames, or an NPZ)
-    and write its levels into the folder ``output``.
+    and write its levels into the folder ``output``, up to the last level coarser than the one
+    before it (a max error or the topology can stop the collapses; ``notes`` say so).
 
     ``aqem_options`` are keyword arguments of :func:`animlod.simplify_animated`; ``progress``
     receives its (done, total) collapse counts, ``measuring`` the (done, total) levels measured
@@ -131,10 +137,14 @@ def simplify_sequence(
         warnings.warn(f"{os.fspath(source)}: its materials are not written: the levels are PLY files, which have "
                       "none", UnreadAttributesWarning, stacklevel=2)  # fmt: skip
     frames = _measured_frames(original.frame_count, measured_frames) if measure else np.arange(0)
+    written = result.levels[: coarser_level_count(result.levels)]
+    max_error = float(aqem_options.get("max_error", math.inf))
+    notes = [short_level_note(index, level, max_error) for index, level in enumerate(written, start=1)]
+    notes.append(unwritten_levels_note(result.levels, len(written), max_error))
     levels = []
-    for index, level in enumerate(result.levels, start=1):
+    for index, level in enumerate(written, start=1):
         if measure and measuring is not None:
-            measuring(index - 1, len(result.levels))
+            measuring(index - 1, len(written))
         path = _write_level(fmt, folder / f"{stem}_lod{index}", level.mesh, carried.of_level(level), shading)
         measured = _surface_error(*(_frames_of(mesh, frames) for mesh in (original, level.mesh))) if measure else None
         surface = measured.summary() if measured is not None else None
@@ -143,9 +153,9 @@ def simplify_sequence(
         levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error,
                                     level.stopped_by_max_error))  # fmt: skip
     if measure and measuring is not None:
-        measuring(len(result.levels), len(result.levels))
+        measuring(len(written), len(written))
     return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used),
-                          len(frames), result.vertex_weights)  # fmt: skip
+                          len(frames), result.vertex_weights, [note for note in notes if note])  # fmt: skip
 
 
 @dataclass(frozen=True)

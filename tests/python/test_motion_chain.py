@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from test_motion_figures import figure_motion
 
+from animlod import rotations
 from animlod.cli import main
 from animlod.motion_lod import analyze_motion
 from animlod.motion_lod.chain import build_motion_chain, level_joint_counts
@@ -135,6 +136,24 @@ def test_cli_writes_bvh_levels_a_plot_and_refuses_bad_requests(tmp_path, capsys)
     assert main(["motion", str(source), "-o", str(out), "--hard", "--solver", "newton"]) == 2
     assert main(["motion", str(source), "-o", str(out), "--lock", "Tail"]) == 2
     assert "no joint named 'Tail'" in capsys.readouterr().err
+
+
+def test_cli_says_why_a_figure_of_one_point_has_no_relative_error(tmp_path, capsys) -> None:
+    """Every joint of glTF's SimpleSkin sits at one point: the summary read "figure size 0", as
+    if the size had been lost, beside a max/size column of dashes."""
+    from animlod.io.bvh import write_bvh
+    from animlod.model import Motion, Skeleton
+
+    skeleton = Skeleton(
+        ["a", "b", "end"], np.array([-1, 0, 1]), np.zeros((3, 3)), end_sites=np.array([False, False, True])
+    )
+    turns = rotations.from_axis_angle(
+        np.array([0.0, 0.0, 1.0]), np.radians([[0.0, 0.0, 0.0], [10, 20, 0], [20, 40, 0]])
+    )
+    write_bvh(tmp_path / "point.bvh", Motion(skeleton, np.zeros((3, 3)), turns, fps=30.0))
+    assert main(["motion", str(tmp_path / "point.bvh"), "-o", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert "figure size 0: every joint of the key posture sits at one point, so errors are in asset units only" in out
 
 
 def test_cli_on_a_skinned_glb_writes_a_glb_per_level(tmp_path) -> None:

@@ -221,7 +221,10 @@ def _print_summary(chain, floor, skin_errors) -> None:
     size = chain.figure_size
     leaves = ", as the skin sees them (leaf joints by points of their skin, joints that move none left out)"
     leaves = leaves if skin_errors is not None else ""
-    print(f"\nfigure size {size:.4g} (asset units); errors over every original joint and frame{leaves}")
+    extent = f"figure size {size:.4g} (asset units)"
+    if size == 0.0:  # a rig whose joints all sit at one point (a two-joint test skin): max/size has no meaning
+        extent = "figure size 0: every joint of the key posture sits at one point, so errors are in asset units only"
+    print(f"\n{extent}; errors over every original joint and frame{leaves}")
     if skin_errors is not None:
         print("skin max: the largest distance of a skin vertex from the input's, over every frame")
     if floor.fewest > floor.paper_fewest:

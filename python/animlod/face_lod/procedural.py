@@ -19,7 +19,7 @@ class ProceduralFace:
 
     Attributes
     ----------
-    rig : the full face with its 20 MPAs on 3x3x3 lattices.
+    rig : the full face with its 21 MPAs on 3x3x3 lattices.
     expressions : smile, anger, surprise and sadness.
     tree : the active tree of Figure 7 (4 levels).
     """

@@ -277,6 +277,17 @@ def test_levels_where_max_error_stopped_the_collapses_are_not_written_twice(tmp_
     assert "where the max error 0.0001 stopped the collapses" in out
 
 
+def test_a_sequence_summary_says_what_the_preparation_dropped(tmp_path, capsys):
+    """A glTF drawable's summary said which faces the simplifier dropped before simplifying; a
+    sequence's said nothing, so the levels' targets looked off by the repeated faces."""
+    mesh = bending_tube(frames=2)
+    write_npz(tmp_path / "tube.npz", type(mesh)(np.concatenate([mesh.faces, mesh.faces[:5]]), mesh.frames))
+    assert main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), "--no-metrics"]) == 0
+    summary = capsys.readouterr().out.splitlines()[0]
+    assert summary.startswith(f"{mesh.face_count + 5} triangles, 2 frames; welded 0 vertices")
+    assert summary.endswith("5 degenerate or repeated faces dropped")
+
+
 def test_bad_ratio_and_bad_mesh_exit_with_code_2(tmp_path, capsys):
     write_npz(tmp_path / "tube.npz", bending_tube(frames=2))
     assert main(["simplify", str(tmp_path / "tube.npz"), "-o", str(tmp_path / "out"), "--ratio", "1.5"]) == 2

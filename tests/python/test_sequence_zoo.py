@@ -75,7 +75,7 @@ def test_simplify_says_which_sequence_levels_stopped_short_of_their_target(tmp_p
     args = ["simplify", str(frames), "-o", str(tmp_path / "out"), "--no-metrics", "--max-error", "1e-9"]
     assert main(args) == 0
     out = capsys.readouterr().out
-    assert "target" in out.splitlines()[1]
+    assert "target" in out.splitlines()[2]
     assert "note: level 1: stopped at" in out and "max error 1e-09 reached" in out
     assert main(["simplify", str(frames), "-o", str(tmp_path / "out2"), "--no-metrics"]) == 0
     assert "note:" not in capsys.readouterr().out

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..aqem import Preparation
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind, input_stem
 from ..model import AnimatedMesh
 from ..options import AqemOptions
@@ -126,18 +127,11 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
     print("errors: max over the rest pose and frames of every clip of the Hausdorff distance, relative to the")
     print("bounding-box diagonal; coverage: the MSFT_screencoverage below which the next level takes over")
     for drawable in report.drawables:
-        prep = drawable.preparation
+        renormalised = drawable.renormalised_weights
         print(
             f"{drawable.label} (nodes {drawable.nodes}): {drawable.faces} triangles, {drawable.clips} clips; "
-            f"welded {prep.welded_vertices} vertices, {prep.seam_vertices} seam positions kept, "
-            f"{prep.split_vertices} cut at non-manifold spots, {prep.degenerate_faces + prep.duplicate_faces} "
-            f"degenerate or repeated faces dropped"
-            + (f", {prep.mirrored_faces} two-sided faces mirrored" if prep.mirrored_faces else "")
-            + (
-                f", {drawable.renormalised_weights} skin weight rows renormalised"
-                if drawable.renormalised_weights
-                else ""
-            )
+            + _preparation_summary(drawable.preparation)
+            + (f", {renormalised} skin weight rows renormalised" if renormalised else "")
         )
         rows = [("level", "faces", "target", "error", "coverage")]
         rows += [
@@ -179,6 +173,7 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
         progress.close()
         measuring.close()
     frame_count = report.original.frame_count
+    print(f"{report.original.face_count} triangles, {frame_count} frames; {_preparation_summary(report.preparation)}")
     over = "frames"
     if 0 < report.frames_measured < frame_count:
         measured = report.frames_measured
@@ -212,6 +207,16 @@ def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:
         features = None if args.no_features else report.vertex_weights > 1.0
         _plot(Path(args.output) / f"{input_stem(args.input)}_levels.png", report.original, levels, features)
     return 0
+
+
+def _preparation_summary(prep: Preparation) -> str:
+    """What the simplifier did to the input before simplifying, for the summary line."""
+    dropped = prep.degenerate_faces + prep.duplicate_faces
+    mirrored = f", {prep.mirrored_faces} two-sided faces mirrored" if prep.mirrored_faces else ""
+    return (
+        f"welded {prep.welded_vertices} vertices, {prep.seam_vertices} seam positions kept, "
+        f"{prep.split_vertices} cut at non-manifold spots, {dropped} degenerate or repeated faces dropped{mirrored}"
+    )
 
 
 def _read_level(path: Path) -> AnimatedMesh:

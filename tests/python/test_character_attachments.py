@@ -241,3 +241,12 @@ def test_every_level_node_of_the_skinned_mesh_plays_its_morph_weights(character_
         (sampler,) = [c.sampler for c in animation.channels if (c.target.node, c.target.path) == (base, "weights")]
         driven = [c.target.node for c in animation.channels if c.target.path == "weights" and c.sampler == sampler]
         assert sorted(driven) == sorted([base, *level_nodes])
+
+
+def test_the_note_on_a_hat_says_it_stays_at_full_detail_and_why(character_with_sockets):
+    # The hat, drawn by the head joint's node, is no skinned mesh: the note said "no skin or no
+    # animation", though it moves with every motion level through its joint.
+    _, _, report = character_with_sockets
+    (note,) = [note for note in report.notes if note.startswith("not simplified")]
+    assert note.startswith("not simplified, drawn at full detail at every level (unskinned; `animlod simplify`")
+    assert note.endswith("mesh 1")

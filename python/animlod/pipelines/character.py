@@ -243,9 +243,15 @@ def build_character(
         _switch_together([chains[d.label] for d in members], [geometry[d.label].size for d in members])
     for drawable in animated:
         _attach(builder, drawable, chains[drawable.label], grids[drawable.label])
-    skipped = [d.label for d in all_drawables if d.label not in chains and d.label not in chained]
-    if skipped:
-        notes.append(f"not simplified (no skin or no animation): {', '.join(skipped)}")
+    skipped = [d for d in all_drawables if d.label not in chains and d.label not in chained]
+    unskinned = [d.label for d in skipped if d.skinned is None]
+    if unskinned:  # props hung from joints among them: they follow each motion level, at full detail
+        notes.append(f"not simplified, drawn at full detail at every level (unskinned; `animlod simplify` gives "
+                     f"such meshes levels of their own): {', '.join(unskinned)}")  # fmt: skip
+    still = [d.label for d in skipped if d.skinned is not None]
+    if still:
+        notes.append(f"not simplified, drawn at full detail at every level (skinned, but no clip moves its joints): "
+                     f"{', '.join(still)}")  # fmt: skip
     builder.save(output)
     return CharacterReport(Path(source), Path(output), chains, motion_seconds, geometry_seconds, notes)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import base64
 import json
 import os
+import re
 import subprocess
 from collections.abc import Callable
 from pathlib import Path
@@ -461,8 +462,26 @@ def test_joints_in_trees_without_a_common_node_are_refused(chain_glb, tmp_path):
         gltf.nodes[0].children = []
         gltf.scenes[0].nodes = [0, 1, 3]
 
-    with pytest.raises(FormatError, match=r"skin 0: joints form 2 separate trees \(node 0 'root', node 1 'mid'\)"):
+    reason = "joints form 2 node trees with no node in common: node 0 'root', the child of no node; node 1 'mid',"
+    with pytest.raises(FormatError, match=f"skin 0: {reason}"):
         read_skinned(edit_glb(path, tmp_path / "forest.glb", two_scene_roots))
+
+
+def test_a_joint_left_out_of_the_armature_is_named_as_the_one_apart(chain_glb, tmp_path):
+    """Blender's flattened deform bones can leave one joint out of the armature's children: the
+    message listed every top joint as a tree of its own, though all but one hang from the armature."""
+    path, _, _ = chain_glb
+
+    def armature_of_two_with_one_left_out(gltf, blob):
+        gltf.nodes[0].children = []  # root, mid, tip: mid and tip under a new armature, root apart
+        gltf.nodes[1].children = []
+        gltf.nodes.append(pygltflib.Node(name="Armature", children=[1, 2]))
+        gltf.scenes[0].nodes = [0, 3, len(gltf.nodes) - 1]
+
+    reason = "2 node trees with no node in common: node 0 'root', the child of no node; "
+    reason += "2 under node 4 'Armature' (node 1 'mid', node 2 'tip'); one root is needed"
+    with pytest.raises(FormatError, match=re.escape(f"skin 0: joints form {reason}")):
+        read_skinned(edit_glb(path, tmp_path / "apart.glb", armature_of_two_with_one_left_out))
 
 
 def test_mesh_node_transform_moves_the_rest_mesh_but_not_the_skinned_result(chain_glb, tmp_path):

@@ -236,9 +236,7 @@ class SkinRig:
             return []
         shared = set.intersection(*({root, *doc.ancestors(root)} for root in roots))
         if not shared:
-            labels = ", ".join(doc.node_label(root) for root in roots)
-            reason = f"joints form {len(roots)} separate trees ({labels}) under no common node; one root is needed"
-            raise doc.fail(self.element, reason)
+            raise doc.fail(self.element, _separate_trees(doc, roots))
         return [max(shared, key=lambda node: len(doc.ancestors(node)))]  # the deepest shared node
 
     def _parent_slots(self, doc: GltfDocument, joint_nodes: list[int]) -> list[int]:
@@ -381,6 +379,24 @@ def _animated_tree(doc: GltfDocument) -> tuple[list[int], list[str]]:
     kept = max(trees.values(), key=len)  # the first of the largest
     left_out = [members[0] for members in trees.values() if members is not kept]
     return kept, [doc.node_label(node) for node in left_out]
+
+
+def _separate_trees(doc: GltfDocument, roots: list[int]) -> str:
+    """Why joints whose top joints ``roots`` share no node cannot be one skeleton, naming the node
+    trees they are in: an exporter that leaves one joint out of the armature's children (Blender's
+    flattened deform bones) reads as that joint, the child of no node, beside the armature holding
+    the rest."""
+    trees: dict[int, list[int]] = {}
+    for root in roots:
+        trees.setdefault(([root, *doc.ancestors(root)])[-1], []).append(root)
+    parts = []
+    for top, members in trees.items():
+        if members == [top]:
+            parts.append(f"{doc.node_label(top)}, the child of no node")
+            continue
+        shown = ", ".join(doc.node_label(member) for member in members[:3]) + (", ..." if len(members) > 3 else "")
+        parts.append(f"{len(members)} under {doc.node_label(top)} ({shown})")
+    return f"joints form {len(trees)} node trees with no node in common: {'; '.join(parts)}; one root is needed"
 
 
 def _mirrored(rotation: np.ndarray, signs: np.ndarray) -> np.ndarray:

@@ -121,3 +121,15 @@ def test_two_dev_characters_driven_by_one_clip_get_distinct_level_clips(data_dir
     names = [clip["name"] for clip in _level_clips(doc)]
     assert len(names) == 4 and len(set(names)) == 4
     _posed_by_clips_of_their_skin(doc)
+
+
+def test_motion_names_the_second_character_it_leaves_out(tmp_path: Path) -> None:
+    """`animlod motion` takes one skeleton: the second character's mesh was counted among meshes
+    "on other joints, bound in another pose or with unnamed morph targets", three reasons for one."""
+    from animlod.pipelines.motion import build_motion_levels
+
+    source = _doubled(_one_character(tmp_path), tmp_path / "pair.glb")
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    (note,) = [note for note in report.notes if "not in the levels' GLBs" in note]
+    assert note.endswith("skinned mesh not in the levels' GLBs: node 5 'skinned mesh' (on another skeleton) "
+                         "(`animlod character` takes every skin)")  # fmt: skip

@@ -346,9 +346,8 @@ def _read_input(
         if skin.vertex_count > scene.skinned_meshes[scene.body].vertex_count:
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
-            note(f"{path}: {left_out} skinned mesh{'es' if left_out > 1 else ''} on other joints, bound in another "
-                 "pose or with unnamed morph targets beside named ones, not in the levels' GLBs (`animlod character` "
-                 "takes every skin)")  # fmt: skip
+            note(f"{path}: skinned mesh{'es' if len(left_out) > 1 else ''} not in the levels' GLBs: "
+                 f"{', '.join(left_out)} (`animlod character` takes every skin)")  # fmt: skip
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
         joined_nodes, mesh_names = set(whole.part_nodes), level_mesh_names(document, whole.part_nodes)

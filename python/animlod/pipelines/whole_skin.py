@@ -40,7 +40,8 @@ class WholeSkin:
     face_materials : (F,) each face's material (index in the document's materials, -1 for none).
     surface : the attributes the materials read besides normals (texture coordinates, colours,
         tangents: :mod:`.surface_attributes`), (V, width) float32 by glTF name.
-    left_out : how many skinned meshes of the document are not in it.
+    left_out : each skinned mesh of the document not in it, its node's label and why
+        (``node 7 'Body2' (on another skeleton)``).
     part_nodes : the nodes whose meshes it joins, the body's first.
     rig : the skeleton's rig (the body's, with the bones of parts that join it).
     morph_weights : per animation that drives a part's morph weights (its index in the document),
@@ -53,7 +54,7 @@ class WholeSkin:
     animations: list[int]
     face_materials: np.ndarray
     surface: dict[str, np.ndarray]
-    left_out: int
+    left_out: list[str]
     part_nodes: list[int]
     morph_weights: dict[int, np.ndarray]
     rig: SkinRig
@@ -69,10 +70,14 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
     body, motions, rig, body_node = (scene.skinned_meshes[scene.body], scene.skinned_motions[scene.body],
                                      scene.skinned_rigs[scene.body], scene.skinned_nodes[scene.body])  # fmt: skip
     parts, part_nodes, vertex_spaces = [body], [body_node], [skinned_mesh_space(doc.rest_world_matrix(body_node))]
+    left_out = []
     for index, mesh in enumerate(scene.skinned_meshes):
-        if index == scene.body or not _targets_join(parts, mesh):
+        if index == scene.body:
             continue
         node, part_rig = scene.skinned_nodes[index], scene.skinned_rigs[index]
+        if not _targets_join(parts, mesh):
+            left_out.append(f"{doc.node_label(node)} (unnamed morph targets beside named ones)")
+            continue
         clips = scene.skinned_motions[index]
         keys = JointKeys(rig.joint_nodes, part_rig.joint_nodes)
         placement = placement_on(body, mesh, keys, join_clips(clips)[0] if clips else None)
@@ -89,13 +94,16 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
             parts.append(moved_onto(mesh, body, placement))
             part_nodes.append(node)
             vertex_spaces.append(placement.transform @ skinned_mesh_space(doc.rest_world_matrix(node)))
+        elif set(part_rig.joint_nodes).isdisjoint(rig.joint_nodes):  # a second character
+            left_out.append(f"{doc.node_label(node)} (on another skeleton)")
+        else:
+            left_out.append(f"{doc.node_label(node)} (on other joints or bound in another pose)")
     parts[0] = body
     meshes = [doc.gltf.nodes[node].mesh for node in part_nodes]
     geometries = [read_mesh_geometry(doc, mesh, skinned=True) for mesh in meshes]
     materials = np.concatenate([_face_materials(doc, mesh, geometry) for mesh, geometry in zip(meshes, geometries)])
     surfaces = [node_surface(geometry, space) for geometry, space in zip(geometries, vertex_spaces)]
     surface = joined_surface([(attributes, part.vertex_count) for attributes, part in zip(surfaces, parts)])
-    left_out = len(scene.skinned_meshes) - len(parts)
     if len(parts) == 1:
         count = 0 if body.morph_targets is None else len(body.morph_targets)
         defaults = np.zeros(count) if body.default_morph_weights is None else body.default_morph_weights

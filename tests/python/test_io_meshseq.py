@@ -465,7 +465,8 @@ def test_frames_with_different_faces(tmp_path: Path) -> None:
     _write(tmp_path / "a_2.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 2 5"))
     message = _error(tmp_path)
     # Counted from 0 unlike OBJ's own indices (f 4 2 5), and said so.
-    expected = "face 2: vertices [3, 1, 4] (counted from 0) differ from [3, 2, 4] in the first frame a_1.obj"
+    expected = ("face 2: vertices [3, 1, 4] (counted from 0) are no triangle of the first frame a_1.obj, and the "
+                "frame's triangles are not a re-triangulation of the first frame's polygons")  # fmt: skip
     assert message == f"{tmp_path / 'a_2.obj'}: {expected}"
 
 

@@ -1,4 +1,5 @@
-"""OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces.
+"""OBJ and PLY frame sequences: one mesh file per frame, every frame with the same faces (or
+the same polygons split along other diagonals, read with the first frame's triangles).
 
 Geometry is read (:mod:`.obj`, :mod:`.ply`), and with :func:`read_textured_sequence` the
 sequence's texture coordinates (an OBJ's ``vt``, a PLY's per-vertex s, t), how its normals
@@ -34,6 +35,7 @@ from .obj import (
     write_obj,
 )
 from .ply import read_ply, read_ply_attributes, write_ply
+from .polygon_splits import first_face_off_the_polygons
 from .vertex_colours import VertexColours
 
 MESH_SUFFIXES = (".obj", ".ply")
@@ -55,12 +57,16 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
     Returns
     -------
     AnimatedMesh with ``frames (F, V, 3) float32`` and the first file's ``faces (M, 3) int32``.
+    A frame whose triangles differ from the first frame's only in where its polygons are split
+    (or at which corner a triangle starts), as exporters that triangulate each deformed frame
+    write them, is the same surface: it is read with the first frame's triangles, and one
+    UserWarning says how many frames are.
 
     Raises
     ------
     FormatError
         When no frame is found, a file cannot be read, or a frame's vertex count or faces
-        differ from the first frame's (naming the file and the first differing face).
+        differ from the first frame's otherwise (naming the file and the first differing face).
     """
     return _read_frames(sequence_paths(source), fps, textured=False)[0]
 
@@ -108,7 +114,9 @@ def read_textured_sequence(
     first frame's OBJ materials, one per face of the mesh (:class:`~animlod.io.obj.ObjMaterials`);
     a position used by faces of two materials is then a vertex per material, as at a UV seam.
     Sixth, where the mesh's vertices are such copies, the files' position each stands on
-    (``points``); else None. Read its fields by name: more may come."""
+    (``points``); else None. Read its fields by name: more may come. A frame whose polygons are
+    split otherwise than the first frame's (:func:`read_sequence`) is read with the first frame's
+    triangles, texture coordinates, normals and materials, and its own positions and colours."""
     return _read_frames(sequence_paths(source), fps, textured=True)
 
 
@@ -133,14 +141,20 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     frames[0] = first_vertices
     first_texture, differing = texture, None  # the first frame whose texture coordinates are not the first's
     frame_colours = _ColourFrames(paths[0], colours, len(paths))
+    retriangulated: list[Path] = []  # frames whose polygons are split otherwise than the first frame's
     with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
         warnings.simplefilter("always")
         for index, path in enumerate(paths[1:], start=1):
             vertices, frame_faces, frame_texture, _, colours, _ = read(path, first=False)
-            _check_same_connectivity(path, vertices, frame_faces, paths[0], faces, len(first_vertices))
+            # A PLY frame's texture coordinates are per vertex: others than the first's tell of
+            # vertices numbered otherwise, where its faces are refused.
+            renumbered = (path.suffix.lower() == ".ply" and None not in (first_texture, frame_texture)
+                          and not np.array_equal(first_texture.uvs, frame_texture.uvs))  # fmt: skip
+            if _check_same_surface(path, vertices, frame_faces, paths[0], faces, len(first_vertices), renumbered):
+                retriangulated.append(path)
             frames[index] = vertices
             frame_colours.add(index, path, colours)
-            if textured and differing is None and not _same_texture(texture, frame_texture):
+            if textured and differing is None and not _same_texture(texture, frame_texture, faces, frame_faces):
                 differing, differing_texture, texture = path, frame_texture, None
     unread = [w for w in later_warnings if issubclass(w.category, UnreadAttributesWarning)]
     if unread and not any(issubclass(w.category, UnreadAttributesWarning) for w in first_warnings):
@@ -148,6 +162,11 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     for warning in later_warnings:  # any other, as each frame gave it
         if not issubclass(warning.category, UnreadAttributesWarning):
             warnings.warn(warning.message, stacklevel=3)
+    if retriangulated:
+        warnings.warn(f"{retriangulated[0]}: {len(retriangulated)} of the {len(paths)} frames (this the first) "
+                      f"triangulate some polygons differently from the first frame {paths[0].name}, as exporters "
+                      "that triangulate each frame do; every frame is read with the first frame's triangles",
+                      stacklevel=3)  # fmt: skip
     if differing is not None:
         first = paths[0].name
         if differing_texture is None:
@@ -240,11 +259,20 @@ def rebuilt_normals(positions: np.ndarray, faces: np.ndarray, shading: Shading) 
     return normals._replace(normals=-normals.normals) if shading.inward else normals
 
 
-def _same_texture(first: ObjTexture | None, other: ObjTexture | None) -> bool:
-    """Whether a frame's texture coordinates (None: it has none) are the first frame's."""
+def _same_texture(
+    first: ObjTexture | None, other: ObjTexture | None, first_faces: np.ndarray, faces: np.ndarray
+) -> bool:
+    """Whether a frame's texture coordinates (None: it has none) are the first frame's; where its
+    ``faces`` split the first frame's polygons otherwise, whether they pair the same positions with
+    the same texture coordinates, as the mesh's vertices are those pairs (an exporter that
+    triangulates each frame numbers its ``vt`` lines in another order too)."""
     if first is None or other is None:
         return first is other
-    return np.array_equal(first.corners, other.corners) and np.array_equal(first.uvs, other.uvs)
+    if np.array_equal(first_faces, faces):
+        return np.array_equal(first.corners, other.corners) and np.array_equal(first.uvs, other.uvs)
+    pairs = (np.unique(np.column_stack([f.ravel(), t.uvs[t.corners.ravel()]]), axis=0)
+             for f, t in ((first_faces, first), (faces, other)))  # fmt: skip
+    return np.array_equal(*pairs)
 
 
 def write_sequence(
@@ -453,19 +481,36 @@ def natural_key(path: Path) -> tuple[list[object], str]:
     return [int(part) if index % 2 else part.lower() for index, part in enumerate(parts)], str(path)
 
 
-def _check_same_connectivity(
-    path: Path, vertices: np.ndarray, faces: np.ndarray, first_path: Path, first_faces: np.ndarray, vertex_count: int
-) -> None:
+def _check_same_surface(
+    path: Path,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    first_path: Path,
+    first_faces: np.ndarray,
+    vertex_count: int,
+    renumbered: bool = False,
+) -> bool:
+    """Check a frame's vertex count and triangles against the first frame's (FormatError naming the
+    file and the first differing face where they differ, and with ``renumbered`` that its vertices'
+    texture coordinates differ too); True where its triangles are the first frame's only up to where
+    polygons are split (:func:`~.polygon_splits.first_face_off_the_polygons`), False where they are the first's as
+    they stand."""
     first = f"the first frame {first_path.name}"
     if len(vertices) != vertex_count:
         raise FormatError(path, "vertices", f"{len(vertices)} vertices, but {first} has {vertex_count}")
     if faces.shape != first_faces.shape:
         raise FormatError(path, "faces", f"{len(faces)} triangles, but {first} has {len(first_faces)}")
-    differs = np.any(faces != first_faces, axis=1)
-    if differs.any():
-        face = int(np.argmax(differs))
-        reason = f"vertices {faces[face].tolist()} (counted from 0) differ from {first_faces[face].tolist()} in {first}"
+    if np.array_equal(faces, first_faces):
+        return False
+    face = first_face_off_the_polygons(faces, first_faces, vertex_count)
+    if face is not None:
+        reason = (f"vertices {faces[face].tolist()} (counted from 0) are no triangle of {first}, and the frame's "
+                  "triangles are not a re-triangulation of the first frame's polygons")  # fmt: skip
+        if renumbered:
+            reason += ("; its vertices' texture coordinates differ from the first frame's too, as where an exporter "
+                       "numbers each frame's vertices in another order")  # fmt: skip
         raise FormatError(path, f"face {face}", reason)
+    return True
 
 
 # ---------------------------------------------------------------------------------------------

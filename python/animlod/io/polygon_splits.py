@@ -1,0 +1,79 @@
+"""Whether two triangulations of one vertex set tile the same polygons.
+
+Exporters that triangulate each frame of a deforming mesh (Blender's OBJ and PLY exporters with
+"Triangulate Faces") pick each quad's and n-gon's diagonals from that frame's shape, and may start
+a triangle at another corner: the frames are one surface with triangles that differ. The test is
+on the triangles of each set not in the other (as multisets): where both use the same vertices
+and have the same directed boundary edges, they tile the same polygons.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def first_face_off_the_polygons(faces: np.ndarray, first_faces: np.ndarray, vertex_count: int) -> int | None:
+    """None where ``faces`` tile the polygons of ``first_faces`` (both (M, 3) triangles): the same
+    triangles, each perhaps started at another corner (winding kept), but where a polygon is split
+    along other diagonals, as exporters that triangulate each frame's deformed shape split it. Else
+    the first of ``faces`` (in their order) that breaks this.
+
+    The triangles of each not among the other's (as multisets) must use the same vertices and have
+    the same directed boundary edges (those whose reverse is not in the same set): then both tile
+    the same polygons."""
+    frame_triangles, first_triangles = _canonical_triangles(faces), _canonical_triangles(first_faces)
+    frame_only, first_only = ~_among(frame_triangles, first_triangles), ~_among(first_triangles, frame_triangles)
+    added, removed = faces[frame_only], first_faces[first_only]
+    added_boundary = _boundary_edges(added, vertex_count)
+    removed_boundary = _boundary_edges(removed, vertex_count)
+    if np.array_equal(added_boundary, removed_boundary) and np.array_equal(np.unique(added), np.unique(removed)):
+        return None
+    # The first added triangle with an outer edge that no replaced triangle has (a polygon split
+    # otherwise has only edges of the triangles it replaces), else one off their boundary.
+    added_edges, added_faces = _directed_edges(added, vertex_count), np.flatnonzero(frame_only)
+    for known in (_directed_edges(removed, vertex_count), removed_boundary):
+        stray = np.isin(added_edges, np.setdiff1d(added_boundary, known)).reshape(3, -1).any(axis=0)
+        if stray.any():
+            return int(added_faces[np.argmax(stray)])
+    return int(added_faces[0])
+
+
+def _canonical_triangles(faces: np.ndarray) -> np.ndarray:
+    """``faces (M, 3)`` each rotated to start at its smallest vertex, winding kept: a triangle
+    started at another corner is then the same row."""
+    start = np.argmin(faces, axis=1)
+    return faces[np.arange(len(faces))[:, None], (start[:, None] + np.arange(3)) % 3]
+
+
+def _among(rows: np.ndarray, others: np.ndarray) -> np.ndarray:
+    """(len(rows),) bool: whether each of ``rows (R, 3)`` is among ``others``, counting repeats:
+    the k-th copy of a row is among them where ``others`` hold it k times or more."""
+    _, ids = np.unique(np.concatenate([rows, others]), axis=0, return_inverse=True)
+    ids = ids.ravel().astype(np.int64)
+    scale = max(len(ids), 1)  # more than any copy number
+    own, theirs = (part * scale + _copy_numbers(part) for part in (ids[: len(rows)], ids[len(rows) :]))
+    return np.isin(own, theirs)
+
+
+def _copy_numbers(ids: np.ndarray) -> np.ndarray:
+    """(N,) int64: which copy of its id each of ``ids`` is (0 for the first, in their order)."""
+    order = np.argsort(ids, kind="stable")
+    ordered = ids[order]
+    copies = np.empty(len(ids), np.int64)
+    copies[order] = np.arange(len(ids)) - np.searchsorted(ordered, ordered)
+    return copies
+
+
+def _directed_edges(triangles: np.ndarray, vertex_count: int) -> np.ndarray:
+    """(3 * T,) int64 keys ``a * vertex_count + b`` of the edges a -> b of ``triangles (T, 3)``:
+    all first edges, then all second, then all third."""
+    starts = triangles.T.astype(np.int64)
+    return (starts * vertex_count + np.roll(starts, -1, axis=0)).ravel()
+
+
+def _boundary_edges(triangles: np.ndarray, vertex_count: int) -> np.ndarray:
+    """The sorted keys (:func:`_directed_edges`) of the edges of ``triangles`` whose reverse no
+    triangle of them has."""
+    edges = _directed_edges(triangles, vertex_count)
+    reversed_edges = (edges % vertex_count) * vertex_count + edges // vertex_count
+    return np.sort(edges[~np.isin(reversed_edges, edges)])

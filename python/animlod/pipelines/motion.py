@@ -8,6 +8,7 @@ call :func:`build_motion_levels`.
 from __future__ import annotations
 
 import errno
+import hashlib
 import os
 import re
 import time
@@ -188,7 +189,8 @@ def build_motion_levels(
 
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
     orders = layout.rotation_orders if layout is not None else "ZXY"
-    suffixes = _clip_suffixes([clip.name for clip in played])
+    last_level = f"{stem}_lod{len(chain.levels) - 1}.bvh"  # the longest level part
+    suffixes = _clip_suffixes([clip.name for clip in played], _LONGEST_NAME - len(last_level.encode()))
     gltf_input = input_kind(source) == "gltf"
     measuring = time.perf_counter()
     skin_errors = None if skin is None else skin_distances(skin, motion, chain.levels, on_measure)
@@ -421,15 +423,33 @@ def _read_input(
     return _Input(_rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None, content)
 
 
-def _clip_suffixes(names: list[str]) -> list[str]:
+# The longest name of a level file, in bytes of UTF-8: Linux's NAME_MAX (255) less what atomic_write's
+# temporary name beside it adds (".NAME.animlod-PID-XXXXXXXX.part", with a PID of 7 digits at most).
+_LONGEST_NAME = 255 - len(".") - len(".animlod-1234567-abcdefgh.part")
+
+
+def _clip_suffixes(names: list[str], room: int = _LONGEST_NAME) -> list[str]:
     """File name suffixes of the clips' BVH files: none for one clip, else ``_<name>`` with what a
     file name should not hold as ``_`` (``Armature|Walk`` -> ``_Armature_Walk``), ``_<name>_<index>``
-    where names repeat."""
+    where names repeat. A suffix longer than ``room`` bytes of UTF-8 keeps the start of the name
+    that fits, cut between characters, and the first 8 hex digits of the whole name's SHA-1
+    (``_<start>_<hash>``, ``_<start>_<hash>_<index>`` where names repeat), so that the file name
+    fits and differs from the other clips'."""
     if len(names) == 1:
         return [""]
     safe = [re.sub(r"[^\w.-]+", "_", name).strip("_.") or "animation" for name in names]
     repeated = {name for name in safe if safe.count(name) > 1}
-    return [f"_{name}_{index}" if name in repeated else f"_{name}" for index, name in enumerate(safe)]
+    suffixes = []
+    for index, (name, original) in enumerate(zip(safe, names)):
+        numbered = f"_{index}" if name in repeated else ""
+        suffix = f"_{name}{numbered}"
+        if len(suffix.encode()) > room:
+            tail = f"_{hashlib.sha1(original.encode(errors='surrogatepass')).hexdigest()[:8]}{numbered}"
+            fits = max(0, room - len(tail.encode()) - 1)
+            start = name.encode()[:fits].decode(errors="ignore").rstrip("_.")  # a cut character dropped
+            suffix = f"_{start}{tail}" if start else tail
+        suffixes.append(suffix)
+    return suffixes
 
 
 def _rigid(path: str, motions: list[Motion], used: range, motion: Motion) -> Motion:

@@ -3,9 +3,9 @@ corners, polygons fan-triangulated, ``#`` comments also at a line's end, a state
 on the next line after a ``\\`` that ends its line; with :func:`read_obj_textured` also ``vt``
 and ``vn`` lines and the corners' indices into them, and colours (``v x y z r g b``); other
 statements such as ``g``, ``usemtl`` are ignored, with a warning for unread ``vt``, ``vn`` and
-``usemtl``; statements may be indented) and written, with texture coordinates, normals and
-colours where given. Parsing works on the whole file's bytes with numpy: there is no Python
-loop over lines, vertices or faces."""
+``usemtl`` and for faces in several objects or groups (``o``, ``g``); statements may be
+indented) and written, with texture coordinates, normals and colours where given. Parsing works
+on the whole file's bytes with numpy: there is no Python loop over lines, vertices or faces."""
 
 from __future__ import annotations
 
@@ -178,6 +178,7 @@ def _read_obj(path: str | os.PathLike, textured: bool, normals: bool = False) ->
     corners = _FaceCorners(path, sizes, owner, face_lines, name_face)
     resolved = corners.resolved(face_block, vertex_lines, len(vertices), ("vertex", "vertices"))
     faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
+    _warn_unread_names(path, data, face_lines)
     if not textured:
         return TexturedMesh(vertices, faces, None, None, None, None)
 
@@ -452,6 +453,31 @@ def _warn_unread_attributes(path: Path, **unread_tags: bool) -> None:
                  "usemtl": "materials (usemtl lines)"}  # fmt: skip
         warnings.warn(f"{path}: its {' and '.join(kinds[tag] for tag in unread)} are not read, and the levels are "
                       "written without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
+
+
+def _warn_unread_names(path: Path, data: bytes, face_lines: np.ndarray) -> None:
+    """Says that the faces of ``data`` (on ``face_lines``, 1-based) fall into several objects or
+    groups (the names of its ``o`` or ``g`` lines above them), which the mesh read does not keep
+    apart: three objects become one unnamed mesh. Faces under one name alone (an exporter's
+    ``o Cube`` for a file of one object) lose only the name, with no warning: the levels are
+    named after the file."""
+    if not len(face_lines) or re.search(rb"(?m)^[og][ \t]", data) is None:
+        return
+    newlines = np.flatnonzero(np.frombuffer(data, np.uint8) == ord("\n"))
+    counts = {}
+    for tag, kind in ((b"o", "object"), (b"g", "group")):
+        named = list(re.finditer(rb"(?m)^" + tag + rb"[ \t]+([^\n]*)", data))
+        if not named:
+            continue
+        lines = np.searchsorted(newlines, [found.start() for found in named]) + 1
+        in_effect = np.searchsorted(lines, face_lines) - 1  # the last o (g) line above each face
+        names = {named[index].group(1).strip() for index in np.unique(in_effect[in_effect >= 0])}
+        if len(names) > 1:
+            counts[kind] = len(names)
+    if counts:
+        said = " and ".join(f"{count} {kind}s ({kind[0]} lines)" for kind, count in counts.items())
+        warnings.warn(f"{path}: its faces fall into {said}, whose names are not read: the levels are written "
+                      "as one mesh without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
 
 
 def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:

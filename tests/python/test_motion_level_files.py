@@ -266,3 +266,60 @@ def test_level_glbs_keep_the_names_of_the_skinned_mesh(walker, tmp_path, edit, n
         doc = GltfDocument(tmp_path / "levels" / files[-1])
         (skinned,) = [written for written in doc.json["nodes"] if "skin" in written]
         assert (skinned["name"], doc.json["meshes"][skinned["mesh"]]["name"]) == (node, mesh)
+
+
+def test_level_glbs_keep_only_the_cameras_and_lights_that_hang_from_the_joints(walker, tmp_path):
+    """The note said the levels leave out the input's cameras and lights elsewhere, but each level
+    GLB still held every camera (and every light of KHR_lights_punctual where one hung from a
+    joint), at the input's indices, used by no node. Now only those of the joints' copies are
+    there, renumbered with the pointers at them."""
+    yfov = "/cameras/1/perspective/yfov"
+
+    def staged(builder: GlbBuilder, named: dict) -> None:
+        js = builder.json
+        lens = {"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}
+        js["cameras"] = [{"name": "scene camera", **lens}, {"name": "head camera", **lens}]
+        js["extensions"] = {"KHR_lights_punctual": {"lights": [{"name": "sun", "type": "directional"},
+                                                               {"name": "torch", "type": "point"}]}}  # fmt: skip
+        builder.add_extension_used("KHR_lights_punctual")
+        js["scenes"][0]["nodes"] += [builder.append("nodes", {"name": "scene camera", "camera": 0}),
+                                     builder.append("nodes", {"name": "sun", "extensions": {
+                                         "KHR_lights_punctual": {"light": 0}}})]  # fmt: skip
+        head_camera = builder.append("nodes", {"name": "head camera", "camera": 1, "translation": [0, 0.1, 0]})
+        torch = builder.append("nodes", {"name": "torch", "extensions": {"KHR_lights_punctual": {"light": 1}}})
+        js["nodes"][named["Head"]]["children"] += [head_camera, torch]
+        _channel(builder, None, "pointer", np.array([[0.7], [0.5]]), yfov)
+
+    source = _edited(walker, tmp_path / "staged.glb", staged)
+    notes: list[str] = []
+    report = build_motion_levels(source, tmp_path / "levels", levels=2, on_note=notes.append)
+    (left_out,) = [note for note in notes if "GLBs hold" in note]
+    assert "its cameras and lights elsewhere" in left_out
+    for files in report.files:
+        js = GltfDocument(tmp_path / "levels" / files[-1]).json
+        assert [camera["name"] for camera in js["cameras"]] == ["head camera"]
+        assert [light["name"] for light in js["extensions"]["KHR_lights_punctual"]["lights"]] == ["torch"]
+        holders = {node["name"]: node for node in js["nodes"] if "camera" in node or "extensions" in node}
+        assert sorted(holders) == ["head camera", "torch"] and holders["head camera"]["camera"] == 0
+        assert holders["torch"]["extensions"]["KHR_lights_punctual"]["light"] == 0
+        pointers = [c["target"]["extensions"]["KHR_animation_pointer"]["pointer"]
+                    for c in js["animations"][0]["channels"] if c["target"]["path"] == "pointer"]  # fmt: skip
+        assert pointers == ["/cameras/0/perspective/yfov"]
+
+
+def test_level_glbs_of_a_figure_with_a_camera_elsewhere_hold_none(walker, tmp_path):
+    """A camera and a light at the scene's root only: the level GLBs hold no camera array."""
+
+    def filmed(builder: GlbBuilder, named: dict) -> None:
+        builder.json["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}]
+        builder.json["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "spot"}]}}
+        builder.add_extension_used("KHR_lights_punctual")
+        spot = {"name": "spot", "extensions": {"KHR_lights_punctual": {"light": 0}}}
+        builder.json["scenes"][0]["nodes"] += [builder.append("nodes", {"name": "camera", "camera": 0}),
+                                               builder.append("nodes", spot)]  # fmt: skip
+
+    source = _edited(walker, tmp_path / "filmed.glb", filmed)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    for files in report.files:
+        js = GltfDocument(tmp_path / "levels" / files[-1]).json
+        assert "cameras" not in js and "extensions" not in js and "extensionsUsed" not in js

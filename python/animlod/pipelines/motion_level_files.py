@@ -10,10 +10,11 @@ go along. `animlod character` keeps the whole document instead.
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING, NamedTuple
 
 from ..io.glb_builder import GlbBuilder
-from ..io.gltf_document import GltfDocument
+from ..io.gltf_document import POINTER_EXTENSION, GltfDocument
 from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import STANDALONE_NODE_EXTENSIONS, STANDALONE_ROOT_EXTENSIONS, HungNodes, MeshNames
 from ..model import Motion
@@ -54,8 +55,55 @@ class LevelContent(NamedTuple):
             for clip, animation in zip(played, animations):
                 if clip.animation is not None:
                     carry_other_channels(builder, document, posing, clip.animation, animation, copies, standalone=True)
+            keep_used_cameras_and_lights(builder.json, joint_nodes[0])
 
         return HungNodes(self.document, add)
+
+
+_LIGHTS = "KHR_lights_punctual"
+_CAMERA_POINTER = re.compile(r"(/cameras/)(\d+)(/.*)?", re.DOTALL)
+_LIGHT_POINTER = re.compile(rf"(/extensions/{_LIGHTS}/lights/)(\d+)(/.*)?", re.DOTALL)
+
+
+def keep_used_cameras_and_lights(js: dict, first: int) -> None:
+    """Of the cameras and KHR_lights_punctual lights that ``js`` holds at the input's indices (for
+    the copies of what hangs from the joints), only those that its nodes from ``first`` on (the
+    level's own, the copies) or its animations' pointers use, renumbered: the input's elsewhere,
+    which the run's note says the levels leave out, were left in the file unused."""
+    nodes = js.get("nodes", [])[first:]
+    targets = [channel["target"] for animation in js.get("animations", []) for channel in animation["channels"]]
+    pointers = [target["extensions"][POINTER_EXTENSION] for target in targets
+                if POINTER_EXTENSION in (target.get("extensions") or {})]  # fmt: skip
+    if "cameras" in js:
+        used = {node["camera"] for node in nodes if "camera" in node}
+        new = _renumbered(js["cameras"], used, pointers, _CAMERA_POINTER)
+        for node in nodes:
+            if "camera" in node:
+                node["camera"] = new[node["camera"]]
+        js["cameras"] = [js["cameras"][old] for old in new]
+        if not js["cameras"]:
+            del js["cameras"]
+    lights = (js.get("extensions") or {}).get(_LIGHTS)
+    if lights is not None:
+        holders = [node["extensions"][_LIGHTS] for node in nodes if _LIGHTS in (node.get("extensions") or {})]
+        new = _renumbered(lights.get("lights", []), {holder["light"] for holder in holders}, pointers, _LIGHT_POINTER)
+        for holder in holders:
+            holder["light"] = new[holder["light"]]
+        lights["lights"] = [lights["lights"][old] for old in new]
+        if not lights["lights"]:
+            del js["extensions"][_LIGHTS]
+
+
+def _renumbered(items: list, used: set[int], pointers: list[dict], pattern: re.Pattern) -> dict[int, int]:
+    """The new index of each of ``items`` kept (those ``used`` or that a pointer of ``pattern``
+    names), old to new in order; the ``pointers`` at them renumbered."""
+    named = [(pointer, pattern.fullmatch(str(pointer.get("pointer", "")))) for pointer in pointers]
+    used = used | {int(match[2]) for _, match in named if match}
+    new = {old: index for index, old in enumerate(sorted(old for old in used if 0 <= old < len(items)))}
+    for pointer, match in named:
+        if match and int(match[2]) in new:
+            pointer["pointer"] = f"{match[1]}{new[int(match[2])]}{match[3] or ''}"
+    return new
 
 
 def level_mesh_names(doc: GltfDocument, part_nodes: list[int]) -> MeshNames:

@@ -68,7 +68,11 @@ struct AqemOptions {
   // few frames when it gains area in the others.
   bool check_inversion = true;
   // Stricter than Eq. 7: rejects a collapse that inverts a face in any single frame. Ignored
-  // when check_inversion is false.
+  // when check_inversion is false. Off by default, as neither test wins everywhere (bench_aqem's
+  // quality and baked tables): on a clean box limb whose flat sides bend in their plane, the sum
+  // lets triangles fold across the knee in the bent frames (15% of the diagonal at 50%, 0 with
+  // this on); on a capture with noise, noise flips some face in some frame near most collapses,
+  // and this refuses them until the levels fall apart (Xbot's baked clip at 25%: 0.27% -> 5.7%).
   bool strict_inversion = false;
   // Quadrics over K frames only: 0 uses every frame, otherwise K frames chosen by
   // farthest-point sampling of the poses (see frames_used). Only the quadrics shrink to

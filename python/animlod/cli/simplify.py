@@ -72,6 +72,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="the paper's quadrics only: no point quadric at needle tips (the ends of legs, beaks and spikes, whose "
         "faces lie nearly parallel to them, then collapse first)",
     )
+    parser.add_argument(
+        "--strict-inversion",
+        action="store_true",
+        help="no face may flip in any frame, instead of Eq. 7's sum over the frames: for clean modelled meshes whose "
+        "flat sides bend in their plane (box limbs), which the sum lets fold across the bend; not for noisy captures, "
+        "whose noise flips faces in some frame and stalls the collapses",
+    )
     parser.add_argument("--separate", action="store_true", help="glTF: one whole GLB per level instead of one LoD GLB")
     parser.add_argument(
         "--clips", nargs="+", default=(), metavar="FILE",
@@ -104,6 +111,8 @@ def run(args: argparse.Namespace) -> int:
         options["placement"] = args.placement
     if args.no_tip_quadrics:
         options["tip_quadrics"] = False
+    if args.strict_inversion:
+        options["strict_inversion"] = True
     if kind == "gltf":
         return _simplify_document(args, options)
     if args.clips or args.joint_map:

@@ -3,12 +3,12 @@
 - :func:`humanoid` and :func:`humanoid_motion`: a 41-joint skinned character and its cyclic
   walk, run and jump (:func:`humanoid_with_clips`: the character with one clip of each);
 - :func:`face` and :func:`face_animation`: a head with named animation regions;
-- :func:`bending_cylinder`, :func:`twisting_bar`, :func:`translating_mesh`: small deforming
-  meshes with known motion for unit tests;
+- :func:`bending_cylinder`, :func:`twisting_bar`, :func:`translating_mesh`,
+  :func:`kicking_box_leg`: small deforming meshes with known motion for unit tests;
 - :func:`icosphere`: a geodesic sphere.
 """
 
-from .deforming import bending_cylinder, bending_cylinder_skinned, translating_mesh, twisting_bar
+from .deforming import bending_cylinder, bending_cylinder_skinned, kicking_box_leg, translating_mesh, twisting_bar
 from .face_animation import face_animation
 from .face_model import REGION_NAMES, STILL_REGIONS, FaceModel, face
 from .gait import KINDS, STILL_FINGER_CHAIN, humanoid_motion, humanoid_with_clips
@@ -31,6 +31,7 @@ __all__ = [
     "humanoid_skeleton",
     "humanoid_with_clips",
     "icosphere",
+    "kicking_box_leg",
     "translating_mesh",
     "twisting_bar",
 ]

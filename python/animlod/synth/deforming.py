@@ -41,17 +41,24 @@ def _capped_prism(length: float, half_width: float, rings: int, segments: int, s
 
 
 def bending_cylinder_skinned(
-    frames: int = 16, rings: int = 24, segments: int = 16, max_angle: float = np.pi / 2, fps: float = 30.0
+    frames: int = 16,
+    rings: int = 24,
+    segments: int = 16,
+    max_angle: float = np.pi / 2,
+    fps: float = 30.0,
+    shape: str = "ellipse",
 ) -> tuple[SkinnedMesh, Motion]:
     """A capped cylinder (radius 0.25, length 2, along +Y from the origin) on two bones.
 
     Bone ``"Root"`` at the origin holds the lower half; bone ``"Bend"`` at y = 1 holds the upper
     half and turns about +Z from 0 at frame 0 to ``max_angle`` at the last frame, linearly. The
-    weights blend linearly over 0.8 <= y <= 1.2 (K = 2 influences).
+    weights blend linearly over 0.8 <= y <= 1.2 (K = 2 influences). ``shape="square"`` makes it a
+    box limb (half width 0.25, ``segments`` a multiple of 8 keeps its corners) whose sides facing
+    +Z and -Z stay in their planes as it bends, as a modelled character's box leg at the knee.
 
     Returns the skin and the motion; ``skin.bake(motion)`` is :func:`bending_cylinder`.
     """
-    positions, faces = _capped_prism(2.0, 0.25, rings, segments, "ellipse")
+    positions, faces = _capped_prism(2.0, 0.25, rings, segments, shape)
     skeleton = Skeleton(["Root", "Bend"], [-1, 0], [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     upper = np.clip((positions[:, 1] - 0.8) / 0.4, 0.0, 1.0)
     joints = np.broadcast_to(np.array([0, 1], np.int32), (len(positions), 2))
@@ -78,6 +85,20 @@ def bending_cylinder(
     """
     skin, motion = bending_cylinder_skinned(frames, rings, segments, max_angle, fps)
     return skin.bake(motion)
+
+
+def kicking_box_leg(frames: int = 16, rings: int = 12) -> AnimatedMesh:
+    """The square limb of :func:`bending_cylinder_skinned` (``rings`` rings, 8 segments) straight
+    for the first three quarters of ``frames``, then kicking: its knee bent from 60 to 150 degrees
+    over the last quarter. Its sides facing +Z and -Z stay in their planes throughout, so folding
+    their triangles across the knee costs no quadric error (a modelled character's box leg)."""
+    skin, _ = bending_cylinder_skinned(rings=rings, segments=8, shape="square")
+    bent = max(frames // 4, 1)
+    angles = np.zeros(len(_frame_numbers(frames)))
+    angles[frames - bent :] = np.radians(np.linspace(60.0, 150.0, bent))
+    turns = rotations.identity((frames, 2))
+    turns[:, 1] = rotations.from_axis_angle(np.array([0.0, 0.0, 1.0]), angles)
+    return skin.bake(Motion(skin.skeleton, np.zeros((frames, 3)), turns, fps=30.0, name="kick"))
 
 
 def twisting_bar(

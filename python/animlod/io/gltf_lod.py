@@ -245,6 +245,10 @@ def _node_target(target: dict) -> tuple[int, str] | None:
     return (int(match.group(1)), match.group(2)) if match else None
 
 
+# A level whose coverage range is narrower than 1% of where it ends is all but never shown.
+_HIDDEN_RANGE = 0.99
+
+
 def screen_coverages(
     errors: list[float], size: float, pixel_error: float = 1.0, viewport_px: float = 1080.0
 ) -> list[float]:
@@ -260,6 +264,21 @@ def screen_coverages(
         limit = 1.0 if error <= 0.0 else pixel_error * size / (error * viewport_px)
         thresholds.append(min(1.0, limit, thresholds[-1] if thresholds else 1.0))
     return [*thresholds, 0.0]
+
+
+def hidden_level_notes(errors: list[float], coverages: list[float]) -> list[str]:
+    """A note for each level 1, 2, ... that a runtime (all but) never shows: its range of screen
+    coverage, from where the level before it ends to where it ends, is under 1% of its end, as
+    where the next level measured about the same error or less (the coverages follow the next
+    level's error and never increase). ``errors`` and ``coverages`` per level, level 0 first
+    (see :func:`screen_coverages`)."""
+    return [
+        f"level {level} is (all but) never shown: level {level + 1} measured about the same error or less "
+        f"({errors[level + 1]:.3g} against {errors[level]:.3g}), so a runtime goes from level {level - 1} to "
+        f"level {level + 1} at screen coverage {coverages[level]:.3g}"
+        for level in range(1, len(coverages) - 1)
+        if coverages[level] >= _HIDDEN_RANGE * coverages[level - 1]
+    ]
 
 
 def lod_ids(doc: GltfDocument, base: int) -> list[int] | None:

@@ -44,6 +44,7 @@ from ..io.gltf_lod import (
     add_level_node,
     attach_chain,
     drive_level_nodes,
+    hidden_level_notes,
     level_node_name,
     screen_coverages,
     unchained,
@@ -243,6 +244,9 @@ def build_character(
         _switch_together([chains[d.label] for d in members], [geometry[d.label].size for d in members])
     for drawable in animated:
         _attach(builder, drawable, chains[drawable.label], grids[drawable.label])
+        chain = chains[drawable.label]
+        hidden = hidden_level_notes([level.error for level in chain], [level.coverage for level in chain])
+        notes += [f"{drawable.label}: {note}" for note in hidden]
     skipped = [d for d in all_drawables if d.label not in chains and d.label not in chained]
     unskinned = [d.label for d in skipped if d.skinned is None]
     if unskinned:  # props hung from joints among them: they follow each motion level, at full detail

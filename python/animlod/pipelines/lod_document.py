@@ -30,6 +30,7 @@ from ..io.gltf_lod import (
     add_level_mesh,
     add_level_node,
     attach_chain,
+    hidden_level_notes,
     node_extras,
     screen_coverages,
     unchained,
@@ -197,6 +198,7 @@ def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettin
     notes = [short_level_note(index, level, max_error) for index, level in enumerate(simplified[: len(written)], 1)]
     notes.append(unwritten_levels_note(simplified, len(written), max_error))
     report.notes.extend(note for note in notes if note)
+    report.notes.extend(hidden_level_notes(errors, coverages))
     report.levels.insert(0, LevelReport(0, report.faces, report.faces, True, 0.0, 0.0, coverages[0]))
     return report
 

@@ -26,7 +26,7 @@ def coarser_level_count(levels: Sequence[SimplifiedLevel]) -> int:
     return len(levels)
 
 
-def short_level_note(number: int, level: SimplifiedLevel, max_error: float) -> str | None:
+def _short_level_note(number: int, level: SimplifiedLevel, max_error: float) -> str | None:
     """``level N: stopped at F faces (target T): why`` for level ``number`` when it fell short of
     its target; None when it reached it."""
     if level.reached:
@@ -40,7 +40,7 @@ def short_level_note(number: int, level: SimplifiedLevel, max_error: float) -> s
     return f"level {number}: stopped at {faces} faces (target {target}): {why}"
 
 
-def unwritten_levels_note(levels: Sequence[SimplifiedLevel], written: int, max_error: float = math.inf) -> str | None:
+def _unwritten_levels_note(levels: Sequence[SimplifiedLevel], written: int, max_error: float = math.inf) -> str | None:
     """``levels N, ... (targets ...) not written: ...`` for the levels after the first ``written``
     (see :func:`coarser_level_count`); None when every level is written."""
     dropped = levels[written:]
@@ -57,3 +57,11 @@ def unwritten_levels_note(levels: Sequence[SimplifiedLevel], written: int, max_e
         f"level{plural} {numbers} (target{plural} {targets}) not written: the same mesh as {same} "
         f"({dropped[0].mesh.face_count} faces), where {cause}"
     )
+
+
+def chain_notes(levels: Sequence[SimplifiedLevel], written: int, max_error: float = math.inf) -> list[str]:
+    """The notes on a chain of ``levels`` of which the first ``written`` are written: each written
+    level short of its target, then the levels left out."""
+    notes = [_short_level_note(number, level, max_error) for number, level in enumerate(levels[:written], start=1)]
+    notes.append(_unwritten_levels_note(levels, written, max_error))
+    return [note for note in notes if note]

@@ -39,7 +39,7 @@ from ..io.stored_weights import normalise_stored_weights
 from ..model import AnimatedMesh
 from .clip_import import with_clips
 from .drawable_levels import DrawableLevels, DrawableSettings, draws_nothing, simplify_drawable
-from .level_chain import coarser_level_count, short_level_note, unwritten_levels_note
+from .level_chain import chain_notes, coarser_level_count
 
 DEFAULT_RATIOS = (0.5, 0.25, 0.1)
 
@@ -195,9 +195,7 @@ def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettin
                 coverage=coverage,
             )
         )
-    notes = [short_level_note(index, level, max_error) for index, level in enumerate(simplified[: len(written)], 1)]
-    notes.append(unwritten_levels_note(simplified, len(written), max_error))
-    report.notes.extend(note for note in notes if note)
+    report.notes.extend(chain_notes(simplified, len(written), max_error))
     report.notes.extend(hidden_level_notes(errors, coverages))
     report.levels.insert(0, LevelReport(0, report.faces, report.faces, True, 0.0, 0.0, coverages[0]))
     return report

@@ -38,7 +38,7 @@ from ..io.vertex_colours import VertexColours
 from ..metrics import SurfaceError, surface_error
 from ..model import AnimatedMesh, whole_number
 from ..normals import Shading
-from .level_chain import coarser_level_count, short_level_note, unwritten_levels_note
+from .level_chain import chain_notes, coarser_level_count
 
 # Frames of a longer sequence measured by default, evenly spaced: every frame of a 300-frame,
 # 20k-triangle sequence took 61 s to measure against 2.3 s to simplify.
@@ -56,7 +56,6 @@ class SequenceLevel:
     aqem_error: float  # asset units, the largest collapse error (RMS plane distance)
     surface: dict[str, float] | None  # mean/max over frames of Hausdorff and RMS, relative; None unmeasured
     error: float | None = None  # asset units, max over frames of the Hausdorff distance; None unmeasured
-    stopped_by_max_error: bool = False  # short of its target because max_error stopped the collapses
 
 
 @dataclass
@@ -139,8 +138,7 @@ def simplify_sequence(
     frames = _measured_frames(original.frame_count, measured_frames) if measure else np.arange(0)
     written = result.levels[: coarser_level_count(result.levels)]
     max_error = float(aqem_options.get("max_error", math.inf))
-    notes = [short_level_note(index, level, max_error) for index, level in enumerate(written, start=1)]
-    notes.append(unwritten_levels_note(result.levels, len(written), max_error))
+    notes = chain_notes(result.levels, len(written), max_error)
     levels = []
     for index, level in enumerate(written, start=1):
         if measure and measuring is not None:
@@ -150,12 +148,11 @@ def simplify_sequence(
         surface = measured.summary() if measured is not None else None
         error = float(measured.hausdorff.max()) if measured is not None else None
         faces, target = level.mesh.face_count, level.target_face_count
-        levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error,
-                                    level.stopped_by_max_error))  # fmt: skip
+        levels.append(SequenceLevel(path, faces, target, level.reached, level.error, surface, error))
     if measure and measuring is not None:
         measuring(len(written), len(written))
     return SequenceReport(os.fspath(source), original, levels, result.preparation, seconds, len(result.frames_used),
-                          len(frames), result.vertex_weights, [note for note in notes if note])  # fmt: skip
+                          len(frames), result.vertex_weights, notes)  # fmt: skip
 
 
 @dataclass(frozen=True)

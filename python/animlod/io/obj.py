@@ -198,17 +198,15 @@ def _read_obj(path: str | os.PathLike, textured: bool, normals: bool = False) ->
 def _materials(data: bytes, face_lines: np.ndarray, triangles: np.ndarray) -> ObjMaterials | None:
     """The materials of ``data``'s usemtl lines for the faces on ``face_lines`` (1-based), each
     fanned into ``triangles``; its mtllib lines' libraries. None without a usemtl line."""
-    uses = list(re.finditer(rb"(?m)^usemtl[ \t]+([^\n]*)", data))
-    if not uses:
+    named = _names_in_effect(data, b"usemtl", face_lines)
+    if named is None:
         return None
-    newlines = np.flatnonzero(np.frombuffer(data, np.uint8) == ord("\n"))
-    use_lines = np.searchsorted(newlines, [use.start() for use in uses]) + 1
-    used = np.array([use.group(1).strip().decode("utf-8", "replace") for use in uses], dtype=object)
+    names, in_effect = named
+    used = np.array([name.decode("utf-8", "replace") for name in names], dtype=object)
     distinct, first, material = np.unique(used, return_index=True, return_inverse=True)
     order = np.argsort(first)  # the materials in the order of first use
     rank = np.empty(first.size, np.int32)
     rank[order] = np.arange(first.size)
-    in_effect = np.searchsorted(use_lines, face_lines) - 1  # the last usemtl line above each face
     per_face = np.where(in_effect >= 0, rank[material.ravel()][np.maximum(in_effect, 0)], -1).astype(np.int32)
     libraries = re.findall(rb"(?m)^mtllib[ \t]+([^\n]*)", data)
     return ObjMaterials(tuple(found.decode("utf-8", "replace").strip() for found in libraries),
@@ -461,23 +459,33 @@ def _warn_unread_names(path: Path, data: bytes, face_lines: np.ndarray) -> None:
     apart: three objects become one unnamed mesh. Faces under one name alone (an exporter's
     ``o Cube`` for a file of one object) lose only the name, with no warning: the levels are
     named after the file."""
-    if not len(face_lines) or re.search(rb"(?m)^[og][ \t]", data) is None:
+    if not len(face_lines) or re.search(rb"(?m)^[og][ \t]", data) is None:  # one scan where most files end
         return
-    newlines = np.flatnonzero(np.frombuffer(data, np.uint8) == ord("\n"))
     counts = {}
     for tag, kind in ((b"o", "object"), (b"g", "group")):
-        named = list(re.finditer(rb"(?m)^" + tag + rb"[ \t]+([^\n]*)", data))
-        if not named:
+        named = _names_in_effect(data, tag, face_lines)
+        if named is None:
             continue
-        lines = np.searchsorted(newlines, [found.start() for found in named]) + 1
-        in_effect = np.searchsorted(lines, face_lines) - 1  # the last o (g) line above each face
-        names = {named[index].group(1).strip() for index in np.unique(in_effect[in_effect >= 0])}
-        if len(names) > 1:
-            counts[kind] = len(names)
+        names, in_effect = named
+        distinct = {names[index] for index in np.unique(in_effect[in_effect >= 0])}
+        if len(distinct) > 1:
+            counts[kind] = len(distinct)
     if counts:
         said = " and ".join(f"{count} {kind}s ({kind[0]} lines)" for kind, count in counts.items())
         warnings.warn(f"{path}: its faces fall into {said}, whose names are not read: the levels are written "
                       "as one mesh without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
+
+
+def _names_in_effect(data: bytes, tag: bytes, face_lines: np.ndarray) -> tuple[list[bytes], np.ndarray] | None:
+    """The names on ``data``'s ``tag`` lines (``usemtl``, ``o``, ``g``), and for each face on
+    ``face_lines`` (1-based) the index of the last of those lines above it, -1 above the first;
+    None where no line has the tag."""
+    found = list(re.finditer(rb"(?m)^" + tag + rb"[ \t]+([^\n]*)", data))
+    if not found:
+        return None
+    newlines = np.flatnonzero(np.frombuffer(data, np.uint8) == ord("\n"))
+    lines = np.searchsorted(newlines, [match.start() for match in found]) + 1
+    return [match.group(1).strip() for match in found], np.searchsorted(lines, face_lines) - 1
 
 
 def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:

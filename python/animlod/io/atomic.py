@@ -24,6 +24,9 @@ from pathlib import Path
 from typing import IO
 
 _TEMPORARY = re.compile(r"^\..+\.animlod-(\d+)-[a-z0-9_]+\.(part|partdir|old)$")
+# The longest name, in bytes of UTF-8, that atomic_write can give a file: its temporary beside
+# it, ".NAME.animlod-PID-XXXXXXXX.part" (a PID of 7 digits at most), must fit Linux's NAME_MAX.
+LONGEST_NAME = 255 - len(".") - len(".animlod-1234567-abcdefgh.part")
 
 
 def _prefix(target: Path) -> str:

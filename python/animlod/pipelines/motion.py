@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..io.atomic import staged_files, unwritable
+from ..io.atomic import LONGEST_NAME, staged_files, unwritable
 from ..io.bvh import BvhLayout
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
@@ -190,7 +190,7 @@ def build_motion_levels(
     # A BVH's levels keep its channel layout: each joint's rotation order as the input writes it.
     orders = layout.rotation_orders if layout is not None else "ZXY"
     last_level = f"{stem}_lod{len(chain.levels) - 1}.bvh"  # the longest level part
-    suffixes = _clip_suffixes([clip.name for clip in played], _LONGEST_NAME - len(last_level.encode()))
+    suffixes = _clip_suffixes([clip.name for clip in played], LONGEST_NAME - len(last_level.encode()))
     gltf_input = input_kind(source) == "gltf"
     measuring = time.perf_counter()
     skin_errors = None if skin is None else skin_distances(skin, motion, chain.levels, on_measure)
@@ -423,12 +423,7 @@ def _read_input(
     return _Input(_rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None, content)
 
 
-# The longest name of a level file, in bytes of UTF-8: Linux's NAME_MAX (255) less what atomic_write's
-# temporary name beside it adds (".NAME.animlod-PID-XXXXXXXX.part", with a PID of 7 digits at most).
-_LONGEST_NAME = 255 - len(".") - len(".animlod-1234567-abcdefgh.part")
-
-
-def _clip_suffixes(names: list[str], room: int = _LONGEST_NAME) -> list[str]:
+def _clip_suffixes(names: list[str], room: int = LONGEST_NAME) -> list[str]:
     """File name suffixes of the clips' BVH files: none for one clip, else ``_<name>`` with what a
     file name should not hold as ``_`` (``Armature|Walk`` -> ``_Armature_Walk``), ``_<name>_<index>``
     where names repeat. A suffix longer than ``room`` bytes of UTF-8 keeps the start of the name

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 from ..io.glb_builder import GlbBuilder
 from ..io.gltf_document import POINTER_EXTENSION, GltfDocument
+from ..io.gltf_references import LIGHTS_EXTENSION
 from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import STANDALONE_NODE_EXTENSIONS, STANDALONE_ROOT_EXTENSIONS, HungNodes, MeshNames
 from ..model import Motion
@@ -55,17 +56,16 @@ class LevelContent(NamedTuple):
             for clip, animation in zip(played, animations):
                 if clip.animation is not None:
                     carry_other_channels(builder, document, posing, clip.animation, animation, copies, standalone=True)
-            keep_used_cameras_and_lights(builder.json, joint_nodes[0])
+            _keep_used_cameras_and_lights(builder.json, joint_nodes[0])
 
         return HungNodes(self.document, add)
 
 
-_LIGHTS = "KHR_lights_punctual"
 _CAMERA_POINTER = re.compile(r"(/cameras/)(\d+)(/.*)?", re.DOTALL)
-_LIGHT_POINTER = re.compile(rf"(/extensions/{_LIGHTS}/lights/)(\d+)(/.*)?", re.DOTALL)
+_LIGHT_POINTER = re.compile(rf"(/extensions/{LIGHTS_EXTENSION}/lights/)(\d+)(/.*)?", re.DOTALL)
 
 
-def keep_used_cameras_and_lights(js: dict, first: int) -> None:
+def _keep_used_cameras_and_lights(js: dict, first: int) -> None:
     """Of the cameras and KHR_lights_punctual lights that ``js`` holds at the input's indices (for
     the copies of what hangs from the joints), only those that its nodes from ``first`` on (the
     level's own, the copies) or its animations' pointers use, renumbered: the input's elsewhere,
@@ -83,15 +83,17 @@ def keep_used_cameras_and_lights(js: dict, first: int) -> None:
         js["cameras"] = [js["cameras"][old] for old in new]
         if not js["cameras"]:
             del js["cameras"]
-    lights = (js.get("extensions") or {}).get(_LIGHTS)
+    lights = (js.get("extensions") or {}).get(LIGHTS_EXTENSION)
     if lights is not None:
-        holders = [node["extensions"][_LIGHTS] for node in nodes if _LIGHTS in (node.get("extensions") or {})]
+        holders = [
+            node["extensions"][LIGHTS_EXTENSION] for node in nodes if LIGHTS_EXTENSION in (node.get("extensions") or {})
+        ]
         new = _renumbered(lights.get("lights", []), {holder["light"] for holder in holders}, pointers, _LIGHT_POINTER)
         for holder in holders:
             holder["light"] = new[holder["light"]]
         lights["lights"] = [lights["lights"][old] for old in new]
         if not lights["lights"]:
-            del js["extensions"][_LIGHTS]
+            del js["extensions"][LIGHTS_EXTENSION]
 
 
 def _renumbered(items: list, used: set[int], pointers: list[dict], pattern: re.Pattern) -> dict[int, int]:

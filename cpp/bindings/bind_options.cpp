@@ -40,7 +40,7 @@ void bind_options(py::module_& m) {
       .field("boundary_quadrics", &AqemOptions::boundary_quadrics)
       .field("tip_quadrics", &AqemOptions::tip_quadrics)
       .field("check_inversion", &AqemOptions::check_inversion)
-      .field("strict_inversion", &AqemOptions::strict_inversion)
+      .field("fold_limit", &AqemOptions::fold_limit)
       .field("max_frames", &AqemOptions::max_frames)
       .field("frame_subset", &AqemOptions::frame_subset)
       .field("quadric_memory_limit", &AqemOptions::quadric_memory_limit)

@@ -264,7 +264,7 @@ bool CollapseEngine::keeps_orientation(const Candidate& candidate, const Workspa
       }
       if (collapses) continue;  // the faces on the edge disappear
       if (!face_keeps_orientation(corners, moved_corner, workspace.placed.data(), frame_count_,
-                                  options_.strict_inversion))
+                                  options_.fold_limit))
         return false;
     } while (out != first_out);
   }

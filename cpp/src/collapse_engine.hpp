@@ -85,8 +85,9 @@ struct CarriedData {
 };
 
 struct EngineOptions {
-  bool check_inversion = true;   // Eq. 7 summed over every frame
-  bool strict_inversion = false; // also reject a flip in any one frame
+  bool check_inversion = true;  // Eq. 7 summed over every frame
+  // Also reject a fold deeper than this many opposite-edge lengths in any one frame (AqemOptions).
+  double fold_limit = std::numeric_limits<double>::infinity();
   double max_error = std::numeric_limits<double>::infinity();
   std::function<void(size_t, size_t)> progress;
   // false: one global greedy order (an indexed heap, re-keyed after every collapse). true:

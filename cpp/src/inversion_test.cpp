@@ -18,7 +18,7 @@ double dot(const Vec3& a, const Vec3& b) { return (a.x * b.x + a.y * b.y) + a.z 
 
 template <int kMoved>
 bool keeps_orientation(const std::array<const float*, 3>& corners, const Eigen::Vector3d* placed, size_t frame_count,
-                       bool strict) {
+                       double fold_limit) {
   double agreement = 0.0;
   bool has_area = false;
   for (size_t frame = 0; frame < frame_count; ++frame) {
@@ -34,7 +34,12 @@ bool keeps_orientation(const std::array<const float*, 3>& corners, const Eigen::
     if (area_product == 0.0) continue;
     has_area = true;
     const double normals = dot(n_before, n_after);
-    if (strict && normals < 0.0) return false;
+    if (normals < 0.0) {
+      // n' . N / |N| = |ab| times the moved corner's signed distance from the line of the
+      // opposite edge ab, within the face's plane: the fold's depth, here in units of |ab|.
+      const Vec3 ab = minus(before[(kMoved + 2) % 3], before[(kMoved + 1) % 3]);
+      if (-normals / (std::sqrt(dot(n_before, n_before)) * dot(ab, ab)) > fold_limit) return false;
+    }
     // n . n' sqrt(A A') with n = N / |N| and A = |N| / 2.
     agreement += normals / (2.0 * std::sqrt(area_product));
   }
@@ -44,11 +49,11 @@ bool keeps_orientation(const std::array<const float*, 3>& corners, const Eigen::
 }  // namespace
 
 bool face_keeps_orientation(const std::array<const float*, 3>& corners, int moved, const Eigen::Vector3d* placed,
-                            size_t frame_count, bool strict) {
+                            size_t frame_count, double fold_limit) {
   switch (moved) {
-    case 0: return keeps_orientation<0>(corners, placed, frame_count, strict);
-    case 1: return keeps_orientation<1>(corners, placed, frame_count, strict);
-    default: return keeps_orientation<2>(corners, placed, frame_count, strict);
+    case 0: return keeps_orientation<0>(corners, placed, frame_count, fold_limit);
+    case 1: return keeps_orientation<1>(corners, placed, frame_count, fold_limit);
+    default: return keeps_orientation<2>(corners, placed, frame_count, fold_limit);
   }
 }
 

@@ -13,6 +13,7 @@
 //                    with one hierarchy for all frames, threads measure a frame each.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -335,6 +336,7 @@ Status aqem_hierarchy(const AnimatedMeshView& mesh, const PointMesh& points, con
   aqem.boundary_quadrics = options.boundary_quadrics;
   aqem.tip_quadrics = false;  // the paper's quadrics, like the TDAG's own (Fig. 6 compares them)
   aqem.check_inversion = options.check_inversion;
+  aqem.fold_limit = std::numeric_limits<double>::infinity();  // and the paper's Eq. 7 alone
   aqem.weld = options.weld;
   aqem.record_positions = false;  // the hierarchy needs the order alone
   AqemResult result;

@@ -263,10 +263,12 @@ def simplify_animated(
         ``use_motion_features`` and the weights of Eq. 6 (see :func:`motion_features`:
         ``"amplitude"`` by default, ``"paper"`` the published rule), ``boundary_quadrics``,
         ``tip_quadrics`` (needle tips cost their displacement; off: the paper's quadrics),
-        ``check_inversion`` and ``strict_inversion`` (Eq. 7 summed over every frame, or per
-        frame), ``max_frames`` and ``frame_subset`` (the frames of the quadrics), ``placement``
-        (``"optimal"``: Eq. 5 in every frame; ``"on_edge"``: one point of the collapsed edge for
-        all frames, so that UVs and skin weights stay consistent with its positions) and
+        ``check_inversion`` and ``fold_limit`` (Eq. 7 summed over every frame, and no fold
+        deeper than ``fold_limit`` opposite-edge lengths in any frame: 1 by default, 0 for no flip
+        at all, ``math.inf`` for Eq. 7 alone), ``max_frames`` and ``frame_subset`` (the frames of
+        the quadrics), ``placement`` (``"optimal"``: Eq. 5 in every frame; ``"on_edge"``: one
+        point of the collapsed edge for all frames, so that UVs and skin weights stay consistent
+        with its positions) and
         ``weld`` (weld copies of a position; off, seams are open borders) and
         ``record_positions`` (off: ``collapses.positions`` stays empty, which saves 12 bytes per
         collapse and frame).

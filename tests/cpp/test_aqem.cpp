@@ -127,7 +127,7 @@ TEST_CASE("aqem checks orientation in the frames outside the quadrics' frames to
   // kept + t (removed - kept) and went unchecked, so faces flipped there. Frame 1 jitters the
   // flat grid in its plane by under half a cell: no input face turns down, but collapses
   // placed from frame 0 alone flipped one. In-plane, every normal is +z or -z, so
-  // strict_inversion (no flip in any single frame) must leave every face up.
+  // fold_limit 0 (no flip in any single frame) must leave every face up.
   OwnedAnimatedMesh mesh = animlod::testing::grid(8);
   const size_t vertex_count = mesh.vertex_count;
   for (size_t v = 0; v < vertex_count; ++v) {
@@ -153,7 +153,7 @@ TEST_CASE("aqem checks orientation in the frames outside the quadrics' frames to
   AqemOptions options;
   options.target_ratios = {0.5, 0.25, 0.1};
   options.max_frames = 1;
-  options.strict_inversion = true;
+  options.fold_limit = 0.0;
   const AqemResult result = simplify(mesh, options);
   CHECK(result.frames_used == std::vector<int32_t>{0});
   for (const AqemLevel& level : result.levels)

@@ -67,13 +67,16 @@ struct AqemOptions {
   // the frames outside frames_used, at their on-edge positions). The sum lets a face flip in a
   // few frames when it gains area in the others.
   bool check_inversion = true;
-  // Stricter than Eq. 7: rejects a collapse that inverts a face in any single frame. Ignored
-  // when check_inversion is false. Off by default, as neither test wins everywhere (bench_aqem's
-  // quality and baked tables): on a clean box limb whose flat sides bend in their plane, the sum
-  // lets triangles fold across the knee in the bent frames (15% of the diagonal at 50%, 0 with
-  // this on); on a capture with noise, noise flips some face in some frame near most collapses,
-  // and this refuses them until the levels fall apart (Xbot's baked clip at 25%: 0.27% -> 5.7%).
-  bool strict_inversion = false;
+  // Beside Eq. 7's sum, rejects a collapse that folds a face deeply in any single frame: the
+  // moved corner passes the line of the face's opposite edge, within the face's plane in that
+  // frame, by more than fold_limit times that edge's length. On a clean box limb whose flat
+  // sides bend in their plane, the sum lets triangles fold across the knee in the few bent
+  // frames (15% of the diagonal at 50%); a capture's noise tips slivers over in some frame near
+  // most collapses, and refusing those too (a limit of 0: no flip in any frame) ruins its levels
+  // (Xbot's baked clip with noise at 25%: 0.27% -> 5.7%). Noise flips stay shallow: the default
+  // 1 (a fold as tall as its edge is long) keeps both (bench_aqem's quality and baked tables).
+  // Infinity: Eq. 7 alone, the paper's test. Ignored when check_inversion is false.
+  double fold_limit = 1.0;
   // Quadrics over K frames only: 0 uses every frame, otherwise K frames chosen by
   // farthest-point sampling of the poses (see frames_used). Only the quadrics shrink to
   // O(V K) memory and placement time; positions, the inversion test and the outputs stay

@@ -73,11 +73,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "faces lie nearly parallel to them, then collapse first)",
     )
     parser.add_argument(
-        "--strict-inversion",
-        action="store_true",
-        help="no face may flip in any frame, instead of Eq. 7's sum over the frames: for clean modelled meshes whose "
-        "flat sides bend in their plane (box limbs), which the sum lets fold across the bend; not for noisy captures, "
-        "whose noise flips faces in some frame and stalls the collapses",
+        "--fold-limit",
+        type=float,
+        default=None,
+        metavar="DEPTH",
+        help="beside Eq. 7's sum over the frames, refuse a collapse that folds a face in any one frame deeper than "
+        "DEPTH lengths of its opposite edge (default 1: box limbs, whose flat sides bend in their plane, do not fold "
+        "across the bend, and captures' noise, which tips slivers over, does not stall the collapses); 0: no flip in "
+        "any frame; inf: Eq. 7 alone, the paper's test",
     )
     parser.add_argument("--separate", action="store_true", help="glTF: one whole GLB per level instead of one LoD GLB")
     parser.add_argument(
@@ -111,8 +114,10 @@ def run(args: argparse.Namespace) -> int:
         options["placement"] = args.placement
     if args.no_tip_quadrics:
         options["tip_quadrics"] = False
-    if args.strict_inversion:
-        options["strict_inversion"] = True
+    if args.fold_limit is not None:
+        if not args.fold_limit >= 0.0:
+            raise UserError(f"--fold-limit: expected a depth >= 0 (0, 1, inf), got {args.fold_limit:g}")
+        options["fold_limit"] = args.fold_limit
     if kind == "gltf":
         return _simplify_document(args, options)
     if args.clips or args.joint_map:

@@ -1,7 +1,7 @@
 // Fuzz harness: simplify_animated (AQEM) with every option and per-vertex input decoded from the
 // bytes. Input (little-endian), a fixed 12-byte header, the mesh, then per-vertex data:
 //   u8 flags      bit 0 use_motion_features, 1 boundary_quadrics, 2 check_inversion,
-//                 3 strict_inversion, 4 boundary_is_feature, 5 placement on_edge,
+//                 3 fold_limit 0, 4 boundary_is_feature, 5 placement on_edge,
 //                 6 locked vertices given, 7 importance given
 //   u8 flags2     bit 0 attributes given, 1 skin given, 2 levels as face counts, 3 frame subset
 //                 given, 4 max_error finite, 5 the progress callback throws, 6 position
@@ -177,7 +177,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.use_motion_features = in.flag(flags, 0);
   options.boundary_quadrics = in.flag(flags, 1);
   options.check_inversion = in.flag(flags, 2);
-  options.strict_inversion = in.flag(flags, 3);
+  if (in.flag(flags, 3)) options.fold_limit = 0.0;
   options.motion_features.boundary_is_feature = in.flag(flags, 4);
   options.motion_features.feature_threshold = threshold / 64.0;
   options.placement = in.flag(flags, 5) ? animlod::Placement::on_edge : animlod::Placement::optimal;

@@ -207,6 +207,8 @@ def _document_lines(path: str) -> list[str]:
             f"{doc.animation_label(index)}: {len(animation.channels or [])} channels, "
             f"{doc.animation_duration(index):.2f} s{level}"
         )
+    if idle := doc.idle_weight_channels_note():
+        lines.append(idle)
     for index in range(len(doc.json.get("nodes", []))):
         ids = lod_ids(doc, index)
         if ids is not None:

@@ -417,6 +417,25 @@ class GltfDocument:
         mesh and moves no node)."""
         return {node for targets in self.channel_targets for node, path in targets if path in NODE_PATHS}
 
+    def idle_weight_channels_note(self) -> str | None:
+        """Names the animation channels that drive the morph weights of a node whose mesh has no
+        morph target (or of a node without a mesh), which glTF does not allow and which change
+        nothing: Blender writes them when it applies modifiers to a mesh with shape keys, which
+        drops the keys its clip animates. None when the document has none."""
+        idle = []
+        for a, targets in enumerate(self.channel_targets):
+            for c, (node, path) in enumerate(targets):
+                if path != "weights" or node is None:
+                    continue
+                mesh = self.gltf.nodes[node].mesh
+                primitives = self.gltf.meshes[mesh].primitives if mesh is not None else []
+                if not any(primitive.targets for primitive in primitives):
+                    idle.append(f"{self.animation_label(a)} channel {c} ({self.node_label(node)})")
+        if not idle:
+            return None
+        return (f"morph weights animated on a mesh without morph targets, which change nothing (an exporter that "
+                f"applied modifiers dropped the shape keys they drove): {', '.join(idle)}")  # fmt: skip
+
     def alternate_nodes(self) -> set[int]:
         """Nodes that stand in for another node at other levels of detail: the ids of its MSFT_lod
         chain and the nodes of animlod's level grid. They are that node drawn otherwise, not

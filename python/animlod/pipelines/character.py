@@ -131,6 +131,8 @@ def build_character(
     notes: list[str] = []
     doc = GltfDocument(source)
     doc = with_clips(doc, clips, notes.append, joint_map)
+    if idle := doc.idle_weight_channels_note():
+        notes.append(idle)
     fps = doc.sample_rate(settings.fps)
     all_drawables = read_drawables(doc, fps)
     chained = {d.label: d for d in all_drawables if unchained(doc, d.nodes) != d.nodes}

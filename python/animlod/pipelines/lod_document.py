@@ -124,6 +124,8 @@ def simplify_document(
     notes: list[str] = []
     doc = GltfDocument(source)
     doc = with_clips(doc, clips, notes.append, joint_map)
+    if idle := doc.idle_weight_channels_note():
+        notes.append(idle)
     drawables = read_drawables(doc, settings.fps)
     lines = [f"{mesh_label(doc, mesh)} (nodes {nodes})" for mesh, nodes in points_and_lines_meshes(doc).items()]
     if lines:

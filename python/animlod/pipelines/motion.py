@@ -338,6 +338,8 @@ def _read_input(
 
     document = GltfDocument(source)
     document = with_clips(document, clip_files, note, joint_map)
+    if idle := document.idle_weight_channels_note():
+        note(f"{path}: {idle}")
     fps = document.sample_rate()
     scene = read_gltf(document, fps)
     if scene.skinned_meshes:

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 from simplify_inputs import two_bone_tube
 
+from animlod.cli import main
 from animlod.io import write_glb
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
@@ -132,4 +133,17 @@ def test_motion_names_the_second_character_it_leaves_out(tmp_path: Path) -> None
     report = build_motion_levels(source, tmp_path / "levels", levels=2)
     (note,) = [note for note in report.notes if "not in the levels' GLBs" in note]
     assert note.endswith("skinned mesh not in the levels' GLBs: node 5 'skinned mesh' (on another skeleton) "
-                         "(`animlod character` takes every skin)")  # fmt: skip
+                         "(`--skin` picks another character; `animlod character` takes every skin)")  # fmt: skip
+
+
+def test_motion_takes_the_character_skin_picks(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`--skin` picks the other character of a file of two: until 2026-12-07 `motion` took the body
+    whose skin lists the most joints, and the other could not have motion levels of its own."""
+    source = _doubled(_one_character(tmp_path), tmp_path / "pair.glb")
+    assert main(["motion", str(source), "-o", str(tmp_path / "levels"), "--levels", "2", "--skin", "1"]) == 0
+    assert "not in the levels' GLBs: node 2 'skinned mesh' (on another skeleton)" in capsys.readouterr().err
+    assert main(["motion", str(source), "-o", str(tmp_path / "other"), "--skin", "hat"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"animlod motion: error: {source}: skin 'hat': not in the file (skinned meshes use skins: 0, 1)"
+    )
+    assert not (tmp_path / "other").exists()

@@ -79,10 +79,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )  # fmt: skip
     parser.add_argument("--max-frames", type=int, default=600, help="frames motion analysis looks at, at most")
     parser.add_argument(
-        "--clip", type=_clip, default=None,
+        "--clip", type=_index_or_name, default=None,
         help="which animation of a glTF file, by index or name; default all of them: as one motion when each "
         "moves other joints (one animation per joint node), else one after another with one skeleton per level "
         "(a BVH per clip and level, every clip in each level's GLB)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--skin", type=_index_or_name, default=None,
+        help="in a glTF of several characters, the one whose motion to simplify: its skin by index, or a skin's or "
+        "mesh's name; default the body whose skin lists the most joints (the others are named in a note)",
     )  # fmt: skip
     parser.add_argument(
         "--clips", nargs="+", default=(), metavar="FILE",
@@ -148,8 +153,8 @@ class _Progress:
 _WHOLE_FRAMES = "{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total_fmt} [{elapsed}<{remaining}, {rate_fmt}]"
 
 
-def _clip(text: str) -> int | str:
-    """--clip's value: an index when it is a whole number, else an animation's name."""
+def _index_or_name(text: str) -> int | str:
+    """--clip's and --skin's value: an index when it is a whole number, else a name."""
     try:
         return int(text)
     except ValueError:
@@ -191,6 +196,7 @@ def run(args: argparse.Namespace) -> int:
             clip=args.clip,
             clips=args.clips,
             joint_map=args.joint_map,
+            body_skin=args.skin,
             on_level=on_level,
             on_choice=lambda chosen, to_choose: progress().chose(chosen, to_choose),
             on_measure=lambda frames, frame_count: progress().measured(frames, frame_count),

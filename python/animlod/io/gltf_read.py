@@ -63,14 +63,17 @@ class GltfScene:
     body: int = 0
 
 
-def read_gltf(path: str | os.PathLike | GltfDocument, fps: float | None = None) -> GltfScene:
+def read_gltf(
+    path: str | os.PathLike | GltfDocument, fps: float | None = None, body_skin: int | str | None = None
+) -> GltfScene:
     """Read every skinned mesh, motion, morph animation and static mesh of a .glb / .gltf file
     (or of a document already parsed).
 
     Animations are sampled at ``fps`` from time 0 to their last key (None: at the rate of their
-    keys, :meth:`~animlod.io.gltf_document.GltfDocument.sample_rate`). Raises
-    :class:`~animlod.io.FormatError` naming the file, the element and the reason for input it
-    cannot read.
+    keys, :meth:`~animlod.io.gltf_document.GltfDocument.sample_rate`). ``body_skin`` picks the
+    character whose mesh is :attr:`GltfScene.body` in a file of several, as :func:`read_skinned`
+    picks a skin. Raises :class:`~animlod.io.FormatError` naming the file, the element and the
+    reason for input it cannot read.
     """
     doc = path if isinstance(path, GltfDocument) else GltfDocument(path)
     fps = doc.sample_rate(fps)
@@ -85,7 +88,8 @@ def read_gltf(path: str | os.PathLike | GltfDocument, fps: float | None = None) 
         skinned.append(mesh)
         skinned_motions.append(motions)
     morph_animations, static_meshes = read_unskinned_meshes(doc, fps)
-    body = nodes.index(body_node(doc, nodes)) if nodes else 0
+    candidates = nodes if body_skin is None else _using_skin(doc, nodes, body_skin)
+    body = nodes.index(body_node(doc, candidates)) if nodes else 0
     return GltfScene(
         skinned_meshes=skinned,
         motions=skinned_motions[body] if skinned_motions else [],
@@ -112,11 +116,7 @@ def read_skinned(
     nodes = _skinned_mesh_nodes(doc)
     if not nodes:
         raise doc.fail("skins", "no node draws a skinned mesh (a skin names the skeleton's joints)")
-    chosen = [node for node in nodes if skin is None or _uses_skin(doc, node, skin)]
-    if not chosen:
-        available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes}))
-        raise doc.fail(f"skin {skin!r}", f"not in the file (skinned meshes use skins: {available})")
-    node = body_node(doc, chosen)
+    node = body_node(doc, nodes if skin is None else _using_skin(doc, nodes, skin))
     return read_skinned_node(doc, node, SkinRig(doc, doc.gltf.nodes[node].skin), doc.sample_rate(fps))
 
 
@@ -151,6 +151,16 @@ def body_node(doc: GltfDocument, nodes: list[int]) -> int:
 def _skin_label(doc: GltfDocument, skin: int) -> str:
     name = doc.gltf.skins[skin].name
     return f"{skin} {name!r}" if name else str(skin)
+
+
+def _using_skin(doc: GltfDocument, nodes: list[int], skin: int | str) -> list[int]:
+    """The nodes of ``nodes`` (each drawing a skinned mesh) that use ``skin``: an index, or a skin's
+    or mesh's name; FormatError naming the skins they use where none does."""
+    chosen = [node for node in nodes if _uses_skin(doc, node, skin)]
+    if not chosen:
+        available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes})) or "none"
+        raise doc.fail(f"skin {skin!r}", f"not in the file (skinned meshes use skins: {available})")
+    return chosen
 
 
 def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:

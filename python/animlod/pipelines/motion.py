@@ -89,6 +89,7 @@ def build_motion_levels(
     clip: int | str | None = None,
     clips: Sequence[str] = (),
     joint_map: str | os.PathLike | None = None,
+    body_skin: int | str | None = None,
     on_level: Callable[[int, int, int, int], Callable[[float], None] | None] | None = None,
     on_choice: Callable[[int, int], None] | None = None,
     on_measure: Callable[[int, int], None] | None = None,
@@ -121,6 +122,10 @@ def build_motion_levels(
         (:mod:`.clip_import`).
     joint_map : a JSON table of the character's node each BVH clip's joint drives, where the
         skeletons' shape, body parts and names do not tell (:func:`.joint_matching.read_joint_map`).
+    body_skin : in a glTF of several characters, the one whose motion to simplify: its skin by
+        index, or a skin's or mesh's name; None: the body whose skin lists the most joints
+        (:attr:`animlod.io.gltf.GltfScene.body`). The skinned meshes on other skeletons are left
+        out of the level files, named in a note.
     on_level : called with (level index, joint count, frame count, number of levels) as each
         level starts; may return a callback taking the frames done.
     on_choice : called with (levels chosen, levels to choose) while the "refit" ranking's trial
@@ -153,7 +158,7 @@ def build_motion_levels(
         if on_note is not None:
             on_note(text)
 
-    motion, played, skin, materials, layout, content = _read_input(source, clip, clips, joint_map, note)
+    motion, played, skin, materials, layout, content = _read_input(source, clip, clips, joint_map, body_skin, note)
     if layout is not None and len(layout.roots) > 1:
         note(f"{os.fspath(source)}: its {len(layout.roots)} ROOTs ({', '.join(layout.roots)}) are joints below "
              f"one ROOT of its own, {motion.skeleton.names[0]!r}, at the origin, in every level")  # fmt: skip
@@ -306,6 +311,7 @@ def _read_input(
     clip: int | str | None,
     clip_files: Sequence[str],
     joint_map: str | os.PathLike | None,
+    body_skin: int | str | None,
     note: Callable[[str], None],
 ) -> _Input:
     """The motion to simplify, the clips it is made of (each one's name and frames in it), for a
@@ -319,6 +325,8 @@ def _read_input(
         raise ValueError(f"{option}: adds glTF clips to a glTF input, not to a {kind} input")
     if clip is not None and kind != "gltf":
         raise ValueError(f"clip: picks one of a glTF input's animations; a {kind} file holds one clip")
+    if body_skin is not None and kind != "gltf":
+        raise ValueError(f"skin: picks one of a glTF input's characters; a {kind} file holds one skeleton")
     if kind == "bvh":
         from ..io.bvh import read_bvh_with_layout
 
@@ -341,7 +349,7 @@ def _read_input(
     if idle := document.idle_weight_channels_note():
         note(f"{path}: {idle}")
     fps = document.sample_rate()
-    scene = read_gltf(document, fps)
+    scene = read_gltf(document, fps, body_skin)
     if scene.skinned_meshes:
         whole = whole_skin(document, scene, note, fps)
         skin, motions, animations, left_out = whole.mesh, whole.motions, whole.animations, whole.left_out
@@ -351,7 +359,7 @@ def _read_input(
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
             note(f"{path}: skinned mesh{'es' if len(left_out) > 1 else ''} not in the levels' GLBs: "
-                 f"{', '.join(left_out)} (`animlod character` takes every skin)")  # fmt: skip
+                 f"{', '.join(left_out)} (`--skin` picks another character; `animlod character` takes every skin)")  # fmt: skip
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
         joined_nodes, mesh_names = set(whole.part_nodes), level_mesh_names(document, whole.part_nodes)

@@ -359,7 +359,8 @@ def _read_input(
             note(f"{path}: the skinned meshes on its skeleton are written as one mesh in each level's GLB")
         if left_out:
             note(f"{path}: skinned mesh{'es' if len(left_out) > 1 else ''} not in the levels' GLBs: "
-                 f"{', '.join(left_out)} (`--skin` picks another character; `animlod character` takes every skin)")  # fmt: skip
+                 f"{', '.join(left_out)} (`--skin` picks another character; `animlod character` takes every "
+                 "skin)")  # fmt: skip
         if not motions:
             raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
         joined_nodes, mesh_names = set(whole.part_nodes), level_mesh_names(document, whole.part_nodes)

@@ -121,8 +121,6 @@ py::dict simplify_animated_py(const FloatArray& frames, const py::array& face_in
   const auto used = static_cast<py::ssize_t>(result.frames_used.size());
   out["frames_used"] = numpy_from_vector(std::move(result.frames_used), {used});
   out["vertex_weights"] = numpy_from_vector(std::move(result.vertex_weights), {vertex_count});
-  out["noise_floor"] = result.noise_floor;
-  out["fold_limit"] = result.fold_limit;
   const AqemPreparation& report = result.preparation;
   py::dict preparation;
   preparation["degenerate_faces"] = report.degenerate_faces;

@@ -31,7 +31,6 @@
 #include "mesh_preparation.hpp"
 #include "mesh_validation_detail.hpp"
 #include "needle_tips.hpp"
-#include "noise_floor.hpp"
 #include "phase_timer.hpp"
 #include "quadric.hpp"
 #include "worker_threads.hpp"
@@ -490,7 +489,7 @@ Status check_aqem_options(const AqemOptions& options) {
         return Status::error("target_ratios: " + std::to_string(ratio) + " outside (0, 1]");
   }
   if (std::isnan(options.max_error) || options.max_error < 0.0) return Status::error("max_error: must be >= 0");
-  if (std::isnan(options.fold_limit)) return Status::error("fold_limit: must be a number (negative: automatic)");
+  if (std::isnan(options.fold_limit) || options.fold_limit < 0.0) return Status::error("fold_limit: must be >= 0");
   for (int32_t f : options.frame_subset)
     if (f < 0) return Status::error("frame_subset: frame " + std::to_string(f) + " is negative");
   if (options.use_motion_features) return check_motion_feature_options(options.motion_features);
@@ -568,9 +567,7 @@ Status simplify_animated(const AnimatedMeshView& mesh, const AqemVertexData& ver
   carried.influence_count = vertex_data.influence_count;
   detail::EngineOptions engine_options;
   engine_options.check_inversion = options.check_inversion;
-  result.noise_floor = detail::frame_noise_floor(points.view());
-  result.fold_limit = options.fold_limit >= 0.0 ? options.fold_limit : result.noise_floor < kNoiseFreeFloor ? 0.0 : 1.0;
-  engine_options.fold_limit = result.fold_limit;
+  engine_options.fold_limit = options.fold_limit;
   engine_options.max_error = options.max_error;
   engine_options.progress = options.progress;
   engine_options.collapse_passes = true;

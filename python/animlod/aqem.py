@@ -172,10 +172,7 @@ class CollapseRecord:
 @dataclass
 class SimplifyResult:
     """Levels (finest first), the collapse record, the frames whose quadrics were used, the
-    vertex weights (V,) of Eq. 6, what preparing the input did and the phases' seconds; the
-    frames' noise floor (relative to the diagonal: the 10th percentile over the edges of each
-    edge length's standard deviation over the frames) and the fold limit the collapses kept
-    (``AqemOptions.fold_limit``, by default 0 where that floor is under 1e-5, else 1)."""
+    vertex weights (V,) of Eq. 6, what preparing the input did and the phases' seconds."""
 
     levels: list[SimplifiedLevel]
     collapses: CollapseRecord
@@ -183,8 +180,6 @@ class SimplifyResult:
     vertex_weights: np.ndarray
     preparation: Preparation
     seconds: PhaseSeconds
-    noise_floor: float
-    fold_limit: float
 
     def lod_chain(self, original: AnimatedMesh, name: str = "") -> LodChain:
         """The levels as a :class:`~animlod.model.LodChain`, ``original`` as level 0; each
@@ -269,11 +264,11 @@ def simplify_animated(
         ``"amplitude"`` by default, ``"paper"`` the published rule), ``boundary_quadrics``,
         ``tip_quadrics`` (needle tips cost their displacement; off: the paper's quadrics),
         ``check_inversion`` and ``fold_limit`` (Eq. 7 summed over every frame, and no fold
-        deeper than ``fold_limit`` opposite-edge lengths in any frame: by default 0, no flip at
-        all, where the frames carry no noise, else 1; ``math.inf`` for Eq. 7 alone),
-        ``max_frames`` and ``frame_subset`` (the frames of the quadrics), ``placement``
-        (``"optimal"``: Eq. 5 in every frame; ``"on_edge"``: one point of the collapsed edge for
-        all frames, so that UVs and skin weights stay consistent with its positions) and
+        deeper than ``fold_limit`` opposite-edge lengths in any frame: 1 by default, 0 for no flip
+        at all, ``math.inf`` for Eq. 7 alone), ``max_frames`` and ``frame_subset`` (the frames of
+        the quadrics), ``placement`` (``"optimal"``: Eq. 5 in every frame; ``"on_edge"``: one
+        point of the collapsed edge for all frames, so that UVs and skin weights stay consistent
+        with its positions) and
         ``weld`` (weld copies of a position; off, seams are open borders) and
         ``record_positions`` (off: ``collapses.positions`` stays empty, which saves 12 bytes per
         collapse and frame).
@@ -500,6 +495,4 @@ def _result(raw: dict, fps: float | None) -> SimplifyResult:
         vertex_weights=raw["vertex_weights"],
         preparation=Preparation(**{name: int(count) for name, count in raw["preparation"].items()}),
         seconds=PhaseSeconds(**raw["seconds"]),
-        noise_floor=float(raw["noise_floor"]),
-        fold_limit=float(raw["fold_limit"]),
     )

@@ -161,27 +161,6 @@ TEST_CASE("aqem checks orientation in the frames outside the quadrics' frames to
       CHECK(downward_faces(level.positions, level.faces, frame, level.kept_vertices.size()) == 0);
 }
 
-TEST_CASE("aqem's default fold limit is 0 on frames without noise and 1 where every edge's length moves") {
-  AqemOptions options;
-  options.target_ratios = {0.5};
-  // sphere() stretches every edge from frame to frame, as a morph or a capture's noise does.
-  const OwnedAnimatedMesh stretched = animlod::testing::sphere(8, 10, 3);
-  const AqemResult moving = simplify(stretched, options);
-  CHECK(moving.noise_floor > animlod::kNoiseFreeFloor);
-  CHECK(moving.fold_limit == 1.0);
-  // Frame 0 of it carried along x: every edge keeps its length.
-  OwnedAnimatedMesh carried = animlod::testing::sphere(8, 10, 1);
-  const std::vector<float> rest = carried.frames;
-  for (int frame = 1; frame < 3; ++frame)
-    for (size_t k = 0; k < rest.size(); ++k) carried.frames.push_back(rest[k] + (k % 3 == 0 ? 0.25f * frame : 0.0f));
-  carried.frame_count = 3;
-  const AqemResult rigid = simplify(carried, options);
-  CHECK(rigid.noise_floor < animlod::kNoiseFreeFloor);
-  CHECK(rigid.fold_limit == 0.0);
-  options.fold_limit = 2.5;
-  CHECK(simplify(carried, options).fold_limit == 2.5);
-}
-
 TEST_CASE("aqem's collapse error is the RMS distance to the merged quadric's planes") {
   // Recomputes the first collapse's error from its definition: the planes of the faces around
   // the kept and the removed vertex (a face around both counts twice, as in Q_i + Q_j), the new
@@ -349,10 +328,6 @@ TEST_CASE("aqem options that no mesh can take are refused without a mesh, and fi
     CHECK(check_aqem_options(options).message == "max_error: must be >= 0");
     options.max_error = NAN;
     CHECK(check_aqem_options(options).message == "max_error: must be >= 0");
-  }
-  SUBCASE("fold_limit") {
-    options.fold_limit = NAN;
-    CHECK(check_aqem_options(options).message == "fold_limit: must be a number (negative: automatic)");
   }
   SUBCASE("a negative frame") {
     options.frame_subset = {0, -2};

@@ -35,14 +35,6 @@ enum class Placement {
   on_edge,
 };
 
-// AqemOptions::fold_limit's default: chosen from the frames' noise.
-inline constexpr double kAutomaticFoldLimit = -1.0;
-// Frames whose noise floor (AqemResult::noise_floor) is under this share of the diagonal carry
-// no noise: rigid parts keep their edges' lengths to float rounding (1e-7 for a Blender export,
-// 2e-6 for the synth humanoid's smooth skin weights), where a capture's noise or a morph moves
-// nearly every edge (crane 8.5e-5, Gaussian noise of 5e-4: 5.3e-4).
-inline constexpr double kNoiseFreeFloor = 1e-5;
-
 // What simplify_animated builds and how: the levels, the weights of Eq. 6, the quadrics, the
 // inversion test and where collapsed vertices go.
 struct AqemOptions {
@@ -77,16 +69,14 @@ struct AqemOptions {
   bool check_inversion = true;
   // Beside Eq. 7's sum, rejects a collapse that folds a face deeply in any single frame: the
   // moved corner passes the line of the face's opposite edge, within the face's plane in that
-  // frame, by more than fold_limit times that edge's length. 0: no flip in any frame; infinity:
-  // Eq. 7 alone, the paper's test. Negative (the default): chosen from the frames' noise
-  // (AqemResult::noise_floor): 0 where it is under kNoiseFreeFloor, else 1. On a clean box limb
-  // whose flat sides bend in their plane, the sum lets triangles fold across the knee in the few
-  // bent frames (15% of the diagonal at 50%); no flip at all keeps them. A capture's noise flips
-  // some face in some frame near most collapses, and refusing those too ruins its levels (Xbot's
-  // baked clip with noise at 25%: 0.26% -> 5.7%); its flips stay shallower than an edge, while
-  // the box leg's fold is deeper (bench_aqem's quality and baked tables). Ignored when
-  // check_inversion is false.
-  double fold_limit = kAutomaticFoldLimit;
+  // frame, by more than fold_limit times that edge's length. On a clean box limb whose flat
+  // sides bend in their plane, the sum lets triangles fold across the knee in the few bent
+  // frames (15% of the diagonal at 50%); a capture's noise tips slivers over in some frame near
+  // most collapses, and refusing those too (a limit of 0: no flip in any frame) ruins its levels
+  // (Xbot's baked clip with noise at 25%: 0.27% -> 5.7%). Noise flips stay shallow: the default
+  // 1 (a fold as tall as its edge is long) keeps both (bench_aqem's quality and baked tables).
+  // Infinity: Eq. 7 alone, the paper's test. Ignored when check_inversion is false.
+  double fold_limit = 1.0;
   // Quadrics over K frames only: 0 uses every frame, otherwise K frames chosen by
   // farthest-point sampling of the poses (see frames_used). Only the quadrics shrink to
   // O(V K) memory and placement time; positions, the inversion test and the outputs stay
@@ -209,11 +199,6 @@ struct AqemTimings {
 struct AqemResult {
   std::vector<AqemLevel> levels;     // one per target, finest first
   CollapseRecord collapses;
-  // The frames' noise: the 10th percentile over the edges of each edge length's standard
-  // deviation over the frames, relative to frame 0's bounding-box diagonal (0 for one frame), and
-  // the fold limit the collapses kept (AqemOptions::fold_limit, chosen from it by default).
-  double noise_floor = 0.0;
-  double fold_limit = 0.0;
   std::vector<int32_t> frames_used;  // frames whose quadrics drove the simplification
   std::vector<float> vertex_weights; // (V,) weights of Eq. 6 (motion features x importance),
                                      //      1 for vertices no face uses
@@ -222,7 +207,7 @@ struct AqemResult {
 };
 
 // The checks of `options` that need no mesh, run first by simplify_animated: no level, a target
-// ratio outside (0, 1], a face count of 0, a negative or NaN max_error, a NaN fold_limit, a negative frame in
+// ratio outside (0, 1], a face count of 0, a negative or NaN max_error, a negative frame in
 // frame_subset, and the motion-feature options' (check_motion_feature_options) when
 // use_motion_features is on. A caller that takes options long before it has the mesh (a batch
 // manifest) can refuse them up front.

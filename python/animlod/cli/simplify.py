@@ -78,10 +78,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=None,
         metavar="DEPTH",
         help="beside Eq. 7's sum over the frames, refuse a collapse that folds a face in any one frame deeper than "
-        "DEPTH lengths of its opposite edge; 0: no flip in any frame (box limbs, whose flat sides bend in their "
-        "plane, do not fold across the bend); inf: Eq. 7 alone, the paper's test; default 0 where the frames carry "
-        "no noise, else 1 (a capture's noise flips faces in some frame, shallower than an edge: refusing those "
-        "stalls the collapses)",
+        "DEPTH lengths of its opposite edge (default 1: box limbs, whose flat sides bend in their plane, do not fold "
+        "across the bend, and captures' noise, which tips slivers over, does not stall the collapses); 0: no flip in "
+        "any frame; inf: Eq. 7 alone, the paper's test",
     )
     parser.add_argument("--separate", action="store_true", help="glTF: one whole GLB per level instead of one LoD GLB")
     parser.add_argument(

@@ -268,9 +268,8 @@ def simplify_animated(
         at all, ``math.inf`` for Eq. 7 alone), ``max_frames`` and ``frame_subset`` (the frames of
         the quadrics), ``placement`` (``"optimal"``: Eq. 5 in every frame; ``"on_edge"``: one
         point of the collapsed edge for all frames, so that UVs and skin weights stay consistent
-        with its positions) and
-        ``weld`` (weld copies of a position; off, seams are open borders) and
-        ``record_positions`` (off: ``collapses.positions`` stays empty, which saves 12 bytes per
+        with its positions), ``weld`` (weld copies of a position; off, seams are open borders)
+        and ``record_positions`` (off: ``collapses.positions`` stays empty, which saves 12 bytes per
         collapse and frame).
     locked_vertices : indices of vertices that are never removed nor moved.
     guarded_vertices : indices of vertices kept like locked ones until no other collapse is

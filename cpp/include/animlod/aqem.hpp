@@ -71,11 +71,12 @@ struct AqemOptions {
   // moved corner passes the line of the face's opposite edge, within the face's plane in that
   // frame, by more than fold_limit times that edge's length. On a clean box limb whose flat
   // sides bend in their plane, the sum lets triangles fold across the knee in the few bent
-  // frames (15% of the diagonal at 50%); a capture's noise tips slivers over in some frame near
-  // most collapses, and refusing those too (a limit of 0: no flip in any frame) ruins its levels
-  // (Xbot's baked clip with noise at 25%: 0.27% -> 5.7%). Noise flips stay shallow: the default
-  // 1 (a fold as tall as its edge is long) keeps both (bench_aqem's quality and baked tables).
-  // Infinity: Eq. 7 alone, the paper's test. Ignored when check_inversion is false.
+  // frames (synth.kicking_box_leg at 50%: 15% of the diagonal, 0.5% with the default 1). A
+  // limit of 0 (no flip in any frame) ruins noisy captures, whose noise flips some face in some
+  // frame near most collapses (Xbot's baked clip with noise at 25%: 0.26% -> 5.7%), less deeply
+  // than an edge (bench_aqem's quality and baked tables). Shallow folds of clean meshes pass the
+  // default too (a Blender export's box limbs: 1.65% at 50%, 0.15% with 0). Infinity: Eq. 7
+  // alone, the paper's test. Ignored when check_inversion is false.
   double fold_limit = 1.0;
   // Quadrics over K frames only: 0 uses every frame, otherwise K frames chosen by
   // farthest-point sampling of the poses (see frames_used). Only the quadrics shrink to

@@ -433,8 +433,8 @@ class GltfDocument:
                     idle.append(f"{self.animation_label(a)} channel {c} ({self.node_label(node)})")
         if not idle:
             return None
-        return (f"morph weights animated on a mesh without morph targets, which change nothing (an exporter that "
-                f"applied modifiers dropped the shape keys they drove): {', '.join(idle)}")  # fmt: skip
+        return (f"morph weights animated on a mesh without morph targets, which change nothing (as where an exporter "
+                f"that applied modifiers dropped the shape keys they drove): {', '.join(idle)}")  # fmt: skip
 
     def alternate_nodes(self) -> set[int]:
         """Nodes that stand in for another node at other levels of detail: the ids of its MSFT_lod

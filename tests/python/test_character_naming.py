@@ -139,9 +139,13 @@ def test_motion_names_the_second_character_it_leaves_out(tmp_path: Path) -> None
 def test_motion_takes_the_character_skin_picks(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """`--skin` picks the other character of a file of two: until 2026-12-07 `motion` took the body
     whose skin lists the most joints, and the other could not have motion levels of its own."""
-    source = _doubled(_one_character(tmp_path), tmp_path / "pair.glb")
-    assert main(["motion", str(source), "-o", str(tmp_path / "levels"), "--levels", "2", "--skin", "1"]) == 0
-    assert "not in the levels' GLBs: node 2 'skinned mesh' (on another skeleton)" in capsys.readouterr().err
+    builder = GlbBuilder.from_document(GltfDocument(_doubled(_one_character(tmp_path), tmp_path / "pair.glb")))
+    builder.json["nodes"][5]["name"] = "Body2"  # the second figure's skinned node, as Blender names objects
+    source = tmp_path / "named.glb"
+    builder.save(source)
+    for skin in ("1", "Body2"):
+        assert main(["motion", str(source), "-o", str(tmp_path / skin), "--levels", "2", "--skin", skin]) == 0
+        assert "not in the levels' GLBs: node 2 'skinned mesh' (on another skeleton)" in capsys.readouterr().err
     assert main(["motion", str(source), "-o", str(tmp_path / "other"), "--skin", "hat"]) == 2
     assert capsys.readouterr().err.strip() == (
         f"animlod motion: error: {source}: skin 'hat': not in the file (skinned meshes use skins: 0, 1)"

@@ -86,8 +86,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )  # fmt: skip
     parser.add_argument(
         "--skin", type=_index_or_name, default=None,
-        help="in a glTF of several characters, the one whose motion to simplify: its skin by index, or a skin's or "
-        "mesh's name; default the body whose skin lists the most joints (the others are named in a note)",
+        help="in a glTF of several characters, the one whose motion to simplify: its skin by index, or the name of "
+        "its skin, mesh or node; default the body whose skin lists the most joints (the others are named in a note)",
     )  # fmt: skip
     parser.add_argument(
         "--clips", nargs="+", default=(), metavar="FILE",

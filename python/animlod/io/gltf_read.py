@@ -108,7 +108,8 @@ def read_skinned(
     """One skinned mesh of a glTF file and its motions sampled at ``fps`` (None: at the rate of
     their keys, as :func:`read_gltf`).
 
-    ``skin`` picks the skin by index, or by skin or mesh name; None takes the body (as
+    ``skin`` picks the skin by index, or by the name of a skin, a mesh or a node that draws
+    it; None takes the body (as
     :attr:`GltfScene.body` picks it). A file without that skin raises FormatError naming the file
     and the skin asked for.
     """
@@ -154,8 +155,8 @@ def _skin_label(doc: GltfDocument, skin: int) -> str:
 
 
 def _using_skin(doc: GltfDocument, nodes: list[int], skin: int | str) -> list[int]:
-    """The nodes of ``nodes`` (each drawing a skinned mesh) that use ``skin``: an index, or a skin's
-    or mesh's name; FormatError naming the skins they use where none does."""
+    """The nodes of ``nodes`` (each drawing a skinned mesh) that use ``skin``: an index, or the name
+    of a skin, a mesh or one of those nodes; FormatError naming the skins they use where none does."""
     chosen = [node for node in nodes if _uses_skin(doc, node, skin)]
     if not chosen:
         available = ", ".join(sorted({_skin_label(doc, doc.gltf.nodes[node].skin) for node in nodes})) or "none"
@@ -164,10 +165,10 @@ def _using_skin(doc: GltfDocument, nodes: list[int], skin: int | str) -> list[in
 
 
 def _uses_skin(doc: GltfDocument, node: int, wanted: int | str) -> bool:
-    skin = doc.gltf.nodes[node].skin
+    drawing = doc.gltf.nodes[node]
     if isinstance(wanted, int):
-        return skin == wanted
-    return wanted in (doc.gltf.skins[skin].name, doc.gltf.meshes[doc.gltf.nodes[node].mesh].name)
+        return drawing.skin == wanted
+    return wanted in (doc.gltf.skins[drawing.skin].name, doc.gltf.meshes[drawing.mesh].name, drawing.name)
 
 
 def read_node_motions(

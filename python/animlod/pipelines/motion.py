@@ -123,7 +123,7 @@ def build_motion_levels(
     joint_map : a JSON table of the character's node each BVH clip's joint drives, where the
         skeletons' shape, body parts and names do not tell (:func:`.joint_matching.read_joint_map`).
     body_skin : in a glTF of several characters, the one whose motion to simplify: its skin by
-        index, or a skin's or mesh's name; None: the body whose skin lists the most joints
+        index, or the name of its skin, mesh or node; None: the body whose skin lists the most joints
         (:attr:`animlod.io.gltf.GltfScene.body`). The skinned meshes on other skeletons are left
         out of the level files, named in a note.
     on_level : called with (level index, joint count, frame count, number of levels) as each

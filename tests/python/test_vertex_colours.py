@@ -155,6 +155,27 @@ def test_frames_whose_colours_disagree_leave_them_out_with_a_warning(tmp_path):
         assert read_textured_sequence(tmp_path / "shot")[3] is None
 
 
+def test_an_alpha_on_some_frames_only_leaves_the_colours_without_it(tmp_path):
+    """Until 2026-12-07 a frame with an alpha beside frames without one dropped every colour."""
+    rest, twisted = twisting_cylinder()
+    stored = _height_colours(rest.frames[0][:, 1])[None, :, :3].round().astype(np.float32)  # as uchar keeps them
+    rgb = VertexColours(stored, ("red", "green", "blue"), ("u1",) * 3)
+    rgba = VertexColours(np.concatenate([rgb.values, np.full((*rgb.values.shape[:2], 1), 128, np.float32)], axis=2),
+                         ("red", "green", "blue", "alpha"), ("u1",) * 4)  # fmt: skip
+    for order, (first, other) in enumerate(((rgb, rgba), (rgba, rgb))):
+        folder = tmp_path / f"order{order}"
+        _write_frames(folder, "ply", twisted, rest.faces, first)
+        write_ply(folder / "shot_3.ply", twisted[3], rest.faces, colours=other)
+        with pytest.warns(
+            UserWarning,
+            match=rf"shot_3.ply: stores its vertex colours as {', '.join(other.names)} \(uchar\), and shot_0.ply as "
+            rf"{', '.join(first.names)} \(uchar\): the levels are written without alpha",
+        ):
+            colours = read_textured_sequence(folder)[3]
+        assert colours.names == ("red", "green", "blue") and colours.types == ("u1",) * 3
+        np.testing.assert_array_equal(colours.values, rgb.values)
+
+
 def test_colours_are_read_by_the_names_and_types_files_store_them_in(tmp_path):
     header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
     face = "element face 1\nproperty list uchar int vertex_indices\nend_header\n"

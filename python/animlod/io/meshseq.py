@@ -199,8 +199,10 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
 
 class _ColourFrames:
     """The vertex colours of a sequence's frames, gathered as they are read: every frame's where
-    each has colours stored as the first frame's; none, with a warning naming the first frame
-    that has none or others, where not."""
+    each has colours stored as the first frame's; red, green and blue alone, with a warning naming
+    the first frame that differs, where some frames store an alpha and others none (or another
+    type of it); none, with a warning, where a frame has no colours or stores a colour channel
+    otherwise."""
 
     def __init__(self, first_path: Path, first: VertexColours | None, frame_count: int) -> None:
         self.first_path, self.first = first_path, first
@@ -208,6 +210,7 @@ class _ColourFrames:
         if self.values is not None:
             self.values[0] = first.values[0]
         self.dropped: str | None = None  # why they are not read: the first frame that differs, and how
+        self.narrowed: str | None = None  # which channels are not read: the first frame that differs
 
     def add(self, index: int, path: Path, colours: VertexColours | None) -> None:
         """Take frame ``index``'s colours (read from ``path``)."""
@@ -217,6 +220,18 @@ class _ColourFrames:
             self.values[index] = colours.values[0]
             return
         first = self.first_path.name
+        shared = [] if colours is None or self.first is None else self._shared(colours)
+        if shared:
+            left = ", ".join(dict.fromkeys(name for name in (*self.first.names, *colours.names) if name not in shared))
+            if not self.narrowed:
+                self.narrowed = (f"{path}: stores its vertex colours as {colours.layout()}, and {first} as "
+                                 f"{self.first.layout()}: the levels are written without {left}")  # fmt: skip
+            keep = [self.first.names.index(name) for name in shared]
+            self.first = VertexColours(self.first.values[..., keep], tuple(shared),
+                                       tuple(self.first.types[k] for k in keep))  # fmt: skip
+            self.values = self.values[..., keep]
+            self.values[index] = colours.values[0][:, [colours.names.index(name) for name in shared]]
+            return
         if colours is None:
             what = f"has no vertex colours that can be read, and {first} has"
         elif self.first is None:
@@ -225,11 +240,23 @@ class _ColourFrames:
             what = f"stores its vertex colours as {colours.layout()}, and {first} as {self.first.layout()}"
         self.dropped, self.values = f"{path}: {what}: the levels are written without them", None
 
+    def _shared(self, colours: VertexColours) -> list[str]:
+        """The channels of the colours kept so far that ``colours`` stores alike (same name, same
+        type, as many vertices), in their order, where they hold the three colour channels: the
+        alpha alone may go."""
+        if colours.values.shape[1] != self.first.values.shape[1]:
+            return []
+        theirs = dict(zip(colours.names, colours.types))
+        shared = [name for name, kind in zip(self.first.names, self.first.types) if theirs.get(name) == kind]
+        return shared if set(self.first.names[:3]) <= set(shared) else []
+
     def read(self) -> VertexColours | None:
         """The frames' colours: one set where every frame's are the first's, else one per frame;
-        None, with the warning saying why, where a frame differs in having them or how."""
-        if self.dropped:
-            warnings.warn(self.dropped, UnreadAttributesWarning, stacklevel=4)
+        None, with the warning saying why, where a frame differs in having them or in every
+        channel."""
+        for message in (self.narrowed, self.dropped):
+            if message:
+                warnings.warn(message, UnreadAttributesWarning, stacklevel=4)
         if self.values is None:
             return None
         values = self.values[:1] if np.all(self.values == self.values[:1]) else self.values

@@ -108,10 +108,9 @@ def read_skinned(
     """One skinned mesh of a glTF file and its motions sampled at ``fps`` (None: at the rate of
     their keys, as :func:`read_gltf`).
 
-    ``skin`` picks the skin by index, or by the name of a skin, a mesh or a node that draws
-    it; None takes the body (as
-    :attr:`GltfScene.body` picks it). A file without that skin raises FormatError naming the file
-    and the skin asked for.
+    ``skin`` picks the skin by index, or by the name of a skin, a mesh or a node that draws it;
+    None takes the body (as :attr:`GltfScene.body` picks it). A file without that skin raises
+    FormatError naming the file and the skin asked for.
     """
     doc = GltfDocument(path)
     nodes = _skinned_mesh_nodes(doc)

@@ -220,24 +220,22 @@ class _ColourFrames:
             self.values[index] = colours.values[0]
             return
         first = self.first_path.name
-        shared = [] if colours is None or self.first is None else self._shared(colours)
-        if shared:
-            left = ", ".join(dict.fromkeys(name for name in (*self.first.names, *colours.names) if name not in shared))
-            if not self.narrowed:
-                self.narrowed = (f"{path}: stores its vertex colours as {colours.layout()}, and {first} as "
-                                 f"{self.first.layout()}: the levels are written without {left}")  # fmt: skip
-            keep = [self.first.names.index(name) for name in shared]
-            self.first = VertexColours(self.first.values[..., keep], tuple(shared),
-                                       tuple(self.first.types[k] for k in keep))  # fmt: skip
-            self.values = self.values[..., keep]
-            self.values[index] = colours.values[0][:, [colours.names.index(name) for name in shared]]
-            return
         if colours is None:
             what = f"has no vertex colours that can be read, and {first} has"
         elif self.first is None:
             what = f"has vertex colours, and {first} has none"
         else:
             what = f"stores its vertex colours as {colours.layout()}, and {first} as {self.first.layout()}"
+            shared = self._shared(colours)
+            if shared:  # an alpha alone differs: keep the rest
+                left = ", ".join(dict.fromkeys(n for n in (*self.first.names, *colours.names) if n not in shared))
+                self.narrowed = self.narrowed or f"{path}: {what}: the levels are written without {left}"
+                keep = [self.first.names.index(name) for name in shared]
+                self.first = VertexColours(self.first.values[..., keep], tuple(shared),
+                                           tuple(self.first.types[k] for k in keep))  # fmt: skip
+                self.values = self.values[..., keep]
+                self.values[index] = colours.values[0][:, [colours.names.index(name) for name in shared]]
+                return
         self.dropped, self.values = f"{path}: {what}: the levels are written without them", None
 
     def _shared(self, colours: VertexColours) -> list[str]:
@@ -517,10 +515,11 @@ def _check_same_surface(
     vertex_count: int,
     renumbered: bool = False,
 ) -> bool:
-    """Check a frame's vertex count and triangles against the first frame's (FormatError naming the
-    file and the first differing face where they differ, and with ``renumbered`` that its vertices'
-    texture coordinates differ too); True where its triangles are the first frame's only up to where
-    polygons are split (:func:`~.polygon_splits.first_face_off_the_polygons`), False where they are the first's as
+    """Check a frame's vertex count and triangles against the first frame's (FormatError naming
+    the file and the first differing face where they differ, and with ``renumbered`` that its
+    vertices' texture coordinates differ too). True where its triangles are the first frame's
+    only up to where polygons are split
+    (:func:`~.polygon_splits.first_face_off_the_polygons`), False where they are the first's as
     they stand."""
     first = f"the first frame {first_path.name}"
     if len(vertices) != vertex_count:

@@ -279,6 +279,24 @@ def test_triangles_that_draw_nothing_are_neither_measured_nor_refused(tmp_path):
     assert not (tmp_path / "alone_lod.glb").exists()
 
 
+def test_a_mesh_of_one_triangle_gets_no_levels_that_copy_it(tmp_path):
+    # Its targets round to the one triangle it has: each level "reached" its target with no
+    # collapse, and the chain listed two copies of the input mesh with coverages of their own.
+    builder = GlbBuilder()
+    corners = builder.add(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32), bounds=True)
+    builder.json["meshes"] = [{"primitives": [{"attributes": {"POSITION": corners}}]}]
+    builder.json["nodes"], builder.json["scenes"], builder.json["scene"] = [{"mesh": 0}], [{"nodes": [0]}], 0
+    builder.save(tmp_path / "triangle.glb")
+    report = simplify_document(tmp_path / "triangle.glb", tmp_path / "lod.glb", [0.5, 0.25], **QUICK)
+    (drawable,) = report.drawables
+    assert [level.faces for level in drawable.levels] == [1]
+    assert drawable.notes == [
+        "levels 1, 2 (targets 1, 1) not written: the same mesh as the input (1 faces), where the targets need no "
+        "collapse"
+    ]
+    assert "extensions" not in GltfDocument(tmp_path / "lod.glb").json["nodes"][0]
+
+
 def test_separate_writes_one_whole_document_per_level(humanoid_glb, tmp_path):
     report = simplify_document(humanoid_glb, tmp_path / "levels", [0.5, 0.25], separate=True, **QUICK)
     assert [path.name for path in report.outputs] == ["humanoid_lod1.glb", "humanoid_lod2.glb"]

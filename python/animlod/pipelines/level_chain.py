@@ -1,7 +1,8 @@
 """Where a chain of AQEM levels ends, and the notes that say why it is short.
 
 A level short of its target (a max error, or no legal collapse left) holds the mesh where the
-collapses stopped, and so do the levels after it. Written, they were copies of one mesh: a glTF
+collapses stopped, and so do the levels after it; a level whose target the level before meets
+already (a mesh of a few triangles) is the same mesh too. Written, they were copies of one mesh: a glTF
 chain with screen coverages of their own, a sequence with folders that differ only in name. Both
 pipelines write the levels up to the last one coarser than the one before it and say what they
 left out.
@@ -15,12 +16,14 @@ from collections.abc import Sequence
 from ..aqem import SimplifiedLevel
 
 
-def coarser_level_count(levels: Sequence[SimplifiedLevel]) -> int:
-    """How many of ``levels`` lead the chain, each coarser than the one before (the input for the
-    first): the count before the first level that made no collapse of its own."""
+def coarser_level_count(levels: Sequence[SimplifiedLevel], ratios: Sequence[float]) -> int:
+    """How many of ``levels`` (made for face ``ratios``) lead the chain, each coarser than the one
+    before (the input for the first): the count before the first level that made no collapse of
+    its own, short of its target or there without one (a mesh of a few triangles), but for a ratio
+    of 1, which asks for the input's faces (the input through the pipeline, its normals rebuilt)."""
     collapses = 0  # the input's
-    for count, level in enumerate(levels):
-        if not level.reached and level.collapse_count == collapses:
+    for count, (level, ratio) in enumerate(zip(levels, ratios, strict=True)):
+        if level.collapse_count == collapses and not (level.reached and ratio >= 1.0):
             return count
         collapses = level.collapse_count
     return len(levels)
@@ -53,6 +56,8 @@ def _unwritten_levels_note(levels: Sequence[SimplifiedLevel], written: int, max_
     cause = "no legal collapse was left"
     if dropped[0].stopped_by_max_error:
         cause = f"the max error {max_error:g} stopped the collapses"
+    elif dropped[0].reached:
+        cause = f"the target{plural} need{'' if plural else 's'} no collapse"
     return (
         f"level{plural} {numbers} (target{plural} {targets}) not written: the same mesh as {same} "
         f"({dropped[0].mesh.face_count} faces), where {cause}"

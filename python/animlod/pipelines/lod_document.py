@@ -140,8 +140,7 @@ def simplify_document(
     empty = [drawable for drawable, skip in zip(drawables, degenerate) if skip]
     drawables = [drawable for drawable, skip in zip(drawables, degenerate) if not skip]
     if empty:
-        notes.append(f"kept as they are, without levels (no triangle with three distinct corners): "
-                     f"{', '.join(drawable.label for drawable in empty)}")  # fmt: skip
+        notes.append(empty_drawables_note(empty))
     if not drawables:
         reason = "no node draws a triangle mesh, nothing to simplify"
         if empty:
@@ -156,7 +155,7 @@ def simplify_document(
         if progress:
             progress(f"{drawable.label}: {drawable.geometry.faces.shape[0]} triangles, {len(drawable.clips)} clips")
         simplified.append(simplify_drawable(drawable, ratios, settings))
-    reports = [_report(d, s, settings) for d, s in zip(drawables, simplified)]
+    reports = [drawable_report(d, s, ratios, settings) for d, s in zip(drawables, simplified)]
     if separate:
         outputs = _write_separate(doc, drawables, simplified, reports, Path(output), source)
         if not outputs:
@@ -167,10 +166,19 @@ def simplify_document(
     return DocumentReport(Path(source), outputs, reports, time.perf_counter() - started, notes)
 
 
-def _report(drawable: Drawable, levels: DrawableLevels, settings: DrawableSettings) -> DrawableReport:
-    """The drawable's report, whose ``levels`` are those written (:func:`coarser_level_count`)."""
+def empty_drawables_note(empty: list[Drawable]) -> str:
+    """The note on drawables left without levels because they draw nothing (:func:`draws_nothing`)."""
+    labels = ", ".join(drawable.label for drawable in empty)
+    return f"kept as they are, without levels (no triangle with three distinct corners): {labels}"
+
+
+def drawable_report(
+    drawable: Drawable, levels: DrawableLevels, ratios: Sequence[float], settings: DrawableSettings
+) -> DrawableReport:
+    """The drawable's report, whose ``levels`` (made for face ``ratios``) are those written
+    (:func:`coarser_level_count`)."""
     simplified = [level.simplified for level in levels.levels]
-    written = levels.levels[: coarser_level_count(simplified)]
+    written = levels.levels[: coarser_level_count(simplified, ratios)]
     errors = [0.0] + [level.error for level in written]
     coverages = screen_coverages(errors, levels.size, settings.pixel_error, settings.viewport_px)
     report = DrawableReport(
@@ -209,25 +217,34 @@ def _write_chain(
     """The input document with every drawable's levels attached to its nodes by MSFT_lod."""
     builder = GlbBuilder.from_document(doc)
     for drawable, levels, report in zip(drawables, simplified, reports):
-        note = normalise_stored_weights(builder, doc, drawable)
-        if note:
-            report.notes.append(note)
-        written = levels.levels[: len(report.levels) - 1]
-        if not written:
-            continue  # no level coarser than the input: its nodes stay as they are
-        meshes = [
-            add_level_mesh(builder, drawable.mesh_index, level.primitives, drawable.geometry.other_primitives, name)
-            for level, name in zip(written, _level_names(doc, drawable, len(written)))
-        ]
-        coverages = [level.coverage for level in report.levels]
-        joints = len(doc.gltf.skins[drawable.skin_index].joints) if drawable.skin_index is not None else 0
-        infos = [LevelInfo(level.level, level.error, level.faces, level.level, 0, joints) for level in report.levels]
-        for base in unchained(doc, drawable.nodes):
-            nodes = [
-                add_level_node(builder, base, mesh, drawable.skin_index, info) for mesh, info in zip(meshes, infos[1:])
-            ]
-            attach_chain(builder, base, nodes, coverages, infos[0])
+        add_drawable_chain(builder, doc, drawable, levels, report)
     return builder
+
+
+def add_drawable_chain(
+    builder: GlbBuilder, doc: GltfDocument, drawable: Drawable, levels: DrawableLevels, report: DrawableReport
+) -> None:
+    """The drawable's written levels (``report.levels``, :func:`drawable_report`) as an MSFT_lod
+    chain on each of its nodes without one; its stored skin weights normalised (a note on it goes
+    to ``report.notes``)."""
+    note = normalise_stored_weights(builder, doc, drawable)
+    if note:
+        report.notes.append(note)
+    written = levels.levels[: len(report.levels) - 1]
+    if not written:
+        return  # no level coarser than the input: its nodes stay as they are
+    meshes = [
+        add_level_mesh(builder, drawable.mesh_index, level.primitives, drawable.geometry.other_primitives, name)
+        for level, name in zip(written, _level_names(doc, drawable, len(written)))
+    ]
+    coverages = [level.coverage for level in report.levels]
+    joints = len(doc.gltf.skins[drawable.skin_index].joints) if drawable.skin_index is not None else 0
+    infos = [LevelInfo(level.level, level.error, level.faces, level.level, 0, joints) for level in report.levels]
+    for base in unchained(doc, drawable.nodes):
+        nodes = [
+            add_level_node(builder, base, mesh, drawable.skin_index, info) for mesh, info in zip(meshes, infos[1:])
+        ]
+        attach_chain(builder, base, nodes, coverages, infos[0])
 
 
 def _write_separate(

@@ -18,6 +18,7 @@ under ``mtllib`` lines that name the input's libraries from the level's folder.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 import time
@@ -30,6 +31,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..aqem import Preparation, SimplifiedLevel, simplify_animated
+from ..io.atomic import nearest_existing
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError, UnreadAttributesWarning
 from ..io.meshseq import SequenceTexture, normals_fit
@@ -94,10 +96,14 @@ def simplify_sequence(
     receives its (done, total) collapse counts, ``measuring`` the (done, total) levels measured
     (on long sequences the measurement takes longer than the simplification). The surface errors
     are over at most ``measured_frames`` frames, evenly spaced from the first to the last (None:
-    every frame). Raises FormatError for unreadable input, ValueError for ``measured_frames`` < 1.
+    every frame). Raises FormatError for unreadable input, ValueError for ``measured_frames`` < 1,
+    NotADirectoryError before any work where a file stands at or above ``output``.
     """
     if measured_frames is not None:
         measured_frames = whole_number("measured_frames", measured_frames, 1)
+    blocking = nearest_existing(output)
+    if blocking.exists() and not blocking.is_dir():  # found before the work, not when the first level is written
+        raise NotADirectoryError(errno.ENOTDIR, "Not a directory", os.fspath(output))
     kind = input_kind(source)
     texture = None  # the sequence's texture coordinates, carried as AQEM attributes
     shading = None  # how the sequence's normals shade it, for the levels' rebuilt normals
@@ -136,7 +142,7 @@ def simplify_sequence(
         warnings.warn(f"{os.fspath(source)}: its materials are not written: the levels are PLY files, which have "
                       "none", UnreadAttributesWarning, stacklevel=2)  # fmt: skip
     frames = _measured_frames(original.frame_count, measured_frames) if measure else np.arange(0)
-    written = result.levels[: coarser_level_count(result.levels)]
+    written = result.levels[: coarser_level_count(result.levels, ratios)]
     max_error = float(aqem_options.get("max_error", math.inf))
     notes = chain_notes(result.levels, len(written), max_error)
     levels = []

@@ -243,10 +243,10 @@ def test_every_level_node_of_the_skinned_mesh_plays_its_morph_weights(character_
         assert sorted(driven) == sorted([base, *level_nodes])
 
 
-def test_the_note_on_a_hat_says_it_stays_at_full_detail_and_why(character_with_sockets):
-    # The hat, drawn by the head joint's node, is no skinned mesh: the note said "no skin or no
-    # animation", though it moves with every motion level through its joint.
+def test_a_hat_too_small_for_levels_stays_as_it_is_and_the_report_says_why(character_with_sockets):
+    # The hat, drawn by the head joint's node, is no skinned mesh: it gets levels of its own as a
+    # prop (test_character_props.py), but one triangle has no coarser level.
     _, _, report = character_with_sockets
-    (note,) = [note for note in report.notes if note.startswith("not simplified")]
-    assert note.startswith("not simplified, drawn at full detail at every level (unskinned; `animlod simplify`")
-    assert note.endswith("mesh 1")
+    (hat,) = report.others
+    assert hat.label.endswith("mesh 1") and [level.faces for level in hat.levels] == [1]
+    assert "not written: the same mesh as the input" in hat.notes[-1]

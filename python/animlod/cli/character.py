@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind
 from . import UserError, add_joint_map_argument, positive_int, print_rows
-from .simplify import feature_options
+from .simplify import feature_options, print_drawable_reports
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -18,7 +18,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "Build the paper's per-character chain: AQEM geometry levels of every skinned mesh (over all its "
             "clips) times motion levels of its skeleton (joints frozen by importance, every clip re-fitted with "
             "SLSQP, skin weights of frozen joints moved to their kept ancestors). Level i combines geometry "
-            "level i and motion level i; every other combination is written too (extras.animlod_grid). The "
+            "level i and motion level i; every other combination is written too (extras.animlod_grid). Meshes "
+            "no clip skins (props, static meshes) get levels of their own, as simplify gives them. The "
             "input document stays whole; a viewer without MSFT_lod shows level 0."
         ),
     )
@@ -82,6 +83,10 @@ def run(args: argparse.Namespace) -> int:
         rows = [("level", "faces", "joints", "error", "coverage")]
         rows += [(lv.level, lv.faces, lv.joints, f"{lv.relative_error:.2e}", f"{lv.coverage:.3g}") for lv in levels]
         print_rows(rows, indent="  ")
+    if report.others:
+        print("meshes no clip skins, with levels of their own (props, static meshes; their copies on each motion")
+        print("level's skeleton have the same levels)")
+        print_drawable_reports(report.others)
     for note in report.notes:
         print(f"note: {note}")
     print(

@@ -12,6 +12,7 @@ from ..aqem import Preparation
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind, input_stem
 from ..model import AnimatedMesh
 from ..options import AqemOptions
+from ..pipelines.lod_document import DrawableReport
 from ..pipelines.lod_sequence import MEASURED_FRAMES
 from . import UserError, add_joint_map_argument, positive_int, print_rows
 
@@ -138,9 +139,24 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
         joint_map=args.joint_map, progress=print, **frame_budget,
         **options,
     )  # fmt: skip
+    print_drawable_reports(report.drawables)
+    for note in report.notes:
+        print(f"note: {note}")
+    for path in report.outputs:
+        print(f"wrote {path}")
+    print(f"{report.seconds:.2f} s")
+    if args.plot:
+        first = report.drawables[0]
+        folder = output.parent if not args.separate else output
+        _plot(folder / f"{input_stem(args.input)}_levels.png", first.rest_meshes[0], first.rest_meshes[1:], None)
+    return 0
+
+
+def print_drawable_reports(drawables: list[DrawableReport]) -> None:
+    """Each drawable's levels (faces, target, relative error, coverage) and notes, under a legend."""
     print("errors: max over the rest pose and frames of every clip of the Hausdorff distance, relative to the")
     print("bounding-box diagonal; coverage: the MSFT_screencoverage below which the next level takes over")
-    for drawable in report.drawables:
+    for drawable in drawables:
         renormalised = drawable.renormalised_weights
         print(
             f"{drawable.label} (nodes {drawable.nodes}): {drawable.faces} triangles, {drawable.clips} clips; "
@@ -155,16 +171,6 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
         print_rows(rows, indent="  ")
         for note in drawable.notes:
             print(f"  note: {note}")
-    for note in report.notes:
-        print(f"note: {note}")
-    for path in report.outputs:
-        print(f"wrote {path}")
-    print(f"{report.seconds:.2f} s")
-    if args.plot:
-        first = report.drawables[0]
-        folder = output.parent if not args.separate else output
-        _plot(folder / f"{input_stem(args.input)}_levels.png", first.rest_meshes[0], first.rest_meshes[1:], None)
-    return 0
 
 
 def _simplify_sequence(args: argparse.Namespace, options: dict) -> int:

@@ -15,7 +15,9 @@ as the level's skin moves the vertices bound to its joint. What hangs from a nod
 (an exporter's helper node), or what such a node draws, hangs from its nearest joint through
 copies of the nodes between, which play their own channels. The copies share the input's meshes,
 cameras and lights. Each level clip then takes the input clip's channels that pose no skeleton,
-retargeted to the copies where they animate an attachment.
+retargeted to the copies where they animate an attachment. A copy of a node with an MSFT_lod
+chain (a prop with levels of its own) gets level nodes of its own, drawing the same level meshes
+(:func:`copy_level_chains`).
 """
 
 from __future__ import annotations
@@ -26,7 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..io.glb_builder import GlbBuilder
-from ..io.gltf_document import POINTER_EXTENSION, GltfDocument
+from ..io.gltf_document import LOD_EXTENSION, POINTER_EXTENSION, GltfDocument
+from ..io.gltf_lod import ANIMLOD_EXTRA, COVERAGE_EXTRA, drive_level_nodes, has_lod_chain, lod_ids, node_extras
 from ..io.gltf_skin import SkinRig
 from ..model import Motion
 from ..motion_lod.chain import MotionLevel
@@ -170,6 +173,32 @@ def add_level_attachments(
                 _copy_subtree(builder, attachment.node, suffix, copies)
             )
     return copies
+
+
+def copy_level_chains(builder: GlbBuilder, doc: GltfDocument, copies: dict[int, int], suffix: str) -> None:
+    """Level nodes of its own for each copy (:func:`add_level_attachments`) of an MSFT_lod chain's
+    base in ``builder``, named with ``suffix``: copies of the base's level nodes where the copy is
+    (its transform), drawing the same meshes, with the base's coverages; the copy's channels in
+    the level clips, added before, drive them. A level node listed by several bases would be one
+    node in several places, and the copies kept the input's ids (and, what a node between or a
+    joint's own node draws, no coverages)."""
+    nodes = builder.json["nodes"]
+    for source, copy in copies.items():
+        if not has_lod_chain(nodes[source]):
+            continue
+        ids = lod_ids(doc, source) or nodes[source]["extensions"][LOD_EXTENSION]["ids"]  # checked if the input's
+        levels = []
+        for level in ids:
+            levels.append(_copy_subtree(builder, level, suffix, {}))
+            for key in _TRANSFORM:
+                nodes[levels[-1]].pop(key, None)
+                if key in nodes[copy]:
+                    nodes[levels[-1]][key] = deepcopy(nodes[copy][key])
+        nodes[copy].setdefault("extensions", {})[LOD_EXTENSION] = {"ids": levels}
+        chain_extras = {key: deepcopy(value) for key, value in node_extras(nodes[source]).items()
+                        if key in (COVERAGE_EXTRA, ANIMLOD_EXTRA)}  # fmt: skip
+        nodes[copy]["extras"] = {**node_extras(nodes[copy]), **chain_extras}
+        drive_level_nodes(builder, copy, levels)
 
 
 def _child(builder: GlbBuilder, parent: int, node: dict) -> int:

@@ -21,6 +21,11 @@ skeleton as joint nodes of its own, a skin over them and one animation per input
 a level node at motion level m uses that skin, so any glTF engine can play it. Nodes hung from the
 input's joints (props, sockets) are copied onto each level's skeleton, and each level clip also
 plays what its input clip moves besides the skeleton (morph weights; :mod:`.attachments`).
+
+The meshes no clip skins (a sword in a hand, a hat a joint's node draws, a prop beside the
+character, a skinned mesh whose joints no clip moves) get levels of their own, as
+:func:`simplify_document` gives them: an MSFT_lod chain on each node that draws one, switched by
+its own size and error, and on each copy of it on a motion level's skeleton.
 """
 
 from __future__ import annotations
@@ -60,10 +65,23 @@ from ..motion_lod.clips import join_clips
 from ..motion_lod.frozen import FrozenLevel
 from ..motion_lod.skin_measure import analyze_skinned_motion, hidden_note, without_skin_tips
 from ..motion_lod.skin_transfer import key_bind_pose, transfer_skin
-from .attachments import add_level_attachments, carry_other_channels, find_attachments, posed_by_level_clips
+from .attachments import (
+    add_level_attachments,
+    carry_other_channels,
+    copy_level_chains,
+    find_attachments,
+    posed_by_level_clips,
+)
 from .clip_import import with_clips
-from .drawable_levels import DrawableLevel, DrawableLevels, DrawableSettings, measure_samples, simplify_drawable
-from .lod_document import DEFAULT_RATIOS
+from .drawable_levels import (
+    DrawableLevel,
+    DrawableLevels,
+    DrawableSettings,
+    draws_nothing,
+    measure_samples,
+    simplify_drawable,
+)
+from .lod_document import DEFAULT_RATIOS, DrawableReport, add_drawable_chain, drawable_report, empty_drawables_note
 from .skin_parts import JointKeys, Placement, joined_rig, moved_onto, placement_on
 
 
@@ -83,7 +101,8 @@ class CharacterLevel:
 
 @dataclass
 class CharacterReport:
-    """The result of :func:`build_character`: one chain per skinned drawable."""
+    """The result of :func:`build_character`: one chain per skinned drawable that its clips move,
+    and the levels of the other drawables (``others``: props, static meshes)."""
 
     source: Path
     output: Path
@@ -91,6 +110,7 @@ class CharacterReport:
     motion_seconds: float
     geometry_seconds: float
     notes: list[str] = field(default_factory=list)
+    others: list[DrawableReport] = field(default_factory=list)
 
 
 def build_character(
@@ -106,7 +126,8 @@ def build_character(
     progress: Callable[[str], None] | None = None,
     **keywords: object,
 ) -> CharacterReport:
-    """Build geometry x motion levels of every skinned drawable of ``source`` into one LoD GLB.
+    """Build geometry x motion levels of every skinned drawable of ``source`` into one LoD GLB,
+    and levels of their own of the drawables no clip skins (props, static meshes).
 
     Parameters
     ----------
@@ -209,9 +230,21 @@ def build_character(
         say(f"{drawable.label}: geometry levels of {len(drawable.geometry.faces)} triangles")
         # The chain's diagonal is measured below (_measure_chain); the geometry levels alone are not.
         geometry[drawable.label] = simplify_drawable(drawable, ratios, settings, measure=False)
+    moved = {drawable.label for drawable in animated}
+    others = [d for d in all_drawables if d.label not in moved and d.label not in chained]
+    empty = [d for d in others if draws_nothing(d, settings.measured_frames)]
+    others = [d for d in others if d not in empty]
+    other_levels = []
+    for drawable in others:
+        say(f"{drawable.label}: levels of {len(drawable.geometry.faces)} triangles (no clip skins it)")
+        other_levels.append(simplify_drawable(drawable, ratios, settings))
     geometry_seconds = time.perf_counter() - started
 
     builder = GlbBuilder.from_document(doc)
+    # Before the motion levels: the copies of what hangs from the joints copy these chains.
+    other_reports = [drawable_report(d, levels, ratios, settings) for d, levels in zip(others, other_levels)]
+    for drawable, levels, report in zip(others, other_levels, other_reports):
+        add_drawable_chain(builder, doc, drawable, levels, report)
     # Where several skeletons have motion levels, one input clip has a level clip on each: their
     # names and extras say whose skeleton each poses.
     leveled = [skin for skin, motion in motion_chains.items() if motion.reduced_levels]
@@ -249,17 +282,10 @@ def build_character(
         chain = chains[drawable.label]
         hidden = hidden_level_notes([level.error for level in chain], [level.coverage for level in chain])
         notes += [f"{drawable.label}: {note}" for note in hidden]
-    skipped = [d for d in all_drawables if d.label not in chains and d.label not in chained]
-    unskinned = [d.label for d in skipped if d.skinned is None]
-    if unskinned:  # props hung from joints among them: they follow each motion level, at full detail
-        notes.append(f"not simplified, drawn at full detail at every level (unskinned; `animlod simplify` gives "
-                     f"such meshes levels of their own): {', '.join(unskinned)}")  # fmt: skip
-    still = [d.label for d in skipped if d.skinned is not None]
-    if still:
-        notes.append(f"not simplified, drawn at full detail at every level (skinned, but no clip moves its joints): "
-                     f"{', '.join(still)}")  # fmt: skip
+    if empty:
+        notes.append(empty_drawables_note(empty))
     builder.save(output)
-    return CharacterReport(Path(source), Path(output), chains, motion_seconds, geometry_seconds, notes)
+    return CharacterReport(Path(source), Path(output), chains, motion_seconds, geometry_seconds, notes, other_reports)
 
 
 @dataclass
@@ -446,6 +472,7 @@ def _add_motion_levels(
             duration = doc.animation_duration(clip.index)
             animation = add_animation(builder, clip_motion, joint_nodes, name, extras, duration)
             carry_other_channels(builder, doc, posing, clip.index, animation, copies)
+        copy_level_chains(builder, doc, copies, suffix)
         nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))
     return nodes
 

@@ -10,8 +10,6 @@ import pytest
 from gltf_conformance import problems
 from gltf_poses import node_named
 
-from animlod import synth
-from animlod.io import write_glb
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
 from animlod.pipelines.character import build_character
@@ -22,15 +20,12 @@ PROPS = ("sword", "LeftHand", "rock")  # hung from a joint, drawn by a joint's n
 
 
 @pytest.fixture(scope="module")
-def character_with_props(tmp_path_factory):
+def character_with_props(humanoid_glb, tmp_path_factory):
     """The procedural humanoid walking with a spinning sword (320 triangles) under its right hand,
     a sphere drawn by its left hand's joint node and a rock at the scene's root; the input, its
     LoD GLB and the build's report."""
     folder = tmp_path_factory.mktemp("props")
-    plain = folder / "humanoid.glb"
-    character = synth.humanoid()
-    write_glb(plain, character, [synth.humanoid_motion(character.skeleton, "walk")])
-    builder = GlbBuilder.from_document(GltfDocument(plain))
+    builder = GlbBuilder.from_document(GltfDocument(humanoid_glb))
     nodes = builder.json["nodes"]
     by_name = {node.get("name"): index for index, node in enumerate(nodes)}
     points, faces = icosphere(2, 0.05)

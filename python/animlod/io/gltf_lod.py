@@ -268,17 +268,23 @@ def screen_coverages(
 
 def hidden_level_notes(errors: list[float], coverages: list[float]) -> list[str]:
     """A note for each level 1, 2, ... that a runtime (all but) never shows: its range of screen
-    coverage, from where the level before it ends to where it ends, is under 1% of its end, as
-    where the next level measured about the same error or less (the coverages follow the next
-    level's error and never increase). ``errors`` and ``coverages`` per level, level 0 first
-    (see :func:`screen_coverages`)."""
-    return [
-        f"level {level} is (all but) never shown: level {level + 1} measured about the same error or less "
-        f"({errors[level + 1]:.3g} against {errors[level]:.3g}), so a runtime goes from level {level - 1} to "
-        f"level {level + 1} at screen coverage {coverages[level]:.3g}"
-        for level in range(1, len(coverages) - 1)
-        if coverages[level] >= _HIDDEN_RANGE * coverages[level - 1]
-    ]
+    coverage, from where the level before it ends to where it ends, is under 1% of its end. Either
+    the next level's error is within the pixel error even where the object fills the viewport (both
+    coverages are 1), or the next level measured about the same error or less (the coverages follow
+    the next level's error and never increase). ``errors`` (in the units the notes show) and
+    ``coverages`` per level, level 0 first (see :func:`screen_coverages`)."""
+    notes = []
+    for level in range(1, len(coverages) - 1):
+        if coverages[level] < _HIDDEN_RANGE * coverages[level - 1]:
+            continue
+        if coverages[level] >= 1.0:
+            why = f"level {level + 1}'s error ({errors[level + 1]:.3g}) is within the pixel error even at full screen"
+        else:
+            why = (f"level {level + 1} measured about the same error or less "
+                   f"({errors[level + 1]:.3g} against {errors[level]:.3g})")  # fmt: skip
+        notes.append(f"level {level} is (all but) never shown: {why}, so a runtime goes from level {level - 1} to "
+                     f"level {level + 1} at screen coverage {coverages[level]:.3g}")  # fmt: skip
+    return notes
 
 
 def lod_ids(doc: GltfDocument, base: int) -> list[int] | None:

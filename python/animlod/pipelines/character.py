@@ -280,7 +280,7 @@ def build_character(
     for drawable in animated:
         _attach(builder, drawable, chains[drawable.label], grids[drawable.label])
         chain = chains[drawable.label]
-        hidden = hidden_level_notes([level.error for level in chain], [level.coverage for level in chain])
+        hidden = hidden_level_notes([level.relative_error for level in chain], [level.coverage for level in chain])
         notes += [f"{drawable.label}: {note}" for note in hidden]
     if empty:
         notes.append(empty_drawables_note(empty))

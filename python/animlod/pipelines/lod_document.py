@@ -206,8 +206,8 @@ def drawable_report(
             )
         )
     report.notes.extend(chain_notes(simplified, len(written), max_error))
-    report.notes.extend(hidden_level_notes(errors, coverages))
     report.levels.insert(0, LevelReport(0, report.faces, report.faces, True, 0.0, 0.0, coverages[0]))
+    report.notes.extend(hidden_level_notes([level.relative_error for level in report.levels], coverages))
     return report
 
 

@@ -98,6 +98,10 @@ def test_each_copy_of_a_prop_on_a_motion_level_has_level_nodes_of_its_own(charac
             copy_ids, copy_coverages = _chain(doc, copy)
             assert [nodes[level]["mesh"] for level in copy_ids] == meshes
             assert copy_coverages == coverages
+            motion_level = int(name.rsplit("@motion", 1)[1])  # said by each node of the copy's chain
+            assert [nodes[node]["extras"]["animlod"]["motion_level"] for node in [copy, *copy_ids]] == [
+                motion_level
+            ] * 3
             for level in copy_ids:  # where the copy is: a joint's own mesh's copy has no transform
                 assert nodes[level]["name"].endswith(name[len(prop) :])
                 assert {k: nodes[level].get(k) for k in ("translation", "rotation", "scale", "matrix")} == {

@@ -175,13 +175,16 @@ def add_level_attachments(
     return copies
 
 
-def copy_level_chains(builder: GlbBuilder, doc: GltfDocument, copies: dict[int, int], suffix: str) -> None:
-    """Level nodes of its own for each copy (:func:`add_level_attachments`) of an MSFT_lod chain's
-    base in ``builder``, named with ``suffix``: copies of the base's level nodes where the copy is
-    (its transform), drawing the same meshes, with the base's coverages; the copy's channels in
-    the level clips, added before, drive them. A level node listed by several bases would be one
-    node in several places, and the copies kept the input's ids (and, what a node between or a
-    joint's own node draws, no coverages)."""
+def copy_level_chains(
+    builder: GlbBuilder, doc: GltfDocument, copies: dict[int, int], suffix: str, motion_level: int
+) -> None:
+    """Level nodes of its own for each copy (:func:`add_level_attachments`) on ``motion_level``'s
+    skeleton of an MSFT_lod chain's base in ``builder``, named with ``suffix``: copies of the
+    base's level nodes where the copy is (its transform), drawing the same meshes, with the base's
+    coverages, their ``extras.animlod`` at that motion level; the copy's channels in the level
+    clips, added before, drive them. A level node listed by several bases would be one node in
+    several places, and the copies kept the input's ids (and, what a node between or a joint's
+    own node draws, no coverages)."""
     nodes = builder.json["nodes"]
     for source, copy in copies.items():
         if not has_lod_chain(nodes[source]):
@@ -198,6 +201,10 @@ def copy_level_chains(builder: GlbBuilder, doc: GltfDocument, copies: dict[int, 
         chain_extras = {key: deepcopy(value) for key, value in node_extras(nodes[source]).items()
                         if key in (COVERAGE_EXTRA, ANIMLOD_EXTRA)}  # fmt: skip
         nodes[copy]["extras"] = {**node_extras(nodes[copy]), **chain_extras}
+        for node in (copy, *levels):
+            info = nodes[node].get("extras", {}).get(ANIMLOD_EXTRA)
+            if isinstance(info, dict):  # animlod's chains; another tool's have none
+                info["motion_level"] = motion_level
         drive_level_nodes(builder, copy, levels)
 
 

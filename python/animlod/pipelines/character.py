@@ -472,7 +472,7 @@ def _add_motion_levels(
             duration = doc.animation_duration(clip.index)
             animation = add_animation(builder, clip_motion, joint_nodes, name, extras, duration)
             carry_other_channels(builder, doc, posing, clip.index, animation, copies)
-        copy_level_chains(builder, doc, copies, suffix)
+        copy_level_chains(builder, doc, copies, suffix, m)
         nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))
     return nodes
 

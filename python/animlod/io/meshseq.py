@@ -37,6 +37,7 @@ from .obj import (
 from .ply import read_ply, read_ply_attributes, write_ply
 from .polygon_splits import first_face_off_the_polygons
 from .vertex_colours import VertexColours
+from .vertex_renumbering import first_frame_order
 
 MESH_SUFFIXES = (".obj", ".ply")
 
@@ -140,16 +141,34 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
     frames[0] = first_vertices
     first_texture, differing = texture, None  # the first frame whose texture coordinates are not the first's
+    first_uvs = None if texture is None else texture.uvs  # a PLY's per vertex, where read
     frame_colours = _ColourFrames(paths[0], colours, len(paths))
     retriangulated: list[Path] = []  # frames whose polygons are split otherwise than the first frame's
+    reordered: list[Path] = []  # frames whose vertices are numbered in another order than the first frame's
     with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
         warnings.simplefilter("always")
         for index, path in enumerate(paths[1:], start=1):
             vertices, frame_faces, frame_texture, _, colours, _ = read(path, first=False)
-            # A PLY frame's texture coordinates are per vertex: others than the first's tell of
-            # vertices numbered otherwise, where its faces are refused.
-            renumbered = (path.suffix.lower() == ".ply" and None not in (first_texture, frame_texture)
-                          and not np.array_equal(first_texture.uvs, frame_texture.uvs))  # fmt: skip
+            # A PLY frame's texture coordinates are per vertex: where its triangles are not the
+            # first frame's, others than the first's tell of vertices numbered otherwise, and
+            # which vertex is which (read for this alone where the sequence is read without them).
+            order, renumbered = None, False
+            if path.suffix.lower() == ".ply" and not np.array_equal(frame_faces, faces):
+                if not textured:
+                    first_uvs = _quiet_ply_uvs(paths[0]) if first_uvs is None else first_uvs
+                    frame_uvs = _quiet_ply_uvs(path)
+                else:
+                    frame_uvs = None if frame_texture is None else frame_texture.uvs
+                renumbered = (
+                    first_uvs is not None and frame_uvs is not None and not np.array_equal(first_uvs, frame_uvs)
+                )
+                order = first_frame_order(faces, first_uvs, frame_faces, frame_uvs) if renumbered else None
+            if order is not None:
+                vertices, frame_faces, frame_texture, colours = _in_first_order(
+                    order, vertices, frame_faces, frame_texture, colours
+                )
+                reordered.append(path)
+                renumbered = False
             if _check_same_surface(path, vertices, frame_faces, paths[0], faces, len(first_vertices), renumbered):
                 retriangulated.append(path)
             frames[index] = vertices
@@ -162,6 +181,11 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     for warning in later_warnings:  # any other, as each frame gave it
         if not issubclass(warning.category, UnreadAttributesWarning):
             warnings.warn(warning.message, stacklevel=3)
+    if reordered:
+        warnings.warn(f"{reordered[0]}: {len(reordered)} of the {len(paths)} frames (this the first) number their "
+                      f"vertices in another order than the first frame {paths[0].name}, as Blender's PLY exporter does "
+                      "where it splits a polygon otherwise; each vertex is matched by its texture coordinates at the "
+                      "corners of its polygon", stacklevel=3)  # fmt: skip
     if retriangulated:
         warnings.warn(f"{retriangulated[0]}: {len(retriangulated)} of the {len(paths)} frames (this the first) "
                       f"triangulate some polygons differently from the first frame {paths[0].name}, as exporters "
@@ -504,6 +528,31 @@ def natural_key(path: Path) -> tuple[list[object], str]:
     anything else it separates (``mesh-001`` is frame 1)."""
     parts = _NUMBER.split(path.name)  # text, number, text, ...: the numbers at odd places
     return [int(part) if index % 2 else part.lower() for index, part in enumerate(parts)], str(path)
+
+
+def _in_first_order(
+    order: np.ndarray,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    texture: ObjTexture | None,
+    colours: VertexColours | None,
+) -> tuple[np.ndarray, np.ndarray, ObjTexture | None, VertexColours | None]:
+    """A PLY frame's vertices, faces, texture coordinates and colours (each None where not read)
+    with its vertices in the first frame's order (``order``: :func:`~.vertex_renumbering.first_frame_order`)."""
+    inverse = np.empty_like(order)
+    inverse[order] = np.arange(order.size)
+    faces = order[faces].astype(faces.dtype)
+    texture = None if texture is None else ObjTexture(texture.uvs[inverse], faces)
+    colours = None if colours is None else replace(colours, values=colours.values[:, inverse])
+    return vertices[inverse], faces, texture, colours
+
+
+def _quiet_ply_uvs(path: Path) -> np.ndarray | None:
+    """A PLY file's per-vertex texture coordinates, or None, without warnings about the properties
+    not read: :func:`read_sequence` reads them only to match renumbered frames."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return read_ply_attributes(path)[2]
 
 
 def _check_same_surface(

@@ -1,0 +1,98 @@
+"""PLY frames that number their vertices in another order than the first frame, as Blender's PLY
+exporter does with "Triangulate Faces" where a quad's diagonal changes with the frame's shape
+(io/vertex_renumbering.py): until 2026-12-07 such sequences were refused."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from animlod.io.errors import FormatError
+from animlod.io.meshseq import read_sequence, read_textured_sequence
+from animlod.io.ply import read_ply
+from animlod.io.vertex_renumbering import first_frame_order
+
+SIDE = 5  # points per side of the grid of quads
+
+
+def _grid_frames(frames: int) -> np.ndarray:
+    """(frames, SIDE * SIDE, 3) positions of a grid that bends more in each frame."""
+    x, y = np.meshgrid(np.linspace(0.0, 1.0, SIDE), np.linspace(0.0, 1.0, SIDE), indexing="ij")
+    flat = np.stack([x.ravel(), y.ravel(), np.zeros(x.size)], axis=1)
+    bend = np.stack([np.zeros(x.size), np.zeros(x.size), np.sin(3.0 * x.ravel()) * y.ravel()], axis=1)
+    return np.stack([flat + 0.2 * k * bend for k in range(frames)])
+
+
+def _write_exported_frame(path, positions: np.ndarray, flipped: np.ndarray) -> None:
+    """One frame as the exporter writes it: each quad split along a-c, or b-d where ``flipped``,
+    and the grid's points numbered in the order the triangles first use them, each with its
+    texture coordinates (the point's place on the grid)."""
+    triangles = []
+    for quad, (i, j) in enumerate((i, j) for i in range(SIDE - 1) for j in range(SIDE - 1)):
+        a, b, c, d = i * SIDE + j, (i + 1) * SIDE + j, (i + 1) * SIDE + j + 1, i * SIDE + j + 1
+        triangles += [(a, b, d), (b, c, d)] if flipped[quad] else [(a, b, c), (a, c, d)]
+    corners = np.array(triangles).ravel()
+    points = corners[np.sort(np.unique(corners, return_index=True)[1])]  # in the order of first use
+    number = np.empty(SIDE * SIDE, np.int64)
+    number[points] = np.arange(points.size)
+    uvs = np.stack(np.divmod(points, SIDE), axis=1) / (SIDE - 1)
+    lines = ["ply", "format ascii 1.0", f"element vertex {points.size}", "property float x", "property float y",
+             "property float z", "property float s", "property float t", f"element face {len(triangles)}",
+             "property list uchar uint vertex_indices", "end_header"]  # fmt: skip
+    lines += [" ".join(f"{value:.7g}" for value in (*positions[p], *uv)) for p, uv in zip(points, uvs)]
+    lines += [f"3 {' '.join(str(n) for n in number[list(triangle)])}" for triangle in triangles]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def _sequence(folder, frames: int = 3):
+    """A folder of exported frames, later frames with other diagonals (so other numbers) in some
+    quads; and the grid's positions in each frame."""
+    positions = _grid_frames(frames)
+    quads = (SIDE - 1) ** 2
+    for k in range(frames):
+        _write_exported_frame(folder / f"frame_{k:03d}.ply", positions[k], np.arange(quads) % (k + 2) == 1)
+    return folder, positions
+
+
+def test_frames_numbered_otherwise_are_read_in_the_first_frames_order(tmp_path):
+    folder, positions = _sequence(tmp_path)
+    with pytest.warns(UserWarning, match="number their vertices in another order than the first frame"):
+        mesh, texture, *_ = read_textured_sequence(folder)
+    # Each vertex's texture coordinates name its grid point: it stands where that point does in every frame.
+    point = np.rint(texture.uvs[:, 0] * (SIDE - 1)).astype(int) * SIDE + np.rint(texture.uvs[:, 1] * (SIDE - 1)).astype(
+        int
+    )
+    np.testing.assert_allclose(mesh.frames, positions[:, point], atol=1e-6)
+    assert mesh.face_count == 2 * (SIDE - 1) ** 2
+
+
+def test_frames_whose_texture_coordinates_do_not_match_are_still_refused(tmp_path):
+    folder, _ = _sequence(tmp_path, frames=2)
+    later = folder / "frame_001.ply"
+    text = later.read_text().split("\n")
+    start = text.index("end_header") + 1
+    for line in range(start, start + SIDE * SIDE):  # every s shifted: no vertex of the first frame's
+        x, y, z, s, t = text[line].split()
+        text[line] = f"{x} {y} {z} {float(s) + 0.01:.7g} {t}"
+    later.write_text("\n".join(text))
+    with pytest.raises(FormatError, match="numbers each frame's vertices in another order"):
+        read_textured_sequence(folder)
+
+
+def test_an_ambiguous_match_gives_no_order():
+    # Vertices 0 and 1 share texture coordinates: the same corner names vertex 1 as the first
+    # frame's 0, but nothing tells which first-frame vertex vertex 0 is, and none is guessed.
+    uvs = np.array([[0.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
+    assert first_frame_order(np.array([[0, 1, 2]]), uvs, np.array([[1, 2, 0]]), uvs) is None
+    assert first_frame_order(np.array([[0, 1, 2]]), uvs, np.array([[1, 0, 2]]), uvs).tolist() == [1, 0, 2]
+
+
+def test_a_sequence_read_without_texture_coordinates_matches_them_too(tmp_path):
+    # read_sequence (tdag build, face) reads positions alone; the texture coordinates still tell
+    # which vertex is which, and the vertices keep the files' first-frame numbering.
+    folder, positions = _sequence(tmp_path)
+    with pytest.warns(UserWarning, match="number their vertices in another order than the first frame"):
+        mesh = read_sequence(folder)
+    first, _ = read_ply(folder / "frame_000.ply")
+    point = [int(np.argmin(np.linalg.norm(positions[0] - vertex, axis=1))) for vertex in first]
+    np.testing.assert_allclose(mesh.frames, positions[:, point], atol=1e-6)

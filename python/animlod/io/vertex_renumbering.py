@@ -12,6 +12,8 @@ a face a few places away in the same polygon, with the same texture coordinates.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
 # Faces before and after a corner's face where its polygon's other triangles may be: a hexagon's
@@ -45,7 +47,12 @@ def first_frame_order(
 
 
 def _matching_pairs(
-    first_faces: np.ndarray, first_uvs: np.ndarray, faces: np.ndarray, uvs: np.ndarray, shifts, every_corner: bool
+    first_faces: np.ndarray,
+    first_uvs: np.ndarray,
+    faces: np.ndarray,
+    uvs: np.ndarray,
+    shifts: Iterable[int],
+    every_corner: bool,
 ) -> np.ndarray:
     """The distinct (vertex, first-frame vertex) pairs with equal texture coordinates where a corner
     of face f meets a corner of the first frame's face f + shift: the same corner, or with

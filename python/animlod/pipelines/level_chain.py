@@ -2,10 +2,10 @@
 
 A level short of its target (a max error, or no legal collapse left) holds the mesh where the
 collapses stopped, and so do the levels after it; a level whose target the level before meets
-already (a mesh of a few triangles) is the same mesh too. Written, they were copies of one mesh: a glTF
-chain with screen coverages of their own, a sequence with folders that differ only in name. Both
-pipelines write the levels up to the last one coarser than the one before it and say what they
-left out.
+already (a mesh of a few triangles) is the same mesh too. Written, they were copies of one mesh:
+a glTF chain with screen coverages of their own, a sequence with folders that differ only in
+name. Both pipelines write the levels up to the last one coarser than the one before it and say
+what they left out.
 """
 
 from __future__ import annotations

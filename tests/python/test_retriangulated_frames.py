@@ -181,3 +181,49 @@ def test_frames_whose_faces_differ_otherwise_are_refused(
     assert "not a re-triangulation of the first frame's polygons" in str(caught.value)
     assert main(["simplify", str(folder), "-o", str(tmp_path / "out"), "--no-metrics"]) == 2
     assert f"animlod simplify: error: {expected}" in capsys.readouterr().err
+
+
+def _closed_quad_box(cells: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """A closed box of (6 * cells**2) quads on shared corners: positions and (Q, 4) quads, each
+    counter-clockwise seen from outside."""
+    steps = np.linspace(-1.0, 1.0, cells + 1)
+    index: dict[tuple, int] = {}
+    quads = []
+    for axis in range(3):
+        for side in (-1.0, 1.0):
+            for i in range(cells):
+                for j in range(cells):
+                    quad = []
+                    for di, dj in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                        point = [0.0, 0.0, 0.0]
+                        point[axis], point[(axis + 1) % 3], point[(axis + 2) % 3] = side, steps[i + di], steps[j + dj]
+                        quad.append(index.setdefault(tuple(point), len(index)))
+                    quads.append(quad if side > 0 else quad[::-1])
+    return np.array(list(index), dtype=np.float32), np.array(quads)
+
+
+def test_a_closed_mesh_with_every_diagonal_turned_is_the_same_surface(tmp_path: Path) -> None:
+    # Every quad of a closed box split along its other diagonal: the changed triangles are the whole
+    # surface and have no boundary, as in the case below, but each quad's corners are on its own.
+    positions, quads = _closed_quad_box()
+    write_ply(tmp_path / "box_1.ply", positions, quads[:, [[0, 1, 2], [0, 2, 3]]].reshape(-1, 3))
+    write_ply(tmp_path / "box_2.ply", positions * 1.5, quads[:, [[0, 1, 3], [1, 2, 3]]].reshape(-1, 3))
+    with pytest.warns(UserWarning, match="triangulate some polygons differently"):
+        mesh = read_sequence(tmp_path)
+    np.testing.assert_array_equal(mesh.frames[1], positions * 1.5)
+
+
+def test_a_closed_mesh_whose_vertices_are_numbered_otherwise_is_refused(tmp_path: Path) -> None:
+    # Each frame's vertices listed in another order with its faces renumbered to match: on a closed
+    # mesh the changed triangles (all of them) had no boundary and used every vertex, which the test
+    # took for a re-triangulation, and 217 of 218 vertices were read at another vertex's place (a
+    # hunt over Blender's PLY exports found it on front-projected texture coordinates).
+    positions, quads = _closed_quad_box()
+    triangles = quads[:, [[0, 1, 2], [0, 2, 3]]].reshape(-1, 3)
+    number = np.random.default_rng(0).permutation(len(positions))  # each vertex's number in frame 2
+    moved = np.empty_like(positions)
+    moved[number] = positions + [1.0, 0.0, 0.0]
+    write_ply(tmp_path / "box_1.ply", positions, triangles)
+    write_ply(tmp_path / "box_2.ply", moved, number[triangles])
+    with pytest.raises(FormatError, match="are not a re-triangulation of the first frame's polygons"):
+        read_sequence(tmp_path)

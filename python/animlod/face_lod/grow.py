@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..components import component_labels
 from ..model import check_finite, checked_faces
 from .regions import FaceRegions, RegionGroup
 
@@ -130,17 +131,7 @@ def _connected_pieces(labels: np.ndarray, faces: np.ndarray) -> np.ndarray:
     (label propagation with pointer jumping); -1 stays -1."""
     edges = _edges(faces)
     same = edges[(labels[edges[:, 0]] == labels[edges[:, 1]]) & (labels[edges[:, 0]] >= 0)]
-    piece = np.arange(len(labels))
-    while True:
-        smaller = np.minimum(piece[same[:, 0]], piece[same[:, 1]])
-        updated = piece.copy()
-        np.minimum.at(updated, same[:, 0], smaller)
-        np.minimum.at(updated, same[:, 1], smaller)
-        updated = updated[updated]
-        if np.array_equal(updated, piece):
-            break
-        piece = updated
-    return np.where(labels >= 0, piece, -1)
+    return np.where(labels >= 0, component_labels(len(labels), same), -1)
 
 
 def _merge_small(labels: np.ndarray, faces: np.ndarray, min_vertices: int) -> np.ndarray:

@@ -4,12 +4,17 @@ Exporters that triangulate each frame of a deforming mesh (Blender's OBJ and PLY
 "Triangulate Faces") pick each quad's and n-gon's diagonals from that frame's shape, and may start
 a triangle at another corner: the frames are one surface with triangles that differ. The test is
 on the triangles of each set not in the other (as multisets): where both use the same vertices
-and have the same directed boundary edges, they tile the same polygons.
+and have the same directed boundary edges, and each set's polygons (its triangles joined across
+the diagonals the other set lacks) have every corner on their boundary, as a polygon's triangles
+do, they tile the same polygons. Without that last test a closed mesh whose vertices are numbered
+otherwise passed: both sets are then the whole surface, without a boundary.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from ..components import component_labels
 
 
 def first_face_off_the_polygons(faces: np.ndarray, first_faces: np.ndarray, vertex_count: int) -> int | None:
@@ -19,14 +24,17 @@ def first_face_off_the_polygons(faces: np.ndarray, first_faces: np.ndarray, vert
     the first of ``faces`` (in their order) that breaks this.
 
     The triangles of each not among the other's (as multisets) must use the same vertices and have
-    the same directed boundary edges (those whose reverse is not in the same set): then both tile
-    the same polygons."""
+    the same directed boundary edges (those whose reverse is not in the same set), and none may have
+    a corner inside its polygon (:func:`_inside_their_polygons`): then both tile the same polygons."""
     frame_triangles, first_triangles = _canonical_triangles(faces), _canonical_triangles(first_faces)
     frame_only, first_only = ~_among(frame_triangles, first_triangles), ~_among(first_triangles, frame_triangles)
     added, removed = faces[frame_only], first_faces[first_only]
     added_boundary = _boundary_edges(added, vertex_count)
     removed_boundary = _boundary_edges(removed, vertex_count)
-    if np.array_equal(added_boundary, removed_boundary) and np.array_equal(np.unique(added), np.unique(removed)):
+    added_inside = _inside_their_polygons(added, removed, vertex_count)
+    whole_polygons = not added_inside.any() and not _inside_their_polygons(removed, added, vertex_count).any()
+    same_vertices = np.array_equal(np.unique(added), np.unique(removed))
+    if np.array_equal(added_boundary, removed_boundary) and same_vertices and whole_polygons:
         return None
     # The first added triangle with an outer edge that no replaced triangle has (a polygon split
     # otherwise has only edges of the triangles it replaces), else one off their boundary.
@@ -35,7 +43,35 @@ def first_face_off_the_polygons(faces: np.ndarray, first_faces: np.ndarray, vert
         stray = np.isin(added_edges, np.setdiff1d(added_boundary, known)).reshape(3, -1).any(axis=0)
         if stray.any():
             return int(added_faces[np.argmax(stray)])
+    if added_inside.any():
+        return int(added_faces[np.argmax(added_inside)])
     return int(added_faces[0])
+
+
+def _inside_their_polygons(triangles: np.ndarray, others: np.ndarray, vertex_count: int) -> np.ndarray:
+    """(T,) bool: which of ``triangles (T, 3)`` have a corner inside the polygon they tile, none on
+    its boundary. Their polygons are the triangles joined across their diagonals, the edges that no
+    triangle of ``others`` has; a polygon's triangles have every corner on its boundary."""
+    count = len(triangles)
+    directed = _directed_edges(triangles, vertex_count)  # triangle t's edge e at e * count + t
+    owner = np.tile(np.arange(count), 3)
+    starts, ends = np.divmod(directed, vertex_count)
+    undirected = np.minimum(starts, ends) * vertex_count + np.maximum(starts, ends)
+    other_starts, other_ends = np.divmod(_directed_edges(others, vertex_count), vertex_count)
+    other_undirected = np.minimum(other_starts, other_ends) * vertex_count + np.maximum(other_starts, other_ends)
+    diagonal = ~np.isin(undirected, other_undirected)
+    order = np.argsort(undirected[diagonal], kind="stable")
+    keys, holders = undirected[diagonal][order], owner[diagonal][order]
+    shared = keys[1:] == keys[:-1]
+    polygon = component_labels(count, np.stack([holders[:-1][shared], holders[1:][shared]], axis=1))
+    # An edge is on its polygon's boundary where no triangle of the same polygon has its reverse.
+    by_edge = np.argsort(directed, kind="stable")
+    found = np.clip(np.searchsorted(directed[by_edge], ends * vertex_count + starts), 0, max(directed.size - 1, 0))
+    inner = (directed[by_edge][found] == ends * vertex_count + starts) & (
+        polygon[owner[by_edge][found]] == polygon[owner]
+    )
+    on_boundary = np.unique(polygon[owner[~inner]] * vertex_count + starts[~inner])
+    return (~np.isin(polygon[owner] * vertex_count + starts, on_boundary)).reshape(3, -1).any(axis=0)
 
 
 def _canonical_triangles(faces: np.ndarray) -> np.ndarray:

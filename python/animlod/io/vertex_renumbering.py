@@ -16,9 +16,10 @@ from collections.abc import Iterable
 
 import numpy as np
 
-# Faces before and after a corner's face where its polygon's other triangles may be: a hexagon's
-# four triangles, split otherwise, are within two places of each other.
-_WINDOW = 2
+# How far, in faces before and after a corner's, its polygon's other triangles are looked for,
+# each step for the vertices the one before left: a quad's two triangles are next to each other,
+# a 32-gon cap's 30 within 29 places.
+_WINDOWS = (2, 8, 32, 128)
 
 
 def first_frame_order(
@@ -29,21 +30,33 @@ def first_frame_order(
     corners do not tell one first-frame vertex for every vertex, each taken once.
 
     A vertex is the first frame's vertex with its texture coordinates at the same corner of the
-    same face; where that corner's vertex differs (a polygon split otherwise), the one with its
-    texture coordinates among the corners of the faces within ``_WINDOW`` places."""
+    same face; where that corner's vertex differs (a polygon split otherwise), the one vertex not
+    yet matched with its texture coordinates among the corners of the faces within a few places
+    (``_WINDOWS``, widening for the vertices a narrower window leaves)."""
     if faces.shape != first_faces.shape or uvs.shape != first_uvs.shape:
         return None
-    same_corner = _matching_pairs(first_faces, first_uvs, faces, uvs, shifts=[0], every_corner=False)
-    nearby = _matching_pairs(first_faces, first_uvs, faces, uvs, range(-_WINDOW, _WINDOW + 1), every_corner=True)
     vertex_count = len(uvs)
     order = np.full(vertex_count, -1, dtype=np.int64)
-    for pairs in (nearby, same_corner):  # a vertex the same corner names overrides its nearby guesses
-        candidates = np.bincount(pairs[:, 0], minlength=vertex_count)
-        single = pairs[candidates[pairs[:, 0]] == 1]
-        order[single[:, 0]] = single[:, 1]
+    taken = np.zeros(vertex_count, dtype=bool)
+    _assign(order, taken, _matching_pairs(first_faces, first_uvs, faces, uvs, [0], every_corner=False))
+    for window in _WINDOWS:
+        if (order >= 0).all():
+            break
+        pairs = _matching_pairs(first_faces, first_uvs, faces, uvs, range(-window, window + 1), every_corner=True)
+        _assign(order, taken, pairs[(order[pairs[:, 0]] < 0) & ~taken[pairs[:, 1]]])
     if (order < 0).any() or np.unique(order).size != vertex_count:
         return None
     return order
+
+
+def _assign(order: np.ndarray, taken: np.ndarray, pairs: np.ndarray) -> None:
+    """Match each vertex of ``pairs (P, 2)`` (vertex, first-frame vertex) that has one candidate
+    there, not yet matched, to it: ``order`` and ``taken`` (the first frame's matched vertices)."""
+    pairs = pairs[order[pairs[:, 0]] < 0]
+    candidates = np.bincount(pairs[:, 0], minlength=len(order))
+    single = pairs[candidates[pairs[:, 0]] == 1]
+    order[single[:, 0]] = single[:, 1]
+    taken[single[:, 1]] = True
 
 
 def _matching_pairs(

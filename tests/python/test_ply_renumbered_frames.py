@@ -15,27 +15,37 @@ from animlod.io.vertex_renumbering import first_frame_order
 SIDE = 5  # points per side of the grid of quads
 
 
-def _grid_frames(frames: int) -> np.ndarray:
-    """(frames, SIDE * SIDE, 3) positions of a grid that bends more in each frame."""
+def _grid_frames(frames: int, parts: int = 1) -> np.ndarray:
+    """(frames, parts * SIDE * SIDE, 3) positions of ``parts`` grids side by side (loose parts),
+    that bend more in each frame."""
     x, y = np.meshgrid(np.linspace(0.0, 1.0, SIDE), np.linspace(0.0, 1.0, SIDE), indexing="ij")
     flat = np.stack([x.ravel(), y.ravel(), np.zeros(x.size)], axis=1)
     bend = np.stack([np.zeros(x.size), np.zeros(x.size), np.sin(3.0 * x.ravel()) * y.ravel()], axis=1)
-    return np.stack([flat + 0.2 * k * bend for k in range(frames)])
+    grids = np.concatenate([flat + [2.0 * part, 0.0, 0.0] for part in range(parts)])
+    return np.stack([grids + 0.2 * k * np.tile(bend, (parts, 1)) for k in range(frames)])
 
 
-def _write_exported_frame(path, positions: np.ndarray, flipped: np.ndarray) -> None:
-    """One frame as the exporter writes it: each quad split along a-c, or b-d where ``flipped``,
-    and the grid's points numbered in the order the triangles first use them, each with its
-    texture coordinates (the point's place on the grid)."""
+def _write_exported_frame(path, positions: np.ndarray, flipped: np.ndarray, mirrored: bool = False) -> None:
+    """One frame as the exporter writes it: each quad of each grid (``positions`` hold SIDE * SIDE
+    points a grid) split along a-c, or b-d where ``flipped`` (started at d), and the points numbered in the order
+    the triangles first use them, each with its texture coordinates (its place on its grid: loose
+    parts alike have the same; ``mirrored``: the grid's two halves have the same, mirrored)."""
     triangles = []
-    for quad, (i, j) in enumerate((i, j) for i in range(SIDE - 1) for j in range(SIDE - 1)):
-        a, b, c, d = i * SIDE + j, (i + 1) * SIDE + j, (i + 1) * SIDE + j + 1, i * SIDE + j + 1
-        triangles += [(a, b, d), (b, c, d)] if flipped[quad] else [(a, b, c), (a, c, d)]
+    cells = [
+        (part, i, j) for part in range(len(positions) // SIDE**2) for i in range(SIDE - 1) for j in range(SIDE - 1)
+    ]
+    for quad, (part, i, j) in enumerate(cells):
+        a, b, c, d = part * SIDE**2 + np.array(
+            [i * SIDE + j, (i + 1) * SIDE + j, (i + 1) * SIDE + j + 1, i * SIDE + j + 1]
+        )
+        triangles += [(d, a, b), (b, c, d)] if flipped[quad] else [(a, b, c), (a, c, d)]
     corners = np.array(triangles).ravel()
     points = corners[np.sort(np.unique(corners, return_index=True)[1])]  # in the order of first use
-    number = np.empty(SIDE * SIDE, np.int64)
+    number = np.empty(len(positions), np.int64)
     number[points] = np.arange(points.size)
-    uvs = np.stack(np.divmod(points, SIDE), axis=1) / (SIDE - 1)
+    uvs = np.stack(np.divmod(points % SIDE**2, SIDE), axis=1) / (SIDE - 1)
+    if mirrored:
+        uvs[:, 0] = np.abs(uvs[:, 0] - 0.5)
     lines = ["ply", "format ascii 1.0", f"element vertex {points.size}", "property float x", "property float y",
              "property float z", "property float s", "property float t", f"element face {len(triangles)}",
              "property list uchar uint vertex_indices", "end_header"]  # fmt: skip
@@ -44,13 +54,14 @@ def _write_exported_frame(path, positions: np.ndarray, flipped: np.ndarray) -> N
     path.write_text("\n".join(lines) + "\n")
 
 
-def _sequence(folder, frames: int = 3):
-    """A folder of exported frames, later frames with other diagonals (so other numbers) in some
-    quads; and the grid's positions in each frame."""
-    positions = _grid_frames(frames)
-    quads = (SIDE - 1) ** 2
+def _sequence(folder, frames: int = 3, parts: int = 1, mirrored: bool = False):
+    """A folder of exported frames of ``parts`` grids, later frames with other diagonals (so other
+    numbers) in some quads; and the grids' positions in each frame."""
+    positions = _grid_frames(frames, parts)
+    quads = parts * (SIDE - 1) ** 2
     for k in range(frames):
-        _write_exported_frame(folder / f"frame_{k:03d}.ply", positions[k], np.arange(quads) % (k + 2) == 1)
+        flipped = np.arange(quads) % (k + 2) == 1
+        _write_exported_frame(folder / f"frame_{k:03d}.ply", positions[k], flipped, mirrored)
     return folder, positions
 
 
@@ -99,12 +110,26 @@ def test_an_n_gon_fanned_from_another_corner_is_matched():
     np.testing.assert_array_equal(first_corner[order], corner)  # each vertex matched to its own corner
 
 
-def test_a_sequence_read_without_texture_coordinates_matches_them_too(tmp_path):
+@pytest.mark.parametrize("parts, mirrored", [(1, False), (3, False), (3, True)])
+def test_a_sequence_read_without_texture_coordinates_matches_them_too(tmp_path, parts, mirrored):
     # read_sequence (tdag build, face) reads positions alone; the texture coordinates still tell
-    # which vertex is which, and the vertices keep the files' first-frame numbering.
-    folder, positions = _sequence(tmp_path)
+    # which vertex is which, and the vertices keep the files' first-frame numbering; also where
+    # loose grids alike, or mirrored halves, repeat texture coordinates nearby.
+    folder, positions = _sequence(tmp_path, parts=parts, mirrored=mirrored)
     with pytest.warns(UserWarning, match="number their vertices in another order than the first frame"):
         mesh = read_sequence(folder)
     first, _ = read_ply(folder / "frame_000.ply")
     point = [int(np.argmin(np.linalg.norm(positions[0] - vertex, axis=1))) for vertex in first]
     np.testing.assert_allclose(mesh.frames, positions[:, point], atol=1e-6)
+
+
+def test_repeated_texture_coordinates_are_told_apart_by_the_neighbours_matches():
+    # Two loose quads alike (the same texture coordinates A, B, C, D), both split along b-d from d
+    # in the later frame: a and b of each meet no corner of their own, and each has two candidates
+    # nearby, one per quad; the one beside its neighbour d's match is it.
+    a, b, c, d = (np.array([0.0, 0.0]), np.array([1.0, 0.0]), np.array([1.0, 1.0]), np.array([0.0, 1.0]))
+    first_faces = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    first_uvs = np.array([a, b, c, d, a, b, c, d])
+    faces = np.array([[0, 1, 2], [2, 3, 0], [4, 5, 6], [6, 7, 4]])  # d, a, b, c numbered by first use
+    uvs = np.array([d, a, b, c, d, a, b, c])
+    assert first_frame_order(first_faces, first_uvs, faces, uvs).tolist() == [3, 0, 1, 2, 7, 4, 5, 6]

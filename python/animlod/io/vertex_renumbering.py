@@ -32,21 +32,61 @@ def first_frame_order(
     A vertex is the first frame's vertex with its texture coordinates at the same corner of the
     same face; where that corner's vertex differs (a polygon split otherwise), the one vertex not
     yet matched with its texture coordinates among the corners of the faces within a few places
-    (``_WINDOWS``, widening for the vertices a narrower window leaves)."""
+    (``_WINDOWS``, widening for the vertices a narrower window leaves), or where several are (UVs
+    repeated: mirrored, "Reset", loose parts alike), the one of them beside the first-frame match
+    of one of its neighbours."""
     if faces.shape != first_faces.shape or uvs.shape != first_uvs.shape:
         return None
     vertex_count = len(uvs)
     order = np.full(vertex_count, -1, dtype=np.int64)
     taken = np.zeros(vertex_count, dtype=bool)
     _assign(order, taken, _matching_pairs(first_faces, first_uvs, faces, uvs, [0], every_corner=False))
+    first_edges = np.unique(_edge_keys(first_faces, vertex_count))
+    neighbours = _Neighbours(faces, vertex_count)
     for window in _WINDOWS:
-        if (order >= 0).all():
-            break
         pairs = _matching_pairs(first_faces, first_uvs, faces, uvs, range(-window, window + 1), every_corner=True)
-        _assign(order, taken, pairs[(order[pairs[:, 0]] < 0) & ~taken[pairs[:, 1]]])
+        matched = -1
+        while matched < (order >= 0).sum() < vertex_count:  # each match may place a neighbour's
+            matched = (order >= 0).sum()
+            pairs = pairs[(order[pairs[:, 0]] < 0) & ~taken[pairs[:, 1]]]
+            _assign(order, taken, pairs)
+            pairs = pairs[(order[pairs[:, 0]] < 0) & ~taken[pairs[:, 1]]]
+            _assign(order, taken, pairs[neighbours.beside_matches(pairs, order, first_edges)])
     if (order < 0).any() or np.unique(order).size != vertex_count:
         return None
     return order
+
+
+class _Neighbours:
+    """The vertices that share an edge with each vertex of a frame's triangles."""
+
+    def __init__(self, faces: np.ndarray, vertex_count: int) -> None:
+        starts = faces.ravel()
+        ends = np.roll(faces, -1, axis=1).ravel()
+        source, target = np.concatenate([starts, ends]), np.concatenate([ends, starts])
+        by_source = np.argsort(source, kind="stable")
+        self.targets = target[by_source]
+        self.offsets = np.searchsorted(source[by_source], np.arange(vertex_count + 1))
+        self.vertex_count = vertex_count
+
+    def beside_matches(self, pairs: np.ndarray, order: np.ndarray, first_edges: np.ndarray) -> np.ndarray:
+        """(P,) bool: which (vertex, first-frame vertex) ``pairs`` put the vertex beside the first-frame
+        match (``order``) of one of its neighbours, along an edge of ``first_edges`` (keys)."""
+        starts = self.offsets[pairs[:, 0]]
+        counts = self.offsets[pairs[:, 0] + 1] - starts
+        pair = np.repeat(np.arange(len(pairs)), counts)
+        neighbour = self.targets[np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts) + starts[pair]]
+        placed = order[neighbour]
+        keys = np.minimum(placed, pairs[pair, 1]) * self.vertex_count + np.maximum(placed, pairs[pair, 1])
+        beside = np.zeros(len(pairs), dtype=bool)
+        beside[pair[(placed >= 0) & np.isin(keys, first_edges)]] = True
+        return beside
+
+
+def _edge_keys(faces: np.ndarray, vertex_count: int) -> np.ndarray:
+    """The undirected edges of ``faces (M, 3)`` as keys ``min * vertex_count + max``."""
+    starts, ends = faces.ravel().astype(np.int64), np.roll(faces, -1, axis=1).ravel().astype(np.int64)
+    return np.minimum(starts, ends) * vertex_count + np.maximum(starts, ends)
 
 
 def _assign(order: np.ndarray, taken: np.ndarray, pairs: np.ndarray) -> None:

@@ -40,11 +40,14 @@ def first_frame_order(
     vertex_count = len(uvs)
     order = np.full(vertex_count, -1, dtype=np.int64)
     taken = np.zeros(vertex_count, dtype=bool)
-    _assign(order, taken, _matching_pairs(first_faces, first_uvs, faces, uvs, [0], every_corner=False))
-    first_edges = np.unique(_edge_keys(first_faces, vertex_count))
+    every_face = np.arange(len(faces))
+    _assign(order, taken, _matching_pairs(first_faces, first_uvs, faces, uvs, every_face, [0], every_corner=False))
+    first_edges = _distinct(_edge_keys(first_faces, vertex_count))
     neighbours = _Neighbours(faces, vertex_count)
     for window in _WINDOWS:
-        pairs = _matching_pairs(first_faces, first_uvs, faces, uvs, range(-window, window + 1), every_corner=True)
+        open_faces = np.flatnonzero((order[faces] < 0).any(axis=1))  # those with a vertex to match
+        shifts = range(-window, window + 1)
+        pairs = _matching_pairs(first_faces, first_uvs, faces, uvs, open_faces, shifts, every_corner=True)
         matched = -1
         while matched < (order >= 0).sum() < vertex_count:  # each match may place a neighbour's
             matched = (order >= 0).sum()
@@ -52,7 +55,7 @@ def first_frame_order(
             _assign(order, taken, pairs)
             pairs = pairs[(order[pairs[:, 0]] < 0) & ~taken[pairs[:, 1]]]
             _assign(order, taken, pairs[neighbours.beside_matches(pairs, order, first_edges)])
-    if (order < 0).any() or np.unique(order).size != vertex_count:
+    if (order < 0).any() or np.bincount(order, minlength=vertex_count).max(initial=0) > 1:
         return None
     return order
 
@@ -104,21 +107,30 @@ def _matching_pairs(
     first_uvs: np.ndarray,
     faces: np.ndarray,
     uvs: np.ndarray,
+    looked_at: np.ndarray,
     shifts: Iterable[int],
     every_corner: bool,
 ) -> np.ndarray:
     """The distinct (vertex, first-frame vertex) pairs with equal texture coordinates where a corner
-    of face f meets a corner of the first frame's face f + shift: the same corner, or with
-    ``every_corner`` any of its three."""
-    found = []
-    face_count = len(faces)
+    of face f (of the faces ``looked_at``) meets a corner of the first frame's face f + shift: the
+    same corner, or with ``every_corner`` any of its three."""
+    found = [np.zeros(0, dtype=np.int64)]  # pairs as keys vertex * V + first-frame vertex
+    face_count, vertex_count = len(faces), len(uvs)
     for shift in shifts:
-        own = np.arange(max(0, -shift), min(face_count, face_count - shift))
+        own = looked_at[(looked_at + shift >= 0) & (looked_at + shift < face_count)]
         if every_corner:
-            vertices = np.repeat(faces[own], 3, axis=1).ravel()
+            vertices = np.repeat(faces[own], 3, axis=1).ravel().astype(np.int64)
             first = np.tile(first_faces[own + shift], (1, 3)).ravel()
         else:
-            vertices, first = faces[own].ravel(), first_faces[own + shift].ravel()
+            vertices, first = faces[own].ravel().astype(np.int64), first_faces[own + shift].ravel()
         same = (uvs[vertices] == first_uvs[first]).all(axis=1)
-        found.append(np.stack([vertices[same], first[same]], axis=1))
-    return np.unique(np.concatenate(found), axis=0)
+        found.append(vertices[same] * vertex_count + first[same])
+    return np.stack(np.divmod(_distinct(np.concatenate(found)), vertex_count), axis=1)
+
+
+def _distinct(keys: np.ndarray) -> np.ndarray:
+    """``keys`` sorted, each once (a sort: numpy's hashed unique took most of the matching's time)."""
+    keys = np.sort(keys)
+    first = np.ones(keys.size, dtype=bool)
+    first[1:] = keys[1:] != keys[:-1]
+    return keys[first]

@@ -16,6 +16,8 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from ..sorted_keys import among, distinct
+
 # How far, in faces before and after a corner's, its polygon's other triangles are looked for,
 # each step for the vertices the one before left: a quad's two triangles are next to each other,
 # a 32-gon cap's 30 within 29 places.
@@ -42,7 +44,7 @@ def first_frame_order(
     taken = np.zeros(vertex_count, dtype=bool)
     every_face = np.arange(len(faces))
     _assign(order, taken, _matching_pairs(first_faces, first_uvs, faces, uvs, every_face, [0], every_corner=False))
-    first_edges = _distinct(_edge_keys(first_faces, vertex_count))
+    first_edges = distinct(_edge_keys(first_faces, vertex_count))
     neighbours = _Neighbours(faces, vertex_count)
     for window in _WINDOWS:
         open_faces = np.flatnonzero((order[faces] < 0).any(axis=1))  # those with a vertex to match
@@ -82,7 +84,7 @@ class _Neighbours:
         placed = order[neighbour]
         keys = np.minimum(placed, pairs[pair, 1]) * self.vertex_count + np.maximum(placed, pairs[pair, 1])
         beside = np.zeros(len(pairs), dtype=bool)
-        beside[pair[(placed >= 0) & np.isin(keys, first_edges)]] = True
+        beside[pair[(placed >= 0) & among(keys, first_edges)]] = True
         return beside
 
 
@@ -125,12 +127,4 @@ def _matching_pairs(
             vertices, first = faces[own].ravel().astype(np.int64), first_faces[own + shift].ravel()
         same = (uvs[vertices] == first_uvs[first]).all(axis=1)
         found.append(vertices[same] * vertex_count + first[same])
-    return np.stack(np.divmod(_distinct(np.concatenate(found)), vertex_count), axis=1)
-
-
-def _distinct(keys: np.ndarray) -> np.ndarray:
-    """``keys`` sorted, each once (a sort: numpy's hashed unique took most of the matching's time)."""
-    keys = np.sort(keys)
-    first = np.ones(keys.size, dtype=bool)
-    first[1:] = keys[1:] != keys[:-1]
-    return keys[first]
+    return np.stack(np.divmod(distinct(np.concatenate(found)), vertex_count), axis=1)

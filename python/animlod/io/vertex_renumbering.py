@@ -35,8 +35,8 @@ def first_frame_order(
     same face; where that corner's vertex differs (a polygon split otherwise), the one vertex not
     yet matched with its texture coordinates among the corners of the faces within a few places
     (``_WINDOWS``, widening for the vertices a narrower window leaves), or where several are (UVs
-    repeated: mirrored, "Reset", loose parts alike), the one of them beside the first-frame match
-    of one of its neighbours."""
+    repeated: mirrored, loose parts alike), the one of them beside the first-frame match of one of
+    its neighbours."""
     if faces.shape != first_faces.shape or uvs.shape != first_uvs.shape:
         return None
     vertex_count = len(uvs)

@@ -56,21 +56,18 @@ def _inside_their_polygons(triangles: np.ndarray, others: np.ndarray, vertex_cou
     count = len(triangles)
     directed = _directed_edges(triangles, vertex_count)  # triangle t's edge e at e * count + t
     owner = np.tile(np.arange(count), 3)
-    starts, ends = np.divmod(directed, vertex_count)
-    undirected = np.minimum(starts, ends) * vertex_count + np.maximum(starts, ends)
-    other_starts, other_ends = np.divmod(_directed_edges(others, vertex_count), vertex_count)
-    other_undirected = np.minimum(other_starts, other_ends) * vertex_count + np.maximum(other_starts, other_ends)
-    diagonal = ~among(undirected, other_undirected)
+    starts = directed // vertex_count
+    undirected = _undirected(directed, vertex_count)
+    diagonal = ~among(undirected, undirected_edge_keys(others, vertex_count))
     order = np.argsort(undirected[diagonal], kind="stable")
     keys, holders = undirected[diagonal][order], owner[diagonal][order]
     shared = keys[1:] == keys[:-1]
     polygon = component_labels(count, np.stack([holders[:-1][shared], holders[1:][shared]], axis=1))
     # An edge is on its polygon's boundary where no triangle of the same polygon has its reverse.
     by_edge = np.argsort(directed, kind="stable")
-    found = np.clip(np.searchsorted(directed[by_edge], ends * vertex_count + starts), 0, max(directed.size - 1, 0))
-    inner = (directed[by_edge][found] == ends * vertex_count + starts) & (
-        polygon[owner[by_edge][found]] == polygon[owner]
-    )
+    reverse = _reversed(directed, vertex_count)
+    found = np.clip(np.searchsorted(directed[by_edge], reverse), 0, max(directed.size - 1, 0))
+    inner = (directed[by_edge][found] == reverse) & (polygon[owner[by_edge][found]] == polygon[owner])
     on_boundary = polygon[owner[~inner]] * vertex_count + starts[~inner]
     return (~among(polygon[owner] * vertex_count + starts, on_boundary)).reshape(3, -1).any(axis=0)
 
@@ -123,5 +120,21 @@ def _boundary_edges(triangles: np.ndarray, vertex_count: int) -> np.ndarray:
     """The sorted keys (:func:`_directed_edges`) of the edges of ``triangles`` whose reverse no
     triangle of them has."""
     edges = _directed_edges(triangles, vertex_count)
-    reversed_edges = (edges % vertex_count) * vertex_count + edges // vertex_count
-    return np.sort(edges[~among(reversed_edges, edges)])
+    return np.sort(edges[~among(_reversed(edges, vertex_count), edges)])
+
+
+def undirected_edge_keys(triangles: np.ndarray, vertex_count: int) -> np.ndarray:
+    """(3 * T,) int64 keys ``min * vertex_count + max`` of the edges of ``triangles (T, 3)``, in the
+    order of :func:`_directed_edges`."""
+    return _undirected(_directed_edges(triangles, vertex_count), vertex_count)
+
+
+def _undirected(edges: np.ndarray, vertex_count: int) -> np.ndarray:
+    """The keys of directed ``edges`` (:func:`_directed_edges`) with each edge's ends in order."""
+    starts, ends = np.divmod(edges, vertex_count)
+    return np.minimum(starts, ends) * vertex_count + np.maximum(starts, ends)
+
+
+def _reversed(edges: np.ndarray, vertex_count: int) -> np.ndarray:
+    """The keys of directed ``edges`` (:func:`_directed_edges`) each the other way."""
+    return (edges % vertex_count) * vertex_count + edges // vertex_count

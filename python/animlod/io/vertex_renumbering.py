@@ -17,6 +17,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from ..sorted_keys import among, distinct
+from .polygon_splits import undirected_edge_keys
 
 # How far, in faces before and after a corner's, its polygon's other triangles are looked for,
 # each step for the vertices the one before left: a quad's two triangles are next to each other,
@@ -44,7 +45,7 @@ def first_frame_order(
     taken = np.zeros(vertex_count, dtype=bool)
     every_face = np.arange(len(faces))
     _assign(order, taken, _matching_pairs(first_faces, first_uvs, faces, uvs, every_face, [0], every_corner=False))
-    first_edges = distinct(_edge_keys(first_faces, vertex_count))
+    first_edges = distinct(undirected_edge_keys(first_faces, vertex_count))
     neighbours = _Neighbours(faces, vertex_count)
     for window in _WINDOWS:
         open_faces = np.flatnonzero((order[faces] < 0).any(axis=1))  # those with a vertex to match
@@ -86,12 +87,6 @@ class _Neighbours:
         beside = np.zeros(len(pairs), dtype=bool)
         beside[pair[(placed >= 0) & among(keys, first_edges)]] = True
         return beside
-
-
-def _edge_keys(faces: np.ndarray, vertex_count: int) -> np.ndarray:
-    """The undirected edges of ``faces (M, 3)`` as keys ``min * vertex_count + max``."""
-    starts, ends = faces.ravel().astype(np.int64), np.roll(faces, -1, axis=1).ravel().astype(np.int64)
-    return np.minimum(starts, ends) * vertex_count + np.maximum(starts, ends)
 
 
 def _assign(order: np.ndarray, taken: np.ndarray, pairs: np.ndarray) -> None:

@@ -142,6 +142,7 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     frames[0] = first_vertices
     first_texture, differing = texture, None  # the first frame whose texture coordinates are not the first's
     first_uvs = None if texture is None else texture.uvs  # a PLY's per vertex, where read
+    first_uvs_read = textured  # read_sequence reads them only for a frame to match (below)
     frame_colours = _ColourFrames(paths[0], colours, len(paths))
     retriangulated: list[Path] = []  # frames whose polygons are split otherwise than the first frame's
     reordered: list[Path] = []  # frames whose vertices are numbered in another order than the first frame's
@@ -154,11 +155,12 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
             # which vertex is which (read for this alone where the sequence is read without them).
             order, renumbered = None, False
             if path.suffix.lower() == ".ply" and not np.array_equal(frame_faces, faces):
-                if not textured:
-                    first_uvs = _quiet_ply_uvs(paths[0]) if first_uvs is None else first_uvs
-                    frame_uvs = _quiet_ply_uvs(path)
-                else:
+                if not first_uvs_read:
+                    first_uvs, first_uvs_read = _quiet_ply_uvs(paths[0]), True
+                if textured or first_uvs is None:  # read with the frame, or not needed: none to match
                     frame_uvs = None if frame_texture is None else frame_texture.uvs
+                else:
+                    frame_uvs = _quiet_ply_uvs(path)
                 renumbered = (
                     first_uvs is not None and frame_uvs is not None and not np.array_equal(first_uvs, frame_uvs)
                 )

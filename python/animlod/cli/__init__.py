@@ -205,6 +205,15 @@ def check_output_is_not_input(
         raise UserError(f"{option} {os.fspath(output)}: is the input file; write {what} to another file")
 
 
+def check_output_writable(output: object) -> None:
+    """Raise, before any work, the OSError that writing ``-o`` would meet only at the end: the
+    folder ``output`` names, or the folder of the file it names, must take new files."""
+    if isinstance(output, (str, os.PathLike)):
+        from ..io.atomic import check_writable_folder
+
+        check_writable_folder(output if os.path.isdir(output) else os.path.dirname(os.fspath(output)) or ".")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     try:
@@ -217,9 +226,11 @@ def main(argv: list[str] | None = None) -> int:
     output = getattr(args, "output", None)
     if os.environ.get("ANIMLOD_DEBUG"):  # tracebacks and live output, for telling a bug from a mistake
         check_output_is_not_input(source, output)
+        check_output_writable(output)
         return int(args.run(args) or 0)
     try:
         check_output_is_not_input(source, output)
+        check_output_writable(output)
         with _sigterm_unwinds(), _guarded_stderr(args.command):
             return int(args.run(args) or 0)
     except (UserError, MachineError) as error:

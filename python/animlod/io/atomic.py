@@ -48,16 +48,30 @@ def unwritable(path: str | os.PathLike) -> str | None:
     end."""
     if os.path.isdir(path):  # the rename onto it would fail only after the work
         return "is a folder"
-    folder = nearest_existing(Path(os.path.abspath(path)).parent)
-    if not folder.is_dir():
-        return f"{folder} is not a folder"
+    folder = Path(os.path.abspath(path)).parent
     try:
-        fd, probe = tempfile.mkstemp(prefix=".animlod-probe-", dir=folder)
+        check_writable_folder(folder)
+    except NotADirectoryError:
+        return f"{nearest_existing(folder)} is not a folder"
     except OSError as error:
-        return f"cannot write into {folder} ({error.strerror})"
+        return f"cannot write into {error.filename} ({error.strerror})"
+    return None
+
+
+def check_writable_folder(path: str | os.PathLike) -> None:
+    """Raise, before any work, the OSError that writing files into the folder ``path`` (made if
+    missing) would meet only at the end: NotADirectoryError naming ``path`` where a file stands at
+    or above it, or the system's error naming the nearest existing folder where that folder takes
+    no new file (no permission, a read-only file system)."""
+    found = nearest_existing(path)
+    if not found.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, "Not a directory", os.fspath(path))
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".animlod-probe-", dir=found)
+    except OSError as error:  # it names the probe, a file the user never asked for
+        raise type(error)(error.errno, error.strerror, os.fspath(found)) from None
     os.close(fd)
     os.unlink(probe)
-    return None
 
 
 @contextlib.contextmanager

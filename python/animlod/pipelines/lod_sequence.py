@@ -18,7 +18,6 @@ under ``mtllib`` lines that name the input's libraries from the level's folder.
 
 from __future__ import annotations
 
-import errno
 import math
 import os
 import time
@@ -31,7 +30,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..aqem import Preparation, SimplifiedLevel, simplify_animated
-from ..io.atomic import nearest_existing
+from ..io.atomic import check_writable_folder
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError, UnreadAttributesWarning
 from ..io.meshseq import SequenceTexture, normals_fit
@@ -97,13 +96,12 @@ def simplify_sequence(
     (on long sequences the measurement takes longer than the simplification). The surface errors
     are over at most ``measured_frames`` frames, evenly spaced from the first to the last (None:
     every frame). Raises FormatError for unreadable input, ValueError for ``measured_frames`` < 1,
-    NotADirectoryError before any work where a file stands at or above ``output``.
+    OSError before any work where ``output`` cannot take the levels (a file at or above it: NotADirectoryError;
+    a folder that takes no new file).
     """
     if measured_frames is not None:
         measured_frames = whole_number("measured_frames", measured_frames, 1)
-    blocking = nearest_existing(output)
-    if blocking.exists() and not blocking.is_dir():  # found before the work, not when the first level is written
-        raise NotADirectoryError(errno.ENOTDIR, "Not a directory", os.fspath(output))
+    check_writable_folder(output)  # before the work, not when the first level is written
     kind = input_kind(source)
     texture = None  # the sequence's texture coordinates, carried as AQEM attributes
     shading = None  # how the sequence's normals shade it, for the levels' rebuilt normals

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..io.atomic import LONGEST_NAME, staged_files, unwritable
+from ..io.atomic import LONGEST_NAME, check_writable_folder, staged_files
 from ..io.bvh import BvhLayout
 from ..io.detect import input_kind, input_stem
 from ..io.errors import FormatError
@@ -149,8 +149,7 @@ def build_motion_levels(
     manifest = Path(f"{stem}_motion_lod.json")
     if (folder / manifest).is_dir():  # found before the work, not after it
         raise IsADirectoryError(errno.EISDIR, "Is a directory", os.fspath(folder / manifest))
-    if unwritable(folder / manifest):
-        raise NotADirectoryError(errno.ENOTDIR, "Not a directory", os.fspath(output))
+    check_writable_folder(folder)
     notes: list[str] = []
 
     def note(text: str) -> None:

@@ -149,3 +149,17 @@ def test_a_prop_with_a_chain_of_its_own_gets_level_nodes_of_its_own_on_each_copy
     assert copy_level != level and coverages == [0.3, 0.0]
     assert doc.json["nodes"][copy_level]["mesh"] == doc.json["nodes"][level]["mesh"]
     assert problems(tmp_path / "lod.glb") == []
+
+
+def test_the_summary_explains_its_errors_once_for_the_character_and_its_props(
+    character_with_props, tmp_path, monkeypatch, capsys
+):
+    import animlod.pipelines.character as pipeline
+    from animlod.cli import main
+
+    source, _, report = character_with_props
+    monkeypatch.setattr(pipeline, "build_character", lambda *args, **kwargs: report)
+    assert main(["character", str(source), "-o", str(tmp_path / "out.glb")]) == 0
+    out = capsys.readouterr().out
+    assert out.count("Hausdorff") == 1  # one legend, not the character's and simplify's
+    assert "error: over their rest pose and every clip's frames" in out

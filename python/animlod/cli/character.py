@@ -85,8 +85,8 @@ def run(args: argparse.Namespace) -> int:
         print_rows(rows, indent="  ")
     if report.others:
         print("meshes no clip skins, with levels of their own (props, static meshes; their copies on each motion")
-        print("level's skeleton have the same levels)")
-        print_drawable_reports(report.others)
+        print("level's skeleton have the same levels); error: over their rest pose and every clip's frames")
+        print_drawable_reports(report.others, legend=False)
     for note in report.notes:
         print(f"note: {note}")
     print(

@@ -152,10 +152,12 @@ def _simplify_document(args: argparse.Namespace, options: dict) -> int:
     return 0
 
 
-def print_drawable_reports(drawables: list[DrawableReport]) -> None:
-    """Each drawable's levels (faces, target, relative error, coverage) and notes, under a legend."""
-    print("errors: max over the rest pose and frames of every clip of the Hausdorff distance, relative to the")
-    print("bounding-box diagonal; coverage: the MSFT_screencoverage below which the next level takes over")
+def print_drawable_reports(drawables: list[DrawableReport], legend: bool = True) -> None:
+    """Each drawable's levels (faces, target, relative error, coverage) and notes, under a legend
+    unless the caller printed one."""
+    if legend:
+        print("errors: max over the rest pose and frames of every clip of the Hausdorff distance, relative to the")
+        print("bounding-box diagonal; coverage: the MSFT_screencoverage below which the next level takes over")
     for drawable in drawables:
         renormalised = drawable.renormalised_weights
         print(

@@ -72,7 +72,7 @@ from .attachments import (
     find_attachments,
     posed_by_level_clips,
 )
-from .clip_import import with_clips
+from .clip_import import document_with_clips
 from .drawable_levels import (
     DrawableLevel,
     DrawableLevels,
@@ -150,10 +150,7 @@ def build_character(
     say = progress or (lambda _line: None)
     settings = DrawableSettings.resolve(settings, keywords)
     notes: list[str] = []
-    doc = GltfDocument(source)
-    doc = with_clips(doc, clips, notes.append, joint_map)
-    if idle := doc.idle_weight_channels_note():
-        notes.append(idle)
+    doc = document_with_clips(source, clips, notes.append, joint_map)
     fps = doc.sample_rate(settings.fps)
     all_drawables = read_drawables(doc, fps)
     chained = {d.label: d for d in all_drawables if unchained(doc, d.nodes) != d.nodes}

@@ -35,6 +35,21 @@ REST_TOLERANCE = 0.01
 _NODE_PATHS = {"translation": 3, "rotation": 4, "scale": 3}
 
 
+def document_with_clips(
+    source: str | os.PathLike,
+    clip_files: Sequence[str | os.PathLike],
+    note: Callable[[str], None],
+    joint_map: str | os.PathLike | None = None,
+) -> GltfDocument:
+    """The glTF at ``source`` with the clips of ``clip_files`` added (:func:`with_clips`), and a
+    note naming its morph weight channels that change nothing
+    (:meth:`~animlod.io.gltf_document.GltfDocument.idle_weight_channels_note`)."""
+    doc = with_clips(GltfDocument(source), clip_files, note, joint_map)
+    if idle := doc.idle_weight_channels_note():
+        note(idle)
+    return doc
+
+
 def with_clips(
     doc: GltfDocument,
     clip_files: Sequence[str | os.PathLike],

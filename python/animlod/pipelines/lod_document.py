@@ -37,7 +37,7 @@ from ..io.gltf_lod import (
 )
 from ..io.stored_weights import normalise_stored_weights
 from ..model import AnimatedMesh
-from .clip_import import with_clips
+from .clip_import import document_with_clips
 from .drawable_levels import DrawableLevels, DrawableSettings, draws_nothing, simplify_drawable
 from .level_chain import chain_notes, coarser_level_count
 
@@ -122,10 +122,7 @@ def simplify_document(
         raise ValueError(f"ratios: each must be in (0, 1], got {list(ratios)}")
     settings = DrawableSettings.resolve(settings, keywords)
     notes: list[str] = []
-    doc = GltfDocument(source)
-    doc = with_clips(doc, clips, notes.append, joint_map)
-    if idle := doc.idle_weight_channels_note():
-        notes.append(idle)
+    doc = document_with_clips(source, clips, notes.append, joint_map)
     drawables = read_drawables(doc, settings.fps)
     lines = [f"{mesh_label(doc, mesh)} (nodes {nodes})" for mesh, nodes in points_and_lines_meshes(doc).items()]
     if lines:

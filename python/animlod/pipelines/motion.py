@@ -334,19 +334,15 @@ def _read_input(
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
     from ..io.gltf import read_gltf
-    from ..io.gltf_document import GltfDocument
     from ..io.gltf_read import rig_motions
     from ..io.gltf_skin import SkinRig
     from ..io.gltf_write import FaceMaterials, MeshNames
     from .attachments import find_attachments
-    from .clip_import import with_clips
+    from .clip_import import document_with_clips
     from .motion_level_files import LevelContent, left_out_of_level_files, level_mesh_names, poses_nothing
     from .whole_skin import whole_skin
 
-    document = GltfDocument(source)
-    document = with_clips(document, clip_files, note, joint_map)
-    if idle := document.idle_weight_channels_note():
-        note(f"{path}: {idle}")
+    document = document_with_clips(source, clip_files, note, joint_map)
     fps = document.sample_rate()
     scene = read_gltf(document, fps, body_skin)
     if scene.skinned_meshes:

@@ -44,7 +44,7 @@ def split_character(tmp_path_factory) -> tuple[Path, Path, Path]:
 
 def test_a_character_plays_the_clips_of_an_animation_library(split_character, tmp_path):
     whole, rest, walk = split_character
-    with pytest.raises(FormatError, match="no skinned mesh with an animation"):
+    with pytest.raises(FormatError, match="its skinned meshes have no clip: add clips with --clips"):
         build_character(rest, tmp_path / "none.glb", [0.5], **QUICK)
     split = build_character(rest, tmp_path / "split.glb", [0.5], clips=[walk], **QUICK)
     joined = build_character(whole, tmp_path / "whole.glb", [0.5], **QUICK)

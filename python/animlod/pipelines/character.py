@@ -164,6 +164,9 @@ def build_character(
         if any(d.skinned is not None for d in chained.values()):
             raise FormatError(doc.path, "skins", "every skinned mesh's node has an MSFT_lod chain already, "
                               "nothing to build a character chain of")  # fmt: skip
+        if any(d.skinned is not None for d in all_drawables):  # a rig in its bind pose, as Mixamo's "with skin"
+            raise FormatError(doc.path, "skins", f"{reason}; its skinned meshes have no clip: add clips with --clips "
+                              "(glTF or BVH files), or `animlod simplify` gives mesh levels alone")  # fmt: skip
         if all_drawables or not doc.gltf.animations:
             raise FormatError(doc.path, "skins", f"{reason} (`animlod simplify` gives mesh levels alone)")
         raise FormatError(doc.path, "skins", f"{reason} (it draws no mesh: `animlod motion` takes its clips)")

@@ -26,6 +26,7 @@ from animlod.pipelines.character import build_character
 from animlod.pipelines.clip_import import with_clips
 from animlod.pipelines.joint_matching import match_joints
 from animlod.pipelines.joint_names import side
+from animlod.pipelines.motion import build_motion_levels
 
 QUICK = {"solver": "newton", "frame_budget": 12, "measured_frames": 2}
 
@@ -46,6 +47,8 @@ def test_a_character_plays_the_clips_of_an_animation_library(split_character, tm
     whole, rest, walk = split_character
     with pytest.raises(FormatError, match="its skinned meshes have no clip: add clips with --clips"):
         build_character(rest, tmp_path / "none.glb", [0.5], **QUICK)
+    with pytest.raises(FormatError, match="has no animation to simplify: add clips with --clips"):
+        build_motion_levels(rest, tmp_path / "none", levels=2)
     split = build_character(rest, tmp_path / "split.glb", [0.5], clips=[walk], **QUICK)
     joined = build_character(whole, tmp_path / "whole.glb", [0.5], **QUICK)
     assert any("walk.glb: 1 of its 1 clip(s) added to rest.glb" in note for note in split.notes)
@@ -112,8 +115,6 @@ def test_simplify_drives_the_skinned_levels_with_added_clips(split_character, tm
 
 
 def test_motion_levels_of_a_character_with_added_clips(split_character, tmp_path):
-    from animlod.pipelines.motion import build_motion_levels
-
     whole, rest, walk = split_character
     split = build_motion_levels(rest, tmp_path / "split", levels=3, clips=[walk], solver="newton")
     joined = build_motion_levels(whole, tmp_path / "whole", levels=3, solver="newton")

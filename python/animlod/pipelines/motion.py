@@ -357,7 +357,8 @@ def _read_input(
                  f"{', '.join(left_out)} (`--skin` picks another character; `animlod character` takes every "
                  "skin)")  # fmt: skip
         if not motions:
-            raise FormatError(path, "animations", "the skinned mesh has no animation to simplify")
+            raise FormatError(path, "animations", "the skinned mesh has no animation to simplify: add clips with "
+                              "--clips (glTF or BVH files)")  # fmt: skip
         joined_nodes, mesh_names = set(whole.part_nodes), level_mesh_names(document, whole.part_nodes)
     else:  # an animation library exported without its mesh
         rig, skin, materials, morph_weights = SkinRig(document, None), None, None, {}

@@ -10,8 +10,9 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]`` (part of ``make bench`
    Fig. 7's bone-length variation (the worst re-fitted bone's standard deviation over frames
    relative to its key length), FK residual, SLSQP evaluations per frame, frames whose first
    solve failed and frames that fell back to the frozen key motion, seconds.
-2. Speed: 8 levels of 131_01.bvh, of the procedural humanoid with fingers (594 frames) and of
-   Xbot.glb's clips end to end (captured fingers, 67 joints, 268 frames), with the default
+2. Speed: 8 levels of 131_01.bvh, of the procedural humanoid with fingers (594 frames), of
+   Xbot.glb's clips end to end (captured fingers, 67 joints, 268 frames) and of two figures with
+   long chains (:func:`hanging_chains`: 10 of 7 joints on the head, one of 40), with the default
    ranking and with Eq. 3 alone (whose chain has no trial re-fits), best of 3 interleaved
    rounds: wall and CPU seconds (goal: 131_01 under 10 s), the cost per joint-frame and its
    ratio to 131_01's with the same ranking (goal: 1).
@@ -47,8 +48,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from devdata import DATA_DIR
 from table import print_table, wall_and_cpu
 
+from animlod import rotations
 from animlod.io.bvh import read_bvh
-from animlod.model import Motion
+from animlod.model import Motion, Skeleton
 from animlod.motion_lod import RANKINGS, analyze_motion, build_motion_chain, joint_floor, level_joint_counts
 from animlod.motion_lod.chain import _cold_starts
 from animlod.motion_lod.clips import merge_split_clips
@@ -105,6 +107,51 @@ def clips_end_to_end(path: Path) -> Motion:
     first = motions[0]
     same = [m for m in motions if m.skeleton.names == first.skeleton.names and m.fps == first.fps]
     return Motion.concatenate(same, f"{path.stem} clips")
+
+
+def hanging_chains(strands: int, length: int, frames: int = 300) -> Motion:
+    """A figure whose head carries ``strands`` chains of ``length`` joints (hair, or one long
+    tail or rope), each with an end site, swinging out of phase above a body of 11 joints that
+    sways and steps; 30 fps, centimetres. Long chains are what captures of animals, hair and
+    cloth rigs bring and the dev clips lack: a frozen run of a chain is one cluster of free
+    points for the re-fit's Newton method."""
+    names, parents, offsets = [], [], []
+
+    def add(name: str, parent: int, offset: tuple[float, float, float]) -> int:
+        names.append(name)
+        parents.append(parent)
+        offsets.append(offset)
+        return len(names) - 1
+
+    hips = add("Hips", -1, (0.0, 90.0, 0.0))
+    for side, x in (("Left", 1.0), ("Right", -1.0)):
+        knee = add(f"{side}Leg", add(f"{side}UpLeg", hips, (10.0 * x, 0.0, 0.0)), (0.0, -40.0, 0.0))
+        add(f"{side}Foot end", add(f"{side}Foot", knee, (0.0, -40.0, 0.0)), (0.0, -5.0, 10.0))
+    head = add("Head", add("Neck", add("Chest", add("Spine", hips, (0.0, 10.0, 0.0)), (0.0, 20.0, 0.0)),
+                           (0.0, 20.0, 0.0)), (0.0, 10.0, 0.0))  # fmt: skip
+    swings = []  # (joint, strand, place along it)
+    for strand in range(strands):
+        angle = 2.0 * np.pi * strand / strands
+        joint = head
+        for place in range(length):
+            offset = (5.0 * np.cos(angle), 8.0, 5.0 * np.sin(angle)) if place == 0 else (
+                0.5 * np.cos(angle), -3.0, 0.5 * np.sin(angle))  # fmt: skip
+            joint = add(f"strand{strand}_{place}", joint, offset)
+            swings.append((joint, strand, place))
+        add(f"strand{strand} end", joint, (0.0, -3.0, 0.0))
+    end_sites = np.array([name.endswith(" end") for name in names])
+    skeleton = Skeleton(names, np.array(parents), np.array(offsets, np.float64), end_sites=end_sites)
+    t = np.arange(frames) / 30.0
+    euler = np.zeros((frames, len(names), 3))  # radians about x, y, z
+    euler[:, hips] = np.stack([np.zeros(frames), 0.17 * np.sin(t), 0.09 * np.sin(2.0 * t)], axis=1)
+    for side, phase in (("Left", 0.0), ("Right", np.pi)):
+        euler[:, names.index(f"{side}UpLeg"), 0] = 0.5 * np.sin(4.0 * t + phase)
+        euler[:, names.index(f"{side}Leg"), 0] = 0.4 * (1.0 + np.sin(4.0 * t + phase + 1.0))
+    for joint, strand, place in swings:
+        euler[:, joint, 0] = 0.26 * np.sin(3.0 * t + 0.3 * strand + 0.5 * place)
+        euler[:, joint, 2] = 0.17 * np.cos(2.0 * t + 0.2 * strand)
+    roots = np.stack([20.0 * np.sin(t), 90.0 + 2.0 * np.sin(4.0 * t), 30.0 * t], axis=1)
+    return Motion(skeleton, roots, rotations.from_euler(euler, "xyz"), 30.0, f"{strands} chains of {length}")
 
 
 def joints_of(motion: Motion) -> int:
@@ -172,6 +219,9 @@ def speed_table(quick: bool) -> None:
     xbot = DATA_DIR / "gltf" / "Xbot.glb"
     if xbot.exists() and not quick:  # captured fingers: 67 joints, 30 of them in the hands
         cases.append(("Xbot.glb, its clips end to end", clips_end_to_end(xbot)))
+    frames = 30 if quick else 150
+    cases.append(("hair: 10 chains of 7 on the head", hanging_chains(10, 7, frames)))
+    cases.append(("tail: one chain of 40", hanging_chains(1, 40, frames)))
     runs = [(label, motion, threads, ranking) for label, motion in cases
             for threads, ranking in ((0, "refit"), (0, "importance"))]  # fmt: skip
     if cases[0][0] == "131_01.bvh":

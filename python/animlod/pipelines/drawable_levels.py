@@ -20,7 +20,7 @@ moving them.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -155,8 +155,10 @@ def simplify_drawable(
     settings: DrawableSettings | None = None,
     importance: np.ndarray | None = None,
     measure: bool = True,
+    progress: Callable[[str], None] | None = None,
 ) -> DrawableLevels:
-    """AQEM levels of ``drawable`` at ``ratios``, each measured over every clip.
+    """AQEM levels of ``drawable`` at ``ratios``, each measured over every clip; ``progress`` is
+    called with a line of text as the collapses and the measurement start.
 
     ``settings`` says how many frames drive and measure the levels and which AQEM options
     replace the pipeline's (unlike :func:`animlod.simplify_animated`, motion features are off
@@ -186,6 +188,8 @@ def simplify_drawable(
     frames, bind_drives = _drive_frames(drawable, rest, size, settings.frame_budget)
     if not bind_drives and not {"frame_subset", "max_frames"} & options.keys():
         options["frame_subset"] = tuple(range(1, len(frames)))  # frame 0 carried along the edges, no quadrics
+    say = progress or (lambda _line: None)
+    say(f"{drawable.label}: collapsing over {len(frames)} frames")
     result = simplify_animated(
         AnimatedMesh(geometry.faces, frames),
         ratios,
@@ -206,6 +210,7 @@ def simplify_drawable(
     if geometry.other_primitives:
         notes.append(f"primitives {geometry.other_primitives}: points or lines, kept unchanged")
     if measure:
+        say(f"{drawable.label}: measuring {len(levels)} levels")
         _measure(drawable, levels, settings.measured_frames)
     return DrawableLevels(levels, size, result.preparation, notes)
 

@@ -111,7 +111,7 @@ def simplify_document(
         name (``fps``, ``frame_budget``, ``measured_frames``, ``pixel_error``, ``viewport_px``)
         and AQEM options (``use_motion_features``, ``max_error``, ``placement`` ..., see
         :class:`~animlod.AqemOptions`).
-    progress : called with a line of text as each drawable starts.
+    progress : called with a line of text as each drawable, its collapses and its measurement start.
 
     Raises
     ------
@@ -151,7 +151,7 @@ def simplify_document(
     for drawable in drawables:
         if progress:
             progress(f"{drawable.label}: {drawable.geometry.faces.shape[0]} triangles, {len(drawable.clips)} clips")
-        simplified.append(simplify_drawable(drawable, ratios, settings))
+        simplified.append(simplify_drawable(drawable, ratios, settings, progress=progress))
     reports = [drawable_report(d, s, ratios, settings) for d, s in zip(drawables, simplified)]
     if separate:
         outputs = _write_separate(doc, drawables, simplified, reports, Path(output), source)

@@ -68,6 +68,7 @@ def run(args: argparse.Namespace) -> int:
         expression=args.expression,
         repeats=args.repeats,
         error_frames=args.error_frames,
+        progress=print,
     )
     for note in result.notes:
         print(note)

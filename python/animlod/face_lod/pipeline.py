@@ -13,7 +13,7 @@ procedural face, its active regions, lattice sizes and the active tree's own thr
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -72,6 +72,7 @@ def run_face_lod(
     expression: str | None = None,
     repeats: int = 3,
     error_frames: int = 24,
+    progress: Callable[[str], None] | None = None,
 ) -> FaceRun:
     """Build, measure and write the levels of a face.
 
@@ -88,15 +89,16 @@ def run_face_lod(
     repeats : timing runs per frame (the fastest is kept).
     error_frames : evenly spaced animation frames the surface error is measured on, besides
         each target's (or MPA's) peak-weight frame (:func:`animlod.face_lod.measure.measured_frames`).
+    progress : a face read from a file: called with a line of text as the levels' building and
+        their measurement start.
     """
     check_face_options(ratios=ratios, face_counts=face_counts, target_fractions=target_fractions, repeats=repeats,
                        error_frames=error_frames)  # fmt: skip
     output = Path(output)  # created only by the writing (io.atomic.staged_files), so a refused run leaves nothing
     if source is None:
         return _run_procedural(output, ratios, face_counts, plot, expression, repeats, error_frames)
-    return _run_blendshape(
-        Path(source), output, ratios, face_counts, target_fractions, neutral, plot, expression, repeats, error_frames
-    )
+    return _run_blendshape(Path(source), output, ratios, face_counts, target_fractions, neutral, plot, expression,
+                           repeats, error_frames, progress or (lambda _line: None))  # fmt: skip
 
 
 def check_face_options(
@@ -197,7 +199,7 @@ def _run_procedural(output, ratios, face_counts, plot, expression, repeats, erro
 
 
 def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutral, plot, expression, repeats,
-                    error_frames) -> FaceRun:  # fmt: skip
+                    error_frames, say) -> FaceRun:  # fmt: skip
     from ..io.detect import glb_name, input_kind, input_stem
     from ..io.manifest import write_lod_manifest
     from .sources import pose_files, read_pose_face
@@ -216,6 +218,7 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
     plot_weights = _plot_weights(face, expression) if plot else None
     options = BlendshapeLodOptions(face_counts=face_counts, target_fractions=target_fractions,
                                    **({"ratios": tuple(ratios)} if ratios else {}))  # fmt: skip
+    say(f"{source}: building the levels")
     try:
         if gltf is not None:
             gltf_levels = gltf_face_levels(gltf, options)
@@ -224,6 +227,7 @@ def _run_blendshape(source, output, ratios, face_counts, target_fractions, neutr
             levels = build_blendshape_lod(face, options)
     except ValueError as error:
         raise ValueError(f"{source}: {error}") from None
+    say(f"{source}: measuring {len(levels)} levels over {len(face.weights)} animation frames")
     measured = measure_blendshape_lod(face, levels, repeats=repeats, max_frames=error_frames, samples=10000)
     errors = [row.hausdorff_units for row in measured]
     thresholds = coverage_thresholds(errors, _radius(face.neutral), Camera(), PIXEL_TOLERANCE)

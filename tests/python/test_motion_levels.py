@@ -337,3 +337,14 @@ def test_cli_a_bvh_of_two_roots_is_simplified_below_one_and_says_so(tmp_path, ca
     assert "its 2 ROOTs (j0, k0) are joints below one ROOT of its own, 'Roots'" in printed.out + printed.err
     assert "\r" not in printed.err  # progress bars are for a terminal: in a log, \r and cursor moves
     assert len(list((tmp_path / "out").glob("two_lod*.bvh"))) == 3
+
+
+def test_cli_without_a_terminal_logs_a_line_as_each_level_starts(tmp_path, capsys) -> None:
+    """The bars draw only on a terminal: with the output redirected to a log, a 36,000-frame
+    clip printed nothing for minutes, until its summary."""
+    source = _write(tmp_path, figure_motion())
+    assert main(["motion", str(source), "-o", str(tmp_path / "out"), "--levels", "3"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    started = [line for line in lines if line.startswith("level ") and " of 2: " in line]
+    assert [line.split(":")[0] for line in started] == ["level 0 of 2", "level 1 of 2", "level 2 of 2"]
+    assert lines[0].startswith("choosing the joints of 2 levels")

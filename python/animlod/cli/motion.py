@@ -101,7 +101,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 class _Progress:
     """tqdm over the default ranking's choice of joints, then over levels and over frames inside
-    each level, then over the frames of the skin measurement."""
+    each level, then over the frames of the skin measurement; without a terminal (a log), one
+    line as each of them starts instead."""
 
     def __init__(self) -> None:
         from functools import partial
@@ -117,6 +118,7 @@ class _Progress:
     def chose(self, chosen: int, to_choose: int) -> None:
         if self.choice is None:
             self.choice = self._tqdm(total=to_choose, desc="choosing joints (trial re-fits)", unit="level", position=0)
+            self._log(self.choice, f"choosing the joints of {to_choose} levels (trial re-fits)")
         self.choice.update(chosen - self.choice.n)
         if chosen == to_choose:
             self.choice.close()
@@ -128,6 +130,7 @@ class _Progress:
         # The re-fit reports fractions of frames (a share of each group of points): shown whole.
         self.frames = self._tqdm(total=frame_count, desc=f"level {index} ({joints} joints)", unit="frame",
                                  position=1, leave=False, bar_format=_WHOLE_FRAMES)  # fmt: skip
+        self._log(self.frames, f"level {index} of {level_count - 1}: {joints} joints, {frame_count} frames")
         return self.frames.update
 
     def measured(self, frames: int, frame_count: int) -> None:
@@ -135,7 +138,15 @@ class _Progress:
             self._end_level()
             self.levels.close()
             self.measure = self._tqdm(total=frame_count, desc="measuring the skins", unit="frame", position=0)
+            self._log(self.measure, f"measuring the skins over {frame_count} frames")
         self.measure.update(frames - self.measure.n)
+
+    @staticmethod
+    def _log(bar, line: str) -> None:
+        """``line`` on stdout where ``bar`` shows nothing (no terminal): a log of a long run that
+        said nothing until its summary."""
+        if bar.disable:
+            print(line, flush=True)
 
     def _end_level(self) -> None:
         if self.frames is not None:

@@ -77,9 +77,9 @@ from .drawable_levels import (
     DrawableLevel,
     DrawableLevels,
     DrawableSettings,
-    draws_nothing,
     measure_samples,
     simplify_drawable,
+    split_empty,
 )
 from .lod_document import DEFAULT_RATIOS, DrawableReport, add_drawable_chain, drawable_report, empty_drawables_note
 from .skin_parts import JointKeys, Placement, joined_rig, moved_onto, placement_on
@@ -232,8 +232,7 @@ def build_character(
         geometry[drawable.label] = simplify_drawable(drawable, ratios, settings, measure=False)
     moved = {drawable.label for drawable in animated}
     others = [d for d in all_drawables if d.label not in moved and d.label not in chained]
-    empty = [d for d in others if draws_nothing(d, settings.measured_frames)]
-    others = [d for d in others if d not in empty]
+    others, empty = split_empty(others, settings.measured_frames)
     other_levels = []
     for drawable in others:
         say(f"{drawable.label}: levels of {len(drawable.geometry.faces)} triangles (no clip skins it)")

@@ -513,6 +513,13 @@ def _measure(drawable: Drawable, levels: list[DrawableLevel], measured_frames: i
             level.error = error
 
 
+def split_empty(drawables: list[Drawable], measured_frames: int) -> tuple[list[Drawable], list[Drawable]]:
+    """``drawables`` that draw something, and those that draw nothing (:func:`draws_nothing`), each
+    in their order."""
+    empty = [draws_nothing(drawable, measured_frames) for drawable in drawables]
+    return [d for d, skip in zip(drawables, empty) if not skip], [d for d, skip in zip(drawables, empty) if skip]
+
+
 def draws_nothing(drawable: Drawable, measured_frames: int) -> bool:
     """Whether no triangle of ``drawable`` has three distinct corner positions at rest or in the
     measured frames of its clips (a placeholder collapsed to a point, or no triangle at all):

@@ -38,7 +38,7 @@ from ..io.gltf_lod import (
 from ..io.stored_weights import normalise_stored_weights
 from ..model import AnimatedMesh
 from .clip_import import document_with_clips
-from .drawable_levels import DrawableLevels, DrawableSettings, draws_nothing, simplify_drawable
+from .drawable_levels import DrawableLevels, DrawableSettings, simplify_drawable, split_empty
 from .level_chain import chain_notes, coarser_level_count
 
 DEFAULT_RATIOS = (0.5, 0.25, 0.1)
@@ -133,9 +133,7 @@ def simplify_document(
         notes.append("kept with the MSFT_lod chains they have: "
                      + ", ".join(f"{drawable.label} (nodes {drawable.nodes})" for drawable in chained))  # fmt: skip
     # Degenerate triangles are valid glTF: a placeholder collapsed to a point stays as it is.
-    degenerate = [draws_nothing(drawable, settings.measured_frames) for drawable in drawables]
-    empty = [drawable for drawable, skip in zip(drawables, degenerate) if skip]
-    drawables = [drawable for drawable, skip in zip(drawables, degenerate) if not skip]
+    drawables, empty = split_empty(drawables, settings.measured_frames)
     if empty:
         notes.append(empty_drawables_note(empty))
     if not drawables:
@@ -164,7 +162,7 @@ def simplify_document(
 
 
 def empty_drawables_note(empty: list[Drawable]) -> str:
-    """The note on drawables left without levels because they draw nothing (:func:`draws_nothing`)."""
+    """The note on drawables left without levels because they draw nothing (:func:`split_empty`)."""
     labels = ", ".join(drawable.label for drawable in empty)
     return f"kept as they are, without levels (no triangle with three distinct corners): {labels}"
 

@@ -184,8 +184,9 @@ def _measured_points(mesh: AnimatedMesh, samples: int, seed: int) -> tuple[np.nd
     points drawn on its surface, (F, U + samples, 3), every frame in one array (the core builds
     each mesh's tree once and refits it from frame to frame)."""
     frames = mesh.frames.astype(np.float64)
-    used = np.unique(mesh.faces)
-    vertices = frames if used.size == mesh.vertex_count else frames[:, used]
+    used = np.zeros(mesh.vertex_count, bool)
+    used[mesh.faces] = True  # a mask, not np.unique: no sort of every corner (seconds at 1M faces)
+    vertices = frames if used.all() else frames[:, used]
     drawn = sample_surface(mesh, samples, seed).positions(mesh, slice(None))
     return frames, np.concatenate([vertices, drawn], axis=1)
 

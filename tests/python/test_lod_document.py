@@ -21,7 +21,7 @@ from animlod.io.errors import FormatError
 from animlod.io.glb_builder import GlbBuilder
 from animlod.io.gltf_document import GltfDocument
 from animlod.io.gltf_drawable import read_drawables
-from animlod.pipelines import DrawableSettings, simplify_document
+from animlod.pipelines import DrawableSettings, drawable_levels, simplify_document
 
 # Small enough to keep the suite quick: few drive frames, two measured frames per clip.
 QUICK = {"frame_budget": 12, "measured_frames": 2}
@@ -287,6 +287,22 @@ def test_triangles_that_draw_nothing_are_neither_measured_nor_refused(tmp_path):
     with pytest.raises(FormatError, match=r"alone.glb: meshes: no mesh has a triangle with three distinct corners"):
         simplify_document(source, tmp_path / "alone_lod.glb", [0.5], **QUICK)
     assert not (tmp_path / "alone_lod.glb").exists()
+
+
+def test_a_face_draws_when_any_measured_frame_gives_it_three_distinct_corners():
+    """The frame-by-frame check (only faces no earlier frame draws are looked at again) against
+    the definition over every frame at once: faces collapsed in the first frame and opened in a
+    later one, collapsed in every frame, and with a repeated corner index."""
+    rng = np.random.default_rng(3)
+    frames = rng.integers(0, 3, size=(4, 12, 3)).astype(np.float64)  # few values: many corners coincide
+    faces = np.vstack([rng.integers(0, 12, size=(200, 3)), [[5, 5, 6]]])
+    corners = frames[:, faces]
+    coincide = [np.all(corners[:, :, a] == corners[:, :, b], axis=-1) for a, b in ((0, 1), (1, 2), (2, 0))]
+    expected = ~np.all(np.logical_or.reduce(coincide), axis=0)
+    assert 0 < expected.sum() < len(faces) and not expected[-1]
+    assert (expected & np.logical_or.reduce(coincide)[0]).any()  # some open only in a later frame
+    np.testing.assert_array_equal(drawable_levels._drawn(faces, frames), expected)
+    assert not drawable_levels._drawn(faces[:0], frames).size
 
 
 def test_a_mesh_of_one_triangle_gets_no_levels_that_copy_it(tmp_path):

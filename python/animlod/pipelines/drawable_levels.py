@@ -541,9 +541,17 @@ def _drawn(faces: np.ndarray, frames: np.ndarray) -> np.ndarray:
     """``(F,) bool``: the faces with three distinct corner positions in some of ``frames`` (T, V, 3).
     The others draw nothing, and AQEM drops them: measured, a placeholder primitive collapsed to
     the origin set every level's error to the distance from there to the surface."""
-    corners = frames[:, faces]  # (T, F, 3, 3)
-    coincide = [np.all(corners[:, :, a] == corners[:, :, b], axis=-1) for a, b in ((0, 1), (1, 2), (2, 0))]
-    return ~np.all(np.logical_or.reduce(coincide), axis=0)
+    drawn = np.zeros(len(faces), bool)
+    undecided = np.arange(len(faces))
+    for positions in frames:  # frame by frame, only the faces no earlier frame draws (few after the first)
+        corners = positions[faces[undecided]]  # (U, 3, 3)
+        coincide = [np.all(corners[:, a] == corners[:, b], axis=-1) for a, b in ((0, 1), (1, 2), (2, 0))]
+        distinct = ~np.logical_or.reduce(coincide)
+        drawn[undecided[distinct]] = True
+        undecided = undecided[~distinct]
+        if undecided.size == 0:
+            break
+    return drawn
 
 
 def posed_frames(drawable: Drawable, level: DrawableLevel, clip: Clip | None, frames: np.ndarray) -> np.ndarray:

@@ -57,12 +57,13 @@ def character_with_props(humanoid_glb, tmp_path_factory):
     source = folder / "props.glb"
     builder.save(source)
     output = folder / "props_lod.glb"
-    report = build_character(source, output, [0.5, 0.1], solver="newton", **QUICK)
-    return source, output, report
+    lines = []
+    report = build_character(source, output, [0.5, 0.1], solver="newton", progress=lines.append, **QUICK)
+    return source, output, report, lines
 
 
 def test_every_prop_gets_levels_and_no_note_says_it_stays_at_full_detail(character_with_props):
-    _, _, report = character_with_props
+    _, _, report, _ = character_with_props
     (other,) = report.others  # one mesh, drawn by three nodes
     assert len(other.nodes) == 3
     assert [level.faces for level in other.levels][0] == 320
@@ -78,7 +79,7 @@ def _chain(doc: GltfDocument, node: int) -> tuple[list[int], list[float]]:
 def test_each_copy_of_a_prop_on_a_motion_level_has_level_nodes_of_its_own(character_with_props):
     # A level node listed by several bases is one node in several places: the copies (sharing the
     # input's meshes) kept the input's ids, and a joint's own mesh's copy no coverages at all.
-    _, output, _ = character_with_props
+    _, output, _, _ = character_with_props
     doc = GltfDocument(output)
     nodes = doc.json["nodes"]
     listed = [child for node in nodes for child in node.get("children", [])]
@@ -116,7 +117,7 @@ def test_each_copy_of_a_prop_on_a_motion_level_has_level_nodes_of_its_own(charac
 def test_the_spin_of_a_prop_drives_its_copies_levels_in_each_level_clip(character_with_props):
     # The sword's rotation channel is carried to its copy in each `@motion<m>` clip; the copy's
     # level nodes play it through the same sampler, as the input's levels play the input clip's.
-    _, output, _ = character_with_props
+    _, output, _, _ = character_with_props
     doc = GltfDocument(output)
     for animation in doc.gltf.animations:
         suffix = animation.name[animation.name.index("@") :] if "@" in (animation.name or "") else ""
@@ -129,7 +130,7 @@ def test_the_spin_of_a_prop_drives_its_copies_levels_in_each_level_clip(characte
 def test_a_prop_with_a_chain_of_its_own_gets_level_nodes_of_its_own_on_each_copy(character_with_props, tmp_path):
     # A sword whose MSFT_lod chain the input has (another tool's levels): its copies kept the
     # input's ids, so that one level node had a base on every motion level's skeleton.
-    source, _, _ = character_with_props
+    source, _, _, _ = character_with_props
     builder = GlbBuilder.from_document(GltfDocument(source))
     nodes = builder.json["nodes"]
     sword = next(index for index, node in enumerate(nodes) if node.get("name") == "sword")
@@ -157,9 +158,21 @@ def test_the_summary_explains_its_errors_once_for_the_character_and_its_props(
     import animlod.pipelines.character as pipeline
     from animlod.cli import main
 
-    source, _, report = character_with_props
+    source, _, report, _ = character_with_props
     monkeypatch.setattr(pipeline, "build_character", lambda *args, **kwargs: report)
     assert main(["character", str(source), "-o", str(tmp_path / "out.glb")]) == 0
     out = capsys.readouterr().out
     assert out.count("Hausdorff") == 1  # one legend, not the character's and simplify's
     assert "error: over their rest pose and every clip's frames" in out
+
+
+def test_progress_tells_when_the_props_levels_are_collapsed_and_measured(character_with_props):
+    # The props' measurement was silent (only the character's geometry said where it stood): on a
+    # large prop, the longest stretch of the run.
+    _, _, report, lines = character_with_props
+    (other,) = report.others
+    label = other.label
+    at = lines.index(f"{label}: levels of 320 triangles (no clip skins it)")
+    assert lines[at + 1].startswith(f"{label}: collapsing over ") and lines[at + 2] == f"{label}: measuring 2 levels"
+    (character,) = report.chains  # its geometry levels say when they collapse too
+    assert any(line.startswith(f"{character}: collapsing over ") for line in lines[:at])

@@ -229,14 +229,14 @@ def build_character(
     for drawable in animated:
         say(f"{drawable.label}: geometry levels of {len(drawable.geometry.faces)} triangles")
         # The chain's diagonal is measured below (_measure_chain); the geometry levels alone are not.
-        geometry[drawable.label] = simplify_drawable(drawable, ratios, settings, measure=False)
+        geometry[drawable.label] = simplify_drawable(drawable, ratios, settings, measure=False, progress=say)
     moved = {drawable.label for drawable in animated}
     others = [d for d in all_drawables if d.label not in moved and d.label not in chained]
     others, empty = split_empty(others, settings.measured_frames)
     other_levels = []
     for drawable in others:
         say(f"{drawable.label}: levels of {len(drawable.geometry.faces)} triangles (no clip skins it)")
-        other_levels.append(simplify_drawable(drawable, ratios, settings))
+        other_levels.append(simplify_drawable(drawable, ratios, settings, progress=say))
     geometry_seconds = time.perf_counter() - started
 
     builder = GlbBuilder.from_document(doc)

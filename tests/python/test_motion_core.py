@@ -96,6 +96,26 @@ def test_core_solve_is_the_same_on_one_and_two_threads(level, warm_start) -> Non
         np.testing.assert_array_equal(whole.positions, two.positions)
 
 
+@pytest.mark.parametrize("warm_start", [False, True])
+def test_a_long_clip_reports_progress_a_slice_at_a_time_with_the_same_result(level, monkeypatch, warm_start) -> None:
+    """A level of a long clip was one call of the core per group of points: its progress sat at 0
+    until the whole level was done. Slices of frames (chunk boundaries with warm starts) give
+    the same result as one call."""
+    from animlod.motion_lod import core_refit
+
+    _, _, problem, original, fallback = level
+    original, fallback = (np.tile(a, (7, 1, 1)) for a in (original, fallback))  # 168 frames
+    steps: list[float] = []
+    sliced = refit_core(problem, original, fallback, chunk_frames=5, warm_start=warm_start, progress=steps.append)
+    assert len(steps) == 3 and sum(steps) == len(original)
+    assert steps[0] == (65 if warm_start else 64)
+    monkeypatch.setattr(core_refit, "_SLICE_FRAMES", len(original))
+    whole = refit_core(problem, original, fallback, chunk_frames=5, warm_start=warm_start)
+    np.testing.assert_array_equal(sliced.positions, whole.positions)
+    np.testing.assert_array_equal(sliced.evaluations, whole.evaluations)
+    np.testing.assert_array_equal(sliced.objective, whole.objective)
+
+
 def test_core_refuses_bad_shapes_and_problems_by_name(level) -> None:
     _, _, problem, original, fallback = level
     core = core_problem(problem)

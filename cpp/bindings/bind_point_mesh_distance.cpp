@@ -83,6 +83,19 @@ py::array_t<double> point_mesh_max_squared_distances_py(const DoubleArray& point
   return out;
 }
 
+py::array_t<double> point_mesh_frame_max_squared_distances_py(const DoubleArray& points, const DoubleArray& vertices,
+                                                              const py::array& face_indices, unsigned threads) {
+  const IndexArray faces = index_array(face_indices, "faces");
+  require_shape(points, "points", {-1, -1, 3}, "(T, N, 3)");
+  const TriangleMeshView mesh = checked_mesh(points, vertices, faces);
+  py::array_t<double> out(points.shape(0));
+  double* out_data = out.mutable_data();
+  call_released([&] {
+    return point_mesh_frame_max_squared_distances(mesh, points.data(), point_count_of(points), threads, out_data);
+  });
+  return out;
+}
+
 }  // namespace
 
 void bind_point_mesh_distance(py::module_& m) {
@@ -124,6 +137,15 @@ end is N) with its own ``floors[s]``: several levels' points measured against on
 tree is built once and refitted once per frame. Returns (S,) float64, each equal to the
 single-segment call on its points to the bit. The same errors, and segment ends that decrease or
 do not end at N.)doc");
+  m.def("point_mesh_frame_max_squared_distances", &point_mesh_frame_max_squared_distances_py, py::arg("points"),
+        py::arg("vertices"), py::arg("faces"), py::arg("threads") = 0,
+        R"doc(The largest squared distance from the points to a triangle mesh in each frame alone.
+
+The arguments of :func:`point_mesh_squared_distance` with (T, N, 3) points. Returns (T,) float64,
+``point_mesh_squared_distance(points, vertices, faces).max(axis=1)`` to the bit (0 for a frame
+of no point), for any thread count, at the cost of :func:`point_mesh_max_squared_distance`: a
+point's search ends at the first triangle no farther than its frame's largest so far. The same
+errors.)doc");
 }
 
 }  // namespace animlod::bindings

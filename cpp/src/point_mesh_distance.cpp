@@ -359,6 +359,29 @@ Status point_mesh_max_squared_distances(const TriangleMeshView& mesh, const doub
   return Status::success();
 }
 
+Status point_mesh_frame_max_squared_distances(const TriangleMeshView& mesh, const double* points,
+                                              size_t point_count, unsigned threads, double* out) {
+  // Each worker's largest so far per frame, a worker's row a cache line apart from the next's.
+  const size_t frames = mesh.frame_count;
+  const size_t workers = worker_count(point_count, threads);
+  const size_t row = (frames + 7) / 8 * 8;
+  std::vector<double> largest(workers * row, 0.0);
+  const Status status = query_frames(
+      mesh, points, point_count, workers,
+      [&](const TriangleTree& tree, const double* frame_points, int64_t* nearest, size_t frame, size_t begin,
+          size_t end, size_t worker) {
+        double& value = largest[worker * row + frame];
+        for (size_t i = begin; i < end; ++i)
+          value = std::max(value, tree.squared_distance(point_at(frame_points, i), nearest[i], value));
+      });
+  if (!status) return status;
+  for (size_t frame = 0; frame < frames; ++frame) {
+    out[frame] = 0.0;
+    for (size_t w = 0; w < workers; ++w) out[frame] = std::max(out[frame], largest[w * row + frame]);
+  }
+  return Status::success();
+}
+
 Status point_mesh_max_squared_distance(const TriangleMeshView& mesh, const double* points, size_t point_count,
                                        unsigned threads, double floor, double& out) {
   if (std::isnan(floor)) return Status::error("floor: not a number");

@@ -8,7 +8,8 @@ frame gives a symmetric Hausdorff distance and an RMS distance; both are reporte
 units and relative to the original frame's bounding-box diagonal. Where only the largest
 Hausdorff distance over the frames counts (the pipelines' level errors),
 :func:`hausdorff_distance` gives it, the same value for a fraction of the cost
-(:func:`hausdorff_distances` for several levels of one original).
+(:func:`hausdorff_distances` for several levels of one original), and where each frame's
+Hausdorff distance counts without the RMS (the face levels' worst frame), :func:`frame_hausdorff`.
 """
 
 from __future__ import annotations
@@ -53,6 +54,24 @@ class SurfaceError:
             "rms_mean": float(self.relative_rms.mean()),
             "rms_max": float(self.relative_rms.max()),
         }
+
+
+@dataclass
+class FrameHausdorff:
+    """Per-frame symmetric Hausdorff distance of a simplification (:func:`frame_hausdorff`).
+
+    Attributes
+    ----------
+    hausdorff : (F,) float64 symmetric Hausdorff distance per frame, asset units.
+    diagonal : (F,) float64 bounding-box diagonal of the original in each frame.
+    """
+
+    hausdorff: np.ndarray
+    diagonal: np.ndarray
+
+    @property
+    def relative_hausdorff(self) -> np.ndarray:
+        return _relative(self.hausdorff, self.diagonal)
 
 
 @dataclass
@@ -120,9 +139,31 @@ def surface_error(
         ],
         axis=1,
     )
-    used_vertices = from_original[:, : from_original.shape[1] - samples]  # the drawn points follow them
-    diagonal = np.linalg.norm(np.ptp(used_vertices, axis=1), axis=-1)
-    return SurfaceError(np.sqrt(squared.max(axis=1)), np.sqrt(squared.mean(axis=1)), diagonal)
+    return SurfaceError(np.sqrt(squared.max(axis=1)), np.sqrt(squared.mean(axis=1)), _diagonals(from_original, samples))
+
+
+def frame_hausdorff(
+    original: AnimatedMesh, simplified: AnimatedMesh, samples: int = 20000, seed: int = 0
+) -> FrameHausdorff:
+    """The symmetric Hausdorff distance of each frame, equal to :func:`surface_error`'s to the
+    bit (the same points, measured both ways), without the distances that cannot raise a frame's
+    largest: the core's ``point_mesh_frame_max_squared_distances`` ends a point's search at the
+    first triangle no farther than its frame's largest so far (a 100k-vertex head's levels
+    measured in a fraction of the time)."""
+    _check_frames(original, simplified)
+    a, from_original = _measured_points(original, samples, seed)
+    b, from_simplified = _measured_points(simplified, samples, seed + 1)
+    squared = np.maximum(
+        _core.point_mesh_frame_max_squared_distances(from_original, b, simplified.faces),
+        _core.point_mesh_frame_max_squared_distances(from_simplified, a, original.faces),
+    )
+    return FrameHausdorff(np.sqrt(squared), _diagonals(from_original, samples))
+
+
+def _diagonals(measured: np.ndarray, samples: int) -> np.ndarray:
+    """(F,) bounding-box diagonal of each frame of a mesh's used vertices, the front of its
+    measured points (``_measured_points``; the drawn points follow them)."""
+    return np.linalg.norm(np.ptp(measured[:, : measured.shape[1] - samples], axis=1), axis=-1)
 
 
 def hausdorff_distance(

@@ -171,6 +171,15 @@ TEST_CASE("point_mesh_max_squared_distance is the largest of every distance, to 
       CHECK(per_segment[s] == expected);
     }
   }
+  // Per frame: each frame's largest to the bit, on one thread and two.
+  for (const unsigned threads : {1u, 2u}) {
+    std::vector<double> per_frame(frames, -1.0);
+    REQUIRE(animlod::point_mesh_frame_max_squared_distances(mesh, points.data(), point_count, threads,
+                                                             per_frame.data()));
+    for (size_t frame = 0; frame < frames; ++frame)
+      CHECK(per_frame[frame] == *std::max_element(every.begin() + static_cast<long>(frame * point_count),
+                                                  every.begin() + static_cast<long>((frame + 1) * point_count)));
+  }
   const std::vector<size_t> short_ends{1000, point_count - 1}, falling{1000, 999, point_count};
   std::vector<double> scratch(ends.size());
   CHECK(animlod::point_mesh_max_squared_distances(mesh, points.data(), point_count, short_ends.data(), 2, 0,

@@ -86,13 +86,13 @@ def test_the_input_level_is_not_measured(face, monkeypatch):
 
     levels = build_blendshape_lod(face, BlendshapeLodOptions(ratios=(0.5,)))
     measured = []
-    surface_error = animlod.metrics.surface_error
+    frame_hausdorff = animlod.metrics.frame_hausdorff
 
     def counted(*args, **kwargs):
         measured.append(args[1])
-        return surface_error(*args, **kwargs)
+        return frame_hausdorff(*args, **kwargs)
 
-    monkeypatch.setattr(animlod.metrics, "surface_error", counted)
+    monkeypatch.setattr(animlod.metrics, "frame_hausdorff", counted)
     rows = measure_blendshape_lod(face, levels, repeats=1, max_frames=4, samples=500)
     assert len(measured) == 1 and rows[0].hausdorff == rows[0].hausdorff_units == 0.0
     copy = dataclasses.replace(levels[0], neutral=levels[0].neutral.copy())

@@ -7,7 +7,7 @@ import pytest
 from simplify_inputs import ellipsoid
 
 from animlod import _core, simplify_animated
-from animlod.metrics import hausdorff_distance, hausdorff_distances, sample_surface, surface_error
+from animlod.metrics import frame_hausdorff, hausdorff_distance, hausdorff_distances, sample_surface, surface_error
 from animlod.model import AnimatedMesh
 
 
@@ -73,6 +73,22 @@ def test_hausdorff_distance_is_the_largest_of_surface_error_to_the_bit():
     assert hausdorff_distances(original, []) == []
     with pytest.raises(ValueError, match="at_least: 1 values for 2 simplified meshes"):
         hausdorff_distances(original, levels, at_least=[0.0])
+
+
+def test_frame_hausdorff_is_surface_errors_hausdorff_to_the_bit():
+    # The face levels' worst frame relative to its own size, without the RMS's full distances.
+    original = ellipsoid(frames=4)
+    level = simplify_animated(original, (0.1,)).levels[0].mesh
+    full = surface_error(original, level, samples=2000, seed=4)
+    per_frame = frame_hausdorff(original, level, samples=2000, seed=4)
+    assert np.all(full.hausdorff > 0.0) and len(np.unique(full.hausdorff)) == 4
+    np.testing.assert_array_equal(per_frame.hausdorff, full.hausdorff)
+    np.testing.assert_array_equal(per_frame.diagonal, full.diagonal)
+    np.testing.assert_array_equal(per_frame.relative_hausdorff, full.relative_hausdorff)
+    itself = surface_error(original, original, samples=500).hausdorff  # rounding: the samples lie between vertices
+    np.testing.assert_array_equal(frame_hausdorff(original, original, samples=500).hausdorff, itself)
+    with pytest.raises(ValueError, match="simplified: 2 frames, the original has 3"):
+        frame_hausdorff(flat_square(np.zeros(3)), flat_square(np.zeros(2)))
 
 
 def test_vertices_no_face_uses_are_not_measured():

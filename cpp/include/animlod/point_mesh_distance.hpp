@@ -46,4 +46,11 @@ Status point_mesh_max_squared_distances(const TriangleMeshView& mesh, const doub
                                         const size_t* segment_ends, size_t segment_count, unsigned threads,
                                         const double* floors, double* out);
 
+// The largest of point_mesh_squared_distance's values in each frame alone into out (T,), to the
+// bit: a per-frame one-sided Hausdorff distance, squared, where every frame's error is wanted
+// (the worst frame relative to its own size), a point's search ending at the first triangle no
+// farther than its frame's largest so far. The same errors as point_mesh_squared_distance.
+Status point_mesh_frame_max_squared_distances(const TriangleMeshView& mesh, const double* points,
+                                              size_t point_count, unsigned threads, double* out);
+
 }  // namespace animlod

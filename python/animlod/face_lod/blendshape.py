@@ -355,7 +355,7 @@ def measure_blendshape_lod(
     bounding-box diagonal. A level that is the input itself (its arrays, every target) is not
     measured: its error is 0 (measuring it gave float rounding, 5e-10 of face-poses' size, at a
     quarter of the measuring time)."""
-    from ..metrics import surface_error
+    from ..metrics import frame_hausdorff
 
     undriven = np.eye(face.target_count)[np.abs(face.weights).max(axis=0) == 0.0]
     weights = np.concatenate([face.weights[measured_frames(face.weights, max_frames)], undriven])
@@ -371,7 +371,7 @@ def measure_blendshape_lod(
                 best[frame] = min(best[frame], time.perf_counter() - start)
         relative = units = 0.0
         if not _is_the_input(level, face):
-            error = surface_error(reference, level.frames(weights), samples=samples)
+            error = frame_hausdorff(reference, level.frames(weights), samples=samples)
             worst = int(np.argmax(error.hausdorff))
             relative, units = float(error.relative_hausdorff[worst]), float(error.hausdorff[worst])
         rows.append(

@@ -417,3 +417,51 @@ def test_the_chains_of_one_skeleton_switch_at_the_same_distance(helmeted) -> Non
     for mine, theirs in zip(helmet[:-1], body[:-1]):
         assert mine.coverage > 0.0 and sizes[0] / theirs.coverage == pytest.approx(sizes[1] / mine.coverage)
     assert helmet[-1].coverage == body[-1].coverage == 0.0
+
+
+def _head_and_teeth(folder: Path, teeth_targets: int) -> Path:
+    """ReadyPlayerMe's layout: a head with two morph targets and teeth with ``teeth_targets``, two
+    meshes on one skin, the walk animating both nodes' weights (the head's from 0 to 1, the
+    teeth's held at 0)."""
+    source = _with_part(folder, "head", targets=["jaw", "blink"])
+    builder = GlbBuilder.from_document(GltfDocument(source))
+    nodes = builder.json["nodes"]
+    head = next(index for index, node in enumerate(nodes) if node.get("name") == "head")
+    teeth_mesh = dict(builder.json["meshes"][nodes[head]["mesh"]], name="teeth")
+    primitive = dict(teeth_mesh["primitives"][0])
+    primitive["targets"] = primitive["targets"][:teeth_targets]
+    teeth_mesh["primitives"] = [primitive]
+    teeth_mesh["extras"] = {"targetNames": ["jaw", "blink"][:teeth_targets]}
+    teeth = builder.append("nodes", {"name": "teeth", "mesh": builder.append("meshes", teeth_mesh),
+                                     "skin": nodes[head]["skin"]})  # fmt: skip
+    builder.json["scenes"][0]["nodes"].append(teeth)
+    animation = builder.json["animations"][0]
+    times = animation["samplers"][0]["input"]
+    keys = builder.json["accessors"][times]["count"]
+    for node, weights in ((head, np.linspace(0.0, 1.0, 2 * keys)), (teeth, np.zeros(teeth_targets * keys))):
+        animation["samplers"].append({"input": times, "output": builder.add(weights.astype(np.float32)[:, None])})
+        animation["channels"].append({"sampler": len(animation["samplers"]) - 1,
+                                      "target": {"node": node, "path": "weights"}})  # fmt: skip
+    path = folder / f"head_and_teeth_{teeth_targets}.glb"
+    builder.save(path)
+    return path
+
+
+@pytest.mark.parametrize("teeth_targets", [1, 2])
+def test_meshes_on_one_skin_are_measured_with_their_own_morph_weights(tmp_path, teeth_targets) -> None:
+    # The skin's clips were read with its last mesh, the teeth: the head was measured with the
+    # teeth's weights, refused as "morph_weights: expected shape (12, 2), got (12, 1)" where the
+    # teeth have fewer targets, and with the teeth's zeros where they have as many.
+    import animlod.pipelines.character as pipeline
+    from animlod.io.gltf_drawable import read_drawables
+
+    source = _head_and_teeth(tmp_path, teeth_targets)
+    report = build_character(source, tmp_path / "lod.glb", [0.5], solver="newton", **QUICK)
+    assert {"mesh 1 'head' with skin 1", "mesh 2 'teeth' with skin 1"} <= set(report.chains)
+    by_name = {d.label.split("'")[1]: d for d in read_drawables(GltfDocument(source)) if d.skinned is not None}
+    head, teeth = by_name["head"], by_name["teeth"]
+    frames = np.arange(0, teeth.clips[0].frame_count, 5)
+    np.testing.assert_array_equal(pipeline._morph_weights(teeth.clips[0], head, frames),
+                                  head.clips[0].morph_weights[frames])  # fmt: skip
+    assert head.clips[0].morph_weights[frames].max() > 0.5
+    np.testing.assert_array_equal(pipeline._morph_weights(head.clips[0], teeth, frames), 0.0)

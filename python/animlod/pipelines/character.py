@@ -364,8 +364,7 @@ def _assign_skeletons(
             placement = _placement(roles.owners[owner], drawable)
         if placement is not None:
             roles.chain_of[skin] = owner
-            own_clips = {clip.index: clip for clip in drawable.clips}
-            roles.parts[skin] = _Part(roles.owners[owner].skinned, placement, own_clips)
+            roles.parts[skin] = _Part(roles.owners[owner].skinned, placement)
             if relation is None:
                 relation = (
                     "its joints belong to" if joints_of[skin] < joints_of[owner] else "its joints hang from those of"
@@ -414,12 +413,10 @@ def _join(doc: GltfDocument, roles: _Roles, owner: int, part: Drawable, animated
 @dataclass
 class _Part:
     """A skinned drawable that plays the motion levels of a skin over more of its joints (a visor
-    on the head): that skin's mesh, where the drawable lies on its skeleton (skin_parts.py), and
-    the drawable's own clips by animation index (its morph weights)."""
+    on the head): that skin's mesh, and where the drawable lies on its skeleton (skin_parts.py)."""
 
     first: SkinnedMesh
     placement: Placement
-    clips: dict[int, Clip]
 
 
 def _joined_clips(drawable: Drawable) -> tuple[list[Clip], Motion, list[slice]]:
@@ -587,7 +584,7 @@ def _measure_chain(
     input_skin = _played(drawable.skinned, part)
     for clip, span in motion.clips:
         frames = spread_frames(clip.frame_count, measured_frames)
-        weights = _morph_weights(clip, part, frames)
+        weights = _morph_weights(clip, drawable, frames)
         clip_frames = clip.motion.take_frames(frames)
         original = input_skin.bake(clip_frames, weights)
         posed = [
@@ -619,13 +616,13 @@ def _switch_together(reports: list[list[CharacterLevel]], sizes: list[float]) ->
             report[i].coverage = min(1.0, size / max(ends))
 
 
-def _morph_weights(clip: Clip, part: _Part | None, frames: np.ndarray) -> np.ndarray | None:
-    """The morph weights of the measured drawable at ``frames`` of ``clip`` (its owner's clip for
-    a ``part``, whose own clip of that animation holds them), or None."""
-    if part is not None:
-        own = part.clips.get(clip.index)
-        clip = own if own is not None and own.frame_count == clip.frame_count else None
-    return None if clip is None or clip.morph_weights is None else clip.morph_weights[frames]
+def _morph_weights(clip: Clip, drawable: Drawable, frames: np.ndarray) -> np.ndarray | None:
+    """The morph weights of ``drawable`` at ``frames`` of ``clip``, or None (its default weights).
+    ``clip`` is the skeleton's, read with another drawable (its owner, or another mesh on its
+    skin: ReadyPlayerMe's teeth beside the head); the drawable's own clip of that animation holds
+    its weights, for its own targets."""
+    own = next((c for c in drawable.clips if c.index == clip.index and c.frame_count == clip.frame_count), None)
+    return None if own is None or own.morph_weights is None else own.morph_weights[frames]
 
 
 def _attach(builder: GlbBuilder, drawable: Drawable, report: list[CharacterLevel], grid: list) -> None:

@@ -63,6 +63,13 @@ def _singular_inverse_bind(gltf, blob) -> None:
     _accessor_floats(gltf, blob, gltf.skins[0].inverseBindMatrices)[16:32] = 0.0  # joint 1
 
 
+def _row_major_inverse_bind(gltf, blob) -> None:
+    """Every inverse bind matrix stored transposed, as hand-written exporters do: the translation
+    lands in the last row, which skinning takes for w."""
+    matrices = _accessor_floats(gltf, blob, gltf.skins[0].inverseBindMatrices).reshape(-1, 4, 4)
+    matrices[:] = matrices.transpose(0, 2, 1).copy()
+
+
 def _json_edit(change: Callable[[dict], None]) -> Callable:
     def edit(gltf, blob):
         document = gltf.to_dict()
@@ -219,6 +226,14 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], str]] = [
     ("readers", "singular inverse bind matrix", lambda t: ["info", str(_edit_gltf(_small_glb(t / "a.glb"),
         _singular_inverse_bind, t / "ibm.glb"))],
      "ibm.glb: skin 0 inverseBindMatrices: inverse bind matrix of joint 1"),
+    ("readers", "row-major inverse bind matrices", lambda t: ["info", str(_edit_gltf(_small_glb(t / "a.glb"),
+        _row_major_inverse_bind, t / "rm.glb"))],
+     "rm.glb: skin 0 inverseBindMatrices: inverse bind matrix of joint 1 (node 1 'Bend') has a last row of (0, -1, 0, "
+     "1), not (0, 0, 0, 1); written row-major instead of column-major?"),
+    ("readers", "row-major node matrix", lambda t: ["info", str(_edit_gltf(_small_glb(t / "a.glb"),
+        _json_edit(lambda d: d["nodes"][0].update(matrix=[1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])),
+        t / "m.gltf"))],
+     "m.gltf: node 0 'Root': matrix has a last row of (2, 0, 0, 1), not (0, 0, 0, 1); written row-major"),
     ("readers", "truncated GLB", lambda t: ["info", str(_write(t / "cut.glb",
         _small_glb(t / "a.glb").read_bytes()[:500]))],
      "cut.glb: GLB header: file is truncated"),

@@ -503,7 +503,12 @@ class GltfDocument:
             matrix = np.asarray(matrix, np.float64)
             if matrix.shape != (16,) or not np.all(np.isfinite(matrix)):
                 raise self.fail(self.node_label(index), "matrix must be 16 finite numbers")
-            return matrix.reshape(4, 4).T  # glTF stores column-major
+            matrix = matrix.reshape(4, 4).T  # glTF stores column-major
+            if not affine_rows(matrix[None])[0]:  # glTF asks for a matrix made of TRS
+                row = ", ".join(f"{v:.6g}" for v in matrix[3])
+                raise self.fail(self.node_label(index), f"matrix has a last row of ({row}), not (0, 0, 0, 1); "
+                                "written row-major instead of column-major?")  # fmt: skip
+            return matrix
         translation, rotation, scale = self.rest_trs(index)
         return rotations.compose_transform(translation, rotation, scale)
 
@@ -650,6 +655,21 @@ def _parse(path: str, data: bytes | None = None) -> tuple[pygltflib.GLTF2, dict]
     if unsupported:
         raise FormatError(path, "extensionsRequired", f"needs {', '.join(unsupported)}, which animlod cannot read")
     return gltf, raw
+
+
+# A last row off (0, 0, 0, 1) by more than this (its first three entries times the translation's
+# length: their share of w for points that far out) is no rounding: skinning or a node would
+# divide positions by a w that is not 1.
+_AFFINE_TOLERANCE = 1e-4
+
+
+def affine_rows(matrices: np.ndarray) -> np.ndarray:
+    """``(N,) bool``: whether each of ``matrices (N, 4, 4)`` (row-major, as read) is affine, its
+    last row (0, 0, 0, 1) to rounding. A matrix written row-major into glTF's column-major
+    storage has its translation there."""
+    reach = np.maximum(1.0, np.linalg.norm(matrices[:, :3, 3], axis=-1))
+    tilt = np.abs(matrices[:, 3, :3]).max(axis=-1) * reach
+    return (tilt <= _AFFINE_TOLERANCE) & (np.abs(matrices[:, 3, 3] - 1.0) <= _AFFINE_TOLERANCE)
 
 
 def document_json(path: str | os.PathLike) -> dict:

@@ -107,3 +107,39 @@ def test_info_says_the_rate_the_clips_are_sampled_at(walk_at_60, capsys):
 
     assert main(["info", str(walk_at_60[0])]) == 0
     assert "1 animations, sampled at 60 fps" in capsys.readouterr().out
+
+
+def _keyed_later(source, path, seconds: float):
+    """``source`` with every key of its animations ``seconds`` later: a clip keyed late on a
+    timeline, which holds its first pose from 0 (Blender's actions keep their frame numbers)."""
+    from animlod.io.glb_builder import GlbBuilder
+
+    doc = GltfDocument(source)
+    builder = GlbBuilder.from_document(doc)
+    for animation in builder.json["animations"]:
+        for sampler in animation["samplers"]:
+            times = doc.accessor(sampler["input"], "test").astype(np.float64) + seconds
+            sampler["input"] = builder.add(times.astype(np.float32), bounds=True)
+    builder.save(path)
+    return path
+
+
+def test_a_clip_keyed_late_drives_and_measures_its_levels_where_it_moves(humanoid_glb, tmp_path):
+    # Its frames were spread from 0: nearly all of them the held first pose, so the levels were
+    # driven and measured on one pose (a character's coarsest level reported 23x below its error).
+    from animlod.io.gltf_drawable import read_drawables
+    from animlod.pipelines import simplify_document
+
+    late = _keyed_later(humanoid_glb, tmp_path / "late.glb", 20.0)
+    (clip,) = read_drawables(GltfDocument(late))[0].clips
+    (plain,) = read_drawables(GltfDocument(humanoid_glb))[0].clips
+    assert clip.start_frame == 20 * 30 and clip.frame_count == plain.frame_count + 600
+    np.testing.assert_array_equal(clip.spread(9), 600 + plain.spread(9))
+    settings = {"frame_budget": 12, "measured_frames": 4}
+    errors = [
+        [level.error for level in simplify_document(path, tmp_path / f"{path.stem}_lod.glb", [0.5, 0.2], **settings)
+         .drawables[0].levels]
+        for path in (humanoid_glb, late)
+    ]  # fmt: skip
+    assert errors[0][-1] > 0.0
+    np.testing.assert_allclose(errors[1], errors[0], rtol=1e-4)  # the keys' float32 times round at 20 s

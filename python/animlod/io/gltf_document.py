@@ -544,6 +544,13 @@ class GltfDocument:
         sets nothing: one of 10 s beside a 1.25 s clip made its levels hold still for 8.75 s."""
         return float(max((times.max(initial=0.0) for times in self._key_times(index)), default=0.0))
 
+    def animation_start(self, index: int) -> float:
+        """The first key time over the samplers that animation ``index``'s channels use. Before it
+        every channel holds its first key (glTF clamps to the keys' range), so a clip keyed late on
+        a timeline (Blender keeps an action's frame numbers unless told to slide it to 0) shows
+        one pose until then."""
+        return float(min((times.min(initial=np.inf) for times in self._key_times(index)), default=0.0))
+
     def sample_rate(self, fps: float | None = None) -> float:
         """``fps``, or where it is None the rate at which the document's clips are sampled: the
         highest of its clips' key rates (:func:`~.gltf_keyframes.key_sample_rate`), within 30 to

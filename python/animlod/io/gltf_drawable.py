@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pygltflib
 
-from ..model import Motion, SkinnedMesh, morphed
+from ..model import Motion, SkinnedMesh, morphed, spread_frames
 from .gltf_document import GltfDocument
 from .gltf_mesh import SINGULAR_DETERMINANT, TRIANGLES, MeshGeometry, read_mesh_geometry, transform_points
 from .gltf_read import morph_weight_tracks, node_weights, skinned_mesh_of_node
@@ -40,6 +40,8 @@ class Clip:
     motion : the skeleton's motion (skinned drawables; the rest pose held when the animation
         moves only morph weights), or None.
     morph_weights : (T, N) morph weights, or None when the animation does not drive them.
+    start_frame : the frame at or just before the animation's first key: the frames before it show
+        that key's pose (a clip keyed late on a timeline holds it from 0).
     """
 
     index: int
@@ -47,6 +49,12 @@ class Clip:
     frame_count: int
     motion: Motion | None = None
     morph_weights: np.ndarray | None = None
+    start_frame: int = 0
+
+    def spread(self, count: int) -> np.ndarray:
+        """At most ``count`` frame indices spread evenly from ``start_frame`` to the last frame:
+        the frames that drive and measure levels, none spent on a late clip's held first pose."""
+        return self.start_frame + spread_frames(self.frame_count - self.start_frame, count)
 
 
 @dataclass
@@ -240,5 +248,6 @@ def _clips(
         frame_count = motion.frame_count if motion is not None else len(weights)
         if motion is None and drawable.rig is not None:
             motion = drawable.rig.skeleton.rest_motion(frame_count, fps)
-        clips.append(Clip(index, animation.name or "", frame_count, motion, weights))
+        start = int(np.clip(np.floor(doc.animation_start(index) * fps), 0, frame_count - 1))
+        clips.append(Clip(index, animation.name or "", frame_count, motion, weights, start))
     return clips

@@ -465,3 +465,19 @@ def test_meshes_on_one_skin_are_measured_with_their_own_morph_weights(tmp_path, 
                                   head.clips[0].morph_weights[frames])  # fmt: skip
     assert head.clips[0].morph_weights[frames].max() > 0.5
     np.testing.assert_array_equal(pipeline._morph_weights(head.clips[0], teeth, frames), 0.0)
+
+
+def test_motion_levels_leave_out_a_mesh_only_a_hidden_scene_draws(humanoid_glb, tmp_path) -> None:
+    # A collision proxy on the body's skin, listed by a "physics" scene alone: joined into the one
+    # scene of the level GLBs, the proxy was drawn over the character.
+    builder = GlbBuilder.from_document(GltfDocument(humanoid_glb))
+    body = next(node for node in builder.json["nodes"] if "skin" in node)
+    mesh = builder.append("meshes", dict(builder.json["meshes"][body["mesh"]], name="proxy"))  # a mesh of its own
+    proxy = builder.append("nodes", {"name": "collision proxy", "mesh": mesh, "skin": body["skin"]})
+    builder.json["scenes"].append({"name": "physics", "nodes": [proxy]})
+    source = tmp_path / "with_proxy.glb"
+    builder.save(source)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    assert any(f"node {proxy} 'collision proxy' (in no scene a viewer shows)" in note for note in report.notes)
+    (skinned,) = read_gltf(tmp_path / "levels" / "with_proxy_lod0.glb").skinned_meshes
+    assert skinned.vertex_count == read_gltf(humanoid_glb).skinned_meshes[0].vertex_count

@@ -463,6 +463,16 @@ class GltfDocument:
             node = self.parents[node]
         return chain
 
+    def in_shown_scene(self, index: int) -> bool:
+        """Whether node ``index`` is drawn in the scene a viewer shows: the default ``scene``, else
+        the first, under one of its root nodes (a collision proxy listed by a "physics" scene
+        alone is not); every node is, in a file without scenes."""
+        scenes = self.gltf.scenes or []
+        if not scenes:
+            return True
+        roots = set(scenes[self.gltf.scene if self.gltf.scene is not None else 0].nodes or [])
+        return index in roots or any(a in roots for a in self.ancestors(index))
+
     def rest_trs(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Rest ``translation (3,)``, ``rotation (4,)`` and ``scale (3,)`` of node ``index``.
 

@@ -63,7 +63,8 @@ class WholeSkin:
 def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None], fps: float) -> WholeSkin:
     """The body of ``scene`` (``scene.body``) with every other skinned mesh on its skeleton joined
     to it, with its motions (sampled at ``fps``). Meshes stay out that lie on other joints, are
-    bound in another pose, or whose morph targets lack names where the others' have them. A part's
+    bound in another pose, whose morph targets lack names where the others' have them, or that
+    only a scene a viewer does not show draws (GltfDocument.in_shown_scene). A part's
     joints match the body's by node; bones of its own that move in its clips join the skeleton,
     the body read again with them, and ``note`` names them. Morph targets join by name
     (:func:`_joined_targets`), each part keeping the shape of its default weights."""
@@ -75,6 +76,9 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
         if index == scene.body:
             continue
         node, part_rig = scene.skinned_nodes[index], scene.skinned_rigs[index]
+        if not doc.in_shown_scene(node):  # the level GLBs have the one scene a viewer shows
+            left_out.append(f"{doc.node_label(node)} (in no scene a viewer shows)")
+            continue
         if not _targets_join(parts, mesh):
             left_out.append(f"{doc.node_label(node)} (unnamed morph targets beside named ones)")
             continue

@@ -176,3 +176,6 @@ def test_progress_tells_when_the_props_levels_are_collapsed_and_measured(charact
     assert lines[at + 1].startswith(f"{label}: collapsing over ") and lines[at + 2] == f"{label}: measuring 2 levels"
     (character,) = report.chains  # its geometry levels say when they collapse too
     assert any(line.startswith(f"{character}: collapsing over ") for line in lines[:at])
+    # The skeleton's motion levels say when their joints are chosen and each is re-fitted.
+    assert "skin 0: joints of 1 of 2 motion levels chosen (trial re-fits)" in lines
+    assert any(line.startswith("skin 0: re-fitting motion level 2 (") for line in lines)

@@ -219,8 +219,12 @@ def build_character(
             )
         say(f"skin {skin}: {levels} motion levels over {len(clips)} clips")
         chain = build_motion_chain(
-            tipped, levels=levels, solver=solver, workers=workers, analysis=analysis, trial_measure=trial_measure
-        )
+            tipped, levels=levels, solver=solver, workers=workers, analysis=analysis, trial_measure=trial_measure,
+            on_choice=lambda chosen, total, s=skin: say(f"skin {s}: joints of {chosen} of {total} motion levels "
+                                                        "chosen (trial re-fits)"),
+            on_level=lambda index, joints, s=skin: say(f"skin {s}: re-fitting motion level {index} ({joints} joints)")
+            if index > 0 else None,
+        )  # fmt: skip
         chain = without_skin_tips(chain, joined)
         motion_chains[skin] = _SkinMotion(chain, list(zip(clips, spans)), drawable.rig, joined)
     motion_seconds = time.perf_counter() - started

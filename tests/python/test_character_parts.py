@@ -480,4 +480,12 @@ def test_motion_levels_leave_out_a_mesh_only_a_hidden_scene_draws(humanoid_glb, 
     report = build_motion_levels(source, tmp_path / "levels", levels=2)
     assert any(f"node {proxy} 'collision proxy' (in no scene a viewer shows)" in note for note in report.notes)
     (skinned,) = read_gltf(tmp_path / "levels" / "with_proxy_lod0.glb").skinned_meshes
-    assert skinned.vertex_count == read_gltf(humanoid_glb).skinned_meshes[0].vertex_count
+    body_vertices = read_gltf(humanoid_glb).skinned_meshes[0].vertex_count
+    assert skinned.vertex_count == body_vertices
+    # Where the scene a viewer shows is not the body's, the scenes tell nothing: every part stays.
+    builder.json["scene"] = 1
+    builder.save(source)
+    report = build_motion_levels(source, tmp_path / "shown", levels=2)
+    assert not any("not in the levels' GLBs" in note for note in report.notes)
+    (skinned,) = read_gltf(tmp_path / "shown" / "with_proxy_lod0.glb").skinned_meshes
+    assert skinned.vertex_count == 2 * body_vertices

@@ -64,7 +64,8 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
     """The body of ``scene`` (``scene.body``) with every other skinned mesh on its skeleton joined
     to it, with its motions (sampled at ``fps``). Meshes stay out that lie on other joints, are
     bound in another pose, whose morph targets lack names where the others' have them, or that
-    only a scene a viewer does not show draws (GltfDocument.in_shown_scene). A part's
+    only a scene a viewer does not show draws where the body is in the one it shows
+    (GltfDocument.in_shown_scene). A part's
     joints match the body's by node; bones of its own that move in its clips join the skeleton,
     the body read again with them, and ``note`` names them. Morph targets join by name
     (:func:`_joined_targets`), each part keeping the shape of its default weights."""
@@ -72,11 +73,12 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
                                      scene.skinned_rigs[scene.body], scene.skinned_nodes[scene.body])  # fmt: skip
     parts, part_nodes, vertex_spaces = [body], [body_node], [skinned_mesh_space(doc.rest_world_matrix(body_node))]
     left_out = []
+    body_shown = doc.in_shown_scene(body_node)  # a body in another scene only: every part stays in
     for index, mesh in enumerate(scene.skinned_meshes):
         if index == scene.body:
             continue
         node, part_rig = scene.skinned_nodes[index], scene.skinned_rigs[index]
-        if not doc.in_shown_scene(node):  # the level GLBs have the one scene a viewer shows
+        if body_shown and not doc.in_shown_scene(node):  # the level GLBs have the body's scene alone
             left_out.append(f"{doc.node_label(node)} (in no scene a viewer shows)")
             continue
         if not _targets_join(parts, mesh):

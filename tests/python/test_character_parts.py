@@ -489,3 +489,31 @@ def test_motion_levels_leave_out_a_mesh_only_a_hidden_scene_draws(humanoid_glb, 
     assert not any("not in the levels' GLBs" in note for note in report.notes)
     (skinned,) = read_gltf(tmp_path / "shown" / "with_proxy_lod0.glb").skinned_meshes
     assert skinned.vertex_count == 2 * body_vertices
+
+
+def test_motion_names_the_joint_a_part_on_bones_of_its_own_alone_hangs_from(humanoid_glb, tmp_path) -> None:
+    # A cape whose skin lists its own bone alone, hung from the body's Head in the node tree
+    # (RecursiveSkeletons' layout): left out as "on another skeleton", as a second character is.
+    doc = GltfDocument(humanoid_glb)
+    builder = GlbBuilder.from_document(doc)
+    nodes = builder.json["nodes"]
+    head = next(index for index, node in enumerate(nodes) if node.get("name") == "Head")
+    bone = builder.append("nodes", {"name": "Cape", "translation": [0.0, 0.1, 0.0]})
+    nodes[head].setdefault("children", []).append(bone)
+    bind = doc.rest_world_matrix(head) @ np.array([[1, 0, 0, 0], [0, 1, 0, 0.1], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+    inverse = np.linalg.inv(bind).T.reshape(1, 16).astype(np.float32)  # column-major storage
+    skin = builder.append("skins", {"joints": [bone], "inverseBindMatrices": builder.add(inverse)})
+    positions, faces = _box(bind[:3, 3], 0.05)
+    attributes = {"POSITION": builder.add(positions, bounds=True),
+                  "JOINTS_0": builder.add(np.zeros((len(positions), 4), np.uint16)),
+                  "WEIGHTS_0": builder.add(np.tile(np.float32([1, 0, 0, 0]), (len(positions), 1)))}  # fmt: skip
+    mesh = builder.append(
+        "meshes", {"primitives": [{"attributes": attributes, "indices": builder.add(faces.reshape(-1, 1))}]}
+    )
+    cape = builder.append("nodes", {"name": "cape", "mesh": mesh, "skin": skin})
+    builder.json["scenes"][0]["nodes"].append(cape)
+    source = tmp_path / "caped.glb"
+    builder.save(source)
+    report = build_motion_levels(source, tmp_path / "levels", levels=2)
+    assert any(f"node {cape} 'cape' (its skin lists only bones below node {head} 'Head', none of the skeleton's "
+               "joints)" in note for note in report.notes)  # fmt: skip

@@ -100,8 +100,11 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
             parts.append(moved_onto(mesh, body, placement))
             part_nodes.append(node)
             vertex_spaces.append(placement.transform @ skinned_mesh_space(doc.rest_world_matrix(node)))
-        elif set(part_rig.joint_nodes).isdisjoint(rig.joint_nodes):  # a second character
-            left_out.append(f"{doc.node_label(node)} (on another skeleton)")
+        elif set(part_rig.joint_nodes).isdisjoint(rig.joint_nodes):  # a second character, or bones hung from it
+            above = next((a for j in part_rig.joint_nodes for a in doc.ancestors(j) if a in rig.joint_nodes), None)
+            why = "on another skeleton" if above is None else (
+                f"its skin lists only bones below {doc.node_label(above)}, none of the skeleton's joints")  # fmt: skip
+            left_out.append(f"{doc.node_label(node)} ({why})")
         else:
             left_out.append(f"{doc.node_label(node)} (on other joints or bound in another pose)")
     parts[0] = body

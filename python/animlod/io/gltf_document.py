@@ -515,9 +515,7 @@ class GltfDocument:
                 raise self.fail(self.node_label(index), "matrix must be 16 finite numbers")
             matrix = matrix.reshape(4, 4).T  # glTF stores column-major
             if not affine_rows(matrix[None])[0]:  # glTF asks for a matrix made of TRS
-                row = ", ".join(f"{v:.6g}" for v in matrix[3])
-                raise self.fail(self.node_label(index), f"matrix has a last row of ({row}), not (0, 0, 0, 1); "
-                                "written row-major instead of column-major?")  # fmt: skip
+                raise self.fail(self.node_label(index), f"matrix {last_row_fault(matrix)}")
             return matrix
         translation, rotation, scale = self.rest_trs(index)
         return rotations.compose_transform(translation, rotation, scale)
@@ -687,6 +685,12 @@ def affine_rows(matrices: np.ndarray) -> np.ndarray:
     reach = np.maximum(1.0, np.linalg.norm(matrices[:, :3, 3], axis=-1))
     tilt = np.abs(matrices[:, 3, :3]).max(axis=-1) * reach
     return (tilt <= _AFFINE_TOLERANCE) & (np.abs(matrices[:, 3, 3] - 1.0) <= _AFFINE_TOLERANCE)
+
+
+def last_row_fault(matrix: np.ndarray) -> str:
+    """What is wrong with a ``(4, 4)`` matrix :func:`affine_rows` refuses, for an error message."""
+    row = ", ".join(f"{v:.6g}" for v in matrix[3])
+    return f"has a last row of ({row}), not (0, 0, 0, 1); written row-major instead of column-major?"
 
 
 def document_json(path: str | os.PathLike) -> dict:

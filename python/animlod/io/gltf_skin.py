@@ -40,7 +40,14 @@ import numpy as np
 
 from .. import rotations
 from ..model import Motion, Skeleton
-from .gltf_document import LIGHTS_EXTENSION, NODE_PATHS, UNIFORM_SCALE_TOLERANCE, GltfDocument, affine_rows
+from .gltf_document import (
+    LIGHTS_EXTENSION,
+    NODE_PATHS,
+    UNIFORM_SCALE_TOLERANCE,
+    GltfDocument,
+    affine_rows,
+    last_row_fault,
+)
 from .gltf_keyframes import sample_keyframes
 
 # Animated bone offsets within this fraction of the skeleton's largest rest offset of their
@@ -262,10 +269,8 @@ class SkinRig:
         projective = np.flatnonzero(~affine_rows(matrices[:count]))
         if projective.size:  # a row-major write puts the translation there: skinning ran on w != 1
             slot = int(projective[0])
-            row = ", ".join(f"{v:.6g}" for v in matrices[slot, 3])
-            reason = f"inverse bind matrix of joint {slot} ({doc.node_label(skin.joints[slot])}) has a last row of "
-            raise doc.fail(f"{self.element} inverseBindMatrices", reason + f"({row}), not (0, 0, 0, 1); written "
-                           "row-major instead of column-major?")  # fmt: skip
+            reason = f"inverse bind matrix of joint {slot} ({doc.node_label(skin.joints[slot])}) "
+            raise doc.fail(f"{self.element} inverseBindMatrices", reason + last_row_fault(matrices[slot]))
         # Skinning and re-skinning invert these; a singular one must be named here, not fail
         # later as a bare "Singular matrix". Volume of the columns relative to their lengths:
         # 1 for a rotation-scale, 0 for a flattened matrix.

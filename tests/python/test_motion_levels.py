@@ -233,7 +233,7 @@ def test_cli_unknown_ranking_is_one_line(tmp_path, capsys) -> None:
     err = capsys.readouterr().err.strip()
     assert err == (
         f"animlod motion: error: {source}: ranking: no ranking named 'alphabetical' (choose from refit, importance, "
-        "paper, depth, variance, cumulative)"
+        "paper, depth, variance, cumulative, spread)"
     )
 
 

@@ -11,9 +11,10 @@ from animlod import _core, rotations
 from animlod.model import Motion, Skeleton
 from animlod.motion_lod import RANKINGS, analyze_motion, build_motion_chain, level_joint_counts
 from animlod.motion_lod.chain import build_level
+from animlod.motion_lod.clips import join_clips
 from animlod.motion_lod.frozen import freeze, frozen_motion
-from animlod.motion_lod.ranking import PROPOSING_RANKINGS, joint_depths, rotation_variance
-from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR, choose_by_refit, proposal_orders
+from animlod.motion_lod.ranking import PROPOSING_RANKINGS, joint_depths, rotation_variance, spread_steps
+from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR, choose_by_refit, proposers
 from animlod.synth import humanoid, humanoid_motion
 
 
@@ -71,7 +72,9 @@ def test_depth_and_variance_orders() -> None:
 
 
 def test_an_unknown_ranking_is_refused_by_name() -> None:
-    expected = r"ranking: no ranking named 'abc' \(choose from refit, importance, paper, depth, variance, cumulative\)"
+    expected = (
+        r"ranking: no ranking named 'abc' \(choose from refit, importance, paper, depth, variance, cumulative, spread\)"
+    )
     with pytest.raises(ValueError, match=expected):
         analyze_motion(figure_motion(), ranking="abc")
 
@@ -106,7 +109,7 @@ def test_the_core_cumulative_ranking_names_bad_arrays() -> None:
 def test_refit_choice_takes_the_proposal_with_the_lowest_trial_error_and_stays_nested() -> None:
     motion = figure_motion()
     analysis = analyze_motion(motion)
-    orders = proposal_orders(motion, analysis)
+    orders = [propose([]) for propose in proposers(motion, analysis)]
     assert len(orders) == len(PROPOSING_RANKINGS) and all(sorted(o) == sorted(analysis.priority) for o in orders)
     depth_first = orders[PROPOSING_RANKINGS.index("depth")]
     counts = level_joint_counts(motion, analysis, [12, 10, 7, 3])
@@ -160,3 +163,73 @@ def test_refit_choice_is_no_worse_than_any_proposal_where_they_first_differ() ->
     for name in PROPOSING_RANKINGS:
         other = build_motion_chain(motion, counts, ranking=name).levels[1].report.mean_error
         assert default <= other * (1 + 1e-6) + 1e-12, name
+
+
+def test_spread_freezes_the_joint_that_makes_the_cheapest_run_of_frozen_joints() -> None:
+    # Against the definition, run by run: a random tree, random importances, some joints frozen
+    # before and some never candidates.
+    rng = np.random.default_rng(4)
+    count = 40
+    parents = np.array([-1] + [int(rng.integers(0, j)) for j in range(1, count)])
+    importance = rng.random(count)
+    candidates = rng.random(count) < 0.8
+    candidates[0] = False
+    frozen = [int(j) for j in np.flatnonzero(candidates)[:5]]
+    steps = spread_steps(importance, parents, candidates, frozen)
+    assert np.all(np.isinf(steps[frozen])) and np.all(np.isinf(steps[~candidates]))
+
+    def run_cost(frozen_set: set[int], joint: int) -> float:  # the run holding joint, walked
+        seen, stack = set(), [joint]
+        while stack:
+            joint = stack.pop()
+            if joint in seen or joint not in frozen_set:
+                continue
+            seen.add(joint)
+            stack += [int(parents[joint])] if joint else []
+            stack += [int(c) for c in np.flatnonzero(parents == joint)]
+        return float(importance[list(seen)].sum())
+
+    done = list(frozen)
+    for joint in np.argsort(steps)[: int(np.isfinite(steps).sum())]:
+        left = [j for j in np.flatnonzero(candidates) if j not in done]
+        costs = {j: run_cost(set(done) | {j}, j) for j in left}
+        assert costs[joint] == pytest.approx(min(costs.values()), rel=1e-12)
+        assert joint == min(j for j in left if costs[j] <= min(costs.values()) * (1 + 1e-12))
+        done.append(int(joint))
+
+
+def chain_clips(joints: int = 20, wave_frames: int = 60) -> tuple[Motion, list[slice]]:
+    """A tail of ``joints`` joints in a row: a wave running down all of it, then a short curl of
+    its first half alone (the hunt's 60-joint tail, smaller)."""
+    skeleton = Skeleton(
+        [f"J{j}" for j in range(joints)] + ["J_End"],
+        list(range(-1, joints)),
+        [[0.0, 0.0, 0.0]] + [[0.0, 0.1, 0.0]] * joints,
+        end_sites=[False] * joints + [True],
+    )
+    t = np.arange(wave_frames) / 12.0
+    wave = rotations.identity((wave_frames, joints + 1))
+    for j in range(1, joints):
+        wave[:, j] = rotations.from_axis_angle(Z, 0.15 * np.sin(2 * np.pi * (t - 0.03 * j)))
+    curl = rotations.identity((12, joints + 1))
+    turn = rotations.from_axis_angle(np.array([1.0, 0.0, 0.0]), 0.1 * np.sin(np.pi * t[:12]))
+    curl[:, 1 : joints // 2] = turn[:, None]
+    return join_clips(
+        [Motion(skeleton, np.zeros((len(r), 3)), r, fps=12.0, name=n) for n, r in (("wave", wave), ("curl", curl))]
+    )
+
+
+def test_refit_choice_spreads_the_freezes_of_a_tail_whose_half_a_short_clip_also_moves() -> None:
+    # The curl raises Eq. 3's importance of the first half a little, so Eq. 3 (and every other
+    # proposal) froze the whole second half at once, one rigid piece; spread keeps every other
+    # joint or so and the re-fit bends the tail through them.
+    motion, spans = chain_clips()
+    counts = [20, 8]
+    errors = {}
+    for ranking in ("refit", "importance", "spread"):
+        chain = build_motion_chain(motion, counts, analysis=analyze_motion(motion, clips=spans, ranking=ranking))
+        errors[ranking] = chain.levels[1].report.mean_error
+        kept = np.flatnonzero(~chain.levels[1].frozen.frozen & ~motion.skeleton.end_sites)
+        if ranking != "importance":
+            assert np.diff(kept).max() <= 3, (ranking, kept)
+    assert errors["refit"] <= errors["spread"] * (1 + 1e-9) < 0.5 * errors["importance"], errors

@@ -44,8 +44,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "joints the other rankings propose, those with the lowest error after a trial re-fit on 16 frames: the "
         "skin's mean distance for a skinned glTF, the joints' otherwise), "
         "importance (Eq. 3 with zero-length bones measured through the joints below them), paper (Eq. 3 as "
-        "printed), depth (deepest first), variance (least rotation first) or cumulative (least movement of the "
-        "whole figure with the joints before it frozen)",
+        "printed), depth (deepest first), variance (least rotation first), cumulative (least movement of the "
+        "whole figure with the joints before it frozen) or spread (least Eq. 3 importance summed over the run of "
+        "connected frozen joints a freeze makes)",
     )  # fmt: skip
     parser.add_argument(
         "--solver",

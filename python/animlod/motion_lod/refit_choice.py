@@ -31,7 +31,7 @@ import numpy as np
 from ..model import Motion, spread_frames
 from .analysis import MotionAnalysis
 from .frozen import FrozenLevel, freeze
-from .ranking import PROPOSING_RANKINGS, elimination_order, rank_scores
+from .ranking import PROPOSING_RANKINGS, elimination_order, rank_scores, spread_steps
 
 # Frames each proposal is re-fitted on: the error is a mean over frames, and the proposals of one
 # level differ by whole joints, so a few frames tell them apart (the chain re-fits every frame).
@@ -42,14 +42,28 @@ TRIAL_FRAMES = 16
 NEGLIGIBLE_ERROR = 1e-7
 
 
-def proposal_orders(motion: Motion, analysis: MotionAnalysis) -> list[list[int]]:
-    """The elimination order of every ranking of PROPOSING_RANKINGS over the analysis's candidates."""
+def proposers(motion: Motion, analysis: MotionAnalysis) -> list[Callable[[list[int]], list[int]]]:
+    """For every ranking of PROPOSING_RANKINGS, a function giving its elimination order of the
+    analysis's candidates left after the given frozen joints. ``spread`` is asked again from what
+    is frozen (its costs are runs of frozen joints); the others' orders do not change with it."""
     candidates = np.zeros(motion.skeleton.joint_count, bool)
     candidates[analysis.priority] = True
+
+    def after(order: list[int]) -> Callable[[list[int]], list[int]]:
+        return lambda frozen: [j for j in order if j not in frozen]
+
+    def spread(frozen: list[int]) -> list[int]:
+        steps = spread_steps(analysis.importance, motion.skeleton.parents, candidates, frozen)
+        return elimination_order(steps, np.isfinite(steps))
+
     return [
-        elimination_order(
-            rank_scores(name, motion, analysis.importance, analysis.key_frames, analysis.frames, candidates),
-            candidates,
+        spread
+        if name == "spread"
+        else after(
+            elimination_order(
+                rank_scores(name, motion, analysis.importance, analysis.key_frames, analysis.frames, candidates),
+                candidates,
+            )
         )
         for name in PROPOSING_RANKINGS
     ]
@@ -78,7 +92,7 @@ def choose_by_refit(
     -------
     MotionAnalysis whose ``priority`` freezes, for each count, the chosen joints first.
     """
-    orders = proposal_orders(motion, analysis)
+    proposing = proposers(motion, analysis)
     frames = spread_frames(motion.frame_count, TRIAL_FRAMES)
     frozen: list[int] = []
     hidden = [j for j in analysis.hidden if not motion.skeleton.end_sites[j]]
@@ -87,8 +101,8 @@ def choose_by_refit(
         frozen += [j for j in hidden if j not in frozen][: counts[0] - count - len(frozen)]
         need = counts[0] - count - len(frozen)
         proposals: list[list[int]] = []
-        for order in orders:
-            proposal = [j for j in order if j not in frozen][:need]
+        for propose in proposing:
+            proposal = propose(frozen)[:need]
             if proposal and sorted(proposal) not in [sorted(p) for p in proposals]:
                 proposals.append(proposal)
         if len(proposals) > 1:

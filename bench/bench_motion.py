@@ -26,7 +26,9 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]`` (part of ``make bench`
 5. Joint choice: mean (and max) joint position error over every original joint and frame after
    the same re-fit, per level, for every ranking: the default (a trial re-fit per level), Eq. 3 with
    zero-length bones looked through, the paper's Eq. 3 as printed, leaf-first by depth, least
-   rotation variance and cumulative.
+   rotation variance, cumulative and spread; on every clip of table 1 and on figures with long
+   chains (the speed table's two, and :func:`animlod.synth.tail_clips`: a tail of 40 joints with
+   a clip that moves all of it and one that moves its first half).
 
 Wall times depend on what else runs on the machine; the load average is printed first and CPU
 seconds (all threads of this process) are given beside wall seconds.
@@ -60,7 +62,7 @@ from animlod.motion_lod.objective import build_problem
 from animlod.motion_lod.refit import refit_slsqp
 from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR
 from animlod.options import MotionRefitOptions
-from animlod.synth import humanoid, humanoid_motion
+from animlod.synth import humanoid, humanoid_motion, tail_clips
 
 # The core's SLSQP in the Python reference's variables (no preconditioner, every point a variable).
 PLAIN = MotionRefitOptions(precondition=False, eliminate_points=False)
@@ -107,6 +109,14 @@ def clips_end_to_end(path: Path) -> Motion:
     first = motions[0]
     same = [m for m in motions if m.skeleton.names == first.skeleton.names and m.fps == first.fps]
     return Motion.concatenate(same, f"{path.stem} clips")
+
+
+def chain_figures(frames: int) -> list[tuple[str, Motion]]:
+    """Figures with long chains of joints, which the dev clips lack: hair and a tail on a body."""
+    return [
+        ("hair: 10 chains of 7 on the head", hanging_chains(10, 7, frames)),
+        ("tail: one chain of 40", hanging_chains(1, 40, frames)),
+    ]
 
 
 def hanging_chains(strands: int, length: int, frames: int = 300) -> Motion:
@@ -220,8 +230,7 @@ def speed_table(quick: bool) -> None:
     if xbot.exists() and not quick:  # captured fingers: 67 joints, 30 of them in the hands
         cases.append(("Xbot.glb, its clips end to end", clips_end_to_end(xbot)))
     frames = 30 if quick else 150
-    cases.append(("hair: 10 chains of 7 on the head", hanging_chains(10, 7, frames)))
-    cases.append(("tail: one chain of 40", hanging_chains(1, 40, frames)))
+    cases += chain_figures(frames)
     runs = [(label, motion, threads, ranking) for label, motion in cases
             for threads, ranking in ((0, "refit"), (0, "importance"))]  # fmt: skip
     if cases[0][0] == "131_01.bvh":
@@ -372,6 +381,9 @@ def main() -> None:
     for label, motion in all_clips:
         # At most ~250 frames: the comparison needs the joints' motion, not every frame of it.
         ranking_table(label, subsample(motion, max(1, motion.frame_count // 250)))
+    two_clips = ("tail of 40 joints: a wave, then a curl of its first half", tail_clips(40, 120, 24.0)[0])
+    for label, motion in chain_figures(30 if args.quick else 150) + [two_clips]:
+        ranking_table(label, motion)
 
 
 if __name__ == "__main__":

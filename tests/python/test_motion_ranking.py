@@ -11,11 +11,10 @@ from animlod import _core, rotations
 from animlod.model import Motion, Skeleton
 from animlod.motion_lod import RANKINGS, analyze_motion, build_motion_chain, level_joint_counts
 from animlod.motion_lod.chain import build_level
-from animlod.motion_lod.clips import join_clips
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.ranking import PROPOSING_RANKINGS, joint_depths, rotation_variance, spread_steps
 from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR, choose_by_refit, proposers
-from animlod.synth import humanoid, humanoid_motion
+from animlod.synth import humanoid, humanoid_motion, tail_clips
 
 
 def zero_length_motion(frames: int = 20) -> Motion:
@@ -198,32 +197,11 @@ def test_spread_freezes_the_joint_that_makes_the_cheapest_run_of_frozen_joints()
         done.append(int(joint))
 
 
-def chain_clips(joints: int = 20, wave_frames: int = 60) -> tuple[Motion, list[slice]]:
-    """A tail of ``joints`` joints in a row: a wave running down all of it, then a short curl of
-    its first half alone (the hunt's 60-joint tail, smaller)."""
-    skeleton = Skeleton(
-        [f"J{j}" for j in range(joints)] + ["J_End"],
-        list(range(-1, joints)),
-        [[0.0, 0.0, 0.0]] + [[0.0, 0.1, 0.0]] * joints,
-        end_sites=[False] * joints + [True],
-    )
-    t = np.arange(wave_frames) / 12.0
-    wave = rotations.identity((wave_frames, joints + 1))
-    for j in range(1, joints):
-        wave[:, j] = rotations.from_axis_angle(Z, 0.15 * np.sin(2 * np.pi * (t - 0.03 * j)))
-    curl = rotations.identity((12, joints + 1))
-    turn = rotations.from_axis_angle(np.array([1.0, 0.0, 0.0]), 0.1 * np.sin(np.pi * t[:12]))
-    curl[:, 1 : joints // 2] = turn[:, None]
-    return join_clips(
-        [Motion(skeleton, np.zeros((len(r), 3)), r, fps=12.0, name=n) for n, r in (("wave", wave), ("curl", curl))]
-    )
-
-
 def test_refit_choice_spreads_the_freezes_of_a_tail_whose_half_a_short_clip_also_moves() -> None:
     # The curl raises Eq. 3's importance of the first half a little, so Eq. 3 (and every other
     # proposal) froze the whole second half at once, one rigid piece; spread keeps every other
     # joint or so and the re-fit bends the tail through them.
-    motion, spans = chain_clips()
+    motion, spans = tail_clips()
     counts = [20, 8]
     errors = {}
     for ranking in ("refit", "importance", "spread"):

@@ -5,7 +5,8 @@
 - :func:`face` and :func:`face_animation`: a head with named animation regions;
 - :func:`bending_cylinder`, :func:`twisting_bar`, :func:`translating_mesh`,
   :func:`kicking_box_leg`: small deforming meshes with known motion for unit tests;
-- :func:`icosphere`: a geodesic sphere.
+- :func:`icosphere`: a geodesic sphere;
+- :func:`tail_clips`: a joint chain with a clip that moves all of it and one that moves half.
 """
 
 from .deforming import bending_cylinder, bending_cylinder_skinned, kicking_box_leg, translating_mesh, twisting_bar
@@ -14,6 +15,7 @@ from .face_model import REGION_NAMES, STILL_REGIONS, FaceModel, face
 from .gait import KINDS, STILL_FINGER_CHAIN, humanoid_motion, humanoid_with_clips
 from .geometry import icosphere
 from .humanoid_body import END_SITES, humanoid, humanoid_skeleton
+from .tail import tail_clips
 
 __all__ = [
     "END_SITES",
@@ -32,6 +34,7 @@ __all__ = [
     "humanoid_with_clips",
     "icosphere",
     "kicking_box_leg",
+    "tail_clips",
     "translating_mesh",
     "twisting_bar",
 ]

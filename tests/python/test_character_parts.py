@@ -41,12 +41,14 @@ def _with_part(
     plain: Path | None = None,
     targets: Sequence[str] = (),
     defaults: Sequence[float] | None = None,
+    hair_bone_alone: bool = False,
 ) -> Path:
     """The procedural humanoid walking (or the character of ``plain``), with a box over its head
     skinned by a skin of its own (bound in the body's pose): over Neck and Head, every vertex on
     Head; or with ``hair`` ("still" or "swinging") over Head and a bone "Hair" of its own below
-    it, every vertex on Hair. The box has a morph target of each name in ``targets``, with the
-    mesh's default weights ``defaults``."""
+    it, every vertex on Hair (over Hair alone with ``hair_bone_alone``: a skin that lists none of
+    the body's joints, as Khronos' RecursiveSkeletons). The box has a morph target of each name in
+    ``targets``, with the mesh's default weights ``defaults``."""
     if plain is None:
         plain = folder / "humanoid.glb"
         character = synth.humanoid()
@@ -67,6 +69,8 @@ def _with_part(
         bone = builder.append("nodes", {"name": "Hair", "translation": lift[:3, 3].tolist()})
         nodes[by_name["Head"]].setdefault("children", []).append(bone)
         joint_nodes, binds = [by_name["Head"], bone], [head_bind, np.linalg.inv(lift) @ head_bind]
+        if hair_bone_alone:
+            joint_nodes, binds = joint_nodes[1:], binds[1:]
         if hair == "swinging":
             animation = builder.json["animations"][0]
             keys = builder.json["accessors"][animation["samplers"][0]["input"]]["count"]
@@ -80,7 +84,7 @@ def _with_part(
     skin = builder.append("skins", {"joints": joint_nodes, "inverseBindMatrices": builder.add(matrices)})
     positions, faces = _box(doc.rest_world_matrix(by_name["Head"])[:3, 3] + [0.0, 0.1, 0.0], 0.12)
     joints = np.zeros((len(positions), 4), np.uint16)
-    joints[:, 0] = 1  # Head, or Hair
+    joints[:, 0] = len(joint_nodes) - 1  # Head, or Hair
     weights = np.zeros((len(positions), 4), np.float32)
     weights[:, 0] = 1.0
     attributes = {"POSITION": builder.add(positions, bounds=True), "JOINTS_0": builder.add(joints),
@@ -184,6 +188,24 @@ def test_swinging_hair_joins_the_bodys_skeleton(tmp_path) -> None:
             turns = level.motions[0].local_rotations[:, level.skeleton.names.index(bone)]
             swings.append(float(2.0 * np.arccos(np.clip(np.abs(turns @ turns[0]), 0.0, 1.0)).max()))
     assert len(swings) >= 2 and min(swings) > 0.5  # the input swings by 0.6 radians
+
+
+@pytest.mark.parametrize("hair", ["still", "swinging"])
+def test_hair_whose_skin_lists_its_own_bone_alone_plays_the_bodys_levels(tmp_path, hair) -> None:
+    # Its skin lists none of the body's joints, only a bone that hangs from the head in the node
+    # tree: it had levels of its own, posed by the input's head where the body's level froze it,
+    # and drifted off the body. It now plays the body's levels like hair that lists the head too:
+    # on the head where its bone holds still, its bone joining the body's skeleton where it swings.
+    source = _with_part(tmp_path, "own bone", hair=hair, hair_bone_alone=True)
+    output = tmp_path / "own_bone_lod.glb"
+    report = build_character(source, output, [0.5, 0.25, 0.1], solver="newton", **QUICK)
+    relation = (
+        "its joints hang from those of"
+        if hair == "still"
+        else "its own joints (node 42 'Hair') move in its clips and join"
+    )
+    assert f"skin 1: {relation} skin 0; it plays that skin's motion levels" in report.notes
+    assert _plays_the_bodys_levels(output, "own bone") >= 1
 
 
 def test_a_head_of_its_own_counts_in_the_choice_of_the_bodys_joints(tmp_path) -> None:
@@ -491,29 +513,10 @@ def test_motion_levels_leave_out_a_mesh_only_a_hidden_scene_draws(humanoid_glb, 
     assert skinned.vertex_count == 2 * body_vertices
 
 
-def test_motion_names_the_joint_a_part_on_bones_of_its_own_alone_hangs_from(humanoid_glb, tmp_path) -> None:
-    # A cape whose skin lists its own bone alone, hung from the body's Head in the node tree
-    # (RecursiveSkeletons' layout): left out as "on another skeleton", as a second character is.
-    doc = GltfDocument(humanoid_glb)
-    builder = GlbBuilder.from_document(doc)
-    nodes = builder.json["nodes"]
-    head = next(index for index, node in enumerate(nodes) if node.get("name") == "Head")
-    bone = builder.append("nodes", {"name": "Cape", "translation": [0.0, 0.1, 0.0]})
-    nodes[head].setdefault("children", []).append(bone)
-    bind = doc.rest_world_matrix(head) @ np.array([[1, 0, 0, 0], [0, 1, 0, 0.1], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-    inverse = np.linalg.inv(bind).T.reshape(1, 16).astype(np.float32)  # column-major storage
-    skin = builder.append("skins", {"joints": [bone], "inverseBindMatrices": builder.add(inverse)})
-    positions, faces = _box(bind[:3, 3], 0.05)
-    attributes = {"POSITION": builder.add(positions, bounds=True),
-                  "JOINTS_0": builder.add(np.zeros((len(positions), 4), np.uint16)),
-                  "WEIGHTS_0": builder.add(np.tile(np.float32([1, 0, 0, 0]), (len(positions), 1)))}  # fmt: skip
-    mesh = builder.append(
-        "meshes", {"primitives": [{"attributes": attributes, "indices": builder.add(faces.reshape(-1, 1))}]}
-    )
-    cape = builder.append("nodes", {"name": "cape", "mesh": mesh, "skin": skin})
-    builder.json["scenes"][0]["nodes"].append(cape)
-    source = tmp_path / "caped.glb"
-    builder.save(source)
-    report = build_motion_levels(source, tmp_path / "levels", levels=2)
-    assert any(f"node {cape} 'cape' (its skin lists only bones below node {head} 'Head', none of the skeleton's "
-               "joints)" in note for note in report.notes)  # fmt: skip
+@pytest.mark.parametrize("hair", ["still", "swinging"])
+def test_motion_levels_show_hair_whose_skin_lists_its_own_bone_alone(tmp_path, hair) -> None:
+    # A skin over a bone hung from the body's Head in the node tree and none of the body's joints
+    # (RecursiveSkeletons' layout) was left out as "on another skeleton", as a second character is.
+    source = _with_part(tmp_path, "own bone", hair=hair, hair_bone_alone=True)
+    notes = _motion_levels_show_every_skin(source, tmp_path / "levels")
+    assert any("has joints of its own that move in its clips" in note for note in notes) == (hair == "swinging")

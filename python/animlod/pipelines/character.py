@@ -12,7 +12,7 @@ too (``extras.animlod_grid`` on the base node lists them by geometry level, then
 so that a benchmark can walk the whole grid.
 
 A skin whose joints belong to a larger skin's (a helmet or visor on the head), or hang from
-them (hair bones), bound in the same pose, is a part (:mod:`.skin_parts`): it plays that skin's
+them (hair bones, listed with the head or alone), bound in the same pose, is a part (:mod:`.skin_parts`): it plays that skin's
 motion levels, on its reduced skeletons, and the chains of one skeleton switch at one distance.
 Its own bones that move in its clips join that skin's skeleton first. Motion level m >= 1 adds, per skin, a reduced
 skeleton as joint nodes of its own, a skin over them and one animation per input clip
@@ -82,7 +82,7 @@ from .drawable_levels import (
     split_empty,
 )
 from .lod_document import DEFAULT_RATIOS, DrawableReport, add_drawable_chain, drawable_report, empty_drawables_note
-from .skin_parts import JointKeys, Placement, joined_rig, moved_onto, placement_on
+from .skin_parts import JointKeys, Placement, hanging_rig, joined_rig, moved_onto, placement_on
 
 
 @dataclass
@@ -357,8 +357,11 @@ def _assign_skeletons(
             notes.append(f"skin {skin}: the joints of skin {twin}; it plays the same motion levels")
             continue
         owner = next((other for other in roles.owners if joints_of[skin] & joints_of[other]), None)
-        joined = played_clips[skin][1]
-        placement = None if owner is None else _placement(roles.owners[owner], drawable, joined)
+        alone = drawable
+        if owner is None:  # its bones may hang from an owner's joint in the node tree
+            owner, drawable = _hanging_from(doc, roles, drawable, joints_of, fps)
+        clips = played_clips[skin] if drawable is alone else _joined_clips(drawable)
+        placement = None if owner is None else _placement(roles.owners[owner], drawable, clips[1])
         relation = None
         if placement is None and owner is not None and _join(doc, roles, owner, drawable, animated, fps):
             own = sorted(set(drawable.rig.joint_nodes) - joints_of[owner])
@@ -367,6 +370,8 @@ def _assign_skeletons(
             played_clips[owner] = _joined_clips(roles.owners[owner])
             placement = _placement(roles.owners[owner], drawable)
         if placement is not None:
+            if drawable is not alone:
+                roles.rejoined[drawable.label], played_clips[skin] = drawable, clips
             roles.chain_of[skin] = owner
             roles.parts[skin] = _Part(roles.owners[owner].skinned, placement)
             if relation is None:
@@ -375,10 +380,23 @@ def _assign_skeletons(
                 )
             notes.append(f"skin {skin}: {relation} skin {owner}; it plays that skin's motion levels")
             continue
-        roles.chain_of[skin], roles.owners[skin] = skin, drawable
-        if owner is not None:
+        roles.chain_of[skin], roles.owners[skin] = skin, alone
+        if owner is not None and drawable is alone:
             roles.sharing[skin] = owner
     return roles
+
+
+def _hanging_from(
+    doc: GltfDocument, roles: _Roles, drawable: Drawable, joints_of: dict[int, set[int]], fps: float
+) -> tuple[int | None, Drawable]:
+    """The owner whose joint ``drawable``'s bones hang from in the node tree (its skin lists none
+    of that owner's joints), with ``drawable`` read again on its rig with that joint
+    (skin_parts.hanging_rig); (None, ``drawable``) where they hang from none."""
+    for owner in roles.owners:
+        rig = hanging_rig(doc, drawable.rig, joints_of[owner])
+        if rig is not None:
+            return owner, on_rig(doc, drawable, rig, fps)
+    return None, drawable
 
 
 def _placement(owner: Drawable, part: Drawable, motion: Motion | None = None) -> Placement | None:

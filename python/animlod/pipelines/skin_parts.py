@@ -8,6 +8,9 @@ one transform ``T`` for every joint its weights use (its mesh node's,
 :func:`animlod.io.gltf_read.skinned_mesh_of_node`); ``T`` moves into its vertices. Bones of the
 part's own that hold their bind pose fold into the joint above them (:func:`placement_on`);
 bones that move join the first skin's skeleton (:func:`joined_rig`), bound as the part binds them.
+A skin that lists none of the other's joints but hangs from one in the node tree (a cape or hair
+skin over its own bones alone, Khronos' RecursiveSkeletons) takes that joint first
+(:func:`hanging_rig`).
 """
 
 from __future__ import annotations
@@ -61,6 +64,28 @@ def placement_on(
         if not _alike(matrices[:, folded], matrices[:, lying.anchor[folded]]):
             return None
     return Placement(lying.joint_map, lying.transform)
+
+
+def hanging_rig(doc: GltfDocument, rig: SkinRig, joints: set[int]) -> SkinRig | None:
+    """``rig`` with the nearest of the nodes ``joints`` above its root joint (another skin's joint
+    that its bones hang from in the node tree) as an extra joint, so that :func:`placement_on` and
+    :func:`joined_rig` see where it meets that skin; None where its joints form several trees, lie
+    under none of ``joints`` or already list one. That joint is bound where the node tree's rest
+    pose puts it relative to the root joint's bind: ``IBM_anchor = L @ IBM_root``, ``L`` the rest
+    transforms of the nodes from the anchor down to the root. Exporters bind at the rest pose; a
+    part bound with its root elsewhere relative to that joint is placed off by as much."""
+    listed = doc.gltf.skins[rig.skin].joints
+    root = rig.joint_nodes[0]
+    if root not in listed or joints & set(listed) or rig.extra_joints:
+        return None
+    above = doc.ancestors(root)
+    anchor = next((i for i, node in enumerate(above) if node in joints), None)
+    if anchor is None:
+        return None
+    down = np.eye(4)
+    for node in reversed([root, *above[:anchor]]):  # the anchor's child first
+        down = down @ doc.rest_matrix(node)
+    return SkinRig(doc, rig.skin, [above[anchor]], (down @ rig.inverse_bind[0])[None])
 
 
 def joined_rig(

@@ -24,7 +24,7 @@ from ..io.gltf_skin import SkinRig
 from ..model import Motion, SkinnedMesh, morphed
 from ..motion_lod.clips import join_clips
 from ..normals import vertex_normals
-from .skin_parts import JointKeys, joined_rig, moved_onto, placement_on
+from .skin_parts import JointKeys, hanging_rig, joined_rig, moved_onto, placement_on
 from .surface_attributes import joined_surface, node_surface
 
 
@@ -66,7 +66,8 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
     bound in another pose, whose morph targets lack names where the others' have them, or that
     only a scene a viewer does not show draws where the body is in the one it shows
     (GltfDocument.in_shown_scene). A part's
-    joints match the body's by node; bones of its own that move in its clips join the skeleton,
+    joints match the body's by node (a part whose skin lists bones of its own alone meets it at the
+    joint they hang from, skin_parts.hanging_rig); bones of its own that move in its clips join the skeleton,
     the body read again with them, and ``note`` names them. Morph targets join by name
     (:func:`_joined_targets`), each part keeping the shape of its default weights."""
     body, motions, rig, body_node = (scene.skinned_meshes[scene.body], scene.skinned_motions[scene.body],
@@ -85,6 +86,10 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
             left_out.append(f"{doc.node_label(node)} (unnamed morph targets beside named ones)")
             continue
         clips = scene.skinned_motions[index]
+        hung = hanging_rig(doc, part_rig, set(rig.joint_nodes))
+        if hung is not None:  # its skin lists bones of its own alone, hung from one of the skeleton's joints
+            part_rig = hung
+            mesh, clips = read_skinned_node(doc, node, hung, fps)
         keys = JointKeys(rig.joint_nodes, part_rig.joint_nodes)
         placement = placement_on(body, mesh, keys, join_clips(clips)[0] if clips else None)
         with_bones = joined_rig(doc, rig, body, part_rig, mesh) if placement is None else None
@@ -100,11 +105,8 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
             parts.append(moved_onto(mesh, body, placement))
             part_nodes.append(node)
             vertex_spaces.append(placement.transform @ skinned_mesh_space(doc.rest_world_matrix(node)))
-        elif set(part_rig.joint_nodes).isdisjoint(rig.joint_nodes):  # a second character, or bones hung from it
-            above = next((a for j in part_rig.joint_nodes for a in doc.ancestors(j) if a in rig.joint_nodes), None)
-            why = "on another skeleton" if above is None else (
-                f"its skin lists only bones below {doc.node_label(above)}, none of the skeleton's joints")  # fmt: skip
-            left_out.append(f"{doc.node_label(node)} ({why})")
+        elif set(part_rig.joint_nodes).isdisjoint(rig.joint_nodes):  # a second character
+            left_out.append(f"{doc.node_label(node)} (on another skeleton)")
         else:
             left_out.append(f"{doc.node_label(node)} (on other joints or bound in another pose)")
     parts[0] = body

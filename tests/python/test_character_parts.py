@@ -504,13 +504,33 @@ def test_motion_levels_leave_out_a_mesh_only_a_hidden_scene_draws(humanoid_glb, 
     (skinned,) = read_gltf(tmp_path / "levels" / "with_proxy_lod0.glb").skinned_meshes
     body_vertices = read_gltf(humanoid_glb).skinned_meshes[0].vertex_count
     assert skinned.vertex_count == body_vertices
-    # Where the scene a viewer shows is not the body's, the scenes tell nothing: every part stays.
-    builder.json["scene"] = 1
+    # Where the scene a viewer shows does not draw the character (it sits in a later scene), the
+    # scenes tell nothing: every part stays.
+    builder.json["scenes"].append({"name": "lights", "nodes": []})
+    builder.json["scene"] = 2
     builder.save(source)
     report = build_motion_levels(source, tmp_path / "shown", levels=2)
     assert not any("not in the levels' GLBs" in note for note in report.notes)
     (skinned,) = read_gltf(tmp_path / "shown" / "with_proxy_lod0.glb").skinned_meshes
     assert skinned.vertex_count == 2 * body_vertices
+
+
+def test_the_body_is_a_mesh_the_shown_scene_draws(humanoid_glb, tmp_path) -> None:
+    # The same character drawn twice, on one skin: by its first node in a "physics" scene alone, and
+    # by a later node in the scene a viewer shows. The first in node order was the body (`motion`,
+    # `tdag build`).
+    builder = GlbBuilder.from_document(GltfDocument(humanoid_glb))
+    hidden = next(index for index, node in enumerate(builder.json["nodes"]) if "skin" in node)
+    original = builder.json["nodes"][hidden]
+    mesh = builder.append("meshes", dict(builder.json["meshes"][original["mesh"]], name="shown"))
+    shown = builder.append("nodes", {"name": "shown", "mesh": mesh, "skin": original["skin"]})
+    scene = builder.json["scenes"][0]
+    scene["nodes"] = [node for node in scene["nodes"] if node != hidden] + [shown]
+    builder.json["scenes"].append({"name": "physics", "nodes": [hidden]})
+    source = tmp_path / "drawn_twice.glb"
+    builder.save(source)
+    read = read_gltf(source)
+    assert read.skinned_nodes[read.body] == shown
 
 
 @pytest.mark.parametrize("hair", ["still", "swinging"])

@@ -134,15 +134,16 @@ def _skinned_mesh_nodes(doc: GltfDocument) -> list[int]:
 
 def body_node(doc: GltfDocument, nodes: list[int]) -> int:
     """The node of ``nodes`` that draws the character's body: the one whose skin lists the most
-    joints the animations move, then the most joints, the first in node order among equals. A
-    visor skinned to a few head joints, or hair to a hundred hair bones that only a runtime's
-    spring simulation moves, comes before the body in some files; its skeleton would leave the
-    body out."""
+    joints the animations move, then the most joints, then one the scene a viewer shows draws
+    (GltfDocument.in_shown_scene: a collision proxy on the body's skin that a "physics" scene
+    alone lists is not the body), the first in node order among equals. A visor skinned to a few
+    head joints, or hair to a hundred hair bones that only a runtime's spring simulation moves,
+    comes before the body in some files; its skeleton would leave the body out."""
     moved = doc.moved_nodes()
 
-    def size(node: int) -> tuple[int, int]:
+    def size(node: int) -> tuple[int, int, bool]:
         joints = doc.gltf.skins[doc.gltf.nodes[node].skin].joints
-        return sum(joint in moved for joint in joints), len(joints)
+        return sum(joint in moved for joint in joints), len(joints), doc.in_shown_scene(node)
 
     sizes = [size(node) for node in nodes]
     return nodes[sizes.index(max(sizes))]

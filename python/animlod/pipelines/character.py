@@ -12,9 +12,10 @@ too (``extras.animlod_grid`` on the base node lists them by geometry level, then
 so that a benchmark can walk the whole grid.
 
 A skin whose joints belong to a larger skin's (a helmet or visor on the head), or hang from
-them (hair bones, listed with the head or alone), bound in the same pose, is a part (:mod:`.skin_parts`): it plays that skin's
-motion levels, on its reduced skeletons, and the chains of one skeleton switch at one distance.
-Its own bones that move in its clips join that skin's skeleton first. Motion level m >= 1 adds, per skin, a reduced
+them (hair bones, listed with the head or alone), bound in the same pose, is a part
+(:mod:`.skin_parts`): it plays that skin's motion levels, on its reduced skeletons, and the
+chains of one skeleton switch at one distance. Its own bones that move in its clips join that
+skin's skeleton first. Motion level m >= 1 adds, per skin, a reduced
 skeleton as joint nodes of its own, a skin over them and one animation per input clip
 (``extras.animlod = {"clip", "motion_level", "skins"}``, the input skins that play it; named
 ``<clip>@motion<m>``, or ``<clip>@skin<s>@motion<m>`` where several skeletons have motion levels);

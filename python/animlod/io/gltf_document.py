@@ -559,6 +559,13 @@ class GltfDocument:
         one pose until then."""
         return float(min((times.min(initial=np.inf) for times in self._key_times(index)), default=0.0))
 
+    def animation_start_frame(self, index: int, fps: float) -> int:
+        """The frame at ``fps`` at or just before animation ``index``'s first key
+        (:meth:`animation_start`): the frames before it show that key's pose, so the clips start
+        there (frame k at ``(animation_start_frame + k) / fps``)."""
+        last = frame_count(self.animation_duration(index), fps) - 1
+        return int(np.clip(np.floor(self.animation_start(index) * fps), 0, last))
+
     def sample_rate(self, fps: float | None = None) -> float:
         """``fps``, or where it is None the rate at which the document's clips are sampled: the
         highest of its clips' key rates (:func:`~.gltf_keyframes.key_sample_rate`), within 30 to

@@ -36,12 +36,14 @@ class Clip:
     ----------
     index : the animation's index in the document.
     name : its name ("" when unnamed).
-    frame_count : T, samples at the drawable's fps.
+    frame_count : T, samples at the drawable's fps from ``start_frame``.
     motion : the skeleton's motion (skinned drawables; the rest pose held when the animation
         moves only morph weights), or None.
     morph_weights : (T, N) morph weights, or None when the animation does not drive them.
-    start_frame : the frame at or just before the animation's first key: the frames before it show
-        that key's pose (a clip keyed late on a timeline holds it from 0).
+    start_frame : the frame at or just before the animation's first key
+        (GltfDocument.animation_start_frame), where the clip's frames start: frame k is at
+        ``(start_frame + k) / fps``. A clip keyed late on a timeline (Blender keeps an action's
+        frame numbers) holds its first key's pose before it; those frames are left out.
     """
 
     index: int
@@ -52,9 +54,9 @@ class Clip:
     start_frame: int = 0
 
     def spread(self, count: int) -> np.ndarray:
-        """At most ``count`` frame indices spread evenly from ``start_frame`` to the last frame:
-        the frames that drive and measure levels, none spent on a late clip's held first pose."""
-        return self.start_frame + spread_frames(self.frame_count - self.start_frame, count)
+        """At most ``count`` frame indices spread evenly from the first frame to the last: the
+        frames that drive and measure levels."""
+        return spread_frames(self.frame_count, count)
 
 
 @dataclass
@@ -245,9 +247,12 @@ def _clips(
         weights = tracks.get(index)
         if motion is None and weights is None:
             continue
+        start = doc.animation_start_frame(index, fps)
+        if motion is not None:
+            motion = motion.take_frames(np.arange(start, motion.frame_count)) if start else motion
+        weights = weights[start:] if weights is not None else None
         frame_count = motion.frame_count if motion is not None else len(weights)
         if motion is None and drawable.rig is not None:
             motion = drawable.rig.skeleton.rest_motion(frame_count, fps)
-        start = int(np.clip(np.floor(doc.animation_start(index) * fps), 0, frame_count - 1))
         clips.append(Clip(index, animation.name or "", frame_count, motion, weights, start))
     return clips

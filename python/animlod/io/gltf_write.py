@@ -88,6 +88,7 @@ def write_glb(
     morph_weights: Sequence[np.ndarray | None] | None = None,
     hung: HungNodes | None = None,
     mesh_names: MeshNames = _SKINNED_MESH,
+    starts: Sequence[float] | None = None,
 ) -> None:
     """Write ``skinned`` and ``motions`` (on its skeleton) to the GLB file ``path``, atomically.
 
@@ -101,6 +102,7 @@ def write_glb(
     durations : per motion, the length of the glTF clip it was sampled from, or None (see
         :func:`add_animation`): its last frame is at the clip's end, which may fall less than a
         frame after the one before it.
+    starts : per motion, the time of its first frame (:func:`add_animation`), or None: 0.
     materials : the material of each of ``skinned``'s faces, or None (no material).
     morph_weights : per motion, (T, N) the weights of ``skinned``'s N morph targets at its T
         frames, written as a channel of the mesh node, or None.
@@ -117,6 +119,8 @@ def write_glb(
     names = _animation_names(motions, names)
     if durations is not None and len(durations) != len(motions):
         raise ValueError(f"durations: {len(durations)} given for {len(motions)} motions")
+    if starts is not None and len(starts) != len(motions):
+        raise ValueError(f"starts: {len(starts)} given for {len(motions)} motions")
     if skinned is None and not motions:
         raise ValueError("motions: a GLB without a skinned mesh needs a motion to give its skeleton")
     skeleton = motions[0].skeleton if skinned is None else skinned.skeleton
@@ -142,8 +146,9 @@ def write_glb(
         mesh = builder.append("meshes", _named(_mesh(builder, skinned, face_materials, surface), mesh_names.mesh))
         scene_nodes.append(builder.append("nodes", _named({"mesh": mesh, "skin": skin}, mesh_names.node)))
     animations = []
-    for motion, name, duration, track in zip(motions, names, durations or [None] * len(motions), weights):
-        animations.append(add_animation(builder, motion, joint_nodes, name, duration=duration))
+    timing = zip(durations or [None] * len(motions), starts or [0.0] * len(motions))
+    for motion, name, (duration, start), track in zip(motions, names, timing, weights):
+        animations.append(add_animation(builder, motion, joint_nodes, name, duration=duration, start=start))
         if track is not None:
             _add_weights_channel(builder, builder.json["animations"][animations[-1]], scene_nodes[-1], track)
     if hung is not None:
@@ -312,6 +317,7 @@ def add_animation(
     name: str,
     extras: dict | None = None,
     duration: float | None = None,
+    start: float = 0.0,
 ) -> int:
     """``motion`` as a LINEAR animation of ``joint_nodes`` (one per joint of its skeleton); its index.
     A rigid motion only: joint deformations have no TRS channels of their own (ValueError).
@@ -320,9 +326,11 @@ def add_animation(
     its end rather than on the frame grid (:func:`~.gltf_keyframes.frame_times`: a clip of 8.275 s
     at 30 fps ends ..., 8.2667, 8.275): the last key is put there, so that the animation lasts as
     long as the clip it stands for and a player that loops each by its own length keeps them in
-    step. It must come after the frame before the last (ValueError)."""
+    step. It must come after the frame before the last (ValueError). ``start``: the time of the
+    first frame (a glTF clip keyed late on its timeline is sampled from its first key,
+    GltfDocument.animation_start_frame), so that the animation plays when the clip did."""
     motion.require_rigid("a glTF animation of a skeleton")
-    times = np.arange(motion.frame_count) / motion.fps
+    times = start + np.arange(motion.frame_count) / motion.fps
     if duration is not None and motion.frame_count > 1:
         if not duration > times[-2]:
             raise ValueError(f"duration: {duration:g} s is not after the frame before the last ({times[-2]:g} s)")

@@ -231,7 +231,7 @@ def carry_other_channels(
     node (a material's colour) as they are. ``standalone``: for a file of its own, which holds
     of the document only the copies and its materials, textures, cameras and lights (at their
     indices): the channels of the copies and the pointers at those. The samplers reuse the
-    input's accessors: both clips' times start at 0."""
+    input's accessors: the level clip keeps the input clip's times (add_animation's ``start``)."""
     source = doc.json["animations"][animation]
     target = builder.json["animations"][level_animation]
     for channel, (node, path) in zip(source.get("channels", []), doc.channel_targets[animation]):

@@ -488,8 +488,8 @@ def _add_motion_levels(
             name = f"{clip.name or f'animation {clip.index}'}{suffix}"
             extras = {"animlod": {"clip": clip.index, "motion_level": m, "skins": list(skins)}}
             clip_motion = level.motion.take_frames(np.arange(span.start, span.stop))
-            duration = doc.animation_duration(clip.index)
-            animation = add_animation(builder, clip_motion, joint_nodes, name, extras, duration)
+            duration, start = doc.animation_duration(clip.index), clip.start_frame / clip_motion.fps
+            animation = add_animation(builder, clip_motion, joint_nodes, name, extras, duration, start)
             carry_other_channels(builder, doc, posing, clip.index, animation, copies)
         copy_level_chains(builder, doc, copies, suffix, m)
         nodes.append(_MotionLevelNodes(joint_nodes, level.report.joint_count))

@@ -235,7 +235,7 @@ def _drive_frames(drawable: Drawable, rest: np.ndarray, size: float, budget: int
         frames.append(undriven[None] + deltas)
     clips = drawable.clips
     remaining = max(budget - sum(len(f) for f in frames), 2 * len(clips))
-    lengths = np.array([clip.frame_count - clip.start_frame for clip in clips], np.float64)
+    lengths = np.array([clip.frame_count for clip in clips], np.float64)
     for clip, length, share in zip(clips, lengths, lengths / max(lengths.sum(), 1.0)):
         count = int(np.clip(round(share * remaining), 2, length))
         frames.append(drawable.clip_frames(clip, clip.spread(count)))

@@ -39,6 +39,7 @@ from ..options import MotionRefitOptions
 from .result import AssetResult, LevelRow, Progress
 
 if TYPE_CHECKING:
+    from ..io.gltf_document import GltfDocument
     from ..io.gltf_write import FaceMaterials
     from .motion_level_files import LevelContent
 
@@ -212,10 +213,10 @@ def build_motion_levels(
 
                 names.append(Path(f"{stem}_lod{index}.glb"))
                 clip_names, durations = [clip.name for clip in played], [clip.duration for clip in played]
-                weights = [clip.morph_weights for clip in played]
+                weights, starts = [clip.morph_weights for clip in played], [clip.start for clip in played]
                 hung = content.on_level(motion, level, played)
                 write_glb(staged / names[-1], level.skin, level_clips, clip_names, durations, materials, weights, hung,
-                          content.mesh_names)  # fmt: skip
+                          content.mesh_names, starts)  # fmt: skip
             files.append(names)
             rows.append(_manifest_row(level, index, names, played, skin_errors))
         # The runtime's level chooser: each level's largest joint position error in asset units
@@ -257,14 +258,16 @@ def _earlier_level_files(folder: Path, stem: str, written: set[str]) -> list[str
 class PlayedClip(NamedTuple):
     """A clip of the simplified motion: its name, its frames in the motion, and for a glTF clip
     its length in seconds (its last key, where its last frame is sampled), the
-    weights its channels give the skinned mesh's morph targets at its frames (T, N), if any, and
-    the document's animation it is (None for several joined into one)."""
+    weights its channels give the skinned mesh's morph targets at its frames (T, N), if any,
+    the document's animation it is (None for several joined into one) and the time of its first
+    frame (a clip keyed late on its timeline starts at its first key, not at 0)."""
 
     name: str
     frames: slice
     duration: float | None = None
     morph_weights: np.ndarray | None = None
     animation: int | None = None
+    start: float = 0.0
 
 
 class _Input(NamedTuple):
@@ -409,10 +412,10 @@ def _read_input(
         if len(rigid) > 1:
             note(f"{path}: its {len(rigid)} animations simplified together, one skeleton per level for all of "
                  "them (use --clip to take one)")  # fmt: skip
-            joined, spans = join_clips([motions[index] for index in rigid])
-            played = [PlayedClip(names[index], span, durations[index], morph_weights.get(animations[index]),
-                                 animations[index])
-                      for index, span in zip(rigid, spans)]  # fmt: skip
+            keyed = [_from_first_key(document, motions[i], animations[i], morph_weights, fps) for i in rigid]
+            joined, spans = join_clips([motion for motion, _, _ in keyed])
+            played = [PlayedClip(names[index], span, durations[index], weights, animations[index], start)
+                      for index, span, (_, weights, start) in zip(rigid, spans, keyed)]  # fmt: skip
             return _Input(joined, played, skin, materials, None, content)
         clip = rigid[0] if rigid else 0
     listed = ", ".join(f"{i}: {name!r}" for i, name in enumerate(names))
@@ -426,8 +429,24 @@ def _read_input(
         raise FormatError(path, "clip", f"the file has {len(motions)} animations that move the skeleton ({listed}), "
                                         f"got index {clip}")  # fmt: skip
     animation = animations[clip]
-    played = [PlayedClip(names[clip], slice(None), durations[clip], morph_weights.get(animation), animation)]
-    return _Input(_rigid(path, motions, range(clip, clip + 1), motions[clip]), played, skin, materials, None, content)
+    motion, weights, start = _from_first_key(document, motions[clip], animation, morph_weights, fps)
+    played = [PlayedClip(names[clip], slice(None), durations[clip], weights, animation, start)]
+    return _Input(_rigid(path, motions, range(clip, clip + 1), motion), played, skin, materials, None, content)
+
+
+def _from_first_key(
+    document: GltfDocument, motion: Motion, animation: int, morph_weights: dict[int, np.ndarray], fps: float
+) -> tuple[Motion, np.ndarray | None, float]:
+    """``motion`` (animation ``animation`` sampled from 0) and its morph weights from the frame at
+    or just before the animation's first key (GltfDocument.animation_start_frame), with that
+    frame's time: a clip keyed late on its timeline holds its first pose until then, and those
+    frames would be analysed, re-fitted and written for nothing."""
+    start = document.animation_start_frame(animation, fps)
+    weights = morph_weights.get(animation)
+    if not start:
+        return motion, weights, 0.0
+    kept = np.arange(start, motion.frame_count)
+    return motion.take_frames(kept), None if weights is None else weights[start:], start / fps
 
 
 def _clip_suffixes(names: list[str], room: int = LONGEST_NAME) -> list[str]:

@@ -65,10 +65,10 @@ def whole_skin(doc: GltfDocument, scene: GltfScene, note: Callable[[str], None],
     to it, with its motions (sampled at ``fps``). Meshes stay out that lie on other joints, are
     bound in another pose, whose morph targets lack names where the others' have them, or that
     only a scene a viewer does not show draws where the body is in the one it shows
-    (GltfDocument.in_shown_scene). A part's
-    joints match the body's by node (a part whose skin lists bones of its own alone meets it at the
-    joint they hang from, skin_parts.hanging_rig); bones of its own that move in its clips join the skeleton,
-    the body read again with them, and ``note`` names them. Morph targets join by name
+    (GltfDocument.in_shown_scene). A part's joints match the body's by node (a part whose skin
+    lists bones of its own alone meets it at the joint they hang from, skin_parts.hanging_rig);
+    bones of its own that move in its clips join the skeleton, the body read again with them, and
+    ``note`` names them. Morph targets join by name
     (:func:`_joined_targets`), each part keeping the shape of its default weights."""
     body, motions, rig, body_node = (scene.skinned_meshes[scene.body], scene.skinned_motions[scene.body],
                                      scene.skinned_rigs[scene.body], scene.skinned_nodes[scene.body])  # fmt: skip

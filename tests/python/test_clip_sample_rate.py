@@ -167,3 +167,14 @@ def test_motion_levels_of_a_clip_keyed_late_start_at_its_first_key(humanoid_glb,
     assert written.animation_start(0) == source.animation_start(0) == 20.0
     assert written.animation_duration(0) == source.animation_duration(0)
     assert len(written.sampler_keys(0, 0, 3, "test")[0]) == len(source.sampler_keys(0, 0, 3, "test")[0])
+
+
+def test_a_morph_animation_keyed_late_starts_at_its_first_key(data_dir, tmp_path):
+    # `tdag build` read a late clip's held first shape from 0 as frames of its own.
+    source = data_dir / "morph" / "Parrot.glb"
+    if not source.exists():
+        pytest.skip("Parrot.glb is not in the development data")
+    late = _keyed_later(source, tmp_path / "late.glb", 20.0)
+    (plain,), (moved,) = (read_gltf(path).morph_animations for path in (source, late))
+    assert moved.frame_count == plain.frame_count
+    np.testing.assert_allclose(moved.frames, plain.frames, atol=1e-3 * np.ptp(plain.frames))

@@ -271,7 +271,8 @@ def on_first_joint_when_unweighted(weights: np.ndarray) -> np.ndarray:
 
 def read_unskinned_meshes(doc: GltfDocument, fps: float | None = None) -> tuple[list[AnimatedMesh], list[AnimatedMesh]]:
     """Morph-animated meshes (one per node and animation, :attr:`GltfScene.morph_animations`,
-    sampled at ``fps``, None: at the rate of their keys) and static meshes
+    sampled at ``fps``, None: at the rate of their keys, from the frame at or just before the
+    animation's first key, GltfDocument.animation_start_frame) and static meshes
     (:attr:`GltfScene.static_meshes`), in world space."""
     fps = doc.sample_rate(fps)
     morphs, statics = [], []
@@ -287,8 +288,9 @@ def read_unskinned_meshes(doc: GltfDocument, fps: float | None = None) -> tuple[
         faces = geometry.faces[:, ::-1] if np.linalg.det(world[:3, :3]) < 0.0 else geometry.faces
         tracks = [] if geometry.targets is None else morph_weight_tracks(doc, node_index, len(geometry.targets), fps)
         for animation, weights in tracks:
-            worlds = _animated_world_matrices(doc, node_index, animation, fps)
-            positions = geometry.positions + np.einsum("tn,nvc->tvc", weights, geometry.targets)
+            start = doc.animation_start_frame(animation, fps)  # a late clip's held first pose left out
+            worlds = _animated_world_matrices(doc, node_index, animation, fps)[start:]
+            positions = geometry.positions + np.einsum("tn,nvc->tvc", weights[start:], geometry.targets)
             frames = positions @ np.swapaxes(worlds[:, :3, :3], 1, 2) + worlds[:, None, :3, 3]
             label = f"{doc.node_label(node_index)} {doc.animation_label(animation)}"
             morphs.append(_animated_mesh(doc, label, faces, frames, fps))

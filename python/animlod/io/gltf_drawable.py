@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pygltflib
 
-from ..model import Motion, SkinnedMesh, morphed, spread_frames
+from ..model import Motion, SkinnedMesh, morphed
 from .gltf_document import GltfDocument
 from .gltf_mesh import SINGULAR_DETERMINANT, TRIANGLES, MeshGeometry, read_mesh_geometry, transform_points
 from .gltf_read import morph_weight_tracks, node_weights, skinned_mesh_of_node
@@ -52,11 +52,6 @@ class Clip:
     motion: Motion | None = None
     morph_weights: np.ndarray | None = None
     start_frame: int = 0
-
-    def spread(self, count: int) -> np.ndarray:
-        """At most ``count`` frame indices spread evenly from the first frame to the last: the
-        frames that drive and measure levels."""
-        return spread_frames(self.frame_count, count)
 
 
 @dataclass

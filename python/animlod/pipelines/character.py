@@ -59,7 +59,7 @@ from ..io.gltf_skin import SkinRig
 from ..io.gltf_write import add_animation, add_skeleton, add_skin, influence_sets
 from ..io.stored_weights import normalise_stored_weights
 from ..metrics import hausdorff_distances
-from ..model import Motion, SkinnedMesh
+from ..model import Motion, SkinnedMesh, spread_frames
 from ..motion_lod import MotionLodChain, build_motion_chain, joint_floor
 from ..motion_lod.chain import MotionLevel
 from ..motion_lod.clips import join_clips
@@ -606,7 +606,7 @@ def _measure_chain(
     errors = [0.0] * len(chain)
     input_skin = _played(drawable.skinned, part)
     for clip, span in motion.clips:
-        frames = clip.spread(measured_frames)
+        frames = spread_frames(clip.frame_count, measured_frames)
         weights = _morph_weights(clip, drawable, frames)
         clip_frames = clip.motion.take_frames(frames)
         original = input_skin.bake(clip_frames, weights)

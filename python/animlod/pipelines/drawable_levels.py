@@ -31,7 +31,7 @@ from ..io.gltf_lod import PrimitiveArrays
 from ..io.gltf_mesh import PrimitiveGeometry, transform_points
 from ..io.gltf_write import influence_sets
 from ..metrics import hausdorff_distances
-from ..model import AnimatedMesh, SkinnedMesh, morphed
+from ..model import AnimatedMesh, SkinnedMesh, morphed, spread_frames
 from ..normals import corner_normals, pairs_within_groups, shading_crease, unit_vectors
 from ..options import AqemOptions
 
@@ -236,9 +236,9 @@ def _drive_frames(drawable: Drawable, rest: np.ndarray, size: float, budget: int
     clips = drawable.clips
     remaining = max(budget - sum(len(f) for f in frames), 2 * len(clips))
     lengths = np.array([clip.frame_count for clip in clips], np.float64)
-    for clip, length, share in zip(clips, lengths, lengths / max(lengths.sum(), 1.0)):
-        count = int(np.clip(round(share * remaining), 2, length))
-        frames.append(drawable.clip_frames(clip, clip.spread(count)))
+    for clip, share in zip(clips, lengths / max(lengths.sum(), 1.0)):
+        count = int(np.clip(round(share * remaining), 2, clip.frame_count))
+        frames.append(drawable.clip_frames(clip, spread_frames(clip.frame_count, count)))
     return np.concatenate(frames).astype(np.float32, copy=False), bind_drives
 
 
@@ -533,7 +533,7 @@ def _measured_poses(drawable: Drawable, measured_frames: int) -> Iterator[tuple[
     rest pose (clip None), then ``measured_frames`` frames spread over each clip."""
     yield None, np.zeros(1, int), drawable.rest_positions()[None]
     for clip in drawable.clips:
-        frames = clip.spread(measured_frames)
+        frames = spread_frames(clip.frame_count, measured_frames)
         yield clip, frames, drawable.clip_frames(clip, frames)
 
 

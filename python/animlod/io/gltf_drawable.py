@@ -21,7 +21,7 @@ import pygltflib
 from ..model import Motion, SkinnedMesh, morphed
 from .gltf_document import GltfDocument
 from .gltf_mesh import SINGULAR_DETERMINANT, TRIANGLES, MeshGeometry, read_mesh_geometry, transform_points
-from .gltf_read import morph_weight_tracks, node_weights, skinned_mesh_of_node
+from .gltf_read import from_first_key, morph_weight_tracks, node_weights, skinned_mesh_of_node
 from .gltf_skin import SkinRig
 from .stored_weights import UnitSumBreaks, stored_unit_sum_breaks
 
@@ -242,10 +242,7 @@ def _clips(
         weights = tracks.get(index)
         if motion is None and weights is None:
             continue
-        start = doc.animation_start_frame(index, fps)
-        if motion is not None:
-            motion = motion.take_frames(np.arange(start, motion.frame_count)) if start else motion
-        weights = weights[start:] if weights is not None else None
+        motion, weights, start = from_first_key(doc, index, fps, motion, weights)
         frame_count = motion.frame_count if motion is not None else len(weights)
         if motion is None and drawable.rig is not None:
             motion = drawable.rig.skeleton.rest_motion(frame_count, fps)

@@ -340,6 +340,20 @@ def node_weights(doc: GltfDocument, node: int, mesh_weights: np.ndarray) -> np.n
     return values
 
 
+def from_first_key(
+    doc: GltfDocument, animation: int, fps: float, motion: Motion | None, weights: np.ndarray | None
+) -> tuple[Motion | None, np.ndarray | None, int]:
+    """``motion`` and morph ``weights (T, N)`` of animation ``animation`` (either None), sampled at
+    ``fps`` from 0, from the frame at or just before its first key
+    (GltfDocument.animation_start_frame), and that frame: a clip keyed late on its timeline holds
+    its first pose until then, and those frames would be driven, analysed and written for nothing."""
+    start = doc.animation_start_frame(animation, fps)
+    if not start:
+        return motion, weights, 0
+    kept = None if motion is None else motion.take_frames(np.arange(start, motion.frame_count))
+    return kept, None if weights is None else weights[start:], start
+
+
 def morph_weight_tracks(doc: GltfDocument, node: int, target_count: int, fps: float) -> list[tuple[int, np.ndarray]]:
     """``(animation index, weights (T, N))`` for every animation that drives the node's morph
     weights, sampled at ``fps``."""

@@ -39,7 +39,6 @@ from ..options import MotionRefitOptions
 from .result import AssetResult, LevelRow, Progress
 
 if TYPE_CHECKING:
-    from ..io.gltf_document import GltfDocument
     from ..io.gltf_write import FaceMaterials
     from .motion_level_files import LevelContent
 
@@ -337,7 +336,7 @@ def _read_input(
     if kind != "gltf":
         raise FormatError(path, "file", f"a {kind} input has no skeleton; motion LoD needs a .bvh or an animated glTF")
     from ..io.gltf import read_gltf
-    from ..io.gltf_read import rig_motions
+    from ..io.gltf_read import from_first_key, rig_motions
     from ..io.gltf_skin import SkinRig
     from ..io.gltf_write import FaceMaterials, MeshNames
     from .attachments import find_attachments
@@ -412,9 +411,10 @@ def _read_input(
         if len(rigid) > 1:
             note(f"{path}: its {len(rigid)} animations simplified together, one skeleton per level for all of "
                  "them (use --clip to take one)")  # fmt: skip
-            keyed = [_from_first_key(document, motions[i], animations[i], morph_weights, fps) for i in rigid]
+            keyed = [from_first_key(document, animations[i], fps, motions[i], morph_weights.get(animations[i]))
+                     for i in rigid]  # fmt: skip
             joined, spans = join_clips([motion for motion, _, _ in keyed])
-            played = [PlayedClip(names[index], span, durations[index], weights, animations[index], start)
+            played = [PlayedClip(names[index], span, durations[index], weights, animations[index], start / fps)
                       for index, span, (_, weights, start) in zip(rigid, spans, keyed)]  # fmt: skip
             return _Input(joined, played, skin, materials, None, content)
         clip = rigid[0] if rigid else 0
@@ -429,24 +429,9 @@ def _read_input(
         raise FormatError(path, "clip", f"the file has {len(motions)} animations that move the skeleton ({listed}), "
                                         f"got index {clip}")  # fmt: skip
     animation = animations[clip]
-    motion, weights, start = _from_first_key(document, motions[clip], animation, morph_weights, fps)
-    played = [PlayedClip(names[clip], slice(None), durations[clip], weights, animation, start)]
+    motion, weights, start = from_first_key(document, animation, fps, motions[clip], morph_weights.get(animation))
+    played = [PlayedClip(names[clip], slice(None), durations[clip], weights, animation, start / fps)]
     return _Input(_rigid(path, motions, range(clip, clip + 1), motion), played, skin, materials, None, content)
-
-
-def _from_first_key(
-    document: GltfDocument, motion: Motion, animation: int, morph_weights: dict[int, np.ndarray], fps: float
-) -> tuple[Motion, np.ndarray | None, float]:
-    """``motion`` (animation ``animation`` sampled from 0) and its morph weights from the frame at
-    or just before the animation's first key (GltfDocument.animation_start_frame), with that
-    frame's time: a clip keyed late on its timeline holds its first pose until then, and those
-    frames would be analysed, re-fitted and written for nothing."""
-    start = document.animation_start_frame(animation, fps)
-    weights = morph_weights.get(animation)
-    if not start:
-        return motion, weights, 0.0
-    kept = np.arange(start, motion.frame_count)
-    return motion.take_frames(kept), None if weights is None else weights[start:], start / fps
 
 
 def _clip_suffixes(names: list[str], room: int = LONGEST_NAME) -> list[str]:

@@ -81,6 +81,7 @@ void bind_options(py::module_& m) {
       .field("precondition", &MotionRefitOptions::precondition)
       .field("eliminate_points", &MotionRefitOptions::eliminate_points)
       .field("rigid_bodies", &MotionRefitOptions::rigid_bodies)
+      .field("bone_directions", &MotionRefitOptions::bone_directions)
       .field("chunk_frames", &MotionRefitOptions::chunk_frames)
       .field("threads", &MotionRefitOptions::threads)
       .finish();

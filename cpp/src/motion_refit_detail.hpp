@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -26,6 +27,21 @@ constexpr double kNewtonDecrement = 1e-15;
 inline void set_points_of(const int32_t* rows, size_t count, size_t width, uint8_t value,
                           std::vector<uint8_t>& flags) {
   for (size_t i = 0; i < count * width; ++i) flags[rows[i]] = value;
+}
+
+// Two unit vectors completing the unit vector u to an orthonormal basis: the tangent plane in
+// which the pendant trees and the bone directions move a direction.
+inline void tangent_basis(const double* u, double* e1, double* e2) {
+  const int axis = std::abs(u[0]) < 0.6 ? 0 : (std::abs(u[1]) < 0.6 ? 1 : 2);
+  double helper[3] = {0.0, 0.0, 0.0};
+  helper[axis] = 1.0;
+  const double along = helper[0] * u[0] + helper[1] * u[1] + helper[2] * u[2];
+  for (int a = 0; a < 3; ++a) e1[a] = helper[a] - along * u[a];
+  const double norm = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  for (int a = 0; a < 3; ++a) e1[a] /= norm;
+  e2[0] = u[1] * e1[2] - u[2] * e1[1];
+  e2[1] = u[2] * e1[0] - u[0] * e1[2];
+  e2[2] = u[0] * e1[1] - u[1] * e1[0];
 }
 
 // E (Eq. 5) of one frame; adds nothing to the root's gradient. gradient: (P, 3) or nullptr.

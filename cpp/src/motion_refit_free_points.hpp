@@ -30,6 +30,8 @@ class FreePointClusters {
   // Clusters share no term, so E's Hessian over the free points is block diagonal by cluster.
   size_t cluster_count() const { return clusters_.size(); }
   const std::vector<int32_t>& cluster_points(size_t cluster) const { return clusters_[cluster].points; }
+  // The other points of the cluster's angle triples (increasing): where E ties it to the rest.
+  const std::vector<int32_t>& held_points(size_t cluster) const { return clusters_[cluster].held; }
 
   // Starts a frame's minimisations. The fixed start: of the minima over the free points reached
   // from x (P, 3) and from the original positions (Ed's minimum), with x's other points, the

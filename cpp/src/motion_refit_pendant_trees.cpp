@@ -40,17 +40,6 @@ bool normalised(Vec3& d) {
   return true;
 }
 
-// Two unit vectors completing u to an orthonormal basis.
-void tangent_basis(const Vec3& u, Vec3& e1, Vec3& e2) {
-  const int axis = std::abs(u[0]) < 0.6 ? 0 : (std::abs(u[1]) < 0.6 ? 1 : 2);
-  Vec3 helper{{0.0, 0.0, 0.0}};
-  helper[axis] = 1.0;
-  const double along = dot(helper, u);
-  for (int a = 0; a < 3; ++a) e1[a] = helper[a] - along * u[a];
-  normalised(e1);
-  e2 = {{u[1] * e1[2] - u[2] * e1[1], u[2] * e1[0] - u[0] * e1[2], u[0] * e1[1] - u[1] * e1[0]}};
-}
-
 }  // namespace
 
 PendantTrees::PendantTrees(const MotionRefitProblem& problem, bool enabled)
@@ -157,7 +146,7 @@ void PendantTrees::place_tree(const Tree& tree, double* x, const double* origina
   auto assemble = [&]() {
     for (size_t i = 0; i < n; ++i) {
       for (int a = 0; a < 3; ++a) sums[i][a] = at[i][a] - original[3 * tree.points[i] + a];
-      tangent_basis(u[i], e1[i], e2[i]);
+      tangent_basis(u[i].v, e1[i].v, e2[i].v);
     }
     for (size_t i = n; i-- > 0;)  // children after parents: subtree sums accumulate upwards
       if (tree.parent[i] >= 0)

@@ -2,7 +2,8 @@
 // re-fit (seeds/000, Eqs. 5-7): a leaf's Ed + Es terms alpha |x_e - x^o_e|^2 + beta (|x_e - x_p|
 // - b)^2 (over L^2) are minimal on the ray from x_p to x^o_e; a coincident pair held as an
 // equality puts both points at one place; free points follow the others through their own
-// minimisation (motion_refit_free_points.hpp); trees and bodies are placed by their own classes.
+// minimisation (motion_refit_free_points.hpp); trees, bodies and directions are placed by their
+// own classes.
 #include "motion_refit_reduction.hpp"
 
 #include <algorithm>
@@ -51,7 +52,7 @@ void multiply(const double* a, const double* b, double* out) {
 }  // namespace
 
 PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_constraints, bool eliminate,
-                               bool rigid_bodies)
+                               bool rigid_bodies, bool bone_directions)
     : problem_(problem),
       hard_(hard_constraints),
       free_points_(problem, free_points(problem, eliminate)),
@@ -111,14 +112,43 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
       }
     }
   }
+  // Directions along the held lengths among the points left as variables (and the root).
+  std::vector<uint8_t> candidate(p, 0), tied(p, 0);
+  set_points_of(problem.coincident_pairs, problem.coincident_pair_count, 2, 1, tied);
+  for (size_t k = 0; k < p; ++k)
+    candidate[k] = k == 0 || (!tied[k] && !free_points_.contains(k) && leaf_anchor_[k] < 0 && !trees_.contains(k) &&
+                              bodies_.body_of(k) < 0);
+  // A length that spans a run of frozen joints (a cluster of free points held at both of its
+  // ends) stays an equality: as a direction, every step of SLSQP moved the runs below it and
+  // their nested minima at once, and it crawled (the bench's tail at 10 joints: twice the
+  // evaluations, E +9%).
+  std::vector<uint8_t> hangable(kept_equalities_.begin(), kept_equalities_.begin() + static_cast<long>(pairs));
+  std::vector<int32_t> held_by(p, -1);  // stamp: the last cluster that holds the point
+  for (size_t c = 0; c < free_points_.cluster_count(); ++c) {
+    for (int32_t point : free_points_.held_points(c)) held_by[point] = static_cast<int32_t>(c);
+    for (size_t k = 0; k < pairs; ++k)
+      if (held_by[problem.length_pairs[2 * k]] == static_cast<int32_t>(c) &&
+          held_by[problem.length_pairs[2 * k + 1]] == static_cast<int32_t>(c))
+        hangable[k] = 0;
+  }
+  directions_ = BoneDirections(problem, candidate, hangable, eliminate && hard_constraints && bone_directions);
+  for (size_t i = 0; i < directions_.count(); ++i) kept_equalities_[directions_.pair(i)] = 0;
+
   free_index_.assign(p, -1);
+  auto add_slot = [&](int32_t width) {
+    slot_offset_.push_back(static_cast<int32_t>(variable_count_));
+    slot_width_.push_back(width);
+    variable_count_ += static_cast<size_t>(width);
+    return static_cast<int32_t>(slot_width_.size() - 1);
+  };
   for (size_t k = 1; k < p; ++k) {
     if (free_points_.contains(k)) free_index_[k] = static_cast<int32_t>(free_count_++);
     else if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0 && !trees_.contains(k) &&
-             bodies_.body_of(k) < 0)
-      index_[k] = static_cast<int32_t>(reduced_points_++);
+             bodies_.body_of(k) < 0 && directions_.direction_of(k) < 0)
+      index_[k] = add_slot(3);
   }
-  for (size_t b = 0; b < bodies_.count(); ++b) body_slot_.push_back(static_cast<int32_t>(reduced_points_++));
+  for (size_t b = 0; b < bodies_.count(); ++b) body_slot_.push_back(add_slot(3));
+  for (size_t i = 0; i < directions_.count(); ++i) direction_slot_.push_back(add_slot(2));
   free_blocks_.resize(free_points_.cluster_count());
   for (size_t c = 0; c < free_blocks_.size(); ++c)
     for (int32_t point : free_points_.cluster_points(c))
@@ -146,15 +176,29 @@ int32_t PointReduction::link_source(size_t k) const {
   if (k == 0 || free_index_[k] >= 0 || index_[k] >= 0) return -1;
   if (substitute_[k] != static_cast<int32_t>(k)) return substitute_[k];
   if (bodies_.body_of(k) >= 0) return bodies_.base(bodies_.body_of(k));
+  if (directions_.direction_of(k) >= 0) return directions_.parent(static_cast<size_t>(directions_.direction_of(k)));
   if (trees_.contains(k)) return trees_.anchor(k);
   return leaf_anchor_[k];
+}
+
+const double* PointReduction::own_slot_derivative(size_t k) const {
+  if (bodies_.body_of(k) >= 0) return bodies_.derivative(k);
+  if (directions_.direction_of(k) >= 0) return directions_.derivative(k);
+  return nullptr;
+}
+
+int32_t PointReduction::own_slot(size_t k) const {
+  if (bodies_.body_of(k) >= 0) return body_slot_[bodies_.body_of(k)];
+  if (directions_.direction_of(k) >= 0) return direction_slot_[directions_.direction_of(k)];
+  return -1;
 }
 
 void PointReduction::build_links() {
   const size_t p = problem_.point_count;
   std::vector<std::vector<int32_t>> slots(p);
   std::vector<uint8_t> done(p, 0);
-  // Depth first: a point's links are its source's, plus its body's slot for a member.
+  // Depth first: a point's links are its source's, plus its own slot for a body's member or a
+  // direction's point.
   auto visit = [&](auto& self, size_t k) -> void {
     if (done[k]) return;
     done[k] = 1;
@@ -165,7 +209,7 @@ void PointReduction::build_links() {
       const int32_t source = link_source(k);
       self(self, static_cast<size_t>(source));
       slots[k] = slots[source];
-      if (bodies_.body_of(k) >= 0) slots[k].push_back(body_slot_[bodies_.body_of(k)]);
+      if (own_slot(k) >= 0) slots[k].push_back(own_slot(k));
     }
     link_order_.push_back(static_cast<int32_t>(k));
   };
@@ -189,9 +233,9 @@ void PointReduction::update_links() {
     if (trees_.contains(k) || leaf_anchor_[k] >= 0) {  // d x_k / d x_anchor times the anchor's
       const double* j = trees_.contains(k) ? trees_.derivative(k) : jacobians_[k].data();
       for (int32_t i = 0; i < inherited; ++i) multiply(j, in[i].data(), out[i].data());
-    } else {  // a substitute or a body's member moves with its source
+    } else {  // a substitute, a body's member or a direction's point moves with its source
       std::copy(in, in + inherited, out);
-      if (bodies_.body_of(k) >= 0) std::copy_n(bodies_.derivative(k), 9, out[inherited].begin());
+      if (const double* own = own_slot_derivative(k)) std::copy_n(own, 9, out[inherited].begin());
     }
   }
 }
@@ -199,16 +243,18 @@ void PointReduction::update_links() {
 void PointReduction::set_start(const double* x, const double* original) {
   free_points_.set_start(x, original);
   bodies_.set_start(x);
+  directions_.set_start(x, original);
 }
 
 void PointReduction::fill(const double* y, const double* original, double* x) {
   const size_t p = problem_.point_count;
   std::copy(original, original + 3, x);
   for (size_t k = 1; k < p; ++k)
-    if (index_[k] >= 0) std::copy(y + 3 * index_[k], y + 3 * index_[k] + 3, x + 3 * k);
+    if (index_[k] >= 0) std::copy_n(y + slot_offset_[index_[k]], 3, x + 3 * k);
+  for (size_t i = 0; i < directions_.count(); ++i) directions_.place(i, y + slot_offset_[direction_slot_[i]], x);
   for (size_t k = 1; k < p; ++k)
     if (substitute_[k] != static_cast<int32_t>(k)) std::copy(x + 3 * substitute_[k], x + 3 * substitute_[k] + 3, x + 3 * k);
-  for (int32_t b : bodies_.order()) bodies_.place(static_cast<size_t>(b), y + 3 * body_slot_[b], x);
+  for (int32_t b : bodies_.order()) bodies_.place(static_cast<size_t>(b), y + slot_offset_[body_slot_[b]], x);
   trees_.place(x, original);
   const double alpha = problem_.distance_weight, beta = problem_.string_weight;
   const double pull = hard_ ? 0.0 : alpha / (alpha + beta);  // dr / dd
@@ -252,47 +298,64 @@ void PointReduction::fill(const double* y, const double* original, double* x) {
     }
   }
   free_points_.minimise(x, original);
-  update_links();
 }
 
 void PointReduction::gather(const double* x, double* y) const {
   for (size_t k = 1; k < problem_.point_count; ++k)
-    if (index_[k] >= 0) std::copy(x + 3 * k, x + 3 * k + 3, y + 3 * index_[k]);
-  for (int32_t slot : body_slot_) std::fill_n(y + 3 * slot, 3, 0.0);
+    if (index_[k] >= 0) std::copy_n(x + 3 * k, 3, y + slot_offset_[index_[k]]);
+  for (int32_t slot : body_slot_) std::fill_n(y + slot_offset_[slot], 3, 0.0);
+  for (size_t i = 0; i < directions_.count(); ++i) directions_.coordinates(i, x, y + slot_offset_[direction_slot_[i]]);
 }
 
 void PointReduction::reduce_rows(const double* rows, size_t count, double* out) const {
   const size_t p = problem_.point_count;
-  std::fill(out, out + count * 3 * reduced_points_, 0.0);
-  for (size_t k = 0; k < p; ++k)
-    for (int32_t link = link_offsets_[k]; link < link_offsets_[k + 1]; ++link) {
-      const int32_t t = link_slots_[link];
-      const double* j = link_blocks_[link].data();
-      for (size_t r = 0; r < count; ++r) {
-        const double* g = rows + r * 3 * p + 3 * k;
-        double* o = out + r * 3 * reduced_points_ + 3 * t;
-        for (int b = 0; b < 3; ++b) o[b] += j[b] * g[0] + j[3 + b] * g[1] + j[6 + b] * g[2];  // J^T g
+  std::fill(out, out + count * variable_count_, 0.0);
+  // Reverse accumulation, children before their sources: a point's total derivative (its own
+  // row plus what the points placed from it pass back) goes to its slot and, through
+  // d x / d x_source, to its source. Linear in the points, where the links are as many as a
+  // point's ancestors in a chain of directions.
+  for (size_t r = 0; r < count; ++r) {
+    totals_.assign(rows + r * 3 * p, rows + (r + 1) * 3 * p);
+    double* o = out + r * variable_count_;
+    for (auto it = link_order_.rbegin(); it != link_order_.rend(); ++it) {
+      const auto k = static_cast<size_t>(*it);
+      const double* g = totals_.data() + 3 * k;
+      if (g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) continue;  // most points of an equality's row
+      if (index_[k] >= 0) {
+        for (int b = 0; b < 3; ++b) o[slot_offset_[index_[k]] + b] += g[b];
+        continue;
+      }
+      double* up = totals_.data() + 3 * link_source(k);
+      const double* j = trees_.contains(k) ? trees_.derivative(k) : leaf_anchor_[k] >= 0 ? jacobians_[k].data() : kIdentity;
+      for (int b = 0; b < 3; ++b) up[b] += j[b] * g[0] + j[3 + b] * g[1] + j[6 + b] * g[2];  // J^T g
+      if (const double* own = own_slot_derivative(k)) {
+        const int32_t slot = own_slot(k);
+        for (int b = 0; b < slot_width_[slot]; ++b)
+          o[slot_offset_[slot] + b] += own[b] * g[0] + own[3 + b] * g[1] + own[6 + b] * g[2];
       }
     }
+  }
 }
 
-void PointReduction::reduce_matrix(const double* full, double* out) const {
+void PointReduction::reduce_matrix(const double* full, double* out) {
+  update_links();
   const size_t p = problem_.point_count;
   const size_t n = 3 * (p - 1);
-  const auto nr = static_cast<Eigen::Index>(3 * reduced_points_);
+  const auto nr = static_cast<Eigen::Index>(variable_count_);
   const auto nf = static_cast<Eigen::Index>(3 * free_count_);
   Eigen::Map<RowMatrix> reduced(out, nr, nr);
   RowMatrix coupling = RowMatrix::Zero(nr, nf);  // T^T M over the free points' columns
   RowMatrix free = RowMatrix::Zero(nf, nf);
   reduced.setZero();
-  // Ja^T `block` (3 x 3, row-major) added to the rows of every slot of point a's links, in the
-  // matrix whose column block starts at `base` (rows `stride` apart).
-  auto add = [&](size_t a, const double* block, double* base, Eigen::Index stride) {
+  // Ja^T `block` (3 x 3, row-major; its first `columns` columns) added to the rows of every slot
+  // of point a's links, in the matrix whose column block starts at `base` (rows `stride` apart).
+  auto add = [&](size_t a, const double* block, double* base, Eigen::Index stride, int columns) {
     for (int32_t link = link_offsets_[a]; link < link_offsets_[a + 1]; ++link) {
       const double* ja = link_blocks_[link].data();
-      double* row = base + 3 * link_slots_[link] * stride;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) {
+      const int32_t slot = link_slots_[link];
+      double* row = base + slot_offset_[slot] * stride;
+      for (int r = 0; r < slot_width_[slot]; ++r)
+        for (int c = 0; c < columns; ++c) {
           double sum = 0.0;
           for (int i = 0; i < 3; ++i) sum += ja[3 * i + r] * block[3 * i + c];
           row[r * stride + c] += sum;
@@ -317,7 +380,7 @@ void PointReduction::reduce_matrix(const double* full, double* out) const {
         double block[9];
         for (int i = 0; i < 3; ++i)
           for (int c = 0; c < 3; ++c) block[3 * i + c] = m_ab[i * n + c];
-        add(a, block, &coupling(0, 3 * fb), nf);
+        add(a, block, &coupling(0, 3 * fb), nf, 3);
         continue;
       }
       for (int32_t link = link_offsets_[b]; link < link_offsets_[b + 1]; ++link) {
@@ -329,7 +392,7 @@ void PointReduction::reduce_matrix(const double* full, double* out) const {
             for (int k = 0; k < 3; ++k) sum += m_ab[i * n + k] * jb[3 * k + c];
             block[3 * i + c] = sum;
           }
-        add(a, block, &reduced(0, 3 * link_slots_[link]), nr);
+        add(a, block, &reduced(0, slot_offset_[link_slots_[link]]), nr, slot_width_[link_slots_[link]]);
       }
     }
   }

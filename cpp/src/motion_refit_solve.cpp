@@ -51,17 +51,16 @@ struct FrameContext {
   const MotionRefitProblem* problem = nullptr;
   detail::PointReduction* reduction = nullptr;
   size_t point_count = 0;
-  size_t variable_count = 0;         // n = 3 P_r
+  size_t variable_count = 0;         // n (PointReduction::variable_count)
   bool precondition = false;
   const double* original = nullptr;  // (P, 3) this frame's x^o
-  std::vector<double> start;         // (P_r, 3) reduced x_start of the preconditioned variables
+  std::vector<double> start;         // (n,) reduced x_start of the preconditioned variables
   Eigen::MatrixXd factor;            // lower L with L L^T = E's (clipped) Hessian at x_start
-  std::vector<double> reduced;       // (P_r, 3) reduced positions of the current variables
+  std::vector<double> reduced;       // (n,) reduced positions of the current variables
   std::vector<double> x;             // (P, 3) positions of the current variables
   std::vector<double> gradient;      // (P, 3)
   std::vector<double> jacobian;      // (rows, P, 3)
   std::vector<double> values;        // (rows,) every row before the kept ones are picked
-  std::vector<double> rows;          // (rows, P_r, 3)
   std::vector<double> placed_at;     // (n,) the variables x was last filled for, when placed
   bool placed = false;
 };
@@ -159,13 +158,14 @@ class FrameSolver {
       : problem_(problem),
         options_(options),
         hard_(options.hard_constraints && motion_refit_equality_count(problem) > 0),
-        reduction_(problem, hard_, options.eliminate_points, options.rigid_bodies && options.precondition) {
+        reduction_(problem, hard_, options.eliminate_points, options.rigid_bodies && options.precondition,
+                   options.bone_directions && options.precondition) {
     const size_t p = problem.point_count;
     const size_t m = motion_refit_equality_count(problem);
     c_.problem = &problem_;
     c_.reduction = &reduction_;
     c_.point_count = p;
-    c_.variable_count = 3 * reduction_.reduced_points();
+    c_.variable_count = reduction_.variable_count();
     c_.precondition = options.precondition;
     c_.start.assign(c_.variable_count, 0.0);
     c_.reduced.assign(c_.variable_count, 0.0);

@@ -28,10 +28,10 @@ TEST_CASE("free points: the reduced gradient and Hessian are those of E minimise
   const std::vector<double> original = f.perturbed(1, 0.05);
   const std::vector<double> x = f.perturbed(2, 0.1);
   // Without hard constraints nothing is substituted: points 1, 2, 5, 6, 7, 8 stay variables.
-  PointReduction reduction(f.problem, false, true, true);
-  REQUIRE(reduction.reduced_points() == 6);
+  PointReduction reduction(f.problem, false, true, true, false);
+  REQUIRE(reduction.variable_count() == 18);
   reduction.set_start(x.data(), original.data());
-  std::vector<double> y(3 * reduction.reduced_points());
+  std::vector<double> y(reduction.variable_count());
   reduction.gather(x.data(), y.data());
   const size_t n = y.size();
 

@@ -119,6 +119,12 @@ struct MotionRefitOptions {
   // three per child, and their group's lengths, heights and handedness leave SLSQP (they hold by
   // construction). A hand with its finger bases, the hips, the chest. The minima are the same.
   bool rigid_bodies = true;
+  // With eliminate_points, hard constraints and precondition: a kept joint held by a length to
+  // a point that stays in the solve (a chain: spine, neck, tail, hair) is placed along the
+  // bone's direction, two variables instead of three and its length left out of SLSQP (it holds
+  // by construction), unless a run of frozen joints hangs between the two. The minima are the
+  // same.
+  bool bone_directions = true;
   int chunk_frames = 64;        // with warm_start, consecutive frames per task (warm starts run
                                 // inside a chunk); without, each frame is a task
   int threads = 0;              // worker threads; 0 uses thread_limit() (animlod/threads.hpp)

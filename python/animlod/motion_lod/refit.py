@@ -197,8 +197,8 @@ def refit_slsqp(
     options, **option_fields : a :class:`~animlod.options.MotionRefitOptions` and/or its fields
         by name: stopping rules, hard constraints, checks, ``warm_start``, ``chunk_frames``
         (frames per warm-started chunk, and per task with ``workers > 1``). ``precondition``,
-        ``eliminate_points``, ``rigid_bodies`` and ``threads`` belong to the core's solve and are
-        ignored here.
+        ``eliminate_points``, ``rigid_bodies``, ``bone_directions`` and ``threads`` belong to the
+        core's solve and are ignored here.
     cold_starts : (T, P, 3) where frames start and failed frames restart (feasible with hard
         constraints), or None: the original positions, or the fallback with hard constraints.
     workers : processes; 1 solves in this process.

@@ -20,9 +20,11 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]`` (part of ``make bench`
    core (nlopt's C library), plain (the reference's variables) and preconditioned (the default),
    on one thread, per level of 131_01 and the Bandai run: ms per frame, evaluations, and how many
    frames reach the reference's E within 1e-6 relative.
-4. Rigid bodies (MotionRefitOptions.rigid_bodies) on and off, per clip, Eq. 3 ranking (no trial
-   re-fits), one thread: CPU seconds of the 8 levels, the largest relative difference of a
-   level's mean E, and at how many levels mean and max error agree to 5 digits.
+4. The re-fit's reductions, rigid bodies and bone directions (MotionRefitOptions.rigid_bodies,
+   .bone_directions), each on and off, per clip and long-chain figure, Eq. 3 ranking (no trial
+   re-fits), one thread: CPU seconds of the 8 levels (best of 3 rounds taking turns), the
+   largest relative differences of a level's mean E, and at how many levels mean and max error
+   agree to 5 digits.
 5. Joint choice: mean (and max) joint position error over every original joint and frame after
    the same re-fit, per level, for every ranking: the default (a trial re-fit per level), Eq. 3 with
    zero-length bones looked through, the paper's Eq. 3 as printed, leaf-first by depth, least
@@ -317,27 +319,35 @@ def solver_table(label: str, motion: Motion, frame_count: int) -> None:
     )  # fmt: skip
 
 
-def rigid_bodies_table(all_clips: list[tuple[str, Motion]]) -> None:
+def reduction_table(all_clips: list[tuple[str, Motion]], option: str, title: str, rounds: int = 3) -> None:
+    """One of the re-fit's reductions (a boolean field of MotionRefitOptions) off and on, taking
+    turns ``rounds`` times: the best CPU seconds of each (single runs move by 10-20% here)."""
     rows = []
     for label, motion in all_clips:
-        runs = {}
-        for rigid in (False, True):
-            cpu = time.process_time()
-            chain = build_motion_chain(
-                motion, 8, workers=1, ranking="importance", slsqp_options=MotionRefitOptions(rigid_bodies=rigid)
-            )
-            runs[rigid] = (time.process_time() - cpu, [level.report for level in chain.levels[1:]])
-        (off_cpu, off), (on_cpu, on) = runs[False], runs[True]
+        cpu_seconds = {False: np.inf, True: np.inf}
+        reports = {}
+        for _ in range(rounds):
+            for enabled in (False, True):
+                cpu = time.process_time()
+                chain = build_motion_chain(
+                    motion, 8, workers=1, ranking="importance", slsqp_options=MotionRefitOptions(**{option: enabled})
+                )
+                cpu_seconds[enabled] = min(cpu_seconds[enabled], time.process_time() - cpu)
+                reports[enabled] = [level.report for level in chain.levels[1:]]
+        off_cpu, on_cpu = cpu_seconds[False], cpu_seconds[True]
+        off, on = reports[False], reports[True]
         change = [(b.energy - a.energy) / max(a.energy, 1e-300) for a, b in zip(off, on)]
         agree = sum(f"{a.mean_error:.5g} {a.max_error:.5g}" == f"{b.mean_error:.5g} {b.max_error:.5g}"
                     for a, b in zip(off, on))  # fmt: skip
-        rows.append((label, f"{off_cpu:.2f}", f"{on_cpu:.2f}", f"{min(change):+.1e}", f"{max(change):+.1e}",
-                     f"{agree}/{len(on)}"))  # fmt: skip
+        rows.append((label, f"{off_cpu:.2f}", f"{on_cpu:.2f}", f"{on_cpu / off_cpu:.2f}", f"{min(change):+.1e}",
+                     f"{max(change):+.1e}", f"{agree}/{len(on)}"))  # fmt: skip
     print_table(
-        "Rigid bodies off and on (Eq. 3 ranking, one thread; E: a level's mean E with them relative to without)",
-        ("clip", "CPU s off", "CPU s on", "E change min", "E change max", "levels with equal errors (5 digits)"),
+        f"{title} off and on ({option}; Eq. 3 ranking, one thread, best CPU of {rounds} rounds taking turns; "
+        "E: a level's mean E with them relative to without)",
+        ("clip", "CPU s off", "CPU s on", "on / off", "E change min", "E change max",
+         "levels with equal errors (5 digits)"),
         rows,
-    )
+    )  # fmt: skip
 
 
 def ranking_table(label: str, motion: Motion) -> None:
@@ -377,12 +387,14 @@ def main() -> None:
     for label in ("131_01.bvh", "dataset-1_run_proud_001.bvh"):
         if label in by_label:
             solver_table(label, by_label[label], 16 if args.quick else 48)
-    rigid_bodies_table(all_clips)
+    figures = chain_figures(30 if args.quick else 150)
+    for option, title in (("rigid_bodies", "Rigid bodies"), ("bone_directions", "Bone directions")):
+        reduction_table(all_clips + figures, option, title)
     for label, motion in all_clips:
         # At most ~250 frames: the comparison needs the joints' motion, not every frame of it.
         ranking_table(label, subsample(motion, max(1, motion.frame_count // 250)))
     two_clips = ("tail of 40 joints: a wave, then a curl of its first half", tail_clips(40, 120, 24.0)[0])
-    for label, motion in chain_figures(30 if args.quick else 150) + [two_clips]:
+    for label, motion in figures + [two_clips]:
         ranking_table(label, motion)
 
 

@@ -24,10 +24,12 @@
 // rigid body, two per direction.
 // The reduced problem has the same minima as the full one; the map from reduced to full
 // positions is differentiated exactly (chain rule; a free point adds nothing, as E's derivative
-// with respect to it is zero at its minimum), so gradients and Jacobians stay analytic. A full
-// point depends on one slot or several (a body's member on its base's slots and its body's;
-// a tree hanging from a member on the same; a chain's point on its parent's and its own
-// direction's), kept as links: (slot, 3 x 3 derivative, its third column zero for a direction).
+// with respect to it is zero at its minimum), so gradients and Jacobians stay analytic:
+// reduce_rows accumulates in reverse from each placed point to the point it is placed from.
+// A full point depends on one slot or several (a body's member on its base's slots and its
+// body's; a tree hanging from a member on the same; a chain's point on its parent's and its own
+// direction's), kept for reduce_matrix as links: (slot, 3 x 3 derivative, its third column zero
+// for a direction).
 #pragma once
 
 #include <array>

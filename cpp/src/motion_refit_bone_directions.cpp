@@ -103,7 +103,7 @@ void BoneDirections::coordinates(size_t i, const double* x, double* s) const {
   }
   const double sine = std::hypot(across[0], across[1]);  // both scaled by |v|
   if (!(sine > 0.0)) {  // on the start's axis: the start, or (pi, 0) opposite it
-    s[0] = along < 0.0 ? M_PI : 0.0, s[1] = 0.0;
+    s[0] = along < 0.0 ? std::acos(-1.0) : 0.0, s[1] = 0.0;
     return;
   }
   const double angle = std::atan2(sine, along);

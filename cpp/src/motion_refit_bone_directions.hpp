@@ -30,9 +30,9 @@ class BoneDirections {
   BoneDirections(const MotionRefitProblem& problem, const std::vector<uint8_t>& candidate,
                  const std::vector<uint8_t>& kept_pairs, bool enabled);
 
+  // The directions, every parent's before its children's (a tree's first point, the root or a
+  // variable, hangs from none).
   size_t count() const { return points_.size(); }
-  // The hanging points, every parent before its children (the root or a variable first).
-  const std::vector<int32_t>& points() const { return points_; }
   int32_t parent(size_t i) const { return parents_[i]; }
   // The held length pair that direction i holds.
   int32_t pair(size_t i) const { return pairs_[i]; }

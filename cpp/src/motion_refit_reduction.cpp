@@ -112,12 +112,16 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
       }
     }
   }
-  // Directions along the held lengths among the points left as variables (and the root).
-  std::vector<uint8_t> candidate(p, 0), tied(p, 0);
+  // The points no reduction so far places: variables, unless they hang along a direction.
+  std::vector<uint8_t> unplaced(p, 0);
+  for (size_t k = 1; k < p; ++k)
+    unplaced[k] = !free_points_.contains(k) && substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0 &&
+                  !trees_.contains(k) && bodies_.body_of(k) < 0;
+  // Directions along the held lengths among those points (and the root).
+  std::vector<uint8_t> candidate(unplaced), tied(p, 0);
   set_points_of(problem.coincident_pairs, problem.coincident_pair_count, 2, 1, tied);
-  for (size_t k = 0; k < p; ++k)
-    candidate[k] = k == 0 || (!tied[k] && !free_points_.contains(k) && leaf_anchor_[k] < 0 && !trees_.contains(k) &&
-                              bodies_.body_of(k) < 0);
+  candidate[0] = 1;
+  for (size_t k = 1; k < p; ++k) candidate[k] = candidate[k] && !tied[k];
   // A length that spans a run of frozen joints (a cluster of free points held at both of its
   // ends) stays an equality: as a direction, every step of SLSQP moved the runs below it and
   // their nested minima at once, and it crawled (the bench's tail at 10 joints: twice the
@@ -143,9 +147,7 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
   };
   for (size_t k = 1; k < p; ++k) {
     if (free_points_.contains(k)) free_index_[k] = static_cast<int32_t>(free_count_++);
-    else if (substitute_[k] == static_cast<int32_t>(k) && leaf_anchor_[k] < 0 && !trees_.contains(k) &&
-             bodies_.body_of(k) < 0 && directions_.direction_of(k) < 0)
-      index_[k] = add_slot(3);
+    else if (unplaced[k] && directions_.direction_of(k) < 0) index_[k] = add_slot(3);
   }
   for (size_t b = 0; b < bodies_.count(); ++b) body_slot_.push_back(add_slot(3));
   for (size_t i = 0; i < directions_.count(); ++i) direction_slot_.push_back(add_slot(2));
@@ -185,6 +187,12 @@ const double* PointReduction::own_slot_derivative(size_t k) const {
   if (bodies_.body_of(k) >= 0) return bodies_.derivative(k);
   if (directions_.direction_of(k) >= 0) return directions_.derivative(k);
   return nullptr;
+}
+
+const double* PointReduction::source_derivative(size_t k) const {
+  if (trees_.contains(k)) return trees_.derivative(k);
+  if (leaf_anchor_[k] >= 0) return jacobians_[k].data();
+  return kIdentity;
 }
 
 int32_t PointReduction::own_slot(size_t k) const {
@@ -231,7 +239,7 @@ void PointReduction::update_links() {
     const Matrix3* in = link_blocks_.data() + link_offsets_[source];
     const int32_t inherited = link_offsets_[source + 1] - link_offsets_[source];
     if (trees_.contains(k) || leaf_anchor_[k] >= 0) {  // d x_k / d x_anchor times the anchor's
-      const double* j = trees_.contains(k) ? trees_.derivative(k) : jacobians_[k].data();
+      const double* j = source_derivative(k);
       for (int32_t i = 0; i < inherited; ++i) multiply(j, in[i].data(), out[i].data());
     } else {  // a substitute, a body's member or a direction's point moves with its source
       std::copy(in, in + inherited, out);
@@ -326,7 +334,7 @@ void PointReduction::reduce_rows(const double* rows, size_t count, double* out) 
         continue;
       }
       double* up = totals_.data() + 3 * link_source(k);
-      const double* j = trees_.contains(k) ? trees_.derivative(k) : leaf_anchor_[k] >= 0 ? jacobians_[k].data() : kIdentity;
+      const double* j = source_derivative(k);
       for (int b = 0; b < 3; ++b) up[b] += j[b] * g[0] + j[3 + b] * g[1] + j[6 + b] * g[2];  // J^T g
       if (const double* own = own_slot_derivative(k)) {
         const int32_t slot = own_slot(k);

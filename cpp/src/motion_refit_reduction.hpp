@@ -89,6 +89,9 @@ class PointReduction {
   // parent, tree or leaf anchor; -1 for a variable, the root and free points), and the links in
   // an order where that point comes first.
   int32_t link_source(size_t k) const;
+  // d x_k / d x_source (3 x 3, row-major) at the last fill: a tree's or a leaf's, the identity
+  // for the points that move with their source.
+  const double* source_derivative(size_t k) const;
   // The slot of a body's member or a direction's point (-1 for others), and d x_k / d that
   // slot (nullptr for others).
   int32_t own_slot(size_t k) const;

@@ -5,6 +5,7 @@
 // directions ends where the solve over every point does.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 

@@ -3,6 +3,8 @@ by rotation variance, cumulative, and the default chosen level by level by a tri
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import pytest
 from test_motion_figures import Z, figure_motion
@@ -13,7 +15,7 @@ from animlod.motion_lod import RANKINGS, analyze_motion, build_motion_chain, lev
 from animlod.motion_lod.chain import build_level
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.ranking import PROPOSING_RANKINGS, joint_depths, rotation_variance, spread_steps
-from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR, choose_by_refit, proposers
+from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR, SEARCH_MARGIN, choose_by_refit, proposers
 from animlod.synth import humanoid, humanoid_motion, tail_clips
 
 
@@ -136,6 +138,33 @@ def test_refit_choice_takes_the_proposal_with_the_lowest_trial_error_and_stays_n
 
         assert choose_by_refit(motion, analysis, counts, tie).priority == analysis.priority
         assert (len(set(tried)) < len(tried)) == tries_all, tried
+
+
+def test_refit_choice_carries_a_runner_up_whose_coarser_level_makes_up_for_it() -> None:
+    # Trial errors made up so that importance's 2 joints are the lowest at 10 joints (1.0) but
+    # bind 8 joints to 10.0, while depth's (1.05) lead to its own 8 at 2.0: the greedy choice
+    # (paths=1) takes importance's, the search depth's; a runner-up beyond SEARCH_MARGIN is dropped.
+    motion = figure_motion()
+    analysis = analyze_motion(motion)
+    orders = [propose([]) for propose in proposers(motion, analysis)]
+    importance, depth = orders[PROPOSING_RANKINGS.index("importance")], orders[PROPOSING_RANKINGS.index("depth")]
+    counts = level_joint_counts(motion, analysis, [12, 10, 8])
+    fine, coarse = counts[0] - counts[1], counts[0] - counts[2]
+    assert set(importance[:fine]) != set(depth[:fine]) and not set(importance[:fine]) <= set(depth[:coarse])
+
+    def trial_error(level, frames, runner_up=1.05, others=1.1) -> float:
+        frozen = set(np.flatnonzero(level.frozen))
+        if len(frozen) == fine:
+            return 1.0 if frozen == set(importance[:fine]) else runner_up if frozen == set(depth[:fine]) else others
+        return 2.0 if frozen == set(depth[:coarse]) else 10.0
+
+    greedy = choose_by_refit(motion, analysis, counts, trial_error, paths=1).priority
+    assert set(greedy[:fine]) == set(importance[:fine]) and set(greedy[:coarse]) != set(depth[:coarse])
+    assert set(choose_by_refit(motion, analysis, counts, trial_error).priority[:coarse]) == set(depth[:coarse])
+    too_far = partial(trial_error, runner_up=1.01 * SEARCH_MARGIN, others=1.01 * SEARCH_MARGIN)
+    assert choose_by_refit(motion, analysis, counts, too_far).priority == greedy
+    with pytest.raises(ValueError, match="paths: must be at least 1, got 0"):
+        choose_by_refit(motion, analysis, counts, trial_error, paths=0)
 
 
 def test_refit_choice_beats_importance_and_depth_on_the_walk() -> None:

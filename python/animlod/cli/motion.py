@@ -40,9 +40,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--lock", nargs="+", default=[], metavar="JOINT", help="joints never to freeze")
     parser.add_argument(
         "--ranking", default=DEFAULT_RANKING, metavar="NAME",
-        help=f"which joints freeze first, one of {', '.join(RANKINGS)}: refit (default: at each level, of the next "
-        "joints the other rankings propose, those with the lowest error after a trial re-fit on 16 frames: the "
-        "skin's mean distance for a skinned glTF, the joints' otherwise), "
+        help=f"which joints freeze first, one of {', '.join(RANKINGS)}: refit (default: at each level, the next "
+        "joints the other rankings propose, scored by their error after a trial re-fit on 16 frames: the skin's "
+        "mean distance for a skinned glTF, the joints' otherwise; the two best choices are carried to the next "
+        "level, and the chain whose levels' errors have the lowest product is kept), "
         "importance (Eq. 3 with zero-length bones measured through the joints below them), paper (Eq. 3 as "
         "printed), depth (deepest first), variance (least rotation first), cumulative (least movement of the "
         "whole figure with the joints before it frozen) or spread (least Eq. 3 importance summed over the run of "

@@ -25,7 +25,7 @@ from .newton import refit_newton
 from .objective import RefitProblem, Weights, build_problem
 from .ranking import DEFAULT_RANKING
 from .refit import refit_slsqp
-from .refit_choice import choose_by_refit
+from .refit_choice import SEARCH_PATHS, choose_by_refit
 from .skeleton_reduce import expand_motion, recover_motion
 from .skin_transfer import transfer_skin
 
@@ -412,6 +412,7 @@ def build_motion_chain(
     ranking: str = DEFAULT_RANKING,
     on_choice: Callable[[int, int], None] | None = None,
     trial_measure: TrialMeasure | None = None,
+    refit_paths: int = SEARCH_PATHS,
 ) -> MotionLodChain:
     """Analyse ``motion`` and build its levels.
 
@@ -442,6 +443,8 @@ def build_motion_chain(
         with the frozen level, its re-fitted motion on the trial frames and those frames. None: the
         mean distance of every measured point from its original position; a skinned rig's chain
         measures its skin (skin_measure.skin_trial_measure).
+    refit_paths : with the "refit" ranking, the choices of joints its search carries from each
+        level to the next (refit_choice.SEARCH_PATHS; 1: each level takes its lowest trial error).
 
     Returns
     -------
@@ -469,7 +472,7 @@ def build_motion_chain(
                 return trial_measure(level, solved.output, frames)
             return float(solved.errors().mean())
 
-        analysis = choose_by_refit(motion, analysis, counts, trial_error, on_choice)
+        analysis = choose_by_refit(motion, analysis, counts, trial_error, on_choice, refit_paths)
     result = []
     for index, count in enumerate(counts):
         progress = on_level(index, count) if on_level else None

@@ -29,7 +29,7 @@ a joint frozen at one level stays frozen at every coarser one.
   frozen at once (tests/python/test_motion_ranking.py's 20-joint tail at 8 joints: mean error
   0.081 with Eq. 3, 0.0039 spread).
 - ``refit`` (default): each level's next joints chosen by the error they leave after the re-fit
-  (refit_choice.py), among what the orders above propose.
+  (refit_choice.py), among what the orders above propose, two choices carried from level to level.
 
 Every ranking but ``paper`` freezes at the key frames of the looked-through Eqs. 1-2.
 """

@@ -8,12 +8,15 @@ not a finger or a chain of several frozen joints. Eq. 3 alone loses levels of th
 leaf-first or least-variance (bench/bench_motion.py's joint-choice table), each for a reason
 the others do not share. So at every level, going from fine to coarse, each ranking of
 ranking.PROPOSING_RANKINGS proposes its next joints after those already frozen; each distinct
-proposal is frozen and re-fitted on TRIAL_FRAMES evenly spaced frames of the clip, and the one
-with the lowest mean joint position error over every original point is kept (ties: the earlier
-ranking, importance first); a skinned rig scores the trials by its skin's mean distance instead
-(skin_measure.skin_trial_measure). A joint frozen at one level stays frozen at every coarser one.
-The kept proposal's trial is the level's own re-fit of those frames (chain.py reuses it). Hidden
-joints (MotionAnalysis.hidden: they move nothing measured) freeze first, without a trial.
+proposal is frozen and re-fitted on TRIAL_FRAMES evenly spaced frames of the clip and scored by
+its mean joint position error over every original point (a skinned rig: its skin's mean
+distance, skin_measure.skin_trial_measure). A joint frozen at one level stays frozen at every
+coarser one, so a level's lowest error can bind the coarser ones to worse: the search carries
+the SEARCH_PATHS best choices from level to level, scored by the sum of the log errors of their
+levels, and the chain takes the best at the coarsest level (ties: the earlier path and ranking,
+importance first). The kept trials are the levels' own re-fits of those frames (chain.py reuses
+them). Hidden joints (MotionAnalysis.hidden: they move nothing measured) freeze first, without
+a trial.
 
 Proposals are tried in ranking order, and one whose error is at the resolution of the float32 keys
 the levels are written with (NEGLIGIBLE_ERROR) is kept without trying the rest: below it the
@@ -40,6 +43,15 @@ TRIAL_FRAMES = 16
 # round-off: storing a dev clip's own keys as float32 moves its joints by 1.3e-8 to 3.7e-8 of the
 # figure on average and 1.2e-7 at most (bench/bench_motion.py's level tables).
 NEGLIGIBLE_ERROR = 1e-7
+# Choices of joints carried from each level to the next. The levels are nested, so a level's
+# lowest trial error can bind the coarser levels to worse ones; a runner-up carried along wins
+# where its coarser levels make up for it (the sum of the log errors over the levels is lower):
+# 131_01's 10-joint level 0.330 -> 0.239 for 0.092 -> 0.100 at 14 joints (README, "Joint choice").
+SEARCH_PATHS = 2
+# A runner-up whose errors so far (their product over the levels) pass the best path's by more
+# than this factor is dropped: the two that won in the speed table's clips stood 1.08x (131_01) and
+# 1.18x (the walk) behind when carried.
+SEARCH_MARGIN = 1.25
 
 
 def proposers(motion: Motion, analysis: MotionAnalysis) -> list[Callable[[list[int]], list[int]]]:
@@ -75,6 +87,7 @@ def choose_by_refit(
     counts: Sequence[int],
     trial_error: Callable[[FrozenLevel, np.ndarray], float],
     progress: Callable[[int, int], None] | None = None,
+    paths: int = SEARCH_PATHS,
 ) -> MotionAnalysis:
     """``analysis`` with its priority chosen level by level by the re-fit's error.
 
@@ -87,42 +100,79 @@ def choose_by_refit(
         level re-fitted on the given frames of ``motion`` (TRIAL_FRAMES evenly spaced ones, the
         same for every call).
     progress : called with (levels chosen, levels to choose) after each level.
+    paths : choices of joints kept from each level to the next (SEARCH_PATHS; 1: each level
+        takes its lowest trial error, whatever it leaves the coarser levels).
 
     Returns
     -------
     MotionAnalysis whose ``priority`` freezes, for each count, the chosen joints first.
     """
+    if paths < 1:
+        raise ValueError(f"paths: must be at least 1, got {paths}")
     proposing = proposers(motion, analysis)
     frames = spread_frames(motion.frame_count, TRIAL_FRAMES)
-    frozen: list[int] = []
     hidden = [j for j in analysis.hidden if not motion.skeleton.end_sites[j]]
+    kept = [_Path([], 0.0)]
     for chosen, count in enumerate(counts[1:], start=1):
-        # Hidden joints move nothing measured: they go first, without a trial.
-        frozen += [j for j in hidden if j not in frozen][: counts[0] - count - len(frozen)]
-        need = counts[0] - count - len(frozen)
-        proposals: list[list[int]] = []
-        for propose in proposing:
-            proposal = propose(frozen)[:need]
-            if proposal and sorted(proposal) not in [sorted(p) for p in proposals]:
-                proposals.append(proposal)
-        if len(proposals) > 1:
-            levels = [freeze(motion, analysis, frozen + p) for p in proposals]
-            proposals = [proposals[_lowest_error(levels, frames, trial_error)]]
-        frozen += proposals[0] if proposals else []
+        need = counts[0] - count
+        extended: list[tuple[_Path, list[list[int]]]] = []
+        for path in kept:
+            # Hidden joints move nothing measured: they go first, without a trial.
+            frozen = path.frozen + [j for j in hidden if j not in path.frozen][: need - len(path.frozen)]
+            extended.append((_Path(frozen, path.score), _proposals(proposing, frozen, need - len(frozen))))
+        kept = _best_paths(extended, motion, analysis, frames, trial_error, paths)
         if progress:
             progress(chosen, len(counts) - 1)
+    frozen = kept[0].frozen
     return dataclasses.replace(analysis, priority=frozen + [j for j in analysis.priority if j not in frozen])
 
 
-def _lowest_error(
-    levels: list[FrozenLevel], frames: np.ndarray, trial_error: Callable[[FrozenLevel, np.ndarray], float]
-) -> int:
-    """Index of the first level with the lowest trial error, or of the first whose error is negligible."""
-    best, best_error = 0, np.inf
-    for index, level in enumerate(levels):
-        error = trial_error(level, frames)
-        if error < best_error:
-            best, best_error = index, error
-        if best_error <= NEGLIGIBLE_ERROR * level.length_scale():
-            break
-    return best
+@dataclasses.dataclass
+class _Path:
+    """Joints frozen so far, in order, and the sum over the levels of the log of their trial error."""
+
+    frozen: list[int]
+    score: float
+
+
+def _proposals(proposing: list[Callable[[list[int]], list[int]]], frozen: list[int], need: int) -> list[list[int]]:
+    """The distinct next ``need`` joints the rankings propose after ``frozen``, in ranking order."""
+    proposals: list[list[int]] = []
+    for propose in proposing:
+        proposal = propose(frozen)[:need]
+        if proposal and sorted(proposal) not in [sorted(p) for p in proposals]:
+            proposals.append(proposal)
+    return proposals or [[]]
+
+
+def _best_paths(
+    extended: list[tuple[_Path, list[list[int]]]],
+    motion: Motion,
+    analysis: MotionAnalysis,
+    frames: np.ndarray,
+    trial_error: Callable[[FrozenLevel, np.ndarray], float],
+    paths: int,
+) -> list[_Path]:
+    """Up to ``paths`` of the paths extended by their proposals, the lowest score first (ties:
+    the earlier path and ranking), none whose score passes the lowest by SEARCH_MARGIN. A path's
+    proposals are tried in order until one's error is negligible; a level with one proposal in
+    all is taken without a trial (it adds the same to every score)."""
+    if len(extended) == 1 and len(extended[0][1]) == 1:
+        path, (proposal,) = extended[0]
+        return [_Path(path.frozen + proposal, path.score)]
+    candidates: list[_Path] = []
+    seen: set[tuple[int, ...]] = set()
+    for path, proposals in extended:
+        for proposal in proposals:
+            frozen = path.frozen + proposal
+            if tuple(sorted(frozen)) in seen:  # reached by a better path first
+                continue
+            seen.add(tuple(sorted(frozen)))
+            level = freeze(motion, analysis, frozen)
+            negligible = NEGLIGIBLE_ERROR * level.length_scale()
+            error = trial_error(level, frames)
+            candidates.append(_Path(frozen, path.score + float(np.log(max(error, negligible)))))
+            if error <= negligible:
+                break
+    candidates.sort(key=lambda c: c.score)  # stable: ties keep the earlier path and ranking
+    return [c for c in candidates[:paths] if c.score <= candidates[0].score + np.log(SEARCH_MARGIN)]

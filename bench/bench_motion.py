@@ -13,7 +13,8 @@ Run: ``.venv/bin/python bench/bench_motion.py [--quick]`` (part of ``make bench`
 2. Speed: 8 levels of 131_01.bvh, of the procedural humanoid with fingers (594 frames), of
    Xbot.glb's clips end to end (captured fingers, 67 joints, 268 frames) and of two figures with
    long chains (:func:`hanging_chains`: 10 of 7 joints on the head, one of 40), with the default
-   ranking and with Eq. 3 alone (whose chain has no trial re-fits), best of 3 interleaved
+   ranking, its greedy form (one choice carried from level to level) and Eq. 3 alone (whose
+   chain has no trial re-fits), best of 3 interleaved
    rounds: wall and CPU seconds (goal: 131_01 under 10 s), the cost per joint-frame and its
    ratio to 131_01's with the same ranking (goal: 1).
 3. Both solvers on the same frames: the Python reference (PyPI nlopt, Python callbacks) and the
@@ -63,9 +64,12 @@ from animlod.motion_lod.core_refit import refit_core
 from animlod.motion_lod.frozen import freeze, frozen_motion
 from animlod.motion_lod.objective import build_problem
 from animlod.motion_lod.refit import refit_slsqp
-from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR
+from animlod.motion_lod.refit_choice import NEGLIGIBLE_ERROR, SEARCH_PATHS
 from animlod.options import MotionRefitOptions
 from animlod.synth import humanoid, humanoid_motion, tail_clips
+
+# The default ranking's greedy form in the tables: one choice carried from level to level.
+GREEDY = "refit, 1 path"
 
 # The core's SLSQP in the Python reference's variables (no preconditioner, every point a variable).
 PLAIN = MotionRefitOptions(precondition=False, eliminate_points=False)
@@ -234,15 +238,19 @@ def speed_table(quick: bool) -> None:
         cases.append(("Xbot.glb, its clips end to end", clips_end_to_end(xbot)))
     frames = 30 if quick else 150
     cases += chain_figures(frames)
+    # The default ranking, its greedy form (one choice carried from level to level) and Eq. 3 alone.
+    rankings = (("refit", SEARCH_PATHS), (GREEDY, 1), ("importance", SEARCH_PATHS))
     runs = [(label, motion, threads, ranking) for label, motion in cases
-            for threads, ranking in ((0, "refit"), (0, "importance"))]  # fmt: skip
+            for threads, ranking in [(0, r) for r in rankings]]  # fmt: skip
     if cases[0][0] == "131_01.bvh":
-        runs.insert(0, (cases[0][0], cases[0][1], 1, "refit"))
+        runs.insert(0, (cases[0][0], cases[0][1], 1, rankings[0]))
     rounds = 1 if quick else 3
     best: dict[int, tuple[float, float, float, int]] = {}
     for _ in range(rounds):
-        for index, (_, motion, threads, ranking) in enumerate(runs):
-            chain, wall, cpu = wall_and_cpu(partial(build_motion_chain, motion, 8, workers=threads, ranking=ranking))
+        for index, (_, motion, threads, (ranking, paths)) in enumerate(runs):
+            name = "refit" if ranking == GREEDY else ranking
+            build = partial(build_motion_chain, motion, 8, workers=threads, ranking=name, refit_paths=paths)
+            chain, wall, cpu = wall_and_cpu(build)
             solved = sum(level.report.joint_count * motion.frame_count for level in chain.levels[1:])
             failed = sum(len(level.report.failures) for level in chain.levels)
             if index not in best or cpu < best[index][1]:
@@ -250,9 +258,9 @@ def speed_table(quick: bool) -> None:
     reference = {(threads, ranking): best[i][2] for i, (label, _, threads, ranking) in enumerate(runs)
                  if label == "131_01.bvh"}  # fmt: skip
     rows = []
-    for index, (label, motion, threads, ranking) in enumerate(runs):
+    for index, (label, motion, threads, (ranking, paths)) in enumerate(runs):
         wall, cpu, per_joint_frame, failed = best[index]
-        peer = reference.get((threads, ranking)) if label != "131_01.bvh" else None
+        peer = reference.get((threads, (ranking, paths))) if label != "131_01.bvh" else None
         rows.append(
             (label, ranking, joints_of(motion), motion.frame_count, threads or os.cpu_count(), f"{wall:.1f}",
              f"{cpu:.1f}", f"{per_joint_frame:.2f}", f"{per_joint_frame / peer:.2f}" if peer else "", failed)
@@ -349,9 +357,6 @@ def reduction_table(all_clips: list[tuple[str, Motion]], option: str, title: str
          "levels with equal errors (5 digits)"),
         rows,
     )  # fmt: skip
-
-
-GREEDY = "refit, 1 path"
 
 
 def ranking_table(label: str, motion: Motion) -> None:

@@ -163,8 +163,8 @@ def test_refit_choice_carries_a_runner_up_whose_coarser_level_makes_up_for_it() 
     assert set(choose_by_refit(motion, analysis, counts, trial_error).priority[:coarse]) == set(depth[:coarse])
     too_far = partial(trial_error, runner_up=1.01 * SEARCH_MARGIN, others=1.01 * SEARCH_MARGIN)
     assert choose_by_refit(motion, analysis, counts, too_far).priority == greedy
-    with pytest.raises(ValueError, match="paths: must be at least 1, got 0"):
-        choose_by_refit(motion, analysis, counts, trial_error, paths=0)
+    with pytest.raises(ValueError, match="refit_paths: must be at least 1, got 0"):
+        build_motion_chain(motion, counts, refit_paths=0)
 
 
 def test_refit_choice_beats_importance_and_depth_on_the_walk() -> None:

@@ -443,7 +443,7 @@ def build_motion_chain(
         with the frozen level, its re-fitted motion on the trial frames and those frames. None: the
         mean distance of every measured point from its original position; a skinned rig's chain
         measures its skin (skin_measure.skin_trial_measure).
-    refit_paths : with the "refit" ranking, the choices of joints its search carries from each
+    refit_paths : with the "refit" ranking, the choices of joints (at least 1) its search carries from each
         level to the next (refit_choice.SEARCH_PATHS; 1: each level takes its lowest trial error).
 
     Returns
@@ -452,6 +452,8 @@ def build_motion_chain(
     """
     if skin is not None and skin.skeleton.names != motion.skeleton.names:
         raise ValueError("skin: its skeleton's joint names differ from the motion's")
+    if refit_paths < 1:
+        raise ValueError(f"refit_paths: must be at least 1, got {refit_paths}")
     analysis = analysis or analyze_motion(
         motion, locked=locked, max_frames=max_frames, ranking=ranking, workers=workers
     )

@@ -100,15 +100,13 @@ def choose_by_refit(
         level re-fitted on the given frames of ``motion`` (TRIAL_FRAMES evenly spaced ones, the
         same for every call).
     progress : called with (levels chosen, levels to choose) after each level.
-    paths : choices of joints kept from each level to the next (SEARCH_PATHS; 1: each level
-        takes its lowest trial error, whatever it leaves the coarser levels).
+    paths : choices of joints kept from each level to the next, at least 1 (SEARCH_PATHS; 1:
+        each level takes its lowest trial error, whatever it leaves the coarser levels).
 
     Returns
     -------
     MotionAnalysis whose ``priority`` freezes, for each count, the chosen joints first.
     """
-    if paths < 1:
-        raise ValueError(f"paths: must be at least 1, got {paths}")
     proposing = proposers(motion, analysis)
     frames = spread_frames(motion.frame_count, TRIAL_FRAMES)
     hidden = [j for j in analysis.hidden if not motion.skeleton.end_sites[j]]

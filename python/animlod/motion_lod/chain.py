@@ -443,8 +443,9 @@ def build_motion_chain(
         with the frozen level, its re-fitted motion on the trial frames and those frames. None: the
         mean distance of every measured point from its original position; a skinned rig's chain
         measures its skin (skin_measure.skin_trial_measure).
-    refit_paths : with the "refit" ranking, the choices of joints (at least 1) its search carries from each
-        level to the next (refit_choice.SEARCH_PATHS; 1: each level takes its lowest trial error).
+    refit_paths : with the "refit" ranking, the choices of joints (at least 1) its search carries
+        from each level to the next (refit_choice.SEARCH_PATHS; 1: each level takes its lowest
+        trial error).
 
     Returns
     -------

@@ -163,9 +163,10 @@ def _best_paths(
     for path, proposals in extended:
         for proposal in proposals:
             frozen = path.frozen + proposal
-            if tuple(sorted(frozen)) in seen:  # reached by a better path first
+            key = tuple(sorted(frozen))
+            if key in seen:  # reached by a better path first
                 continue
-            seen.add(tuple(sorted(frozen)))
+            seen.add(key)
             level = freeze(motion, analysis, frozen)
             negligible = NEGLIGIBLE_ERROR * level.length_scale()
             error = trial_error(level, frames)

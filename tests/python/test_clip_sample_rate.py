@@ -169,6 +169,49 @@ def test_motion_levels_of_a_clip_keyed_late_start_at_its_first_key(humanoid_glb,
     assert len(written.sampler_keys(0, 0, 3, "test")[0]) == len(source.sampler_keys(0, 0, 3, "test")[0])
 
 
+def _split_by_joint(source, path):
+    """``source`` with its one animation split into one per node, each with that node's channels,
+    as some exporters write a clip (Khronos' Monster: an animation per joint)."""
+    from animlod.io.glb_builder import GlbBuilder
+
+    builder = GlbBuilder.from_document(GltfDocument(source))
+    (animation,) = builder.json["animations"]
+    by_node = {}
+    for channel in animation["channels"]:
+        by_node.setdefault(channel["target"]["node"], []).append(channel)
+    builder.json["animations"] = [
+        {
+            "name": f"node{node}",
+            "samplers": [animation["samplers"][channel["sampler"]] for channel in channels],
+            "channels": [{**channel, "sampler": index} for index, channel in enumerate(channels)],
+        }
+        for node, channels in by_node.items()
+    ]
+    builder.save(path)
+    return path
+
+
+def test_motion_levels_of_a_clip_split_by_joint_and_keyed_late_start_at_its_first_key(humanoid_glb, tmp_path):
+    # `motion` merges the parts of a clip split by joint into one motion, which it sampled from 0:
+    # keyed at 20 s, 666 frames for 66, as for a late clip of one animation (above).
+    from animlod.pipelines.motion import build_motion_levels
+
+    split = _split_by_joint(humanoid_glb, tmp_path / "split.glb")
+    late = _keyed_later(split, tmp_path / "late.glb", 20.0)
+    reports = [build_motion_levels(path, tmp_path / path.stem, levels=3) for path in (split, late)]
+    assert all(any("simplifying them as one motion" in note for note in report.notes) for report in reports)
+    assert reports[1].motion.frame_count == reports[0].motion.frame_count
+    plain, late_levels = ([level.report for level in report.chain.levels] for report in reports)
+    assert [level.joint_count for level in late_levels] == [level.joint_count for level in plain]
+    for statistic in ("mean_error", "max_error"):
+        np.testing.assert_allclose(
+            [getattr(r, statistic) for r in late_levels], [getattr(r, statistic) for r in plain], rtol=2e-2, atol=1e-9
+        )
+    written = GltfDocument(tmp_path / "late" / "late_lod1.glb")
+    assert written.animation_start(0) == 20.0
+    assert written.animation_duration(0) == GltfDocument(late).animation_duration(0)
+
+
 def test_a_morph_animation_keyed_late_starts_at_its_first_key(data_dir, tmp_path):
     # `tdag build` read a late clip's held first shape from 0 as frames of its own.
     source = data_dir / "morph" / "Parrot.glb"

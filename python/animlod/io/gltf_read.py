@@ -72,7 +72,8 @@ def read_gltf(
     Animations are sampled at ``fps`` (None: at the rate of their keys,
     :meth:`~animlod.io.gltf_document.GltfDocument.sample_rate`) to their last key: the skeletons'
     motions from time 0, so that clips split by joint line up frame by frame (the pipelines start
-    each clip at its first key where they play it alone: ``Clip.start_frame``), the morph
+    each clip at its first key, and a clip split by joint at its parts' earliest first key:
+    ``Clip.start_frame``, :func:`from_first_key`), the morph
     animations from the frame at or just before their first key. ``body_skin`` picks the
     character whose mesh is :attr:`GltfScene.body` in a file of several, as :func:`read_skinned`
     picks a skin. Raises :class:`~animlod.io.FormatError` naming the file, the element and the

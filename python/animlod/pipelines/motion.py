@@ -400,7 +400,12 @@ def _read_input(
                 note(f"{path}: the channels of its animations that pose no joint (morph weights, what hangs from the "
                      "joints, KHR_animation_pointer) are not in the levels' GLBs (the animations are joined into one "
                      "motion)")  # fmt: skip
-            played = PlayedClip(merged.name, slice(None), max(durations))
+            # The parts of one motion start together, at the earliest first key: a late one's held
+            # first pose would be analysed, re-fitted and written for nothing.
+            start = min(document.animation_start_frame(animation, fps) for animation in animations)
+            if start:
+                merged = merged.take_frames(np.arange(start, merged.frame_count))
+            played = PlayedClip(merged.name, slice(None), max(durations), start=start / fps)
             return _Input(_rigid(path, motions, range(len(motions)), merged), [played], skin, materials, None, content)
         # A clip that scales a joint cannot be re-fitted; the others still make levels.
         rigid = [index for index, motion in enumerate(motions) if motion.deforming_joint() is None]

@@ -42,13 +42,15 @@ def _with_part(
     targets: Sequence[str] = (),
     defaults: Sequence[float] | None = None,
     hair_bone_alone: bool = False,
+    locks: int = 1,
 ) -> Path:
     """The procedural humanoid walking (or the character of ``plain``), with a box over its head
     skinned by a skin of its own (bound in the body's pose): over Neck and Head, every vertex on
     Head; or with ``hair`` ("still" or "swinging") over Head and a bone "Hair" of its own below
     it, every vertex on Hair (over Hair alone with ``hair_bone_alone``: a skin that lists none of
-    the body's joints, as Khronos' RecursiveSkeletons). The box has a morph target of each name in
-    ``targets``, with the mesh's default weights ``defaults``."""
+    the body's joints, as Khronos' RecursiveSkeletons; with ``locks`` such bones side by side
+    under Head, "Hair", "Hair2", ..., the box's vertices shared among them). The box has a morph
+    target of each name in ``targets``, with the mesh's default weights ``defaults``."""
     if plain is None:
         plain = folder / "humanoid.glb"
         character = synth.humanoid()
@@ -64,11 +66,15 @@ def _with_part(
         joint_nodes = [by_name["Neck"], by_name["Head"]]
         binds = [stored[body_skin["joints"].index(node)].T for node in joint_nodes]
     else:
-        lift = np.eye(4)
-        lift[1, 3] = 0.15
-        bone = builder.append("nodes", {"name": "Hair", "translation": lift[:3, 3].tolist()})
-        nodes[by_name["Head"]].setdefault("children", []).append(bone)
-        joint_nodes, binds = [by_name["Head"], bone], [head_bind, np.linalg.inv(lift) @ head_bind]
+        joint_nodes, binds = [by_name["Head"]], [head_bind]
+        for lock in range(locks):
+            lift = np.eye(4)
+            lift[:3, 3] = [0.05 * lock, 0.15, 0.0]
+            bone_name = "Hair" if lock == 0 else f"Hair{lock + 1}"
+            bone = builder.append("nodes", {"name": bone_name, "translation": lift[:3, 3].tolist()})
+            nodes[by_name["Head"]].setdefault("children", []).append(bone)
+            joint_nodes.append(bone)
+            binds.append(np.linalg.inv(lift) @ head_bind)
         if hair_bone_alone:
             joint_nodes, binds = joint_nodes[1:], binds[1:]
         if hair == "swinging":
@@ -78,13 +84,16 @@ def _with_part(
             turns = np.stack([np.sin(angles / 2), 0 * angles, 0 * angles, np.cos(angles / 2)], axis=1)
             animation["samplers"].append({"input": animation["samplers"][0]["input"],
                                           "output": builder.add(turns.astype(np.float32))})  # fmt: skip
-            target = {"node": bone, "path": "rotation"}
-            animation["channels"].append({"sampler": len(animation["samplers"]) - 1, "target": target})
+            for bone in joint_nodes[-locks:]:
+                target = {"node": bone, "path": "rotation"}
+                animation["channels"].append({"sampler": len(animation["samplers"]) - 1, "target": target})
     matrices = np.stack([bind.T for bind in binds]).reshape(-1, 16).astype(np.float32)
     skin = builder.append("skins", {"joints": joint_nodes, "inverseBindMatrices": builder.add(matrices)})
     positions, faces = _box(doc.rest_world_matrix(by_name["Head"])[:3, 3] + [0.0, 0.1, 0.0], 0.12)
     joints = np.zeros((len(positions), 4), np.uint16)
-    joints[:, 0] = len(joint_nodes) - 1  # Head, or Hair
+    joints[:, 0] = len(joint_nodes) - 1  # Head, or the last lock of Hair
+    if hair is not None:  # the locks' vertices side by side
+        joints[:, 0] -= (np.arange(len(positions)) * locks // len(positions)).astype(np.uint16)
     weights = np.zeros((len(positions), 4), np.float32)
     weights[:, 0] = 1.0
     attributes = {"POSITION": builder.add(positions, bounds=True), "JOINTS_0": builder.add(joints),
@@ -190,19 +199,20 @@ def test_swinging_hair_joins_the_bodys_skeleton(tmp_path) -> None:
     assert len(swings) >= 2 and min(swings) > 0.5  # the input swings by 0.6 radians
 
 
+@pytest.mark.parametrize("locks", [1, 2])
 @pytest.mark.parametrize("hair", ["still", "swinging"])
-def test_hair_whose_skin_lists_its_own_bone_alone_plays_the_bodys_levels(tmp_path, hair) -> None:
-    # Its skin lists none of the body's joints, only a bone that hangs from the head in the node
+def test_hair_whose_skin_lists_its_own_bone_alone_plays_the_bodys_levels(tmp_path, hair, locks) -> None:
+    # Its skin lists none of the body's joints, only bones that hang from the head in the node
     # tree: it had levels of its own, posed by the input's head where the body's level froze it,
-    # and drifted off the body. It now plays the body's levels like hair that lists the head too:
-    # on the head where its bone holds still, its bone joining the body's skeleton where it swings.
-    source = _with_part(tmp_path, "own bone", hair=hair, hair_bone_alone=True)
+    # and drifted off the body (with two locks, two trees of joints, until 2026-12-07 evening). It
+    # now plays the body's levels like hair that lists the head too: on the head where its bones
+    # hold still, its bones joining the body's skeleton where they swing.
+    source = _with_part(tmp_path, "own bone", hair=hair, hair_bone_alone=True, locks=locks)
     output = tmp_path / "own_bone_lod.glb"
     report = build_character(source, output, [0.5, 0.25, 0.1], solver="newton", **QUICK)
+    bones = ", ".join(["node 42 'Hair'", "node 43 'Hair2'"][:locks])
     relation = (
-        "its joints hang from those of"
-        if hair == "still"
-        else "its own joints (node 42 'Hair') move in its clips and join"
+        "its joints hang from those of" if hair == "still" else f"its own joints ({bones}) move in its clips and join"
     )
     assert f"skin 1: {relation} skin 0; it plays that skin's motion levels" in report.notes
     assert _plays_the_bodys_levels(output, "own bone") >= 1
@@ -533,10 +543,12 @@ def test_the_body_is_a_mesh_the_shown_scene_draws(humanoid_glb, tmp_path) -> Non
     assert read.skinned_nodes[read.body] == shown
 
 
+@pytest.mark.parametrize("locks", [1, 2])
 @pytest.mark.parametrize("hair", ["still", "swinging"])
-def test_motion_levels_show_hair_whose_skin_lists_its_own_bone_alone(tmp_path, hair) -> None:
-    # A skin over a bone hung from the body's Head in the node tree and none of the body's joints
-    # (RecursiveSkeletons' layout) was left out as "on another skeleton", as a second character is.
-    source = _with_part(tmp_path, "own bone", hair=hair, hair_bone_alone=True)
+def test_motion_levels_show_hair_whose_skin_lists_its_own_bone_alone(tmp_path, hair, locks) -> None:
+    # A skin over bones hung from the body's Head in the node tree and none of the body's joints
+    # (RecursiveSkeletons' layout) was left out as "on another skeleton", as a second character is
+    # (with two locks, two trees of joints, until 2026-12-07 evening).
+    source = _with_part(tmp_path, "own bone", hair=hair, hair_bone_alone=True, locks=locks)
     notes = _motion_levels_show_every_skin(source, tmp_path / "levels")
     assert any("has joints of its own that move in its clips" in note for note in notes) == (hair == "swinging")

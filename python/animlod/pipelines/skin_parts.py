@@ -67,25 +67,37 @@ def placement_on(
 
 
 def hanging_rig(doc: GltfDocument, rig: SkinRig, joints: set[int]) -> SkinRig | None:
-    """``rig`` with the nearest of the nodes ``joints`` above its root joint (another skin's joint
-    that its bones hang from in the node tree) as an extra joint, so that :func:`placement_on` and
-    :func:`joined_rig` see where it meets that skin; None where its joints form several trees, lie
-    under none of ``joints`` or already list one. That joint is bound where the node tree's rest
-    pose puts it relative to the root joint's bind: ``IBM_anchor = L @ IBM_root``, ``L`` the rest
-    transforms of the nodes from the anchor down to the root. Exporters bind at the rest pose; a
-    part bound with its root elsewhere relative to that joint is placed off by as much."""
-    listed = doc.gltf.skins[rig.skin].joints
-    root = rig.joint_nodes[0]
-    if root not in listed or joints & set(listed) or rig.extra_joints:
+    """``rig`` with the node of ``joints`` that its bones hang from in the node tree (another
+    skin's joint, the nearest above each tree of its joints: two locks of hair under the head) as
+    an extra joint, so that :func:`placement_on` and :func:`joined_rig` see where it meets that
+    skin; None where a tree of its joints lies under none of ``joints``, its trees hang from
+    different ones or were bound apart, or it already lists one. That joint is bound where the
+    node tree's rest pose puts it relative to a tree's root joint's bind: ``IBM_anchor = L @
+    IBM_root``, ``L`` the rest transforms of the nodes from the anchor down to that root.
+    Exporters bind at the rest pose; a part bound with its roots elsewhere relative to that joint
+    is placed off by as much."""
+    listed = set(doc.gltf.skins[rig.skin].joints)
+    if joints & listed or rig.extra_joints:
         return None
-    above = doc.ancestors(root)
-    anchor = next((i for i, node in enumerate(above) if node in joints), None)
-    if anchor is None:
+    anchor, binds = None, []
+    for root in (node for node in rig.joint_nodes if node in listed and listed.isdisjoint(doc.ancestors(node))):
+        above = doc.ancestors(root)
+        depth = next((i for i, node in enumerate(above) if node in joints), None)
+        if depth is None or anchor not in (None, above[depth]):
+            return None
+        anchor, down = above[depth], np.eye(4)
+        for node in reversed([root, *above[:depth]]):  # the anchor's child first
+            down = down @ doc.rest_matrix(node)
+        binds.append(down @ rig.inverse_bind[rig.joint_nodes.index(root)])
+    if anchor is None or not all(_same_bind(bind, binds[0]) for bind in binds[1:]):
         return None
-    down = np.eye(4)
-    for node in reversed([root, *above[:anchor]]):  # the anchor's child first
-        down = down @ doc.rest_matrix(node)
-    return SkinRig(doc, rig.skin, [above[anchor]], (down @ rig.inverse_bind[0])[None])
+    return SkinRig(doc, rig.skin, [anchor], binds[0][None])
+
+
+def _same_bind(first: np.ndarray, second: np.ndarray) -> bool:
+    """Whether two inverse binds (4, 4) of one joint agree to the float32 rounding of stored ones."""
+    scale = 1.0 + np.abs(first[:3, 3]).max()
+    return bool(np.allclose(first[:3], second[:3], rtol=0.0, atol=1e-5 * scale))
 
 
 def joined_rig(

@@ -62,10 +62,18 @@ std::vector<std::pair<int32_t, int64_t>> skin_set(const WeldInput& input, size_t
   return set;
 }
 
-// 1 / the weld's cell for positions and position attributes: kWeldTolerance of the largest
-// extent of the used vertices over the frames.
-double weld_inverse_cell(const AnimatedMeshView& mesh, const std::vector<uint8_t>& used) {
-  double extent = 0.0;
+// 1 / the weld's cell: in each frame, kWeldTolerance of that frame's extent of the used vertices
+// or of the median frame's if larger (a frame where the mesh shrinks keeps the cell that welds
+// its seams); for the position attributes, of the median frame's. Per frame: with one cell for
+// every frame, a stray vertex far out in one frame made the cell as coarse in all of them, and
+// real vertices welded (a vertex at 1e6 on a 2-unit body left 128 of 13,776 faces).
+struct WeldCells {
+  std::vector<double> inverse_frame;  // (F,)
+  double inverse_attribute = 0.0;
+};
+
+WeldCells weld_cells(const AnimatedMeshView& mesh, const std::vector<uint8_t>& used) {
+  std::vector<double> extents(mesh.frame_count, 0.0);
   for (size_t frame = 0; frame < mesh.frame_count; ++frame) {
     std::array<float, 3> low{}, high{};
     bool first = true;
@@ -79,9 +87,16 @@ double weld_inverse_cell(const AnimatedMeshView& mesh, const std::vector<uint8_t
       first = false;
     }
     for (size_t axis = 0; axis < 3; ++axis)
-      extent = std::max(extent, static_cast<double>(high[axis]) - static_cast<double>(low[axis]));
+      extents[frame] = std::max(extents[frame], static_cast<double>(high[axis]) - static_cast<double>(low[axis]));
   }
-  return 1.0 / (kWeldTolerance * std::max(extent, 1e-30));
+  std::vector<double> sorted = extents;
+  const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+  std::nth_element(sorted.begin(), middle, sorted.end());
+  const double median = std::max(sorted.empty() ? 0.0 : *middle, 1e-30);
+  WeldCells cells;
+  for (const double extent : extents) cells.inverse_frame.push_back(1.0 / (kWeldTolerance * std::max(extent, median)));
+  cells.inverse_attribute = 1.0 / (kWeldTolerance * median);
+  return cells;
 }
 
 // Step 1: vertices equal in every frame, in position attributes and in skin (each snapped to the
@@ -98,8 +113,8 @@ std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, 
       if (used[v]) welded_to[v] = static_cast<int32_t>(v);
     return welded_to;
   }
-  const double inverse_cell = weld_inverse_cell(mesh, used);
-  auto same_rows = [&](const float* a, const float* b, size_t count) {
+  const WeldCells cells = weld_cells(mesh, used);
+  auto same_rows = [&](const float* a, const float* b, size_t count, double inverse_cell) {
     for (size_t i = 0; i < count; ++i)
       if (snapped(a[i], inverse_cell) != snapped(b[i], inverse_cell)) return false;
     return true;
@@ -108,11 +123,12 @@ std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, 
     for (size_t frame = 0; frame < mesh.frame_count; ++frame) {
       const float* pa = mesh.frames + frame * frame_stride + static_cast<size_t>(a) * 3;
       const float* pb = mesh.frames + frame * frame_stride + static_cast<size_t>(b) * 3;
-      if (!same_rows(pa, pb, 3)) return false;
+      if (!same_rows(pa, pb, 3, cells.inverse_frame[frame])) return false;
     }
     const size_t width = input.position_attribute_count;
     if (width && !same_rows(input.position_attributes + static_cast<size_t>(a) * width,
-                            input.position_attributes + static_cast<size_t>(b) * width, width))
+                            input.position_attributes + static_cast<size_t>(b) * width, width,
+                            cells.inverse_attribute))
       return false;
     return !input.skin_joints || skin_set(input, static_cast<size_t>(a)) == skin_set(input, static_cast<size_t>(b));
   };
@@ -125,9 +141,10 @@ std::vector<int32_t> weld(const AnimatedMeshView& mesh, const WeldInput& input, 
   auto hash = [&](size_t v) {
     uint64_t h = 0x9e3779b97f4a7c15ull;
     for (size_t frame = 0; frame < mesh.frame_count; ++frame)
-      for (size_t axis = 0; axis < 3; ++axis) h = mix(h, snapped(mesh.frames[frame * frame_stride + v * 3 + axis], inverse_cell));
+      for (size_t axis = 0; axis < 3; ++axis)
+        h = mix(h, snapped(mesh.frames[frame * frame_stride + v * 3 + axis], cells.inverse_frame[frame]));
     for (size_t b = 0; b < input.position_attribute_count; ++b)
-      h = mix(h, snapped(input.position_attributes[v * input.position_attribute_count + b], inverse_cell));
+      h = mix(h, snapped(input.position_attributes[v * input.position_attribute_count + b], cells.inverse_attribute));
     uint64_t skin = 0;  // a sum: the influences' order does not count, zero weights do not count
     for (size_t k = 0; input.skin_joints && k < input.influence_count; ++k) {
       const int64_t weight = snapped_weight(input, v, k);

@@ -442,6 +442,19 @@ def test_welding_joins_exactly_the_copies_equal_everywhere():
     assert result.preparation.face_count == 3 * mesh.face_count
 
 
+def test_a_stray_vertex_in_one_frame_welds_no_other_vertex():
+    # The weld's cell was 1e-6 of the largest extent over all frames: one vertex a million units
+    # out in one frame made it a unit wide in every frame, and the whole tube welded into a few
+    # points. Each frame now has its own cell, and copies weld only where every frame agrees.
+    mesh = bending_tube(frames=5)
+    frames = mesh.frames.copy()
+    frames[2, 7] = [1e6, 0.0, 0.0]
+    result = simplify_animated(AnimatedMesh(mesh.faces, frames), (0.5,))
+    assert result.preparation.welded_vertices == 0
+    assert result.preparation.face_count == mesh.face_count
+    assert result.levels[0].mesh.face_count == mesh.face_count // 2
+
+
 def test_phase_seconds_account_for_the_call():
     # Small meshes take the greedy order (no pass chooses anything); one above 100k edges takes
     # collapse passes, which rank and choose.

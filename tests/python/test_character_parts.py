@@ -552,3 +552,15 @@ def test_motion_levels_show_hair_whose_skin_lists_its_own_bone_alone(tmp_path, h
     source = _with_part(tmp_path, "own bone", hair=hair, hair_bone_alone=True, locks=locks)
     notes = _motion_levels_show_every_skin(source, tmp_path / "levels")
     assert any("has joints of its own that move in its clips" in note for note in notes) == (hair == "swinging")
+
+
+def test_the_lod_glb_is_the_same_whatever_the_threads(tmp_path) -> None:
+    # `character` re-fitted on one thread until its default became every core, as `motion`'s is:
+    # the frames are solved apart, so the threads must not change a byte.
+    source = _with_part(tmp_path, "helmet")
+    written = []
+    for workers in (1, 2):
+        output = tmp_path / f"threads{workers}.glb"
+        build_character(source, output, [0.5, 0.25], solver="slsqp", workers=workers, **QUICK)
+        written.append(output.read_bytes())
+    assert written[0] == written[1]

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io.detect import GLB_OUTPUT_SUFFIXES, glb_name, input_kind
-from . import UserError, add_joint_map_argument, positive_int, print_rows
+from . import UserError, add_joint_map_argument, non_negative_int, positive_int, print_rows
 from .simplify import feature_options, print_drawable_reports
 
 
@@ -33,7 +33,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--ratio", type=float, nargs="+", default=[0.5, 0.25, 0.1], help="face ratios of levels 1, 2, ..."
     )
     parser.add_argument("--solver", choices=("slsqp", "newton"), default="slsqp", help="motion re-fit (default slsqp)")
-    parser.add_argument("--workers", type=positive_int, default=1, help="processes for the motion re-fit (default 1)")
+    parser.add_argument(
+        "--workers", type=non_negative_int, default=0,
+        help="threads of the motion analysis and re-fit; 0: every core (the default)",
+    )  # fmt: skip
     parser.add_argument("--no-features", action="store_true", help="ignore motion features in AQEM (the default)")
     parser.add_argument(
         "--feature-weighting",

@@ -120,7 +120,7 @@ def build_character(
     ratios: Sequence[float] = DEFAULT_RATIOS,
     *,
     solver: str = "slsqp",
-    workers: int = 1,
+    workers: int = 0,
     clips: Sequence[str] = (),
     joint_map: str | os.PathLike | None = None,
     settings: DrawableSettings | None = None,
@@ -135,8 +135,8 @@ def build_character(
     source, output : the input glTF and the LoD GLB to write (atomically).
     ratios : face ratios of geometry levels 1, 2, ...; motion levels are as many (joint counts
         spread down to the fewest the skeleton allows, see :func:`animlod.build_motion_chain`).
-    solver, workers : the motion re-fit (``"slsqp"``, the paper's SQP, or ``"newton"``) and the
-        processes it uses.
+    solver, workers : the motion re-fit (``"slsqp"``, the paper's SQP, or ``"newton"``), and the
+        threads of the motion analysis and re-fit (0: every core; the levels are the same).
     clips : glTF files of clips on the same rig (an animation library without the mesh), added to
         the character's own by node name (:mod:`.clip_import`).
     joint_map : a JSON table of the character's node each BVH clip's joint drives, where the

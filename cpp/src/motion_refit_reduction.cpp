@@ -149,7 +149,7 @@ PointReduction::PointReduction(const MotionRefitProblem& problem, bool hard_cons
     if (free_points_.contains(k)) free_index_[k] = static_cast<int32_t>(free_count_++);
     else if (unplaced[k] && directions_.direction_of(k) < 0) index_[k] = add_slot(3);
   }
-  for (size_t b = 0; b < bodies_.count(); ++b) body_slot_.push_back(add_slot(3));
+  for (size_t b = 0; b < bodies_.count(); ++b) body_slot_.push_back(add_slot(bodies_.width(b)));
   for (size_t i = 0; i < directions_.count(); ++i) direction_slot_.push_back(add_slot(2));
   free_blocks_.resize(free_points_.cluster_count());
   for (size_t c = 0; c < free_blocks_.size(); ++c)
@@ -311,7 +311,7 @@ void PointReduction::fill(const double* y, const double* original, double* x) {
 void PointReduction::gather(const double* x, double* y) const {
   for (size_t k = 1; k < problem_.point_count; ++k)
     if (index_[k] >= 0) std::copy_n(x + 3 * k, 3, y + slot_offset_[index_[k]]);
-  for (int32_t slot : body_slot_) std::fill_n(y + slot_offset_[slot], 3, 0.0);
+  for (int32_t slot : body_slot_) std::fill_n(y + slot_offset_[slot], slot_width_[slot], 0.0);
   for (size_t i = 0; i < directions_.count(); ++i) directions_.coordinates(i, x, y + slot_offset_[direction_slot_[i]]);
 }
 

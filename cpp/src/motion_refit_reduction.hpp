@@ -21,7 +21,7 @@
 //   constraints) hangs from it along a direction, a slot of two variables
 //   (motion_refit_bone_directions.hpp).
 // The variables are the slots' in order: three per point that stays a variable, three per
-// rigid body, two per direction.
+// rigid body (two for one along a line), two per direction.
 // The reduced problem has the same minima as the full one; the map from reduced to full
 // positions is differentiated exactly (chain rule; a free point adds nothing, as E's derivative
 // with respect to it is zero at its minimum), so gradients and Jacobians stay analytic:

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <Eigen/QR>
 
 #include "motion_refit_detail.hpp"
@@ -24,6 +25,34 @@ constexpr int kRigidIterations = 30;
 // [w]x as a row-major 3 x 3 matrix.
 std::array<double, 9> cross_matrix(const double* w) {
   return {0.0, -w[2], w[1], w[2], 0.0, -w[0], -w[1], w[0], 0.0};
+}
+
+// Sine of the widest angle at its base below which a body lies along a line (about 3 degrees, as
+// objective.py's _FLAT).
+constexpr double kAlongALine = 0.05;
+
+// Whether the held lengths `held` (rows of the body's set) put every member within kAlongALine
+// of one line through `base`: no triangle of held lengths (base, a, b) opens wider at the base.
+bool along_a_line(const MotionRefitProblem& problem, const std::vector<size_t>& held, int32_t base) {
+  auto length = [&](int32_t a, int32_t b) {  // the held length between a and b, 0 if none
+    for (size_t r : held) {
+      if (r >= problem.length_pair_count) continue;
+      const int32_t* pair = problem.length_pairs + 2 * r;
+      if ((pair[0] == a && pair[1] == b) || (pair[0] == b && pair[1] == a)) return problem.key_lengths[r];
+    }
+    return 0.0;
+  };
+  bool triangle = false;
+  for (size_t r : held) {
+    if (r >= problem.length_pair_count) continue;
+    const int32_t a = problem.length_pairs[2 * r], b = problem.length_pairs[2 * r + 1];
+    const double la = length(base, a), lb = length(base, b), lab = problem.key_lengths[r];
+    if (a == base || b == base || la == 0.0 || lb == 0.0) continue;
+    const double cosine = std::clamp((la * la + lb * lb - lab * lab) / (2.0 * la * lb), -1.0, 1.0);
+    if (std::sqrt(1.0 - cosine * cosine) > kAlongALine) return false;
+    triangle = true;
+  }
+  return triangle;
 }
 
 }  // namespace
@@ -85,6 +114,7 @@ RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<ui
     if (held.size() != 3 * set.size() - 3) continue;  // not a minimal rigid set: leave it to SLSQP
     const auto body = static_cast<int32_t>(bases_.size());
     bases_.push_back(static_cast<int32_t>(base));
+    along_a_line_.push_back(along_a_line(problem, held, static_cast<int32_t>(base)) ? 1 : 0);
     std::sort(set.begin(), set.end());
     for (int32_t c : set) body_of_[c] = body;
     members_.push_back(set);
@@ -118,6 +148,7 @@ RigidBodies::RigidBodies(const MotionRefitProblem& problem, const std::vector<ui
   std::fill(body_of_.begin(), body_of_.end(), -1);
   bases_.clear();
   members_.clear();
+  along_a_line_.clear();
   order_.clear();
 }
 
@@ -125,9 +156,23 @@ void RigidBodies::set_start(const double* x) {
   if (bases_.empty()) return;
   shape_.assign(x, x + 3 * problem_.point_count);
   make_rigid();
-  for (size_t b = 0; b < bases_.size(); ++b)
-    for (int32_t k : members_[b])
+  turn_bases_.assign(bases_.size(), Matrix3{});
+  for (size_t b = 0; b < bases_.size(); ++b) {
+    Eigen::Vector3d line = Eigen::Vector3d::Zero();  // the farthest member's offset
+    for (int32_t k : members_[b]) {
       for (int a = 0; a < 3; ++a) offsets_[3 * k + a] = shape_[3 * k + a] - shape_[3 * bases_[b] + a];
+      const Eigen::Map<const Eigen::Vector3d> offset(&offsets_[3 * k]);
+      if (offset.squaredNorm() > line.squaredNorm()) line = offset;
+    }
+    if (!along_a_line_[b] || !(line.squaredNorm() > 0.0)) continue;
+    // Two axes across the line: turns about them move it, a turn about it moves nothing.
+    line.normalize();
+    Eigen::Index least = 0;
+    line.cwiseAbs().minCoeff(&least);
+    const Eigen::Vector3d first = line.cross(Eigen::Vector3d::Unit(least)).normalized();
+    const Eigen::Vector3d second = line.cross(first);
+    for (int i = 0; i < 3; ++i) turn_bases_[b][3 * i] = first(i), turn_bases_[b][3 * i + 1] = second(i);
+  }
 }
 
 void RigidBodies::make_rigid() {
@@ -162,7 +207,14 @@ void RigidBodies::make_rigid() {
   }
 }
 
-void RigidBodies::place(size_t body, const double* w, double* x) {
+void RigidBodies::place(size_t body, const double* variables, double* x) {
+  // A body along a line turns about the two axes across it (turn_bases_ columns), others about
+  // any axis.
+  const Matrix3& across = turn_bases_[body];
+  const bool line = along_a_line_[body] != 0;
+  double w[3];
+  for (int i = 0; i < 3; ++i)
+    w[i] = line ? across[3 * i] * variables[0] + across[3 * i + 1] * variables[1] : variables[i];
   const double t2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
   const double t = std::sqrt(t2);
   // sin t / t, (1 - cos t) / t^2, (t - sin t) / t^3
@@ -186,12 +238,16 @@ void RigidBodies::place(size_t body, const double* w, double* x) {
              c * (wx2[3 * i] * d[0] + wx2[3 * i + 1] * d[1] + wx2[3 * i + 2] * d[2]);
     for (int i = 0; i < 3; ++i) x[3 * k + i] = origin[i] + v[i];
     const std::array<double, 9> vx = cross_matrix(v);
-    Matrix3& j = jacobians_[k];  // -[v]x J_l
+    Matrix3 j{};  // -[v]x J_l
+    for (int i = 0; i < 3; ++i)
+      for (int col = 0; col < 3; ++col)
+        for (int k2 = 0; k2 < 3; ++k2) j[3 * i + col] -= vx[3 * i + k2] * left[3 * k2 + col];
+    Matrix3& derivative = jacobians_[k];  // d x_k / d variables: j, or j times the axes across
     for (int i = 0; i < 3; ++i)
       for (int col = 0; col < 3; ++col) {
         double sum = 0.0;
-        for (int k2 = 0; k2 < 3; ++k2) sum -= vx[3 * i + k2] * left[3 * k2 + col];
-        j[3 * i + col] = sum;
+        for (int k2 = 0; line && k2 < 3; ++k2) sum += j[3 * i + k2] * across[3 * k2 + col];
+        derivative[3 * i + col] = line ? sum : j[3 * i + col];
       }
   }
 }

@@ -146,23 +146,33 @@ def test_a_clip_keyed_late_drives_and_measures_its_levels_where_it_moves(humanoi
     np.testing.assert_allclose(errors[1], errors[0], rtol=1e-4)  # the keys' float32 times round at 20 s
 
 
+def _levels_alike(plain, late, folder) -> list:
+    """The reports of `motion`'s 3 levels of ``plain`` and of ``late`` (the same clip keyed later),
+    having checked that they read as many frames and keep as many joints at errors within 2%: the
+    keys' float32 times round at 20 s, and the coarsest level's minimum moves by about 1% (with the
+    held frames its mean error was a tenth of the plain clip's, diluted by 600 frames)."""
+    from animlod.pipelines.motion import build_motion_levels
+
+    reports = [build_motion_levels(path, folder / path.stem, levels=3) for path in (plain, late)]
+    assert reports[1].motion.frame_count == reports[0].motion.frame_count
+    plain_levels, late_levels = ([level.report for level in report.chain.levels] for report in reports)
+    assert [level.joint_count for level in late_levels] == [level.joint_count for level in plain_levels]
+    for statistic in ("mean_error", "max_error"):
+        np.testing.assert_allclose(
+            [getattr(r, statistic) for r in late_levels],
+            [getattr(r, statistic) for r in plain_levels],
+            rtol=2e-2,
+            atol=1e-9,
+        )
+    return reports
+
+
 def test_motion_levels_of_a_clip_keyed_late_start_at_its_first_key(humanoid_glb, tmp_path):
     # `motion` analysed, re-fitted and wrote the held first pose from 0 to the first key too: a
     # walk keyed at 20 s was 666 frames, the moving 66 of them a tenth of the analysis and of the
     # re-fit's trial frames. The level clips now start where the input's does, key for key.
-    from animlod.pipelines.motion import build_motion_levels
-
     late = _keyed_later(humanoid_glb, tmp_path / "late.glb", 20.0)
-    reports = [build_motion_levels(path, tmp_path / path.stem, levels=3) for path in (humanoid_glb, late)]
-    assert reports[1].motion.frame_count == reports[0].motion.frame_count
-    plain, late_levels = ([level.report for level in report.chain.levels] for report in reports)
-    assert [level.joint_count for level in late_levels] == [level.joint_count for level in plain]
-    # The keys' float32 times round at 20 s, and the coarsest level's minimum moves by about 1%;
-    # with the held frames its mean error was a tenth of the plain clip's (diluted by 600 frames).
-    for statistic in ("mean_error", "max_error"):
-        np.testing.assert_allclose(
-            [getattr(r, statistic) for r in late_levels], [getattr(r, statistic) for r in plain], rtol=2e-2, atol=1e-9
-        )
+    _levels_alike(humanoid_glb, late, tmp_path)
     written, source = GltfDocument(tmp_path / "late" / "late_lod1.glb"), GltfDocument(late)
     assert written.animation_start(0) == source.animation_start(0) == 20.0
     assert written.animation_duration(0) == source.animation_duration(0)
@@ -194,19 +204,10 @@ def _split_by_joint(source, path):
 def test_motion_levels_of_a_clip_split_by_joint_and_keyed_late_start_at_its_first_key(humanoid_glb, tmp_path):
     # `motion` merges the parts of a clip split by joint into one motion, which it sampled from 0:
     # keyed at 20 s, 666 frames for 66, as for a late clip of one animation (above).
-    from animlod.pipelines.motion import build_motion_levels
-
     split = _split_by_joint(humanoid_glb, tmp_path / "split.glb")
     late = _keyed_later(split, tmp_path / "late.glb", 20.0)
-    reports = [build_motion_levels(path, tmp_path / path.stem, levels=3) for path in (split, late)]
+    reports = _levels_alike(split, late, tmp_path)
     assert all(any("simplifying them as one motion" in note for note in report.notes) for report in reports)
-    assert reports[1].motion.frame_count == reports[0].motion.frame_count
-    plain, late_levels = ([level.report for level in report.chain.levels] for report in reports)
-    assert [level.joint_count for level in late_levels] == [level.joint_count for level in plain]
-    for statistic in ("mean_error", "max_error"):
-        np.testing.assert_allclose(
-            [getattr(r, statistic) for r in late_levels], [getattr(r, statistic) for r in plain], rtol=2e-2, atol=1e-9
-        )
     written = GltfDocument(tmp_path / "late" / "late_lod1.glb")
     assert written.animation_start(0) == 20.0
     assert written.animation_duration(0) == GltfDocument(late).animation_duration(0)

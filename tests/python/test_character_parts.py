@@ -218,6 +218,26 @@ def test_hair_whose_skin_lists_its_own_bone_alone_plays_the_bodys_levels(tmp_pat
     assert _plays_the_bodys_levels(output, "own bone") >= 1
 
 
+def test_locks_of_hair_bound_apart_do_not_hang_from_the_head(tmp_path) -> None:
+    # Two trees of the hair's own bones give the head one bind only where their binds agree on
+    # where the head is: with one lock's bind moved, hanging_rig leaves the skin as it is.
+    from animlod.io.gltf_skin import SkinRig
+    from animlod.pipelines.skin_parts import hanging_rig
+
+    source = _with_part(tmp_path, "own bone", hair="still", hair_bone_alone=True, locks=2)
+    doc = GltfDocument(source)
+    body = set(SkinRig(doc, 0).joint_nodes)
+    assert hanging_rig(doc, SkinRig(doc, 1), body) is not None
+    builder = GlbBuilder.from_document(doc)
+    skin = builder.json["skins"][1]
+    stored = np.asarray(doc.accessor(skin["inverseBindMatrices"], "test"), np.float32).reshape(-1, 4, 4).copy()
+    stored[1, 3, 0] += 0.05  # the second lock's bind, 5 cm along x (column-major storage)
+    skin["inverseBindMatrices"] = builder.add(stored.reshape(-1, 16))
+    builder.save(tmp_path / "apart.glb")
+    apart = GltfDocument(tmp_path / "apart.glb")
+    assert hanging_rig(apart, SkinRig(apart, 1), body) is None
+
+
 def test_a_head_of_its_own_counts_in_the_choice_of_the_bodys_joints(tmp_path) -> None:
     # A modular character: the body's skin weighs nothing to Head, a leaf joint, and the head is a
     # mesh of its own on Neck and Head. Measured by the body's skin alone, Head moved nothing and

@@ -238,17 +238,19 @@ void RigidBodies::place(size_t body, const double* variables, double* x) {
              c * (wx2[3 * i] * d[0] + wx2[3 * i + 1] * d[1] + wx2[3 * i + 2] * d[2]);
     for (int i = 0; i < 3; ++i) x[3 * k + i] = origin[i] + v[i];
     const std::array<double, 9> vx = cross_matrix(v);
-    Matrix3 j{};  // -[v]x J_l
+    Matrix3 j{};  // d x_k / d w = -[v]x J_l
     for (int i = 0; i < 3; ++i)
       for (int col = 0; col < 3; ++col)
         for (int k2 = 0; k2 < 3; ++k2) j[3 * i + col] -= vx[3 * i + k2] * left[3 * k2 + col];
-    Matrix3& derivative = jacobians_[k];  // d x_k / d variables: j, or j times the axes across
+    if (!line) {
+      jacobians_[k] = j;
+      continue;
+    }
+    Matrix3& derivative = jacobians_[k];  // d x_k / d variables: j times the axes across
     for (int i = 0; i < 3; ++i)
-      for (int col = 0; col < 3; ++col) {
-        double sum = 0.0;
-        for (int k2 = 0; line && k2 < 3; ++k2) sum += j[3 * i + k2] * across[3 * k2 + col];
-        derivative[3 * i + col] = line ? sum : j[3 * i + col];
-      }
+      for (int col = 0; col < 3; ++col)
+        derivative[3 * i + col] =
+            j[3 * i] * across[col] + j[3 * i + 1] * across[3 + col] + j[3 * i + 2] * across[6 + col];
   }
 }
 

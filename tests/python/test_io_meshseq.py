@@ -361,6 +361,26 @@ def test_frames_numbered_below_zero_come_first(tmp_path: Path, names: list[str],
     assert [path.name for path in meshseq.frame_files(tmp_path)] == [names[index] for index in order]
 
 
+@pytest.mark.parametrize(
+    ("names", "order"),
+    [
+        # Houdini's sub-frames ($FF): natural order read 0.5 before 0.25, and 1.25 before 1.
+        (["mesh.1.obj", "mesh.0.5.obj", "mesh.1.25.obj", "mesh.0.25.obj", "mesh.0.75.obj"], [3, 1, 4, 0, 2]),
+        (["mesh.-0.5.obj", "mesh.0.obj", "mesh.-1.obj", "mesh.0.25.obj"], [2, 0, 1, 3]),
+        # 2.1 and 2.10 are one value as decimals: versions, in natural order.
+        (["v2.10.obj", "v2.2.obj", "v2.1.obj", "v2.9.obj"], [2, 1, 3, 0]),
+        # Other prefixes: separate names, in natural order.
+        (["a.0.5.obj", "b.0.25.obj"], [0, 1]),
+    ],
+)
+def test_sub_frames_are_read_in_the_order_of_their_values(tmp_path: Path, names: list[str], order: list[int]) -> None:
+    for name in names:
+        (tmp_path / name).write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    expected = [names[index] for index in order]
+    assert [path.name for path in meshseq.frame_files(tmp_path)] == expected
+    assert [path.name for path in meshseq.sequence_paths(str(tmp_path / "*.obj"))] == expected
+
+
 # --- real sequences (SOURCES.md) ------------------------------------------------------------
 
 

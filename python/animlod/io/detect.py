@@ -12,7 +12,8 @@ from collections.abc import Iterator
 from pathlib import Path, PurePosixPath
 
 from .errors import FormatError
-from .meshseq import MESH_SUFFIXES, frame_files, is_frame_name, natural_key
+from .frame_order import natural_key
+from .meshseq import MESH_SUFFIXES, frame_files, is_frame_name
 
 # A .vrm is a VRM avatar (VRoid, UniVRM): a binary glTF whose VRM extensions animlod carries.
 GLTF_SUFFIXES = (".glb", ".gltf", ".vrm")

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import glob
 import os
-import re
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -24,6 +23,7 @@ from ..model import AnimatedMesh
 from ..normals import Shading, corner_normals, shading_of, unit_vectors, vertex_normals
 from .atomic import atomic_folder
 from .errors import FormatError
+from .frame_order import in_frame_order
 from .obj import (
     ObjMaterials,
     ObjNormals,
@@ -51,8 +51,8 @@ def read_sequence(source: str | os.PathLike | Sequence[str | os.PathLike], fps: 
     Parameters
     ----------
     source : a folder (every .obj and .ply file in it, in natural order: frame2 before
-        frame10), a glob pattern (its matches in natural order), a single file, or a list of
-        files (in the order given).
+        frame10, and sub-frames such as mesh.1.25.obj by value), a glob pattern (its matches in
+        the same order), a single file, or a list of files (in the order given).
     fps : frames per second of the sequence, or None for a set of poses.
 
     Returns
@@ -485,10 +485,6 @@ def frame_names_fit(names: Sequence[str], frames: int) -> bool:
     return plain and len(names) == frames and len({name.casefold() for name in names}) == frames
 
 
-# A number in a frame name, with its sign where a minus follows a separator.
-_NUMBER = re.compile(r"((?:(?<=[._ ])-)?\d+)")
-
-
 def sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> list[Path]:
     """The frame files :func:`read_sequence` reads for ``source``, in its order; FormatError when
     there is none."""
@@ -503,7 +499,7 @@ def sequence_paths(source: str | os.PathLike | Sequence[str | os.PathLike]) -> l
     elif location.is_file():  # before the pattern test: "take[1].obj" is a file name
         return [location]
     elif glob.has_magic(os.fspath(source)):
-        paths = sorted((Path(match) for match in glob.glob(os.fspath(source))), key=natural_key)
+        paths = in_frame_order(Path(match) for match in glob.glob(os.fspath(source)))
     else:
         raise FormatError(source, "source", "is not a folder, a glob pattern or an existing file")
     if not paths:
@@ -518,18 +514,8 @@ def is_frame_name(name: str) -> bool:
 
 
 def frame_files(folder: str | os.PathLike) -> list[Path]:
-    """The OBJ/PLY frames of ``folder``, in natural order (see :func:`natural_key`)."""
-    found = (path for path in Path(folder).iterdir() if is_frame_name(path.name) and path.is_file())
-    return sorted(found, key=natural_key)
-
-
-def natural_key(path: Path) -> tuple[list[object], str]:
-    """Sort key that orders embedded numbers by value (frame2 < frame10) and letters regardless
-    of case, then by full path. A minus sign after a separator is the number's
-    (``frame.-001.obj``, before frame 0, as Houdini numbers frames before the first); after
-    anything else it separates (``mesh-001`` is frame 1)."""
-    parts = _NUMBER.split(path.name)  # text, number, text, ...: the numbers at odd places
-    return [int(part) if index % 2 else part.lower() for index, part in enumerate(parts)], str(path)
+    """The OBJ/PLY frames of ``folder``, in the order of their frame numbers (:func:`~.frame_order.in_frame_order`)."""
+    return in_frame_order(path for path in Path(folder).iterdir() if is_frame_name(path.name) and path.is_file())
 
 
 def _in_first_order(

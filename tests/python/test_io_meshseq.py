@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import warnings
 from collections.abc import Callable
@@ -379,6 +380,119 @@ def test_sub_frames_are_read_in_the_order_of_their_values(tmp_path: Path, names:
     expected = [names[index] for index in order]
     assert [path.name for path in meshseq.frame_files(tmp_path)] == expected
     assert [path.name for path in meshseq.sequence_paths(str(tmp_path / "*.obj"))] == expected
+
+
+# --- later OBJ frames read from their v lines alone ---------------------------------------------
+
+
+def _grid_frame(frame: int) -> str:
+    """Frame ``frame`` of a textured, coloured 3 x 3 grid as exporters write a sequence: its
+    comment, positions, colours and normals its own, every other line the first frame's byte for
+    byte. The last quad's corners at positions 5, 6 and 9 take texture coordinates of their own
+    (a seam); two materials."""
+    rng = np.random.default_rng(frame)
+    grid = np.stack(np.meshgrid(np.arange(3), np.arange(3)), axis=-1).reshape(-1, 2)
+    positions = np.column_stack([grid, rng.normal(size=9)])
+    colours = rng.uniform(size=(9, 3))
+    uvs = np.concatenate([grid / 2, [[0.9, 0.5], [0.9, 0.9], [0.5, 0.9]]])
+    lines = [f"# frame {frame}", "mtllib grid.mtl", "o grid"]
+    lines += ["v " + " ".join(f"{value:.6g}" for value in row) for row in np.column_stack([positions, colours])]
+    lines += [f"vt {u:.6g} {v:.6g}" for u, v in uvs]
+    lines += [f"vn 0 {0.1 * frame:.6g} 1"]
+    lines += ["usemtl skin", "f 1/1/1 2/2/1 5/5/1 4/4/1", "f 2/2/1 3/3/1 6/6/1 5/5/1"]
+    lines += ["usemtl cloth", "f 4/4/1 5/5/1 8/8/1 7/7/1", "f 5/10/1 6/11/1 9/12/1 8/8/1"]
+    return "\n".join(lines) + "\n"
+
+
+def _grid_frames(folder: Path, count: int = 3) -> list[Path]:
+    folder.mkdir()
+    return [_write(folder / f"f{frame}.obj", _grid_frame(frame)) for frame in range(count)]
+
+
+def _spy_on_fits(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
+    """Whether each later frame read since fitted the first frame's template (read from its v lines
+    alone)."""
+    fitted, fits = [], obj.ObjTemplate.fits
+    monkeypatch.setattr(obj.ObjTemplate, "fits", lambda *args: fitted.append(fits(*args)) or fitted[-1])
+    return fitted
+
+
+def _assert_same_read(read: object, other: object) -> None:
+    """Two reads equal part by part: arrays (with their types), names, flags."""
+    if dataclasses.is_dataclass(read) or isinstance(read, tuple):
+        assert type(read) is type(other)
+        parts = (dataclasses.astuple(value) if dataclasses.is_dataclass(value) else value for value in (read, other))
+        for mine, theirs in zip(*parts, strict=True):
+            _assert_same_read(mine, theirs)
+    else:
+        assert np.asarray(read).dtype == np.asarray(other).dtype
+        np.testing.assert_array_equal(read, other)
+
+
+@pytest.mark.parametrize("textured", [False, True])
+def test_later_obj_frames_read_from_their_v_lines_alone_read_as_in_full(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, textured: bool
+) -> None:
+    paths = _grid_frames(tmp_path / "grid", 4)
+    read = meshseq.read_textured_sequence if textured else read_sequence
+    fitted = _spy_on_fits(monkeypatch)
+    with warnings.catch_warnings(record=True) as quick_warnings:
+        warnings.simplefilter("always")
+        quick = read(paths)
+    assert fitted == [True, True, True]  # the comments differ: they are no statement
+    monkeypatch.setattr(obj.ObjTemplate, "fits", lambda *args: False)
+    with warnings.catch_warnings(record=True) as full_warnings:
+        warnings.simplefilter("always")
+        full = read(paths)
+    _assert_same_read(quick, full)
+    assert [str(w.message) for w in quick_warnings] == [str(w.message) for w in full_warnings]
+    if textured:  # each frame's own positions and colours, the seam's copies and the materials
+        assert quick.mesh.vertex_count == 13 and len(quick.colours.values) == 4  # seam and material copies
+        np.testing.assert_array_equal(quick.mesh.frames[3], obj.read_obj_textured(paths[3]).vertices[quick.points])
+
+
+def test_a_later_frame_whose_faces_or_texture_differ_is_read_in_full(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The same number of lines, the v lines where the first frame's are: the bytes tell them apart.
+    paths = _grid_frames(tmp_path / "grid")
+    text = paths[2].read_text()
+    _write(paths[2], text.replace("f 1/1/1 2/2/1 5/5/1 4/4/1", "f 2/2/1 5/5/1 4/4/1 1/1/1"))  # the other diagonal
+    fitted = _spy_on_fits(monkeypatch)
+    with pytest.warns(UserWarning, match=r"f2.obj: 1 of the 3 frames \(this the first\) triangulate some polygons"):
+        sequence = meshseq.read_textured_sequence(paths)
+    assert fitted == [True, False] and sequence.texture is not None
+    _write(paths[2], text.replace("vt 0.5 0\n", "vt 0.5 0.25\n"))
+    with pytest.warns(UnreadAttributesWarning, match=r"f2.obj: has texture coordinates other than f0.obj's"):
+        sequence = meshseq.read_textured_sequence(paths)
+    assert sequence.texture is None and sequence.mesh.vertex_count == 12  # the materials' copies alone
+
+
+@pytest.mark.parametrize(("value", "reason"), [("x1", "'x1' is not a number or out of range"), ("nan", "are not")])
+def test_a_bad_v_line_in_a_later_frame_names_that_file_and_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, value: str, reason: str
+) -> None:
+    paths = _grid_frames(tmp_path / "grid")
+    lines = paths[1].read_text().splitlines(keepends=True)
+    lines[5] = f"v 2 {value} 0 0.5 0.5 0.5\n"  # vertex 2, after the comment, mtllib and o lines
+    _write(paths[1], "".join(lines))
+    fitted = _spy_on_fits(monkeypatch)
+    with pytest.raises(FormatError) as caught:
+        meshseq.read_textured_sequence(paths)
+    assert fitted == [True]  # read from its v lines alone
+    assert str(caught.value).startswith(f"{paths[1]}: vertex 2 (line 6): ") and reason in str(caught.value)
+
+
+@pytest.mark.parametrize("replaced", ["# frame 1", "vn 0 0.1 1"])
+def test_a_later_frame_with_another_number_of_v_lines_is_refused(tmp_path: Path, replaced: str) -> None:
+    # As many lines as the first frame; where a vn line gives way, the lines kept are the first's.
+    paths = _grid_frames(tmp_path / "grid")
+    _write(paths[1], paths[1].read_text().replace(replaced, "v 9 9 9 0 0 0"))
+    message = f"{paths[1]}: vertices: 10 vertices, but the first frame f0.obj has 9"
+    for read in (read_sequence, meshseq.read_textured_sequence):
+        with pytest.raises(FormatError) as caught:
+            read(paths)
+        assert str(caught.value) == message
 
 
 # --- real sequences (SOURCES.md) ------------------------------------------------------------

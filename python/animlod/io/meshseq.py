@@ -27,10 +27,12 @@ from .frame_order import in_frame_order
 from .obj import (
     ObjMaterials,
     ObjNormals,
+    ObjTemplate,
     ObjTexture,
     TexturedMesh,
     UnreadAttributesWarning,
     read_obj,
+    read_obj_template,
     read_obj_textured,
     write_obj,
 )
@@ -125,13 +127,10 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     """The frames of ``paths`` (:func:`read_sequence`), and with ``textured`` their texture
     coordinates, normals' shading, colours and materials (:func:`read_textured_sequence`)."""
 
-    def read(path: Path, first: bool) -> TexturedMesh:
-        # Only the first frame's normals are read: they tell the shading the levels rebuild.
-        return read_mesh_textured(path, normals=first) if textured else _geometry_of(path)
-
     with warnings.catch_warnings(record=True) as first_warnings:
         warnings.simplefilter("always")
-        first_vertices, faces, texture, normals, colours, materials = read(paths[0], first=True)
+        first_mesh, template = _read_first_frame(paths[0], textured)
+        first_vertices, faces, texture, normals, colours, materials = first_mesh
     for warning in first_warnings:
         warnings.warn(warning.message, stacklevel=3)
     # A file without triangles is no frame of a mesh (random bytes named .obj parse as one).
@@ -149,7 +148,7 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
         warnings.simplefilter("always")
         for index, path in enumerate(paths[1:], start=1):
-            vertices, frame_faces, frame_texture, _, colours, _ = read(path, first=False)
+            vertices, frame_faces, frame_texture, _, colours, _ = _read_later_frame(path, textured, template)
             # A PLY frame's texture coordinates are per vertex: where its triangles are not the
             # first frame's, others than the first's tell of vertices numbered otherwise, and
             # which vertex is which (read for this alone where the sequence is read without them).
@@ -221,6 +220,22 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
         colours = replace(colours, values=colours.values[:, points])
     texture = None if texture is None else SequenceTexture(texture.uvs[wedges[:, 1]], points)
     return TexturedSequence(split, texture, shading, colours, materials, points)
+
+
+def _read_first_frame(path: Path, textured: bool) -> tuple[TexturedMesh, ObjTemplate | None]:
+    """A sequence's first frame, with its normals where ``textured`` (they tell the shading the
+    levels rebuild), and for an OBJ file the template its later OBJ frames are read by."""
+    if path.suffix.lower() == ".obj":
+        return read_obj_template(path, textured)
+    return read_mesh_textured(path) if textured else _geometry_of(path), None
+
+
+def _read_later_frame(path: Path, textured: bool, template: ObjTemplate | None) -> TexturedMesh:
+    """A later frame of a sequence, without normals; an OBJ frame by the first frame's
+    ``template``, which reads only the ``v`` lines of a frame that repeats the rest of it."""
+    if template is not None and path.suffix.lower() == ".obj":
+        return template.read(path)
+    return read_mesh_textured(path, normals=False) if textured else _geometry_of(path)
 
 
 class _ColourFrames:

@@ -5,7 +5,9 @@ and ``vn`` lines and the corners' indices into them, and colours (``v x y z r g 
 statements such as ``g``, ``usemtl`` are ignored, with a warning for unread ``vt``, ``vn`` and
 ``usemtl`` and for faces in several objects or groups (``o``, ``g``); statements may be
 indented) and written, with texture coordinates, normals and colours where given. Parsing works
-on the whole file's bytes with numpy: there is no Python loop over lines, vertices or faces."""
+on the whole file's bytes with numpy: there is no Python loop over lines, vertices or faces. A
+sequence's later frames that repeat the first frame's statements but for their ``v`` lines are
+read from those alone (:class:`ObjTemplate`)."""
 
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ import re
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import NamedTuple
 
@@ -30,7 +33,7 @@ from .polygon_mesh import (
     parse_numbers,
     polygon_mask,
 )
-from .tokens import parse_all, tokens_per_line
+from .tokens import parse_all, token_starts, tokens_per_line
 from .vertex_colours import OBJ_COLOUR_NAMES, VertexColours
 
 
@@ -93,7 +96,7 @@ def read_obj(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
         index outside the vertices defined so far, or faces that all have fewer than three
         corners (some such faces among polygons are left out with a warning).
     """
-    mesh = _read_obj(path, textured=False)
+    mesh, _ = _read_obj(path, textured=False)
     return mesh.vertices, mesh.faces
 
 
@@ -109,13 +112,156 @@ def read_obj_textured(path: str | os.PathLike, normals: bool = True) -> Textured
     some lines have one or one is not finite. The
     ``usemtl`` lines give each triangle its material (:class:`ObjMaterials`, with the ``mtllib``
     lines' libraries)."""
-    return _read_obj(path, textured=True, normals=normals)
+    return _read_obj(path, textured=True, normals=normals)[0]
 
 
-def _read_obj(path: str | os.PathLike, textured: bool, normals: bool = False) -> TexturedMesh:
+def read_obj_template(path: str | os.PathLike, textured: bool) -> tuple[TexturedMesh, ObjTemplate | None]:
+    """The first frame of a sequence: :func:`read_obj` (``textured`` False, the geometry alone) or
+    :func:`read_obj_textured` (with normals), and the file as the template its later frames are
+    read by (:meth:`ObjTemplate.read`); None where it has faces of fewer than three corners, whose
+    warning every frame gives."""
+    return _read_obj(path, textured, normals=textured)
+
+
+class _Statements(NamedTuple):
+    """Which lines of an OBJ file's text (:class:`_ObjLines`) hold each statement read, (L,) bool
+    each."""
+
+    v: np.ndarray
+    f: np.ndarray
+    l: np.ndarray  # noqa: E741 (the statement's name)
+    vt: np.ndarray
+    vn: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class ObjTemplate:
+    """An OBJ file read as the first frame of a sequence (:func:`read_obj_template`), by which a
+    later frame is read from its ``v`` lines alone where its other lines are this file's byte for
+    byte (comments, continuations and indents taken out) and its ``v`` and ``vn`` lines stand
+    where this file's do (so that a message names the line as a full read would): exporters write
+    every frame's faces, texture coordinates and materials alike."""
+
+    textured: bool
+    lines: _ObjLines
+    statements: _Statements
+    mesh: TexturedMesh  # its faces, texture coordinates and materials are every fitting frame's
+
+    @cached_property
+    def _kept(self) -> np.ndarray:
+        """(L,) bool: the lines a later frame repeats byte for byte (all but ``v`` and ``vn``)."""
+        return ~(self.statements.v | self.statements.vn)
+
+    @cached_property
+    def _kept_bytes(self) -> bytes:
+        """This file's kept lines, one after another: a fitting frame's are these bytes."""
+        return self.lines.block(self._kept)
+
+    def fits(self, lines: _ObjLines, statements: _Statements) -> bool:
+        """Whether a later frame's ``lines`` (holding ``statements``) read as this file's but for
+        their ``v`` lines (and the ``vn`` lines, which later frames leave unread): one bytes
+        comparison, no parse."""
+        mine = self.statements
+        return (np.array_equal(statements.v, mine.v) and np.array_equal(statements.vn, mine.vn)
+                and lines.block(self._kept) == self._kept_bytes)  # fmt: skip
+
+    def read(self, path: str | os.PathLike) -> TexturedMesh:
+        """A later frame of the sequence, as :func:`read_obj` (``textured`` False, in a
+        TexturedMesh) or :func:`read_obj_textured` with ``normals=False`` read it, errors and
+        warnings alike: from its ``v`` lines alone, with this file's faces, texture coordinates and
+        materials, where it :meth:`fits`; by a full read otherwise."""
+        return _read_obj(path, self.textured, template=self)[0]
+
+
+def _read_obj(
+    path: str | os.PathLike, textured: bool, normals: bool = False, template: ObjTemplate | None = None
+) -> tuple[TexturedMesh, ObjTemplate | None]:
     """:func:`read_obj`, and with ``textured`` its texture coordinates, colours, materials and,
-    with ``normals``, its normals (:func:`read_obj_textured`)."""
+    with ``normals``, its normals (:func:`read_obj_textured`); and the file as a template
+    (:func:`read_obj_template`). Where ``template`` fits the file, its ``v`` lines alone are read
+    (:meth:`ObjTemplate.read`)."""
     path = Path(path)
+    lines = _obj_lines(path)
+    statements = _Statements(*(lines.tagged(tag) for tag in (b"v", b"f", b"l", b"vt", b"vn")))
+    reused = template is not None and template.fits(lines, statements)
+    vertex_lines, face_lines, polylines = (np.flatnonzero(selected) + 1 for selected in statements[:3])
+    vertex_block = lines.block(statements.v)
+    values_per_vertex = _row_sizes(vertex_block, len(vertex_lines))
+    _warn_unread_attributes(path, vt=not textured and bool(statements.vt.any()),
+                            vn=not textured and bool(statements.vn.any()),
+                            colours=not textured and bool(np.any(values_per_vertex >= 6)),
+                            usemtl=not textured and bool(lines.tagged(b"usemtl").any()))  # fmt: skip
+    if not len(vertex_lines):
+        _require_obj_statement(path, lines.data)
+    if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
+        reason = f"{len(polylines)} polylines ('l') and no face: animlod simplifies surfaces"
+        raise FormatError(path, f"line {polylines[0]}", reason)
+
+    def name_vertex(vertex: int) -> str:
+        return f"vertex {vertex} (line {vertex_lines[vertex]})"
+
+    channels = _colour_channels(path, values_per_vertex) if textured else 0
+    values = _vertex_values(path, vertex_block, values_per_vertex, channels, name_vertex)
+    channels = values.shape[1] - 3  # 0 where a colour did not parse
+    vertices = values[:, :3].astype(np.float32)
+    check_finite_vertices(path, vertices, name_vertex)
+    colours = None
+    if channels:
+        rows = all_finite(path, values[:, 3:].astype(np.float32), "colours", name_vertex)
+        colours = None if rows is None else VertexColours(rows[None], OBJ_COLOUR_NAMES[:channels], ("f4",) * channels)
+    if reused:
+        return template.mesh._replace(vertices=vertices, normals=None, colours=colours), template
+
+    def name_face(face: int) -> str:
+        return f"face {face} (line {face_lines[face]})"
+
+    face_block = lines.block(statements.f)
+    sizes = _row_sizes(face_block, len(face_lines))
+    uniform = _uniform_corners(face_block, sizes)
+    vertex_numbers = face_block if uniform is None else uniform[:, 0]
+    if uniform is None and b"/" in face_block:
+        vertex_numbers = re.sub(rb"/\S*", b"", face_block)  # v of v/vt/vn
+        sizes = _row_sizes(vertex_numbers, len(face_lines))
+    polygons = sizes >= 3  # pybullet's samurai_monastry.obj has 201 faces of two vertices among its 125k
+    if sizes.size:
+        first = int(np.argmin(polygons))  # the first face of fewer than 3 vertices, named in the warning
+        refusal = f"needs at least 3 vertices, has {sizes[first]}; so does every face"
+        polygons = polygon_mask(path, sizes, name_face(first), refusal)
+    owner = np.repeat(np.arange(sizes.size), sizes)
+    corners = _FaceCorners(path, face_block, sizes, owner, face_lines, name_face, uniform)
+    resolved = corners.resolved(vertex_numbers, vertex_lines, len(vertices), ("vertex", "vertices"))
+    faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
+    _warn_unread_names(path, lines, face_lines)
+    mesh = TexturedMesh(vertices, faces, None, None, None, None)
+    if textured:
+
+        def per_triangle(selected: np.ndarray, attribute: _Attribute) -> tuple | None:
+            """The attribute's values and each triangle corner's index into them, or None."""
+            if not selected.any():
+                return None
+            found = _corner_attribute(path, attribute, lines.block(selected), np.flatnonzero(selected) + 1, corners)
+            return found and (found[0], fan_triangulate(found[1][polygons[owner]], sizes[polygons]))
+
+        texture = per_triangle(statements.vt, _TEXTURE)
+        corner_normals = per_triangle(statements.vn, _NORMALS) if normals else None
+        materials = _materials(lines, face_lines[polygons], sizes[polygons] - 2)
+        mesh = TexturedMesh(vertices, faces, texture and ObjTexture(*texture),
+                            corner_normals and ObjNormals(*corner_normals), colours, materials)  # fmt: skip
+    return mesh, ObjTemplate(textured, lines, statements, mesh) if polygons.all() else None
+
+
+def _obj_lines(path: Path) -> _ObjLines:
+    """The lines of the OBJ file at ``path`` as its statements are read (:func:`_obj_text`), and
+    not indented: an indented statement still counts; line numbers stay."""
+    lines = _ObjLines(_obj_text(path))
+    if _IS_BLANK[lines.codes[lines.starts]].any():
+        lines = _ObjLines(re.sub(rb"(?m)^[ \t]+", b"", lines.data))
+    return lines
+
+
+def _obj_text(path: Path) -> bytes:
+    """The text of the OBJ file at ``path``: UTF-8 (a UTF-16 file converted), LF line ends,
+    without comments and continuations, every statement on the line it starts on."""
     data = path.read_bytes()
     if data.startswith((b"\xfe\xff", b"\xff\xfe")):  # UTF-16 after its byte order mark (assimp's box_UTF16BE.obj)
         try:
@@ -127,78 +273,19 @@ def _read_obj(path: str | os.PathLike, textured: bool, normals: bool = False) ->
         raise FormatError(path, f"byte {nul}", "NUL byte: an OBJ file is text, this looks like binary data")
     if data.startswith(b"\xef\xbb\xbf"):  # a UTF-8 byte order mark (.NET, Notepad) before the first statement
         data = data[3:]
-    data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    if b"\r" in data:
+        data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
     if b"#" in data:  # a comment may also end a statement ("f 1 2 3 # cap"); line numbers stay
         data = re.sub(rb"#[^\n]*", b"", data)
     if b"\\" in data:
         data = _join_continued_lines(data)
-    if data.startswith((b" ", b"\t")) or b"\n " in data or b"\n\t" in data:
-        data = re.sub(rb"(?m)^[ \t]+", b"", data)  # an indented statement still counts; line numbers stay
-    statements = _obj_statements(data, (b"v", b"f", b"l", b"vt", b"vn"))
-    (vertex_block, vertex_lines), (face_block, face_lines), (_, polylines), uv_statements, normal_statements = (
-        statements
-    )
-    values_per_vertex = _row_sizes(vertex_block, len(vertex_lines))
-    _warn_unread_attributes(path, vt=not textured and len(uv_statements[1]) > 0,
-                            vn=not textured and len(normal_statements[1]) > 0,
-                            colours=not textured and bool(np.any(values_per_vertex >= 6)),
-                            usemtl=not textured and re.search(rb"(?m)^usemtl[ \t]", data) is not None)  # fmt: skip
-    if not len(vertex_lines):
-        _require_obj_statement(path, data)
-    if not len(face_lines) and len(polylines):  # Inkscape's axes, OpenFOAM's edge curves
-        reason = f"{len(polylines)} polylines ('l') and no face: animlod simplifies surfaces"
-        raise FormatError(path, f"line {polylines[0]}", reason)
-
-    def name_vertex(vertex: int) -> str:
-        return f"vertex {vertex} (line {vertex_lines[vertex]})"
-
-    channels = _colour_channels(path, values_per_vertex) if textured else 0
-    values = _vertex_values(path, vertex_block, len(vertex_lines), channels, name_vertex)
-    channels = values.shape[1] - 3  # 0 where a colour did not parse
-    vertices = values[:, :3].astype(np.float32)
-    check_finite_vertices(path, vertices, name_vertex)
-    colours = None
-    if channels:
-        rows = all_finite(path, values[:, 3:].astype(np.float32), "colours", name_vertex)
-        colours = None if rows is None else VertexColours(rows[None], OBJ_COLOUR_NAMES[:channels], ("f4",) * channels)
-
-    def name_face(face: int) -> str:
-        return f"face {face} (line {face_lines[face]})"
-
-    texture_block = face_block
-    if b"/" in face_block:
-        face_block = re.sub(rb"/\S*", b"", face_block)  # v of v/vt/vn
-    sizes = _row_sizes(face_block, len(face_lines))
-    polygons = sizes >= 3  # pybullet's samurai_monastry.obj has 201 faces of two vertices among its 125k
-    if sizes.size:
-        first = int(np.argmin(polygons))  # the first face of fewer than 3 vertices, named in the warning
-        refusal = f"needs at least 3 vertices, has {sizes[first]}; so does every face"
-        polygons = polygon_mask(path, sizes, name_face(first), refusal)
-    owner = np.repeat(np.arange(sizes.size), sizes)
-    corners = _FaceCorners(path, sizes, owner, face_lines, name_face)
-    resolved = corners.resolved(face_block, vertex_lines, len(vertices), ("vertex", "vertices"))
-    faces = fan_triangulate(resolved[polygons[owner]], sizes[polygons])
-    _warn_unread_names(path, data, face_lines)
-    if not textured:
-        return TexturedMesh(vertices, faces, None, None, None, None)
-
-    def per_triangle(statements: tuple[bytes, np.ndarray], attribute: _Attribute) -> tuple | None:
-        """The attribute's values and each triangle corner's index into them, or None."""
-        block, lines = statements
-        found = _corner_attribute(path, attribute, block, lines, texture_block, corners) if len(lines) else None
-        return found and (found[0], fan_triangulate(found[1][polygons[owner]], sizes[polygons]))
-
-    texture = per_triangle(uv_statements, _TEXTURE)
-    corner_normals = per_triangle(normal_statements, _NORMALS) if normals else None
-    materials = _materials(data, face_lines[polygons], sizes[polygons] - 2)
-    return TexturedMesh(vertices, faces, texture and ObjTexture(*texture),
-                        corner_normals and ObjNormals(*corner_normals), colours, materials)  # fmt: skip
+    return data
 
 
-def _materials(data: bytes, face_lines: np.ndarray, triangles: np.ndarray) -> ObjMaterials | None:
-    """The materials of ``data``'s usemtl lines for the faces on ``face_lines`` (1-based), each
-    fanned into ``triangles``; its mtllib lines' libraries. None without a usemtl line."""
-    named = _names_in_effect(data, b"usemtl", face_lines)
+def _materials(lines: _ObjLines, face_lines: np.ndarray, triangles: np.ndarray) -> ObjMaterials | None:
+    """The materials of the usemtl lines for the faces on ``face_lines`` (1-based), each fanned
+    into ``triangles``; the mtllib lines' libraries. None without a usemtl line."""
+    named = _names_in_effect(lines, b"usemtl", face_lines)
     if named is None:
         return None
     names, in_effect = named
@@ -208,7 +295,7 @@ def _materials(data: bytes, face_lines: np.ndarray, triangles: np.ndarray) -> Ob
     rank = np.empty(first.size, np.int32)
     rank[order] = np.arange(first.size)
     per_face = np.where(in_effect >= 0, rank[material.ravel()][np.maximum(in_effect, 0)], -1).astype(np.int32)
-    libraries = re.findall(rb"(?m)^mtllib[ \t]+([^\n]*)", data)
+    libraries = lines.names(lines.tagged(b"mtllib"), len(b"mtllib"))
     return ObjMaterials(tuple(found.decode("utf-8", "replace").strip() for found in libraries),
                         tuple(distinct[order].tolist()), np.repeat(per_face, triangles))  # fmt: skip
 
@@ -230,17 +317,17 @@ def _colour_channels(path: Path, sizes: np.ndarray) -> int:
 
 
 def _vertex_values(
-    path: Path, block: bytes, count: int, channels: int, name_vertex: Callable[[int], str]
+    path: Path, block: bytes, sizes: np.ndarray, channels: int, name_vertex: Callable[[int], str]
 ) -> np.ndarray:
-    """(count, 3 + channels) float64: each ``v`` line's x, y, z and its ``channels`` colour
-    values, in one parse. A coordinate that does not parse is a FormatError as ever; a colour
-    value that does not parse costs only the colours (a warning), and gives (count, 3)."""
+    """(V, 3 + channels) float64: each ``v`` line's x, y, z and its ``channels`` colour values
+    (``sizes`` values each), in one parse. A coordinate that does not parse is a FormatError as
+    ever; a colour value that does not parse costs only the colours (a warning), and gives (V, 3)."""
     try:
-        return _leading_values(path, block, count, 3 + channels, 3, name_vertex, "coordinates")
+        return _leading_values(path, block, sizes, 3 + channels, 3, name_vertex, "coordinates")
     except FormatError as error:
         if not channels:
             raise
-        coordinates = _leading_values(path, block, count, 3, 3, name_vertex, "coordinates")  # raises for theirs
+        coordinates = _leading_values(path, block, sizes, 3, 3, name_vertex, "coordinates")  # raises for theirs
         _warn_unread_colours(path, str(error).removeprefix(f"{path}: "))
         return coordinates
 
@@ -252,23 +339,38 @@ def _warn_unread_colours(path: Path, reason: str) -> None:
 
 @dataclass(frozen=True)
 class _FaceCorners:
-    """The corners of an OBJ file's ``f`` lines: ``sizes`` per face, ``owner`` the face of each
-    corner, the faces' ``lines`` and how messages name a face."""
+    """The corners of an OBJ file's ``f`` lines (``block``, as written): ``sizes`` per face,
+    ``owner`` the face of each corner, the faces' ``lines``, how messages name a face, and
+    ``uniform``, every corner's numbers where all are written alike (:func:`_uniform_corners`)."""
 
     path: Path
+    block: bytes
     sizes: np.ndarray
     owner: np.ndarray
     lines: np.ndarray
     name_face: Callable[[int], str]
+    uniform: np.ndarray | None
 
-    def resolved(self, block: bytes, item_lines: np.ndarray, count: int, indexed: tuple[str, str]) -> np.ndarray:
+    def field(self, field: int) -> tuple[bytes | np.ndarray, int]:
+        """The corners' numbers in their ``field`` (1: vt, 2: vn) for :meth:`resolved`, and how
+        many corners have one: ``uniform``'s, or the ``f`` lines with each corner cut to the field
+        (:func:`_corner_field`), parsed once the attribute's own lines are read."""
+        if self.uniform is None:
+            return _corner_field(self.block, field)
+        if field >= self.uniform.shape[1]:
+            return b"", 0
+        return self.uniform[:, field], len(self.owner)
+
+    def resolved(
+        self, numbers: bytes | np.ndarray, item_lines: np.ndarray, count: int, indexed: tuple[str, str]
+    ) -> np.ndarray:
         """Every corner's 0-based index into the ``count`` items defined on ``item_lines`` (v, vt
-        or vn lines), from ``block`` (the ``f`` lines, one number per corner): negative indices count
-        back from the last item defined above the face's line. FormatError names the face of a
-        corner that does not parse or lies outside the items."""
-        written = _untagged_values(block, np.int64, self.sizes)
+        or vn lines), from ``numbers``, one per corner, or the ``f`` lines holding one number per
+        corner: negative indices count back from the last item defined above the face's line.
+        FormatError names the face of a corner that does not parse or lies outside the items."""
+        written = numbers if isinstance(numbers, np.ndarray) else _untagged_values(numbers, np.int64, self.sizes)
         if written is None:
-            tokens, starts = _row_tokens(block, self.sizes)
+            tokens, starts = _row_tokens(numbers, self.sizes)
             written = parse_numbers(self.path, np.delete(tokens, starts), np.int64,
                                     lambda corner: self.name_face(self.owner[corner]))  # fmt: skip
         defined = np.searchsorted(item_lines, self.lines)[self.owner]
@@ -296,12 +398,12 @@ _NORMALS = _Attribute("vn", 2, 3, 3, "normal", ("normal", "normals"), "normals")
 
 
 def _corner_attribute(
-    path: Path, attribute: _Attribute, block: bytes, lines: np.ndarray, face_block: bytes, corners: _FaceCorners
+    path: Path, attribute: _Attribute, block: bytes, lines: np.ndarray, corners: _FaceCorners
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """The ``attribute``'s lines (``block``: u and v of ``vt``, a w dropped; x, y, z of ``vn``) as
-    float32, and every face corner's 0-based index into them (``face_block``: the ``f`` lines as
-    written); None, with a warning, where some corners have an index and others none."""
-    index_block, indexed = _corner_field(face_block, attribute.field)
+    float32, and every face corner's 0-based index into them; None, with a warning, where some
+    corners have an index and others none."""
+    index_numbers, indexed = corners.field(attribute.field)
     if indexed < corners.sizes.sum():
         if indexed:
             warnings.warn(f"{path}: {indexed} of {corners.sizes.sum()} face corners have {attribute.kind} "
@@ -312,9 +414,10 @@ def _corner_attribute(
     def name_row(row: int) -> str:
         return f"{attribute.item} {row} (line {lines[row]})"
 
-    values = _leading_values(path, block, len(lines), attribute.width, attribute.minimum, name_row, "values")
+    sizes = _row_sizes(block, len(lines))
+    values = _leading_values(path, block, sizes, attribute.width, attribute.minimum, name_row, "values")
     check_finite_vertices(path, values.astype(np.float32), name_row)
-    return values.astype(np.float32), corners.resolved(index_block, lines, len(values), attribute.items)
+    return values.astype(np.float32), corners.resolved(index_numbers, lines, len(values), attribute.items)
 
 
 def write_obj(
@@ -441,6 +544,27 @@ def _corner_field(face_block: bytes, field: int) -> tuple[bytes, int]:
     return codes[keep].tobytes(), indexed
 
 
+def _uniform_corners(block: bytes, sizes: np.ndarray) -> np.ndarray | None:
+    """(C, F) int64: the numbers each of the C corners of ``block`` (``f`` lines of ``sizes``
+    corners, as written) holds, where every corner is written alike, F numbers parted by single
+    slashes (``v/vt/vn``: F = 3; ``v``: F = 1), as exporters write them: one parse for all.
+    None otherwise (``v//vn``, corners written differently, a number that does not parse, a
+    vertical tab or form feed, which the fields' own reading parts otherwise), for
+    :func:`_corner_field` to read or name field by field."""
+    corners = int(sizes.sum())
+    slashes = np.flatnonzero(np.frombuffer(block, dtype=np.uint8) == ord("/"))
+    if not corners or slashes.size % corners or b"\x0b" in block or b"\x0c" in block:
+        return None
+    fields = slashes.size // corners + 1
+    starts = token_starts(block)  # each face's tag, then its corners
+    expected = np.full(starts.size, fields - 1)
+    expected[np.cumsum(sizes + 1) - (sizes + 1)] = 0
+    if not np.array_equal(np.diff(np.searchsorted(slashes, starts), append=slashes.size), expected):
+        return None
+    values = _untagged_values(block.replace(b"/", b" "), np.int64, sizes * fields)  # an empty field: too few
+    return None if values is None else values.reshape(corners, fields)
+
+
 def _warn_unread_attributes(path: Path, **unread_tags: bool) -> None:
     """Says that the file's ``vt`` or ``vn`` lines, the colours of its ``v`` lines or its
     materials (``usemtl`` lines), where flagged, are not read, so that levels written without
@@ -453,17 +577,17 @@ def _warn_unread_attributes(path: Path, **unread_tags: bool) -> None:
                       "written without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
 
 
-def _warn_unread_names(path: Path, data: bytes, face_lines: np.ndarray) -> None:
-    """Says that the faces of ``data`` (on ``face_lines``, 1-based) fall into several objects or
+def _warn_unread_names(path: Path, lines: _ObjLines, face_lines: np.ndarray) -> None:
+    """Says that the faces of ``lines`` (on ``face_lines``, 1-based) fall into several objects or
     groups (the names of its ``o`` or ``g`` lines above them), which the mesh read does not keep
     apart: three objects become one unnamed mesh. Faces under one name alone (an exporter's
     ``o Cube`` for a file of one object) lose only the name, with no warning: the levels are
     named after the file."""
-    if not len(face_lines) or re.search(rb"(?m)^[og][ \t]", data) is None:  # one scan where most files end
+    if not len(face_lines):
         return
     counts = {}
     for tag, kind in ((b"o", "object"), (b"g", "group")):
-        named = _names_in_effect(data, tag, face_lines)
+        named = _names_in_effect(lines, tag, face_lines)
         if named is None:
             continue
         names, in_effect = named
@@ -476,41 +600,58 @@ def _warn_unread_names(path: Path, data: bytes, face_lines: np.ndarray) -> None:
                       "as one mesh without them", UnreadAttributesWarning, stacklevel=4)  # fmt: skip
 
 
-def _names_in_effect(data: bytes, tag: bytes, face_lines: np.ndarray) -> tuple[list[bytes], np.ndarray] | None:
-    """The names on ``data``'s ``tag`` lines (``usemtl``, ``o``, ``g``), and for each face on
+def _names_in_effect(lines: _ObjLines, tag: bytes, face_lines: np.ndarray) -> tuple[list[bytes], np.ndarray] | None:
+    """The names on the ``tag`` lines (``usemtl``, ``o``, ``g``), and for each face on
     ``face_lines`` (1-based) the index of the last of those lines above it, -1 above the first;
     None where no line has the tag."""
-    found = list(re.finditer(rb"(?m)^" + tag + rb"[ \t]+([^\n]*)", data))
-    if not found:
+    selected = lines.tagged(tag)
+    if not selected.any():
         return None
-    newlines = np.flatnonzero(np.frombuffer(data, np.uint8) == ord("\n"))
-    lines = np.searchsorted(newlines, [match.start() for match in found]) + 1
-    return [match.group(1).strip() for match in found], np.searchsorted(lines, face_lines) - 1
+    return lines.names(selected, len(tag)), np.searchsorted(np.flatnonzero(selected) + 1, face_lines) - 1
 
 
-def _obj_statements(data: bytes, tags: tuple[bytes, ...]) -> list[tuple[bytes, np.ndarray]]:
-    """For each tag of one or two letters: the bytes of all lines starting with it, and their
-    1-based line numbers."""
-    codes = np.frombuffer(data + b"\n\n\n", dtype=np.uint8)  # padding: every line start has three bytes
-    line_starts = np.concatenate(([0], np.flatnonzero(codes[: len(data)] == ord("\n")) + 1))
-    line_lengths = np.diff(line_starts, append=len(data))
-    separators = np.frombuffer(b" \t", dtype=np.uint8)
-    result = []
-    for tag in tags:
-        selected = np.isin(codes[line_starts + len(tag)], separators)
-        for offset, letter in enumerate(tag):
-            selected &= codes[line_starts + offset] == letter
-        result.append((codes[: len(data)][np.repeat(selected, line_lengths)].tobytes(), np.flatnonzero(selected) + 1))
-    return result
+class _ObjLines:
+    """The lines of an OBJ file's text (:func:`_obj_lines`): where each starts and how long it is
+    (its newline included), so that statements are found by their first bytes alone, not by a
+    scan of the whole text per statement."""
+
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+        self.codes = np.frombuffer(data + b"\n" * 8, dtype=np.uint8)  # the last line's first 8 bytes, padded
+        self.starts = np.concatenate(([0], np.flatnonzero(self.codes[: len(data)] == ord("\n")) + 1))
+        self.lengths = np.diff(self.starts, append=len(data))
+        # Each line's first 8 bytes as one number (those of the next line, or line ends, after a
+        # short one): a tag is found by a comparison per line, not one per letter.
+        self.heads = self.codes[self.starts[:, None] + np.arange(8)].view("<u8").ravel()
+
+    def tagged(self, tag: bytes) -> np.ndarray:
+        """(L,) bool: the lines that hold a ``tag`` statement (the tag, of up to 7 letters, then a
+        space or a tab)."""
+        mask = (1 << 8 * (len(tag) + 1)) - 1
+        key = self.heads & np.uint64(mask)
+        return (key == int.from_bytes(tag + b" ", "little")) | (key == int.from_bytes(tag + b"\t", "little"))
+
+    def block(self, selected: np.ndarray) -> bytes:
+        """The ``selected`` lines, one after another as in the text."""
+        return self.codes[: len(self.data)][np.repeat(selected, self.lengths)].tobytes()
+
+    def names(self, selected: np.ndarray, tag_length: int) -> list[bytes]:
+        """What follows the tag on each ``selected`` line, white space stripped (a name or path)."""
+        return [self.data[start + tag_length : start + length].strip()
+                for start, length in zip(self.starts[selected].tolist(), self.lengths[selected].tolist())]  # fmt: skip
+
+
+_IS_BLANK = np.zeros(256, dtype=bool)
+_IS_BLANK[list(b" \t")] = True
 
 
 def _leading_values(
-    path: Path, block: bytes, line_count: int, width: int, minimum: int, element: Callable[[int], str], what: str
+    path: Path, block: bytes, sizes: np.ndarray, width: int, minimum: int, element: Callable[[int], str], what: str
 ) -> np.ndarray:
-    """(line_count, width) float64: the first ``width`` values after the tag on each line of
-    ``block``, 0 where a line gives fewer (it must give ``minimum``); values past them are dropped
-    unread. FormatError names the line (``element``) with too few values or a bad one."""
-    sizes = _row_sizes(block, line_count)
+    """(L, width) float64: the first ``width`` values after the tag on each line of ``block``
+    (``sizes`` values each, :func:`_row_sizes`), 0 where a line gives fewer (it must give
+    ``minimum``); values past them are dropped unread. FormatError names the line (``element``)
+    with too few values or a bad one."""
     _require_sizes(path, sizes, minimum, element, what)
     given = np.arange(width)[None] < sizes[:, None]
     values = _untagged_values(block, np.float64, sizes)
@@ -532,10 +673,13 @@ def _row_sizes(block: bytes, line_count: int) -> np.ndarray:
 
 
 def _untagged_values(block: bytes, dtype: type, sizes: np.ndarray) -> np.ndarray | None:
-    """Every value after the tags of ``block``'s lines, in order, as ``dtype``; None when one does
-    not parse (then :func:`_row_tokens` and :func:`parse_numbers` name it)."""
+    """Every value after the tags of ``block``'s lines (one tag for all: ``v``, ``vt``), in order,
+    as ``dtype``; None when one does not parse (then :func:`_row_tokens` and
+    :func:`parse_numbers` name it)."""
     codes = np.frombuffer(block, dtype=np.uint8).copy()
-    codes[np.concatenate(([0], np.flatnonzero(codes[:-1] == ord("\n")) + 1))[: sizes.size]] = ord(" ")
+    starts = np.concatenate(([0], np.flatnonzero(codes[:-1] == ord("\n")) + 1))[: sizes.size]
+    tag_length = len(block[:8].split(maxsplit=1)[0]) if block else 0
+    codes[starts[:, None] + np.arange(tag_length)] = ord(" ")
     values = parse_all(codes.tobytes(), dtype)
     return values if values is not None and values.size == sizes.sum() else None
 

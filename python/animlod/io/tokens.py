@@ -34,6 +34,11 @@ def tokens_per_line(data: bytes) -> np.ndarray:
     return np.diff(np.searchsorted(token_starts, line_starts)).astype(np.int64)
 
 
+def token_starts(data: bytes) -> np.ndarray:
+    """The offset of every whitespace-separated token of ``data``: ``(T,) int64``, ascending."""
+    return _token_layout(data)[2]
+
+
 def integer_tokens(data: bytes) -> np.ndarray:
     """Whether each whitespace-separated token of ``data`` is written with ASCII digits and signs
     only (``12``, ``-3``; not ``3.0`` or ``1e3``), as an integer table must be: ``(N,) bool``."""

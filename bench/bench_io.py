@@ -2,7 +2,8 @@
 
 Run: ``.venv/bin/python bench/bench_io.py``. Each row is the best of a few runs; inputs that
 are absent are skipped. The crane sequence is also converted to binary PLY and NPZ in a
-temporary folder, to show what the faster containers buy over OBJ text. Every dev glTF is parsed
+temporary folder, to show what the faster containers buy over OBJ text, and written as a
+textured OBJ sequence (texture coordinates and normals, as exporters write one). Every dev glTF is parsed
 into its checked document (io/gltf_decode.py builds pygltflib's object model), with pygltflib's
 own loader (dataclasses_json) as the peer.
 """
@@ -16,11 +17,15 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import numpy as np
 from devdata import DATA_DIR
 from table import print_table, stopwatch
 
-from animlod.io import read_bvh, read_npz, read_sequence, write_npz, write_sequence
+from animlod.io import read_bvh, read_npz, read_sequence, read_textured_sequence, write_npz, write_sequence
 from animlod.io.gltf_document import GltfDocument
+from animlod.io.meshseq import SequenceTexture
+from animlod.model import AnimatedMesh
+from animlod.normals import Shading
 
 REPEATS = 3
 
@@ -52,6 +57,9 @@ def main() -> None:
         size = f"{mesh.vertex_count} vertices, {mesh.face_count} faces, {mesh.frame_count} frames"
         rows.append(("read OBJ sequence crane/", size, seconds * 1e3, mesh.frame_count / seconds))
         with tempfile.TemporaryDirectory() as folder:
+            write_textured_crane(Path(folder) / "textured", mesh)
+            seconds, _ = best_time(lambda: read_textured_sequence(Path(folder) / "textured"))
+            rows.append(("read textured OBJ sequence (crane)", size, seconds * 1e3, mesh.frame_count / seconds))
             write_sequence(Path(folder) / "ply", mesh, fmt="ply")
             write_npz(Path(folder) / "crane.npz", mesh)
             seconds, _ = best_time(lambda: read_sequence(Path(folder) / "ply"))
@@ -62,6 +70,17 @@ def main() -> None:
         print(f"skipped {crane}: not found")
     rows += gltf_rows()
     print_table("File reading (best of 3)", ["case", "size", "time (ms)", "frames/s"], rows)
+
+
+def write_textured_crane(folder: Path, mesh: AnimatedMesh) -> None:
+    """The crane as an exporter writes a textured sequence: every frame's ``v`` and ``vn`` lines
+    its own, its ``vt`` lines (a planar projection of the first frame) and ``f v/vt/vn`` corners
+    the same in every file."""
+    first = mesh.frames[0]
+    span = np.ptp(first[:, :2], axis=0)
+    uvs = ((first[:, :2] - first[:, :2].min(axis=0)) / np.where(span > 0, span, 1)).astype(np.float32)
+    points = np.arange(mesh.vertex_count, dtype=np.int32)
+    write_sequence(folder, mesh, texture=SequenceTexture(uvs, points), shading=Shading(np.pi, False))
 
 
 def gltf_rows() -> list[tuple]:

@@ -387,15 +387,15 @@ def test_sub_frames_are_read_in_the_order_of_their_values(tmp_path: Path, names:
 
 def _grid_frame(frame: int) -> str:
     """Frame ``frame`` of a textured, coloured 3 x 3 grid as exporters write a sequence: its
-    comment, positions, colours and normals its own, every other line the first frame's byte for
-    byte. The last quad's corners at positions 5, 6 and 9 take texture coordinates of their own
-    (a seam); two materials."""
+    comment, positions, colours, normals and material library its own (Blender names one after
+    each frame), every other line the first frame's byte for byte. The last quad's corners at
+    positions 5, 6 and 9 take texture coordinates of their own (a seam); two materials."""
     rng = np.random.default_rng(frame)
     grid = np.stack(np.meshgrid(np.arange(3), np.arange(3)), axis=-1).reshape(-1, 2)
     positions = np.column_stack([grid, rng.normal(size=9)])
     colours = rng.uniform(size=(9, 3))
     uvs = np.concatenate([grid / 2, [[0.9, 0.5], [0.9, 0.9], [0.5, 0.9]]])
-    lines = [f"# frame {frame}", "mtllib grid.mtl", "o grid"]
+    lines = [f"# frame {frame}", f"mtllib grid_{frame}.mtl", "o grid"]
     lines += ["v " + " ".join(f"{value:.6g}" for value in row) for row in np.column_stack([positions, colours])]
     lines += [f"vt {u:.6g} {v:.6g}" for u, v in uvs]
     lines += [f"vn 0 {0.1 * frame:.6g} 1"]
@@ -449,6 +449,8 @@ def test_later_obj_frames_read_from_their_v_lines_alone_read_as_in_full(
     if textured:  # each frame's own positions and colours, the seam's copies and the materials
         assert quick.mesh.vertex_count == 13 and len(quick.colours.values) == 4  # seam and material copies
         np.testing.assert_array_equal(quick.mesh.frames[3], obj.read_obj_textured(paths[3]).vertices[quick.points])
+        later = obj.read_obj_template(paths[0], textured=True)[1].read(paths[2])
+        assert later.materials.libraries == ("grid_2.mtl",) == obj.read_obj_textured(paths[2]).materials.libraries
 
 
 def test_a_later_frame_whose_faces_or_texture_differ_is_read_in_full(
@@ -466,6 +468,10 @@ def test_a_later_frame_whose_faces_or_texture_differ_is_read_in_full(
     with pytest.warns(UnreadAttributesWarning, match=r"f2.obj: has texture coordinates other than f0.obj's"):
         sequence = meshseq.read_textured_sequence(paths)
     assert sequence.texture is None and sequence.mesh.vertex_count == 12  # the materials' copies alone
+    _write(paths[2], text.replace("mtllib grid_2.mtl", "f 1/1/1 2/2/1 5/5/1"))  # a face for the library
+    with pytest.raises(FormatError, match=r"f2.obj: "):
+        meshseq.read_textured_sequence(paths)
+    assert fitted[-1] is False
 
 
 @pytest.mark.parametrize(("value", "reason"), [("x1", "'x1' is not a number or out of range"), ("nan", "are not")])

@@ -132,15 +132,17 @@ class _Statements(NamedTuple):
     l: np.ndarray  # noqa: E741 (the statement's name)
     vt: np.ndarray
     vn: np.ndarray
+    mtllib: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
 class ObjTemplate:
     """An OBJ file read as the first frame of a sequence (:func:`read_obj_template`), by which a
     later frame is read from its ``v`` lines alone where its other lines are this file's byte for
-    byte (comments, continuations and indents taken out) and its ``v`` and ``vn`` lines stand
-    where this file's do (so that a message names the line as a full read would): exporters write
-    every frame's faces, texture coordinates and materials alike."""
+    byte (comments, continuations and indents taken out) and its ``v``, ``vn`` and ``mtllib``
+    lines stand where this file's do (so that a message names the line as a full read would):
+    exporters write every frame's faces, texture coordinates and materials alike, and Blender a
+    material library of each frame's own name."""
 
     textured: bool
     lines: _ObjLines
@@ -149,8 +151,10 @@ class ObjTemplate:
 
     @cached_property
     def _kept(self) -> np.ndarray:
-        """(L,) bool: the lines a later frame repeats byte for byte (all but ``v`` and ``vn``)."""
-        return ~(self.statements.v | self.statements.vn)
+        """(L,) bool: the lines a later frame repeats byte for byte: all but its own (``v``),
+        those a sequence's later frames leave unread (``vn``) and those read from each frame
+        (``mtllib``)."""
+        return ~(self.statements.v | self.statements.vn | self.statements.mtllib)
 
     @cached_property
     def _kept_bytes(self) -> bytes:
@@ -159,17 +163,17 @@ class ObjTemplate:
 
     def fits(self, lines: _ObjLines, statements: _Statements) -> bool:
         """Whether a later frame's ``lines`` (holding ``statements``) read as this file's but for
-        their ``v`` lines (and the ``vn`` lines, which later frames leave unread): one bytes
+        their ``v``, ``vn`` and ``mtllib`` lines, which stand where this file's do: one bytes
         comparison, no parse."""
         mine = self.statements
-        return (np.array_equal(statements.v, mine.v) and np.array_equal(statements.vn, mine.vn)
+        return (all(np.array_equal(getattr(statements, tag), getattr(mine, tag)) for tag in ("v", "vn", "mtllib"))
                 and lines.block(self._kept) == self._kept_bytes)  # fmt: skip
 
     def read(self, path: str | os.PathLike) -> TexturedMesh:
         """A later frame of the sequence, as :func:`read_obj` (``textured`` False, in a
         TexturedMesh) or :func:`read_obj_textured` with ``normals=False`` read it, errors and
-        warnings alike: from its ``v`` lines alone, with this file's faces, texture coordinates and
-        materials, where it :meth:`fits`; by a full read otherwise."""
+        warnings alike: from its ``v`` (and ``mtllib``) lines alone, with this file's faces, texture
+        coordinates and materials, where it :meth:`fits`; by a full read otherwise."""
         return _read_obj(path, self.textured, template=self)[0]
 
 
@@ -182,7 +186,7 @@ def _read_obj(
     (:meth:`ObjTemplate.read`)."""
     path = Path(path)
     lines = _obj_lines(path)
-    statements = _Statements(*(lines.tagged(tag) for tag in (b"v", b"f", b"l", b"vt", b"vn")))
+    statements = _Statements(*(lines.tagged(tag) for tag in (b"v", b"f", b"l", b"vt", b"vn", b"mtllib")))
     reused = template is not None and template.fits(lines, statements)
     vertex_lines, face_lines, polylines = (np.flatnonzero(selected) + 1 for selected in statements[:3])
     vertex_block = lines.block(statements.v)
@@ -210,7 +214,10 @@ def _read_obj(
         rows = all_finite(path, values[:, 3:].astype(np.float32), "colours", name_vertex)
         colours = None if rows is None else VertexColours(rows[None], OBJ_COLOUR_NAMES[:channels], ("f4",) * channels)
     if reused:
-        return template.mesh._replace(vertices=vertices, normals=None, colours=colours), template
+        materials = template.mesh.materials
+        if materials is not None:  # the file may name a library of its own (Blender: one per frame)
+            materials = materials._replace(libraries=_libraries(lines, statements.mtllib))
+        return template.mesh._replace(vertices=vertices, normals=None, colours=colours, materials=materials), template
 
     def name_face(face: int) -> str:
         return f"face {face} (line {face_lines[face]})"
@@ -244,7 +251,7 @@ def _read_obj(
 
         texture = per_triangle(statements.vt, _TEXTURE)
         corner_normals = per_triangle(statements.vn, _NORMALS) if normals else None
-        materials = _materials(lines, face_lines[polygons], sizes[polygons] - 2)
+        materials = _materials(lines, statements.mtllib, face_lines[polygons], sizes[polygons] - 2)
         mesh = TexturedMesh(vertices, faces, texture and ObjTexture(*texture),
                             corner_normals and ObjNormals(*corner_normals), colours, materials)  # fmt: skip
     return mesh, ObjTemplate(textured, lines, statements, mesh) if polygons.all() else None
@@ -282,9 +289,11 @@ def _obj_text(path: Path) -> bytes:
     return data
 
 
-def _materials(lines: _ObjLines, face_lines: np.ndarray, triangles: np.ndarray) -> ObjMaterials | None:
+def _materials(
+    lines: _ObjLines, mtllib: np.ndarray, face_lines: np.ndarray, triangles: np.ndarray
+) -> ObjMaterials | None:
     """The materials of the usemtl lines for the faces on ``face_lines`` (1-based), each fanned
-    into ``triangles``; the mtllib lines' libraries. None without a usemtl line."""
+    into ``triangles``; the libraries of the ``mtllib`` lines. None without a usemtl line."""
     named = _names_in_effect(lines, b"usemtl", face_lines)
     if named is None:
         return None
@@ -295,9 +304,12 @@ def _materials(lines: _ObjLines, face_lines: np.ndarray, triangles: np.ndarray) 
     rank = np.empty(first.size, np.int32)
     rank[order] = np.arange(first.size)
     per_face = np.where(in_effect >= 0, rank[material.ravel()][np.maximum(in_effect, 0)], -1).astype(np.int32)
-    libraries = lines.names(lines.tagged(b"mtllib"), len(b"mtllib"))
-    return ObjMaterials(tuple(found.decode("utf-8", "replace").strip() for found in libraries),
-                        tuple(distinct[order].tolist()), np.repeat(per_face, triangles))  # fmt: skip
+    return ObjMaterials(_libraries(lines, mtllib), tuple(distinct[order].tolist()), np.repeat(per_face, triangles))
+
+
+def _libraries(lines: _ObjLines, mtllib: np.ndarray) -> tuple[str, ...]:
+    """The material libraries the ``mtllib`` lines name, as written."""
+    return tuple(found.decode("utf-8", "replace").strip() for found in lines.names(mtllib, len(b"mtllib")))
 
 
 def _colour_channels(path: Path, sizes: np.ndarray) -> int:

@@ -466,7 +466,7 @@ def write_obj(
         if not fits or indices.size and indices.max() >= len(values):
             raise ValueError(f"{os.fspath(path)}: {name}: expected finite values (N, {width}) and a (M, 3) "
                              f"corner index into them per face, got {values.shape} and {indices.shape}")  # fmt: skip
-        lines += ((tag + " %.9g" * width + "\n") * len(values)) % tuple(values.ravel())
+        lines += ((tag + " %.9g" * width + "\n") * len(values)) % tuple(values.ravel().tolist())
         columns.append(indices.astype(np.int64) + 1)
         corner += "/%d"
     vertex_line = "v %.9g %.9g %.9g\n"
@@ -490,12 +490,12 @@ def write_obj(
     face_line = f"f {corner} {corner} {corner}\n"
     with atomic_write(path, "w", encoding="utf-8", newline="\n") as handle:
         handle.write("# written by animlod\n" + header)
-        handle.write((vertex_line * len(vertices)) % tuple(vertices.ravel()))
+        handle.write((vertex_line * len(vertices)) % tuple(vertices.ravel().tolist()))
         handle.write(lines)
         for material, run in runs:
             if material is not None and material >= 0:
                 handle.write(f"usemtl {materials.names[material]}\n")
-            handle.write((face_line * len(run)) % tuple(run.ravel()))
+            handle.write((face_line * len(run)) % tuple(run.ravel().tolist()))
 
 
 # The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.

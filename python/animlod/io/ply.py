@@ -227,8 +227,8 @@ def write_ply(
         digits = {4: "%.9g", 8: "%.17g"}  # each float round-trips
         line = " ".join(digits[row[name].itemsize] if row[name].kind == "f" else "%d" for name in row.names) + "\n"
         table = np.stack([vertex_rows[name].astype(np.float64) for name in row.names], axis=1)
-        text = (line * len(vertex_rows)) % tuple(table.ravel())
-        text += ("3 %d %d %d\n" * len(faces)) % tuple(faces.ravel())
+        text = (line * len(vertex_rows)) % tuple(table.ravel().tolist())
+        text += ("3 %d %d %d\n" * len(faces)) % tuple(faces.ravel().tolist())
         body = text.encode("ascii")
     with atomic_write(path, "wb") as handle:
         handle.write(header.encode("ascii") + body)

@@ -369,7 +369,9 @@ def test_frames_numbered_below_zero_come_first(tmp_path: Path, names: list[str],
         (["mesh.1.obj", "mesh.0.5.obj", "mesh.1.25.obj", "mesh.0.25.obj", "mesh.0.75.obj"], [3, 1, 4, 0, 2]),
         (["mesh.-0.5.obj", "mesh.0.obj", "mesh.-1.obj", "mesh.0.25.obj"], [2, 0, 1, 3]),
         # 2.1 and 2.10 are one value as decimals: versions, in natural order.
-        (["v2.10.obj", "v2.2.obj", "v2.1.obj", "v2.9.obj"], [2, 1, 3, 0]),
+        (["v2.10.obj", "v2.2.obj", "v2.1.obj", "v2.9.obj", "v2.obj"], [4, 2, 1, 3, 0]),
+        # Every name with a fraction: a shot and its frames, in natural order.
+        (["shot.1.10.obj", "shot.1.2.obj", "shot.1.9.obj"], [1, 2, 0]),
         # Other prefixes: separate names, in natural order.
         (["a.0.5.obj", "b.0.25.obj"], [0, 1]),
     ],

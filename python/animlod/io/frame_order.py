@@ -14,26 +14,33 @@ _NUMBER = re.compile(r"((?:(?<=[._ ])-)?\d+)")
 _FRAME_NUMBER = re.compile(r"(.*?)((?:(?<=[._ ])-)?\d+(?:\.\d+)?)(\.[^.]*)")
 
 
-def natural_key(path: Path) -> tuple[list[object], str]:
+def natural_key(path: Path) -> tuple[list[object], str, str]:
     """Sort key that orders embedded numbers by value (frame2 < frame10) and letters regardless
-    of case, then by full path. A minus sign after a separator is the number's
-    (``frame.-001.obj``, before frame 0, as Houdini numbers frames before the first); after
-    anything else it separates (``mesh-001`` is frame 1)."""
-    parts = _NUMBER.split(path.name)  # text, number, text, ...: the numbers at odd places
-    return [int(part) if index % 2 else part.lower() for index, part in enumerate(parts)], str(path)
+    of case, the name before its extension (``v2.obj`` before ``v2.1.obj``), then by full path. A
+    minus sign after a separator is the number's (``frame.-001.obj``, before frame 0, as Houdini
+    numbers frames before the first); after anything else it separates (``mesh-001`` is frame 1)."""
+    parts = _NUMBER.split(path.stem)  # text, number, text, ...: the numbers at odd places
+    return (
+        [int(part) if index % 2 else part.lower() for index, part in enumerate(parts)],
+        path.suffix.lower(),
+        str(path),
+    )
 
 
 def in_frame_order(paths: Iterable[Path]) -> list[Path]:
     """``paths`` in natural order (:func:`natural_key`), or by the value of a decimal frame number
-    where every name is the same prefix, a frame number and the same extension, some numbers have
-    a fraction and no two are equal as decimals: sub-frames (``mesh.1.obj``, ``mesh.1.25.obj``,
-    ``mesh.1.5.obj``), which natural order would read as 1.25, 1.5, 1. Names such as ``v2.1`` ...
-    ``v2.10`` (2.1 twice as decimals) are versions and keep their natural order."""
+    where every name is the same prefix, a frame number and the same extension, some numbers with
+    a fraction and some without, no two equal as decimals: sub-frames (``mesh.1.obj``,
+    ``mesh.1.25.obj``, ``mesh.1.5.obj``, as Houdini's ``$FF`` numbers them), which natural order
+    would read as 1.25, 1.5, 1. Names that all have a fraction (a shot and its frames,
+    ``shot.1.2`` ... ``shot.1.10``) and names equal as decimals (versions ``v2.1`` ... ``v2.10``)
+    keep their natural order."""
     paths = sorted(paths, key=natural_key)
     names = [_FRAME_NUMBER.fullmatch(path.name) for path in paths]
     if not all(names) or len({(name[1], name[3].lower()) for name in names}) > 1:
         return paths
     values = [Decimal(name[2]) for name in names]
-    if not any("." in name[2] for name in names) or len(set(values)) < len(values):
+    fractions = {"." in name[2] for name in names}
+    if fractions != {True, False} or len(set(values)) < len(values):
         return paths
     return [path for _, path in sorted(zip(values, paths), key=lambda pair: pair[0])]

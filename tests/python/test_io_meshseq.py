@@ -106,6 +106,31 @@ def test_obj_texture_coordinates_are_read_per_corner(tmp_path: Path) -> None:
         np.testing.assert_array_equal(read, written)
 
 
+def test_a_frame_written_with_the_text_of_the_frame_before_is_written_as_alone(tmp_path: Path) -> None:
+    """write_obj formats the vt and face lines once for a sequence's frames; a frame whose normals
+    split otherwise, or of other faces, texture or materials, gets text of its own."""
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.5]], np.float32)
+    faces = np.array([[0, 1, 2], [1, 3, 2]], np.int32)
+    texture = obj.ObjTexture(np.array([[0, 0], [1, 0], [0, 1], [1, 1]], np.float32), faces)
+    materials = obj.ObjMaterials(("a.mtl",), ("skin", "cloth"), np.array([1, 0], np.int32))
+    smooth = obj.ObjNormals(np.array([[0, 0, 1], [0, 0.6, 0.8]], np.float32), np.array([[0, 0, 0], [0, 1, 0]]))
+    split = obj.ObjNormals(smooth.normals, np.array([[0, 0, 0], [1, 1, 1]]))
+    shared = obj.write_obj(tmp_path / "f0.obj", positions, faces, texture, smooth, None, materials)
+    cases = {
+        "same": (positions + 1, faces, texture, smooth, materials),
+        "normals split otherwise": (positions, faces, texture, split, materials),
+        "other faces": (positions, faces[:, ::-1].copy(), texture, smooth, materials),
+        "other texture": (positions, faces, texture._replace(uvs=texture.uvs[::-1].copy()), smooth, materials),
+        "no materials": (positions, faces, texture, smooth, None),
+    }
+    for case, (frame, frame_faces, frame_texture, frame_normals, frame_materials) in cases.items():
+        after = obj.write_obj(tmp_path / "f1.obj", frame, frame_faces, frame_texture, frame_normals, None,
+                              frame_materials, shared)  # fmt: skip
+        obj.write_obj(tmp_path / "alone.obj", frame, frame_faces, frame_texture, frame_normals, None, frame_materials)
+        assert (tmp_path / "f1.obj").read_bytes() == (tmp_path / "alone.obj").read_bytes(), case
+        assert (after is shared) == (case == "same"), case
+
+
 def test_obj_normals_are_read_per_corner_and_written_back(tmp_path: Path) -> None:
     """vn lines and each corner's normal index (v//vn, v/vt/vn; negative ones counting back), and
     both attributes written back as v/vt/vn corners."""

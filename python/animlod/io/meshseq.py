@@ -27,6 +27,7 @@ from .frame_order import in_frame_order
 from .obj import (
     ObjMaterials,
     ObjNormals,
+    ObjSharedText,
     ObjTemplate,
     ObjTexture,
     TexturedMesh,
@@ -390,8 +391,9 @@ def write_sequence(
     names = [f"{name}.{fmt}" for name in names]
     layout = frame_layout(mesh, texture, fmt, normals=shading is not None, points=points)
     with atomic_folder(folder) as temporary:
+        shared = None  # the text an OBJ frame shares with the next (write_obj)
         for frame, name in enumerate(names):
-            layout.write(temporary / name, mesh, frame, shading, colours, materials)
+            shared = layout.write(temporary / name, mesh, frame, shading, colours, materials, shared)
     return [Path(folder) / name for name in names]
 
 
@@ -430,13 +432,16 @@ class FrameLayout:
         shading: Shading | None,
         colours: VertexColours | None,
         materials: ObjMaterials | None = None,
-    ) -> None:
+        shared: ObjSharedText | None = None,
+    ) -> ObjSharedText | None:
         """Write ``mesh``'s ``frame`` to ``path`` (:func:`write_mesh`) laid out so, with its
-        normals rebuilt where ``shading`` is given, its ``colours`` and its faces' ``materials``."""
+        normals rebuilt where ``shading`` is given, its ``colours`` and its faces' ``materials``;
+        an OBJ file with the text it ``shared`` with the frame before, which it returns for the
+        next."""
         positions = mesh.frames[frame][self.written]
         normals = None if shading is None else self.normals(positions, shading)
         written_colours = None if colours is None else colours.of_frame(frame, self.written)
-        write_mesh(path, positions, self.faces, self.texture, normals, written_colours, materials)
+        return write_mesh(path, positions, self.faces, self.texture, normals, written_colours, materials, shared)
 
 
 def frame_layout(
@@ -635,22 +640,24 @@ def write_mesh(
     normals: ObjNormals | None = None,
     colours: VertexColours | None = None,
     materials: ObjMaterials | None = None,
-) -> None:
+    shared: ObjSharedText | None = None,
+) -> ObjSharedText | None:
     """Write one .obj or .ply (binary) file, chosen by the suffix of ``path``, with ``texture``
     and ``normals``, each an index per corner into its values (a PLY file's are one per vertex:
     ValueError where a vertex's corners have two), one frame's vertex ``colours``, and (OBJ:
-    a PLY file has none) the faces' ``materials``."""
+    a PLY file has none) the faces' ``materials``. An OBJ file reuses the text it ``shared``
+    with the frame before and returns it (:func:`~.obj.write_obj`); a PLY file returns None."""
     suffix = Path(path).suffix.lower()
     if suffix == ".obj":
-        write_obj(path, vertices, faces, texture, normals, colours, materials)
-    elif suffix == ".ply":
+        return write_obj(path, vertices, faces, texture, normals, colours, materials, shared)
+    if suffix == ".ply":
         uvs, normal_rows = (
             None if given is None else _per_vertex(path, name, len(vertices), faces, *given)
             for name, given in (("texture", texture), ("normals", normals))
         )
         write_ply(path, vertices, faces, uvs=uvs, normals=normal_rows, colours=colours)
-    else:
-        raise ValueError(f"{os.fspath(path)}: expected one of {', '.join(MESH_SUFFIXES)}")
+        return None
+    raise ValueError(f"{os.fspath(path)}: expected one of {', '.join(MESH_SUFFIXES)}")
 
 
 def _per_vertex(

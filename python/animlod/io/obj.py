@@ -440,7 +440,8 @@ def write_obj(
     normals: ObjNormals | None = None,
     colours: VertexColours | None = None,
     materials: ObjMaterials | None = None,
-) -> None:
+    shared: ObjSharedText | None = None,
+) -> ObjSharedText:
     """Write ``vertices (V, 3)`` and ``faces (M, 3)`` as OBJ ``v``/``f`` lines, atomically; with
     ``texture`` also its ``vt`` lines, with ``normals`` its ``vn`` lines, and each corner's
     indices into them (``v/vt``, ``v//vn`` or ``v/vt/vn``); with one frame's ``colours`` (three
@@ -448,27 +449,20 @@ def write_obj(
     per face) its ``mtllib`` lines, and the faces in runs of one material, each after its
     ``usemtl`` line (the faces of none first).
 
+    Returns the text the file shares with other frames of its sequence (:class:`ObjSharedText`);
+    given as ``shared`` to the next frame's call, it is written again without being formatted
+    anew where that frame has the same ``faces``, ``texture`` and ``materials`` objects and its
+    normals the same corner indices.
+
     Coordinates are written with 9 significant digits, which round-trips float32 exactly. A wrong
     shape, a coordinate that is not finite as float32 or a face index outside the vertices is a
     ValueError naming the file and the argument (``vertices``, ``faces``, ``texture``,
     ``normals`` or ``colours``); nothing is written.
     """
-    vertices, faces = checked_for_writing(path, vertices, faces)
-    vertices, faces = vertices.astype(np.float64), faces.astype(np.int64) + 1
-    columns, corner, lines = [faces], "%d", ""
-    for name, attribute, tag, width in (("texture", texture, "vt", 2), ("normals", normals, "vn", 3)):
-        if attribute is None:
-            corner += "/" if tag == "vt" and normals is not None else ""  # v//vn
-            continue
-        values, indices = np.asarray(attribute[0], dtype=np.float64), np.asarray(attribute[1])
-        fits = values.ndim == 2 and values.shape[1] == width and np.isfinite(values).all()
-        fits = fits and indices.shape == faces.shape and (not indices.size or 0 <= indices.min() <= indices.max())
-        if not fits or indices.size and indices.max() >= len(values):
-            raise ValueError(f"{os.fspath(path)}: {name}: expected finite values (N, {width}) and a (M, 3) "
-                             f"corner index into them per face, got {values.shape} and {indices.shape}")  # fmt: skip
-        lines += ((tag + " %.9g" * width + "\n") * len(values)) % tuple(values.ravel().tolist())
-        columns.append(indices.astype(np.int64) + 1)
-        corner += "/%d"
+    vertices, checked_faces = checked_for_writing(path, vertices, faces)
+    vertices = vertices.astype(np.float64)
+    uvs, uv_corners = _checked_attribute(path, "texture", texture, 2, checked_faces.shape)
+    normal_values, normal_corners = _checked_attribute(path, "normals", normals, 3, checked_faces.shape)
     vertex_line = "v %.9g %.9g %.9g\n"
     if colours is not None:
         if len(colours.names) not in (3, 4):
@@ -476,26 +470,99 @@ def write_obj(
                              f"{', '.join(colours.names)}")  # fmt: skip
         vertices = np.concatenate([vertices, np.stack(colours.stored(path, len(vertices)), axis=1)], axis=1)
         vertex_line = "v" + " %.9g" * vertices.shape[1] + "\n"
-    corners = np.stack(columns, axis=2).reshape(len(faces), -1)
-    runs, header = [(None, corners)], ""
-    if materials is not None:
-        if np.shape(materials.faces) != (len(faces),) or np.any(materials.faces >= len(materials.names)):
-            raise ValueError(f"{os.fspath(path)}: materials: expected a material (< {len(materials.names)}) per "
-                             f"face, got {np.shape(materials.faces)}")  # fmt: skip
-        order = np.argsort(materials.faces, kind="stable")
-        starts = np.flatnonzero(np.diff(materials.faces[order], prepend=-2))
-        runs = [(materials.faces[order[start]], corners[order[start:end]])
-                for start, end in zip(starts, [*starts[1:], len(order)])]  # fmt: skip
-        header = "".join(f"mtllib {library}\n" for library in materials.libraries)
-    face_line = f"f {corner} {corner} {corner}\n"
+    if shared is None or not shared.fits(faces, texture, materials, normal_corners):
+        shared = ObjSharedText.made(path, faces, checked_faces, texture, uvs, uv_corners, normal_corners, materials)
     with atomic_write(path, "w", encoding="utf-8", newline="\n") as handle:
-        handle.write("# written by animlod\n" + header)
+        handle.write("# written by animlod\n" + shared.header)
         handle.write((vertex_line * len(vertices)) % tuple(vertices.ravel().tolist()))
-        handle.write(lines)
-        for material, run in runs:
-            if material is not None and material >= 0:
-                handle.write(f"usemtl {materials.names[material]}\n")
-            handle.write((face_line * len(run)) % tuple(run.ravel().tolist()))
+        handle.write(shared.uv_lines)
+        if normal_values is not None:
+            handle.write(("vn %.9g %.9g %.9g\n" * len(normal_values)) % tuple(normal_values.ravel().tolist()))
+        handle.write(shared.face_lines)
+    return shared
+
+
+def _checked_attribute(
+    path: str | os.PathLike, name: str, attribute: ObjTexture | ObjNormals | None, width: int, shape: tuple
+) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """A texture's or normals' values (N, ``width``) as float64 and their corner indices (``shape``,
+    the faces') as int64; ValueError naming the file and ``name`` where they do not fit. None and
+    None without the attribute."""
+    if attribute is None:
+        return None, None
+    values, indices = np.asarray(attribute[0], dtype=np.float64), np.asarray(attribute[1])
+    fits = values.ndim == 2 and values.shape[1] == width and np.isfinite(values).all()
+    fits = fits and indices.shape == shape and (not indices.size or 0 <= indices.min() <= indices.max())
+    if not fits or indices.size and indices.max() >= len(values):
+        raise ValueError(f"{os.fspath(path)}: {name}: expected finite values (N, {width}) and a (M, 3) "
+                         f"corner index into them per face, got {values.shape} and {indices.shape}")  # fmt: skip
+    return values, indices.astype(np.int64)
+
+
+@dataclass(frozen=True, eq=False)
+class ObjSharedText:
+    """The text of an OBJ file that the other frames of its sequence repeat, formatted once
+    (:func:`write_obj`): the ``mtllib`` lines (``header``), the ``vt`` lines and the faces (each
+    run of one material after its ``usemtl`` line), made for the ``faces``, ``texture`` and
+    ``materials`` objects and the normals' corner indices it holds."""
+
+    faces: np.ndarray
+    texture: ObjTexture | None
+    materials: ObjMaterials | None
+    normal_corners: np.ndarray | None
+    header: str
+    uv_lines: str
+    face_lines: str
+
+    def fits(
+        self,
+        faces: np.ndarray,
+        texture: ObjTexture | None,
+        materials: ObjMaterials | None,
+        normal_corners: np.ndarray | None,
+    ) -> bool:
+        """Whether a frame of these objects, its normals with these corner indices, shares this text."""
+        same_normals = (normal_corners is None) == (self.normal_corners is None) and (
+            normal_corners is None or np.array_equal(normal_corners, self.normal_corners)
+        )
+        return faces is self.faces and texture is self.texture and materials is self.materials and same_normals
+
+    @classmethod
+    def made(
+        cls,
+        path: str | os.PathLike,
+        faces: np.ndarray,
+        checked_faces: np.ndarray,
+        texture: ObjTexture | None,
+        uvs: np.ndarray | None,
+        uv_corners: np.ndarray | None,
+        normal_corners: np.ndarray | None,
+        materials: ObjMaterials | None,
+    ) -> ObjSharedText:
+        """The text of ``checked_faces`` (the ``faces`` object, checked) with the ``texture``'s
+        values ``uvs`` and ``uv_corners``, the normals' corners and the ``materials``."""
+        columns = [checked_faces.astype(np.int64) + 1] + [c + 1 for c in (uv_corners, normal_corners) if c is not None]
+        corner = "%d" + ("/%d" if uv_corners is not None else "/" if normal_corners is not None else "")
+        corner += "/%d" if normal_corners is not None else ""  # v//vn where there is no texture
+        corners = np.stack(columns, axis=2).reshape(len(checked_faces), -1)
+        runs, header = [(None, corners)], ""
+        if materials is not None:
+            if np.shape(materials.faces) != (len(checked_faces),) or np.any(materials.faces >= len(materials.names)):
+                raise ValueError(f"{os.fspath(path)}: materials: expected a material (< {len(materials.names)}) "
+                                 f"per face, got {np.shape(materials.faces)}")  # fmt: skip
+            order = np.argsort(materials.faces, kind="stable")
+            starts = np.flatnonzero(np.diff(materials.faces[order], prepend=-2))
+            runs = [(materials.faces[order[start]], corners[order[start:end]])
+                    for start, end in zip(starts, [*starts[1:], len(order)])]  # fmt: skip
+            header = "".join(f"mtllib {library}\n" for library in materials.libraries)
+        face_line = f"f {corner} {corner} {corner}\n"
+        face_lines = "".join(
+            (f"usemtl {materials.names[material]}\n" if material is not None and material >= 0 else "")
+            + (face_line * len(run)) % tuple(run.ravel().tolist())
+            for material, run in runs
+        )
+        uv_lines = "" if uvs is None else ("vt %.9g %.9g\n" * len(uvs)) % tuple(uvs.ravel().tolist())
+        return cls(faces, texture, materials, normal_corners, header, uv_lines, face_lines)
 
 
 # The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.

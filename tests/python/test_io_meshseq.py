@@ -393,6 +393,18 @@ def test_frames_numbered_below_zero_come_first(tmp_path: Path, names: list[str],
         # Houdini's sub-frames ($FF): natural order read 0.5 before 0.25, and 1.25 before 1.
         (["mesh.1.obj", "mesh.0.5.obj", "mesh.1.25.obj", "mesh.0.25.obj", "mesh.0.75.obj"], [3, 1, 4, 0, 2]),
         (["mesh.-0.5.obj", "mesh.0.obj", "mesh.-1.obj", "mesh.0.25.obj"], [2, 0, 1, 3]),
+        # Houdini's default name, $HIPNAME.$OS.$FF, of a node whose name ends in a digit.
+        (
+            [
+                "untitled.rop_geometry1.1.25.obj",
+                "untitled.rop_geometry1.2.obj",
+                "untitled.rop_geometry1.1.obj",
+                "untitled.rop_geometry1.1.5.obj",
+            ],
+            [2, 0, 3, 1],
+        ),
+        # Whole frames written with a fraction of zeros.
+        (["mesh.1.5.obj", "mesh.1.0.obj", "mesh.2.0.obj", "mesh.1.25.obj"], [1, 3, 0, 2]),
         # 2.1 and 2.10 are one value as decimals: versions, in natural order.
         (["v2.10.obj", "v2.2.obj", "v2.1.obj", "v2.9.obj", "v2.obj"], [4, 2, 1, 3, 0]),
         # Every name with a fraction: a shot and its frames, in natural order.

@@ -488,8 +488,22 @@ def test_later_obj_frames_read_from_their_v_lines_alone_read_as_in_full(
     if textured:  # each frame's own positions and colours, the seam's copies and the materials
         assert quick.mesh.vertex_count == 13 and len(quick.colours.values) == 4  # seam and material copies
         np.testing.assert_array_equal(quick.mesh.frames[3], obj.read_obj_textured(paths[3]).vertices[quick.points])
-        later = obj.read_obj_template(paths[0], textured=True)[1].read(paths[2])
+        later = obj.read_obj_template(paths[0], textured=True)[1].read(paths[2])[0]
         assert later.materials.libraries == ("grid_2.mtl",) == obj.read_obj_textured(paths[2]).materials.libraries
+
+
+def test_frames_alike_after_a_first_frame_of_its_own_are_read_from_their_v_lines(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Blender merges equal normals: its rest pose, exported first, has fewer vn lines than the
+    frames after it. The frame after a frame that did not fit is read by that frame's lines."""
+    paths = _grid_frames(tmp_path / "grid", 4)
+    _write(paths[0], paths[0].read_text().replace("vn 0 0 1\n", "vn 0 0 1\nvn 0 1 0\n"))
+    fitted = _spy_on_fits(monkeypatch)
+    quick = meshseq.read_textured_sequence(paths)
+    assert fitted == [False, True, True]
+    monkeypatch.setattr(obj.ObjTemplate, "fits", lambda *args: False)
+    _assert_same_read(quick, meshseq.read_textured_sequence(paths))
 
 
 def test_a_later_frame_whose_faces_or_texture_differ_is_read_in_full(

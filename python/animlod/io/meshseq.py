@@ -149,7 +149,8 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
         warnings.simplefilter("always")
         for index, path in enumerate(paths[1:], start=1):
-            vertices, frame_faces, frame_texture, _, colours, _ = _read_later_frame(path, textured, template)
+            frame, template = _read_later_frame(path, textured, template)
+            vertices, frame_faces, frame_texture, _, colours, _ = frame
             # A PLY frame's texture coordinates are per vertex: where its triangles are not the
             # first frame's, others than the first's tell of vertices numbered otherwise, and
             # which vertex is which (read for this alone where the sequence is read without them).
@@ -231,12 +232,15 @@ def _read_first_frame(path: Path, textured: bool) -> tuple[TexturedMesh, ObjTemp
     return read_mesh_textured(path) if textured else _geometry_of(path), None
 
 
-def _read_later_frame(path: Path, textured: bool, template: ObjTemplate | None) -> TexturedMesh:
-    """A later frame of a sequence, without normals; an OBJ frame by the first frame's
-    ``template``, which reads only the ``v`` lines of a frame that repeats the rest of it."""
+def _read_later_frame(
+    path: Path, textured: bool, template: ObjTemplate | None
+) -> tuple[TexturedMesh, ObjTemplate | None]:
+    """A later frame of a sequence, without normals, and the template to read the next by; an
+    OBJ frame by the ``template`` of an OBJ frame before it (:meth:`~.obj.ObjTemplate.read`),
+    which reads only the ``v`` lines of a frame that repeats the rest of it."""
     if template is not None and path.suffix.lower() == ".obj":
         return template.read(path)
-    return read_mesh_textured(path, normals=False) if textured else _geometry_of(path)
+    return read_mesh_textured(path, normals=False) if textured else _geometry_of(path), template
 
 
 class _ColourFrames:

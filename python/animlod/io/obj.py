@@ -169,12 +169,16 @@ class ObjTemplate:
         return (all(np.array_equal(getattr(statements, tag), getattr(mine, tag)) for tag in ("v", "vn", "mtllib"))
                 and lines.block(self._kept) == self._kept_bytes)  # fmt: skip
 
-    def read(self, path: str | os.PathLike) -> TexturedMesh:
+    def read(self, path: str | os.PathLike) -> tuple[TexturedMesh, ObjTemplate]:
         """A later frame of the sequence, as :func:`read_obj` (``textured`` False, in a
         TexturedMesh) or :func:`read_obj_textured` with ``normals=False`` read it, errors and
         warnings alike: from its ``v`` (and ``mtllib``) lines alone, with this file's faces, texture
-        coordinates and materials, where it :meth:`fits`; by a full read otherwise."""
-        return _read_obj(path, self.textured, template=self)[0]
+        coordinates and materials, where it :meth:`fits`; by a full read otherwise. Also the
+        template to read the next frame by: this one where the frame fits, else the frame itself
+        (a rest pose first, whose normals Blender merges into fewer ``vn`` lines, then frames
+        alike), or this one again where the frame can be none."""
+        mesh, template = _read_obj(path, self.textured, template=self)
+        return mesh, template or self
 
 
 def _read_obj(

@@ -527,6 +527,14 @@ def test_a_later_frame_whose_faces_or_texture_differ_is_read_in_full(
     assert fitted[-1] is False
 
 
+def test_a_later_frame_that_gives_faces_other_materials_is_named(tmp_path: Path) -> None:
+    paths = _grid_frames(tmp_path / "grid")
+    _write(paths[1], paths[1].read_text().replace("usemtl skin", "usemtl cloth"))
+    with pytest.warns(UnreadAttributesWarning, match=r"f1.obj: gives some faces other materials than f0.obj"):
+        sequence = meshseq.read_textured_sequence(paths)
+    assert sequence.materials.names == ("skin", "cloth")  # the first frame's
+
+
 @pytest.mark.parametrize(("value", "reason"), [("x1", "'x1' is not a number or out of range"), ("nan", "are not")])
 def test_a_bad_v_line_in_a_later_frame_names_that_file_and_line(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, value: str, reason: str

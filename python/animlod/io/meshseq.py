@@ -141,6 +141,7 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     frames = np.empty((len(paths),) + first_vertices.shape, dtype=np.float32)
     frames[0] = first_vertices
     first_texture, differing = texture, None  # the first frame whose texture coordinates are not the first's
+    recoloured = None  # the first frame whose faces have other materials than the first frame's
     first_uvs = None if texture is None else texture.uvs  # a PLY's per vertex, where read
     first_uvs_read = textured  # read_sequence reads them only for a frame to match (below)
     frame_colours = _ColourFrames(paths[0], colours, len(paths))
@@ -150,7 +151,7 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
         warnings.simplefilter("always")
         for index, path in enumerate(paths[1:], start=1):
             frame, template = _read_later_frame(path, textured, template)
-            vertices, frame_faces, frame_texture, _, colours, _ = frame
+            vertices, frame_faces, frame_texture, _, colours, frame_materials = frame
             # A PLY frame's texture coordinates are per vertex: where its triangles are not the
             # first frame's, others than the first's tell of vertices numbered otherwise, and
             # which vertex is which (read for this alone where the sequence is read without them).
@@ -178,6 +179,8 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
             frame_colours.add(index, path, colours)
             if textured and differing is None and not _same_texture(texture, frame_texture, faces, frame_faces):
                 differing, differing_texture, texture = path, frame_texture, None
+            if textured and recoloured is None and not _same_materials(materials, frame_materials, faces, frame_faces):
+                recoloured = path
     unread = [w for w in later_warnings if issubclass(w.category, UnreadAttributesWarning)]
     if unread and not any(issubclass(w.category, UnreadAttributesWarning) for w in first_warnings):
         warnings.warn(unread[0].message, stacklevel=3)  # a later frame's own, where the first has none
@@ -194,6 +197,9 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
                       f"triangulate some polygons differently from the first frame {paths[0].name}, as exporters "
                       "that triangulate each frame do; every frame is read with the first frame's triangles",
                       stacklevel=3)  # fmt: skip
+    if recoloured is not None:
+        warnings.warn(f"{recoloured}: gives some faces other materials than {paths[0].name}: every frame is read "
+                      f"with the materials of {paths[0].name}", UnreadAttributesWarning, stacklevel=3)  # fmt: skip
     if differing is not None:
         first = paths[0].name
         if differing_texture is None:
@@ -344,6 +350,22 @@ def _same_texture(
     pairs = (np.unique(np.column_stack([f.ravel(), t.uvs[t.corners.ravel()]]), axis=0)
              for f, t in ((first_faces, first), (faces, other)))  # fmt: skip
     return np.array_equal(*pairs)
+
+
+def _same_materials(
+    first: ObjMaterials | None, other: ObjMaterials | None, first_faces: np.ndarray, faces: np.ndarray
+) -> bool:
+    """Whether a frame's faces have the first frame's materials, by name (None: no usemtl line);
+    frames whose triangles split the first frame's polygons otherwise are not compared."""
+    if first is None or other is None:
+        return first is other
+    if not np.array_equal(first_faces, faces):
+        return True
+
+    def names(materials: ObjMaterials) -> np.ndarray:  # each face's material name, "" for none
+        return np.array([*materials.names, ""], dtype=object)[materials.faces]
+
+    return np.array_equal(names(first), names(other))
 
 
 def write_sequence(

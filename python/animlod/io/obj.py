@@ -176,7 +176,8 @@ class ObjTemplate:
         coordinates and materials, where it :meth:`fits`; by a full read otherwise. Also the
         template to read the next frame by: this one where the frame fits, else the frame itself
         (a rest pose first, whose normals Blender merges into fewer ``vn`` lines, then frames
-        alike), or this one again where the frame can be none."""
+        alike), but this one where the frame has faces of fewer than three corners and so makes no
+        template (:func:`read_obj_template`)."""
         mesh, template = _read_obj(path, self.textured, template=self)
         return mesh, template or self
 

@@ -661,14 +661,58 @@ def test_frames_with_different_vertex_counts(tmp_path: Path) -> None:
     assert _error(tmp_path) == f"{tmp_path / 'a_2.obj'}: vertices: 6 vertices, but the first frame a_1.obj has 5"
 
 
-def test_frames_with_different_faces(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("old", "new", "face", "vertices"),
+    [
+        ("f 4//1 3//1 -1//1", "f 4 2 5", "face 1 (line 11)", [3, 1, 4]),  # the triangle after the quad's two
+        ("f 1/1/1 2/1/1 3/1/1 4/1/1", "f 1/1/1 2/1/1 5/1/1 4/1/1", "face 0 (line 9)", [0, 1, 4]),  # the quad's first
+    ],
+)
+def test_frames_with_different_faces(tmp_path: Path, old: str, new: str, face: str, vertices: list[int]) -> None:
     _write(tmp_path / "a_1.obj", OBJ_TEXT)
-    _write(tmp_path / "a_2.obj", OBJ_TEXT.replace("f 4//1 3//1 -1//1", "f 4 2 5"))
+    _write(tmp_path / "a_2.obj", OBJ_TEXT.replace(old, new))
     message = _error(tmp_path)
-    # Counted from 0 unlike OBJ's own indices (f 4 2 5), and said so.
-    expected = ("face 2: vertices [3, 1, 4] (counted from 0) are no triangle of the first frame a_1.obj, and the "
-                "frame's triangles are not a re-triangulation of the first frame's polygons")  # fmt: skip
+    # The face and its line as the file has them; the triangle's vertices counted from 0 unlike OBJ's
+    # own indices (f 4 2 5), and said so.
+    expected = (f"{face}: its triangle on vertices {vertices} (counted from 0) is no triangle of the first frame "
+                "a_1.obj, and the frame's triangles are not a re-triangulation of the first frame's "
+                "polygons")  # fmt: skip
     assert message == f"{tmp_path / 'a_2.obj'}: {expected}"
+
+
+@pytest.mark.filterwarnings("ignore:.*fewer than 3 vertices")
+@pytest.mark.parametrize("binary", [None, False, True])  # None: OBJ
+def test_a_face_that_differs_is_named_as_the_file_lists_it(tmp_path: Path, binary: bool | None) -> None:
+    # A line of two corners, a pentagon (three triangles) and a triangle: the triangle is the
+    # file's third face and the reader's fourth triangle.
+    vertices = np.random.default_rng(1).random((7, 3)).astype(np.float32)
+    sizes, corners = np.array([2, 5, 3]), np.array([0, 1, 0, 1, 2, 3, 4, 4, 3, 5])
+    moved = corners.copy()
+    moved[-1] = 6
+    for name, rows in (("a_1", corners), ("a_2", moved)):
+        if binary is None:
+            faces = np.split(rows + 1, np.cumsum(sizes)[:-1])
+            text = "".join(f"v {x} {y} {z}\n" for x, y, z in vertices) + "".join(
+                "f " + " ".join(map(str, face)) + "\n" for face in faces
+            )
+            _write(tmp_path / f"{name}.obj", text)
+        else:
+            _write(tmp_path / f"{name}.ply", _polygon_ply(binary, sizes, rows, vertices))
+    face = "face 2 (line 10)" if binary is None else "face 2"
+    assert _error(tmp_path).startswith(f"{next(tmp_path.glob('a_2.*'))}: {face}: its triangle on vertices [4, 3, 6]")
+
+
+def test_frames_that_list_the_first_frames_triangles_otherwise_are_said_to(tmp_path: Path) -> None:
+    _write(tmp_path / "a_1.obj", OBJ_TEXT)
+    moved = OBJ_TEXT.replace("f 1/1/1 2/1/1 3/1/1 4/1/1\r\n", "").replace("f 4//1 3//1 -1//1", "f 3 5 4\r\nf 1 2 3 4")
+    _write(tmp_path / "a_2.obj", moved)
+    with pytest.warns(UserWarning) as caught:
+        mesh = read_sequence(tmp_path)
+    about = [str(w.message) for w in caught if "triangles" in str(w.message)]
+    assert about == [f"{tmp_path / 'a_2.obj'}: 1 of the 2 frames (this the first) list the triangles of the first "
+                     "frame a_1.obj in another order or start them at other corners; every frame is read with the "
+                     "first frame's triangles"]  # fmt: skip
+    np.testing.assert_array_equal(mesh.faces, EXPECTED_FACES)
 
 
 @pytest.mark.parametrize(

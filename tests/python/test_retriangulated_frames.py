@@ -99,11 +99,14 @@ def test_frames_split_otherwise_are_read_with_the_first_frames_triangles(
     np.testing.assert_array_equal(mesh.faces, _triangles(0))
     for frame in range(FRAMES):
         np.testing.assert_array_equal(mesh.frames[frame], _grid_positions(frame))
-    # One warning for the sequence, naming the first such frame and how many there are.
+    # One warning for the sequence, naming the first such frame and how many there are; frame 2's
+    # triangles, only started at other corners, are the first frame's listed otherwise.
     about = [message for message in messages if "triangulate some polygons differently" in message]
     assert len(about) == 1
-    assert about[0].startswith(f"{folder / 'grid_002.'}{fmt}: 3 of the 4 frames")
+    assert about[0].startswith(f"{folder / 'grid_002.'}{fmt}: 2 of the 4 frames")
     assert "the first frame's triangles" in about[0]
+    listed = [message for message in messages if "in another order or start them at other corners" in message]
+    assert len(listed) == 1 and listed[0].startswith(f"{folder / 'grid_003.'}{fmt}: 1 of the 4 frames")
 
 
 @pytest.mark.parametrize(("fmt", "with_uvs"), [("obj", False), ("obj", True), ("ply", True)])
@@ -173,8 +176,10 @@ def test_frames_whose_faces_differ_otherwise_are_refused(
         faces[8, 2], faces[10, 2] = faces[10, 2], faces[8, 2]
         bad_face = 8
     path = _frame_with(fmt, folder, faces)
-    expected = (f"{path}: face {bad_face}: vertices {faces[bad_face].tolist()} (counted from 0) are no triangle of "
-                "the first frame grid_001.") + fmt  # fmt: skip
+    # Each triangle is a face of the file: an OBJ face's line comes after the 25 v lines.
+    face = f"face {bad_face} (line {bad_face + 26})" if fmt == "obj" else f"face {bad_face}"
+    expected = (f"{path}: {face}: its triangle on vertices {faces[bad_face].tolist()} (counted from 0) is no "
+                "triangle of the first frame grid_001.") + fmt  # fmt: skip
     with pytest.raises(FormatError) as caught:
         read_sequence(folder)
     assert str(caught.value).startswith(expected)

@@ -14,6 +14,7 @@ import os
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from enum import Enum, auto
 from pathlib import Path
 from typing import NamedTuple
 
@@ -37,8 +38,10 @@ from .obj import (
     read_obj_textured,
     write_obj,
 )
+from .obj import face_of_triangle as obj_face_of_triangle
+from .ply import face_of_triangle as ply_face_of_triangle
 from .ply import read_ply, read_ply_attributes, write_ply
-from .polygon_splits import first_face_off_the_polygons
+from .polygon_splits import first_face_off_the_polygons, same_triangles
 from .vertex_colours import VertexColours
 from .vertex_renumbering import first_frame_order
 
@@ -145,7 +148,8 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
     first_uvs = None if texture is None else texture.uvs  # a PLY's per vertex, where read
     first_uvs_read = textured  # read_sequence reads them only for a frame to match (below)
     frame_colours = _ColourFrames(paths[0], colours, len(paths))
-    retriangulated: list[Path] = []  # frames whose polygons are split otherwise than the first frame's
+    # Frames whose triangles are the first frame's listed otherwise, or its polygons split otherwise.
+    otherwise: dict[_Triangles, list[Path]] = {_Triangles.LISTED_OTHERWISE: [], _Triangles.SPLIT_OTHERWISE: []}
     reordered: list[Path] = []  # frames whose vertices are numbered in another order than the first frame's
     with warnings.catch_warnings(record=True) as later_warnings:  # the first frame's speak for the sequence
         warnings.simplefilter("always")
@@ -173,8 +177,11 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
                 )
                 reordered.append(path)
                 renumbered = False
-            if _check_same_surface(path, vertices, frame_faces, paths[0], faces, len(first_vertices), renumbered):
-                retriangulated.append(path)
+            standing = _check_same_surface(
+                path, vertices, frame_faces, paths[0], faces, len(first_vertices), renumbered
+            )
+            if standing is not _Triangles.SAME:
+                otherwise[standing].append(path)
             frames[index] = vertices
             frame_colours.add(index, path, colours)
             if textured and differing is None and not _same_texture(texture, frame_texture, faces, frame_faces):
@@ -192,11 +199,14 @@ def _read_frames(paths: list[Path], fps: float | None, textured: bool) -> Textur
                       f"vertices in another order than the first frame {paths[0].name}, as Blender's PLY exporter does "
                       "where it splits a polygon otherwise; each vertex is matched by its texture coordinates at the "
                       "corners of its polygon", stacklevel=3)  # fmt: skip
-    if retriangulated:
-        warnings.warn(f"{retriangulated[0]}: {len(retriangulated)} of the {len(paths)} frames (this the first) "
-                      f"triangulate some polygons differently from the first frame {paths[0].name}, as exporters "
-                      "that triangulate each frame do; every frame is read with the first frame's triangles",
-                      stacklevel=3)  # fmt: skip
+    first_frame = f"the first frame {paths[0].name}"
+    for kind, how in ((_Triangles.SPLIT_OTHERWISE, f"triangulate some polygons differently from {first_frame}, as "
+                                                   "exporters that triangulate each frame do"),
+                      (_Triangles.LISTED_OTHERWISE, f"list the triangles of {first_frame} in another order or start "
+                                                    "them at other corners")):  # fmt: skip
+        if otherwise[kind]:
+            warnings.warn(f"{otherwise[kind][0]}: {len(otherwise[kind])} of the {len(paths)} frames (this the first) "
+                          f"{how}; every frame is read with the first frame's triangles", stacklevel=3)  # fmt: skip
     if recoloured is not None:
         warnings.warn(f"{recoloured}: gives some faces other materials than {paths[0].name}: every frame is read "
                       f"with the materials of {paths[0].name}", UnreadAttributesWarning, stacklevel=3)  # fmt: skip
@@ -589,6 +599,14 @@ def _quiet_ply_uvs(path: Path) -> np.ndarray | None:
         return read_ply_attributes(path)[2]
 
 
+class _Triangles(Enum):
+    """How a later frame's triangles stand to the first frame's."""
+
+    SAME = auto()  # the first frame's as they stand
+    LISTED_OTHERWISE = auto()  # the first frame's, in another order or started at other corners
+    SPLIT_OTHERWISE = auto()  # the first frame's polygons split along other diagonals
+
+
 def _check_same_surface(
     path: Path,
     vertices: np.ndarray,
@@ -597,29 +615,32 @@ def _check_same_surface(
     first_faces: np.ndarray,
     vertex_count: int,
     renumbered: bool = False,
-) -> bool:
+) -> _Triangles:
     """Check a frame's vertex count and triangles against the first frame's (FormatError naming
-    the file and the first differing face where they differ, and with ``renumbered`` that its
-    vertices' texture coordinates differ too). True where its triangles are the first frame's
-    only up to where polygons are split
-    (:func:`~.polygon_splits.first_face_off_the_polygons`), False where they are the first's as
-    they stand."""
+    the file and the face of the first differing triangle where they differ, and with
+    ``renumbered`` that its vertices' texture coordinates differ too), and say how its triangles
+    stand to the first frame's (:func:`~.polygon_splits.same_triangles`,
+    :func:`~.polygon_splits.first_face_off_the_polygons`)."""
     first = f"the first frame {first_path.name}"
     if len(vertices) != vertex_count:
         raise FormatError(path, "vertices", f"{len(vertices)} vertices, but {first} has {vertex_count}")
     if faces.shape != first_faces.shape:
         raise FormatError(path, "faces", f"{len(faces)} triangles, but {first} has {len(first_faces)}")
     if np.array_equal(faces, first_faces):
-        return False
-    face = first_face_off_the_polygons(faces, first_faces, vertex_count)
-    if face is not None:
-        reason = (f"vertices {faces[face].tolist()} (counted from 0) are no triangle of {first}, and the frame's "
-                  "triangles are not a re-triangulation of the first frame's polygons")  # fmt: skip
+        return _Triangles.SAME
+    if same_triangles(faces, first_faces):
+        return _Triangles.LISTED_OTHERWISE
+    triangle = first_face_off_the_polygons(faces, first_faces, vertex_count)
+    if triangle is not None:
+        reason = (f"its triangle on vertices {faces[triangle].tolist()} (counted from 0) is no triangle of "
+                  f"{first}, and the frame's triangles are not a re-triangulation of the first frame's "
+                  "polygons")  # fmt: skip
         if renumbered:
             reason += ("; its vertices' texture coordinates differ from the first frame's too, as where an exporter "
                        "numbers each frame's vertices in another order")  # fmt: skip
-        raise FormatError(path, f"face {face}", reason)
-    return True
+        face = (obj_face_of_triangle if path.suffix.lower() == ".obj" else ply_face_of_triangle)(path, triangle)
+        raise FormatError(path, face, reason)
+    return _Triangles.SPLIT_OTHERWISE
 
 
 # ---------------------------------------------------------------------------------------------

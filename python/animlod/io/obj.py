@@ -32,6 +32,7 @@ from .polygon_mesh import (
     fan_triangulate,
     parse_numbers,
     polygon_mask,
+    polygon_of_triangle,
 )
 from .tokens import parse_all, token_starts, tokens_per_line
 from .vertex_colours import OBJ_COLOUR_NAMES, VertexColours
@@ -232,7 +233,7 @@ def _read_obj(
     uniform = _uniform_corners(face_block, sizes)
     vertex_numbers = face_block if uniform is None else uniform[:, 0]
     if uniform is None and b"/" in face_block:
-        vertex_numbers = re.sub(rb"/\S*", b"", face_block)  # v of v/vt/vn
+        vertex_numbers = _vertex_numbers(face_block)
         sizes = _row_sizes(vertex_numbers, len(face_lines))
     polygons = sizes >= 3  # pybullet's samurai_monastry.obj has 201 faces of two vertices among its 125k
     if sizes.size:
@@ -260,6 +261,22 @@ def _read_obj(
         mesh = TexturedMesh(vertices, faces, texture and ObjTexture(*texture),
                             corner_normals and ObjNormals(*corner_normals), colours, materials)  # fmt: skip
     return mesh, ObjTemplate(textured, lines, statements, mesh) if polygons.all() else None
+
+
+def face_of_triangle(path: str | os.PathLike, triangle: int) -> str:
+    """The face (and its line) that triangle ``triangle`` of :func:`read_obj`'s faces comes from,
+    named as the reader's errors name faces: for a fault found in the triangles after the file was
+    read."""
+    lines = _obj_lines(Path(path))
+    selected = lines.tagged(b"f")
+    face_lines = np.flatnonzero(selected) + 1
+    face = polygon_of_triangle(_row_sizes(_vertex_numbers(lines.block(selected)), len(face_lines)), triangle)
+    return f"face {face} (line {face_lines[face]})"
+
+
+def _vertex_numbers(face_block: bytes) -> bytes:
+    """Face lines with each corner's ``/vt/vn`` dropped: its vertex number alone."""
+    return re.sub(rb"/\S*", b"", face_block)
 
 
 def _obj_lines(path: Path) -> _ObjLines:

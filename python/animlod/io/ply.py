@@ -25,6 +25,7 @@ from .polygon_mesh import (
     fan_triangulate,
     parse_numbers,
     polygon_mask,
+    polygon_of_triangle,
     within_runs,
 )
 from .tokens import integer_tokens, parse_all, tokens_per_line
@@ -98,15 +99,28 @@ def read_ply_attributes(
     return _read_ply(Path(path), attributes=True)
 
 
-def _read_ply(
-    path: Path, attributes: bool
-) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, VertexColours | None]:
+def face_of_triangle(path: str | os.PathLike, triangle: int) -> str:
+    """The face element that triangle ``triangle`` of :func:`read_ply`'s faces comes from, named as
+    the reader's errors name faces: for a fault found in the triangles after the file was read."""
+    _, values = _ply_values(Path(path))
+    face = values["face"]
+    sizes, _ = next(face[name] for name in _FACE_LIST_NAMES if isinstance(face.get(name), tuple))
+    return f"face {polygon_of_triangle(sizes, triangle)}"
+
+
+def _ply_values(path: Path) -> tuple[list[_PlyElement], dict[str, _ElementValues]]:
+    """A PLY file's elements as its header declares them, and their values."""
     data = path.read_bytes()
     byte_order, elements, body = _read_ply_header(path, data)
     if byte_order is None:
-        values = _read_ply_ascii(path, data[body:], elements)
-    else:
-        values = _read_ply_binary(path, data, body, elements, byte_order)
+        return elements, _read_ply_ascii(path, data[body:], elements)
+    return elements, _read_ply_binary(path, data, body, elements, byte_order)
+
+
+def _read_ply(
+    path: Path, attributes: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, VertexColours | None]:
+    elements, values = _ply_values(path)
     vertex = values.get("vertex", {})
     missing = [axis for axis in "xyz" if axis not in vertex or isinstance(vertex[axis], tuple)]
     if missing:

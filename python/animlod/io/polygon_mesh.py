@@ -122,3 +122,11 @@ def fan_triangulate(corners: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     step = within_runs(triangle_counts)
     base = first[polygon]
     return np.stack([corners[base], corners[base + step + 1], corners[base + step + 2]], axis=1).astype(np.int32)
+
+
+def polygon_of_triangle(sizes: np.ndarray, triangle: int) -> int:
+    """The polygon (an index into ``sizes``, the corner counts of every face as the file lists them)
+    whose fan holds triangle ``triangle`` of :func:`fan_triangulate` over the faces of three corners
+    or more, as the readers triangulate them."""
+    kept = np.flatnonzero(sizes >= 3)
+    return int(kept[np.searchsorted(np.cumsum(sizes[kept] - 2), triangle, side="right")])

@@ -49,6 +49,14 @@ def first_face_off_the_polygons(faces: np.ndarray, first_faces: np.ndarray, vert
     return int(added_faces[0])
 
 
+def same_triangles(faces: np.ndarray, first_faces: np.ndarray) -> bool:
+    """Whether ``faces`` are the triangles of ``first_faces`` (both (M, 3)) but for their order and
+    the corner each starts at (winding kept): the same surface, listed otherwise."""
+    return len(faces) == len(first_faces) and bool(
+        _among(_canonical_triangles(faces), _canonical_triangles(first_faces)).all()
+    )
+
+
 def _inside_their_polygons(triangles: np.ndarray, others: np.ndarray, vertex_count: int) -> np.ndarray:
     """(T,) bool: which of ``triangles (T, 3)`` have a corner inside the polygon they tile, none on
     its boundary. Their polygons are the triangles joined across their diagonals, the edges that no

@@ -1,4 +1,4 @@
-"""Reading speed of the file formats on the real development data (../shared/data).
+"""Reading (and OBJ writing) speed of the file formats on the real development data (../shared/data).
 
 Run: ``.venv/bin/python bench/bench_io.py``. Each row is the best of a few runs; inputs that
 are absent are skipped. The crane sequence is also converted to binary PLY and NPZ in a
@@ -57,7 +57,8 @@ def main() -> None:
         size = f"{mesh.vertex_count} vertices, {mesh.face_count} faces, {mesh.frame_count} frames"
         rows.append(("read OBJ sequence crane/", size, seconds * 1e3, mesh.frame_count / seconds))
         with tempfile.TemporaryDirectory() as folder:
-            write_textured_crane(Path(folder) / "textured", mesh)
+            seconds, _ = best_time(lambda: write_textured_crane(Path(folder) / "textured", mesh))
+            rows.append(("write textured OBJ sequence (crane)", size, seconds * 1e3, mesh.frame_count / seconds))
             seconds, _ = best_time(lambda: read_textured_sequence(Path(folder) / "textured"))
             rows.append(("read textured OBJ sequence (crane)", size, seconds * 1e3, mesh.frame_count / seconds))
             write_sequence(Path(folder) / "ply", mesh, fmt="ply")
@@ -69,7 +70,7 @@ def main() -> None:
     else:
         print(f"skipped {crane}: not found")
     rows += gltf_rows()
-    print_table("File reading (best of 3)", ["case", "size", "time (ms)", "frames/s"], rows)
+    print_table("File reading and writing (best of 3)", ["case", "size", "time (ms)", "frames/s"], rows)
 
 
 def write_textured_crane(folder: Path, mesh: AnimatedMesh) -> None:

@@ -18,6 +18,7 @@ void bind_posture_error(py::module_& m);
 void bind_cumulative_ranking(py::module_& m);
 void bind_motion_recovery(py::module_& m);
 void bind_threads(py::module_& m);
+void bind_decimal_rows(py::module_& m);
 }
 
 PYBIND11_MODULE(_core, m) {
@@ -36,4 +37,5 @@ PYBIND11_MODULE(_core, m) {
   animlod::bindings::bind_cumulative_ranking(m);
   animlod::bindings::bind_motion_recovery(m);
   animlod::bindings::bind_threads(m);
+  animlod::bindings::bind_decimal_rows(m);
 }

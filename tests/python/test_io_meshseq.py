@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from animlod import _core
 from animlod.io import (
     FormatError,
     meshseq,
@@ -129,6 +130,23 @@ def test_a_frame_written_with_the_text_of_the_frame_before_is_written_as_alone(t
         obj.write_obj(tmp_path / "alone.obj", frame, frame_faces, frame_texture, frame_normals, None, frame_materials)
         assert (tmp_path / "f1.obj").read_bytes() == (tmp_path / "alone.obj").read_bytes(), case
         assert (after is shared) == (case == "same"), case
+
+
+def test_obj_numbers_are_written_as_python_formats_them() -> None:
+    # The core's lines (std::to_chars) against Python's own .9g, which the writer used before them:
+    # float32 values of every magnitude, zeros of both signs, and halfway cases of the 9th digit.
+    rng = np.random.default_rng(8)
+    values = (rng.normal(size=30000) * 10.0 ** rng.uniform(-40, 40, 30000)).astype(np.float32).astype(np.float64)
+    values = np.concatenate([values, [0.0, -0.0, 1.0, 0.1, 1e-5, 1e-4, 123456789.5, 1234567890.0, 2.0**-149]])
+    values = values[: len(values) // 3 * 3].reshape(-1, 3)
+    expected = "".join(f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in values.tolist()).encode()
+    assert _core.decimal_rows(values, "v ") == expected
+    assert (
+        _core.decimal_rows(values[:, :2], "vt ", 17)
+        == "".join(f"vt {u:.17g} {v:.17g}\n" for u, v in values[:, :2].tolist()).encode()
+    )
+    with pytest.raises(ValueError, match=r"values: expected shape \(N, K\), got \(3,\)"):
+        _core.decimal_rows(np.zeros(3), "v ")
 
 
 def test_obj_normals_are_read_per_corner_and_written_back(tmp_path: Path) -> None:

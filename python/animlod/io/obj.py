@@ -22,6 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._core import decimal_rows
 from .atomic import atomic_write
 from .errors import FormatError, UnreadAttributesWarning
 from .polygon_mesh import (
@@ -485,21 +486,19 @@ def write_obj(
     vertices = vertices.astype(np.float64)
     uvs, uv_corners = _checked_attribute(path, "texture", texture, 2, checked_faces.shape)
     normal_values, normal_corners = _checked_attribute(path, "normals", normals, 3, checked_faces.shape)
-    vertex_line = "v %.9g %.9g %.9g\n"
     if colours is not None:
         if len(colours.names) not in (3, 4):
             raise ValueError(f"{os.fspath(path)}: colours: an OBJ v line holds r, g, b and perhaps a, got "
                              f"{', '.join(colours.names)}")  # fmt: skip
         vertices = np.concatenate([vertices, np.stack(colours.stored(path, len(vertices)), axis=1)], axis=1)
-        vertex_line = "v" + " %.9g" * vertices.shape[1] + "\n"
     if shared is None or not shared.fits(faces, texture, materials, normal_corners):
         shared = ObjSharedText.made(path, faces, checked_faces, texture, uvs, uv_corners, normal_corners, materials)
-    with atomic_write(path, "w", encoding="utf-8", newline="\n") as handle:
-        handle.write("# written by animlod\n" + shared.header)
-        handle.write((vertex_line * len(vertices)) % tuple(vertices.ravel().tolist()))
+    with atomic_write(path, "wb") as handle:
+        handle.write(b"# written by animlod\n" + shared.header)
+        handle.write(decimal_rows(vertices, "v "))
         handle.write(shared.uv_lines)
         if normal_values is not None:
-            handle.write(("vn %.9g %.9g %.9g\n" * len(normal_values)) % tuple(normal_values.ravel().tolist()))
+            handle.write(decimal_rows(normal_values, "vn "))
         handle.write(shared.face_lines)
     return shared
 
@@ -532,9 +531,9 @@ class ObjSharedText:
     texture: ObjTexture | None
     materials: ObjMaterials | None
     normal_corners: np.ndarray | None
-    header: str
-    uv_lines: str
-    face_lines: str
+    header: bytes
+    uv_lines: bytes
+    face_lines: bytes
 
     def fits(
         self,
@@ -583,8 +582,8 @@ class ObjSharedText:
             + (face_line * len(run)) % tuple(run.ravel().tolist())
             for material, run in runs
         )
-        uv_lines = "" if uvs is None else ("vt %.9g %.9g\n" * len(uvs)) % tuple(uvs.ravel().tolist())
-        return cls(faces, texture, materials, normal_corners, header, uv_lines, face_lines)
+        uv_lines = b"" if uvs is None else decimal_rows(uvs, "vt ")
+        return cls(faces, texture, materials, normal_corners, header.encode(), uv_lines, face_lines.encode())
 
 
 # The statements of the OBJ specification (Appendix B1), geometry and grouping and display alike.

@@ -41,7 +41,7 @@ from .obj import (
 from .obj import face_of_triangle as obj_face_of_triangle
 from .ply import face_of_triangle as ply_face_of_triangle
 from .ply import read_ply, read_ply_attributes, write_ply
-from .polygon_splits import first_face_off_the_polygons, same_triangles
+from .polygon_splits import triangle_change
 from .vertex_colours import VertexColours
 from .vertex_renumbering import first_frame_order
 
@@ -619,8 +619,7 @@ def _check_same_surface(
     """Check a frame's vertex count and triangles against the first frame's (FormatError naming
     the file and the face of the first differing triangle where they differ, and with
     ``renumbered`` that its vertices' texture coordinates differ too), and say how its triangles
-    stand to the first frame's (:func:`~.polygon_splits.same_triangles`,
-    :func:`~.polygon_splits.first_face_off_the_polygons`)."""
+    stand to the first frame's (:func:`~.polygon_splits.triangle_change`)."""
     first = f"the first frame {first_path.name}"
     if len(vertices) != vertex_count:
         raise FormatError(path, "vertices", f"{len(vertices)} vertices, but {first} has {vertex_count}")
@@ -628,9 +627,10 @@ def _check_same_surface(
         raise FormatError(path, "faces", f"{len(faces)} triangles, but {first} has {len(first_faces)}")
     if np.array_equal(faces, first_faces):
         return _Triangles.SAME
-    if same_triangles(faces, first_faces):
+    change = triangle_change(faces, first_faces, vertex_count)
+    if change.listed_otherwise:
         return _Triangles.LISTED_OTHERWISE
-    triangle = first_face_off_the_polygons(faces, first_faces, vertex_count)
+    triangle = change.stray
     if triangle is not None:
         reason = (f"its triangle on vertices {faces[triangle].tolist()} (counted from 0) is no triangle of "
                   f"{first}, and the frame's triangles are not a re-triangulation of the first frame's "

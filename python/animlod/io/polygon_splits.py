@@ -12,23 +12,36 @@ otherwise passed: both sets are then the whole surface, without a boundary.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ..components import component_labels
 from ..sorted_keys import among, distinct
 
 
-def first_face_off_the_polygons(faces: np.ndarray, first_faces: np.ndarray, vertex_count: int) -> int | None:
-    """None where ``faces`` tile the polygons of ``first_faces`` (both (M, 3) triangles): the same
-    triangles, each perhaps started at another corner (winding kept), but where a polygon is split
-    along other diagonals, as exporters that triangulate each frame's deformed shape split it. Else
-    the first of ``faces`` (in their order) that breaks this.
+class TriangleChange(NamedTuple):
+    """How a frame's triangles stand to the first frame's (:func:`triangle_change`)."""
+
+    listed_otherwise: bool  # every one is the first frame's: in another order, or started at another corner
+    stray: int | None  # the first that tiles none of the first frame's polygons; None where they all do
+
+
+def triangle_change(faces: np.ndarray, first_faces: np.ndarray, vertex_count: int) -> TriangleChange:
+    """How ``faces`` stand to ``first_faces`` (both (M, 3) triangles, as many): the same triangles,
+    each perhaps started at another corner (winding kept), listed otherwise; else whether they tile
+    the same polygons, split along other diagonals, as exporters that triangulate each frame's
+    deformed shape split them (``stray`` None), or the first of ``faces`` (in their order) that
+    breaks this.
 
     The triangles of each not among the other's (as multisets) must use the same vertices and have
     the same directed boundary edges (those whose reverse is not in the same set), and none may have
     a corner inside its polygon (:func:`_inside_their_polygons`): then both tile the same polygons."""
     frame_triangles, first_triangles = _canonical_triangles(faces), _canonical_triangles(first_faces)
-    frame_only, first_only = ~_among(frame_triangles, first_triangles), ~_among(first_triangles, frame_triangles)
+    frame_only = ~_among(frame_triangles, first_triangles)
+    if not frame_only.any():
+        return TriangleChange(listed_otherwise=True, stray=None)
+    first_only = ~_among(first_triangles, frame_triangles)
     added, removed = faces[frame_only], first_faces[first_only]
     added_boundary = _boundary_edges(added, vertex_count)
     removed_boundary = _boundary_edges(removed, vertex_count)
@@ -36,25 +49,16 @@ def first_face_off_the_polygons(faces: np.ndarray, first_faces: np.ndarray, vert
     whole_polygons = not added_inside.any() and not _inside_their_polygons(removed, added, vertex_count).any()
     same_vertices = np.array_equal(distinct(added.ravel()), distinct(removed.ravel()))
     if np.array_equal(added_boundary, removed_boundary) and same_vertices and whole_polygons:
-        return None
+        return TriangleChange(listed_otherwise=False, stray=None)
     # The first added triangle with an outer edge that no replaced triangle has (a polygon split
     # otherwise has only edges of the triangles it replaces), else one off their boundary.
     added_edges, added_faces = _directed_edges(added, vertex_count), np.flatnonzero(frame_only)
     for known in (_directed_edges(removed, vertex_count), removed_boundary):
         stray = among(added_edges, added_boundary[~among(added_boundary, known)]).reshape(3, -1).any(axis=0)
         if stray.any():
-            return int(added_faces[np.argmax(stray)])
-    if added_inside.any():
-        return int(added_faces[np.argmax(added_inside)])
-    return int(added_faces[0])
-
-
-def same_triangles(faces: np.ndarray, first_faces: np.ndarray) -> bool:
-    """Whether ``faces`` are the triangles of ``first_faces`` (both (M, 3)) but for their order and
-    the corner each starts at (winding kept): the same surface, listed otherwise."""
-    return len(faces) == len(first_faces) and bool(
-        _among(_canonical_triangles(faces), _canonical_triangles(first_faces)).all()
-    )
+            return TriangleChange(listed_otherwise=False, stray=int(added_faces[np.argmax(stray)]))
+    first_stray = np.argmax(added_inside) if added_inside.any() else 0
+    return TriangleChange(listed_otherwise=False, stray=int(added_faces[first_stray]))
 
 
 def _inside_their_polygons(triangles: np.ndarray, others: np.ndarray, vertex_count: int) -> np.ndarray:

@@ -366,7 +366,8 @@ def _same_materials(
     first: ObjMaterials | None, other: ObjMaterials | None, first_faces: np.ndarray, faces: np.ndarray
 ) -> bool:
     """Whether a frame's faces have the first frame's materials, by name (None: no usemtl line);
-    frames whose triangles split the first frame's polygons otherwise are not compared."""
+    frames whose triangles are not the first frame's as they stand (listed or split otherwise)
+    are not compared."""
     if first is None or other is None:
         return first is other
     if not np.array_equal(first_faces, faces):
